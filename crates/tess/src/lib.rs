@@ -1,0 +1,1 @@
+//! Tessellation techniques.
