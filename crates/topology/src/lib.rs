@@ -1,2 +1,13 @@
 //! CPU truth for every GPU technique: control meshes, subdivision, stencils, limit evaluation.
 #![forbid(unsafe_code)]
+
+pub mod error;
+pub mod mesh;
+pub mod obj;
+
+pub use error::TopologyError;
+pub use mesh::{
+    BoundaryInterpolation, ControlMesh, CreaseMethod, EdgeCrease, SubdivOptions, Topology,
+    TriangleSubdivision, VertexCorner,
+};
+pub use obj::{load_obj, parse_obj, write_control_mesh, write_obj};

@@ -1,0 +1,101 @@
+//! The crate's single error type: every failure names the face, edge, vertex or file involved.
+
+/// Everything that can go wrong while loading, validating or refining a control mesh.
+#[derive(Debug, thiserror::Error)]
+pub enum TopologyError {
+    /// The OBJ file could not be read.
+    #[error("{file}: cannot read file: {source}")]
+    Io {
+        file: String,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A line of OBJ text could not be understood.
+    #[error("{file}:{line}: {message}")]
+    Parse {
+        file: String,
+        line: usize,
+        message: String,
+    },
+    /// A validation error found in a named file (the inner error says what and where).
+    #[error("{file}: {source}")]
+    InFile {
+        file: String,
+        #[source]
+        source: Box<TopologyError>,
+    },
+    /// The mesh has no faces (or no vertices): there is nothing to subdivide.
+    #[error("empty mesh: {what}")]
+    EmptyMesh { what: &'static str },
+    /// A face refers to a vertex that does not exist.
+    #[error("face {face}: vertex index {index} out of range (mesh has {count} vertices)")]
+    IndexOutOfRange {
+        face: usize,
+        index: i64,
+        count: usize,
+    },
+    /// A face with fewer than three corners.
+    #[error("face {face} has {size} vertices; a face needs at least 3")]
+    DegenerateFace { face: usize, size: usize },
+    /// A face that visits the same vertex twice.
+    #[error("face {face} uses vertex {vertex} more than once")]
+    RepeatedVertex { face: usize, vertex: u32 },
+    /// An edge shared by more than two faces.
+    #[error("edge {v0}-{v1} is shared by {faces} faces (non-manifold edge)")]
+    NonManifoldEdge { v0: u32, v1: u32, faces: usize },
+    /// A vertex whose incident faces form more than one fan.
+    #[error("vertex {vertex}: its faces form {fans} separate fans (non-manifold vertex)")]
+    NonManifoldVertex { vertex: u32, fans: usize },
+    /// Two faces traverse a shared edge in the same direction.
+    #[error(
+        "faces {face0} and {face1} both traverse edge {v0}->{v1} in the same direction (inconsistent orientation)"
+    )]
+    InconsistentOrientation {
+        face0: usize,
+        face1: usize,
+        v0: u32,
+        v1: u32,
+    },
+    /// A vertex position with NaN or infinite coordinates.
+    #[error("vertex {vertex} has a non-finite position {position:?}")]
+    NonFinitePosition { vertex: usize, position: [f64; 3] },
+    /// Loop subdivision was asked for a mesh with non-triangular faces.
+    #[error("Loop subdivision needs triangles, but face {face} has {size} vertices")]
+    LoopRequiresTriangles { face: usize, size: usize },
+    /// A crease, corner or hole tag that cannot apply to this mesh.
+    #[error("invalid tag: {message}")]
+    InvalidTag { message: String },
+    /// Per-corner attribute arrays (normals, UVs) whose length does not match the faces.
+    #[error("{attribute}: {len} values but the faces have {expected} corners")]
+    AttributeLength {
+        attribute: &'static str,
+        len: usize,
+        expected: usize,
+    },
+    /// The refinement would not fit 32-bit indices.
+    #[error("refinement too large: {what}")]
+    TooLarge { what: String },
+}
+
+impl TopologyError {
+    /// The underlying error with any file wrapper removed (useful to match on the kind).
+    pub fn root(&self) -> &TopologyError {
+        match self {
+            TopologyError::InFile { source, .. } => source.root(),
+            other => other,
+        }
+    }
+
+    /// Attach a file name to a validation error, so the user knows which file is broken.
+    pub(crate) fn in_file(self, file: &str) -> TopologyError {
+        match self {
+            e @ (TopologyError::Io { .. }
+            | TopologyError::Parse { .. }
+            | TopologyError::InFile { .. }) => e,
+            other => TopologyError::InFile {
+                file: file.to_string(),
+                source: Box::new(other),
+            },
+        }
+    }
+}

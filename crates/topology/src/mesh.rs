@@ -1,0 +1,512 @@
+//! Control meshes (plain data as loaded) and their validated edge/vertex adjacency ([`Topology`]).
+
+use crate::error::TopologyError;
+use rayon::prelude::*;
+
+/// Sentinel for "no face" / "no edge" in adjacency tables.
+pub const INVALID: u32 = u32::MAX;
+
+/// How boundary vertices are treated (OpenSubdiv `VtxBoundaryInterpolation`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BoundaryInterpolation {
+    /// OBJ tag value 0. OpenSubdiv turns the boundary faces into holes; this crate still
+    /// refines them like [`BoundaryInterpolation::EdgesOnly`] (boundary edges stay sharp).
+    None,
+    /// OBJ tag value 2 (the default): boundary edges are infinitely sharp creases.
+    #[default]
+    EdgesOnly,
+    /// OBJ tag value 1: boundary edges are sharp and corners (vertices with a single face)
+    /// are infinitely sharp too, so they stay put.
+    EdgesAndCorners,
+}
+
+/// How semi-sharp edge sharpness decays per level (OpenSubdiv `CreasingMethod`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CreaseMethod {
+    /// Subtract one per level.
+    #[default]
+    Uniform,
+    /// Chaikin: blend with the average sharpness of the other semi-sharp edges at the end vertex.
+    Chaikin,
+}
+
+/// Catmull-Clark rule for edges next to triangles (OpenSubdiv `TriangleSubdivision`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TriangleSubdivision {
+    /// The plain Catmull-Clark edge rule.
+    #[default]
+    Catmark,
+    /// OpenSubdiv's "smooth triangle" weights for edges next to triangles.
+    Smooth,
+}
+
+/// Subdivision options carried by a control mesh (set from OBJ `t` tags).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SubdivOptions {
+    pub boundary: BoundaryInterpolation,
+    pub crease_method: CreaseMethod,
+    pub triangle_subdivision: TriangleSubdivision,
+}
+
+/// A semi-sharp or infinitely sharp (≥ 10) edge, named by its two vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeCrease {
+    pub vertices: [u32; 2],
+    pub sharpness: f32,
+}
+
+/// A semi-sharp or infinitely sharp (≥ 10) vertex.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VertexCorner {
+    pub vertex: u32,
+    pub sharpness: f32,
+}
+
+/// A polygonal control mesh as loaded: plain data, no adjacency.
+///
+/// Faces are stored flat: face `f` has corners `face_vertices[face_offsets[f]..face_offsets[f + 1]]`.
+/// `uvs` and `normals`, when present, have one entry per face corner (aligned with `face_vertices`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ControlMesh {
+    pub positions: Vec<[f64; 3]>,
+    pub face_offsets: Vec<u32>,
+    pub face_vertices: Vec<u32>,
+    pub uvs: Option<Vec<[f64; 2]>>,
+    pub normals: Option<Vec<[f64; 3]>>,
+    pub creases: Vec<EdgeCrease>,
+    pub corners: Vec<VertexCorner>,
+    /// Faces tagged as holes (`t hole`). Stored only: refinement keeps them.
+    pub holes: Vec<u32>,
+    pub options: SubdivOptions,
+}
+
+impl ControlMesh {
+    /// Build a mesh from positions and a list of polygons (no tags, default options).
+    pub fn from_polygons<F: AsRef<[u32]>>(positions: Vec<[f64; 3]>, faces: &[F]) -> ControlMesh {
+        let mut face_offsets = Vec::with_capacity(faces.len() + 1);
+        let mut face_vertices = Vec::new();
+        face_offsets.push(0);
+        for f in faces {
+            face_vertices.extend_from_slice(f.as_ref());
+            face_offsets.push(face_vertices.len() as u32);
+        }
+        ControlMesh {
+            positions,
+            face_offsets,
+            face_vertices,
+            ..ControlMesh::default()
+        }
+    }
+
+    /// Number of faces.
+    pub fn num_faces(&self) -> usize {
+        self.face_offsets.len().saturating_sub(1)
+    }
+
+    /// The vertex indices of face `f`.
+    pub fn face(&self, f: usize) -> &[u32] {
+        &self.face_vertices[self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize]
+    }
+
+    /// Iterate over the faces as vertex-index slices.
+    pub fn faces(&self) -> impl Iterator<Item = &[u32]> + '_ {
+        (0..self.num_faces()).map(move |f| self.face(f))
+    }
+
+    /// Check everything the refiner relies on; see [`TopologyError`] for the cases.
+    pub fn validate(&self) -> Result<(), TopologyError> {
+        Topology::from_mesh(self).map(|_| ())
+    }
+}
+
+/// Validated adjacency of a manifold, consistently oriented polygon mesh.
+///
+/// Edges are numbered; `face_edges` is aligned with `face_vertices` (corner `i` of a face owns the
+/// edge from corner `i` to corner `i + 1`). Vertex incidence lists are unordered.
+#[derive(Clone, Debug, Default)]
+pub struct Topology {
+    pub(crate) num_vertices: usize,
+    pub(crate) face_offsets: Vec<u32>,
+    pub(crate) face_verts: Vec<u32>,
+    pub(crate) face_edges: Vec<u32>,
+    pub(crate) edge_verts: Vec<[u32; 2]>,
+    pub(crate) edge_faces: Vec<[u32; 2]>,
+    pub(crate) vert_edge_offsets: Vec<u32>,
+    pub(crate) vert_edges: Vec<u32>,
+    pub(crate) vert_face_offsets: Vec<u32>,
+    pub(crate) vert_faces: Vec<u32>,
+}
+
+impl Topology {
+    /// Validate `mesh` and build its adjacency.
+    pub fn from_mesh(mesh: &ControlMesh) -> Result<Topology, TopologyError> {
+        if mesh.positions.is_empty() {
+            return Err(TopologyError::EmptyMesh {
+                what: "no vertices",
+            });
+        }
+        if mesh.num_faces() == 0 {
+            return Err(TopologyError::EmptyMesh { what: "no faces" });
+        }
+        if mesh.face_offsets.first() != Some(&0)
+            || mesh.face_offsets.windows(2).any(|w| w[0] > w[1])
+            || *mesh.face_offsets.last().unwrap_or(&0) as usize != mesh.face_vertices.len()
+        {
+            return Err(TopologyError::InvalidTag {
+                message: "face_offsets is not a valid prefix table over face_vertices".into(),
+            });
+        }
+        for (vertex, p) in mesh.positions.iter().enumerate() {
+            if !p.iter().all(|c| c.is_finite()) {
+                return Err(TopologyError::NonFinitePosition {
+                    vertex,
+                    position: *p,
+                });
+            }
+        }
+        let corners = mesh.face_vertices.len();
+        if let Some(n) = &mesh.normals {
+            if n.len() != corners {
+                return Err(TopologyError::AttributeLength {
+                    attribute: "normals",
+                    len: n.len(),
+                    expected: corners,
+                });
+            }
+        }
+        if let Some(uv) = &mesh.uvs {
+            if uv.len() != corners {
+                return Err(TopologyError::AttributeLength {
+                    attribute: "uvs",
+                    len: uv.len(),
+                    expected: corners,
+                });
+            }
+        }
+        let nv = mesh.positions.len();
+        for (face, fv) in mesh.faces().enumerate() {
+            if fv.len() < 3 {
+                return Err(TopologyError::DegenerateFace {
+                    face,
+                    size: fv.len(),
+                });
+            }
+            for (i, &v) in fv.iter().enumerate() {
+                if v as usize >= nv {
+                    return Err(TopologyError::IndexOutOfRange {
+                        face,
+                        index: v as i64,
+                        count: nv,
+                    });
+                }
+                if fv[..i].contains(&v) {
+                    return Err(TopologyError::RepeatedVertex { face, vertex: v });
+                }
+            }
+        }
+        if corners >= INVALID as usize / 4 {
+            return Err(TopologyError::TooLarge {
+                what: format!("{corners} face corners"),
+            });
+        }
+        let topo = Topology::build(nv, mesh.face_offsets.clone(), mesh.face_vertices.clone())?;
+        topo.check_manifold_vertices()?;
+        Ok(topo)
+    }
+
+    /// Build edges from faces by sorting half-edges; reports non-manifold edges and
+    /// inconsistent orientation.
+    fn build(
+        num_vertices: usize,
+        face_offsets: Vec<u32>,
+        face_verts: Vec<u32>,
+    ) -> Result<Topology, TopologyError> {
+        let nf = face_offsets.len() - 1;
+        // (min, max, corner index); corner index identifies face + direction.
+        let mut half: Vec<(u64, u32)> = (0..nf)
+            .into_par_iter()
+            .flat_map_iter(|f| {
+                let (s, e) = (face_offsets[f] as usize, face_offsets[f + 1] as usize);
+                let fv = &face_verts[s..e];
+                (0..fv.len()).map(move |i| {
+                    let a = fv[i];
+                    let b = fv[(i + 1) % fv.len()];
+                    let key = ((a.min(b) as u64) << 32) | a.max(b) as u64;
+                    (key, (s + i) as u32)
+                })
+            })
+            .collect();
+        half.par_sort_unstable();
+
+        let corner_face = corner_to_face(&face_offsets, face_verts.len());
+        let mut face_edges = vec![INVALID; face_verts.len()];
+        let mut edge_verts = Vec::with_capacity(half.len() / 2 + 1);
+        let mut edge_faces = Vec::with_capacity(half.len() / 2 + 1);
+        let mut i = 0;
+        while i < half.len() {
+            let key = half[i].0;
+            let mut j = i + 1;
+            while j < half.len() && half[j].0 == key {
+                j += 1;
+            }
+            let v0 = (key >> 32) as u32;
+            let v1 = key as u32;
+            if j - i > 2 {
+                return Err(TopologyError::NonManifoldEdge {
+                    v0,
+                    v1,
+                    faces: j - i,
+                });
+            }
+            let e = edge_verts.len() as u32;
+            let c0 = half[i].1 as usize;
+            let f0 = corner_face[c0];
+            // Orient the edge as the first face traverses it.
+            let a0 = face_verts[c0];
+            edge_verts.push(if a0 == v0 { [v0, v1] } else { [v1, v0] });
+            face_edges[c0] = e;
+            let mut faces = [f0, INVALID];
+            if j - i == 2 {
+                let c1 = half[i + 1].1 as usize;
+                let f1 = corner_face[c1];
+                if face_verts[c1] == a0 {
+                    let (b0, b1) = if a0 == v0 { (v0, v1) } else { (v1, v0) };
+                    return Err(TopologyError::InconsistentOrientation {
+                        face0: f0.min(f1) as usize,
+                        face1: f0.max(f1) as usize,
+                        v0: b0,
+                        v1: b1,
+                    });
+                }
+                face_edges[c1] = e;
+                faces[1] = f1;
+            }
+            edge_faces.push(faces);
+            i = j;
+        }
+        let mut topo = Topology {
+            num_vertices,
+            face_offsets,
+            face_verts,
+            face_edges,
+            edge_verts,
+            edge_faces,
+            ..Topology::default()
+        };
+        topo.build_vertex_incidence();
+        Ok(topo)
+    }
+
+    /// Assemble a topology whose faces, face-edges and edge-vertices are already known
+    /// (used for refined levels, which are manifold by construction).
+    pub(crate) fn from_parts(
+        num_vertices: usize,
+        face_offsets: Vec<u32>,
+        face_verts: Vec<u32>,
+        face_edges: Vec<u32>,
+        edge_verts: Vec<[u32; 2]>,
+    ) -> Topology {
+        let mut edge_faces = vec![[INVALID, INVALID]; edge_verts.len()];
+        let nf = face_offsets.len() - 1;
+        for f in 0..nf {
+            for c in face_offsets[f]..face_offsets[f + 1] {
+                let slot = &mut edge_faces[face_edges[c as usize] as usize];
+                if slot[0] == INVALID {
+                    slot[0] = f as u32;
+                } else {
+                    slot[1] = f as u32;
+                }
+            }
+        }
+        let mut topo = Topology {
+            num_vertices,
+            face_offsets,
+            face_verts,
+            face_edges,
+            edge_verts,
+            edge_faces,
+            ..Topology::default()
+        };
+        topo.build_vertex_incidence();
+        topo
+    }
+
+    /// Counting-sort the vertex→edge and vertex→face incidence lists.
+    fn build_vertex_incidence(&mut self) {
+        let nv = self.num_vertices;
+        let mut counts = vec![0u32; nv + 1];
+        for e in &self.edge_verts {
+            counts[e[0] as usize + 1] += 1;
+            counts[e[1] as usize + 1] += 1;
+        }
+        prefix_sum(&mut counts);
+        let mut fill = counts.clone();
+        let mut vert_edges = vec![0u32; *counts.last().unwrap_or(&0) as usize];
+        for (e, ev) in self.edge_verts.iter().enumerate() {
+            for &v in ev {
+                vert_edges[fill[v as usize] as usize] = e as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        self.vert_edge_offsets = counts;
+        self.vert_edges = vert_edges;
+
+        let mut counts = vec![0u32; nv + 1];
+        for &v in &self.face_verts {
+            counts[v as usize + 1] += 1;
+        }
+        prefix_sum(&mut counts);
+        let mut fill = counts.clone();
+        let mut vert_faces = vec![0u32; self.face_verts.len()];
+        for f in 0..self.num_faces() {
+            for &v in self.face_vertices(f) {
+                vert_faces[fill[v as usize] as usize] = f as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        self.vert_face_offsets = counts;
+        self.vert_faces = vert_faces;
+    }
+
+    /// Each used vertex must have its faces in a single fan (walk across shared edges).
+    fn check_manifold_vertices(&self) -> Result<(), TopologyError> {
+        let bad = (0..self.num_vertices).into_par_iter().find_map_first(|v| {
+            let faces = self.vertex_faces(v);
+            if faces.is_empty() {
+                return None; // isolated vertices are allowed and ignored
+            }
+            let reached = self.fan_size(v as u32, faces[0]);
+            if reached == faces.len() {
+                None
+            } else {
+                // Count fans by repeated walks (rare path, only for the error message).
+                let mut seen: Vec<u32> = Vec::new();
+                let mut fans = 0;
+                for &f in faces {
+                    if !seen.contains(&f) {
+                        fans += 1;
+                        seen.extend(self.fan_faces(v as u32, f));
+                    }
+                }
+                Some(TopologyError::NonManifoldVertex {
+                    vertex: v as u32,
+                    fans,
+                })
+            }
+        });
+        match bad {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
+    fn fan_size(&self, v: u32, start: u32) -> usize {
+        self.fan_faces(v, start).len()
+    }
+
+    /// Faces reachable from `start` by rotating around `v` across its incident edges.
+    fn fan_faces(&self, v: u32, start: u32) -> Vec<u32> {
+        let limit = self.vertex_faces(v as usize).len();
+        let mut out = vec![start];
+        for outgoing in [true, false] {
+            let mut f = start;
+            while let Some(g) = self.face_across(v, f, outgoing) {
+                if g == start {
+                    return out; // closed fan
+                }
+                if out.len() > limit {
+                    return out;
+                }
+                out.push(g);
+                f = g;
+            }
+        }
+        out
+    }
+
+    /// The face across the edge of `f` leaving (`outgoing`) or entering vertex `v`.
+    fn face_across(&self, v: u32, f: u32, outgoing: bool) -> Option<u32> {
+        let fv = self.face_vertices(f as usize);
+        let fe = self.face_edge_list(f as usize);
+        let i = fv.iter().position(|&x| x == v)?;
+        let e = if outgoing {
+            fe[i]
+        } else {
+            fe[(i + fv.len() - 1) % fv.len()]
+        };
+        let [a, b] = self.edge_faces[e as usize];
+        let g = if a == f { b } else { a };
+        (g != INVALID).then_some(g)
+    }
+
+    /// Number of vertices (including isolated ones).
+    pub fn num_vertices(&self) -> usize {
+        self.num_vertices
+    }
+    /// Number of faces.
+    pub fn num_faces(&self) -> usize {
+        self.face_offsets.len() - 1
+    }
+    /// Number of edges.
+    pub fn num_edges(&self) -> usize {
+        self.edge_verts.len()
+    }
+    /// Corners of face `f`.
+    pub fn face_vertices(&self, f: usize) -> &[u32] {
+        &self.face_verts[self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize]
+    }
+    /// Edges of face `f`; entry `i` joins corner `i` and corner `i + 1`.
+    pub fn face_edge_list(&self, f: usize) -> &[u32] {
+        &self.face_edges[self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize]
+    }
+    /// The two end vertices of edge `e` (oriented as its first face traverses it).
+    pub fn edge_vertices(&self, e: usize) -> [u32; 2] {
+        self.edge_verts[e]
+    }
+    /// The one or two faces of edge `e` (`INVALID` in the second slot on a boundary).
+    pub fn edge_faces(&self, e: usize) -> [u32; 2] {
+        self.edge_faces[e]
+    }
+    /// Whether edge `e` has a single face.
+    pub fn is_boundary_edge(&self, e: usize) -> bool {
+        self.edge_faces[e][1] == INVALID
+    }
+    /// Edges incident to vertex `v` (unordered); their count is the valence.
+    pub fn vertex_edges(&self, v: usize) -> &[u32] {
+        &self.vert_edges[self.vert_edge_offsets[v] as usize..self.vert_edge_offsets[v + 1] as usize]
+    }
+    /// Faces incident to vertex `v` (unordered).
+    pub fn vertex_faces(&self, v: usize) -> &[u32] {
+        &self.vert_faces[self.vert_face_offsets[v] as usize..self.vert_face_offsets[v + 1] as usize]
+    }
+    /// Flat face tables: offsets (len faces + 1) and corner vertices.
+    pub fn face_tables(&self) -> (&[u32], &[u32]) {
+        (&self.face_offsets, &self.face_verts)
+    }
+    /// Index of the edge joining `a` and `b`, if any.
+    pub fn find_edge(&self, a: u32, b: u32) -> Option<u32> {
+        if a as usize >= self.num_vertices {
+            return None;
+        }
+        self.vertex_edges(a as usize).iter().copied().find(|&e| {
+            let [x, y] = self.edge_verts[e as usize];
+            (x == a && y == b) || (x == b && y == a)
+        })
+    }
+}
+
+fn prefix_sum(v: &mut [u32]) {
+    for i in 1..v.len() {
+        v[i] += v[i - 1];
+    }
+}
+
+fn corner_to_face(face_offsets: &[u32], corners: usize) -> Vec<u32> {
+    let mut out = vec![0u32; corners];
+    for f in 0..face_offsets.len() - 1 {
+        for c in face_offsets[f]..face_offsets[f + 1] {
+            out[c as usize] = f as u32;
+        }
+    }
+    out
+}

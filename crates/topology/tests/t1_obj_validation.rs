@@ -1,0 +1,204 @@
+//! OBJ parsing, OpenSubdiv tags and every validation error on small inline meshes.
+
+use topology::{
+    parse_obj, BoundaryInterpolation, CreaseMethod, TopologyError, TriangleSubdivision,
+};
+
+const QUAD_PAIR: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\n";
+
+fn err(text: &str) -> TopologyError {
+    parse_obj(text, "inline.obj").expect_err("mesh should be rejected")
+}
+
+#[test]
+fn parses_polygons_uvs_normals_and_tags() {
+    let text = "# test\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 2 0\n\
+vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.5 1\nvn 0 0 1\n\
+f 1/1/1 2/2/1 3/3/1 4/4/1\nf 4/4/1 3/3/1 5/5/1\n\
+t crease 2/1/0 0 1 2.5\nt crease 4/2/0 1 2 2 3 1.0 3.0\nt corner 1/1/0 4 10\n\
+t interpolateboundary 1/0/0 1\nt creasemethod 0/0/1 chaikin\nt smoothtriangles 0/0/1 smooth\n\
+t hole 1/0/0 1\nt vertexedit 1/0/0 3\n";
+    let m = parse_obj(text, "tags.obj").unwrap();
+    assert_eq!(m.positions.len(), 5);
+    assert_eq!(m.num_faces(), 2);
+    assert_eq!(m.face(0), &[0, 1, 2, 3]);
+    assert_eq!(m.face(1), &[3, 2, 4]);
+    assert_eq!(m.uvs.as_ref().unwrap()[6], [0.5, 1.0]);
+    assert_eq!(m.normals.as_ref().unwrap().len(), 7);
+    assert_eq!(m.creases.len(), 3);
+    assert_eq!(m.creases[0].vertices, [0, 1]);
+    assert_eq!(m.creases[0].sharpness, 2.5);
+    assert_eq!(m.creases[2].vertices, [2, 3]);
+    assert_eq!(m.creases[2].sharpness, 3.0);
+    assert_eq!(m.corners[0].vertex, 4);
+    assert_eq!(m.corners[0].sharpness, 10.0);
+    assert_eq!(m.options.boundary, BoundaryInterpolation::EdgesAndCorners);
+    assert_eq!(m.options.crease_method, CreaseMethod::Chaikin);
+    assert_eq!(m.options.triangle_subdivision, TriangleSubdivision::Smooth);
+    assert_eq!(m.holes, vec![1]);
+}
+
+#[test]
+fn negative_indices_and_missing_attributes() {
+    let m = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n", "neg.obj").unwrap();
+    assert_eq!(m.face(0), &[0, 1, 2]);
+    assert!(m.uvs.is_none() && m.normals.is_none());
+}
+
+#[test]
+fn isolated_vertices_are_allowed() {
+    let m = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 5 5\nf 1 2 3\n", "iso.obj").unwrap();
+    m.validate().unwrap();
+}
+
+#[test]
+fn missing_file_names_the_file() {
+    let e = topology::load_obj("/nonexistent/dir/missing_mesh.obj").unwrap_err();
+    assert!(matches!(e, TopologyError::Io { .. }));
+    assert!(e.to_string().contains("missing_mesh.obj"), "{e}");
+}
+
+#[test]
+fn malformed_text_names_file_and_line() {
+    let e = err("v 0 0 0\nv 1 zero 0\n");
+    match &e {
+        TopologyError::Parse { file, line, .. } => {
+            assert_eq!(file, "inline.obj");
+            assert_eq!(*line, 2);
+        }
+        other => panic!("unexpected {other:?}"),
+    }
+    assert!(matches!(
+        err("v 0 0\n"),
+        TopologyError::Parse { line: 1, .. }
+    ));
+    assert!(matches!(
+        err("v 0 0 0\nf 0 1 2\n"),
+        TopologyError::Parse { line: 2, .. }
+    ));
+    assert!(matches!(
+        err("v 0 0 0\nf 1/x 1 1\n"),
+        TopologyError::Parse { .. }
+    ));
+    assert!(matches!(
+        err("v 0 0 0\nt crease 2/1/0 0\n"),
+        TopologyError::Parse { .. }
+    ));
+    assert!(matches!(
+        err("v 0 0 0\nt crease x/1/0 0 1 1\n"),
+        TopologyError::Parse { .. }
+    ));
+    let text = format!("{QUAD_PAIR}vt 0 0\nf 1/1 2/1 3/7\n");
+    assert!(matches!(err(&text), TopologyError::Parse { line: 8, .. }));
+}
+
+#[test]
+fn empty_mesh() {
+    assert!(matches!(err("").root(), TopologyError::EmptyMesh { .. }));
+    assert!(matches!(
+        err("v 0 0 0\n").root(),
+        TopologyError::EmptyMesh { what: "no faces" }
+    ));
+    let e = err("# nothing\n");
+    assert!(e.to_string().contains("inline.obj"), "{e}");
+}
+
+#[test]
+fn index_out_of_range() {
+    let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3 9\n");
+    assert!(e.to_string().contains("inline.obj"), "{e}");
+    match e.root() {
+        TopologyError::IndexOutOfRange { face, index, count } => {
+            assert_eq!((*face, *index, *count), (1, 8, 3));
+        }
+        other => panic!("unexpected {other:?}"),
+    }
+}
+
+#[test]
+fn face_with_too_few_or_repeated_vertices() {
+    let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n");
+    assert!(matches!(
+        e.root(),
+        TopologyError::DegenerateFace { face: 0, size: 2 }
+    ));
+    let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 2 3\n");
+    assert!(matches!(
+        e.root(),
+        TopologyError::RepeatedVertex { face: 1, vertex: 1 }
+    ));
+}
+
+#[test]
+fn non_manifold_edge() {
+    // Three triangles on edge 0-1.
+    let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n");
+    match e.root() {
+        TopologyError::NonManifoldEdge { v0, v1, faces } => {
+            assert_eq!((*v0, *v1, *faces), (0, 1, 3));
+        }
+        other => panic!("unexpected {other:?}"),
+    }
+}
+
+#[test]
+fn inconsistent_orientation() {
+    // The second quad walks the shared edge 1->2 the same way as the first.
+    let e = err(&format!("{QUAD_PAIR}f 1 2 3 4\nf 2 3 6 5\n"));
+    match e.root() {
+        TopologyError::InconsistentOrientation {
+            face0,
+            face1,
+            v0,
+            v1,
+        } => {
+            assert_eq!((*face0, *face1), (0, 1));
+            assert_eq!((*v0, *v1), (1, 2));
+        }
+        other => panic!("unexpected {other:?}"),
+    }
+}
+
+#[test]
+fn non_manifold_vertex() {
+    // Two triangles touching only at vertex 0 (a bow tie).
+    let e = err("v 0 0 0\nv 1 0 0\nv 1 1 0\nv -1 0 0\nv -1 -1 0\nf 1 2 3\nf 1 4 5\n");
+    match e.root() {
+        TopologyError::NonManifoldVertex { vertex, fans } => {
+            assert_eq!((*vertex, *fans), (0, 2));
+        }
+        other => panic!("unexpected {other:?}"),
+    }
+}
+
+#[test]
+fn non_finite_positions() {
+    let e = err("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
+    assert!(matches!(
+        e.root(),
+        TopologyError::NonFinitePosition { vertex: 1, .. }
+    ));
+    let e = err("v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n");
+    assert!(matches!(
+        e.root(),
+        TopologyError::NonFinitePosition { vertex: 2, .. }
+    ));
+}
+
+#[test]
+fn tags_naming_missing_vertices() {
+    let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nt corner 1/1/0 7 1.0\n");
+    assert!(matches!(e.root(), TopologyError::InvalidTag { .. }));
+    let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nt crease 2/1/0 0 5 1.0\n");
+    assert!(matches!(e.root(), TopologyError::InvalidTag { .. }));
+}
+
+#[test]
+fn write_obj_round_trips() {
+    let m = parse_obj(&format!("{QUAD_PAIR}f 1 2 3 4\nf 2 5 6 3\n"), "rt.obj").unwrap();
+    let mut buf = Vec::new();
+    topology::write_obj(&mut buf, &m.positions, &m.face_offsets, &m.face_vertices).unwrap();
+    let back = parse_obj(std::str::from_utf8(&buf).unwrap(), "back.obj").unwrap();
+    assert_eq!(back.positions, m.positions);
+    assert_eq!(back.face_vertices, m.face_vertices);
+}
