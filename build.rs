@@ -56,16 +56,33 @@ fn main() {
             }
             Err(format!("include \"{name}\" not found in glsl/include or glsl/"))
         });
-        match compiler.compile_into_spirv(&source, kind, &path.display().to_string(), "main", Some(&options)) {
-            Ok(artifact) => {
-                let words = artifact.as_binary();
-                let ident = const_name(&file_name);
-                let spv = out.join(format!("{file_name}.spv"));
-                std::fs::write(&spv, artifact.as_binary_u8()).expect("write spv");
-                writeln!(generated, "/// SPIR-V of `glsl/{file_name}`.").unwrap();
-                writeln!(generated, "pub static {ident}: &[u32] = &{words:?};").unwrap();
+        // Tessellation spacing is a layout qualifier, not a specialization constant: a stage that
+        // names `SPACING` is compiled once per spacing, as NAME_EQUAL / _FRACTIONAL_EVEN / _ODD.
+        let variants: Vec<(&str, Option<&str>)> = if source.contains("SPACING") {
+            vec![
+                ("_EQUAL", Some("equal_spacing")),
+                ("_FRACTIONAL_EVEN", Some("fractional_even_spacing")),
+                ("_FRACTIONAL_ODD", Some("fractional_odd_spacing")),
+            ]
+        } else {
+            vec![("", None)]
+        };
+        for (suffix, spacing) in variants {
+            let mut opts = options.clone();
+            if let Some(spacing) = spacing {
+                opts.add_macro_definition("SPACING", Some(spacing));
             }
-            Err(e) => failures.push(format!("{e}")),
+            match compiler.compile_into_spirv(&source, kind, &path.display().to_string(), "main", Some(&opts)) {
+                Ok(artifact) => {
+                    let words = artifact.as_binary();
+                    let ident = format!("{}{suffix}", const_name(&file_name));
+                    let spv = out.join(format!("{ident}.spv"));
+                    std::fs::write(&spv, artifact.as_binary_u8()).expect("write spv");
+                    writeln!(generated, "/// SPIR-V of `glsl/{file_name}` ({}).", spacing.unwrap_or("single variant")).unwrap();
+                    writeln!(generated, "pub static {ident}: &[u32] = &{words:?};").unwrap();
+                }
+                Err(e) => failures.push(format!("{e}")),
+            }
         }
     }
     if !failures.is_empty() {

@@ -1,1 +1,31 @@
-//! Vulkan plumbing.
+//! Vulkan plumbing for Tessera: instance, device, memory, buffers, images, pipelines, targets and
+//! queries, on `ash` with `gpu-allocator`. It knows nothing of subdivision.
+//!
+//! Design decisions:
+//! - Vulkan is loaded at run time (`ash::Entry::load`), so a missing loader is an error value.
+//! - Every resource holds an `Arc<DeviceShared>` and frees itself in `Drop`; the device outlives
+//!   all of them and the instance outlives the device. Field order states the drop order.
+//! - The validation layer's messages are counted by severity; tests assert no error-severity one.
+//! - Rendering uses Vulkan 1.3 dynamic rendering (no render-pass objects).
+//! - Driver bugs are worked around through [`workarounds`], a documented list keyed by driver.
+pub mod buffer;
+pub mod command;
+pub mod descriptor;
+pub mod device;
+pub mod error;
+pub mod image;
+pub mod instance;
+pub mod pipeline;
+pub mod query;
+pub mod swapchain;
+pub mod target;
+pub mod workarounds;
+
+pub use ash;
+pub use ash::vk;
+pub use buffer::{Buffer, BufferDesc};
+pub use device::{AdapterInfo, Device, DeviceDesc, DeviceSelector, DeviceShared};
+pub use error::{Result, VkError};
+pub use gpu_allocator::MemoryLocation;
+pub use image::{Image, ImageDesc};
+pub use instance::{Instance, InstanceDesc, MessageCounts, Validation};

@@ -1,0 +1,429 @@
+//! Physical-device choice (deterministic, overridable) and the logical device with its allocator.
+use crate::error::{Result, VkContext, VkError};
+use crate::instance::Instance;
+use crate::workarounds::Workarounds;
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use std::ffi::CStr;
+use std::fmt;
+use std::mem::ManuallyDrop;
+use std::sync::{Arc, Mutex};
+
+/// Which device to use: the best-scored, or one named by index or name substring (`--device`).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum DeviceSelector {
+    #[default]
+    Auto,
+    Index(usize),
+    Name(String),
+}
+
+impl std::str::FromStr for DeviceSelector {
+    type Err = std::convert::Infallible;
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        Ok(match s.parse::<usize>() {
+            Ok(i) => DeviceSelector::Index(i),
+            Err(_) if s.is_empty() || s == "auto" => DeviceSelector::Auto,
+            Err(_) => DeviceSelector::Name(s.to_owned()),
+        })
+    }
+}
+
+/// What Tessera needs of a device, one field per feature, gathered in one place.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Capabilities {
+    pub tessellation_shader: bool,
+    pub fill_mode_non_solid: bool,
+    pub pipeline_statistics_query: bool,
+    pub vertex_pipeline_stores_and_atomics: bool,
+    pub dynamic_rendering: bool,
+    pub timestamps: bool,
+    pub max_tessellation_generation_level: u32,
+    pub max_tessellation_patch_size: u32,
+    pub max_tess_evaluation_output_components: u32,
+    pub timestamp_period_ns: f32,
+}
+
+/// One physical device as seen at start-up: identity, capabilities, and what it lacks.
+#[derive(Clone, Debug)]
+pub struct AdapterInfo {
+    pub index: usize,
+    pub name: String,
+    pub device_type: vk::PhysicalDeviceType,
+    pub driver_id: vk::DriverId,
+    pub driver_name: String,
+    pub driver_info: String,
+    pub driver_version: u32,
+    pub api_version: u32,
+    pub vendor_id: u32,
+    pub caps: Capabilities,
+    pub queue_family: Option<u32>,
+    /// Empty when the device can run Tessera.
+    pub missing: Vec<String>,
+    pub physical: vk::PhysicalDevice,
+}
+
+impl AdapterInfo {
+    /// Discrete > integrated > virtual > CPU; unusable devices score 0.
+    pub fn score(&self) -> u32 {
+        if !self.missing.is_empty() {
+            return 0;
+        }
+        match self.device_type {
+            vk::PhysicalDeviceType::DISCRETE_GPU => 4,
+            vk::PhysicalDeviceType::INTEGRATED_GPU => 3,
+            vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+            vk::PhysicalDeviceType::CPU => 1,
+            _ => 1,
+        }
+    }
+
+    pub fn type_name(&self) -> &'static str {
+        match self.device_type {
+            vk::PhysicalDeviceType::DISCRETE_GPU => "discrete GPU",
+            vk::PhysicalDeviceType::INTEGRATED_GPU => "integrated GPU",
+            vk::PhysicalDeviceType::VIRTUAL_GPU => "virtual GPU",
+            vk::PhysicalDeviceType::CPU => "CPU",
+            _ => "other",
+        }
+    }
+
+    pub fn is_lavapipe(&self) -> bool {
+        self.driver_id == vk::DriverId::MESA_LLVMPIPE
+    }
+}
+
+impl fmt::Display for AdapterInfo {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "[{}] {} ({}, driver {} {}, Vulkan {}.{}.{})",
+            self.index,
+            self.name,
+            self.type_name(),
+            self.driver_name,
+            self.driver_info,
+            vk::api_version_major(self.api_version),
+            vk::api_version_minor(self.api_version),
+            vk::api_version_patch(self.api_version)
+        )?;
+        if !self.missing.is_empty() {
+            write!(f, " — lacks: {}", self.missing.join(", "))?;
+        }
+        Ok(())
+    }
+}
+
+fn cstr_field(chars: &[std::ffi::c_char]) -> String {
+    // SAFETY: Vulkan fixed-size string fields are NUL-terminated within their length.
+    let bytes: &[u8] = unsafe { std::slice::from_raw_parts(chars.as_ptr().cast(), chars.len()) };
+    CStr::from_bytes_until_nul(bytes).map(|c| c.to_string_lossy().into_owned()).unwrap_or_default()
+}
+
+/// Lists every physical device with what it offers and lacks, in the loader's order.
+pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
+    // SAFETY: instance.raw is a live instance.
+    let physicals = unsafe { instance.raw.enumerate_physical_devices() }.ctx("vkEnumeratePhysicalDevices")?;
+    let mut out = Vec::new();
+    for (index, &physical) in physicals.iter().enumerate() {
+        let mut driver = vk::PhysicalDeviceDriverProperties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+        let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+        let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+        // SAFETY: physical comes from this instance; the out-structs are valid chains.
+        let families = unsafe {
+            instance.raw.get_physical_device_properties2(physical, &mut props2);
+            instance.raw.get_physical_device_features2(physical, &mut features2);
+            instance.raw.get_physical_device_queue_family_properties(physical)
+        };
+        let props = props2.properties;
+        let feats = features2.features;
+        let queue_family = families
+            .iter()
+            .position(|q| q.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE))
+            .map(|i| i as u32);
+        let timestamps = queue_family
+            .map(|q| families[q as usize].timestamp_valid_bits > 0)
+            .unwrap_or(false);
+        let caps = Capabilities {
+            tessellation_shader: feats.tessellation_shader == vk::TRUE,
+            fill_mode_non_solid: feats.fill_mode_non_solid == vk::TRUE,
+            pipeline_statistics_query: feats.pipeline_statistics_query == vk::TRUE,
+            vertex_pipeline_stores_and_atomics: feats.vertex_pipeline_stores_and_atomics == vk::TRUE,
+            dynamic_rendering: f13.dynamic_rendering == vk::TRUE,
+            timestamps,
+            max_tessellation_generation_level: props.limits.max_tessellation_generation_level,
+            max_tessellation_patch_size: props.limits.max_tessellation_patch_size,
+            max_tess_evaluation_output_components: props.limits.max_tessellation_evaluation_output_components,
+            timestamp_period_ns: props.limits.timestamp_period,
+        };
+        let mut missing = Vec::new();
+        if props.api_version < vk::API_VERSION_1_3 {
+            missing.push("Vulkan 1.3".to_owned());
+        }
+        if !caps.tessellation_shader {
+            missing.push("tessellationShader".to_owned());
+        }
+        if !caps.fill_mode_non_solid {
+            missing.push("fillModeNonSolid".to_owned());
+        }
+        if !caps.dynamic_rendering {
+            missing.push("dynamicRendering".to_owned());
+        }
+        if caps.tessellation_shader && caps.max_tessellation_generation_level < 64 {
+            missing.push(format!("maxTessellationGenerationLevel ≥ 64 (has {})", caps.max_tessellation_generation_level));
+        }
+        if caps.tessellation_shader && caps.max_tessellation_patch_size < 32 {
+            missing.push(format!("maxTessellationPatchSize ≥ 32 (has {})", caps.max_tessellation_patch_size));
+        }
+        if queue_family.is_none() {
+            missing.push("a graphics+compute queue".to_owned());
+        }
+        out.push(AdapterInfo {
+            index,
+            name: cstr_field(&props.device_name),
+            device_type: props.device_type,
+            driver_id: driver.driver_id,
+            driver_name: cstr_field(&driver.driver_name),
+            driver_info: cstr_field(&driver.driver_info),
+            driver_version: props.driver_version,
+            api_version: props.api_version,
+            vendor_id: props.vendor_id,
+            caps,
+            queue_family,
+            missing,
+            physical,
+        });
+    }
+    Ok(out)
+}
+
+/// Chooses deterministically: highest score, ties broken by the lowest index.
+pub fn choose_adapter(adapters: &[AdapterInfo], selector: &DeviceSelector) -> Result<usize> {
+    let listing = || adapters.iter().map(|a| format!("  {a}")).collect::<Vec<_>>().join("\n");
+    let pick = match selector {
+        DeviceSelector::Auto => adapters
+            .iter()
+            .filter(|a| a.score() > 0)
+            .max_by_key(|a| (a.score(), std::cmp::Reverse(a.index)))
+            .map(|a| a.index),
+        DeviceSelector::Index(i) => adapters.iter().find(|a| a.index == *i).map(|a| a.index),
+        DeviceSelector::Name(n) => {
+            let n = n.to_lowercase();
+            adapters.iter().find(|a| a.name.to_lowercase().contains(&n)).map(|a| a.index)
+        }
+    };
+    match (pick, selector) {
+        (None, DeviceSelector::Auto) if adapters.is_empty() => {
+            Err(VkError::NoSuitableDevice("the loader reports no Vulkan device (install mesa-vulkan-drivers for lavapipe)".into()))
+        }
+        (None, DeviceSelector::Auto) => Err(VkError::NoSuitableDevice(format!(
+            "no device has tessellation shaders and the other features Tessera needs; devices seen:\n{}",
+            listing()
+        ))),
+        (None, s) => Err(VkError::NoSuchDevice { selector: format!("{s:?}"), devices: listing() }),
+        (Some(i), _) => {
+            let a = &adapters[i];
+            if a.missing.is_empty() {
+                Ok(i)
+            } else {
+                Err(VkError::MissingFeatures { name: a.name.clone(), missing: a.missing.join(", ") })
+            }
+        }
+    }
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct DeviceDesc {
+    pub selector: DeviceSelector,
+    /// Where the pipeline cache is kept between runs; `None` keeps it in memory only.
+    pub pipeline_cache_path: Option<std::path::PathBuf>,
+}
+
+/// The state every resource shares. Drop order: idle wait, pipeline cache, command pool,
+/// allocator (all allocations already freed by their owners), device; then the instance Arc.
+pub struct DeviceShared {
+    pub raw: ash::Device,
+    pub physical: vk::PhysicalDevice,
+    pub queue: vk::Queue,
+    pub queue_family: u32,
+    pub info: AdapterInfo,
+    pub workarounds: Workarounds,
+    pub debug_utils: Option<ash::ext::debug_utils::Device>,
+    pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
+    pub(crate) one_shot_pool: Mutex<vk::CommandPool>,
+    pub(crate) queue_lock: Mutex<()>,
+    pub(crate) pipeline_cache: vk::PipelineCache,
+    pub(crate) pipeline_cache_path: Option<std::path::PathBuf>,
+    pub instance: Arc<Instance>,
+}
+
+/// A handle to the logical device; clones share it.
+#[derive(Clone)]
+pub struct Device {
+    pub shared: Arc<DeviceShared>,
+}
+
+impl std::ops::Deref for Device {
+    type Target = DeviceShared;
+    fn deref(&self) -> &DeviceShared {
+        &self.shared
+    }
+}
+
+impl Device {
+    pub fn new(instance: &Arc<Instance>, desc: &DeviceDesc, extra_extensions: &[&'static CStr]) -> Result<Self> {
+        let adapters = enumerate_adapters(instance)?;
+        let chosen = choose_adapter(&adapters, &desc.selector)?;
+        let info = adapters[chosen].clone();
+        let physical = info.physical;
+        let queue_family = info.queue_family.ok_or_else(|| VkError::NoSuitableDevice("no queue".into()))?;
+        let priorities = [1.0f32];
+        let queue_info = [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
+        let features = vk::PhysicalDeviceFeatures::default()
+            .tessellation_shader(true)
+            .fill_mode_non_solid(true)
+            .pipeline_statistics_query(info.caps.pipeline_statistics_query)
+            .vertex_pipeline_stores_and_atomics(info.caps.vertex_pipeline_stores_and_atomics);
+        let mut f13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true);
+        let ext_names: Vec<*const i8> = extra_extensions.iter().map(|e| e.as_ptr()).collect();
+        let create = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queue_info)
+            .enabled_features(&features)
+            .enabled_extension_names(&ext_names)
+            .push_next(&mut f13);
+        // SAFETY: physical belongs to instance; create info references live locals.
+        let raw = unsafe { instance.raw.create_device(physical, &create, None) }.ctx("vkCreateDevice")?;
+        // SAFETY: the family/index were requested above.
+        let queue = unsafe { raw.get_device_queue(queue_family, 0) };
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.raw.clone(),
+            device: raw.clone(),
+            physical_device: physical,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        });
+        let allocator = match allocator {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: nothing was created on the device yet.
+                unsafe { raw.destroy_device(None) };
+                return Err(e.into());
+            }
+        };
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(queue_family)
+            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER | vk::CommandPoolCreateFlags::TRANSIENT);
+        // SAFETY: raw is a live device.
+        let pool = unsafe { raw.create_command_pool(&pool_info, None) }.ctx("vkCreateCommandPool")?;
+        let initial = desc
+            .pipeline_cache_path
+            .as_ref()
+            .and_then(|p| std::fs::read(p).ok())
+            .unwrap_or_default();
+        let cache_info = vk::PipelineCacheCreateInfo::default().initial_data(&initial);
+        // SAFETY: the driver validates the header of `initial` and ignores incompatible data.
+        let pipeline_cache = match unsafe { raw.create_pipeline_cache(&cache_info, None) } {
+            Ok(c) => c,
+            Err(_) => {
+                // SAFETY: as above, without initial data.
+                unsafe { raw.create_pipeline_cache(&vk::PipelineCacheCreateInfo::default(), None) }
+                    .ctx("vkCreatePipelineCache")?
+            }
+        };
+        let debug_utils = instance.has_debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance.raw, &raw));
+        let workarounds = Workarounds::for_adapter(&info);
+        for w in workarounds.active() {
+            log::info!("driver workaround active on {}: {}", info.name, w.summary);
+        }
+        let shared = DeviceShared {
+            raw,
+            physical,
+            queue,
+            queue_family,
+            info,
+            workarounds,
+            debug_utils,
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            one_shot_pool: Mutex::new(pool),
+            queue_lock: Mutex::new(()),
+            pipeline_cache,
+            pipeline_cache_path: desc.pipeline_cache_path.clone(),
+            instance: instance.clone(),
+        };
+        let device = Device { shared: Arc::new(shared) };
+        device.set_name(device.queue, "main queue");
+        Ok(device)
+    }
+
+    /// Names a Vulkan object for debug-utils (validation messages and capture tools show it).
+    pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
+        self.shared.set_name(handle, name)
+    }
+}
+
+impl DeviceShared {
+    pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
+        let Some(du) = &self.debug_utils else { return };
+        let Ok(name) = std::ffi::CString::new(name) else { return };
+        let info = vk::DebugUtilsObjectNameInfoEXT::default().object_handle(handle).object_name(&name);
+        // SAFETY: handle is a live object of this device; naming has no other effect.
+        let _ = unsafe { du.set_debug_utils_object_name(&info) };
+    }
+
+    /// Bytes still held by the allocator: zero once every resource is dropped.
+    pub fn allocated_bytes(&self) -> u64 {
+        self.allocator.lock().map(|a| a.generate_report().total_allocated_bytes).unwrap_or(0)
+    }
+
+    pub fn wait_idle(&self) {
+        let _q = self.queue_lock.lock();
+        // SAFETY: raw is live; waiting has no other effect.
+        let _ = unsafe { self.raw.device_wait_idle() };
+    }
+
+    pub fn pipeline_cache(&self) -> vk::PipelineCache {
+        self.pipeline_cache
+    }
+
+    /// Writes the pipeline cache to its file (if one was given); failures only warn.
+    pub fn save_pipeline_cache(&self) {
+        let Some(path) = &self.pipeline_cache_path else { return };
+        // SAFETY: the cache belongs to this device.
+        match unsafe { self.raw.get_pipeline_cache_data(self.pipeline_cache) } {
+            Ok(data) => {
+                if let Some(dir) = path.parent() {
+                    let _ = std::fs::create_dir_all(dir);
+                }
+                if let Err(e) = std::fs::write(path, data) {
+                    log::warn!("pipeline cache not saved to {}: {e}", path.display());
+                }
+            }
+            Err(e) => log::warn!("pipeline cache data unavailable: {e}"),
+        }
+    }
+}
+
+impl Drop for DeviceShared {
+    fn drop(&mut self) {
+        self.save_pipeline_cache();
+        // SAFETY: the last Arc is gone, so no resource of this device remains; we wait for the
+        // queue, then destroy children before the device. The allocator must go before the device.
+        unsafe {
+            let _ = self.raw.device_wait_idle();
+            if let Ok(pool) = self.one_shot_pool.lock() {
+                self.raw.destroy_command_pool(*pool, None);
+            }
+            self.raw.destroy_pipeline_cache(self.pipeline_cache, None);
+            if let Ok(a) = self.allocator.lock() {
+                let report = a.generate_report();
+                if !report.allocations.is_empty() {
+                    log::error!("gpu-allocator: {} allocations leaked at device drop", report.allocations.len());
+                }
+            }
+            ManuallyDrop::drop(&mut self.allocator);
+            self.raw.destroy_device(None);
+        }
+    }
+}

@@ -1,0 +1,129 @@
+//! 2D images with one view, for render targets and depth.
+use crate::device::{Device, DeviceShared};
+use crate::error::{Result, VkContext, VkError};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::MemoryLocation;
+use std::sync::Arc;
+
+#[derive(Clone, Debug)]
+pub struct ImageDesc<'a> {
+    pub name: &'a str,
+    pub extent: vk::Extent2D,
+    pub format: vk::Format,
+    pub usage: vk::ImageUsageFlags,
+    pub aspect: vk::ImageAspectFlags,
+}
+
+/// Drop order: view, image, then the allocation.
+pub struct Image {
+    pub view: vk::ImageView,
+    pub raw: vk::Image,
+    pub format: vk::Format,
+    pub extent: vk::Extent2D,
+    pub aspect: vk::ImageAspectFlags,
+    allocation: Option<Allocation>,
+    device: Arc<DeviceShared>,
+}
+
+impl Image {
+    pub fn new(device: &Device, desc: &ImageDesc<'_>) -> Result<Self> {
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(desc.format)
+            .extent(vk::Extent3D { width: desc.extent.width.max(1), height: desc.extent.height.max(1), depth: 1 })
+            .mip_levels(1)
+            .array_layers(1)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(desc.usage)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        // SAFETY: device live; info valid.
+        let raw = unsafe { device.raw.create_image(&info, None) }.ctx("vkCreateImage")?;
+        // SAFETY: raw just created.
+        let requirements = unsafe { device.raw.get_image_memory_requirements(raw) };
+        let allocation = device
+            .allocator
+            .lock()
+            .map_err(|_| VkError::Invalid("allocator lock poisoned".into()))?
+            .allocate(&AllocationCreateDesc {
+                name: desc.name,
+                requirements,
+                location: MemoryLocation::GpuOnly,
+                linear: false,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            });
+        let allocation = match allocation {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: raw unused.
+                unsafe { device.raw.destroy_image(raw, None) };
+                return Err(e.into());
+            }
+        };
+        // SAFETY: fresh image, matching memory.
+        unsafe { device.raw.bind_image_memory(raw, allocation.memory(), allocation.offset()) }.ctx("vkBindImageMemory")?;
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(raw)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(desc.format)
+            .subresource_range(subresource_range(desc.aspect));
+        // SAFETY: image is bound to memory.
+        let view = unsafe { device.raw.create_image_view(&view_info, None) }.ctx("vkCreateImageView")?;
+        device.set_name(raw, desc.name);
+        device.set_name(view, &format!("{} view", desc.name));
+        Ok(Self {
+            view,
+            raw,
+            format: desc.format,
+            extent: desc.extent,
+            aspect: desc.aspect,
+            allocation: Some(allocation),
+            device: device.shared.clone(),
+        })
+    }
+}
+
+pub fn subresource_range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
+    vk::ImageSubresourceRange::default().aspect_mask(aspect).level_count(1).layer_count(1)
+}
+
+impl Drop for Image {
+    fn drop(&mut self) {
+        // SAFETY: owners drop images only after the GPU is done with them.
+        unsafe {
+            self.device.raw.destroy_image_view(self.view, None);
+            self.device.raw.destroy_image(self.raw, None);
+        }
+        if let Some(a) = self.allocation.take() {
+            if let Ok(mut alloc) = self.device.allocator.lock() {
+                let _ = alloc.free(a);
+            }
+        }
+    }
+}
+
+/// Records a whole-image layout transition with a conservative all-commands barrier.
+pub fn transition(device: &ash::Device, cmd: vk::CommandBuffer, image: vk::Image, aspect: vk::ImageAspectFlags, from: vk::ImageLayout, to: vk::ImageLayout) {
+    let barrier = vk::ImageMemoryBarrier::default()
+        .image(image)
+        .old_layout(from)
+        .new_layout(to)
+        .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
+        .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .subresource_range(subresource_range(aspect));
+    // SAFETY: cmd is recording; image is live.
+    unsafe {
+        device.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::ALL_COMMANDS,
+            vk::PipelineStageFlags::ALL_COMMANDS,
+            vk::DependencyFlags::empty(),
+            &[],
+            &[],
+            &[barrier],
+        )
+    };
+}

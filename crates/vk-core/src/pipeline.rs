@@ -1,0 +1,249 @@
+//! Graphics pipelines with tessellation stages, and compute pipelines. All go through the
+//! device's pipeline cache (kept on disk when the device was given a path).
+use crate::device::{Device, DeviceShared};
+use crate::error::{Result, VkContext, VkError};
+use ash::vk;
+use std::sync::Arc;
+
+/// A shader stage: SPIR-V words plus optional specialization constants `(id, bytes)`.
+#[derive(Clone, Copy)]
+pub struct ShaderStage<'a> {
+    pub stage: vk::ShaderStageFlags,
+    pub spirv: &'a [u32],
+    pub specialization: Option<(&'a [vk::SpecializationMapEntry], &'a [u8])>,
+}
+
+impl<'a> ShaderStage<'a> {
+    pub fn new(stage: vk::ShaderStageFlags, spirv: &'a [u32]) -> Self {
+        Self { stage, spirv, specialization: None }
+    }
+}
+
+/// Tessellation state: control points per patch and where the domain origin lies.
+#[derive(Clone, Copy, Debug)]
+pub struct TessellationDesc {
+    pub patch_control_points: u32,
+    pub domain_origin: vk::TessellationDomainOrigin,
+}
+
+#[derive(Clone)]
+pub struct GraphicsPipelineDesc<'a> {
+    pub name: &'a str,
+    pub stages: Vec<ShaderStage<'a>>,
+    pub vertex_bindings: Vec<vk::VertexInputBindingDescription>,
+    pub vertex_attributes: Vec<vk::VertexInputAttributeDescription>,
+    pub topology: vk::PrimitiveTopology,
+    pub tessellation: Option<TessellationDesc>,
+    pub polygon_mode: vk::PolygonMode,
+    pub cull_mode: vk::CullModeFlags,
+    pub front_face: vk::FrontFace,
+    pub depth_test: bool,
+    pub depth_write: bool,
+    pub depth_compare: vk::CompareOp,
+    /// Constant and slope factors; pushes filled geometry back behind its wireframe overlay.
+    pub depth_bias: Option<(f32, f32)>,
+    pub color_format: vk::Format,
+    pub depth_format: vk::Format,
+    /// No rasterization: for passes that only capture TES output through storage buffers.
+    pub rasterizer_discard: bool,
+    pub set_layouts: Vec<vk::DescriptorSetLayout>,
+    pub push_constant_bytes: u32,
+}
+
+impl<'a> GraphicsPipelineDesc<'a> {
+    /// Defaults: triangle list, filled, back faces culled (CCW front), depth test LESS.
+    pub fn new(name: &'a str, color_format: vk::Format, depth_format: vk::Format) -> Self {
+        Self {
+            name,
+            stages: Vec::new(),
+            vertex_bindings: Vec::new(),
+            vertex_attributes: Vec::new(),
+            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            tessellation: None,
+            polygon_mode: vk::PolygonMode::FILL,
+            cull_mode: vk::CullModeFlags::NONE,
+            front_face: vk::FrontFace::COUNTER_CLOCKWISE,
+            depth_test: true,
+            depth_write: true,
+            depth_compare: vk::CompareOp::LESS,
+            depth_bias: None,
+            color_format,
+            depth_format,
+            rasterizer_discard: false,
+            set_layouts: Vec::new(),
+            push_constant_bytes: 0,
+        }
+    }
+}
+
+/// A pipeline and its layout. Drop order: pipeline, then layout.
+pub struct Pipeline {
+    pub raw: vk::Pipeline,
+    pub layout: vk::PipelineLayout,
+    pub bind_point: vk::PipelineBindPoint,
+    device: Arc<DeviceShared>,
+}
+
+fn shader_modules(device: &Device, name: &str, stages: &[ShaderStage<'_>]) -> Result<Vec<vk::ShaderModule>> {
+    let mut modules = Vec::new();
+    for s in stages {
+        let info = vk::ShaderModuleCreateInfo::default().code(s.spirv);
+        // SAFETY: SPIR-V comes from the build-time compiler.
+        match unsafe { device.raw.create_shader_module(&info, None) } {
+            Ok(m) => {
+                device.set_name(m, &format!("{name} {:?}", s.stage));
+                modules.push(m)
+            }
+            Err(e) => {
+                destroy_modules(device, &modules);
+                return Err(VkError::Call { call: "vkCreateShaderModule", result: e });
+            }
+        }
+    }
+    Ok(modules)
+}
+
+fn destroy_modules(device: &Device, modules: &[vk::ShaderModule]) {
+    for &m in modules {
+        // SAFETY: modules are only needed during pipeline creation.
+        unsafe { device.raw.destroy_shader_module(m, None) };
+    }
+}
+
+fn pipeline_layout(device: &Device, name: &str, sets: &[vk::DescriptorSetLayout], push_bytes: u32) -> Result<vk::PipelineLayout> {
+    let ranges = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::ALL).size(push_bytes)];
+    let mut info = vk::PipelineLayoutCreateInfo::default().set_layouts(sets);
+    if push_bytes > 0 {
+        info = info.push_constant_ranges(&ranges);
+    }
+    // SAFETY: set layouts are live.
+    let layout = unsafe { device.raw.create_pipeline_layout(&info, None) }.ctx("vkCreatePipelineLayout")?;
+    device.set_name(layout, &format!("{name} layout"));
+    Ok(layout)
+}
+
+impl Pipeline {
+    pub fn graphics(device: &Device, desc: &GraphicsPipelineDesc<'_>) -> Result<Self> {
+        let layout = pipeline_layout(device, desc.name, &desc.set_layouts, desc.push_constant_bytes)?;
+        let modules = match shader_modules(device, desc.name, &desc.stages) {
+            Ok(m) => m,
+            Err(e) => {
+                // SAFETY: layout unused.
+                unsafe { device.raw.destroy_pipeline_layout(layout, None) };
+                return Err(e);
+            }
+        };
+        let spec_infos: Vec<Option<vk::SpecializationInfo>> = desc
+            .stages
+            .iter()
+            .map(|s| s.specialization.map(|(entries, data)| vk::SpecializationInfo::default().map_entries(entries).data(data)))
+            .collect();
+        let stage_infos: Vec<_> = desc
+            .stages
+            .iter()
+            .zip(&modules)
+            .zip(&spec_infos)
+            .map(|((s, &m), spec)| {
+                let info = vk::PipelineShaderStageCreateInfo::default().stage(s.stage).module(m).name(c"main");
+                match spec {
+                    Some(spec) => info.specialization_info(spec),
+                    None => info,
+                }
+            })
+            .collect();
+        let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
+            .vertex_binding_descriptions(&desc.vertex_bindings)
+            .vertex_attribute_descriptions(&desc.vertex_attributes);
+        let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(desc.topology);
+        let mut domain = vk::PipelineTessellationDomainOriginStateCreateInfo::default()
+            .domain_origin(desc.tessellation.map(|t| t.domain_origin).unwrap_or(vk::TessellationDomainOrigin::UPPER_LEFT));
+        let tess_state = vk::PipelineTessellationStateCreateInfo::default()
+            .patch_control_points(desc.tessellation.map(|t| t.patch_control_points).unwrap_or(1))
+            .push_next(&mut domain);
+        let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
+        let raster = vk::PipelineRasterizationStateCreateInfo::default()
+            .polygon_mode(desc.polygon_mode)
+            .cull_mode(desc.cull_mode)
+            .front_face(desc.front_face)
+            .line_width(1.0)
+            .rasterizer_discard_enable(desc.rasterizer_discard)
+            .depth_bias_enable(desc.depth_bias.is_some())
+            .depth_bias_constant_factor(desc.depth_bias.map(|b| b.0).unwrap_or(0.0))
+            .depth_bias_slope_factor(desc.depth_bias.map(|b| b.1).unwrap_or(0.0));
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+            .depth_test_enable(desc.depth_test)
+            .depth_write_enable(desc.depth_write)
+            .depth_compare_op(desc.depth_compare);
+        let attachments = [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
+        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
+        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+        let color_formats = [desc.color_format];
+        let mut rendering = vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&color_formats).depth_attachment_format(desc.depth_format);
+        let mut info = vk::GraphicsPipelineCreateInfo::default()
+            .stages(&stage_infos)
+            .vertex_input_state(&vertex_input)
+            .input_assembly_state(&input_assembly)
+            .viewport_state(&viewport)
+            .rasterization_state(&raster)
+            .multisample_state(&multisample)
+            .depth_stencil_state(&depth)
+            .color_blend_state(&blend)
+            .dynamic_state(&dynamic)
+            .layout(layout)
+            .push_next(&mut rendering);
+        if desc.tessellation.is_some() {
+            info = info.tessellation_state(&tess_state);
+        }
+        // SAFETY: every referenced struct lives until the call returns.
+        let result = unsafe { device.raw.create_graphics_pipelines(device.pipeline_cache(), &[info], None) };
+        destroy_modules(device, &modules);
+        match result {
+            Ok(p) => {
+                device.set_name(p[0], desc.name);
+                Ok(Self { raw: p[0], layout, bind_point: vk::PipelineBindPoint::GRAPHICS, device: device.shared.clone() })
+            }
+            Err((_, e)) => {
+                // SAFETY: layout unused.
+                unsafe { device.raw.destroy_pipeline_layout(layout, None) };
+                Err(VkError::Call { call: "vkCreateGraphicsPipelines", result: e })
+            }
+        }
+    }
+
+    pub fn compute(device: &Device, name: &str, stage: ShaderStage<'_>, set_layouts: &[vk::DescriptorSetLayout], push_constant_bytes: u32) -> Result<Self> {
+        let layout = pipeline_layout(device, name, set_layouts, push_constant_bytes)?;
+        let modules = shader_modules(device, name, &[stage])?;
+        let spec = stage.specialization.map(|(entries, data)| vk::SpecializationInfo::default().map_entries(entries).data(data));
+        let mut stage_info = vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::COMPUTE).module(modules[0]).name(c"main");
+        if let Some(spec) = &spec {
+            stage_info = stage_info.specialization_info(spec);
+        }
+        let info = vk::ComputePipelineCreateInfo::default().stage(stage_info).layout(layout);
+        // SAFETY: referenced structs live until return.
+        let result = unsafe { device.raw.create_compute_pipelines(device.pipeline_cache(), &[info], None) };
+        destroy_modules(device, &modules);
+        match result {
+            Ok(p) => {
+                device.set_name(p[0], name);
+                Ok(Self { raw: p[0], layout, bind_point: vk::PipelineBindPoint::COMPUTE, device: device.shared.clone() })
+            }
+            Err((_, e)) => {
+                // SAFETY: layout unused.
+                unsafe { device.raw.destroy_pipeline_layout(layout, None) };
+                Err(VkError::Call { call: "vkCreateComputePipelines", result: e })
+            }
+        }
+    }
+}
+
+impl Drop for Pipeline {
+    fn drop(&mut self) {
+        // SAFETY: owners drop pipelines after the GPU is done with them.
+        unsafe {
+            self.device.raw.destroy_pipeline(self.raw, None);
+            self.device.raw.destroy_pipeline_layout(self.layout, None);
+        }
+    }
+}

@@ -1,0 +1,110 @@
+//! GPU timestamps and pipeline statistics (TCS patches, TES invocations, clipping primitives).
+use crate::device::{Device, DeviceShared};
+use crate::error::{Result, VkContext, VkError};
+use ash::vk;
+use std::sync::Arc;
+
+/// Counters read back from a pipeline-statistics query, in the order Vulkan writes them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PipelineStatistics {
+    pub input_assembly_vertices: u64,
+    pub vertex_shader_invocations: u64,
+    pub clipping_invocations: u64,
+    pub clipping_primitives: u64,
+    pub fragment_shader_invocations: u64,
+    pub tess_control_patches: u64,
+    pub tess_evaluation_invocations: u64,
+}
+
+impl PipelineStatistics {
+    /// The flags in bit order (Vulkan writes results in ascending bit order).
+    pub fn flags() -> vk::QueryPipelineStatisticFlags {
+        vk::QueryPipelineStatisticFlags::INPUT_ASSEMBLY_VERTICES
+            | vk::QueryPipelineStatisticFlags::VERTEX_SHADER_INVOCATIONS
+            | vk::QueryPipelineStatisticFlags::CLIPPING_INVOCATIONS
+            | vk::QueryPipelineStatisticFlags::CLIPPING_PRIMITIVES
+            | vk::QueryPipelineStatisticFlags::FRAGMENT_SHADER_INVOCATIONS
+            | vk::QueryPipelineStatisticFlags::TESSELLATION_CONTROL_SHADER_PATCHES
+            | vk::QueryPipelineStatisticFlags::TESSELLATION_EVALUATION_SHADER_INVOCATIONS
+    }
+}
+
+/// A pool of `count` timestamp queries or pipeline-statistics queries.
+pub struct QueryPool {
+    pub raw: vk::QueryPool,
+    pub ty: vk::QueryType,
+    pub count: u32,
+    device: Arc<DeviceShared>,
+}
+
+impl QueryPool {
+    pub fn timestamps(device: &Device, name: &str, count: u32) -> Result<Self> {
+        if !device.info.caps.timestamps {
+            return Err(VkError::Invalid(format!("{} has no timestamp queries on its queue", device.info.name)));
+        }
+        Self::new(device, name, vk::QueryType::TIMESTAMP, count, vk::QueryPipelineStatisticFlags::empty())
+    }
+
+    pub fn statistics(device: &Device, name: &str, count: u32) -> Result<Self> {
+        if !device.info.caps.pipeline_statistics_query {
+            return Err(VkError::Invalid(format!("{} has no pipeline-statistics queries", device.info.name)));
+        }
+        Self::new(device, name, vk::QueryType::PIPELINE_STATISTICS, count, PipelineStatistics::flags())
+    }
+
+    fn new(device: &Device, name: &str, ty: vk::QueryType, count: u32, stats: vk::QueryPipelineStatisticFlags) -> Result<Self> {
+        let info = vk::QueryPoolCreateInfo::default().query_type(ty).query_count(count).pipeline_statistics(stats);
+        // SAFETY: device live; the feature was checked above.
+        let raw = unsafe { device.raw.create_query_pool(&info, None) }.ctx("vkCreateQueryPool")?;
+        device.set_name(raw, name);
+        Ok(Self { raw, ty, count, device: device.shared.clone() })
+    }
+
+    /// Records a reset of all queries (must precede their first use in a submission).
+    pub fn cmd_reset(&self, cmd: vk::CommandBuffer) {
+        // SAFETY: cmd is recording outside a render pass.
+        unsafe { self.device.raw.cmd_reset_query_pool(cmd, self.raw, 0, self.count) };
+    }
+
+    /// Waits for and reads raw 64-bit results.
+    pub fn results(&self) -> Result<Vec<u64>> {
+        let per = if self.ty == vk::QueryType::PIPELINE_STATISTICS { 7 } else { 1 };
+        let mut data = vec![0u64; (self.count * per) as usize];
+        // SAFETY: data has room for count results of `per` u64s each, tightly packed.
+        unsafe {
+            self.device.raw.get_query_pool_results(self.raw, 0, &mut data, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT)
+        }
+        .ctx("vkGetQueryPoolResults")?;
+        Ok(data)
+    }
+
+    pub fn statistics_results(&self) -> Result<Vec<PipelineStatistics>> {
+        let raw = self.results()?;
+        Ok(raw
+            .chunks_exact(7)
+            .map(|c| PipelineStatistics {
+                input_assembly_vertices: c[0],
+                vertex_shader_invocations: c[1],
+                clipping_invocations: c[2],
+                clipping_primitives: c[3],
+                fragment_shader_invocations: c[4],
+                tess_control_patches: c[5],
+                tess_evaluation_invocations: c[6],
+            })
+            .collect())
+    }
+
+    /// Timestamp differences in nanoseconds between consecutive pairs (0–1, 2–3, …).
+    pub fn durations_ns(&self) -> Result<Vec<f64>> {
+        let period = self.device.info.caps.timestamp_period_ns as f64;
+        let raw = self.results()?;
+        Ok(raw.chunks_exact(2).map(|p| p[1].wrapping_sub(p[0]) as f64 * period).collect())
+    }
+}
+
+impl Drop for QueryPool {
+    fn drop(&mut self) {
+        // SAFETY: results were read (or the pool unused) before the owner drops it.
+        unsafe { self.device.raw.destroy_query_pool(self.raw, None) };
+    }
+}

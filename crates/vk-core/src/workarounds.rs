@@ -1,0 +1,67 @@
+//! Driver workarounds: a documented list keyed by driver and version. Each entry names the bug,
+//! how it was measured and what Tessera does about it. Never hide a bug by lowering quality
+//! (e.g. tessellation factors): work around it.
+use crate::device::AdapterInfo;
+use ash::vk;
+
+/// One known driver bug.
+#[derive(Clone, Debug)]
+pub struct Workaround {
+    pub id: WorkaroundId,
+    pub driver: vk::DriverId,
+    pub summary: &'static str,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WorkaroundId {
+    /// lavapipe (Mesa llvmpipe's Vulkan driver), measured on Mesa 22.3: a tessellated draw is
+    /// processed in chunks of min(patches, 4096 / control points per patch) patches, and a chunk
+    /// emitting more than 65,536 vertices gets corrupt triangles (its vertex indices are 16-bit;
+    /// the TES outputs themselves stay right) and slows down super-linearly. We split tessellated
+    /// draws so that no chunk can exceed 65,536 vertices at the largest factor the draw can use.
+    /// This is likely the cause of OpenSubdiv's holes on llvmpipe.
+    LavapipeTessChunkVertexLimit,
+}
+
+/// The list of every known workaround; `Workarounds::for_adapter` picks the active ones.
+pub fn known() -> Vec<Workaround> {
+    vec![Workaround {
+        id: WorkaroundId::LavapipeTessChunkVertexLimit,
+        driver: vk::DriverId::MESA_LLVMPIPE,
+        summary: "lavapipe: tessellated draws split so no internal chunk emits > 65,536 vertices (16-bit chunk indices)",
+    }]
+}
+
+/// The workarounds active on one device.
+#[derive(Clone, Debug, Default)]
+pub struct Workarounds {
+    active: Vec<Workaround>,
+}
+
+/// Vertices a lavapipe chunk may emit before its 16-bit indices overflow.
+pub const LAVAPIPE_CHUNK_VERTEX_LIMIT: u64 = 65_536;
+
+impl Workarounds {
+    pub fn for_adapter(info: &AdapterInfo) -> Self {
+        // No fixed Mesa version is known yet: every lavapipe gets the split.
+        Self { active: known().into_iter().filter(|w| w.driver == info.driver_id).collect() }
+    }
+
+    pub fn active(&self) -> &[Workaround] {
+        &self.active
+    }
+
+    pub fn has(&self, id: WorkaroundId) -> bool {
+        self.active.iter().any(|w| w.id == id)
+    }
+
+    /// How many patches one tessellated draw may hold, given the most vertices one patch can
+    /// emit at the draw's largest factors. `u32::MAX` when no limit applies.
+    pub fn max_patches_per_draw(&self, max_vertices_per_patch: u64) -> u32 {
+        if self.has(WorkaroundId::LavapipeTessChunkVertexLimit) {
+            (LAVAPIPE_CHUNK_VERTEX_LIMIT / max_vertices_per_patch.max(1)).max(1) as u32
+        } else {
+            u32::MAX
+        }
+    }
+}

@@ -1,0 +1,13 @@
+#version 450
+// Flat tessellation of a triangle: the planar point at the barycentric tess coordinate.
+#include "frame.glsl"
+#include "tese_out.glsl"
+layout(triangles, SPACING, ccw) in;
+layout(location = 0) in vec3 in_position[];
+layout(location = 1) in vec3 in_normal[];
+void main() {
+    vec3 b = gl_TessCoord;
+    vec3 p = b.x * in_position[0] + b.y * in_position[1] + b.z * in_position[2];
+    vec3 n = b.x * in_normal[0] + b.y * in_normal[1] + b.z * in_normal[2];
+    emit(p, n);
+}

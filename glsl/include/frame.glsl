@@ -1,0 +1,17 @@
+// Per-frame uniforms shared by every technique. Mirrors `tess::gpu::FrameUniforms` (std140);
+// the Rust side asserts sizes and offsets, and a test reads them back from the SPIR-V.
+layout(std140, set = 0, binding = 0) uniform Frame {
+    mat4 view_proj;
+    mat4 view;
+    vec4 camera_pos;   // xyz: eye in world space
+    vec4 light_dir;    // xyz: direction towards the light, normalised
+    vec4 tess;         // x: outer level, y: inner level, z: Phong shape factor alpha
+    vec4 base_color;   // rgb: surface albedo
+    vec4 wire_color;   // rgb: wireframe overlay
+    vec4 viewport;     // xy: size in pixels
+} frame;
+
+// Push constant: what a draw is for (shaded surface or wireframe overlay).
+layout(push_constant) uniform Draw {
+    uint mode;         // 0: shaded, 1: wireframe
+} draw;
