@@ -4,6 +4,9 @@
 pub mod error;
 pub mod mesh;
 pub mod obj;
+pub mod refine;
+pub mod sdc;
+pub mod stencil;
 
 pub use error::TopologyError;
 pub use mesh::{
@@ -11,3 +14,6 @@ pub use mesh::{
     TriangleSubdivision, VertexCorner,
 };
 pub use obj::{load_obj, parse_obj, write_control_mesh, write_obj};
+pub use refine::{refine_level, refine_uniform, uniform_stencils, Level, UniformRefinement};
+pub use sdc::{Rule, Scheme};
+pub use stencil::{StencilTable, StencilTableF32};

@@ -91,7 +91,7 @@ pub fn parse_obj(text: &str, name: &str) -> Result<ControlMesh, TopologyError> {
     let all_n = !corners.is_empty() && corners.iter().all(|c| c.2.is_some());
     let mut corner_uvs = Vec::with_capacity(if all_uv { corners.len() } else { 0 });
     let mut corner_normals = Vec::with_capacity(if all_n { corners.len() } else { 0 });
-    for f in 0..face_lines.len() {
+    for (f, &face_line) in face_lines.iter().enumerate() {
         let (s, e) = (
             mesh.face_offsets[f] as usize,
             mesh.face_offsets[f + 1] as usize,
@@ -110,20 +110,14 @@ pub fn parse_obj(text: &str, name: &str) -> Result<ControlMesh, TopologyError> {
                 let t = t.unwrap_or(-1);
                 let uv = usize::try_from(t).ok().and_then(|t| uvs.get(t));
                 corner_uvs.push(*uv.ok_or_else(|| {
-                    perr(
-                        face_lines[f],
-                        format!("texture index {} out of range", t + 1),
-                    )
+                    perr(face_line, format!("texture index {} out of range", t + 1))
                 })?);
             }
             if all_n {
                 let n = n.unwrap_or(-1);
                 let nn = usize::try_from(n).ok().and_then(|n| normals.get(n));
                 corner_normals.push(*nn.ok_or_else(|| {
-                    perr(
-                        face_lines[f],
-                        format!("normal index {} out of range", n + 1),
-                    )
+                    perr(face_line, format!("normal index {} out of range", n + 1))
                 })?);
             }
         }
@@ -262,7 +256,7 @@ fn parse_tag<E: Fn(usize, String) -> TopologyError>(
     };
     match tag {
         "crease" => {
-            if ints.len() < 2 || ints.len() % 2 != 0 {
+            if ints.len() < 2 || ints.len() & 1 != 0 {
                 return Err(perr(line, "crease tag needs vertex pairs".into()));
             }
             let pairs = ints.len() / 2;

@@ -1,0 +1,280 @@
+//! Limit masks: weights that push a vertex of any refinement level onto the limit surface,
+//! with two limit tangents (OpenSubdiv `Sdc` semantics for smooth, crease/boundary and corner
+//! vertices).
+//!
+//! A mask is expressed over the vertex's ordered one-ring:
+//! * `vertex`: the vertex itself;
+//! * `edges[i]`: the edge-neighbours `e_0 … e_{n−1}` in counter-clockwise order. For a
+//!   boundary vertex `e_0` and `e_{n−1}` are the two boundary neighbours (the fan runs CCW from
+//!   `e_0` to `e_{n−1}`, so it has `n−1` faces);
+//! * `faces[i]` (Catmull-Clark only): the vertex of quad `i` (between `e_i` and `e_{i+1}`)
+//!   opposite the centre. Catmull-Clark masks need an all-quad ring, which every vertex has
+//!   after one refinement.
+//!
+//! Tangent magnitudes follow OpenSubdiv (cos/sin masks for smooth vertices); they give exact
+//! tangent *directions*. Parametric derivatives of a patch are produced by [`crate::patch`]
+//! and [`crate::eval`] instead.
+
+use std::f64::consts::PI;
+
+/// Which limit rule applies at a vertex (the refinement rule once sharpness has decayed).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LimitRule {
+    /// Smooth interior vertex (also a dart: one sharp edge).
+    Smooth,
+    /// Two infinitely sharp edges (boundary edges count): `ends` are their indices in the ring,
+    /// `ends[0]` the leading edge (CCW start of the span containing the surface).
+    Crease { ends: [usize; 2] },
+    /// Infinitely sharp vertex (or more than two sharp edges): the vertex stays put.
+    Corner,
+}
+
+/// A vertex's one-ring shape for mask computation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LimitVertex {
+    /// Number of edge-neighbours.
+    pub valence: usize,
+    /// Boundary vertex (fan, `valence − 1` faces) or interior (cycle, `valence` faces).
+    pub boundary: bool,
+    pub rule: LimitRule,
+}
+
+/// Weights over (vertex, edge-neighbours, face-opposite vertices).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mask {
+    pub vertex: f64,
+    pub edges: Vec<f64>,
+    pub faces: Vec<f64>,
+}
+
+impl Mask {
+    fn zero(n_edges: usize, n_faces: usize) -> Mask {
+        Mask {
+            vertex: 0.0,
+            edges: vec![0.0; n_edges],
+            faces: vec![0.0; n_faces],
+        }
+    }
+
+    /// Apply to points of any dimension: `edges`/`faces` must match the mask's lengths
+    /// (faces may be empty when the mask has no face weights).
+    pub fn apply(&self, vertex: &[f64], edges: &[&[f64]], faces: &[&[f64]]) -> Vec<f64> {
+        let mut out: Vec<f64> = vertex.iter().map(|x| x * self.vertex).collect();
+        for (w, p) in self.edges.iter().zip(edges) {
+            for (o, x) in out.iter_mut().zip(p.iter()) {
+                *o += w * x;
+            }
+        }
+        for (w, p) in self.faces.iter().zip(faces) {
+            for (o, x) in out.iter_mut().zip(p.iter()) {
+                *o += w * x;
+            }
+        }
+        out
+    }
+}
+
+/// Position and tangent masks of one vertex.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LimitMasks {
+    pub position: Mask,
+    /// First tangent: along `e_0` for smooth vertices, along the crease for creases.
+    pub tangent1: Mask,
+    /// Second tangent: 90° CCW of `tangent1` for smooth vertices, across the surface (inward)
+    /// for creases; `tangent1 × tangent2` is the outward normal.
+    pub tangent2: Mask,
+}
+
+fn n_faces(v: &LimitVertex) -> usize {
+    if v.boundary {
+        v.valence.saturating_sub(1)
+    } else {
+        v.valence
+    }
+}
+
+/// Loop limit masks (no face weights).
+pub fn loop_limit_masks(v: &LimitVertex) -> LimitMasks {
+    let n = v.valence;
+    let mut pos = Mask::zero(n, 0);
+    let mut t1 = Mask::zero(n, 0);
+    let mut t2 = Mask::zero(n, 0);
+    match v.rule {
+        LimitRule::Smooth => {
+            let nf = n as f64;
+            let beta = 0.25 * (2.0 * PI / nf).cos() + 0.375;
+            let gamma = (0.625 - beta * beta) / nf;
+            let e = 1.0 / (nf + 3.0 / (8.0 * gamma));
+            pos.vertex = 1.0 - e * nf;
+            pos.edges.iter_mut().for_each(|w| *w = e);
+            for i in 0..n {
+                let a = 2.0 * PI * i as f64 / nf;
+                t1.edges[i] = a.cos();
+                t2.edges[i] = a.sin();
+            }
+        }
+        LimitRule::Crease { ends } => {
+            pos.vertex = 2.0 / 3.0;
+            pos.edges[ends[0]] = 1.0 / 6.0;
+            pos.edges[ends[1]] = 1.0 / 6.0;
+            t1.edges[ends[0]] = 1.5;
+            t1.edges[ends[1]] = -1.5;
+            crease_cross_tangent(&mut t2, ends, n, 3.0);
+        }
+        LimitRule::Corner => {
+            pos.vertex = 1.0;
+            corner_tangents(&mut t1, &mut t2, v, 3.0);
+        }
+    }
+    LimitMasks {
+        position: pos,
+        tangent1: t1,
+        tangent2: t2,
+    }
+}
+
+/// Cross-crease tangent over the interior edges strictly between `ends[0]` and `ends[1]`
+/// (CCW), pointing into the surface (OpenSubdiv's Loop formulae).
+fn crease_cross_tangent(t2: &mut Mask, ends: [usize; 2], n: usize, scale: f64) {
+    let interior: Vec<usize> = {
+        let mut v = Vec::new();
+        let mut i = (ends[0] + 1) % n;
+        while i != ends[1] {
+            v.push(i);
+            i = (i + 1) % n;
+        }
+        v
+    };
+    let k = interior.len();
+    match k {
+        0 => {
+            t2.vertex = -2.0 * scale;
+            t2.edges[ends[0]] = scale;
+            t2.edges[ends[1]] = scale;
+        }
+        1 => {
+            t2.vertex = -scale;
+            t2.edges[interior[0]] = scale;
+        }
+        2 => {
+            let r3 = 3f64.sqrt();
+            t2.vertex = -r3;
+            t2.edges[ends[0]] = -r3 / 2.0;
+            t2.edges[ends[1]] = -r3 / 2.0;
+            t2.edges[interior[0]] = r3;
+            t2.edges[interior[1]] = r3;
+        }
+        _ => {
+            let theta = PI / (k as f64 + 1.0);
+            let c = -scale * theta.sin();
+            t2.edges[ends[0]] = c;
+            t2.edges[ends[1]] = c;
+            let e = -scale * 2.0 * (theta.cos() - 1.0);
+            for (j, &i) in interior.iter().enumerate() {
+                t2.edges[i] = e * ((j + 1) as f64 * theta).sin();
+            }
+        }
+    }
+}
+
+fn corner_tangents(t1: &mut Mask, t2: &mut Mask, v: &LimitVertex, scale: f64) {
+    let n = v.valence;
+    if n == 0 {
+        return;
+    }
+    // Tangents along the first and last edge of the fan (the surface lies between them).
+    let last = if v.boundary { n - 1 } else { 1.min(n - 1) };
+    t1.vertex = -scale;
+    t1.edges[0] = scale;
+    t2.vertex = -scale;
+    t2.edges[last] += scale;
+}
+
+/// Catmull-Clark limit masks. Smooth masks need the all-quad ring (`faces` = opposite vertices).
+pub fn catmark_limit_masks(v: &LimitVertex) -> LimitMasks {
+    let n = v.valence;
+    let nf_count = n_faces(v);
+    match v.rule {
+        LimitRule::Smooth => {
+            let nf = n as f64;
+            let mut pos = Mask::zero(n, n);
+            let fw = 1.0 / (nf * (nf + 5.0));
+            pos.vertex = 1.0 - nf * 5.0 * fw;
+            pos.edges.iter_mut().for_each(|w| *w = 4.0 * fw);
+            pos.faces.iter_mut().for_each(|w| *w = fw);
+            let mut t1 = Mask::zero(n, n);
+            let mut t2 = Mask::zero(n, n);
+            let c = (2.0 * PI / nf).cos();
+            let an = 1.0 + c + (PI / nf).cos() * (2.0 * (9.0 + c)).sqrt();
+            for i in 0..n {
+                let a0 = 2.0 * PI * i as f64 / nf;
+                let a1 = 2.0 * PI * (i + 1) as f64 / nf;
+                t1.edges[i] = an * a0.cos();
+                t1.faces[i] = a0.cos() + a1.cos();
+                t2.edges[i] = an * a0.sin();
+                t2.faces[i] = a0.sin() + a1.sin();
+            }
+            LimitMasks {
+                position: pos,
+                tangent1: t1,
+                tangent2: t2,
+            }
+        }
+        LimitRule::Crease { ends } => {
+            let mut pos = Mask::zero(n, nf_count);
+            pos.vertex = 2.0 / 3.0;
+            pos.edges[ends[0]] = 1.0 / 6.0;
+            pos.edges[ends[1]] = 1.0 / 6.0;
+            let mut t1 = Mask::zero(n, nf_count);
+            t1.edges[ends[0]] = 1.0;
+            t1.edges[ends[1]] = -1.0;
+            let mut t2 = Mask::zero(n, nf_count);
+            crease_cross_tangent(&mut t2, ends, n, 2.0);
+            LimitMasks {
+                position: pos,
+                tangent1: t1,
+                tangent2: t2,
+            }
+        }
+        LimitRule::Corner => {
+            let mut pos = Mask::zero(n, nf_count);
+            pos.vertex = 1.0;
+            let mut t1 = Mask::zero(n, nf_count);
+            let mut t2 = Mask::zero(n, nf_count);
+            corner_tangents(&mut t1, &mut t2, v, 1.0);
+            LimitMasks {
+                position: pos,
+                tangent1: t1,
+                tangent2: t2,
+            }
+        }
+    }
+}
+
+/// Smooth-vertex tangent directed along edge-neighbour `k`, as a weight vector over
+/// `(edges, faces)`: the cos/sin masks rotated so the parametric derivative along an edge of a
+/// regular vertex comes out exactly (Loop: `(2/n)·Σ cos(θᵢ−θₖ) eᵢ`, which is `1/3` of the mask
+/// at valence 6; Catmull-Clark: `1/(3n)` of the Halstead mask, `1/12` at valence 4).
+pub fn smooth_directional_tangent(loop_scheme: bool, n: usize, k: usize) -> (Vec<f64>, Vec<f64>) {
+    let nf = n as f64;
+    let tk = 2.0 * PI * k as f64 / nf;
+    if loop_scheme {
+        let e = (0..n)
+            .map(|i| (2.0 / nf) * (2.0 * PI * i as f64 / nf - tk).cos())
+            .collect();
+        (e, Vec::new())
+    } else {
+        let c = (2.0 * PI / nf).cos();
+        let an = 1.0 + c + (PI / nf).cos() * (2.0 * (9.0 + c)).sqrt();
+        let s = 1.0 / (3.0 * nf);
+        let mut e = Vec::with_capacity(n);
+        let mut f = Vec::with_capacity(n);
+        for i in 0..n {
+            let a0 = 2.0 * PI * i as f64 / nf - tk;
+            let a1 = 2.0 * PI * (i + 1) as f64 / nf - tk;
+            e.push(s * an * a0.cos());
+            f.push(s * (a0.cos() + a1.cos()));
+        }
+        (e, f)
+    }
+}
