@@ -1,0 +1,47 @@
+//! An orbit camera framed from the mesh's bounding box.
+use glam::{Mat4, Vec3};
+
+/// Orbit parameters: angles in degrees, zoom > 1 moves closer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub yaw: f32,
+    pub pitch: f32,
+    pub zoom: f32,
+    pub fov_y_degrees: f32,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Self { yaw: 35.0, pitch: 20.0, zoom: 1.0, fov_y_degrees: 40.0 }
+    }
+}
+
+/// View, projection and eye position for one frame.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraMatrices {
+    pub view: Mat4,
+    pub proj: Mat4,
+    pub eye: Vec3,
+}
+
+impl Camera {
+    /// Places the eye on a sphere around the box centre, far enough that the bounding sphere
+    /// fits the vertical field of view (and the horizontal one for narrow images).
+    pub fn matrices(&self, bbox_min: [f32; 3], bbox_max: [f32; 3], aspect: f32) -> CameraMatrices {
+        let lo = Vec3::from(bbox_min);
+        let hi = Vec3::from(bbox_max);
+        let center = (lo + hi) * 0.5;
+        let radius = ((hi - lo).length() * 0.5).max(1e-6);
+        let fov = self.fov_y_degrees.to_radians();
+        let half = (fov * 0.5).tan().min((fov * 0.5).tan() * aspect.max(1e-3));
+        let distance = radius / half.atan().sin() / self.zoom.max(1e-3);
+        let (yaw, pitch) = (self.yaw.to_radians(), self.pitch.clamp(-89.0, 89.0).to_radians());
+        let dir = Vec3::new(yaw.sin() * pitch.cos(), pitch.sin(), yaw.cos() * pitch.cos());
+        let eye = center + dir * distance;
+        let view = Mat4::look_at_rh(eye, center, Vec3::Y);
+        let near = (distance - radius * 1.5).max(distance * 0.01);
+        let far = distance + radius * 1.5;
+        let proj = Mat4::perspective_rh(fov, aspect.max(1e-3), near, far);
+        CameraMatrices { view, proj, eye }
+    }
+}

@@ -1,0 +1,186 @@
+//! Renderable form of a control mesh for the triangle/quad techniques: f32 positions with
+//! vertex normals, triangle patches (every face fan-triangulated) and quad patches (quads kept
+//! for flat quad tessellation, the rest triangulated).
+use crate::error::{Result, TessError};
+use crate::gpu::Vertex;
+use topology::ControlMesh;
+
+#[derive(Clone, Debug, Default)]
+pub struct RenderMesh {
+    pub vertices: Vec<Vertex>,
+    /// Every face as triangles (for Phong and PN, and flat triangles).
+    pub triangles: Vec<[u32; 3]>,
+    /// Quads as quads; other faces go to `quad_mode_triangles`.
+    pub quads: Vec<[u32; 4]>,
+    pub quad_mode_triangles: Vec<[u32; 3]>,
+    pub bbox_min: [f32; 3],
+    pub bbox_max: [f32; 3],
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn normalize(a: [f64; 3]) -> Option<[f64; 3]> {
+    let l = dot(a, a).sqrt();
+    (l > 0.0 && l.is_finite()).then(|| [a[0] / l, a[1] / l, a[2] / l])
+}
+
+impl RenderMesh {
+    /// Builds vertex normals (the OBJ's own when every corner has one, else angle-weighted face
+    /// normals) and the patch index lists. Indices are checked here, so the GPU never receives
+    /// one that reads out of bounds.
+    pub fn from_control_mesh(mesh: &ControlMesh) -> Result<Self> {
+        let nv = mesh.positions.len();
+        if mesh.num_faces() == 0 || nv == 0 {
+            return Err(TessError::Topology(topology::TopologyError::EmptyMesh { what: "no faces to draw" }));
+        }
+        for (f, face) in mesh.faces().enumerate() {
+            if face.len() < 3 {
+                return Err(TessError::Topology(topology::TopologyError::DegenerateFace { face: f, size: face.len() }));
+            }
+            if let Some(&bad) = face.iter().find(|&&i| i as usize >= nv) {
+                return Err(TessError::Topology(topology::TopologyError::IndexOutOfRange { face: f, index: bad as i64, count: nv }));
+            }
+        }
+        if let Some((v, _)) = mesh.positions.iter().enumerate().find(|(_, p)| p.iter().any(|c| !c.is_finite())) {
+            return Err(TessError::Invalid(format!("vertex {v} has a NaN or infinite coordinate")));
+        }
+
+        // Corner normals from the file are used when complete: vertices are then split by
+        // (position, normal) so faces sharing both share the vertex.
+        let corner_normals = mesh.normals.as_ref().filter(|n| n.len() == mesh.face_vertices.len());
+        let (positions, corner_index): (Vec<[f64; 3]>, Vec<u32>) = match corner_normals {
+            Some(_) => {
+                let mut map = std::collections::HashMap::new();
+                let mut pos = Vec::new();
+                let mut idx = Vec::with_capacity(mesh.face_vertices.len());
+                let normals = corner_normals.expect("checked");
+                for (c, &v) in mesh.face_vertices.iter().enumerate() {
+                    let n = normals[c];
+                    let key = (v, n.map(f64::to_bits));
+                    let id = *map.entry(key).or_insert_with(|| {
+                        pos.push(mesh.positions[v as usize]);
+                        (pos.len() - 1) as u32
+                    });
+                    idx.push(id);
+                }
+                (pos, idx)
+            }
+            None => (mesh.positions.clone(), mesh.face_vertices.clone()),
+        };
+
+        let normals: Vec<[f64; 3]> = match corner_normals {
+            Some(cn) => {
+                let mut n = vec![[0.0; 3]; positions.len()];
+                for (c, &id) in corner_index.iter().enumerate() {
+                    n[id as usize] = normalize(cn[c]).unwrap_or([0.0, 0.0, 1.0]);
+                }
+                n
+            }
+            None => angle_weighted_normals(&positions, &mesh.face_offsets, &corner_index),
+        };
+
+        let mut out = RenderMesh {
+            vertices: positions
+                .iter()
+                .zip(&normals)
+                .map(|(p, n)| Vertex { position: p.map(|c| c as f32), normal: n.map(|c| c as f32) })
+                .collect(),
+            ..Default::default()
+        };
+        for f in 0..mesh.num_faces() {
+            let face = &corner_index[mesh.face_offsets[f] as usize..mesh.face_offsets[f + 1] as usize];
+            let fan = (1..face.len() - 1).map(|i| [face[0], face[i], face[i + 1]]);
+            out.triangles.extend(fan.clone());
+            if face.len() == 4 {
+                out.quads.push([face[0], face[1], face[2], face[3]]);
+            } else {
+                out.quad_mode_triangles.extend(fan);
+            }
+        }
+        let mut lo = [f32::INFINITY; 3];
+        let mut hi = [f32::NEG_INFINITY; 3];
+        for v in &out.vertices {
+            for k in 0..3 {
+                lo[k] = lo[k].min(v.position[k]);
+                hi[k] = hi[k].max(v.position[k]);
+            }
+        }
+        out.bbox_min = lo;
+        out.bbox_max = hi;
+        Ok(out)
+    }
+}
+
+/// Vertex normals as the sum of face normals weighted by each corner's angle (Thürmer & Wüthrich),
+/// independent of how faces are split into triangles.
+pub fn angle_weighted_normals(positions: &[[f64; 3]], face_offsets: &[u32], corners: &[u32]) -> Vec<[f64; 3]> {
+    let mut acc = vec![[0.0f64; 3]; positions.len()];
+    for f in 0..face_offsets.len().saturating_sub(1) {
+        let face = &corners[face_offsets[f] as usize..face_offsets[f + 1] as usize];
+        // Newell's method: robust for non-planar polygons.
+        let mut n = [0.0; 3];
+        for i in 0..face.len() {
+            let a = positions[face[i] as usize];
+            let b = positions[face[(i + 1) % face.len()] as usize];
+            n[0] += (a[1] - b[1]) * (a[2] + b[2]);
+            n[1] += (a[2] - b[2]) * (a[0] + b[0]);
+            n[2] += (a[0] - b[0]) * (a[1] + b[1]);
+        }
+        let Some(n) = normalize(n) else { continue };
+        for i in 0..face.len() {
+            let v = face[i] as usize;
+            let prev = positions[face[(i + face.len() - 1) % face.len()] as usize];
+            let next = positions[face[(i + 1) % face.len()] as usize];
+            let (Some(e0), Some(e1)) = (normalize(sub(prev, positions[v])), normalize(sub(next, positions[v]))) else { continue };
+            let angle = dot(e0, e1).clamp(-1.0, 1.0).acos();
+            for k in 0..3 {
+                acc[v][k] += angle * n[k];
+            }
+        }
+    }
+    acc.into_iter().map(|n| normalize(n).unwrap_or([0.0, 0.0, 1.0])).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cube_normals_point_along_diagonals() {
+        let mesh = topology::parse_obj(include_str!("../../../tests/data/meshes/cube.obj"), "cube.obj").unwrap();
+        let rm = RenderMesh::from_control_mesh(&mesh).unwrap();
+        assert_eq!(rm.quads.len(), 6);
+        assert_eq!(rm.triangles.len(), 12);
+        for v in &rm.vertices {
+            // Equal angles (90°) at each corner: the normal is the corner's diagonal direction.
+            let p = v.position;
+            let len = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+            for k in 0..3 {
+                assert!((v.normal[k] - p[k] / len).abs() < 1e-6, "{v:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn pentagon_is_fan_triangulated() {
+        let mesh = topology::ControlMesh::from_polygons(
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.5, 1.0, 0.0], [0.5, 1.5, 0.0], [-0.5, 1.0, 0.0]],
+            &[[0u32, 1, 2, 3, 4]],
+        );
+        let rm = RenderMesh::from_control_mesh(&mesh).unwrap();
+        assert_eq!(rm.triangles, vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]]);
+        assert_eq!(rm.quad_mode_triangles.len(), 3);
+        assert!(rm.vertices.iter().all(|v| (v.normal[2] - 1.0).abs() < 1e-6));
+    }
+
+    #[test]
+    fn out_of_range_index_is_an_error() {
+        let mesh = topology::ControlMesh::from_polygons(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[0u32, 1, 7]]);
+        let e = RenderMesh::from_control_mesh(&mesh).unwrap_err().to_string();
+        assert!(e.contains("face 0") && e.contains('7'), "{e}");
+    }
+}

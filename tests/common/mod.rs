@@ -1,0 +1,54 @@
+//! Shared GPU test harness: a device with the validation layer forced on, and a guard that
+//! fails the test on any error-severity validation message (checked when the guard drops, after
+//! every resource is gone, so leaks reported at device destruction count too).
+#![allow(dead_code)]
+use std::sync::Arc;
+use tessera::vk_core::{Device, DeviceDesc, Instance, InstanceDesc, Validation};
+
+pub struct Gpu {
+    pub device: Option<Device>,
+    pub instance: Arc<Instance>,
+}
+
+impl Gpu {
+    pub fn new() -> Gpu {
+        let _ = env_logger_init();
+        let instance = Instance::new(&InstanceDesc { app_name: "tessera-tests".into(), validation: Validation::On, surface_extensions: vec![] })
+            .expect("Vulkan instance (install mesa-vulkan-drivers and vulkan-validationlayers)");
+        assert_eq!(instance.validation(), Validation::On, "tests need VK_LAYER_KHRONOS_validation (package vulkan-validationlayers)");
+        let device = Device::new(&instance, &DeviceDesc::default(), &[]).expect("a Vulkan device with tessellation");
+        Gpu { device: Some(device), instance }
+    }
+
+    pub fn device(&self) -> &Device {
+        self.device.as_ref().expect("device alive")
+    }
+
+    pub fn errors(&self) -> Vec<String> {
+        self.instance.messages().error_messages()
+    }
+}
+
+impl Drop for Gpu {
+    fn drop(&mut self) {
+        if let Some(d) = self.device.take() {
+            let leaked = d.allocated_bytes();
+            drop(d);
+            if !std::thread::panicking() {
+                assert_eq!(leaked, 0, "gpu-allocator still holds {leaked} bytes at the end of the test");
+            }
+        }
+        let n = self.instance.messages().error_count();
+        if !std::thread::panicking() {
+            assert_eq!(n, 0, "validation errors: {:#?}", self.instance.messages().error_messages());
+        }
+    }
+}
+
+fn env_logger_init() -> Result<(), ()> {
+    Ok(())
+}
+
+pub fn data(path: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
+}
