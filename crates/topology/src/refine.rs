@@ -144,8 +144,11 @@ impl UniformRefinement {
     }
     /// Stencils of level `k` over the base (control) vertices; level 0 gives the identity.
     pub fn stencils(&self, k: usize) -> StencilTable {
-        let mut table = StencilTable::identity(self.levels[0].num_vertices());
-        for step in &self.steps[..k] {
+        if k == 0 {
+            return StencilTable::identity(self.levels[0].num_vertices());
+        }
+        let mut table = self.steps[0].clone();
+        for step in &self.steps[1..k] {
             table = step.compose(&table);
         }
         table
@@ -420,11 +423,13 @@ impl MaskContext<'_> {
     fn smooth_edge(&self, e: usize, scale: f64, out: &mut Vec<(u32, f64)>) {
         let p = &self.parent.topology;
         let [a, b] = p.edge_verts[e];
-        let faces: Vec<u32> = p.edge_faces[e]
-            .iter()
-            .copied()
-            .filter(|&f| f != INVALID)
-            .collect();
+        let [f0, f1] = p.edge_faces[e];
+        let face_pair = [f0, f1];
+        let faces: &[u32] = if f1 == INVALID {
+            &face_pair[..1]
+        } else {
+            &face_pair[..]
+        };
         match self.scheme {
             Scheme::Loop => {
                 let (vw, fw) = if faces.len() == 2 {
@@ -433,7 +438,7 @@ impl MaskContext<'_> {
                     (0.375, 0.25 / faces.len() as f64)
                 };
                 out.extend([(a, scale * vw), (b, scale * vw)]);
-                for &f in &faces {
+                for &f in faces {
                     if let Some(&o) = p
                         .face_vertices(f as usize)
                         .iter()
@@ -460,7 +465,7 @@ impl MaskContext<'_> {
                     (0.25, 0.5 / faces.len() as f64)
                 };
                 out.extend([(a, scale * vw), (b, scale * vw)]);
-                for &f in &faces {
+                for &f in faces {
                     self.face_center(f as usize, scale * fw, out);
                 }
             }
@@ -476,12 +481,13 @@ impl MaskContext<'_> {
         }
         let es = &self.parent.edge_sharpness;
         let pvs = self.parent.vertex_sharpness[v];
-        let parent_edges: Vec<f32> = edges.iter().map(|&e| es[e as usize]).collect();
-        let p_rule = vertex_rule(pvs, parent_edges.iter().filter(|&&s| is_sharp(s)).count());
+        let sharp_count = edges.iter().filter(|&&e| is_sharp(es[e as usize])).count();
+        let p_rule = vertex_rule(pvs, sharp_count);
         if matches!(p_rule, Rule::Smooth | Rule::Dart) {
             self.smooth_vertex(v, 1.0, out);
             return;
         }
+        let parent_edges: Vec<f32> = edges.iter().map(|&e| es[e as usize]).collect();
         let child_edges: Vec<f32> = edges
             .iter()
             .map(|&e| self.child_edge_sharpness[child_edge_at(p, e, v as u32) as usize])

@@ -12,7 +12,9 @@ pub enum Scheme {
     Loop,
     /// Catmull-Clark: any polygons, split into quads; bicubic B-spline on regular regions.
     CatmullClark,
-    /// Doo-Sabin: the dual quadratic scheme (one vertex per face corner).
+    /// Doo-Sabin: the dual quadratic scheme (one vertex per face corner). Sharpness tags are
+    /// ignored; boundary edges and boundary vertices get no new face, so the refined surface
+    /// pulls away from an open boundary instead of interpolating it.
     DooSabin,
     /// Bilinear: the same quad split as Catmull-Clark with linear interpolation.
     Bilinear,
