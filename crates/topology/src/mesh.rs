@@ -459,7 +459,8 @@ impl Topology {
     pub fn face_edge_list(&self, f: usize) -> &[u32] {
         &self.face_edges[self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize]
     }
-    /// The two end vertices of edge `e` (oriented as its first face traverses it).
+    /// The two end vertices of edge `e` (on a validated base mesh, in the direction its first
+    /// face traverses it; on refined levels, in no particular direction).
     pub fn edge_vertices(&self, e: usize) -> [u32; 2] {
         self.edge_verts[e]
     }

@@ -202,3 +202,54 @@ fn write_obj_round_trips() {
     assert_eq!(back.positions, m.positions);
     assert_eq!(back.face_vertices, m.face_vertices);
 }
+
+mod never_panics {
+    use proptest::prelude::*;
+    use topology::{parse_obj, refine_uniform, ControlMesh, Scheme};
+
+    fn line() -> impl Strategy<Value = String> {
+        prop_oneof![
+            (-3.0f64..3.0, -3.0f64..3.0, -3.0f64..3.0)
+                .prop_map(|(x, y, z)| format!("v {x} {y} {z}")),
+            prop::collection::vec(-8i64..9, 0..6).prop_map(|ix| {
+                let s: Vec<String> = ix.iter().map(|i| i.to_string()).collect();
+                format!("f {}", s.join(" "))
+            }),
+            (0i64..8, 0i64..8, -1.0f32..12.0)
+                .prop_map(|(a, b, s)| format!("t crease 2/1/0 {a} {b} {s}")),
+            (0i64..8, -1.0f32..12.0).prop_map(|(a, s)| format!("t corner 1/1/0 {a} {s}")),
+            "[ -~]{0,20}",
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+        /// Arbitrary OBJ-like text: parse either succeeds or returns an error, and whatever
+        /// parses also refines without panicking.
+        #[test]
+        fn parse_and_refine_never_panic(lines in prop::collection::vec(line(), 0..24)) {
+            let text = lines.join("\n");
+            if let Ok(mesh) = parse_obj(&text, "fuzz.obj") {
+                for scheme in [Scheme::CatmullClark, Scheme::Loop, Scheme::Bilinear, Scheme::DooSabin] {
+                    let _ = refine_uniform(&mesh, scheme, 2);
+                }
+            }
+        }
+
+        /// Random polygon soups built in memory (bypassing the parser) are validated, not trusted.
+        #[test]
+        fn random_polygon_soups_never_panic(
+            n in 0usize..8,
+            faces in prop::collection::vec(prop::collection::vec(0u32..10, 0..6), 0..8),
+        ) {
+            let positions = (0..n).map(|i| [i as f64, (i * i) as f64, 1.0]).collect();
+            let mesh = ControlMesh::from_polygons(positions, &faces);
+            if mesh.validate().is_ok() {
+                for scheme in [Scheme::CatmullClark, Scheme::Loop, Scheme::DooSabin] {
+                    let _ = refine_uniform(&mesh, scheme, 2);
+                }
+            }
+        }
+    }
+}
