@@ -84,7 +84,11 @@ struct Dual {
 
 impl Dual {
     fn c(v: f64) -> Dual {
-        Dual { v, du: 0.0, dv: 0.0 }
+        Dual {
+            v,
+            du: 0.0,
+            dv: 0.0,
+        }
     }
     fn pow(self, n: u32) -> Dual {
         let mut r = Dual::c(1.0);
@@ -131,8 +135,16 @@ impl std::ops::Mul<Dual> for f64 {
 /// Quartic box-spline weights of the regular Loop patch at `(u, v)` (domain in the module docs).
 pub fn loop_regular_weights(u: f64, v: f64) -> PatchWeights<12> {
     // Barycentrics: s for v0, a for v1 (= u), b for v2 (= v).
-    let a = Dual { v: u, du: 1.0, dv: 0.0 };
-    let b = Dual { v, du: 0.0, dv: 1.0 };
+    let a = Dual {
+        v: u,
+        du: 1.0,
+        dv: 0.0,
+    };
+    let b = Dual {
+        v,
+        du: 0.0,
+        dv: 1.0,
+    };
     let s = Dual {
         v: 1.0 - u - v,
         du: -1.0,
