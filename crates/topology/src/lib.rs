@@ -2,8 +2,11 @@
 #![forbid(unsafe_code)]
 
 pub mod error;
+pub mod eval;
+pub mod limit;
 pub mod mesh;
 pub mod obj;
+pub mod patch;
 pub mod refine;
 pub mod sdc;
 pub mod stencil;
