@@ -1,3 +1,19 @@
-//! The tessera binary.
+//! `tessera`: render, view and inspect subdivision surfaces drawn on the tessellation stage.
 #![forbid(unsafe_code)]
-fn main() {}
+mod cli;
+mod commands;
+mod view;
+
+use clap::Parser;
+
+fn main() -> std::process::ExitCode {
+    let args = cli::Cli::parse();
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(if args.verbose { "info" } else { "warn" })).init();
+    match commands::run(args) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,107 @@
+//! Command-line definition.
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+use tess::{Method, Spacing};
+
+#[derive(Parser, Debug)]
+#[command(name = "tessera", version, about = "Subdivision surfaces on the GPU tessellation stage (Vulkan)")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+    /// Log more (info level); RUST_LOG overrides.
+    #[arg(long, short, global = true)]
+    pub verbose: bool,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render a mesh (the embedded spot control mesh by default) to a PNG.
+    Render(RenderArgs),
+    /// Open a window: drag to orbit, wheel to zoom, 1/2/3 method, +/- level, W wireframe.
+    View(ViewArgs),
+    /// List Vulkan devices, their tessellation features and limits, and which would be chosen.
+    Info(GpuArgs),
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct GpuArgs {
+    /// Device to use: an index from `tessera info` or a name substring.
+    #[arg(long, default_value = "auto")]
+    pub device: String,
+    /// Enable the Vulkan validation layer (always on in debug builds).
+    #[arg(long)]
+    pub validation: bool,
+    /// Also run synchronization validation.
+    #[arg(long)]
+    pub sync_validation: bool,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct SceneArgs {
+    /// OBJ control mesh; the embedded spot control mesh when absent.
+    pub mesh: Option<PathBuf>,
+    #[arg(long, default_value = "flat", value_parser = parse_method)]
+    pub method: Method,
+    /// Tessellation level (outer and inner), 1 to 64.
+    #[arg(long, default_value_t = 8.0)]
+    pub level: f32,
+    #[arg(long, default_value = "equal", value_parser = parse_spacing)]
+    pub spacing: Spacing,
+    /// Draw the tessellated wireframe over the shaded surface.
+    #[arg(long)]
+    pub wireframe: bool,
+    #[arg(long, default_value_t = 35.0, allow_hyphen_values = true)]
+    pub yaw: f32,
+    #[arg(long, default_value_t = 20.0, allow_hyphen_values = true)]
+    pub pitch: f32,
+    #[arg(long, default_value_t = 1.0)]
+    pub zoom: f32,
+    /// Phong tessellation shape factor α.
+    #[arg(long, default_value_t = 0.75)]
+    pub alpha: f32,
+    #[command(flatten)]
+    pub gpu: GpuArgs,
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "800x600", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Output PNG.
+    #[arg(short, long, default_value = "tessera.png")]
+    pub output: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct ViewArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[arg(long, default_value = "1024x768", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Render this many frames, then exit (with --screenshot: save the last one).
+    #[arg(long)]
+    pub frames: Option<u32>,
+    /// PNG to save the last frame to (needs --frames).
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+}
+
+fn parse_method(s: &str) -> Result<Method, String> {
+    s.parse()
+}
+fn parse_spacing(s: &str) -> Result<Spacing, String> {
+    s.parse()
+}
+
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("size '{s}' is not WIDTHxHEIGHT"))?;
+    let w: u32 = w.trim().parse().map_err(|_| format!("bad width in '{s}'"))?;
+    let h: u32 = h.trim().parse().map_err(|_| format!("bad height in '{s}'"))?;
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(format!("size '{s}' must be between 1x1 and 16384x16384"));
+    }
+    Ok((w, h))
+}
