@@ -317,7 +317,8 @@ impl LocalMesh {
         Ok(())
     }
 
-    fn is_boundary_edge(&self, a: u32, b: u32) -> bool {
+    /// True if edge `a–b` has a face on one side only.
+    pub fn is_boundary_edge(&self, a: u32, b: u32) -> bool {
         !(self.halfedges.contains_key(&(a, b)) && self.halfedges.contains_key(&(b, a)))
     }
 
@@ -569,8 +570,8 @@ impl LocalMesh {
             }
         }
         let mut vs = vec![0.0f32; n_child];
-        for v in 0..nv {
-            vs[v] = decrement(self.vertex_sharpness[v]);
+        for (c, &p) in vs.iter_mut().zip(&self.vertex_sharpness) {
+            *c = decrement(p);
         }
         LocalMesh::new(
             self.scheme,
@@ -795,34 +796,50 @@ impl LocalMesh {
         out
     }
 
-    /// Limit at corner `c` of face `f`: position and parametric-direction tangents.
+    /// Limit at corner `c` of face `f`: position and the face-relative tangents. `D(k)` is the
+    /// limit tangent toward ring neighbour `k` (smooth: rotated cos masks, exact at regular
+    /// vertices; crease: `cos θ·T_along + sin θ·T_across` with `θ` spread over the sector;
+    /// corner: `e_k − v`); `du`, `dv` are the combinations a regular patch would give, so
+    /// `du × dv` is the outward normal and mirrored faces see swapped `du`/`dv`.
     fn corner_limit(&self, f: usize, c: usize) -> Option<LimitSample> {
         let fv = self.face(f);
         let v = fv[c];
         let (p, t1, t2) = self.vertex_limit(v, Some(f as u32))?;
         let lv = self.limit_vertex(v, Some(f as u32))?;
-        if lv.rule != LimitRule::Smooth {
-            return Some(LimitSample {
-                position: p,
-                du: t1,
-                dv: t2,
-            });
-        }
         let fan = &self.fans[v as usize];
         let n = fan.ring.len();
         let j = fan.faces.iter().position(|&(g, _)| g == f as u32)?;
+        let dir = |k: usize| -> Vec<f64> {
+            match lv.rule {
+                LimitRule::Smooth => self.directional(v, k % n),
+                LimitRule::Crease { ends } => {
+                    let m = ((ends[1] + n - ends[0]) % n).max(1);
+                    let th = std::f64::consts::PI * ((k + n - ends[0]) % n) as f64 / m as f64;
+                    t1.iter()
+                        .zip(&t2)
+                        .map(|(a, b)| th.cos() * a + th.sin() * b)
+                        .collect()
+                }
+                LimitRule::Corner => self
+                    .point(fan.ring[k % n])
+                    .iter()
+                    .zip(self.point(v))
+                    .map(|(a, b)| a - b)
+                    .collect(),
+            }
+        };
         // Tangents toward the next and previous face vertices.
-        let dn = self.directional(v, j);
-        let dp = self.directional(v, (j + 1) % n);
+        let dn = dir(j);
+        let dp = dir(j + 1);
         let neg = |x: &[f64]| x.iter().map(|a| -a).collect::<Vec<f64>>();
         let sub = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a - b).collect::<Vec<f64>>();
         let (du, dv) = if fv.len() == 3 {
             // D(next), D(prev) at v0: (du, dv); at v1: D(v2)=dv−du, D(v0)=−du;
-            // at v2: D(v0)=−dv, D(v1)=du−dv.
+            // at v2: D(v0)=−dv, D(v1)=du−dv, so du = D(v1) − D(v0).
             match c {
                 0 => (dn, dp),
                 1 => (neg(&dp), sub(&dn, &dp)),
-                _ => (sub(&dn, &dp), neg(&dn)),
+                _ => (sub(&dp, &dn), neg(&dn)),
             }
         } else {
             match c {
@@ -991,10 +1008,10 @@ impl LocalMesh {
         for (c, &s) in corner_slots.iter().enumerate() {
             net[s] = Some(self.point(fv[c]).to_vec());
         }
-        for c in 0..fv.len() {
+        for (c, slots) in ring_slots.iter().enumerate().take(fv.len()) {
             let seq = self.regular_corner_ring(f, c)?;
             for (k, p) in seq.into_iter().enumerate() {
-                let s = ring_slots[c][k];
+                let s = slots[k];
                 if net[s].is_none() {
                     net[s] = Some(p);
                 }
@@ -1069,13 +1086,7 @@ impl LocalMesh {
             };
             if let Some(c) = corners.iter().position(|&(a, b)| a == u && b == v) {
                 if let Some(s) = mesh.corner_limit(0, c) {
-                    if mesh.limit_vertex(mesh.face(0)[c], Some(0)).map(|l| l.rule)
-                        == Some(LimitRule::Smooth)
-                    {
-                        return Ok(chain(s.position, s.du, s.dv, &jac));
-                    }
-                    // Mask tangents at features are not parametric: no chain rule.
-                    return Ok(s);
+                    return Ok(chain(s.position, s.du, s.dv, &jac));
                 }
             }
             let child = mesh.refine()?;

@@ -240,10 +240,10 @@ pub fn loop_regular_weights(u: f64, v: f64) -> PatchWeights<12> {
         du: [0.0; 12],
         dv: [0.0; 12],
     };
-    for i in 0..12 {
-        out.point[i] = w[i].v / 12.0;
-        out.du[i] = w[i].du / 12.0;
-        out.dv[i] = w[i].dv / 12.0;
+    for (i, wi) in w.iter().enumerate() {
+        out.point[i] = wi.v / 12.0;
+        out.du[i] = wi.du / 12.0;
+        out.dv[i] = wi.dv / 12.0;
     }
     out
 }

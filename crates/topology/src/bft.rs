@@ -1,0 +1,775 @@
+//! Basis-function tables (BFT) for Loop surfaces (Holländer & Boubekeur, section II).
+//!
+//! After one Loop step every triangle has at most one extraordinary vertex. For each valence
+//! `n` and configuration case a table gives, at every dyadic point `(i, j)` of the triangle at
+//! a maximum level `L` (`N = 2^L` segments per edge), the exact limit weights (position and the
+//! parametric derivatives `du`, `dv`) over the face's ordered control points.
+//!
+//! # Supported cases ([`BftCase`])
+//! * `Interior`: all three corners interior; `v0` has valence `n ≥ 3`, `v1`, `v2` valence 6.
+//!   `n + 6` control points. `n = 6` is the regular patch.
+//! * `Boundary { fan_position: k }`: `v0` is a boundary vertex with `n ≥ 2` edges (`n − 1`
+//!   faces) and the face is face `k` of its fan (CCW from the first boundary edge); `v1`, `v2`
+//!   are regular (valence 6 interior, or valence 4 on the boundary where the fan edge is a
+//!   boundary edge). `n = 4` covers every face that touches the boundary without an
+//!   extraordinary vertex. This is every face of a once-refined Loop mesh with "edges only"
+//!   boundaries, no creases, and corners of one face (`n = 2`) included.
+//!
+//! Not tabulated (use [`crate::eval`]): infinitely sharp or semi-sharp creases, "edges and
+//! corners" corner vertices, faces with two extraordinary vertices.
+//!
+//! # Control-point ordering (the shader mirrors this through [`face_control_ring`])
+//! `v0` (the extraordinary vertex, else a boundary vertex, else corner 0), `v1`, `v2` in the
+//! face's CCW order, then the one-ring of `v0` CCW starting at `v1`, the one-ring of `v1` CCW
+//! starting at `v2`, the one-ring of `v2` CCW starting at `v0`, each vertex kept at its first
+//! occurrence. Boundary fans are walked cyclically (past the gap).
+//!
+//! # Dyadic index mapping
+//! Point `(i, j)` (`u = i/N`, `v = j/N`, `i + j ≤ N`) → row `row_map[i·(N+1) + j]` of the
+//! table's row map ([`BasisTables::row_map_full`] or, for half tables,
+//! [`BasisTables::row_map_half`], which stores only `i ≥ j`).
+//!
+//! # Mirror symmetry (≈ half the memory)
+//! The reflection through `v0`'s bisector swaps `v1 ↔ v2` and `u ↔ v`. Interior tables and the
+//! middle boundary fan position are self-symmetric: only rows `i ≥ j` are stored. Boundary
+//! position `k` and `n − 2 − k` are mirror images: only `k ≤ n − 2 − k` is stored. A lookup is
+//! *flipped* when exactly one of "the case is stored as its mirror" and "`i < j` in a half
+//! table" holds; a flipped lookup reads row `(j, i)`, weight of face slot `s` at table slot
+//! `perm[s]`, and swaps `du` with `dv`.
+//!
+//! # Bit-identical shared edges
+//! A point on an edge (or at a vertex) is never computed from the current face's table: every
+//! face edge and corner names an *owner* (the face with the smallest index among the faces
+//! that contain it, see [`PatchRecord`]); both neighbours evaluate the owner's row with the
+//! owner's control points, summed in the owner's slot order ([`shader_eval`]). The owner's
+//! edge rows are nonzero only on control points both faces share (exact zeros are stored as
+//! 0.0), so the two invocations perform the same f32 operations on the same operands.
+
+use std::collections::HashMap;
+
+use crate::eval::{EvalError, LimitScheme, LocalMesh};
+use crate::mesh::{BoundaryInterpolation, CreaseMethod};
+
+/// Configuration of a face around its (possibly) extraordinary vertex `v0`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum BftCase {
+    Interior,
+    Boundary { fan_position: u32 },
+}
+
+/// Table key: valence of `v0` (edge count) and case.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct BftKey {
+    pub valence: u32,
+    pub case: BftCase,
+}
+
+impl BftKey {
+    /// The stored table serving this key, and whether the key is that table's mirror image.
+    pub fn canonical(self) -> (BftKey, bool) {
+        match self.case {
+            BftCase::Interior => (self, false),
+            BftCase::Boundary { fan_position: k } => {
+                let m = self.valence.saturating_sub(2).saturating_sub(k);
+                if k <= m {
+                    (self, false)
+                } else {
+                    (
+                        BftKey {
+                            valence: self.valence,
+                            case: BftCase::Boundary { fan_position: m },
+                        },
+                        true,
+                    )
+                }
+            }
+        }
+    }
+
+    fn self_symmetric(self) -> bool {
+        match self.case {
+            BftCase::Interior => true,
+            BftCase::Boundary { fan_position: k } => 2 * k + 2 == self.valence,
+        }
+    }
+
+    fn valid(self) -> bool {
+        match self.case {
+            BftCase::Interior => self.valence >= 3,
+            BftCase::Boundary { fan_position } => {
+                self.valence >= 2 && fan_position + 2 <= self.valence
+            }
+        }
+    }
+}
+
+/// Radius (in lattice rings) of the configuration meshes: 2 covers the face's one-ring.
+const RADIUS: u32 = 2;
+
+/// Configuration mesh of a key: `v0` at the centre of `n` (interior) or `n − 1` (boundary)
+/// regular lattice sectors. Points are 2D lattice positions lifted to `z = 0` when
+/// `identity` is false, else unit vectors (one basis function per vertex). Returns the mesh
+/// and the face index.
+pub fn configuration_mesh(key: BftKey, identity: bool) -> Result<(LocalMesh, usize), EvalError> {
+    if !key.valid() {
+        return Err(EvalError::Unsupported(format!("no BFT case {key:?}")));
+    }
+    let n = key.valence;
+    let boundary = matches!(key.case, BftCase::Boundary { .. });
+    let sectors = if boundary { n - 1 } else { n };
+    let r = RADIUS;
+    // Vertex ids: centre 0; per sector the points (i ≥ 1, j ≥ 0, i + j ≤ R); a boundary fan has
+    // one more closing ray (the last sector's (0, j)).
+    let per: Vec<(u32, u32)> = (1..=r)
+        .flat_map(|i| (0..=r - i).map(move |j| (i, j)))
+        .collect();
+    let index: HashMap<(u32, u32), u32> = per
+        .iter()
+        .enumerate()
+        .map(|(k, &p)| (p, k as u32))
+        .collect();
+    let closing = sectors * per.len() as u32 + 1;
+    let id = |s: u32, i: u32, j: u32| -> u32 {
+        if i == 0 && j == 0 {
+            0
+        } else if i == 0 {
+            if s + 1 == sectors && boundary {
+                closing + j - 1
+            } else {
+                1 + ((s + 1) % sectors) * per.len() as u32 + index[&(j, 0)]
+            }
+        } else {
+            1 + s * per.len() as u32 + index[&(i, j)]
+        }
+    };
+    let nv = (closing + if boundary { r } else { 0 }) as usize;
+    let mut fo = vec![0u32];
+    let mut fv = Vec::new();
+    let mut face = 0;
+    for s in 0..sectors {
+        for i in 0..r {
+            for j in 0..r - i {
+                if s == match key.case {
+                    BftCase::Boundary { fan_position } => fan_position,
+                    BftCase::Interior => 0,
+                } && i == 0
+                    && j == 0
+                {
+                    face = fo.len() - 1;
+                }
+                fv.extend_from_slice(&[id(s, i, j), id(s, i + 1, j), id(s, i, j + 1)]);
+                fo.push(fv.len() as u32);
+                if i + j + 2 <= r {
+                    fv.extend_from_slice(&[id(s, i + 1, j), id(s, i + 1, j + 1), id(s, i, j + 1)]);
+                    fo.push(fv.len() as u32);
+                }
+            }
+        }
+    }
+    let (dim, points) = if identity {
+        let mut p = vec![0.0; nv * nv];
+        for v in 0..nv {
+            p[v * nv + v] = 1.0;
+        }
+        (nv, p)
+    } else {
+        // A planar fan: sector s spans angles [s, s+1]·span (boundary fans cover a half-plane).
+        let span = if boundary {
+            std::f64::consts::PI / sectors as f64
+        } else {
+            2.0 * std::f64::consts::PI / sectors as f64
+        };
+        let mut p = vec![0.0; nv * 3];
+        for s in 0..sectors {
+            let (a0, a1) = (s as f64 * span, (s + 1) as f64 * span);
+            for i in 0..=r {
+                for j in 0..=r - i {
+                    let v = id(s, i, j) as usize;
+                    p[v * 3] = i as f64 * a0.cos() + j as f64 * a1.cos();
+                    p[v * 3 + 1] = i as f64 * a0.sin() + j as f64 * a1.sin();
+                }
+            }
+        }
+        (3, p)
+    };
+    let mesh = LocalMesh::new(
+        LimitScheme::Loop,
+        dim,
+        points,
+        fo,
+        fv,
+        HashMap::new(),
+        vec![0.0; nv],
+        BoundaryInterpolation::EdgesOnly,
+        CreaseMethod::Uniform,
+    )?;
+    Ok((mesh, face))
+}
+
+fn ring_from(mesh: &LocalMesh, v: u32, start: u32) -> Vec<u32> {
+    let ring = mesh.vertex_ring(v);
+    let k = ring.iter().position(|&x| x == start).unwrap_or(0);
+    ring[k..].iter().chain(&ring[..k]).copied().collect()
+}
+
+/// Ordered control points of triangle `face` with corner `first` as `v0` (see module docs).
+pub fn face_control_ring(mesh: &LocalMesh, face: usize, first: usize) -> Vec<u32> {
+    let f = mesh.face(face);
+    let (v0, v1, v2) = (f[first % 3], f[(first + 1) % 3], f[(first + 2) % 3]);
+    let mut out = vec![v0, v1, v2];
+    for (c, s) in [(v0, v1), (v1, v2), (v2, v0)] {
+        for x in ring_from(mesh, c, s) {
+            if !out.contains(&x) {
+                out.push(x);
+            }
+        }
+    }
+    out
+}
+
+/// (valence, boundary, fan position if boundary) of each corner starting at `first`.
+fn corner_signature(mesh: &LocalMesh, face: usize, first: usize) -> [(usize, bool, usize); 3] {
+    let f = mesh.face(face);
+    let mut out = [(0, false, 0); 3];
+    for (k, o) in out.iter_mut().enumerate() {
+        let v = f[(first + k) % 3];
+        let b = mesh.is_boundary_vertex(v);
+        let pos = if b {
+            mesh.vertex_faces(v)
+                .position(|g| g == face as u32)
+                .unwrap_or(0)
+        } else {
+            0
+        };
+        *o = (mesh.vertex_ring(v).len(), b, pos);
+    }
+    out
+}
+
+/// The BFT case of a triangle of a Loop mesh and the corner to use as `v0`, or `None` when the
+/// face is not covered by a table (see the module docs).
+pub fn classify_face(mesh: &LocalMesh, face: usize) -> Option<(BftKey, usize)> {
+    let f = mesh.face(face);
+    if f.len() != 3 || mesh.scheme != LimitScheme::Loop {
+        return None;
+    }
+    for &v in f {
+        if mesh.vert_sharp(v) > 0.0 {
+            return None;
+        }
+        for &w in mesh.vertex_ring(v) {
+            let s = mesh.edge_sharp(v, w);
+            if s > 0.0 && !mesh.is_boundary_edge(v, w) {
+                return None;
+            }
+        }
+    }
+    let sig = corner_signature(mesh, face, 0);
+    let irregular: Vec<usize> = (0..3)
+        .filter(|&k| {
+            let (n, b, _) = sig[k];
+            (b && n != 4) || (!b && n != 6)
+        })
+        .collect();
+    if irregular.len() > 1 {
+        return None;
+    }
+    let mut candidates: Vec<usize> = irregular.clone();
+    if candidates.is_empty() {
+        candidates = (0..3).filter(|&k| sig[k].1).collect();
+        if candidates.is_empty() {
+            candidates.push(0);
+        }
+    }
+    for c in candidates {
+        let s = corner_signature(mesh, face, c);
+        let key = BftKey {
+            valence: s[0].0 as u32,
+            case: if s[0].1 {
+                BftCase::Boundary {
+                    fan_position: s[0].2 as u32,
+                }
+            } else {
+                BftCase::Interior
+            },
+        };
+        let Ok((cfg, cf)) = configuration_mesh(key, false) else {
+            continue;
+        };
+        let cs = corner_signature(&cfg, cf, 0);
+        let same = (0..3)
+            .all(|k| s[k].0 == cs[k].0 && s[k].1 == cs[k].1 && (!s[k].1 || s[k].2 == cs[k].2));
+        if same && face_control_ring(mesh, face, c).len() == face_control_ring(&cfg, cf, 0).len() {
+            return Some((key, c));
+        }
+    }
+    None
+}
+
+/// One stored table.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BftEntry {
+    pub key: BftKey,
+    /// Number of control points (row stride).
+    pub ring_size: u32,
+    /// Rows `i ≥ j` only (use [`BasisTables::row_map_half`]).
+    pub half: bool,
+    pub rows: u32,
+    /// Offsets (in f32 units) into [`BasisTables::weights`] of the position, `du` and `dv`
+    /// blocks; row `r`, slot `s` is at `offset + r·ring_size + s`.
+    pub offset_position: u32,
+    pub offset_du: u32,
+    pub offset_dv: u32,
+    /// Offset into [`BasisTables::mirror_perm`] of this table's `ring_size` slot permutation.
+    pub offset_perm: u32,
+}
+
+/// GPU-ready flattened tables at one maximum level.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BasisTables {
+    pub level: u32,
+    pub weights: Vec<f32>,
+    pub mirror_perm: Vec<u32>,
+    pub entries: Vec<BftEntry>,
+    /// `(N+1)²` entries, `i·(N+1) + j` → row, `u32::MAX` outside the triangle.
+    pub row_map_full: Vec<u32>,
+    /// Same for half tables (`i ≥ j` only; `u32::MAX` elsewhere).
+    pub row_map_half: Vec<u32>,
+}
+
+/// Weights of one dyadic point over the face's slots.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RowWeights {
+    pub position: Vec<f32>,
+    pub du: Vec<f32>,
+    pub dv: Vec<f32>,
+}
+
+fn row_maps(level: u32) -> (Vec<u32>, Vec<u32>) {
+    let n = 1u32 << level;
+    let w = (n + 1) as usize;
+    let mut full = vec![u32::MAX; w * w];
+    let mut half = vec![u32::MAX; w * w];
+    let (mut rf, mut rh) = (0u32, 0u32);
+    for j in 0..=n {
+        for i in 0..=n - j {
+            full[i as usize * w + j as usize] = rf;
+            rf += 1;
+            if i >= j {
+                half[i as usize * w + j as usize] = rh;
+                rh += 1;
+            }
+        }
+    }
+    (full, half)
+}
+
+/// Per row: (position, du, dv) weights over the slots.
+type Rows = Vec<[Vec<f64>; 3]>;
+
+/// Exact limit weights of one stored table, in f64, and its mirror permutation.
+fn table_rows(key: BftKey, level: u32, half: bool) -> Result<(Rows, Vec<u32>), EvalError> {
+    let (mesh, face) = configuration_mesh(key, true)?;
+    let ring = face_control_ring(&mesh, face, 0);
+    // Mirror permutation: the reflected configuration's ring order → this table's slots.
+    let mut fo = vec![0u32];
+    let mut fvs = Vec::new();
+    for f in 0..mesh.num_faces() {
+        let fv = mesh.face(f);
+        fvs.extend_from_slice(&[fv[0], fv[2], fv[1]]);
+        fo.push(fvs.len() as u32);
+    }
+    let nv = mesh.num_vertices();
+    let reflected = LocalMesh::new(
+        LimitScheme::Loop,
+        1,
+        vec![0.0; nv],
+        fo,
+        fvs,
+        HashMap::new(),
+        vec![0.0; nv],
+        BoundaryInterpolation::EdgesOnly,
+        CreaseMethod::Uniform,
+    )?;
+    let rring = face_control_ring(&reflected, face, 0);
+    let perm: Vec<u32> = rring
+        .iter()
+        .map(|x| ring.iter().position(|y| y == x).unwrap_or(0) as u32)
+        .collect();
+    let n = 1u32 << level;
+    let mut rows = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n - j {
+            if half && i < j {
+                continue;
+            }
+            let s = mesh.evaluate(face, i as f64 / n as f64, j as f64 / n as f64)?;
+            let pick = |x: &[f64]| -> Vec<f64> {
+                ring.iter()
+                    .map(|&v| {
+                        let w = x[v as usize];
+                        if w.abs() < 1e-13 {
+                            0.0
+                        } else {
+                            w
+                        }
+                    })
+                    .collect()
+            };
+            rows.push([pick(&s.position), pick(&s.du), pick(&s.dv)]);
+        }
+    }
+    Ok((rows, perm))
+}
+
+impl BasisTables {
+    /// Build the tables serving `keys` at maximum level `level` (1–6).
+    pub fn build(keys: &[BftKey], level: u32) -> Result<BasisTables, EvalError> {
+        if !(1..=6).contains(&level) {
+            return Err(EvalError::Unsupported(format!(
+                "BFT level {level} not in 1..=6"
+            )));
+        }
+        let mut stored: Vec<BftKey> = keys.iter().map(|k| k.canonical().0).collect();
+        stored.sort();
+        stored.dedup();
+        let (row_map_full, row_map_half) = row_maps(level);
+        let mut t = BasisTables {
+            level,
+            weights: Vec::new(),
+            mirror_perm: Vec::new(),
+            entries: Vec::new(),
+            row_map_full,
+            row_map_half,
+        };
+        for key in stored {
+            let half = key.self_symmetric();
+            let (rows, perm) = table_rows(key, level, half)?;
+            let ring_size = perm.len() as u32;
+            let mut offs = [0u32; 3];
+            for (b, off) in offs.iter_mut().enumerate() {
+                *off = t.weights.len() as u32;
+                for r in &rows {
+                    t.weights.extend(r[b].iter().map(|&w| w as f32));
+                }
+            }
+            t.entries.push(BftEntry {
+                key,
+                ring_size,
+                half,
+                rows: rows.len() as u32,
+                offset_position: offs[0],
+                offset_du: offs[1],
+                offset_dv: offs[2],
+                offset_perm: t.mirror_perm.len() as u32,
+            });
+            t.mirror_perm.extend_from_slice(&perm);
+        }
+        Ok(t)
+    }
+
+    /// Tables for interior valences `valences` and, if `boundary`, every boundary fan position
+    /// of boundary valences `2..=max(valences)`.
+    pub fn build_for_valences(
+        valences: std::ops::RangeInclusive<u32>,
+        boundary: bool,
+        level: u32,
+    ) -> Result<BasisTables, EvalError> {
+        let mut keys: Vec<BftKey> = valences
+            .clone()
+            .filter(|&n| n >= 3)
+            .map(|n| BftKey {
+                valence: n,
+                case: BftCase::Interior,
+            })
+            .collect();
+        if boundary {
+            for n in 2..=*valences.end() {
+                for k in 0..n - 1 {
+                    keys.push(BftKey {
+                        valence: n,
+                        case: BftCase::Boundary { fan_position: k },
+                    });
+                }
+            }
+        }
+        BasisTables::build(&keys, level)
+    }
+
+    /// Segments per edge at the maximum level.
+    pub fn segments(&self) -> u32 {
+        1 << self.level
+    }
+
+    /// Bytes the GPU needs: weights, permutations, row maps and 8 u32 per entry.
+    pub fn memory_bytes(&self) -> usize {
+        4 * (self.weights.len()
+            + self.mirror_perm.len()
+            + self.row_map_full.len()
+            + self.row_map_half.len()
+            + 8 * self.entries.len())
+    }
+
+    /// Entry index serving `key`, and whether the lookup is mirrored.
+    pub fn lookup(&self, key: BftKey) -> Option<(usize, bool)> {
+        let (canon, mirrored) = key.canonical();
+        self.entries
+            .iter()
+            .position(|e| e.key == canon)
+            .map(|i| (i, mirrored))
+    }
+
+    /// Weights of dyadic point `(i, j)` over the face's slots (face ring order), exactly as a
+    /// shader reads them.
+    pub fn row(&self, key: BftKey, i: u32, j: u32) -> Option<RowWeights> {
+        let (e, mirrored) = self.lookup(key)?;
+        let e = &self.entries[e];
+        let n = self.segments();
+        if i + j > n {
+            return None;
+        }
+        let (mut a, mut b, mut flip) = if mirrored {
+            (j, i, true)
+        } else {
+            (i, j, false)
+        };
+        if e.half && a < b {
+            std::mem::swap(&mut a, &mut b);
+            flip = !flip;
+        }
+        let map = if e.half {
+            &self.row_map_half
+        } else {
+            &self.row_map_full
+        };
+        let r = map[(a * (n + 1) + b) as usize];
+        let rs = e.ring_size as usize;
+        let slot = |s: usize| {
+            if flip {
+                self.mirror_perm[e.offset_perm as usize + s] as usize
+            } else {
+                s
+            }
+        };
+        let read = |off: u32| -> Vec<f32> {
+            (0..rs)
+                .map(|s| self.weights[off as usize + r as usize * rs + slot(s)])
+                .collect()
+        };
+        let (du, dv) = if flip {
+            (read(e.offset_dv), read(e.offset_du))
+        } else {
+            (read(e.offset_du), read(e.offset_dv))
+        };
+        Some(RowWeights {
+            position: read(e.offset_position),
+            du,
+            dv,
+        })
+    }
+}
+
+/// Bytes [`BasisTables::build`] would use for `keys` at `level` (computed from the table
+/// shapes without evaluating anything); with `mirror = false`, the size without the mirror
+/// savings (every key stored with all rows), for comparison.
+pub fn memory_for(keys: &[BftKey], level: u32, mirror: bool) -> Result<usize, EvalError> {
+    let mut stored: Vec<(BftKey, bool)> = keys
+        .iter()
+        .map(|k| {
+            if mirror {
+                (k.canonical().0, k.canonical().0.self_symmetric())
+            } else {
+                (*k, false)
+            }
+        })
+        .collect();
+    stored.sort();
+    stored.dedup();
+    let n = 1usize << level;
+    let full = (n + 1) * (n + 2) / 2;
+    let half = (n / 2 + 1) * (n / 2 + 1);
+    let maps = 2 * (n + 1) * (n + 1);
+    let mut words = maps;
+    for (k, h) in stored {
+        let (m, f) = configuration_mesh(k, false)?;
+        let ring = face_control_ring(&m, f, 0).len();
+        let rows = if h { half } else { full };
+        words += 3 * rows * ring + ring + 8;
+    }
+    Ok(4 * words)
+}
+
+/// On-demand tables: built for the valences/cases a mesh actually uses.
+#[derive(Clone, Debug)]
+pub struct BftCache {
+    pub level: u32,
+    tables: Option<BasisTables>,
+    keys: Vec<BftKey>,
+}
+
+impl BftCache {
+    pub fn new(level: u32) -> BftCache {
+        BftCache {
+            level,
+            tables: None,
+            keys: Vec::new(),
+        }
+    }
+
+    /// Tables covering `keys` (rebuilt only when a new key appears).
+    pub fn tables_for(&mut self, keys: &[BftKey]) -> Result<&BasisTables, EvalError> {
+        let mut changed = self.tables.is_none();
+        for k in keys {
+            let c = k.canonical().0;
+            if !self.keys.contains(&c) {
+                self.keys.push(c);
+                changed = true;
+            }
+        }
+        if changed {
+            self.tables = Some(BasisTables::build(&self.keys, self.level)?);
+        }
+        self.tables
+            .as_ref()
+            .ok_or_else(|| EvalError::Unsupported("no tables".into()))
+    }
+}
+
+/// What the GPU needs per face of the once-refined mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PatchRecord {
+    pub key: BftKey,
+    /// Global vertex indices in slot order ([`face_control_ring`]).
+    pub ring: Vec<u32>,
+    /// Global index of the face's `v0`, `v1`, `v2` (rotated order).
+    pub corners: [u32; 3],
+    /// For local edge `e` (0: v0→v1 where `j = 0`; 1: v1→v2 where `i + j = N`; 2: v2→v0 where
+    /// `i = 0`): the owner face and the edge's index in the owner.
+    pub edge_owner: [(u32, u8); 3],
+    /// For local corner `c`: the owner face and the corner's index in the owner.
+    pub corner_owner: [(u32, u8); 3],
+}
+
+/// Patch records of every face of a Loop mesh (typically level 1), or the first face not
+/// covered by the tables.
+pub fn build_patch_records(mesh: &LocalMesh) -> Result<Vec<PatchRecord>, EvalError> {
+    let nf = mesh.num_faces();
+    let mut recs = Vec::with_capacity(nf);
+    for f in 0..nf {
+        let (key, first) = classify_face(mesh, f).ok_or_else(|| {
+            EvalError::Unsupported(format!("face {f} is not covered by a basis-function table"))
+        })?;
+        let fv = mesh.face(f);
+        let corners = [fv[first], fv[(first + 1) % 3], fv[(first + 2) % 3]];
+        recs.push(PatchRecord {
+            key,
+            ring: face_control_ring(mesh, f, first),
+            corners,
+            edge_owner: [(0, 0); 3],
+            corner_owner: [(0, 0); 3],
+        });
+    }
+    let mut edge_faces: HashMap<(u32, u32), Vec<(u32, u8)>> = HashMap::new();
+    let mut vert_faces: HashMap<u32, Vec<(u32, u8)>> = HashMap::new();
+    for (f, r) in recs.iter().enumerate() {
+        for e in 0..3 {
+            let (a, b) = (r.corners[e], r.corners[(e + 1) % 3]);
+            edge_faces
+                .entry((a.min(b), a.max(b)))
+                .or_default()
+                .push((f as u32, e as u8));
+            vert_faces.entry(a).or_default().push((f as u32, e as u8));
+        }
+    }
+    for r in recs.iter_mut() {
+        for e in 0..3 {
+            let (a, b) = (r.corners[e], r.corners[(e + 1) % 3]);
+            r.edge_owner[e] = edge_faces[&(a.min(b), a.max(b))]
+                .iter()
+                .copied()
+                .min()
+                .unwrap_or((0, 0));
+            r.corner_owner[e] = vert_faces[&a].iter().copied().min().unwrap_or((0, 0));
+        }
+    }
+    Ok(recs)
+}
+
+/// Which table row (face, point) a shader uses for dyadic point `(i, j)` of `face`: the face
+/// itself for interior points, else the owner of the edge or corner, with the point's
+/// coordinates in the owner's parameters.
+pub fn resolve_owner(
+    recs: &[PatchRecord],
+    face: usize,
+    i: u32,
+    j: u32,
+    n: u32,
+) -> (usize, u32, u32) {
+    let r = &recs[face];
+    let corner = match (i, j) {
+        (0, 0) => Some(0),
+        (x, 0) if x == n => Some(1),
+        (0, y) if y == n => Some(2),
+        _ => None,
+    };
+    let corner_param = |c: u8| match c {
+        0 => (0, 0),
+        1 => (n, 0),
+        _ => (0, n),
+    };
+    if let Some(c) = corner {
+        let (g, gc) = r.corner_owner[c];
+        let (a, b) = corner_param(gc);
+        return (g as usize, a, b);
+    }
+    // Edge index and position k along it from its start corner.
+    let edge = if j == 0 {
+        Some((0, i))
+    } else if i + j == n {
+        Some((1, j))
+    } else if i == 0 {
+        Some((2, n - j))
+    } else {
+        None
+    };
+    match edge {
+        None => (face, i, j),
+        Some((e, k)) => {
+            let (g, ge) = r.edge_owner[e];
+            // The owner walks the edge the other way unless it is this face.
+            let kk = if g as usize == face { k } else { n - k };
+            let (a, b) = match ge {
+                0 => (kk, 0),
+                1 => (n - kk, kk),
+                _ => (0, n - kk),
+            };
+            (g as usize, a, b)
+        }
+    }
+}
+
+/// CPU emulation of the shader: f32 position of dyadic point `(i, j)` of `face`, summing
+/// `w[s]·p[s]` for `s = 0..ring_size` in slot order (separate multiply and add, as GLSL
+/// `precise` guarantees) over the owner's control points.
+pub fn shader_eval(
+    tables: &BasisTables,
+    recs: &[PatchRecord],
+    points: &[[f32; 3]],
+    face: usize,
+    i: u32,
+    j: u32,
+) -> Option<[f32; 3]> {
+    let n = tables.segments();
+    let (g, a, b) = resolve_owner(recs, face, i, j, n);
+    let r = &recs[g];
+    let w = tables.row(r.key, a, b)?;
+    let mut acc = [0.0f32; 3];
+    for (s, &v) in r.ring.iter().enumerate() {
+        let p = points[v as usize];
+        for k in 0..3 {
+            let t = w.position[s] * p[k];
+            acc[k] += t;
+        }
+    }
+    Some(acc)
+}

@@ -1,0 +1,341 @@
+//! Basis-function tables: exactness against limit evaluation on random one-rings, mirror
+//! lookups, bit-identical shared edges under the shader's f32 summation, memory figures.
+
+use std::collections::HashMap;
+
+use topology::bft::{
+    build_patch_records, classify_face, configuration_mesh, face_control_ring, memory_for,
+    shader_eval, BasisTables, BftCase, BftKey,
+};
+use topology::eval::{LimitScheme, LocalMesh};
+use topology::refine::refine_uniform;
+use topology::{load_obj, ControlMesh, Scheme};
+
+const DATA: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../tests/data/opensubdiv/shapes/"
+);
+
+/// Small deterministic generator (xorshift) for random control points.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    }
+}
+
+fn random_config(key: BftKey, rng: &mut Rng) -> (LocalMesh, usize) {
+    let (mut m, f) = configuration_mesh(key, false).expect("config");
+    for x in m.points.iter_mut() {
+        *x += 0.3 * rng.next();
+    }
+    // Rebuild so the jittered points are used (topology unchanged).
+    let m2 = LocalMesh::new(
+        m.scheme,
+        3,
+        m.points.clone(),
+        m.face_offsets.clone(),
+        m.face_verts.clone(),
+        HashMap::new(),
+        vec![0.0; m.num_vertices()],
+        m.boundary,
+        m.crease_method,
+    )
+    .expect("config mesh");
+    (m2, f)
+}
+
+fn check_keys(keys: &[BftKey], level: u32, seed: u64) {
+    let tables = BasisTables::build(keys, level).expect("tables");
+    let n = tables.segments();
+    let mut rng = Rng(seed);
+    for &key in keys {
+        let (mesh, face) = random_config(key, &mut rng);
+        let ring = face_control_ring(&mesh, face, 0);
+        assert_eq!(
+            classify_face(&mesh, face),
+            Some((key, 0)),
+            "{key:?} classifies"
+        );
+        for j in 0..=n {
+            for i in 0..=n - j {
+                let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                let exact = mesh.evaluate(face, u, v).expect("eval");
+                let row = tables.row(key, i, j).expect("row");
+                for k in 0..3 {
+                    let apply = |w: &[f32]| -> f64 {
+                        ring.iter()
+                            .enumerate()
+                            .map(|(s, &x)| w[s] as f64 * mesh.point(x)[k])
+                            .sum()
+                    };
+                    let (p, du, dv) = (apply(&row.position), apply(&row.du), apply(&row.dv));
+                    let tol = 2e-6 * (1.0 + exact.du[k].abs() + exact.dv[k].abs());
+                    assert!(
+                        (p - exact.position[k]).abs() < 2e-6,
+                        "{key:?} ({i},{j}) pos {p} vs {}",
+                        exact.position[k]
+                    );
+                    assert!((du - exact.du[k]).abs() < tol, "{key:?} ({i},{j}) du");
+                    assert!((dv - exact.dv[k]).abs() < tol, "{key:?} ({i},{j}) dv");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn interior_tables_match_limit_evaluation_valence_3_to_20() {
+    let keys: Vec<BftKey> = (3..=20)
+        .map(|n| BftKey {
+            valence: n,
+            case: BftCase::Interior,
+        })
+        .collect();
+    check_keys(&keys, 2, 7);
+    // One finer level on a few valences.
+    check_keys(&keys[..4], 3, 11);
+}
+
+#[test]
+fn boundary_tables_match_limit_evaluation_all_fan_positions() {
+    let mut keys = Vec::new();
+    for n in [2u32, 3, 4, 5, 6, 9] {
+        for k in 0..n - 1 {
+            keys.push(BftKey {
+                valence: n,
+                case: BftCase::Boundary { fan_position: k },
+            });
+        }
+    }
+    check_keys(&keys, 2, 3);
+}
+
+#[test]
+fn high_valence_boundary_tables() {
+    let keys: Vec<BftKey> = [0u32, 7, 18]
+        .iter()
+        .map(|&k| BftKey {
+            valence: 20,
+            case: BftCase::Boundary { fan_position: k },
+        })
+        .collect();
+    check_keys(&keys, 1, 5);
+}
+
+/// A bumpy triangulated grid with pseudo-random diagonals (interior valences 4–8, boundary
+/// valences 2–5); corner quads are split through the corner so no triangle has two boundary
+/// edges.
+fn grid_mesh(m: u32) -> ControlMesh {
+    let mut pos = Vec::new();
+    for y in 0..=m {
+        for x in 0..=m {
+            let (fx, fy) = (x as f64, y as f64);
+            pos.push([fx, fy, 0.3 * (0.7 * fx).sin() * (0.5 * fy).cos()]);
+        }
+    }
+    let id = |x: u32, y: u32| y * (m + 1) + x;
+    let mut faces = Vec::new();
+    for y in 0..m {
+        for x in 0..m {
+            let (a, b, c, d) = (id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1));
+            let corner_ac = (x == 0 && y == 0) || (x == m - 1 && y == m - 1);
+            let corner_bd = (x == m - 1 && y == 0) || (x == 0 && y == m - 1);
+            let diag_ac = corner_ac || (!corner_bd && (x * 7 + y * 13 + x * y) % 3 != 0);
+            if diag_ac {
+                faces.push(vec![a, b, c]);
+                faces.push(vec![a, c, d]);
+            } else {
+                faces.push(vec![a, b, d]);
+                faces.push(vec![b, c, d]);
+            }
+        }
+    }
+    ControlMesh::from_polygons(pos, &faces)
+}
+
+fn level1(name: &str) -> (ControlMesh, LocalMesh) {
+    let mesh = if name == "grid" {
+        grid_mesh(6)
+    } else {
+        load_obj(format!("{DATA}{name}.obj")).expect("shape")
+    };
+    let r = refine_uniform(&mesh, Scheme::Loop, 1).expect("refine");
+    let l = r.level(1);
+    let lm = LocalMesh::new(
+        LimitScheme::Loop,
+        3,
+        l.positions.iter().flat_map(|p| p.iter().copied()).collect(),
+        l.face_offsets().to_vec(),
+        l.face_vertices().to_vec(),
+        HashMap::new(),
+        vec![0.0; l.positions.len()],
+        mesh.options.boundary,
+        mesh.options.crease_method,
+    )
+    .expect("level 1");
+    (mesh, lm)
+}
+
+/// Every point on a shared edge or vertex gets bit-identical f32 results from all faces that
+/// contain it, and all points agree with the exact f64 limit.
+fn check_bit_identity(name: &str, level: u32) {
+    let (_, mesh) = level1(name);
+    let recs = build_patch_records(&mesh).expect("all faces covered");
+    let keys: Vec<BftKey> = recs.iter().map(|r| r.key).collect();
+    let tables = BasisTables::build(&keys, level).expect("tables");
+    let pts: Vec<[f32; 3]> = (0..mesh.num_vertices() as u32)
+        .map(|v| {
+            let p = mesh.point(v);
+            [p[0] as f32, p[1] as f32, p[2] as f32]
+        })
+        .collect();
+    let n = tables.segments();
+    let mut shared: HashMap<(u32, u32, u32), [u32; 3]> = HashMap::new();
+    let mut compared = 0;
+    for (f, r) in recs.iter().enumerate() {
+        let fv = mesh.face(f);
+        let first = fv.iter().position(|&x| x == r.corners[0]).expect("v0");
+        for j in 0..=n {
+            for i in 0..=n - j {
+                let p = shader_eval(&tables, &recs, &pts, f, i, j).expect("row");
+                // Exact value in the face's own parameters.
+                let (ur, vr) = (i as f64 / n as f64, j as f64 / n as f64);
+                let mut b = [0.0; 3];
+                b[first] = 1.0 - ur - vr;
+                b[(first + 1) % 3] = ur;
+                b[(first + 2) % 3] = vr;
+                let exact = mesh.evaluate(f, b[1], b[2]).expect("eval");
+                for (k, &pk) in p.iter().enumerate() {
+                    assert!(
+                        (pk as f64 - exact.position[k]).abs() < 1e-5,
+                        "{name} face {f} ({i},{j}) {pk} vs {}",
+                        exact.position[k]
+                    );
+                }
+                // Global identity of the point if it lies on an edge or vertex.
+                let id = if (i, j) == (0, 0) {
+                    Some((r.corners[0], u32::MAX, 0))
+                } else if (i, j) == (n, 0) {
+                    Some((r.corners[1], u32::MAX, 0))
+                } else if (i, j) == (0, n) {
+                    Some((r.corners[2], u32::MAX, 0))
+                } else {
+                    let e = if j == 0 {
+                        Some((0, 1, i))
+                    } else if i + j == n {
+                        Some((1, 2, j))
+                    } else if i == 0 {
+                        Some((2, 0, n - j))
+                    } else {
+                        None
+                    };
+                    e.map(|(a, b, k)| {
+                        let (va, vb) = (r.corners[a], r.corners[b]);
+                        if va < vb {
+                            (va, vb, k)
+                        } else {
+                            (vb, va, n - k)
+                        }
+                    })
+                };
+                if let Some(id) = id {
+                    let bits = [p[0].to_bits(), p[1].to_bits(), p[2].to_bits()];
+                    if let Some(prev) = shared.insert(id, bits) {
+                        assert_eq!(prev, bits, "{name}: point {id:?} differs between faces");
+                        compared += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert!(compared > 0);
+}
+
+#[test]
+fn shared_edges_are_bit_identical_icosahedron() {
+    check_bit_identity("loop_icosahedron", 3);
+}
+
+#[test]
+fn shared_edges_are_bit_identical_with_boundary() {
+    check_bit_identity("grid", 2);
+}
+
+/// The owner's rows on an edge are nonzero only on control points that both faces share.
+#[test]
+fn edge_rows_use_only_shared_control_points() {
+    let (_, mesh) = level1("loop_icosahedron");
+    let recs = build_patch_records(&mesh).expect("records");
+    let keys: Vec<BftKey> = recs.iter().map(|r| r.key).collect();
+    let tables = BasisTables::build(&keys, 2).expect("tables");
+    let n = tables.segments();
+    let mut owners_by_edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    for (f, r) in recs.iter().enumerate() {
+        for e in 0..3 {
+            let (a, b) = (r.corners[e], r.corners[(e + 1) % 3]);
+            owners_by_edge
+                .entry((a.min(b), a.max(b)))
+                .or_default()
+                .push(f);
+        }
+    }
+    for faces in owners_by_edge.values() {
+        let (f, g) = (faces[0], faces[1]);
+        let rf = &recs[f];
+        let e = (0..3)
+            .find(|&e| {
+                recs[g].corners.contains(&rf.corners[e])
+                    && recs[g].corners.contains(&rf.corners[(e + 1) % 3])
+            })
+            .expect("shared edge");
+        for k in 1..n {
+            let (i, j) = match e {
+                0 => (k, 0),
+                1 => (n - k, k),
+                _ => (0, n - k),
+            };
+            let row = tables.row(rf.key, i, j).expect("row");
+            for (s, &w) in row.position.iter().enumerate() {
+                if w != 0.0 {
+                    assert!(recs[g].ring.contains(&rf.ring[s]), "slot {s} not shared");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn memory_figures() {
+    let mut keys: Vec<BftKey> = (3..=18)
+        .map(|n| BftKey {
+            valence: n,
+            case: BftCase::Interior,
+        })
+        .collect();
+    let interior = keys.clone();
+    for n in 2..=18u32 {
+        for k in 0..n - 1 {
+            keys.push(BftKey {
+                valence: n,
+                case: BftCase::Boundary { fan_position: k },
+            });
+        }
+    }
+    let all_mirror = memory_for(&keys, 5, true).expect("size");
+    let all_plain = memory_for(&keys, 5, false).expect("size");
+    let int_mirror = memory_for(&interior, 5, true).expect("size");
+    println!(
+        "BFT level 5, valence <= 18: interior {int_mirror} B; interior+boundary {all_mirror} B \
+         (without mirror symmetry {all_plain} B)"
+    );
+    assert!(int_mirror < 1_000_000);
+    assert!(all_mirror * 10 < all_plain * 6);
+    // The prediction is the real size.
+    let small = &keys[..6];
+    let t = BasisTables::build(small, 2).expect("tables");
+    assert_eq!(t.memory_bytes(), memory_for(small, 2, true).expect("size"));
+}
