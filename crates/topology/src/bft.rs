@@ -328,6 +328,8 @@ pub struct BftEntry {
 #[derive(Clone, Debug, PartialEq)]
 pub struct BasisTables {
     pub level: u32,
+    /// Whether the `du`/`dv` blocks are present (else their offsets are `u32::MAX`).
+    pub tangents: bool,
     pub weights: Vec<f32>,
     pub mirror_perm: Vec<u32>,
     pub entries: Vec<BftEntry>,
@@ -423,8 +425,18 @@ fn table_rows(key: BftKey, level: u32, half: bool) -> Result<(Rows, Vec<u32>), E
 }
 
 impl BasisTables {
-    /// Build the tables serving `keys` at maximum level `level` (1–6).
+    /// Build the tables (positions and tangents) serving `keys` at maximum level `level` (1–6).
     pub fn build(keys: &[BftKey], level: u32) -> Result<BasisTables, EvalError> {
+        BasisTables::build_with(keys, level, true)
+    }
+
+    /// As [`BasisTables::build`]; `tangents = false` stores position weights only (a third of
+    /// the memory, for subdivision shading that reuses the position weights for normals).
+    pub fn build_with(
+        keys: &[BftKey],
+        level: u32,
+        tangents: bool,
+    ) -> Result<BasisTables, EvalError> {
         if !(1..=6).contains(&level) {
             return Err(EvalError::Unsupported(format!(
                 "BFT level {level} not in 1..=6"
@@ -436,6 +448,7 @@ impl BasisTables {
         let (row_map_full, row_map_half) = row_maps(level);
         let mut t = BasisTables {
             level,
+            tangents,
             weights: Vec::new(),
             mirror_perm: Vec::new(),
             entries: Vec::new(),
@@ -446,8 +459,9 @@ impl BasisTables {
             let half = key.self_symmetric();
             let (rows, perm) = table_rows(key, level, half)?;
             let ring_size = perm.len() as u32;
-            let mut offs = [0u32; 3];
-            for (b, off) in offs.iter_mut().enumerate() {
+            let mut offs = [u32::MAX; 3];
+            let blocks = if tangents { 3 } else { 1 };
+            for (b, off) in offs.iter_mut().enumerate().take(blocks) {
                 *off = t.weights.len() as u32;
                 for r in &rows {
                     t.weights.extend(r[b].iter().map(|&w| w as f32));
@@ -520,7 +534,7 @@ impl BasisTables {
     }
 
     /// Weights of dyadic point `(i, j)` over the face's slots (face ring order), exactly as a
-    /// shader reads them.
+    /// shader reads them (`du`/`dv` empty without tangent blocks).
     pub fn row(&self, key: BftKey, i: u32, j: u32) -> Option<RowWeights> {
         let (e, mirrored) = self.lookup(key)?;
         let e = &self.entries[e];
@@ -552,6 +566,9 @@ impl BasisTables {
             }
         };
         let read = |off: u32| -> Vec<f32> {
+            if off == u32::MAX {
+                return Vec::new();
+            }
             (0..rs)
                 .map(|s| self.weights[off as usize + r as usize * rs + slot(s)])
                 .collect()
@@ -569,10 +586,15 @@ impl BasisTables {
     }
 }
 
-/// Bytes [`BasisTables::build`] would use for `keys` at `level` (computed from the table
+/// Bytes [`BasisTables::build_with`] would use for `keys` at `level` (computed from the table
 /// shapes without evaluating anything); with `mirror = false`, the size without the mirror
 /// savings (every key stored with all rows), for comparison.
-pub fn memory_for(keys: &[BftKey], level: u32, mirror: bool) -> Result<usize, EvalError> {
+pub fn memory_for(
+    keys: &[BftKey],
+    level: u32,
+    mirror: bool,
+    tangents: bool,
+) -> Result<usize, EvalError> {
     let mut stored: Vec<(BftKey, bool)> = keys
         .iter()
         .map(|k| {
@@ -594,7 +616,8 @@ pub fn memory_for(keys: &[BftKey], level: u32, mirror: bool) -> Result<usize, Ev
         let (m, f) = configuration_mesh(k, false)?;
         let ring = face_control_ring(&m, f, 0).len();
         let rows = if h { half } else { full };
-        words += 3 * rows * ring + ring + 8;
+        let blocks = if tangents { 3 } else { 1 };
+        words += blocks * rows * ring + ring + 8;
     }
     Ok(4 * words)
 }

@@ -214,6 +214,37 @@ impl LocalMesh {
         )
     }
 
+    /// A level of T1's uniform refinement (e.g. the level-1 mesh the BFT pipeline starts from).
+    pub fn from_refined_level(
+        level: &crate::refine::Level,
+        scheme: LimitScheme,
+        options: &crate::mesh::SubdivOptions,
+    ) -> Result<Self, EvalError> {
+        let mut es = HashMap::new();
+        for e in 0..level.topology.num_edges() {
+            let s = level.edge_sharpness[e];
+            if s > 0.0 && !level.topology.is_boundary_edge(e) {
+                let [a, b] = level.topology.edge_vertices(e);
+                es.insert(key(a, b), s);
+            }
+        }
+        LocalMesh::new(
+            scheme,
+            3,
+            level
+                .positions
+                .iter()
+                .flat_map(|p| p.iter().copied())
+                .collect(),
+            level.face_offsets().to_vec(),
+            level.face_vertices().to_vec(),
+            es,
+            level.vertex_sharpness.clone(),
+            options.boundary,
+            options.crease_method,
+        )
+    }
+
     pub fn num_vertices(&self) -> usize {
         self.fans.len()
     }
@@ -1047,9 +1078,45 @@ impl LocalMesh {
         if bad {
             return Err(EvalError::ParamOutOfRange(u, v));
         }
-        let mut mesh = self.face_neighbourhood(face)?;
-        let (mut u, mut v) = (u, v);
-        // d(u_cur, v_cur)/d(u0, v0), row-major.
+        let mesh = self.face_neighbourhood(face)?;
+        evaluate_local(mesh, u, v)
+    }
+
+    /// Catmull-Clark faces of any size: `(u, v) ∈ [0,1]²` on sub-quad `sub` of `face` after one
+    /// refinement (`[v_sub', e_{sub,sub+1}, face point, e_{sub−1,sub}]`, `v_sub'` at `(0,0)`, the
+    /// face point at `(1,1)`), as OpenSubdiv parameterises non-quads. Derivatives are with
+    /// respect to the sub-quad's parameters.
+    pub fn evaluate_subface(
+        &self,
+        face: usize,
+        sub: usize,
+        u: f64,
+        v: f64,
+    ) -> Result<LimitSample, EvalError> {
+        if face >= self.num_faces() {
+            return Err(EvalError::FaceOutOfRange(face));
+        }
+        let size = self.face(face).len();
+        if self.scheme != LimitScheme::CatmullClark || sub >= size {
+            return Err(EvalError::Unsupported(format!(
+                "sub-face {sub} of a {size}-sided {:?} face",
+                self.scheme
+            )));
+        }
+        if !(u.is_finite() && v.is_finite() && (0.0..=1.0).contains(&u) && (0.0..=1.0).contains(&v))
+        {
+            return Err(EvalError::ParamOutOfRange(u, v));
+        }
+        let child = self.face_neighbourhood(face)?.refine()?;
+        evaluate_local(child.face_neighbourhood(sub)?, u, v)
+    }
+}
+
+/// The recursion of [`LocalMesh::evaluate`] on a neighbourhood whose face 0 holds the point.
+fn evaluate_local(mut mesh: LocalMesh, u: f64, v: f64) -> Result<LimitSample, EvalError> {
+    let quad = mesh.scheme == LimitScheme::CatmullClark;
+    let (mut u, mut v) = (u, v);
+    {
         let mut jac = [[1.0, 0.0], [0.0, 1.0]];
         const MAX_DEPTH: usize = 56;
         for depth in 0..=MAX_DEPTH {
@@ -1177,6 +1244,8 @@ pub fn normal_of(du: &[f64; 3], dv: &[f64; 3]) -> [f64; 3] {
 pub struct LimitPoint {
     pub scheme: LimitScheme,
     pub face: usize,
+    /// Sub-quad of a non-quad Catmull-Clark face (see [`LocalMesh::evaluate_subface`]).
+    pub subface: Option<usize>,
     pub u: f64,
     pub v: f64,
     pub position: [f64; 3],
@@ -1188,11 +1257,11 @@ pub struct LimitPoint {
 impl fmt::Display for LimitPoint {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let v3 = |a: &[f64; 3]| format!("{:.12} {:.12} {:.12}", a[0], a[1], a[2]);
-        writeln!(
-            f,
-            "scheme {:?} face {} uv {} {}",
-            self.scheme, self.face, self.u, self.v
-        )?;
+        write!(f, "scheme {:?} face {}", self.scheme, self.face)?;
+        if let Some(s) = self.subface {
+            write!(f, " subface {s}")?;
+        }
+        writeln!(f, " uv {} {}", self.u, self.v)?;
         writeln!(f, "position {}", v3(&self.position))?;
         writeln!(f, "du {}", v3(&self.du))?;
         writeln!(f, "dv {}", v3(&self.dv))?;
@@ -1205,7 +1274,8 @@ fn to3(x: &[f64]) -> [f64; 3] {
 }
 
 /// `tessera limit`: exact limit position, tangents and normal of a control mesh at
-/// `(face, u, v)` (face indices of the control mesh itself).
+/// `(face, u, v)` (face indices of the control mesh itself). Non-quad Catmull-Clark faces need
+/// a sub-quad: see [`limit_point_subface`].
 pub fn limit_point(
     mesh: &ControlMesh,
     scheme: LimitScheme,
@@ -1215,15 +1285,47 @@ pub fn limit_point(
 ) -> Result<LimitPoint, EvalError> {
     let lm = LocalMesh::from_control_mesh(mesh, scheme)?;
     let s = lm.evaluate(face, u, v)?;
+    Ok(to_point(scheme, face, None, u, v, &s))
+}
+
+/// [`limit_point`] on sub-quad `sub` of a Catmull-Clark face of any size.
+pub fn limit_point_subface(
+    mesh: &ControlMesh,
+    face: usize,
+    sub: usize,
+    u: f64,
+    v: f64,
+) -> Result<LimitPoint, EvalError> {
+    let lm = LocalMesh::from_control_mesh(mesh, LimitScheme::CatmullClark)?;
+    let s = lm.evaluate_subface(face, sub, u, v)?;
+    Ok(to_point(
+        LimitScheme::CatmullClark,
+        face,
+        Some(sub),
+        u,
+        v,
+        &s,
+    ))
+}
+
+fn to_point(
+    scheme: LimitScheme,
+    face: usize,
+    subface: Option<usize>,
+    u: f64,
+    v: f64,
+    s: &LimitSample,
+) -> LimitPoint {
     let (du, dv) = (to3(&s.du), to3(&s.dv));
-    Ok(LimitPoint {
+    LimitPoint {
         scheme,
         face,
+        subface,
         u,
         v,
         position: to3(&s.position),
         du,
         dv,
         normal: normal_of(&du, &dv),
-    })
+    }
 }

@@ -325,17 +325,24 @@ fn memory_figures() {
             });
         }
     }
-    let all_mirror = memory_for(&keys, 5, true).expect("size");
-    let all_plain = memory_for(&keys, 5, false).expect("size");
-    let int_mirror = memory_for(&interior, 5, true).expect("size");
-    println!(
-        "BFT level 5, valence <= 18: interior {int_mirror} B; interior+boundary {all_mirror} B \
-         (without mirror symmetry {all_plain} B)"
-    );
-    assert!(int_mirror < 1_000_000);
-    assert!(all_mirror * 10 < all_plain * 6);
+    for tangents in [true, false] {
+        let all_mirror = memory_for(&keys, 5, true, tangents).expect("size");
+        let all_plain = memory_for(&keys, 5, false, tangents).expect("size");
+        let int_mirror = memory_for(&interior, 5, true, tangents).expect("size");
+        println!(
+            "BFT level 5, valence <= 18, tangents {tangents}: interior {int_mirror} B; \
+             interior+boundary {all_mirror} B (without mirror symmetry {all_plain} B)"
+        );
+        assert!(int_mirror < 1_000_000);
+        assert!(all_mirror * 10 < all_plain * 6);
+    }
     // The prediction is the real size.
     let small = &keys[..6];
-    let t = BasisTables::build(small, 2).expect("tables");
-    assert_eq!(t.memory_bytes(), memory_for(small, 2, true).expect("size"));
+    for tangents in [true, false] {
+        let t = BasisTables::build_with(small, 2, tangents).expect("tables");
+        assert_eq!(
+            t.memory_bytes(),
+            memory_for(small, 2, true, tangents).expect("size")
+        );
+    }
 }

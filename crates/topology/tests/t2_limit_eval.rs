@@ -3,7 +3,7 @@
 
 use std::collections::HashMap;
 
-use topology::eval::{limit_point, LimitScheme, LocalMesh};
+use topology::eval::{limit_point, limit_point_subface, LimitScheme, LocalMesh};
 use topology::patch::{
     catmark_regular_weights, loop_regular_weights, CATMARK_CORNER_SLOTS, LOOP_REGULAR_LATTICE,
 };
@@ -327,12 +327,17 @@ fn spot_quads_evaluate_on_refined_limit() {
         .collect();
     limits.sort_by(|a, b| a[0].total_cmp(&b[0]));
     let mut n = 0;
-    for f in (0..base.num_faces()).step_by(7) {
-        if base.face(f).len() != 4 {
-            continue;
-        }
+    let mut odd = 0;
+    for f in (0..base.num_faces()).step_by(3) {
+        let size = base.face(f).len();
         for &(u, v) in &[(0.0, 0.0), (0.5, 0.0), (0.5, 0.5), (1.0, 0.5)] {
-            let s = base.evaluate(f, u, v).expect("eval");
+            // Quads directly; other faces through their sub-quads (dyadic at level 1 there).
+            let s = if size == 4 {
+                base.evaluate(f, u, v).expect("eval")
+            } else {
+                odd += 1;
+                base.evaluate_subface(f, f % size, u, v).expect("eval")
+            };
             let x = s.position[0];
             let lo = limits.partition_point(|q| q[0] < x - 1e-9);
             let hit = limits[lo..]
@@ -343,5 +348,20 @@ fn spot_quads_evaluate_on_refined_limit() {
             n += 1;
         }
     }
-    assert!(n > 50);
+    assert!(n > 50 && odd > 0);
+    // A quad's sub-quad 0 is its lower-left quadrant.
+    let q = (0..base.num_faces())
+        .find(|&f| base.face(f).len() == 4)
+        .expect("a quad");
+    let a = base.evaluate(q, 0.15, 0.35).expect("quad");
+    let b = base.evaluate_subface(q, 0, 0.3, 0.7).expect("sub-quad");
+    for k in 0..3 {
+        assert!((a.position[k] - b.position[k]).abs() < 1e-12);
+        assert!((a.du[k] - 2.0 * b.du[k]).abs() < 1e-9);
+    }
+    let tri = (0..base.num_faces())
+        .find(|&f| base.face(f).len() == 3)
+        .expect("a triangle");
+    let p = limit_point_subface(&mesh, tri, 2, 0.25, 0.5).expect("sub-quad point");
+    assert!(p.to_string().contains("subface 2"));
 }
