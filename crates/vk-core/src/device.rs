@@ -427,3 +427,49 @@ impl Drop for DeviceShared {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn adapter(index: usize, ty: vk::PhysicalDeviceType, tess: bool) -> AdapterInfo {
+        AdapterInfo {
+            index,
+            name: format!("device{index}"),
+            device_type: ty,
+            driver_id: vk::DriverId::default(),
+            driver_name: "test".into(),
+            driver_info: String::new(),
+            driver_version: 0,
+            api_version: vk::API_VERSION_1_3,
+            vendor_id: 0,
+            caps: Capabilities { tessellation_shader: tess, fill_mode_non_solid: true, dynamic_rendering: true, ..Default::default() },
+            queue_family: Some(0),
+            missing: if tess { vec![] } else { vec!["tessellationShader".into()] },
+            physical: vk::PhysicalDevice::null(),
+        }
+    }
+
+    #[test]
+    fn scoring_prefers_discrete_then_lowest_index() {
+        use vk::PhysicalDeviceType as T;
+        let a = [adapter(0, T::CPU, true), adapter(1, T::INTEGRATED_GPU, true), adapter(2, T::DISCRETE_GPU, true), adapter(3, T::DISCRETE_GPU, true)];
+        assert_eq!(choose_adapter(&a, &DeviceSelector::Auto).unwrap(), 2);
+        assert_eq!(choose_adapter(&a, &DeviceSelector::Index(0)).unwrap(), 0);
+        assert_eq!(choose_adapter(&a, &DeviceSelector::Name("DEVICE1".into())).unwrap(), 1);
+    }
+
+    #[test]
+    fn no_tessellation_is_a_typed_error_listing_devices() {
+        use vk::PhysicalDeviceType as T;
+        let a = [adapter(0, T::DISCRETE_GPU, false), adapter(1, T::CPU, false)];
+        let e = choose_adapter(&a, &DeviceSelector::Auto).unwrap_err();
+        let text = e.to_string();
+        assert!(matches!(e, VkError::NoSuitableDevice(_)));
+        assert!(text.contains("device0") && text.contains("device1") && text.contains("tessellationShader"), "{text}");
+        let e = choose_adapter(&a, &DeviceSelector::Index(0)).unwrap_err();
+        assert!(matches!(e, VkError::MissingFeatures { .. }), "{e}");
+        let e = choose_adapter(&a, &DeviceSelector::Name("nvidia".into())).unwrap_err();
+        assert!(matches!(e, VkError::NoSuchDevice { .. }), "{e}");
+    }
+}

@@ -117,8 +117,14 @@ unsafe extern "system" fn debug_callback(
 
 impl Instance {
     pub fn new(desc: &InstanceDesc) -> Result<Arc<Self>> {
-        // SAFETY: loading the system Vulkan loader; its exported symbols follow the Vulkan ABI.
-        let entry = unsafe { ash::Entry::load() }.map_err(|e| VkError::NoLoader(e.to_string()))?;
+        // TESSERA_VULKAN_LIBRARY names a specific loader (e.g. a debug build); default: the system one.
+        let entry = match std::env::var_os("TESSERA_VULKAN_LIBRARY") {
+            // SAFETY: loading a Vulkan loader; its exported symbols follow the Vulkan ABI.
+            Some(path) => unsafe { ash::Entry::load_from(&path) }
+                .map_err(|e| VkError::NoLoader(format!("{}: {e}", std::path::Path::new(&path).display())))?,
+            // SAFETY: as above, for the system loader.
+            None => unsafe { ash::Entry::load() }.map_err(|e| VkError::NoLoader(e.to_string()))?,
+        };
         // SAFETY: entry is a valid loader.
         let api_version = unsafe { entry.try_enumerate_instance_version() }
             .ctx("vkEnumerateInstanceVersion")?

@@ -66,11 +66,11 @@ impl QueryPool {
         unsafe { self.device.raw.cmd_reset_query_pool(cmd, self.raw, 0, self.count) };
     }
 
-    /// Waits for and reads raw 64-bit results.
-    pub fn results(&self) -> Result<Vec<u64>> {
-        let per = if self.ty == vk::QueryType::PIPELINE_STATISTICS { 7 } else { 1 };
-        let mut data = vec![0u64; (self.count * per) as usize];
-        // SAFETY: data has room for count results of `per` u64s each, tightly packed.
+    /// Waits for and reads `N` 64-bit values per query (ash takes one `T` per query: its size
+    /// is the stride, so a flat `u64` slice would claim 7× too many statistics queries).
+    fn results<const N: usize>(&self) -> Result<Vec<[u64; N]>> {
+        let mut data = vec![[0u64; N]; self.count as usize];
+        // SAFETY: one [u64; N] per query, N matching the query type's value count.
         unsafe {
             self.device.raw.get_query_pool_results(self.raw, 0, &mut data, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT)
         }
@@ -79,9 +79,12 @@ impl QueryPool {
     }
 
     pub fn statistics_results(&self) -> Result<Vec<PipelineStatistics>> {
-        let raw = self.results()?;
-        Ok(raw
-            .chunks_exact(7)
+        if self.ty != vk::QueryType::PIPELINE_STATISTICS {
+            return Err(VkError::Invalid("not a pipeline-statistics pool".into()));
+        }
+        Ok(self
+            .results::<7>()?
+            .into_iter()
             .map(|c| PipelineStatistics {
                 input_assembly_vertices: c[0],
                 vertex_shader_invocations: c[1],
@@ -97,8 +100,11 @@ impl QueryPool {
     /// Timestamp differences in nanoseconds between consecutive pairs (0–1, 2–3, …).
     pub fn durations_ns(&self) -> Result<Vec<f64>> {
         let period = self.device.info.caps.timestamp_period_ns as f64;
-        let raw = self.results()?;
-        Ok(raw.chunks_exact(2).map(|p| p[1].wrapping_sub(p[0]) as f64 * period).collect())
+        if self.ty != vk::QueryType::TIMESTAMP {
+            return Err(VkError::Invalid("not a timestamp pool".into()));
+        }
+        let raw = self.results::<1>()?;
+        Ok(raw.chunks_exact(2).map(|p| p[1][0].wrapping_sub(p[0][0]) as f64 * period).collect())
     }
 }
 

@@ -1,0 +1,96 @@
+//! Pipeline statistics against the CPU tessellator, and the lavapipe draw-split workaround.
+mod common;
+use common::Gpu;
+use tessera::tess::renderer::{GpuMesh, Method};
+use tessera::tess::tessellator::{uniform_vertex_count, Domain};
+use tessera::tess::{DrawParams, DrawSplit, RenderMesh, Renderer, Spacing};
+use tessera::topology::ControlMesh;
+use tessera::vk_core::vk;
+
+const SMALL: vk::Extent2D = vk::Extent2D { width: 96, height: 64 };
+
+/// A strip of `k` unit quads (or 2k triangles when `triangles`), with normals along +z.
+fn strip(k: u32, triangles: bool) -> ControlMesh {
+    let mut pos = Vec::new();
+    for i in 0..=k {
+        pos.push([i as f64, 0.0, 0.0]);
+        pos.push([i as f64, 1.0, 0.0]);
+    }
+    let mut faces: Vec<Vec<u32>> = Vec::new();
+    for i in 0..k {
+        let (a, b, c, d) = (2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1);
+        if triangles {
+            faces.push(vec![a, b, c]);
+            faces.push(vec![a, c, d]);
+        } else {
+            faces.push(vec![a, b, c, d]);
+        }
+    }
+    ControlMesh::from_polygons(pos, &faces)
+}
+
+#[test]
+fn tes_invocations_equal_cpu_tessellator_counts() {
+    let gpu = Gpu::new();
+    let mut r = Renderer::offscreen(gpu.device()).unwrap();
+    for (triangles, domain) in [(true, Domain::Triangle), (false, Domain::Quad)] {
+        let k = if triangles { 10 } else { 5 };
+        let mesh = GpuMesh::upload(gpu.device(), &RenderMesh::from_control_mesh(&strip(5, triangles)).unwrap()).unwrap();
+        for spacing in [Spacing::Equal, Spacing::FractionalEven, Spacing::FractionalOdd] {
+            for level in [1.0f32, 2.0, 2.5, 3.0, 4.7, 7.0, 16.0, 33.3, 64.0] {
+                let p = DrawParams { method: Method::Flat, spacing, level, ..Default::default() };
+                let (_, stats, counts) = r.render_offscreen_stats(&mesh, &p, SMALL, true).unwrap();
+                let stats = stats.unwrap();
+                let expected = k as u64 * uniform_vertex_count(domain, spacing, level);
+                assert_eq!(stats.tess_control_patches, k as u64, "{domain:?} {spacing:?} {level}");
+                assert_eq!(counts.patches, k, "{domain:?} {spacing:?} {level}");
+                assert_eq!(stats.tess_evaluation_invocations, expected, "TES invocations, {domain:?} {spacing:?} level {level}");
+            }
+        }
+    }
+    assert!(gpu.errors().is_empty());
+}
+
+/// A gently curved w × h grid of quads (curved so the wireframe shows every patch's triangles).
+fn grid(w: u32, h: u32) -> ControlMesh {
+    let mut pos = Vec::new();
+    for j in 0..=h {
+        for i in 0..=w {
+            let (x, y) = (i as f64, j as f64);
+            pos.push([x, y, 0.1 * ((x * 0.7).sin() + (y * 0.9).cos())]);
+        }
+    }
+    let mut faces = Vec::new();
+    for j in 0..h {
+        for i in 0..w {
+            let v = j * (w + 1) + i;
+            faces.push(vec![v, v + 1, v + w + 2, v + w + 1]);
+        }
+    }
+    ControlMesh::from_polygons(pos, &faces)
+}
+
+/// lavapipe splits a draw into chunks of min(patches, 4096 / control points) patches and a chunk
+/// emitting more than 65,536 vertices gets corrupt triangles. 24 quads at level 64 emit
+/// 24 × 4225 = 101,400 vertices in one chunk. The split draw must equal a one-patch-per-draw reference
+/// exactly; on lavapipe the unsplit draw must not (showing the test can fail without the split).
+#[test]
+fn draw_split_matches_per_patch_reference() {
+    let gpu = Gpu::new();
+    let mut r = Renderer::offscreen(gpu.device()).unwrap();
+    let mesh = GpuMesh::upload(gpu.device(), &RenderMesh::from_control_mesh(&grid(6, 4)).unwrap()).unwrap();
+    let extent = vk::Extent2D { width: 192, height: 192 };
+    let base = DrawParams { method: Method::Flat, level: 64.0, wireframe: true, ..Default::default() };
+    let (reference, _, ref_counts) = r.render_offscreen_stats(&mesh, &DrawParams { split: DrawSplit::PerPatch, ..base }, extent, false).unwrap();
+    let (split, _, split_counts) = r.render_offscreen_stats(&mesh, &DrawParams { split: DrawSplit::Auto, ..base }, extent, false).unwrap();
+    assert_eq!(ref_counts.patches, split_counts.patches);
+    let differing = |a: &[u8], b: &[u8]| a.chunks(4).zip(b.chunks(4)).filter(|(x, y)| x != y).count();
+    assert_eq!(differing(&split.pixels, &reference.pixels), 0, "split draw differs from the per-patch reference");
+    if gpu.device().info.is_lavapipe() {
+        assert!(split_counts.draws > 2, "lavapipe needs the split: {split_counts:?}");
+        let (unsplit, _, counts) = r.render_offscreen_stats(&mesh, &DrawParams { split: DrawSplit::Off, ..base }, extent, false).unwrap();
+        assert_eq!(counts.draws, 2, "one draw per pass");
+        let bad = differing(&unsplit.pixels, &reference.pixels);
+        assert!(bad > 100, "expected lavapipe's chunk corruption without the split, only {bad} pixels differ");
+    }
+}
