@@ -173,7 +173,15 @@ impl Instance {
             info = info.push_next(&mut features);
         }
         // SAFETY: all pointers in `info` reference locals that outlive the call.
-        let raw = unsafe { entry.create_instance(&info, None) }.ctx("vkCreateInstance")?;
+        let raw = match unsafe { entry.create_instance(&info, None) } {
+            Ok(raw) => raw,
+            Err(vk::Result::ERROR_INCOMPATIBLE_DRIVER) => {
+                return Err(VkError::NoSuitableDevice(
+                    "the Vulkan loader found no driver, so no device (install mesa-vulkan-drivers for lavapipe, or a GPU driver)".into(),
+                ))
+            }
+            Err(result) => return Err(VkError::Call { call: "vkCreateInstance", result }),
+        };
 
         let messages = Arc::new(MessageCounts::default());
         let debug = if has_debug_utils {
