@@ -200,6 +200,14 @@ fn loop_shapes_match_refined_limit() {
 }
 
 #[test]
+fn level3_dyadic_points_match_refined_limit() {
+    check_shape("loop_icosahedron", 3);
+    check_shape("loop_saddle_edgecorner", 3);
+    check_shape("catmark_cube", 3);
+    check_shape("catmark_edgecorner", 3);
+}
+
+#[test]
 fn loop_semi_sharp_shapes_match_refined_limit() {
     for name in ["loop_cube_creases1", "loop_chaikin0"] {
         check_shape(name, 2);
