@@ -782,17 +782,116 @@ pub fn shader_eval(
     i: u32,
     j: u32,
 ) -> Option<[f32; 3]> {
+    shader_eval_full(tables, recs, points, face, i, j).map(|(p, _)| p)
+}
+
+fn dot_rows(w: &[f32], ring: &[u32], points: &[[f32; 3]]) -> [f32; 3] {
+    let mut acc = [0.0f32; 3];
+    for (s, &v) in ring.iter().enumerate() {
+        let p = points[v as usize];
+        for k in 0..3 {
+            let t = w[s] * p[k];
+            acc[k] += t;
+        }
+    }
+    acc
+}
+
+/// [`shader_eval`] plus the geometric normal `normalize(du × dv)` (zero without tangent
+/// tables). Shared points take `du`, `dv` from the owner too, so normals are bit-identical
+/// across edges as well; both parameterisations are CCW, so the owner's normal is the face's.
+pub fn shader_eval_full(
+    tables: &BasisTables,
+    recs: &[PatchRecord],
+    points: &[[f32; 3]],
+    face: usize,
+    i: u32,
+    j: u32,
+) -> Option<([f32; 3], [f32; 3])> {
     let n = tables.segments();
     let (g, a, b) = resolve_owner(recs, face, i, j, n);
     let r = &recs[g];
     let w = tables.row(r.key, a, b)?;
-    let mut acc = [0.0f32; 3];
-    for (s, &v) in r.ring.iter().enumerate() {
-        let p = points[v as usize];
-        for k in 0..3 {
-            let t = w.position[s] * p[k];
-            acc[k] += t;
-        }
+    let p = dot_rows(&w.position, &r.ring, points);
+    if w.du.is_empty() {
+        return Some((p, [0.0; 3]));
     }
-    Some(acc)
+    let du = dot_rows(&w.du, &r.ring, points);
+    let dv = dot_rows(&w.dv, &r.ring, points);
+    let c = [
+        du[1] * dv[2] - du[2] * dv[1],
+        du[2] * dv[0] - du[0] * dv[2],
+        du[0] * dv[1] - du[1] * dv[0],
+    ];
+    let l = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+    let nrm = if l > 0.0 {
+        [c[0] / l, c[1] / l, c[2] / l]
+    } else {
+        [0.0; 3]
+    };
+    Some((p, nrm))
+}
+
+/// GPU buffers for the patch records. `headers`: 6 u32 per face,
+/// `[ring_offset, ring_size, entry | mirrored << 31, edge_owner[0], edge_owner[1],
+/// edge_owner[2]]`; `corner_owners`: 3 u32 per face; an owner packs `face << 2 | local index`
+/// (edge 0: v0→v1, 1: v1→v2, 2: v2→v0; corner c: v_c). `ring_indices` holds every face's
+/// control-vertex indices (into the level-1 vertices) back to back, in slot order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GpuPatches {
+    pub headers: Vec<u32>,
+    pub corner_owners: Vec<u32>,
+    pub ring_indices: Vec<u32>,
+}
+
+/// Flatten records for the GPU against `tables` (`None` if a key has no table).
+pub fn pack_patches(recs: &[PatchRecord], tables: &BasisTables) -> Option<GpuPatches> {
+    let mut out = GpuPatches {
+        headers: Vec::with_capacity(recs.len() * 6),
+        corner_owners: Vec::with_capacity(recs.len() * 3),
+        ring_indices: Vec::new(),
+    };
+    for r in recs {
+        let (e, mirrored) = tables.lookup(r.key)?;
+        out.headers.push(out.ring_indices.len() as u32);
+        out.headers.push(r.ring.len() as u32);
+        out.headers.push(e as u32 | (mirrored as u32) << 31);
+        for &(f, k) in &r.edge_owner {
+            out.headers.push(f << 2 | k as u32);
+        }
+        for &(f, k) in &r.corner_owner {
+            out.corner_owners.push(f << 2 | k as u32);
+        }
+        out.ring_indices.extend_from_slice(&r.ring);
+    }
+    Some(out)
+}
+
+/// Everything the BFT pipeline needs for a Loop control mesh: the once-refined mesh (its
+/// positions are what the shader combines), per-face records and the tables at `level`.
+#[derive(Clone, Debug)]
+pub struct LoopBft {
+    pub level1: LocalMesh,
+    pub records: Vec<PatchRecord>,
+    pub tables: BasisTables,
+}
+
+/// Refine `mesh` once (T1's uniform refinement), classify every level-1 face and build the
+/// tables it needs.
+pub fn prepare_loop_bft(
+    mesh: &crate::mesh::ControlMesh,
+    level: u32,
+    tangents: bool,
+) -> Result<LoopBft, EvalError> {
+    let r = crate::refine::refine_uniform(mesh, crate::sdc::Scheme::Loop, 1)
+        .map_err(|e| EvalError::Unsupported(e.to_string()))?;
+    let level1 = LocalMesh::from_refined_level(r.level(1), LimitScheme::Loop, &mesh.options)?;
+    let records = build_patch_records(&level1)?;
+    let keys: Vec<BftKey> = records.iter().map(|r| r.key).collect();
+    let tables = BasisTables::build_with(&keys, level, tangents)?;
+    Ok(LoopBft {
+        level1,
+        records,
+        tables,
+    })
 }

@@ -5,7 +5,7 @@ use std::collections::HashMap;
 
 use topology::bft::{
     build_patch_records, classify_face, configuration_mesh, face_control_ring, memory_for,
-    shader_eval, BasisTables, BftCase, BftKey,
+    pack_patches, prepare_loop_bft, shader_eval, shader_eval_full, BasisTables, BftCase, BftKey,
 };
 use topology::eval::{LimitScheme, LocalMesh};
 use topology::refine::refine_uniform;
@@ -194,14 +194,15 @@ fn check_bit_identity(name: &str, level: u32) {
         })
         .collect();
     let n = tables.segments();
-    let mut shared: HashMap<(u32, u32, u32), [u32; 3]> = HashMap::new();
+    let mut shared: HashMap<(u32, u32, u32), [u32; 6]> = HashMap::new();
     let mut compared = 0;
     for (f, r) in recs.iter().enumerate() {
         let fv = mesh.face(f);
         let first = fv.iter().position(|&x| x == r.corners[0]).expect("v0");
         for j in 0..=n {
             for i in 0..=n - j {
-                let p = shader_eval(&tables, &recs, &pts, f, i, j).expect("row");
+                let (p, nrm) = shader_eval_full(&tables, &recs, &pts, f, i, j).expect("row");
+                assert_eq!(p, shader_eval(&tables, &recs, &pts, f, i, j).expect("row"));
                 // Exact value in the face's own parameters.
                 let (ur, vr) = (i as f64 / n as f64, j as f64 / n as f64);
                 let mut b = [0.0; 3];
@@ -243,7 +244,14 @@ fn check_bit_identity(name: &str, level: u32) {
                     })
                 };
                 if let Some(id) = id {
-                    let bits = [p[0].to_bits(), p[1].to_bits(), p[2].to_bits()];
+                    let bits = [
+                        p[0].to_bits(),
+                        p[1].to_bits(),
+                        p[2].to_bits(),
+                        nrm[0].to_bits(),
+                        nrm[1].to_bits(),
+                        nrm[2].to_bits(),
+                    ];
                     if let Some(prev) = shared.insert(id, bits) {
                         assert_eq!(prev, bits, "{name}: point {id:?} differs between faces");
                         compared += 1;
@@ -344,5 +352,48 @@ fn memory_figures() {
             t.memory_bytes(),
             memory_for(small, 2, true, tangents).expect("size")
         );
+    }
+}
+
+#[test]
+fn prepare_and_pack_for_the_gpu() {
+    let mesh = grid_mesh(4);
+    let bft = prepare_loop_bft(&mesh, 2, true).expect("grid is covered");
+    assert_eq!(bft.records.len(), bft.level1.num_faces());
+    let packed = pack_patches(&bft.records, &bft.tables).expect("packed");
+    assert_eq!(packed.headers.len(), 6 * bft.records.len());
+    assert_eq!(packed.corner_owners.len(), 3 * bft.records.len());
+    let total: usize = bft.records.iter().map(|r| r.ring.len()).sum();
+    assert_eq!(packed.ring_indices.len(), total);
+    // Header of face 1 points at its ring.
+    let r = &bft.records[1];
+    let off = packed.headers[6] as usize;
+    assert_eq!(&packed.ring_indices[off..off + r.ring.len()], &r.ring[..]);
+    // Normals agree with the exact limit normal away from extraordinary vertices.
+    let pts: Vec<[f32; 3]> = (0..bft.level1.num_vertices() as u32)
+        .map(|v| {
+            let p = bft.level1.point(v);
+            [p[0] as f32, p[1] as f32, p[2] as f32]
+        })
+        .collect();
+    let (_, nrm) = shader_eval_full(&bft.tables, &bft.records, &pts, 5, 1, 1).expect("row");
+    let fv = bft.level1.face(5);
+    let first = fv
+        .iter()
+        .position(|&x| x == bft.records[5].corners[0])
+        .expect("v0");
+    let mut b = [0.0; 3];
+    b[first] = 0.5;
+    b[(first + 1) % 3] = 0.25;
+    b[(first + 2) % 3] = 0.25;
+    let s = bft.level1.evaluate(5, b[1], b[2]).expect("eval");
+    let c = [
+        s.du[1] * s.dv[2] - s.du[2] * s.dv[1],
+        s.du[2] * s.dv[0] - s.du[0] * s.dv[2],
+        s.du[0] * s.dv[1] - s.du[1] * s.dv[0],
+    ];
+    let l = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+    for k in 0..3 {
+        assert!((nrm[k] as f64 - c[k] / l).abs() < 1e-5, "normal {k}");
     }
 }
