@@ -7,9 +7,16 @@ use tessera::tess::{DrawParams, Method, RenderMesh, Renderer};
 use tessera::vk_core::target::Rgba8;
 use tessera::vk_core::vk;
 
-const EXTENT: vk::Extent2D = vk::Extent2D { width: 160, height: 120 };
+const EXTENT: vk::Extent2D = vk::Extent2D {
+    width: 160,
+    height: 120,
+};
 const LEVEL: f32 = 3.0;
-const MESHES: [&str; 3] = ["assets/spot_control_mesh.obj", "tests/data/meshes/cube.obj", "tests/data/opensubdiv/shapes/loop_icosahedron.obj"];
+const MESHES: [&str; 3] = [
+    "assets/spot_control_mesh.obj",
+    "tests/data/meshes/cube.obj",
+    "tests/data/opensubdiv/shapes/loop_icosahedron.obj",
+];
 const METHODS: [Method; 3] = [Method::Flat, Method::Phong, Method::Pn];
 
 /// A pixel differs when any channel moves by more than 24/255; an image matches when at most
@@ -17,7 +24,12 @@ const METHODS: [Method; 3] = [Method::Flat, Method::Phong, Method::Pn];
 /// one-level change of the tessellation moves every wireframe line and fails.
 fn differing_fraction(a: &Rgba8, b: &Rgba8) -> f64 {
     assert_eq!((a.width, a.height), (b.width, b.height));
-    let n = a.pixels.chunks(4).zip(b.pixels.chunks(4)).filter(|(p, q)| p.iter().zip(q.iter()).any(|(x, y)| x.abs_diff(*y) > 24)).count();
+    let n = a
+        .pixels
+        .chunks(4)
+        .zip(b.pixels.chunks(4))
+        .filter(|(p, q)| p.iter().zip(q.iter()).any(|(x, y)| x.abs_diff(*y) > 24))
+        .count();
     n as f64 / (a.width * a.height) as f64
 }
 const TOLERANCE: f64 = 0.005;
@@ -28,11 +40,24 @@ fn render_all(level: f32) -> Vec<(String, Rgba8)> {
     let mut out = Vec::new();
     for path in MESHES {
         let mesh = tessera::topology::load_obj(common::data(path)).unwrap();
-        let gm = GpuMesh::upload(gpu.device(), &RenderMesh::from_control_mesh(&mesh).unwrap()).unwrap();
+        let gm =
+            GpuMesh::upload(gpu.device(), &RenderMesh::from_control_mesh(&mesh).unwrap()).unwrap();
         for m in METHODS {
-            let p = DrawParams { method: m, level, wireframe: true, ..Default::default() };
-            let stem = std::path::Path::new(path).file_stem().unwrap().to_string_lossy().into_owned();
-            out.push((format!("{stem}_{m:?}").to_lowercase(), r.render_offscreen(&gm, &p, EXTENT).unwrap()));
+            let p = DrawParams {
+                method: m,
+                level,
+                wireframe: true,
+                ..Default::default()
+            };
+            let stem = std::path::Path::new(path)
+                .file_stem()
+                .unwrap()
+                .to_string_lossy()
+                .into_owned();
+            out.push((
+                format!("{stem}_{m:?}").to_lowercase(),
+                r.render_offscreen(&gm, &p, EXTENT).unwrap(),
+            ));
         }
     }
     out
@@ -50,12 +75,22 @@ fn golden_images_match_and_detect_a_level_change() {
     let second = render_all(LEVEL);
     let changed = render_all(LEVEL + 1.0);
     for (((name, a), (_, b)), (_, c)) in first.iter().zip(&second).zip(&changed) {
-        let golden = Rgba8::load_png(&dir.join(format!("{name}.png"))).unwrap_or_else(|e| panic!("{name}: {e} (TESSERA_UPDATE_GOLDEN=1 writes it)"));
+        let golden = Rgba8::load_png(&dir.join(format!("{name}.png")))
+            .unwrap_or_else(|e| panic!("{name}: {e} (TESSERA_UPDATE_GOLDEN=1 writes it)"));
         let d1 = differing_fraction(a, &golden);
         let d2 = differing_fraction(b, &golden);
         let d3 = differing_fraction(c, &golden);
-        eprintln!("{name}: run 1 {d1:.5}, run 2 {d2:.5}, level {} {d3:.5}", LEVEL + 1.0);
-        assert!(d1 <= TOLERANCE && d2 <= TOLERANCE, "{name}: differs from golden ({d1:.5}, {d2:.5})");
-        assert!(d3 > TOLERANCE, "{name}: a one-level change passed the tolerance ({d3:.5}) — the check is too loose");
+        eprintln!(
+            "{name}: run 1 {d1:.5}, run 2 {d2:.5}, level {} {d3:.5}",
+            LEVEL + 1.0
+        );
+        assert!(
+            d1 <= TOLERANCE && d2 <= TOLERANCE,
+            "{name}: differs from golden ({d1:.5}, {d2:.5})"
+        );
+        assert!(
+            d3 > TOLERANCE,
+            "{name}: a one-level change passed the tolerance ({d3:.5}) — the check is too loose"
+        );
     }
 }

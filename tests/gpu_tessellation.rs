@@ -7,7 +7,10 @@ use tessera::tess::{DrawParams, DrawSplit, RenderMesh, Renderer, Spacing};
 use tessera::topology::ControlMesh;
 use tessera::vk_core::vk;
 
-const SMALL: vk::Extent2D = vk::Extent2D { width: 96, height: 64 };
+const SMALL: vk::Extent2D = vk::Extent2D {
+    width: 96,
+    height: 64,
+};
 
 /// A strip of `k` unit quads (or 2k triangles when `triangles`), with normals along +z.
 fn strip(k: u32, triangles: bool) -> ControlMesh {
@@ -35,16 +38,35 @@ fn tes_invocations_equal_cpu_tessellator_counts() {
     let mut r = Renderer::offscreen(gpu.device()).unwrap();
     for (triangles, domain) in [(true, Domain::Triangle), (false, Domain::Quad)] {
         let k = if triangles { 10 } else { 5 };
-        let mesh = GpuMesh::upload(gpu.device(), &RenderMesh::from_control_mesh(&strip(5, triangles)).unwrap()).unwrap();
-        for spacing in [Spacing::Equal, Spacing::FractionalEven, Spacing::FractionalOdd] {
+        let mesh = GpuMesh::upload(
+            gpu.device(),
+            &RenderMesh::from_control_mesh(&strip(5, triangles)).unwrap(),
+        )
+        .unwrap();
+        for spacing in [
+            Spacing::Equal,
+            Spacing::FractionalEven,
+            Spacing::FractionalOdd,
+        ] {
             for level in [1.0f32, 2.0, 2.5, 3.0, 4.7, 7.0, 16.0, 33.3, 64.0] {
-                let p = DrawParams { method: Method::Flat, spacing, level, ..Default::default() };
+                let p = DrawParams {
+                    method: Method::Flat,
+                    spacing,
+                    level,
+                    ..Default::default()
+                };
                 let (_, stats, counts) = r.render_offscreen_stats(&mesh, &p, SMALL, true).unwrap();
                 let stats = stats.unwrap();
                 let expected = k as u64 * uniform_vertex_count(domain, spacing, level);
-                assert_eq!(stats.tess_control_patches, k as u64, "{domain:?} {spacing:?} {level}");
+                assert_eq!(
+                    stats.tess_control_patches, k as u64,
+                    "{domain:?} {spacing:?} {level}"
+                );
                 assert_eq!(counts.patches, k, "{domain:?} {spacing:?} {level}");
-                assert_eq!(stats.tess_evaluation_invocations, expected, "TES invocations, {domain:?} {spacing:?} level {level}");
+                assert_eq!(
+                    stats.tess_evaluation_invocations, expected,
+                    "TES invocations, {domain:?} {spacing:?} level {level}"
+                );
             }
         }
     }
@@ -78,19 +100,72 @@ fn grid(w: u32, h: u32) -> ControlMesh {
 fn draw_split_matches_per_patch_reference() {
     let gpu = Gpu::new();
     let mut r = Renderer::offscreen(gpu.device()).unwrap();
-    let mesh = GpuMesh::upload(gpu.device(), &RenderMesh::from_control_mesh(&grid(6, 4)).unwrap()).unwrap();
-    let extent = vk::Extent2D { width: 192, height: 192 };
-    let base = DrawParams { method: Method::Flat, level: 64.0, wireframe: true, ..Default::default() };
-    let (reference, _, ref_counts) = r.render_offscreen_stats(&mesh, &DrawParams { split: DrawSplit::PerPatch, ..base }, extent, false).unwrap();
-    let (split, _, split_counts) = r.render_offscreen_stats(&mesh, &DrawParams { split: DrawSplit::Auto, ..base }, extent, false).unwrap();
+    let mesh = GpuMesh::upload(
+        gpu.device(),
+        &RenderMesh::from_control_mesh(&grid(6, 4)).unwrap(),
+    )
+    .unwrap();
+    let extent = vk::Extent2D {
+        width: 192,
+        height: 192,
+    };
+    let base = DrawParams {
+        method: Method::Flat,
+        level: 64.0,
+        wireframe: true,
+        ..Default::default()
+    };
+    let (reference, _, ref_counts) = r
+        .render_offscreen_stats(
+            &mesh,
+            &DrawParams {
+                split: DrawSplit::PerPatch,
+                ..base
+            },
+            extent,
+            false,
+        )
+        .unwrap();
+    let (split, _, split_counts) = r
+        .render_offscreen_stats(
+            &mesh,
+            &DrawParams {
+                split: DrawSplit::Auto,
+                ..base
+            },
+            extent,
+            false,
+        )
+        .unwrap();
     assert_eq!(ref_counts.patches, split_counts.patches);
-    let differing = |a: &[u8], b: &[u8]| a.chunks(4).zip(b.chunks(4)).filter(|(x, y)| x != y).count();
-    assert_eq!(differing(&split.pixels, &reference.pixels), 0, "split draw differs from the per-patch reference");
+    let differing =
+        |a: &[u8], b: &[u8]| a.chunks(4).zip(b.chunks(4)).filter(|(x, y)| x != y).count();
+    assert_eq!(
+        differing(&split.pixels, &reference.pixels),
+        0,
+        "split draw differs from the per-patch reference"
+    );
     if gpu.device().info.is_lavapipe() {
-        assert!(split_counts.draws > 2, "lavapipe needs the split: {split_counts:?}");
-        let (unsplit, _, counts) = r.render_offscreen_stats(&mesh, &DrawParams { split: DrawSplit::Off, ..base }, extent, false).unwrap();
+        assert!(
+            split_counts.draws > 2,
+            "lavapipe needs the split: {split_counts:?}"
+        );
+        let (unsplit, _, counts) = r
+            .render_offscreen_stats(
+                &mesh,
+                &DrawParams {
+                    split: DrawSplit::Off,
+                    ..base
+                },
+                extent,
+                false,
+            )
+            .unwrap();
         assert_eq!(counts.draws, 2, "one draw per pass");
         let bad = differing(&unsplit.pixels, &reference.pixels);
-        assert!(bad > 100, "expected lavapipe's chunk corruption without the split, only {bad} pixels differ");
+        assert!(
+            bad > 100,
+            "expected lavapipe's chunk corruption without the split, only {bad} pixels differ"
+        );
     }
 }

@@ -11,9 +11,24 @@ fn renders_spot_with_each_method() {
     let gm = GpuMesh::upload(gpu.device(), &rm).unwrap();
     let mut r = Renderer::offscreen(gpu.device()).unwrap();
     for m in [Method::Flat, Method::Phong, Method::Pn] {
-        let p = DrawParams { method: m, level: 6.0, wireframe: true, ..Default::default() };
-        let img = r.render_offscreen(&gm, &p, vk::Extent2D { width: 320, height: 240 }).unwrap();
-        img.save_png(std::path::Path::new(&format!("/tmp/smoke_{m:?}.png"))).unwrap();
+        let p = DrawParams {
+            method: m,
+            level: 6.0,
+            wireframe: true,
+            ..Default::default()
+        };
+        let img = r
+            .render_offscreen(
+                &gm,
+                &p,
+                vk::Extent2D {
+                    width: 320,
+                    height: 240,
+                },
+            )
+            .unwrap();
+        img.save_png(std::path::Path::new(&format!("/tmp/smoke_{m:?}.png")))
+            .unwrap();
     }
 }
 use common::Gpu;

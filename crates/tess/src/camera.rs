@@ -12,7 +12,12 @@ pub struct Camera {
 
 impl Default for Camera {
     fn default() -> Self {
-        Self { yaw: 35.0, pitch: 20.0, zoom: 1.0, fov_y_degrees: 40.0 }
+        Self {
+            yaw: 35.0,
+            pitch: 20.0,
+            zoom: 1.0,
+            fov_y_degrees: 40.0,
+        }
     }
 }
 
@@ -35,8 +40,15 @@ impl Camera {
         let fov = self.fov_y_degrees.to_radians();
         let half = (fov * 0.5).tan().min((fov * 0.5).tan() * aspect.max(1e-3));
         let distance = radius / half.atan().sin() / self.zoom.max(1e-3);
-        let (yaw, pitch) = (self.yaw.to_radians(), self.pitch.clamp(-89.0, 89.0).to_radians());
-        let dir = Vec3::new(yaw.sin() * pitch.cos(), pitch.sin(), yaw.cos() * pitch.cos());
+        let (yaw, pitch) = (
+            self.yaw.to_radians(),
+            self.pitch.clamp(-89.0, 89.0).to_radians(),
+        );
+        let dir = Vec3::new(
+            yaw.sin() * pitch.cos(),
+            pitch.sin(),
+            yaw.cos() * pitch.cos(),
+        );
         let eye = center + dir * distance;
         let view = Mat4::look_at_rh(eye, center, Vec3::Y);
         let near = (distance - radius * 1.5).max(distance * 0.01);

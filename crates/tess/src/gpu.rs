@@ -79,7 +79,11 @@ pub fn spirv_member_offsets(words: &[u32], struct_name: &str) -> Option<Vec<u32>
         let ins = &words[i..i + count];
         if op == OP_NAME && count >= 3 {
             let bytes: Vec<u8> = ins[2..].iter().flat_map(|w| w.to_le_bytes()).collect();
-            let name: String = bytes.iter().take_while(|&&b| b != 0).map(|&b| b as char).collect();
+            let name: String = bytes
+                .iter()
+                .take_while(|&&b| b != 0)
+                .map(|&b| b as char)
+                .collect();
             if name == struct_name {
                 id = Some(ins[1]);
             }
@@ -104,9 +108,16 @@ mod tests {
 
     #[test]
     fn frame_block_matches_spirv_layout() {
-        for (name, words) in [("mesh+frag", crate::shaders::SHADE_FRAG), ("tri.tesc", crate::shaders::TRI_TESC)] {
-            let offsets = spirv_member_offsets(words, "Frame").unwrap_or_else(|| panic!("{name}: Frame block not found"));
-            assert_eq!(offsets, FRAME_UNIFORM_OFFSETS, "{name}: GLSL and Rust Frame layouts differ");
+        for (name, words) in [
+            ("mesh+frag", crate::shaders::SHADE_FRAG),
+            ("tri.tesc", crate::shaders::TRI_TESC),
+        ] {
+            let offsets = spirv_member_offsets(words, "Frame")
+                .unwrap_or_else(|| panic!("{name}: Frame block not found"));
+            assert_eq!(
+                offsets, FRAME_UNIFORM_OFFSETS,
+                "{name}: GLSL and Rust Frame layouts differ"
+            );
         }
     }
 

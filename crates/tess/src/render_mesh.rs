@@ -35,23 +35,46 @@ impl RenderMesh {
     pub fn from_control_mesh(mesh: &ControlMesh) -> Result<Self> {
         let nv = mesh.positions.len();
         if mesh.num_faces() == 0 || nv == 0 {
-            return Err(TessError::Topology(topology::TopologyError::EmptyMesh { what: "no faces to draw" }));
+            return Err(TessError::Topology(topology::TopologyError::EmptyMesh {
+                what: "no faces to draw",
+            }));
         }
         for (f, face) in mesh.faces().enumerate() {
             if face.len() < 3 {
-                return Err(TessError::Topology(topology::TopologyError::DegenerateFace { face: f, size: face.len() }));
+                return Err(TessError::Topology(
+                    topology::TopologyError::DegenerateFace {
+                        face: f,
+                        size: face.len(),
+                    },
+                ));
             }
             if let Some(&bad) = face.iter().find(|&&i| i as usize >= nv) {
-                return Err(TessError::Topology(topology::TopologyError::IndexOutOfRange { face: f, index: bad as i64, count: nv }));
+                return Err(TessError::Topology(
+                    topology::TopologyError::IndexOutOfRange {
+                        face: f,
+                        index: bad as i64,
+                        count: nv,
+                    },
+                ));
             }
         }
-        if let Some((v, _)) = mesh.positions.iter().enumerate().find(|(_, p)| p.iter().any(|c| !c.is_finite())) {
-            return Err(TessError::Invalid(format!("vertex {v} has a NaN or infinite coordinate")));
+        if let Some((v, _)) = mesh
+            .positions
+            .iter()
+            .enumerate()
+            .find(|(_, p)| p.iter().any(|c| !c.is_finite()))
+        {
+            return Err(TessError::Invalid(format!(
+                "vertex {v} has a NaN or infinite coordinate"
+            )));
         }
 
         // Corner normals from the file are used when complete: vertices are then split by
         // (position, normal) so faces sharing both share the vertex.
-        let corner_normals = mesh.normals.as_ref().filter(|n| n.len() == mesh.face_vertices.len());
+        let corner_normals = mesh
+            .normals
+            .as_ref()
+            .filter(|n| n.len() == mesh.face_vertices.len());
         let (positions, corner_index): (Vec<[f64; 3]>, Vec<u32>) = match corner_normals {
             Some(_) => {
                 let mut map = std::collections::HashMap::new();
@@ -87,12 +110,16 @@ impl RenderMesh {
             vertices: positions
                 .iter()
                 .zip(&normals)
-                .map(|(p, n)| Vertex { position: p.map(|c| c as f32), normal: n.map(|c| c as f32) })
+                .map(|(p, n)| Vertex {
+                    position: p.map(|c| c as f32),
+                    normal: n.map(|c| c as f32),
+                })
                 .collect(),
             ..Default::default()
         };
         for f in 0..mesh.num_faces() {
-            let face = &corner_index[mesh.face_offsets[f] as usize..mesh.face_offsets[f + 1] as usize];
+            let face =
+                &corner_index[mesh.face_offsets[f] as usize..mesh.face_offsets[f + 1] as usize];
             let fan = (1..face.len() - 1).map(|i| [face[0], face[i], face[i + 1]]);
             out.triangles.extend(fan.clone());
             if face.len() == 4 {
@@ -117,7 +144,11 @@ impl RenderMesh {
 
 /// Vertex normals as the sum of face normals weighted by each corner's angle (Thürmer & Wüthrich),
 /// independent of how faces are split into triangles.
-pub fn angle_weighted_normals(positions: &[[f64; 3]], face_offsets: &[u32], corners: &[u32]) -> Vec<[f64; 3]> {
+pub fn angle_weighted_normals(
+    positions: &[[f64; 3]],
+    face_offsets: &[u32],
+    corners: &[u32],
+) -> Vec<[f64; 3]> {
     let mut acc = vec![[0.0f64; 3]; positions.len()];
     for f in 0..face_offsets.len().saturating_sub(1) {
         let face = &corners[face_offsets[f] as usize..face_offsets[f + 1] as usize];
@@ -135,14 +166,21 @@ pub fn angle_weighted_normals(positions: &[[f64; 3]], face_offsets: &[u32], corn
             let v = face[i] as usize;
             let prev = positions[face[(i + face.len() - 1) % face.len()] as usize];
             let next = positions[face[(i + 1) % face.len()] as usize];
-            let (Some(e0), Some(e1)) = (normalize(sub(prev, positions[v])), normalize(sub(next, positions[v]))) else { continue };
+            let (Some(e0), Some(e1)) = (
+                normalize(sub(prev, positions[v])),
+                normalize(sub(next, positions[v])),
+            ) else {
+                continue;
+            };
             let angle = dot(e0, e1).clamp(-1.0, 1.0).acos();
             for k in 0..3 {
                 acc[v][k] += angle * n[k];
             }
         }
     }
-    acc.into_iter().map(|n| normalize(n).unwrap_or([0.0, 0.0, 1.0])).collect()
+    acc.into_iter()
+        .map(|n| normalize(n).unwrap_or([0.0, 0.0, 1.0]))
+        .collect()
 }
 
 #[cfg(test)]
@@ -151,7 +189,11 @@ mod tests {
 
     #[test]
     fn cube_normals_point_along_diagonals() {
-        let mesh = topology::parse_obj(include_str!("../../../tests/data/meshes/cube.obj"), "cube.obj").unwrap();
+        let mesh = topology::parse_obj(
+            include_str!("../../../tests/data/meshes/cube.obj"),
+            "cube.obj",
+        )
+        .unwrap();
         let rm = RenderMesh::from_control_mesh(&mesh).unwrap();
         assert_eq!(rm.quads.len(), 6);
         assert_eq!(rm.triangles.len(), 12);
@@ -159,8 +201,8 @@ mod tests {
             // Equal angles (90°) at each corner: the normal is the corner's diagonal direction.
             let p = v.position;
             let len = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-            for k in 0..3 {
-                assert!((v.normal[k] - p[k] / len).abs() < 1e-6, "{v:?}");
+            for (n, c) in v.normal.iter().zip(p) {
+                assert!((n - c / len).abs() < 1e-6, "{v:?}");
             }
         }
     }
@@ -168,7 +210,13 @@ mod tests {
     #[test]
     fn pentagon_is_fan_triangulated() {
         let mesh = topology::ControlMesh::from_polygons(
-            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.5, 1.0, 0.0], [0.5, 1.5, 0.0], [-0.5, 1.0, 0.0]],
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.5, 1.0, 0.0],
+                [0.5, 1.5, 0.0],
+                [-0.5, 1.0, 0.0],
+            ],
             &[[0u32, 1, 2, 3, 4]],
         );
         let rm = RenderMesh::from_control_mesh(&mesh).unwrap();
@@ -179,8 +227,13 @@ mod tests {
 
     #[test]
     fn out_of_range_index_is_an_error() {
-        let mesh = topology::ControlMesh::from_polygons(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[0u32, 1, 7]]);
-        let e = RenderMesh::from_control_mesh(&mesh).unwrap_err().to_string();
+        let mesh = topology::ControlMesh::from_polygons(
+            vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            &[[0u32, 1, 7]],
+        );
+        let e = RenderMesh::from_control_mesh(&mesh)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("face 0") && e.contains('7'), "{e}");
     }
 }

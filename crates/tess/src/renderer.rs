@@ -109,12 +109,26 @@ pub struct PatchList {
     pub control_points: u32,
 }
 
-fn patch_list(device: &Device, name: &str, indices: &[u32], control_points: u32) -> Result<Option<PatchList>> {
+fn patch_list(
+    device: &Device,
+    name: &str,
+    indices: &[u32],
+    control_points: u32,
+) -> Result<Option<PatchList>> {
     if indices.is_empty() {
         return Ok(None);
     }
-    let buffer = Buffer::with_data(device, name, vk::BufferUsageFlags::INDEX_BUFFER, bytemuck::cast_slice(indices))?;
-    Ok(Some(PatchList { indices: buffer, patches: indices.len() as u32 / control_points, control_points }))
+    let buffer = Buffer::with_data(
+        device,
+        name,
+        vk::BufferUsageFlags::INDEX_BUFFER,
+        bytemuck::cast_slice(indices),
+    )?;
+    Ok(Some(PatchList {
+        indices: buffer,
+        patches: indices.len() as u32 / control_points,
+        control_points,
+    }))
 }
 
 impl GpuMesh {
@@ -126,9 +140,16 @@ impl GpuMesh {
         let quad: Vec<u32> = mesh.quads.iter().flatten().copied().collect();
         let qtri: Vec<u32> = mesh.quad_mode_triangles.iter().flatten().copied().collect();
         if !(in_range(&tri) && in_range(&quad) && in_range(&qtri)) {
-            return Err(TessError::Invalid("patch index out of range of the vertex buffer".into()));
+            return Err(TessError::Invalid(
+                "patch index out of range of the vertex buffer".into(),
+            ));
         }
-        let vertices = Buffer::with_data(device, "mesh vertices", vk::BufferUsageFlags::VERTEX_BUFFER, bytemuck::cast_slice(&mesh.vertices))?;
+        let vertices = Buffer::with_data(
+            device,
+            "mesh vertices",
+            vk::BufferUsageFlags::VERTEX_BUFFER,
+            bytemuck::cast_slice(&mesh.vertices),
+        )?;
         Ok(Self {
             vertices,
             triangles: patch_list(device, "triangle patches", &tri, 3)?,
@@ -168,14 +189,28 @@ pub struct DrawCounts {
 }
 
 impl Renderer {
-    pub fn new(device: &Device, color_format: vk::Format, depth_format: vk::Format, frames_in_flight: usize) -> Result<Self> {
+    pub fn new(
+        device: &Device,
+        color_format: vk::Format,
+        depth_format: vk::Format,
+        frames_in_flight: usize,
+    ) -> Result<Self> {
         let stages = vk::ShaderStageFlags::ALL_GRAPHICS;
         let set_layout = DescriptorSetLayout::new(
             device,
             "frame set layout",
-            &[BindingDesc { binding: 0, ty: vk::DescriptorType::UNIFORM_BUFFER, stages }],
+            &[BindingDesc {
+                binding: 0,
+                ty: vk::DescriptorType::UNIFORM_BUFFER,
+                stages,
+            }],
         )?;
-        let pool = DescriptorPool::new(device, "frame descriptor pool", &set_layout, frames_in_flight as u32)?;
+        let pool = DescriptorPool::new(
+            device,
+            "frame descriptor pool",
+            &set_layout,
+            frames_in_flight as u32,
+        )?;
         let mut slots = Vec::new();
         for i in 0..frames_in_flight {
             let uniforms = Buffer::new(
@@ -188,10 +223,21 @@ impl Renderer {
                 },
             )?;
             let set = pool.allocate(&set_layout)?;
-            pool.write_buffers(set, &[(0, vk::DescriptorType::UNIFORM_BUFFER, uniforms.descriptor())]);
+            pool.write_buffers(
+                set,
+                &[(0, vk::DescriptorType::UNIFORM_BUFFER, uniforms.descriptor())],
+            );
             slots.push(FrameSlot { uniforms, set });
         }
-        Ok(Self { pipelines: HashMap::new(), _pool: pool, set_layout, slots, color_format, depth_format, device: device.clone() })
+        Ok(Self {
+            pipelines: HashMap::new(),
+            _pool: pool,
+            set_layout,
+            slots,
+            color_format,
+            depth_format,
+            device: device.clone(),
+        })
     }
 
     /// A renderer for offscreen targets (RGBA8 + D32), one frame slot.
@@ -219,13 +265,51 @@ impl Renderer {
             FractionalOdd => fo,
         };
         let (tesc, tese, cp) = match (key.method, key.domain) {
-            (Method::Flat, Domain::Quad) => (shaders::QUAD_TESC, pick(shaders::FLAT_QUAD_TESE_EQUAL, shaders::FLAT_QUAD_TESE_FRACTIONAL_EVEN, shaders::FLAT_QUAD_TESE_FRACTIONAL_ODD), 4),
-            (Method::Flat, Domain::Triangle) => (shaders::TRI_TESC, pick(shaders::FLAT_TRI_TESE_EQUAL, shaders::FLAT_TRI_TESE_FRACTIONAL_EVEN, shaders::FLAT_TRI_TESE_FRACTIONAL_ODD), 3),
-            (Method::Phong, Domain::Triangle) => (shaders::TRI_TESC, pick(shaders::PHONG_TESE_EQUAL, shaders::PHONG_TESE_FRACTIONAL_EVEN, shaders::PHONG_TESE_FRACTIONAL_ODD), 3),
-            (Method::Pn, Domain::Triangle) => (shaders::PN_TESC, pick(shaders::PN_TESE_EQUAL, shaders::PN_TESE_FRACTIONAL_EVEN, shaders::PN_TESE_FRACTIONAL_ODD), 3),
+            (Method::Flat, Domain::Quad) => (
+                shaders::QUAD_TESC,
+                pick(
+                    shaders::FLAT_QUAD_TESE_EQUAL,
+                    shaders::FLAT_QUAD_TESE_FRACTIONAL_EVEN,
+                    shaders::FLAT_QUAD_TESE_FRACTIONAL_ODD,
+                ),
+                4,
+            ),
+            (Method::Flat, Domain::Triangle) => (
+                shaders::TRI_TESC,
+                pick(
+                    shaders::FLAT_TRI_TESE_EQUAL,
+                    shaders::FLAT_TRI_TESE_FRACTIONAL_EVEN,
+                    shaders::FLAT_TRI_TESE_FRACTIONAL_ODD,
+                ),
+                3,
+            ),
+            (Method::Phong, Domain::Triangle) => (
+                shaders::TRI_TESC,
+                pick(
+                    shaders::PHONG_TESE_EQUAL,
+                    shaders::PHONG_TESE_FRACTIONAL_EVEN,
+                    shaders::PHONG_TESE_FRACTIONAL_ODD,
+                ),
+                3,
+            ),
+            (Method::Pn, Domain::Triangle) => (
+                shaders::PN_TESC,
+                pick(
+                    shaders::PN_TESE_EQUAL,
+                    shaders::PN_TESE_FRACTIONAL_EVEN,
+                    shaders::PN_TESE_FRACTIONAL_ODD,
+                ),
+                3,
+            ),
             (m, d) => return Err(TessError::Invalid(format!("{m:?} has no {d:?} patches"))),
         };
-        let name = format!("{:?} {:?} {:?}{}", key.method, key.domain, key.spacing, if key.wireframe { " wireframe" } else { "" });
+        let name = format!(
+            "{:?} {:?} {:?}{}",
+            key.method,
+            key.domain,
+            key.spacing,
+            if key.wireframe { " wireframe" } else { "" }
+        );
         let mut desc = GraphicsPipelineDesc::new(&name, self.color_format, self.depth_format);
         desc.stages = vec![
             ShaderStage::new(vk::ShaderStageFlags::VERTEX, shaders::MESH_VERT),
@@ -233,13 +317,30 @@ impl Renderer {
             ShaderStage::new(vk::ShaderStageFlags::TESSELLATION_EVALUATION, tese),
             ShaderStage::new(vk::ShaderStageFlags::FRAGMENT, shaders::SHADE_FRAG),
         ];
-        desc.vertex_bindings = vec![vk::VertexInputBindingDescription { binding: 0, stride: std::mem::size_of::<Vertex>() as u32, input_rate: vk::VertexInputRate::VERTEX }];
+        desc.vertex_bindings = vec![vk::VertexInputBindingDescription {
+            binding: 0,
+            stride: std::mem::size_of::<Vertex>() as u32,
+            input_rate: vk::VertexInputRate::VERTEX,
+        }];
         desc.vertex_attributes = vec![
-            vk::VertexInputAttributeDescription { location: 0, binding: 0, format: vk::Format::R32G32B32_SFLOAT, offset: 0 },
-            vk::VertexInputAttributeDescription { location: 1, binding: 0, format: vk::Format::R32G32B32_SFLOAT, offset: 12 },
+            vk::VertexInputAttributeDescription {
+                location: 0,
+                binding: 0,
+                format: vk::Format::R32G32B32_SFLOAT,
+                offset: 0,
+            },
+            vk::VertexInputAttributeDescription {
+                location: 1,
+                binding: 0,
+                format: vk::Format::R32G32B32_SFLOAT,
+                offset: 12,
+            },
         ];
         desc.topology = vk::PrimitiveTopology::PATCH_LIST;
-        desc.tessellation = Some(TessellationDesc { patch_control_points: cp, domain_origin: vk::TessellationDomainOrigin::UPPER_LEFT });
+        desc.tessellation = Some(TessellationDesc {
+            patch_control_points: cp,
+            domain_origin: vk::TessellationDomainOrigin::UPPER_LEFT,
+        });
         desc.set_layouts = vec![self.set_layout.raw];
         desc.push_constant_bytes = std::mem::size_of::<DrawPush>() as u32;
         if key.wireframe {
@@ -254,10 +355,18 @@ impl Renderer {
     }
 
     /// Writes the frame uniforms of slot `slot` for `params` and a target of `extent`.
-    pub fn update_uniforms(&mut self, slot: usize, mesh: &GpuMesh, params: &DrawParams, extent: vk::Extent2D) -> Result<()> {
+    pub fn update_uniforms(
+        &mut self,
+        slot: usize,
+        mesh: &GpuMesh,
+        params: &DrawParams,
+        extent: vk::Extent2D,
+    ) -> Result<()> {
         let aspect = extent.width as f32 / extent.height.max(1) as f32;
         let m = params.camera.matrices(mesh.bbox_min, mesh.bbox_max, aspect);
-        let light = (m.eye - glam::Vec3::from(mesh.bbox_min).lerp(glam::Vec3::from(mesh.bbox_max), 0.5)).normalize_or_zero();
+        let light = (m.eye
+            - glam::Vec3::from(mesh.bbox_min).lerp(glam::Vec3::from(mesh.bbox_max), 0.5))
+        .normalize_or_zero();
         let light = (light + glam::Vec3::new(0.3, 0.6, 0.2)).normalize_or_zero();
         let level = params.level.clamp(1.0, crate::tessellator::MAX_LEVEL);
         let u = FrameUniforms {
@@ -266,54 +375,128 @@ impl Renderer {
             camera_pos: [m.eye.x, m.eye.y, m.eye.z, 1.0],
             light_dir: [light.x, light.y, light.z, 0.0],
             tess: [level, level, params.phong_alpha, 0.0],
-            base_color: [params.base_color[0], params.base_color[1], params.base_color[2], 1.0],
+            base_color: [
+                params.base_color[0],
+                params.base_color[1],
+                params.base_color[2],
+                1.0,
+            ],
             wire_color: [0.05, 0.05, 0.08, 1.0],
             viewport: [extent.width as f32, extent.height as f32, 0.0, 0.0],
         };
-        let slot = self.slots.get_mut(slot).ok_or_else(|| TessError::Invalid(format!("no frame slot {slot}")))?;
+        let slot = self
+            .slots
+            .get_mut(slot)
+            .ok_or_else(|| TessError::Invalid(format!("no frame slot {slot}")))?;
         slot.uniforms.write(0, bytemuck::bytes_of(&u))?;
         Ok(())
     }
 
     /// Records the draws of one frame inside an active rendering scope.
-    pub fn record(&mut self, cmd: vk::CommandBuffer, slot: usize, mesh: &GpuMesh, params: &DrawParams) -> Result<DrawCounts> {
-        let passes: &[bool] = if params.wireframe { &[false, true] } else { &[false] };
+    pub fn record(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        slot: usize,
+        mesh: &GpuMesh,
+        params: &DrawParams,
+    ) -> Result<DrawCounts> {
+        let passes: &[bool] = if params.wireframe {
+            &[false, true]
+        } else {
+            &[false]
+        };
         self.record_passes(cmd, slot, mesh, params, passes)
     }
 
     /// Records the shaded (`false`) and/or wireframe (`true`) passes.
-    fn record_passes(&mut self, cmd: vk::CommandBuffer, slot: usize, mesh: &GpuMesh, params: &DrawParams, passes: &[bool]) -> Result<DrawCounts> {
+    fn record_passes(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        slot: usize,
+        mesh: &GpuMesh,
+        params: &DrawParams,
+        passes: &[bool],
+    ) -> Result<DrawCounts> {
         let mut counts = DrawCounts::default();
-        let set = self.slots.get(slot).ok_or_else(|| TessError::Invalid(format!("no frame slot {slot}")))?.set;
+        let set = self
+            .slots
+            .get(slot)
+            .ok_or_else(|| TessError::Invalid(format!("no frame slot {slot}")))?
+            .set;
         let lists: Vec<(&PatchList, Domain)> = match params.method {
-            Method::Flat => [(mesh.quads.as_ref(), Domain::Quad), (mesh.quad_mode_triangles.as_ref(), Domain::Triangle)]
-                .into_iter()
-                .filter_map(|(l, d)| l.map(|l| (l, d)))
-                .collect(),
-            Method::Phong | Method::Pn => mesh.triangles.as_ref().map(|l| vec![(l, Domain::Triangle)]).unwrap_or_default(),
+            Method::Flat => [
+                (mesh.quads.as_ref(), Domain::Quad),
+                (mesh.quad_mode_triangles.as_ref(), Domain::Triangle),
+            ]
+            .into_iter()
+            .filter_map(|(l, d)| l.map(|l| (l, d)))
+            .collect(),
+            Method::Phong | Method::Pn => mesh
+                .triangles
+                .as_ref()
+                .map(|l| vec![(l, Domain::Triangle)])
+                .unwrap_or_default(),
         };
         let device = self.device.clone();
         device.begin_label(cmd, &format!("{:?} level {}", params.method, params.level));
         for &wire in passes {
             for &(list, domain) in &lists {
-                let key = PipelineKey { method: params.method, domain, spacing: params.spacing, wireframe: wire };
+                let key = PipelineKey {
+                    method: params.method,
+                    domain,
+                    spacing: params.spacing,
+                    wireframe: wire,
+                };
                 let pipeline = self.pipeline(key)?;
                 let push = DrawPush { mode: wire as u32 };
                 // SAFETY: cmd is recording inside a rendering scope; all bound objects are live
                 // and owned by self or mesh, which outlive the submission (callers wait).
                 unsafe {
-                    device.raw.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.raw);
-                    device.raw.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.layout, 0, &[set], &[]);
-                    device.raw.cmd_push_constants(cmd, pipeline.layout, vk::ShaderStageFlags::ALL, 0, bytemuck::bytes_of(&push));
-                    device.raw.cmd_bind_vertex_buffers(cmd, 0, &[mesh.vertices.raw], &[0]);
-                    device.raw.cmd_bind_index_buffer(cmd, list.indices.raw, 0, vk::IndexType::UINT32);
+                    device.raw.cmd_bind_pipeline(
+                        cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        pipeline.raw,
+                    );
+                    device.raw.cmd_bind_descriptor_sets(
+                        cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        pipeline.layout,
+                        0,
+                        &[set],
+                        &[],
+                    );
+                    device.raw.cmd_push_constants(
+                        cmd,
+                        pipeline.layout,
+                        vk::ShaderStageFlags::ALL,
+                        0,
+                        bytemuck::bytes_of(&push),
+                    );
+                    device
+                        .raw
+                        .cmd_bind_vertex_buffers(cmd, 0, &[mesh.vertices.raw], &[0]);
+                    device.raw.cmd_bind_index_buffer(
+                        cmd,
+                        list.indices.raw,
+                        0,
+                        vk::IndexType::UINT32,
+                    );
                 }
                 let per_draw = patches_per_draw(&device, params, domain, list.control_points);
                 let mut first = 0;
                 while first < list.patches {
                     let n = per_draw.min(list.patches - first);
                     // SAFETY: first + n ≤ patches, so the range lies inside the index buffer.
-                    unsafe { device.raw.cmd_draw_indexed(cmd, n * list.control_points, 1, first * list.control_points, 0, 0) };
+                    unsafe {
+                        device.raw.cmd_draw_indexed(
+                            cmd,
+                            n * list.control_points,
+                            1,
+                            first * list.control_points,
+                            0,
+                            0,
+                        )
+                    };
                     counts.draws += 1;
                     counts.patches += n;
                     first += n;
@@ -325,7 +508,12 @@ impl Renderer {
     }
 
     /// Renders one frame offscreen and reads it back.
-    pub fn render_offscreen(&mut self, mesh: &GpuMesh, params: &DrawParams, extent: vk::Extent2D) -> Result<Rgba8> {
+    pub fn render_offscreen(
+        &mut self,
+        mesh: &GpuMesh,
+        params: &DrawParams,
+        extent: vk::Extent2D,
+    ) -> Result<Rgba8> {
         Ok(self.render_offscreen_stats(mesh, params, extent, false)?.0)
     }
 
@@ -341,7 +529,11 @@ impl Renderer {
         let device = self.device.clone();
         let target = OffscreenTarget::new(&device, extent)?;
         let readback = target.readback_buffer(&device)?;
-        let query = if statistics { Some(QueryPool::statistics(&device, "pipeline statistics", 1)?) } else { None };
+        let query = if statistics {
+            Some(QueryPool::statistics(&device, "pipeline statistics", 1)?)
+        } else {
+            None
+        };
         self.update_uniforms(0, mesh, params, extent)?;
         let mut result = Ok(DrawCounts::default());
         device.one_shot(|cmd| {
@@ -351,7 +543,11 @@ impl Renderer {
             target.cmd_begin(&device, cmd, params.clear_color);
             if let Some(q) = &query {
                 // SAFETY: the query was reset above in this command buffer.
-                unsafe { device.raw.cmd_begin_query(cmd, q.raw, 0, vk::QueryControlFlags::empty()) };
+                unsafe {
+                    device
+                        .raw
+                        .cmd_begin_query(cmd, q.raw, 0, vk::QueryControlFlags::empty())
+                };
             }
             result = self.record_passes(cmd, 0, mesh, params, &[false]);
             if let Some(q) = &query {
@@ -360,10 +556,12 @@ impl Renderer {
             }
             if params.wireframe {
                 if let Ok(shaded) = result {
-                    result = self.record_passes(cmd, 0, mesh, params, &[true]).map(|w| DrawCounts {
-                        draws: shaded.draws + w.draws,
-                        patches: shaded.patches + w.patches,
-                    });
+                    result =
+                        self.record_passes(cmd, 0, mesh, params, &[true])
+                            .map(|w| DrawCounts {
+                                draws: shaded.draws + w.draws,
+                                patches: shaded.patches + w.patches,
+                            });
                 }
             }
             target.cmd_end_and_copy(&device, cmd, &readback);
@@ -379,12 +577,21 @@ impl Renderer {
 
 /// Patches per draw call: the whole list, unless a driver workaround limits it (see
 /// `vk_core::workarounds::WorkaroundId::LavapipeTessChunkVertexLimit`).
-pub fn patches_per_draw(device: &Device, params: &DrawParams, domain: Domain, _control_points: u32) -> u32 {
+pub fn patches_per_draw(
+    device: &Device,
+    params: &DrawParams,
+    domain: Domain,
+    _control_points: u32,
+) -> u32 {
     match params.split {
         DrawSplit::Off => u32::MAX,
         DrawSplit::PerPatch => 1,
         DrawSplit::Auto => {
-            let max_vertices = uniform_vertex_count(domain, params.spacing, params.level.clamp(1.0, crate::tessellator::MAX_LEVEL));
+            let max_vertices = uniform_vertex_count(
+                domain,
+                params.spacing,
+                params.level.clamp(1.0, crate::tessellator::MAX_LEVEL),
+            );
             device.workarounds.max_patches_per_draw(max_vertices)
         }
     }

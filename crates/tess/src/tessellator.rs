@@ -19,7 +19,9 @@ impl std::str::FromStr for Spacing {
             "equal" => Ok(Spacing::Equal),
             "fractional-even" | "fractional_even" => Ok(Spacing::FractionalEven),
             "fractional-odd" | "fractional_odd" => Ok(Spacing::FractionalOdd),
-            _ => Err(format!("unknown spacing '{s}' (equal, fractional-even, fractional-odd)")),
+            _ => Err(format!(
+                "unknown spacing '{s}' (equal, fractional-even, fractional-odd)"
+            )),
         }
     }
 }
@@ -128,19 +130,34 @@ mod tests {
 
     #[test]
     fn known_counts() {
-        assert_eq!(uniform_vertex_count(Domain::Triangle, Spacing::Equal, 1.0), 3);
-        assert_eq!(uniform_vertex_count(Domain::Triangle, Spacing::Equal, 2.0), 7);
-        assert_eq!(uniform_vertex_count(Domain::Triangle, Spacing::Equal, 3.0), 12);
+        assert_eq!(
+            uniform_vertex_count(Domain::Triangle, Spacing::Equal, 1.0),
+            3
+        );
+        assert_eq!(
+            uniform_vertex_count(Domain::Triangle, Spacing::Equal, 2.0),
+            7
+        );
+        assert_eq!(
+            uniform_vertex_count(Domain::Triangle, Spacing::Equal, 3.0),
+            12
+        );
         assert_eq!(uniform_vertex_count(Domain::Quad, Spacing::Equal, 1.0), 4);
         assert_eq!(uniform_vertex_count(Domain::Quad, Spacing::Equal, 2.0), 9);
         assert_eq!(uniform_vertex_count(Domain::Quad, Spacing::Equal, 4.0), 25);
         // Quads with uniform level n form an (n+1)^2 grid.
         for n in 1..=64u32 {
-            assert_eq!(uniform_vertex_count(Domain::Quad, Spacing::Equal, n as f32), ((n + 1) * (n + 1)) as u64);
+            assert_eq!(
+                uniform_vertex_count(Domain::Quad, Spacing::Equal, n as f32),
+                ((n + 1) * (n + 1)) as u64
+            );
         }
         // Triangles with uniform level n hold (n+1)(n+2)/2 points when n is even.
         for n in (2..=64u32).step_by(2) {
-            assert_eq!(uniform_vertex_count(Domain::Triangle, Spacing::Equal, n as f32), ((n + 1) * (n + 2) / 2) as u64);
+            assert_eq!(
+                uniform_vertex_count(Domain::Triangle, Spacing::Equal, n as f32),
+                ((n + 1) * (n + 2) / 2) as u64
+            );
         }
     }
 

@@ -4,7 +4,11 @@ use std::path::PathBuf;
 use tess::{Method, Spacing};
 
 #[derive(Parser, Debug)]
-#[command(name = "tessera", version, about = "Subdivision surfaces on the GPU tessellation stage (Vulkan)")]
+#[command(
+    name = "tessera",
+    version,
+    about = "Subdivision surfaces on the GPU tessellation stage (Vulkan)"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -50,7 +54,7 @@ pub struct SceneArgs {
     /// Draw the tessellated wireframe over the shaded surface.
     #[arg(long)]
     pub wireframe: bool,
-    #[arg(long, default_value_t = 35.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 145.0, allow_hyphen_values = true)]
     pub yaw: f32,
     #[arg(long, default_value_t = 20.0, allow_hyphen_values = true)]
     pub pitch: f32,
@@ -97,9 +101,17 @@ fn parse_spacing(s: &str) -> Result<Spacing, String> {
 }
 
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("size '{s}' is not WIDTHxHEIGHT"))?;
-    let w: u32 = w.trim().parse().map_err(|_| format!("bad width in '{s}'"))?;
-    let h: u32 = h.trim().parse().map_err(|_| format!("bad height in '{s}'"))?;
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("size '{s}' is not WIDTHxHEIGHT"))?;
+    let w: u32 = w
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad width in '{s}'"))?;
+    let h: u32 = h
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad height in '{s}'"))?;
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
         return Err(format!("size '{s}' must be between 1x1 and 16384x16384"));
     }

@@ -34,7 +34,10 @@ pub fn load_mesh(path: Option<&std::path::Path>) -> Result<topology::ControlMesh
         None => topology::parse_obj(DEFAULT_MESH, "spot_control_mesh.obj (embedded)")?,
     };
     if mesh.num_faces() == 0 {
-        bail!("{}: empty mesh (no faces)", path.map(|p| p.display().to_string()).unwrap_or_default());
+        bail!(
+            "{}: empty mesh (no faces)",
+            path.map(|p| p.display().to_string()).unwrap_or_default()
+        );
     }
     Ok(mesh)
 }
@@ -48,21 +51,41 @@ pub fn draw_params(s: &SceneArgs) -> Result<DrawParams> {
         spacing: s.spacing,
         level: s.level,
         wireframe: s.wireframe,
-        camera: Camera { yaw: s.yaw, pitch: s.pitch, zoom: s.zoom, ..Camera::default() },
+        camera: Camera {
+            yaw: s.yaw,
+            pitch: s.pitch,
+            zoom: s.zoom,
+            ..Camera::default()
+        },
         phong_alpha: s.alpha,
         ..DrawParams::default()
     })
 }
 
 /// Instance + device as the command line asks; errors list the devices seen.
-pub fn open_device(g: &GpuArgs, surface_extensions: Vec<&'static std::ffi::CStr>, device_extensions: &[&'static std::ffi::CStr]) -> Result<(Arc<Instance>, Device)> {
-    let instance = Instance::new(&InstanceDesc { app_name: "tessera".into(), validation: validation(g), surface_extensions })?;
+pub fn open_device(
+    g: &GpuArgs,
+    surface_extensions: Vec<&'static std::ffi::CStr>,
+    device_extensions: &[&'static std::ffi::CStr],
+) -> Result<(Arc<Instance>, Device)> {
+    let instance = Instance::new(&InstanceDesc {
+        app_name: "tessera".into(),
+        validation: validation(g),
+        surface_extensions,
+    })?;
     let selector = g.device.parse().unwrap_or_default();
     let cache = std::env::var_os("XDG_CACHE_HOME")
         .map(std::path::PathBuf::from)
         .or_else(|| std::env::var_os("HOME").map(|h| std::path::PathBuf::from(h).join(".cache")))
         .map(|d| d.join("tessera").join("pipeline-cache.bin"));
-    let device = Device::new(&instance, &DeviceDesc { selector, pipeline_cache_path: cache }, device_extensions)?;
+    let device = Device::new(
+        &instance,
+        &DeviceDesc {
+            selector,
+            pipeline_cache_path: cache,
+        },
+        device_extensions,
+    )?;
     log::info!("using {}", device.info);
     Ok((instance, device))
 }
@@ -71,7 +94,10 @@ pub fn open_device(g: &GpuArgs, surface_extensions: Vec<&'static std::ffi::CStr>
 pub fn check_validation(instance: &Instance) -> Result<()> {
     let n = instance.messages().error_count();
     if n > 0 {
-        bail!("the Vulkan validation layer reported {n} error(s): {:#?}", instance.messages().error_messages());
+        bail!(
+            "the Vulkan validation layer reported {n} error(s): {:#?}",
+            instance.messages().error_messages()
+        );
     }
     Ok(())
 }
@@ -84,19 +110,42 @@ fn render(a: RenderArgs) -> Result<()> {
     {
         let gm = GpuMesh::upload(&device, &rm)?;
         let mut renderer = Renderer::offscreen(&device)?;
-        let img = renderer.render_offscreen(&gm, &params, vk::Extent2D { width: a.size.0, height: a.size.1 })?;
+        let img = renderer.render_offscreen(
+            &gm,
+            &params,
+            vk::Extent2D {
+                width: a.size.0,
+                height: a.size.1,
+            },
+        )?;
         img.save_png(&a.output)?;
     }
     drop(device);
     check_validation(&instance)?;
-    println!("wrote {} ({}x{}, {:?}, level {})", a.output.display(), a.size.0, a.size.1, params.method, params.level);
+    println!(
+        "wrote {} ({}x{}, {:?}, level {})",
+        a.output.display(),
+        a.size.0,
+        a.size.1,
+        params.method,
+        params.level
+    );
     Ok(())
 }
 
 fn info(g: &GpuArgs) -> Result<()> {
-    let instance = Instance::new(&InstanceDesc { app_name: "tessera info".into(), validation: validation(g), surface_extensions: vec![] })?;
+    let instance = Instance::new(&InstanceDesc {
+        app_name: "tessera info".into(),
+        validation: validation(g),
+        surface_extensions: vec![],
+    })?;
     let v = instance.api_version;
-    println!("Vulkan loader: {}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v));
+    println!(
+        "Vulkan loader: {}.{}.{}",
+        vk::api_version_major(v),
+        vk::api_version_minor(v),
+        vk::api_version_patch(v)
+    );
     println!("validation layer: {:?}", instance.validation());
     let adapters = vk_core::device::enumerate_adapters(&instance)?;
     if adapters.is_empty() {

@@ -8,7 +8,10 @@ use clap::Parser;
 
 fn main() -> std::process::ExitCode {
     let args = cli::Cli::parse();
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(if args.verbose { "info" } else { "warn" })).init();
+    env_logger::Builder::from_env(
+        env_logger::Env::default().default_filter_or(if args.verbose { "info" } else { "warn" }),
+    )
+    .init();
     match commands::run(args) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {

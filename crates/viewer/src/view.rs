@@ -46,38 +46,79 @@ impl App {
     fn init(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
         let attrs = Window::default_attributes()
             .with_title("tessera")
-            .with_inner_size(winit::dpi::PhysicalSize::new(self.args.size.0, self.args.size.1));
-        let window = Arc::new(event_loop.create_window(attrs).context("creating the window")?);
+            .with_inner_size(winit::dpi::PhysicalSize::new(
+                self.args.size.0,
+                self.args.size.1,
+            ));
+        let window = Arc::new(
+            event_loop
+                .create_window(attrs)
+                .context("creating the window")?,
+        );
         let display = window.display_handle().context("display handle")?.as_raw();
         let handle = window.window_handle().context("window handle")?.as_raw();
-        let (instance, device) = open_device(&self.args.scene.gpu, required_surface_extensions(display)?, &[Swapchain::DEVICE_EXTENSION])?;
+        let (instance, device) = open_device(
+            &self.args.scene.gpu,
+            required_surface_extensions(display)?,
+            &[Swapchain::DEVICE_EXTENSION],
+        )?;
         let size = window.inner_size();
-        let swapchain = Swapchain::new(&device, display, handle, vk::Extent2D { width: size.width, height: size.height })?;
+        let swapchain = Swapchain::new(
+            &device,
+            display,
+            handle,
+            vk::Extent2D {
+                width: size.width,
+                height: size.height,
+            },
+        )?;
         let renderer = Renderer::new(&device, swapchain.format, DEPTH_FORMAT, FRAMES_IN_FLIGHT)?;
         let mesh = GpuMesh::upload(&device, &self.rm)?;
-        self.gpu = Some(Gpu { renderer, mesh, swapchain, device, instance });
+        self.gpu = Some(Gpu {
+            renderer,
+            mesh,
+            swapchain,
+            device,
+            instance,
+        });
         self.window = Some(window);
         Ok(())
     }
 
     fn draw(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
-        let Some(gpu) = self.gpu.as_mut() else { return Ok(()) };
-        let Some(frame) = gpu.swapchain.begin_frame()? else { return Ok(()) };
-        gpu.renderer.update_uniforms(frame.slot, &gpu.mesh, &self.params, frame.extent)?;
-        gpu.swapchain.cmd_begin_rendering(&frame, self.params.clear_color)?;
-        gpu.renderer.record(frame.cmd, frame.slot, &gpu.mesh, &self.params)?;
+        let Some(gpu) = self.gpu.as_mut() else {
+            return Ok(());
+        };
+        let Some(frame) = gpu.swapchain.begin_frame()? else {
+            return Ok(());
+        };
+        gpu.renderer
+            .update_uniforms(frame.slot, &gpu.mesh, &self.params, frame.extent)?;
+        gpu.swapchain
+            .cmd_begin_rendering(&frame, self.params.clear_color)?;
+        gpu.renderer
+            .record(frame.cmd, frame.slot, &gpu.mesh, &self.params)?;
         let last = self.args.frames.is_some_and(|n| self.frames_drawn + 1 >= n);
-        let shot = gpu.swapchain.end_frame(frame, last && self.args.screenshot.is_some())?;
+        let shot = gpu
+            .swapchain
+            .end_frame(frame, last && self.args.screenshot.is_some())?;
         self.frames_drawn += 1;
         let now = Instant::now();
         self.frame_ms = 0.9 * self.frame_ms + 0.1 * (now - self.last_frame).as_secs_f64() * 1e3;
         self.last_frame = now;
         if let Some(w) = &self.window {
-            w.set_title(&format!("tessera — {:?} level {} {:?} — {:.2} ms/frame", self.params.method, self.params.level, self.params.spacing, self.frame_ms));
+            w.set_title(&format!(
+                "tessera — {:?} level {} {:?} — {:.2} ms/frame",
+                self.params.method, self.params.level, self.params.spacing, self.frame_ms
+            ));
         }
         if let (Some(img), Some(path)) = (shot, &self.args.screenshot) {
             img.save_png(path)?;
-            println!("wrote {} after {} frames", path.display(), self.frames_drawn);
+            println!(
+                "wrote {} after {} frames",
+                path.display(),
+                self.frames_drawn
+            );
         }
         if last {
             event_loop.exit();
@@ -96,8 +137,12 @@ impl App {
                 "w" | "W" => self.params.wireframe = !self.params.wireframe,
                 _ => {}
             },
-            Key::Named(NamedKey::ArrowUp) => self.params.level = (self.params.level * 2.0).min(64.0),
-            Key::Named(NamedKey::ArrowDown) => self.params.level = (self.params.level * 0.5).max(1.0),
+            Key::Named(NamedKey::ArrowUp) => {
+                self.params.level = (self.params.level * 2.0).min(64.0)
+            }
+            Key::Named(NamedKey::ArrowDown) => {
+                self.params.level = (self.params.level * 0.5).max(1.0)
+            }
             _ => {}
         }
     }
@@ -122,7 +167,10 @@ impl ApplicationHandler for App {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => {
                 if let Some(gpu) = self.gpu.as_mut() {
-                    gpu.swapchain.resize(vk::Extent2D { width: size.width, height: size.height });
+                    gpu.swapchain.resize(vk::Extent2D {
+                        width: size.width,
+                        height: size.height,
+                    });
                 }
             }
             WindowEvent::RedrawRequested => {
@@ -136,25 +184,30 @@ impl ApplicationHandler for App {
                 }
                 self.key(&event.logical_key);
             }
-            WindowEvent::MouseInput { state, button: MouseButton::Left, .. } => {
+            WindowEvent::MouseInput {
+                state,
+                button: MouseButton::Left,
+                ..
+            } => {
                 self.dragging = state == ElementState::Pressed;
                 self.last_cursor = None;
             }
-            WindowEvent::CursorMoved { position, .. } => {
-                if self.dragging {
-                    if let Some((x, y)) = self.last_cursor {
-                        self.params.camera.yaw -= (position.x - x) as f32 * 0.4;
-                        self.params.camera.pitch = (self.params.camera.pitch + (position.y - y) as f32 * 0.4).clamp(-89.0, 89.0);
-                    }
-                    self.last_cursor = Some((position.x, position.y));
+            WindowEvent::CursorMoved { position, .. } if self.dragging => {
+                if let Some((x, y)) = self.last_cursor {
+                    self.params.camera.yaw -= (position.x - x) as f32 * 0.4;
+                    self.params.camera.pitch = (self.params.camera.pitch
+                        + (position.y - y) as f32 * 0.4)
+                        .clamp(-89.0, 89.0);
                 }
+                self.last_cursor = Some((position.x, position.y));
             }
             WindowEvent::MouseWheel { delta, .. } => {
                 let steps = match delta {
                     MouseScrollDelta::LineDelta(_, y) => y,
                     MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
                 };
-                self.params.camera.zoom = (self.params.camera.zoom * 1.1f32.powf(steps)).clamp(0.1, 20.0);
+                self.params.camera.zoom =
+                    (self.params.camera.zoom * 1.1f32.powf(steps)).clamp(0.1, 20.0);
             }
             _ => {}
         }
@@ -174,7 +227,9 @@ pub fn run(args: ViewArgs) -> Result<()> {
     let mesh = load_mesh(args.scene.mesh.as_deref())?;
     let params = draw_params(&args.scene)?;
     let rm = RenderMesh::from_control_mesh(&mesh)?;
-    let event_loop = EventLoop::new().context("no window system (set DISPLAY or WAYLAND_DISPLAY; use `tessera render` headless)")?;
+    let event_loop = EventLoop::new().context(
+        "no window system (set DISPLAY or WAYLAND_DISPLAY; use `tessera render` headless)",
+    )?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
         args,
@@ -192,7 +247,13 @@ pub fn run(args: ViewArgs) -> Result<()> {
     event_loop.run_app(&mut app).context("event loop")?;
     let gpu = app.gpu.take();
     let result = match gpu {
-        Some(Gpu { renderer, mesh, swapchain, device, instance }) => {
+        Some(Gpu {
+            renderer,
+            mesh,
+            swapchain,
+            device,
+            instance,
+        }) => {
             drop((renderer, mesh, swapchain));
             drop(device);
             check_validation(&instance)

@@ -32,7 +32,11 @@ fn fails_with(args: &[&str], env: &[(&str, &str)], needles: &[&str]) {
     let o = tessera(args, env);
     let e = stderr(&o);
     assert!(!o.status.success(), "{args:?} should fail");
-    assert_eq!(o.status.code(), Some(1), "{args:?}: an error exit, not a crash: {e}");
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{args:?}: an error exit, not a crash: {e}"
+    );
     assert!(!e.contains("panicked"), "{args:?} panicked: {e}");
     for n in needles {
         assert!(e.contains(n), "{args:?}: error should mention {n:?}: {e}");
@@ -42,19 +46,29 @@ fn fails_with(args: &[&str], env: &[(&str, &str)], needles: &[&str]) {
 #[test]
 fn default_render_writes_a_shaded_png() {
     let out = tmp("default.png");
-    let o = tessera(&["render", "--size", "200x150", "-o", out.to_str().unwrap()], &[]);
+    let o = tessera(
+        &["render", "--size", "200x150", "-o", out.to_str().unwrap()],
+        &[],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let img = image::open(&out).unwrap().to_rgba8();
     assert_eq!(img.dimensions(), (200, 150));
     // The mesh covers a good part of the frame and is lit (not just background).
     let bg = img.get_pixel(0, 0).0;
     let covered = img.pixels().filter(|p| p.0 != bg).count();
-    assert!(covered > 200 * 150 / 10, "only {covered} pixels show the mesh");
+    assert!(
+        covered > 200 * 150 / 10,
+        "only {covered} pixels show the mesh"
+    );
 }
 
 #[test]
 fn missing_file_names_the_file() {
-    fails_with(&["render", "/nonexistent/cow.obj", "-o", "/tmp/x.png"], &[], &["/nonexistent/cow.obj"]);
+    fails_with(
+        &["render", "/nonexistent/cow.obj", "-o", "/tmp/x.png"],
+        &[],
+        &["/nonexistent/cow.obj"],
+    );
 }
 
 #[test]
@@ -66,30 +80,50 @@ fn malformed_obj_names_file_and_line() {
 #[test]
 fn out_of_range_face_names_the_face() {
     let p = write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n");
-    fails_with(&["render", p.to_str().unwrap()], &[], &["range.obj", "face 1"]);
+    fails_with(
+        &["render", p.to_str().unwrap()],
+        &[],
+        &["range.obj", "face 1"],
+    );
 }
 
 #[test]
 fn empty_mesh_is_an_error() {
     let p = write("empty.obj", "# nothing here\nv 0 0 0\n");
-    fails_with(&["render", p.to_str().unwrap()], &[], &["empty.obj", "empty"]);
+    fails_with(
+        &["render", p.to_str().unwrap()],
+        &[],
+        &["empty.obj", "empty"],
+    );
 }
 
 #[test]
 fn no_vulkan_loader_is_an_error() {
-    fails_with(&["render", "-o", "/tmp/x.png"], &[("TESSERA_VULKAN_LIBRARY", "/nonexistent/libvulkan.so.1")], &["Vulkan loader"]);
+    fails_with(
+        &["render", "-o", "/tmp/x.png"],
+        &[("TESSERA_VULKAN_LIBRARY", "/nonexistent/libvulkan.so.1")],
+        &["Vulkan loader"],
+    );
 }
 
 #[test]
 fn no_vulkan_device_is_an_error() {
     let icd = write("no_driver.json", "{}");
     let icd = icd.to_str().unwrap();
-    fails_with(&["render", "-o", "/tmp/x.png"], &[("VK_ICD_FILENAMES", icd), ("VK_DRIVER_FILES", icd)], &["device"]);
+    fails_with(
+        &["render", "-o", "/tmp/x.png"],
+        &[("VK_ICD_FILENAMES", icd), ("VK_DRIVER_FILES", icd)],
+        &["device"],
+    );
 }
 
 #[test]
 fn bad_level_is_an_error() {
-    fails_with(&["render", "--level", "65", "-o", "/tmp/x.png"], &[], &["level"]);
+    fails_with(
+        &["render", "--level", "65", "-o", "/tmp/x.png"],
+        &[],
+        &["level"],
+    );
 }
 
 #[test]
@@ -97,18 +131,26 @@ fn info_lists_devices_and_choice() {
     let o = tessera(&["info"], &[]);
     let s = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(s.contains("maxTessellationGenerationLevel") && s.contains("chosen:"), "{s}");
+    assert!(
+        s.contains("maxTessellationGenerationLevel") && s.contains("chosen:"),
+        "{s}"
+    );
 }
 
 /// Starts Xvfb on a free display; None when Xvfb is not installed (the README's test command
 /// installs it, and CI sets TESSERA_REQUIRE_XVFB=1 so a missing Xvfb fails there).
 fn xvfb() -> Option<(std::process::Child, String)> {
     for n in 90..120 {
-        if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() || Path::new(&format!("/tmp/.X{n}-lock")).exists() {
+        if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
+            || Path::new(&format!("/tmp/.X{n}-lock")).exists()
+        {
             continue;
         }
         let display = format!(":{n}");
-        let child = Command::new("Xvfb").args([&display, "-screen", "0", "640x480x24", "-nolisten", "tcp"]).spawn().ok()?;
+        let child = Command::new("Xvfb")
+            .args([&display, "-screen", "0", "640x480x24", "-nolisten", "tcp"])
+            .spawn()
+            .ok()?;
         for _ in 0..100 {
             if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
                 return Some((child, display));
@@ -123,23 +165,65 @@ fn xvfb() -> Option<(std::process::Child, String)> {
 #[test]
 fn window_screenshot_matches_offscreen_render() {
     let Some((mut server, display)) = xvfb() else {
-        assert!(std::env::var_os("TESSERA_REQUIRE_XVFB").is_none(), "Xvfb is required here but not installed");
+        assert!(
+            std::env::var_os("TESSERA_REQUIRE_XVFB").is_none(),
+            "Xvfb is required here but not installed"
+        );
         eprintln!("skipping: Xvfb not installed");
         return;
     };
     let shot = tmp("window.png");
     let offscreen = tmp("offscreen.png");
-    let common = ["--method", "pn", "--level", "5", "--wireframe", "--size", "320x240", "--yaw", "-30"];
-    let o = tessera(&[&["view"][..], &common, &["--frames", "30", "--screenshot", shot.to_str().unwrap()]].concat(), &[("DISPLAY", &display), ("WAYLAND_DISPLAY", "")]);
+    let common = [
+        "--method",
+        "pn",
+        "--level",
+        "5",
+        "--wireframe",
+        "--size",
+        "320x240",
+        "--yaw",
+        "-30",
+    ];
+    let o = tessera(
+        &[
+            &["view"][..],
+            &common,
+            &["--frames", "30", "--screenshot", shot.to_str().unwrap()],
+        ]
+        .concat(),
+        &[("DISPLAY", &display), ("WAYLAND_DISPLAY", "")],
+    );
     let _ = server.kill();
     let _ = server.wait();
     assert!(o.status.success(), "view failed: {}", stderr(&o));
-    let r = tessera(&[&["render"][..], &common, &["-o", offscreen.to_str().unwrap()]].concat(), &[]);
+    let r = tessera(
+        &[
+            &["render"][..],
+            &common,
+            &["-o", offscreen.to_str().unwrap()],
+        ]
+        .concat(),
+        &[],
+    );
     assert!(r.status.success(), "{}", stderr(&r));
     let a = image::open(&shot).unwrap().to_rgba8();
     let b = image::open(&offscreen).unwrap().to_rgba8();
     assert_eq!(a.dimensions(), b.dimensions());
-    let differing = a.pixels().zip(b.pixels()).filter(|(p, q)| p.0.iter().zip(q.0.iter()).take(3).any(|(x, y)| x.abs_diff(*y) > 24)).count();
+    let differing = a
+        .pixels()
+        .zip(b.pixels())
+        .filter(|(p, q)| {
+            p.0.iter()
+                .zip(q.0.iter())
+                .take(3)
+                .any(|(x, y)| x.abs_diff(*y) > 24)
+        })
+        .count();
     let fraction = differing as f64 / (a.width() * a.height()) as f64;
-    assert!(fraction <= 0.005, "window and offscreen differ in {:.3}% of pixels", fraction * 100.0);
+    assert!(
+        fraction <= 0.005,
+        "window and offscreen differ in {:.3}% of pixels",
+        fraction * 100.0
+    );
 }

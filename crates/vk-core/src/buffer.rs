@@ -27,7 +27,10 @@ pub struct Buffer {
 impl Buffer {
     pub fn new(device: &Device, desc: &BufferDesc<'_>) -> Result<Self> {
         let size = desc.size.max(4);
-        let info = vk::BufferCreateInfo::default().size(size).usage(desc.usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
+        let info = vk::BufferCreateInfo::default()
+            .size(size)
+            .usage(desc.usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: device is live; info is valid.
         let raw = unsafe { device.raw.create_buffer(&info, None) }.ctx("vkCreateBuffer")?;
         // SAFETY: raw was just created on this device.
@@ -52,21 +55,44 @@ impl Buffer {
             }
         };
         // SAFETY: memory comes from the allocator for these requirements; offset is aligned.
-        if let Err(e) = unsafe { device.raw.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) } {
+        if let Err(e) = unsafe {
+            device
+                .raw
+                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
+        } {
             // SAFETY: raw is unused.
             unsafe { device.raw.destroy_buffer(raw, None) };
             let _ = device.allocator.lock().map(|mut a| a.free(allocation));
-            return Err(VkError::Call { call: "vkBindBufferMemory", result: e });
+            return Err(VkError::Call {
+                call: "vkBindBufferMemory",
+                result: e,
+            });
         }
         device.set_name(raw, desc.name);
-        Ok(Self { raw, size, allocation: Some(allocation), name: desc.name.to_owned(), device: device.shared.clone() })
+        Ok(Self {
+            raw,
+            size,
+            allocation: Some(allocation),
+            name: desc.name.to_owned(),
+            device: device.shared.clone(),
+        })
     }
 
     /// A device-local buffer filled with `data` (through staging when not host-visible).
-    pub fn with_data(device: &Device, name: &str, usage: vk::BufferUsageFlags, data: &[u8]) -> Result<Self> {
+    pub fn with_data(
+        device: &Device,
+        name: &str,
+        usage: vk::BufferUsageFlags,
+        data: &[u8],
+    ) -> Result<Self> {
         let mut buffer = Self::new(
             device,
-            &BufferDesc { name, size: data.len() as u64, usage: usage | vk::BufferUsageFlags::TRANSFER_DST, location: MemoryLocation::GpuOnly },
+            &BufferDesc {
+                name,
+                size: data.len() as u64,
+                usage: usage | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuOnly,
+            },
         )?;
         if buffer.mapped_mut().is_some() {
             buffer.write(0, data)?;
@@ -87,7 +113,11 @@ impl Buffer {
         device.one_shot(|cmd| {
             let region = [vk::BufferCopy::default().size(size.max(4))];
             // SAFETY: both buffers are live and large enough; cmd is recording.
-            unsafe { device.raw.cmd_copy_buffer(cmd, staging.raw, buffer.raw, &region) };
+            unsafe {
+                device
+                    .raw
+                    .cmd_copy_buffer(cmd, staging.raw, buffer.raw, &region)
+            };
         })?;
         Ok(buffer)
     }
@@ -107,26 +137,40 @@ impl Buffer {
     /// Copies bytes into a host-visible buffer at `offset`.
     pub fn write(&mut self, offset: u64, data: &[u8]) -> Result<()> {
         let name = self.name.clone();
-        let slice = self.mapped_mut().ok_or_else(|| VkError::Invalid(format!("buffer {name} is not host-visible")))?;
+        let slice = self
+            .mapped_mut()
+            .ok_or_else(|| VkError::Invalid(format!("buffer {name} is not host-visible")))?;
         let start = offset as usize;
-        let end = start.checked_add(data.len()).filter(|&e| e <= slice.len()).ok_or_else(|| {
-            VkError::Invalid(format!("write of {} bytes at {offset} overflows buffer {name}", data.len()))
-        })?;
+        let end = start
+            .checked_add(data.len())
+            .filter(|&e| e <= slice.len())
+            .ok_or_else(|| {
+                VkError::Invalid(format!(
+                    "write of {} bytes at {offset} overflows buffer {name}",
+                    data.len()
+                ))
+            })?;
         slice[start..end].copy_from_slice(data);
         Ok(())
     }
 
     /// Reads a host-visible buffer as `T`s (the buffer's whole size, rounded down).
     pub fn read<T: bytemuck::Pod>(&self) -> Result<Vec<T>> {
-        let slice = self.mapped().ok_or_else(|| VkError::Invalid(format!("buffer {} is not host-visible", self.name)))?;
+        let slice = self
+            .mapped()
+            .ok_or_else(|| VkError::Invalid(format!("buffer {} is not host-visible", self.name)))?;
         let n = slice.len() / std::mem::size_of::<T>();
         let mut out = vec![T::zeroed(); n];
-        bytemuck::cast_slice_mut::<T, u8>(&mut out).copy_from_slice(&slice[..n * std::mem::size_of::<T>()]);
+        bytemuck::cast_slice_mut::<T, u8>(&mut out)
+            .copy_from_slice(&slice[..n * std::mem::size_of::<T>()]);
         Ok(out)
     }
 
     pub fn descriptor(&self) -> vk::DescriptorBufferInfo {
-        vk::DescriptorBufferInfo::default().buffer(self.raw).offset(0).range(vk::WHOLE_SIZE)
+        vk::DescriptorBufferInfo::default()
+            .buffer(self.raw)
+            .offset(0)
+            .range(vk::WHOLE_SIZE)
     }
 }
 

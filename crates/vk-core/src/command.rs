@@ -7,17 +7,30 @@ use ash::vk;
 impl Device {
     /// Records commands with `record`, submits them and waits for completion.
     pub fn one_shot<R>(&self, record: impl FnOnce(vk::CommandBuffer) -> R) -> Result<R> {
-        let pool = self.one_shot_pool.lock().map_err(|_| VkError::Invalid("command pool lock poisoned".into()))?;
-        let info = vk::CommandBufferAllocateInfo::default().command_pool(*pool).level(vk::CommandBufferLevel::PRIMARY).command_buffer_count(1);
+        let pool = self
+            .one_shot_pool
+            .lock()
+            .map_err(|_| VkError::Invalid("command pool lock poisoned".into()))?;
+        let info = vk::CommandBufferAllocateInfo::default()
+            .command_pool(*pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
         // SAFETY: pool belongs to this device and is externally synchronized by the lock.
-        let cmd = unsafe { self.raw.allocate_command_buffers(&info) }.ctx("vkAllocateCommandBuffers")?[0];
+        let cmd =
+            unsafe { self.raw.allocate_command_buffers(&info) }.ctx("vkAllocateCommandBuffers")?[0];
         let fence_info = vk::FenceCreateInfo::default();
         // SAFETY: device is live.
         let fence = unsafe { self.raw.create_fence(&fence_info, None) }.ctx("vkCreateFence")?;
         let result = (|| {
             // SAFETY: fresh command buffer.
-            unsafe { self.raw.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT)) }
-                .ctx("vkBeginCommandBuffer")?;
+            unsafe {
+                self.raw.begin_command_buffer(
+                    cmd,
+                    &vk::CommandBufferBeginInfo::default()
+                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                )
+            }
+            .ctx("vkBeginCommandBuffer")?;
             let r = record(cmd);
             // SAFETY: recording started above.
             unsafe { self.raw.end_command_buffer(cmd) }.ctx("vkEndCommandBuffer")?;
@@ -26,7 +39,8 @@ impl Device {
             {
                 let _q = self.queue_lock.lock();
                 // SAFETY: queue access is serialized by queue_lock.
-                unsafe { self.raw.queue_submit(self.queue, &submit, fence) }.ctx("vkQueueSubmit")?;
+                unsafe { self.raw.queue_submit(self.queue, &submit, fence) }
+                    .ctx("vkQueueSubmit")?;
             }
             // SAFETY: fence was submitted above.
             unsafe { self.raw.wait_for_fences(&[fence], true, u64::MAX) }.ctx("vkWaitForFences")?;

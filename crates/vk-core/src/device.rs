@@ -117,13 +117,16 @@ impl fmt::Display for AdapterInfo {
 fn cstr_field(chars: &[std::ffi::c_char]) -> String {
     // SAFETY: Vulkan fixed-size string fields are NUL-terminated within their length.
     let bytes: &[u8] = unsafe { std::slice::from_raw_parts(chars.as_ptr().cast(), chars.len()) };
-    CStr::from_bytes_until_nul(bytes).map(|c| c.to_string_lossy().into_owned()).unwrap_or_default()
+    CStr::from_bytes_until_nul(bytes)
+        .map(|c| c.to_string_lossy().into_owned())
+        .unwrap_or_default()
 }
 
 /// Lists every physical device with what it offers and lacks, in the loader's order.
 pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
     // SAFETY: instance.raw is a live instance.
-    let physicals = unsafe { instance.raw.enumerate_physical_devices() }.ctx("vkEnumeratePhysicalDevices")?;
+    let physicals =
+        unsafe { instance.raw.enumerate_physical_devices() }.ctx("vkEnumeratePhysicalDevices")?;
     let mut out = Vec::new();
     for (index, &physical) in physicals.iter().enumerate() {
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
@@ -132,15 +135,24 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
         let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
         // SAFETY: physical comes from this instance; the out-structs are valid chains.
         let families = unsafe {
-            instance.raw.get_physical_device_properties2(physical, &mut props2);
-            instance.raw.get_physical_device_features2(physical, &mut features2);
-            instance.raw.get_physical_device_queue_family_properties(physical)
+            instance
+                .raw
+                .get_physical_device_properties2(physical, &mut props2);
+            instance
+                .raw
+                .get_physical_device_features2(physical, &mut features2);
+            instance
+                .raw
+                .get_physical_device_queue_family_properties(physical)
         };
         let props = props2.properties;
         let feats = features2.features;
         let queue_family = families
             .iter()
-            .position(|q| q.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE))
+            .position(|q| {
+                q.queue_flags
+                    .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+            })
             .map(|i| i as u32);
         let timestamps = queue_family
             .map(|q| families[q as usize].timestamp_valid_bits > 0)
@@ -149,12 +161,15 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
             tessellation_shader: feats.tessellation_shader == vk::TRUE,
             fill_mode_non_solid: feats.fill_mode_non_solid == vk::TRUE,
             pipeline_statistics_query: feats.pipeline_statistics_query == vk::TRUE,
-            vertex_pipeline_stores_and_atomics: feats.vertex_pipeline_stores_and_atomics == vk::TRUE,
+            vertex_pipeline_stores_and_atomics: feats.vertex_pipeline_stores_and_atomics
+                == vk::TRUE,
             dynamic_rendering: f13.dynamic_rendering == vk::TRUE,
             timestamps,
             max_tessellation_generation_level: props.limits.max_tessellation_generation_level,
             max_tessellation_patch_size: props.limits.max_tessellation_patch_size,
-            max_tess_evaluation_output_components: props.limits.max_tessellation_evaluation_output_components,
+            max_tess_evaluation_output_components: props
+                .limits
+                .max_tessellation_evaluation_output_components,
             timestamp_period_ns: props.limits.timestamp_period,
         };
         let mut missing = Vec::new();
@@ -171,10 +186,16 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
             missing.push("dynamicRendering".to_owned());
         }
         if caps.tessellation_shader && caps.max_tessellation_generation_level < 64 {
-            missing.push(format!("maxTessellationGenerationLevel ≥ 64 (has {})", caps.max_tessellation_generation_level));
+            missing.push(format!(
+                "maxTessellationGenerationLevel ≥ 64 (has {})",
+                caps.max_tessellation_generation_level
+            ));
         }
         if caps.tessellation_shader && caps.max_tessellation_patch_size < 32 {
-            missing.push(format!("maxTessellationPatchSize ≥ 32 (has {})", caps.max_tessellation_patch_size));
+            missing.push(format!(
+                "maxTessellationPatchSize ≥ 32 (has {})",
+                caps.max_tessellation_patch_size
+            ));
         }
         if queue_family.is_none() {
             missing.push("a graphics+compute queue".to_owned());
@@ -200,7 +221,13 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
 
 /// Chooses deterministically: highest score, ties broken by the lowest index.
 pub fn choose_adapter(adapters: &[AdapterInfo], selector: &DeviceSelector) -> Result<usize> {
-    let listing = || adapters.iter().map(|a| format!("  {a}")).collect::<Vec<_>>().join("\n");
+    let listing = || {
+        adapters
+            .iter()
+            .map(|a| format!("  {a}"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
     let pick = match selector {
         DeviceSelector::Auto => adapters
             .iter()
@@ -210,7 +237,10 @@ pub fn choose_adapter(adapters: &[AdapterInfo], selector: &DeviceSelector) -> Re
         DeviceSelector::Index(i) => adapters.iter().find(|a| a.index == *i).map(|a| a.index),
         DeviceSelector::Name(n) => {
             let n = n.to_lowercase();
-            adapters.iter().find(|a| a.name.to_lowercase().contains(&n)).map(|a| a.index)
+            adapters
+                .iter()
+                .find(|a| a.name.to_lowercase().contains(&n))
+                .map(|a| a.index)
         }
     };
     match (pick, selector) {
@@ -272,14 +302,22 @@ impl std::ops::Deref for Device {
 }
 
 impl Device {
-    pub fn new(instance: &Arc<Instance>, desc: &DeviceDesc, extra_extensions: &[&'static CStr]) -> Result<Self> {
+    pub fn new(
+        instance: &Arc<Instance>,
+        desc: &DeviceDesc,
+        extra_extensions: &[&'static CStr],
+    ) -> Result<Self> {
         let adapters = enumerate_adapters(instance)?;
         let chosen = choose_adapter(&adapters, &desc.selector)?;
         let info = adapters[chosen].clone();
         let physical = info.physical;
-        let queue_family = info.queue_family.ok_or_else(|| VkError::NoSuitableDevice("no queue".into()))?;
+        let queue_family = info
+            .queue_family
+            .ok_or_else(|| VkError::NoSuitableDevice("no queue".into()))?;
         let priorities = [1.0f32];
-        let queue_info = [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
+        let queue_info = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(queue_family)
+            .queue_priorities(&priorities)];
         let features = vk::PhysicalDeviceFeatures::default()
             .tessellation_shader(true)
             .fill_mode_non_solid(true)
@@ -293,7 +331,8 @@ impl Device {
             .enabled_extension_names(&ext_names)
             .push_next(&mut f13);
         // SAFETY: physical belongs to instance; create info references live locals.
-        let raw = unsafe { instance.raw.create_device(physical, &create, None) }.ctx("vkCreateDevice")?;
+        let raw =
+            unsafe { instance.raw.create_device(physical, &create, None) }.ctx("vkCreateDevice")?;
         // SAFETY: the family/index were requested above.
         let queue = unsafe { raw.get_device_queue(queue_family, 0) };
         let allocator = Allocator::new(&AllocatorCreateDesc {
@@ -314,9 +353,13 @@ impl Device {
         };
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(queue_family)
-            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER | vk::CommandPoolCreateFlags::TRANSIENT);
+            .flags(
+                vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER
+                    | vk::CommandPoolCreateFlags::TRANSIENT,
+            );
         // SAFETY: raw is a live device.
-        let pool = unsafe { raw.create_command_pool(&pool_info, None) }.ctx("vkCreateCommandPool")?;
+        let pool =
+            unsafe { raw.create_command_pool(&pool_info, None) }.ctx("vkCreateCommandPool")?;
         let initial = desc
             .pipeline_cache_path
             .as_ref()
@@ -332,7 +375,9 @@ impl Device {
                     .ctx("vkCreatePipelineCache")?
             }
         };
-        let debug_utils = instance.has_debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance.raw, &raw));
+        let debug_utils = instance
+            .has_debug_utils
+            .then(|| ash::ext::debug_utils::Device::new(&instance.raw, &raw));
         let workarounds = Workarounds::for_adapter(&info);
         for w in workarounds.active() {
             log::info!("driver workaround active on {}: {}", info.name, w.summary);
@@ -352,7 +397,9 @@ impl Device {
             pipeline_cache_path: desc.pipeline_cache_path.clone(),
             instance: instance.clone(),
         };
-        let device = Device { shared: Arc::new(shared) };
+        let device = Device {
+            shared: Arc::new(shared),
+        };
         device.set_name(device.queue, "main queue");
         Ok(device)
     }
@@ -366,15 +413,22 @@ impl Device {
 impl DeviceShared {
     pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
         let Some(du) = &self.debug_utils else { return };
-        let Ok(name) = std::ffi::CString::new(name) else { return };
-        let info = vk::DebugUtilsObjectNameInfoEXT::default().object_handle(handle).object_name(&name);
+        let Ok(name) = std::ffi::CString::new(name) else {
+            return;
+        };
+        let info = vk::DebugUtilsObjectNameInfoEXT::default()
+            .object_handle(handle)
+            .object_name(&name);
         // SAFETY: handle is a live object of this device; naming has no other effect.
         let _ = unsafe { du.set_debug_utils_object_name(&info) };
     }
 
     /// Bytes still held by the allocator: zero once every resource is dropped.
     pub fn allocated_bytes(&self) -> u64 {
-        self.allocator.lock().map(|a| a.generate_report().total_allocated_bytes).unwrap_or(0)
+        self.allocator
+            .lock()
+            .map(|a| a.generate_report().total_allocated_bytes)
+            .unwrap_or(0)
     }
 
     pub fn wait_idle(&self) {
@@ -389,7 +443,9 @@ impl DeviceShared {
 
     /// Writes the pipeline cache to its file (if one was given); failures only warn.
     pub fn save_pipeline_cache(&self) {
-        let Some(path) = &self.pipeline_cache_path else { return };
+        let Some(path) = &self.pipeline_cache_path else {
+            return;
+        };
         // SAFETY: the cache belongs to this device.
         match unsafe { self.raw.get_pipeline_cache_data(self.pipeline_cache) } {
             Ok(data) => {
@@ -419,7 +475,10 @@ impl Drop for DeviceShared {
             if let Ok(a) = self.allocator.lock() {
                 let report = a.generate_report();
                 if !report.allocations.is_empty() {
-                    log::error!("gpu-allocator: {} allocations leaked at device drop", report.allocations.len());
+                    log::error!(
+                        "gpu-allocator: {} allocations leaked at device drop",
+                        report.allocations.len()
+                    );
                 }
             }
             ManuallyDrop::drop(&mut self.allocator);
@@ -443,9 +502,18 @@ mod tests {
             driver_version: 0,
             api_version: vk::API_VERSION_1_3,
             vendor_id: 0,
-            caps: Capabilities { tessellation_shader: tess, fill_mode_non_solid: true, dynamic_rendering: true, ..Default::default() },
+            caps: Capabilities {
+                tessellation_shader: tess,
+                fill_mode_non_solid: true,
+                dynamic_rendering: true,
+                ..Default::default()
+            },
             queue_family: Some(0),
-            missing: if tess { vec![] } else { vec!["tessellationShader".into()] },
+            missing: if tess {
+                vec![]
+            } else {
+                vec!["tessellationShader".into()]
+            },
             physical: vk::PhysicalDevice::null(),
         }
     }
@@ -453,20 +521,36 @@ mod tests {
     #[test]
     fn scoring_prefers_discrete_then_lowest_index() {
         use vk::PhysicalDeviceType as T;
-        let a = [adapter(0, T::CPU, true), adapter(1, T::INTEGRATED_GPU, true), adapter(2, T::DISCRETE_GPU, true), adapter(3, T::DISCRETE_GPU, true)];
+        let a = [
+            adapter(0, T::CPU, true),
+            adapter(1, T::INTEGRATED_GPU, true),
+            adapter(2, T::DISCRETE_GPU, true),
+            adapter(3, T::DISCRETE_GPU, true),
+        ];
         assert_eq!(choose_adapter(&a, &DeviceSelector::Auto).unwrap(), 2);
         assert_eq!(choose_adapter(&a, &DeviceSelector::Index(0)).unwrap(), 0);
-        assert_eq!(choose_adapter(&a, &DeviceSelector::Name("DEVICE1".into())).unwrap(), 1);
+        assert_eq!(
+            choose_adapter(&a, &DeviceSelector::Name("DEVICE1".into())).unwrap(),
+            1
+        );
     }
 
     #[test]
     fn no_tessellation_is_a_typed_error_listing_devices() {
         use vk::PhysicalDeviceType as T;
-        let a = [adapter(0, T::DISCRETE_GPU, false), adapter(1, T::CPU, false)];
+        let a = [
+            adapter(0, T::DISCRETE_GPU, false),
+            adapter(1, T::CPU, false),
+        ];
         let e = choose_adapter(&a, &DeviceSelector::Auto).unwrap_err();
         let text = e.to_string();
         assert!(matches!(e, VkError::NoSuitableDevice(_)));
-        assert!(text.contains("device0") && text.contains("device1") && text.contains("tessellationShader"), "{text}");
+        assert!(
+            text.contains("device0")
+                && text.contains("device1")
+                && text.contains("tessellationShader"),
+            "{text}"
+        );
         let e = choose_adapter(&a, &DeviceSelector::Index(0)).unwrap_err();
         assert!(matches!(e, VkError::MissingFeatures { .. }), "{e}");
         let e = choose_adapter(&a, &DeviceSelector::Name("nvidia".into())).unwrap_err();

@@ -5,10 +5,15 @@ pub type Result<T, E = VkError> = std::result::Result<T, E>;
 
 #[derive(Debug, thiserror::Error)]
 pub enum VkError {
-    #[error("no Vulkan loader found (install libvulkan1 and a driver such as mesa-vulkan-drivers): {0}")]
+    #[error(
+        "no Vulkan loader found (install libvulkan1 and a driver such as mesa-vulkan-drivers): {0}"
+    )]
     NoLoader(String),
     #[error("{call} failed: {result}")]
-    Call { call: &'static str, result: vk::Result },
+    Call {
+        call: &'static str,
+        result: vk::Result,
+    },
     #[error("no usable Vulkan device: {0}")]
     NoSuitableDevice(String),
     #[error("device selector {selector:?} matches no device; devices seen:\n{devices}")]
@@ -20,7 +25,10 @@ pub enum VkError {
     #[error("{0}")]
     Invalid(String),
     #[error("I/O on {path}: {source}")]
-    Io { path: String, source: std::io::Error },
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
     #[error("image encoding for {path}: {message}")]
     Image { path: String, message: String },
     #[error("window surface: {0}")]

@@ -31,7 +31,11 @@ impl Image {
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(desc.format)
-            .extent(vk::Extent3D { width: desc.extent.width.max(1), height: desc.extent.height.max(1), depth: 1 })
+            .extent(vk::Extent3D {
+                width: desc.extent.width.max(1),
+                height: desc.extent.height.max(1),
+                depth: 1,
+            })
             .mip_levels(1)
             .array_layers(1)
             .samples(vk::SampleCountFlags::TYPE_1)
@@ -62,14 +66,20 @@ impl Image {
             }
         };
         // SAFETY: fresh image, matching memory.
-        unsafe { device.raw.bind_image_memory(raw, allocation.memory(), allocation.offset()) }.ctx("vkBindImageMemory")?;
+        unsafe {
+            device
+                .raw
+                .bind_image_memory(raw, allocation.memory(), allocation.offset())
+        }
+        .ctx("vkBindImageMemory")?;
         let view_info = vk::ImageViewCreateInfo::default()
             .image(raw)
             .view_type(vk::ImageViewType::TYPE_2D)
             .format(desc.format)
             .subresource_range(subresource_range(desc.aspect));
         // SAFETY: image is bound to memory.
-        let view = unsafe { device.raw.create_image_view(&view_info, None) }.ctx("vkCreateImageView")?;
+        let view =
+            unsafe { device.raw.create_image_view(&view_info, None) }.ctx("vkCreateImageView")?;
         device.set_name(raw, desc.name);
         device.set_name(view, &format!("{} view", desc.name));
         Ok(Self {
@@ -85,7 +95,10 @@ impl Image {
 }
 
 pub fn subresource_range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
-    vk::ImageSubresourceRange::default().aspect_mask(aspect).level_count(1).layer_count(1)
+    vk::ImageSubresourceRange::default()
+        .aspect_mask(aspect)
+        .level_count(1)
+        .layer_count(1)
 }
 
 impl Drop for Image {
@@ -104,7 +117,14 @@ impl Drop for Image {
 }
 
 /// Records a whole-image layout transition with a conservative all-commands barrier.
-pub fn transition(device: &ash::Device, cmd: vk::CommandBuffer, image: vk::Image, aspect: vk::ImageAspectFlags, from: vk::ImageLayout, to: vk::ImageLayout) {
+pub fn transition(
+    device: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: vk::Image,
+    aspect: vk::ImageAspectFlags,
+    from: vk::ImageLayout,
+    to: vk::ImageLayout,
+) {
     let barrier = vk::ImageMemoryBarrier::default()
         .image(image)
         .old_layout(from)

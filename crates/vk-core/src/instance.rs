@@ -64,7 +64,10 @@ impl MessageCounts {
     }
     /// The first error-severity messages (at most 16 kept).
     pub fn error_messages(&self) -> Vec<String> {
-        self.error_texts.lock().map(|v| v.clone()).unwrap_or_default()
+        self.error_texts
+            .lock()
+            .map(|v| v.clone())
+            .unwrap_or_default()
     }
 }
 
@@ -93,7 +96,9 @@ unsafe extern "system" fn debug_callback(
         let text = if data.is_null() || (*data).p_message.is_null() {
             String::from("(no message)")
         } else {
-            CStr::from_ptr((*data).p_message).to_string_lossy().into_owned()
+            CStr::from_ptr((*data).p_message)
+                .to_string_lossy()
+                .into_owned()
         };
         (counts, text)
     };
@@ -120,8 +125,9 @@ impl Instance {
         // TESSERA_VULKAN_LIBRARY names a specific loader (e.g. a debug build); default: the system one.
         let entry = match std::env::var_os("TESSERA_VULKAN_LIBRARY") {
             // SAFETY: loading a Vulkan loader; its exported symbols follow the Vulkan ABI.
-            Some(path) => unsafe { ash::Entry::load_from(&path) }
-                .map_err(|e| VkError::NoLoader(format!("{}: {e}", std::path::Path::new(&path).display())))?,
+            Some(path) => unsafe { ash::Entry::load_from(&path) }.map_err(|e| {
+                VkError::NoLoader(format!("{}: {e}", std::path::Path::new(&path).display()))
+            })?,
             // SAFETY: as above, for the system loader.
             None => unsafe { ash::Entry::load() }.map_err(|e| VkError::NoLoader(e.to_string()))?,
         };
@@ -137,12 +143,17 @@ impl Instance {
             )));
         }
         // SAFETY: entry is valid.
-        let layers = unsafe { entry.enumerate_instance_layer_properties() }.ctx("vkEnumerateInstanceLayerProperties")?;
+        let layers = unsafe { entry.enumerate_instance_layer_properties() }
+            .ctx("vkEnumerateInstanceLayerProperties")?;
         // SAFETY: entry is valid.
         let exts = unsafe { entry.enumerate_instance_extension_properties(None) }
             .ctx("vkEnumerateInstanceExtensionProperties")?;
-        let has_layer = layers.iter().any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER));
-        let has_debug_utils = exts.iter().any(|e| e.extension_name_as_c_str() == Ok(ash::ext::debug_utils::NAME));
+        let has_layer = layers
+            .iter()
+            .any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER));
+        let has_debug_utils = exts
+            .iter()
+            .any(|e| e.extension_name_as_c_str() == Ok(ash::ext::debug_utils::NAME));
         let validation = if desc.validation != Validation::Off && !has_layer {
             log::warn!("validation requested but VK_LAYER_KHRONOS_validation is not installed (package vulkan-validationlayers)");
             Validation::Off
@@ -154,17 +165,20 @@ impl Instance {
         if validation != Validation::Off {
             layer_names.push(VALIDATION_LAYER.as_ptr());
         }
-        let mut ext_names: Vec<*const i8> = desc.surface_extensions.iter().map(|e| e.as_ptr()).collect();
+        let mut ext_names: Vec<*const i8> =
+            desc.surface_extensions.iter().map(|e| e.as_ptr()).collect();
         if has_debug_utils {
             ext_names.push(ash::ext::debug_utils::NAME.as_ptr());
         }
-        let app_name = CString::new(desc.app_name.clone()).unwrap_or_else(|_| c"tessera".to_owned());
+        let app_name =
+            CString::new(desc.app_name.clone()).unwrap_or_else(|_| c"tessera".to_owned());
         let app = vk::ApplicationInfo::default()
             .application_name(&app_name)
             .engine_name(c"tessera")
             .api_version(vk::API_VERSION_1_3);
         let enables = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
-        let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enables);
+        let mut features =
+            vk::ValidationFeaturesEXT::default().enabled_validation_features(&enables);
         let mut info = vk::InstanceCreateInfo::default()
             .application_info(&app)
             .enabled_layer_names(&layer_names)
@@ -186,7 +200,8 @@ impl Instance {
         let messages = Arc::new(MessageCounts::default());
         let debug = if has_debug_utils {
             let loader = ash::ext::debug_utils::Instance::new(&entry, &raw);
-            let mut severity = vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING;
+            let mut severity = vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING;
             if log::log_enabled!(log::Level::Debug) {
                 severity |= vk::DebugUtilsMessageSeverityFlagsEXT::INFO;
             }
@@ -211,7 +226,15 @@ impl Instance {
         } else {
             None
         };
-        Ok(Arc::new(Self { debug, messages, validation, raw, entry, api_version, has_debug_utils }))
+        Ok(Arc::new(Self {
+            debug,
+            messages,
+            validation,
+            raw,
+            entry,
+            api_version,
+            has_debug_utils,
+        }))
     }
 
     pub fn messages(&self) -> &Arc<MessageCounts> {

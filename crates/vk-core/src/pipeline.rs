@@ -15,7 +15,11 @@ pub struct ShaderStage<'a> {
 
 impl<'a> ShaderStage<'a> {
     pub fn new(stage: vk::ShaderStageFlags, spirv: &'a [u32]) -> Self {
-        Self { stage, spirv, specialization: None }
+        Self {
+            stage,
+            spirv,
+            specialization: None,
+        }
     }
 }
 
@@ -84,7 +88,11 @@ pub struct Pipeline {
     device: Arc<DeviceShared>,
 }
 
-fn shader_modules(device: &Device, name: &str, stages: &[ShaderStage<'_>]) -> Result<Vec<vk::ShaderModule>> {
+fn shader_modules(
+    device: &Device,
+    name: &str,
+    stages: &[ShaderStage<'_>],
+) -> Result<Vec<vk::ShaderModule>> {
     let mut modules = Vec::new();
     for s in stages {
         let info = vk::ShaderModuleCreateInfo::default().code(s.spirv);
@@ -96,7 +104,10 @@ fn shader_modules(device: &Device, name: &str, stages: &[ShaderStage<'_>]) -> Re
             }
             Err(e) => {
                 destroy_modules(device, &modules);
-                return Err(VkError::Call { call: "vkCreateShaderModule", result: e });
+                return Err(VkError::Call {
+                    call: "vkCreateShaderModule",
+                    result: e,
+                });
             }
         }
     }
@@ -110,21 +121,34 @@ fn destroy_modules(device: &Device, modules: &[vk::ShaderModule]) {
     }
 }
 
-fn pipeline_layout(device: &Device, name: &str, sets: &[vk::DescriptorSetLayout], push_bytes: u32) -> Result<vk::PipelineLayout> {
-    let ranges = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::ALL).size(push_bytes)];
+fn pipeline_layout(
+    device: &Device,
+    name: &str,
+    sets: &[vk::DescriptorSetLayout],
+    push_bytes: u32,
+) -> Result<vk::PipelineLayout> {
+    let ranges = [vk::PushConstantRange::default()
+        .stage_flags(vk::ShaderStageFlags::ALL)
+        .size(push_bytes)];
     let mut info = vk::PipelineLayoutCreateInfo::default().set_layouts(sets);
     if push_bytes > 0 {
         info = info.push_constant_ranges(&ranges);
     }
     // SAFETY: set layouts are live.
-    let layout = unsafe { device.raw.create_pipeline_layout(&info, None) }.ctx("vkCreatePipelineLayout")?;
+    let layout =
+        unsafe { device.raw.create_pipeline_layout(&info, None) }.ctx("vkCreatePipelineLayout")?;
     device.set_name(layout, &format!("{name} layout"));
     Ok(layout)
 }
 
 impl Pipeline {
     pub fn graphics(device: &Device, desc: &GraphicsPipelineDesc<'_>) -> Result<Self> {
-        let layout = pipeline_layout(device, desc.name, &desc.set_layouts, desc.push_constant_bytes)?;
+        let layout = pipeline_layout(
+            device,
+            desc.name,
+            &desc.set_layouts,
+            desc.push_constant_bytes,
+        )?;
         let modules = match shader_modules(device, desc.name, &desc.stages) {
             Ok(m) => m,
             Err(e) => {
@@ -136,7 +160,13 @@ impl Pipeline {
         let spec_infos: Vec<Option<vk::SpecializationInfo>> = desc
             .stages
             .iter()
-            .map(|s| s.specialization.map(|(entries, data)| vk::SpecializationInfo::default().map_entries(entries).data(data)))
+            .map(|s| {
+                s.specialization.map(|(entries, data)| {
+                    vk::SpecializationInfo::default()
+                        .map_entries(entries)
+                        .data(data)
+                })
+            })
             .collect();
         let stage_infos: Vec<_> = desc
             .stages
@@ -144,7 +174,10 @@ impl Pipeline {
             .zip(&modules)
             .zip(&spec_infos)
             .map(|((s, &m), spec)| {
-                let info = vk::PipelineShaderStageCreateInfo::default().stage(s.stage).module(m).name(c"main");
+                let info = vk::PipelineShaderStageCreateInfo::default()
+                    .stage(s.stage)
+                    .module(m)
+                    .name(c"main");
                 match spec {
                     Some(spec) => info.specialization_info(spec),
                     None => info,
@@ -154,13 +187,24 @@ impl Pipeline {
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
             .vertex_binding_descriptions(&desc.vertex_bindings)
             .vertex_attribute_descriptions(&desc.vertex_attributes);
-        let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(desc.topology);
+        let input_assembly =
+            vk::PipelineInputAssemblyStateCreateInfo::default().topology(desc.topology);
         let mut domain = vk::PipelineTessellationDomainOriginStateCreateInfo::default()
-            .domain_origin(desc.tessellation.map(|t| t.domain_origin).unwrap_or(vk::TessellationDomainOrigin::UPPER_LEFT));
+            .domain_origin(
+                desc.tessellation
+                    .map(|t| t.domain_origin)
+                    .unwrap_or(vk::TessellationDomainOrigin::UPPER_LEFT),
+            );
         let tess_state = vk::PipelineTessellationStateCreateInfo::default()
-            .patch_control_points(desc.tessellation.map(|t| t.patch_control_points).unwrap_or(1))
+            .patch_control_points(
+                desc.tessellation
+                    .map(|t| t.patch_control_points)
+                    .unwrap_or(1),
+            )
             .push_next(&mut domain);
-        let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
+        let viewport = vk::PipelineViewportStateCreateInfo::default()
+            .viewport_count(1)
+            .scissor_count(1);
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(desc.polygon_mode)
             .cull_mode(desc.cull_mode)
@@ -170,17 +214,21 @@ impl Pipeline {
             .depth_bias_enable(desc.depth_bias.is_some())
             .depth_bias_constant_factor(desc.depth_bias.map(|b| b.0).unwrap_or(0.0))
             .depth_bias_slope_factor(desc.depth_bias.map(|b| b.1).unwrap_or(0.0));
-        let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(desc.depth_test)
             .depth_write_enable(desc.depth_write)
             .depth_compare_op(desc.depth_compare);
-        let attachments = [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
+        let attachments = [vk::PipelineColorBlendAttachmentState::default()
+            .color_write_mask(vk::ColorComponentFlags::RGBA)];
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
         let color_formats = [desc.color_format];
-        let mut rendering = vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&color_formats).depth_attachment_format(desc.depth_format);
+        let mut rendering = vk::PipelineRenderingCreateInfo::default()
+            .color_attachment_formats(&color_formats)
+            .depth_attachment_format(desc.depth_format);
         let mut info = vk::GraphicsPipelineCreateInfo::default()
             .stages(&stage_infos)
             .vertex_input_state(&vertex_input)
@@ -197,42 +245,81 @@ impl Pipeline {
             info = info.tessellation_state(&tess_state);
         }
         // SAFETY: every referenced struct lives until the call returns.
-        let result = unsafe { device.raw.create_graphics_pipelines(device.pipeline_cache(), &[info], None) };
+        let result = unsafe {
+            device
+                .raw
+                .create_graphics_pipelines(device.pipeline_cache(), &[info], None)
+        };
         destroy_modules(device, &modules);
         match result {
             Ok(p) => {
                 device.set_name(p[0], desc.name);
-                Ok(Self { raw: p[0], layout, bind_point: vk::PipelineBindPoint::GRAPHICS, device: device.shared.clone() })
+                Ok(Self {
+                    raw: p[0],
+                    layout,
+                    bind_point: vk::PipelineBindPoint::GRAPHICS,
+                    device: device.shared.clone(),
+                })
             }
             Err((_, e)) => {
                 // SAFETY: layout unused.
                 unsafe { device.raw.destroy_pipeline_layout(layout, None) };
-                Err(VkError::Call { call: "vkCreateGraphicsPipelines", result: e })
+                Err(VkError::Call {
+                    call: "vkCreateGraphicsPipelines",
+                    result: e,
+                })
             }
         }
     }
 
-    pub fn compute(device: &Device, name: &str, stage: ShaderStage<'_>, set_layouts: &[vk::DescriptorSetLayout], push_constant_bytes: u32) -> Result<Self> {
+    pub fn compute(
+        device: &Device,
+        name: &str,
+        stage: ShaderStage<'_>,
+        set_layouts: &[vk::DescriptorSetLayout],
+        push_constant_bytes: u32,
+    ) -> Result<Self> {
         let layout = pipeline_layout(device, name, set_layouts, push_constant_bytes)?;
         let modules = shader_modules(device, name, &[stage])?;
-        let spec = stage.specialization.map(|(entries, data)| vk::SpecializationInfo::default().map_entries(entries).data(data));
-        let mut stage_info = vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::COMPUTE).module(modules[0]).name(c"main");
+        let spec = stage.specialization.map(|(entries, data)| {
+            vk::SpecializationInfo::default()
+                .map_entries(entries)
+                .data(data)
+        });
+        let mut stage_info = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(modules[0])
+            .name(c"main");
         if let Some(spec) = &spec {
             stage_info = stage_info.specialization_info(spec);
         }
-        let info = vk::ComputePipelineCreateInfo::default().stage(stage_info).layout(layout);
+        let info = vk::ComputePipelineCreateInfo::default()
+            .stage(stage_info)
+            .layout(layout);
         // SAFETY: referenced structs live until return.
-        let result = unsafe { device.raw.create_compute_pipelines(device.pipeline_cache(), &[info], None) };
+        let result = unsafe {
+            device
+                .raw
+                .create_compute_pipelines(device.pipeline_cache(), &[info], None)
+        };
         destroy_modules(device, &modules);
         match result {
             Ok(p) => {
                 device.set_name(p[0], name);
-                Ok(Self { raw: p[0], layout, bind_point: vk::PipelineBindPoint::COMPUTE, device: device.shared.clone() })
+                Ok(Self {
+                    raw: p[0],
+                    layout,
+                    bind_point: vk::PipelineBindPoint::COMPUTE,
+                    device: device.shared.clone(),
+                })
             }
             Err((_, e)) => {
                 // SAFETY: layout unused.
                 unsafe { device.raw.destroy_pipeline_layout(layout, None) };
-                Err(VkError::Call { call: "vkCreateComputePipelines", result: e })
+                Err(VkError::Call {
+                    call: "vkCreateComputePipelines",
+                    result: e,
+                })
             }
         }
     }

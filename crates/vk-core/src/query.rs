@@ -40,30 +40,66 @@ pub struct QueryPool {
 impl QueryPool {
     pub fn timestamps(device: &Device, name: &str, count: u32) -> Result<Self> {
         if !device.info.caps.timestamps {
-            return Err(VkError::Invalid(format!("{} has no timestamp queries on its queue", device.info.name)));
+            return Err(VkError::Invalid(format!(
+                "{} has no timestamp queries on its queue",
+                device.info.name
+            )));
         }
-        Self::new(device, name, vk::QueryType::TIMESTAMP, count, vk::QueryPipelineStatisticFlags::empty())
+        Self::new(
+            device,
+            name,
+            vk::QueryType::TIMESTAMP,
+            count,
+            vk::QueryPipelineStatisticFlags::empty(),
+        )
     }
 
     pub fn statistics(device: &Device, name: &str, count: u32) -> Result<Self> {
         if !device.info.caps.pipeline_statistics_query {
-            return Err(VkError::Invalid(format!("{} has no pipeline-statistics queries", device.info.name)));
+            return Err(VkError::Invalid(format!(
+                "{} has no pipeline-statistics queries",
+                device.info.name
+            )));
         }
-        Self::new(device, name, vk::QueryType::PIPELINE_STATISTICS, count, PipelineStatistics::flags())
+        Self::new(
+            device,
+            name,
+            vk::QueryType::PIPELINE_STATISTICS,
+            count,
+            PipelineStatistics::flags(),
+        )
     }
 
-    fn new(device: &Device, name: &str, ty: vk::QueryType, count: u32, stats: vk::QueryPipelineStatisticFlags) -> Result<Self> {
-        let info = vk::QueryPoolCreateInfo::default().query_type(ty).query_count(count).pipeline_statistics(stats);
+    fn new(
+        device: &Device,
+        name: &str,
+        ty: vk::QueryType,
+        count: u32,
+        stats: vk::QueryPipelineStatisticFlags,
+    ) -> Result<Self> {
+        let info = vk::QueryPoolCreateInfo::default()
+            .query_type(ty)
+            .query_count(count)
+            .pipeline_statistics(stats);
         // SAFETY: device live; the feature was checked above.
         let raw = unsafe { device.raw.create_query_pool(&info, None) }.ctx("vkCreateQueryPool")?;
         device.set_name(raw, name);
-        Ok(Self { raw, ty, count, device: device.shared.clone() })
+        Ok(Self {
+            raw,
+            ty,
+            count,
+            device: device.shared.clone(),
+        })
     }
 
     /// Records a reset of all queries (must precede their first use in a submission).
     pub fn cmd_reset(&self, cmd: vk::CommandBuffer) {
         // SAFETY: cmd is recording outside a render pass.
-        unsafe { self.device.raw.cmd_reset_query_pool(cmd, self.raw, 0, self.count) };
+        unsafe {
+            self.device
+                .raw
+                .cmd_reset_query_pool(cmd, self.raw, 0, self.count)
+        };
     }
 
     /// Waits for and reads `N` 64-bit values per query (ash takes one `T` per query: its size
@@ -72,7 +108,12 @@ impl QueryPool {
         let mut data = vec![[0u64; N]; self.count as usize];
         // SAFETY: one [u64; N] per query, N matching the query type's value count.
         unsafe {
-            self.device.raw.get_query_pool_results(self.raw, 0, &mut data, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT)
+            self.device.raw.get_query_pool_results(
+                self.raw,
+                0,
+                &mut data,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+            )
         }
         .ctx("vkGetQueryPoolResults")?;
         Ok(data)
@@ -104,7 +145,10 @@ impl QueryPool {
             return Err(VkError::Invalid("not a timestamp pool".into()));
         }
         let raw = self.results::<1>()?;
-        Ok(raw.chunks_exact(2).map(|p| p[1][0].wrapping_sub(p[0][0]) as f64 * period).collect())
+        Ok(raw
+            .chunks_exact(2)
+            .map(|p| p[1][0].wrapping_sub(p[0][0]) as f64 * period)
+            .collect())
     }
 }
 

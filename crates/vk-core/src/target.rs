@@ -21,12 +21,24 @@ impl Rgba8 {
     pub fn save_png(&self, path: &std::path::Path) -> Result<()> {
         let img = image::RgbaImage::from_raw(self.width, self.height, self.pixels.clone())
             .ok_or_else(|| VkError::Invalid("image size mismatch".into()))?;
-        img.save(path).map_err(|e| VkError::Image { path: path.display().to_string(), message: e.to_string() })
+        img.save(path).map_err(|e| VkError::Image {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })
     }
 
     pub fn load_png(path: &std::path::Path) -> Result<Self> {
-        let img = image::open(path).map_err(|e| VkError::Image { path: path.display().to_string(), message: e.to_string() })?.to_rgba8();
-        Ok(Self { width: img.width(), height: img.height(), pixels: img.into_raw() })
+        let img = image::open(path)
+            .map_err(|e| VkError::Image {
+                path: path.display().to_string(),
+                message: e.to_string(),
+            })?
+            .to_rgba8();
+        Ok(Self {
+            width: img.width(),
+            height: img.height(),
+            pixels: img.into_raw(),
+        })
     }
 }
 
@@ -39,8 +51,12 @@ pub struct OffscreenTarget {
 
 impl OffscreenTarget {
     pub fn new(device: &Device, extent: vk::Extent2D) -> Result<Self> {
-        if extent.width == 0 || extent.height == 0 || extent.width > 16384 || extent.height > 16384 {
-            return Err(VkError::Invalid(format!("image size {}x{} is outside 1..16384", extent.width, extent.height)));
+        if extent.width == 0 || extent.height == 0 || extent.width > 16384 || extent.height > 16384
+        {
+            return Err(VkError::Invalid(format!(
+                "image size {}x{} is outside 1..16384",
+                extent.width, extent.height
+            )));
         }
         let color = Image::new(
             device,
@@ -62,28 +78,73 @@ impl OffscreenTarget {
                 aspect: vk::ImageAspectFlags::DEPTH,
             },
         )?;
-        Ok(Self { color, depth, extent })
+        Ok(Self {
+            color,
+            depth,
+            extent,
+        })
     }
 
     /// Records the transitions into attachment layouts and begins dynamic rendering with clears.
     pub fn cmd_begin(&self, device: &Device, cmd: vk::CommandBuffer, clear: [f32; 4]) {
-        begin_rendering(device, cmd, &self.color, vk::ImageLayout::UNDEFINED, &self.depth, self.extent, clear);
+        begin_rendering(
+            device,
+            cmd,
+            &self.color,
+            vk::ImageLayout::UNDEFINED,
+            &self.depth,
+            self.extent,
+            clear,
+        );
     }
 
     /// Ends rendering and records the copy of the color image into `readback`.
     pub fn cmd_end_and_copy(&self, device: &Device, cmd: vk::CommandBuffer, readback: &Buffer) {
         // SAFETY: rendering was begun by cmd_begin on this command buffer.
         unsafe { device.raw.cmd_end_rendering(cmd) };
-        transition(&device.raw, cmd, self.color.raw, vk::ImageAspectFlags::COLOR, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+        transition(
+            &device.raw,
+            cmd,
+            self.color.raw,
+            vk::ImageAspectFlags::COLOR,
+            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+        );
         let region = vk::BufferImageCopy::default()
-            .image_subresource(vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(1))
-            .image_extent(vk::Extent3D { width: self.extent.width, height: self.extent.height, depth: 1 });
+            .image_subresource(
+                vk::ImageSubresourceLayers::default()
+                    .aspect_mask(vk::ImageAspectFlags::COLOR)
+                    .layer_count(1),
+            )
+            .image_extent(vk::Extent3D {
+                width: self.extent.width,
+                height: self.extent.height,
+                depth: 1,
+            });
         // SAFETY: the image is in TRANSFER_SRC layout; readback has width*height*4 bytes.
-        unsafe { device.raw.cmd_copy_image_to_buffer(cmd, self.color.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, readback.raw, &[region]) };
-        let barrier = vk::MemoryBarrier::default().src_access_mask(vk::AccessFlags::TRANSFER_WRITE).dst_access_mask(vk::AccessFlags::HOST_READ);
+        unsafe {
+            device.raw.cmd_copy_image_to_buffer(
+                cmd,
+                self.color.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                readback.raw,
+                &[region],
+            )
+        };
+        let barrier = vk::MemoryBarrier::default()
+            .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+            .dst_access_mask(vk::AccessFlags::HOST_READ);
         // SAFETY: cmd is recording.
         unsafe {
-            device.raw.cmd_pipeline_barrier(cmd, vk::PipelineStageFlags::TRANSFER, vk::PipelineStageFlags::HOST, vk::DependencyFlags::empty(), &[barrier], &[], &[])
+            device.raw.cmd_pipeline_barrier(
+                cmd,
+                vk::PipelineStageFlags::TRANSFER,
+                vk::PipelineStageFlags::HOST,
+                vk::DependencyFlags::empty(),
+                &[barrier],
+                &[],
+                &[],
+            )
         };
     }
 
@@ -100,16 +161,32 @@ impl OffscreenTarget {
     }
 
     pub fn read(&self, readback: &Buffer) -> Result<Rgba8> {
-        let bytes = readback.mapped().ok_or_else(|| VkError::Invalid("readback buffer not mapped".into()))?;
+        let bytes = readback
+            .mapped()
+            .ok_or_else(|| VkError::Invalid("readback buffer not mapped".into()))?;
         let n = (self.extent.width * self.extent.height * 4) as usize;
-        Ok(Rgba8 { width: self.extent.width, height: self.extent.height, pixels: bytes[..n].to_vec() })
+        Ok(Rgba8 {
+            width: self.extent.width,
+            height: self.extent.height,
+            pixels: bytes[..n].to_vec(),
+        })
     }
 }
 
 /// Transitions color (from `color_from`) and depth into attachment layouts, begins dynamic
 /// rendering with clears, and sets a full-extent viewport (y flipped so +y is up) and scissor.
-pub fn begin_rendering(device: &Device, cmd: vk::CommandBuffer, color: &Image, color_from: vk::ImageLayout, depth: &Image, extent: vk::Extent2D, clear: [f32; 4]) {
-    begin_rendering_view(device, cmd, color.raw, color.view, color_from, depth, extent, clear)
+pub fn begin_rendering(
+    device: &Device,
+    cmd: vk::CommandBuffer,
+    color: &Image,
+    color_from: vk::ImageLayout,
+    depth: &Image,
+    extent: vk::Extent2D,
+    clear: [f32; 4],
+) {
+    begin_rendering_view(
+        device, cmd, color.raw, color.view, color_from, depth, extent, clear,
+    )
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -123,22 +200,46 @@ pub fn begin_rendering_view(
     extent: vk::Extent2D,
     clear: [f32; 4],
 ) {
-    transition(&device.raw, cmd, color, vk::ImageAspectFlags::COLOR, color_from, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
-    transition(&device.raw, cmd, depth.raw, vk::ImageAspectFlags::DEPTH, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
+    transition(
+        &device.raw,
+        cmd,
+        color,
+        vk::ImageAspectFlags::COLOR,
+        color_from,
+        vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+    );
+    transition(
+        &device.raw,
+        cmd,
+        depth.raw,
+        vk::ImageAspectFlags::DEPTH,
+        vk::ImageLayout::UNDEFINED,
+        vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+    );
     let color_att = [vk::RenderingAttachmentInfo::default()
         .image_view(color_view)
         .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
         .load_op(vk::AttachmentLoadOp::CLEAR)
         .store_op(vk::AttachmentStoreOp::STORE)
-        .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: clear } })];
+        .clear_value(vk::ClearValue {
+            color: vk::ClearColorValue { float32: clear },
+        })];
     let depth_att = vk::RenderingAttachmentInfo::default()
         .image_view(depth.view)
         .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
         .load_op(vk::AttachmentLoadOp::CLEAR)
         .store_op(vk::AttachmentStoreOp::DONT_CARE)
-        .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
+        .clear_value(vk::ClearValue {
+            depth_stencil: vk::ClearDepthStencilValue {
+                depth: 1.0,
+                stencil: 0,
+            },
+        });
     let info = vk::RenderingInfo::default()
-        .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent })
+        .render_area(vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent,
+        })
         .layer_count(1)
         .color_attachments(&color_att)
         .depth_attachment(&depth_att);
@@ -154,6 +255,13 @@ pub fn begin_rendering_view(
     unsafe {
         device.raw.cmd_begin_rendering(cmd, &info);
         device.raw.cmd_set_viewport(cmd, 0, &[viewport]);
-        device.raw.cmd_set_scissor(cmd, 0, &[vk::Rect2D { offset: vk::Offset2D::default(), extent }]);
+        device.raw.cmd_set_scissor(
+            cmd,
+            0,
+            &[vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent,
+            }],
+        );
     }
 }

@@ -44,7 +44,12 @@ pub const LAVAPIPE_CHUNK_VERTEX_LIMIT: u64 = 65_536;
 impl Workarounds {
     pub fn for_adapter(info: &AdapterInfo) -> Self {
         // No fixed Mesa version is known yet: every lavapipe gets the split.
-        Self { active: known().into_iter().filter(|w| w.driver == info.driver_id).collect() }
+        Self {
+            active: known()
+                .into_iter()
+                .filter(|w| w.driver == info.driver_id)
+                .collect(),
+        }
     }
 
     pub fn active(&self) -> &[Workaround] {
