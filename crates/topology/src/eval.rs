@@ -773,7 +773,7 @@ impl LocalMesh {
         let fan = &self.fans[v as usize];
         let quad = self.scheme == LimitScheme::CatmullClark;
         let masks = if quad {
-            if lv.rule == LimitRule::Smooth
+            if lv.rule != LimitRule::Corner
                 && fan
                     .faces
                     .iter()

@@ -11,8 +11,8 @@
 //!   opposite the centre. Catmull-Clark masks need an all-quad ring, which every vertex has
 //!   after one refinement.
 //!
-//! Tangent magnitudes follow OpenSubdiv (cos/sin masks for smooth vertices); they give exact
-//! tangent *directions*. Parametric derivatives of a patch are produced by [`crate::patch`]
+//! Tangent magnitudes follow OpenSubdiv (cos/sin masks for smooth vertices, Biermann et al.'s
+//! cross-crease masks for Catmull-Clark); they give exact tangent *directions*. Parametric derivatives of a patch are produced by [`crate::patch`]
 //! and [`crate::eval`] instead.
 
 use std::f64::consts::PI;
@@ -226,10 +226,10 @@ pub fn catmark_limit_masks(v: &LimitVertex) -> LimitMasks {
             pos.edges[ends[0]] = 1.0 / 6.0;
             pos.edges[ends[1]] = 1.0 / 6.0;
             let mut t1 = Mask::zero(n, nf_count);
-            t1.edges[ends[0]] = 1.0;
-            t1.edges[ends[1]] = -1.0;
+            t1.edges[ends[0]] = 0.5;
+            t1.edges[ends[1]] = -0.5;
             let mut t2 = Mask::zero(n, nf_count);
-            crease_cross_tangent(&mut t2, ends, n, 2.0);
+            catmark_cross_tangent(&mut t2, ends, n);
             LimitMasks {
                 position: pos,
                 tangent1: t1,
@@ -246,6 +246,48 @@ pub fn catmark_limit_masks(v: &LimitVertex) -> LimitMasks {
                 position: pos,
                 tangent1: t1,
                 tangent2: t2,
+            }
+        }
+    }
+}
+
+/// Catmull-Clark tangent across a crease, pointing into the span `ends[0] → ends[1]` (CCW):
+/// the uniform B-spline cross tangent for one interior edge, Biermann et al.'s eigenvector
+/// formula for more, and the average of the two crease edges for a single face. Face `i` is
+/// the quad between edges `i` and `i + 1`.
+fn catmark_cross_tangent(t2: &mut Mask, ends: [usize; 2], n: usize) {
+    let interior = (ends[1] + n - ends[0]) % n - 1;
+    let e = |i: usize| (ends[0] + i) % n;
+    let nf = t2.faces.len().max(1);
+    let f = |i: usize| (ends[0] + i) % nf;
+    match interior {
+        0 => {
+            t2.vertex = -6.0;
+            t2.edges[ends[0]] = 3.0;
+            t2.edges[ends[1]] = 3.0;
+        }
+        1 => {
+            t2.vertex = -4.0 / 6.0;
+            t2.edges[ends[0]] = -1.0 / 6.0;
+            t2.edges[e(1)] = 4.0 / 6.0;
+            t2.edges[ends[1]] = -1.0 / 6.0;
+            t2.faces[f(0)] = 1.0 / 6.0;
+            t2.faces[f(1)] = 1.0 / 6.0;
+        }
+        _ => {
+            let k = (interior + 1) as f64;
+            let th = PI / k;
+            let (c, s) = (th.cos(), th.sin());
+            let d = 1.0 / (k * (3.0 + c));
+            let r = (c + 1.0) / s;
+            t2.vertex = 4.0 * r * (c - 1.0) * d;
+            t2.edges[ends[0]] = -r * (1.0 + 2.0 * c) * d;
+            t2.edges[ends[1]] = -r * (1.0 + 2.0 * c) * d;
+            t2.faces[f(0)] = s * d;
+            for i in 1..=interior {
+                let (si, si1) = ((i as f64 * th).sin(), ((i + 1) as f64 * th).sin());
+                t2.edges[e(i)] = 4.0 * si * d;
+                t2.faces[f(i)] = (si + si1) * d;
             }
         }
     }

@@ -209,7 +209,7 @@ fn level3_dyadic_points_match_refined_limit() {
 
 #[test]
 fn loop_semi_sharp_shapes_match_refined_limit() {
-    for name in ["loop_cube_creases1", "loop_chaikin0"] {
+    for name in ["loop_cube_creases1", "loop_chaikin0", "loop_chaikin1"] {
         check_shape(name, 2);
     }
 }
@@ -237,6 +237,13 @@ fn catmark_semi_sharp_shapes_match_refined_limit() {
         "catmark_cube_creases1",
         "catmark_chaikin0",
         "catmark_pyramid_creases0",
+        "catmark_chaikin1",
+        "catmark_pyramid_creases1",
+        "catmark_tent_creases1",
+        "catmark_cube_corner1",
+        "catmark_cube_corner2",
+        "catmark_cube_corner3",
+        "catmark_flap",
     ] {
         check_shape(name, 2);
     }
