@@ -25,6 +25,46 @@ pub enum Command {
     View(ViewArgs),
     /// List Vulkan devices, their tessellation features and limits, and which would be chosen.
     Info(GpuArgs),
+    /// Uniformly refine a mesh on the CPU and write it as OBJ (optionally at limit positions).
+    Subdivide(SubdivideArgs),
+    /// Print the exact limit position, tangents and normal at (face, u, v).
+    Limit(LimitArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct SubdivideArgs {
+    pub input: PathBuf,
+    #[arg(long, value_parser = crate::topo_cmds::parse_scheme)]
+    pub scheme: topology::Scheme,
+    #[arg(long)]
+    pub level: usize,
+    /// Move every vertex to its limit position.
+    #[arg(long)]
+    pub limit: bool,
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct LimitArgs {
+    pub input: PathBuf,
+    /// loop or catmull-clark
+    #[arg(long)]
+    pub scheme: String,
+    #[arg(long)]
+    pub face: usize,
+    /// Domain coordinate U,V.
+    #[arg(long, value_parser = parse_uv, allow_hyphen_values = true)]
+    pub uv: (f64, f64),
+}
+
+fn parse_uv(s: &str) -> Result<(f64, f64), String> {
+    let (u, v) = s
+        .split_once(',')
+        .ok_or_else(|| format!("'{s}' is not U,V"))?;
+    let u: f64 = u.trim().parse().map_err(|_| format!("bad U in '{s}'"))?;
+    let v: f64 = v.trim().parse().map_err(|_| format!("bad V in '{s}'"))?;
+    Ok((u, v))
 }
 
 #[derive(Args, Debug, Clone)]

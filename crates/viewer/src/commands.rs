@@ -15,6 +15,8 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Render(a) => render(a),
         Command::View(a) => crate::view::run(a),
         Command::Info(g) => info(&g),
+        Command::Subdivide(a) => crate::topo_cmds::subdivide(a),
+        Command::Limit(a) => crate::topo_cmds::limit(a),
     }
 }
 

@@ -2,6 +2,7 @@
 #![forbid(unsafe_code)]
 mod cli;
 mod commands;
+mod topo_cmds;
 mod view;
 
 use clap::Parser;

@@ -5,7 +5,10 @@ use std::process::{Command, Output};
 
 fn tessera(args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_tessera"));
-    c.args(args).arg("--validation");
+    c.args(args);
+    if matches!(args.first(), Some(&"render" | &"view" | &"info")) {
+        c.arg("--validation");
+    }
     for (k, v) in env {
         c.env(k, v);
     }
@@ -226,4 +229,95 @@ fn window_screenshot_matches_offscreen_render() {
         "window and offscreen differ in {:.3}% of pixels",
         fraction * 100.0
     );
+}
+
+fn data(p: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(p)
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// Base vertices keep their index under refinement, so `subdivide --limit` must put vertex v of
+/// face 0 where `limit` evaluates face 0 at that corner: two independent code paths agree.
+#[test]
+fn subdivide_limit_agrees_with_limit_evaluation() {
+    for (shape, scheme, corner_uv) in [
+        (
+            "tests/data/opensubdiv/shapes/loop_icosahedron.obj",
+            "loop",
+            [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)],
+        ),
+        (
+            "tests/data/opensubdiv/shapes/catmark_cube.obj",
+            "catmull-clark",
+            [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0)],
+        ),
+    ] {
+        let out = tmp(&format!("{scheme}_limit.obj"));
+        let o = tessera(
+            &[
+                "subdivide",
+                &data(shape),
+                "--scheme",
+                scheme,
+                "--level",
+                "2",
+                "--limit",
+                "-o",
+                out.to_str().unwrap(),
+            ],
+            &[],
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = std::fs::read_to_string(&out).unwrap();
+        let verts: Vec<[f64; 3]> = text
+            .lines()
+            .filter_map(|l| l.strip_prefix("v "))
+            .map(|l| {
+                let c: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+                [c[0], c[1], c[2]]
+            })
+            .collect();
+        let base = std::fs::read_to_string(data(shape)).unwrap();
+        let face0: Vec<usize> = base
+            .lines()
+            .find_map(|l| l.strip_prefix("f "))
+            .unwrap()
+            .split_whitespace()
+            .map(|t| t.split('/').next().unwrap().parse::<usize>().unwrap() - 1)
+            .collect();
+        for (k, (u, v)) in corner_uv.iter().enumerate() {
+            let o = tessera(
+                &[
+                    "limit",
+                    &data(shape),
+                    "--scheme",
+                    scheme,
+                    "--face",
+                    "0",
+                    "--uv",
+                    &format!("{u},{v}"),
+                ],
+                &[],
+            );
+            assert!(o.status.success(), "{}", stderr(&o));
+            let s = String::from_utf8_lossy(&o.stdout);
+            let pos: Vec<f64> = s
+                .lines()
+                .find_map(|l| l.strip_prefix("position "))
+                .unwrap()
+                .split_whitespace()
+                .map(|x| x.parse().unwrap())
+                .collect();
+            let got = verts[face0[k]];
+            for c in 0..3 {
+                assert!(
+                    (got[c] - pos[c]).abs() < 1e-9,
+                    "{shape} corner {k}: subdivide --limit {got:?} vs limit {pos:?}"
+                );
+            }
+        }
+    }
 }

@@ -1,0 +1,121 @@
+//! `tessera subdivide` and `tessera limit`: the CPU reference, from the command line.
+use crate::cli::{LimitArgs, SubdivideArgs};
+use anyhow::{bail, Context, Result};
+use topology::eval::{limit_point, LimitScheme, LocalMesh};
+use topology::{
+    refine_level, refine_uniform, ControlMesh, EdgeCrease, Level, Scheme, VertexCorner,
+};
+
+pub fn parse_scheme(s: &str) -> Result<Scheme, String> {
+    match s {
+        "loop" => Ok(Scheme::Loop),
+        "catmull-clark" | "catmark" => Ok(Scheme::CatmullClark),
+        "doo-sabin" => Ok(Scheme::DooSabin),
+        "bilinear" => Ok(Scheme::Bilinear),
+        _ => Err(format!(
+            "unknown scheme '{s}' (loop, catmull-clark, doo-sabin, bilinear)"
+        )),
+    }
+}
+
+/// A refined level as a control mesh, its propagated sharpness written back as tags.
+fn level_as_mesh(level: &Level, base: &ControlMesh) -> ControlMesh {
+    let (offsets, verts) = level.topology.face_tables();
+    let mut m = ControlMesh::from_polygons(level.positions.clone(), &[] as &[[u32; 3]]);
+    m.face_offsets = offsets.to_vec();
+    m.face_vertices = verts.to_vec();
+    m.options = base.options;
+    for (e, &s) in level.edge_sharpness.iter().enumerate() {
+        if s > 0.0 && !level.topology.is_boundary_edge(e) {
+            m.creases.push(EdgeCrease {
+                vertices: level.topology.edge_vertices(e),
+                sharpness: s,
+            });
+        }
+    }
+    for (v, &s) in level.vertex_sharpness.iter().enumerate() {
+        if s > 0.0 {
+            m.corners.push(VertexCorner {
+                vertex: v as u32,
+                sharpness: s,
+            });
+        }
+    }
+    m
+}
+
+/// Limit positions of every vertex of `level`: by limit masks where no semi-sharp feature is
+/// left, else after further refinement (vertex indices persist across levels).
+fn limit_positions(level: &Level, base: &ControlMesh, scheme: Scheme) -> Result<Vec<[f64; 3]>> {
+    let ls = match scheme {
+        Scheme::Loop => LimitScheme::Loop,
+        Scheme::CatmullClark => LimitScheme::CatmullClark,
+        Scheme::Bilinear => return Ok(level.positions.clone()),
+        Scheme::DooSabin => bail!(
+            "--limit is supported for loop and catmull-clark (Doo-Sabin has no limit masks here)"
+        ),
+    };
+    let n = level.positions.len();
+    let mut out: Vec<Option<[f64; 3]>> = vec![None; n];
+    let mut current = level.clone();
+    for _ in 0..12 {
+        let lm = LocalMesh::from_control_mesh(&level_as_mesh(&current, base), ls)
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        for (v, slot) in out.iter_mut().enumerate() {
+            if slot.is_none() {
+                if let Some(p) = lm.vertex_limit_position(v as u32) {
+                    *slot = Some([p[0], p[1], p[2]]);
+                }
+            }
+        }
+        if out.iter().all(Option::is_some) {
+            break;
+        }
+        current = refine_level(&current, scheme, &base.options)?.0;
+    }
+    out.into_iter()
+        .enumerate()
+        .map(|(v, p)| {
+            p.with_context(|| format!("vertex {v}: no limit position after 12 more levels"))
+        })
+        .collect()
+}
+
+pub fn subdivide(a: SubdivideArgs) -> Result<()> {
+    let mesh = topology::load_obj(&a.input)?;
+    if a.level > 6 {
+        bail!("--level {} is above 6 (meshes grow 4× per level)", a.level);
+    }
+    let r = refine_uniform(&mesh, a.scheme, a.level)
+        .with_context(|| format!("{}", a.input.display()))?;
+    let level = r.level(a.level);
+    let positions = if a.limit {
+        limit_positions(level, &mesh, a.scheme)?
+    } else {
+        level.positions.clone()
+    };
+    let (offsets, verts) = level.topology.face_tables();
+    let file = std::fs::File::create(&a.output)
+        .with_context(|| format!("creating {}", a.output.display()))?;
+    topology::write_obj(file, &positions, offsets, verts)
+        .with_context(|| format!("writing {}", a.output.display()))?;
+    println!(
+        "wrote {}: {} vertices, {} faces (level {}, {:?}{})",
+        a.output.display(),
+        positions.len(),
+        level.num_faces(),
+        a.level,
+        a.scheme,
+        if a.limit { ", limit positions" } else { "" }
+    );
+    Ok(())
+}
+
+pub fn limit(a: LimitArgs) -> Result<()> {
+    let mesh = topology::load_obj(&a.input)?;
+    let scheme: LimitScheme = a.scheme.parse().map_err(|e| anyhow::anyhow!("{e}"))?;
+    let p = limit_point(&mesh, scheme, a.face, a.uv.0, a.uv.1)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
+    println!("{p}");
+    Ok(())
+}
