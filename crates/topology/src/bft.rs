@@ -12,11 +12,14 @@
 //!   faces) and the face is face `k` of its fan (CCW from the first boundary edge); `v1`, `v2`
 //!   are regular (valence 6 interior, or valence 4 on the boundary where the fan edge is a
 //!   boundary edge). `n = 4` covers every face that touches the boundary without an
-//!   extraordinary vertex. This is every face of a once-refined Loop mesh with "edges only"
-//!   boundaries, no creases, and corners of one face (`n = 2`) included.
+//!   extraordinary vertex, `n = 2` the corner child of a triangle with two boundary edges.
 //!
-//! Not tabulated (use [`crate::eval`]): infinitely sharp or semi-sharp creases, "edges and
-//! corners" corner vertices, faces with two extraordinary vertices.
+//! Together these cover every face of a once-refined Loop mesh with "edges only" boundaries
+//! and no creases, except the centre child of a base triangle with two or three boundary edges
+//! (three boundary corners, none joined by a boundary edge): [`classify_face`] returns `None`
+//! there. Not tabulated either (use [`crate::eval`], or refine once more): infinitely sharp or
+//! semi-sharp creases, "edges and corners" corner vertices, faces with two extraordinary
+//! vertices.
 //!
 //! # Control-point ordering (the shader mirrors this through [`face_control_ring`])
 //! `v0` (the extraordinary vertex, else a boundary vertex, else corner 0), `v1`, `v2` in the
@@ -31,11 +34,24 @@
 //!
 //! # Mirror symmetry (≈ half the memory)
 //! The reflection through `v0`'s bisector swaps `v1 ↔ v2` and `u ↔ v`. Interior tables and the
-//! middle boundary fan position are self-symmetric: only rows `i ≥ j` are stored. Boundary
-//! position `k` and `n − 2 − k` are mirror images: only `k ≤ n − 2 − k` is stored. A lookup is
-//! *flipped* when exactly one of "the case is stored as its mirror" and "`i < j` in a half
-//! table" holds; a flipped lookup reads row `(j, i)`, weight of face slot `s` at table slot
-//! `perm[s]`, and swaps `du` with `dv`.
+//! middle boundary fan position are self-symmetric: only rows `i ≥ j` are stored (`half`).
+//! Boundary position `k` and `n − 2 − k` are mirror images: only `k ≤ n − 2 − k` is stored and
+//! [`BasisTables::lookup`] reports `mirrored` for the other. The read, exactly as
+//! [`BasisTables::row`] does it:
+//!
+//! ```text
+//! (a, b, flip) = mirrored ? (j, i, true) : (i, j, false)
+//! if half && a < b { swap(a, b); flip = !flip }
+//! row  = (half ? row_map_half : row_map_full)[a·(N+1) + b]
+//! slot = flip ? mirror_perm[offset_perm + s] : s          // for face slot s
+//! pos[s] = weights[offset_position + row·ring_size + slot]
+//! du[s], dv[s] = same from offset_du, offset_dv, exchanged when flip
+//! ```
+//!
+//! # Flattened layout
+//! [`BasisTables::weights`] concatenates, per stored entry ([`BftEntry`]), a position block and
+//! (unless built without tangents) a `du` and a `dv` block, each `rows × ring_size` f32,
+//! row-major. [`pack_patches`] flattens the per-face [`PatchRecord`]s.
 //!
 //! # Bit-identical shared edges
 //! A point on an edge (or at a vertex) is never computed from the current face's table: every
@@ -43,7 +59,10 @@
 //! that contain it, see [`PatchRecord`]); both neighbours evaluate the owner's row with the
 //! owner's control points, summed in the owner's slot order ([`shader_eval`]). The owner's
 //! edge rows are nonzero only on control points both faces share (exact zeros are stored as
-//! 0.0), so the two invocations perform the same f32 operations on the same operands.
+//! 0.0), so the two invocations perform the same f32 operations on the same operands, and the
+//! same holds for normals computed from the owner's `du`, `dv` ([`shader_eval_full`]). The
+//! shader must run one code path for this sum (one function; `precise` keeps the compiler from
+//! contracting it differently at different call sites). Tests emulate this in f32.
 
 use std::collections::HashMap;
 

@@ -17,9 +17,14 @@
 //! Because the one-ring of a face refines into a superset of the one-ring of each child face,
 //! the local refinement is exact. At dyadic parameters the recursion ends after at most
 //! `level + 1` steps on a corner or a regular patch, so results are exact to rounding.
-//! Derivatives `du`, `dv` are parametric; at an extraordinary, crease or corner vertex (where
-//! parametric derivatives vanish or diverge) they are the limit tangent masks' vectors, with
-//! `du × dv` along the normal.
+//! Derivatives `du`, `dv` are parametric (exact on regular patches, including regular vertices).
+//! Exactly at an extraordinary, crease or corner vertex, where parametric derivatives vanish or
+//! diverge, they are built from the limit tangent masks as the tangents toward the face's
+//! neighbouring corners (exact directions; `du × dv` is the outward normal; magnitudes are
+//! OpenSubdiv's, scaled to match the regular case for smooth vertices).
+//!
+//! Holes are evaluated like ordinary faces; Loop needs triangles, Catmull-Clark quads (use
+//! [`LocalMesh::evaluate_subface`] for other faces).
 
 use std::collections::HashMap;
 use std::fmt;
