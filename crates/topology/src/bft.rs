@@ -21,7 +21,7 @@
 //! semi-sharp creases, "edges and corners" corner vertices, faces with two extraordinary
 //! vertices.
 //!
-//! # Control-point ordering (the shader mirrors this through [`face_control_ring`])
+//! # Control-point ordering ([`bft_face_ring`] / [`face_control_ring`]; shaders index by slot)
 //! `v0` (the extraordinary vertex, else a boundary vertex, else corner 0), `v1`, `v2` in the
 //! face's CCW order, then the one-ring of `v0` CCW starting at `v1`, the one-ring of `v1` CCW
 //! starting at `v2`, the one-ring of `v2` CCW starting at `v0`, each vertex kept at its first
@@ -244,6 +244,14 @@ pub fn face_control_ring(mesh: &LocalMesh, face: usize, first: usize) -> Vec<u32
         }
     }
     out
+}
+
+/// The table key of a face and its ordered control-vertex indices (rotated so the
+/// extraordinary vertex — else a boundary vertex — comes first): the one call the GPU upload
+/// needs per face. `None` where no table applies ([`classify_face`]).
+pub fn bft_face_ring(mesh: &LocalMesh, face: usize) -> Option<(BftKey, Vec<u32>)> {
+    let (key, first) = classify_face(mesh, face)?;
+    Some((key, face_control_ring(mesh, face, first)))
 }
 
 /// (valence, boundary, fan position if boundary) of each corner starting at `first`.

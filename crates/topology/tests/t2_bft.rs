@@ -4,8 +4,9 @@
 use std::collections::HashMap;
 
 use topology::bft::{
-    build_patch_records, classify_face, configuration_mesh, face_control_ring, memory_for,
-    pack_patches, prepare_loop_bft, shader_eval, shader_eval_full, BasisTables, BftCase, BftKey,
+    bft_face_ring, build_patch_records, classify_face, configuration_mesh, face_control_ring,
+    memory_for, pack_patches, prepare_loop_bft, shader_eval, shader_eval_full, BasisTables,
+    BftCase, BftKey,
 };
 use topology::eval::{LimitScheme, LocalMesh};
 use topology::refine::refine_uniform;
@@ -60,6 +61,7 @@ fn check_keys(keys: &[BftKey], level: u32, seed: u64) {
             Some((key, 0)),
             "{key:?} classifies"
         );
+        assert_eq!(bft_face_ring(&mesh, face), Some((key, ring.clone())));
         for j in 0..=n {
             for i in 0..=n - j {
                 let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
