@@ -1,9 +1,12 @@
 //! Mesh building and uniform stencil tables on the spot meshes and large generated quad grids.
+//!
+//! `TESSERA_BENCH_PHASES=250,1000 cargo bench -p topology --bench refine` skips criterion and
+//! prints one-shot phase timings (best of a few runs) for those grid sizes instead.
 
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::Criterion;
 use std::path::PathBuf;
-use std::time::Duration;
-use topology::{load_obj, uniform_stencils, ControlMesh, Scheme, Topology};
+use std::time::{Duration, Instant};
+use topology::{load_obj, refine_uniform, uniform_stencils, ControlMesh, Scheme, Topology};
 
 fn asset(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -57,6 +60,9 @@ fn grids(c: &mut Criterion) {
         g.bench_function(format!("{n}x{n}_topology"), |b| {
             b.iter(|| Topology::from_mesh(&mesh).unwrap())
         });
+        g.bench_function(format!("{n}x{n}_level1_stencils"), |b| {
+            b.iter(|| uniform_stencils(&mesh, Scheme::CatmullClark, 1).unwrap())
+        });
         g.bench_function(format!("{n}x{n}_level2_stencils"), |b| {
             b.iter(|| uniform_stencils(&mesh, Scheme::CatmullClark, 2).unwrap())
         });
@@ -64,5 +70,53 @@ fn grids(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, spot, grids);
-criterion_main!(benches);
+/// Best wall time of `runs` calls of `f`, in milliseconds.
+fn best_ms<T>(runs: usize, mut f: impl FnMut() -> T) -> f64 {
+    let mut best = f64::INFINITY;
+    for _ in 0..runs {
+        let t = Instant::now();
+        let out = f();
+        best = best.min(t.elapsed().as_secs_f64() * 1e3);
+        drop(out);
+    }
+    best
+}
+
+/// One-shot phase timings for grids of the given sizes.
+fn phases(sizes: &str) {
+    for n in sizes
+        .split(',')
+        .filter_map(|s| s.trim().parse::<usize>().ok())
+    {
+        let mesh = grid(n);
+        let runs = if n >= 1000 { 2 } else { 5 };
+        let topo = best_ms(runs, || Topology::from_mesh(&mesh).unwrap());
+        let l1 = best_ms(runs, || {
+            uniform_stencils(&mesh, Scheme::CatmullClark, 1).unwrap()
+        });
+        let r1 = best_ms(runs, || {
+            refine_uniform(&mesh, Scheme::CatmullClark, 1).unwrap()
+        });
+        let l2 = best_ms(runs, || {
+            uniform_stencils(&mesh, Scheme::CatmullClark, 2).unwrap()
+        });
+        let t = uniform_stencils(&mesh, Scheme::CatmullClark, 2).unwrap();
+        println!(
+            "{n}x{n}: topology {topo:.1} ms | level-1 stencils {l1:.1} ms | refine_uniform(1) \
+             {r1:.1} ms | level-2 stencils {l2:.1} ms ({} stencils, {} weights)",
+            t.len(),
+            t.weights.len()
+        );
+    }
+}
+
+fn main() {
+    if let Ok(sizes) = std::env::var("TESSERA_BENCH_PHASES") {
+        phases(&sizes);
+        return;
+    }
+    let mut c = Criterion::default().configure_from_args();
+    spot(&mut c);
+    grids(&mut c);
+    c.final_summary();
+}

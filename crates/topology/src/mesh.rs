@@ -238,7 +238,7 @@ impl Topology {
             .collect();
         half.par_sort_unstable();
 
-        let corner_face = corner_to_face(&face_offsets, face_verts.len());
+        let corner_face = corner_faces(&face_offsets, face_verts.len());
         let mut face_edges = vec![INVALID; face_verts.len()];
         let mut edge_verts = Vec::with_capacity(half.len() / 2 + 1);
         let mut edge_faces = Vec::with_capacity(half.len() / 2 + 1);
@@ -502,12 +502,54 @@ fn prefix_sum(v: &mut [u32]) {
     }
 }
 
-fn corner_to_face(face_offsets: &[u32], corners: usize) -> Vec<u32> {
+/// Face of every corner, filled in parallel chunks (each chunk finds its first face by binary
+/// search, then walks).
+pub(crate) fn corner_faces(face_offsets: &[u32], corners: usize) -> Vec<u32> {
+    const CHUNK: usize = 1 << 14;
     let mut out = vec![0u32; corners];
-    for f in 0..face_offsets.len() - 1 {
-        for c in face_offsets[f]..face_offsets[f + 1] {
-            out[c as usize] = f as u32;
-        }
-    }
+    out.par_chunks_mut(CHUNK)
+        .enumerate()
+        .for_each(|(k, chunk)| {
+            let c0 = k * CHUNK;
+            // Last face whose offset is <= c0 (skipping empty faces).
+            let mut f = face_offsets.partition_point(|&o| o as usize <= c0) - 1;
+            for (j, slot) in chunk.iter_mut().enumerate() {
+                while face_offsets[f + 1] as usize <= c0 + j {
+                    f += 1;
+                }
+                *slot = f as u32;
+            }
+        });
     out
+}
+
+/// Fill ragged rows in parallel: row `i` is `data[offsets[i]..offsets[i + 1]]`, written by
+/// `f(i, row)`. Rows are handed out in contiguous blocks of about `BLOCK` entries.
+pub(crate) fn par_fill_ragged<T, F>(offsets: &[u32], data: &mut [T], f: F)
+where
+    T: Send,
+    F: Fn(usize, &mut [T]) + Sync,
+{
+    const BLOCK: usize = 1 << 15;
+    let rows = offsets.len().saturating_sub(1);
+    let mut jobs = Vec::new();
+    let mut rest = data;
+    let mut row = 0;
+    while row < rows {
+        let start = offsets[row] as usize;
+        let end_row =
+            (offsets.partition_point(|&o| (o as usize) < start + BLOCK) - 1).clamp(row + 1, rows);
+        let len = offsets[end_row] as usize - start;
+        let (chunk, tail) = std::mem::take(&mut rest).split_at_mut(len);
+        jobs.push((row, end_row, chunk));
+        rest = tail;
+        row = end_row;
+    }
+    jobs.into_par_iter().for_each(|(r0, r1, chunk)| {
+        let base = offsets[r0] as usize;
+        for i in r0..r1 {
+            let (s, e) = (offsets[i] as usize - base, offsets[i + 1] as usize - base);
+            f(i, &mut chunk[s..e]);
+        }
+    });
 }

@@ -11,13 +11,14 @@
 
 use crate::error::TopologyError;
 use crate::mesh::{
-    BoundaryInterpolation, ControlMesh, SubdivOptions, Topology, TriangleSubdivision, INVALID,
+    corner_faces, par_fill_ragged, BoundaryInterpolation, ControlMesh, SubdivOptions, Topology,
+    TriangleSubdivision, INVALID,
 };
 use crate::sdc::{
     decrement_sharpness, fractional_weight, is_sharp, subdivide_edge_sharpness_at_vertex,
     vertex_rule, Rule, Scheme, SHARPNESS_INFINITE,
 };
-use crate::stencil::{build_rows, StencilTable};
+use crate::stencil::{build_rows, compose_rows, RowKind, StencilTable};
 use rayon::prelude::*;
 
 /// One level of a refinement: topology, positions and (propagated) sharpness.
@@ -51,53 +52,8 @@ impl Level {
 
     /// Base level of `mesh`: validated topology plus sharpness from tags and boundary rules.
     pub fn from_mesh(mesh: &ControlMesh, scheme: Scheme) -> Result<Level, TopologyError> {
-        let topology = Topology::from_mesh(mesh)?;
-        if scheme == Scheme::Loop {
-            if let Some(f) =
-                (0..topology.num_faces()).find(|&f| topology.face_vertices(f).len() != 3)
-            {
-                return Err(TopologyError::LoopRequiresTriangles {
-                    face: f,
-                    size: topology.face_vertices(f).len(),
-                });
-            }
-        }
-        let nv = topology.num_vertices();
-        let mut edge_sharpness = vec![0.0f32; topology.num_edges()];
-        for c in &mesh.creases {
-            let [a, b] = c.vertices;
-            if a as usize >= nv || b as usize >= nv {
-                return Err(TopologyError::InvalidTag {
-                    message: format!("crease names vertex {}, mesh has {nv} vertices", a.max(b)),
-                });
-            }
-            match topology.find_edge(a, b) {
-                Some(e) => edge_sharpness[e as usize] = c.sharpness.max(0.0),
-                None => log::warn!("crease tag on {a}-{b}, which is not an edge: ignored"),
-            }
-        }
-        let mut vertex_sharpness = vec![0.0f32; nv];
-        for c in &mesh.corners {
-            if c.vertex as usize >= nv {
-                return Err(TopologyError::InvalidTag {
-                    message: format!("corner names vertex {}, mesh has {nv} vertices", c.vertex),
-                });
-            }
-            vertex_sharpness[c.vertex as usize] = c.sharpness.max(0.0);
-        }
-        // Boundary edges are always infinitely sharp (OpenSubdiv does this for every rule).
-        for (e, s) in edge_sharpness.iter_mut().enumerate() {
-            if topology.is_boundary_edge(e) {
-                *s = SHARPNESS_INFINITE;
-            }
-        }
-        if mesh.options.boundary == BoundaryInterpolation::EdgesAndCorners {
-            for (v, s) in vertex_sharpness.iter_mut().enumerate() {
-                if topology.vertex_faces(v).len() == 1 && topology.vertex_edges(v).len() == 2 {
-                    *s = SHARPNESS_INFINITE;
-                }
-            }
-        }
+        let topology = base_topology(mesh, scheme)?;
+        let (edge_sharpness, vertex_sharpness) = base_sharpness(mesh, &topology)?;
         Ok(Level {
             topology,
             positions: mesh.positions.clone(),
@@ -105,6 +61,64 @@ impl Level {
             vertex_sharpness,
         })
     }
+}
+
+/// Validated base topology; Loop needs triangles.
+fn base_topology(mesh: &ControlMesh, scheme: Scheme) -> Result<Topology, TopologyError> {
+    let topology = Topology::from_mesh(mesh)?;
+    if scheme == Scheme::Loop {
+        if let Some(f) = (0..topology.num_faces()).find(|&f| topology.face_vertices(f).len() != 3) {
+            return Err(TopologyError::LoopRequiresTriangles {
+                face: f,
+                size: topology.face_vertices(f).len(),
+            });
+        }
+    }
+    Ok(topology)
+}
+
+/// Edge and vertex sharpness of the base level from tags and boundary rules.
+fn base_sharpness(
+    mesh: &ControlMesh,
+    topology: &Topology,
+) -> Result<(Vec<f32>, Vec<f32>), TopologyError> {
+    let nv = topology.num_vertices();
+    let mut edge_sharpness = vec![0.0f32; topology.num_edges()];
+    for c in &mesh.creases {
+        let [a, b] = c.vertices;
+        if a as usize >= nv || b as usize >= nv {
+            return Err(TopologyError::InvalidTag {
+                message: format!("crease names vertex {}, mesh has {nv} vertices", a.max(b)),
+            });
+        }
+        match topology.find_edge(a, b) {
+            Some(e) => edge_sharpness[e as usize] = c.sharpness.max(0.0),
+            None => log::warn!("crease tag on {a}-{b}, which is not an edge: ignored"),
+        }
+    }
+    let mut vertex_sharpness = vec![0.0f32; nv];
+    for c in &mesh.corners {
+        if c.vertex as usize >= nv {
+            return Err(TopologyError::InvalidTag {
+                message: format!("corner names vertex {}, mesh has {nv} vertices", c.vertex),
+            });
+        }
+        vertex_sharpness[c.vertex as usize] = c.sharpness.max(0.0);
+    }
+    // Boundary edges are always infinitely sharp (OpenSubdiv does this for every rule).
+    for (e, s) in edge_sharpness.iter_mut().enumerate() {
+        if topology.is_boundary_edge(e) {
+            *s = SHARPNESS_INFINITE;
+        }
+    }
+    if mesh.options.boundary == BoundaryInterpolation::EdgesAndCorners {
+        for (v, s) in vertex_sharpness.iter_mut().enumerate() {
+            if topology.vertex_faces(v).len() == 1 && topology.vertex_edges(v).len() == 2 {
+                *s = SHARPNESS_INFINITE;
+            }
+        }
+    }
+    Ok((edge_sharpness, vertex_sharpness))
 }
 
 /// Result of [`refine_uniform`]: every level from the base (index 0) to the requested one,
@@ -180,21 +194,60 @@ pub fn refine_uniform(
 }
 
 /// Stencils of the level-`level` vertices over the control vertices of `mesh`.
+///
+/// Only what the stencils need is built: no positions, no topology of the deepest level, no
+/// per-step tables. Each level's rows are composed with the previous level's table on the fly.
 pub fn uniform_stencils(
     mesh: &ControlMesh,
     scheme: Scheme,
     level: usize,
 ) -> Result<StencilTable, TopologyError> {
-    Ok(refine_uniform(mesh, scheme, level)?.stencils(level))
+    if scheme == Scheme::DooSabin {
+        return Ok(refine_uniform(mesh, scheme, level)?.stencils(level));
+    }
+    let mut topology = base_topology(mesh, scheme)?;
+    let (mut edge_sharpness, mut vertex_sharpness) = base_sharpness(mesh, &topology)?;
+    let num_sources = topology.num_vertices();
+    let options = &mesh.options;
+    let mut table: Option<StencilTable> = None;
+    for k in 0..level {
+        check_size(&topology, scheme)?;
+        let (child_es, child_vs) = child_sharpness(
+            &topology,
+            &edge_sharpness,
+            &vertex_sharpness,
+            scheme,
+            options,
+        );
+        let nv = topology.num_vertices();
+        let ctx = MaskContext {
+            p: &topology,
+            es: &edge_sharpness,
+            vs: &vertex_sharpness,
+            scheme,
+            options,
+            child_edge_sharpness: &child_es,
+            child_vertex_sharpness: &child_vs[..nv],
+        };
+        let next = compose_rows(
+            child_vs.len(),
+            table.as_ref(),
+            RowKind::Raw,
+            num_sources,
+            |i, out| ctx.row(i, out),
+        );
+        table = Some(next);
+        if k + 1 < level {
+            topology = split(&topology, scheme);
+            edge_sharpness = child_es;
+            vertex_sharpness = child_vs;
+        }
+    }
+    Ok(table.unwrap_or_else(|| StencilTable::identity(num_sources)))
 }
 
-/// One uniform refinement step: child level and its stencils over the parent vertices.
-pub fn refine_level(
-    parent: &Level,
-    scheme: Scheme,
-    options: &SubdivOptions,
-) -> Result<(Level, StencilTable), TopologyError> {
-    let p = &parent.topology;
+/// Refuse steps whose child indices would overflow 32 bits.
+fn check_size(p: &Topology, scheme: Scheme) -> Result<(), TopologyError> {
     let corners = p.face_verts.len();
     let max_children = match scheme {
         Scheme::Loop => p.num_vertices() + p.num_edges() * 4,
@@ -208,37 +261,75 @@ pub fn refine_level(
             ),
         });
     }
+    Ok(())
+}
+
+/// Child topology of a Catmull-Clark / bilinear (quad split) or Loop (triangle split) step.
+fn split(p: &Topology, scheme: Scheme) -> Topology {
+    match scheme {
+        Scheme::Loop => split_triangles(p),
+        _ => split_quads(p),
+    }
+}
+
+/// Child edge sharpness (see [`child_edge_sharpness`]) and child vertex sharpness (vertex
+/// vertices decay, new vertices are smooth) of a Catmull-Clark, bilinear or Loop step.
+fn child_sharpness(
+    p: &Topology,
+    edge_sharpness: &[f32],
+    vertex_sharpness: &[f32],
+    scheme: Scheme,
+    options: &SubdivOptions,
+) -> (Vec<f32>, Vec<f32>) {
+    let (nv, ne, nf) = (p.num_vertices(), p.num_edges(), p.num_faces());
+    let (extra, child_nv) = match scheme {
+        Scheme::Loop => (3 * nf, nv + ne),
+        _ => (p.face_verts.len(), nv + ne + nf),
+    };
+    let es = child_edge_sharpness(p, edge_sharpness, options, extra);
+    let mut vs = vec![0.0f32; child_nv];
+    for (c, &s) in vs.iter_mut().zip(vertex_sharpness) {
+        *c = decrement_sharpness(s);
+    }
+    (es, vs)
+}
+
+/// One uniform refinement step: child level and its stencils over the parent vertices.
+pub fn refine_level(
+    parent: &Level,
+    scheme: Scheme,
+    options: &SubdivOptions,
+) -> Result<(Level, StencilTable), TopologyError> {
+    let p = &parent.topology;
+    check_size(p, scheme)?;
     if scheme == Scheme::DooSabin {
         return refine_doo_sabin(parent);
     }
-    let (topology, child_edge_sharpness) = match scheme {
-        Scheme::Loop => split_triangles(parent, options),
-        _ => split_quads(parent, options),
-    };
-    let nv = p.num_vertices();
-    let mut vertex_sharpness = vec![0.0f32; topology.num_vertices()];
-    for (c, &s) in vertex_sharpness.iter_mut().zip(&parent.vertex_sharpness) {
-        *c = decrement_sharpness(s);
-    }
-    let ctx = MaskContext {
-        parent,
+    let (edge_sharpness, vertex_sharpness) = child_sharpness(
+        p,
+        &parent.edge_sharpness,
+        &parent.vertex_sharpness,
         scheme,
         options,
-        child_edge_sharpness: &child_edge_sharpness,
+    );
+    let nv = p.num_vertices();
+    let ctx = MaskContext {
+        p,
+        es: &parent.edge_sharpness,
+        vs: &parent.vertex_sharpness,
+        scheme,
+        options,
+        child_edge_sharpness: &edge_sharpness,
         child_vertex_sharpness: &vertex_sharpness[..nv],
     };
-    let step = build_rows(
-        topology.num_vertices(),
-        nv,
-        || (),
-        |_, i, out| ctx.row(i, out),
-    );
+    let step = build_rows(vertex_sharpness.len(), nv, |i, out| ctx.row(i, out));
+    let topology = split(p, scheme);
     let positions = step.apply(&parent.positions);
     Ok((
         Level {
             topology,
             positions,
-            edge_sharpness: child_edge_sharpness,
+            edge_sharpness,
             vertex_sharpness,
         },
         step,
@@ -253,84 +344,247 @@ fn child_edge_at(p: &Topology, e: u32, v: u32) -> u32 {
 
 /// Sharpness of the two children of every parent edge (child `2e` at end 0, `2e + 1` at end 1),
 /// followed by smooth interior edges (`extra` of them).
-fn child_edge_sharpness(parent: &Level, options: &SubdivOptions, extra: usize) -> Vec<f32> {
-    let p = &parent.topology;
+fn child_edge_sharpness(
+    p: &Topology,
+    edge_sharpness: &[f32],
+    options: &SubdivOptions,
+    extra: usize,
+) -> Vec<f32> {
     let mut out = vec![0.0f32; 2 * p.num_edges() + extra];
     out[..2 * p.num_edges()]
         .par_chunks_mut(2)
         .enumerate()
+        .with_min_len(4096)
         .for_each(|(e, pair)| {
-            let s = parent.edge_sharpness[e];
+            let s = edge_sharpness[e];
             if !is_sharp(s) {
                 return;
             }
+            let mut incident: Vec<f32> = Vec::new();
             for (k, slot) in pair.iter_mut().enumerate() {
                 let v = p.edge_verts[e][k] as usize;
-                let incident: Vec<f32> = p
-                    .vertex_edges(v)
-                    .iter()
-                    .map(|&x| parent.edge_sharpness[x as usize])
-                    .collect();
+                incident.clear();
+                incident.extend(
+                    p.vertex_edges(v)
+                        .iter()
+                        .map(|&x| edge_sharpness[x as usize]),
+                );
                 *slot = subdivide_edge_sharpness_at_vertex(options.crease_method, s, &incident);
             }
         });
     out
 }
 
+/// Position of edge `e` in the edge list of face `f` (corner `i` owns edge `i → i + 1`).
+#[inline]
+fn edge_slot(p: &Topology, f: u32, e: u32) -> usize {
+    p.face_edge_list(f as usize)
+        .iter()
+        .position(|&x| x == e)
+        .expect("edge lists its faces")
+}
+
+/// Push `x` into the first free (`INVALID`) slot of a pair.
+#[inline]
+fn push_pair(pair: &mut [u32; 2], x: u32) {
+    if pair[0] == INVALID {
+        pair[0] = x;
+    } else {
+        pair[1] = x;
+    }
+}
+
 /// Catmull-Clark / bilinear split: face `f` with n corners → n quads (one per corner).
-fn split_quads(parent: &Level, options: &SubdivOptions) -> (Topology, Vec<f32>) {
-    let p = &parent.topology;
+///
+/// Child face `c` is the quad at parent corner `c`; child edges are `2e`, `2e + 1` (halves of
+/// parent edge `e`) then one interior edge per parent corner. Every adjacency table of the
+/// child is written directly from the parent's, in parallel and in the order (ascending
+/// indices) a generic counting sort would produce.
+fn split_quads(p: &Topology) -> Topology {
     let (nv, ne, nf) = (p.num_vertices(), p.num_edges(), p.num_faces());
     let corners = p.face_verts.len();
     let vert_e = |e: u32| (nv as u32) + e;
     let vert_f = |f: u32| (nv + ne) as u32 + f;
     let face_edge = |c: usize| (2 * ne + c) as u32;
+    let corner_face = corner_faces(&p.face_offsets, corners);
+    let min_len = 4096;
 
-    let mut edge_verts = Vec::with_capacity(2 * ne + corners);
-    for (e, &[a, b]) in p.edge_verts.iter().enumerate() {
-        edge_verts.push([a, vert_e(e as u32)]);
-        edge_verts.push([vert_e(e as u32), b]);
+    let mut edge_verts = vec![[0u32; 2]; 2 * ne + corners];
+    let mut edge_faces = vec![[INVALID; 2]; 2 * ne + corners];
+    {
+        let (halves, inner) = edge_verts.split_at_mut(2 * ne);
+        halves
+            .par_chunks_mut(2)
+            .enumerate()
+            .with_min_len(min_len)
+            .for_each(|(e, pair)| {
+                let [a, b] = p.edge_verts[e];
+                pair[0] = [a, vert_e(e as u32)];
+                pair[1] = [vert_e(e as u32), b];
+            });
+        inner
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(min_len)
+            .for_each(|(c, slot)| *slot = [vert_e(p.face_edges[c]), vert_f(corner_face[c])]);
+        let (halves, inner) = edge_faces.split_at_mut(2 * ne);
+        halves
+            .par_chunks_mut(2)
+            .enumerate()
+            .with_min_len(min_len)
+            .for_each(|(e, pair)| {
+                for f in p.edge_faces[e] {
+                    if f == INVALID {
+                        continue;
+                    }
+                    let s = p.face_offsets[f as usize] as usize;
+                    let n = p.face_offsets[f as usize + 1] as usize - s;
+                    let i = edge_slot(p, f, e as u32);
+                    // The face runs fv[i] → fv[i + 1] along e.
+                    let x = (child_edge_at(p, e as u32, p.face_verts[s + i]) & 1) as usize;
+                    push_pair(&mut pair[x], (s + i) as u32);
+                    push_pair(&mut pair[1 - x], (s + (i + 1) % n) as u32);
+                }
+                for slot in pair.iter_mut() {
+                    if slot[1] != INVALID && slot[0] > slot[1] {
+                        slot.swap(0, 1);
+                    }
+                }
+            });
+        inner
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(min_len)
+            .for_each(|(c, slot)| {
+                let f = corner_face[c] as usize;
+                let s = p.face_offsets[f] as usize;
+                let n = p.face_offsets[f + 1] as usize - s;
+                let next = (s + (c - s + 1) % n) as u32;
+                *slot = [(c as u32).min(next), (c as u32).max(next)];
+            });
     }
     let mut face_verts = vec![0u32; 4 * corners];
     let mut face_edges = vec![0u32; 4 * corners];
-    for f in 0..nf {
-        let s = p.face_offsets[f] as usize;
-        let fv = p.face_vertices(f);
-        let fe = p.face_edge_list(f);
-        let n = fv.len();
-        for i in 0..n {
-            let prev = (i + n - 1) % n;
-            edge_verts.push([vert_e(fe[i]), vert_f(f as u32)]);
-            let c = 4 * (s + i);
-            face_verts[c..c + 4].copy_from_slice(&[
-                fv[i],
-                vert_e(fe[i]),
-                vert_f(f as u32),
-                vert_e(fe[prev]),
+    face_verts
+        .par_chunks_mut(4)
+        .zip(face_edges.par_chunks_mut(4))
+        .enumerate()
+        .with_min_len(min_len)
+        .for_each(|(c, (qv, qe))| {
+            let f = corner_face[c] as usize;
+            let s = p.face_offsets[f] as usize;
+            let n = p.face_offsets[f + 1] as usize - s;
+            let i = c - s;
+            let prev = s + (i + n - 1) % n;
+            let v = p.face_verts[c];
+            let (e, ep) = (p.face_edges[c], p.face_edges[prev]);
+            qv.copy_from_slice(&[v, vert_e(e), vert_f(f as u32), vert_e(ep)]);
+            qe.copy_from_slice(&[
+                child_edge_at(p, e, v),
+                face_edge(c),
+                face_edge(prev),
+                child_edge_at(p, ep, v),
             ]);
-            face_edges[c..c + 4].copy_from_slice(&[
-                child_edge_at(p, fe[i], fv[i]),
-                face_edge(s + i),
-                face_edge(s + prev),
-                child_edge_at(p, fe[prev], fv[i]),
-            ]);
-        }
-    }
+        });
     let face_offsets: Vec<u32> = (0..=corners as u32).map(|i| 4 * i).collect();
-    let sharp = child_edge_sharpness(parent, options, corners);
-    let topo = Topology::from_parts(
-        nv + ne + nf,
+
+    // Vertex incidence: vertex-vertices inherit their parent's counts, edge-vertices have the
+    // two halves plus one interior edge per face, face-vertices one edge and face per corner.
+    let nc = nv + ne + nf;
+    let mut vert_edge_offsets = Vec::with_capacity(nc + 1);
+    let mut vert_face_offsets = Vec::with_capacity(nc + 1);
+    vert_edge_offsets.extend_from_slice(&p.vert_edge_offsets);
+    vert_face_offsets.extend_from_slice(&p.vert_face_offsets);
+    let (mut oe, mut of) = (p.vert_edges.len() as u32, p.vert_faces.len() as u32);
+    for ef in &p.edge_faces {
+        let k = 1 + u32::from(ef[1] != INVALID);
+        oe += 2 + k;
+        of += 2 * k;
+        vert_edge_offsets.push(oe);
+        vert_face_offsets.push(of);
+    }
+    for w in p.face_offsets.windows(2) {
+        let n = w[1] - w[0];
+        oe += n;
+        of += n;
+        vert_edge_offsets.push(oe);
+        vert_face_offsets.push(of);
+    }
+    let mut vert_edges = vec![0u32; oe as usize];
+    let mut vert_faces = vec![0u32; of as usize];
+    par_fill_ragged(&vert_edge_offsets, &mut vert_edges, |i, out| {
+        if i < nv {
+            for (slot, &e) in out.iter_mut().zip(p.vertex_edges(i)) {
+                *slot = child_edge_at(p, e, i as u32);
+            }
+        } else if i < nv + ne {
+            let e = (i - nv) as u32;
+            out[0] = 2 * e;
+            out[1] = 2 * e + 1;
+            let mut k = 2;
+            for f in p.edge_faces[e as usize] {
+                if f != INVALID {
+                    let c = p.face_offsets[f as usize] as usize + edge_slot(p, f, e);
+                    out[k] = face_edge(c);
+                    k += 1;
+                }
+            }
+            out[2..].sort_unstable();
+        } else {
+            let s = p.face_offsets[i - nv - ne] as usize;
+            for (k, slot) in out.iter_mut().enumerate() {
+                *slot = face_edge(s + k);
+            }
+        }
+    });
+    par_fill_ragged(&vert_face_offsets, &mut vert_faces, |i, out| {
+        if i < nv {
+            for (slot, &f) in out.iter_mut().zip(p.vertex_faces(i)) {
+                let s = p.face_offsets[f as usize] as usize;
+                let k = p
+                    .face_vertices(f as usize)
+                    .iter()
+                    .position(|&x| x as usize == i)
+                    .expect("face lists its vertices");
+                *slot = (s + k) as u32;
+            }
+        } else if i < nv + ne {
+            let e = (i - nv) as u32;
+            let mut k = 0;
+            for f in p.edge_faces[e as usize] {
+                if f != INVALID {
+                    let s = p.face_offsets[f as usize] as usize;
+                    let n = p.face_offsets[f as usize + 1] as usize - s;
+                    let j = edge_slot(p, f, e);
+                    out[k] = (s + j) as u32;
+                    out[k + 1] = (s + (j + 1) % n) as u32;
+                    k += 2;
+                }
+            }
+            out.sort_unstable();
+        } else {
+            let s = p.face_offsets[i - nv - ne];
+            for (k, slot) in out.iter_mut().enumerate() {
+                *slot = s + k as u32;
+            }
+        }
+    });
+    Topology {
+        num_vertices: nc,
         face_offsets,
         face_verts,
         face_edges,
         edge_verts,
-    );
-    (topo, sharp)
+        edge_faces,
+        vert_edge_offsets,
+        vert_edges,
+        vert_face_offsets,
+        vert_faces,
+    }
 }
 
 /// Loop split: each triangle → three corner triangles and a middle one.
-fn split_triangles(parent: &Level, options: &SubdivOptions) -> (Topology, Vec<f32>) {
-    let p = &parent.topology;
+fn split_triangles(p: &Topology) -> Topology {
     let (nv, ne, nf) = (p.num_vertices(), p.num_edges(), p.num_faces());
     let vert_e = |e: u32| (nv as u32) + e;
     let inner = |f: usize, j: usize| (2 * ne + 3 * f + j) as u32;
@@ -362,14 +616,15 @@ fn split_triangles(parent: &Level, options: &SubdivOptions) -> (Topology, Vec<f3
         face_edges[c..c + 3].copy_from_slice(&[inner(f, 1), inner(f, 2), inner(f, 0)]);
     }
     let face_offsets: Vec<u32> = (0..=4 * nf as u32).map(|i| 3 * i).collect();
-    let sharp = child_edge_sharpness(parent, options, 3 * nf);
-    let topo = Topology::from_parts(nv + ne, face_offsets, face_verts, face_edges, edge_verts);
-    (topo, sharp)
+    Topology::from_parts(nv + ne, face_offsets, face_verts, face_edges, edge_verts)
 }
 
 /// Everything the vertex masks need for one refinement step.
 struct MaskContext<'a> {
-    parent: &'a Level,
+    /// Parent topology, edge sharpness and vertex sharpness.
+    p: &'a Topology,
+    es: &'a [f32],
+    vs: &'a [f32],
     scheme: Scheme,
     options: &'a SubdivOptions,
     child_edge_sharpness: &'a [f32],
@@ -379,7 +634,7 @@ struct MaskContext<'a> {
 impl MaskContext<'_> {
     /// Stencil row of child vertex `i` over the parent vertices.
     fn row(&self, i: usize, out: &mut Vec<(u32, f64)>) {
-        let p = &self.parent.topology;
+        let p = self.p;
         let (nv, ne) = (p.num_vertices(), p.num_edges());
         if i < nv {
             self.vertex_vertex(i, out);
@@ -391,19 +646,19 @@ impl MaskContext<'_> {
     }
 
     fn face_center(&self, f: usize, scale: f64, out: &mut Vec<(u32, f64)>) {
-        let fv = self.parent.topology.face_vertices(f);
+        let fv = self.p.face_vertices(f);
         let w = scale / fv.len() as f64;
         out.extend(fv.iter().map(|&v| (v, w)));
     }
 
     fn edge_vertex(&self, e: usize, out: &mut Vec<(u32, f64)>) {
-        let p = &self.parent.topology;
+        let p = self.p;
         let [a, b] = p.edge_verts[e];
         if self.scheme == Scheme::Bilinear {
             out.extend([(a, 0.5), (b, 0.5)]);
             return;
         }
-        let s = self.parent.edge_sharpness[e];
+        let s = self.es[e];
         if !is_sharp(s) {
             self.smooth_edge(e, 1.0, out);
             return;
@@ -421,7 +676,7 @@ impl MaskContext<'_> {
     }
 
     fn smooth_edge(&self, e: usize, scale: f64, out: &mut Vec<(u32, f64)>) {
-        let p = &self.parent.topology;
+        let p = self.p;
         let [a, b] = p.edge_verts[e];
         let [f0, f1] = p.edge_faces[e];
         let face_pair = [f0, f1];
@@ -473,14 +728,14 @@ impl MaskContext<'_> {
     }
 
     fn vertex_vertex(&self, v: usize, out: &mut Vec<(u32, f64)>) {
-        let p = &self.parent.topology;
+        let p = self.p;
         let edges = p.vertex_edges(v);
         if self.scheme == Scheme::Bilinear || edges.is_empty() {
             out.push((v as u32, 1.0));
             return;
         }
-        let es = &self.parent.edge_sharpness;
-        let pvs = self.parent.vertex_sharpness[v];
+        let es = self.es;
+        let pvs = self.vs[v];
         let sharp_count = edges.iter().filter(|&&e| is_sharp(es[e as usize])).count();
         let p_rule = vertex_rule(pvs, sharp_count);
         if matches!(p_rule, Rule::Smooth | Rule::Dart) {
@@ -522,7 +777,7 @@ impl MaskContext<'_> {
         out: &mut Vec<(u32, f64)>,
     ) {
         if rule == Rule::Crease {
-            let p = &self.parent.topology;
+            let p = self.p;
             out.push((v as u32, 0.75 * scale));
             for (k, &e) in p.vertex_edges(v).iter().enumerate() {
                 if is_sharp(sharpness[k]) {
@@ -535,7 +790,7 @@ impl MaskContext<'_> {
     }
 
     fn smooth_vertex(&self, v: usize, scale: f64, out: &mut Vec<(u32, f64)>) {
-        let p = &self.parent.topology;
+        let p = self.p;
         let edges = p.vertex_edges(v);
         let n = edges.len() as f64;
         match self.scheme {
@@ -662,27 +917,22 @@ fn refine_doo_sabin(parent: &Level) -> Result<(Level, StencilTable), TopologyErr
         }
         faces.push(ring);
     }
-    let step = build_rows(
-        corners,
-        p.num_vertices(),
-        || (),
-        |_, c, out| {
-            let f = corner_face[c] as usize;
-            let fv = p.face_vertices(f);
-            let n = fv.len();
-            let i = c - p.face_offsets[f] as usize;
-            let nf = n as f64;
-            for (j, &v) in fv.iter().enumerate() {
-                let w = if i == j {
-                    (nf + 5.0) / (4.0 * nf)
-                } else {
-                    let d = (i + n - j) % n;
-                    (3.0 + 2.0 * (2.0 * std::f64::consts::PI * d as f64 / nf).cos()) / (4.0 * nf)
-                };
-                out.push((v, w));
-            }
-        },
-    );
+    let step = build_rows(corners, p.num_vertices(), |c, out| {
+        let f = corner_face[c] as usize;
+        let fv = p.face_vertices(f);
+        let n = fv.len();
+        let i = c - p.face_offsets[f] as usize;
+        let nf = n as f64;
+        for (j, &v) in fv.iter().enumerate() {
+            let w = if i == j {
+                (nf + 5.0) / (4.0 * nf)
+            } else {
+                let d = (i + n - j) % n;
+                (3.0 + 2.0 * (2.0 * std::f64::consts::PI * d as f64 / nf).cos()) / (4.0 * nf)
+            };
+            out.push((v, w));
+        }
+    });
     let positions = step.apply(&parent.positions);
     let mesh = ControlMesh::from_polygons(positions.clone(), &faces);
     let topology = Topology::from_mesh(&mesh)?;

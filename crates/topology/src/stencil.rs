@@ -88,86 +88,192 @@ impl StencilTable {
     /// Stencils of `self` (over the vertices `parent` produces) re-expressed over `parent`'s
     /// sources: `result_i = Σ_j w_ij · parent_j`.
     pub fn compose(&self, parent: &StencilTable) -> StencilTable {
-        let n_src = parent.num_sources;
-        build_rows(
+        compose_rows(
             self.len(),
-            n_src,
-            || {
-                (
-                    vec![0.0f64; n_src],
-                    vec![u32::MAX; n_src],
-                    Vec::<u32>::new(),
-                )
-            },
-            |(acc, stamp, touched), i, out| {
-                touched.clear();
+            Some(parent),
+            RowKind::Merged,
+            parent.num_sources,
+            |i, out| {
                 let (idx, w) = self.stencil(i);
-                for (&j, &wj) in idx.iter().zip(w) {
-                    let (pidx, pw) = parent.stencil(j as usize);
-                    for (&b, &wb) in pidx.iter().zip(pw) {
-                        let b = b as usize;
-                        if stamp[b] != i as u32 {
-                            stamp[b] = i as u32;
-                            acc[b] = 0.0;
-                            touched.push(b as u32);
-                        }
-                        acc[b] += wj * wb;
-                    }
-                }
-                touched.sort_unstable();
-                out.extend(touched.iter().map(|&b| (b, acc[b as usize])));
+                out.extend(idx.iter().copied().zip(w.iter().copied()));
             },
         )
     }
 }
 
-/// Build a table row by row in parallel. `f` writes the (index, weight) pairs of row `i`;
-/// they are sorted, merged and stripped of exact zeros here. `init` makes per-block scratch.
-pub(crate) fn build_rows<S, I, F>(n: usize, num_sources: usize, init: I, f: F) -> StencilTable
-where
-    I: Fn() -> S + Sync,
-    F: Fn(&mut S, usize, &mut Vec<(u32, f64)>) + Sync,
-{
-    let threads = rayon::current_num_threads().max(1);
-    let blocks = n.div_ceil(2048).clamp(1, threads * 4);
-    let block_len = n.div_ceil(blocks).max(1);
-    let parts: Vec<(Vec<u32>, Vec<u32>, Vec<f64>)> = (0..blocks)
-        .into_par_iter()
-        .map(|b| {
-            let start = (b * block_len).min(n);
-            let end = ((b + 1) * block_len).min(n);
-            let mut scratch = init();
-            let mut sizes = Vec::with_capacity(end - start);
-            let mut idx = Vec::with_capacity((end - start) * 8);
-            let mut wts = Vec::with_capacity((end - start) * 8);
-            let mut row = Vec::with_capacity(64);
-            for i in start..end {
-                row.clear();
-                f(&mut scratch, i, &mut row);
-                merge_row(&mut row);
-                sizes.push(row.len() as u32);
-                for &(j, w) in &row {
-                    idx.push(j);
-                    wts.push(w);
-                }
-            }
-            (sizes, idx, wts)
-        })
-        .collect();
-    let total: usize = parts.iter().map(|p| p.1.len()).sum();
-    let mut offsets = Vec::with_capacity(n + 1);
-    let mut indices = Vec::with_capacity(total);
-    let mut weights = Vec::with_capacity(total);
-    offsets.push(0u32);
-    let mut acc = 0u32;
-    for (sizes, idx, wts) in parts {
-        for s in sizes {
-            acc += s;
-            offsets.push(acc);
+/// What a row generator writes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum RowKind {
+    /// Indices may repeat and come in any order (subdivision masks).
+    Raw,
+    /// Indices are sorted and unique, weights non-zero (rows of an existing table).
+    Merged,
+}
+
+/// A dense accumulator over `n` slots with a touched list: O(1) per added entry, no hashing.
+/// Slot `k` holds a live value for the current row when its stamp equals the row's tag; stamp
+/// and value share a cache line.
+struct Dense {
+    slots: Vec<(u32, f64)>,
+    touched: Vec<u32>,
+}
+
+impl Dense {
+    fn new(n: usize) -> Dense {
+        Dense {
+            slots: vec![(0, 0.0); n],
+            touched: Vec::with_capacity(64),
         }
-        indices.extend_from_slice(&idx);
-        weights.extend_from_slice(&wts);
     }
+
+    #[inline]
+    fn add(&mut self, tag: u32, j: u32, w: f64) {
+        let slot = &mut self.slots[j as usize];
+        if slot.0 != tag {
+            *slot = (tag, w);
+            self.touched.push(j);
+        } else {
+            slot.1 += w;
+        }
+    }
+
+    /// Sort the touched list (short: insertion sort).
+    #[inline]
+    fn sort_touched(&mut self) {
+        let t = &mut self.touched;
+        if t.len() > 32 {
+            t.sort_unstable();
+            return;
+        }
+        for i in 1..t.len() {
+            let x = t[i];
+            let mut j = i;
+            while j > 0 && t[j - 1] > x {
+                t[j] = t[j - 1];
+                j -= 1;
+            }
+            t[j] = x;
+        }
+    }
+}
+
+/// Per-thread scratch of [`compose_rows`], reused across rounds: accumulators and the output
+/// of the block last computed with it.
+struct Scratch {
+    mask: Option<Dense>,
+    out: Option<Dense>,
+    row: Vec<(u32, f64)>,
+    rows: std::ops::Range<usize>,
+    sizes: Vec<u32>,
+    idx: Vec<u32>,
+    wts: Vec<f64>,
+}
+
+/// Rows per block of [`compose_rows`].
+const BLOCK_ROWS: usize = 8192;
+
+/// Build a table of `n` rows in parallel blocks. `gen` writes the (index, weight) pairs of row
+/// `i` over the "parent" vertices. Without `parent` those are the sources: rows are merged
+/// (duplicates added, sorted, exact zeros dropped). With `parent`, each entry `(j, w)` adds `w`
+/// times parent row `j` into a dense accumulator over the parent's sources, so the result is the
+/// composition without an intermediate table, hashing or per-row allocation.
+///
+/// Blocks run in rounds of a few per thread; each round's blocks are then copied in parallel
+/// straight into the final arrays, so block buffers and accumulators are reused (touched once
+/// per thread, not once per row) and the final arrays are touched once.
+pub(crate) fn compose_rows<G>(
+    n: usize,
+    parent: Option<&StencilTable>,
+    kind: RowKind,
+    num_sources: usize,
+    gen: G,
+) -> StencilTable
+where
+    G: Fn(usize, &mut Vec<(u32, f64)>) + Sync,
+{
+    assert!(
+        n < u32::MAX as usize,
+        "too many stencils for 32-bit offsets"
+    );
+    let threads = rayon::current_num_threads().max(1);
+    let num_parent = parent.map_or(num_sources, StencilTable::len);
+    let blocks = n.div_ceil(BLOCK_ROWS).max(1);
+    let per_round = threads * 2;
+    let pool = std::sync::Mutex::new(Vec::<Scratch>::new());
+    let new_scratch = || Scratch {
+        mask: (kind == RowKind::Raw).then(|| Dense::new(num_parent)),
+        out: parent.map(|_| Dense::new(num_sources)),
+        row: Vec::with_capacity(64),
+        rows: 0..0,
+        sizes: Vec::with_capacity(BLOCK_ROWS),
+        idx: Vec::new(),
+        wts: Vec::new(),
+    };
+    // Entries per row: ~10 for a composed Catmull-Clark row, fewer for masks. The arrays grow
+    // if the guess is short; untouched capacity costs no memory (zeroed pages are lazy).
+    let guess = if parent.is_some() { 12 } else { 8 };
+    let mut offsets = vec![0u32; n + 1];
+    let mut indices = vec![0u32; n * guess];
+    let mut weights = vec![0.0f64; n * guess];
+    let mut cursor = 0usize;
+    let mut b0 = 0;
+    while b0 < blocks {
+        let b1 = (b0 + per_round).min(blocks);
+        let done: Vec<Scratch> = (b0..b1)
+            .into_par_iter()
+            .map(|b| {
+                let mut sc = pool
+                    .lock()
+                    .ok()
+                    .and_then(|mut p| p.pop())
+                    .unwrap_or_else(new_scratch);
+                let rows = (b * BLOCK_ROWS).min(n)..((b + 1) * BLOCK_ROWS).min(n);
+                fill_block(&mut sc, rows, parent, &gen);
+                sc
+            })
+            .collect();
+        let total: usize = done.iter().map(|sc| sc.idx.len()).sum();
+        if cursor + total > indices.len() {
+            let cap = (cursor + total).max(indices.len() + indices.len() / 2);
+            indices.resize(cap, 0);
+            weights.resize(cap, 0.0);
+        }
+        let mut jobs = Vec::with_capacity(done.len());
+        {
+            let mut o_rest = &mut offsets[1 + done[0].rows.start..];
+            let mut i_rest = &mut indices[cursor..];
+            let mut w_rest = &mut weights[cursor..];
+            for sc in &done {
+                let (o, o_tail) = std::mem::take(&mut o_rest).split_at_mut(sc.sizes.len());
+                let (ix, i_tail) = std::mem::take(&mut i_rest).split_at_mut(sc.idx.len());
+                let (w, w_tail) = std::mem::take(&mut w_rest).split_at_mut(sc.wts.len());
+                jobs.push((sc, cursor as u32, o, ix, w));
+                cursor += sc.idx.len();
+                (o_rest, i_rest, w_rest) = (o_tail, i_tail, w_tail);
+            }
+        }
+        jobs.into_par_iter().for_each(|(sc, base, o, ix, w)| {
+            let mut acc = base;
+            for (slot, &s) in o.iter_mut().zip(&sc.sizes) {
+                acc += s;
+                *slot = acc;
+            }
+            ix.copy_from_slice(&sc.idx);
+            w.copy_from_slice(&sc.wts);
+        });
+        if let Ok(mut p) = pool.lock() {
+            p.extend(done);
+        }
+        b0 = b1;
+    }
+    assert!(
+        cursor < u32::MAX as usize,
+        "too many stencil weights for 32-bit offsets"
+    );
+    indices.truncate(cursor);
+    indices.shrink_to_fit();
+    weights.truncate(cursor);
+    weights.shrink_to_fit();
     StencilTable {
         offsets,
         indices,
@@ -176,22 +282,83 @@ where
     }
 }
 
-/// Sort by index, add duplicates, drop exact zeros.
-fn merge_row(row: &mut Vec<(u32, f64)>) {
-    if row.len() > 1 {
-        row.sort_unstable_by_key(|e| e.0);
-        let mut w = 0;
-        for r in 1..row.len() {
-            if row[r].0 == row[w].0 {
-                row[w].1 += row[r].1;
-            } else {
-                w += 1;
-                row[w] = row[r];
+/// Compute rows `rows` into the scratch's output buffers.
+fn fill_block<G>(
+    sc: &mut Scratch,
+    rows: std::ops::Range<usize>,
+    parent: Option<&StencilTable>,
+    gen: &G,
+) where
+    G: Fn(usize, &mut Vec<(u32, f64)>) + Sync,
+{
+    let Scratch {
+        mask,
+        out,
+        row,
+        sizes,
+        idx,
+        wts,
+        ..
+    } = sc;
+    sizes.clear();
+    idx.clear();
+    wts.clear();
+    for i in rows.clone() {
+        let tag = i as u32 + 1;
+        row.clear();
+        gen(i, row);
+        if let Some(m) = mask.as_mut() {
+            m.touched.clear();
+            for &(j, w) in row.iter() {
+                m.add(tag, j, w);
+            }
+            m.sort_touched();
+            row.clear();
+            row.extend(
+                m.touched
+                    .iter()
+                    .map(|&j| (j, m.slots[j as usize].1))
+                    .filter(|e| e.1 != 0.0),
+            );
+        }
+        let before = idx.len();
+        match (parent, out.as_mut()) {
+            (Some(p), Some(o)) => {
+                o.touched.clear();
+                for &(j, wj) in row.iter() {
+                    let (pidx, pw) = p.stencil(j as usize);
+                    for (&s, &ws) in pidx.iter().zip(pw) {
+                        o.add(tag, s, wj * ws);
+                    }
+                }
+                o.sort_touched();
+                for &s in &o.touched {
+                    let w = o.slots[s as usize].1;
+                    if w != 0.0 {
+                        idx.push(s);
+                        wts.push(w);
+                    }
+                }
+            }
+            _ => {
+                for &(j, w) in row.iter() {
+                    idx.push(j);
+                    wts.push(w);
+                }
             }
         }
-        row.truncate(w + 1);
+        sizes.push((idx.len() - before) as u32);
     }
-    row.retain(|e| e.1 != 0.0);
+    sc.rows = rows;
+}
+
+/// Build a table row by row in parallel. `gen` writes the (index, weight) pairs of row `i`;
+/// they are sorted, merged and stripped of exact zeros here.
+pub(crate) fn build_rows<G>(n: usize, num_sources: usize, gen: G) -> StencilTable
+where
+    G: Fn(usize, &mut Vec<(u32, f64)>) + Sync,
+{
+    compose_rows(n, None, RowKind::Raw, num_sources, gen)
 }
 
 #[cfg(test)]
@@ -200,16 +367,11 @@ mod tests {
 
     #[test]
     fn compose_with_identity_is_unchanged() {
-        let t = build_rows(
-            3,
-            4,
-            || (),
-            |_, i, out| {
-                out.push((i as u32, 0.5));
-                out.push((i as u32 + 1, 0.25));
-                out.push((i as u32 + 1, 0.25));
-            },
-        );
+        let t = build_rows(3, 4, |i, out| {
+            out.push((i as u32, 0.5));
+            out.push((i as u32 + 1, 0.25));
+            out.push((i as u32 + 1, 0.25));
+        });
         assert_eq!(t.stencil(1), (&[1u32, 2][..], &[0.5, 0.5][..]));
         let c = t.compose(&StencilTable::identity(4));
         assert_eq!(c, t);
