@@ -169,3 +169,54 @@ fn draw_split_matches_per_patch_reference() {
         );
     }
 }
+
+/// Timestamps bracket real GPU work: the later one is not earlier, and the pool refuses to be
+/// read as statistics.
+#[test]
+fn timestamp_queries_measure_a_draw() {
+    use tessera::vk_core::query::QueryPool;
+    use tessera::vk_core::target::OffscreenTarget;
+    let gpu = Gpu::new();
+    let device = gpu.device();
+    let mut r = Renderer::offscreen(device).unwrap();
+    let mesh =
+        GpuMesh::upload(device, &RenderMesh::from_control_mesh(&grid(6, 4)).unwrap()).unwrap();
+    let target = OffscreenTarget::new(device, SMALL).unwrap();
+    let readback = target.readback_buffer(device).unwrap();
+    let pool = QueryPool::timestamps(device, "test timestamps", 2).unwrap();
+    let params = DrawParams {
+        level: 32.0,
+        ..Default::default()
+    };
+    r.update_uniforms(0, &mesh, &params, SMALL).unwrap();
+    device
+        .one_shot(|cmd| {
+            pool.cmd_reset(cmd);
+            // SAFETY: the pool was reset above; cmd is recording.
+            unsafe {
+                device.raw.cmd_write_timestamp(
+                    cmd,
+                    vk::PipelineStageFlags::TOP_OF_PIPE,
+                    pool.raw,
+                    0,
+                )
+            };
+            target.cmd_begin(device, cmd, params.clear_color);
+            r.record(cmd, 0, &mesh, &params).unwrap();
+            target.cmd_end_and_copy(device, cmd, &readback);
+            // SAFETY: as above.
+            unsafe {
+                device.raw.cmd_write_timestamp(
+                    cmd,
+                    vk::PipelineStageFlags::BOTTOM_OF_PIPE,
+                    pool.raw,
+                    1,
+                )
+            };
+        })
+        .unwrap();
+    let d = pool.durations_ns().unwrap();
+    assert_eq!(d.len(), 1);
+    assert!(d[0] >= 0.0 && d[0] < 60e9, "duration {} ns", d[0]);
+    assert!(pool.statistics_results().is_err());
+}
