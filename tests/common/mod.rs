@@ -13,11 +13,23 @@ pub struct Gpu {
 impl Gpu {
     pub fn new() -> Gpu {
         let _ = env_logger_init();
-        let instance = Instance::new(&InstanceDesc { app_name: "tessera-tests".into(), validation: Validation::On, surface_extensions: vec![] })
-            .expect("Vulkan instance (install mesa-vulkan-drivers and vulkan-validationlayers)");
-        assert_eq!(instance.validation(), Validation::On, "tests need VK_LAYER_KHRONOS_validation (package vulkan-validationlayers)");
-        let device = Device::new(&instance, &DeviceDesc::default(), &[]).expect("a Vulkan device with tessellation");
-        Gpu { device: Some(device), instance }
+        let instance = Instance::new(&InstanceDesc {
+            app_name: "tessera-tests".into(),
+            validation: Validation::On,
+            surface_extensions: vec![],
+        })
+        .expect("Vulkan instance (install mesa-vulkan-drivers and vulkan-validationlayers)");
+        assert_eq!(
+            instance.validation(),
+            Validation::On,
+            "tests need VK_LAYER_KHRONOS_validation (package vulkan-validationlayers)"
+        );
+        let device = Device::new(&instance, &DeviceDesc::default(), &[])
+            .expect("a Vulkan device with tessellation");
+        Gpu {
+            device: Some(device),
+            instance,
+        }
     }
 
     pub fn device(&self) -> &Device {
@@ -35,12 +47,20 @@ impl Drop for Gpu {
             let leaked = d.allocated_bytes();
             drop(d);
             if !std::thread::panicking() {
-                assert_eq!(leaked, 0, "gpu-allocator still holds {leaked} bytes at the end of the test");
+                assert_eq!(
+                    leaked, 0,
+                    "gpu-allocator still holds {leaked} bytes at the end of the test"
+                );
             }
         }
         let n = self.instance.messages().error_count();
         if !std::thread::panicking() {
-            assert_eq!(n, 0, "validation errors: {:#?}", self.instance.messages().error_messages());
+            assert_eq!(
+                n,
+                0,
+                "validation errors: {:#?}",
+                self.instance.messages().error_messages()
+            );
         }
     }
 }
