@@ -156,13 +156,17 @@ impl Topology {
                 message: "face_offsets is not a valid prefix table over face_vertices".into(),
             });
         }
-        for (vertex, p) in mesh.positions.iter().enumerate() {
-            if !p.iter().all(|c| c.is_finite()) {
-                return Err(TopologyError::NonFinitePosition {
-                    vertex,
-                    position: *p,
-                });
-            }
+        if let Some((vertex, p)) = mesh
+            .positions
+            .par_iter()
+            .enumerate()
+            .with_min_len(4096)
+            .find_first(|(_, p)| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(TopologyError::NonFinitePosition {
+                vertex,
+                position: *p,
+            });
         }
         let corners = mesh.face_vertices.len();
         if let Some(n) = &mesh.normals {
@@ -184,25 +188,33 @@ impl Topology {
             }
         }
         let nv = mesh.positions.len();
-        for (face, fv) in mesh.faces().enumerate() {
-            if fv.len() < 3 {
-                return Err(TopologyError::DegenerateFace {
-                    face,
-                    size: fv.len(),
-                });
-            }
-            for (i, &v) in fv.iter().enumerate() {
-                if v as usize >= nv {
-                    return Err(TopologyError::IndexOutOfRange {
+        let bad_face = (0..mesh.num_faces())
+            .into_par_iter()
+            .with_min_len(4096)
+            .find_map_first(|face| {
+                let fv = mesh.face(face);
+                if fv.len() < 3 {
+                    return Some(TopologyError::DegenerateFace {
                         face,
-                        index: v as i64,
-                        count: nv,
+                        size: fv.len(),
                     });
                 }
-                if fv[..i].contains(&v) {
-                    return Err(TopologyError::RepeatedVertex { face, vertex: v });
+                for (i, &v) in fv.iter().enumerate() {
+                    if v as usize >= nv {
+                        return Some(TopologyError::IndexOutOfRange {
+                            face,
+                            index: v as i64,
+                            count: nv,
+                        });
+                    }
+                    if fv[..i].contains(&v) {
+                        return Some(TopologyError::RepeatedVertex { face, vertex: v });
+                    }
                 }
-            }
+                None
+            });
+        if let Some(e) = bad_face {
+            return Err(e);
         }
         if corners >= INVALID as usize / 4 {
             return Err(TopologyError::TooLarge {
@@ -221,24 +233,46 @@ impl Topology {
         face_offsets: Vec<u32>,
         face_verts: Vec<u32>,
     ) -> Result<Topology, TopologyError> {
-        let nf = face_offsets.len() - 1;
-        // (min, max, corner index); corner index identifies face + direction.
-        let mut half: Vec<(u64, u32)> = (0..nf)
-            .into_par_iter()
-            .flat_map_iter(|f| {
-                let (s, e) = (face_offsets[f] as usize, face_offsets[f + 1] as usize);
-                let fv = &face_verts[s..e];
-                (0..fv.len()).map(move |i| {
-                    let a = fv[i];
-                    let b = fv[(i + 1) % fv.len()];
-                    let key = ((a.min(b) as u64) << 32) | a.max(b) as u64;
-                    (key, (s + i) as u32)
-                })
+        // Half-edges as (min, max, corner) keys, ordered by a counting sort on `min` and a short
+        // sort of each bucket (a vertex's valence) — the same order as sorting the keys, in
+        // linear time. The corner index identifies face + direction.
+        let corners = face_verts.len();
+        let corner_face = corner_faces(&face_offsets, corners);
+        let next = |c: usize| {
+            let f = corner_face[c] as usize;
+            if c + 1 == face_offsets[f + 1] as usize {
+                face_offsets[f] as usize
+            } else {
+                c + 1
+            }
+        };
+        let mut bucket_offsets = vec![0u32; num_vertices + 1];
+        for c in 0..corners {
+            let (a, b) = (face_verts[c], face_verts[next(c)]);
+            bucket_offsets[a.min(b) as usize + 1] += 1;
+        }
+        prefix_sum(&mut bucket_offsets);
+        let mut fill = bucket_offsets.clone();
+        // (max, corner), packed so a plain integer sort orders by max then corner.
+        let mut buckets = vec![0u64; corners];
+        for c in 0..corners {
+            let (a, b) = (face_verts[c], face_verts[next(c)]);
+            let slot = &mut fill[a.min(b) as usize];
+            buckets[*slot as usize] = ((a.max(b) as u64) << 32) | c as u64;
+            *slot += 1;
+        }
+        drop(fill);
+        par_fill_ragged(&bucket_offsets, &mut buckets, |_, row| row.sort_unstable());
+        let half: Vec<(u64, u32)> = (0..num_vertices)
+            .flat_map(|v| {
+                let r = bucket_offsets[v] as usize..bucket_offsets[v + 1] as usize;
+                buckets[r]
+                    .iter()
+                    .map(move |&k| (((v as u64) << 32) | (k >> 32), k as u32))
             })
             .collect();
-        half.par_sort_unstable();
+        drop(buckets);
 
-        let corner_face = corner_faces(&face_offsets, face_verts.len());
         let mut face_edges = vec![INVALID; face_verts.len()];
         let mut edge_verts = Vec::with_capacity(half.len() / 2 + 1);
         let mut edge_faces = Vec::with_capacity(half.len() / 2 + 1);
@@ -400,8 +434,22 @@ impl Topology {
         }
     }
 
+    /// Number of faces in the fan of `v` containing `start` (as [`Self::fan_faces`], without
+    /// allocating).
     fn fan_size(&self, v: u32, start: u32) -> usize {
-        self.fan_faces(v, start).len()
+        let limit = self.vertex_faces(v as usize).len();
+        let mut count = 1;
+        for outgoing in [true, false] {
+            let mut f = start;
+            while let Some(g) = self.face_across(v, f, outgoing) {
+                if g == start || count > limit {
+                    return count;
+                }
+                count += 1;
+                f = g;
+            }
+        }
+        count
     }
 
     /// Faces reachable from `start` by rotating around `v` across its incident edges.
