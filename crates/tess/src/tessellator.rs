@@ -152,11 +152,19 @@ mod tests {
                 ((n + 1) * (n + 1)) as u64
             );
         }
-        // Triangles with uniform level n hold (n+1)(n+2)/2 points when n is even.
-        for n in (2..=64u32).step_by(2) {
+        // Triangles are concentric rings of 3n, 3(n-2), ... vertices (not a barycentric grid:
+        // level 2 has 7 vertices, as the GPU's TES invocation count confirms), closing with a
+        // centre point for even n: 3(n/2)(n/2+1)+1 for even n, 3 ceil(n/2)^2 for odd n.
+        for n in 1..=64u64 {
+            let expected = if n % 2 == 0 {
+                3 * (n / 2) * (n / 2 + 1) + 1
+            } else {
+                3 * n.div_ceil(2).pow(2)
+            };
             assert_eq!(
                 uniform_vertex_count(Domain::Triangle, Spacing::Equal, n as f32),
-                ((n + 1) * (n + 2) / 2) as u64
+                expected,
+                "level {n}"
             );
         }
     }
