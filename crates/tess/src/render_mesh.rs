@@ -76,11 +76,10 @@ impl RenderMesh {
             .as_ref()
             .filter(|n| n.len() == mesh.face_vertices.len());
         let (positions, corner_index): (Vec<[f64; 3]>, Vec<u32>) = match corner_normals {
-            Some(_) => {
+            Some(normals) => {
                 let mut map = std::collections::HashMap::new();
                 let mut pos = Vec::new();
                 let mut idx = Vec::with_capacity(mesh.face_vertices.len());
-                let normals = corner_normals.expect("checked");
                 for (c, &v) in mesh.face_vertices.iter().enumerate() {
                     let n = normals[c];
                     let key = (v, n.map(f64::to_bits));
