@@ -11,7 +11,10 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     vec4 viewport;     // xy: size in pixels
 } frame;
 
-// Push constant: what a draw is for (shaded surface or wireframe overlay).
+// Push constant: what a draw is for (shaded surface or wireframe overlay). BFT stages define
+// BFT_PUSH_CONSTANTS and use their own block (bft.glsl).
+#ifndef BFT_PUSH_CONSTANTS
 layout(push_constant) uniform Draw {
     uint mode;         // 0: shaded, 1: wireframe
 } draw;
+#endif

@@ -50,6 +50,28 @@ pub struct DrawPush {
     pub mode: u32,
 }
 
+/// `BftDraw` push constant of every BFT stage, `glsl/include/bft.glsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct BftPush {
+    /// 0: shaded, 1: wireframe.
+    pub mode: u32,
+    /// Patch (level-1 face) index of the draw's first patch.
+    pub first_patch: u32,
+    /// 0: uniform, 1: screen-space edge length, 2: camera distance.
+    pub factor_mode: u32,
+    /// Bit 0: geometric normals; 1: patch colours; 2: fractional factors.
+    pub options: u32,
+    pub uniform_level: f32,
+    pub pixels_per_segment: f32,
+    pub distance_ref: f32,
+    pub max_level: f32,
+    /// Compute passes: level-1 vertex count.
+    pub count: u32,
+}
+
+const _: () = assert!(size_of::<BftPush>() == 36);
+
 /// Interleaved vertex of the mesh vertex buffer (`mesh.vert` locations 0 and 1).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]

@@ -3,6 +3,7 @@
 //! Every technique draws patches through a real TCS/TES pair; the host side here builds the
 //! buffers, chooses the shader variant by a [`renderer::PipelineKey`], sets tessellation factors,
 //! and splits draws where a driver needs it ([`vk_core::workarounds`]).
+pub mod bft;
 pub mod camera;
 pub mod error;
 pub mod gpu;
@@ -10,6 +11,7 @@ pub mod render_mesh;
 pub mod renderer;
 pub mod tessellator;
 
+pub use bft::{BftParams, BftSurface, FactorPolicy};
 pub use camera::Camera;
 pub use error::{Result, TessError};
 pub use render_mesh::RenderMesh;

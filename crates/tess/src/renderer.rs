@@ -249,6 +249,21 @@ impl Renderer {
         &self.device
     }
 
+    /// Layout of set 0 (the frame uniforms), shared by every technique's pipelines.
+    pub fn frame_set_layout(&self) -> vk::DescriptorSetLayout {
+        self.set_layout.raw
+    }
+
+    /// Set 0 of frame slot `slot` (clamped to the slots there are).
+    pub fn frame_set(&self, slot: usize) -> vk::DescriptorSet {
+        self.slots[slot.min(self.slots.len() - 1)].set
+    }
+
+    /// Colour and depth formats the pipelines render to.
+    pub fn formats(&self) -> (vk::Format, vk::Format) {
+        (self.color_format, self.depth_format)
+    }
+
     fn pipeline(&mut self, key: PipelineKey) -> Result<&Pipeline> {
         if !self.pipelines.contains_key(&key) {
             let p = self.build_pipeline(key)?;
@@ -362,11 +377,21 @@ impl Renderer {
         params: &DrawParams,
         extent: vk::Extent2D,
     ) -> Result<()> {
+        self.update_frame(slot, (mesh.bbox_min, mesh.bbox_max), params, extent)
+    }
+
+    /// Writes the frame uniforms of slot `slot` for a scene framed by `bbox`.
+    pub fn update_frame(
+        &mut self,
+        slot: usize,
+        bbox: ([f32; 3], [f32; 3]),
+        params: &DrawParams,
+        extent: vk::Extent2D,
+    ) -> Result<()> {
         let aspect = extent.width as f32 / extent.height.max(1) as f32;
-        let m = params.camera.matrices(mesh.bbox_min, mesh.bbox_max, aspect);
-        let light = (m.eye
-            - glam::Vec3::from(mesh.bbox_min).lerp(glam::Vec3::from(mesh.bbox_max), 0.5))
-        .normalize_or_zero();
+        let m = params.camera.matrices(bbox.0, bbox.1, aspect);
+        let light = (m.eye - glam::Vec3::from(bbox.0).lerp(glam::Vec3::from(bbox.1), 0.5))
+            .normalize_or_zero();
         let light = (light + glam::Vec3::new(0.3, 0.6, 0.2)).normalize_or_zero();
         let level = params.level.clamp(1.0, crate::tessellator::MAX_LEVEL);
         let u = FrameUniforms {

@@ -73,7 +73,15 @@ use crate::mesh::{BoundaryInterpolation, CreaseMethod};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum BftCase {
     Interior,
-    Boundary { fan_position: u32 },
+    Boundary {
+        fan_position: u32,
+    },
+    /// A table private to one level-1 face that no shared case covers (a coarse mesh whose
+    /// one-rings overlap, a corner triangle, an "edges and corners" corner, a crease): its
+    /// rows are exact limit weights over the face's own neighbourhood ([`private_table`]).
+    Private {
+        face: u32,
+    },
 }
 
 /// Table key: valence of `v0` (edge count) and case.
@@ -87,7 +95,7 @@ impl BftKey {
     /// The stored table serving this key, and whether the key is that table's mirror image.
     pub fn canonical(self) -> (BftKey, bool) {
         match self.case {
-            BftCase::Interior => (self, false),
+            BftCase::Interior | BftCase::Private { .. } => (self, false),
             BftCase::Boundary { fan_position: k } => {
                 let m = self.valence.saturating_sub(2).saturating_sub(k);
                 if k <= m {
@@ -109,12 +117,14 @@ impl BftKey {
         match self.case {
             BftCase::Interior => true,
             BftCase::Boundary { fan_position: k } => 2 * k + 2 == self.valence,
+            BftCase::Private { .. } => false,
         }
     }
 
     fn valid(self) -> bool {
         match self.case {
             BftCase::Interior => self.valence >= 3,
+            BftCase::Private { .. } => false,
             BftCase::Boundary { fan_position } => {
                 self.valence >= 2 && fan_position + 2 <= self.valence
             }
@@ -170,7 +180,7 @@ pub fn configuration_mesh(key: BftKey, identity: bool) -> Result<(LocalMesh, usi
             for j in 0..r - i {
                 if s == match key.case {
                     BftCase::Boundary { fan_position } => fan_position,
-                    BftCase::Interior => 0,
+                    _ => 0,
                 } && i == 0
                     && j == 0
                 {
@@ -374,27 +384,92 @@ pub struct RowWeights {
     pub dv: Vec<f32>,
 }
 
-fn row_maps(level: u32) -> (Vec<u32>, Vec<u32>) {
+/// Resolution of the grid every table point lies on: `3·2^level` steps per edge.
+pub fn grid_size(level: u32) -> u32 {
+    3 << level
+}
+
+/// Interior points the triangle tessellator generates for inner level `s` (equal spacing), in
+/// units of `1/(3s)`, as `(w1, w2)` (weights of `v1`, `v2`). Ring `r` (`1 ≤ r < s/2`) is the
+/// triangle whose corners have barycentric coordinates `(3s − 4r, 2r, 2r)/(3s)` and its
+/// permutations — the reference tessellator places inner corners on the lines perpendicular to
+/// the outer edges, which is `2/3` of `r/s` in barycentric terms — with `s − 2r` equal
+/// segments of length `1/s` per side; an even `s` adds the centre `(s, s, s)/(3s)`.
+pub fn tessellator_interior_points(s: u32) -> Vec<(u32, u32)> {
+    let mut out = Vec::new();
+    let mut r = 1;
+    while 2 * r < s {
+        let (big, small) = (3 * s - 4 * r, 2 * r);
+        let corners = [
+            [big, small, small],
+            [small, big, small],
+            [small, small, big],
+        ];
+        for side in 0..3 {
+            let c = corners[side];
+            let (from, to) = (side, (side + 1) % 3);
+            for k in 0..s - 2 * r {
+                let mut w = c;
+                w[from] -= 3 * k;
+                w[to] += 3 * k;
+                out.push((w[1], w[2]));
+            }
+        }
+        r += 1;
+    }
+    if s % 2 == 0 && s >= 2 {
+        out.push((s, s));
+    }
+    out
+}
+
+/// Points `(a, b)` of the `1/grid_size(level)` grid that carry a table row, sorted by
+/// `(b, a)`: every dyadic point of the level, and the interior tessellator points of every
+/// power-of-two inner level `2 ≤ s ≤ 2^level` (all on this grid, see
+/// [`tessellator_interior_points`]). With power-of-two factors every vertex the tessellator
+/// makes is one of these, so the TES evaluates the exact limit everywhere.
+pub fn table_points(level: u32) -> Vec<(u32, u32)> {
     let n = 1u32 << level;
-    let w = (n + 1) as usize;
+    let mut pts: Vec<(u32, u32)> = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n - j {
+            pts.push((3 * i, 3 * j));
+        }
+    }
+    let mut s = 2;
+    while s <= n {
+        let scale = n / s;
+        pts.extend(
+            tessellator_interior_points(s)
+                .into_iter()
+                .map(|(a, b)| (a * scale, b * scale)),
+        );
+        s *= 2;
+    }
+    pts.sort_by_key(|&(a, b)| (b, a));
+    pts.dedup();
+    pts
+}
+
+fn row_maps(level: u32) -> (Vec<u32>, Vec<u32>) {
+    let m = grid_size(level);
+    let w = (m + 1) as usize;
     let mut full = vec![u32::MAX; w * w];
     let mut half = vec![u32::MAX; w * w];
     let (mut rf, mut rh) = (0u32, 0u32);
-    for j in 0..=n {
-        for i in 0..=n - j {
-            full[i as usize * w + j as usize] = rf;
-            rf += 1;
-            if i >= j {
-                half[i as usize * w + j as usize] = rh;
-                rh += 1;
-            }
+    for (a, b) in table_points(level) {
+        full[a as usize * w + b as usize] = rf;
+        rf += 1;
+        if a >= b {
+            half[a as usize * w + b as usize] = rh;
+            rh += 1;
         }
     }
     (full, half)
 }
 
 /// Per row: (position, du, dv) weights over the slots.
-type Rows = Vec<[Vec<f64>; 3]>;
+pub type Rows = Vec<[Vec<f64>; 3]>;
 
 /// Exact limit weights of one stored table, in f64, and its mirror permutation.
 fn table_rows(key: BftKey, level: u32, half: bool) -> Result<(Rows, Vec<u32>), EvalError> {
@@ -425,28 +500,26 @@ fn table_rows(key: BftKey, level: u32, half: bool) -> Result<(Rows, Vec<u32>), E
         .iter()
         .map(|x| ring.iter().position(|y| y == x).unwrap_or(0) as u32)
         .collect();
-    let n = 1u32 << level;
+    let m = grid_size(level) as f64;
     let mut rows = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n - j {
-            if half && i < j {
-                continue;
-            }
-            let s = mesh.evaluate(face, i as f64 / n as f64, j as f64 / n as f64)?;
-            let pick = |x: &[f64]| -> Vec<f64> {
-                ring.iter()
-                    .map(|&v| {
-                        let w = x[v as usize];
-                        if w.abs() < 1e-13 {
-                            0.0
-                        } else {
-                            w
-                        }
-                    })
-                    .collect()
-            };
-            rows.push([pick(&s.position), pick(&s.du), pick(&s.dv)]);
+    for (a, b) in table_points(level) {
+        if half && a < b {
+            continue;
         }
+        let s = mesh.evaluate(face, a as f64 / m, b as f64 / m)?;
+        let pick = |x: &[f64]| -> Vec<f64> {
+            ring.iter()
+                .map(|&v| {
+                    let w = x[v as usize];
+                    if w.abs() < 1e-13 {
+                        0.0
+                    } else {
+                        w
+                    }
+                })
+                .collect()
+        };
+        rows.push([pick(&s.position), pick(&s.du), pick(&s.dv)]);
     }
     Ok((rows, perm))
 }
@@ -469,7 +542,11 @@ impl BasisTables {
                 "BFT level {level} not in 1..=6"
             )));
         }
-        let mut stored: Vec<BftKey> = keys.iter().map(|k| k.canonical().0).collect();
+        let mut stored: Vec<BftKey> = keys
+            .iter()
+            .filter(|k| !matches!(k.case, BftCase::Private { .. }))
+            .map(|k| k.canonical().0)
+            .collect();
         stored.sort();
         stored.dedup();
         let (row_map_full, row_map_half) = row_maps(level);
@@ -542,6 +619,11 @@ impl BasisTables {
         1 << self.level
     }
 
+    /// Steps per edge of the grid that holds every table point ([`grid_size`]).
+    pub fn grid(&self) -> u32 {
+        grid_size(self.level)
+    }
+
     /// Bytes the GPU needs: weights, permutations, row maps and 8 u32 per entry.
     pub fn memory_bytes(&self) -> usize {
         4 * (self.weights.len()
@@ -563,16 +645,25 @@ impl BasisTables {
     /// Weights of dyadic point `(i, j)` over the face's slots (face ring order), exactly as a
     /// shader reads them (`du`/`dv` empty without tangent blocks).
     pub fn row(&self, key: BftKey, i: u32, j: u32) -> Option<RowWeights> {
+        if i + j > self.segments() {
+            return None;
+        }
+        self.row_grid(key, 3 * i, 3 * j)
+    }
+
+    /// Weights of grid point `(a, b)` (`u = a/grid`, `v = b/grid`, [`table_points`]); `None`
+    /// where the grid point carries no row.
+    pub fn row_grid(&self, key: BftKey, a: u32, b: u32) -> Option<RowWeights> {
         let (e, mirrored) = self.lookup(key)?;
         let e = &self.entries[e];
-        let n = self.segments();
-        if i + j > n {
+        let m = self.grid();
+        if a + b > m {
             return None;
         }
         let (mut a, mut b, mut flip) = if mirrored {
-            (j, i, true)
+            (b, a, true)
         } else {
-            (i, j, false)
+            (a, b, false)
         };
         if e.half && a < b {
             std::mem::swap(&mut a, &mut b);
@@ -583,7 +674,10 @@ impl BasisTables {
         } else {
             &self.row_map_full
         };
-        let r = map[(a * (n + 1) + b) as usize];
+        let r = map[(a * (m + 1) + b) as usize];
+        if r == u32::MAX {
+            return None;
+        }
         let rs = e.ring_size as usize;
         let slot = |s: usize| {
             if flip {
@@ -634,10 +728,11 @@ pub fn memory_for(
         .collect();
     stored.sort();
     stored.dedup();
-    let n = 1usize << level;
-    let full = (n + 1) * (n + 2) / 2;
-    let half = (n / 2 + 1) * (n / 2 + 1);
-    let maps = 2 * (n + 1) * (n + 1);
+    let pts = table_points(level);
+    let full = pts.len();
+    let half = pts.iter().filter(|&&(a, b)| a >= b).count();
+    let g = grid_size(level) as usize + 1;
+    let maps = 2 * g * g;
     let mut words = maps;
     for (k, h) in stored {
         let (m, f) = configuration_mesh(k, false)?;
@@ -706,14 +801,28 @@ pub fn build_patch_records(mesh: &LocalMesh) -> Result<Vec<PatchRecord>, EvalErr
     let nf = mesh.num_faces();
     let mut recs = Vec::with_capacity(nf);
     for f in 0..nf {
-        let (key, first) = classify_face(mesh, f).ok_or_else(|| {
-            EvalError::Unsupported(format!("face {f} is not covered by a basis-function table"))
-        })?;
         let fv = mesh.face(f);
+        if fv.len() != 3 {
+            return Err(EvalError::Unsupported(format!(
+                "face {f} has {} sides; Loop patches are triangles",
+                fv.len()
+            )));
+        }
+        let (key, first, ring) = match classify_face(mesh, f) {
+            Some((key, first)) => (key, first, face_control_ring(mesh, f, first)),
+            None => (
+                BftKey {
+                    valence: 0,
+                    case: BftCase::Private { face: f as u32 },
+                },
+                0,
+                neighbourhood_vertices(mesh, f),
+            ),
+        };
         let corners = [fv[first], fv[(first + 1) % 3], fv[(first + 2) % 3]];
         recs.push(PatchRecord {
             key,
-            ring: face_control_ring(mesh, f, first),
+            ring,
             corners,
             edge_owner: [(0, 0); 3],
             corner_owner: [(0, 0); 3],
@@ -743,6 +852,91 @@ pub fn build_patch_records(mesh: &LocalMesh) -> Result<Vec<PatchRecord>, EvalErr
         }
     }
     Ok(recs)
+}
+
+/// The vertices of `face` and of every face touching one of its corners, in the order
+/// [`LocalMesh::face_neighbourhood`] numbers them (the face's corners first).
+pub fn neighbourhood_vertices(mesh: &LocalMesh, face: usize) -> Vec<u32> {
+    let mut faces = vec![face as u32];
+    for &v in mesh.face(face) {
+        for f in mesh.vertex_faces(v) {
+            if !faces.contains(&f) {
+                faces.push(f);
+            }
+        }
+    }
+    let mut out: Vec<u32> = Vec::new();
+    for &f in &faces {
+        for &v in mesh.face(f as usize) {
+            if !out.contains(&v) {
+                out.push(v);
+            }
+        }
+    }
+    out
+}
+
+/// Exact limit weights of one face over its neighbourhood ([`neighbourhood_vertices`]) at every
+/// table point: `(rows, ring size)`, rows as `[position, du, dv]`.
+pub fn private_table(
+    mesh: &LocalMesh,
+    face: usize,
+    level: u32,
+) -> Result<(Rows, usize), EvalError> {
+    let nb = mesh.face_neighbourhood(face)?;
+    let k = nb.num_vertices();
+    let mut pts = vec![0.0; k * k];
+    for v in 0..k {
+        pts[v * k + v] = 1.0;
+    }
+    let id = LocalMesh::new(
+        nb.scheme,
+        k,
+        pts,
+        nb.face_offsets.clone(),
+        nb.face_verts.clone(),
+        nb.edge_sharpness.clone(),
+        nb.vertex_sharpness.clone(),
+        nb.boundary,
+        nb.crease_method,
+    )?;
+    let m = grid_size(level) as f64;
+    let mut rows = Vec::new();
+    for (a, b) in table_points(level) {
+        let s = id.evaluate(0, a as f64 / m, b as f64 / m)?;
+        let clean = |x: &[f64]| -> Vec<f64> {
+            x.iter()
+                .map(|&w| if w.abs() < 1e-13 { 0.0 } else { w })
+                .collect()
+        };
+        rows.push([clean(&s.position), clean(&s.du), clean(&s.dv)]);
+    }
+    Ok((rows, k))
+}
+
+impl BasisTables {
+    /// Appends the private table of `key` (a [`BftCase::Private`] face) from its rows.
+    pub fn add_private(&mut self, key: BftKey, rows: &Rows, ring_size: usize) {
+        let mut offs = [u32::MAX; 3];
+        let blocks = if self.tangents { 3 } else { 1 };
+        for (b, off) in offs.iter_mut().enumerate().take(blocks) {
+            *off = self.weights.len() as u32;
+            for r in rows {
+                self.weights.extend(r[b].iter().map(|&w| w as f32));
+            }
+        }
+        self.entries.push(BftEntry {
+            key,
+            ring_size: ring_size as u32,
+            half: false,
+            rows: rows.len() as u32,
+            offset_position: offs[0],
+            offset_du: offs[1],
+            offset_dv: offs[2],
+            offset_perm: self.mirror_perm.len() as u32,
+        });
+        self.mirror_perm.extend(0..ring_size as u32);
+    }
 }
 
 /// Which table row (face, point) a shader uses for dyadic point `(i, j)` of `face`: the face
@@ -895,12 +1089,19 @@ pub fn pack_patches(recs: &[PatchRecord], tables: &BasisTables) -> Option<GpuPat
 }
 
 /// Everything the BFT pipeline needs for a Loop control mesh: the once-refined mesh (its
-/// positions are what the shader combines), per-face records and the tables at `level`.
+/// positions are what the shader combines), the base → level-1 stencils that produce them, the
+/// level-1 limit-tangent stencils (for the normals subdivision shading starts from), per-face
+/// records and the tables at `level`.
 #[derive(Clone, Debug)]
 pub struct LoopBft {
     pub level1: LocalMesh,
+    pub stencils: crate::stencil::StencilTable,
+    /// Per level-1 vertex: control indices and the two tangent weight rows.
+    pub tangent_stencils: Vec<(Vec<u32>, Vec<f64>, Vec<f64>)>,
     pub records: Vec<PatchRecord>,
     pub tables: BasisTables,
+    pub base_vertices: usize,
+    pub base_faces: usize,
 }
 
 /// Refine `mesh` once (T1's uniform refinement), classify every level-1 face and build the
@@ -915,10 +1116,583 @@ pub fn prepare_loop_bft(
     let level1 = LocalMesh::from_refined_level(r.level(1), LimitScheme::Loop, &mesh.options)?;
     let records = build_patch_records(&level1)?;
     let keys: Vec<BftKey> = records.iter().map(|r| r.key).collect();
-    let tables = BasisTables::build_with(&keys, level, tangents)?;
+    let mut tables = BasisTables::build_with(&keys, level, tangents)?;
+    for (f, r) in records.iter().enumerate() {
+        if matches!(r.key.case, BftCase::Private { .. }) {
+            let (rows, k) = private_table(&level1, f, level)?;
+            debug_assert_eq!(k, r.ring.len());
+            tables.add_private(r.key, &rows, k);
+        }
+    }
+    let tangent_stencils = (0..level1.num_vertices() as u32)
+        .map(|v| {
+            level1.loop_tangent_stencils(v).unwrap_or_else(|| {
+                // No limit mask (e.g. a valence-2 corner under "edges only"): the fan's
+                // chord tangents, first and last ring neighbour, still give the outward side.
+                let ring = level1.vertex_ring(v);
+                let mut idx = vec![v];
+                idx.extend_from_slice(ring);
+                let mut t1 = vec![0.0; idx.len()];
+                let mut t2 = vec![0.0; idx.len()];
+                if idx.len() >= 3 {
+                    t1[0] = -1.0;
+                    t1[1] = 1.0;
+                    t2[0] = -1.0;
+                    t2[idx.len() - 1] = 1.0;
+                }
+                (idx, t1, t2)
+            })
+        })
+        .collect::<Vec<_>>();
     Ok(LoopBft {
+        stencils: r.stencils(1),
         level1,
+        tangent_stencils,
         records,
         tables,
+        base_vertices: mesh.positions.len(),
+        base_faces: mesh.num_faces(),
     })
+}
+
+impl LoopBft {
+    /// Barycentric weights, in the level-1 face's own corner order, of the point with patch
+    /// coordinate `(u, v)` (weights of the record's `v1`, `v2`: the TES's frame).
+    pub fn face_barycentric(&self, face: usize, u: f64, v: f64) -> [f64; 3] {
+        let r = &self.records[face];
+        let fv = self.level1.face(face);
+        let first = fv.iter().position(|&x| x == r.corners[0]).unwrap_or(0);
+        let mut b = [0.0; 3];
+        b[first] = 1.0 - u - v;
+        b[(first + 1) % 3] = u;
+        b[(first + 2) % 3] = v;
+        b
+    }
+
+    /// The base face and its domain coordinate `(U, V)` (weights of the base face's corners 1
+    /// and 2) of patch coordinate `(u, v)` on level-1 face `face`. Loop's split makes child
+    /// `4f + j` the triangle at corner `j` of base face `f` and child `4f + 3` the middle one.
+    pub fn base_domain(&self, face: usize, u: f64, v: f64) -> (usize, f64, f64) {
+        let c = self.face_barycentric(face, u, v);
+        let (f, j) = (face / 4, face % 4);
+        let mut b = [0.0; 3];
+        if j < 3 {
+            let (next, prev) = ((j + 1) % 3, (j + 2) % 3);
+            b[j] += c[0] + 0.5 * (c[1] + c[2]);
+            b[next] += 0.5 * c[1];
+            b[prev] += 0.5 * c[2];
+        } else {
+            for k in 0..3 {
+                b[k] += 0.5 * c[k];
+                b[(k + 1) % 3] += 0.5 * c[k];
+            }
+        }
+        (f, b[1], b[2])
+    }
+}
+
+/// Words of a patch header in [`GpuBft::patches`]: ring offset, ring size, entry | mirrored <<
+/// 31, three edge owners, three corner owners (owners pack `face << 2 | local index`).
+pub const PATCH_HEADER_WORDS: usize = 9;
+/// Words of the table header at the start of [`GpuBft::table_words`].
+pub const TABLE_HEADER_WORDS: usize = 8;
+/// Words per table entry: ring size, half, rows, offsets of the position, `du`, `dv` blocks and
+/// of the mirror permutation, patch kind (0 regular, 1 extraordinary, 2 boundary).
+pub const ENTRY_WORDS: usize = 8;
+
+/// Everything the GPU reads, flattened into the buffers the shaders index, and checked: every
+/// index the shaders can form from these arrays is in range ([`GpuBft::validate`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GpuBft {
+    /// CSR base → level-1 stencils.
+    pub stencil_offsets: Vec<u32>,
+    pub stencil_indices: Vec<u32>,
+    pub stencil_weights: Vec<f32>,
+    /// CSR level-1 tangent stencils (two weight rows over the same indices).
+    pub tangent_offsets: Vec<u32>,
+    pub tangent_indices: Vec<u32>,
+    pub tangent_weights: Vec<[f32; 2]>,
+    /// [`PATCH_HEADER_WORDS`] per level-1 face, then every face's ring (level-1 indices).
+    pub patches: Vec<u32>,
+    /// Header `[level, N, grid, entry count, entries offset, perm offset, full map offset,
+    /// half map offset]`, entries, mirror permutations, row maps.
+    pub table_words: Vec<u32>,
+    pub table_weights: Vec<f32>,
+    pub base_vertices: u32,
+    pub level1_vertices: u32,
+    pub patch_count: u32,
+}
+
+fn patch_kind(key: BftKey) -> u32 {
+    match key.case {
+        BftCase::Interior if key.valence == 6 => 0,
+        BftCase::Interior => 1,
+        BftCase::Boundary { .. } => 2,
+        BftCase::Private { .. } => 3,
+    }
+}
+
+impl GpuBft {
+    pub fn new(bft: &LoopBft) -> Result<GpuBft, EvalError> {
+        let st = &bft.stencils;
+        let mut tangent_offsets = vec![0u32];
+        let mut tangent_indices = Vec::new();
+        let mut tangent_weights = Vec::new();
+        for (idx, t1, t2) in &bft.tangent_stencils {
+            tangent_indices.extend_from_slice(idx);
+            tangent_weights.extend(t1.iter().zip(t2).map(|(&a, &b)| [a as f32, b as f32]));
+            tangent_offsets.push(tangent_indices.len() as u32);
+        }
+        let t = &bft.tables;
+        let nf = bft.records.len();
+        let mut patches = Vec::with_capacity(nf * (PATCH_HEADER_WORDS + 12));
+        let mut ring_off = (nf * PATCH_HEADER_WORDS) as u32;
+        for r in &bft.records {
+            let (e, mirrored) = t
+                .lookup(r.key)
+                .ok_or_else(|| EvalError::Unsupported(format!("no table for {:?}", r.key)))?;
+            patches.push(ring_off);
+            patches.push(r.ring.len() as u32);
+            patches.push(e as u32 | (mirrored as u32) << 31);
+            for &(f, k) in r.edge_owner.iter().chain(&r.corner_owner) {
+                patches.push(f << 2 | k as u32);
+            }
+            ring_off += r.ring.len() as u32;
+        }
+        for r in &bft.records {
+            patches.extend_from_slice(&r.ring);
+        }
+        let mut words = vec![0u32; TABLE_HEADER_WORDS];
+        let off_entries = words.len() as u32;
+        for e in &t.entries {
+            words.extend_from_slice(&[
+                e.ring_size,
+                e.half as u32,
+                e.rows,
+                e.offset_position,
+                e.offset_du,
+                e.offset_dv,
+                e.offset_perm,
+                patch_kind(e.key),
+            ]);
+        }
+        let off_perm = words.len() as u32;
+        words.extend_from_slice(&t.mirror_perm);
+        let off_full = words.len() as u32;
+        words.extend_from_slice(&t.row_map_full);
+        let off_half = words.len() as u32;
+        words.extend_from_slice(&t.row_map_half);
+        words[..TABLE_HEADER_WORDS].copy_from_slice(&[
+            t.level,
+            t.segments(),
+            t.grid(),
+            t.entries.len() as u32,
+            off_entries,
+            off_perm,
+            off_full,
+            off_half,
+        ]);
+        let g = GpuBft {
+            stencil_offsets: st.offsets.clone(),
+            stencil_indices: st.indices.clone(),
+            stencil_weights: st.weights_f32(),
+            tangent_offsets,
+            tangent_indices,
+            tangent_weights,
+            patches,
+            table_words: words,
+            table_weights: t.weights.clone(),
+            base_vertices: bft.base_vertices as u32,
+            level1_vertices: bft.level1.num_vertices() as u32,
+            patch_count: nf as u32,
+        };
+        g.validate()?;
+        Ok(g)
+    }
+
+    /// Proves every read the shaders make is in bounds: stencil and ring indices name existing
+    /// vertices, owners existing faces and corners, entries existing tables whose ring size
+    /// equals the face's, rows and permutations lie inside the weight and word arrays.
+    pub fn validate(&self) -> Result<(), EvalError> {
+        let bad = |what: String| Err(EvalError::Unsupported(format!("GPU data invalid: {what}")));
+        let csr = |off: &[u32], idx: &[u32], n_rows: u32, n_src: u32, what: &str| {
+            if off.len() != n_rows as usize + 1
+                || off.windows(2).any(|w| w[0] > w[1])
+                || *off.last().unwrap_or(&0) as usize != idx.len()
+            {
+                return Err(format!("{what} offsets"));
+            }
+            if let Some(i) = idx.iter().position(|&i| i >= n_src) {
+                return Err(format!("{what} index {} at {i} ≥ {n_src}", idx[i]));
+            }
+            Ok(())
+        };
+        if let Err(e) = csr(
+            &self.stencil_offsets,
+            &self.stencil_indices,
+            self.level1_vertices,
+            self.base_vertices,
+            "stencil",
+        ) {
+            return bad(e);
+        }
+        if self.stencil_weights.len() != self.stencil_indices.len() {
+            return bad("stencil weights".into());
+        }
+        if let Err(e) = csr(
+            &self.tangent_offsets,
+            &self.tangent_indices,
+            self.level1_vertices,
+            self.level1_vertices,
+            "tangent stencil",
+        ) {
+            return bad(e);
+        }
+        if self.tangent_weights.len() != self.tangent_indices.len() {
+            return bad("tangent weights".into());
+        }
+        let w = &self.table_words;
+        if w.len() < TABLE_HEADER_WORDS {
+            return bad("table header".into());
+        }
+        let (grid, n_entries) = (w[2] as usize, w[3] as usize);
+        let (off_e, off_p, off_f, off_h) =
+            (w[4] as usize, w[5] as usize, w[6] as usize, w[7] as usize);
+        let map_len = (grid + 1) * (grid + 1);
+        if off_e + n_entries * ENTRY_WORDS > w.len()
+            || off_f + map_len > w.len()
+            || off_h + map_len > w.len()
+            || w[1] as usize * 3 != grid
+        {
+            return bad("table layout".into());
+        }
+        for e in 0..n_entries {
+            let ent = &w[off_e + e * ENTRY_WORDS..off_e + (e + 1) * ENTRY_WORDS];
+            let (rs, half, rows) = (ent[0] as usize, ent[1] != 0, ent[2] as usize);
+            for &off in &ent[3..6] {
+                if off != u32::MAX && off as usize + rows * rs > self.table_weights.len() {
+                    return bad(format!("entry {e} weights"));
+                }
+            }
+            if ent[3] == u32::MAX || off_p + ent[6] as usize + rs > off_f {
+                return bad(format!("entry {e} offsets"));
+            }
+            let perm = &w[off_p + ent[6] as usize..off_p + ent[6] as usize + rs];
+            if perm.iter().any(|&p| p as usize >= rs) {
+                return bad(format!("entry {e} permutation"));
+            }
+            let map = if half {
+                &w[off_h..off_h + map_len]
+            } else {
+                &w[off_f..off_f + map_len]
+            };
+            if map.iter().any(|&r| r != u32::MAX && r as usize >= rows) {
+                return bad(format!("entry {e} row map"));
+            }
+        }
+        // Every dyadic point must have a row (the interpolating path reads them unchecked).
+        let n = w[1] as usize;
+        for j in 0..=n {
+            for i in 0..=n - j {
+                let (a, b) = (3 * i, 3 * j);
+                let full = w[off_f + a * (grid + 1) + b];
+                let (ha, hb) = if a >= b { (a, b) } else { (b, a) };
+                let half = w[off_h + ha * (grid + 1) + hb];
+                if full == u32::MAX || half == u32::MAX {
+                    return bad(format!("dyadic point ({i}, {j}) has no row"));
+                }
+            }
+        }
+        let nf = self.patch_count as usize;
+        let p = &self.patches;
+        if p.len() < nf * PATCH_HEADER_WORDS {
+            return bad("patch headers".into());
+        }
+        for f in 0..nf {
+            let h = &p[f * PATCH_HEADER_WORDS..(f + 1) * PATCH_HEADER_WORDS];
+            let (off, rs, e) = (h[0] as usize, h[1] as usize, (h[2] & 0x7fff_ffff) as usize);
+            if off + rs > p.len() || rs < 3 {
+                return bad(format!("patch {f} ring"));
+            }
+            if e >= n_entries || w[off_e + e * ENTRY_WORDS] as usize != rs {
+                return bad(format!("patch {f} table entry"));
+            }
+            if let Some(&x) = p[off..off + rs]
+                .iter()
+                .find(|&&x| x >= self.level1_vertices)
+            {
+                return bad(format!("patch {f} ring index {x}"));
+            }
+            for (k, &o) in h[3..9].iter().enumerate() {
+                if (o >> 2) as usize >= nf || (o & 3) > 2 {
+                    return bad(format!("patch {f} owner {k}"));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What the TES computes for one tessellated vertex ([`GpuBft::eval_tess`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TessSample {
+    pub position: [f32; 3],
+    /// Unnormalised: subdivision-shading sum, or `du × dv` for geometric normals.
+    pub normal: [f32; 3],
+    /// The point is a table point (exact limit); else it was interpolated on the level-`L`
+    /// virtual mesh (fractional factors: the paper's linear geomorph).
+    pub exact: bool,
+}
+
+/// Flag bit of a captured vertex evaluated from a table row (exact limit).
+pub const FLAG_EXACT: u32 = 1;
+
+type Acc = ([f32; 3], [f32; 3], [f32; 3]);
+
+impl GpuBft {
+    fn entry(&self, e: usize) -> &[u32] {
+        let off = self.table_words[4] as usize + e * ENTRY_WORDS;
+        &self.table_words[off..off + ENTRY_WORDS]
+    }
+
+    /// Row of grid point `(a, b)` in the patch's table, and whether slots are mirrored;
+    /// `u32::MAX` when the point has no row. Mirrors `bft_row` in `glsl/include/bft.glsl`.
+    fn row_of(&self, face: usize, a: u32, b: u32) -> (u32, bool) {
+        let h = &self.patches[face * PATCH_HEADER_WORDS..];
+        let mirrored = h[2] >> 31 != 0;
+        let ent = self.entry((h[2] & 0x7fff_ffff) as usize);
+        let grid = self.table_words[2];
+        let (mut a, mut b, mut flip) = if mirrored {
+            (b, a, true)
+        } else {
+            (a, b, false)
+        };
+        if ent[1] != 0 && a < b {
+            std::mem::swap(&mut a, &mut b);
+            flip = !flip;
+        }
+        let map = if ent[1] != 0 {
+            self.table_words[7]
+        } else {
+            self.table_words[6]
+        };
+        (self.table_words[(map + a * (grid + 1) + b) as usize], flip)
+    }
+
+    /// Σ w·P over the patch ring for one row (position, normal source, and for geometric
+    /// normals `du`, `dv`), in slot order with separate multiply and add (GLSL `precise`).
+    fn accumulate(
+        &self,
+        face: usize,
+        row: u32,
+        flip: bool,
+        pos: &[[f32; 4]],
+        nrm: &[[f32; 4]],
+        geometric: bool,
+    ) -> Acc {
+        let h = &self.patches[face * PATCH_HEADER_WORDS..];
+        let (ring, rs) = (h[0] as usize, h[1] as usize);
+        let ent = self.entry((h[2] & 0x7fff_ffff) as usize);
+        let perm = self.table_words[5] as usize + ent[6] as usize;
+        let (mut p, mut q, mut r) = ([0f32; 3], [0f32; 3], [0f32; 3]);
+        let (off_du, off_dv) = if flip {
+            (ent[5], ent[4])
+        } else {
+            (ent[4], ent[5])
+        };
+        for s in 0..rs {
+            let slot = if flip {
+                self.table_words[perm + s] as usize
+            } else {
+                s
+            };
+            let at = |off: u32| self.table_weights[off as usize + row as usize * rs + slot];
+            let v = self.patches[ring + s] as usize;
+            let w = at(ent[3]);
+            for k in 0..3 {
+                let t = w * pos[v][k];
+                p[k] += t;
+            }
+            if geometric {
+                let (wu, wv) = (at(off_du), at(off_dv));
+                for k in 0..3 {
+                    let t = wu * pos[v][k];
+                    q[k] += t;
+                    let t = wv * pos[v][k];
+                    r[k] += t;
+                }
+            } else {
+                for k in 0..3 {
+                    let t = w * nrm[v][k];
+                    q[k] += t;
+                }
+            }
+        }
+        (p, q, r)
+    }
+
+    /// The TES of `glsl/bft.tese` in f32, for tess coordinate `b` (weights of the patch's
+    /// `v0`, `v1`, `v2`) of patch `face`: points on an edge or corner are evaluated by the
+    /// owner in its frame, table points exactly, other points by linear interpolation on the
+    /// level-`L` lattice. `pos`/`nrm`: level-1 positions and normals (`w` unused).
+    pub fn eval_tess(
+        &self,
+        pos: &[[f32; 4]],
+        nrm: &[[f32; 4]],
+        face: usize,
+        b: [f32; 3],
+        geometric: bool,
+    ) -> TessSample {
+        let h = &self.patches[face * PATCH_HEADER_WORDS..];
+        let (mut g, mut u, mut v) = (face, b[1], b[2]);
+        let corner = if b[0] == 1.0 {
+            Some(0)
+        } else if b[1] == 1.0 {
+            Some(1)
+        } else if b[2] == 1.0 {
+            Some(2)
+        } else {
+            None
+        };
+        let edge = if b[2] == 0.0 {
+            Some((0, b[1]))
+        } else if b[0] == 0.0 {
+            Some((1, b[2]))
+        } else if b[1] == 0.0 {
+            Some((2, b[0]))
+        } else {
+            None
+        };
+        if let Some(c) = corner {
+            let o = h[6 + c];
+            g = (o >> 2) as usize;
+            (u, v) = match o & 3 {
+                0 => (0.0, 0.0),
+                1 => (1.0, 0.0),
+                _ => (0.0, 1.0),
+            };
+        } else if let Some((e, t)) = edge {
+            let o = h[3 + e];
+            g = (o >> 2) as usize;
+            let t = if g == face { t } else { 1.0 - t };
+            (u, v) = match o & 3 {
+                0 => (t, 0.0),
+                1 => (1.0 - t, t),
+                _ => (0.0, 1.0 - t),
+            };
+        }
+        let grid = self.table_words[2];
+        let n = self.table_words[1];
+        let (ga, gb) = (u * grid as f32, v * grid as f32);
+        let (ra, rb) = ((ga + 0.5).floor(), (gb + 0.5).floor());
+        if (ga - ra).abs() < 0.02 && (gb - rb).abs() < 0.02 {
+            let (row, flip) = self.row_of(g, ra as u32, rb as u32);
+            if row != u32::MAX {
+                let (p, q, r) = self.accumulate(g, row, flip, pos, nrm, geometric);
+                return TessSample {
+                    position: p,
+                    normal: if geometric { cross(q, r) } else { q },
+                    exact: true,
+                };
+            }
+        }
+        let (x, y) = (u * n as f32, v * n as f32);
+        let i0 = x.floor().min(n as f32 - 1.0);
+        let j0 = y.floor().min(n as f32 - 1.0 - i0);
+        let (fx, fy) = (x - i0, y - j0);
+        let (i0, j0) = (i0 as u32, j0 as u32);
+        let (pts, w) = if fx + fy <= 1.0 {
+            (
+                [(i0, j0), (i0 + 1, j0), (i0, j0 + 1)],
+                [1.0 - fx - fy, fx, fy],
+            )
+        } else {
+            (
+                [(i0 + 1, j0 + 1), (i0, j0 + 1), (i0 + 1, j0)],
+                [fx + fy - 1.0, 1.0 - fx, 1.0 - fy],
+            )
+        };
+        let mut acc = ([0f32; 3], [0f32; 3], [0f32; 3]);
+        for (k, &(i, j)) in pts.iter().enumerate() {
+            let (row, flip) = self.row_of(g, 3 * i, 3 * j);
+            let (p, q, r) = self.accumulate(g, row, flip, pos, nrm, geometric);
+            for c in 0..3 {
+                let t = w[k] * p[c];
+                acc.0[c] += t;
+                let t = w[k] * q[c];
+                acc.1[c] += t;
+                let t = w[k] * r[c];
+                acc.2[c] += t;
+            }
+        }
+        TessSample {
+            position: acc.0,
+            normal: if geometric {
+                cross(acc.1, acc.2)
+            } else {
+                acc.1
+            },
+            exact: false,
+        }
+    }
+
+    /// Level-1 positions from base positions, as `glsl/bft_subdivide.comp` computes them.
+    pub fn subdivide(&self, base: &[[f32; 3]]) -> Vec<[f32; 4]> {
+        (0..self.level1_vertices as usize)
+            .map(|v| {
+                let (a, b) = (
+                    self.stencil_offsets[v] as usize,
+                    self.stencil_offsets[v + 1] as usize,
+                );
+                let mut p = [0f32; 4];
+                for k in a..b {
+                    let w = self.stencil_weights[k];
+                    let q = base[self.stencil_indices[k] as usize];
+                    for c in 0..3 {
+                        let t = w * q[c];
+                        p[c] += t;
+                    }
+                }
+                p
+            })
+            .collect()
+    }
+
+    /// Level-1 limit normals, as `glsl/bft_normals.comp` computes them.
+    pub fn normals(&self, level1: &[[f32; 4]]) -> Vec<[f32; 4]> {
+        (0..self.level1_vertices as usize)
+            .map(|v| {
+                let (a, b) = (
+                    self.tangent_offsets[v] as usize,
+                    self.tangent_offsets[v + 1] as usize,
+                );
+                let (mut t1, mut t2) = ([0f32; 3], [0f32; 3]);
+                for k in a..b {
+                    let [w1, w2] = self.tangent_weights[k];
+                    let q = level1[self.tangent_indices[k] as usize];
+                    for c in 0..3 {
+                        let t = w1 * q[c];
+                        t1[c] += t;
+                        let t = w2 * q[c];
+                        t2[c] += t;
+                    }
+                }
+                let n = cross(t1, t2);
+                let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                if l > 0.0 {
+                    [n[0] / l, n[1] / l, n[2] / l, 0.0]
+                } else {
+                    [0.0; 4]
+                }
+            })
+            .collect()
+    }
+}
+
+fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }

@@ -815,6 +815,27 @@ impl LocalMesh {
         Some((p, t1, t2))
     }
 
+    /// Loop limit tangent masks of vertex `v` as stencils: control indices `[v, ring…]` and the
+    /// weights of `tangent1` and `tangent2` over them (`tangent1 × tangent2` points outward).
+    /// For the GPU's limit normals of the once-refined mesh. `None` for Catmull-Clark meshes
+    /// and where [`Self::vertex_limit_position`] has no mask.
+    pub fn loop_tangent_stencils(&self, v: u32) -> Option<(Vec<u32>, Vec<f64>, Vec<f64>)> {
+        if self.scheme != LimitScheme::Loop {
+            return None;
+        }
+        let lv = self.limit_vertex(v, None)?;
+        let masks = loop_limit_masks(&lv);
+        let fan = &self.fans[v as usize];
+        let mut idx = vec![v];
+        idx.extend_from_slice(&fan.ring);
+        let flat = |m: &crate::limit::Mask| {
+            let mut w = vec![m.vertex];
+            w.extend_from_slice(&m.edges);
+            w
+        };
+        Some((idx, flat(&masks.tangent1), flat(&masks.tangent2)))
+    }
+
     /// Smooth directional tangent of `v` along its ring neighbour index `k`.
     fn directional(&self, v: u32, k: usize) -> Vec<f64> {
         let fan = &self.fans[v as usize];

@@ -113,6 +113,44 @@ impl ControlMesh {
         (0..self.num_faces()).map(move |f| self.face(f))
     }
 
+    /// The mesh with every polygon of more than three sides fan-triangulated from its first
+    /// corner (Loop needs triangles). Vertex indices, creases, corners and options are kept;
+    /// per-corner uvs and normals follow their corners; hole tags are dropped. Also returns,
+    /// per new face, the face it came from.
+    pub fn triangulated(&self) -> (ControlMesh, Vec<u32>) {
+        let mut out = ControlMesh {
+            positions: self.positions.clone(),
+            face_offsets: vec![0],
+            creases: self.creases.clone(),
+            corners: self.corners.clone(),
+            options: self.options,
+            ..ControlMesh::default()
+        };
+        let mut uvs = self.uvs.as_ref().map(|_| Vec::new());
+        let mut normals = self.normals.as_ref().map(|_| Vec::new());
+        let mut origin = Vec::new();
+        for f in 0..self.num_faces() {
+            let start = self.face_offsets[f] as usize;
+            let n = self.face(f).len();
+            for k in 1..n.saturating_sub(1) {
+                for c in [start, start + k, start + k + 1] {
+                    out.face_vertices.push(self.face_vertices[c]);
+                    if let (Some(o), Some(src)) = (uvs.as_mut(), self.uvs.as_ref()) {
+                        o.push(src[c]);
+                    }
+                    if let (Some(o), Some(src)) = (normals.as_mut(), self.normals.as_ref()) {
+                        o.push(src[c]);
+                    }
+                }
+                out.face_offsets.push(out.face_vertices.len() as u32);
+                origin.push(f as u32);
+            }
+        }
+        out.uvs = uvs;
+        out.normals = normals;
+        (out, origin)
+    }
+
     /// Check everything the refiner relies on; see [`TopologyError`] for the cases.
     pub fn validate(&self) -> Result<(), TopologyError> {
         Topology::from_mesh(self).map(|_| ())

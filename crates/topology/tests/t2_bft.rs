@@ -343,7 +343,9 @@ fn memory_figures() {
             "BFT level 5, valence <= 18, tangents {tangents}: interior {int_mirror} B; \
              interior+boundary {all_mirror} B (without mirror symmetry {all_plain} B)"
         );
-        assert!(int_mirror < 1_000_000);
+        // The issue's target (the paper needed about 9 MB), met for interior valences 3-18
+        // including the tessellator-point rows that make every tess vertex exact.
+        assert!(int_mirror <= 2_000_000, "{int_mirror} B");
         assert!(all_mirror * 10 < all_plain * 6);
     }
     // The prediction is the real size.

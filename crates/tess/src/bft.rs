@@ -1,0 +1,645 @@
+//! Loop limit surfaces on the tessellation stage through basis-function tables (Holländer &
+//! Boubekeur, the paper's Fig. 2):
+//!
+//! 1. **Initial GPU subdivision step** (compute, every frame): level-1 positions as stencils over
+//!    the base positions (`bft_subdivide.comp`), then level-1 limit normals from the limit
+//!    tangent masks (`bft_normals.comp`). An animated base mesh costs one upload of its
+//!    positions per frame; stencils, patch records and tables never change.
+//! 2. **Main pass**: one patch (one control point carrying the face index) per level-1 face.
+//!    `bft.tesc` sets power-of-two (or fractional) edge factors from each edge's two endpoints
+//!    only; `bft.tese` evaluates the table row of each tess coordinate (see
+//!    `glsl/include/bft.glsl`, mirrored in f32 by `topology::bft::GpuBft::eval_tess`).
+use crate::error::{Result, TessError};
+use crate::gpu::BftPush;
+use crate::renderer::{DrawCounts, DrawSplit, Renderer};
+use crate::shaders;
+use crate::tessellator::{uniform_vertex_count, Domain, Spacing};
+use std::collections::HashMap;
+use topology::bft::{prepare_loop_bft, GpuBft, LoopBft};
+use topology::ControlMesh;
+use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
+use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage, TessellationDesc};
+use vk_core::query::{PipelineStatistics, QueryPool};
+use vk_core::target::{OffscreenTarget, Rgba8};
+use vk_core::{vk, Buffer, BufferDesc, Device, MemoryLocation};
+
+/// Default maximum table level: 32 segments per level-1 edge, 64 per base edge.
+pub const DEFAULT_TABLE_LEVEL: u32 = 5;
+
+/// How a BFT draw chooses its tessellation factors.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FactorPolicy {
+    /// `S` segments per base edge (`S/2` per level-1 edge), `S ∈ {2, 4, …, 2^(L+1)}`.
+    Uniform { segments: u32 },
+    /// Edge factor = projected edge length / `pixels` per segment.
+    Screen { pixels: f32 },
+    /// An edge at `reference` distance from the eye gets the maximum level; the factor halves
+    /// each time the distance doubles.
+    Distance { reference: f32 },
+}
+
+impl Default for FactorPolicy {
+    fn default() -> Self {
+        FactorPolicy::Uniform { segments: 16 }
+    }
+}
+
+/// What one BFT frame shows, beyond the shared [`crate::DrawParams`] (camera, colours,
+/// wireframe, draw split).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BftParams {
+    pub factors: FactorPolicy,
+    /// Fractional factors (fractional-even spacing) morphing linearly on the level-`L` virtual
+    /// mesh, instead of power-of-two factors.
+    pub fractional: bool,
+    /// Normals from the tangent tables (`du × dv`) instead of subdivision shading.
+    pub geometric_normals: bool,
+    /// Colour patches by kind: regular, extraordinary, boundary.
+    pub patch_colours: bool,
+}
+
+impl BftParams {
+    fn spacing(&self) -> Spacing {
+        if self.fractional {
+            Spacing::FractionalEven
+        } else {
+            Spacing::Equal
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct BftPipelineKey {
+    spacing: Spacing,
+    wireframe: bool,
+}
+
+/// One base mesh on the GPU with everything the BFT pipeline reads. Drop order: pipelines,
+/// descriptor pool, set layout, buffers, device handle.
+pub struct BftSurface {
+    pipelines: HashMap<BftPipelineKey, Pipeline>,
+    subdivide: Pipeline,
+    normals: Pipeline,
+    _pool: DescriptorPool,
+    set_layout: DescriptorSetLayout,
+    /// One descriptor set per frame slot (they differ only in the base-position buffer).
+    sets: Vec<vk::DescriptorSet>,
+    base: Vec<Buffer>,
+    _static: Vec<Buffer>,
+    pub gpu: GpuBft,
+    pub bft: LoopBft,
+    /// Base positions as last uploaded (for the bounding box and the CPU reference).
+    pub base_positions: Vec<[f32; 3]>,
+    pub bbox_min: [f32; 3],
+    pub bbox_max: [f32; 3],
+    color_format: vk::Format,
+    depth_format: vk::Format,
+    device: Device,
+}
+
+fn storage(device: &Device, name: &str, bytes: &[u8]) -> Result<Buffer> {
+    // Zero-length storage buffers are invalid; pad empty arrays to one word.
+    let pad = [0u8; 4];
+    let data = if bytes.is_empty() { &pad[..] } else { bytes };
+    Ok(Buffer::with_data(
+        device,
+        name,
+        vk::BufferUsageFlags::STORAGE_BUFFER,
+        data,
+    )?)
+}
+
+/// The base positions of `mesh` in f32.
+pub fn base_positions(mesh: &ControlMesh) -> Vec<[f32; 3]> {
+    mesh.positions
+        .iter()
+        .map(|p| [p[0] as f32, p[1] as f32, p[2] as f32])
+        .collect()
+}
+
+impl BftSurface {
+    /// Prepares `mesh` (refines once on the CPU for the topology, builds stencils, patch records
+    /// and the tables at `table_level`) and uploads it; `frames_in_flight` base-position
+    /// buffers let frame `k + 1` upload while frame `k` renders.
+    pub fn new(
+        renderer: &Renderer,
+        mesh: &ControlMesh,
+        name: &str,
+        table_level: u32,
+        tangents: bool,
+        frames_in_flight: usize,
+    ) -> Result<Self> {
+        let device = renderer.device().clone();
+        let max_level = device.info.caps.max_tessellation_generation_level;
+        if (1u32 << table_level) > max_level {
+            return Err(TessError::Invalid(format!(
+                "table level {table_level} needs tessellation level {} but the device allows {max_level}",
+                1u32 << table_level
+            )));
+        }
+        let bft = prepare_loop_bft(mesh, table_level, tangents)
+            .map_err(|e| TessError::Invalid(format!("{name}: {e}")))?;
+        let gpu = GpuBft::new(&bft).map_err(|e| TessError::Invalid(format!("{name}: {e}")))?;
+        let stages = vk::ShaderStageFlags::COMPUTE
+            | vk::ShaderStageFlags::VERTEX
+            | vk::ShaderStageFlags::TESSELLATION_CONTROL
+            | vk::ShaderStageFlags::TESSELLATION_EVALUATION
+            | vk::ShaderStageFlags::FRAGMENT;
+        let bindings: Vec<BindingDesc> = (0..12)
+            .map(|binding| BindingDesc {
+                binding,
+                ty: vk::DescriptorType::STORAGE_BUFFER,
+                stages,
+            })
+            .collect();
+        let set_layout = DescriptorSetLayout::new(&device, "bft set layout", &bindings)?;
+        let pool = DescriptorPool::new(
+            &device,
+            "bft descriptor pool",
+            &set_layout,
+            frames_in_flight as u32,
+        )?;
+        let b = bytemuck::cast_slice::<u32, u8>;
+        let f = bytemuck::cast_slice::<f32, u8>;
+        let level1_bytes = 16 * gpu.level1_vertices.max(1) as u64;
+        let level1 = |name: &str| {
+            Buffer::new(
+                &device,
+                &BufferDesc {
+                    name,
+                    size: level1_bytes,
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                    location: MemoryLocation::GpuOnly,
+                },
+            )
+        };
+        let tw: Vec<f32> = gpu.tangent_weights.iter().flatten().copied().collect();
+        let statics = vec![
+            storage(&device, "bft stencil offsets", b(&gpu.stencil_offsets))?,
+            storage(&device, "bft stencil indices", b(&gpu.stencil_indices))?,
+            storage(&device, "bft stencil weights", f(&gpu.stencil_weights))?,
+            storage(&device, "bft tangent offsets", b(&gpu.tangent_offsets))?,
+            storage(&device, "bft tangent indices", b(&gpu.tangent_indices))?,
+            storage(&device, "bft tangent weights", f(&tw))?,
+            level1("bft level-1 positions")?,
+            level1("bft level-1 normals")?,
+            storage(&device, "bft patches", b(&gpu.patches))?,
+            storage(&device, "bft table words", b(&gpu.table_words))?,
+            storage(&device, "bft table weights", f(&gpu.table_weights))?,
+        ];
+        let base_positions = base_positions(mesh);
+        let mut base = Vec::new();
+        let mut sets = Vec::new();
+        for i in 0..frames_in_flight {
+            let mut buf = Buffer::new(
+                &device,
+                &BufferDesc {
+                    name: &format!("bft base positions {i}"),
+                    size: (12 * base_positions.len().max(1)) as u64,
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                    location: MemoryLocation::CpuToGpu,
+                },
+            )?;
+            buf.write(0, bytemuck::cast_slice(&base_positions))?;
+            let set = pool.allocate(&set_layout)?;
+            let mut writes = vec![(0, vk::DescriptorType::STORAGE_BUFFER, buf.descriptor())];
+            for (k, s) in statics.iter().enumerate() {
+                writes.push((
+                    k as u32 + 1,
+                    vk::DescriptorType::STORAGE_BUFFER,
+                    s.descriptor(),
+                ));
+            }
+            pool.write_buffers(set, &writes);
+            base.push(buf);
+            sets.push(set);
+        }
+        let layouts = [renderer.frame_set_layout(), set_layout.raw];
+        let push = std::mem::size_of::<BftPush>() as u32;
+        let subdivide = Pipeline::compute(
+            &device,
+            "bft subdivide",
+            ShaderStage::new(vk::ShaderStageFlags::COMPUTE, shaders::BFT_SUBDIVIDE_COMP),
+            &layouts,
+            push,
+        )?;
+        let normals = Pipeline::compute(
+            &device,
+            "bft normals",
+            ShaderStage::new(vk::ShaderStageFlags::COMPUTE, shaders::BFT_NORMALS_COMP),
+            &layouts,
+            push,
+        )?;
+        let (bbox_min, bbox_max) = bbox(&base_positions);
+        let (color_format, depth_format) = renderer.formats();
+        Ok(Self {
+            pipelines: HashMap::new(),
+            subdivide,
+            normals,
+            _pool: pool,
+            set_layout,
+            sets,
+            base,
+            _static: statics,
+            gpu,
+            bft,
+            base_positions,
+            bbox_min,
+            bbox_max,
+            color_format,
+            depth_format,
+            device,
+        })
+    }
+
+    /// Bytes of basis-function tables on the GPU (weights, table words).
+    pub fn table_bytes(&self) -> usize {
+        4 * (self.gpu.table_weights.len() + self.gpu.table_words.len())
+    }
+
+    /// Level-1 faces: patches per frame.
+    pub fn patch_count(&self) -> u32 {
+        self.gpu.patch_count
+    }
+
+    /// Uploads new base positions into frame slot `slot` (same vertex count).
+    pub fn update_base(&mut self, slot: usize, positions: &[[f32; 3]]) -> Result<()> {
+        if positions.len() != self.base_positions.len() {
+            return Err(TessError::Invalid(format!(
+                "{} base positions given, the mesh has {}",
+                positions.len(),
+                self.base_positions.len()
+            )));
+        }
+        let buf = self
+            .base
+            .get_mut(slot)
+            .ok_or_else(|| TessError::Invalid(format!("no frame slot {slot}")))?;
+        buf.write(0, bytemuck::cast_slice(positions))?;
+        self.base_positions = positions.to_vec();
+        Ok(())
+    }
+
+    fn pipeline(&mut self, renderer: &Renderer, key: BftPipelineKey) -> Result<&Pipeline> {
+        if !self.pipelines.contains_key(&key) {
+            let p = self.build_pipeline(renderer, key)?;
+            self.pipelines.insert(key, p);
+        }
+        Ok(&self.pipelines[&key])
+    }
+
+    fn build_pipeline(&self, renderer: &Renderer, key: BftPipelineKey) -> Result<Pipeline> {
+        let tese = match key.spacing {
+            Spacing::Equal => shaders::BFT_TESE_EQUAL,
+            Spacing::FractionalEven => shaders::BFT_TESE_FRACTIONAL_EVEN,
+            Spacing::FractionalOdd => shaders::BFT_TESE_FRACTIONAL_ODD,
+        };
+        let name = format!(
+            "bft {:?}{}",
+            key.spacing,
+            if key.wireframe { " wireframe" } else { "" }
+        );
+        let mut desc = GraphicsPipelineDesc::new(&name, self.color_format, self.depth_format);
+        desc.stages = vec![
+            ShaderStage::new(vk::ShaderStageFlags::VERTEX, shaders::BFT_VERT),
+            ShaderStage::new(
+                vk::ShaderStageFlags::TESSELLATION_CONTROL,
+                shaders::BFT_TESC,
+            ),
+            ShaderStage::new(vk::ShaderStageFlags::TESSELLATION_EVALUATION, tese),
+            ShaderStage::new(vk::ShaderStageFlags::FRAGMENT, shaders::BFT_FRAG),
+        ];
+        desc.topology = vk::PrimitiveTopology::PATCH_LIST;
+        desc.tessellation = Some(TessellationDesc {
+            patch_control_points: 1,
+            domain_origin: vk::TessellationDomainOrigin::UPPER_LEFT,
+        });
+        desc.set_layouts = vec![renderer.frame_set_layout(), self.set_layout.raw];
+        desc.push_constant_bytes = std::mem::size_of::<BftPush>() as u32;
+        if key.wireframe {
+            desc.polygon_mode = vk::PolygonMode::LINE;
+            desc.depth_compare = vk::CompareOp::LESS_OR_EQUAL;
+            desc.depth_write = false;
+        } else {
+            desc.depth_bias = Some((1.0, 1.0));
+        }
+        Ok(Pipeline::graphics(&self.device, &desc)?)
+    }
+
+    fn push(&self, params: &BftParams, mode: u32) -> BftPush {
+        let max_level = self.gpu.table_words[1] as f32;
+        let (factor_mode, uniform_level, pixels, reference) = match params.factors {
+            FactorPolicy::Uniform { segments } => (0, segments as f32 * 0.5, 0.0, 0.0),
+            FactorPolicy::Screen { pixels } => (1, 0.0, pixels.max(0.01), 0.0),
+            FactorPolicy::Distance { reference } => (2, 0.0, 0.0, reference.max(1e-6)),
+        };
+        BftPush {
+            mode,
+            first_patch: 0,
+            factor_mode,
+            options: params.geometric_normals as u32
+                | (params.patch_colours as u32) << 1
+                | (params.fractional as u32) << 2,
+            uniform_level,
+            pixels_per_segment: pixels,
+            distance_ref: reference,
+            max_level,
+            count: self.gpu.level1_vertices,
+        }
+    }
+
+    /// Checks the factors against the tables: uniform `S` must be a power of two in
+    /// `2..=2^(L+1)` unless fractional.
+    pub fn check_params(&self, params: &BftParams) -> Result<()> {
+        let max = 2 * self.gpu.table_words[1];
+        if let FactorPolicy::Uniform { segments } = params.factors {
+            if segments < 2 || segments > max || (!params.fractional && !segments.is_power_of_two())
+            {
+                return Err(TessError::Invalid(format!(
+                    "--segments {segments}: BFT takes a power of two in 2..={max} segments per base edge \
+                     (tables at level {}; raise --table-level for more)",
+                    self.gpu.table_words[0]
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Records the initial subdivision step of frame slot `slot`: level-1 positions, then
+    /// normals, with the barriers that order them after the previous frame's reads and before
+    /// this frame's tessellation stages. Outside any rendering scope.
+    pub fn record_compute(&self, cmd: vk::CommandBuffer, renderer: &Renderer, slot: usize) {
+        let d = &self.device;
+        let push = BftPush {
+            count: self.gpu.level1_vertices,
+            ..Default::default()
+        };
+        let groups = self.gpu.level1_vertices.div_ceil(64);
+        let tess_stages = vk::PipelineStageFlags::VERTEX_SHADER
+            | vk::PipelineStageFlags::TESSELLATION_CONTROL_SHADER
+            | vk::PipelineStageFlags::TESSELLATION_EVALUATION_SHADER;
+        let set = self.sets[slot.min(self.sets.len() - 1)];
+        let frame_set = renderer.frame_set(slot);
+        let barrier = |src_stage, src, dst_stage, dst| {
+            let m = [vk::MemoryBarrier::default()
+                .src_access_mask(src)
+                .dst_access_mask(dst)];
+            // SAFETY: cmd is recording outside a render pass.
+            unsafe {
+                d.raw.cmd_pipeline_barrier(
+                    cmd,
+                    src_stage,
+                    dst_stage,
+                    vk::DependencyFlags::empty(),
+                    &m,
+                    &[],
+                    &[],
+                )
+            };
+        };
+        d.begin_label(cmd, "bft initial subdivision step");
+        // The previous frame's tessellation stages read level 1 before we overwrite it; host
+        // writes of the base positions are visible at submit.
+        barrier(
+            tess_stages,
+            vk::AccessFlags::SHADER_READ,
+            vk::PipelineStageFlags::COMPUTE_SHADER,
+            vk::AccessFlags::SHADER_WRITE,
+        );
+        for (pipeline, last) in [(&self.subdivide, false), (&self.normals, true)] {
+            // SAFETY: pipelines, sets and buffers are owned by self/renderer and outlive the
+            // submission (callers wait for the frame's fence before dropping them).
+            unsafe {
+                d.raw
+                    .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline.raw);
+                d.raw.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::COMPUTE,
+                    pipeline.layout,
+                    0,
+                    &[frame_set, set],
+                    &[],
+                );
+                d.raw.cmd_push_constants(
+                    cmd,
+                    pipeline.layout,
+                    vk::ShaderStageFlags::ALL,
+                    0,
+                    bytemuck::bytes_of(&push),
+                );
+                d.raw.cmd_dispatch(cmd, groups.max(1), 1, 1);
+            }
+            if last {
+                barrier(
+                    vk::PipelineStageFlags::COMPUTE_SHADER,
+                    vk::AccessFlags::SHADER_WRITE,
+                    tess_stages,
+                    vk::AccessFlags::SHADER_READ,
+                );
+            } else {
+                barrier(
+                    vk::PipelineStageFlags::COMPUTE_SHADER,
+                    vk::AccessFlags::SHADER_WRITE,
+                    vk::PipelineStageFlags::COMPUTE_SHADER,
+                    vk::AccessFlags::SHADER_READ,
+                );
+            }
+        }
+        d.end_label(cmd);
+    }
+
+    /// Patches per draw: all of them, unless a driver workaround limits the vertices one draw
+    /// may emit (`vk_core::workarounds`), computed at the largest factor the policy can reach.
+    pub fn patches_per_draw(&self, params: &BftParams, split: DrawSplit) -> u32 {
+        match split {
+            DrawSplit::Off => u32::MAX,
+            DrawSplit::PerPatch => 1,
+            DrawSplit::Auto => {
+                let max = match params.factors {
+                    FactorPolicy::Uniform { segments } => segments as f32 * 0.5,
+                    _ => self.gpu.table_words[1] as f32,
+                };
+                let verts = uniform_vertex_count(Domain::Triangle, params.spacing(), max);
+                self.device.workarounds.max_patches_per_draw(verts)
+            }
+        }
+    }
+
+    /// Records the draws of one pass (shaded, or the wireframe overlay) inside a rendering
+    /// scope; [`Self::record_compute`] must have run earlier in the frame.
+    pub fn record_draw(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        renderer: &Renderer,
+        slot: usize,
+        params: &BftParams,
+        split: DrawSplit,
+        wireframe: bool,
+    ) -> Result<DrawCounts> {
+        let key = BftPipelineKey {
+            spacing: params.spacing(),
+            wireframe,
+        };
+        let mut push = self.push(params, wireframe as u32);
+        let per_draw = self.patches_per_draw(params, split);
+        let set = self.sets[slot.min(self.sets.len() - 1)];
+        let frame_set = renderer.frame_set(slot);
+        let total = self.gpu.patch_count;
+        let device = self.device.clone();
+        let pipeline = self.pipeline(renderer, key)?;
+        let mut counts = DrawCounts::default();
+        // SAFETY: cmd is recording inside a rendering scope; everything bound is owned by self
+        // or the renderer and outlives the submission.
+        unsafe {
+            device
+                .raw
+                .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.raw);
+            device.raw.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                pipeline.layout,
+                0,
+                &[frame_set, set],
+                &[],
+            );
+        }
+        let mut first = 0;
+        while first < total {
+            let n = per_draw.min(total - first);
+            push.first_patch = first;
+            // SAFETY: as above; vertex indices first..first+n name existing level-1 faces,
+            // whose records were validated (`GpuBft::validate`).
+            unsafe {
+                device.raw.cmd_push_constants(
+                    cmd,
+                    pipeline.layout,
+                    vk::ShaderStageFlags::ALL,
+                    0,
+                    bytemuck::bytes_of(&push),
+                );
+                device.raw.cmd_draw(cmd, n, 1, first, 0);
+            }
+            counts.draws += 1;
+            counts.patches += n;
+            first += n;
+        }
+        Ok(counts)
+    }
+}
+
+/// Axis-aligned bounds of points.
+pub fn bbox(points: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
+    let mut lo = [f32::MAX; 3];
+    let mut hi = [f32::MIN; 3];
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    if points.is_empty() {
+        ([0.0; 3], [0.0; 3])
+    } else {
+        (lo, hi)
+    }
+}
+
+/// Per-vertex unit normals of the base mesh (area-weighted face normals), the directions the
+/// animation moves vertices along.
+pub fn base_normals(mesh: &ControlMesh) -> Vec<[f32; 3]> {
+    let mut n = vec![glam::DVec3::ZERO; mesh.positions.len()];
+    for f in mesh.faces() {
+        let p = |i: usize| glam::DVec3::from(mesh.positions[f[i] as usize]);
+        for k in 1..f.len().saturating_sub(1) {
+            let c = (p(k) - p(0)).cross(p(k + 1) - p(0));
+            for &v in f {
+                n[v as usize] += c;
+            }
+        }
+    }
+    n.iter()
+        .map(|v| v.normalize_or_zero().as_vec3().to_array())
+        .collect()
+}
+
+/// The `--animate` deformation (a travelling wave along the vertex normals, as in the Doo-Sabin
+/// paper's §3): base position + `amplitude · sin(2π(k·p/diag − t))` along the normal. Only these
+/// positions are uploaded per frame.
+pub fn wave(
+    base: &[[f32; 3]],
+    normals: &[[f32; 3]],
+    bbox_min: [f32; 3],
+    bbox_max: [f32; 3],
+    time: f32,
+) -> Vec<[f32; 3]> {
+    let lo = glam::Vec3::from(bbox_min);
+    let hi = glam::Vec3::from(bbox_max);
+    let diag = (hi - lo).length().max(1e-6);
+    let dir = glam::Vec3::new(0.6, 0.8, 0.0);
+    let amplitude = 0.03 * diag;
+    base.iter()
+        .zip(normals)
+        .map(|(p, n)| {
+            let p = glam::Vec3::from(*p);
+            let phase = 2.0 * std::f32::consts::PI * (2.0 * dir.dot(p - lo) / diag - 0.5 * time);
+            (p + glam::Vec3::from(*n) * amplitude * phase.sin()).to_array()
+        })
+        .collect()
+}
+
+impl BftSurface {
+    /// Renders one frame offscreen (compute pass, shaded pass, optional wireframe overlay) and
+    /// reads it back; with `statistics`, also the pipeline statistics of the shaded pass.
+    pub fn render_offscreen(
+        &mut self,
+        renderer: &mut Renderer,
+        draw: &crate::DrawParams,
+        params: &BftParams,
+        extent: vk::Extent2D,
+        statistics: bool,
+    ) -> Result<(Rgba8, Option<PipelineStatistics>, DrawCounts)> {
+        self.check_params(params)?;
+        let device = self.device.clone();
+        let target = OffscreenTarget::new(&device, extent)?;
+        let readback = target.readback_buffer(&device)?;
+        let query = if statistics {
+            Some(QueryPool::statistics(&device, "bft statistics", 1)?)
+        } else {
+            None
+        };
+        renderer.update_frame(0, (self.bbox_min, self.bbox_max), draw, extent)?;
+        let mut result = Ok(DrawCounts::default());
+        device.one_shot(|cmd| {
+            if let Some(q) = &query {
+                q.cmd_reset(cmd);
+            }
+            self.record_compute(cmd, renderer, 0);
+            target.cmd_begin(&device, cmd, draw.clear_color);
+            if let Some(q) = &query {
+                // SAFETY: the query was reset above in this command buffer.
+                unsafe {
+                    device
+                        .raw
+                        .cmd_begin_query(cmd, q.raw, 0, vk::QueryControlFlags::empty())
+                };
+            }
+            result = self.record_draw(cmd, renderer, 0, params, draw.split, false);
+            if let Some(q) = &query {
+                // SAFETY: matches the begin above.
+                unsafe { device.raw.cmd_end_query(cmd, q.raw, 0) };
+            }
+            if draw.wireframe && result.is_ok() {
+                if let Err(e) = self.record_draw(cmd, renderer, 0, params, draw.split, true) {
+                    result = Err(e);
+                }
+            }
+            target.cmd_end_and_copy(&device, cmd, &readback);
+        })?;
+        let counts = result?;
+        let stats = match &query {
+            Some(q) => q.statistics_results()?.first().copied(),
+            None => None,
+        };
+        Ok((target.read(&readback)?, stats, counts))
+    }
+}

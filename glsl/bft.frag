@@ -1,0 +1,13 @@
+#version 450
+// Shading of BFT surfaces: as shade.frag, with the per-patch albedo (patch colouring mode).
+#define BFT_PUSH_CONSTANTS
+#include "frame.glsl"
+#include "bft.glsl"
+#include "shading.glsl"
+layout(location = 0) in vec3 in_world;
+layout(location = 1) in vec3 in_normal;
+layout(location = 5) flat in vec3 in_albedo;
+layout(location = 0) out vec4 out_color;
+void main() {
+    out_color = bft.mode == 1u ? vec4(frame.wire_color.rgb, 1.0) : shade(in_world, in_normal, in_albedo);
+}

@@ -1,0 +1,27 @@
+#version 450
+// Loop limit surface by basis-function tables: one level-1 face per patch. gl_TessCoord
+// (weights of the face's v0, v1, v2) names a table point (exact limit) or, for fractional
+// factors, a point of the level-L virtual mesh. Normals by subdivision shading (the same
+// weights over the level-1 limit normals, then normalised) or from the tangent tables.
+// Built in SPACING variants and CAPTURE variants (tese_out.glsl).
+#define BFT_PUSH_CONSTANTS
+#include "frame.glsl"
+#include "bft.glsl"
+#include "tese_out.glsl"
+layout(triangles, SPACING, ccw) in;
+layout(location = 0) patch in uint tc_face;
+layout(location = 5) flat out vec3 out_albedo;
+
+// Regular, extraordinary, boundary, private-table patches.
+const vec3 KIND_COLOURS[4] = vec3[4](vec3(0.55, 0.75, 0.95), vec3(0.95, 0.45, 0.35), vec3(0.55, 0.85, 0.45), vec3(0.75, 0.5, 0.9));
+
+void main() {
+    uint face = tc_face;
+    bool geometric = (bft.options & 1u) != 0u;
+    vec3 p, n;
+    bool exact = bft_eval(face, gl_TessCoord, geometric, p, n);
+    uint kind = entry_word(patch_word(face, 2u) & 0x7fffffffu, 7u);
+    out_albedo = (bft.options & 2u) != 0u ? KIND_COLOURS[min(kind, 3u)] : frame.base_color.rgb;
+    float l = length(n);
+    emit_sample(p, l > 0.0 ? n / l : n, face, (exact ? 1u : 0u) | (kind << 1));
+}

@@ -1,0 +1,19 @@
+#version 450
+// Level-1 limit normals from the Loop limit tangent masks over each vertex's one-ring
+// (boundary fans use the boundary masks): where subdivision shading starts.
+#define BFT_WRITES_LEVEL1
+#include "bft.glsl"
+layout(local_size_x = 64) in;
+void main() {
+    uint v = gl_GlobalInvocationID.x;
+    if (v >= bft.count) return;
+    precise vec3 t1 = vec3(0.0), t2 = vec3(0.0);
+    for (uint k = tangent_offsets[v]; k < tangent_offsets[v + 1u]; ++k) {
+        vec3 x = level1_pos[tangent_indices[k]].xyz;
+        t1 += tangent_weights[k].x * x;
+        t2 += tangent_weights[k].y * x;
+    }
+    vec3 n = cross(t1, t2);
+    float l = length(n);
+    level1_nrm[v] = vec4(l > 0.0 ? n / l : vec3(0.0), 0.0);
+}
