@@ -11,7 +11,9 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     vec4 viewport;     // xy: size in pixels
 } frame;
 
-// Push constant: what a draw is for (shaded surface or wireframe overlay).
+// Push constant: what a draw is for, and where it starts in the frame's patch numbering.
+// Mirrors `tess::gpu::DrawPush` (std430 offsets checked against the SPIR-V by a test).
 layout(push_constant) uniform Draw {
     uint mode;         // 0: shaded, 1: wireframe
+    uint first_patch;  // patch id of this draw's first patch (gl_PrimitiveID restarts per draw)
 } draw;
