@@ -5,6 +5,15 @@
 //! Stage files are named `technique.stage` (`.vert .tesc .tese .frag .comp`); shared includes live
 //! in `glsl/include` and are resolved by `#include "name.glsl"`. Warnings are errors; a failed
 //! compile fails the build with glslang's file:line message.
+//!
+//! Generated names: `pn.tese` → `PN_TESE`, then one suffix per variant axis, in this order:
+//! - a stage whose source names `SPACING` is built once per spacing (a layout qualifier, so not a
+//!   specialization constant): `_EQUAL`, `_FRACTIONAL_EVEN`, `_FRACTIONAL_ODD`;
+//! - a stage whose source names `CAPTURE` is additionally built with `-DCAPTURE` (transform
+//!   feedback outputs, `glsl/include/tese_out.glsl`): `_CAPTURE`.
+//!
+//! So `pn.tese` yields `PN_TESE_EQUAL`, `PN_TESE_EQUAL_CAPTURE`, `PN_TESE_FRACTIONAL_EVEN`, …;
+//! a stage naming neither keeps its bare name (`MESH_VERT`).
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -16,6 +25,12 @@ fn main() {
     let glsl = glsl.canonicalize().unwrap_or(glsl);
     let include_dir = glsl.join("include");
     let out = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
+    // Listing any path turns off cargo's default of rerunning on any package change, and this
+    // script lives outside the package, so it names itself too.
+    println!(
+        "cargo:rerun-if-changed={}",
+        root.join("../../build.rs").display()
+    );
     println!("cargo:rerun-if-changed={}", glsl.display());
     println!("cargo:rerun-if-changed={}", include_dir.display());
 
@@ -69,7 +84,7 @@ fn main() {
         });
         // Tessellation spacing is a layout qualifier, not a specialization constant: a stage that
         // names `SPACING` is compiled once per spacing, as NAME_EQUAL / _FRACTIONAL_EVEN / _ODD.
-        let variants: Vec<(&str, Option<&str>)> = if source.contains("SPACING") {
+        let spacings: Vec<(&str, Option<&str>)> = if source.contains("SPACING") {
             vec![
                 ("_EQUAL", Some("equal_spacing")),
                 ("_FRACTIONAL_EVEN", Some("fractional_even_spacing")),
@@ -78,11 +93,24 @@ fn main() {
         } else {
             vec![("", None)]
         };
-        for (suffix, spacing) in variants {
+        // A stage that names `CAPTURE` also gets a transform-feedback build, NAME…_CAPTURE.
+        let captures: &[bool] = if source.contains("CAPTURE") {
+            &[false, true]
+        } else {
+            &[false]
+        };
+        let variants = spacings
+            .iter()
+            .flat_map(|&s| captures.iter().map(move |&c| (s, c)));
+        for ((spacing_suffix, spacing), capture) in variants {
             let mut opts = options.clone();
             if let Some(spacing) = spacing {
                 opts.add_macro_definition("SPACING", Some(spacing));
             }
+            if capture {
+                opts.add_macro_definition("CAPTURE", None);
+            }
+            let suffix = format!("{spacing_suffix}{}", if capture { "_CAPTURE" } else { "" });
             match compiler.compile_into_spirv(
                 &source,
                 kind,
@@ -97,8 +125,9 @@ fn main() {
                     std::fs::write(&spv, artifact.as_binary_u8()).expect("write spv");
                     writeln!(
                         generated,
-                        "/// SPIR-V of `glsl/{file_name}` ({}).",
-                        spacing.unwrap_or("single variant")
+                        "/// SPIR-V of `glsl/{file_name}` ({}{}).",
+                        spacing.unwrap_or("single variant"),
+                        if capture { ", -DCAPTURE" } else { "" }
                     )
                     .unwrap();
                     writeln!(generated, "pub static {ident}: &[u32] = &{words:?};").unwrap();

@@ -1,5 +1,6 @@
 #version 450
 // Flat tessellation of a triangle: the planar point at the barycentric tess coordinate.
+// Built also as a CAPTURE variant (transform feedback of every emitted corner, tese_out.glsl).
 #include "frame.glsl"
 #include "tese_out.glsl"
 layout(triangles, SPACING, ccw) in;
@@ -9,5 +10,5 @@ void main() {
     vec3 b = gl_TessCoord;
     vec3 p = b.x * in_position[0] + b.y * in_position[1] + b.z * in_position[2];
     vec3 n = b.x * in_normal[0] + b.y * in_normal[1] + b.z * in_normal[2];
-    emit(p, n);
+    emit_sample(p, n, draw.first_patch + uint(gl_PrimitiveID), 0u);
 }

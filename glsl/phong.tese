@@ -2,6 +2,7 @@
 // Phong tessellation (Boubekeur & Alexa 2008): the linear point projected onto each corner's
 // tangent plane, the projections blended barycentrically, then mixed with the linear point by
 // the shape factor alpha (frame.tess.z, default 3/4). Normals are interpolated linearly.
+// Built also as a CAPTURE variant (transform feedback of every emitted corner, tese_out.glsl).
 #include "frame.glsl"
 #include "tese_out.glsl"
 layout(triangles, SPACING, ccw) in;
@@ -17,5 +18,5 @@ void main() {
     vec3 phong = b.x * project(p, 0) + b.y * project(p, 1) + b.z * project(p, 2);
     float alpha = frame.tess.z;
     vec3 n = b.x * in_normal[0] + b.y * in_normal[1] + b.z * in_normal[2];
-    emit(mix(p, phong, alpha), n);
+    emit_sample(mix(p, phong, alpha), n, draw.first_patch + uint(gl_PrimitiveID), 0u);
 }

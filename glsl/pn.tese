@@ -2,6 +2,7 @@
 // Curved PN triangle evaluation: cubic Bézier position (standard Bernstein weights) and the
 // appendix's quadratic normal field n = N1 u^2 + N2 v^2 + N3 w^2 + n110 uv + n011 vw + n101 wu,
 // normalised. Barycentric (u, v, w) = gl_TessCoord weights of corners 0, 1, 2.
+// Built also as a CAPTURE variant (transform feedback of every emitted corner, tese_out.glsl).
 #include "frame.glsl"
 #include "tese_out.glsl"
 layout(triangles, SPACING, ccw) in;
@@ -19,5 +20,5 @@ void main() {
         + b111 * (6.0 * u * v * w);
     vec3 n = in_normal[0] * (u * u) + in_normal[1] * (v * v) + in_normal[2] * (w * w)
         + n_edge[0] * (u * v) + n_edge[1] * (v * w) + n_edge[2] * (w * u);
-    emit(p, normalize(n));
+    emit_sample(p, normalize(n), draw.first_patch + uint(gl_PrimitiveID), 0u);
 }

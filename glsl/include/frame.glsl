@@ -11,10 +11,12 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     vec4 viewport;     // xy: size in pixels
 } frame;
 
-// Push constant: what a draw is for (shaded surface or wireframe overlay). BFT stages define
-// BFT_PUSH_CONSTANTS and use their own block (bft.glsl).
+// Push constant: what a draw is for, and where it starts in the frame's patch numbering.
+// Mirrors `tess::gpu::DrawPush` (std430 offsets checked against the SPIR-V by a test).
+// BFT stages define BFT_PUSH_CONSTANTS and use their own block (bft.glsl).
 #ifndef BFT_PUSH_CONSTANTS
 layout(push_constant) uniform Draw {
     uint mode;         // 0: shaded, 1: wireframe
+    uint first_patch;  // patch id of this draw's first patch (gl_PrimitiveID restarts per draw)
 } draw;
 #endif

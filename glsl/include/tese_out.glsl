@@ -6,7 +6,8 @@
 //   offset  0: vec3 world position      offset 12: vec3 normal (as shaded)
 //   offset 24: uint patch id            offset 28: uint flags (technique-defined, 0 = none)
 //   offset 32: vec2 domain coordinate (gl_TessCoord.xy, as the tessellator produced it)
-// The patch id is the index of the patch in the whole patch list (draw splits included).
+// The patch id is the index of the patch in the frame's patch numbering, draw splits included:
+// the triangle/quad techniques pass `draw.first_patch + uint(gl_PrimitiveID)`.
 #ifdef CAPTURE
 #define XFB_AT(off) , xfb_buffer = 0, xfb_stride = 40, xfb_offset = off
 #else
@@ -27,9 +28,4 @@ void emit_sample(vec3 p, vec3 n, uint patch_id, uint flags) {
     out_domain = gl_TessCoord.xy;
 #endif
     gl_Position = frame.view_proj * vec4(p, 1.0);
-}
-
-// Techniques without their own patch ids: the primitive id within the draw, no flags.
-void emit(vec3 p, vec3 n) {
-    emit_sample(p, n, uint(gl_PrimitiveID), 0u);
 }

@@ -9,4 +9,16 @@ pub enum TessError {
     Topology(#[from] topology::TopologyError),
     #[error("{0}")]
     Invalid(String),
+    /// A capture larger than the transform-feedback buffer limit or the caller's budget.
+    #[error("capturing {triangles} triangles needs {bytes} bytes of transform feedback, over the limit of {limit} bytes (lower the level or raise the limit)")]
+    CaptureTooLarge {
+        triangles: u64,
+        bytes: u64,
+        limit: u64,
+    },
+    #[error("I/O on {path}: {source}")]
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
 }

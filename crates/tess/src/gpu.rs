@@ -42,13 +42,27 @@ pub const FRAME_UNIFORM_OFFSETS: [u32; 8] = [
     offset_of!(FrameUniforms, viewport) as u32,
 ];
 
-/// `Draw` push constant, `glsl/include/frame.glsl`.
+/// `Draw` push constant (std430), `glsl/include/frame.glsl`.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct DrawPush {
     /// 0: shaded, 1: wireframe.
     pub mode: u32,
+    /// Patch id of the draw's first patch: `gl_PrimitiveID` restarts at 0 in every draw, and
+    /// draws are split on some drivers, so the TES adds this to number patches frame-wide.
+    pub first_patch: u32,
 }
+
+const _: () = {
+    assert!(size_of::<DrawPush>() == 8);
+    assert!(offset_of!(DrawPush, first_patch) == 4);
+};
+
+/// Member offsets of `DrawPush` in declaration order, for the SPIR-V layout test.
+pub const DRAW_PUSH_OFFSETS: [u32; 2] = [
+    offset_of!(DrawPush, mode) as u32,
+    offset_of!(DrawPush, first_patch) as u32,
+];
 
 /// `BftDraw` push constant of every BFT stage, `glsl/include/bft.glsl`.
 #[repr(C)]
@@ -139,6 +153,30 @@ mod tests {
             assert_eq!(
                 offsets, FRAME_UNIFORM_OFFSETS,
                 "{name}: GLSL and Rust Frame layouts differ"
+            );
+        }
+    }
+
+    #[test]
+    fn draw_push_matches_spirv_layout() {
+        // Only the capture builds read first_patch (the optimizer drops the block elsewhere).
+        for (name, words) in [
+            ("flat_tri.tese", crate::shaders::FLAT_TRI_TESE_EQUAL_CAPTURE),
+            (
+                "flat_quad.tese",
+                crate::shaders::FLAT_QUAD_TESE_EQUAL_CAPTURE,
+            ),
+            (
+                "phong.tese",
+                crate::shaders::PHONG_TESE_FRACTIONAL_ODD_CAPTURE,
+            ),
+            ("pn.tese", crate::shaders::PN_TESE_FRACTIONAL_EVEN_CAPTURE),
+        ] {
+            let offsets = spirv_member_offsets(words, "Draw")
+                .unwrap_or_else(|| panic!("{name}: Draw block not found"));
+            assert_eq!(
+                offsets, DRAW_PUSH_OFFSETS,
+                "{name}: GLSL and Rust Draw layouts differ"
             );
         }
     }

@@ -2,9 +2,11 @@
 //!
 //! Every technique draws patches through a real TCS/TES pair; the host side here builds the
 //! buffers, chooses the shader variant by a [`renderer::PipelineKey`], sets tessellation factors,
-//! and splits draws where a driver needs it ([`vk_core::workarounds`]).
+//! and splits draws where a driver needs it ([`vk_core::workarounds`]). [`capture`] reads back
+//! exactly what the TES emitted (transform feedback) and checks it for cracks.
 pub mod bft;
 pub mod camera;
+pub mod capture;
 pub mod error;
 pub mod gpu;
 pub mod render_mesh;
@@ -13,6 +15,7 @@ pub mod tessellator;
 
 pub use bft::{BftParams, BftSurface, FactorPolicy};
 pub use camera::Camera;
+pub use capture::{CaptureRecord, CapturedSoup, Capturer, WeldedMesh};
 pub use error::{Result, TessError};
 pub use render_mesh::RenderMesh;
 pub use renderer::{DrawParams, DrawSplit, Method, Renderer};

@@ -3,6 +3,8 @@
 //! for flat quad tessellation, the rest triangulated).
 use crate::error::{Result, TessError};
 use crate::gpu::Vertex;
+use crate::renderer::Method;
+use crate::tessellator::Domain;
 use topology::ControlMesh;
 
 #[derive(Clone, Debug, Default)]
@@ -13,8 +15,35 @@ pub struct RenderMesh {
     /// Quads as quads; other faces go to `quad_mode_triangles`.
     pub quads: Vec<[u32; 4]>,
     pub quad_mode_triangles: Vec<[u32; 3]>,
+    /// Where each entry of `triangles`, `quads` and `quad_mode_triangles` came from, in the same
+    /// order: vertices were split by normal, so patch indices alone cannot name base corners.
+    pub triangle_origins: Vec<PatchOrigin>,
+    pub quad_origins: Vec<PatchOrigin>,
+    pub quad_mode_triangle_origins: Vec<PatchOrigin>,
     pub bbox_min: [f32; 3],
     pub bbox_max: [f32; 3],
+}
+
+/// The base face a patch was made from, and which of the face's corners it spans: a quad patch
+/// spans corners 0, 1, 2, 3 of a quad; fan triangle `fan` (1 ≤ fan ≤ n − 2) of an n-gon spans
+/// corners 0, fan, fan + 1 (a triangle face is fan triangle 1 of itself).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PatchOrigin {
+    pub face: u32,
+    pub face_size: u32,
+    pub domain: Domain,
+    pub fan: u32,
+}
+
+impl PatchOrigin {
+    /// The face-local corner slots of the patch's control points, in patch order (3 used for
+    /// triangles).
+    pub fn face_corners(&self) -> [u32; 4] {
+        match self.domain {
+            Domain::Quad => [0, 1, 2, 3],
+            Domain::Triangle => [0, self.fan, self.fan + 1, 0],
+        }
+    }
 }
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
@@ -120,11 +149,21 @@ impl RenderMesh {
             let face =
                 &corner_index[mesh.face_offsets[f] as usize..mesh.face_offsets[f + 1] as usize];
             let fan = (1..face.len() - 1).map(|i| [face[0], face[i], face[i + 1]]);
+            let origin = |domain, fan| PatchOrigin {
+                face: f as u32,
+                face_size: face.len() as u32,
+                domain,
+                fan,
+            };
+            let fan_origins = (1..face.len() - 1).map(|i| origin(Domain::Triangle, i as u32));
             out.triangles.extend(fan.clone());
+            out.triangle_origins.extend(fan_origins.clone());
             if face.len() == 4 {
                 out.quads.push([face[0], face[1], face[2], face[3]]);
+                out.quad_origins.push(origin(Domain::Quad, 0));
             } else {
                 out.quad_mode_triangles.extend(fan);
+                out.quad_mode_triangle_origins.extend(fan_origins);
             }
         }
         let mut lo = [f32::INFINITY; 3];
@@ -138,6 +177,18 @@ impl RenderMesh {
         out.bbox_min = lo;
         out.bbox_max = hi;
         Ok(out)
+    }
+}
+
+impl RenderMesh {
+    /// The origin of every patch `method` draws, indexed by captured patch id (the frame-wide
+    /// numbering of [`crate::renderer::draw_lists`]: flat numbers quads first, then the other
+    /// faces' triangles; Phong and PN number every face's triangles).
+    pub fn patch_origins(&self, method: Method) -> Vec<PatchOrigin> {
+        match method {
+            Method::Flat => [&self.quad_origins[..], &self.quad_mode_triangle_origins[..]].concat(),
+            Method::Phong | Method::Pn => self.triangle_origins.clone(),
+        }
     }
 }
 
@@ -221,6 +272,12 @@ mod tests {
         let rm = RenderMesh::from_control_mesh(&mesh).unwrap();
         assert_eq!(rm.triangles, vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]]);
         assert_eq!(rm.quad_mode_triangles.len(), 3);
+        let fans: Vec<_> = rm.patch_origins(Method::Pn).iter().map(|o| o.fan).collect();
+        assert_eq!(fans, vec![1, 2, 3]);
+        assert!(rm
+            .patch_origins(Method::Flat)
+            .iter()
+            .all(|o| o.face == 0 && o.face_size == 5 && o.domain == Domain::Triangle));
         assert!(rm.vertices.iter().all(|v| (v.normal[2] - 1.0).abs() < 1e-6));
     }
 

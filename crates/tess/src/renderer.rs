@@ -273,51 +273,7 @@ impl Renderer {
     }
 
     fn build_pipeline(&self, key: PipelineKey) -> Result<Pipeline> {
-        use Spacing::*;
-        let pick = |e: &'static [u32], fe: &'static [u32], fo: &'static [u32]| match key.spacing {
-            Equal => e,
-            FractionalEven => fe,
-            FractionalOdd => fo,
-        };
-        let (tesc, tese, cp) = match (key.method, key.domain) {
-            (Method::Flat, Domain::Quad) => (
-                shaders::QUAD_TESC,
-                pick(
-                    shaders::FLAT_QUAD_TESE_EQUAL,
-                    shaders::FLAT_QUAD_TESE_FRACTIONAL_EVEN,
-                    shaders::FLAT_QUAD_TESE_FRACTIONAL_ODD,
-                ),
-                4,
-            ),
-            (Method::Flat, Domain::Triangle) => (
-                shaders::TRI_TESC,
-                pick(
-                    shaders::FLAT_TRI_TESE_EQUAL,
-                    shaders::FLAT_TRI_TESE_FRACTIONAL_EVEN,
-                    shaders::FLAT_TRI_TESE_FRACTIONAL_ODD,
-                ),
-                3,
-            ),
-            (Method::Phong, Domain::Triangle) => (
-                shaders::TRI_TESC,
-                pick(
-                    shaders::PHONG_TESE_EQUAL,
-                    shaders::PHONG_TESE_FRACTIONAL_EVEN,
-                    shaders::PHONG_TESE_FRACTIONAL_ODD,
-                ),
-                3,
-            ),
-            (Method::Pn, Domain::Triangle) => (
-                shaders::PN_TESC,
-                pick(
-                    shaders::PN_TESE_EQUAL,
-                    shaders::PN_TESE_FRACTIONAL_EVEN,
-                    shaders::PN_TESE_FRACTIONAL_ODD,
-                ),
-                3,
-            ),
-            (m, d) => return Err(TessError::Invalid(format!("{m:?} has no {d:?} patches"))),
-        };
+        let (tesc, tese, cp) = technique_stages(key.method, key.domain, key.spacing, false)?;
         let name = format!(
             "{:?} {:?} {:?}{}",
             key.method,
@@ -332,32 +288,7 @@ impl Renderer {
             ShaderStage::new(vk::ShaderStageFlags::TESSELLATION_EVALUATION, tese),
             ShaderStage::new(vk::ShaderStageFlags::FRAGMENT, shaders::SHADE_FRAG),
         ];
-        desc.vertex_bindings = vec![vk::VertexInputBindingDescription {
-            binding: 0,
-            stride: std::mem::size_of::<Vertex>() as u32,
-            input_rate: vk::VertexInputRate::VERTEX,
-        }];
-        desc.vertex_attributes = vec![
-            vk::VertexInputAttributeDescription {
-                location: 0,
-                binding: 0,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 0,
-            },
-            vk::VertexInputAttributeDescription {
-                location: 1,
-                binding: 0,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 12,
-            },
-        ];
-        desc.topology = vk::PrimitiveTopology::PATCH_LIST;
-        desc.tessellation = Some(TessellationDesc {
-            patch_control_points: cp,
-            domain_origin: vk::TessellationDomainOrigin::UPPER_LEFT,
-        });
-        desc.set_layouts = vec![self.set_layout.raw];
-        desc.push_constant_bytes = std::mem::size_of::<DrawPush>() as u32;
+        set_patch_input(&mut desc, cp, self.set_layout.raw);
         if key.wireframe {
             desc.polygon_mode = vk::PolygonMode::LINE;
             desc.depth_compare = vk::CompareOp::LESS_OR_EQUAL;
@@ -388,27 +319,7 @@ impl Renderer {
         params: &DrawParams,
         extent: vk::Extent2D,
     ) -> Result<()> {
-        let aspect = extent.width as f32 / extent.height.max(1) as f32;
-        let m = params.camera.matrices(bbox.0, bbox.1, aspect);
-        let light = (m.eye - glam::Vec3::from(bbox.0).lerp(glam::Vec3::from(bbox.1), 0.5))
-            .normalize_or_zero();
-        let light = (light + glam::Vec3::new(0.3, 0.6, 0.2)).normalize_or_zero();
-        let level = params.level.clamp(1.0, crate::tessellator::MAX_LEVEL);
-        let u = FrameUniforms {
-            view_proj: (m.proj * m.view).to_cols_array_2d(),
-            view: m.view.to_cols_array_2d(),
-            camera_pos: [m.eye.x, m.eye.y, m.eye.z, 1.0],
-            light_dir: [light.x, light.y, light.z, 0.0],
-            tess: [level, level, params.phong_alpha, 0.0],
-            base_color: [
-                params.base_color[0],
-                params.base_color[1],
-                params.base_color[2],
-                1.0,
-            ],
-            wire_color: [0.05, 0.05, 0.08, 1.0],
-            viewport: [extent.width as f32, extent.height as f32, 0.0, 0.0],
-        };
+        let u = frame_uniforms_for(bbox, params, extent);
         let slot = self
             .slots
             .get_mut(slot)
@@ -448,34 +359,20 @@ impl Renderer {
             .get(slot)
             .ok_or_else(|| TessError::Invalid(format!("no frame slot {slot}")))?
             .set;
-        let lists: Vec<(&PatchList, Domain)> = match params.method {
-            Method::Flat => [
-                (mesh.quads.as_ref(), Domain::Quad),
-                (mesh.quad_mode_triangles.as_ref(), Domain::Triangle),
-            ]
-            .into_iter()
-            .filter_map(|(l, d)| l.map(|l| (l, d)))
-            .collect(),
-            Method::Phong | Method::Pn => mesh
-                .triangles
-                .as_ref()
-                .map(|l| vec![(l, Domain::Triangle)])
-                .unwrap_or_default(),
-        };
+        let lists = draw_lists(mesh, params.method);
         let device = self.device.clone();
         device.begin_label(cmd, &format!("{:?} level {}", params.method, params.level));
         for &wire in passes {
-            for &(list, domain) in &lists {
+            for draw in &lists {
                 let key = PipelineKey {
                     method: params.method,
-                    domain,
+                    domain: draw.domain,
                     spacing: params.spacing,
                     wireframe: wire,
                 };
                 let pipeline = self.pipeline(key)?;
-                let push = DrawPush { mode: wire as u32 };
-                // SAFETY: cmd is recording inside a rendering scope; all bound objects are live
-                // and owned by self or mesh, which outlive the submission (callers wait).
+                // SAFETY: cmd is recording inside a rendering scope; the pipeline and set are
+                // live and owned by self, which outlives the submission (callers wait).
                 unsafe {
                     device.raw.cmd_bind_pipeline(
                         cmd,
@@ -490,42 +387,20 @@ impl Renderer {
                         &[set],
                         &[],
                     );
-                    device.raw.cmd_push_constants(
-                        cmd,
-                        pipeline.layout,
-                        vk::ShaderStageFlags::ALL,
-                        0,
-                        bytemuck::bytes_of(&push),
-                    );
-                    device
-                        .raw
-                        .cmd_bind_vertex_buffers(cmd, 0, &[mesh.vertices.raw], &[0]);
-                    device.raw.cmd_bind_index_buffer(
-                        cmd,
-                        list.indices.raw,
-                        0,
-                        vk::IndexType::UINT32,
-                    );
                 }
-                let per_draw = patches_per_draw(&device, params, domain, list.control_points);
-                let mut first = 0;
-                while first < list.patches {
-                    let n = per_draw.min(list.patches - first);
-                    // SAFETY: first + n ≤ patches, so the range lies inside the index buffer.
-                    unsafe {
-                        device.raw.cmd_draw_indexed(
-                            cmd,
-                            n * list.control_points,
-                            1,
-                            first * list.control_points,
-                            0,
-                            0,
-                        )
-                    };
-                    counts.draws += 1;
-                    counts.patches += n;
-                    first += n;
-                }
+                let per_draw =
+                    patches_per_draw(&device, params, draw.domain, draw.list.control_points);
+                let c = record_list_draws(
+                    &device,
+                    cmd,
+                    pipeline.layout,
+                    mesh,
+                    draw,
+                    wire as u32,
+                    per_draw,
+                );
+                counts.draws += c.draws;
+                counts.patches += c.patches;
             }
         }
         device.end_label(cmd);
@@ -598,6 +473,265 @@ impl Renderer {
         };
         Ok((target.read(&readback)?, stats, counts))
     }
+}
+
+/// The frame block for `params` on a target of `extent`: camera, light, uniform levels, colours.
+pub(crate) fn frame_uniforms(
+    mesh: &GpuMesh,
+    params: &DrawParams,
+    extent: vk::Extent2D,
+) -> FrameUniforms {
+    frame_uniforms_for((mesh.bbox_min, mesh.bbox_max), params, extent)
+}
+
+/// Frame uniforms for a scene framed by `bbox`.
+pub(crate) fn frame_uniforms_for(
+    bbox: ([f32; 3], [f32; 3]),
+    params: &DrawParams,
+    extent: vk::Extent2D,
+) -> FrameUniforms {
+    let aspect = extent.width as f32 / extent.height.max(1) as f32;
+    let m = params.camera.matrices(bbox.0, bbox.1, aspect);
+    let light = (m.eye - glam::Vec3::from(bbox.0).lerp(glam::Vec3::from(bbox.1), 0.5))
+        .normalize_or_zero();
+    let light = (light + glam::Vec3::new(0.3, 0.6, 0.2)).normalize_or_zero();
+    let level = params.level.clamp(1.0, crate::tessellator::MAX_LEVEL);
+    FrameUniforms {
+        view_proj: (m.proj * m.view).to_cols_array_2d(),
+        view: m.view.to_cols_array_2d(),
+        camera_pos: [m.eye.x, m.eye.y, m.eye.z, 1.0],
+        light_dir: [light.x, light.y, light.z, 0.0],
+        tess: [level, level, params.phong_alpha, 0.0],
+        base_color: [
+            params.base_color[0],
+            params.base_color[1],
+            params.base_color[2],
+            1.0,
+        ],
+        wire_color: [0.05, 0.05, 0.08, 1.0],
+        viewport: [extent.width as f32, extent.height as f32, 0.0, 0.0],
+    }
+}
+
+/// The TCS, the TES (the `-DCAPTURE` build when `capture`) and the control points per patch of
+/// one technique on one patch domain.
+pub(crate) fn technique_stages(
+    method: Method,
+    domain: Domain,
+    spacing: Spacing,
+    capture: bool,
+) -> Result<(&'static [u32], &'static [u32], u32)> {
+    use Spacing::*;
+    // (equal, fractional even, fractional odd), each (render, capture).
+    type Variants = [(&'static [u32], &'static [u32]); 3];
+    let pick = |v: Variants| {
+        let (render, cap) = match spacing {
+            Equal => v[0],
+            FractionalEven => v[1],
+            FractionalOdd => v[2],
+        };
+        if capture {
+            cap
+        } else {
+            render
+        }
+    };
+    Ok(match (method, domain) {
+        (Method::Flat, Domain::Quad) => (
+            shaders::QUAD_TESC,
+            pick([
+                (
+                    shaders::FLAT_QUAD_TESE_EQUAL,
+                    shaders::FLAT_QUAD_TESE_EQUAL_CAPTURE,
+                ),
+                (
+                    shaders::FLAT_QUAD_TESE_FRACTIONAL_EVEN,
+                    shaders::FLAT_QUAD_TESE_FRACTIONAL_EVEN_CAPTURE,
+                ),
+                (
+                    shaders::FLAT_QUAD_TESE_FRACTIONAL_ODD,
+                    shaders::FLAT_QUAD_TESE_FRACTIONAL_ODD_CAPTURE,
+                ),
+            ]),
+            4,
+        ),
+        (Method::Flat, Domain::Triangle) => (
+            shaders::TRI_TESC,
+            pick([
+                (
+                    shaders::FLAT_TRI_TESE_EQUAL,
+                    shaders::FLAT_TRI_TESE_EQUAL_CAPTURE,
+                ),
+                (
+                    shaders::FLAT_TRI_TESE_FRACTIONAL_EVEN,
+                    shaders::FLAT_TRI_TESE_FRACTIONAL_EVEN_CAPTURE,
+                ),
+                (
+                    shaders::FLAT_TRI_TESE_FRACTIONAL_ODD,
+                    shaders::FLAT_TRI_TESE_FRACTIONAL_ODD_CAPTURE,
+                ),
+            ]),
+            3,
+        ),
+        (Method::Phong, Domain::Triangle) => (
+            shaders::TRI_TESC,
+            pick([
+                (shaders::PHONG_TESE_EQUAL, shaders::PHONG_TESE_EQUAL_CAPTURE),
+                (
+                    shaders::PHONG_TESE_FRACTIONAL_EVEN,
+                    shaders::PHONG_TESE_FRACTIONAL_EVEN_CAPTURE,
+                ),
+                (
+                    shaders::PHONG_TESE_FRACTIONAL_ODD,
+                    shaders::PHONG_TESE_FRACTIONAL_ODD_CAPTURE,
+                ),
+            ]),
+            3,
+        ),
+        (Method::Pn, Domain::Triangle) => (
+            shaders::PN_TESC,
+            pick([
+                (shaders::PN_TESE_EQUAL, shaders::PN_TESE_EQUAL_CAPTURE),
+                (
+                    shaders::PN_TESE_FRACTIONAL_EVEN,
+                    shaders::PN_TESE_FRACTIONAL_EVEN_CAPTURE,
+                ),
+                (
+                    shaders::PN_TESE_FRACTIONAL_ODD,
+                    shaders::PN_TESE_FRACTIONAL_ODD_CAPTURE,
+                ),
+            ]),
+            3,
+        ),
+        (m, d) => return Err(TessError::Invalid(format!("{m:?} has no {d:?} patches"))),
+    })
+}
+
+/// Vertex input (the mesh's interleaved [`Vertex`]), patch topology, the frame set and the
+/// [`DrawPush`] range: what render and capture pipelines share.
+pub(crate) fn set_patch_input(
+    desc: &mut GraphicsPipelineDesc<'_>,
+    control_points: u32,
+    set_layout: vk::DescriptorSetLayout,
+) {
+    desc.vertex_bindings = vec![vk::VertexInputBindingDescription {
+        binding: 0,
+        stride: std::mem::size_of::<Vertex>() as u32,
+        input_rate: vk::VertexInputRate::VERTEX,
+    }];
+    desc.vertex_attributes = vec![
+        vk::VertexInputAttributeDescription {
+            location: 0,
+            binding: 0,
+            format: vk::Format::R32G32B32_SFLOAT,
+            offset: 0,
+        },
+        vk::VertexInputAttributeDescription {
+            location: 1,
+            binding: 0,
+            format: vk::Format::R32G32B32_SFLOAT,
+            offset: 12,
+        },
+    ];
+    desc.topology = vk::PrimitiveTopology::PATCH_LIST;
+    desc.tessellation = Some(TessellationDesc {
+        patch_control_points: control_points,
+        domain_origin: vk::TessellationDomainOrigin::UPPER_LEFT,
+    });
+    desc.set_layouts = vec![set_layout];
+    desc.push_constant_bytes = std::mem::size_of::<DrawPush>() as u32;
+}
+
+/// One patch list a technique draws, with where its patches start in the frame's numbering.
+pub struct DrawList<'a> {
+    pub list: &'a PatchList,
+    pub domain: Domain,
+    /// Patch id of the list's first patch.
+    pub first_patch: u32,
+}
+
+/// The patch lists `method` draws, in order, numbered frame-wide: flat draws the quads
+/// (ids `0..quads`) then the other faces' triangles (ids `quads..`); Phong and PN draw every
+/// face's triangles (ids `0..triangles`). The captured patch id is this number, which
+/// [`RenderMesh::patch_origins`] maps back to base faces.
+pub fn draw_lists(mesh: &GpuMesh, method: Method) -> Vec<DrawList<'_>> {
+    let lists: Vec<(Option<&PatchList>, Domain)> = match method {
+        Method::Flat => vec![
+            (mesh.quads.as_ref(), Domain::Quad),
+            (mesh.quad_mode_triangles.as_ref(), Domain::Triangle),
+        ],
+        Method::Phong | Method::Pn => vec![(mesh.triangles.as_ref(), Domain::Triangle)],
+    };
+    let mut first_patch = 0;
+    let mut out = Vec::new();
+    for (list, domain) in lists {
+        if let Some(list) = list {
+            out.push(DrawList {
+                list,
+                domain,
+                first_patch,
+            });
+            first_patch += list.patches;
+        }
+    }
+    out
+}
+
+/// Binds `list`'s buffers and records its draws, split `per_draw` patches at a time, each with
+/// its own [`DrawPush::first_patch`]. The pipeline and descriptor set must be bound.
+pub(crate) fn record_list_draws(
+    device: &Device,
+    cmd: vk::CommandBuffer,
+    layout: vk::PipelineLayout,
+    mesh: &GpuMesh,
+    draw: &DrawList<'_>,
+    mode: u32,
+    per_draw: u32,
+) -> DrawCounts {
+    let list = draw.list;
+    let mut counts = DrawCounts::default();
+    // SAFETY: cmd is recording with a compatible pipeline bound; the buffers are live and owned
+    // by mesh, which outlives the submission (callers wait).
+    unsafe {
+        device
+            .raw
+            .cmd_bind_vertex_buffers(cmd, 0, &[mesh.vertices.raw], &[0]);
+        device
+            .raw
+            .cmd_bind_index_buffer(cmd, list.indices.raw, 0, vk::IndexType::UINT32);
+    }
+    let per_draw = per_draw.max(1);
+    let mut first = 0;
+    while first < list.patches {
+        let n = per_draw.min(list.patches - first);
+        let push = DrawPush {
+            mode,
+            first_patch: draw.first_patch + first,
+        };
+        // SAFETY: the layout has a DrawPush-sized range for all stages; first + n ≤ patches,
+        // so the index range lies inside the index buffer.
+        unsafe {
+            device.raw.cmd_push_constants(
+                cmd,
+                layout,
+                vk::ShaderStageFlags::ALL,
+                0,
+                bytemuck::bytes_of(&push),
+            );
+            device.raw.cmd_draw_indexed(
+                cmd,
+                n * list.control_points,
+                1,
+                first * list.control_points,
+                0,
+                0,
+            )
+        };
+        counts.draws += 1;
+        counts.patches += n;
+        first += n;
+    }
+    counts
 }
 
 /// Patches per draw call: the whole list, unless a driver workaround limits it (see

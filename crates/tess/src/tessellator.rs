@@ -124,6 +124,33 @@ pub fn uniform_vertex_count(domain: Domain, spacing: Spacing, level: f32) -> u64
     }
 }
 
+/// Triangles a tessellated patch emits, from its vertex count `vertices` and the segments on its
+/// outer edges `boundary`: the tessellation is a triangulated disc, so Euler's formula gives
+/// T = 2V − B − 2. (It holds for every spacing: fractional levels move vertices, not topology.)
+fn disc_triangles(vertices: u64, boundary: u64) -> u64 {
+    (2 * vertices).saturating_sub(boundary + 2)
+}
+
+/// Triangles one triangle patch emits (what transform feedback captures, ÷ 3 corners).
+pub fn triangle_triangle_count(spacing: Spacing, outer: [f32; 3], inner: f32) -> u64 {
+    let boundary = outer.iter().map(|&l| spacing.segments(l) as u64).sum();
+    disc_triangles(triangle_vertex_count(spacing, outer, inner), boundary)
+}
+
+/// Triangles one quad patch emits.
+pub fn quad_triangle_count(spacing: Spacing, outer: [f32; 4], inner: [f32; 2]) -> u64 {
+    let boundary = outer.iter().map(|&l| spacing.segments(l) as u64).sum();
+    disc_triangles(quad_vertex_count(spacing, outer, inner), boundary)
+}
+
+/// Triangles one patch emits with every level equal to `level`.
+pub fn uniform_triangle_count(domain: Domain, spacing: Spacing, level: f32) -> u64 {
+    match domain {
+        Domain::Triangle => triangle_triangle_count(spacing, [level; 3], level),
+        Domain::Quad => quad_triangle_count(spacing, [level; 4], [level; 2]),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -164,6 +191,30 @@ mod tests {
             assert_eq!(
                 uniform_vertex_count(Domain::Triangle, Spacing::Equal, n as f32),
                 expected,
+                "level {n}"
+            );
+        }
+    }
+
+    #[test]
+    fn triangle_counts() {
+        // Quads: an n × n grid of split squares.
+        for n in 1..=64u64 {
+            assert_eq!(
+                uniform_triangle_count(Domain::Quad, Spacing::Equal, n as f32),
+                2 * n * n
+            );
+        }
+        // Triangles: one at level 1; level 2 fans six triangles around the centre; level 3 is
+        // a ring of 9 + 3 around one inner triangle.
+        let tri = |n: f32| uniform_triangle_count(Domain::Triangle, Spacing::Equal, n);
+        assert_eq!((tri(1.0), tri(2.0), tri(3.0)), (1, 6, 13));
+        // Each ring of an n-segment triangle holds 3(2n − 2) triangles: 3n outer + 3(n − 2) inner
+        // segments, each the base of one triangle.
+        for n in 3..=64u64 {
+            assert_eq!(
+                tri(n as f32),
+                tri((n - 2) as f32) + 6 * (n - 1),
                 "level {n}"
             );
         }

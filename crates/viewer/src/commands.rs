@@ -164,6 +164,10 @@ fn info(g: &GpuArgs) -> Result<()> {
             "    maxTessellationGenerationLevel {} maxTessellationPatchSize {} maxTessellationEvaluationOutputComponents {} score {}",
             c.max_tessellation_generation_level, c.max_tessellation_patch_size, c.max_tess_evaluation_output_components, a.score()
         );
+        println!(
+            "    transformFeedback {} (queries {}, maxTransformFeedbackBufferSize {}, stride ≤ {}) — optional, used by `tessera export`",
+            c.transform_feedback, c.transform_feedback_queries, c.max_transform_feedback_buffer_size, c.max_transform_feedback_stride
+        );
     }
     let selector = g.device.parse().unwrap_or_default();
     match vk_core::device::choose_adapter(&adapters, &selector) {

@@ -42,6 +42,15 @@ pub struct Capabilities {
     pub max_tessellation_patch_size: u32,
     pub max_tess_evaluation_output_components: u32,
     pub timestamp_period_ns: f32,
+    /// VK_EXT_transform_feedback with its `transformFeedback` feature: optional, needed only to
+    /// capture what the TES emitted (`tess::capture`); a device without it still renders.
+    pub transform_feedback: bool,
+    /// Transform-feedback stream queries (primitives written / needed), used to size captures.
+    pub transform_feedback_queries: bool,
+    /// Largest transform-feedback buffer binding, in bytes (0 without the extension).
+    pub max_transform_feedback_buffer_size: u64,
+    /// Largest transform-feedback vertex stride, in bytes (0 without the extension).
+    pub max_transform_feedback_stride: u32,
 }
 
 /// One physical device as seen at start-up: identity, capabilities, and what it lacks.
@@ -129,11 +138,30 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
         unsafe { instance.raw.enumerate_physical_devices() }.ctx("vkEnumeratePhysicalDevices")?;
     let mut out = Vec::new();
     for (index, &physical) in physicals.iter().enumerate() {
+        // SAFETY: physical comes from this instance.
+        let extensions = unsafe {
+            instance
+                .raw
+                .enumerate_device_extension_properties(physical)
+        }
+        .ctx("vkEnumerateDeviceExtensionProperties")?;
+        let has_xfb_extension = extensions.iter().any(|e| {
+            e.extension_name_as_c_str().ok() == Some(ash::ext::transform_feedback::NAME)
+        });
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
+        let mut xfb_props = vk::PhysicalDeviceTransformFeedbackPropertiesEXT::default();
         let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+        if has_xfb_extension {
+            props2 = props2.push_next(&mut xfb_props);
+        }
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+        let mut xfb_feats = vk::PhysicalDeviceTransformFeedbackFeaturesEXT::default();
         let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
-        // SAFETY: physical comes from this instance; the out-structs are valid chains.
+        if has_xfb_extension {
+            features2 = features2.push_next(&mut xfb_feats);
+        }
+        // SAFETY: physical comes from this instance; the out-structs are valid chains (the
+        // transform-feedback structs are chained only when the device reports the extension).
         let families = unsafe {
             instance
                 .raw
@@ -171,6 +199,20 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
                 .limits
                 .max_tessellation_evaluation_output_components,
             timestamp_period_ns: props.limits.timestamp_period,
+            transform_feedback: has_xfb_extension && xfb_feats.transform_feedback == vk::TRUE,
+            transform_feedback_queries: has_xfb_extension
+                && xfb_feats.transform_feedback == vk::TRUE
+                && xfb_props.transform_feedback_queries == vk::TRUE,
+            max_transform_feedback_buffer_size: if has_xfb_extension {
+                xfb_props.max_transform_feedback_buffer_size
+            } else {
+                0
+            },
+            max_transform_feedback_stride: if has_xfb_extension {
+                xfb_props.max_transform_feedback_buffer_data_stride
+            } else {
+                0
+            },
         };
         let mut missing = Vec::new();
         if props.api_version < vk::API_VERSION_1_3 {
@@ -280,6 +322,9 @@ pub struct DeviceShared {
     pub info: AdapterInfo,
     pub workarounds: Workarounds,
     pub debug_utils: Option<ash::ext::debug_utils::Device>,
+    /// VK_EXT_transform_feedback's commands; `None` when the device lacks the extension or the
+    /// feature (see [`DeviceShared::transform_feedback`] for a typed error instead).
+    pub transform_feedback: Option<ash::ext::transform_feedback::Device>,
     pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
     pub(crate) one_shot_pool: Mutex<vk::CommandPool>,
     pub(crate) queue_lock: Mutex<()>,
@@ -324,12 +369,24 @@ impl Device {
             .pipeline_statistics_query(info.caps.pipeline_statistics_query)
             .vertex_pipeline_stores_and_atomics(info.caps.vertex_pipeline_stores_and_atomics);
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true);
-        let ext_names: Vec<*const i8> = extra_extensions.iter().map(|e| e.as_ptr()).collect();
-        let create = vk::DeviceCreateInfo::default()
+        // Transform feedback is enabled whenever the device has it: capture is optional, and
+        // enabling it costs nothing when unused.
+        let xfb = info.caps.transform_feedback;
+        let mut xfb_feats =
+            vk::PhysicalDeviceTransformFeedbackFeaturesEXT::default().transform_feedback(true);
+        let mut extensions: Vec<&CStr> = extra_extensions.to_vec();
+        if xfb && !extensions.contains(&ash::ext::transform_feedback::NAME) {
+            extensions.push(ash::ext::transform_feedback::NAME);
+        }
+        let ext_names: Vec<*const i8> = extensions.iter().map(|e| e.as_ptr()).collect();
+        let mut create = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_info)
             .enabled_features(&features)
             .enabled_extension_names(&ext_names)
             .push_next(&mut f13);
+        if xfb {
+            create = create.push_next(&mut xfb_feats);
+        }
         // SAFETY: physical belongs to instance; create info references live locals.
         let raw =
             unsafe { instance.raw.create_device(physical, &create, None) }.ctx("vkCreateDevice")?;
@@ -378,6 +435,8 @@ impl Device {
         let debug_utils = instance
             .has_debug_utils
             .then(|| ash::ext::debug_utils::Device::new(&instance.raw, &raw));
+        let transform_feedback =
+            xfb.then(|| ash::ext::transform_feedback::Device::new(&instance.raw, &raw));
         let workarounds = Workarounds::for_adapter(&info);
         for w in workarounds.active() {
             log::info!("driver workaround active on {}: {}", info.name, w.summary);
@@ -390,6 +449,7 @@ impl Device {
             info,
             workarounds,
             debug_utils,
+            transform_feedback,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             one_shot_pool: Mutex::new(pool),
             queue_lock: Mutex::new(()),
@@ -421,6 +481,16 @@ impl DeviceShared {
             .object_name(&name);
         // SAFETY: handle is a live object of this device; naming has no other effect.
         let _ = unsafe { du.set_debug_utils_object_name(&info) };
+    }
+
+    /// The transform-feedback commands, or a typed error naming the device when it has none.
+    pub fn transform_feedback(&self) -> Result<&ash::ext::transform_feedback::Device> {
+        self.transform_feedback
+            .as_ref()
+            .ok_or_else(|| VkError::Unsupported {
+                device: self.info.name.clone(),
+                what: "VK_EXT_transform_feedback with the transformFeedback feature",
+            })
     }
 
     /// Bytes still held by the allocator: zero once every resource is dropped.

@@ -20,6 +20,9 @@ pub enum VkError {
     NoSuchDevice { selector: String, devices: String },
     #[error("device {name} lacks what Tessera needs: {missing}")]
     MissingFeatures { name: String, missing: String },
+    /// An optional capability (not needed to render) that one operation needs.
+    #[error("device {device} lacks {what}, which this operation needs")]
+    Unsupported { device: String, what: &'static str },
     #[error("gpu-allocator: {0}")]
     Allocator(#[from] gpu_allocator::AllocationError),
     #[error("{0}")]

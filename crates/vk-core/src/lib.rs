@@ -7,6 +7,8 @@
 //!   all of them and the instance outlives the device. Field order states the drop order.
 //! - The validation layer's messages are counted by severity; tests assert no error-severity one.
 //! - Rendering uses Vulkan 1.3 dynamic rendering (no render-pass objects).
+//! - Optional features (VK_EXT_transform_feedback, for captures) are detected and enabled when
+//!   present; what needs them returns [`VkError::Unsupported`] where they are absent.
 //! - Driver bugs are worked around through [`workarounds`], a documented list keyed by driver.
 pub mod buffer;
 pub mod command;
@@ -19,6 +21,7 @@ pub mod pipeline;
 pub mod query;
 pub mod swapchain;
 pub mod target;
+pub mod transform_feedback;
 pub mod workarounds;
 
 pub use ash;

@@ -48,7 +48,9 @@ pub struct GraphicsPipelineDesc<'a> {
     pub depth_bias: Option<(f32, f32)>,
     pub color_format: vk::Format,
     pub depth_format: vk::Format,
-    /// No rasterization: for passes that only capture TES output through storage buffers.
+    /// No rasterization: for passes that only capture TES output (transform feedback or storage
+    /// buffers). Such a pipeline needs no fragment stage; give `vk::Format::UNDEFINED` as both
+    /// formats to render into a scope without attachments.
     pub rasterizer_discard: bool,
     pub set_layouts: Vec<vk::DescriptorSetLayout>,
     pub push_constant_bytes: u32,
@@ -220,14 +222,18 @@ impl Pipeline {
             .depth_test_enable(desc.depth_test)
             .depth_write_enable(desc.depth_write)
             .depth_compare_op(desc.depth_compare);
+        // VK_FORMAT_UNDEFINED as the colour format means no colour attachment at all (capture
+        // passes render into nothing), so the attachment count matches the rendering scope.
+        let color_count = usize::from(desc.color_format != vk::Format::UNDEFINED);
         let attachments = [vk::PipelineColorBlendAttachmentState::default()
             .color_write_mask(vk::ColorComponentFlags::RGBA)];
-        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
+        let blend = vk::PipelineColorBlendStateCreateInfo::default()
+            .attachments(&attachments[..color_count]);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
         let color_formats = [desc.color_format];
         let mut rendering = vk::PipelineRenderingCreateInfo::default()
-            .color_attachment_formats(&color_formats)
+            .color_attachment_formats(&color_formats[..color_count])
             .depth_attachment_format(desc.depth_format);
         let mut info = vk::GraphicsPipelineCreateInfo::default()
             .stages(&stage_infos)

@@ -1,6 +1,8 @@
-//! GPU timestamps and pipeline statistics (TCS patches, TES invocations, clipping primitives).
+//! GPU timestamps, pipeline statistics (TCS patches, TES invocations, clipping primitives) and
+//! transform-feedback stream counts (primitives written / needed, to size and check captures).
 use crate::device::{Device, DeviceShared};
 use crate::error::{Result, VkContext, VkError};
+use crate::transform_feedback::TransformFeedbackCommands;
 use ash::vk;
 use std::sync::Arc;
 
@@ -29,7 +31,15 @@ impl PipelineStatistics {
     }
 }
 
-/// A pool of `count` timestamp queries or pipeline-statistics queries.
+/// Counters of a transform-feedback stream query: what was written to the bound buffers, and what
+/// would have been written had they been large enough (needed > written means overflow).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TransformFeedbackCounts {
+    pub primitives_written: u64,
+    pub primitives_needed: u64,
+}
+
+/// A pool of `count` timestamp, pipeline-statistics or transform-feedback stream queries.
 pub struct QueryPool {
     pub raw: vk::QueryPool,
     pub ty: vk::QueryType,
@@ -67,6 +77,25 @@ impl QueryPool {
             vk::QueryType::PIPELINE_STATISTICS,
             count,
             PipelineStatistics::flags(),
+        )
+    }
+
+    /// Transform-feedback stream queries (VK_EXT_transform_feedback, `transformFeedbackQueries`);
+    /// a typed error on a device without them.
+    pub fn transform_feedback_stream(device: &Device, name: &str, count: u32) -> Result<Self> {
+        device.transform_feedback()?;
+        if !device.info.caps.transform_feedback_queries {
+            return Err(VkError::Unsupported {
+                device: device.info.name.clone(),
+                what: "transform-feedback queries (transformFeedbackQueries)",
+            });
+        }
+        Self::new(
+            device,
+            name,
+            vk::QueryType::TRANSFORM_FEEDBACK_STREAM_EXT,
+            count,
+            vk::QueryPipelineStatisticFlags::empty(),
         )
     }
 
@@ -134,6 +163,58 @@ impl QueryPool {
                 fragment_shader_invocations: c[4],
                 tess_control_patches: c[5],
                 tess_evaluation_invocations: c[6],
+            })
+            .collect())
+    }
+
+    /// Begins query `query` counting vertex stream `stream` (`vkCmdBeginQueryIndexedEXT`; the
+    /// plain begin would count stream 0 only, and says nothing of which stream is meant).
+    pub fn cmd_begin_stream(&self, cmd: vk::CommandBuffer, query: u32, stream: u32) -> Result<()> {
+        let xfb = self.stream_pool_commands()?;
+        // SAFETY: cmd is recording; the query was reset earlier in submission order; the pool is
+        // a transform-feedback stream pool of this device.
+        unsafe {
+            xfb.cmd_begin_query_indexed(
+                cmd,
+                self.raw,
+                query,
+                vk::QueryControlFlags::empty(),
+                stream,
+            )
+        };
+        Ok(())
+    }
+
+    /// Ends what [`QueryPool::cmd_begin_stream`] began.
+    pub fn cmd_end_stream(&self, cmd: vk::CommandBuffer, query: u32, stream: u32) -> Result<()> {
+        let xfb = self.stream_pool_commands()?;
+        // SAFETY: matches cmd_begin_stream on the same command buffer, query and stream.
+        unsafe { xfb.cmd_end_query_indexed(cmd, self.raw, query, stream) };
+        Ok(())
+    }
+
+    fn stream_pool_commands(&self) -> Result<&ash::ext::transform_feedback::Device> {
+        if self.ty != vk::QueryType::TRANSFORM_FEEDBACK_STREAM_EXT {
+            return Err(VkError::Invalid(
+                "not a transform-feedback stream pool".into(),
+            ));
+        }
+        self.device.transform_feedback()
+    }
+
+    /// Waits for and reads every query's (primitives written, primitives needed).
+    pub fn transform_feedback_results(&self) -> Result<Vec<TransformFeedbackCounts>> {
+        if self.ty != vk::QueryType::TRANSFORM_FEEDBACK_STREAM_EXT {
+            return Err(VkError::Invalid(
+                "not a transform-feedback stream pool".into(),
+            ));
+        }
+        Ok(self
+            .results::<2>()?
+            .into_iter()
+            .map(|c| TransformFeedbackCounts {
+                primitives_written: c[0],
+                primitives_needed: c[1],
             })
             .collect())
     }
