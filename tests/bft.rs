@@ -1,24 +1,257 @@
-//! Loop BFT on the tessellation stage: renders, factors, draw split, animation.
+//! Loop BFT on the tessellation stage, checked from the GPU's own output (transform feedback):
+//! every captured vertex against the CPU exact limit, watertightness under every factor policy,
+//! and animation. Validation is on and any error fails (tests/common).
 mod common;
 use common::Gpu;
+use tessera::tess::bft::{base_normals, patch_uv, wave};
+use tessera::tess::capture::{classify_open_edges, CapturedSoup};
 use tessera::tess::{BftParams, BftSurface, DrawParams, FactorPolicy, Renderer};
-use tessera::topology;
+use tessera::topology::eval::{LimitScheme, LocalMesh};
+use tessera::topology::{self, ControlMesh};
 use tessera::vk_core::vk;
 
-pub fn spot() -> topology::ControlMesh {
+const EXTENT: vk::Extent2D = vk::Extent2D {
+    width: 640,
+    height: 480,
+};
+
+pub fn spot() -> ControlMesh {
     let m = topology::load_obj(common::data("assets/spot_control_mesh.obj")).expect("spot");
     m.triangulated().0
 }
 
+fn shape(name: &str) -> ControlMesh {
+    topology::load_obj(common::data(&format!(
+        "tests/data/opensubdiv/shapes/{name}.obj"
+    )))
+    .expect("shape")
+}
+
+fn diag(m: &ControlMesh) -> f64 {
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in &m.positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// Worst distance (over the bounding-box diagonal) between captured vertices and the CPU exact
+/// limit of `mesh` at the captured (base face, u, v), over at most `samples` welded vertices;
+/// also asserts every captured vertex came from a table point when `all_exact`.
+fn exactness(surf: &BftSurface, soup: &CapturedSoup, mesh: &ControlMesh, samples: usize) -> f64 {
+    let cpu = LocalMesh::from_control_mesh(mesh, LimitScheme::Loop).expect("cpu mesh");
+    let welded = soup.weld().expect("weld");
+    let n = welded.positions.len();
+    let stride = n.div_ceil(samples).max(1);
+    let d = diag(mesh);
+    let mut worst = 0.0f64;
+    for i in (0..n).step_by(stride) {
+        let (u, v) = patch_uv(welded.domain[i]);
+        let (f, bu, bv) = surf.bft.base_domain(welded.patch[i] as usize, u, v);
+        let e = cpu.evaluate(f, bu, bv).expect("exact limit");
+        for k in 0..3 {
+            worst = worst.max((welded.positions[i][k] as f64 - e.position[k]).abs() / d);
+        }
+    }
+    worst
+}
+
+fn cracks(surf: &BftSurface, soup: &CapturedSoup, mesh: &ControlMesh) -> (usize, usize, usize) {
+    let welded = soup.weld().expect("weld");
+    let report = welded.open_edges();
+    let map = |p: u32, d: [f32; 2]| surf.face_point(p, d);
+    let c = classify_open_edges(soup, &welded, &report, &map, mesh);
+    (
+        c.cracks + c.unmapped,
+        c.on_base_boundary,
+        report.non_manifold.len(),
+    )
+}
+
+/// Every captured vertex equals the exact limit within 1e-5 of the diagonal, for S = 2…64, on
+/// OpenSubdiv's Loop shapes (valences 3 to 64, boundaries, coarse meshes with overlapping
+/// rings) and the triangulated spot; all come from table points (flag bit 0).
 #[test]
-fn bft_renders_spot() {
+fn captured_bft_vertices_are_the_exact_limit() {
+    let gpu = Gpu::new();
+    {
+        let mut renderer = Renderer::offscreen(gpu.device()).expect("renderer");
+        let cases: Vec<(&str, ControlMesh, &[u32])> = vec![
+            ("loop_cube", shape("loop_cube"), &[2, 4, 8, 16, 32, 64]),
+            ("loop_icosahedron", shape("loop_icosahedron"), &[2, 8, 64]),
+            ("loop_pole64", shape("loop_pole64"), &[2, 16, 64]),
+            ("loop_xord_boundary", shape("loop_xord_boundary"), &[4, 32]),
+            ("loop_tetrahedron", shape("loop_tetrahedron"), &[2, 64]),
+            (
+                "loop_saddle_edgeonly",
+                shape("loop_saddle_edgeonly"),
+                &[8, 64],
+            ),
+            ("spot", spot(), &[2, 16, 64]),
+        ];
+        for (name, mesh, segments) in cases {
+            let mut surf = BftSurface::new(&renderer, &mesh, name, 5, false, 1).expect(name);
+            for &s in segments {
+                let params = BftParams {
+                    factors: FactorPolicy::Uniform { segments: s },
+                    ..Default::default()
+                };
+                let soup = surf
+                    .capture(&mut renderer, &DrawParams::default(), &params, EXTENT)
+                    .expect("capture");
+                assert!(!soup.records.is_empty());
+                let inexact = soup.records.iter().filter(|r| r.flags & 1 == 0).count();
+                assert_eq!(
+                    inexact, 0,
+                    "{name} S={s}: {inexact} vertices not from table points"
+                );
+                let worst = exactness(&surf, &soup, &mesh, 3000);
+                println!(
+                    "{name} S={s}: {} triangles, worst |GPU − limit|/diag = {worst:.2e}",
+                    soup.triangle_count()
+                );
+                assert!(worst <= 1e-5, "{name} S={s}: {worst:.3e}");
+            }
+        }
+    }
+}
+
+/// No open edge beyond the base mesh's own boundary, for uniform, both adaptive policies and
+/// fractional factors, on every test mesh (positions welded only when bit-identical).
+#[test]
+fn bft_is_watertight_under_every_factor_policy() {
+    let gpu = Gpu::new();
+    {
+        let mut renderer = Renderer::offscreen(gpu.device()).expect("renderer");
+        let meshes = vec![
+            ("loop_cube", shape("loop_cube")),
+            ("loop_pole64", shape("loop_pole64")),
+            ("loop_xord_boundary", shape("loop_xord_boundary")),
+            ("loop_saddle_edgeonly", shape("loop_saddle_edgeonly")),
+            ("spot", spot()),
+        ];
+        let draw = DrawParams {
+            camera: tessera::tess::Camera {
+                zoom: 2.5,
+                yaw: 30.0,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        for (name, mesh) in meshes {
+            let mut surf = BftSurface::new(&renderer, &mesh, name, 5, false, 1).expect(name);
+            let policies = [
+                ("uniform 16", FactorPolicy::Uniform { segments: 16 }, false),
+                ("screen 6px", FactorPolicy::Screen { pixels: 6.0 }, false),
+                (
+                    "distance",
+                    FactorPolicy::Distance {
+                        reference: 0.6 * diag(&mesh) as f32,
+                    },
+                    false,
+                ),
+                (
+                    "screen 6px fractional",
+                    FactorPolicy::Screen { pixels: 6.0 },
+                    true,
+                ),
+                (
+                    "distance fractional",
+                    FactorPolicy::Distance {
+                        reference: 0.45 * diag(&mesh) as f32,
+                    },
+                    true,
+                ),
+            ];
+            for (label, factors, fractional) in policies {
+                let params = BftParams {
+                    factors,
+                    fractional,
+                    ..Default::default()
+                };
+                let soup = surf
+                    .capture(&mut renderer, &draw, &params, EXTENT)
+                    .expect("capture");
+                let (cracks, boundary, nonmanifold) = cracks(&surf, &soup, &mesh);
+                let interpolated = soup.records.iter().filter(|r| r.flags & 1 == 0).count();
+                println!(
+                    "{name} {label}: {} triangles, {cracks} cracks, {boundary} boundary edges, \
+                     {interpolated} interpolated corners",
+                    soup.triangle_count()
+                );
+                assert_eq!(
+                    cracks, 0,
+                    "{name} {label}: open edges beyond the base boundary"
+                );
+                assert_eq!(nonmanifold, 0, "{name} {label}");
+                if !fractional {
+                    assert_eq!(
+                        interpolated, 0,
+                        "{name} {label}: power-of-two factors are exact"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// After T animated frames (base positions uploaded per frame, nothing else), the captured
+/// vertices are the exact limit of the deformed base mesh.
+#[test]
+fn animated_base_mesh_gives_the_deformed_limit() {
+    let gpu = Gpu::new();
+    {
+        let mut renderer = Renderer::offscreen(gpu.device()).expect("renderer");
+        let mesh = shape("loop_icosahedron");
+        let mut surf = BftSurface::new(&renderer, &mesh, "ico", 5, false, 1).expect("surface");
+        let base = tessera::tess::bft::base_positions(&mesh);
+        let normals = base_normals(&mesh);
+        let (lo, hi) = (surf.bbox_min, surf.bbox_max);
+        let params = BftParams {
+            factors: FactorPolicy::Uniform { segments: 16 },
+            ..Default::default()
+        };
+        let draw = DrawParams::default();
+        let mut deformed = base.clone();
+        for frame in 0..5 {
+            deformed = wave(&base, &normals, lo, hi, frame as f32 * 0.1);
+            surf.update_base(0, &deformed).expect("upload");
+            surf.render_offscreen(&mut renderer, &draw, &params, EXTENT, false)
+                .expect("frame");
+        }
+        let soup = surf
+            .capture(&mut renderer, &draw, &params, EXTENT)
+            .expect("capture");
+        let mut moved = mesh.clone();
+        moved.positions = deformed
+            .iter()
+            .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64])
+            .collect();
+        let worst = exactness(&surf, &soup, &moved, 2000);
+        let against_rest = exactness(&surf, &soup, &mesh, 2000);
+        println!(
+            "animated: {worst:.2e} to the deformed limit, {against_rest:.2e} to the rest pose"
+        );
+        assert!(worst <= 1e-5, "{worst}");
+        assert!(
+            against_rest > 1e-3,
+            "the deformation must be visible in the capture"
+        );
+    }
+}
+
+#[test]
+fn bft_renders_spot_with_patch_colours_and_wireframe() {
     let gpu = Gpu::new();
     {
         let mut renderer = Renderer::offscreen(gpu.device()).expect("renderer");
         let mesh = spot();
         let mut surf = BftSurface::new(&renderer, &mesh, "spot", 5, false, 1).expect("surface");
         let draw = DrawParams {
-            wireframe: std::env::var("WIRE").is_ok(),
+            wireframe: true,
             ..Default::default()
         };
         let params = BftParams {
@@ -26,27 +259,47 @@ fn bft_renders_spot() {
             patch_colours: true,
             ..Default::default()
         };
-        let extent = vk::Extent2D {
-            width: 640,
-            height: 480,
-        };
-        let (img, stats, counts) = surf
-            .render_offscreen(&mut renderer, &draw, &params, extent, false)
+        let (img, _, counts) = surf
+            .render_offscreen(&mut renderer, &draw, &params, EXTENT, false)
             .expect("render");
-        println!("{counts:?} {stats:?}");
-        assert_eq!(counts.patches, surf.patch_count());
+        assert_eq!(
+            counts.patches,
+            surf.patch_count(),
+            "the shaded pass draws every patch"
+        );
+        // The surface covers a good part of the frame and patch colours differ.
+        let lit = img
+            .pixels
+            .chunks_exact(4)
+            .filter(|p| p[0] > 60 || p[1] > 60 || p[2] > 60)
+            .count();
+        assert!(lit > 20_000, "{lit} lit pixels");
     }
 }
 
 #[test]
-fn bft_compute_only() {
+fn bad_segments_are_rejected_with_a_clear_error() {
     let gpu = Gpu::new();
     {
-        let renderer = Renderer::offscreen(gpu.device()).expect("renderer");
-        let mesh = spot();
-        let surf = BftSurface::new(&renderer, &mesh, "spot", 5, false, 1).expect("surface");
-        gpu.device()
-            .one_shot(|cmd| surf.record_compute(cmd, &renderer, 0))
-            .expect("compute");
+        let mut renderer = Renderer::offscreen(gpu.device()).expect("renderer");
+        let mesh = shape("loop_cube");
+        let mut surf = BftSurface::new(&renderer, &mesh, "cube", 3, false, 1).expect("surface");
+        for s in [3, 0, 32] {
+            let params = BftParams {
+                factors: FactorPolicy::Uniform { segments: s },
+                ..Default::default()
+            };
+            let e = surf
+                .render_offscreen(
+                    &mut renderer,
+                    &DrawParams::default(),
+                    &params,
+                    EXTENT,
+                    false,
+                )
+                .err()
+                .expect("rejected");
+            assert!(e.to_string().contains("--segments"), "{e}");
+        }
     }
 }

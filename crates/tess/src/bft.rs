@@ -9,6 +9,7 @@
 //!    `bft.tesc` sets power-of-two (or fractional) edge factors from each edge's two endpoints
 //!    only; `bft.tese` evaluates the table row of each tess coordinate (see
 //!    `glsl/include/bft.glsl`, mirrored in f32 by `topology::bft::GpuBft::eval_tess`).
+use crate::capture::{CaptureRecord, CapturedSoup, FacePoint, CAPTURE_STRIDE};
 use crate::error::{Result, TessError};
 use crate::gpu::BftPush;
 use crate::renderer::{DrawCounts, DrawSplit, Renderer};
@@ -21,6 +22,7 @@ use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
 use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage, TessellationDesc};
 use vk_core::query::{PipelineStatistics, QueryPool};
 use vk_core::target::{OffscreenTarget, Rgba8};
+use vk_core::transform_feedback::TransformFeedbackCommands;
 use vk_core::{vk, Buffer, BufferDesc, Device, MemoryLocation};
 
 /// Default maximum table level: 32 segments per level-1 edge, 64 per base edge.
@@ -78,6 +80,7 @@ struct BftPipelineKey {
 /// descriptor pool, set layout, buffers, device handle.
 pub struct BftSurface {
     pipelines: HashMap<BftPipelineKey, Pipeline>,
+    capture_pipelines: HashMap<BftPipelineKey, Pipeline>,
     subdivide: Pipeline,
     normals: Pipeline,
     _pool: DescriptorPool,
@@ -234,6 +237,7 @@ impl BftSurface {
         let (color_format, depth_format) = renderer.formats();
         Ok(Self {
             pipelines: HashMap::new(),
+            capture_pipelines: HashMap::new(),
             subdivide,
             normals,
             _pool: pool,
@@ -642,4 +646,233 @@ impl BftSurface {
         };
         Ok((target.read(&readback)?, stats, counts))
     }
+}
+
+impl BftSurface {
+    fn capture_pipeline(&mut self, renderer: &Renderer, spacing: Spacing) -> Result<vk::Pipeline> {
+        let key = BftPipelineKey {
+            spacing,
+            wireframe: true,
+        };
+        if let Some(p) = self.capture_pipelines.get(&key) {
+            return Ok(p.raw);
+        }
+        let tese = match spacing {
+            Spacing::Equal => shaders::BFT_TESE_EQUAL_CAPTURE,
+            Spacing::FractionalEven => shaders::BFT_TESE_FRACTIONAL_EVEN_CAPTURE,
+            Spacing::FractionalOdd => shaders::BFT_TESE_FRACTIONAL_ODD_CAPTURE,
+        };
+        let mut desc =
+            GraphicsPipelineDesc::new("bft capture", vk::Format::UNDEFINED, vk::Format::UNDEFINED);
+        desc.stages = vec![
+            ShaderStage::new(vk::ShaderStageFlags::VERTEX, shaders::BFT_VERT),
+            ShaderStage::new(
+                vk::ShaderStageFlags::TESSELLATION_CONTROL,
+                shaders::BFT_TESC,
+            ),
+            ShaderStage::new(vk::ShaderStageFlags::TESSELLATION_EVALUATION, tese),
+        ];
+        desc.topology = vk::PrimitiveTopology::PATCH_LIST;
+        desc.tessellation = Some(TessellationDesc {
+            patch_control_points: 1,
+            domain_origin: vk::TessellationDomainOrigin::UPPER_LEFT,
+        });
+        desc.set_layouts = vec![renderer.frame_set_layout(), self.set_layout.raw];
+        desc.push_constant_bytes = std::mem::size_of::<BftPush>() as u32;
+        desc.rasterizer_discard = true;
+        desc.depth_test = false;
+        desc.depth_write = false;
+        let p = Pipeline::graphics(&self.device, &desc)?;
+        let raw = p.raw;
+        self.capture_pipelines.insert(key, p);
+        Ok(raw)
+    }
+
+    /// Captures, through transform feedback, every triangle corner the BFT TES emits for one
+    /// frame of `draw` (camera) and `params` (factors), after running the compute pass on the
+    /// current base positions. Sized by a first pass's stream query when the factors are
+    /// adaptive, so no triangle is dropped.
+    pub fn capture(
+        &mut self,
+        renderer: &mut Renderer,
+        draw: &crate::DrawParams,
+        params: &BftParams,
+        extent: vk::Extent2D,
+    ) -> Result<CapturedSoup> {
+        self.check_params(params)?;
+        let device = self.device.clone();
+        let xfb = device.transform_feedback()?.clone();
+        let pipeline = self.capture_pipeline(renderer, params.spacing())?;
+        let layout = self.pipelines_layout(renderer, params.spacing())?;
+        renderer.update_frame(0, (self.bbox_min, self.bbox_max), draw, extent)?;
+        let mut capacity: u64 = match params.factors {
+            FactorPolicy::Uniform { segments } => {
+                self.gpu.patch_count as u64
+                    * crate::tessellator::uniform_triangle_count(
+                        Domain::Triangle,
+                        params.spacing(),
+                        segments as f32 * 0.5,
+                    )
+            }
+            _ => self.gpu.patch_count as u64 * 16,
+        };
+        let per_draw = self.patches_per_draw(params, draw.split);
+        let mut push = self.push(params, 0);
+        let total = self.gpu.patch_count;
+        let set = self.sets[0];
+        let frame_set = renderer.frame_set(0);
+        for _pass in 0..2 {
+            let bytes = capacity.max(1) * 3 * CAPTURE_STRIDE;
+            if bytes > device.info.caps.max_transform_feedback_buffer_size {
+                return Err(TessError::Invalid(format!(
+                    "capture needs {bytes} bytes, more than the device's transform feedback limit"
+                )));
+            }
+            let buffer = Buffer::new(
+                &device,
+                &BufferDesc {
+                    name: "bft capture records",
+                    size: bytes,
+                    usage: vk::BufferUsageFlags::TRANSFORM_FEEDBACK_BUFFER_EXT,
+                    location: MemoryLocation::GpuToCpu,
+                },
+            )?;
+            let query = QueryPool::transform_feedback_stream(&device, "bft capture", 1)?;
+            let mut failure = None;
+            device.one_shot(|cmd| {
+                query.cmd_reset(cmd);
+                self.record_compute(cmd, renderer, 0);
+                let area = vk::Rect2D {
+                    offset: vk::Offset2D { x: 0, y: 0 },
+                    extent: vk::Extent2D {
+                        width: 1,
+                        height: 1,
+                    },
+                };
+                let rendering = vk::RenderingInfo::default()
+                    .render_area(area)
+                    .layer_count(1);
+                // SAFETY: cmd is recording outside a rendering scope; pipeline, sets and the
+                // buffer live until one_shot returns (it waits); the bound range is the buffer.
+                unsafe {
+                    device.raw.cmd_begin_rendering(cmd, &rendering);
+                    device
+                        .raw
+                        .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                    device.raw.cmd_bind_descriptor_sets(
+                        cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        layout,
+                        0,
+                        &[frame_set, set],
+                        &[],
+                    );
+                    let viewport = vk::Viewport {
+                        x: 0.0,
+                        y: 0.0,
+                        width: 1.0,
+                        height: 1.0,
+                        min_depth: 0.0,
+                        max_depth: 1.0,
+                    };
+                    device.raw.cmd_set_viewport(cmd, 0, &[viewport]);
+                    device.raw.cmd_set_scissor(cmd, 0, &[area]);
+                    xfb.cmd_bind_transform_feedback_buffer(cmd, 0, buffer.raw, 0, bytes);
+                    xfb.cmd_begin_transform_feedback(cmd);
+                }
+                if let Err(e) = query.cmd_begin_stream(cmd, 0, 0) {
+                    failure = Some(e);
+                }
+                let mut first = 0;
+                while first < total {
+                    let n = per_draw.min(total - first);
+                    push.first_patch = first;
+                    // SAFETY: as above; the vertex range names existing (validated) faces.
+                    unsafe {
+                        device.raw.cmd_push_constants(
+                            cmd,
+                            layout,
+                            vk::ShaderStageFlags::ALL,
+                            0,
+                            bytemuck::bytes_of(&push),
+                        );
+                        device.raw.cmd_draw(cmd, n, 1, first, 0);
+                    }
+                    first += n;
+                }
+                if let Err(e) = query.cmd_end_stream(cmd, 0, 0) {
+                    failure = Some(e);
+                }
+                let barrier = [vk::MemoryBarrier::default()
+                    .src_access_mask(vk::AccessFlags::TRANSFORM_FEEDBACK_WRITE_EXT)
+                    .dst_access_mask(vk::AccessFlags::HOST_READ)];
+                // SAFETY: transform feedback and rendering were begun above on this cmd.
+                unsafe {
+                    xfb.cmd_end_transform_feedback(cmd);
+                    device.raw.cmd_end_rendering(cmd);
+                    device.raw.cmd_pipeline_barrier(
+                        cmd,
+                        vk::PipelineStageFlags::TRANSFORM_FEEDBACK_EXT,
+                        vk::PipelineStageFlags::HOST,
+                        vk::DependencyFlags::empty(),
+                        &barrier,
+                        &[],
+                        &[],
+                    );
+                }
+            })?;
+            if let Some(e) = failure {
+                return Err(e.into());
+            }
+            let counts = query.transform_feedback_results()?;
+            let c = counts.first().copied().unwrap_or_default();
+            if c.primitives_needed > capacity {
+                capacity = c.primitives_needed;
+                continue;
+            }
+            let all: Vec<CaptureRecord> = buffer.read()?;
+            let n = (c.primitives_written as usize * 3).min(all.len());
+            return Ok(CapturedSoup {
+                records: all[..n].to_vec(),
+            });
+        }
+        Err(TessError::Invalid(
+            "transform feedback overflowed twice".into(),
+        ))
+    }
+
+    fn pipelines_layout(
+        &mut self,
+        renderer: &Renderer,
+        spacing: Spacing,
+    ) -> Result<vk::PipelineLayout> {
+        let key = BftPipelineKey {
+            spacing,
+            wireframe: true,
+        };
+        self.capture_pipeline(renderer, spacing)?;
+        Ok(self.capture_pipelines[&key].layout)
+    }
+
+    /// Maps a captured (patch, `gl_TessCoord.xy`) to the base face and its domain coordinate in
+    /// [`crate::capture::face_corner_uv`]'s convention (weights of the base face's corners 0, 1).
+    pub fn face_point(&self, patch: u32, domain: [f32; 2]) -> Option<FacePoint> {
+        if patch >= self.gpu.patch_count {
+            return None;
+        }
+        let (u, v) = patch_uv(domain);
+        let (f, bu, bv) = self.bft.base_domain(patch as usize, u, v);
+        Some(FacePoint {
+            face: f as u32,
+            u: (1.0 - bu - bv) as f32,
+            v: bu as f32,
+        })
+    }
+}
+
+/// The patch coordinate `(u, v)` (weights of the patch's `v1`, `v2`) of a captured
+/// `gl_TessCoord.xy` (weights of `v0`, `v1`).
+pub fn patch_uv(domain: [f32; 2]) -> (f64, f64) {
+    let (x, y) = (domain[0] as f64, domain[1] as f64);
+    (y, 1.0 - x - y)
 }
