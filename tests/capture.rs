@@ -41,7 +41,7 @@ fn strip(k: u32, triangles: bool) -> ControlMesh {
 }
 
 fn load(path: &str) -> ControlMesh {
-    tessera::topology::load_obj(&common::data(path)).unwrap()
+    tessera::topology::load_obj(common::data(path)).unwrap()
 }
 
 struct Captured {
@@ -174,9 +174,8 @@ fn flat_positions_equal_cpu_interpolation() {
                             bottom * (1.0 - v) + top * v
                         })
                     };
-                    for k in 0..3 {
-                        let d = (r.position[k] as f64 - expected[k]).abs() / scale;
-                        worst = worst.max(d);
+                    for (got, want) in r.position.iter().zip(expected) {
+                        worst = worst.max((*got as f64 - want).abs() / scale);
                     }
                 }
                 assert!(

@@ -126,7 +126,7 @@ impl CapturedSoup {
     /// Merges corners whose position bits are identical into one indexed vertex; triangles keep
     /// their captured order and corner order (triangle `t` is corners `3t..3t + 3`).
     pub fn weld(&self) -> Result<WeldedMesh> {
-        if self.records.len() % 3 != 0 {
+        if !self.records.chunks_exact(3).remainder().is_empty() {
             return Err(TessError::Invalid(format!(
                 "captured soup has {} corners, not whole triangles",
                 self.records.len()
@@ -923,5 +923,20 @@ mod tests {
         assert_eq!(face_edges_at(4, [1.0, 1.0]), vec![1, 2]);
         assert_eq!(face_edges_at(3, [0.25, 0.75]), vec![0]);
         assert!(face_edges_at(5, [0.5, 0.5]).is_empty());
+        // Fan triangle 2 of a pentagon spans corners 0, 2, 3: halfway along its corners 1–2
+        // is on the pentagon's edge 2; halfway along 0–2 (weights of corners 0 and 2) is on
+        // the inner fan diagonal 0–3, on no edge.
+        let t = PatchFaceTable::new(vec![PatchOrigin {
+            face: 3,
+            face_size: 5,
+            domain: Domain::Triangle,
+            fan: 2,
+        }]);
+        let p = t.face_point(0, [0.0, 0.5]).unwrap();
+        assert_eq!(face_edges_at(5, [p.u, p.v]), vec![2]);
+        let p = t.face_point(0, [0.5, 0.0]).unwrap();
+        assert!(face_edges_at(5, [p.u, p.v]).is_empty());
+        let p = t.face_point(0, [1.0, 0.0]).unwrap();
+        assert_eq!(face_edges_at(5, [p.u, p.v]), vec![0, 4], "corner 0");
     }
 }
