@@ -444,8 +444,39 @@ fn capture_across_draw_split_numbers_patches_frame_wide() {
     }
 }
 
-/// Without transform feedback the capture is a typed error, not a panic: shown by asking a
-/// pass to exceed its budget (the same error path a too-small device limit takes).
+/// Without transform feedback the device still renders, and capture is a typed error.
+#[test]
+fn capture_without_transform_feedback_is_a_typed_error() {
+    use tessera::vk_core::{DeviceDesc, VkError};
+    let gpu = Gpu::with(&DeviceDesc {
+        without_transform_feedback: true,
+        ..DeviceDesc::default()
+    });
+    assert!(gpu.device().transform_feedback.is_none());
+    let e = Capturer::new(gpu.device()).err().expect("no capturer");
+    assert!(
+        matches!(
+            e,
+            tessera::tess::TessError::Vulkan(VkError::Unsupported { .. })
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("VK_EXT_transform_feedback"), "{e}");
+    let rm = RenderMesh::from_control_mesh(&strip(2, true)).unwrap();
+    let mesh = GpuMesh::upload(gpu.device(), &rm).unwrap();
+    let mut r = Renderer::offscreen(gpu.device()).unwrap();
+    r.render_offscreen(
+        &mesh,
+        &DrawParams::default(),
+        vk::Extent2D {
+            width: 16,
+            height: 16,
+        },
+    )
+    .unwrap();
+}
+
+/// A capture over the byte budget (or the device's buffer limit) is a typed error.
 #[test]
 fn oversized_capture_is_a_typed_error() {
     let gpu = Gpu::new();

@@ -651,6 +651,10 @@ impl Capturer {
             },
         )?;
         let lists = draw_lists(mesh, params.method);
+        if lists.is_empty() {
+            // Nothing to draw; a query that is never begun would never become available.
+            return Ok((CapturedSoup::default(), Vec::new(), DrawCounts::default()));
+        }
         let query = QueryPool::transform_feedback_stream(
             &device,
             "capture primitives",

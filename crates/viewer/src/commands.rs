@@ -86,6 +86,7 @@ pub fn open_device(
         &DeviceDesc {
             selector,
             pipeline_cache_path: cache,
+            ..DeviceDesc::default()
         },
         device_extensions,
     )?;

@@ -85,7 +85,7 @@ fn capture(
     }
 }
 
-/// What the export found (printed, and the test of `--fail-on-cracks`).
+/// What the export found: printed, and what `--fail-on-cracks` decides on.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ExportReport {
     pub triangles: usize,
