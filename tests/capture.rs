@@ -476,6 +476,34 @@ fn capture_without_transform_feedback_is_a_typed_error() {
     .unwrap();
 }
 
+/// Sizing by measurement (first pass overflows on purpose, the query says how much is needed)
+/// captures the same soup in two passes; the CPU bound does it in one.
+#[test]
+fn measured_sizing_reruns_and_agrees_with_cpu_bound() {
+    use tessera::tess::capture::CaptureSizing;
+    let gpu = Gpu::new();
+    let mut capturer = Capturer::new(gpu.device()).unwrap();
+    let rm = RenderMesh::from_control_mesh(&load("assets/spot_control_mesh.obj")).unwrap();
+    for method in [Method::Flat, Method::Pn] {
+        let p = DrawParams {
+            method,
+            spacing: Spacing::FractionalOdd,
+            level: 5.5,
+            ..Default::default()
+        };
+        capturer.sizing = CaptureSizing::CpuBound;
+        let cpu = capture(&mut capturer, &gpu, &rm, &p);
+        capturer.sizing = CaptureSizing::Measure;
+        let measured = capture(&mut capturer, &gpu, &rm, &p);
+        assert_eq!((cpu.stats.passes, measured.stats.passes), (1, 2));
+        assert_eq!(
+            measured.stats.primitives_written,
+            cpu.stats.expected_triangles
+        );
+        assert!(measured.soup == cpu.soup, "{method:?}");
+    }
+}
+
 /// A capture over the byte budget (or the device's buffer limit) is a typed error.
 #[test]
 fn oversized_capture_is_a_typed_error() {

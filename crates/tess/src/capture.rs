@@ -9,6 +9,7 @@
 //! the CPU tessellator's exact triangle count; a transform-feedback stream query per list counts
 //! primitives written and needed, and if a region overflowed (a TCS that sets other levels than
 //! the CPU assumed) a second pass runs with the measured sizes, so no triangle is lost silently.
+//! [`CaptureSizing::Measure`] skips the CPU bound: the first pass only measures.
 //!
 //! # Post-processing
 //! - [`CapturedSoup::weld`] merges corners only when the bits of their three position
@@ -475,6 +476,17 @@ pub struct CaptureKey {
     pub spacing: Spacing,
 }
 
+/// How the first capture pass sizes each patch list's region.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CaptureSizing {
+    /// The CPU tessellator's exact count for uniform levels: one pass.
+    #[default]
+    CpuBound,
+    /// One triangle per list, so the first pass only measures (primitives needed) and the second
+    /// captures: for TCSs whose levels the CPU cannot predict.
+    Measure,
+}
+
 /// Largest capture by default (bytes of records): beyond this the caller must raise
 /// [`Capturer::max_bytes`] deliberately.
 pub const DEFAULT_MAX_CAPTURE_BYTES: u64 = 1 << 30;
@@ -489,6 +501,7 @@ pub struct Capturer {
     uniforms: Buffer,
     /// Captures needing more record bytes than this fail with [`TessError::CaptureTooLarge`].
     pub max_bytes: u64,
+    pub sizing: CaptureSizing,
     device: Device,
 }
 
@@ -528,6 +541,7 @@ impl Capturer {
             set,
             uniforms,
             max_bytes: DEFAULT_MAX_CAPTURE_BYTES,
+            sizing: CaptureSizing::default(),
             device: device.clone(),
         })
     }
@@ -590,7 +604,10 @@ impl Capturer {
             expected_triangles: expected.iter().sum(),
             ..Default::default()
         };
-        let mut capacity = expected.clone();
+        let mut capacity = match self.sizing {
+            CaptureSizing::CpuBound => expected.clone(),
+            CaptureSizing::Measure => vec![1; expected.len()],
+        };
         for pass in 1..=2 {
             let (soup, counts, draws) = self.capture_pass(mesh, params, &capacity)?;
             let overflow = counts.iter().zip(&capacity).any(|(c, &cap)| {
