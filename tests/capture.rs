@@ -41,7 +41,7 @@ fn strip(k: u32, triangles: bool) -> ControlMesh {
 }
 
 fn load(path: &str) -> ControlMesh {
-    tessera::topology::load_obj(&common::data(path)).unwrap()
+    tessera::topology::load_obj(common::data(path)).unwrap()
 }
 
 struct Captured {
@@ -174,9 +174,8 @@ fn flat_positions_equal_cpu_interpolation() {
                             bottom * (1.0 - v) + top * v
                         })
                     };
-                    for k in 0..3 {
-                        let d = (r.position[k] as f64 - expected[k]).abs() / scale;
-                        worst = worst.max(d);
+                    for (got, want) in r.position.iter().zip(expected) {
+                        worst = worst.max((*got as f64 - want).abs() / scale);
                     }
                 }
                 assert!(
@@ -445,8 +444,67 @@ fn capture_across_draw_split_numbers_patches_frame_wide() {
     }
 }
 
-/// Without transform feedback the capture is a typed error, not a panic: shown by asking a
-/// pass to exceed its budget (the same error path a too-small device limit takes).
+/// Without transform feedback the device still renders, and capture is a typed error.
+#[test]
+fn capture_without_transform_feedback_is_a_typed_error() {
+    use tessera::vk_core::{DeviceDesc, VkError};
+    let gpu = Gpu::with(&DeviceDesc {
+        without_transform_feedback: true,
+        ..DeviceDesc::default()
+    });
+    assert!(gpu.device().transform_feedback.is_none());
+    let e = Capturer::new(gpu.device()).err().expect("no capturer");
+    assert!(
+        matches!(
+            e,
+            tessera::tess::TessError::Vulkan(VkError::Unsupported { .. })
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("VK_EXT_transform_feedback"), "{e}");
+    let rm = RenderMesh::from_control_mesh(&strip(2, true)).unwrap();
+    let mesh = GpuMesh::upload(gpu.device(), &rm).unwrap();
+    let mut r = Renderer::offscreen(gpu.device()).unwrap();
+    r.render_offscreen(
+        &mesh,
+        &DrawParams::default(),
+        vk::Extent2D {
+            width: 16,
+            height: 16,
+        },
+    )
+    .unwrap();
+}
+
+/// Sizing by measurement (first pass overflows on purpose, the query says how much is needed)
+/// captures the same soup in two passes; the CPU bound does it in one.
+#[test]
+fn measured_sizing_reruns_and_agrees_with_cpu_bound() {
+    use tessera::tess::capture::CaptureSizing;
+    let gpu = Gpu::new();
+    let mut capturer = Capturer::new(gpu.device()).unwrap();
+    let rm = RenderMesh::from_control_mesh(&load("assets/spot_control_mesh.obj")).unwrap();
+    for method in [Method::Flat, Method::Pn] {
+        let p = DrawParams {
+            method,
+            spacing: Spacing::FractionalOdd,
+            level: 5.5,
+            ..Default::default()
+        };
+        capturer.sizing = CaptureSizing::CpuBound;
+        let cpu = capture(&mut capturer, &gpu, &rm, &p);
+        capturer.sizing = CaptureSizing::Measure;
+        let measured = capture(&mut capturer, &gpu, &rm, &p);
+        assert_eq!((cpu.stats.passes, measured.stats.passes), (1, 2));
+        assert_eq!(
+            measured.stats.primitives_written,
+            cpu.stats.expected_triangles
+        );
+        assert!(measured.soup == cpu.soup, "{method:?}");
+    }
+}
+
+/// A capture over the byte budget (or the device's buffer limit) is a typed error.
 #[test]
 fn oversized_capture_is_a_typed_error() {
     let gpu = Gpu::new();

@@ -12,6 +12,11 @@ pub struct Gpu {
 
 impl Gpu {
     pub fn new() -> Gpu {
+        Self::with(&DeviceDesc::default())
+    }
+
+    /// A device made from `desc` (e.g. with optional features turned off).
+    pub fn with(desc: &DeviceDesc) -> Gpu {
         let _ = env_logger_init();
         let instance = Instance::new(&InstanceDesc {
             app_name: "tessera-tests".into(),
@@ -24,8 +29,7 @@ impl Gpu {
             Validation::On,
             "tests need VK_LAYER_KHRONOS_validation (package vulkan-validationlayers)"
         );
-        let device = Device::new(&instance, &DeviceDesc::default(), &[])
-            .expect("a Vulkan device with tessellation");
+        let device = Device::new(&instance, desc, &[]).expect("a Vulkan device with tessellation");
         Gpu {
             device: Some(device),
             instance,

@@ -9,6 +9,7 @@
 //! the CPU tessellator's exact triangle count; a transform-feedback stream query per list counts
 //! primitives written and needed, and if a region overflowed (a TCS that sets other levels than
 //! the CPU assumed) a second pass runs with the measured sizes, so no triangle is lost silently.
+//! [`CaptureSizing::Measure`] skips the CPU bound: the first pass only measures.
 //!
 //! # Post-processing
 //! - [`CapturedSoup::weld`] merges corners only when the bits of their three position
@@ -126,7 +127,7 @@ impl CapturedSoup {
     /// Merges corners whose position bits are identical into one indexed vertex; triangles keep
     /// their captured order and corner order (triangle `t` is corners `3t..3t + 3`).
     pub fn weld(&self) -> Result<WeldedMesh> {
-        if self.records.len() % 3 != 0 {
+        if !self.records.chunks_exact(3).remainder().is_empty() {
             return Err(TessError::Invalid(format!(
                 "captured soup has {} corners, not whole triangles",
                 self.records.len()
@@ -475,6 +476,17 @@ pub struct CaptureKey {
     pub spacing: Spacing,
 }
 
+/// How the first capture pass sizes each patch list's region.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CaptureSizing {
+    /// The CPU tessellator's exact count for uniform levels: one pass.
+    #[default]
+    CpuBound,
+    /// One triangle per list, so the first pass only measures (primitives needed) and the second
+    /// captures: for TCSs whose levels the CPU cannot predict.
+    Measure,
+}
+
 /// Largest capture by default (bytes of records): beyond this the caller must raise
 /// [`Capturer::max_bytes`] deliberately.
 pub const DEFAULT_MAX_CAPTURE_BYTES: u64 = 1 << 30;
@@ -489,6 +501,7 @@ pub struct Capturer {
     uniforms: Buffer,
     /// Captures needing more record bytes than this fail with [`TessError::CaptureTooLarge`].
     pub max_bytes: u64,
+    pub sizing: CaptureSizing,
     device: Device,
 }
 
@@ -528,6 +541,7 @@ impl Capturer {
             set,
             uniforms,
             max_bytes: DEFAULT_MAX_CAPTURE_BYTES,
+            sizing: CaptureSizing::default(),
             device: device.clone(),
         })
     }
@@ -590,7 +604,10 @@ impl Capturer {
             expected_triangles: expected.iter().sum(),
             ..Default::default()
         };
-        let mut capacity = expected.clone();
+        let mut capacity = match self.sizing {
+            CaptureSizing::CpuBound => expected.clone(),
+            CaptureSizing::Measure => vec![1; expected.len()],
+        };
         for pass in 1..=2 {
             let (soup, counts, draws) = self.capture_pass(mesh, params, &capacity)?;
             let overflow = counts.iter().zip(&capacity).any(|(c, &cap)| {
@@ -651,6 +668,10 @@ impl Capturer {
             },
         )?;
         let lists = draw_lists(mesh, params.method);
+        if lists.is_empty() {
+            // Nothing to draw; a query that is never begun would never become available.
+            return Ok((CapturedSoup::default(), Vec::new(), DrawCounts::default()));
+        }
         let query = QueryPool::transform_feedback_stream(
             &device,
             "capture primitives",
@@ -923,5 +944,20 @@ mod tests {
         assert_eq!(face_edges_at(4, [1.0, 1.0]), vec![1, 2]);
         assert_eq!(face_edges_at(3, [0.25, 0.75]), vec![0]);
         assert!(face_edges_at(5, [0.5, 0.5]).is_empty());
+        // Fan triangle 2 of a pentagon spans corners 0, 2, 3: halfway along its corners 1–2
+        // is on the pentagon's edge 2; halfway along 0–2 (weights of corners 0 and 2) is on
+        // the inner fan diagonal 0–3, on no edge.
+        let t = PatchFaceTable::new(vec![PatchOrigin {
+            face: 3,
+            face_size: 5,
+            domain: Domain::Triangle,
+            fan: 2,
+        }]);
+        let p = t.face_point(0, [0.0, 0.5]).unwrap();
+        assert_eq!(face_edges_at(5, [p.u, p.v]), vec![2]);
+        let p = t.face_point(0, [0.5, 0.0]).unwrap();
+        assert!(face_edges_at(5, [p.u, p.v]).is_empty());
+        let p = t.face_point(0, [1.0, 0.0]).unwrap();
+        assert_eq!(face_edges_at(5, [p.u, p.v]), vec![0, 4], "corner 0");
     }
 }

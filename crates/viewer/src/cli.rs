@@ -29,6 +29,38 @@ pub enum Command {
     Subdivide(SubdivideArgs),
     /// Print the exact limit position, tangents and normal at (face, u, v).
     Limit(LimitArgs),
+    /// Capture the triangles the GPU's TES emitted (transform feedback), weld them by position
+    /// bits, report open edges and cracks, and write them as OBJ.
+    Export(ExportArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct ExportArgs {
+    /// OBJ control mesh.
+    pub input: PathBuf,
+    /// flat, phong or pn.
+    #[arg(long, value_parser = crate::export::parse_export_method)]
+    pub method: crate::export::ExportMethod,
+    /// Tessellation level (outer and inner), 1 to 64.
+    #[arg(long)]
+    pub segments: f32,
+    #[arg(long, default_value = "equal", value_parser = parse_spacing)]
+    pub spacing: Spacing,
+    /// Subdivision scheme, for methods that evaluate one (only loop is accepted for now;
+    /// flat, phong and pn do not use it).
+    #[arg(long)]
+    pub scheme: Option<String>,
+    /// Phong tessellation shape factor α.
+    #[arg(long, default_value_t = 0.75)]
+    pub alpha: f32,
+    /// Exit with status 1 when any crack (an open edge not on the base mesh's boundary) is found.
+    #[arg(long)]
+    pub fail_on_cracks: bool,
+    #[command(flatten)]
+    pub gpu: GpuArgs,
+    /// Output OBJ.
+    #[arg(short, long)]
+    pub output: PathBuf,
 }
 
 #[derive(Args, Debug)]

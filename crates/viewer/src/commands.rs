@@ -17,6 +17,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Info(g) => info(&g),
         Command::Subdivide(a) => crate::topo_cmds::subdivide(a),
         Command::Limit(a) => crate::topo_cmds::limit(a),
+        Command::Export(a) => crate::export::run(a),
     }
 }
 
@@ -85,6 +86,7 @@ pub fn open_device(
         &DeviceDesc {
             selector,
             pipeline_cache_path: cache,
+            ..DeviceDesc::default()
         },
         device_extensions,
     )?;

@@ -2,6 +2,7 @@
 #![forbid(unsafe_code)]
 mod cli;
 mod commands;
+mod export;
 mod topo_cmds;
 mod view;
 

@@ -6,7 +6,10 @@ use std::process::{Command, Output};
 fn tessera(args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_tessera"));
     c.args(args);
-    if matches!(args.first(), Some(&"render" | &"view" | &"info")) {
+    if matches!(
+        args.first(),
+        Some(&"render" | &"view" | &"info" | &"export")
+    ) {
         c.arg("--validation");
     }
     for (k, v) in env {
@@ -320,4 +323,200 @@ fn subdivide_limit_agrees_with_limit_evaluation() {
             }
         }
     }
+}
+
+/// Runs `tessera export` and returns its stdout; panics with stderr when it fails.
+fn export_ok(args: &[&str]) -> String {
+    let o = tessera(args, &[]);
+    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// The number printed after `label` on its line of the export report.
+fn reported(stdout: &str, label: &str) -> usize {
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with(label))
+        .unwrap_or_else(|| panic!("no '{label}' line in:\n{stdout}"));
+    line[label.len()..]
+        .split_whitespace()
+        .next()
+        .and_then(|w| w.parse().ok())
+        .unwrap_or_else(|| panic!("no number after '{label}': {line}"))
+}
+
+#[test]
+fn export_writes_a_watertight_outward_obj_for_flat() {
+    let out = tmp("cube_flat.obj");
+    let cube = data("tests/data/meshes/cube.obj");
+    let s = export_ok(&[
+        "export",
+        &cube,
+        "--method",
+        "flat",
+        "--segments",
+        "4",
+        "--scheme",
+        "loop",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    // 6 quads × 2 × 4² triangles; 6 × 4² + 2 vertices once welded.
+    assert_eq!(reported(&s, "captured:"), 192, "{s}");
+    assert!(s.contains("192 triangles, 576 vertices"), "{s}");
+    assert_eq!(reported(&s, "welded:"), 98, "{s}");
+    assert_eq!(reported(&s, "open edges:"), 0, "{s}");
+    assert!(s.contains("0 cracks"), "{s}");
+    assert_eq!(reported(&s, "zero-area triangles:"), 0, "{s}");
+
+    let text = std::fs::read_to_string(&out).unwrap();
+    let count = |p: &str| text.lines().filter(|l| l.starts_with(p)).count();
+    assert_eq!((count("v "), count("vn "), count("# p ")), (98, 98, 98));
+    assert_eq!(count("f "), 192);
+    // Every vertex's base face and domain coordinate: a cube face, inside the unit square.
+    for l in text.lines().filter(|l| l.starts_with("# p ")) {
+        let w: Vec<f64> = l[4..]
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        assert!(w[0] >= 0.0 && w[0] < 6.0 && w[0].fract() == 0.0, "{l}");
+        assert!(
+            (0.0..=1.0).contains(&w[1]) && (0.0..=1.0).contains(&w[2]),
+            "{l}"
+        );
+    }
+    // The topology reader accepts it as a closed, consistently oriented manifold, wound
+    // outward like the input (positive volume: 8 for the 2 × 2 × 2 cube).
+    let mesh = topology::load_obj(&out).expect("exported OBJ parses and validates");
+    assert_eq!((mesh.positions.len(), mesh.num_faces()), (98, 192));
+    let volume: f64 = mesh
+        .faces()
+        .map(|f| {
+            let [a, b, c] = [0, 1, 2].map(|i| mesh.positions[f[i] as usize]);
+            (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                / 6.0
+        })
+        .sum();
+    assert!((volume - 8.0).abs() < 1e-9, "volume {volume}");
+}
+
+#[test]
+fn export_reports_pn_cracks_and_fails_on_them_when_asked() {
+    let out = tmp("cube_pn.obj");
+    let cube = data("tests/data/meshes/cube.obj");
+    let args = [
+        "export",
+        &cube,
+        "--method",
+        "pn",
+        "--segments",
+        "5",
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    // PN evaluates shared edges in a different float order from each side: bit-level cracks,
+    // reported (exit 0) unless --fail-on-cracks.
+    let s = export_ok(&args);
+    let open = reported(&s, "open edges:");
+    assert!(
+        open > 0 && s.contains(&format!("0 on the base mesh's boundary, {open} cracks")),
+        "{s}"
+    );
+    let mut strict = args.to_vec();
+    strict.push("--fail-on-cracks");
+    fails_with(&strict, &[], &["cracks", "--fail-on-cracks"]);
+}
+
+#[test]
+fn export_tells_base_boundary_from_cracks() {
+    // An open square of two quads: its 6 base edges, 3 segments each, are boundary.
+    let p = write(
+        "open_quads.obj",
+        "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0.5\nv 2 1 0\nf 1 2 5 4\nf 2 3 6 5\n",
+    );
+    let out = tmp("open_quads_out.obj");
+    let s = export_ok(&[
+        "export",
+        p.to_str().unwrap(),
+        "--method",
+        "flat",
+        "--segments",
+        "3",
+        "--fail-on-cracks",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(reported(&s, "open edges:"), 18, "{s}");
+    assert!(
+        s.contains("18 on the base mesh's boundary, 0 cracks"),
+        "{s}"
+    );
+}
+
+#[test]
+fn export_bad_inputs_are_named_errors() {
+    let out = tmp("never.obj");
+    let out = out.to_str().unwrap();
+    fails_with(
+        &[
+            "export",
+            "/nonexistent/cow.obj",
+            "--method",
+            "flat",
+            "--segments",
+            "4",
+            "-o",
+            out,
+        ],
+        &[],
+        &["/nonexistent/cow.obj"],
+    );
+    let cube = data("tests/data/meshes/cube.obj");
+    fails_with(
+        &[
+            "export",
+            &cube,
+            "--method",
+            "flat",
+            "--segments",
+            "4",
+            "--scheme",
+            "catmull-clark",
+            "-o",
+            out,
+        ],
+        &[],
+        &["--scheme catmull-clark", "loop"],
+    );
+    fails_with(
+        &[
+            "export",
+            &cube,
+            "--method",
+            "flat",
+            "--segments",
+            "65",
+            "-o",
+            out,
+        ],
+        &[],
+        &["--segments"],
+    );
+    let bad = write("bad_export.obj", "v 0 0 0\nv 1 0 0\nv 0 1 zero\nf 1 2 3\n");
+    fails_with(
+        &[
+            "export",
+            bad.to_str().unwrap(),
+            "--method",
+            "pn",
+            "--segments",
+            "2",
+            "-o",
+            out,
+        ],
+        &[],
+        &["bad_export.obj", ":3"],
+    );
+    assert!(!Path::new(out).exists(), "no output on error");
 }

@@ -139,15 +139,11 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
     let mut out = Vec::new();
     for (index, &physical) in physicals.iter().enumerate() {
         // SAFETY: physical comes from this instance.
-        let extensions = unsafe {
-            instance
-                .raw
-                .enumerate_device_extension_properties(physical)
-        }
-        .ctx("vkEnumerateDeviceExtensionProperties")?;
-        let has_xfb_extension = extensions.iter().any(|e| {
-            e.extension_name_as_c_str().ok() == Some(ash::ext::transform_feedback::NAME)
-        });
+        let extensions = unsafe { instance.raw.enumerate_device_extension_properties(physical) }
+            .ctx("vkEnumerateDeviceExtensionProperties")?;
+        let has_xfb_extension = extensions
+            .iter()
+            .any(|e| e.extension_name_as_c_str().ok() == Some(ash::ext::transform_feedback::NAME));
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
         let mut xfb_props = vk::PhysicalDeviceTransformFeedbackPropertiesEXT::default();
         let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
@@ -310,6 +306,9 @@ pub struct DeviceDesc {
     pub selector: DeviceSelector,
     /// Where the pipeline cache is kept between runs; `None` keeps it in memory only.
     pub pipeline_cache_path: Option<std::path::PathBuf>,
+    /// Leaves VK_EXT_transform_feedback off even where the device has it, so the path of devices
+    /// without it (typed errors from captures) can be tested on any device.
+    pub without_transform_feedback: bool,
 }
 
 /// The state every resource shares. Drop order: idle wait, pipeline cache, command pool,
@@ -371,7 +370,7 @@ impl Device {
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true);
         // Transform feedback is enabled whenever the device has it: capture is optional, and
         // enabling it costs nothing when unused.
-        let xfb = info.caps.transform_feedback;
+        let xfb = info.caps.transform_feedback && !desc.without_transform_feedback;
         let mut xfb_feats =
             vk::PhysicalDeviceTransformFeedbackFeaturesEXT::default().transform_feedback(true);
         let mut extensions: Vec<&CStr> = extra_extensions.to_vec();
@@ -603,6 +602,15 @@ mod tests {
             choose_adapter(&a, &DeviceSelector::Name("DEVICE1".into())).unwrap(),
             1
         );
+    }
+
+    #[test]
+    fn transform_feedback_is_optional() {
+        use vk::PhysicalDeviceType as T;
+        let mut a = adapter(0, T::CPU, true);
+        a.caps.transform_feedback = false;
+        assert!(a.score() > 0 && a.missing.is_empty());
+        assert_eq!(choose_adapter(&[a], &DeviceSelector::Auto).unwrap(), 0);
     }
 
     #[test]
