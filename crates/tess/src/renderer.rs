@@ -492,8 +492,8 @@ pub(crate) fn frame_uniforms_for(
 ) -> FrameUniforms {
     let aspect = extent.width as f32 / extent.height.max(1) as f32;
     let m = params.camera.matrices(bbox.0, bbox.1, aspect);
-    let light = (m.eye - glam::Vec3::from(bbox.0).lerp(glam::Vec3::from(bbox.1), 0.5))
-        .normalize_or_zero();
+    let light =
+        (m.eye - glam::Vec3::from(bbox.0).lerp(glam::Vec3::from(bbox.1), 0.5)).normalize_or_zero();
     let light = (light + glam::Vec3::new(0.3, 0.6, 0.2)).normalize_or_zero();
     let level = params.level.clamp(1.0, crate::tessellator::MAX_LEVEL);
     FrameUniforms {
