@@ -267,13 +267,17 @@ fn bft_renders_spot_with_patch_colours_and_wireframe() {
             surf.patch_count(),
             "the shaded pass draws every patch"
         );
-        // The surface covers a good part of the frame and patch colours differ.
-        let lit = img
-            .pixels
-            .chunks_exact(4)
-            .filter(|p| p[0] > 60 || p[1] > 60 || p[2] > 60)
-            .count();
-        assert!(lit > 20_000, "{lit} lit pixels");
+        // The surface covers a good part of the frame, in both the regular (blue) and the
+        // extraordinary (red) patch colours.
+        let px = || img.pixels.chunks_exact(4);
+        let lit = px().filter(|p| p[0] > 60 || p[1] > 60 || p[2] > 60).count();
+        let red = px().filter(|p| p[0] as i32 > p[2] as i32 + 40).count();
+        let blue = px().filter(|p| p[2] as i32 > p[0] as i32 + 20).count();
+        assert!(lit > 10_000, "{lit} lit pixels");
+        assert!(
+            red > 500 && blue > 500,
+            "patch colours: {red} red, {blue} blue"
+        );
     }
 }
 
@@ -297,8 +301,7 @@ fn bad_segments_are_rejected_with_a_clear_error() {
                     EXTENT,
                     false,
                 )
-                .err()
-                .expect("rejected");
+                .expect_err("rejected");
             assert!(e.to_string().contains("--segments"), "{e}");
         }
     }

@@ -405,8 +405,7 @@ pub fn tessellator_interior_points(s: u32) -> Vec<(u32, u32)> {
             [small, big, small],
             [small, small, big],
         ];
-        for side in 0..3 {
-            let c = corners[side];
+        for (side, &c) in corners.iter().enumerate() {
             let (from, to) = (side, (side + 1) % 3);
             for k in 0..s - 2 * r {
                 let mut w = c;
@@ -417,7 +416,7 @@ pub fn tessellator_interior_points(s: u32) -> Vec<(u32, u32)> {
         }
         r += 1;
     }
-    if s % 2 == 0 && s >= 2 {
+    if s.is_multiple_of(2) && s >= 2 {
         out.push((s, s));
     }
     out
