@@ -147,3 +147,39 @@ pub fn transition(
         )
     };
 }
+
+/// Records the copy of a whole colour `image` (in `TRANSFER_SRC_OPTIMAL`, tightly packed
+/// 4-byte texels) into `buffer`: the readback of offscreen targets and swapchain screenshots.
+///
+/// # Safety
+/// `cmd` is recording outside a rendering scope; `image` is in `TRANSFER_SRC_OPTIMAL` and has
+/// `extent`; `buffer` holds at least `extent.width · extent.height · 4` bytes.
+pub unsafe fn cmd_copy_color_to_buffer(
+    device: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: vk::Image,
+    extent: vk::Extent2D,
+    buffer: vk::Buffer,
+) {
+    let region = vk::BufferImageCopy::default()
+        .image_subresource(
+            vk::ImageSubresourceLayers::default()
+                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                .layer_count(1),
+        )
+        .image_extent(vk::Extent3D {
+            width: extent.width,
+            height: extent.height,
+            depth: 1,
+        });
+    // SAFETY: the caller's contract.
+    unsafe {
+        device.cmd_copy_image_to_buffer(
+            cmd,
+            image,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            buffer,
+            &[region],
+        )
+    };
+}

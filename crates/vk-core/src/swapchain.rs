@@ -398,25 +398,15 @@ impl Swapchain {
                 vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
                 vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
             );
-            let region = vk::BufferImageCopy::default()
-                .image_subresource(
-                    vk::ImageSubresourceLayers::default()
-                        .aspect_mask(vk::ImageAspectFlags::COLOR)
-                        .layer_count(1),
-                )
-                .image_extent(vk::Extent3D {
-                    width: frame.extent.width,
-                    height: frame.extent.height,
-                    depth: 1,
-                });
-            // SAFETY: image in TRANSFER_SRC layout (swapchain created with TRANSFER_SRC when supported).
+            // SAFETY: image in TRANSFER_SRC layout (swapchain created with TRANSFER_SRC when
+            // supported); the buffer was sized for the extent above.
             unsafe {
-                device.raw.cmd_copy_image_to_buffer(
+                crate::image::cmd_copy_color_to_buffer(
+                    &device.raw,
                     frame.cmd,
                     self.images[i],
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    frame.extent,
                     buffer.raw,
-                    &[region],
                 )
             };
             transition(

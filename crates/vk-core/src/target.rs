@@ -110,25 +110,14 @@ impl OffscreenTarget {
             vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
             vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
         );
-        let region = vk::BufferImageCopy::default()
-            .image_subresource(
-                vk::ImageSubresourceLayers::default()
-                    .aspect_mask(vk::ImageAspectFlags::COLOR)
-                    .layer_count(1),
-            )
-            .image_extent(vk::Extent3D {
-                width: self.extent.width,
-                height: self.extent.height,
-                depth: 1,
-            });
         // SAFETY: the image is in TRANSFER_SRC layout; readback has width*height*4 bytes.
         unsafe {
-            device.raw.cmd_copy_image_to_buffer(
+            crate::image::cmd_copy_color_to_buffer(
+                &device.raw,
                 cmd,
                 self.color.raw,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                self.extent,
                 readback.raw,
-                &[region],
             )
         };
         let barrier = vk::MemoryBarrier::default()
