@@ -306,3 +306,24 @@ fn bad_segments_are_rejected_with_a_clear_error() {
         }
     }
 }
+
+/// Asking for statistics never reaches the lavapipe crash: the workaround skips the query.
+#[test]
+fn statistics_request_is_safe_on_every_driver() {
+    let gpu = Gpu::new();
+    {
+        let mut renderer = Renderer::offscreen(gpu.device()).expect("renderer");
+        let mesh = shape("loop_cube");
+        let mut surf = BftSurface::new(&renderer, &mesh, "cube", 3, false, 1).expect("surface");
+        let params = BftParams::default();
+        let (_, stats, counts) = surf
+            .render_offscreen(&mut renderer, &DrawParams::default(), &params, EXTENT, true)
+            .expect("render");
+        assert_eq!(counts.patches, surf.patch_count());
+        let skipped = gpu
+            .device()
+            .workarounds
+            .has(tessera::vk_core::workarounds::WorkaroundId::LavapipeStatisticsQueryPointPatches);
+        assert_eq!(stats.is_none(), skipped);
+    }
+}

@@ -9,10 +9,13 @@
 //!    `bft.tesc` sets power-of-two (or fractional) edge factors from each edge's two endpoints
 //!    only; `bft.tese` evaluates the table row of each tess coordinate (see
 //!    `glsl/include/bft.glsl`, mirrored in f32 by `topology::bft::GpuBft::eval_tess`).
-use crate::capture::{CaptureRecord, CapturedSoup, FacePoint, CAPTURE_STRIDE};
+use crate::capture::{
+    begin_capture_scope, capture_to_host_barrier, end_capture_scope, CaptureRecord, CapturedSoup,
+    FacePoint, CAPTURE_STRIDE,
+};
 use crate::error::{Result, TessError};
 use crate::gpu::BftPush;
-use crate::renderer::{DrawCounts, DrawSplit, Renderer};
+use crate::renderer::{set_pass_style, DrawCounts, DrawSplit, Renderer};
 use crate::shaders;
 use crate::tessellator::{uniform_vertex_count, Domain, Spacing};
 use std::collections::HashMap;
@@ -22,7 +25,7 @@ use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
 use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage, TessellationDesc};
 use vk_core::query::{PipelineStatistics, QueryPool};
 use vk_core::target::{OffscreenTarget, Rgba8};
-use vk_core::transform_feedback::TransformFeedbackCommands;
+use vk_core::workarounds::WorkaroundId;
 use vk_core::{vk, Buffer, BufferDesc, Device, MemoryLocation};
 
 /// Default maximum table level: 32 segments per level-1 edge, 64 per base edge.
@@ -80,7 +83,7 @@ struct BftPipelineKey {
 /// descriptor pool, set layout, buffers, device handle.
 pub struct BftSurface {
     pipelines: HashMap<BftPipelineKey, Pipeline>,
-    capture_pipelines: HashMap<BftPipelineKey, Pipeline>,
+    capture_pipelines: HashMap<Spacing, Pipeline>,
     subdivide: Pipeline,
     normals: Pipeline,
     _pool: DescriptorPool,
@@ -320,13 +323,7 @@ impl BftSurface {
         });
         desc.set_layouts = vec![renderer.frame_set_layout(), self.set_layout.raw];
         desc.push_constant_bytes = std::mem::size_of::<BftPush>() as u32;
-        if key.wireframe {
-            desc.polygon_mode = vk::PolygonMode::LINE;
-            desc.depth_compare = vk::CompareOp::LESS_OR_EQUAL;
-            desc.depth_write = false;
-        } else {
-            desc.depth_bias = Some((1.0, 1.0));
-        }
+        set_pass_style(&mut desc, key.wireframe);
         Ok(Pipeline::graphics(&self.device, &desc)?)
     }
 
@@ -491,7 +488,6 @@ impl BftSurface {
         let total = self.gpu.patch_count;
         let device = self.device.clone();
         let pipeline = self.pipeline(renderer, key)?;
-        let mut counts = DrawCounts::default();
         // SAFETY: cmd is recording inside a rendering scope; everything bound is owned by self
         // or the renderer and outlives the submission.
         unsafe {
@@ -507,28 +503,49 @@ impl BftSurface {
                 &[],
             );
         }
-        let mut first = 0;
-        while first < total {
-            let n = per_draw.min(total - first);
-            push.first_patch = first;
-            // SAFETY: as above; vertex indices first..first+n name existing level-1 faces,
-            // whose records were validated (`GpuBft::validate`).
-            unsafe {
-                device.raw.cmd_push_constants(
-                    cmd,
-                    pipeline.layout,
-                    vk::ShaderStageFlags::ALL,
-                    0,
-                    bytemuck::bytes_of(&push),
-                );
-                device.raw.cmd_draw(cmd, n, 1, first, 0);
-            }
-            counts.draws += 1;
-            counts.patches += n;
-            first += n;
-        }
+        // SAFETY: the pipeline and its sets are bound on cmd inside a rendering scope.
+        let counts = unsafe {
+            record_patch_draws(&device, cmd, pipeline.layout, &mut push, total, per_draw)
+        };
         Ok(counts)
     }
+}
+
+/// Draws patches `0..total` (one control point each: the level-1 face) in draws of at most
+/// `per_draw`, with `push.first_patch` set per draw so patch ids stay frame-wide.
+///
+/// # Safety
+/// A BFT pipeline with `layout` and its sets is bound on `cmd`, inside a rendering scope (or a
+/// capture scope); `total` is the validated patch count.
+unsafe fn record_patch_draws(
+    device: &Device,
+    cmd: vk::CommandBuffer,
+    layout: vk::PipelineLayout,
+    push: &mut BftPush,
+    total: u32,
+    per_draw: u32,
+) -> DrawCounts {
+    let mut counts = DrawCounts::default();
+    let mut first = 0;
+    while first < total {
+        let n = per_draw.min(total - first);
+        push.first_patch = first;
+        // SAFETY: the caller's contract; first..first + n are existing, validated patches.
+        unsafe {
+            device.raw.cmd_push_constants(
+                cmd,
+                layout,
+                vk::ShaderStageFlags::ALL,
+                0,
+                bytemuck::bytes_of(push),
+            );
+            device.raw.cmd_draw(cmd, n, 1, first, 0);
+        }
+        counts.draws += 1;
+        counts.patches += n;
+        first += n;
+    }
+    counts
 }
 
 /// Axis-aligned bounds of points.
@@ -593,7 +610,8 @@ pub fn wave(
 
 impl BftSurface {
     /// Renders one frame offscreen (compute pass, shaded pass, optional wireframe overlay) and
-    /// reads it back; with `statistics`, also the pipeline statistics of the shaded pass.
+    /// reads it back; with `statistics`, also the pipeline statistics of the shaded pass (None
+    /// where a driver workaround forbids the query).
     pub fn render_offscreen(
         &mut self,
         renderer: &mut Renderer,
@@ -606,6 +624,12 @@ impl BftSurface {
         let device = self.device.clone();
         let target = OffscreenTarget::new(&device, extent)?;
         let readback = target.readback_buffer(&device)?;
+        // See WorkaroundId::LavapipeStatisticsQueryPointPatches: there the query is skipped and
+        // the statistics come back as None.
+        let statistics = statistics
+            && !device
+                .workarounds
+                .has(WorkaroundId::LavapipeStatisticsQueryPointPatches);
         let query = if statistics {
             Some(QueryPool::statistics(&device, "bft statistics", 1)?)
         } else {
@@ -649,13 +673,14 @@ impl BftSurface {
 }
 
 impl BftSurface {
-    fn capture_pipeline(&mut self, renderer: &Renderer, spacing: Spacing) -> Result<vk::Pipeline> {
-        let key = BftPipelineKey {
-            spacing,
-            wireframe: true,
-        };
-        if let Some(p) = self.capture_pipelines.get(&key) {
-            return Ok(p.raw);
+    /// The capture pipeline of `spacing` (created on first use): its handle and layout.
+    fn capture_pipeline(
+        &mut self,
+        renderer: &Renderer,
+        spacing: Spacing,
+    ) -> Result<(vk::Pipeline, vk::PipelineLayout)> {
+        if let Some(p) = self.capture_pipelines.get(&spacing) {
+            return Ok((p.raw, p.layout));
         }
         let tese = match spacing {
             Spacing::Equal => shaders::BFT_TESE_EQUAL_CAPTURE,
@@ -683,9 +708,9 @@ impl BftSurface {
         desc.depth_test = false;
         desc.depth_write = false;
         let p = Pipeline::graphics(&self.device, &desc)?;
-        let raw = p.raw;
-        self.capture_pipelines.insert(key, p);
-        Ok(raw)
+        let handles = (p.raw, p.layout);
+        self.capture_pipelines.insert(spacing, p);
+        Ok(handles)
     }
 
     /// Captures, through transform feedback, every triangle corner the BFT TES emits for one
@@ -702,8 +727,7 @@ impl BftSurface {
         self.check_params(params)?;
         let device = self.device.clone();
         let xfb = device.transform_feedback()?.clone();
-        let pipeline = self.capture_pipeline(renderer, params.spacing())?;
-        let layout = self.pipelines_layout(renderer, params.spacing())?;
+        let (pipeline, layout) = self.capture_pipeline(renderer, params.spacing())?;
         renderer.update_frame(0, (self.bbox_min, self.bbox_max), draw, extent)?;
         let mut capacity: u64 = match params.factors {
             FactorPolicy::Uniform { segments } => {
@@ -742,83 +766,30 @@ impl BftSurface {
             device.one_shot(|cmd| {
                 query.cmd_reset(cmd);
                 self.record_compute(cmd, renderer, 0);
-                let area = vk::Rect2D {
-                    offset: vk::Offset2D { x: 0, y: 0 },
-                    extent: vk::Extent2D {
-                        width: 1,
-                        height: 1,
-                    },
-                };
-                let rendering = vk::RenderingInfo::default()
-                    .render_area(area)
-                    .layer_count(1);
-                // SAFETY: cmd is recording outside a rendering scope; pipeline, sets and the
-                // buffer live until one_shot returns (it waits); the bound range is the buffer.
+                // SAFETY: pipeline, sets and buffer live until one_shot returns (it waits); the
+                // bound region is the whole buffer.
                 unsafe {
-                    device.raw.cmd_begin_rendering(cmd, &rendering);
-                    device
-                        .raw
-                        .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                    device.raw.cmd_bind_descriptor_sets(
+                    begin_capture_scope(
+                        &device,
+                        &xfb,
                         cmd,
-                        vk::PipelineBindPoint::GRAPHICS,
-                        layout,
-                        0,
+                        (pipeline, layout),
                         &[frame_set, set],
-                        &[],
-                    );
-                    let viewport = vk::Viewport {
-                        x: 0.0,
-                        y: 0.0,
-                        width: 1.0,
-                        height: 1.0,
-                        min_depth: 0.0,
-                        max_depth: 1.0,
-                    };
-                    device.raw.cmd_set_viewport(cmd, 0, &[viewport]);
-                    device.raw.cmd_set_scissor(cmd, 0, &[area]);
-                    xfb.cmd_bind_transform_feedback_buffer(cmd, 0, buffer.raw, 0, bytes);
-                    xfb.cmd_begin_transform_feedback(cmd);
-                }
+                        (buffer.raw, 0, bytes),
+                    )
+                };
                 if let Err(e) = query.cmd_begin_stream(cmd, 0, 0) {
                     failure = Some(e);
                 }
-                let mut first = 0;
-                while first < total {
-                    let n = per_draw.min(total - first);
-                    push.first_patch = first;
-                    // SAFETY: as above; the vertex range names existing (validated) faces.
-                    unsafe {
-                        device.raw.cmd_push_constants(
-                            cmd,
-                            layout,
-                            vk::ShaderStageFlags::ALL,
-                            0,
-                            bytemuck::bytes_of(&push),
-                        );
-                        device.raw.cmd_draw(cmd, n, 1, first, 0);
-                    }
-                    first += n;
-                }
+                // SAFETY: the capture pipeline and its sets are bound in the scope above.
+                unsafe { record_patch_draws(&device, cmd, layout, &mut push, total, per_draw) };
                 if let Err(e) = query.cmd_end_stream(cmd, 0, 0) {
                     failure = Some(e);
                 }
-                let barrier = [vk::MemoryBarrier::default()
-                    .src_access_mask(vk::AccessFlags::TRANSFORM_FEEDBACK_WRITE_EXT)
-                    .dst_access_mask(vk::AccessFlags::HOST_READ)];
-                // SAFETY: transform feedback and rendering were begun above on this cmd.
+                // SAFETY: the scope was begun above; cmd is then outside any rendering scope.
                 unsafe {
-                    xfb.cmd_end_transform_feedback(cmd);
-                    device.raw.cmd_end_rendering(cmd);
-                    device.raw.cmd_pipeline_barrier(
-                        cmd,
-                        vk::PipelineStageFlags::TRANSFORM_FEEDBACK_EXT,
-                        vk::PipelineStageFlags::HOST,
-                        vk::DependencyFlags::empty(),
-                        &barrier,
-                        &[],
-                        &[],
-                    );
+                    end_capture_scope(&device, &xfb, cmd);
+                    capture_to_host_barrier(&device, cmd);
                 }
             })?;
             if let Some(e) = failure {
@@ -839,19 +810,6 @@ impl BftSurface {
         Err(TessError::Invalid(
             "transform feedback overflowed twice".into(),
         ))
-    }
-
-    fn pipelines_layout(
-        &mut self,
-        renderer: &Renderer,
-        spacing: Spacing,
-    ) -> Result<vk::PipelineLayout> {
-        let key = BftPipelineKey {
-            spacing,
-            wireframe: true,
-        };
-        self.capture_pipeline(renderer, spacing)?;
-        Ok(self.capture_pipelines[&key].layout)
     }
 
     /// Maps a captured (patch, `gl_TessCoord.xy`) to the base face and its domain coordinate in

@@ -696,55 +696,19 @@ impl Capturer {
             let mut offset = 0u64;
             for (i, (l, &(pipeline, layout))) in lists.iter().zip(&pipelines).enumerate() {
                 let size = capacity[i] * TRIANGLE_BYTES;
-                let rendering = vk::RenderingInfo::default()
-                    .render_area(vk::Rect2D {
-                        offset: vk::Offset2D { x: 0, y: 0 },
-                        extent: vk::Extent2D {
-                            width: 1,
-                            height: 1,
-                        },
-                    })
-                    .layer_count(1);
-                // SAFETY: cmd is recording outside a rendering scope; the pipeline, set and
-                // buffer are live until one_shot returns (it waits); the region
-                // [offset, offset + size) lies inside the buffer (sizes sum to at most its size)
-                // and size > 0 unless the list is empty, which draw_lists never yields.
+                // SAFETY: the pipeline, set and buffer are live until one_shot returns (it
+                // waits); [offset, offset + size) lies inside the buffer (sizes sum to at most
+                // its size).
                 unsafe {
-                    device.raw.cmd_begin_rendering(cmd, &rendering);
-                    device
-                        .raw
-                        .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                    device.raw.cmd_bind_descriptor_sets(
+                    begin_capture_scope(
+                        &device,
+                        &xfb,
                         cmd,
-                        vk::PipelineBindPoint::GRAPHICS,
-                        layout,
-                        0,
+                        (pipeline, layout),
                         &[set],
-                        &[],
-                    );
-                    let viewport = vk::Viewport {
-                        x: 0.0,
-                        y: 0.0,
-                        width: 1.0,
-                        height: 1.0,
-                        min_depth: 0.0,
-                        max_depth: 1.0,
-                    };
-                    device.raw.cmd_set_viewport(cmd, 0, &[viewport]);
-                    device.raw.cmd_set_scissor(
-                        cmd,
-                        0,
-                        &[vk::Rect2D {
-                            offset: vk::Offset2D { x: 0, y: 0 },
-                            extent: vk::Extent2D {
-                                width: 1,
-                                height: 1,
-                            },
-                        }],
-                    );
-                    xfb.cmd_bind_transform_feedback_buffer(cmd, 0, buffer.raw, offset, size.max(4));
-                    xfb.cmd_begin_transform_feedback(cmd);
-                }
+                        (buffer.raw, offset, size.max(4)),
+                    )
+                };
                 if let Err(e) = query.cmd_begin_stream(cmd, i as u32, 0) {
                     failure = Some(e);
                 }
@@ -755,28 +719,12 @@ impl Capturer {
                 if let Err(e) = query.cmd_end_stream(cmd, i as u32, 0) {
                     failure = Some(e);
                 }
-                // SAFETY: transform feedback and rendering were begun above on this cmd.
-                unsafe {
-                    xfb.cmd_end_transform_feedback(cmd);
-                    device.raw.cmd_end_rendering(cmd);
-                }
+                // SAFETY: begun above on this cmd.
+                unsafe { end_capture_scope(&device, &xfb, cmd) };
                 offset += size;
             }
-            let barrier = vk::MemoryBarrier::default()
-                .src_access_mask(vk::AccessFlags::TRANSFORM_FEEDBACK_WRITE_EXT)
-                .dst_access_mask(vk::AccessFlags::HOST_READ);
             // SAFETY: cmd is recording outside a rendering scope.
-            unsafe {
-                device.raw.cmd_pipeline_barrier(
-                    cmd,
-                    vk::PipelineStageFlags::TRANSFORM_FEEDBACK_EXT,
-                    vk::PipelineStageFlags::HOST,
-                    vk::DependencyFlags::empty(),
-                    &[barrier],
-                    &[],
-                    &[],
-                )
-            };
+            unsafe { capture_to_host_barrier(&device, cmd) };
         })?;
         if let Some(e) = failure {
             return Err(e.into());
@@ -792,6 +740,97 @@ impl Capturer {
             offset += (capacity[i] * TRIANGLE_BYTES) as usize;
         }
         Ok((CapturedSoup { records }, results, counts))
+    }
+}
+
+/// Begins a capture scope: an attachment-less 1×1 rendering scope with `pipeline` and `sets`
+/// bound and transform feedback writing into `region` (buffer, offset, size).
+///
+/// # Safety
+/// `cmd` is recording outside a rendering scope; the pipeline, sets and buffer outlive the
+/// submission; the region lies inside the buffer. Pair with [`end_capture_scope`].
+pub(crate) unsafe fn begin_capture_scope(
+    device: &Device,
+    xfb: &ash::ext::transform_feedback::Device,
+    cmd: vk::CommandBuffer,
+    (pipeline, layout): (vk::Pipeline, vk::PipelineLayout),
+    sets: &[vk::DescriptorSet],
+    (buffer, offset, size): (vk::Buffer, u64, u64),
+) {
+    let area = vk::Rect2D {
+        offset: vk::Offset2D { x: 0, y: 0 },
+        extent: vk::Extent2D {
+            width: 1,
+            height: 1,
+        },
+    };
+    let rendering = vk::RenderingInfo::default()
+        .render_area(area)
+        .layer_count(1);
+    let viewport = vk::Viewport {
+        x: 0.0,
+        y: 0.0,
+        width: 1.0,
+        height: 1.0,
+        min_depth: 0.0,
+        max_depth: 1.0,
+    };
+    // SAFETY: the caller upholds this function's contract.
+    unsafe {
+        device.raw.cmd_begin_rendering(cmd, &rendering);
+        device
+            .raw
+            .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+        device.raw.cmd_bind_descriptor_sets(
+            cmd,
+            vk::PipelineBindPoint::GRAPHICS,
+            layout,
+            0,
+            sets,
+            &[],
+        );
+        device.raw.cmd_set_viewport(cmd, 0, &[viewport]);
+        device.raw.cmd_set_scissor(cmd, 0, &[area]);
+        xfb.cmd_bind_transform_feedback_buffer(cmd, 0, buffer, offset, size);
+        xfb.cmd_begin_transform_feedback(cmd);
+    }
+}
+
+/// Ends what [`begin_capture_scope`] began.
+///
+/// # Safety
+/// A capture scope is open on `cmd`.
+pub(crate) unsafe fn end_capture_scope(
+    device: &Device,
+    xfb: &ash::ext::transform_feedback::Device,
+    cmd: vk::CommandBuffer,
+) {
+    // SAFETY: the caller upholds this function's contract.
+    unsafe {
+        xfb.cmd_end_transform_feedback(cmd);
+        device.raw.cmd_end_rendering(cmd);
+    }
+}
+
+/// Makes transform-feedback writes visible to the host read that follows the submission.
+///
+/// # Safety
+/// `cmd` is recording outside a rendering scope.
+pub(crate) unsafe fn capture_to_host_barrier(device: &Device, cmd: vk::CommandBuffer) {
+    let barrier = vk::MemoryBarrier::default()
+        .src_access_mask(vk::AccessFlags::TRANSFORM_FEEDBACK_WRITE_EXT)
+        .dst_access_mask(vk::AccessFlags::HOST_READ);
+    // SAFETY: the caller upholds this function's contract.
+    unsafe {
+        device.raw.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::TRANSFORM_FEEDBACK_EXT,
+            vk::PipelineStageFlags::HOST,
+            vk::DependencyFlags::empty(),
+            &[barrier],
+            &[],
+            &[],
+        );
     }
 }
 

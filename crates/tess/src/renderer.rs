@@ -289,14 +289,7 @@ impl Renderer {
             ShaderStage::new(vk::ShaderStageFlags::FRAGMENT, shaders::SHADE_FRAG),
         ];
         set_patch_input(&mut desc, cp, self.set_layout.raw);
-        if key.wireframe {
-            desc.polygon_mode = vk::PolygonMode::LINE;
-            desc.depth_compare = vk::CompareOp::LESS_OR_EQUAL;
-            desc.depth_write = false;
-        } else {
-            // Pushes the surface slightly back so the wireframe overlay wins the depth test.
-            desc.depth_bias = Some((1.0, 1.0));
-        }
+        set_pass_style(&mut desc, key.wireframe);
         Ok(Pipeline::graphics(&self.device, &desc)?)
     }
 
@@ -605,6 +598,18 @@ pub(crate) fn technique_stages(
         ),
         (m, d) => return Err(TessError::Invalid(format!("{m:?} has no {d:?} patches"))),
     })
+}
+
+/// Shaded pass or wireframe overlay: the overlay draws lines without writing depth, the shaded
+/// pass is pushed slightly back so the overlay wins the depth test. Every technique uses this.
+pub(crate) fn set_pass_style(desc: &mut GraphicsPipelineDesc<'_>, wireframe: bool) {
+    if wireframe {
+        desc.polygon_mode = vk::PolygonMode::LINE;
+        desc.depth_compare = vk::CompareOp::LESS_OR_EQUAL;
+        desc.depth_write = false;
+    } else {
+        desc.depth_bias = Some((1.0, 1.0));
+    }
 }
 
 /// Vertex input (the mesh's interleaved [`Vertex`]), patch topology, the frame set and the

@@ -21,15 +21,27 @@ pub enum WorkaroundId {
     /// draws so that no chunk can exceed 65,536 vertices at the largest factor the draw can use.
     /// This is likely the cause of OpenSubdiv's holes on llvmpipe.
     LavapipeTessChunkVertexLimit,
+    /// lavapipe, Mesa 22.3: a pipeline-statistics query around a draw of one-control-point
+    /// patches with no vertex input (the BFT main pass) crashes a worker thread (SIGSEGV); the
+    /// same draw without the query renders correctly. Tessera does not query statistics for
+    /// such draws there and counts their output through transform feedback instead.
+    LavapipeStatisticsQueryPointPatches,
 }
 
 /// The list of every known workaround; `Workarounds::for_adapter` picks the active ones.
 pub fn known() -> Vec<Workaround> {
-    vec![Workaround {
-        id: WorkaroundId::LavapipeTessChunkVertexLimit,
-        driver: vk::DriverId::MESA_LLVMPIPE,
-        summary: "lavapipe: tessellated draws split so no internal chunk emits > 65,536 vertices (16-bit chunk indices)",
-    }]
+    vec![
+        Workaround {
+            id: WorkaroundId::LavapipeTessChunkVertexLimit,
+            driver: vk::DriverId::MESA_LLVMPIPE,
+            summary: "lavapipe: tessellated draws split so no internal chunk emits > 65,536 vertices (16-bit chunk indices)",
+        },
+        Workaround {
+            id: WorkaroundId::LavapipeStatisticsQueryPointPatches,
+            driver: vk::DriverId::MESA_LLVMPIPE,
+            summary: "lavapipe: no pipeline-statistics query around one-control-point patch draws (crashes)",
+        },
+    ]
 }
 
 /// The workarounds active on one device.
