@@ -124,6 +124,32 @@ pub fn uniform_vertex_count(domain: Domain, spacing: Spacing, level: f32) -> u64
     }
 }
 
+/// Triangles one patch emits: the tessellation of a patch is a triangulated disc whose boundary
+/// holds exactly the outer edges' vertices, so Euler's formula gives T = 2V − B − 2.
+fn disc_triangles(vertices: u64, boundary: u64) -> u64 {
+    (2 * vertices).saturating_sub(boundary + 2)
+}
+
+/// Triangles one triangle patch emits with outer levels `outer` and inner level `inner`.
+pub fn triangle_triangle_count(spacing: Spacing, outer: [f32; 3], inner: f32) -> u64 {
+    let boundary: u64 = outer.iter().map(|&l| spacing.segments(l) as u64).sum();
+    disc_triangles(triangle_vertex_count(spacing, outer, inner), boundary)
+}
+
+/// Triangles one quad patch emits with outer levels `outer` and inner levels `inner`.
+pub fn quad_triangle_count(spacing: Spacing, outer: [f32; 4], inner: [f32; 2]) -> u64 {
+    let boundary: u64 = outer.iter().map(|&l| spacing.segments(l) as u64).sum();
+    disc_triangles(quad_vertex_count(spacing, outer, inner), boundary)
+}
+
+/// Triangles one patch emits with every level equal to `level` (what the clipper receives).
+pub fn uniform_triangle_count(domain: Domain, spacing: Spacing, level: f32) -> u64 {
+    match domain {
+        Domain::Triangle => triangle_triangle_count(spacing, [level; 3], level),
+        Domain::Quad => quad_triangle_count(spacing, [level; 4], [level; 2]),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -167,6 +193,40 @@ mod tests {
                 "level {n}"
             );
         }
+    }
+
+    #[test]
+    fn triangle_counts() {
+        // Quads at level n: an n × n grid of cells, two triangles each.
+        for n in 1..=64u64 {
+            assert_eq!(
+                uniform_triangle_count(Domain::Quad, Spacing::Equal, n as f32),
+                2 * n * n
+            );
+        }
+        // Triangles: concentric rings, 3(2m − 2) triangles between the ring of m segments per
+        // side and the next one inside, closed by a centre point (even n) or a triangle (odd n);
+        // this sums to 3n²/2 for even n and (3n² − 1)/2 for odd n.
+        for n in 1..=64u64 {
+            let expected = if n % 2 == 0 {
+                3 * n * n / 2
+            } else {
+                (3 * n * n - 1) / 2
+            };
+            assert_eq!(
+                uniform_triangle_count(Domain::Triangle, Spacing::Equal, n as f32),
+                expected,
+                "level {n}"
+            );
+        }
+        assert_eq!(
+            uniform_triangle_count(Domain::Triangle, Spacing::Equal, 2.0),
+            6
+        );
+        assert_eq!(
+            uniform_triangle_count(Domain::Triangle, Spacing::Equal, 3.0),
+            13
+        );
     }
 
     #[test]
