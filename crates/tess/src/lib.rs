@@ -6,6 +6,7 @@
 pub mod camera;
 pub mod error;
 pub mod gpu;
+pub mod plain;
 pub mod render_mesh;
 pub mod renderer;
 pub mod tessellator;

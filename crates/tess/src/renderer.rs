@@ -162,6 +162,37 @@ impl GpuMesh {
     }
 }
 
+/// The frame uniforms for `params`, a mesh bounding box and a target of `extent`; shared by every
+/// pipeline that includes `frame.glsl` (tessellated or not), so they all see the same view.
+pub fn frame_uniforms(
+    bbox_min: [f32; 3],
+    bbox_max: [f32; 3],
+    params: &DrawParams,
+    extent: vk::Extent2D,
+) -> FrameUniforms {
+    let aspect = extent.width as f32 / extent.height.max(1) as f32;
+    let m = params.camera.matrices(bbox_min, bbox_max, aspect);
+    let light = (m.eye - glam::Vec3::from(bbox_min).lerp(glam::Vec3::from(bbox_max), 0.5))
+        .normalize_or_zero();
+    let light = (light + glam::Vec3::new(0.3, 0.6, 0.2)).normalize_or_zero();
+    let level = params.level.clamp(1.0, crate::tessellator::MAX_LEVEL);
+    FrameUniforms {
+        view_proj: (m.proj * m.view).to_cols_array_2d(),
+        view: m.view.to_cols_array_2d(),
+        camera_pos: [m.eye.x, m.eye.y, m.eye.z, 1.0],
+        light_dir: [light.x, light.y, light.z, 0.0],
+        tess: [level, level, params.phong_alpha, 0.0],
+        base_color: [
+            params.base_color[0],
+            params.base_color[1],
+            params.base_color[2],
+            1.0,
+        ],
+        wire_color: [0.05, 0.05, 0.08, 1.0],
+        viewport: [extent.width as f32, extent.height as f32, 0.0, 0.0],
+    }
+}
+
 /// Per-frame-in-flight resources: a uniform buffer and its descriptor set.
 struct FrameSlot {
     uniforms: Buffer,
@@ -362,28 +393,7 @@ impl Renderer {
         params: &DrawParams,
         extent: vk::Extent2D,
     ) -> Result<()> {
-        let aspect = extent.width as f32 / extent.height.max(1) as f32;
-        let m = params.camera.matrices(mesh.bbox_min, mesh.bbox_max, aspect);
-        let light = (m.eye
-            - glam::Vec3::from(mesh.bbox_min).lerp(glam::Vec3::from(mesh.bbox_max), 0.5))
-        .normalize_or_zero();
-        let light = (light + glam::Vec3::new(0.3, 0.6, 0.2)).normalize_or_zero();
-        let level = params.level.clamp(1.0, crate::tessellator::MAX_LEVEL);
-        let u = FrameUniforms {
-            view_proj: (m.proj * m.view).to_cols_array_2d(),
-            view: m.view.to_cols_array_2d(),
-            camera_pos: [m.eye.x, m.eye.y, m.eye.z, 1.0],
-            light_dir: [light.x, light.y, light.z, 0.0],
-            tess: [level, level, params.phong_alpha, 0.0],
-            base_color: [
-                params.base_color[0],
-                params.base_color[1],
-                params.base_color[2],
-                1.0,
-            ],
-            wire_color: [0.05, 0.05, 0.08, 1.0],
-            viewport: [extent.width as f32, extent.height as f32, 0.0, 0.0],
-        };
+        let u = frame_uniforms(mesh.bbox_min, mesh.bbox_max, params, extent);
         let slot = self
             .slots
             .get_mut(slot)
