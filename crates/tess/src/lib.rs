@@ -3,6 +3,7 @@
 //! Every technique draws patches through a real TCS/TES pair; the host side here builds the
 //! buffers, chooses the shader variant by a [`renderer::PipelineKey`], sets tessellation factors,
 //! and splits draws where a driver needs it ([`vk_core::workarounds`]).
+pub mod bench;
 pub mod camera;
 pub mod error;
 pub mod gpu;
