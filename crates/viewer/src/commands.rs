@@ -17,6 +17,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Info(g) => info(&g),
         Command::Subdivide(a) => crate::topo_cmds::subdivide(a),
         Command::Limit(a) => crate::topo_cmds::limit(a),
+        Command::Bench(a) => crate::bench::run(a),
     }
 }
 
