@@ -265,18 +265,10 @@ pub fn cpu_loop_limit_mesh(mesh: &ControlMesh, level: usize) -> Result<CpuLimitM
     for _ in 0..level {
         current = refine_level(&current, Scheme::Loop, &mesh.options)?.0;
     }
-    let local = LocalMesh::from_refined_level(&current, LimitScheme::Loop, &mesh.options)
-        .map_err(|e| TessError::Invalid(format!("limit masks at level {level}: {e}")))?;
-    let mut positions = Vec::with_capacity(current.num_vertices());
-    for v in 0..current.num_vertices() {
-        let p = local.vertex_limit_position(v as u32).ok_or_else(|| {
-            TessError::Invalid(format!(
-                "vertex {v} of level {level} has no limit mask (a semi-sharp crease is left); \
-                 bench meshes must be crease-free"
-            ))
-        })?;
-        positions.push([p[0], p[1], p[2]]);
-    }
+    let positions = match loop_limit_positions(&current) {
+        Some(p) => p,
+        None => evaluator_limit_positions(&current, level, &mesh.options)?,
+    };
     let normals =
         angle_weighted_normals(&positions, current.face_offsets(), current.face_vertices());
     let vertices = positions
@@ -291,6 +283,101 @@ pub fn cpu_loop_limit_mesh(mesh: &ControlMesh, level: usize) -> Result<CpuLimitM
         vertices,
         indices: current.face_vertices().to_vec(),
     })
+}
+
+/// Limit positions of every vertex of a Loop level by the limit masks of
+/// [`topology::limit::loop_limit_masks`], read straight off the level's edge lists and
+/// sharpness: what a CPU application does, without building an evaluator. `None` when a
+/// semi-sharp feature is left (its vertices need more refinement first).
+pub fn loop_limit_positions(level: &Level) -> Option<Vec<[f64; 3]>> {
+    use topology::limit::{loop_limit_masks, LimitRule, LimitVertex};
+    const INF: f32 = topology::sdc::SHARPNESS_INFINITE;
+    let semi = |s: f32| s > 0.0 && s < INF;
+    let t = &level.topology;
+    // Smooth weights (vertex, each neighbour) depend on the valence only.
+    let mut smooth: std::collections::HashMap<usize, (f64, f64)> = Default::default();
+    let mut out = Vec::with_capacity(level.num_vertices());
+    for v in 0..level.num_vertices() {
+        let vs = level.vertex_sharpness[v];
+        if semi(vs) {
+            return None;
+        }
+        let p = level.positions[v];
+        let edges = t.vertex_edges(v);
+        let mut sharp = Vec::with_capacity(2);
+        for &e in edges {
+            let s = level.edge_sharpness[e as usize];
+            if semi(s) {
+                return None;
+            }
+            if s >= INF {
+                let [a, b] = t.edge_vertices(e as usize);
+                sharp.push(if a as usize == v { b } else { a });
+            }
+        }
+        let n = edges.len();
+        let q = if vs >= INF || sharp.len() > 2 {
+            p
+        } else if sharp.len() == 2 {
+            // Crease (boundaries included): only the two crease neighbours weigh.
+            let m = loop_limit_masks(&LimitVertex {
+                valence: 2,
+                boundary: false,
+                rule: LimitRule::Crease { ends: [0, 1] },
+            });
+            let w = &m.position;
+            let (a, b) = (
+                level.positions[sharp[0] as usize],
+                level.positions[sharp[1] as usize],
+            );
+            std::array::from_fn(|k| w.vertex * p[k] + w.edges[0] * a[k] + w.edges[1] * b[k])
+        } else {
+            let (wv, we) = *smooth.entry(n).or_insert_with(|| {
+                let m = loop_limit_masks(&LimitVertex {
+                    valence: n,
+                    boundary: false,
+                    rule: LimitRule::Smooth,
+                });
+                (
+                    m.position.vertex,
+                    m.position.edges.first().copied().unwrap_or(0.0),
+                )
+            });
+            let mut q = p.map(|c| wv * c);
+            for &e in edges {
+                let [a, b] = t.edge_vertices(e as usize);
+                let w = level.positions[if a as usize == v { b } else { a } as usize];
+                for k in 0..3 {
+                    q[k] += we * w[k];
+                }
+            }
+            q
+        };
+        out.push(q);
+    }
+    Some(out)
+}
+
+/// Limit positions through the general evaluator ([`LocalMesh::vertex_limit_position`]), for
+/// levels [`loop_limit_positions`] declines.
+fn evaluator_limit_positions(
+    current: &Level,
+    level: usize,
+    options: &topology::SubdivOptions,
+) -> Result<Vec<[f64; 3]>> {
+    let local = LocalMesh::from_refined_level(current, LimitScheme::Loop, options)
+        .map_err(|e| TessError::Invalid(format!("limit masks at level {level}: {e}")))?;
+    (0..current.num_vertices())
+        .map(|v| {
+            let p = local.vertex_limit_position(v as u32).ok_or_else(|| {
+                TessError::Invalid(format!(
+                    "vertex {v} of level {level} has no limit mask (a semi-sharp crease is \
+                     left); bench meshes must be crease-free"
+                ))
+            })?;
+            Ok([p[0], p[1], p[2]])
+        })
+        .collect()
 }
 
 /// The paper's comparison point: subdivision on the CPU, a plain triangle draw on the GPU.
@@ -440,5 +527,95 @@ impl BenchMethod for CpuLoopMethod {
         self.subdivide_ms.clear();
         self.upload_ms.clear();
         notes
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 3 × 2 grid of quads split into triangles: boundary creases and corners.
+    fn open_grid() -> ControlMesh {
+        let mut pos = Vec::new();
+        for j in 0..3 {
+            for i in 0..4 {
+                pos.push([i as f64, j as f64, ((i * j) as f64 * 0.7).sin()]);
+            }
+        }
+        let mut faces = Vec::new();
+        for j in 0..2u32 {
+            for i in 0..3u32 {
+                let a = j * 4 + i;
+                faces.push([a, a + 1, a + 5]);
+                faces.push([a, a + 5, a + 4]);
+            }
+        }
+        ControlMesh::from_polygons(pos, &faces)
+    }
+
+    fn tetrahedron() -> ControlMesh {
+        ControlMesh::from_polygons(
+            vec![
+                [1.0, 1.0, 1.0],
+                [1.0, -1.0, -1.0],
+                [-1.0, 1.0, -1.0],
+                [-1.0, -1.0, 1.0],
+            ],
+            &[[0u32, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]],
+        )
+    }
+
+    #[test]
+    fn mask_limit_positions_equal_the_evaluator() {
+        let mut corners = open_grid();
+        corners.options.boundary = topology::BoundaryInterpolation::EdgesAndCorners;
+        let mut creased = tetrahedron();
+        creased.creases.push(topology::EdgeCrease {
+            vertices: [0, 1],
+            sharpness: 10.0,
+        });
+        creased.creases.push(topology::EdgeCrease {
+            vertices: [1, 2],
+            sharpness: 10.0,
+        });
+        for (name, mesh) in [
+            ("grid", open_grid()),
+            ("grid, corners", corners),
+            ("tetrahedron", tetrahedron()),
+            ("tetrahedron, crease", creased),
+        ] {
+            let mut level = Level::from_mesh(&mesh, Scheme::Loop).unwrap();
+            for k in 0..3 {
+                let fast = loop_limit_positions(&level).expect("no semi-sharp features");
+                let slow = evaluator_limit_positions(&level, k, &mesh.options).unwrap();
+                assert_eq!(fast.len(), slow.len());
+                for (v, (a, b)) in fast.iter().zip(&slow).enumerate() {
+                    for c in 0..3 {
+                        assert!((a[c] - b[c]).abs() < 1e-12, "{name} level {k} vertex {v}");
+                    }
+                }
+                level = refine_level(&level, Scheme::Loop, &mesh.options).unwrap().0;
+            }
+        }
+    }
+
+    #[test]
+    fn semi_sharp_creases_are_declined_until_decayed() {
+        let mut mesh = tetrahedron();
+        mesh.creases.push(topology::EdgeCrease {
+            vertices: [0, 1],
+            sharpness: 1.5,
+        });
+        let level = Level::from_mesh(&mesh, Scheme::Loop).unwrap();
+        assert!(loop_limit_positions(&level).is_none());
+        // One level later it is 0.5: still semi-sharp, a typed error, no panic.
+        let e = cpu_loop_limit_mesh(&mesh, 1)
+            .err()
+            .expect("semi-sharp")
+            .to_string();
+        assert!(e.contains("semi-sharp"), "{e}");
+        // Two levels later the crease has decayed and the masks apply.
+        let cpu = cpu_loop_limit_mesh(&mesh, 2).unwrap();
+        assert_eq!(cpu.indices.len(), 3 * 4 * 16);
     }
 }
