@@ -5,7 +5,8 @@
 //!
 //! Techniques are [`BenchMethod`]s built by name from [`registry`]; the runner owns the frame
 //! structure (timestamps, pipeline statistics, rendering scope) so every technique is timed the
-//! same way. Speed is measured here, never asserted by tests.
+//! same way, and interleaves the techniques' frames at each mesh and S so that a machine's
+//! drift does not bias one of them. Speed is measured here, never asserted by tests.
 mod methods;
 mod report;
 pub mod stats;
@@ -443,25 +444,28 @@ pub fn run_bench(
         };
         let mut methods = build_methods(&config.methods, &ctx)?;
         for &segments in &config.segments {
-            let mut flat_total = None;
+            let mut runnable = Vec::new();
             for method in methods.iter_mut() {
-                if let Some(reason) = method.skip_reason(segments) {
-                    report.skipped.push(SkippedRow {
+                match method.skip_reason(segments) {
+                    Some(reason) => report.skipped.push(SkippedRow {
                         mesh: mesh.name.clone(),
                         segments,
                         method: method.label().to_owned(),
                         reason,
-                    });
-                    continue;
+                    }),
+                    None => runnable.push(method),
                 }
-                let mut row = run_row(&harness, method.as_mut(), mesh, segments, config)?;
-                if row.method == "flat" {
-                    flat_total = Some(row.total_median_ms);
-                }
-                row.ratio_to_flat = flat_total.map(|f| row.total_median_ms / f);
-                on_row(&row);
-                report.rows.push(row);
             }
+            let mut rows = run_group(&harness, &mut runnable, mesh, segments, config)?;
+            let flat_total = rows
+                .iter()
+                .find(|r| r.method == "flat")
+                .map(|r| r.total_median_ms);
+            for row in &mut rows {
+                row.ratio_to_flat = flat_total.map(|f| row.total_median_ms / f);
+                on_row(row);
+            }
+            report.rows.extend(rows);
         }
         for m in &methods {
             for n in m.report_notes() {
@@ -506,75 +510,131 @@ fn validate(config: &BenchConfig, meshes: &[BenchMesh]) -> Result<()> {
     Ok(())
 }
 
-fn run_row(
+/// One technique's frames within a group.
+struct RowState {
+    frames: u32,
+    times: FrameTimes,
+    expected: Option<u64>,
+    counted: Option<u64>,
+    last_warmup_cost_s: f64,
+    notes: Vec<String>,
+}
+
+/// Measures every technique at one mesh and S. Frames are interleaved round robin (warm-up
+/// frames first, then timed frames), so a slow drift of the machine (another process, clock
+/// changes) spreads over all techniques instead of biasing whichever ran during it.
+fn run_group(
     harness: &Harness<'_>,
-    method: &mut dyn BenchMethod,
+    methods: &mut [&mut Box<dyn BenchMethod>],
     mesh: &BenchMesh,
     segments: u32,
     config: &BenchConfig,
-) -> Result<BenchRow> {
+) -> Result<Vec<BenchRow>> {
+    if methods.is_empty() {
+        return Ok(Vec::new());
+    }
     let clear = crate::renderer::DrawParams::default().clear_color;
     let warmup = config.warmup;
-    let mut frames = config.frames;
-    let mut notes = Vec::new();
-    let mut times = FrameTimes {
-        gpu_ms: Vec::new(),
-        cpu_ms: Vec::new(),
-        wall_ms: Vec::new(),
-    };
-    let mut expected = None;
-    let mut counted = None;
-    let mut last_warmup_cost_s = 0.0;
+    let mut states: Vec<RowState> = methods
+        .iter()
+        .map(|_| RowState {
+            frames: config.frames,
+            times: FrameTimes {
+                gpu_ms: Vec::new(),
+                cpu_ms: Vec::new(),
+                wall_ms: Vec::new(),
+            },
+            expected: None,
+            counted: None,
+            last_warmup_cost_s: 0.0,
+            notes: Vec::new(),
+        })
+        .collect();
     let mut index = 0;
-    while index < warmup + frames {
+    loop {
         let is_warmup = index < warmup;
-        let frame = BenchFrame {
-            index,
-            warmup: is_warmup,
-            segments,
-            extent: config.extent,
-            camera: config.camera,
-        };
-        let frame_start = Instant::now();
-        let cpu = method.begin_frame(&frame)?;
-        let (gpu, wall, cpu_count, stats_count) =
-            harness.frame(method, &frame, index == 0, clear)?;
-        if index == 0 {
-            counted = stats_count;
-        }
-        match expected {
-            None => expected = Some(cpu_count),
-            Some(e) if e != cpu_count => {
-                return Err(TessError::Invalid(format!(
-                    "{} drew {cpu_count} triangles in frame {index}, {e} before",
-                    method.label()
-                )))
+        let mut any = false;
+        for (method, st) in methods.iter_mut().zip(&mut states) {
+            if !is_warmup && index - warmup >= st.frames {
+                continue;
             }
-            Some(_) => {}
-        }
-        if is_warmup {
-            last_warmup_cost_s = frame_start.elapsed().as_secs_f64();
-        } else {
-            times.gpu_ms.push(gpu);
-            times.cpu_ms.push(cpu);
-            times.wall_ms.push(wall);
+            any = true;
+            let frame = BenchFrame {
+                index,
+                warmup: is_warmup,
+                segments,
+                extent: config.extent,
+                camera: config.camera,
+            };
+            let frame_start = Instant::now();
+            let cpu = method.begin_frame(&frame)?;
+            let (gpu, wall, cpu_count, stats_count) =
+                harness.frame(method.as_mut(), &frame, index == 0, clear)?;
+            if index == 0 {
+                st.counted = stats_count;
+            }
+            match st.expected {
+                None => st.expected = Some(cpu_count),
+                Some(e) if e != cpu_count => {
+                    return Err(TessError::Invalid(format!(
+                        "{} drew {cpu_count} triangles in frame {index}, {e} before",
+                        method.label()
+                    )))
+                }
+                Some(_) => {}
+            }
+            if is_warmup {
+                st.last_warmup_cost_s = frame_start.elapsed().as_secs_f64();
+            } else {
+                st.times.gpu_ms.push(gpu);
+                st.times.cpu_ms.push(cpu);
+                st.times.wall_ms.push(wall);
+            }
         }
         index += 1;
-        // After the warm-up, fit the timed frames into the row budget.
+        // After the warm-up, fit each technique's timed frames into the row budget.
         if index == warmup {
             if let Some(budget) = config.row_budget_s {
-                let fit = (budget / last_warmup_cost_s.max(1e-9)).floor() as u32;
-                let reduced = fit.clamp(config.min_frames.max(1), frames);
-                if reduced < frames {
-                    notes.push(format!(
-                        "frames reduced from {frames} to {reduced} (row budget {budget} s, \
-                         {last_warmup_cost_s:.2} s per frame)"
-                    ));
-                    frames = reduced;
+                for st in &mut states {
+                    let per_frame = st.last_warmup_cost_s.max(1e-9);
+                    let fit = (budget / per_frame).floor() as u32;
+                    let reduced = fit.clamp(config.min_frames.max(1), st.frames);
+                    if reduced < st.frames {
+                        st.notes.push(format!(
+                            "frames reduced from {} to {reduced} (row budget {budget} s, \
+                             {per_frame:.2} s per frame)",
+                            st.frames
+                        ));
+                        st.frames = reduced;
+                    }
                 }
             }
         }
+        if !any && index > warmup {
+            break;
+        }
     }
+    methods
+        .iter_mut()
+        .zip(states)
+        .map(|(method, st)| finish_row(method.as_mut(), st, mesh, segments, warmup))
+        .collect()
+}
+
+fn finish_row(
+    method: &mut dyn BenchMethod,
+    st: RowState,
+    mesh: &BenchMesh,
+    segments: u32,
+    warmup: u32,
+) -> Result<BenchRow> {
+    let RowState {
+        times,
+        expected,
+        counted,
+        mut notes,
+        ..
+    } = st;
     let expected = expected.unwrap_or(0);
     let (triangles, triangles_source) = match counted {
         Some(c) => {

@@ -73,8 +73,8 @@ impl BenchReport {
             format!("Build profile: {}", self.profile),
             format!(
                 "Setup: offscreen {}x{}, default camera (yaw {}°, pitch {}°, zoom {}), equal spacing, \
-                 {} timed frames after {} warm-up frames per row (unless a row says otherwise); \
-                 GPU time = timestamps around the frame's work; ratio = total ms / Flat's total ms \
+                 {} timed frames after {} warm-up frames per row (unless a row says otherwise), the \
+                 techniques' frames interleaved round robin at each mesh and S; GPU time = timestamps around the frame's work; ratio = total ms / Flat's total ms \
                  at the same mesh and S",
                 c.extent.width,
                 c.extent.height,
