@@ -4,11 +4,13 @@
 //! buffers, chooses the shader variant by a [`renderer::PipelineKey`], sets tessellation factors,
 //! and splits draws where a driver needs it ([`vk_core::workarounds`]). [`capture`] reads back
 //! exactly what the TES emitted (transform feedback) and checks it for cracks.
+pub mod bench;
 pub mod bft;
 pub mod camera;
 pub mod capture;
 pub mod error;
 pub mod gpu;
+pub mod plain;
 pub mod render_mesh;
 pub mod renderer;
 pub mod tessellator;

@@ -477,8 +477,9 @@ pub(crate) fn frame_uniforms(
     frame_uniforms_for((mesh.bbox_min, mesh.bbox_max), params, extent)
 }
 
-/// Frame uniforms for a scene framed by `bbox`.
-pub(crate) fn frame_uniforms_for(
+/// Frame uniforms for a scene framed by `bbox`; shared by every pipeline that includes
+/// `frame.glsl` (tessellated or not), so they all see the same view.
+pub fn frame_uniforms_for(
     bbox: ([f32; 3], [f32; 3]),
     params: &DrawParams,
     extent: vk::Extent2D,

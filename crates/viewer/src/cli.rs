@@ -32,6 +32,9 @@ pub enum Command {
     /// Capture the triangles the GPU's TES emitted (transform feedback), weld them by position
     /// bits, report open edges and cracks, and write them as OBJ.
     Export(ExportArgs),
+    /// Measure output triangles and GPU frame times per mesh, segments per edge and technique
+    /// (Table I of Holländer & Boubekeur), offscreen.
+    Bench(BenchArgs),
 }
 
 #[derive(Args, Debug)]
@@ -61,6 +64,46 @@ pub struct ExportArgs {
     /// Output OBJ.
     #[arg(short, long)]
     pub output: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Segments per base edge S (4, 16, 32 are the paper's levels 2, 4, 5).
+    #[arg(long, value_delimiter = ',', default_value = "4,16,32")]
+    pub segments: Vec<u32>,
+    /// Techniques: flat, phong, pn, cpu (CPU Loop subdivision: cpu-static and cpu-animated rows).
+    #[arg(long, value_delimiter = ',', default_value = "flat,phong,pn,cpu")]
+    pub methods: Vec<String>,
+    /// Timed frames per row.
+    #[arg(long, default_value_t = 30)]
+    pub frames: u32,
+    /// Untimed frames before them.
+    #[arg(long, default_value_t = 5)]
+    pub warmup: u32,
+    /// OBJ control mesh (repeatable); replaces the default set.
+    #[arg(long)]
+    pub mesh: Vec<PathBuf>,
+    /// Offscreen size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Seconds a row's timed frames may take; slower rows get fewer frames (noted in the row).
+    #[arg(long)]
+    pub row_budget: Option<f64>,
+    /// The fewest timed frames --row-budget may leave.
+    #[arg(long, default_value_t = 5)]
+    pub min_frames: u32,
+    /// The CPU baseline skips subdivision levels with more vertices than this (Loop level 5
+    /// of the quadrangulated spot, 3.0 M vertices, peaks at about 1.6 GB of memory).
+    #[arg(long, default_value_t = 4_000_000)]
+    pub cpu_max_vertices: u64,
+    /// Write the rows as CSV.
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+    /// Write a Markdown report (device, date, build profile, table).
+    #[arg(long)]
+    pub markdown: Option<PathBuf>,
+    #[command(flatten)]
+    pub gpu: GpuArgs,
 }
 
 #[derive(Args, Debug)]

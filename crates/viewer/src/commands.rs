@@ -18,6 +18,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Subdivide(a) => crate::topo_cmds::subdivide(a),
         Command::Limit(a) => crate::topo_cmds::limit(a),
         Command::Export(a) => crate::export::run(a),
+        Command::Bench(a) => crate::bench::run(a),
     }
 }
 

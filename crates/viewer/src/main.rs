@@ -1,5 +1,6 @@
 //! `tessera`: render, view and inspect subdivision surfaces drawn on the tessellation stage.
 #![forbid(unsafe_code)]
+mod bench;
 mod cli;
 mod commands;
 mod export;

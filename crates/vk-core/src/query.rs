@@ -131,6 +131,58 @@ impl QueryPool {
         };
     }
 
+    fn check_index(&self, query: u32) -> Result<()> {
+        if query < self.count {
+            Ok(())
+        } else {
+            Err(VkError::Invalid(format!(
+                "query {query} is outside a pool of {}",
+                self.count
+            )))
+        }
+    }
+
+    /// Records a timestamp write at `stage` into query `query` (reset earlier in the submission).
+    pub fn cmd_write_timestamp(
+        &self,
+        cmd: vk::CommandBuffer,
+        stage: vk::PipelineStageFlags,
+        query: u32,
+    ) -> Result<()> {
+        if self.ty != vk::QueryType::TIMESTAMP {
+            return Err(VkError::Invalid("not a timestamp pool".into()));
+        }
+        self.check_index(query)?;
+        // SAFETY: cmd is recording; the index is inside the pool; the caller reset the query.
+        unsafe {
+            self.device
+                .raw
+                .cmd_write_timestamp(cmd, stage, self.raw, query)
+        };
+        Ok(())
+    }
+
+    /// Begins query `query` (pipeline statistics). A query begun outside a rendering scope must
+    /// end outside it too (it may span whole rendering scopes and compute dispatches).
+    pub fn cmd_begin(&self, cmd: vk::CommandBuffer, query: u32) -> Result<()> {
+        self.check_index(query)?;
+        // SAFETY: cmd is recording; the index is inside the pool; the caller reset the query.
+        unsafe {
+            self.device
+                .raw
+                .cmd_begin_query(cmd, self.raw, query, vk::QueryControlFlags::empty())
+        };
+        Ok(())
+    }
+
+    /// Ends query `query`, begun by [`QueryPool::cmd_begin`] in the same command buffer.
+    pub fn cmd_end(&self, cmd: vk::CommandBuffer, query: u32) -> Result<()> {
+        self.check_index(query)?;
+        // SAFETY: cmd is recording and the query is active (begun above by the caller).
+        unsafe { self.device.raw.cmd_end_query(cmd, self.raw, query) };
+        Ok(())
+    }
+
     /// Waits for and reads `N` 64-bit values per query (ash takes one `T` per query: its size
     /// is the stride, so a flat `u64` slice would claim 7× too many statistics queries).
     fn results<const N: usize>(&self) -> Result<Vec<[u64; N]>> {

@@ -1,0 +1,753 @@
+//! The benchmark behind `tessera bench`, after Table I of Holländer & Boubekeur ("Synthesizing
+//! Subdivision Meshes using Real Time Tessellation"): for each mesh, each number of segments per
+//! base edge S and each technique, the output triangles and the GPU frame time (median and p90
+//! over timed frames after warm-up), offscreen, with the ratio to Flat at the same S.
+//!
+//! Techniques are [`BenchMethod`]s built by name from [`registry`]; the runner owns the frame
+//! structure (timestamps, pipeline statistics, rendering scope) so every technique is timed the
+//! same way, and interleaves the techniques' frames at each mesh and S so that a machine's
+//! drift does not bias one of them. Speed is measured here, never asserted by tests.
+mod methods;
+mod report;
+pub mod stats;
+
+pub use methods::{
+    build_methods, cpu_loop_limit_mesh, loop_level_for, loop_level_size, method_names, one,
+    registry, BenchFrame, BenchMethod, CpuLimitMesh, CpuLoopMethod, MethodContext, MethodEntry,
+    MethodFactory, TessMethod,
+};
+pub use report::{parse_csv, CSV_HEADER};
+
+use crate::camera::Camera;
+use crate::error::{Result, TessError};
+use crate::render_mesh::RenderMesh;
+use std::time::Instant;
+use topology::ControlMesh;
+use vk_core::query::QueryPool;
+use vk_core::target::{OffscreenTarget, COLOR_FORMAT, DEPTH_FORMAT};
+use vk_core::{vk, AdapterInfo, Device};
+
+/// What to measure.
+#[derive(Clone, Debug)]
+pub struct BenchConfig {
+    /// Segments per base edge S (Table I: 4, 16, 32 for levels 2, 4, 5).
+    pub segments: Vec<u32>,
+    /// Registry names, e.g. `["flat", "phong", "pn", "cpu"]`.
+    pub methods: Vec<String>,
+    /// Timed frames per row.
+    pub frames: u32,
+    /// Untimed frames before them (pipeline creation, caches).
+    pub warmup: u32,
+    pub extent: vk::Extent2D,
+    pub camera: Camera,
+    /// When set, a row whose timed frames would take longer than this (judged from the last
+    /// warm-up frame's wall time) gets fewer frames, never fewer than `min_frames`; the row
+    /// says so in its note.
+    pub row_budget_s: Option<f64>,
+    pub min_frames: u32,
+    /// The CPU baseline skips levels with more vertices than this (3 M vertices peak at about
+    /// 1.6 GB of host memory).
+    pub cpu_max_vertices: u64,
+}
+
+impl Default for BenchConfig {
+    fn default() -> Self {
+        Self {
+            segments: vec![4, 16, 32],
+            methods: ["flat", "phong", "pn", "cpu"].map(String::from).to_vec(),
+            frames: 30,
+            warmup: 5,
+            extent: vk::Extent2D {
+                width: 1280,
+                height: 720,
+            },
+            camera: Camera::default(),
+            row_budget_s: None,
+            min_frames: 5,
+            cpu_max_vertices: 4_000_000,
+        }
+    }
+}
+
+/// A control mesh prepared for every technique: triangles only (Loop and the triangle
+/// techniques need them), and its render form.
+#[derive(Clone, Debug)]
+pub struct BenchMesh {
+    pub name: String,
+    pub mesh: ControlMesh,
+    pub render: RenderMesh,
+    /// How the mesh was changed on load (fan triangulation), for the report.
+    pub notes: Vec<String>,
+}
+
+impl BenchMesh {
+    /// Fan-triangulates `mesh` (quads and n-gons; the paper's techniques take triangles) and
+    /// builds its render form.
+    pub fn new(name: &str, mesh: &ControlMesh) -> Result<Self> {
+        let (tri, split) = fan_triangulate(mesh)?;
+        let mut notes = Vec::new();
+        if split.polygons > 0 {
+            notes.push(format!(
+                "{name}: fan-triangulated on load ({} of {} faces were quads or n-gons; {} triangles)",
+                split.polygons,
+                mesh.num_faces(),
+                tri.num_faces()
+            ));
+        }
+        let render = RenderMesh::from_control_mesh(&tri)?;
+        Ok(Self {
+            name: name.to_owned(),
+            mesh: tri,
+            render,
+            notes,
+        })
+    }
+
+    pub fn triangles(&self) -> u64 {
+        self.mesh.num_faces() as u64
+    }
+}
+
+/// How many faces [`fan_triangulate`] split.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TriangulationSummary {
+    pub polygons: usize,
+}
+
+/// Splits every face of more than three corners into a fan from its first corner. Corner
+/// attributes (normals, UVs) follow their corners; crease tags keep naming the same edges
+/// (fans only add diagonals); holes become all triangles of the holed face.
+pub fn fan_triangulate(mesh: &ControlMesh) -> Result<(ControlMesh, TriangulationSummary)> {
+    let mut out = ControlMesh {
+        positions: mesh.positions.clone(),
+        face_offsets: vec![0],
+        creases: mesh.creases.clone(),
+        corners: mesh.corners.clone(),
+        options: mesh.options,
+        ..ControlMesh::default()
+    };
+    let mut normals = mesh.normals.as_ref().map(|_| Vec::new());
+    let mut uvs = mesh.uvs.as_ref().map(|_| Vec::new());
+    let mut summary = TriangulationSummary::default();
+    let mut first_triangle = Vec::with_capacity(mesh.num_faces() + 1);
+    for f in 0..mesh.num_faces() {
+        let start = mesh.face_offsets[f] as usize;
+        let face = mesh.face(f);
+        if face.len() < 3 {
+            return Err(TessError::Topology(
+                topology::TopologyError::DegenerateFace {
+                    face: f,
+                    size: face.len(),
+                },
+            ));
+        }
+        if face.len() > 3 {
+            summary.polygons += 1;
+        }
+        first_triangle.push(out.num_faces() as u32);
+        for i in 1..face.len() - 1 {
+            for c in [0, i, i + 1] {
+                out.face_vertices.push(face[c]);
+                if let (Some(dst), Some(src)) = (normals.as_mut(), mesh.normals.as_ref()) {
+                    dst.push(*src.get(start + c).unwrap_or(&[0.0, 0.0, 0.0]));
+                }
+                if let (Some(dst), Some(src)) = (uvs.as_mut(), mesh.uvs.as_ref()) {
+                    dst.push(*src.get(start + c).unwrap_or(&[0.0, 0.0]));
+                }
+            }
+            out.face_offsets.push(out.face_vertices.len() as u32);
+        }
+    }
+    first_triangle.push(out.num_faces() as u32);
+    // Attributes are per corner only when the source had one per corner.
+    out.normals =
+        normals.filter(|_| mesh.normals.as_ref().map(Vec::len) == Some(mesh.face_vertices.len()));
+    out.uvs = uvs.filter(|_| mesh.uvs.as_ref().map(Vec::len) == Some(mesh.face_vertices.len()));
+    for &h in &mesh.holes {
+        if let (Some(&a), Some(&b)) = (
+            first_triangle.get(h as usize),
+            first_triangle.get(h as usize + 1),
+        ) {
+            out.holes.extend(a..b);
+        }
+    }
+    Ok((out, summary))
+}
+
+/// Where a row's triangle count comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TriangleSource {
+    /// The pipeline-statistics query (clipping invocations) of the first warm-up frame.
+    PipelineStatistics,
+    /// The CPU count the method reported (no statistics on this device).
+    Cpu,
+}
+
+impl TriangleSource {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            TriangleSource::PipelineStatistics => "pipeline-statistics",
+            TriangleSource::Cpu => "cpu",
+        }
+    }
+}
+
+impl std::str::FromStr for TriangleSource {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "pipeline-statistics" => Ok(TriangleSource::PipelineStatistics),
+            "cpu" => Ok(TriangleSource::Cpu),
+            _ => Err(format!("unknown triangle source '{s}'")),
+        }
+    }
+}
+
+/// One measured row of the table. Times are milliseconds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BenchRow {
+    pub mesh: String,
+    pub input_triangles: u64,
+    pub segments: u32,
+    pub method: String,
+    /// Output triangles per frame, as `triangles_source` counted them.
+    pub triangles: u64,
+    /// The method's own CPU count (the tessellator's arithmetic, or the refined mesh's size).
+    pub triangles_expected: u64,
+    pub triangles_source: TriangleSource,
+    /// Timed frames (after `warmup` untimed ones).
+    pub frames: u32,
+    pub warmup: u32,
+    /// GPU time between the frame's two timestamps (compute + draws).
+    pub gpu_median_ms: f64,
+    pub gpu_p90_ms: f64,
+    /// Per-frame CPU work the method reported (CPU subdivision + upload); `None` when none.
+    pub cpu_median_ms: Option<f64>,
+    pub cpu_p90_ms: Option<f64>,
+    /// Per-frame CPU + GPU time.
+    pub total_median_ms: f64,
+    pub total_p90_ms: f64,
+    /// Host time to record, submit and wait for the frame (a cross-check of the timestamps).
+    pub wall_median_ms: f64,
+    /// `total_median_ms` over Flat's at the same mesh and S.
+    pub ratio_to_flat: Option<f64>,
+    pub note: String,
+}
+
+/// A row that was not measured, and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SkippedRow {
+    pub mesh: String,
+    pub segments: u32,
+    pub method: String,
+    pub reason: String,
+}
+
+/// The device, as the report names it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeviceSummary {
+    pub name: String,
+    pub device_type: String,
+    pub driver_name: String,
+    pub driver_info: String,
+    pub driver_version_raw: u32,
+    /// `driver_version` decoded by the vendor's convention.
+    pub driver_version: String,
+    pub lavapipe: bool,
+}
+
+impl DeviceSummary {
+    pub fn from_adapter(a: &AdapterInfo) -> Self {
+        let v = a.driver_version;
+        // NVIDIA packs 10.8.8.6 bits; Mesa and most others use VK_MAKE_VERSION's 10.10.12.
+        let driver_version = if a.vendor_id == 0x10de {
+            format!(
+                "{}.{}.{}.{}",
+                v >> 22,
+                (v >> 14) & 0xff,
+                (v >> 6) & 0xff,
+                v & 0x3f
+            )
+        } else {
+            format!("{}.{}.{}", v >> 22, (v >> 12) & 0x3ff, v & 0xfff)
+        };
+        Self {
+            name: a.name.clone(),
+            device_type: a.type_name().to_owned(),
+            driver_name: a.driver_name.clone(),
+            driver_info: a.driver_info.clone(),
+            driver_version_raw: v,
+            driver_version,
+            lavapipe: a.is_lavapipe(),
+        }
+    }
+}
+
+/// Everything one run measured, and how.
+#[derive(Clone, Debug)]
+pub struct BenchReport {
+    pub device: DeviceSummary,
+    /// UTC, `YYYY-MM-DD HH:MM`.
+    pub date_utc: String,
+    /// "release" or "debug" (of the crate that ran the frames).
+    pub profile: &'static str,
+    pub config: BenchConfig,
+    pub rows: Vec<BenchRow>,
+    pub skipped: Vec<SkippedRow>,
+    /// Per-mesh notes (triangulation).
+    pub mesh_notes: Vec<String>,
+    /// Lines from the methods for the header (e.g. a technique's table memory).
+    pub extra_notes: Vec<String>,
+}
+
+/// The build profile of this crate: timings of a debug build say little.
+pub fn build_profile() -> &'static str {
+    if cfg!(debug_assertions) {
+        "debug"
+    } else {
+        "release"
+    }
+}
+
+/// `YYYY-MM-DD HH:MM` UTC of a Unix time (the civil-from-days algorithm, no time-zone data).
+pub fn utc_date(unix_seconds: u64) -> String {
+    let days = (unix_seconds / 86_400) as i64;
+    let secs = unix_seconds % 86_400;
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1_460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}-{m:02}-{d:02} {:02}:{:02}",
+        secs / 3_600,
+        (secs / 60) % 60
+    )
+}
+
+/// Per-frame measurements of one row.
+struct FrameTimes {
+    gpu_ms: Vec<f64>,
+    cpu_ms: Vec<Option<f64>>,
+    wall_ms: Vec<f64>,
+}
+
+/// Query pools and target shared by every row.
+struct Harness<'a> {
+    device: &'a Device,
+    target: OffscreenTarget,
+    timestamps: QueryPool,
+    statistics: Option<QueryPool>,
+}
+
+impl Harness<'_> {
+    /// Records, submits and waits for one frame; returns (GPU ms, wall ms, CPU triangles,
+    /// statistics triangles when queried).
+    fn frame(
+        &self,
+        method: &mut dyn BenchMethod,
+        frame: &BenchFrame,
+        query_statistics: bool,
+        clear: [f32; 4],
+    ) -> Result<(f64, f64, u64, Option<u64>)> {
+        let stats = self.statistics.as_ref().filter(|_| query_statistics);
+        let device = self.device;
+        let start = Instant::now();
+        let recorded = device.one_shot(|cmd| -> Result<u64> {
+            self.timestamps.cmd_reset(cmd);
+            if let Some(q) = stats {
+                q.cmd_reset(cmd);
+            }
+            self.timestamps
+                .cmd_write_timestamp(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, 0)?;
+            if let Some(q) = stats {
+                q.cmd_begin(cmd, 0)?;
+            }
+            let pre = method.record_pre_pass(cmd, frame);
+            self.target.cmd_begin(device, cmd, clear);
+            let drawn = pre.and_then(|_| method.record(cmd, frame));
+            // SAFETY: the rendering scope was begun by cmd_begin above on this command buffer;
+            // it is ended even when the method failed, so the command buffer stays valid.
+            unsafe { device.raw.cmd_end_rendering(cmd) };
+            if let Some(q) = stats {
+                q.cmd_end(cmd, 0)?;
+            }
+            self.timestamps
+                .cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, 1)?;
+            drawn
+        })??;
+        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        let gpu_ms = self
+            .timestamps
+            .durations_ns()?
+            .first()
+            .copied()
+            .ok_or_else(|| TessError::Invalid("no timestamp pair read back".into()))?
+            / 1e6;
+        let counted = match stats {
+            Some(q) => q
+                .statistics_results()?
+                .first()
+                .map(|s| s.clipping_invocations),
+            None => None,
+        };
+        Ok((gpu_ms, wall_ms, recorded, counted))
+    }
+}
+
+/// Measures every mesh × S × method of `config` on `device`; `on_row` sees each row as soon as
+/// it is measured (long runs print progress).
+pub fn run_bench(
+    device: &Device,
+    meshes: &[BenchMesh],
+    config: &BenchConfig,
+    on_row: &mut dyn FnMut(&BenchRow),
+) -> Result<BenchReport> {
+    validate(config, meshes)?;
+    let harness = Harness {
+        device,
+        target: OffscreenTarget::new(device, config.extent)?,
+        timestamps: QueryPool::timestamps(device, "bench frame timestamps", 2)?,
+        statistics: if device.info.caps.pipeline_statistics_query {
+            Some(QueryPool::statistics(device, "bench triangle count", 1)?)
+        } else {
+            None
+        },
+    };
+    let mut report = BenchReport {
+        device: DeviceSummary::from_adapter(&device.info),
+        date_utc: utc_date(
+            std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map(|d| d.as_secs())
+                .unwrap_or(0),
+        ),
+        profile: build_profile(),
+        config: config.clone(),
+        rows: Vec::new(),
+        skipped: Vec::new(),
+        mesh_notes: Vec::new(),
+        extra_notes: Vec::new(),
+    };
+    for mesh in meshes {
+        report.mesh_notes.extend(mesh.notes.iter().cloned());
+        let ctx = MethodContext {
+            device,
+            mesh,
+            config,
+            color_format: COLOR_FORMAT,
+            depth_format: DEPTH_FORMAT,
+        };
+        let mut methods = build_methods(&config.methods, &ctx)?;
+        for &segments in &config.segments {
+            let mut runnable = Vec::new();
+            for method in methods.iter_mut() {
+                match method.skip_reason(segments) {
+                    Some(reason) => report.skipped.push(SkippedRow {
+                        mesh: mesh.name.clone(),
+                        segments,
+                        method: method.label().to_owned(),
+                        reason,
+                    }),
+                    None => runnable.push(method),
+                }
+            }
+            let mut rows = run_group(&harness, &mut runnable, mesh, segments, config)?;
+            let flat_total = rows
+                .iter()
+                .find(|r| r.method == "flat")
+                .map(|r| r.total_median_ms);
+            for row in &mut rows {
+                row.ratio_to_flat = flat_total.map(|f| row.total_median_ms / f);
+                on_row(row);
+            }
+            report.rows.extend(rows);
+        }
+        for m in &methods {
+            for n in m.report_notes() {
+                if !report.extra_notes.contains(&n) {
+                    report.extra_notes.push(n);
+                }
+            }
+        }
+    }
+    Ok(report)
+}
+
+fn validate(config: &BenchConfig, meshes: &[BenchMesh]) -> Result<()> {
+    let bad = |m: String| Err(TessError::Invalid(m));
+    if meshes.is_empty() {
+        return bad("no meshes to benchmark".into());
+    }
+    if config.segments.is_empty() || config.segments.contains(&0) {
+        return bad(format!(
+            "segments per edge must be at least 1 (got {:?})",
+            config.segments
+        ));
+    }
+    if config.frames == 0 {
+        return bad("at least one timed frame is needed".into());
+    }
+    if config.methods.is_empty() {
+        return bad("no methods to benchmark".into());
+    }
+    if let Some(b) = config.row_budget_s {
+        if !(b > 0.0 && b.is_finite()) {
+            return bad(format!("row budget {b} s must be a positive number"));
+        }
+    }
+    let names = method_names();
+    if let Some(m) = config.methods.iter().find(|m| !names.contains(&m.as_str())) {
+        return bad(format!(
+            "unknown bench method '{m}' (known: {})",
+            names.join(", ")
+        ));
+    }
+    Ok(())
+}
+
+/// One technique's frames within a group.
+struct RowState {
+    frames: u32,
+    times: FrameTimes,
+    expected: Option<u64>,
+    counted: Option<u64>,
+    last_warmup_cost_s: f64,
+    notes: Vec<String>,
+}
+
+/// Measures every technique at one mesh and S. Frames are interleaved round robin (warm-up
+/// frames first, then timed frames), so a slow drift of the machine (another process, clock
+/// changes) spreads over all techniques instead of biasing whichever ran during it.
+fn run_group(
+    harness: &Harness<'_>,
+    methods: &mut [&mut Box<dyn BenchMethod>],
+    mesh: &BenchMesh,
+    segments: u32,
+    config: &BenchConfig,
+) -> Result<Vec<BenchRow>> {
+    if methods.is_empty() {
+        return Ok(Vec::new());
+    }
+    let clear = crate::renderer::DrawParams::default().clear_color;
+    let warmup = config.warmup;
+    let mut states: Vec<RowState> = methods
+        .iter()
+        .map(|_| RowState {
+            frames: config.frames,
+            times: FrameTimes {
+                gpu_ms: Vec::new(),
+                cpu_ms: Vec::new(),
+                wall_ms: Vec::new(),
+            },
+            expected: None,
+            counted: None,
+            last_warmup_cost_s: 0.0,
+            notes: Vec::new(),
+        })
+        .collect();
+    let mut index = 0;
+    loop {
+        let is_warmup = index < warmup;
+        let mut any = false;
+        for (method, st) in methods.iter_mut().zip(&mut states) {
+            if !is_warmup && index - warmup >= st.frames {
+                continue;
+            }
+            any = true;
+            let frame = BenchFrame {
+                index,
+                warmup: is_warmup,
+                segments,
+                extent: config.extent,
+                camera: config.camera,
+            };
+            let frame_start = Instant::now();
+            let cpu = method.begin_frame(&frame)?;
+            let (gpu, wall, cpu_count, stats_count) =
+                harness.frame(method.as_mut(), &frame, index == 0, clear)?;
+            if index == 0 {
+                st.counted = stats_count;
+            }
+            match st.expected {
+                None => st.expected = Some(cpu_count),
+                Some(e) if e != cpu_count => {
+                    return Err(TessError::Invalid(format!(
+                        "{} drew {cpu_count} triangles in frame {index}, {e} before",
+                        method.label()
+                    )))
+                }
+                Some(_) => {}
+            }
+            if is_warmup {
+                st.last_warmup_cost_s = frame_start.elapsed().as_secs_f64();
+            } else {
+                st.times.gpu_ms.push(gpu);
+                st.times.cpu_ms.push(cpu);
+                st.times.wall_ms.push(wall);
+            }
+        }
+        index += 1;
+        // After the warm-up, fit each technique's timed frames into the row budget.
+        if index == warmup {
+            if let Some(budget) = config.row_budget_s {
+                for st in &mut states {
+                    let per_frame = st.last_warmup_cost_s.max(1e-9);
+                    let fit = (budget / per_frame).floor() as u32;
+                    let reduced = fit.clamp(config.min_frames.max(1), st.frames);
+                    if reduced < st.frames {
+                        st.notes.push(format!(
+                            "frames reduced from {} to {reduced} (row budget {budget} s, \
+                             {per_frame:.2} s per frame)",
+                            st.frames
+                        ));
+                        st.frames = reduced;
+                    }
+                }
+            }
+        }
+        if !any && index > warmup {
+            break;
+        }
+    }
+    methods
+        .iter_mut()
+        .zip(states)
+        .map(|(method, st)| finish_row(method.as_mut(), st, mesh, segments, warmup))
+        .collect()
+}
+
+fn finish_row(
+    method: &mut dyn BenchMethod,
+    st: RowState,
+    mesh: &BenchMesh,
+    segments: u32,
+    warmup: u32,
+) -> Result<BenchRow> {
+    let RowState {
+        times,
+        expected,
+        counted,
+        mut notes,
+        ..
+    } = st;
+    let expected = expected.unwrap_or(0);
+    let (triangles, triangles_source) = match counted {
+        Some(c) => {
+            if c != expected {
+                notes.push(format!(
+                    "pipeline statistics counted {c} triangles, the CPU count is {expected}"
+                ));
+            }
+            (c, TriangleSource::PipelineStatistics)
+        }
+        None => (expected, TriangleSource::Cpu),
+    };
+    notes.extend(method.row_notes());
+    let has_cpu = times.cpu_ms.iter().any(Option::is_some);
+    let cpu: Vec<f64> = times.cpu_ms.iter().map(|c| c.unwrap_or(0.0)).collect();
+    let total: Vec<f64> = times.gpu_ms.iter().zip(&cpu).map(|(g, c)| g + c).collect();
+    let stat = |v: &[f64], f: fn(&[f64]) -> Option<f64>| {
+        f(v).ok_or_else(|| TessError::Invalid("no frame times to summarise".into()))
+    };
+    Ok(BenchRow {
+        mesh: mesh.name.clone(),
+        input_triangles: mesh.triangles(),
+        segments,
+        method: method.label().to_owned(),
+        triangles,
+        triangles_expected: expected,
+        triangles_source,
+        frames: times.gpu_ms.len() as u32,
+        warmup,
+        gpu_median_ms: stat(&times.gpu_ms, stats::median)?,
+        gpu_p90_ms: stat(&times.gpu_ms, stats::p90)?,
+        cpu_median_ms: if has_cpu {
+            Some(stat(&cpu, stats::median)?)
+        } else {
+            None
+        },
+        cpu_p90_ms: if has_cpu {
+            Some(stat(&cpu, stats::p90)?)
+        } else {
+            None
+        },
+        total_median_ms: stat(&total, stats::median)?,
+        total_p90_ms: stat(&total, stats::p90)?,
+        wall_median_ms: stat(&times.wall_ms, stats::median)?,
+        ratio_to_flat: None,
+        note: notes.join("; "),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn utc_dates() {
+        assert_eq!(utc_date(0), "1970-01-01 00:00");
+        assert_eq!(utc_date(951_782_400), "2000-02-29 00:00");
+        assert_eq!(utc_date(1_700_000_000), "2023-11-14 22:13");
+    }
+
+    #[test]
+    fn fan_triangulation_keeps_corner_attributes() {
+        let mut mesh = ControlMesh::from_polygons(
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [2.0, 0.0, 0.0],
+            ],
+            &[vec![0u32, 1, 2, 3], vec![1, 4, 2]],
+        );
+        mesh.normals = Some((0..7).map(|i| [i as f64, 0.0, 1.0]).collect());
+        mesh.holes = vec![0];
+        let (tri, s) = fan_triangulate(&mesh).unwrap();
+        assert_eq!(s.polygons, 1);
+        assert_eq!(tri.face_vertices, vec![0, 1, 2, 0, 2, 3, 1, 4, 2]);
+        assert_eq!(tri.face_offsets, vec![0, 3, 6, 9]);
+        let n: Vec<f64> = tri.normals.unwrap().iter().map(|n| n[0]).collect();
+        assert_eq!(n, vec![0.0, 1.0, 2.0, 0.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        assert_eq!(tri.holes, vec![0, 1]);
+    }
+
+    #[test]
+    fn loop_sizes_follow_the_recurrence() {
+        // Octahedron: V 6, E 12, F 8; one step: V 18, E 48, F 32.
+        let mesh = ControlMesh::from_polygons(
+            vec![
+                [1.0, 0.0, 0.0],
+                [-1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, -1.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [0.0, 0.0, -1.0],
+            ],
+            &[
+                [0u32, 2, 4],
+                [2, 1, 4],
+                [1, 3, 4],
+                [3, 0, 4],
+                [2, 0, 5],
+                [1, 2, 5],
+                [3, 1, 5],
+                [0, 3, 5],
+            ],
+        );
+        assert_eq!(loop_level_size(&mesh, 0), (6, 12, 8));
+        assert_eq!(loop_level_size(&mesh, 1), (18, 48, 32));
+        let cpu = cpu_loop_limit_mesh(&mesh, 2).unwrap();
+        let (v, _, f) = loop_level_size(&mesh, 2);
+        assert_eq!(cpu.vertices.len() as u64, v);
+        assert_eq!(cpu.indices.len() as u64, 3 * f);
+        assert_eq!(loop_level_for(32), Ok(5));
+        assert!(loop_level_for(12).is_err());
+    }
+}

@@ -1,0 +1,261 @@
+//! A plain indexed triangle draw, no tessellation stage: how a mesh refined on the CPU (the
+//! paper's comparison point, CPU subdivision to M^k) is drawn. Same `Frame` uniforms and
+//! `shade.frag` as the tessellated techniques, so only the geometry path differs.
+use crate::error::{Result, TessError};
+use crate::gpu::{DrawPush, Vertex};
+use crate::renderer::{frame_uniforms_for, DrawParams};
+use crate::shaders;
+use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
+use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage};
+use vk_core::{vk, Buffer, BufferDesc, Device, MemoryLocation};
+
+/// A triangle mesh on the GPU: vertices and a `u32` index list.
+pub struct PlainMesh {
+    pub vertices: Buffer,
+    pub indices: Buffer,
+    pub index_count: u32,
+    pub vertex_count: u32,
+    pub bbox_min: [f32; 3],
+    pub bbox_max: [f32; 3],
+}
+
+fn bbox(vertices: &[Vertex]) -> ([f32; 3], [f32; 3]) {
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for v in vertices {
+        for k in 0..3 {
+            lo[k] = lo[k].min(v.position[k]);
+            hi[k] = hi[k].max(v.position[k]);
+        }
+    }
+    (lo, hi)
+}
+
+fn check(vertices: &[Vertex], indices: &[u32]) -> Result<()> {
+    if vertices.is_empty() || indices.is_empty() || !indices.chunks_exact(3).remainder().is_empty()
+    {
+        return Err(TessError::Invalid(format!(
+            "a plain mesh needs vertices and whole triangles ({} vertices, {} indices)",
+            vertices.len(),
+            indices.len()
+        )));
+    }
+    let n = vertices.len() as u32;
+    if let Some(&bad) = indices.iter().find(|&&i| i >= n) {
+        return Err(TessError::Invalid(format!(
+            "index {bad} is out of range of {n} vertices"
+        )));
+    }
+    Ok(())
+}
+
+impl PlainMesh {
+    /// Uploads once into device-local memory (a static refined mesh).
+    pub fn upload(device: &Device, vertices: &[Vertex], indices: &[u32]) -> Result<Self> {
+        check(vertices, indices)?;
+        let (bbox_min, bbox_max) = bbox(vertices);
+        Ok(Self {
+            vertices: Buffer::with_data(
+                device,
+                "plain vertices",
+                vk::BufferUsageFlags::VERTEX_BUFFER,
+                bytemuck::cast_slice(vertices),
+            )?,
+            indices: Buffer::with_data(
+                device,
+                "plain indices",
+                vk::BufferUsageFlags::INDEX_BUFFER,
+                bytemuck::cast_slice(indices),
+            )?,
+            index_count: indices.len() as u32,
+            vertex_count: vertices.len() as u32,
+            bbox_min,
+            bbox_max,
+        })
+    }
+
+    /// Vertices in host-visible memory, rewritten every frame by [`PlainMesh::write_vertices`]
+    /// (an animated mesh re-subdivided on the CPU); the connectivity does not change.
+    pub fn dynamic(device: &Device, vertices: &[Vertex], indices: &[u32]) -> Result<Self> {
+        check(vertices, indices)?;
+        let (bbox_min, bbox_max) = bbox(vertices);
+        let mut vb = Buffer::new(
+            device,
+            &BufferDesc {
+                name: "plain vertices (per-frame upload)",
+                size: std::mem::size_of_val(vertices) as u64,
+                usage: vk::BufferUsageFlags::VERTEX_BUFFER,
+                location: MemoryLocation::CpuToGpu,
+            },
+        )?;
+        vb.write(0, bytemuck::cast_slice(vertices))?;
+        Ok(Self {
+            vertices: vb,
+            indices: Buffer::with_data(
+                device,
+                "plain indices",
+                vk::BufferUsageFlags::INDEX_BUFFER,
+                bytemuck::cast_slice(indices),
+            )?,
+            index_count: indices.len() as u32,
+            vertex_count: vertices.len() as u32,
+            bbox_min,
+            bbox_max,
+        })
+    }
+
+    /// Replaces the vertices of a [`PlainMesh::dynamic`] mesh; the GPU must be done with the
+    /// previous frame (the bench waits for every frame).
+    pub fn write_vertices(&mut self, vertices: &[Vertex]) -> Result<()> {
+        if vertices.len() != self.vertex_count as usize {
+            return Err(TessError::Invalid(format!(
+                "{} vertices written to a mesh of {}",
+                vertices.len(),
+                self.vertex_count
+            )));
+        }
+        self.vertices.write(0, bytemuck::cast_slice(vertices))?;
+        Ok(())
+    }
+
+    pub fn triangles(&self) -> u64 {
+        self.index_count as u64 / 3
+    }
+}
+
+/// The non-tessellated pipeline with its own frame uniforms (one frame slot). Drop order:
+/// pipeline, pool (frees the set), set layout, uniform buffer.
+pub struct PlainRenderer {
+    pipeline: Pipeline,
+    _pool: DescriptorPool,
+    _set_layout: DescriptorSetLayout,
+    set: vk::DescriptorSet,
+    uniforms: Buffer,
+    device: Device,
+}
+
+impl PlainRenderer {
+    pub fn new(
+        device: &Device,
+        color_format: vk::Format,
+        depth_format: vk::Format,
+    ) -> Result<Self> {
+        let set_layout = DescriptorSetLayout::new(
+            device,
+            "plain frame set layout",
+            &[BindingDesc {
+                binding: 0,
+                ty: vk::DescriptorType::UNIFORM_BUFFER,
+                stages: vk::ShaderStageFlags::ALL_GRAPHICS,
+            }],
+        )?;
+        let pool = DescriptorPool::new(device, "plain descriptor pool", &set_layout, 1)?;
+        let uniforms = Buffer::new(
+            device,
+            &BufferDesc {
+                name: "plain frame uniforms",
+                size: std::mem::size_of::<crate::gpu::FrameUniforms>() as u64,
+                usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                location: MemoryLocation::CpuToGpu,
+            },
+        )?;
+        let set = pool.allocate(&set_layout)?;
+        pool.write_buffers(
+            set,
+            &[(0, vk::DescriptorType::UNIFORM_BUFFER, uniforms.descriptor())],
+        );
+        let mut desc = GraphicsPipelineDesc::new("plain triangles", color_format, depth_format);
+        desc.stages = vec![
+            ShaderStage::new(vk::ShaderStageFlags::VERTEX, shaders::PLAIN_VERT),
+            ShaderStage::new(vk::ShaderStageFlags::FRAGMENT, shaders::SHADE_FRAG),
+        ];
+        desc.vertex_bindings = vec![vk::VertexInputBindingDescription {
+            binding: 0,
+            stride: std::mem::size_of::<Vertex>() as u32,
+            input_rate: vk::VertexInputRate::VERTEX,
+        }];
+        desc.vertex_attributes = vec![
+            vk::VertexInputAttributeDescription {
+                location: 0,
+                binding: 0,
+                format: vk::Format::R32G32B32_SFLOAT,
+                offset: 0,
+            },
+            vk::VertexInputAttributeDescription {
+                location: 1,
+                binding: 0,
+                format: vk::Format::R32G32B32_SFLOAT,
+                offset: 12,
+            },
+        ];
+        desc.set_layouts = vec![set_layout.raw];
+        desc.push_constant_bytes = std::mem::size_of::<DrawPush>() as u32;
+        // The tessellated techniques' shaded pass uses this bias too: same raster work.
+        desc.depth_bias = Some((1.0, 1.0));
+        let pipeline = Pipeline::graphics(device, &desc)?;
+        Ok(Self {
+            pipeline,
+            _pool: pool,
+            _set_layout: set_layout,
+            set,
+            uniforms,
+            device: device.clone(),
+        })
+    }
+
+    /// Writes the frame uniforms for `params` (its level and Phong factor are unused here).
+    pub fn update_uniforms(
+        &mut self,
+        mesh: &PlainMesh,
+        params: &DrawParams,
+        extent: vk::Extent2D,
+    ) -> Result<()> {
+        let u = frame_uniforms_for((mesh.bbox_min, mesh.bbox_max), params, extent);
+        self.uniforms.write(0, bytemuck::bytes_of(&u))?;
+        Ok(())
+    }
+
+    /// Records the shaded draw inside an active rendering scope; returns the triangles drawn.
+    pub fn record(&self, cmd: vk::CommandBuffer, mesh: &PlainMesh) -> u64 {
+        let device = &self.device;
+        let push = DrawPush {
+            mode: 0,
+            first_patch: 0,
+        };
+        device.begin_label(cmd, "plain triangles");
+        // SAFETY: cmd is recording inside a rendering scope; the pipeline, set and buffers are
+        // owned by self and mesh, which outlive the submission (the bench waits for each frame);
+        // the index count stays inside the index buffer (checked when it was built).
+        unsafe {
+            device
+                .raw
+                .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.raw);
+            device.raw.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.pipeline.layout,
+                0,
+                &[self.set],
+                &[],
+            );
+            device.raw.cmd_push_constants(
+                cmd,
+                self.pipeline.layout,
+                vk::ShaderStageFlags::ALL,
+                0,
+                bytemuck::bytes_of(&push),
+            );
+            device
+                .raw
+                .cmd_bind_vertex_buffers(cmd, 0, &[mesh.vertices.raw], &[0]);
+            device
+                .raw
+                .cmd_bind_index_buffer(cmd, mesh.indices.raw, 0, vk::IndexType::UINT32);
+            device
+                .raw
+                .cmd_draw_indexed(cmd, mesh.index_count, 1, 0, 0, 0);
+        }
+        device.end_label(cmd);
+        mesh.triangles()
+    }
+}

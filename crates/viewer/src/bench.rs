@@ -1,0 +1,146 @@
+//! `tessera bench`: Table I of Holländer & Boubekeur on this machine. The measuring lives in
+//! `tess::bench` (so GPU tests can drive it); this is the command line around it: the mesh
+//! set, the options, the console table and the CSV / Markdown files.
+use crate::cli::BenchArgs;
+use crate::commands::{check_validation, open_device};
+use anyhow::{bail, Context, Result};
+use tess::bench::{self, BenchConfig, BenchMesh};
+use tess::Camera;
+use vk_core::vk;
+
+/// The default set, embedded so the command runs from any directory: Keenan Crane's spot
+/// (control mesh and quadrangulated, both fan-triangulated on load) and two crease-free
+/// OpenSubdiv Loop shapes.
+const DEFAULT_MESHES: [(&str, &str); 4] = [
+    ("spot_control_mesh", crate::commands::DEFAULT_MESH),
+    (
+        "spot_quadrangulated",
+        include_str!("../../../assets/spot_quadrangulated.obj"),
+    ),
+    (
+        "loop_cube",
+        include_str!("../../../tests/data/opensubdiv/shapes/loop_cube.obj"),
+    ),
+    (
+        "loop_icosahedron",
+        include_str!("../../../tests/data/opensubdiv/shapes/loop_icosahedron.obj"),
+    ),
+];
+
+fn load_meshes(paths: &[std::path::PathBuf]) -> Result<Vec<BenchMesh>> {
+    let mut out = Vec::new();
+    if paths.is_empty() {
+        for (name, text) in DEFAULT_MESHES {
+            let mesh = topology::parse_obj(text, &format!("{name}.obj (embedded)"))?;
+            out.push(BenchMesh::new(name, &mesh).with_context(|| format!("preparing {name}"))?);
+        }
+    } else {
+        for p in paths {
+            let mesh = crate::commands::load_mesh(Some(p))?;
+            let name = p
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| p.display().to_string());
+            out.push(
+                BenchMesh::new(&name, &mesh)
+                    .with_context(|| format!("preparing {}", p.display()))?,
+            );
+        }
+    }
+    Ok(out)
+}
+
+fn config(a: &BenchArgs) -> Result<BenchConfig> {
+    let known = bench::method_names();
+    for m in &a.methods {
+        if !known.contains(&m.as_str()) {
+            bail!("unknown method '{m}' (known: {})", known.join(", "));
+        }
+    }
+    if a.frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    if let Some(&s) = a.segments.iter().find(|&&s| s == 0 || s > 64) {
+        bail!("--segments {s} is outside 1..64");
+    }
+    Ok(BenchConfig {
+        segments: a.segments.clone(),
+        methods: a.methods.clone(),
+        frames: a.frames,
+        warmup: a.warmup,
+        extent: vk::Extent2D {
+            width: a.size.0,
+            height: a.size.1,
+        },
+        camera: Camera::default(),
+        row_budget_s: a.row_budget,
+        min_frames: a.min_frames.max(1),
+        cpu_max_vertices: a.cpu_max_vertices,
+    })
+}
+
+fn write(path: &std::path::Path, text: &str) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+}
+
+pub fn run(a: BenchArgs) -> Result<()> {
+    let config = config(&a)?;
+    let meshes = load_meshes(&a.mesh)?;
+    if bench::build_profile() != "release" {
+        eprintln!(
+            "WARNING: this is a debug build; the timings are not representative. \
+             Run `cargo run --release -p tessera-viewer -- bench`."
+        );
+    }
+    let (instance, device) = open_device(&a.gpu, vec![], &[])?;
+    if device.info.is_lavapipe() {
+        eprintln!(
+            "note: {} is lavapipe, a CPU rasterizer: only ratios on lavapipe mean anything.",
+            device.info.name
+        );
+    }
+    for m in &meshes {
+        for n in &m.notes {
+            eprintln!("note: {n}");
+        }
+    }
+    eprintln!(
+        "measuring {} meshes × S {:?} × {:?}: {} timed frames after {} warm-up frames per row",
+        meshes.len(),
+        config.segments,
+        config.methods,
+        config.frames,
+        config.warmup
+    );
+    let report = bench::run_bench(&device, &meshes, &config, &mut |r| {
+        eprintln!(
+            "  {} S={} {}: {} triangles, GPU median {:.3} ms{}{}",
+            r.mesh,
+            r.segments,
+            r.method,
+            r.triangles,
+            r.gpu_median_ms,
+            r.cpu_median_ms
+                .map(|c| format!(", CPU median {c:.3} ms"))
+                .unwrap_or_default(),
+            r.ratio_to_flat
+                .map(|x| format!(", {x:.2}× Flat"))
+                .unwrap_or_default()
+        );
+    })?;
+    drop(device);
+    check_validation(&instance)?;
+    println!("{}", report.to_text());
+    if let Some(p) = &a.csv {
+        write(p, &report.to_csv())?;
+        println!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.markdown {
+        write(p, &report.to_markdown())?;
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,159 @@
+//! The benchmark machinery on a tiny mesh, two timed frames: structure only (rows, triangle
+//! counts, CSV round trip). Speed is measured by `tessera bench`, never asserted here.
+mod common;
+use common::Gpu;
+use tessera::tess::bench::{self, parse_csv, BenchConfig, BenchMesh, BenchRow, TriangleSource};
+use tessera::tess::tessellator::{uniform_triangle_count, Domain, Spacing};
+use tessera::vk_core::vk;
+
+fn tiny_config(segments: Vec<u32>) -> BenchConfig {
+    BenchConfig {
+        segments,
+        frames: 2,
+        warmup: 1,
+        extent: vk::Extent2D {
+            width: 96,
+            height: 64,
+        },
+        ..BenchConfig::default()
+    }
+}
+
+#[test]
+fn bench_rows_counts_and_csv_round_trip() {
+    let gpu = Gpu::new();
+    // Six quads: fan-triangulated to 12 triangles on load, as the default meshes are.
+    let cube = tessera::topology::load_obj(common::data("tests/data/meshes/cube.obj")).unwrap();
+    let mesh = BenchMesh::new("cube", &cube).unwrap();
+    assert_eq!(mesh.triangles(), 12);
+    assert_eq!(mesh.notes.len(), 1, "the triangulation is reported");
+
+    let mut config = tiny_config(vec![1, 3, 4]);
+    // Loop level 2 of the cube has 98 vertices: over this limit, so cpu rows skip S = 4.
+    config.cpu_max_vertices = 50;
+    let mut seen = 0;
+    let report = bench::run_bench(gpu.device(), &[mesh], &config, &mut |_| seen += 1).unwrap();
+    assert_eq!(seen, report.rows.len());
+
+    let tess_methods = ["flat", "phong", "pn"];
+    let cpu_methods = ["cpu-static", "cpu-animated"];
+    let mut expected_rows = Vec::new();
+    for s in [1u32, 3, 4] {
+        for m in tess_methods {
+            expected_rows.push((s, m));
+        }
+        if s == 1 {
+            for m in cpu_methods {
+                expected_rows.push((s, m));
+            }
+        }
+    }
+    let got: Vec<(u32, &str)> = report
+        .rows
+        .iter()
+        .map(|r| (r.segments, r.method.as_str()))
+        .collect();
+    assert_eq!(got, expected_rows);
+    // S = 3 is not a power of two; S = 4 is over the vertex limit.
+    let skipped: Vec<(u32, &str)> = report
+        .skipped
+        .iter()
+        .map(|s| (s.segments, s.method.as_str()))
+        .collect();
+    assert_eq!(
+        skipped,
+        vec![
+            (3, "cpu-static"),
+            (3, "cpu-animated"),
+            (4, "cpu-static"),
+            (4, "cpu-animated")
+        ]
+    );
+    assert!(
+        report.skipped[2].reason.contains("98 vertices"),
+        "{:?}",
+        report.skipped[2]
+    );
+
+    let stats = gpu.device().info.caps.pipeline_statistics_query;
+    for r in &report.rows {
+        let expected = if r.method.starts_with("cpu") {
+            // Loop level k multiplies the triangles by 4^k; S = 2^k.
+            12 * (r.segments as u64).pow(2)
+        } else {
+            12 * uniform_triangle_count(Domain::Triangle, Spacing::Equal, r.segments as f32)
+        };
+        assert_eq!(r.triangles_expected, expected, "{r:?}");
+        assert_eq!(r.triangles, expected, "GPU count, {r:?}");
+        assert_eq!(
+            r.triangles_source,
+            if stats {
+                TriangleSource::PipelineStatistics
+            } else {
+                TriangleSource::Cpu
+            }
+        );
+        assert_eq!(r.input_triangles, 12);
+        assert_eq!((r.frames, r.warmup), (2, 1), "{r:?}");
+        for t in [
+            r.gpu_median_ms,
+            r.gpu_p90_ms,
+            r.total_median_ms,
+            r.total_p90_ms,
+            r.wall_median_ms,
+        ] {
+            assert!(t.is_finite() && t > 0.0, "{r:?}");
+        }
+        assert!(r.gpu_p90_ms >= r.gpu_median_ms, "{r:?}");
+        match r.method.as_str() {
+            "cpu-animated" => {
+                let c = r.cpu_median_ms.expect("CPU time of the animated baseline");
+                assert!(c.is_finite() && c > 0.0, "{r:?}");
+                assert!(r.cpu_p90_ms.is_some());
+            }
+            _ => assert_eq!(r.cpu_median_ms, None, "{r:?}"),
+        }
+        let ratio = r.ratio_to_flat.expect("flat ran at every S");
+        assert!(ratio.is_finite() && ratio > 0.0);
+        if r.method == "flat" {
+            assert_eq!(ratio, 1.0);
+        }
+        assert!(!r.note.contains("pipeline statistics counted"), "{r:?}");
+    }
+
+    eprintln!("{}", report.to_text());
+    let csv = report.to_csv();
+    let back: Vec<BenchRow> = parse_csv(&csv).unwrap();
+    assert_eq!(back, report.rows);
+    let md = report.to_markdown();
+    assert!(md.contains(&report.device.name) && md.contains("Build profile"));
+    assert!(md.contains("fan-triangulated"));
+    assert_eq!(
+        md.lines().filter(|l| l.starts_with("| cube |")).count(),
+        report.rows.len()
+    );
+    if report.device.lavapipe {
+        assert!(md.contains("CPU rasterizer"));
+    }
+}
+
+#[test]
+fn bench_rejects_bad_configurations() {
+    let gpu = Gpu::new();
+    let cube = tessera::topology::load_obj(common::data("tests/data/meshes/cube.obj")).unwrap();
+    let mesh = BenchMesh::new("cube", &cube).unwrap();
+    let run = |c: BenchConfig| {
+        bench::run_bench(gpu.device(), std::slice::from_ref(&mesh), &c, &mut |_| {})
+            .map(|_| ())
+            .unwrap_err()
+            .to_string()
+    };
+    let mut c = tiny_config(vec![4]);
+    c.methods = vec!["nope".into()];
+    assert!(run(c).contains("unknown bench method 'nope'"));
+    let mut c = tiny_config(vec![4]);
+    c.frames = 0;
+    assert!(run(c).contains("timed frame"));
+    assert!(run(tiny_config(vec![])).contains("segments"));
+    assert!(bench::run_bench(gpu.device(), &[], &tiny_config(vec![4]), &mut |_| {}).is_err());
+}
