@@ -6,7 +6,7 @@ use crate::error::{Result, TessError};
 use crate::gpu::Vertex;
 use crate::plain::{PlainMesh, PlainRenderer};
 use crate::render_mesh::angle_weighted_normals;
-use crate::renderer::{DrawParams, GpuMesh, Method, Renderer};
+use crate::renderer::{DrawParams, DrawSplit, GpuMesh, Method, Renderer};
 use crate::tessellator::{uniform_triangle_count, Domain, Spacing, MAX_LEVEL};
 use std::time::Instant;
 use topology::eval::{LimitScheme, LocalMesh};
@@ -74,6 +74,12 @@ pub trait BenchMethod {
     fn report_notes(&self) -> Vec<String> {
         Vec::new()
     }
+
+    /// Whether a pipeline-statistics query may wrap this method's frame (a driver workaround
+    /// can forbid it; the row then reports the CPU triangle count).
+    fn statistics_query_safe(&self) -> bool {
+        true
+    }
 }
 
 /// Builds the rows of one registry entry for one mesh (usually one method).
@@ -109,6 +115,18 @@ pub fn registry() -> Vec<MethodEntry> {
             name: "pn",
             help: "curved PN triangles at level S",
             build: |c| one(TessMethod::new(c, Method::Pn, "pn")),
+        },
+        MethodEntry {
+            name: "bft",
+            help: "Loop limit surface from basis-function tables (one GPU subdivision step per \
+                   frame, then S/2 segments per level-1 edge): bft (static base) and \
+                   bft-animated (the --animate wave uploaded every frame)",
+            build: |c| {
+                Ok(vec![
+                    Box::new(BftMethod::new(c, false)?),
+                    Box::new(BftMethod::new(c, true)?),
+                ])
+            },
         },
         MethodEntry {
             name: "cpu",
@@ -217,6 +235,122 @@ impl BenchMethod for TessMethod {
         let params = self.params(frame);
         self.renderer.record(cmd, 0, &self.mesh, &params)?;
         Ok(self.expected_triangles(frame.segments))
+    }
+}
+
+/// Loop basis-function tables ([`crate::bft`]): the compute pass (base → level-1 positions and
+/// normals) is the pre-pass, inside the timed span; the draw is one patch per level-1 face at
+/// `S/2` segments per edge, so it emits as many triangles as Flat at `S`.
+pub struct BftMethod {
+    label: &'static str,
+    mesh_name: String,
+    animated: bool,
+    renderer: Renderer,
+    surface: crate::bft::BftSurface,
+    rest: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+}
+
+impl BftMethod {
+    pub fn new(ctx: &MethodContext<'_>, animated: bool) -> Result<Self> {
+        use crate::bft::{base_normals, BftSurface, DEFAULT_TABLE_LEVEL};
+        let renderer = Renderer::new(ctx.device, ctx.color_format, ctx.depth_format, 1)?;
+        let surface = BftSurface::new(
+            &renderer,
+            &ctx.mesh.mesh,
+            &ctx.mesh.name,
+            DEFAULT_TABLE_LEVEL,
+            false,
+            1,
+        )?;
+        Ok(Self {
+            label: if animated { "bft-animated" } else { "bft" },
+            mesh_name: ctx.mesh.name.clone(),
+            animated,
+            rest: surface.base_positions.clone(),
+            normals: base_normals(&ctx.mesh.mesh),
+            renderer,
+            surface,
+        })
+    }
+
+    fn params(segments: u32) -> crate::bft::BftParams {
+        crate::bft::BftParams {
+            factors: crate::bft::FactorPolicy::Uniform { segments },
+            ..Default::default()
+        }
+    }
+}
+
+impl BenchMethod for BftMethod {
+    fn label(&self) -> &str {
+        self.label
+    }
+
+    fn skip_reason(&self, segments: u32) -> Option<String> {
+        self.surface
+            .check_params(&Self::params(segments))
+            .err()
+            .map(|e| e.to_string())
+    }
+
+    fn begin_frame(&mut self, frame: &BenchFrame) -> Result<Option<f64>> {
+        let draw = DrawParams {
+            camera: frame.camera,
+            ..DrawParams::default()
+        };
+        let bbox = (self.surface.bbox_min, self.surface.bbox_max);
+        self.renderer.update_frame(0, bbox, &draw, frame.extent)?;
+        if !self.animated {
+            return Ok(None);
+        }
+        // The viewer's --animate: deform on the CPU, upload only the base positions.
+        let start = Instant::now();
+        let t = frame.index as f32 / 30.0;
+        let moved = crate::bft::wave(&self.rest, &self.normals, bbox.0, bbox.1, t);
+        self.surface.update_base(0, &moved)?;
+        Ok(Some(start.elapsed().as_secs_f64() * 1e3))
+    }
+
+    fn record_pre_pass(&mut self, cmd: vk::CommandBuffer, _frame: &BenchFrame) -> Result<()> {
+        self.surface.record_compute(cmd, &self.renderer, 0);
+        Ok(())
+    }
+
+    fn record(&mut self, cmd: vk::CommandBuffer, frame: &BenchFrame) -> Result<u64> {
+        let params = Self::params(frame.segments);
+        self.surface
+            .record_draw(cmd, &self.renderer, 0, &params, DrawSplit::Auto, false)?;
+        Ok(self.surface.patch_count() as u64
+            * uniform_triangle_count(
+                Domain::Triangle,
+                Spacing::Equal,
+                frame.segments as f32 * 0.5,
+            ))
+    }
+
+    fn report_notes(&self) -> Vec<String> {
+        let g = &self.surface.gpu;
+        let words = |n: usize| 4 * n;
+        let stencils =
+            words(g.stencil_offsets.len() + g.stencil_indices.len() + g.stencil_weights.len());
+        vec![format!(
+            "{}: BFT tables {} bytes at level {} (the valences and cases present in the mesh), \
+             patch records {} bytes, base-to-level-1 stencils {} bytes",
+            self.mesh_name,
+            self.surface.table_bytes(),
+            g.table_words[0],
+            words(g.patches.len()),
+            stencils
+        )]
+    }
+
+    fn statistics_query_safe(&self) -> bool {
+        !self
+            .renderer
+            .device()
+            .workarounds
+            .has(vk_core::workarounds::WorkaroundId::LavapipeStatisticsQueryPointPatches)
     }
 }
 

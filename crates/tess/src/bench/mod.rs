@@ -568,8 +568,9 @@ fn run_group(
             };
             let frame_start = Instant::now();
             let cpu = method.begin_frame(&frame)?;
+            let query = index == 0 && method.statistics_query_safe();
             let (gpu, wall, cpu_count, stats_count) =
-                harness.frame(method.as_mut(), &frame, index == 0, clear)?;
+                harness.frame(method.as_mut(), &frame, query, clear)?;
             if index == 0 {
                 st.counted = stats_count;
             }
