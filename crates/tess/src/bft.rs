@@ -350,8 +350,15 @@ impl BftSurface {
     }
 
     /// Checks the factors against the tables: uniform `S` must be a power of two in
-    /// `2..=2^(L+1)` unless fractional.
+    /// `2..=2^(L+1)` unless fractional; geometric normals need tangent tables.
     pub fn check_params(&self, params: &BftParams) -> Result<()> {
+        // Without tangent tables the du/dv offsets are u32::MAX: the TES must never read them.
+        if params.geometric_normals && !self.bft.tables.tangents {
+            return Err(TessError::Invalid(
+                "geometric normals need the tangent tables (this surface was built without them)"
+                    .into(),
+            ));
+        }
         let max = 2 * self.gpu.table_words[1];
         if let FactorPolicy::Uniform { segments } = params.factors {
             if segments < 2 || segments > max || (!params.fractional && !segments.is_power_of_two())
@@ -477,6 +484,7 @@ impl BftSurface {
         split: DrawSplit,
         wireframe: bool,
     ) -> Result<DrawCounts> {
+        self.check_params(params)?;
         let key = BftPipelineKey {
             spacing: params.spacing(),
             wireframe,
