@@ -1,7 +1,8 @@
 //! Command-line definition.
+use crate::technique::{SurfaceArgs, Technique};
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
-use tess::{Method, Spacing};
+use tess::Spacing;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -41,21 +42,26 @@ pub enum Command {
 pub struct ExportArgs {
     /// OBJ control mesh.
     pub input: PathBuf,
-    /// flat, phong or pn.
-    #[arg(long, value_parser = crate::export::parse_export_method)]
-    pub method: crate::export::ExportMethod,
-    /// Tessellation level (outer and inner), 1 to 64.
-    #[arg(long)]
+    /// flat, phong, pn or bft.
+    #[arg(long, value_parser = crate::technique::parse_technique)]
+    pub method: Technique,
+    /// Segments per base edge (tessellation level of flat, phong and pn: 1 to 64; bft: a power
+    /// of two from 2 to 2^(table level + 1) unless --fractional). Ignored with --adaptive.
+    #[arg(long, default_value_t = 8.0)]
     pub segments: f32,
     #[arg(long, default_value = "equal", value_parser = parse_spacing)]
     pub spacing: Spacing,
-    /// Subdivision scheme, for methods that evaluate one (only loop is accepted for now;
-    /// flat, phong and pn do not use it).
-    #[arg(long)]
-    pub scheme: Option<String>,
+    #[command(flatten)]
+    pub surface: SurfaceArgs,
     /// Phong tessellation shape factor α.
     #[arg(long, default_value_t = 0.75)]
     pub alpha: f32,
+    /// The view --adaptive screen and distance see.
+    #[command(flatten)]
+    pub camera: CameraArgs,
+    /// Viewport --adaptive screen sees, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    pub size: (u32, u32),
     /// Exit with status 1 when any crack (an open edge not on the base mesh's boundary) is found.
     #[arg(long)]
     pub fail_on_cracks: bool,
@@ -156,28 +162,43 @@ pub struct GpuArgs {
 }
 
 #[derive(Args, Debug, Clone)]
-pub struct SceneArgs {
-    /// OBJ control mesh; the embedded spot control mesh when absent.
-    pub mesh: Option<PathBuf>,
-    #[arg(long, default_value = "flat", value_parser = parse_method)]
-    pub method: Method,
-    /// Tessellation level (outer and inner), 1 to 64.
-    #[arg(long, default_value_t = 8.0)]
-    pub level: f32,
-    #[arg(long, default_value = "equal", value_parser = parse_spacing)]
-    pub spacing: Spacing,
-    /// Draw the tessellated wireframe over the shaded surface.
-    #[arg(long)]
-    pub wireframe: bool,
+pub struct CameraArgs {
     #[arg(long, default_value_t = 145.0, allow_hyphen_values = true)]
     pub yaw: f32,
     #[arg(long, default_value_t = 20.0, allow_hyphen_values = true)]
     pub pitch: f32,
     #[arg(long, default_value_t = 1.0)]
     pub zoom: f32,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct SceneArgs {
+    /// OBJ control mesh; the embedded spot control mesh when absent.
+    pub mesh: Option<PathBuf>,
+    /// flat, phong, pn (the base faces as patches) or bft (the Loop limit surface from
+    /// basis-function tables).
+    #[arg(long, default_value = "flat", value_parser = crate::technique::parse_technique)]
+    pub method: Technique,
+    /// Tessellation level: segments per base edge (outer and inner), 1 to 64; bft takes powers
+    /// of two from 2 to 2^(table level + 1) unless --fractional.
+    #[arg(long, alias = "segments", default_value_t = 8.0)]
+    pub level: f32,
+    #[arg(long, default_value = "equal", value_parser = parse_spacing)]
+    pub spacing: Spacing,
+    /// Draw the tessellated wireframe over the shaded surface.
+    #[arg(long)]
+    pub wireframe: bool,
+    #[command(flatten)]
+    pub camera: CameraArgs,
     /// Phong tessellation shape factor α.
     #[arg(long, default_value_t = 0.75)]
     pub alpha: f32,
+    #[command(flatten)]
+    pub surface: SurfaceArgs,
+    /// Move the base vertices along their normals with a travelling wave (bft): only the base
+    /// positions are uploaded per frame. `render` shows time --frame (default 0).
+    #[arg(long)]
+    pub animate: bool,
     #[command(flatten)]
     pub gpu: GpuArgs,
 }
@@ -208,9 +229,6 @@ pub struct ViewArgs {
     pub screenshot: Option<PathBuf>,
 }
 
-fn parse_method(s: &str) -> Result<Method, String> {
-    s.parse()
-}
 fn parse_spacing(s: &str) -> Result<Spacing, String> {
     s.parse()
 }

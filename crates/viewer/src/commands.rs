@@ -1,9 +1,11 @@
 //! The subcommands' bodies.
-use crate::cli::{Cli, Command, GpuArgs, RenderArgs, SceneArgs};
+use crate::cli::{CameraArgs, Cli, Command, GpuArgs, RenderArgs, SceneArgs};
+use crate::technique::{loop_control_mesh, BftSetup, Technique, Wave};
 use anyhow::{bail, Context, Result};
 use std::sync::Arc;
+use tess::bft::BftSurface;
 use tess::renderer::GpuMesh;
-use tess::{Camera, DrawParams, RenderMesh, Renderer};
+use tess::{Camera, DrawParams, Method, RenderMesh, Renderer};
 use vk_core::{vk, Device, DeviceDesc, Instance, InstanceDesc, Validation};
 
 /// The spot control mesh by Keenan Crane (public domain), embedded so `tessera render` works
@@ -46,24 +48,42 @@ pub fn load_mesh(path: Option<&std::path::Path>) -> Result<topology::ControlMesh
     Ok(mesh)
 }
 
-pub fn draw_params(s: &SceneArgs) -> Result<DrawParams> {
-    if !(1.0..=64.0).contains(&s.level) {
+/// The name a mesh goes by in messages: its path, or the embedded default's.
+pub fn mesh_name(path: Option<&std::path::Path>) -> String {
+    path.map(|p| p.display().to_string())
+        .unwrap_or_else(|| "spot_control_mesh.obj (embedded)".into())
+}
+
+pub fn camera(c: &CameraArgs) -> Camera {
+    Camera {
+        yaw: c.yaw,
+        pitch: c.pitch,
+        zoom: c.zoom,
+        ..Camera::default()
+    }
+}
+
+/// Draw parameters and, for `--method bft`, its setup, checked against each other.
+pub fn draw_params(s: &SceneArgs) -> Result<(DrawParams, Option<BftSetup>)> {
+    let bft = s.surface.setup(s.method, s.level, s.spacing, s.animate)?;
+    if bft.is_none() && !(1.0..=64.0).contains(&s.level) {
         bail!("--level {} is outside 1..64", s.level);
     }
-    Ok(DrawParams {
-        method: s.method,
+    let method = match s.method {
+        Technique::Tessellated(m) => m,
+        // Unused by the BFT pipeline; the frame uniforms only need a valid one.
+        Technique::Bft => Method::Flat,
+    };
+    let params = DrawParams {
+        method,
         spacing: s.spacing,
-        level: s.level,
+        level: s.level.clamp(1.0, 64.0),
         wireframe: s.wireframe,
-        camera: Camera {
-            yaw: s.yaw,
-            pitch: s.pitch,
-            zoom: s.zoom,
-            ..Camera::default()
-        },
+        camera: camera(&s.camera),
         phong_alpha: s.alpha,
         ..DrawParams::default()
-    })
+    };
+    Ok((params, bft))
 }
 
 /// Instance + device as the command line asks; errors list the devices seen.
@@ -109,33 +129,91 @@ pub fn check_validation(instance: &Instance) -> Result<()> {
 
 fn render(a: RenderArgs) -> Result<()> {
     let mesh = load_mesh(a.scene.mesh.as_deref())?;
-    let params = draw_params(&a.scene)?;
-    let rm = RenderMesh::from_control_mesh(&mesh).context("preparing the mesh for drawing")?;
+    let name = mesh_name(a.scene.mesh.as_deref());
+    let (params, bft) = draw_params(&a.scene)?;
+    let extent = vk::Extent2D {
+        width: a.size.0,
+        height: a.size.1,
+    };
     let (instance, device) = open_device(&a.scene.gpu, vec![], &[])?;
-    {
-        let gm = GpuMesh::upload(&device, &rm)?;
-        let mut renderer = Renderer::offscreen(&device)?;
-        let img = renderer.render_offscreen(
-            &gm,
+    let what = match &bft {
+        None => render_tessellated(&device, &mesh, &params, extent, &a.output),
+        Some(setup) => render_bft(
+            &device,
+            &mesh,
+            &name,
             &params,
-            vk::Extent2D {
-                width: a.size.0,
-                height: a.size.1,
-            },
-        )?;
-        img.save_png(&a.output)?;
-    }
+            setup,
+            a.scene.animate,
+            extent,
+            &a.output,
+        ),
+    };
     drop(device);
     check_validation(&instance)?;
     println!(
-        "wrote {} ({}x{}, {:?}, level {})",
+        "wrote {} ({}x{}, {})",
         a.output.display(),
         a.size.0,
         a.size.1,
-        params.method,
-        params.level
+        what?
     );
     Ok(())
+}
+
+fn render_tessellated(
+    device: &Device,
+    mesh: &topology::ControlMesh,
+    params: &DrawParams,
+    extent: vk::Extent2D,
+    output: &std::path::Path,
+) -> Result<String> {
+    let rm = RenderMesh::from_control_mesh(mesh).context("preparing the mesh for drawing")?;
+    let gm = GpuMesh::upload(device, &rm)?;
+    let mut renderer = Renderer::offscreen(device)?;
+    let img = renderer.render_offscreen(&gm, params, extent)?;
+    img.save_png(output)?;
+    Ok(format!("{:?}, level {}", params.method, params.level))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn render_bft(
+    device: &Device,
+    mesh: &topology::ControlMesh,
+    name: &str,
+    params: &DrawParams,
+    setup: &BftSetup,
+    animate: bool,
+    extent: vk::Extent2D,
+    output: &std::path::Path,
+) -> Result<String> {
+    let (loop_mesh, _, note) = loop_control_mesh(mesh, name);
+    if let Some(n) = note {
+        eprintln!("{n}");
+    }
+    let mut renderer = Renderer::offscreen(device)?;
+    let mut surface = BftSurface::new(
+        &renderer,
+        &loop_mesh,
+        name,
+        setup.table_level,
+        setup.params.geometric_normals,
+        1,
+    )?;
+    if animate || setup.frame.is_some() {
+        let positions = Wave::new(&loop_mesh).at(setup.frame.unwrap_or(0.0));
+        surface.update_base(0, &positions)?;
+    }
+    let bft = setup.world_params((surface.bbox_min, surface.bbox_max));
+    let (img, _, counts) = surface.render_offscreen(&mut renderer, params, &bft, extent, false)?;
+    img.save_png(output)?;
+    Ok(format!(
+        "bft, {:?}{}, {} patches in {} draws",
+        bft.factors,
+        if bft.fractional { " fractional" } else { "" },
+        surface.patch_count(),
+        counts.draws
+    ))
 }
 
 fn info(g: &GpuArgs) -> Result<()> {

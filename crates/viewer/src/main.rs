@@ -4,6 +4,7 @@ mod bench;
 mod cli;
 mod commands;
 mod export;
+mod technique;
 mod topo_cmds;
 mod view;
 

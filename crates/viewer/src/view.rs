@@ -1,14 +1,19 @@
-//! `tessera view`: a window with an orbit camera. Drag to orbit, wheel to zoom, 1/2/3 switch
-//! flat/Phong/PN, +/- raise/lower the level, W toggles the wireframe, Esc quits. The title shows
-//! the frame time. `--frames N --screenshot out.png` renders N frames, saves the last and exits.
+//! `tessera view`: a window with an orbit camera. Drag to orbit, wheel to zoom, 1/2/3/4 switch
+//! flat/Phong/PN/BFT, +/- raise/lower the level (BFT: halve/double unless fractional), arrows
+//! halve/double it, W toggles the wireframe; for BFT, A toggles the animation, C the patch
+//! colours, F fractional factors, G geometric normals. Esc quits. The title shows the frame
+//! time. `--frames N --screenshot out.png` renders N frames, saves the last and exits.
 use crate::cli::ViewArgs;
-use crate::commands::{check_validation, draw_params, load_mesh, open_device};
+use crate::commands::{check_validation, draw_params, load_mesh, mesh_name, open_device};
+use crate::technique::{loop_control_mesh, BftSetup, Technique, Wave};
 use anyhow::{Context, Result};
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use std::sync::Arc;
 use std::time::Instant;
+use tess::bft::{BftSurface, FactorPolicy};
 use tess::renderer::GpuMesh;
 use tess::{DrawParams, Method, RenderMesh, Renderer};
+use topology::ControlMesh;
 use vk_core::swapchain::{required_surface_extensions, Swapchain, FRAMES_IN_FLIGHT};
 use vk_core::target::DEPTH_FORMAT;
 use vk_core::{vk, Device, Instance};
@@ -18,9 +23,10 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
 
-/// GPU state that lives while the window does. Drop order: renderer and mesh, swapchain, then
-/// the device and instance; the window itself is dropped after all of them.
+/// GPU state that lives while the window does. Drop order: BFT surface, renderer and mesh,
+/// swapchain, then the device and instance; the window itself is dropped after all of them.
 struct Gpu {
+    bft: Option<BftSurface>,
     renderer: Renderer,
     mesh: GpuMesh,
     swapchain: Swapchain,
@@ -28,9 +34,24 @@ struct Gpu {
     instance: Arc<Instance>,
 }
 
+/// The BFT side of the view: the Loop control mesh, its options and the animation clock.
+struct BftView {
+    mesh: ControlMesh,
+    name: String,
+    setup: BftSetup,
+    wave: Wave,
+    animate: bool,
+    /// Wave time shown (advances while animating, kept when paused).
+    time: f32,
+    /// Whether the base has left the rest pose (every frame slot then gets the current pose).
+    moved: bool,
+}
+
 struct App {
     args: ViewArgs,
     rm: RenderMesh,
+    technique: Technique,
+    bft: BftView,
     params: DrawParams,
     gpu: Option<Gpu>,
     window: Option<Arc<Window>>,
@@ -75,6 +96,7 @@ impl App {
         let renderer = Renderer::new(&device, swapchain.format, DEPTH_FORMAT, FRAMES_IN_FLIGHT)?;
         let mesh = GpuMesh::upload(&device, &self.rm)?;
         self.gpu = Some(Gpu {
+            bft: None,
             renderer,
             mesh,
             swapchain,
@@ -85,19 +107,74 @@ impl App {
         Ok(())
     }
 
+    /// The BFT surface, built on first use (tangent tables included, so G can toggle).
+    fn bft_surface(gpu: &mut Gpu, view: &BftView) -> Result<()> {
+        if gpu.bft.is_none() {
+            gpu.bft = Some(BftSurface::new(
+                &gpu.renderer,
+                &view.mesh,
+                &view.name,
+                view.setup.table_level,
+                true,
+                FRAMES_IN_FLIGHT,
+            )?);
+        }
+        Ok(())
+    }
+
     fn draw(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
         let Some(gpu) = self.gpu.as_mut() else {
             return Ok(());
         };
+        if self.technique == Technique::Bft {
+            Self::bft_surface(gpu, &self.bft)?;
+        }
         let Some(frame) = gpu.swapchain.begin_frame()? else {
             return Ok(());
         };
-        gpu.renderer
-            .update_uniforms(frame.slot, &gpu.mesh, &self.params, frame.extent)?;
-        gpu.swapchain
-            .cmd_begin_rendering(&frame, self.params.clear_color)?;
-        gpu.renderer
-            .record(frame.cmd, frame.slot, &gpu.mesh, &self.params)?;
+        let dt = self.last_frame.elapsed().as_secs_f32();
+        match (self.technique, gpu.bft.as_mut()) {
+            (Technique::Bft, Some(surface)) => {
+                let view = &mut self.bft;
+                if view.animate {
+                    view.time += dt;
+                    view.moved = true;
+                }
+                if view.moved {
+                    surface.update_base(frame.slot, &view.wave.at(view.time))?;
+                }
+                let bbox = (surface.bbox_min, surface.bbox_max);
+                gpu.renderer
+                    .update_frame(frame.slot, bbox, &self.params, frame.extent)?;
+                let params = view.setup.world_params(bbox);
+                surface.check_params(&params)?;
+                surface.record_compute(frame.cmd, &gpu.renderer, frame.slot);
+                gpu.swapchain
+                    .cmd_begin_rendering(&frame, self.params.clear_color)?;
+                let split = self.params.split;
+                surface.record_draw(frame.cmd, &gpu.renderer, frame.slot, &params, split, false)?;
+                if self.params.wireframe {
+                    surface.record_draw(
+                        frame.cmd,
+                        &gpu.renderer,
+                        frame.slot,
+                        &params,
+                        split,
+                        true,
+                    )?;
+                }
+            }
+            (Technique::Tessellated(m), _) => {
+                self.params.method = m;
+                gpu.renderer
+                    .update_uniforms(frame.slot, &gpu.mesh, &self.params, frame.extent)?;
+                gpu.swapchain
+                    .cmd_begin_rendering(&frame, self.params.clear_color)?;
+                gpu.renderer
+                    .record(frame.cmd, frame.slot, &gpu.mesh, &self.params)?;
+            }
+            (Technique::Bft, None) => unreachable!("built above"),
+        }
         let last = self.args.frames.is_some_and(|n| self.frames_drawn + 1 >= n);
         let shot = gpu
             .swapchain
@@ -108,8 +185,9 @@ impl App {
         self.last_frame = now;
         if let Some(w) = &self.window {
             w.set_title(&format!(
-                "tessera — {:?} level {} {:?} — {:.2} ms/frame",
-                self.params.method, self.params.level, self.params.spacing, self.frame_ms
+                "tessera — {} — {:.2} ms/frame",
+                self.describe(),
+                self.frame_ms
             ));
         }
         if let (Some(img), Some(path)) = (shot, &self.args.screenshot) {
@@ -126,23 +204,97 @@ impl App {
         Ok(())
     }
 
+    fn describe(&self) -> String {
+        match self.technique {
+            Technique::Tessellated(m) => {
+                format!(
+                    "{m:?} level {} {:?}",
+                    self.params.level, self.params.spacing
+                )
+            }
+            Technique::Bft => {
+                let p = &self.bft.setup.params;
+                format!(
+                    "BFT {:?}{}{}{}{}",
+                    p.factors,
+                    if p.fractional { " fractional" } else { "" },
+                    if p.geometric_normals {
+                        " geometric normals"
+                    } else {
+                        ""
+                    },
+                    if p.patch_colours {
+                        " patch colours"
+                    } else {
+                        ""
+                    },
+                    if self.bft.animate { " animated" } else { "" }
+                )
+            }
+        }
+    }
+
+    /// Sets the uniform level, for BFT snapped to what its tables take.
+    fn set_level(&mut self, level: f32) {
+        let max_bft = (2u32 << self.bft.setup.table_level) as f32;
+        self.params.level = level.clamp(1.0, 64.0);
+        let p = &mut self.bft.setup.params;
+        if let FactorPolicy::Uniform { segments } = &mut p.factors {
+            let s = level.round().clamp(2.0, max_bft);
+            *segments = if p.fractional {
+                s as u32
+            } else {
+                (s as u32).next_power_of_two().min(max_bft as u32)
+            };
+        }
+    }
+
     fn key(&mut self, key: &Key) {
+        let bft = self.technique == Technique::Bft;
+        let level = match &self.bft.setup.params.factors {
+            FactorPolicy::Uniform { segments } if bft => *segments as f32,
+            _ => self.params.level,
+        };
+        let step_up = if bft && !self.bft.setup.params.fractional {
+            level * 2.0
+        } else {
+            level + 1.0
+        };
+        let step_down = if bft && !self.bft.setup.params.fractional {
+            level * 0.5
+        } else {
+            level - 1.0
+        };
         match key {
             Key::Character(c) => match c.as_str() {
-                "1" => self.params.method = Method::Flat,
-                "2" => self.params.method = Method::Phong,
-                "3" => self.params.method = Method::Pn,
-                "+" | "=" => self.params.level = (self.params.level + 1.0).min(64.0),
-                "-" => self.params.level = (self.params.level - 1.0).max(1.0),
+                "1" => self.technique = Technique::Tessellated(Method::Flat),
+                "2" => self.technique = Technique::Tessellated(Method::Phong),
+                "3" => self.technique = Technique::Tessellated(Method::Pn),
+                "4" => {
+                    self.technique = Technique::Bft;
+                    self.set_level(level);
+                }
+                "+" | "=" => self.set_level(step_up),
+                "-" => self.set_level(step_down),
                 "w" | "W" => self.params.wireframe = !self.params.wireframe,
+                "a" | "A" => self.bft.animate = !self.bft.animate,
+                "c" | "C" => {
+                    let p = &mut self.bft.setup.params;
+                    p.patch_colours = !p.patch_colours;
+                }
+                "f" | "F" => {
+                    let p = &mut self.bft.setup.params;
+                    p.fractional = !p.fractional;
+                    self.set_level(level);
+                }
+                "g" | "G" => {
+                    let p = &mut self.bft.setup.params;
+                    p.geometric_normals = !p.geometric_normals;
+                }
                 _ => {}
             },
-            Key::Named(NamedKey::ArrowUp) => {
-                self.params.level = (self.params.level * 2.0).min(64.0)
-            }
-            Key::Named(NamedKey::ArrowDown) => {
-                self.params.level = (self.params.level * 0.5).max(1.0)
-            }
+            Key::Named(NamedKey::ArrowUp) => self.set_level(level * 2.0),
+            Key::Named(NamedKey::ArrowDown) => self.set_level(level * 0.5),
             _ => {}
         }
     }
@@ -225,15 +377,42 @@ pub fn run(args: ViewArgs) -> Result<()> {
         anyhow::bail!("--screenshot needs --frames N");
     }
     let mesh = load_mesh(args.scene.mesh.as_deref())?;
-    let params = draw_params(&args.scene)?;
+    let name = mesh_name(args.scene.mesh.as_deref());
+    let (params, setup) = draw_params(&args.scene)?;
     let rm = RenderMesh::from_control_mesh(&mesh)?;
+    // The BFT options hold even when the view starts on another technique (key 4 switches).
+    let setup = match setup {
+        Some(s) => s,
+        None => {
+            let mut surface = args.scene.surface.clone();
+            surface.table_level = tess::bft::DEFAULT_TABLE_LEVEL;
+            surface
+                .setup(Technique::Bft, 16.0, tess::Spacing::Equal, false)?
+                .context("bft setup")?
+        }
+    };
+    let (loop_mesh, _, note) = loop_control_mesh(&mesh, &name);
+    if let (Some(n), Technique::Bft) = (note, args.scene.method) {
+        eprintln!("{n}");
+    }
+    let bft = BftView {
+        wave: Wave::new(&loop_mesh),
+        mesh: loop_mesh,
+        name,
+        animate: args.scene.animate,
+        time: setup.frame.unwrap_or(0.0),
+        moved: args.scene.animate || setup.frame.is_some(),
+        setup,
+    };
     let event_loop = EventLoop::new().context(
         "no window system (set DISPLAY or WAYLAND_DISPLAY; use `tessera render` headless)",
     )?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
+        technique: args.scene.method,
         args,
         rm,
+        bft,
         params,
         gpu: None,
         window: None,
@@ -248,12 +427,14 @@ pub fn run(args: ViewArgs) -> Result<()> {
     let gpu = app.gpu.take();
     let result = match gpu {
         Some(Gpu {
+            bft,
             renderer,
             mesh,
             swapchain,
             device,
             instance,
         }) => {
+            drop(bft);
             drop((renderer, mesh, swapchain));
             drop(device);
             check_validation(&instance)

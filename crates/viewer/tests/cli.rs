@@ -520,3 +520,377 @@ fn export_bad_inputs_are_named_errors() {
     );
     assert!(!Path::new(out).exists(), "no output on error");
 }
+
+/// `v` positions and `# p face u v` lines of an exported OBJ, in vertex order.
+fn exported_points(path: &Path) -> Vec<([f64; 3], usize, f64, f64)> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let nums = |l: &str, skip: usize| -> Vec<f64> {
+        l.split_whitespace()
+            .skip(skip)
+            .map(|x| x.parse().unwrap())
+            .collect()
+    };
+    let v: Vec<Vec<f64>> = text
+        .lines()
+        .filter(|l| l.starts_with("v "))
+        .map(|l| nums(l, 1))
+        .collect();
+    let p: Vec<Vec<f64>> = text
+        .lines()
+        .filter(|l| l.starts_with("# p "))
+        .map(|l| nums(l, 2))
+        .collect();
+    assert_eq!(v.len(), p.len(), "one `# p` line per vertex");
+    v.iter()
+        .zip(&p)
+        .map(|(v, p)| ([v[0], v[1], v[2]], p[0] as usize, p[1], p[2]))
+        .collect()
+}
+
+/// The exact Loop limit (CPU) of `mesh`'s fan triangulation at a point of polygon `face` given
+/// in the export's domain convention (triangles: weights of corners 0 and 1; quads: the unit
+/// square, fan triangles (0, 1, 2) below the diagonal and (0, 2, 3) above it).
+fn loop_limit_at(
+    cpu: &topology::eval::LocalMesh,
+    mesh: &topology::ControlMesh,
+    face: usize,
+    u: f64,
+    v: f64,
+) -> [f64; 3] {
+    // Triangles before `face` in the fan triangulation.
+    let first: usize = (0..face).map(|f| mesh.face(f).len() - 2).sum();
+    let (t, w1, w2) = match mesh.face(face).len() {
+        3 => (first, v, 1.0 - u - v),
+        4 if u >= v => (first, u - v, v),
+        4 => (first + 1, u, v - u),
+        n => panic!("no test mapping for {n}-gons"),
+    };
+    let p = cpu.evaluate(t, w1, w2).expect("exact limit").position;
+    [p[0], p[1], p[2]]
+}
+
+fn bbox_diag(points: &[[f64; 3]]) -> f64 {
+    let mut lo = [f64::MAX; 3];
+    let mut hi = [f64::MIN; 3];
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// `export --method bft` on a quad mesh (fan-triangulated for Loop) and on a triangle mesh whose
+/// base is moved by the animation wave: every written vertex, read back through its `# p` line,
+/// is the CPU's exact Loop limit there; no cracks.
+#[test]
+fn export_bft_writes_the_exact_limit_at_each_vertex() {
+    use topology::eval::{LimitScheme, LocalMesh};
+    let cube = data("tests/data/meshes/cube.obj");
+    let ico = data("tests/data/opensubdiv/shapes/loop_icosahedron.obj");
+    for (input, frame, segments) in [(&cube, None, "8"), (&ico, Some("0.7"), "16")] {
+        let out = tmp(&format!("bft_export_{segments}.obj"));
+        let mut args = vec![
+            "export",
+            input.as_str(),
+            "--method",
+            "bft",
+            "--scheme",
+            "loop",
+            "--segments",
+            segments,
+            "--fail-on-cracks",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        if let Some(t) = frame {
+            args.extend(["--frame", t]);
+        }
+        let s = export_ok(&args);
+        assert_eq!(reported(&s, "open edges:"), 0, "{s}");
+        assert_eq!(reported(&s, "zero-area triangles:"), 0, "{s}");
+        let mut mesh = topology::load_obj(input).unwrap();
+        if let Some(t) = frame {
+            // The deformation the GPU saw: the same wave on the same rest pose.
+            let rest = tess::bft::base_positions(&mesh);
+            let normals = tess::bft::base_normals(&mesh);
+            let (lo, hi) = tess::bft::bbox(&rest);
+            let moved = tess::bft::wave(&rest, &normals, lo, hi, t.parse().unwrap());
+            for (p, q) in mesh.positions.iter_mut().zip(moved) {
+                *p = q.map(f64::from);
+            }
+        }
+        let (tri, _) = mesh.triangulated();
+        let cpu = LocalMesh::from_control_mesh(&tri, LimitScheme::Loop).unwrap();
+        let points = exported_points(&out);
+        let diag = bbox_diag(&points.iter().map(|p| p.0).collect::<Vec<_>>());
+        let mut worst = 0.0f64;
+        for &(p, face, u, v) in &points {
+            let e = loop_limit_at(&cpu, &mesh, face, u, v);
+            for k in 0..3 {
+                worst = worst.max((p[k] - e[k]).abs() / diag);
+            }
+        }
+        eprintln!(
+            "{input} S={segments}: {} vertices, worst |GPU − limit|/diag {worst:.2e}",
+            points.len()
+        );
+        assert!(worst < 1e-5, "{input}: {worst:.2e}");
+    }
+}
+
+/// Adaptive and fractional BFT factors stay watertight through the whole command.
+#[test]
+fn export_bft_adaptive_and_fractional_are_watertight() {
+    let cube = data("tests/data/meshes/cube.obj");
+    let out = tmp("bft_adaptive.obj");
+    for extra in [
+        &["--adaptive", "screen", "--pixels", "6"][..],
+        &["--adaptive", "distance", "--distance", "0.8"],
+        &["--adaptive", "screen", "--pixels", "5", "--fractional"],
+        &["--segments", "6", "--fractional"],
+        &["--segments", "16", "--yaw", "-70", "--table-level", "4"],
+    ] {
+        let mut args = vec![
+            "export",
+            cube.as_str(),
+            "--method",
+            "bft",
+            "--fail-on-cracks",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let s = export_ok(&args);
+        assert_eq!(reported(&s, "open edges:"), 0, "{extra:?}: {s}");
+        assert!(reported(&s, "captured:") > 0, "{extra:?}: {s}");
+    }
+}
+
+#[test]
+fn bft_bad_options_are_named_errors() {
+    let cube = data("tests/data/meshes/cube.obj");
+    let out = tmp("never_bft.png");
+    let out = out.to_str().unwrap();
+    let render = |extra: &[&'static str], needles: &[&str]| {
+        let mut args = vec!["render", cube.as_str(), "-o", out];
+        args.extend_from_slice(extra);
+        fails_with(&args, &[], needles);
+    };
+    render(
+        &["--method", "bft", "--scheme", "catmull-clark"],
+        &["--scheme catmull-clark", "loop"],
+    );
+    render(
+        &["--method", "bft", "--segments", "3"],
+        &["--segments 3", "power of two"],
+    );
+    render(
+        &["--method", "bft", "--segments", "128"],
+        &["--segments 128", "--table-level"],
+    );
+    render(
+        &["--method", "bft", "--table-level", "9"],
+        &["--table-level 9"],
+    );
+    render(
+        &["--method", "bft", "--spacing", "fractional-odd"],
+        &["fractional-odd", "--fractional"],
+    );
+    render(
+        &["--method", "bft", "--adaptive", "screen", "--pixels", "0"],
+        &["--pixels 0"],
+    );
+    // A value clap itself refuses: its usage error (exit 2), naming the choices.
+    let o = tessera(
+        &[
+            "render",
+            cube.as_str(),
+            "--method",
+            "bft",
+            "--adaptive",
+            "nearby",
+            "-o",
+            out,
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("screen, distance"), "{}", stderr(&o));
+    render(
+        &["--method", "flat", "--patch-colours", "--animate"],
+        &["--patch-colours", "--animate", "--method bft"],
+    );
+    assert!(!Path::new(out).exists(), "no output on error");
+}
+
+/// Pixels whose colour is clearly one of the patch kinds' hues (shading scales brightness, not
+/// hue): blue-dominant (regular), red-dominant (extraordinary).
+fn hue_counts(img: &image::RgbaImage) -> (usize, usize) {
+    let mut blue = 0;
+    let mut red = 0;
+    for p in img.pixels() {
+        let [r, g, b, _] = p.0.map(i32::from);
+        if b > r + 30 && b > g {
+            blue += 1;
+        }
+        // The extraordinary red, not the tan base colour (r − g about 40 when lit).
+        if r > b + 70 && r > g + 70 {
+            red += 1;
+        }
+    }
+    (blue, red)
+}
+
+/// `render --method bft` on the default (quad) spot: the surface covers somewhat less than the
+/// flat control mesh (the limit surface lies inside the control hull); patch colours show regular and extraordinary patches; an animation frame
+/// moves the surface.
+#[test]
+fn render_bft_patch_colours_and_animation_frames() {
+    let png = |name: &str, extra: &[&str]| {
+        let out = tmp(name);
+        let mut args = vec!["render", "--size", "240x180", "-o", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = tessera(&args, &[]);
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+        image::open(&out).unwrap().to_rgba8()
+    };
+    let covered = |img: &image::RgbaImage| {
+        let bg = img.get_pixel(0, 0).0;
+        img.pixels().filter(|p| p.0 != bg).count()
+    };
+    let flat = png("spot_flat.png", &["--method", "flat"]);
+    let bft = png("spot_bft.png", &["--method", "bft", "--segments", "16"]);
+    let ratio = covered(&bft) as f64 / covered(&flat) as f64;
+    assert!(
+        (0.6..1.05).contains(&ratio),
+        "limit surface covers {ratio:.2}× the control mesh's pixels"
+    );
+    let coloured = png(
+        "spot_bft_colours.png",
+        &["--method", "bft", "--segments", "8", "--patch-colours"],
+    );
+    let (blue, red) = hue_counts(&coloured);
+    assert!(
+        blue > 2000 && red > 200,
+        "regular {blue}, extraordinary {red} pixels"
+    );
+    let (blue0, red0) = hue_counts(&bft);
+    assert!(
+        blue0 < blue / 20 && red0 < red / 4,
+        "without --patch-colours: {blue0} blue, {red0} red"
+    );
+    let moved = png(
+        "spot_bft_frame.png",
+        &[
+            "--method",
+            "bft",
+            "--segments",
+            "16",
+            "--animate",
+            "--frame",
+            "0.3",
+        ],
+    );
+    let differing = bft
+        .pixels()
+        .zip(moved.pixels())
+        .filter(|(p, q)| p.0.iter().zip(q.0.iter()).any(|(x, y)| x.abs_diff(*y) > 24))
+        .count();
+    assert!(
+        differing > 500,
+        "the animation frame moved only {differing} pixels"
+    );
+}
+
+/// The window shows BFT as the offscreen renderer does, and animates without errors.
+#[test]
+fn window_shows_bft_like_offscreen_and_animates() {
+    let Some((mut server, display)) = xvfb() else {
+        assert!(
+            std::env::var_os("TESSERA_REQUIRE_XVFB").is_none(),
+            "Xvfb is required here but not installed"
+        );
+        eprintln!("skipping: Xvfb not installed");
+        return;
+    };
+    let shot = tmp("window_bft.png");
+    let animated = tmp("window_bft_animated.png");
+    let offscreen = tmp("offscreen_bft.png");
+    let common = [
+        "--method",
+        "bft",
+        "--segments",
+        "8",
+        "--wireframe",
+        "--patch-colours",
+        "--size",
+        "320x240",
+    ];
+    let env = [("DISPLAY", display.as_str()), ("WAYLAND_DISPLAY", "")];
+    let o = tessera(
+        &[
+            &["view"][..],
+            &common,
+            &["--frames", "10", "--screenshot", shot.to_str().unwrap()],
+        ]
+        .concat(),
+        &env,
+    );
+    // Shaded, no overlay: the wave changes the shading everywhere, not only the silhouette.
+    let shaded = ["--method", "bft", "--segments", "8", "--size", "320x240"];
+    let a = tessera(
+        &[
+            &["view"][..],
+            &shaded,
+            &[
+                "--animate",
+                "--frames",
+                "20",
+                "--screenshot",
+                animated.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+        &env,
+    );
+    let _ = server.kill();
+    let _ = server.wait();
+    assert!(o.status.success(), "view failed: {}", stderr(&o));
+    assert!(a.status.success(), "animated view failed: {}", stderr(&a));
+    let still = tmp("offscreen_bft_still.png");
+    for (args, out) in [(&common[..], &offscreen), (&shaded[..], &still)] {
+        let r = tessera(
+            &[&["render"][..], args, &["-o", out.to_str().unwrap()]].concat(),
+            &[],
+        );
+        assert!(r.status.success(), "{}", stderr(&r));
+    }
+    let a = image::open(&shot).unwrap().to_rgba8();
+    let b = image::open(&offscreen).unwrap().to_rgba8();
+    let c = image::open(&animated).unwrap().to_rgba8();
+    let d = image::open(&still).unwrap().to_rgba8();
+    let differ = |x: &image::RgbaImage, y: &image::RgbaImage| {
+        x.pixels()
+            .zip(y.pixels())
+            .filter(|(p, q)| {
+                p.0.iter()
+                    .zip(q.0.iter())
+                    .take(3)
+                    .any(|(s, t)| s.abs_diff(*t) > 24)
+            })
+            .count() as f64
+            / (x.width() * x.height()) as f64
+    };
+    assert!(
+        differ(&a, &b) <= 0.005,
+        "window and offscreen differ in {:.3}",
+        differ(&a, &b)
+    );
+    assert!(
+        differ(&c, &d) > 0.01,
+        "the animated window did not move ({:.4})",
+        differ(&c, &d)
+    );
+}
