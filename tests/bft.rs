@@ -327,3 +327,130 @@ fn statistics_request_is_safe_on_every_driver() {
         assert_eq!(stats.is_none(), skipped);
     }
 }
+
+/// Angles (degrees) between captured normals and the exact limit normal du × dv over at most
+/// `samples` welded vertices plus every level-1 vertex (patch corner): (worst at the corners,
+/// worst, mean). Orientation-free: the winding convention is not at stake here.
+fn normal_angles(
+    surf: &BftSurface,
+    soup: &CapturedSoup,
+    mesh: &ControlMesh,
+    samples: usize,
+) -> (f64, f64, f64) {
+    let cpu = LocalMesh::from_control_mesh(mesh, LimitScheme::Loop).expect("cpu mesh");
+    let welded = soup.weld().expect("weld");
+    let n = welded.positions.len();
+    let stride = n.div_ceil(samples).max(1);
+    let (mut corners, mut worst, mut sum, mut count) = (0.0f64, 0.0f64, 0.0f64, 0usize);
+    let corner = |d: [f32; 2]| (d[0] == 0.0 || d[0] == 1.0) && (d[1] == 0.0 || d[1] == 1.0);
+    for i in (0..n).filter(|&i| i % stride == 0 || corner(welded.domain[i])) {
+        let (u, v) = patch_uv(welded.domain[i]);
+        let (f, bu, bv) = surf.bft.base_domain(welded.patch[i] as usize, u, v);
+        let e = cpu.evaluate(f, bu, bv).expect("exact limit");
+        let (a, b) = (&e.du, &e.dv);
+        let exact = [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ];
+        let g = welded.normals[i].map(f64::from);
+        let dot: f64 = (0..3).map(|k| exact[k] * g[k]).sum();
+        let len = |x: [f64; 3]| x.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let cos = (dot.abs() / (len(exact) * len(g))).min(1.0);
+        let a = cos.acos().to_degrees();
+        if corner(welded.domain[i]) {
+            corners = corners.max(a);
+        }
+        worst = worst.max(a);
+        sum += a;
+        count += 1;
+    }
+    (corners, worst, sum / count.max(1) as f64)
+}
+
+/// Geometric normals from the tangent tables are the exact limit normals; subdivision shading
+/// approximates them (the paper's point: close, and cheaper to store). A surface built without
+/// tangent tables refuses geometric normals instead of reading past its tables.
+#[test]
+fn geometric_normals_are_the_exact_limit_normals() {
+    let gpu = Gpu::new();
+    {
+        let mut renderer = Renderer::offscreen(gpu.device()).expect("renderer");
+        let mesh = spot();
+        let mut surf = BftSurface::new(&renderer, &mesh, "spot", 5, true, 1).expect("surface");
+        let draw = DrawParams::default();
+        let mut angles = Vec::new();
+        for geometric_normals in [true, false] {
+            let params = BftParams {
+                factors: FactorPolicy::Uniform { segments: 8 },
+                geometric_normals,
+                ..Default::default()
+            };
+            let soup = surf
+                .capture(&mut renderer, &draw, &params, EXTENT)
+                .expect("capture");
+            angles.push(normal_angles(&surf, &soup, &mesh, 3000));
+        }
+        let ((_, geo_worst, geo_mean), (sub_corners, sub_worst, sub_mean)) = (angles[0], angles[1]);
+        println!(
+            "spot S=8: angle to the exact normal: geometric worst {geo_worst:.4}° mean \
+             {geo_mean:.5}°; subdivision shading at level-1 vertices {sub_corners:.2}°, worst \
+             {sub_worst:.2}°, mean {sub_mean:.3}°"
+        );
+        assert!(geo_worst < 0.01, "geometric normals: {geo_worst:.4}°");
+        // Subdivision shading treats the level-1 limit normals as control values: its normal
+        // field is their limit (then normalised), an approximation of the true normal even at
+        // level-1 vertices. It must be the shader's arithmetic, the f32 mirror's, exactly.
+        assert!(
+            sub_mean > geo_mean && sub_mean < 10.0,
+            "subdivision shading: mean {sub_mean:.3}°"
+        );
+        let soup = surf
+            .capture(
+                &mut renderer,
+                &draw,
+                &BftParams {
+                    factors: FactorPolicy::Uniform { segments: 8 },
+                    ..Default::default()
+                },
+                EXTENT,
+            )
+            .expect("capture");
+        let base = tessera::tess::bft::base_positions(&mesh);
+        let level1 = surf.gpu.subdivide(&base);
+        let normals = surf.gpu.normals(&level1);
+        let mut mirror_worst = 0.0f64;
+        for r in &soup.records {
+            let [x, y] = r.domain;
+            let m = surf.gpu.eval_tess(
+                &level1,
+                &normals,
+                r.patch as usize,
+                [x, y, 1.0 - x - y],
+                false,
+            );
+            let len = |v: [f32; 3]| v.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt();
+            let dot: f64 = (0..3)
+                .map(|k| m.normal[k] as f64 * r.normal[k] as f64)
+                .sum();
+            let cos = (dot / (len(m.normal) * len(r.normal))).clamp(-1.0, 1.0);
+            mirror_worst = mirror_worst.max(cos.acos().to_degrees());
+        }
+        println!("subdivision shading vs its f32 mirror: worst {mirror_worst:.5}°");
+        assert!(
+            mirror_worst < 0.01,
+            "subdivision shading vs mirror: {mirror_worst:.4}°"
+        );
+
+        let mut plain = BftSurface::new(&renderer, &mesh, "spot", 5, false, 1).expect("surface");
+        let params = BftParams {
+            geometric_normals: true,
+            ..Default::default()
+        };
+        let e = plain
+            .render_offscreen(&mut renderer, &draw, &params, EXTENT, false)
+            .map(|_| ())
+            .expect_err("geometric normals without tangent tables");
+        assert!(e.to_string().contains("tangent tables"), "{e}");
+    }
+}

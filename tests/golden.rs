@@ -94,3 +94,100 @@ fn golden_images_match_and_detect_a_level_change() {
         );
     }
 }
+
+/// Larger than the other goldens: at 160 × 120 the spot's wireframe at S = 4 already covers
+/// nearly every pixel, so no change of S could show.
+const BFT_EXTENT: vk::Extent2D = vk::Extent2D {
+    width: 320,
+    height: 240,
+};
+const BFT_MESHES: [&str; 3] = [
+    "assets/spot_control_mesh.obj",
+    "tests/data/opensubdiv/shapes/loop_icosahedron.obj",
+    "tests/data/opensubdiv/shapes/loop_xord_boundary.obj",
+];
+
+/// BFT images per mesh: shaded (subdivision shading at S segments, posed by the animation wave
+/// at `time`) and wireframe with patch colours.
+fn render_bft(segments: u32, time: f32) -> Vec<(String, Rgba8)> {
+    use tessera::tess::bft::{base_normals, base_positions, wave};
+    use tessera::tess::{BftParams, BftSurface, FactorPolicy};
+    let gpu = Gpu::new();
+    let mut r = Renderer::offscreen(gpu.device()).unwrap();
+    let mut out = Vec::new();
+    for path in BFT_MESHES {
+        let mesh = tessera::topology::load_obj(common::data(path))
+            .unwrap()
+            .triangulated()
+            .0;
+        let stem = std::path::Path::new(path)
+            .file_stem()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        let mut surf = BftSurface::new(&r, &mesh, &stem, 5, false, 1).unwrap();
+        let rest = base_positions(&mesh);
+        let (lo, hi) = (surf.bbox_min, surf.bbox_max);
+        surf.update_base(0, &wave(&rest, &base_normals(&mesh), lo, hi, time))
+            .unwrap();
+        for (kind, wireframe) in [("shaded", false), ("wire", true)] {
+            // From above: loop_xord_boundary is an open sheet seen edge-on by the default view.
+            let draw = DrawParams {
+                wireframe,
+                camera: tessera::tess::Camera {
+                    pitch: 55.0,
+                    ..Default::default()
+                },
+                ..Default::default()
+            };
+            let params = BftParams {
+                factors: FactorPolicy::Uniform { segments },
+                patch_colours: wireframe,
+                ..Default::default()
+            };
+            let (img, _, _) = surf
+                .render_offscreen(&mut r, &draw, &params, BFT_EXTENT, false)
+                .unwrap();
+            out.push((format!("{stem}_bft_{kind}"), img));
+        }
+    }
+    out
+}
+
+/// BFT goldens: shaded and wireframe. The shaded image must notice the surface moving (an
+/// animation frame later), the wireframe one a change of the segments.
+#[test]
+fn bft_golden_images_match_and_detect_changes() {
+    const S: u32 = 4;
+    const T: f32 = 0.0;
+    let first = render_bft(S, T);
+    let dir = common::data("tests/data/golden");
+    if std::env::var_os("TESSERA_UPDATE_GOLDEN").is_some() {
+        for (name, img) in &first {
+            img.save_png(&dir.join(format!("{name}.png"))).unwrap();
+        }
+    }
+    let second = render_bft(S, T);
+    let finer = render_bft(2 * S, T);
+    let later = render_bft(S, T + 0.5);
+    for (((name, a), b), (c, d)) in first.iter().zip(&second).zip(finer.iter().zip(&later)) {
+        let golden = Rgba8::load_png(&dir.join(format!("{name}.png")))
+            .unwrap_or_else(|e| panic!("{name}: {e} (TESSERA_UPDATE_GOLDEN=1 writes it)"));
+        let d1 = differing_fraction(a, &golden);
+        let d2 = differing_fraction(&b.1, &golden);
+        let changed = if name.ends_with("_wire") {
+            differing_fraction(&c.1, &golden)
+        } else {
+            differing_fraction(&d.1, &golden)
+        };
+        eprintln!("{name}: run 1 {d1:.5}, run 2 {d2:.5}, changed {changed:.5}");
+        assert!(
+            d1 <= TOLERANCE && d2 <= TOLERANCE,
+            "{name}: differs from golden ({d1:.5}, {d2:.5})"
+        );
+        assert!(
+            changed > TOLERANCE,
+            "{name}: a change passed the tolerance ({changed:.5}) — the check is too loose"
+        );
+    }
+}
