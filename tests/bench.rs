@@ -29,6 +29,7 @@ fn bench_rows_counts_and_csv_round_trip() {
     assert_eq!(mesh.notes.len(), 1, "the triangulation is reported");
 
     let mut config = tiny_config(vec![1, 3, 4]);
+    config.methods = ["flat", "phong", "pn", "cpu"].map(String::from).to_vec();
     // Loop level 2 of the cube has 98 vertices: over this limit, so cpu rows skip S = 4.
     config.cpu_max_vertices = 50;
     let mut seen = 0;
@@ -156,4 +157,67 @@ fn bench_rejects_bad_configurations() {
     assert!(run(c).contains("timed frame"));
     assert!(run(tiny_config(vec![])).contains("segments"));
     assert!(bench::run_bench(gpu.device(), &[], &tiny_config(vec![4]), &mut |_| {}).is_err());
+}
+
+/// BFT rows: one patch per level-1 face at S/2 emits exactly Flat's triangles at S; S outside
+/// the tables' range is skipped with the reason; the animated row reports its upload's CPU time;
+/// the report names the table memory.
+#[test]
+fn bench_bft_rows_match_flat_triangles() {
+    let gpu = Gpu::new();
+    let cube = tessera::topology::load_obj(common::data("tests/data/meshes/cube.obj")).unwrap();
+    let mesh = BenchMesh::new("cube", &cube).unwrap();
+    let mut config = tiny_config(vec![1, 4, 16]);
+    config.methods = vec!["flat".into(), "bft".into()];
+    let report = bench::run_bench(gpu.device(), &[mesh], &config, &mut |_| {}).unwrap();
+    let got: Vec<(u32, &str)> = report
+        .rows
+        .iter()
+        .map(|r| (r.segments, r.method.as_str()))
+        .collect();
+    assert_eq!(
+        got,
+        vec![
+            (1, "flat"),
+            (4, "flat"),
+            (4, "bft"),
+            (4, "bft-animated"),
+            (16, "flat"),
+            (16, "bft"),
+            (16, "bft-animated"),
+        ]
+    );
+    let skipped: Vec<(u32, &str)> = report
+        .skipped
+        .iter()
+        .map(|s| (s.segments, s.method.as_str()))
+        .collect();
+    assert_eq!(skipped, vec![(1, "bft"), (1, "bft-animated")]);
+    assert!(report.skipped[0].reason.contains("power of two in 2..=64"));
+    for r in report.rows.iter().filter(|r| r.method.starts_with("bft")) {
+        let flat = report
+            .rows
+            .iter()
+            .find(|f| f.method == "flat" && f.segments == r.segments)
+            .unwrap();
+        assert_eq!(r.triangles, flat.triangles, "{r:?}");
+        assert_eq!(
+            r.triangles,
+            12 * uniform_triangle_count(Domain::Triangle, Spacing::Equal, r.segments as f32)
+        );
+        assert_eq!(
+            r.cpu_median_ms.is_some(),
+            r.method == "bft-animated",
+            "{r:?}"
+        );
+        assert!(r.ratio_to_flat.is_some_and(|x| x.is_finite() && x > 0.0));
+    }
+    assert!(
+        report
+            .extra_notes
+            .iter()
+            .any(|n| n.starts_with("cube: BFT tables") && n.contains("at level 5")),
+        "{:?}",
+        report.extra_notes
+    );
 }

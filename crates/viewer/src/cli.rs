@@ -77,8 +77,9 @@ pub struct BenchArgs {
     /// Segments per base edge S (4, 16, 32 are the paper's levels 2, 4, 5).
     #[arg(long, value_delimiter = ',', default_value = "4,16,32")]
     pub segments: Vec<u32>,
-    /// Techniques: flat, phong, pn, cpu (CPU Loop subdivision: cpu-static and cpu-animated rows).
-    #[arg(long, value_delimiter = ',', default_value = "flat,phong,pn,cpu")]
+    /// Techniques: flat, phong, pn, bft (Loop basis-function tables: bft and bft-animated rows),
+    /// cpu (CPU Loop subdivision: cpu-static and cpu-animated rows).
+    #[arg(long, value_delimiter = ',', default_value = "flat,phong,pn,bft,cpu")]
     pub methods: Vec<String>,
     /// Timed frames per row.
     #[arg(long, default_value_t = 30)]

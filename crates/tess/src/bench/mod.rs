@@ -32,7 +32,7 @@ use vk_core::{vk, AdapterInfo, Device};
 pub struct BenchConfig {
     /// Segments per base edge S (Table I: 4, 16, 32 for levels 2, 4, 5).
     pub segments: Vec<u32>,
-    /// Registry names, e.g. `["flat", "phong", "pn", "cpu"]`.
+    /// Registry names, e.g. `["flat", "phong", "pn", "bft", "cpu"]`.
     pub methods: Vec<String>,
     /// Timed frames per row.
     pub frames: u32,
@@ -54,7 +54,9 @@ impl Default for BenchConfig {
     fn default() -> Self {
         Self {
             segments: vec![4, 16, 32],
-            methods: ["flat", "phong", "pn", "cpu"].map(String::from).to_vec(),
+            methods: ["flat", "phong", "pn", "bft", "cpu"]
+                .map(String::from)
+                .to_vec(),
             frames: 30,
             warmup: 5,
             extent: vk::Extent2D {
