@@ -49,7 +49,7 @@ use crate::error::{Result, TessError};
 use crate::render_mesh::PatchOrigin;
 use crate::renderer::{
     draw_lists, frame_uniforms, patches_per_draw, record_list_draws, set_patch_input,
-    technique_stages, DrawCounts, DrawParams, GpuMesh, Method,
+    technique_stages, DrawCounts, DrawParams, FrameSets, GpuMesh, Method,
 };
 use crate::tessellator::{uniform_triangle_count, Domain, Spacing};
 use bytemuck::{Pod, Zeroable};
@@ -58,7 +58,6 @@ use std::io::Write as _;
 use std::mem::{offset_of, size_of};
 use std::path::Path;
 use topology::ControlMesh;
-use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
 use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage};
 use vk_core::query::{QueryPool, TransformFeedbackCounts};
 use vk_core::transform_feedback::TransformFeedbackCommands;
@@ -491,14 +490,11 @@ pub enum CaptureSizing {
 /// [`Capturer::max_bytes`] deliberately.
 pub const DEFAULT_MAX_CAPTURE_BYTES: u64 = 1 << 30;
 
-/// Owns capture pipelines and the frame uniforms they read. Drop order: pipelines, descriptor
-/// pool, set layout, uniforms, device.
+/// Owns capture pipelines and the frame uniforms they read. Drop order: pipelines, frame set,
+/// device.
 pub struct Capturer {
     pipelines: HashMap<CaptureKey, Pipeline>,
-    _pool: DescriptorPool,
-    set_layout: DescriptorSetLayout,
-    set: vk::DescriptorSet,
-    uniforms: Buffer,
+    frame: FrameSets,
     /// Captures needing more record bytes than this fail with [`TessError::CaptureTooLarge`].
     pub max_bytes: u64,
     pub sizing: CaptureSizing,
@@ -510,36 +506,9 @@ impl Capturer {
     pub fn new(device: &Device) -> Result<Self> {
         device.transform_feedback()?;
         QueryPool::transform_feedback_stream(device, "capture query probe", 1)?;
-        let set_layout = DescriptorSetLayout::new(
-            device,
-            "capture frame set layout",
-            &[BindingDesc {
-                binding: 0,
-                ty: vk::DescriptorType::UNIFORM_BUFFER,
-                stages: vk::ShaderStageFlags::ALL_GRAPHICS,
-            }],
-        )?;
-        let pool = DescriptorPool::new(device, "capture descriptor pool", &set_layout, 1)?;
-        let uniforms = Buffer::new(
-            device,
-            &BufferDesc {
-                name: "capture frame uniforms",
-                size: size_of::<crate::gpu::FrameUniforms>() as u64,
-                usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
-                location: MemoryLocation::CpuToGpu,
-            },
-        )?;
-        let set = pool.allocate(&set_layout)?;
-        pool.write_buffers(
-            set,
-            &[(0, vk::DescriptorType::UNIFORM_BUFFER, uniforms.descriptor())],
-        );
         Ok(Self {
             pipelines: HashMap::new(),
-            _pool: pool,
-            set_layout,
-            set,
-            uniforms,
+            frame: FrameSets::new(device, "capture", 1)?,
             max_bytes: DEFAULT_MAX_CAPTURE_BYTES,
             sizing: CaptureSizing::default(),
             device: device.clone(),
@@ -561,7 +530,7 @@ impl Capturer {
                 ShaderStage::new(vk::ShaderStageFlags::TESSELLATION_CONTROL, tesc),
                 ShaderStage::new(vk::ShaderStageFlags::TESSELLATION_EVALUATION, tese),
             ];
-            set_patch_input(&mut desc, cp, self.set_layout.raw);
+            set_patch_input(&mut desc, cp, self.frame.layout());
             desc.rasterizer_discard = true;
             desc.depth_test = false;
             desc.depth_write = false;
@@ -591,7 +560,7 @@ impl Capturer {
                 height: 1,
             },
         );
-        self.uniforms.write(0, bytemuck::bytes_of(&u))?;
+        self.frame.write(0, &u)?;
         let level = params.level.clamp(1.0, crate::tessellator::MAX_LEVEL);
         let lists = draw_lists(mesh, params.method);
         let expected: Vec<u64> = lists
@@ -688,7 +657,7 @@ impl Capturer {
             let p = self.pipeline(key)?;
             pipelines.push((p.raw, p.layout));
         }
-        let set = self.set;
+        let set = self.frame.set(0)?;
         let mut counts = DrawCounts::default();
         let mut failure = None;
         device.one_shot(|cmd| {

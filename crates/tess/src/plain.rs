@@ -3,9 +3,8 @@
 //! `shade.frag` as the tessellated techniques, so only the geometry path differs.
 use crate::error::{Result, TessError};
 use crate::gpu::{DrawPush, Vertex};
-use crate::renderer::{frame_uniforms_for, DrawParams};
+use crate::renderer::{frame_uniforms_for, set_vertex_input, DrawParams, FrameSets};
 use crate::shaders;
-use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
 use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage};
 use vk_core::{vk, Buffer, BufferDesc, Device, MemoryLocation};
 
@@ -124,13 +123,10 @@ impl PlainMesh {
 }
 
 /// The non-tessellated pipeline with its own frame uniforms (one frame slot). Drop order:
-/// pipeline, pool (frees the set), set layout, uniform buffer.
+/// pipeline, frame set.
 pub struct PlainRenderer {
     pipeline: Pipeline,
-    _pool: DescriptorPool,
-    _set_layout: DescriptorSetLayout,
-    set: vk::DescriptorSet,
-    uniforms: Buffer,
+    frame: FrameSets,
     device: Device,
 }
 
@@ -140,65 +136,21 @@ impl PlainRenderer {
         color_format: vk::Format,
         depth_format: vk::Format,
     ) -> Result<Self> {
-        let set_layout = DescriptorSetLayout::new(
-            device,
-            "plain frame set layout",
-            &[BindingDesc {
-                binding: 0,
-                ty: vk::DescriptorType::UNIFORM_BUFFER,
-                stages: vk::ShaderStageFlags::ALL_GRAPHICS,
-            }],
-        )?;
-        let pool = DescriptorPool::new(device, "plain descriptor pool", &set_layout, 1)?;
-        let uniforms = Buffer::new(
-            device,
-            &BufferDesc {
-                name: "plain frame uniforms",
-                size: std::mem::size_of::<crate::gpu::FrameUniforms>() as u64,
-                usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
-                location: MemoryLocation::CpuToGpu,
-            },
-        )?;
-        let set = pool.allocate(&set_layout)?;
-        pool.write_buffers(
-            set,
-            &[(0, vk::DescriptorType::UNIFORM_BUFFER, uniforms.descriptor())],
-        );
+        let frame = FrameSets::new(device, "plain", 1)?;
         let mut desc = GraphicsPipelineDesc::new("plain triangles", color_format, depth_format);
         desc.stages = vec![
             ShaderStage::new(vk::ShaderStageFlags::VERTEX, shaders::PLAIN_VERT),
             ShaderStage::new(vk::ShaderStageFlags::FRAGMENT, shaders::SHADE_FRAG),
         ];
-        desc.vertex_bindings = vec![vk::VertexInputBindingDescription {
-            binding: 0,
-            stride: std::mem::size_of::<Vertex>() as u32,
-            input_rate: vk::VertexInputRate::VERTEX,
-        }];
-        desc.vertex_attributes = vec![
-            vk::VertexInputAttributeDescription {
-                location: 0,
-                binding: 0,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 0,
-            },
-            vk::VertexInputAttributeDescription {
-                location: 1,
-                binding: 0,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 12,
-            },
-        ];
-        desc.set_layouts = vec![set_layout.raw];
+        set_vertex_input(&mut desc);
+        desc.set_layouts = vec![frame.layout()];
         desc.push_constant_bytes = std::mem::size_of::<DrawPush>() as u32;
         // The tessellated techniques' shaded pass uses this bias too: same raster work.
         desc.depth_bias = Some((1.0, 1.0));
         let pipeline = Pipeline::graphics(device, &desc)?;
         Ok(Self {
             pipeline,
-            _pool: pool,
-            _set_layout: set_layout,
-            set,
-            uniforms,
+            frame,
             device: device.clone(),
         })
     }
@@ -210,14 +162,16 @@ impl PlainRenderer {
         params: &DrawParams,
         extent: vk::Extent2D,
     ) -> Result<()> {
-        let u = frame_uniforms_for((mesh.bbox_min, mesh.bbox_max), params, extent);
-        self.uniforms.write(0, bytemuck::bytes_of(&u))?;
-        Ok(())
+        self.frame.write(
+            0,
+            &frame_uniforms_for((mesh.bbox_min, mesh.bbox_max), params, extent),
+        )
     }
 
     /// Records the shaded draw inside an active rendering scope; returns the triangles drawn.
-    pub fn record(&self, cmd: vk::CommandBuffer, mesh: &PlainMesh) -> u64 {
+    pub fn record(&self, cmd: vk::CommandBuffer, mesh: &PlainMesh) -> Result<u64> {
         let device = &self.device;
+        let set = self.frame.set(0)?;
         let push = DrawPush {
             mode: 0,
             first_patch: 0,
@@ -235,7 +189,7 @@ impl PlainRenderer {
                 vk::PipelineBindPoint::GRAPHICS,
                 self.pipeline.layout,
                 0,
-                &[self.set],
+                &[set],
                 &[],
             );
             device.raw.cmd_push_constants(
@@ -256,6 +210,6 @@ impl PlainRenderer {
                 .cmd_draw_indexed(cmd, mesh.index_count, 1, 0, 0, 0);
         }
         device.end_label(cmd);
-        mesh.triangles()
+        Ok(mesh.triangles())
     }
 }

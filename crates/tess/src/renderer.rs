@@ -162,20 +162,84 @@ impl GpuMesh {
     }
 }
 
-/// Per-frame-in-flight resources: a uniform buffer and its descriptor set.
-struct FrameSlot {
-    uniforms: Buffer,
-    set: vk::DescriptorSet,
+/// Set 0 of every pipeline that includes `frame.glsl`: one uniform buffer and descriptor set
+/// per frame slot, with their layout. Drop order: pool (frees the sets), layout, buffers.
+pub(crate) struct FrameSets {
+    _pool: DescriptorPool,
+    layout: DescriptorSetLayout,
+    slots: Vec<(Buffer, vk::DescriptorSet)>,
 }
 
-/// Owns pipelines and per-frame uniforms. Drop order: pipelines, descriptor pool (frees the
-/// sets), set layout, uniform buffers, then the device handle.
+impl FrameSets {
+    /// `slots` uniform buffers and sets, named after `name` (for debuggers).
+    pub(crate) fn new(device: &Device, name: &str, slots: usize) -> Result<Self> {
+        let layout = DescriptorSetLayout::new(
+            device,
+            &format!("{name} frame set layout"),
+            &[BindingDesc {
+                binding: 0,
+                ty: vk::DescriptorType::UNIFORM_BUFFER,
+                stages: vk::ShaderStageFlags::ALL_GRAPHICS,
+            }],
+        )?;
+        let pool = DescriptorPool::new(
+            device,
+            &format!("{name} frame descriptor pool"),
+            &layout,
+            slots as u32,
+        )?;
+        let mut out = Vec::with_capacity(slots);
+        for i in 0..slots {
+            let uniforms = Buffer::new(
+                device,
+                &BufferDesc {
+                    name: &format!("{name} frame uniforms {i}"),
+                    size: std::mem::size_of::<FrameUniforms>() as u64,
+                    usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                    location: MemoryLocation::CpuToGpu,
+                },
+            )?;
+            let set = pool.allocate(&layout)?;
+            pool.write_buffers(
+                set,
+                &[(0, vk::DescriptorType::UNIFORM_BUFFER, uniforms.descriptor())],
+            );
+            out.push((uniforms, set));
+        }
+        Ok(Self {
+            _pool: pool,
+            layout,
+            slots: out,
+        })
+    }
+
+    pub(crate) fn layout(&self) -> vk::DescriptorSetLayout {
+        self.layout.raw
+    }
+
+    /// The set of slot `slot`, or a typed error for a slot that does not exist.
+    pub(crate) fn set(&self, slot: usize) -> Result<vk::DescriptorSet> {
+        self.slots
+            .get(slot)
+            .map(|s| s.1)
+            .ok_or_else(|| TessError::Invalid(format!("no frame slot {slot}")))
+    }
+
+    pub(crate) fn write(&mut self, slot: usize, uniforms: &FrameUniforms) -> Result<()> {
+        let s = self
+            .slots
+            .get_mut(slot)
+            .ok_or_else(|| TessError::Invalid(format!("no frame slot {slot}")))?;
+        s.0.write(0, bytemuck::bytes_of(uniforms))?;
+        Ok(())
+    }
+}
+
+/// Owns pipelines and per-frame uniforms. Drop order: pipelines, frame sets, then the device
+/// handle.
 pub struct Renderer {
     pipelines: HashMap<PipelineKey, Pipeline>,
-    /// Not read after creation; owning it frees the descriptor sets on drop.
-    _pool: DescriptorPool,
-    set_layout: DescriptorSetLayout,
-    slots: Vec<FrameSlot>,
+    frames: FrameSets,
     color_format: vk::Format,
     depth_format: vk::Format,
     device: Device,
@@ -195,45 +259,9 @@ impl Renderer {
         depth_format: vk::Format,
         frames_in_flight: usize,
     ) -> Result<Self> {
-        let stages = vk::ShaderStageFlags::ALL_GRAPHICS;
-        let set_layout = DescriptorSetLayout::new(
-            device,
-            "frame set layout",
-            &[BindingDesc {
-                binding: 0,
-                ty: vk::DescriptorType::UNIFORM_BUFFER,
-                stages,
-            }],
-        )?;
-        let pool = DescriptorPool::new(
-            device,
-            "frame descriptor pool",
-            &set_layout,
-            frames_in_flight as u32,
-        )?;
-        let mut slots = Vec::new();
-        for i in 0..frames_in_flight {
-            let uniforms = Buffer::new(
-                device,
-                &BufferDesc {
-                    name: &format!("frame uniforms {i}"),
-                    size: std::mem::size_of::<FrameUniforms>() as u64,
-                    usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
-                    location: MemoryLocation::CpuToGpu,
-                },
-            )?;
-            let set = pool.allocate(&set_layout)?;
-            pool.write_buffers(
-                set,
-                &[(0, vk::DescriptorType::UNIFORM_BUFFER, uniforms.descriptor())],
-            );
-            slots.push(FrameSlot { uniforms, set });
-        }
         Ok(Self {
             pipelines: HashMap::new(),
-            _pool: pool,
-            set_layout,
-            slots,
+            frames: FrameSets::new(device, "renderer", frames_in_flight)?,
             color_format,
             depth_format,
             device: device.clone(),
@@ -251,12 +279,13 @@ impl Renderer {
 
     /// Layout of set 0 (the frame uniforms), shared by every technique's pipelines.
     pub fn frame_set_layout(&self) -> vk::DescriptorSetLayout {
-        self.set_layout.raw
+        self.frames.layout()
     }
 
     /// Set 0 of frame slot `slot` (clamped to the slots there are).
     pub fn frame_set(&self, slot: usize) -> vk::DescriptorSet {
-        self.slots[slot.min(self.slots.len() - 1)].set
+        let last = self.frames.slots.len() - 1;
+        self.frames.slots[slot.min(last)].1
     }
 
     /// Colour and depth formats the pipelines render to.
@@ -288,7 +317,7 @@ impl Renderer {
             ShaderStage::new(vk::ShaderStageFlags::TESSELLATION_EVALUATION, tese),
             ShaderStage::new(vk::ShaderStageFlags::FRAGMENT, shaders::SHADE_FRAG),
         ];
-        set_patch_input(&mut desc, cp, self.set_layout.raw);
+        set_patch_input(&mut desc, cp, self.frames.layout());
         set_pass_style(&mut desc, key.wireframe);
         Ok(Pipeline::graphics(&self.device, &desc)?)
     }
@@ -312,13 +341,8 @@ impl Renderer {
         params: &DrawParams,
         extent: vk::Extent2D,
     ) -> Result<()> {
-        let u = frame_uniforms_for(bbox, params, extent);
-        let slot = self
-            .slots
-            .get_mut(slot)
-            .ok_or_else(|| TessError::Invalid(format!("no frame slot {slot}")))?;
-        slot.uniforms.write(0, bytemuck::bytes_of(&u))?;
-        Ok(())
+        self.frames
+            .write(slot, &frame_uniforms_for(bbox, params, extent))
     }
 
     /// Records the draws of one frame inside an active rendering scope.
@@ -347,11 +371,7 @@ impl Renderer {
         passes: &[bool],
     ) -> Result<DrawCounts> {
         let mut counts = DrawCounts::default();
-        let set = self
-            .slots
-            .get(slot)
-            .ok_or_else(|| TessError::Invalid(format!("no frame slot {slot}")))?
-            .set;
+        let set = self.frames.set(slot)?;
         let lists = draw_lists(mesh, params.method);
         let device = self.device.clone();
         device.begin_label(cmd, &format!("{:?} level {}", params.method, params.level));
@@ -613,13 +633,9 @@ pub(crate) fn set_pass_style(desc: &mut GraphicsPipelineDesc<'_>, wireframe: boo
     }
 }
 
-/// Vertex input (the mesh's interleaved [`Vertex`]), patch topology, the frame set and the
-/// [`DrawPush`] range: what render and capture pipelines share.
-pub(crate) fn set_patch_input(
-    desc: &mut GraphicsPipelineDesc<'_>,
-    control_points: u32,
-    set_layout: vk::DescriptorSetLayout,
-) {
+/// Vertex input of the interleaved [`Vertex`] (position at location 0, normal at 1): what mesh.vert
+/// and plain.vert read.
+pub(crate) fn set_vertex_input(desc: &mut GraphicsPipelineDesc<'_>) {
     desc.vertex_bindings = vec![vk::VertexInputBindingDescription {
         binding: 0,
         stride: std::mem::size_of::<Vertex>() as u32,
@@ -639,6 +655,16 @@ pub(crate) fn set_patch_input(
             offset: 12,
         },
     ];
+}
+
+/// Vertex input (the mesh's interleaved [`Vertex`]), patch topology, the frame set and the
+/// [`DrawPush`] range: what render and capture pipelines share.
+pub(crate) fn set_patch_input(
+    desc: &mut GraphicsPipelineDesc<'_>,
+    control_points: u32,
+    set_layout: vk::DescriptorSetLayout,
+) {
+    set_vertex_input(desc);
     desc.topology = vk::PrimitiveTopology::PATCH_LIST;
     desc.tessellation = Some(TessellationDesc {
         patch_control_points: control_points,

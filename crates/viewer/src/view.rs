@@ -147,7 +147,6 @@ impl App {
                 gpu.renderer
                     .update_frame(frame.slot, bbox, &self.params, frame.extent)?;
                 let params = view.setup.world_params(bbox);
-                surface.check_params(&params)?;
                 surface.record_compute(frame.cmd, &gpu.renderer, frame.slot);
                 gpu.swapchain
                     .cmd_begin_rendering(&frame, self.params.clear_color)?;

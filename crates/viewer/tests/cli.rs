@@ -168,14 +168,40 @@ fn xvfb() -> Option<(std::process::Child, String)> {
     None
 }
 
-#[test]
-fn window_screenshot_matches_offscreen_render() {
-    let Some((mut server, display)) = xvfb() else {
+/// [`xvfb`], or None after saying the test is skipped; fails where Xvfb is required.
+fn xvfb_or_skip() -> Option<(std::process::Child, String)> {
+    let server = xvfb();
+    if server.is_none() {
         assert!(
             std::env::var_os("TESSERA_REQUIRE_XVFB").is_none(),
             "Xvfb is required here but not installed"
         );
         eprintln!("skipping: Xvfb not installed");
+    }
+    server
+}
+
+/// Pixels whose colour (RGB) differs by more than 24/255 in some channel.
+fn differing_pixels(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
+    assert_eq!(a.dimensions(), b.dimensions());
+    a.pixels()
+        .zip(b.pixels())
+        .filter(|(p, q)| {
+            p.0.iter()
+                .zip(q.0.iter())
+                .take(3)
+                .any(|(x, y)| x.abs_diff(*y) > 24)
+        })
+        .count()
+}
+
+fn differing_fraction(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    differing_pixels(a, b) as f64 / (a.width() * a.height()) as f64
+}
+
+#[test]
+fn window_screenshot_matches_offscreen_render() {
+    let Some((mut server, display)) = xvfb_or_skip() else {
         return;
     };
     let shot = tmp("window.png");
@@ -215,18 +241,7 @@ fn window_screenshot_matches_offscreen_render() {
     assert!(r.status.success(), "{}", stderr(&r));
     let a = image::open(&shot).unwrap().to_rgba8();
     let b = image::open(&offscreen).unwrap().to_rgba8();
-    assert_eq!(a.dimensions(), b.dimensions());
-    let differing = a
-        .pixels()
-        .zip(b.pixels())
-        .filter(|(p, q)| {
-            p.0.iter()
-                .zip(q.0.iter())
-                .take(3)
-                .any(|(x, y)| x.abs_diff(*y) > 24)
-        })
-        .count();
-    let fraction = differing as f64 / (a.width() * a.height()) as f64;
+    let fraction = differing_fraction(&a, &b);
     assert!(
         fraction <= 0.005,
         "window and offscreen differ in {:.3}% of pixels",
@@ -793,11 +808,7 @@ fn render_bft_patch_colours_and_animation_frames() {
             "0.3",
         ],
     );
-    let differing = bft
-        .pixels()
-        .zip(moved.pixels())
-        .filter(|(p, q)| p.0.iter().zip(q.0.iter()).any(|(x, y)| x.abs_diff(*y) > 24))
-        .count();
+    let differing = differing_pixels(&bft, &moved);
     assert!(
         differing > 500,
         "the animation frame moved only {differing} pixels"
@@ -807,12 +818,7 @@ fn render_bft_patch_colours_and_animation_frames() {
 /// The window shows BFT as the offscreen renderer does, and animates without errors.
 #[test]
 fn window_shows_bft_like_offscreen_and_animates() {
-    let Some((mut server, display)) = xvfb() else {
-        assert!(
-            std::env::var_os("TESSERA_REQUIRE_XVFB").is_none(),
-            "Xvfb is required here but not installed"
-        );
-        eprintln!("skipping: Xvfb not installed");
+    let Some((mut server, display)) = xvfb_or_skip() else {
         return;
     };
     let shot = tmp("window_bft.png");
@@ -871,18 +877,7 @@ fn window_shows_bft_like_offscreen_and_animates() {
     let b = image::open(&offscreen).unwrap().to_rgba8();
     let c = image::open(&animated).unwrap().to_rgba8();
     let d = image::open(&still).unwrap().to_rgba8();
-    let differ = |x: &image::RgbaImage, y: &image::RgbaImage| {
-        x.pixels()
-            .zip(y.pixels())
-            .filter(|(p, q)| {
-                p.0.iter()
-                    .zip(q.0.iter())
-                    .take(3)
-                    .any(|(s, t)| s.abs_diff(*t) > 24)
-            })
-            .count() as f64
-            / (x.width() * x.height()) as f64
-    };
+    let differ = differing_fraction;
     assert!(
         differ(&a, &b) <= 0.005,
         "window and offscreen differ in {:.3}",

@@ -636,7 +636,7 @@ impl BenchMethod for CpuLoopMethod {
             .mesh
             .as_ref()
             .ok_or_else(|| TessError::Invalid("cpu baseline recorded before begin_frame".into()))?;
-        Ok(self.renderer.record(cmd, mesh))
+        self.renderer.record(cmd, mesh)
     }
 
     fn row_notes(&mut self) -> Vec<String> {
