@@ -3,7 +3,7 @@
 use crate::device::{Device, DeviceShared};
 use crate::error::{Result, VkContext, VkError};
 use ash::vk;
-use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::vulkan::Allocation;
 use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 
@@ -35,39 +35,19 @@ impl Buffer {
         let raw = unsafe { device.raw.create_buffer(&info, None) }.ctx("vkCreateBuffer")?;
         // SAFETY: raw was just created on this device.
         let requirements = unsafe { device.raw.get_buffer_memory_requirements(raw) };
-        let allocation = device
-            .allocator
-            .lock()
-            .map_err(|_| VkError::Invalid("allocator lock poisoned".into()))?
-            .allocate(&AllocationCreateDesc {
-                name: desc.name,
-                requirements,
-                location: desc.location,
-                linear: true,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            });
-        let allocation = match allocation {
-            Ok(a) => a,
-            Err(e) => {
-                // SAFETY: raw is unused.
-                unsafe { device.raw.destroy_buffer(raw, None) };
-                return Err(e.into());
-            }
+        let bind = |memory, offset| {
+            // SAFETY: raw is unbound; allocate_bound passes memory made for its requirements.
+            unsafe { device.raw.bind_buffer_memory(raw, memory, offset) }.ctx("vkBindBufferMemory")
         };
-        // SAFETY: memory comes from the allocator for these requirements; offset is aligned.
-        if let Err(e) = unsafe {
-            device
-                .raw
-                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
-        } {
-            // SAFETY: raw is unused.
-            unsafe { device.raw.destroy_buffer(raw, None) };
-            let _ = device.allocator.lock().map(|mut a| a.free(allocation));
-            return Err(VkError::Call {
-                call: "vkBindBufferMemory",
-                result: e,
-            });
-        }
+        let allocation =
+            match device.allocate_bound(desc.name, requirements, desc.location, true, bind) {
+                Ok(a) => a,
+                Err(e) => {
+                    // SAFETY: raw is unused.
+                    unsafe { device.raw.destroy_buffer(raw, None) };
+                    return Err(e);
+                }
+            };
         device.set_name(raw, desc.name);
         Ok(Self {
             raw,
@@ -180,9 +160,7 @@ impl Drop for Buffer {
         // wait; frame resources are dropped after a wait for their fence).
         unsafe { self.device.raw.destroy_buffer(self.raw, None) };
         if let Some(a) = self.allocation.take() {
-            if let Ok(mut alloc) = self.device.allocator.lock() {
-                let _ = alloc.free(a);
-            }
+            self.device.free(a);
         }
     }
 }

@@ -3,7 +3,10 @@ use crate::error::{Result, VkContext, VkError};
 use crate::instance::Instance;
 use crate::workarounds::Workarounds;
 use ash::vk;
-use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use gpu_allocator::vulkan::{
+    Allocation, AllocationCreateDesc, AllocationScheme, Allocator, AllocatorCreateDesc,
+};
+use gpu_allocator::MemoryLocation;
 use std::ffi::CStr;
 use std::fmt;
 use std::mem::ManuallyDrop;
@@ -342,6 +345,46 @@ impl std::ops::Deref for Device {
     type Target = DeviceShared;
     fn deref(&self) -> &DeviceShared {
         &self.shared
+    }
+}
+
+impl DeviceShared {
+    /// Allocates memory for `requirements` and binds it through `bind` (memory, offset). On any
+    /// failure the memory is handed back, so the caller only destroys its own handle.
+    pub(crate) fn allocate_bound(
+        &self,
+        name: &str,
+        requirements: vk::MemoryRequirements,
+        location: MemoryLocation,
+        linear: bool,
+        bind: impl FnOnce(vk::DeviceMemory, u64) -> Result<()>,
+    ) -> Result<Allocation> {
+        let allocation = self
+            .allocator
+            .lock()
+            .map_err(|_| VkError::Invalid("allocator lock poisoned".into()))?
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements,
+                location,
+                linear,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })?;
+        // SAFETY: the handle is only passed to `bind`, which binds it while the allocation is
+        // alive; the memory was made for these requirements and the offset is aligned to them.
+        let memory = unsafe { allocation.memory() };
+        if let Err(e) = bind(memory, allocation.offset()) {
+            self.free(allocation);
+            return Err(e);
+        }
+        Ok(allocation)
+    }
+
+    /// Hands `allocation` back (a poisoned lock leaks it rather than panicking in a drop).
+    pub(crate) fn free(&self, allocation: Allocation) {
+        if let Ok(mut a) = self.allocator.lock() {
+            let _ = a.free(allocation);
+        }
     }
 }
 

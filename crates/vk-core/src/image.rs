@@ -1,8 +1,8 @@
 //! 2D images with one view, for render targets and depth.
 use crate::device::{Device, DeviceShared};
-use crate::error::{Result, VkContext, VkError};
+use crate::error::{Result, VkContext};
 use ash::vk;
-use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::vulkan::Allocation;
 use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 
@@ -46,40 +46,41 @@ impl Image {
         let raw = unsafe { device.raw.create_image(&info, None) }.ctx("vkCreateImage")?;
         // SAFETY: raw just created.
         let requirements = unsafe { device.raw.get_image_memory_requirements(raw) };
-        let allocation = device
-            .allocator
-            .lock()
-            .map_err(|_| VkError::Invalid("allocator lock poisoned".into()))?
-            .allocate(&AllocationCreateDesc {
-                name: desc.name,
-                requirements,
-                location: MemoryLocation::GpuOnly,
-                linear: false,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            });
-        let allocation = match allocation {
+        let bind = |memory, offset| {
+            // SAFETY: raw is unbound; allocate_bound passes memory made for its requirements.
+            unsafe { device.raw.bind_image_memory(raw, memory, offset) }.ctx("vkBindImageMemory")
+        };
+        let allocation = match device.allocate_bound(
+            desc.name,
+            requirements,
+            MemoryLocation::GpuOnly,
+            false,
+            bind,
+        ) {
             Ok(a) => a,
             Err(e) => {
-                // SAFETY: raw unused.
+                // SAFETY: raw is unused.
                 unsafe { device.raw.destroy_image(raw, None) };
-                return Err(e.into());
+                return Err(e);
             }
         };
-        // SAFETY: fresh image, matching memory.
-        unsafe {
-            device
-                .raw
-                .bind_image_memory(raw, allocation.memory(), allocation.offset())
-        }
-        .ctx("vkBindImageMemory")?;
         let view_info = vk::ImageViewCreateInfo::default()
             .image(raw)
             .view_type(vk::ImageViewType::TYPE_2D)
             .format(desc.format)
             .subresource_range(subresource_range(desc.aspect));
         // SAFETY: image is bound to memory.
-        let view =
-            unsafe { device.raw.create_image_view(&view_info, None) }.ctx("vkCreateImageView")?;
+        let view = match unsafe { device.raw.create_image_view(&view_info, None) }
+            .ctx("vkCreateImageView")
+        {
+            Ok(v) => v,
+            Err(e) => {
+                // SAFETY: raw has no view and was never used.
+                unsafe { device.raw.destroy_image(raw, None) };
+                device.free(allocation);
+                return Err(e);
+            }
+        };
         device.set_name(raw, desc.name);
         device.set_name(view, &format!("{} view", desc.name));
         Ok(Self {
@@ -109,9 +110,7 @@ impl Drop for Image {
             self.device.raw.destroy_image(self.raw, None);
         }
         if let Some(a) = self.allocation.take() {
-            if let Ok(mut alloc) = self.device.allocator.lock() {
-                let _ = alloc.free(a);
-            }
+            self.device.free(a);
         }
     }
 }
