@@ -3,9 +3,9 @@
 //! and animation. Validation is on and any error fails (tests/common).
 mod common;
 use common::Gpu;
-use tessera::tess::bft::{base_normals, patch_uv, wave};
-use tessera::tess::capture::{classify_open_edges, CapturedSoup};
-use tessera::tess::{BftParams, BftSurface, DrawParams, FactorPolicy, Renderer};
+use tessera::tess::capture::{classify_open_edges, CapturedSoup, Capturer};
+use tessera::tess::techniques::bft::{base_normals, patch_uv, wave, Bft, BftOptions};
+use tessera::tess::{Context, FactorPolicy, FrameParams, Spacing, Technique};
 use tessera::topology::eval::{LimitScheme, LocalMesh};
 use tessera::topology::{self, ControlMesh};
 use tessera::vk_core::vk;
@@ -14,6 +14,25 @@ const EXTENT: vk::Extent2D = vk::Extent2D {
     width: 640,
     height: 480,
 };
+
+/// A BFT surface of `mesh` at table level `level`, with tangent tables when `tangents`.
+fn surface(ctx: &mut Context, mesh: &ControlMesh, name: &str, level: u32, tangents: bool) -> Bft {
+    Bft::new(
+        ctx,
+        mesh,
+        &BftOptions {
+            table_level: level,
+            tangents,
+            name: name.into(),
+        },
+    )
+    .expect(name)
+}
+
+/// Uniform factors of `s` segments per base edge.
+fn uniform(s: u32) -> FrameParams {
+    FrameParams::uniform(s as f32)
+}
 
 pub fn spot() -> ControlMesh {
     let m = topology::load_obj(common::data("assets/spot_control_mesh.obj")).expect("spot");
@@ -41,7 +60,7 @@ fn diag(m: &ControlMesh) -> f64 {
 /// Worst distance (over the bounding-box diagonal) between captured vertices and the CPU exact
 /// limit of `mesh` at the captured (base face, u, v), over at most `samples` welded vertices;
 /// also asserts every captured vertex came from a table point when `all_exact`.
-fn exactness(surf: &BftSurface, soup: &CapturedSoup, mesh: &ControlMesh, samples: usize) -> f64 {
+fn exactness(surf: &Bft, soup: &CapturedSoup, mesh: &ControlMesh, samples: usize) -> f64 {
     let cpu = LocalMesh::from_control_mesh(mesh, LimitScheme::Loop).expect("cpu mesh");
     let welded = soup.weld().expect("weld");
     let n = welded.positions.len();
@@ -59,7 +78,7 @@ fn exactness(surf: &BftSurface, soup: &CapturedSoup, mesh: &ControlMesh, samples
     worst
 }
 
-fn cracks(surf: &BftSurface, soup: &CapturedSoup, mesh: &ControlMesh) -> (usize, usize, usize) {
+fn cracks(surf: &Bft, soup: &CapturedSoup, mesh: &ControlMesh) -> (usize, usize, usize) {
     let welded = soup.weld().expect("weld");
     let report = welded.open_edges();
     let map = |p: u32, d: [f32; 2]| surf.face_point(p, d);
@@ -78,7 +97,8 @@ fn cracks(surf: &BftSurface, soup: &CapturedSoup, mesh: &ControlMesh) -> (usize,
 fn captured_bft_vertices_are_the_exact_limit() {
     let gpu = Gpu::new();
     {
-        let mut renderer = Renderer::offscreen(gpu.device()).expect("renderer");
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
         let cases: Vec<(&str, ControlMesh, &[u32])> = vec![
             ("loop_cube", shape("loop_cube"), &[2, 4, 8, 16, 32, 64]),
             ("loop_icosahedron", shape("loop_icosahedron"), &[2, 8, 64]),
@@ -93,14 +113,10 @@ fn captured_bft_vertices_are_the_exact_limit() {
             ("spot", spot(), &[2, 16, 64]),
         ];
         for (name, mesh, segments) in cases {
-            let mut surf = BftSurface::new(&renderer, &mesh, name, 5, false, 1).expect(name);
+            let surf = surface(&mut ctx, &mesh, name, 5, false);
             for &s in segments {
-                let params = BftParams {
-                    factors: FactorPolicy::Uniform { segments: s },
-                    ..Default::default()
-                };
-                let soup = surf
-                    .capture(&mut renderer, &DrawParams::default(), &params, EXTENT)
+                let (soup, _) = capturer
+                    .capture(&mut ctx, &surf, &uniform(s), EXTENT)
                     .expect("capture");
                 assert!(!soup.records.is_empty());
                 let inexact = soup.records.iter().filter(|r| r.flags & 1 == 0).count();
@@ -125,7 +141,8 @@ fn captured_bft_vertices_are_the_exact_limit() {
 fn bft_is_watertight_under_every_factor_policy() {
     let gpu = Gpu::new();
     {
-        let mut renderer = Renderer::offscreen(gpu.device()).expect("renderer");
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
         let meshes = vec![
             ("loop_cube", shape("loop_cube")),
             ("loop_pole64", shape("loop_pole64")),
@@ -133,18 +150,15 @@ fn bft_is_watertight_under_every_factor_policy() {
             ("loop_saddle_edgeonly", shape("loop_saddle_edgeonly")),
             ("spot", spot()),
         ];
-        let draw = DrawParams {
-            camera: tessera::tess::Camera {
-                zoom: 2.5,
-                yaw: 30.0,
-                ..Default::default()
-            },
+        let camera = tessera::tess::Camera {
+            zoom: 2.5,
+            yaw: 30.0,
             ..Default::default()
         };
         for (name, mesh) in meshes {
-            let mut surf = BftSurface::new(&renderer, &mesh, name, 5, false, 1).expect(name);
+            let surf = surface(&mut ctx, &mesh, name, 5, false);
             let policies = [
-                ("uniform 16", FactorPolicy::Uniform { segments: 16 }, false),
+                ("uniform 16", FactorPolicy::Uniform { segments: 16.0 }, false),
                 ("screen 6px", FactorPolicy::Screen { pixels: 6.0 }, false),
                 (
                     "distance",
@@ -167,13 +181,18 @@ fn bft_is_watertight_under_every_factor_policy() {
                 ),
             ];
             for (label, factors, fractional) in policies {
-                let params = BftParams {
+                let params = FrameParams {
                     factors,
-                    fractional,
-                    ..Default::default()
+                    spacing: if fractional {
+                        Spacing::FractionalEven
+                    } else {
+                        Spacing::Equal
+                    },
+                    camera,
+                    ..FrameParams::default()
                 };
-                let soup = surf
-                    .capture(&mut renderer, &draw, &params, EXTENT)
+                let (soup, _) = capturer
+                    .capture(&mut ctx, &surf, &params, EXTENT)
                     .expect("capture");
                 let (cracks, boundary, nonmanifold) = cracks(&surf, &soup, &mesh);
                 let interpolated = soup.records.iter().filter(|r| r.flags & 1 == 0).count();
@@ -204,26 +223,23 @@ fn bft_is_watertight_under_every_factor_policy() {
 fn animated_base_mesh_gives_the_deformed_limit() {
     let gpu = Gpu::new();
     {
-        let mut renderer = Renderer::offscreen(gpu.device()).expect("renderer");
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
         let mesh = shape("loop_icosahedron");
-        let mut surf = BftSurface::new(&renderer, &mesh, "ico", 5, false, 1).expect("surface");
-        let base = tessera::tess::bft::base_positions(&mesh);
+        let mut surf = surface(&mut ctx, &mesh, "ico", 5, false);
+        let base = tessera::tess::techniques::bft::base_positions(&mesh);
         let normals = base_normals(&mesh);
-        let (lo, hi) = (surf.bbox_min, surf.bbox_max);
-        let params = BftParams {
-            factors: FactorPolicy::Uniform { segments: 16 },
-            ..Default::default()
-        };
-        let draw = DrawParams::default();
+        let (lo, hi) = surf.bbox();
+        let params = uniform(16);
         let mut deformed = base.clone();
         for frame in 0..5 {
             deformed = wave(&base, &normals, lo, hi, frame as f32 * 0.1);
             surf.update_base(0, &deformed).expect("upload");
-            surf.render_offscreen(&mut renderer, &draw, &params, EXTENT, false)
+            ctx.render_offscreen(&surf, &params, EXTENT)
                 .expect("frame");
         }
-        let soup = surf
-            .capture(&mut renderer, &draw, &params, EXTENT)
+        let (soup, _) = capturer
+            .capture(&mut ctx, &surf, &params, EXTENT)
             .expect("capture");
         let mut moved = mesh.clone();
         moved.positions = deformed
@@ -247,25 +263,22 @@ fn animated_base_mesh_gives_the_deformed_limit() {
 fn bft_renders_spot_with_patch_colours_and_wireframe() {
     let gpu = Gpu::new();
     {
-        let mut renderer = Renderer::offscreen(gpu.device()).expect("renderer");
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let mesh = spot();
-        let mut surf = BftSurface::new(&renderer, &mesh, "spot", 5, false, 1).expect("surface");
-        let draw = DrawParams {
+        let surf = surface(&mut ctx, &mesh, "spot", 5, false);
+        let params = FrameParams {
             wireframe: true,
-            ..Default::default()
-        };
-        let params = BftParams {
-            factors: FactorPolicy::Uniform { segments: 4 },
             patch_colours: true,
-            ..Default::default()
+            ..uniform(4)
         };
-        let (img, _, counts) = surf
-            .render_offscreen(&mut renderer, &draw, &params, EXTENT, false)
+        let frame = ctx
+            .render_offscreen_stats(&surf, &params, EXTENT, false)
             .expect("render");
+        let (img, counts) = (frame.image, frame.counts);
         assert_eq!(
             counts.patches,
-            surf.patch_count(),
-            "the shaded pass draws every patch"
+            2 * surf.patch_count(),
+            "the shaded pass and the wireframe overlay each draw every patch"
         );
         // The surface covers a good part of the frame, in both the regular (blue) and the
         // extraordinary (red) patch colours.
@@ -285,22 +298,13 @@ fn bft_renders_spot_with_patch_colours_and_wireframe() {
 fn bad_segments_are_rejected_with_a_clear_error() {
     let gpu = Gpu::new();
     {
-        let mut renderer = Renderer::offscreen(gpu.device()).expect("renderer");
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let mesh = shape("loop_cube");
-        let mut surf = BftSurface::new(&renderer, &mesh, "cube", 3, false, 1).expect("surface");
+        let surf = surface(&mut ctx, &mesh, "cube", 3, false);
         for s in [3, 0, 32] {
-            let params = BftParams {
-                factors: FactorPolicy::Uniform { segments: s },
-                ..Default::default()
-            };
-            let e = surf
-                .render_offscreen(
-                    &mut renderer,
-                    &DrawParams::default(),
-                    &params,
-                    EXTENT,
-                    false,
-                )
+            let e = ctx
+                .render_offscreen(&surf, &uniform(s), EXTENT)
+                .map(|_| ())
                 .expect_err("rejected");
             assert!(e.to_string().contains("--segments"), "{e}");
         }
@@ -312,13 +316,13 @@ fn bad_segments_are_rejected_with_a_clear_error() {
 fn statistics_request_is_safe_on_every_driver() {
     let gpu = Gpu::new();
     {
-        let mut renderer = Renderer::offscreen(gpu.device()).expect("renderer");
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let mesh = shape("loop_cube");
-        let mut surf = BftSurface::new(&renderer, &mesh, "cube", 3, false, 1).expect("surface");
-        let params = BftParams::default();
-        let (_, stats, counts) = surf
-            .render_offscreen(&mut renderer, &DrawParams::default(), &params, EXTENT, true)
+        let surf = surface(&mut ctx, &mesh, "cube", 3, false);
+        let frame = ctx
+            .render_offscreen_stats(&surf, &uniform(16), EXTENT, true)
             .expect("render");
+        let (stats, counts) = (frame.statistics, frame.counts);
         assert_eq!(counts.patches, surf.patch_count());
         let skipped = gpu
             .device()
@@ -332,7 +336,7 @@ fn statistics_request_is_safe_on_every_driver() {
 /// `samples` welded vertices plus every level-1 vertex (patch corner): (worst at the corners,
 /// worst, mean). Orientation-free: the winding convention is not at stake here.
 fn normal_angles(
-    surf: &BftSurface,
+    surf: &Bft,
     soup: &CapturedSoup,
     mesh: &ControlMesh,
     samples: usize,
@@ -375,19 +379,18 @@ fn normal_angles(
 fn geometric_normals_are_the_exact_limit_normals() {
     let gpu = Gpu::new();
     {
-        let mut renderer = Renderer::offscreen(gpu.device()).expect("renderer");
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
         let mesh = spot();
-        let mut surf = BftSurface::new(&renderer, &mesh, "spot", 5, true, 1).expect("surface");
-        let draw = DrawParams::default();
+        let surf = surface(&mut ctx, &mesh, "spot", 5, true);
         let mut angles = Vec::new();
         for geometric_normals in [true, false] {
-            let params = BftParams {
-                factors: FactorPolicy::Uniform { segments: 8 },
+            let params = FrameParams {
                 geometric_normals,
-                ..Default::default()
+                ..uniform(8)
             };
-            let soup = surf
-                .capture(&mut renderer, &draw, &params, EXTENT)
+            let (soup, _) = capturer
+                .capture(&mut ctx, &surf, &params, EXTENT)
                 .expect("capture");
             angles.push(normal_angles(&surf, &soup, &mesh, 3000));
         }
@@ -405,18 +408,10 @@ fn geometric_normals_are_the_exact_limit_normals() {
             sub_mean > geo_mean && sub_mean < 10.0,
             "subdivision shading: mean {sub_mean:.3}°"
         );
-        let soup = surf
-            .capture(
-                &mut renderer,
-                &draw,
-                &BftParams {
-                    factors: FactorPolicy::Uniform { segments: 8 },
-                    ..Default::default()
-                },
-                EXTENT,
-            )
+        let (soup, _) = capturer
+            .capture(&mut ctx, &surf, &uniform(8), EXTENT)
             .expect("capture");
-        let base = tessera::tess::bft::base_positions(&mesh);
+        let base = tessera::tess::techniques::bft::base_positions(&mesh);
         let level1 = surf.gpu.subdivide(&base);
         let normals = surf.gpu.normals(&level1);
         let mut mirror_worst = 0.0f64;
@@ -442,13 +437,13 @@ fn geometric_normals_are_the_exact_limit_normals() {
             "subdivision shading vs mirror: {mirror_worst:.4}°"
         );
 
-        let mut plain = BftSurface::new(&renderer, &mesh, "spot", 5, false, 1).expect("surface");
-        let params = BftParams {
+        let plain = surface(&mut ctx, &mesh, "spot", 5, false);
+        let params = FrameParams {
             geometric_normals: true,
-            ..Default::default()
+            ..uniform(16)
         };
-        let e = plain
-            .render_offscreen(&mut renderer, &draw, &params, EXTENT, false)
+        let e = ctx
+            .render_offscreen(&plain, &params, EXTENT)
             .map(|_| ())
             .expect_err("geometric normals without tangent tables");
         assert!(e.to_string().contains("tangent tables"), "{e}");

@@ -5,11 +5,12 @@ mod common;
 use common::Gpu;
 use std::collections::HashMap;
 use tessera::tess::capture::{
-    classify_open_edges, CaptureStats, CapturedSoup, Capturer, OpenEdgeClasses, PatchFaceTable,
+    classify_open_edges, CaptureStats, CapturedSoup, Capturer, OpenEdgeClasses,
 };
-use tessera::tess::renderer::{GpuMesh, Method};
 use tessera::tess::tessellator::{uniform_triangle_count, Domain};
-use tessera::tess::{DrawParams, DrawSplit, RenderMesh, Renderer, Spacing};
+use tessera::tess::{
+    Context, DrawSplit, FrameParams, RenderMesh, Spacing, Technique, TechniqueId,
+};
 use tessera::topology::ControlMesh;
 use tessera::vk_core::vk;
 
@@ -47,26 +48,58 @@ fn load(path: &str) -> ControlMesh {
 struct Captured {
     soup: CapturedSoup,
     stats: CaptureStats,
+    technique: Box<dyn Technique>,
 }
 
-fn capture(capturer: &mut Capturer, gpu: &Gpu, rm: &RenderMesh, p: &DrawParams) -> Captured {
-    let mesh = GpuMesh::upload(gpu.device(), rm).unwrap();
-    let (soup, stats) = capturer.capture_with_stats(&mesh, p).unwrap();
-    Captured { soup, stats }
+/// The context and capturer of a test (dropped before its [`Gpu`]).
+struct Harness {
+    ctx: Context,
+    capturer: Capturer,
+}
+
+impl Harness {
+    fn new(gpu: &Gpu) -> Harness {
+        let ctx = Context::offscreen(gpu.device()).unwrap();
+        let capturer = Capturer::new(&ctx).unwrap();
+        Harness { ctx, capturer }
+    }
+}
+
+const EXTENT: vk::Extent2D = vk::Extent2D {
+    width: 1,
+    height: 1,
+};
+
+/// Builds technique `id` for `base` and captures one frame of `p`.
+fn capture(h: &mut Harness, base: &ControlMesh, id: TechniqueId, p: &FrameParams) -> Captured {
+    let technique = common::build(&mut h.ctx, id, base);
+    let (soup, stats) = h
+        .capturer
+        .capture(&mut h.ctx, technique.as_ref(), p, EXTENT)
+        .unwrap();
+    Captured {
+        soup,
+        stats,
+        technique,
+    }
+}
+
+/// Flat factors: uniform `level`, `spacing`.
+fn flat(level: f32, spacing: Spacing) -> FrameParams {
+    FrameParams {
+        spacing,
+        ..FrameParams::uniform(level)
+    }
 }
 
 /// Welds, counts edges and classifies the open ones; returns (classes, non-manifold, zero-area,
 /// welded vertices).
-fn watertightness(
-    soup: &CapturedSoup,
-    rm: &RenderMesh,
-    base: &ControlMesh,
-    method: Method,
-) -> (OpenEdgeClasses, usize, usize, usize) {
+fn watertightness(c: &Captured, base: &ControlMesh) -> (OpenEdgeClasses, usize, usize, usize) {
+    let soup = &c.soup;
     let welded = soup.weld().unwrap();
     let report = welded.open_edges();
-    let table = PatchFaceTable::new(rm.patch_origins(method));
-    let classes = classify_open_edges(soup, &welded, &report, &|p, d| table.face_point(p, d), base);
+    let map = |p, d| c.technique.face_point(p, d);
+    let classes = classify_open_edges(soup, &welded, &report, &map, base);
     assert_eq!(
         classes.on_base_boundary + classes.cracks,
         report.open.len(),
@@ -85,21 +118,18 @@ fn watertightness(
 #[test]
 fn corner_count_is_three_per_tessellated_triangle() {
     let gpu = Gpu::new();
-    let mut capturer = Capturer::new(gpu.device()).unwrap();
-    let mut renderer = Renderer::offscreen(gpu.device()).unwrap();
+    let mut h = Harness::new(&gpu);
     for (triangles, domain) in [(true, Domain::Triangle), (false, Domain::Quad)] {
-        let rm = RenderMesh::from_control_mesh(&strip(5, triangles)).unwrap();
-        let mesh = GpuMesh::upload(gpu.device(), &rm).unwrap();
+        let base = strip(5, triangles);
         let patches = if triangles { 10 } else { 5 };
         for spacing in SPACINGS {
             for level in [1.0f32, 2.0, 2.5, 3.0, 4.7, 7.0, 16.0, 33.3, 64.0] {
-                let p = DrawParams {
-                    method: Method::Flat,
-                    spacing,
-                    level,
-                    ..Default::default()
-                };
-                let (soup, stats) = capturer.capture_with_stats(&mesh, &p).unwrap();
+                let p = flat(level, spacing);
+                let Captured {
+                    soup,
+                    stats,
+                    technique,
+                } = capture(&mut h, &base, TechniqueId::Flat, &p);
                 let per_patch = uniform_triangle_count(domain, spacing, level);
                 let cpu = patches as u64 * per_patch;
                 let what = format!("{domain:?} {spacing:?} level {level}");
@@ -116,9 +146,10 @@ fn corner_count_is_three_per_tessellated_triangle() {
                 assert_eq!(per.len(), patches, "{what}");
                 assert!(per.values().all(|&n| n == per_patch), "{what}: {per:?}");
                 // The pipeline statistics of a rendered frame count the same primitives.
-                let (_, s, _) = renderer
+                let s = h
+                    .ctx
                     .render_offscreen_stats(
-                        &mesh,
+                        technique.as_ref(),
                         &p,
                         vk::Extent2D {
                             width: 32,
@@ -126,8 +157,9 @@ fn corner_count_is_three_per_tessellated_triangle() {
                         },
                         true,
                     )
+                    .unwrap()
+                    .statistics
                     .unwrap();
-                let s = s.unwrap();
                 assert_eq!(s.clipping_invocations, cpu, "{what}: {s:?}");
             }
         }
@@ -139,9 +171,10 @@ fn corner_count_is_three_per_tessellated_triangle() {
 #[test]
 fn flat_positions_equal_cpu_interpolation() {
     let gpu = Gpu::new();
-    let mut capturer = Capturer::new(gpu.device()).unwrap();
+    let mut h = Harness::new(&gpu);
     for triangles in [true, false] {
-        let rm = RenderMesh::from_control_mesh(&strip(4, triangles)).unwrap();
+        let base = strip(4, triangles);
+        let rm = RenderMesh::from_control_mesh(&base).unwrap();
         let scale = rm
             .vertices
             .iter()
@@ -149,13 +182,7 @@ fn flat_positions_equal_cpu_interpolation() {
             .fold(0.0f64, |m, c| m.max((c as f64).abs()));
         for spacing in SPACINGS {
             for level in [1.0f32, 3.0, 5.5, 16.0] {
-                let p = DrawParams {
-                    method: Method::Flat,
-                    spacing,
-                    level,
-                    ..Default::default()
-                };
-                let c = capture(&mut capturer, &gpu, &rm, &p);
+                let c = capture(&mut h, &base, TechniqueId::Flat, &flat(level, spacing));
                 assert!(!c.soup.records.is_empty());
                 let mut worst = 0.0f64;
                 for r in &c.soup.records {
@@ -191,17 +218,10 @@ fn flat_positions_equal_cpu_interpolation() {
 #[test]
 fn cpu_interpolation_check_detects_a_swapped_domain() {
     let gpu = Gpu::new();
-    let mut capturer = Capturer::new(gpu.device()).unwrap();
-    let rm = RenderMesh::from_control_mesh(&strip(2, true)).unwrap();
-    let c = capture(
-        &mut capturer,
-        &gpu,
-        &rm,
-        &DrawParams {
-            level: 4.0,
-            ..Default::default()
-        },
-    );
+    let mut h = Harness::new(&gpu);
+    let base = strip(2, true);
+    let rm = RenderMesh::from_control_mesh(&base).unwrap();
+    let c = capture(&mut h, &base, TechniqueId::Flat, &FrameParams::uniform(4.0));
     let off = c
         .soup
         .records
@@ -237,25 +257,17 @@ fn cpu_interpolation_check_detects_a_swapped_domain() {
 #[test]
 fn welded_flat_is_watertight_and_curved_cracks_are_bit_level() {
     let gpu = Gpu::new();
-    let mut capturer = Capturer::new(gpu.device()).unwrap();
+    let mut h = Harness::new(&gpu);
     let meshes = [
         ("cube", load("tests/data/meshes/cube.obj")),
         ("spot", load("assets/spot_control_mesh.obj")),
     ];
     for (name, base) in &meshes {
-        let rm = RenderMesh::from_control_mesh(base).unwrap();
-        for method in [Method::Flat, Method::Phong, Method::Pn] {
+        for method in [TechniqueId::Flat, TechniqueId::Phong, TechniqueId::Pn] {
             for spacing in SPACINGS {
                 for level in [1.0f32, 2.0, 5.0, 8.0] {
-                    let p = DrawParams {
-                        method,
-                        spacing,
-                        level,
-                        ..Default::default()
-                    };
-                    let c = capture(&mut capturer, &gpu, &rm, &p);
-                    let (classes, non_manifold, zero_area, welded) =
-                        watertightness(&c.soup, &rm, base, method);
+                    let c = capture(&mut h, base, method, &flat(level, spacing));
+                    let (classes, non_manifold, zero_area, welded) = watertightness(&c, base);
                     println!(
                         "{name} {method:?} {spacing:?} level {level}: {} triangles, {welded} welded vertices, {} cracks, {non_manifold} non-manifold, {zero_area} zero-area",
                         c.soup.triangle_count(),
@@ -273,12 +285,12 @@ fn welded_flat_is_watertight_and_curved_cracks_are_bit_level() {
                     let volume = signed_volume(&c.soup);
                     assert!(volume < 0.0, "{what}: signed volume {volume}");
                     match method {
-                        Method::Flat | Method::Phong => assert_eq!(classes.cracks, 0, "{what}"),
-                        Method::Pn => assert_eq!(
+                        TechniqueId::Pn => assert_eq!(
                             tolerant_open_edges(&c.soup, 1e-6),
                             0,
                             "{what}: cracks wider than the last bits"
                         ),
+                        _ => assert_eq!(classes.cracks, 0, "{what}"),
                     }
                 }
             }
@@ -348,21 +360,12 @@ fn tolerant_open_edges(soup: &CapturedSoup, eps: f64) -> usize {
 #[test]
 fn open_strip_edges_are_base_boundary() {
     let gpu = Gpu::new();
-    let mut capturer = Capturer::new(gpu.device()).unwrap();
+    let mut h = Harness::new(&gpu);
     for triangles in [true, false] {
         let base = strip(3, triangles);
-        let rm = RenderMesh::from_control_mesh(&base).unwrap();
         for level in [1.0f32, 4.0, 7.0] {
-            let c = capture(
-                &mut capturer,
-                &gpu,
-                &rm,
-                &DrawParams {
-                    level,
-                    ..Default::default()
-                },
-            );
-            let (classes, ..) = watertightness(&c.soup, &rm, &base, Method::Flat);
+            let c = capture(&mut h, &base, TechniqueId::Flat, &FrameParams::uniform(level));
+            let (classes, ..) = watertightness(&c, &base);
             // The strip's outline: 2 long sides of 3 faces and 2 ends, each base edge cut into
             // `level` segments.
             let n = level.ceil() as usize;
@@ -378,16 +381,11 @@ fn open_strip_edges_are_base_boundary() {
 #[test]
 fn capture_across_draw_split_numbers_patches_frame_wide() {
     let gpu = Gpu::new();
-    let mut capturer = Capturer::new(gpu.device()).unwrap();
+    let mut h = Harness::new(&gpu);
     // 24 quads at level 64: 101,400 TES vertices, more than one lavapipe chunk may hold.
     let base = strip(24, false);
-    let rm = RenderMesh::from_control_mesh(&base).unwrap();
-    let base_params = DrawParams {
-        method: Method::Flat,
-        level: 64.0,
-        ..Default::default()
-    };
-    let split = capture(&mut capturer, &gpu, &rm, &base_params);
+    let base_params = FrameParams::uniform(64.0);
+    let split = capture(&mut h, &base, TechniqueId::Flat, &base_params);
     let per_patch = uniform_triangle_count(Domain::Quad, Spacing::Equal, 64.0);
     assert_eq!(split.stats.patches, 24);
     if gpu.device().info.is_lavapipe() {
@@ -400,10 +398,10 @@ fn capture_across_draw_split_numbers_patches_frame_wide() {
         assert!(chunk.iter().all(|&p| p == i as u32), "patch {i}");
     }
     let reference = capture(
-        &mut capturer,
-        &gpu,
-        &rm,
-        &DrawParams {
+        &mut h,
+        &base,
+        TechniqueId::Flat,
+        &FrameParams {
             split: DrawSplit::PerPatch,
             ..base_params
         },
@@ -413,14 +411,14 @@ fn capture_across_draw_split_numbers_patches_frame_wide() {
         split.soup == reference.soup,
         "split capture differs from the per-patch reference"
     );
-    let (classes, ..) = watertightness(&split.soup, &rm, &base, Method::Flat);
+    let (classes, ..) = watertightness(&split, &base);
     assert_eq!(classes.cracks, 0);
     if gpu.device().info.is_lavapipe() {
         let unsplit = capture(
-            &mut capturer,
-            &gpu,
-            &rm,
-            &DrawParams {
+            &mut h,
+            &base,
+            TechniqueId::Flat,
+            &FrameParams {
                 split: DrawSplit::Off,
                 ..base_params
             },
@@ -432,7 +430,7 @@ fn capture_across_draw_split_numbers_patches_frame_wide() {
             .zip(&reference.soup.records)
             .filter(|(a, b)| a != b)
             .count();
-        let (classes, ..) = watertightness(&unsplit.soup, &rm, &base, Method::Flat);
+        let (classes, ..) = watertightness(&unsplit, &base);
         // Without the split, lavapipe's 16-bit chunk indices corrupt the assembled triangles
         // (measured: 208,994 of 589,824 corners differ, 72 cracks): the capture sees the driver
         // bug that the split works around, so this test would fail without the split.
@@ -453,7 +451,8 @@ fn capture_without_transform_feedback_is_a_typed_error() {
         ..DeviceDesc::default()
     });
     assert!(gpu.device().transform_feedback.is_none());
-    let e = Capturer::new(gpu.device()).err().expect("no capturer");
+    let mut ctx = Context::offscreen(gpu.device()).unwrap();
+    let e = Capturer::new(&ctx).err().expect("no capturer");
     assert!(
         matches!(
             e,
@@ -462,12 +461,10 @@ fn capture_without_transform_feedback_is_a_typed_error() {
         "{e}"
     );
     assert!(e.to_string().contains("VK_EXT_transform_feedback"), "{e}");
-    let rm = RenderMesh::from_control_mesh(&strip(2, true)).unwrap();
-    let mesh = GpuMesh::upload(gpu.device(), &rm).unwrap();
-    let mut r = Renderer::offscreen(gpu.device()).unwrap();
-    r.render_offscreen(
-        &mesh,
-        &DrawParams::default(),
+    let t = common::build(&mut ctx, TechniqueId::Flat, &strip(2, true));
+    ctx.render_offscreen(
+        t.as_ref(),
+        &FrameParams::default(),
         vk::Extent2D {
             width: 16,
             height: 16,
@@ -482,19 +479,14 @@ fn capture_without_transform_feedback_is_a_typed_error() {
 fn measured_sizing_reruns_and_agrees_with_cpu_bound() {
     use tessera::tess::capture::CaptureSizing;
     let gpu = Gpu::new();
-    let mut capturer = Capturer::new(gpu.device()).unwrap();
-    let rm = RenderMesh::from_control_mesh(&load("assets/spot_control_mesh.obj")).unwrap();
-    for method in [Method::Flat, Method::Pn] {
-        let p = DrawParams {
-            method,
-            spacing: Spacing::FractionalOdd,
-            level: 5.5,
-            ..Default::default()
-        };
-        capturer.sizing = CaptureSizing::CpuBound;
-        let cpu = capture(&mut capturer, &gpu, &rm, &p);
-        capturer.sizing = CaptureSizing::Measure;
-        let measured = capture(&mut capturer, &gpu, &rm, &p);
+    let mut h = Harness::new(&gpu);
+    let base = load("assets/spot_control_mesh.obj");
+    for method in [TechniqueId::Flat, TechniqueId::Pn] {
+        let p = flat(5.5, Spacing::FractionalOdd);
+        h.capturer.sizing = CaptureSizing::CpuBound;
+        let cpu = capture(&mut h, &base, method, &p);
+        h.capturer.sizing = CaptureSizing::Measure;
+        let measured = capture(&mut h, &base, method, &p);
         assert_eq!((cpu.stats.passes, measured.stats.passes), (1, 2));
         assert_eq!(
             measured.stats.primitives_written,
@@ -508,18 +500,12 @@ fn measured_sizing_reruns_and_agrees_with_cpu_bound() {
 #[test]
 fn oversized_capture_is_a_typed_error() {
     let gpu = Gpu::new();
-    let mut capturer = Capturer::new(gpu.device()).unwrap();
-    capturer.max_bytes = 1000;
-    let rm = RenderMesh::from_control_mesh(&strip(2, true)).unwrap();
-    let mesh = GpuMesh::upload(gpu.device(), &rm).unwrap();
-    let e = capturer
-        .capture(
-            &mesh,
-            &DrawParams {
-                level: 8.0,
-                ..Default::default()
-            },
-        )
+    let mut h = Harness::new(&gpu);
+    h.capturer.max_bytes = 1000;
+    let t = common::build(&mut h.ctx, TechniqueId::Flat, &strip(2, true));
+    let e = h
+        .capturer
+        .capture(&mut h.ctx, t.as_ref(), &FrameParams::uniform(8.0), EXTENT)
         .unwrap_err();
     assert!(
         matches!(

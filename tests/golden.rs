@@ -2,8 +2,7 @@
 //! the tessellation itself is visible. Regenerate with TESSERA_UPDATE_GOLDEN=1.
 mod common;
 use common::Gpu;
-use tessera::tess::renderer::GpuMesh;
-use tessera::tess::{DrawParams, Method, RenderMesh, Renderer};
+use tessera::tess::{Context, FrameParams, TechniqueId};
 use tessera::vk_core::target::Rgba8;
 use tessera::vk_core::vk;
 
@@ -17,7 +16,7 @@ const MESHES: [&str; 3] = [
     "tests/data/meshes/cube.obj",
     "tests/data/opensubdiv/shapes/loop_icosahedron.obj",
 ];
-const METHODS: [Method; 3] = [Method::Flat, Method::Phong, Method::Pn];
+const METHODS: [TechniqueId; 3] = [TechniqueId::Flat, TechniqueId::Phong, TechniqueId::Pn];
 
 /// A pixel differs when any channel moves by more than 24/255; an image matches when at most
 /// 0.5% of its pixels differ. Rasterisation noise (an edge pixel flipping) stays far below; a
@@ -36,18 +35,15 @@ const TOLERANCE: f64 = 0.005;
 
 fn render_all(level: f32) -> Vec<(String, Rgba8)> {
     let gpu = Gpu::new();
-    let mut r = Renderer::offscreen(gpu.device()).unwrap();
+    let mut ctx = Context::offscreen(gpu.device()).unwrap();
     let mut out = Vec::new();
     for path in MESHES {
         let mesh = tessera::topology::load_obj(common::data(path)).unwrap();
-        let gm =
-            GpuMesh::upload(gpu.device(), &RenderMesh::from_control_mesh(&mesh).unwrap()).unwrap();
         for m in METHODS {
-            let p = DrawParams {
-                method: m,
-                level,
+            let t = common::build(&mut ctx, m, &mesh);
+            let p = FrameParams {
                 wireframe: true,
-                ..Default::default()
+                ..FrameParams::uniform(level)
             };
             let stem = std::path::Path::new(path)
                 .file_stem()
@@ -56,7 +52,7 @@ fn render_all(level: f32) -> Vec<(String, Rgba8)> {
                 .into_owned();
             out.push((
                 format!("{stem}_{m:?}").to_lowercase(),
-                r.render_offscreen(&gm, &p, EXTENT).unwrap(),
+                ctx.render_offscreen(t.as_ref(), &p, EXTENT).unwrap(),
             ));
         }
     }
@@ -110,10 +106,9 @@ const BFT_MESHES: [&str; 3] = [
 /// BFT images per mesh: shaded (subdivision shading at S segments, posed by the animation wave
 /// at `time`) and wireframe with patch colours.
 fn render_bft(segments: u32, time: f32) -> Vec<(String, Rgba8)> {
-    use tessera::tess::bft::{base_normals, base_positions, wave};
-    use tessera::tess::{BftParams, BftSurface, FactorPolicy};
+    use tessera::tess::techniques::bft::{base_normals, base_positions, wave};
     let gpu = Gpu::new();
-    let mut r = Renderer::offscreen(gpu.device()).unwrap();
+    let mut ctx = Context::offscreen(gpu.device()).unwrap();
     let mut out = Vec::new();
     for path in BFT_MESHES {
         let mesh = tessera::topology::load_obj(common::data(path))
@@ -125,28 +120,24 @@ fn render_bft(segments: u32, time: f32) -> Vec<(String, Rgba8)> {
             .unwrap()
             .to_string_lossy()
             .into_owned();
-        let mut surf = BftSurface::new(&r, &mesh, &stem, 5, false, 1).unwrap();
+        let mut surf = common::build_with(&mut ctx, TechniqueId::Bft, &mesh, 5, false);
         let rest = base_positions(&mesh);
-        let (lo, hi) = (surf.bbox_min, surf.bbox_max);
+        let (lo, hi) = surf.bbox();
         surf.update_base(0, &wave(&rest, &base_normals(&mesh), lo, hi, time))
             .unwrap();
         for (kind, wireframe) in [("shaded", false), ("wire", true)] {
             // From above: loop_xord_boundary is an open sheet seen edge-on by the default view.
-            let draw = DrawParams {
+            let params = FrameParams {
                 wireframe,
                 camera: tessera::tess::Camera {
                     pitch: 55.0,
                     ..Default::default()
                 },
-                ..Default::default()
-            };
-            let params = BftParams {
-                factors: FactorPolicy::Uniform { segments },
                 patch_colours: wireframe,
-                ..Default::default()
+                ..FrameParams::uniform(segments as f32)
             };
-            let (img, _, _) = surf
-                .render_offscreen(&mut r, &draw, &params, BFT_EXTENT, false)
+            let img = ctx
+                .render_offscreen(surf.as_ref(), &params, BFT_EXTENT)
                 .unwrap();
             out.push((format!("{stem}_bft_{kind}"), img));
         }

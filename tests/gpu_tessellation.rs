@@ -1,9 +1,8 @@
 //! Pipeline statistics against the CPU tessellator, and the lavapipe draw-split workaround.
 mod common;
 use common::Gpu;
-use tessera::tess::renderer::{GpuMesh, Method};
 use tessera::tess::tessellator::{uniform_vertex_count, Domain};
-use tessera::tess::{DrawParams, DrawSplit, RenderMesh, Renderer, Spacing};
+use tessera::tess::{Context, DrawSplit, FrameParams, Pass, Spacing, TechniqueId};
 use tessera::topology::ControlMesh;
 use tessera::vk_core::vk;
 
@@ -35,28 +34,24 @@ fn strip(k: u32, triangles: bool) -> ControlMesh {
 #[test]
 fn tes_invocations_equal_cpu_tessellator_counts() {
     let gpu = Gpu::new();
-    let mut r = Renderer::offscreen(gpu.device()).unwrap();
+    let mut r = Context::offscreen(gpu.device()).unwrap();
     for (triangles, domain) in [(true, Domain::Triangle), (false, Domain::Quad)] {
         let k = if triangles { 10 } else { 5 };
-        let mesh = GpuMesh::upload(
-            gpu.device(),
-            &RenderMesh::from_control_mesh(&strip(5, triangles)).unwrap(),
-        )
-        .unwrap();
+        let mesh = common::build(&mut r, TechniqueId::Flat, &strip(5, triangles));
         for spacing in [
             Spacing::Equal,
             Spacing::FractionalEven,
             Spacing::FractionalOdd,
         ] {
             for level in [1.0f32, 2.0, 2.5, 3.0, 4.7, 7.0, 16.0, 33.3, 64.0] {
-                let p = DrawParams {
-                    method: Method::Flat,
+                let p = FrameParams {
                     spacing,
-                    level,
-                    ..Default::default()
+                    ..FrameParams::uniform(level)
                 };
-                let (_, stats, counts) = r.render_offscreen_stats(&mesh, &p, SMALL, true).unwrap();
-                let stats = stats.unwrap();
+                let frame = r
+                    .render_offscreen_stats(mesh.as_ref(), &p, SMALL, true)
+                    .unwrap();
+                let (stats, counts) = (frame.statistics.unwrap(), frame.counts);
                 let expected = k as u64 * uniform_vertex_count(domain, spacing, level);
                 assert_eq!(
                     stats.tess_control_patches, k as u64,
@@ -99,44 +94,25 @@ fn grid(w: u32, h: u32) -> ControlMesh {
 #[test]
 fn draw_split_matches_per_patch_reference() {
     let gpu = Gpu::new();
-    let mut r = Renderer::offscreen(gpu.device()).unwrap();
-    let mesh = GpuMesh::upload(
-        gpu.device(),
-        &RenderMesh::from_control_mesh(&grid(6, 4)).unwrap(),
-    )
-    .unwrap();
+    let mut r = Context::offscreen(gpu.device()).unwrap();
+    let mesh = common::build(&mut r, TechniqueId::Flat, &grid(6, 4));
+    let mesh = mesh.as_ref();
     let extent = vk::Extent2D {
         width: 192,
         height: 192,
     };
-    let base = DrawParams {
-        method: Method::Flat,
-        level: 64.0,
+    let base = FrameParams {
         wireframe: true,
-        ..Default::default()
+        ..FrameParams::uniform(64.0)
     };
-    let (reference, _, ref_counts) = r
-        .render_offscreen_stats(
-            &mesh,
-            &DrawParams {
-                split: DrawSplit::PerPatch,
-                ..base
-            },
-            extent,
-            false,
-        )
-        .unwrap();
-    let (split, _, split_counts) = r
-        .render_offscreen_stats(
-            &mesh,
-            &DrawParams {
-                split: DrawSplit::Auto,
-                ..base
-            },
-            extent,
-            false,
-        )
-        .unwrap();
+    let render = |r: &mut Context, split: DrawSplit| {
+        let f = r
+            .render_offscreen_stats(mesh, &FrameParams { split, ..base }, extent, false)
+            .unwrap();
+        (f.image, f.counts)
+    };
+    let (reference, ref_counts) = render(&mut r, DrawSplit::PerPatch);
+    let (split, split_counts) = render(&mut r, DrawSplit::Auto);
     assert_eq!(ref_counts.patches, split_counts.patches);
     let differing =
         |a: &[u8], b: &[u8]| a.chunks(4).zip(b.chunks(4)).filter(|(x, y)| x != y).count();
@@ -150,17 +126,7 @@ fn draw_split_matches_per_patch_reference() {
             split_counts.draws > 2,
             "lavapipe needs the split: {split_counts:?}"
         );
-        let (unsplit, _, counts) = r
-            .render_offscreen_stats(
-                &mesh,
-                &DrawParams {
-                    split: DrawSplit::Off,
-                    ..base
-                },
-                extent,
-                false,
-            )
-            .unwrap();
+        let (unsplit, counts) = render(&mut r, DrawSplit::Off);
         assert_eq!(counts.draws, 2, "one draw per pass");
         let bad = differing(&unsplit.pixels, &reference.pixels);
         assert!(
@@ -178,41 +144,26 @@ fn timestamp_queries_measure_a_draw() {
     use tessera::vk_core::target::OffscreenTarget;
     let gpu = Gpu::new();
     let device = gpu.device();
-    let mut r = Renderer::offscreen(device).unwrap();
-    let mesh =
-        GpuMesh::upload(device, &RenderMesh::from_control_mesh(&grid(6, 4)).unwrap()).unwrap();
+    let mut r = Context::offscreen(device).unwrap();
+    let mesh = common::build(&mut r, TechniqueId::Flat, &grid(6, 4));
+    let mesh = mesh.as_ref();
     let target = OffscreenTarget::new(device, SMALL).unwrap();
     let readback = target.readback_buffer(device).unwrap();
     let pool = QueryPool::timestamps(device, "test timestamps", 2).unwrap();
-    let params = DrawParams {
-        level: 32.0,
-        ..Default::default()
-    };
-    r.update_uniforms(0, &mesh, &params, SMALL).unwrap();
+    let params = FrameParams::uniform(32.0);
+    r.prepare(mesh, &params, &[Pass::Shaded]).unwrap();
+    r.write_frame(0, mesh.bbox(), &params, SMALL).unwrap();
+    let r = &r;
     device
-        .one_shot(|cmd| {
-            pool.cmd_reset(cmd);
-            // SAFETY: the pool was reset above; cmd is recording.
-            unsafe {
-                device.raw.cmd_write_timestamp(
-                    cmd,
-                    vk::PipelineStageFlags::TOP_OF_PIPE,
-                    pool.raw,
-                    0,
-                )
-            };
-            target.cmd_begin(device, cmd, params.clear_color);
-            r.record(cmd, 0, &mesh, &params).unwrap();
-            target.cmd_end_and_copy(device, cmd, &readback);
-            // SAFETY: as above.
-            unsafe {
-                device.raw.cmd_write_timestamp(
-                    cmd,
-                    vk::PipelineStageFlags::BOTTOM_OF_PIPE,
-                    pool.raw,
-                    1,
-                )
-            };
+        .submit_once(|enc| {
+            enc.reset_queries(&pool);
+            enc.write_timestamp(&pool, vk::PipelineStageFlags::TOP_OF_PIPE, 0)
+                .unwrap();
+            enc.begin_offscreen(&target, params.clear_color);
+            r.record_frame(enc, mesh, 0, &params).unwrap();
+            enc.end_offscreen_and_copy(&target, &readback);
+            enc.write_timestamp(&pool, vk::PipelineStageFlags::BOTTOM_OF_PIPE, 1)
+                .unwrap();
         })
         .unwrap();
     let d = pool.durations_ns().unwrap();

@@ -1,25 +1,21 @@
 mod common;
-use tessera::tess::renderer::GpuMesh;
-use tessera::tess::{DrawParams, Method, RenderMesh, Renderer};
+use tessera::tess::{Context, FrameParams, TechniqueId};
 use tessera::vk_core::vk;
 
 #[test]
 fn renders_spot_with_each_method() {
     let gpu = Gpu::new();
     let mesh = tessera::topology::load_obj(common::data("assets/spot_control_mesh.obj")).unwrap();
-    let rm = RenderMesh::from_control_mesh(&mesh).unwrap();
-    let gm = GpuMesh::upload(gpu.device(), &rm).unwrap();
-    let mut r = Renderer::offscreen(gpu.device()).unwrap();
-    for m in [Method::Flat, Method::Phong, Method::Pn] {
-        let p = DrawParams {
-            method: m,
-            level: 6.0,
+    let mut ctx = Context::offscreen(gpu.device()).unwrap();
+    for m in [TechniqueId::Flat, TechniqueId::Phong, TechniqueId::Pn] {
+        let t = common::build(&mut ctx, m, &mesh);
+        let p = FrameParams {
             wireframe: true,
-            ..Default::default()
+            ..FrameParams::uniform(6.0)
         };
-        let img = r
+        let img = ctx
             .render_offscreen(
-                &gm,
+                t.as_ref(),
                 &p,
                 vk::Extent2D {
                     width: 320,

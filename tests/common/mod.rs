@@ -76,3 +76,35 @@ fn env_logger_init() -> Result<(), ()> {
 pub fn data(path: &str) -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
 }
+
+/// Builds technique `id` for `mesh` on `ctx` with default options (tangent tables included,
+/// so geometric normals can be drawn).
+pub fn build(
+    ctx: &mut tessera::tess::Context,
+    id: tessera::tess::TechniqueId,
+    mesh: &tessera::topology::ControlMesh,
+) -> Box<dyn tessera::tess::Technique> {
+    build_with(ctx, id, mesh, 5, true)
+}
+
+/// [`build`] with a table level and tangent choice.
+pub fn build_with(
+    ctx: &mut tessera::tess::Context,
+    id: tessera::tess::TechniqueId,
+    mesh: &tessera::topology::ControlMesh,
+    table_level: u32,
+    tangents: bool,
+) -> Box<dyn tessera::tess::Technique> {
+    tessera::tess::build(
+        ctx,
+        id,
+        mesh,
+        &tessera::tess::BuildOptions {
+            name: "test mesh".into(),
+            table_level,
+            tangents,
+        },
+    )
+    .unwrap_or_else(|e| panic!("building {id}: {e}"))
+    .technique
+}

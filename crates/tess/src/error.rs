@@ -1,4 +1,8 @@
-//! The crate's error type: Vulkan, topology (with file/face/edge) and parameter errors.
+//! The crate's error type. Each variant is one class of failure a caller (the CLI, a C ABI)
+//! can map to a status code, with fields naming the option, technique, file or index at fault.
+use crate::shaders::{Stage, Variant};
+use crate::technique::{Pass, TechniqueId};
+
 pub type Result<T, E = TessError> = std::result::Result<T, E>;
 
 #[derive(Debug, thiserror::Error)]
@@ -7,14 +11,93 @@ pub enum TessError {
     Vulkan(#[from] vk_core::VkError),
     #[error(transparent)]
     Topology(#[from] topology::TopologyError),
-    #[error("{0}")]
-    Invalid(String),
+    /// The mesh `name` could not be prepared (its topology error says where).
+    #[error("{name}: {source}")]
+    Mesh {
+        name: String,
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+    /// An option's value outside what it accepts.
+    #[error("{option} {value}: expected {range}")]
+    OutOfRange {
+        option: &'static str,
+        value: String,
+        range: &'static str,
+    },
+    /// A technique asked for something it does not do.
+    #[error("{technique} does not support {what}")]
+    Unsupported {
+        technique: TechniqueId,
+        what: &'static str,
+    },
+    #[error("unknown method '{name}' ({known})")]
+    UnknownTechnique { name: String, known: String },
+    /// Basis-function tables reach `2^(L+1)` segments per base edge.
+    #[error(
+        "--segments {segments}: BFT takes a power of two in 2..={max} segments per base edge \
+         (tables at level {table_level}; raise --table-level for more)"
+    )]
+    BftSegments {
+        segments: f32,
+        max: u32,
+        table_level: u32,
+    },
+    #[error(
+        "--table-level {level}: tables must be at level 1..6 and need tessellation level 2^level \
+         (the device allows {max_tessellation_level})"
+    )]
+    TableLevel {
+        level: u32,
+        max_tessellation_level: u32,
+    },
+    #[error("geometric normals need the tangent tables (this surface was built without them)")]
+    NeedsTangentTables,
+    #[error("{given} base positions given, the mesh has {expected}")]
+    BasePositionCount { given: usize, expected: usize },
+    #[error("no frame slot {slot} (the context has {slots})")]
+    FrameSlot { slot: usize, slots: usize },
+    #[error("no patch array {array}")]
+    NoPatchArray { array: usize },
+    #[error("{what} {index} is out of range of {len}")]
+    IndexOutOfRange {
+        what: &'static str,
+        index: u64,
+        len: u64,
+    },
+    #[error("vertex {vertex} has a NaN or infinite coordinate")]
+    NonFiniteVertex { vertex: usize },
+    /// Recording before [`crate::Context::prepare`] built the pass's pipelines.
+    #[error("{technique}: no {pass:?} pipeline was prepared before recording")]
+    PipelineNotPrepared { technique: TechniqueId, pass: Pass },
+    /// The shader manifest declares no such variant.
+    #[error("shader {stage:?} has no variant {variant:?}")]
+    MissingShaderVariant { stage: Stage, variant: Variant },
     /// A capture larger than the transform-feedback buffer limit or the caller's budget.
     #[error("capturing {triangles} triangles needs {bytes} bytes of transform feedback, over the limit of {limit} bytes (lower the level or raise the limit)")]
     CaptureTooLarge {
         triangles: u64,
         bytes: u64,
         limit: u64,
+    },
+    #[error("transform feedback overflowed twice: {needed} triangles needed, {capacity} captured")]
+    CaptureOverflow { needed: u64, capacity: u64 },
+    #[error("captured soup has {corners} corners, not whole triangles")]
+    PartialTriangle { corners: usize },
+    #[error("{path}: vertex {vertex} has patch id {patch}, which maps to no base face")]
+    UnmappedPatch {
+        path: String,
+        vertex: usize,
+        patch: u32,
+    },
+    /// A benchmark setting that cannot run (the message names the option).
+    #[error("{option}: {reason}")]
+    BenchConfig { option: String, reason: String },
+    #[error("{path}:{line}: bad {column} '{value}'")]
+    Csv {
+        path: String,
+        line: usize,
+        column: String,
+        value: String,
     },
     #[error("I/O on {path}: {source}")]
     Io {

@@ -1,12 +1,12 @@
 //! A plain indexed triangle draw, no tessellation stage: how a mesh refined on the CPU (the
 //! paper's comparison point, CPU subdivision to M^k) is drawn. Same `Frame` uniforms and
 //! `shade.frag` as the tessellated techniques, so only the geometry path differs.
+use crate::context::{set_vertex_input, Context};
 use crate::error::{Result, TessError};
 use crate::gpu::{DrawPush, Vertex};
-use crate::renderer::{frame_uniforms_for, set_vertex_input, DrawParams, FrameSets};
-use crate::shaders;
+use crate::shaders::{self, Stage, Variant};
 use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage};
-use vk_core::{vk, Buffer, BufferDesc, Device, MemoryLocation};
+use vk_core::{vk, Buffer, BufferDesc, Device, Encoder, MemoryLocation};
 
 /// A triangle mesh on the GPU: vertices and a `u32` index list.
 pub struct PlainMesh {
@@ -31,19 +31,23 @@ fn bbox(vertices: &[Vertex]) -> ([f32; 3], [f32; 3]) {
 }
 
 fn check(vertices: &[Vertex], indices: &[u32]) -> Result<()> {
-    if vertices.is_empty() || indices.is_empty() || !indices.chunks_exact(3).remainder().is_empty()
-    {
-        return Err(TessError::Invalid(format!(
-            "a plain mesh needs vertices and whole triangles ({} vertices, {} indices)",
-            vertices.len(),
-            indices.len()
-        )));
+    if vertices.is_empty() || indices.is_empty() {
+        return Err(TessError::Topology(topology::TopologyError::EmptyMesh {
+            what: "a plain mesh needs vertices and triangles",
+        }));
+    }
+    if !indices.chunks_exact(3).remainder().is_empty() {
+        return Err(TessError::PartialTriangle {
+            corners: indices.len(),
+        });
     }
     let n = vertices.len() as u32;
     if let Some(&bad) = indices.iter().find(|&&i| i >= n) {
-        return Err(TessError::Invalid(format!(
-            "index {bad} is out of range of {n} vertices"
-        )));
+        return Err(TessError::IndexOutOfRange {
+            what: "plain mesh index",
+            index: bad as u64,
+            len: n as u64,
+        });
     }
     Ok(())
 }
@@ -107,11 +111,10 @@ impl PlainMesh {
     /// previous frame (the bench waits for every frame).
     pub fn write_vertices(&mut self, vertices: &[Vertex]) -> Result<()> {
         if vertices.len() != self.vertex_count as usize {
-            return Err(TessError::Invalid(format!(
-                "{} vertices written to a mesh of {}",
-                vertices.len(),
-                self.vertex_count
-            )));
+            return Err(TessError::BasePositionCount {
+                given: vertices.len(),
+                expected: self.vertex_count as usize,
+            });
         }
         self.vertices.write(0, bytemuck::cast_slice(vertices))?;
         Ok(())
@@ -122,94 +125,56 @@ impl PlainMesh {
     }
 }
 
-/// The non-tessellated pipeline with its own frame uniforms (one frame slot). Drop order:
-/// pipeline, frame set.
+/// The non-tessellated pipeline; its set 0 is a [`Context`]'s frame set, so it sees the same
+/// view as the tessellated techniques drawn through that context.
 pub struct PlainRenderer {
     pipeline: Pipeline,
-    frame: FrameSets,
-    device: Device,
 }
 
 impl PlainRenderer {
-    pub fn new(
-        device: &Device,
-        color_format: vk::Format,
-        depth_format: vk::Format,
-    ) -> Result<Self> {
-        let frame = FrameSets::new(device, "plain", 1)?;
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let (color_format, depth_format) = ctx.formats();
         let mut desc = GraphicsPipelineDesc::new("plain triangles", color_format, depth_format);
         desc.stages = vec![
-            ShaderStage::new(vk::ShaderStageFlags::VERTEX, shaders::PLAIN_VERT),
-            ShaderStage::new(vk::ShaderStageFlags::FRAGMENT, shaders::SHADE_FRAG),
+            ShaderStage::new(
+                vk::ShaderStageFlags::VERTEX,
+                shaders::spirv(Stage::PlainPlainVert, Variant::default())?,
+            ),
+            ShaderStage::new(
+                vk::ShaderStageFlags::FRAGMENT,
+                shaders::spirv(Stage::CommonShadeFrag, Variant::default())?,
+            ),
         ];
         set_vertex_input(&mut desc);
-        desc.set_layouts = vec![frame.layout()];
+        desc.set_layouts = vec![ctx.frame_set_layout().raw];
         desc.push_constant_bytes = std::mem::size_of::<DrawPush>() as u32;
         // The tessellated techniques' shaded pass uses this bias too: same raster work.
         desc.depth_bias = Some((1.0, 1.0));
-        let pipeline = Pipeline::graphics(device, &desc)?;
         Ok(Self {
-            pipeline,
-            frame,
-            device: device.clone(),
+            pipeline: Pipeline::graphics(ctx.device(), &desc)?,
         })
     }
 
-    /// Writes the frame uniforms for `params` (its level and Phong factor are unused here).
-    pub fn update_uniforms(
-        &mut self,
-        mesh: &PlainMesh,
-        params: &DrawParams,
-        extent: vk::Extent2D,
-    ) -> Result<()> {
-        self.frame.write(
-            0,
-            &frame_uniforms_for((mesh.bbox_min, mesh.bbox_max), params, extent),
-        )
-    }
-
-    /// Records the shaded draw inside an active rendering scope; returns the triangles drawn.
-    pub fn record(&self, cmd: vk::CommandBuffer, mesh: &PlainMesh) -> Result<u64> {
-        let device = &self.device;
-        let set = self.frame.set(0)?;
-        let push = DrawPush {
+    /// Records the shaded draw of frame slot `slot` inside an active rendering scope; returns
+    /// the triangles drawn.
+    pub fn record<'a>(
+        &'a self,
+        enc: &mut Encoder<'a>,
+        ctx: &'a Context,
+        slot: usize,
+        mesh: &'a PlainMesh,
+    ) -> Result<u64> {
+        enc.begin_label("plain triangles");
+        enc.bind_pipeline(&self.pipeline);
+        enc.bind_descriptor_sets(0, &[ctx.frame_set(slot)?])?;
+        enc.push_constants(&DrawPush {
             mode: 0,
             first_patch: 0,
-        };
-        device.begin_label(cmd, "plain triangles");
-        // SAFETY: cmd is recording inside a rendering scope; the pipeline, set and buffers are
-        // owned by self and mesh, which outlive the submission (the bench waits for each frame);
-        // the index count stays inside the index buffer (checked when it was built).
-        unsafe {
-            device
-                .raw
-                .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline.raw);
-            device.raw.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.pipeline.layout,
-                0,
-                &[set],
-                &[],
-            );
-            device.raw.cmd_push_constants(
-                cmd,
-                self.pipeline.layout,
-                vk::ShaderStageFlags::ALL,
-                0,
-                bytemuck::bytes_of(&push),
-            );
-            device
-                .raw
-                .cmd_bind_vertex_buffers(cmd, 0, &[mesh.vertices.raw], &[0]);
-            device
-                .raw
-                .cmd_bind_index_buffer(cmd, mesh.indices.raw, 0, vk::IndexType::UINT32);
-            device
-                .raw
-                .cmd_draw_indexed(cmd, mesh.index_count, 1, 0, 0, 0);
-        }
-        device.end_label(cmd);
+        })?;
+        enc.bind_vertex_buffer(0, &mesh.vertices);
+        enc.bind_index_buffer_u32(&mesh.indices);
+        enc.draw_indexed(0..mesh.index_count)?;
+        enc.end_label();
         Ok(mesh.triangles())
     }
 }

@@ -3,7 +3,6 @@
 //! for flat quad tessellation, the rest triangulated).
 use crate::error::{Result, TessError};
 use crate::gpu::Vertex;
-use crate::renderer::Method;
 use crate::tessellator::Domain;
 use topology::ControlMesh;
 
@@ -93,9 +92,7 @@ impl RenderMesh {
             .enumerate()
             .find(|(_, p)| p.iter().any(|c| !c.is_finite()))
         {
-            return Err(TessError::Invalid(format!(
-                "vertex {v} has a NaN or infinite coordinate"
-            )));
+            return Err(TessError::NonFiniteVertex { vertex: v });
         }
 
         // Corner normals from the file are used when complete: vertices are then split by
@@ -180,18 +177,6 @@ impl RenderMesh {
     }
 }
 
-impl RenderMesh {
-    /// The origin of every patch `method` draws, indexed by captured patch id (the frame-wide
-    /// numbering of [`crate::renderer::draw_lists`]: flat numbers quads first, then the other
-    /// faces' triangles; Phong and PN number every face's triangles).
-    pub fn patch_origins(&self, method: Method) -> Vec<PatchOrigin> {
-        match method {
-            Method::Flat => [&self.quad_origins[..], &self.quad_mode_triangle_origins[..]].concat(),
-            Method::Phong | Method::Pn => self.triangle_origins.clone(),
-        }
-    }
-}
-
 /// Vertex normals as the sum of face normals weighted by each corner's angle (Thürmer & Wüthrich),
 /// independent of how faces are split into triangles.
 pub fn angle_weighted_normals(
@@ -272,10 +257,11 @@ mod tests {
         let rm = RenderMesh::from_control_mesh(&mesh).unwrap();
         assert_eq!(rm.triangles, vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]]);
         assert_eq!(rm.quad_mode_triangles.len(), 3);
-        let fans: Vec<_> = rm.patch_origins(Method::Pn).iter().map(|o| o.fan).collect();
+        let fans: Vec<_> = rm.triangle_origins.iter().map(|o| o.fan).collect();
         assert_eq!(fans, vec![1, 2, 3]);
+        assert!(rm.quad_origins.is_empty());
         assert!(rm
-            .patch_origins(Method::Flat)
+            .quad_mode_triangle_origins
             .iter()
             .all(|o| o.face == 0 && o.face_size == 5 && o.domain == Domain::Triangle));
         assert!(rm.vertices.iter().all(|v| (v.normal[2] - 1.0).abs() < 1e-6));

@@ -1,5 +1,6 @@
 //! Command-line definition.
-use crate::technique::{SurfaceArgs, Technique};
+use crate::technique::SurfaceArgs;
+use tess::TechniqueId;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use tess::Spacing;
@@ -44,7 +45,7 @@ pub struct ExportArgs {
     pub input: PathBuf,
     /// flat, phong, pn or bft.
     #[arg(long, value_parser = crate::technique::parse_technique)]
-    pub method: Technique,
+    pub method: TechniqueId,
     /// Segments per base edge (tessellation level of flat, phong and pn: 1 to 64; bft: a power
     /// of two from 2 to 2^(table level + 1) unless --fractional). Ignored with --adaptive.
     #[arg(long, default_value_t = 8.0)]
@@ -179,7 +180,7 @@ pub struct SceneArgs {
     /// flat, phong, pn (the base faces as patches) or bft (the Loop limit surface from
     /// basis-function tables).
     #[arg(long, default_value = "flat", value_parser = crate::technique::parse_technique)]
-    pub method: Technique,
+    pub method: TechniqueId,
     /// Tessellation level: segments per base edge (outer and inner), 1 to 64; bft takes powers
     /// of two from 2 to 2^(table level + 1) unless --fractional.
     #[arg(long, alias = "segments", default_value_t = 8.0)]

@@ -1,11 +1,10 @@
 //! The subcommands' bodies.
 use crate::cli::{CameraArgs, Cli, Command, GpuArgs, RenderArgs, SceneArgs};
-use crate::technique::{loop_control_mesh, BftSetup, Technique, Wave};
-use anyhow::{bail, Context, Result};
+use crate::technique::{describe, Setup};
+use anyhow::{bail, Result};
 use std::sync::Arc;
-use tess::bft::BftSurface;
-use tess::renderer::GpuMesh;
-use tess::{Camera, DrawParams, Method, RenderMesh, Renderer};
+use tess::techniques::bft::Wave;
+use tess::{Camera, Context, FrameParams, Technique};
 use vk_core::{vk, Device, DeviceDesc, Instance, InstanceDesc, Validation};
 
 /// The spot control mesh by Keenan Crane (public domain), embedded so `tessera render` works
@@ -63,27 +62,43 @@ pub fn camera(c: &CameraArgs) -> Camera {
     }
 }
 
-/// Draw parameters and, for `--method bft`, its setup, checked against each other.
-pub fn draw_params(s: &SceneArgs) -> Result<(DrawParams, Option<BftSetup>)> {
-    let bft = s.surface.setup(s.method, s.level, s.spacing, s.animate)?;
-    if bft.is_none() && !(1.0..=64.0).contains(&s.level) {
-        bail!("--level {} is outside 1..64", s.level);
-    }
-    let method = match s.method {
-        Technique::Tessellated(m) => m,
-        // Unused by the BFT pipeline; the frame uniforms only need a valid one.
-        Technique::Bft => Method::Flat,
-    };
-    let params = DrawParams {
-        method,
-        spacing: s.spacing,
-        level: s.level.clamp(1.0, 64.0),
+/// What `render` and `view` draw: the technique, how to build it and each frame's
+/// parameters, checked against the technique's features (before any device is opened).
+pub fn scene_setup(s: &SceneArgs, name: &str) -> Result<Setup> {
+    let params = FrameParams {
         wireframe: s.wireframe,
         camera: camera(&s.camera),
         phong_alpha: s.alpha,
-        ..DrawParams::default()
+        ..FrameParams::default()
     };
-    Ok((params, bft))
+    let mut setup = s
+        .surface
+        .setup(s.method, s.level, s.spacing, s.animate, params)?;
+    setup.build.name = name.to_string();
+    Ok(setup)
+}
+
+/// Builds `setup`'s technique for `mesh` on `ctx`, says how it took the mesh (stderr), and
+/// poses an animated base at `--frame` (0 by default) in every frame slot.
+pub fn build_technique(
+    ctx: &mut Context,
+    mesh: &topology::ControlMesh,
+    setup: &Setup,
+) -> Result<Box<dyn Technique>> {
+    let built = tess::build(ctx, setup.technique, mesh, &setup.build)?;
+    for n in &built.notes {
+        eprintln!("{n}");
+    }
+    let mut technique = built.technique;
+    if setup.moved() {
+        if let Some(base) = technique.base_mesh() {
+            let posed = Wave::new(base).at(setup.frame.unwrap_or(0.0));
+            for slot in 0..ctx.frames_in_flight() {
+                technique.update_base(slot, &posed)?;
+            }
+        }
+    }
+    Ok(technique)
 }
 
 /// Instance + device as the command line asks; errors list the devices seen.
@@ -129,26 +144,13 @@ pub fn check_validation(instance: &Instance) -> Result<()> {
 
 fn render(a: RenderArgs) -> Result<()> {
     let mesh = load_mesh(a.scene.mesh.as_deref())?;
-    let name = mesh_name(a.scene.mesh.as_deref());
-    let (params, bft) = draw_params(&a.scene)?;
+    let setup = scene_setup(&a.scene, &mesh_name(a.scene.mesh.as_deref()))?;
     let extent = vk::Extent2D {
         width: a.size.0,
         height: a.size.1,
     };
     let (instance, device) = open_device(&a.scene.gpu, vec![], &[])?;
-    let what = match &bft {
-        None => render_tessellated(&device, &mesh, &params, extent, &a.output),
-        Some(setup) => render_bft(
-            &device,
-            &mesh,
-            &name,
-            &params,
-            setup,
-            a.scene.animate,
-            extent,
-            &a.output,
-        ),
-    };
+    let what = render_offscreen(&device, &mesh, &setup, extent, &a.output);
     drop(device);
     check_validation(&instance)?;
     println!(
@@ -161,58 +163,23 @@ fn render(a: RenderArgs) -> Result<()> {
     Ok(())
 }
 
-fn render_tessellated(
+fn render_offscreen(
     device: &Device,
     mesh: &topology::ControlMesh,
-    params: &DrawParams,
+    setup: &Setup,
     extent: vk::Extent2D,
     output: &std::path::Path,
 ) -> Result<String> {
-    let rm = RenderMesh::from_control_mesh(mesh).context("preparing the mesh for drawing")?;
-    let gm = GpuMesh::upload(device, &rm)?;
-    let mut renderer = Renderer::offscreen(device)?;
-    let img = renderer.render_offscreen(&gm, params, extent)?;
-    img.save_png(output)?;
-    Ok(format!("{:?}, level {}", params.method, params.level))
-}
-
-#[allow(clippy::too_many_arguments)]
-fn render_bft(
-    device: &Device,
-    mesh: &topology::ControlMesh,
-    name: &str,
-    params: &DrawParams,
-    setup: &BftSetup,
-    animate: bool,
-    extent: vk::Extent2D,
-    output: &std::path::Path,
-) -> Result<String> {
-    let (loop_mesh, _, note) = loop_control_mesh(mesh, name);
-    if let Some(n) = note {
-        eprintln!("{n}");
-    }
-    let mut renderer = Renderer::offscreen(device)?;
-    let mut surface = BftSurface::new(
-        &renderer,
-        &loop_mesh,
-        name,
-        setup.table_level,
-        setup.params.geometric_normals,
-        1,
-    )?;
-    if animate || setup.frame.is_some() {
-        let positions = Wave::new(&loop_mesh).at(setup.frame.unwrap_or(0.0));
-        surface.update_base(0, &positions)?;
-    }
-    let bft = setup.world_params((surface.bbox_min, surface.bbox_max));
-    let (img, _, counts) = surface.render_offscreen(&mut renderer, params, &bft, extent, false)?;
-    img.save_png(output)?;
+    let mut ctx = Context::offscreen(device)?;
+    let technique = build_technique(&mut ctx, mesh, setup)?;
+    let params = setup.world_params(technique.bbox());
+    let frame = ctx.render_offscreen_stats(technique.as_ref(), &params, extent, false)?;
+    frame.image.save_png(output)?;
+    let patches: u32 = technique.patch_arrays().iter().map(|a| a.patches).sum();
     Ok(format!(
-        "bft, {:?}{}, {} patches in {} draws",
-        bft.factors,
-        if bft.fractional { " fractional" } else { "" },
-        surface.patch_count(),
-        counts.draws
+        "{}, {patches} patches in {} draws",
+        describe(setup.technique, &params),
+        frame.counts.draws
     ))
 }
 

@@ -1,30 +1,16 @@
-//! Which technique draws the surface, and the options of the Loop basis-function-table one
-//! (`--method bft`), shared by `render`, `view` and `export`.
+//! The technique options shared by `render`, `view` and `export`, checked against what the
+//! chosen technique declares it takes ([`tess::Features`] in [`tess::techniques::registry`]):
+//! no per-technique code here, so a new technique needs no change in the viewer.
 use anyhow::{bail, Result};
 use clap::Args;
-use tess::bft::{base_normals, base_positions, wave, BftParams, FactorPolicy, DEFAULT_TABLE_LEVEL};
-use tess::{Method, Spacing};
-use topology::ControlMesh;
+use tess::techniques::{self, bft::DEFAULT_TABLE_LEVEL, BuildOptions};
+use tess::{FactorPolicy, Features, FrameParams, Spacing, TechniqueId};
 
-/// A technique of the renderer (flat, phong, pn: the base faces as patches) or the Loop limit
-/// surface from basis-function tables (Holländer & Boubekeur).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Technique {
-    Tessellated(Method),
-    Bft,
+pub fn parse_technique(s: &str) -> Result<TechniqueId, String> {
+    s.parse::<TechniqueId>().map_err(|e| e.to_string())
 }
 
-pub fn parse_technique(s: &str) -> Result<Technique, String> {
-    match s {
-        "bft" => Ok(Technique::Bft),
-        _ => s
-            .parse::<Method>()
-            .map(Technique::Tessellated)
-            .map_err(|_| format!("unknown method '{s}' (flat, phong, pn, bft)")),
-    }
-}
-
-/// Adaptive factor policies of `--method bft`.
+/// Adaptive factor policies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Adaptive {
     Screen,
@@ -39,11 +25,11 @@ fn parse_adaptive(s: &str) -> Result<Adaptive, String> {
     }
 }
 
-/// Options of the subdivision-surface techniques (`--method bft`); the others refuse them.
+/// Options of the subdivision-surface techniques; techniques that do not take one refuse it.
 #[derive(Args, Debug, Clone)]
 pub struct SurfaceArgs {
-    /// Subdivision scheme of `--method bft`: loop (its only scheme, the default). Polygons of
-    /// more than three sides are fan-triangulated first.
+    /// Subdivision scheme whose limit surface is drawn (bft: loop, its only scheme, the
+    /// default). Polygons of more than three sides are fan-triangulated first.
     #[arg(long)]
     pub scheme: Option<String>,
     /// Adaptive edge factors (bft): screen (projected edge length / --pixels) or distance
@@ -58,134 +44,211 @@ pub struct SurfaceArgs {
     /// tables' maximum level.
     #[arg(long, default_value_t = 1.0)]
     pub distance: f32,
-    /// Fractional factors (bft): linear geomorph between the two dyadic levels (same as
-    /// `--spacing fractional-even`).
+    /// Fractional factors (bft: linear geomorph between the two dyadic levels); the same as
+    /// `--spacing fractional-even`.
     #[arg(long)]
     pub fractional: bool,
     /// Maximum table level L (bft): segments per base edge up to 2^(L+1).
     #[arg(long, default_value_t = DEFAULT_TABLE_LEVEL)]
     pub table_level: u32,
-    /// Normals from the tangent tables (du × dv) instead of subdivision shading (bft).
+    /// Normals from the surface's derivatives (bft: du × dv from the tangent tables) instead of
+    /// its shading normals.
     #[arg(long)]
     pub geometric_normals: bool,
-    /// Colour patches by kind (bft): regular blue, extraordinary red, boundary green, private
-    /// table violet.
+    /// Colour patches by type (bft: regular blue, extraordinary red, boundary green, private
+    /// table violet).
     #[arg(long, alias = "patch-colors")]
     pub patch_colours: bool,
-    /// Time T of the --animate wave (base vertices moved along their normals), in seconds;
-    /// needs --method bft.
+    /// Time T of the --animate wave (base vertices moved along their normals), in seconds.
     #[arg(long, allow_hyphen_values = true)]
     pub frame: Option<f32>,
 }
 
-/// Everything `--method bft` needs beyond the shared draw parameters.
+/// What a command asks of a technique: how to build it, what each frame shows, and the
+/// animation.
 #[derive(Clone, Debug)]
-pub struct BftSetup {
-    pub params: BftParams,
-    pub table_level: u32,
+pub struct Setup {
+    pub technique: TechniqueId,
+    pub build: BuildOptions,
+    /// Per frame; `--adaptive distance` is in diagonals here until [`Setup::world_params`].
+    pub params: FrameParams,
     /// `--adaptive distance` in diagonals (turned into world units once the mesh is known).
     pub distance_diagonals: Option<f32>,
+    pub animate: bool,
     pub frame: Option<f32>,
 }
 
+/// One command-line option a technique may refuse: its name, whether it was given, and which
+/// feature takes it.
+struct OptionUse {
+    name: &'static str,
+    given: bool,
+    feature: fn(&Features) -> bool,
+}
+
 impl SurfaceArgs {
-    /// Checks the options against `technique` and builds the BFT setup (None for the other
-    /// techniques, which refuse BFT-only options rather than ignore them). `segments` is the
-    /// uniform segments per base edge, `spacing` the `--spacing` option.
+    /// Checks the options against `technique`'s features and builds the setup. `segments` is
+    /// the uniform segments per base edge, `spacing` the `--spacing` option, `params` the
+    /// shared frame parameters (camera, wireframe, α) to complete.
     pub fn setup(
         &self,
-        technique: Technique,
+        technique: TechniqueId,
         segments: f32,
         spacing: Spacing,
         animate: bool,
-    ) -> Result<Option<BftSetup>> {
+        mut params: FrameParams,
+    ) -> Result<Setup> {
+        let info = techniques::info(technique);
+        let f = info.features;
         if let Some(scheme) = &self.scheme {
-            if scheme != "loop" {
-                bail!("--scheme {scheme}: only loop is supported (the bft method evaluates Loop limit surfaces)");
+            let wanted = crate::topo_cmds::parse_scheme(scheme)
+                .map_err(|e| anyhow::anyhow!("--scheme {scheme}: {e}"))?;
+            if info.scheme != Some(wanted) {
+                let drawn: Vec<String> = techniques::registry()
+                    .iter()
+                    .filter_map(|i| {
+                        i.scheme
+                            .map(|s| format!("{} (--method {})", scheme_name(s), i.id))
+                    })
+                    .collect();
+                bail!(
+                    "--scheme {scheme}: --method {technique} does not draw it; limit surfaces \
+                     drawn so far: {}",
+                    drawn.join(", ")
+                );
             }
         }
-        if technique != Technique::Bft {
-            let used: Vec<&str> = [
-                (self.adaptive.is_some(), "--adaptive"),
-                (self.fractional, "--fractional"),
-                (self.geometric_normals, "--geometric-normals"),
-                (self.patch_colours, "--patch-colours"),
-                (self.frame.is_some(), "--frame"),
-                (animate, "--animate"),
-                (self.table_level != DEFAULT_TABLE_LEVEL, "--table-level"),
-            ]
+        let uses = [
+            OptionUse {
+                name: "--adaptive",
+                given: self.adaptive.is_some(),
+                feature: |f| f.adaptive_factors,
+            },
+            OptionUse {
+                name: "--geometric-normals",
+                given: self.geometric_normals,
+                feature: |f| f.geometric_normals,
+            },
+            OptionUse {
+                name: "--patch-colours",
+                given: self.patch_colours,
+                feature: |f| f.patch_colours,
+            },
+            OptionUse {
+                name: "--frame",
+                given: self.frame.is_some(),
+                feature: |f| f.animation,
+            },
+            OptionUse {
+                name: "--animate",
+                given: animate,
+                feature: |f| f.animation,
+            },
+            OptionUse {
+                name: "--table-level",
+                given: self.table_level != DEFAULT_TABLE_LEVEL,
+                feature: |f| f.table_level,
+            },
+        ];
+        let refused: Vec<&OptionUse> = uses
             .iter()
-            .filter(|(on, _)| *on)
-            .map(|(_, name)| *name)
+            .filter(|u| u.given && !(u.feature)(&f))
             .collect();
-            if !used.is_empty() {
-                bail!("{} only apply to --method bft", used.join(", "));
+        if !refused.is_empty() {
+            let mut takers: Vec<&str> = Vec::new();
+            for u in &refused {
+                for n in techniques::names_with(u.feature) {
+                    if !takers.contains(&n) {
+                        takers.push(n);
+                    }
+                }
             }
-            return Ok(None);
+            let names: Vec<&str> = refused.iter().map(|u| u.name).collect();
+            bail!(
+                "{} only apply to --method {} (not to --method {technique})",
+                names.join(", "),
+                takers.join(" or --method ")
+            );
         }
-        if spacing == Spacing::FractionalOdd {
-            bail!("--spacing fractional-odd: bft morphs between dyadic levels, use --fractional (fractional-even)");
+        let spacing = if self.fractional {
+            Spacing::FractionalEven
+        } else {
+            spacing
+        };
+        if !f.spacing(spacing) {
+            bail!(
+                "--spacing {}: --method {technique} does not take it (--fractional is \
+                 fractional-even)",
+                spacing_name(spacing)
+            );
         }
-        if !(1..=6).contains(&self.table_level) {
+        if f.table_level && !(1..=6).contains(&self.table_level) {
             bail!("--table-level {} is outside 1..6", self.table_level);
         }
-        let fractional = self.fractional || spacing == Spacing::FractionalEven;
-        let factors = match self.adaptive {
-            None => {
-                if segments.fract() != 0.0 || segments < 1.0 {
-                    bail!("--segments {segments}: bft takes whole segments per base edge");
-                }
-                FactorPolicy::Uniform {
-                    segments: segments as u32,
-                }
-            }
-            Some(Adaptive::Screen) => {
-                if !(self.pixels.is_finite() && self.pixels >= 0.5) {
-                    bail!(
-                        "--pixels {}: give at least 0.5 pixels per segment",
-                        self.pixels
-                    );
-                }
-                FactorPolicy::Screen {
-                    pixels: self.pixels,
-                }
-            }
-            Some(Adaptive::Distance) => {
-                if !(self.distance.is_finite() && self.distance > 0.0) {
-                    bail!(
-                        "--distance {}: give a positive number of diagonals",
-                        self.distance
-                    );
-                }
-                // Set in world units by `world_factors` once the mesh is loaded.
-                FactorPolicy::Distance {
-                    reference: self.distance,
-                }
-            }
+        params.spacing = spacing;
+        params.geometric_normals = self.geometric_normals;
+        params.patch_colours = self.patch_colours;
+        params.factors = match self.adaptive {
+            None => FactorPolicy::Uniform { segments },
+            Some(Adaptive::Screen) => FactorPolicy::Screen {
+                pixels: self.pixels,
+            },
+            // Set in world units by `world_params` once the mesh is loaded.
+            Some(Adaptive::Distance) => FactorPolicy::Distance {
+                reference: self.distance,
+            },
         };
+        if let FactorPolicy::Screen { pixels } = params.factors {
+            if !(pixels.is_finite() && pixels >= 0.5) {
+                bail!("--pixels {pixels}: give at least 0.5 pixels per segment");
+            }
+        }
+        if let FactorPolicy::Distance { reference } = params.factors {
+            if !(reference.is_finite() && reference > 0.0) {
+                bail!("--distance {reference}: give a positive number of diagonals");
+            }
+        }
         if let Some(t) = self.frame {
             if !t.is_finite() {
                 bail!("--frame {t}: give a finite time");
             }
         }
-        Ok(Some(BftSetup {
-            params: BftParams {
-                factors,
-                fractional,
-                geometric_normals: self.geometric_normals,
-                patch_colours: self.patch_colours,
+        Ok(Setup {
+            technique,
+            build: BuildOptions {
+                name: String::new(),
+                table_level: self.table_level,
+                tangents: self.geometric_normals,
             },
-            table_level: self.table_level,
+            params,
             distance_diagonals: (self.adaptive == Some(Adaptive::Distance))
                 .then_some(self.distance),
+            animate,
             frame: self.frame,
-        }))
+        })
     }
 }
 
-impl BftSetup {
-    /// The factors with `--distance` in world units of a mesh whose box is `bbox`.
-    pub fn world_params(&self, bbox: ([f32; 3], [f32; 3])) -> BftParams {
+fn scheme_name(s: topology::Scheme) -> &'static str {
+    match s {
+        topology::Scheme::Loop => "loop",
+        topology::Scheme::CatmullClark => "catmull-clark",
+        topology::Scheme::DooSabin => "doo-sabin",
+        topology::Scheme::Bilinear => "bilinear",
+    }
+}
+
+fn spacing_name(s: Spacing) -> &'static str {
+    match s {
+        Spacing::Equal => "equal",
+        Spacing::FractionalEven => "fractional-even",
+        Spacing::FractionalOdd => "fractional-odd",
+    }
+}
+
+impl Setup {
+    /// The frame parameters with `--distance` in world units of a mesh whose box is `bbox`.
+    pub fn world_params(&self, bbox: ([f32; 3], [f32; 3])) -> FrameParams {
         let mut p = self.params;
         if let Some(d) = self.distance_diagonals {
             let diag = glam::Vec3::from(bbox.1).distance(glam::Vec3::from(bbox.0));
@@ -195,48 +258,28 @@ impl BftSetup {
         }
         p
     }
-}
 
-/// The control mesh Loop subdivides: `mesh` itself when it is all triangles, else its fan
-/// triangulation, plus per triangle the face it came from and, when triangulated, a note saying
-/// so (for stderr).
-pub fn loop_control_mesh(
-    mesh: &ControlMesh,
-    name: &str,
-) -> (ControlMesh, Vec<u32>, Option<String>) {
-    let polygons = mesh.faces().filter(|f| f.len() != 3).count();
-    if polygons == 0 {
-        return (mesh.clone(), (0..mesh.num_faces() as u32).collect(), None);
+    /// Whether the base moves: `--animate`, or a `--frame` of the wave.
+    pub fn moved(&self) -> bool {
+        self.animate || self.frame.is_some()
     }
-    let (tri, origin) = mesh.triangulated();
-    let note = format!(
-        "note: {name}: {polygons} of {} faces are not triangles; Loop subdivides their fan \
-         triangulation ({} triangles)",
-        mesh.num_faces(),
-        tri.num_faces()
-    );
-    (tri, origin, Some(note))
 }
 
-/// The `--animate` wave at time `t` applied to the rest pose of `mesh`: what is uploaded.
-pub struct Wave {
-    rest: Vec<[f32; 3]>,
-    normals: Vec<[f32; 3]>,
-    bbox: ([f32; 3], [f32; 3]),
-}
-
-impl Wave {
-    pub fn new(mesh: &ControlMesh) -> Self {
-        let rest = base_positions(mesh);
-        let bbox = tess::bft::bbox(&rest);
-        Self {
-            normals: base_normals(mesh),
-            rest,
-            bbox,
+/// A one-line summary of what a frame shows, for messages and the window title.
+pub fn describe(technique: TechniqueId, p: &FrameParams) -> String {
+    let mut s = format!("{technique}, {}", p.factors);
+    if p.spacing != Spacing::Equal {
+        s.push_str(&format!(", {} spacing", spacing_name(p.spacing)));
+    }
+    for (on, what) in [
+        (p.geometric_normals, "geometric normals"),
+        (p.patch_colours, "patch colours"),
+        (p.wireframe, "wireframe"),
+    ] {
+        if on {
+            s.push_str(", ");
+            s.push_str(what);
         }
     }
-
-    pub fn at(&self, t: f32) -> Vec<[f32; 3]> {
-        wave(&self.rest, &self.normals, self.bbox.0, self.bbox.1, t)
-    }
+    s
 }

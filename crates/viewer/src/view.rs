@@ -1,18 +1,20 @@
-//! `tessera view`: a window with an orbit camera. Drag to orbit, wheel to zoom, 1/2/3/4 switch
-//! flat/Phong/PN/BFT, +/- raise/lower the level (BFT: halve/double unless fractional), arrows
-//! halve/double it, W toggles the wireframe; for BFT, A toggles the animation, C the patch
-//! colours, F fractional factors, G geometric normals. Esc quits. The title shows the frame
-//! time. `--frames N --screenshot out.png` renders N frames, saves the last and exits.
+//! `tessera view`: a window with an orbit camera. Drag to orbit, wheel to zoom, 1, 2, 3, ...
+//! switch technique in the registry's order (flat, Phong, PN, BFT), +/- raise/lower the level
+//! to the next one the technique takes (BFT: the next power of two unless fractional), arrows
+//! double/halve it, W toggles the wireframe; where the technique takes them, A toggles the
+//! animation, C the patch colours, F fractional factors, G geometric normals. Esc quits. The
+//! title shows the frame time. `--frames N --screenshot out.png` renders N frames, saves the
+//! last and exits. Techniques are built on first use and kept.
 use crate::cli::ViewArgs;
-use crate::commands::{check_validation, draw_params, load_mesh, mesh_name, open_device};
-use crate::technique::{loop_control_mesh, BftSetup, Technique, Wave};
-use anyhow::{Context, Result};
+use crate::commands::{check_validation, load_mesh, mesh_name, open_device, scene_setup};
+use crate::technique::{describe, Setup};
+use anyhow::{Context as _, Result};
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Instant;
-use tess::bft::{BftSurface, FactorPolicy};
-use tess::renderer::GpuMesh;
-use tess::{DrawParams, Method, RenderMesh, Renderer};
+use tess::techniques::{self, bft::Wave};
+use tess::{Context, FactorPolicy, Spacing, Technique, TechniqueId};
 use topology::ControlMesh;
 use vk_core::swapchain::{required_surface_extensions, Swapchain, FRAMES_IN_FLIGHT};
 use vk_core::target::DEPTH_FORMAT;
@@ -23,36 +25,32 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
 
-/// GPU state that lives while the window does. Drop order: BFT surface, renderer and mesh,
-/// swapchain, then the device and instance; the window itself is dropped after all of them.
+/// A technique built for the window, with its animation wave.
+struct Surface {
+    technique: Box<dyn Technique>,
+    wave: Option<Wave>,
+}
+
+/// GPU state that lives while the window does. Drop order: surfaces, context, swapchain, then
+/// the device and instance; the window itself is dropped after all of them.
 struct Gpu {
-    bft: Option<BftSurface>,
-    renderer: Renderer,
-    mesh: GpuMesh,
+    surfaces: HashMap<TechniqueId, Surface>,
+    context: Context,
     swapchain: Swapchain,
     device: Device,
     instance: Arc<Instance>,
 }
 
-/// The BFT side of the view: the Loop control mesh, its options and the animation clock.
-struct BftView {
+struct App {
+    args: ViewArgs,
     mesh: ControlMesh,
-    name: String,
-    setup: BftSetup,
-    wave: Wave,
-    animate: bool,
+    setup: Setup,
     /// Wave time shown (advances while animating, kept when paused).
     time: f32,
     /// Whether the base has left the rest pose (every frame slot then gets the current pose).
     moved: bool,
-}
-
-struct App {
-    args: ViewArgs,
-    rm: RenderMesh,
-    technique: Technique,
-    bft: BftView,
-    params: DrawParams,
+    /// A level to snap once the technique switched to is built.
+    pending_level: Option<f32>,
     gpu: Option<Gpu>,
     window: Option<Arc<Window>>,
     frames_drawn: u32,
@@ -93,12 +91,10 @@ impl App {
                 height: size.height,
             },
         )?;
-        let renderer = Renderer::new(&device, swapchain.format, DEPTH_FORMAT, FRAMES_IN_FLIGHT)?;
-        let mesh = GpuMesh::upload(&device, &self.rm)?;
+        let context = Context::new(&device, swapchain.format, DEPTH_FORMAT, FRAMES_IN_FLIGHT)?;
         self.gpu = Some(Gpu {
-            bft: None,
-            renderer,
-            mesh,
+            surfaces: HashMap::new(),
+            context,
             swapchain,
             device,
             instance,
@@ -107,17 +103,24 @@ impl App {
         Ok(())
     }
 
-    /// The BFT surface, built on first use (tangent tables included, so G can toggle).
-    fn bft_surface(gpu: &mut Gpu, view: &BftView) -> Result<()> {
-        if gpu.bft.is_none() {
-            gpu.bft = Some(BftSurface::new(
-                &gpu.renderer,
-                &view.mesh,
-                &view.name,
-                view.setup.table_level,
-                true,
-                FRAMES_IN_FLIGHT,
-            )?);
+    /// The current technique's surface, built on first use (with what every key may need,
+    /// e.g. tangent tables for geometric normals).
+    fn surface(gpu: &mut Gpu, mesh: &ControlMesh, setup: &Setup) -> Result<()> {
+        if !gpu.surfaces.contains_key(&setup.technique) {
+            let mut build = setup.build.clone();
+            build.tangents = techniques::info(setup.technique).features.geometric_normals;
+            let built = tess::build(&mut gpu.context, setup.technique, mesh, &build)?;
+            for n in &built.notes {
+                eprintln!("{n}");
+            }
+            let wave = built.technique.base_mesh().map(Wave::new);
+            gpu.surfaces.insert(
+                setup.technique,
+                Surface {
+                    technique: built.technique,
+                    wave,
+                },
+            );
         }
         Ok(())
     }
@@ -126,66 +129,63 @@ impl App {
         let Some(gpu) = self.gpu.as_mut() else {
             return Ok(());
         };
-        if self.technique == Technique::Bft {
-            Self::bft_surface(gpu, &self.bft)?;
+        Self::surface(gpu, &self.mesh, &self.setup)?;
+        if let Some(l) = self.pending_level.take() {
+            self.set_level(l, true);
         }
-        let Some(frame) = gpu.swapchain.begin_frame()? else {
+        let Some(gpu) = self.gpu.as_mut() else {
+            return Ok(());
+        };
+        let Gpu {
+            surfaces,
+            context,
+            swapchain,
+            ..
+        } = gpu;
+        let surface = surfaces
+            .get_mut(&self.setup.technique)
+            .context("the surface built above")?;
+        let Some(frame) = swapchain.begin_frame()? else {
             return Ok(());
         };
         let dt = self.last_frame.elapsed().as_secs_f32();
-        match (self.technique, gpu.bft.as_mut()) {
-            (Technique::Bft, Some(surface)) => {
-                let view = &mut self.bft;
-                if view.animate {
-                    view.time += dt;
-                    view.moved = true;
-                }
-                if view.moved {
-                    surface.update_base(frame.slot, &view.wave.at(view.time))?;
-                }
-                let bbox = (surface.bbox_min, surface.bbox_max);
-                gpu.renderer
-                    .update_frame(frame.slot, bbox, &self.params, frame.extent)?;
-                let params = view.setup.world_params(bbox);
-                surface.record_compute(frame.cmd, &gpu.renderer, frame.slot);
-                gpu.swapchain
-                    .cmd_begin_rendering(&frame, self.params.clear_color)?;
-                let split = self.params.split;
-                surface.record_draw(frame.cmd, &gpu.renderer, frame.slot, &params, split, false)?;
-                if self.params.wireframe {
-                    surface.record_draw(
-                        frame.cmd,
-                        &gpu.renderer,
-                        frame.slot,
-                        &params,
-                        split,
-                        true,
-                    )?;
-                }
-            }
-            (Technique::Tessellated(m), _) => {
-                self.params.method = m;
-                gpu.renderer
-                    .update_uniforms(frame.slot, &gpu.mesh, &self.params, frame.extent)?;
-                gpu.swapchain
-                    .cmd_begin_rendering(&frame, self.params.clear_color)?;
-                gpu.renderer
-                    .record(frame.cmd, frame.slot, &gpu.mesh, &self.params)?;
-            }
-            (Technique::Bft, None) => unreachable!("built above"),
+        if self.setup.animate {
+            self.time += dt;
+            self.moved = true;
         }
+        if let (true, Some(wave)) = (self.moved, &surface.wave) {
+            surface
+                .technique
+                .update_base(frame.slot, &wave.at(self.time))?;
+        }
+        let technique = surface.technique.as_ref();
+        let params = self.setup.world_params(technique.bbox());
+        context.prepare(technique, &params, Context::frame_passes(&params))?;
+        context.write_frame(frame.slot, technique.bbox(), &params, frame.extent)?;
         let last = self.args.frames.is_some_and(|n| self.frames_drawn + 1 >= n);
-        let shot = gpu
-            .swapchain
-            .end_frame(frame, last && self.args.screenshot.is_some())?;
+        let context = &*context;
+        let shot = swapchain.present(
+            frame,
+            last && self.args.screenshot.is_some(),
+            params.clear_color,
+            |enc, slot| -> Result<()> {
+                context.record_pre_pass(enc, technique, slot)?;
+                Ok(())
+            },
+            |enc, slot| -> Result<()> {
+                context.record_frame(enc, technique, slot, &params)?;
+                Ok(())
+            },
+        )?;
         self.frames_drawn += 1;
         let now = Instant::now();
         self.frame_ms = 0.9 * self.frame_ms + 0.1 * (now - self.last_frame).as_secs_f64() * 1e3;
         self.last_frame = now;
         if let Some(w) = &self.window {
             w.set_title(&format!(
-                "tessera — {} — {:.2} ms/frame",
-                self.describe(),
+                "tessera — {}{} — {:.2} ms/frame",
+                describe(self.setup.technique, &params),
+                if self.setup.animate { ", animated" } else { "" },
                 self.frame_ms
             ));
         }
@@ -203,97 +203,89 @@ impl App {
         Ok(())
     }
 
-    fn describe(&self) -> String {
-        match self.technique {
-            Technique::Tessellated(m) => {
-                format!(
-                    "{m:?} level {} {:?}",
-                    self.params.level, self.params.spacing
-                )
-            }
-            Technique::Bft => {
-                let p = &self.bft.setup.params;
-                format!(
-                    "BFT {:?}{}{}{}{}",
-                    p.factors,
-                    if p.fractional { " fractional" } else { "" },
-                    if p.geometric_normals {
-                        " geometric normals"
-                    } else {
-                        ""
-                    },
-                    if p.patch_colours {
-                        " patch colours"
-                    } else {
-                        ""
-                    },
-                    if self.bft.animate { " animated" } else { "" }
-                )
-            }
+    /// Whether the current technique (its surface already built) draws `params`.
+    fn accepts(&self, params: &tess::FrameParams) -> bool {
+        let Some(gpu) = &self.gpu else {
+            return true;
+        };
+        match gpu.surfaces.get(&self.setup.technique) {
+            Some(s) => s.technique.check(params).is_ok(),
+            None => true,
         }
     }
 
-    /// Sets the uniform level, for BFT snapped to what its tables take.
-    fn set_level(&mut self, level: f32) {
-        let max_bft = (2u32 << self.bft.setup.table_level) as f32;
-        self.params.level = level.clamp(1.0, 64.0);
-        let p = &mut self.bft.setup.params;
-        if let FactorPolicy::Uniform { segments } = &mut p.factors {
-            let s = level.round().clamp(2.0, max_bft);
-            *segments = if p.fractional {
-                s as u32
-            } else {
-                (s as u32).next_power_of_two().min(max_bft as u32)
+    /// Sets the uniform segments per edge, snapped to what the technique takes: the nearest
+    /// accepted value from `level` in the direction of the change.
+    fn set_level(&mut self, level: f32, up: bool) {
+        let FactorPolicy::Uniform { segments } = self.setup.params.factors else {
+            return;
+        };
+        let mut candidate = level.round().clamp(1.0, 64.0);
+        for _ in 0..64 {
+            let mut p = self.setup.params;
+            p.factors = FactorPolicy::Uniform {
+                segments: candidate,
             };
+            if self.accepts(&p) {
+                self.setup.params = p;
+                return;
+            }
+            candidate = if up { candidate + 1.0 } else { candidate - 1.0 };
+            if !(1.0..=64.0).contains(&candidate) {
+                break;
+            }
+        }
+        self.setup.params.factors = FactorPolicy::Uniform { segments };
+    }
+
+    /// Switches technique (keys 1, 2, 3, ...: the registry's order), keeping the level where
+    /// the new technique takes it.
+    fn switch_technique(&mut self, id: TechniqueId) {
+        self.setup.technique = id;
+        let f = techniques::info(id).features;
+        if !f.spacing(self.setup.params.spacing) {
+            self.setup.params.spacing = Spacing::Equal;
+        }
+        if let FactorPolicy::Uniform { segments } = self.setup.params.factors {
+            self.pending_level = Some(segments);
         }
     }
 
     fn key(&mut self, key: &Key) {
-        let bft = self.technique == Technique::Bft;
-        let level = match &self.bft.setup.params.factors {
-            FactorPolicy::Uniform { segments } if bft => *segments as f32,
-            _ => self.params.level,
-        };
-        let step_up = if bft && !self.bft.setup.params.fractional {
-            level * 2.0
-        } else {
-            level + 1.0
-        };
-        let step_down = if bft && !self.bft.setup.params.fractional {
-            level * 0.5
-        } else {
-            level - 1.0
-        };
+        let features = techniques::info(self.setup.technique).features;
+        let level = self.setup.params.uniform_segments().unwrap_or(8.0);
+        let p = &mut self.setup.params;
         match key {
             Key::Character(c) => match c.as_str() {
-                "1" => self.technique = Technique::Tessellated(Method::Flat),
-                "2" => self.technique = Technique::Tessellated(Method::Phong),
-                "3" => self.technique = Technique::Tessellated(Method::Pn),
-                "4" => {
-                    self.technique = Technique::Bft;
-                    self.set_level(level);
+                d if d.len() == 1 && d.as_bytes()[0].is_ascii_digit() => {
+                    let k = (d.as_bytes()[0] - b'0') as usize;
+                    if let Some(info) = k.checked_sub(1).and_then(|i| techniques::registry().get(i)) {
+                        self.switch_technique(info.id);
+                    }
                 }
-                "+" | "=" => self.set_level(step_up),
-                "-" => self.set_level(step_down),
-                "w" | "W" => self.params.wireframe = !self.params.wireframe,
-                "a" | "A" => self.bft.animate = !self.bft.animate,
-                "c" | "C" => {
-                    let p = &mut self.bft.setup.params;
-                    p.patch_colours = !p.patch_colours;
-                }
+                "+" | "=" => self.set_level(level + 1.0, true),
+                "-" => self.set_level(level - 1.0, false),
+                "w" | "W" => p.wireframe = !p.wireframe,
+                "a" | "A" if features.animation => self.setup.animate = !self.setup.animate,
+                "c" | "C" if features.patch_colours => p.patch_colours = !p.patch_colours,
                 "f" | "F" => {
-                    let p = &mut self.bft.setup.params;
-                    p.fractional = !p.fractional;
-                    self.set_level(level);
+                    let next = if p.spacing == Spacing::Equal {
+                        Spacing::FractionalEven
+                    } else {
+                        Spacing::Equal
+                    };
+                    if features.spacing(next) {
+                        p.spacing = next;
+                        self.set_level(level, true);
+                    }
                 }
-                "g" | "G" => {
-                    let p = &mut self.bft.setup.params;
-                    p.geometric_normals = !p.geometric_normals;
+                "g" | "G" if features.geometric_normals => {
+                    p.geometric_normals = !p.geometric_normals
                 }
                 _ => {}
             },
-            Key::Named(NamedKey::ArrowUp) => self.set_level(level * 2.0),
-            Key::Named(NamedKey::ArrowDown) => self.set_level(level * 0.5),
+            Key::Named(NamedKey::ArrowUp) => self.set_level(level * 2.0, true),
+            Key::Named(NamedKey::ArrowDown) => self.set_level(level * 0.5, false),
             _ => {}
         }
     }
@@ -345,8 +337,8 @@ impl ApplicationHandler for App {
             }
             WindowEvent::CursorMoved { position, .. } if self.dragging => {
                 if let Some((x, y)) = self.last_cursor {
-                    self.params.camera.yaw -= (position.x - x) as f32 * 0.4;
-                    self.params.camera.pitch = (self.params.camera.pitch
+                    self.setup.params.camera.yaw -= (position.x - x) as f32 * 0.4;
+                    self.setup.params.camera.pitch = (self.setup.params.camera.pitch
                         + (position.y - y) as f32 * 0.4)
                         .clamp(-89.0, 89.0);
                 }
@@ -357,8 +349,8 @@ impl ApplicationHandler for App {
                     MouseScrollDelta::LineDelta(_, y) => y,
                     MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
                 };
-                self.params.camera.zoom =
-                    (self.params.camera.zoom * 1.1f32.powf(steps)).clamp(0.1, 20.0);
+                self.setup.params.camera.zoom =
+                    (self.setup.params.camera.zoom * 1.1f32.powf(steps)).clamp(0.1, 20.0);
             }
             _ => {}
         }
@@ -376,43 +368,18 @@ pub fn run(args: ViewArgs) -> Result<()> {
         anyhow::bail!("--screenshot needs --frames N");
     }
     let mesh = load_mesh(args.scene.mesh.as_deref())?;
-    let name = mesh_name(args.scene.mesh.as_deref());
-    let (params, setup) = draw_params(&args.scene)?;
-    let rm = RenderMesh::from_control_mesh(&mesh)?;
-    // The BFT options hold even when the view starts on another technique (key 4 switches).
-    let setup = match setup {
-        Some(s) => s,
-        None => {
-            let mut surface = args.scene.surface.clone();
-            surface.table_level = tess::bft::DEFAULT_TABLE_LEVEL;
-            surface
-                .setup(Technique::Bft, 16.0, tess::Spacing::Equal, false)?
-                .context("bft setup")?
-        }
-    };
-    let (loop_mesh, _, note) = loop_control_mesh(&mesh, &name);
-    if let (Some(n), Technique::Bft) = (note, args.scene.method) {
-        eprintln!("{n}");
-    }
-    let bft = BftView {
-        wave: Wave::new(&loop_mesh),
-        mesh: loop_mesh,
-        name,
-        animate: args.scene.animate,
-        time: setup.frame.unwrap_or(0.0),
-        moved: args.scene.animate || setup.frame.is_some(),
-        setup,
-    };
+    let setup = scene_setup(&args.scene, &mesh_name(args.scene.mesh.as_deref()))?;
     let event_loop = EventLoop::new().context(
         "no window system (set DISPLAY or WAYLAND_DISPLAY; use `tessera render` headless)",
     )?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
-        technique: args.scene.method,
+        time: setup.frame.unwrap_or(0.0),
+        moved: setup.moved(),
+        setup,
         args,
-        rm,
-        bft,
-        params,
+        mesh,
+        pending_level: None,
         gpu: None,
         window: None,
         frames_drawn: 0,
@@ -426,15 +393,13 @@ pub fn run(args: ViewArgs) -> Result<()> {
     let gpu = app.gpu.take();
     let result = match gpu {
         Some(Gpu {
-            bft,
-            renderer,
-            mesh,
+            surfaces,
+            context,
             swapchain,
             device,
             instance,
         }) => {
-            drop(bft);
-            drop((renderer, mesh, swapchain));
+            drop((surfaces, context, swapchain));
             drop(device);
             check_validation(&instance)
         }

@@ -87,6 +87,7 @@ pub struct Pipeline {
     pub raw: vk::Pipeline,
     pub layout: vk::PipelineLayout,
     pub bind_point: vk::PipelineBindPoint,
+    pub push_constant_bytes: u32,
     device: Arc<DeviceShared>,
 }
 
@@ -264,6 +265,7 @@ impl Pipeline {
                     raw: p[0],
                     layout,
                     bind_point: vk::PipelineBindPoint::GRAPHICS,
+                    push_constant_bytes: desc.push_constant_bytes,
                     device: device.shared.clone(),
                 })
             }
@@ -316,6 +318,7 @@ impl Pipeline {
                     raw: p[0],
                     layout,
                     bind_point: vk::PipelineBindPoint::COMPUTE,
+                    push_constant_bytes,
                     device: device.shared.clone(),
                 })
             }

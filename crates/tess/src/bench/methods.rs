@@ -2,16 +2,18 @@
 //! them by name. A new technique is one [`MethodEntry`] in [`registry`].
 use super::{BenchConfig, BenchMesh};
 use crate::camera::Camera;
+use crate::context::{statistics_query_safe, Context};
 use crate::error::{Result, TessError};
 use crate::gpu::Vertex;
 use crate::plain::{PlainMesh, PlainRenderer};
 use crate::render_mesh::angle_weighted_normals;
-use crate::renderer::{DrawParams, DrawSplit, GpuMesh, Method, Renderer};
-use crate::tessellator::{uniform_triangle_count, Domain, Spacing, MAX_LEVEL};
+use crate::technique::{FrameParams, Technique};
+use crate::techniques::bft::Wave;
+use crate::techniques::{self, BuildOptions, TechniqueInfo};
 use std::time::Instant;
 use topology::eval::{LimitScheme, LocalMesh};
 use topology::{refine_level, ControlMesh, Level, Scheme};
-use vk_core::{vk, Device};
+use vk_core::{vk, Device, Encoder};
 
 /// What one frame of a row asks for.
 #[derive(Clone, Copy, Debug)]
@@ -27,18 +29,23 @@ pub struct BenchFrame {
 }
 
 /// Everything a method may need to build its resources for one mesh.
+#[derive(Clone, Copy)]
 pub struct MethodContext<'a> {
     pub device: &'a Device,
+    /// The technique a technique row is built for (None for other rows).
+    pub technique: Option<&'static TechniqueInfo>,
     pub mesh: &'a BenchMesh,
     pub config: &'a BenchConfig,
     pub color_format: vk::Format,
     pub depth_format: vk::Format,
 }
 
-/// One technique as the benchmark drives it. Per frame the runner calls `begin_frame` (host
-/// work), then records one command buffer: timestamp, `record_pre_pass` (outside any rendering
-/// scope: compute), the rendering scope with `record` (draws), timestamp; it submits and waits.
-/// The GPU time is the span between the two timestamps, so a compute pre-pass counts.
+/// One row source as the benchmark drives it: every [`Technique`] (through
+/// [`TechniqueMethod`]) and the CPU baseline. Per frame the runner calls `begin_frame` (host
+/// work, `&mut self`), then records one command buffer: timestamp, `record_pre_pass` (outside
+/// any rendering scope: compute), the rendering scope with `record` (draws), timestamp; it
+/// submits and waits. The GPU time is the span between the two timestamps, so a compute
+/// pre-pass counts. Recording borrows the method for the encoder's lifetime.
 pub trait BenchMethod {
     /// The row label, equal to the name it was built by ("flat", "cpu-static", ...).
     fn label(&self) -> &str;
@@ -55,15 +62,15 @@ pub trait BenchMethod {
     fn begin_frame(&mut self, frame: &BenchFrame) -> Result<Option<f64>>;
 
     /// Commands recorded before the rendering scope, inside the timed span (a compute pre-pass).
-    fn record_pre_pass(&mut self, cmd: vk::CommandBuffer, frame: &BenchFrame) -> Result<()> {
-        let _ = (cmd, frame);
+    fn record_pre_pass<'a>(&'a self, enc: &mut Encoder<'a>, frame: &BenchFrame) -> Result<()> {
+        let _ = (enc, frame);
         Ok(())
     }
 
     /// The frame's draws, inside the rendering scope. Returns how many triangles they emit by
     /// the CPU's count (the tessellator's arithmetic for tessellated draws); the runner checks it
     /// against the pipeline-statistics count where the device has one.
-    fn record(&mut self, cmd: vk::CommandBuffer, frame: &BenchFrame) -> Result<u64>;
+    fn record<'a>(&'a self, enc: &mut Encoder<'a>, frame: &BenchFrame) -> Result<u64>;
 
     /// Notes about the row just measured (called once after its last frame).
     fn row_notes(&mut self) -> Vec<String> {
@@ -97,49 +104,53 @@ pub fn one<M: BenchMethod + 'static>(method: Result<M>) -> Result<Vec<Box<dyn Be
     Ok(vec![Box::new(method?)])
 }
 
-/// Every technique the benchmark knows, in table order (Flat first: the ratios divide by it).
-/// Adding a technique is one entry here.
+/// Every technique the benchmark knows, in table order (Flat first: the ratios divide by it):
+/// each technique of [`techniques::registry`] (plus an `-animated` row for those that animate),
+/// then the CPU baseline. A new technique needs no entry here.
 pub fn registry() -> Vec<MethodEntry> {
-    vec![
-        MethodEntry {
-            name: "flat",
-            help: "flat tessellation at level S (no displacement)",
-            build: |c| one(TessMethod::new(c, Method::Flat, "flat")),
+    let mut out: Vec<MethodEntry> = techniques::registry()
+        .iter()
+        .map(|info| MethodEntry {
+            name: info.id.name(),
+            help: info.help,
+            build: technique_rows,
+        })
+        .collect();
+    out.push(MethodEntry {
+        name: "cpu",
+        help: "CPU Loop subdivision to level log2 S at the limit, drawn as plain triangles: \
+               cpu-static (drawn only) and cpu-animated (re-subdivided and uploaded every frame)",
+        build: |c| {
+            Ok(vec![
+                Box::new(CpuLoopMethod::new(c, false)?),
+                Box::new(CpuLoopMethod::new(c, true)?),
+            ])
         },
-        MethodEntry {
-            name: "phong",
-            help: "Phong tessellation at level S",
-            build: |c| one(TessMethod::new(c, Method::Phong, "phong")),
-        },
-        MethodEntry {
-            name: "pn",
-            help: "curved PN triangles at level S",
-            build: |c| one(TessMethod::new(c, Method::Pn, "pn")),
-        },
-        MethodEntry {
-            name: "bft",
-            help: "Loop limit surface from basis-function tables (one GPU subdivision step per \
-                   frame, then S/2 segments per level-1 edge): bft (static base) and \
-                   bft-animated (the --animate wave uploaded every frame)",
-            build: |c| {
-                Ok(vec![
-                    Box::new(BftMethod::new(c, false)?),
-                    Box::new(BftMethod::new(c, true)?),
-                ])
-            },
-        },
-        MethodEntry {
-            name: "cpu",
-            help: "CPU Loop subdivision to level log2 S at the limit, drawn as plain triangles: \
-                   cpu-static (drawn only) and cpu-animated (re-subdivided and uploaded every frame)",
-            build: |c| {
-                Ok(vec![
-                    Box::new(CpuLoopMethod::new(c, false)?),
-                    Box::new(CpuLoopMethod::new(c, true)?),
-                ])
-            },
-        },
-    ]
+    });
+    out
+}
+
+/// The rows of the technique named `name`: static, and animated when it animates.
+fn technique_rows_named(
+    ctx: &MethodContext<'_>,
+    info: &'static TechniqueInfo,
+) -> Result<Vec<Box<dyn BenchMethod>>> {
+    let mut rows: Vec<Box<dyn BenchMethod>> = vec![Box::new(TechniqueMethod::new(ctx, info, false)?)];
+    if info.features.animation {
+        rows.push(Box::new(TechniqueMethod::new(ctx, info, true)?));
+    }
+    Ok(rows)
+}
+
+/// [`MethodFactory`] of the technique rows; the entry's name picks the technique.
+fn technique_rows(ctx: &MethodContext<'_>) -> Result<Vec<Box<dyn BenchMethod>>> {
+    let info = ctx
+        .technique
+        .ok_or_else(|| TessError::BenchConfig {
+            option: "--methods".into(),
+            reason: "a technique row was built without its technique".into(),
+        })?;
+    technique_rows_named(ctx, info)
 }
 
 /// The registry's names, for messages.
@@ -157,200 +168,144 @@ pub fn build_methods(
         .iter()
         .find(|n| !entries.iter().any(|e| e.name == n.as_str()))
     {
-        return Err(TessError::Invalid(format!(
-            "unknown bench method '{bad}' (known: {})",
-            method_names().join(", ")
-        )));
+        return Err(TessError::BenchConfig {
+            option: "--methods".into(),
+            reason: format!(
+                "unknown bench method '{bad}' (known: {})",
+                method_names().join(", ")
+            ),
+        });
     }
     let mut out = Vec::new();
     for e in entries.iter().filter(|e| names.iter().any(|n| n == e.name)) {
-        out.extend((e.build)(ctx)?);
+        let ctx = MethodContext {
+            technique: techniques::registry().iter().find(|i| i.id.name() == e.name),
+            ..*ctx
+        };
+        out.extend((e.build)(&ctx)?);
     }
     Ok(out)
 }
 
-/// Flat, Phong or PN through [`Renderer`]: the base mesh's triangles as patches at level S.
-pub struct TessMethod {
-    label: &'static str,
-    method: Method,
-    renderer: Renderer,
-    mesh: GpuMesh,
-}
-
-impl TessMethod {
-    pub fn new(ctx: &MethodContext<'_>, method: Method, label: &'static str) -> Result<Self> {
-        Ok(Self {
-            label,
-            method,
-            renderer: Renderer::new(ctx.device, ctx.color_format, ctx.depth_format, 1)?,
-            mesh: GpuMesh::upload(ctx.device, &ctx.mesh.render)?,
-        })
-    }
-
-    fn params(&self, frame: &BenchFrame) -> DrawParams {
-        DrawParams {
-            method: self.method,
-            spacing: Spacing::Equal,
-            level: frame.segments as f32,
-            camera: frame.camera,
-            ..DrawParams::default()
-        }
-    }
-
-    /// Triangles the draws emit by the tessellator's arithmetic (same lists as `Renderer`).
-    fn expected_triangles(&self, segments: u32) -> u64 {
-        let level = segments as f32;
-        let count = |l: Option<&crate::renderer::PatchList>, d| {
-            l.map(|l| l.patches as u64 * uniform_triangle_count(d, Spacing::Equal, level))
-                .unwrap_or(0)
-        };
-        match self.method {
-            Method::Flat => {
-                count(self.mesh.quads.as_ref(), Domain::Quad)
-                    + count(self.mesh.quad_mode_triangles.as_ref(), Domain::Triangle)
-            }
-            Method::Phong | Method::Pn => count(self.mesh.triangles.as_ref(), Domain::Triangle),
-        }
-    }
-}
-
-impl BenchMethod for TessMethod {
-    fn label(&self) -> &str {
-        self.label
-    }
-
-    fn skip_reason(&self, segments: u32) -> Option<String> {
-        (segments as f32 > MAX_LEVEL)
-            .then(|| format!("tessellation level {segments} is above the maximum {MAX_LEVEL}"))
-    }
-
-    fn begin_frame(&mut self, frame: &BenchFrame) -> Result<Option<f64>> {
-        let params = self.params(frame);
-        self.renderer
-            .update_uniforms(0, &self.mesh, &params, frame.extent)?;
-        Ok(None)
-    }
-
-    fn record(&mut self, cmd: vk::CommandBuffer, frame: &BenchFrame) -> Result<u64> {
-        let params = self.params(frame);
-        self.renderer.record(cmd, 0, &self.mesh, &params)?;
-        Ok(self.expected_triangles(frame.segments))
-    }
-}
-
-/// Loop basis-function tables ([`crate::bft`]): the compute pass (base → level-1 positions and
-/// normals) is the pre-pass, inside the timed span; the draw is one patch per level-1 face at
-/// `S/2` segments per edge, so it emits as many triangles as Flat at `S`.
-pub struct BftMethod {
-    label: &'static str,
+/// Any technique through a [`Context`] of its own: uniform factors of S segments per base
+/// edge, the pre-pass (if any) inside the timed span; the `-animated` row uploads the
+/// `--animate` wave every frame, its CPU time reported.
+pub struct TechniqueMethod {
+    label: String,
     mesh_name: String,
     animated: bool,
-    renderer: Renderer,
-    surface: crate::bft::BftSurface,
-    rest: Vec<[f32; 3]>,
-    normals: Vec<[f32; 3]>,
+    technique: Box<dyn Technique>,
+    wave: Option<Wave>,
+    context: Context,
 }
 
-impl BftMethod {
-    pub fn new(ctx: &MethodContext<'_>, animated: bool) -> Result<Self> {
-        use crate::bft::{base_normals, BftSurface, DEFAULT_TABLE_LEVEL};
-        let renderer = Renderer::new(ctx.device, ctx.color_format, ctx.depth_format, 1)?;
-        let surface = BftSurface::new(
-            &renderer,
+impl TechniqueMethod {
+    pub fn new(ctx: &MethodContext<'_>, info: &TechniqueInfo, animated: bool) -> Result<Self> {
+        let mut context = Context::new(ctx.device, ctx.color_format, ctx.depth_format, 1)?;
+        let built = techniques::build(
+            &mut context,
+            info.id,
             &ctx.mesh.mesh,
-            &ctx.mesh.name,
-            DEFAULT_TABLE_LEVEL,
-            false,
-            1,
+            &BuildOptions {
+                name: ctx.mesh.name.clone(),
+                ..BuildOptions::default()
+            },
         )?;
+        let wave = match (animated, built.technique.base_mesh()) {
+            (true, Some(m)) => Some(Wave::new(m)),
+            _ => None,
+        };
         Ok(Self {
-            label: if animated { "bft-animated" } else { "bft" },
+            label: if animated {
+                format!("{}-animated", info.id)
+            } else {
+                info.id.name().to_string()
+            },
             mesh_name: ctx.mesh.name.clone(),
             animated,
-            rest: surface.base_positions.clone(),
-            normals: base_normals(&ctx.mesh.mesh),
-            renderer,
-            surface,
+            technique: built.technique,
+            wave,
+            context,
         })
     }
 
-    fn params(segments: u32) -> crate::bft::BftParams {
-        crate::bft::BftParams {
-            factors: crate::bft::FactorPolicy::Uniform { segments },
-            ..Default::default()
+    fn params(frame: &BenchFrame) -> FrameParams {
+        FrameParams {
+            camera: frame.camera,
+            ..FrameParams::uniform(frame.segments as f32)
         }
     }
 }
 
-impl BenchMethod for BftMethod {
+impl BenchMethod for TechniqueMethod {
     fn label(&self) -> &str {
-        self.label
+        &self.label
     }
 
     fn skip_reason(&self, segments: u32) -> Option<String> {
-        self.surface
-            .check_params(&Self::params(segments))
+        let probe = BenchFrame {
+            index: 0,
+            warmup: true,
+            segments,
+            extent: vk::Extent2D {
+                width: 1,
+                height: 1,
+            },
+            camera: Camera::default(),
+        };
+        self.technique
+            .check(&Self::params(&probe))
             .err()
             .map(|e| e.to_string())
     }
 
     fn begin_frame(&mut self, frame: &BenchFrame) -> Result<Option<f64>> {
-        let draw = DrawParams {
-            camera: frame.camera,
-            ..DrawParams::default()
+        let params = Self::params(frame);
+        self.context
+            .prepare(self.technique.as_ref(), &params, &[crate::Pass::Shaded])?;
+        let cpu = match (&self.wave, self.animated) {
+            (Some(wave), true) => {
+                // The viewer's --animate: deform on the CPU, upload only the base positions.
+                let start = Instant::now();
+                let moved = wave.at(frame.index as f32 / 30.0);
+                self.technique.update_base(0, &moved)?;
+                Some(start.elapsed().as_secs_f64() * 1e3)
+            }
+            _ => None,
         };
-        let bbox = (self.surface.bbox_min, self.surface.bbox_max);
-        self.renderer.update_frame(0, bbox, &draw, frame.extent)?;
-        if !self.animated {
-            return Ok(None);
-        }
-        // The viewer's --animate: deform on the CPU, upload only the base positions.
-        let start = Instant::now();
-        let t = frame.index as f32 / 30.0;
-        let moved = crate::bft::wave(&self.rest, &self.normals, bbox.0, bbox.1, t);
-        self.surface.update_base(0, &moved)?;
-        Ok(Some(start.elapsed().as_secs_f64() * 1e3))
+        self.context
+            .write_frame(0, self.technique.bbox(), &params, frame.extent)?;
+        Ok(cpu)
     }
 
-    fn record_pre_pass(&mut self, cmd: vk::CommandBuffer, _frame: &BenchFrame) -> Result<()> {
-        self.surface.record_compute(cmd, &self.renderer, 0);
-        Ok(())
+    fn record_pre_pass<'a>(&'a self, enc: &mut Encoder<'a>, _frame: &BenchFrame) -> Result<()> {
+        self.context
+            .record_pre_pass(enc, self.technique.as_ref(), 0)
     }
 
-    fn record(&mut self, cmd: vk::CommandBuffer, frame: &BenchFrame) -> Result<u64> {
-        let params = Self::params(frame.segments);
-        self.surface
-            .record_draw(cmd, &self.renderer, 0, &params, DrawSplit::Auto, false)?;
-        Ok(self.surface.patch_count() as u64
-            * uniform_triangle_count(
-                Domain::Triangle,
-                Spacing::Equal,
-                frame.segments as f32 * 0.5,
-            ))
+    fn record<'a>(&'a self, enc: &mut Encoder<'a>, frame: &BenchFrame) -> Result<u64> {
+        let params = Self::params(frame);
+        let t = self.technique.as_ref();
+        self.context
+            .record_pass(enc, t, 0, &params, crate::Pass::Shaded)?;
+        Ok((0..t.patch_arrays().len())
+            .map(|i| t.triangles(&params, i).unwrap_or(0))
+            .sum())
     }
 
     fn report_notes(&self) -> Vec<String> {
-        let g = &self.surface.gpu;
-        let words = |n: usize| 4 * n;
-        let stencils =
-            words(g.stencil_offsets.len() + g.stencil_indices.len() + g.stencil_weights.len());
-        vec![format!(
-            "{}: BFT tables {} bytes at level {} (the valences and cases present in the mesh), \
-             patch records {} bytes, base-to-level-1 stencils {} bytes",
-            self.mesh_name,
-            self.surface.table_bytes(),
-            g.table_words[0],
-            words(g.patches.len()),
-            stencils
-        )]
+        if self.animated {
+            return Vec::new();
+        }
+        self.technique
+            .report_notes()
+            .into_iter()
+            .map(|n| format!("{}: {n}", self.mesh_name))
+            .collect()
     }
 
     fn statistics_query_safe(&self) -> bool {
-        !self
-            .renderer
-            .device()
-            .workarounds
-            .has(vk_core::workarounds::WorkaroundId::LavapipeStatisticsQueryPointPatches)
+        statistics_query_safe(self.context.device(), self.technique.as_ref())
     }
 }
 
@@ -500,14 +455,20 @@ fn evaluator_limit_positions(
     options: &topology::SubdivOptions,
 ) -> Result<Vec<[f64; 3]>> {
     let local = LocalMesh::from_refined_level(current, LimitScheme::Loop, options)
-        .map_err(|e| TessError::Invalid(format!("limit masks at level {level}: {e}")))?;
+        .map_err(|e| TessError::Mesh {
+            name: format!("Loop level {level}"),
+            source: e.into(),
+        })?;
     (0..current.num_vertices())
         .map(|v| {
             let p = local.vertex_limit_position(v as u32).ok_or_else(|| {
-                TessError::Invalid(format!(
-                    "vertex {v} of level {level} has no limit mask (a semi-sharp crease is \
-                     left); bench meshes must be crease-free"
-                ))
+                TessError::BenchConfig {
+                    option: "--mesh".into(),
+                    reason: format!(
+                        "vertex {v} of level {level} has no limit mask (a semi-sharp crease is \
+                         left); bench meshes must be crease-free"
+                    ),
+                }
             })?;
             Ok([p[0], p[1], p[2]])
         })
@@ -522,6 +483,7 @@ pub struct CpuLoopMethod {
     base: ControlMesh,
     max_vertices: u64,
     renderer: PlainRenderer,
+    context: Context,
     /// The level-k mesh and its k.
     mesh: Option<(usize, PlainMesh)>,
     subdivide_ms: Vec<f64>,
@@ -531,11 +493,13 @@ pub struct CpuLoopMethod {
 
 impl CpuLoopMethod {
     pub fn new(ctx: &MethodContext<'_>, animated: bool) -> Result<Self> {
+        let context = Context::new(ctx.device, ctx.color_format, ctx.depth_format, 1)?;
         Ok(Self {
             animated,
             base: ctx.mesh.mesh.clone(),
             max_vertices: ctx.config.cpu_max_vertices,
-            renderer: PlainRenderer::new(ctx.device, ctx.color_format, ctx.depth_format)?,
+            renderer: PlainRenderer::new(&context)?,
+            context,
             mesh: None,
             subdivide_ms: Vec::new(),
             upload_ms: Vec::new(),
@@ -590,7 +554,10 @@ impl BenchMethod for CpuLoopMethod {
     }
 
     fn begin_frame(&mut self, frame: &BenchFrame) -> Result<Option<f64>> {
-        let level = loop_level_for(frame.segments).map_err(TessError::Invalid)?;
+        let level = loop_level_for(frame.segments).map_err(|reason| TessError::BenchConfig {
+            option: "--segments".into(),
+            reason,
+        })?;
         if self.mesh.as_ref().map(|(k, _)| *k) != Some(level) {
             // Not timed: the static mesh is built once, and the animated one needs its buffers.
             self.mesh = None;
@@ -622,21 +589,26 @@ impl BenchMethod for CpuLoopMethod {
             None
         };
         if let Some((_, mesh)) = &self.mesh {
-            let params = DrawParams {
+            let params = FrameParams {
                 camera: frame.camera,
-                ..DrawParams::default()
+                ..FrameParams::default()
             };
-            self.renderer.update_uniforms(mesh, &params, frame.extent)?;
+            self.context.write_frame(
+                0,
+                (mesh.bbox_min, mesh.bbox_max),
+                &params,
+                frame.extent,
+            )?;
         }
         Ok(cpu_ms)
     }
 
-    fn record(&mut self, cmd: vk::CommandBuffer, _frame: &BenchFrame) -> Result<u64> {
-        let (_, mesh) = self
-            .mesh
-            .as_ref()
-            .ok_or_else(|| TessError::Invalid("cpu baseline recorded before begin_frame".into()))?;
-        self.renderer.record(cmd, mesh)
+    fn record<'a>(&'a self, enc: &mut Encoder<'a>, _frame: &BenchFrame) -> Result<u64> {
+        let (_, mesh) = self.mesh.as_ref().ok_or_else(|| TessError::BenchConfig {
+            option: "cpu".into(),
+            reason: "the CPU baseline was recorded before begin_frame".into(),
+        })?;
+        self.renderer.record(enc, &self.context, 0, mesh)
     }
 
     fn row_notes(&mut self) -> Vec<String> {

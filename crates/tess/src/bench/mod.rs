@@ -14,7 +14,7 @@ pub mod stats;
 pub use methods::{
     build_methods, cpu_loop_limit_mesh, loop_level_for, loop_level_size, method_names, one,
     registry, BenchFrame, BenchMethod, CpuLimitMesh, CpuLoopMethod, MethodContext, MethodEntry,
-    MethodFactory, TessMethod,
+    MethodFactory, TechniqueMethod,
 };
 pub use report::{parse_csv, CSV_HEADER};
 
@@ -351,7 +351,7 @@ impl Harness<'_> {
     /// statistics triangles when queried).
     fn frame(
         &self,
-        method: &mut dyn BenchMethod,
+        method: &dyn BenchMethod,
         frame: &BenchFrame,
         query_statistics: bool,
         clear: [f32; 4],
@@ -359,27 +359,24 @@ impl Harness<'_> {
         let stats = self.statistics.as_ref().filter(|_| query_statistics);
         let device = self.device;
         let start = Instant::now();
-        let recorded = device.one_shot(|cmd| -> Result<u64> {
-            self.timestamps.cmd_reset(cmd);
+        let recorded = device.submit_once(|enc| -> Result<u64> {
+            enc.reset_queries(&self.timestamps);
             if let Some(q) = stats {
-                q.cmd_reset(cmd);
+                enc.reset_queries(q);
             }
-            self.timestamps
-                .cmd_write_timestamp(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, 0)?;
+            enc.write_timestamp(&self.timestamps, vk::PipelineStageFlags::TOP_OF_PIPE, 0)?;
             if let Some(q) = stats {
-                q.cmd_begin(cmd, 0)?;
+                enc.begin_query(q, 0)?;
             }
-            let pre = method.record_pre_pass(cmd, frame);
-            self.target.cmd_begin(device, cmd, clear);
-            let drawn = pre.and_then(|_| method.record(cmd, frame));
-            // SAFETY: the rendering scope was begun by cmd_begin above on this command buffer;
-            // it is ended even when the method failed, so the command buffer stays valid.
-            unsafe { device.raw.cmd_end_rendering(cmd) };
+            let pre = method.record_pre_pass(enc, frame);
+            enc.begin_offscreen(&self.target, clear);
+            let drawn = pre.and_then(|_| method.record(enc, frame));
+            // Ended even when the method failed, so the command buffer stays valid.
+            enc.end_rendering();
             if let Some(q) = stats {
-                q.cmd_end(cmd, 0)?;
+                enc.end_query(q, 0)?;
             }
-            self.timestamps
-                .cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, 1)?;
+            enc.write_timestamp(&self.timestamps, vk::PipelineStageFlags::BOTTOM_OF_PIPE, 1)?;
             drawn
         })??;
         let wall_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -388,7 +385,10 @@ impl Harness<'_> {
             .durations_ns()?
             .first()
             .copied()
-            .ok_or_else(|| TessError::Invalid("no timestamp pair read back".into()))?
+            .ok_or_else(|| TessError::BenchConfig {
+                option: "timestamps".into(),
+                reason: "no timestamp pair was read back".into(),
+            })?
             / 1e6;
         let counted = match stats {
             Some(q) => q
@@ -439,6 +439,7 @@ pub fn run_bench(
         report.mesh_notes.extend(mesh.notes.iter().cloned());
         let ctx = MethodContext {
             device,
+            technique: None,
             mesh,
             config,
             color_format: COLOR_FORMAT,
@@ -481,7 +482,12 @@ pub fn run_bench(
 }
 
 fn validate(config: &BenchConfig, meshes: &[BenchMesh]) -> Result<()> {
-    let bad = |m: String| Err(TessError::Invalid(m));
+    let bad = |m: String| {
+        Err(TessError::BenchConfig {
+            option: "bench".into(),
+            reason: m,
+        })
+    };
     if meshes.is_empty() {
         return bad("no meshes to benchmark".into());
     }
@@ -535,7 +541,7 @@ fn run_group(
     if methods.is_empty() {
         return Ok(Vec::new());
     }
-    let clear = crate::renderer::DrawParams::default().clear_color;
+    let clear = crate::FrameParams::default().clear_color;
     let warmup = config.warmup;
     let mut states: Vec<RowState> = methods
         .iter()
@@ -572,17 +578,17 @@ fn run_group(
             let cpu = method.begin_frame(&frame)?;
             let query = index == 0 && method.statistics_query_safe();
             let (gpu, wall, cpu_count, stats_count) =
-                harness.frame(method.as_mut(), &frame, query, clear)?;
+                harness.frame(method.as_ref(), &frame, query, clear)?;
             if index == 0 {
                 st.counted = stats_count;
             }
             match st.expected {
                 None => st.expected = Some(cpu_count),
                 Some(e) if e != cpu_count => {
-                    return Err(TessError::Invalid(format!(
-                        "{} drew {cpu_count} triangles in frame {index}, {e} before",
-                        method.label()
-                    )))
+                    return Err(TessError::BenchConfig {
+                        option: method.label().to_string(),
+                        reason: format!("drew {cpu_count} triangles in frame {index}, {e} before"),
+                    })
                 }
                 Some(_) => {}
             }
@@ -655,7 +661,10 @@ fn finish_row(
     let cpu: Vec<f64> = times.cpu_ms.iter().map(|c| c.unwrap_or(0.0)).collect();
     let total: Vec<f64> = times.gpu_ms.iter().zip(&cpu).map(|(g, c)| g + c).collect();
     let stat = |v: &[f64], f: fn(&[f64]) -> Option<f64>| {
-        f(v).ok_or_else(|| TessError::Invalid("no frame times to summarise".into()))
+        f(v).ok_or_else(|| TessError::BenchConfig {
+            option: "--frames".into(),
+            reason: "no frame times to summarise".into(),
+        })
     };
     Ok(BenchRow {
         mesh: mesh.name.clone(),

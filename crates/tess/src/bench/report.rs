@@ -269,9 +269,12 @@ pub fn parse_csv(text: &str) -> Result<Vec<BenchRow>> {
     let mut lines = text.lines();
     let header = lines.next().unwrap_or_default();
     if header.trim_end() != CSV_HEADER {
-        return Err(TessError::Invalid(format!(
-            "not a tessera bench CSV (header is '{header}')"
-        )));
+        return Err(TessError::Csv {
+            path: "CSV".into(),
+            line: 1,
+            column: "header".into(),
+            value: header.to_string(),
+        });
     }
     let mut rows = Vec::new();
     for (n, line) in lines.enumerate() {
@@ -281,13 +284,19 @@ pub fn parse_csv(text: &str) -> Result<Vec<BenchRow>> {
         let line_no = n + 2;
         let f = split_csv_line(line);
         if f.len() != 18 {
-            return Err(TessError::Invalid(format!(
-                "CSV line {line_no}: {} fields, expected 18",
-                f.len()
-            )));
+            return Err(TessError::Csv {
+                path: "CSV".into(),
+                line: line_no,
+                column: "field count (expected 18)".into(),
+                value: f.len().to_string(),
+            });
         }
-        let err =
-            |col: &str, v: &str| TessError::Invalid(format!("CSV line {line_no}: bad {col} '{v}'"));
+        let err = |col: &str, v: &str| TessError::Csv {
+            path: "CSV".into(),
+            line: line_no,
+            column: col.into(),
+            value: v.into(),
+        };
         let int = |i: usize, col: &str| f[i].parse::<u64>().map_err(|_| err(col, &f[i]));
         let num = |i: usize, col: &str| {
             f[i].parse::<f64>()

@@ -1,0 +1,180 @@
+//! Base-face domains: where a captured (patch, domain coordinate) lies on the base mesh, and
+//! which open edges lie on the base mesh's own boundary.
+use super::soup::{CapturedSoup, EdgeReport, WeldedMesh};
+use crate::render_mesh::PatchOrigin;
+use crate::tessellator::Domain;
+use std::collections::HashMap;
+use topology::ControlMesh;
+
+/// A point of the base mesh: face index and its (u, v) in the face's domain ([`face_corner_uv`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FacePoint {
+    pub face: u32,
+    pub u: f32,
+    pub v: f32,
+}
+
+/// Maps a captured patch id and domain coordinate to the base mesh; `None` for an unknown patch.
+pub type PatchToFace<'a> = dyn Fn(u32, [f32; 2]) -> Option<FacePoint> + 'a;
+
+/// Where corner `k` of an `n`-sided face sits in the face's (u, v) domain:
+/// - triangles: corner 0 (1, 0), corner 1 (0, 1), corner 2 (0, 0), so (u, v) are the
+///   barycentric weights of corners 0 and 1 (= `gl_TessCoord.xy` of a triangle patch);
+/// - quads: (0, 0), (1, 0), (1, 1), (0, 1), the bilinear domain of the quad TES;
+/// - n-gons, n ≥ 5: the regular n-gon inscribed in the unit square's circle,
+///   (½ + ½ cos 2πk/n, ½ + ½ sin 2πk/n); a fan triangle's barycentrics map linearly into it.
+pub fn face_corner_uv(n: u32, k: u32) -> [f64; 2] {
+    match (n, k % n.max(1)) {
+        (3, 0) => [1.0, 0.0],
+        (3, 1) => [0.0, 1.0],
+        (3, _) => [0.0, 0.0],
+        (4, 0) => [0.0, 0.0],
+        (4, 1) => [1.0, 0.0],
+        (4, 2) => [1.0, 1.0],
+        (4, _) => [0.0, 1.0],
+        (n, k) => {
+            let a = std::f64::consts::TAU * k as f64 / n as f64;
+            [0.5 + 0.5 * a.cos(), 0.5 + 0.5 * a.sin()]
+        }
+    }
+}
+
+/// How far (in domain units) a captured coordinate may sit from a face edge and still count as
+/// on it: the tessellator's edge coordinates are exact 0 or 1 or i/n with 1 − x − y rounding.
+const ON_EDGE: f64 = 1e-5;
+
+/// The face-local edges (edge `k` runs from corner `k` to corner `k + 1`) that `uv` lies on.
+pub fn face_edges_at(n: u32, uv: [f32; 2]) -> Vec<u32> {
+    let p = [uv[0] as f64, uv[1] as f64];
+    (0..n)
+        .filter(|&k| {
+            let a = face_corner_uv(n, k);
+            let b = face_corner_uv(n, k + 1);
+            let d = [b[0] - a[0], b[1] - a[1]];
+            let len2 = d[0] * d[0] + d[1] * d[1];
+            let t = (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / len2).clamp(0.0, 1.0);
+            let q = [a[0] + t * d[0] - p[0], a[1] + t * d[1] - p[1]];
+            (q[0] * q[0] + q[1] * q[1]).sqrt() <= ON_EDGE
+        })
+        .collect()
+}
+
+/// The patch → base face table of the triangle/quad techniques, indexed by captured patch id
+/// (from [`crate::RenderMesh`]'s origins, in the technique's array order).
+#[derive(Clone, Debug, Default)]
+pub struct PatchFaceTable {
+    pub origins: Vec<PatchOrigin>,
+}
+
+impl PatchFaceTable {
+    pub fn new(origins: Vec<PatchOrigin>) -> Self {
+        Self { origins }
+    }
+
+    /// A triangle patch spanning a whole triangle face, or a quad patch, is the identity (bit
+    /// for bit); a fan triangle of a larger face maps its barycentrics into the face's domain.
+    pub fn face_point(&self, patch: u32, domain: [f32; 2]) -> Option<FacePoint> {
+        let o = self.origins.get(patch as usize)?;
+        let identity = match o.domain {
+            Domain::Quad => true,
+            Domain::Triangle => o.face_size == 3,
+        };
+        if identity {
+            return Some(FacePoint {
+                face: o.face,
+                u: domain[0],
+                v: domain[1],
+            });
+        }
+        let b = [
+            domain[0] as f64,
+            domain[1] as f64,
+            1.0 - domain[0] as f64 - domain[1] as f64,
+        ];
+        let corners = o.face_corners();
+        let mut uv = [0.0f64; 2];
+        for i in 0..3 {
+            let c = face_corner_uv(o.face_size, corners[i]);
+            uv[0] += b[i] * c[0];
+            uv[1] += b[i] * c[1];
+        }
+        Some(FacePoint {
+            face: o.face,
+            u: uv[0] as f32,
+            v: uv[1] as f32,
+        })
+    }
+}
+
+/// Open edges split by where they lie.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OpenEdgeClasses {
+    /// Both endpoints lie on one edge of one base face, and that base edge is a boundary edge
+    /// of the base mesh (used by one face).
+    pub on_base_boundary: usize,
+    /// Every other open edge: a gap the GPU left inside the surface.
+    pub cracks: usize,
+    /// Of the cracks, those whose patch id maps to no base face (a mapping bug, not geometry).
+    pub unmapped: usize,
+}
+
+/// Classifies `report.open` from the base mesh's topology and the captured patch ids and domain
+/// coordinates of each open edge's own triangle (never from positions).
+pub fn classify_open_edges(
+    soup: &CapturedSoup,
+    welded: &WeldedMesh,
+    report: &EdgeReport,
+    map: &PatchToFace<'_>,
+    base: &ControlMesh,
+) -> OpenEdgeClasses {
+    let mut uses: HashMap<[u32; 2], u32> = HashMap::new();
+    for face in base.faces() {
+        for k in 0..face.len() {
+            let (a, b) = (face[k], face[(k + 1) % face.len()]);
+            *uses.entry([a.min(b), a.max(b)]).or_default() += 1;
+        }
+    }
+    let base_boundary = |face: u32, k: u32| -> bool {
+        if face as usize >= base.num_faces() {
+            return false;
+        }
+        let f = base.face(face as usize);
+        let n = f.len();
+        let (a, b) = (f[k as usize % n], f[(k as usize + 1) % n]);
+        uses.get(&[a.min(b), a.max(b)]) == Some(&1)
+    };
+    let mut out = OpenEdgeClasses::default();
+    for e in &report.open {
+        let t = e.triangle as usize;
+        let corner = |v: u32| {
+            (0..3)
+                .find(|&i| welded.triangles[t][i] == v)
+                .map(|i| soup.records[3 * t + i])
+        };
+        let (Some(ra), Some(rb)) = (corner(e.vertices[0]), corner(e.vertices[1])) else {
+            out.cracks += 1;
+            continue;
+        };
+        let (Some(fa), Some(fb)) = (map(ra.patch, ra.domain), map(rb.patch, rb.domain)) else {
+            out.cracks += 1;
+            out.unmapped += 1;
+            continue;
+        };
+        let on_boundary = fa.face == fb.face && {
+            let n = base
+                .faces()
+                .nth(fa.face as usize)
+                .map_or(0, |f| f.len() as u32);
+            let ea = face_edges_at(n, [fa.u, fa.v]);
+            let eb = face_edges_at(n, [fb.u, fb.v]);
+            ea.iter()
+                .any(|k| eb.contains(k) && base_boundary(fa.face, *k))
+        };
+        if on_boundary {
+            out.on_base_boundary += 1;
+        } else {
+            out.cracks += 1;
+        }
+    }
+    out
+}

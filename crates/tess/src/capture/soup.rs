@@ -1,0 +1,225 @@
+//! What the GPU wrote (the transform-feedback records), welded by position bits, with edge
+//! use and the OBJ writer.
+use super::domain::PatchToFace;
+use crate::error::{Result, TessError};
+use bytemuck::{Pod, Zeroable};
+use std::collections::HashMap;
+use std::io::Write as _;
+use std::mem::{offset_of, size_of};
+use std::path::Path;
+
+/// One captured triangle corner: the transform-feedback record of `tese_out.glsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CaptureRecord {
+    /// World position as the TES computed it.
+    pub position: [f32; 3],
+    /// Normal as shaded.
+    pub normal: [f32; 3],
+    /// Frame-wide patch id.
+    pub patch: u32,
+    /// Technique-defined flags (0 for the triangle/quad techniques).
+    pub flags: u32,
+    /// `gl_TessCoord.xy` as the fixed-function tessellator produced it.
+    pub domain: [f32; 2],
+}
+
+/// Bytes per record: the `xfb_stride` of `tese_out.glsl`.
+pub const CAPTURE_STRIDE: u64 = 40;
+
+const _: () = {
+    assert!(size_of::<CaptureRecord>() == CAPTURE_STRIDE as usize);
+    assert!(offset_of!(CaptureRecord, normal) == 12);
+    assert!(offset_of!(CaptureRecord, patch) == 24);
+    assert!(offset_of!(CaptureRecord, flags) == 28);
+    assert!(offset_of!(CaptureRecord, domain) == 32);
+};
+
+/// Every corner the TES emitted, three per triangle, in the order the GPU wrote them.
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CapturedSoup {
+    pub records: Vec<CaptureRecord>,
+}
+
+impl CapturedSoup {
+    pub fn triangle_count(&self) -> usize {
+        self.records.len() / 3
+    }
+
+    /// The captured triangles, three corners each.
+    pub fn triangles(&self) -> impl Iterator<Item = &[CaptureRecord]> + '_ {
+        self.records.chunks_exact(3)
+    }
+
+    /// Merges corners whose position bits are identical into one indexed vertex; triangles keep
+    /// their captured order and corner order (triangle `t` is corners `3t..3t + 3`).
+    pub fn weld(&self) -> Result<WeldedMesh> {
+        if !self.records.chunks_exact(3).remainder().is_empty() {
+            return Err(TessError::PartialTriangle {
+                corners: self.records.len(),
+            });
+        }
+        let mut index: HashMap<[u32; 3], u32> = HashMap::with_capacity(self.records.len() / 4);
+        let mut out = WeldedMesh::default();
+        let mut corner_vertex = Vec::with_capacity(self.records.len());
+        for r in &self.records {
+            let key = r.position.map(f32::to_bits);
+            let id = *index.entry(key).or_insert_with(|| {
+                out.positions.push(r.position);
+                out.normals.push(r.normal);
+                out.patch.push(r.patch);
+                out.domain.push(r.domain);
+                out.flags.push(r.flags);
+                (out.positions.len() - 1) as u32
+            });
+            corner_vertex.push(id);
+        }
+        out.triangles = corner_vertex
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
+        Ok(out)
+    }
+}
+
+/// The soup welded by position bits. Per-vertex attributes come from the first corner welded
+/// into the vertex.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WeldedMesh {
+    pub positions: Vec<[f32; 3]>,
+    pub normals: Vec<[f32; 3]>,
+    pub patch: Vec<u32>,
+    pub domain: Vec<[f32; 2]>,
+    pub flags: Vec<u32>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// An edge used by exactly one triangle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OpenEdge {
+    /// Welded vertex indices, smaller first.
+    pub vertices: [u32; 2],
+    /// The triangle using it (also its index in the soup: corners `3t..3t + 3`).
+    pub triangle: u32,
+}
+
+/// Edge use of a welded mesh.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct EdgeReport {
+    /// Edges used by exactly one triangle, sorted.
+    pub open: Vec<OpenEdge>,
+    /// Edges used by three or more triangles, sorted.
+    pub non_manifold: Vec<[u32; 2]>,
+    /// Triangles with two identical welded corners, in order (not counted in edge use).
+    pub zero_area: Vec<u32>,
+}
+
+impl WeldedMesh {
+    /// Counts how many triangles use each edge; see [`EdgeReport`].
+    pub fn open_edges(&self) -> EdgeReport {
+        let mut uses: HashMap<[u32; 2], (u32, u32)> = HashMap::new();
+        let mut report = EdgeReport::default();
+        for (t, tri) in self.triangles.iter().enumerate() {
+            if tri[0] == tri[1] || tri[1] == tri[2] || tri[2] == tri[0] {
+                report.zero_area.push(t as u32);
+                continue;
+            }
+            for i in 0..3 {
+                let (a, b) = (tri[i], tri[(i + 1) % 3]);
+                let e = uses.entry([a.min(b), a.max(b)]).or_insert((0, t as u32));
+                e.0 += 1;
+            }
+        }
+        for (edge, (count, triangle)) in uses {
+            match count {
+                1 => report.open.push(OpenEdge {
+                    vertices: edge,
+                    triangle,
+                }),
+                2 => {}
+                _ => report.non_manifold.push(edge),
+            }
+        }
+        report.open.sort_by_key(|e| e.vertices);
+        report.non_manifold.sort();
+        report
+    }
+
+    /// Writes the mesh as OBJ (format in the module doc); `map` names each vertex's base face.
+    pub fn write_obj(&self, path: &Path, map: &PatchToFace<'_>, winding: Winding) -> Result<()> {
+        let io = |source| TessError::Io {
+            path: path.display().to_string(),
+            source,
+        };
+        let file = std::fs::File::create(path).map_err(io)?;
+        let mut w = std::io::BufWriter::new(file);
+        self.write_obj_to(&mut w, map, winding)
+            .map_err(|e| match e {
+                ObjWriteError::Io(source) => io(source),
+                ObjWriteError::Unmapped { vertex, patch } => TessError::UnmappedPatch {
+                    path: path.display().to_string(),
+                    vertex,
+                    patch,
+                },
+            })?;
+        w.flush().map_err(io)
+    }
+
+    fn write_obj_to(
+        &self,
+        w: &mut impl std::io::Write,
+        map: &PatchToFace<'_>,
+        winding: Winding,
+    ) -> std::result::Result<(), ObjWriteError> {
+        writeln!(
+            w,
+            "# tessera capture: {} welded vertices, {} triangles, corners welded by position bits",
+            self.positions.len(),
+            self.triangles.len()
+        )?;
+        writeln!(
+            w,
+            "# per vertex: v, vn, then '# p <base face> <u> <v>' (0-based face, its domain)"
+        )?;
+        for (i, (p, n)) in self.positions.iter().zip(&self.normals).enumerate() {
+            let fp = map(self.patch[i], self.domain[i]).ok_or(ObjWriteError::Unmapped {
+                vertex: i,
+                patch: self.patch[i],
+            })?;
+            writeln!(w, "v {} {} {}", p[0], p[1], p[2])?;
+            writeln!(w, "vn {} {} {}", n[0], n[1], n[2])?;
+            writeln!(w, "# p {} {} {}", fp.face, fp.u, fp.v)?;
+        }
+        for t in &self.triangles {
+            let [a, b, c] = match winding {
+                Winding::AsCaptured => t.map(|i| i + 1),
+                Winding::Reversed => [t[0] + 1, t[2] + 1, t[1] + 1],
+            };
+            writeln!(w, "f {a}//{a} {b}//{b} {c}//{c}")?;
+        }
+        Ok(())
+    }
+}
+
+/// Corner order of the faces [`WeldedMesh::write_obj`] writes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Winding {
+    /// The order the GPU wrote the corners in.
+    #[default]
+    AsCaptured,
+    /// Second and third corners swapped (see the module doc on winding).
+    Reversed,
+}
+
+enum ObjWriteError {
+    Io(std::io::Error),
+    Unmapped { vertex: usize, patch: u32 },
+}
+
+impl From<std::io::Error> for ObjWriteError {
+    fn from(e: std::io::Error) -> Self {
+        ObjWriteError::Io(e)
+    }
+}
+

@@ -1,0 +1,550 @@
+//! The context every technique draws through: frame uniforms (set 0 of every pipeline), the
+//! one pipeline cache, per-technique descriptor-set layouts, and the recording of a frame —
+//! pre-pass, shaded pass, wireframe overlay, capture pass — the same for every technique.
+//!
+//! Pipelines are built on first use from a technique's [`PatchPipeline`] and keyed by
+//! [`PipelineKey`] (technique, patch type, spacing, pass). Spacing is a layout qualifier of
+//! the evaluation stage, so it selects a SPIR-V variant, not a specialization constant.
+//!
+//! Drop order (field order): pipelines, set layouts, frame sets, device handle.
+use crate::error::{Result, TessError};
+use crate::gpu::{FrameUniforms, Vertex};
+use crate::shaders::{self, Variant};
+use crate::technique::{
+    DrawCounts, DrawSplit, FactorPolicy, FrameParams, Pass, PatchType, Technique, TechniqueId,
+};
+use crate::tessellator::{Spacing, MAX_LEVEL};
+use std::collections::HashMap;
+use std::mem::{offset_of, size_of};
+use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
+use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage, TessellationDesc};
+use vk_core::query::{PipelineStatistics, QueryPool};
+use vk_core::target::{OffscreenTarget, Rgba8, COLOR_FORMAT, DEPTH_FORMAT};
+use vk_core::workarounds::WorkaroundId;
+use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Device, Encoder, MemoryLocation};
+
+/// Selects one pipeline of the cache.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PipelineKey {
+    pub technique: TechniqueId,
+    pub patch: PatchType,
+    pub spacing: Spacing,
+    pub pass: Pass,
+}
+
+/// Set 0 of every pipeline: one uniform buffer and descriptor set per frame slot.
+/// Drop order: sets (they keep their pool alive), pool, layout, buffers.
+struct FrameSets {
+    slots: Vec<(DescriptorSet, Buffer)>,
+    _pool: DescriptorPool,
+    layout: DescriptorSetLayout,
+}
+
+impl FrameSets {
+    fn new(device: &Device, slots: usize) -> Result<Self> {
+        let layout = DescriptorSetLayout::new(
+            device,
+            "frame set layout",
+            &[BindingDesc {
+                binding: 0,
+                ty: vk::DescriptorType::UNIFORM_BUFFER,
+                stages: vk::ShaderStageFlags::ALL_GRAPHICS | vk::ShaderStageFlags::COMPUTE,
+            }],
+        )?;
+        let pool = DescriptorPool::new(device, "frame descriptor pool", &layout, slots as u32)?;
+        let mut out = Vec::with_capacity(slots);
+        for i in 0..slots {
+            let uniforms = Buffer::new(
+                device,
+                &BufferDesc {
+                    name: &format!("frame uniforms {i}"),
+                    size: size_of::<FrameUniforms>() as u64,
+                    usage: vk::BufferUsageFlags::UNIFORM_BUFFER,
+                    location: MemoryLocation::CpuToGpu,
+                },
+            )?;
+            let set = pool.allocate_set(&layout)?;
+            set.write_buffer(0, vk::DescriptorType::UNIFORM_BUFFER, &uniforms)?;
+            out.push((set, uniforms));
+        }
+        Ok(Self {
+            slots: out,
+            _pool: pool,
+            layout,
+        })
+    }
+}
+
+/// See the module docs.
+pub struct Context {
+    pipelines: HashMap<PipelineKey, Pipeline>,
+    set_layouts: HashMap<TechniqueId, DescriptorSetLayout>,
+    frames: FrameSets,
+    color_format: vk::Format,
+    depth_format: vk::Format,
+    device: Device,
+}
+
+impl Context {
+    /// A context rendering to `color_format`/`depth_format` with `frames_in_flight` frame
+    /// slots (frame `k + 1` writes its uniforms while frame `k` renders).
+    pub fn new(
+        device: &Device,
+        color_format: vk::Format,
+        depth_format: vk::Format,
+        frames_in_flight: usize,
+    ) -> Result<Self> {
+        if frames_in_flight == 0 {
+            return Err(TessError::FrameSlot { slot: 0, slots: 0 });
+        }
+        Ok(Self {
+            pipelines: HashMap::new(),
+            set_layouts: HashMap::new(),
+            frames: FrameSets::new(device, frames_in_flight)?,
+            color_format,
+            depth_format,
+            device: device.clone(),
+        })
+    }
+
+    /// A context for offscreen targets (RGBA8 + D32) and captures, one frame slot.
+    pub fn offscreen(device: &Device) -> Result<Self> {
+        Self::new(device, COLOR_FORMAT, DEPTH_FORMAT, 1)
+    }
+
+    pub fn device(&self) -> &Device {
+        &self.device
+    }
+
+    pub fn frames_in_flight(&self) -> usize {
+        self.frames.slots.len()
+    }
+
+    /// Colour and depth formats the pipelines render to.
+    pub fn formats(&self) -> (vk::Format, vk::Format) {
+        (self.color_format, self.depth_format)
+    }
+
+    /// The frame set of `slot`, or a typed error for a slot that does not exist.
+    pub fn frame_set(&self, slot: usize) -> Result<&DescriptorSet> {
+        self.frames
+            .slots
+            .get(slot)
+            .map(|s| &s.0)
+            .ok_or(TessError::FrameSlot {
+                slot,
+                slots: self.frames.slots.len(),
+            })
+    }
+
+    /// The set-1 layout of `technique` (made once, from `bindings`): one per technique
+    /// type, so pipelines built for one surface serve every surface of that technique.
+    pub fn ensure_set_layout(
+        &mut self,
+        technique: TechniqueId,
+        bindings: &[BindingDesc],
+    ) -> Result<()> {
+        if !self.set_layouts.contains_key(&technique) {
+            let layout = DescriptorSetLayout::new(
+                &self.device,
+                &format!("{technique} set layout"),
+                bindings,
+            )?;
+            self.set_layouts.insert(technique, layout);
+        }
+        Ok(())
+    }
+
+    /// The set-1 layout of `technique`, once [`Self::ensure_set_layout`] made it.
+    pub fn set_layout(&self, technique: TechniqueId) -> Result<&DescriptorSetLayout> {
+        self.set_layouts
+            .get(&technique)
+            .ok_or(TessError::Unsupported {
+                technique,
+                what: "a descriptor set before its layout was made",
+            })
+    }
+
+    /// Layout of set 0 (the frame uniforms), for pipelines built outside the cache (compute
+    /// pre-passes, the plain CPU-refined draw).
+    pub fn frame_set_layout(&self) -> &DescriptorSetLayout {
+        &self.frames.layout
+    }
+
+    /// Writes the frame uniforms of `slot` for `params` on a target of `extent`, framing `bbox`
+    /// (a technique's [`Technique::bbox`]).
+    pub fn write_frame(
+        &mut self,
+        slot: usize,
+        bbox: ([f32; 3], [f32; 3]),
+        params: &FrameParams,
+        extent: vk::Extent2D,
+    ) -> Result<()> {
+        let uniforms = frame_uniforms(bbox, params, extent);
+        let slots = self.frames.slots.len();
+        let (_, buffer) = self
+            .frames
+            .slots
+            .get_mut(slot)
+            .ok_or(TessError::FrameSlot { slot, slots })?;
+        buffer.write(0, bytemuck::bytes_of(&uniforms))?;
+        Ok(())
+    }
+
+    /// Checks `params` and builds the pipelines `passes` need for `technique`. Must precede
+    /// recording (which borrows the context immutably for the encoder's lifetime).
+    pub fn prepare(
+        &mut self,
+        technique: &dyn Technique,
+        params: &FrameParams,
+        passes: &[Pass],
+    ) -> Result<()> {
+        technique.check(params)?;
+        let bindings = technique.set_layout_bindings();
+        if !bindings.is_empty() {
+            self.ensure_set_layout(technique.id(), bindings)?;
+        }
+        for array in technique.patch_arrays() {
+            for &pass in passes {
+                let key = PipelineKey {
+                    technique: technique.id(),
+                    patch: array.patch,
+                    spacing: params.spacing,
+                    pass,
+                };
+                if !self.pipelines.contains_key(&key) {
+                    let p = self.build_pipeline(technique, key)?;
+                    self.pipelines.insert(key, p);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn build_pipeline(&self, technique: &dyn Technique, key: PipelineKey) -> Result<Pipeline> {
+        let pp = technique.patch_pipeline(key.patch);
+        let capture = key.pass == Pass::Capture;
+        let name = format!(
+            "{} {:?} {:?} {:?}",
+            key.technique, key.patch, key.spacing, key.pass
+        );
+        let (color, depth) = if capture {
+            (vk::Format::UNDEFINED, vk::Format::UNDEFINED)
+        } else {
+            (self.color_format, self.depth_format)
+        };
+        let mut desc = GraphicsPipelineDesc::new(&name, color, depth);
+        let plain = Variant::default();
+        let evaluation = Variant {
+            spacing: Some(key.spacing),
+            capture,
+        };
+        desc.stages = vec![
+            ShaderStage::new(
+                vk::ShaderStageFlags::VERTEX,
+                shaders::spirv(pp.vertex, plain)?,
+            ),
+            ShaderStage::new(
+                vk::ShaderStageFlags::TESSELLATION_CONTROL,
+                shaders::spirv(pp.control, plain)?,
+            ),
+            ShaderStage::new(
+                vk::ShaderStageFlags::TESSELLATION_EVALUATION,
+                shaders::spirv(pp.evaluation, evaluation)?,
+            ),
+        ];
+        if !capture {
+            desc.stages.push(ShaderStage::new(
+                vk::ShaderStageFlags::FRAGMENT,
+                shaders::spirv(pp.fragment, plain)?,
+            ));
+        }
+        if pp.mesh_vertex_input {
+            set_vertex_input(&mut desc);
+        }
+        desc.topology = vk::PrimitiveTopology::PATCH_LIST;
+        desc.tessellation = Some(TessellationDesc {
+            patch_control_points: pp.control_points,
+            domain_origin: vk::TessellationDomainOrigin::UPPER_LEFT,
+        });
+        desc.set_layouts = vec![self.frames.layout.raw];
+        if let Some(l) = self.set_layouts.get(&key.technique) {
+            desc.set_layouts.push(l.raw);
+        }
+        desc.push_constant_bytes = pp.push_constant_bytes;
+        set_pass_style(&mut desc, key.pass);
+        Ok(Pipeline::graphics(&self.device, &desc)?)
+    }
+
+    /// Patches per draw of `array`: all, unless a driver workaround limits the vertices one
+    /// draw may emit (`vk_core::workarounds::WorkaroundId::LavapipeTessChunkVertexLimit`),
+    /// computed at the largest factor the policy can reach.
+    pub fn patches_per_draw(
+        &self,
+        technique: &dyn Technique,
+        params: &FrameParams,
+        array: usize,
+    ) -> u32 {
+        match params.split {
+            DrawSplit::Off => u32::MAX,
+            DrawSplit::PerPatch => 1,
+            DrawSplit::Auto => {
+                let max = technique.max_vertices_per_patch(params, array);
+                self.device.workarounds.max_patches_per_draw(max)
+            }
+        }
+    }
+
+    /// Records the technique's pre-pass for frame slot `slot` (outside any rendering scope).
+    pub fn record_pre_pass<'a>(
+        &'a self,
+        enc: &mut Encoder<'a>,
+        technique: &'a dyn Technique,
+        slot: usize,
+    ) -> Result<()> {
+        technique.record_pre_pass(enc, self.frame_set(slot)?, slot)
+    }
+
+    /// Records one pass of every patch array inside an open rendering (or capture) scope.
+    /// [`Self::prepare`] must have built the pass's pipelines.
+    pub fn record_pass<'a>(
+        &'a self,
+        enc: &mut Encoder<'a>,
+        technique: &'a dyn Technique,
+        slot: usize,
+        params: &FrameParams,
+        pass: Pass,
+    ) -> Result<DrawCounts> {
+        let mut counts = DrawCounts::default();
+        for i in 0..technique.patch_arrays().len() {
+            counts += self.record_array(enc, technique, slot, params, pass, i)?;
+        }
+        Ok(counts)
+    }
+
+    /// Records one pass of one patch array (binds its pipeline and sets).
+    pub fn record_array<'a>(
+        &'a self,
+        enc: &mut Encoder<'a>,
+        technique: &'a dyn Technique,
+        slot: usize,
+        params: &FrameParams,
+        pass: Pass,
+        array: usize,
+    ) -> Result<DrawCounts> {
+        let a = technique
+            .patch_arrays()
+            .get(array)
+            .ok_or(TessError::NoPatchArray { array })?;
+        let key = PipelineKey {
+            technique: technique.id(),
+            patch: a.patch,
+            spacing: params.spacing,
+            pass,
+        };
+        let pipeline = self
+            .pipelines
+            .get(&key)
+            .ok_or(TessError::PipelineNotPrepared {
+                technique: key.technique,
+                pass,
+            })?;
+        enc.begin_label(&format!("{} {:?} {:?}", key.technique, a.patch, pass));
+        enc.bind_pipeline(pipeline);
+        let frame_set = self.frame_set(slot)?;
+        match technique.descriptor_set(slot) {
+            Some(set) => enc.bind_descriptor_sets(0, &[frame_set, set])?,
+            None => enc.bind_descriptor_sets(0, &[frame_set])?,
+        }
+        let per_draw = self.patches_per_draw(technique, params, array);
+        let counts = technique.record_array(enc, array, params, pass, per_draw)?;
+        enc.end_label();
+        Ok(counts)
+    }
+
+    /// Records a whole frame's passes inside an open rendering scope: shaded, then the
+    /// wireframe overlay when `params.wireframe`.
+    pub fn record_frame<'a>(
+        &'a self,
+        enc: &mut Encoder<'a>,
+        technique: &'a dyn Technique,
+        slot: usize,
+        params: &FrameParams,
+    ) -> Result<DrawCounts> {
+        let mut counts = self.record_pass(enc, technique, slot, params, Pass::Shaded)?;
+        if params.wireframe {
+            counts += self.record_pass(enc, technique, slot, params, Pass::Wireframe)?;
+        }
+        Ok(counts)
+    }
+
+    /// The passes a frame of `params` draws.
+    pub fn frame_passes(params: &FrameParams) -> &'static [Pass] {
+        if params.wireframe {
+            &[Pass::Shaded, Pass::Wireframe]
+        } else {
+            &[Pass::Shaded]
+        }
+    }
+
+    /// Renders one frame of `technique` offscreen (pre-pass, shaded pass, optional wireframe
+    /// overlay) and reads it back.
+    pub fn render_offscreen(
+        &mut self,
+        technique: &dyn Technique,
+        params: &FrameParams,
+        extent: vk::Extent2D,
+    ) -> Result<Rgba8> {
+        Ok(self
+            .render_offscreen_stats(technique, params, extent, false)?
+            .image)
+    }
+
+    /// [`Self::render_offscreen`]; with `statistics`, also the pipeline statistics of the
+    /// shaded pass (None where a driver workaround forbids the query for these patches).
+    pub fn render_offscreen_stats(
+        &mut self,
+        technique: &dyn Technique,
+        params: &FrameParams,
+        extent: vk::Extent2D,
+        statistics: bool,
+    ) -> Result<OffscreenFrame> {
+        self.prepare(technique, params, Self::frame_passes(params))?;
+        self.write_frame(0, technique.bbox(), params, extent)?;
+        let device = self.device.clone();
+        let target = OffscreenTarget::new(&device, extent)?;
+        let readback = target.readback_buffer(&device)?;
+        let statistics = statistics && statistics_query_safe(&device, technique);
+        let query = if statistics {
+            Some(QueryPool::statistics(&device, "pipeline statistics", 1)?)
+        } else {
+            None
+        };
+        let this = &*self;
+        let counts = device.submit_once(|enc| -> Result<DrawCounts> {
+            if let Some(q) = &query {
+                enc.reset_queries(q);
+            }
+            this.record_pre_pass(enc, technique, 0)?;
+            enc.begin_offscreen(&target, params.clear_color);
+            if let Some(q) = &query {
+                enc.begin_query(q, 0)?;
+            }
+            let mut counts = this.record_pass(enc, technique, 0, params, Pass::Shaded)?;
+            if let Some(q) = &query {
+                enc.end_query(q, 0)?;
+            }
+            if params.wireframe {
+                counts += this.record_pass(enc, technique, 0, params, Pass::Wireframe)?;
+            }
+            enc.end_offscreen_and_copy(&target, &readback);
+            Ok(counts)
+        })??;
+        let statistics = match &query {
+            Some(q) => q.statistics_results()?.first().copied(),
+            None => None,
+        };
+        Ok(OffscreenFrame {
+            image: target.read(&readback)?,
+            statistics,
+            counts,
+        })
+    }
+}
+
+/// One frame rendered offscreen.
+pub struct OffscreenFrame {
+    pub image: Rgba8,
+    pub statistics: Option<PipelineStatistics>,
+    pub counts: DrawCounts,
+}
+
+/// Whether a pipeline-statistics query may wrap `technique`'s draws on `device`: lavapipe
+/// crashes on one around one-control-point patches
+/// (`WorkaroundId::LavapipeStatisticsQueryPointPatches`).
+pub fn statistics_query_safe(device: &Device, technique: &dyn Technique) -> bool {
+    !(device
+        .workarounds
+        .has(WorkaroundId::LavapipeStatisticsQueryPointPatches)
+        && technique
+            .patch_arrays()
+            .iter()
+            .any(|a| a.control_points == 1))
+}
+
+/// The frame block for `params` on a target of `extent`, framing `bbox`: camera, light,
+/// uniform levels, colours. Shared by every pipeline that includes `frame.glsl` (tessellated
+/// or not), so they all see the same view.
+pub fn frame_uniforms(
+    bbox: ([f32; 3], [f32; 3]),
+    params: &FrameParams,
+    extent: vk::Extent2D,
+) -> FrameUniforms {
+    let aspect = extent.width as f32 / extent.height.max(1) as f32;
+    let m = params.camera.matrices(bbox.0, bbox.1, aspect);
+    let light =
+        (m.eye - glam::Vec3::from(bbox.0).lerp(glam::Vec3::from(bbox.1), 0.5)).normalize_or_zero();
+    let light = (light + glam::Vec3::new(0.3, 0.6, 0.2)).normalize_or_zero();
+    let level = match params.factors {
+        FactorPolicy::Uniform { segments } => segments.clamp(1.0, MAX_LEVEL),
+        _ => 1.0,
+    };
+    FrameUniforms {
+        view_proj: (m.proj * m.view).to_cols_array_2d(),
+        view: m.view.to_cols_array_2d(),
+        camera_pos: [m.eye.x, m.eye.y, m.eye.z, 1.0],
+        light_dir: [light.x, light.y, light.z, 0.0],
+        tess: [level, level, params.phong_alpha, 0.0],
+        base_color: [
+            params.base_color[0],
+            params.base_color[1],
+            params.base_color[2],
+            1.0,
+        ],
+        wire_color: [0.05, 0.05, 0.08, 1.0],
+        viewport: [extent.width as f32, extent.height as f32, 0.0, 0.0],
+    }
+}
+
+/// Shaded pass, wireframe overlay or capture: the overlay draws lines without writing depth,
+/// the shaded pass is pushed slightly back so the overlay wins the depth test, the capture
+/// pass rasterizes nothing. Every technique's pipelines get this.
+pub(crate) fn set_pass_style(desc: &mut GraphicsPipelineDesc<'_>, pass: Pass) {
+    match pass {
+        Pass::Wireframe => {
+            desc.polygon_mode = vk::PolygonMode::LINE;
+            desc.depth_compare = vk::CompareOp::LESS_OR_EQUAL;
+            desc.depth_write = false;
+        }
+        Pass::Shaded => desc.depth_bias = Some((1.0, 1.0)),
+        Pass::Capture => {
+            desc.rasterizer_discard = true;
+            desc.depth_test = false;
+            desc.depth_write = false;
+        }
+    }
+}
+
+/// Vertex input of the interleaved [`Vertex`] (position at location 0, normal at 1): what
+/// `mesh.vert` and `plain.vert` read.
+pub(crate) fn set_vertex_input(desc: &mut GraphicsPipelineDesc<'_>) {
+    desc.vertex_bindings = vec![vk::VertexInputBindingDescription {
+        binding: 0,
+        stride: size_of::<Vertex>() as u32,
+        input_rate: vk::VertexInputRate::VERTEX,
+    }];
+    desc.vertex_attributes = vec![
+        vk::VertexInputAttributeDescription {
+            location: 0,
+            binding: 0,
+            format: vk::Format::R32G32B32_SFLOAT,
+            offset: offset_of!(Vertex, position) as u32,
+        },
+        vk::VertexInputAttributeDescription {
+            location: 1,
+            binding: 0,
+            format: vk::Format::R32G32B32_SFLOAT,
+            offset: offset_of!(Vertex, normal) as u32,
+        },
+    ];
+}

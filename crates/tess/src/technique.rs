@@ -1,0 +1,383 @@
+//! The one seam between Tessera's techniques and everything that uses them (viewer, bench,
+//! capture/export, the C ABI).
+//!
+//! A technique turns a control mesh into **patch arrays** (OpenSubdiv's `PatchTable` arrays:
+//! one patch type, a patch count, control points per patch) and records them. Callers never
+//! see which technique they hold: they go through [`Technique`] and the [`crate::Context`]
+//! that owns the pipelines, the frame uniforms and the recording of a frame.
+//!
+//! Design decisions:
+//! - **Patch ids are frame-wide.** Arrays are numbered in order; patch `i` of array `a` has id
+//!   `arrays[a].first_patch + i`, which is what the TES writes into a captured record and what
+//!   [`Technique::face_point`] maps back to a base face.
+//! - **Pipelines are described, not built, by techniques.** [`Technique::patch_pipeline`] names
+//!   the stages of one patch type; the context builds and caches every (technique, patch type,
+//!   spacing, pass) in one cache keyed by [`crate::context::PipelineKey`], and applies the pass
+//!   style (shaded, wireframe overlay, attachment-less capture) the same way for all.
+//! - **Recording borrows.** [`Technique::record_array`] takes `&'a self` with a
+//!   [`vk_core::Encoder<'a>`], so every buffer and set bound stays alive as long as the
+//!   encoder; a technique's mutable work (uploading animated base positions) happens before.
+//! - **Capabilities are data.** What options a technique takes ([`Features`]) is declared in
+//!   the [`crate::techniques::registry`], so callers check options generically and name the
+//!   techniques that would accept a refused option.
+use crate::camera::Camera;
+use crate::capture::FacePoint;
+use crate::error::{Result, TessError};
+use crate::shaders::Stage;
+use crate::tessellator::{Domain, Spacing};
+use vk_core::{DescriptorSet, Encoder};
+
+/// The techniques Tessera has; keys pipelines and names techniques in messages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TechniqueId {
+    Flat,
+    Phong,
+    Pn,
+    Bft,
+}
+
+impl TechniqueId {
+    /// The command-line name (`--method NAME`).
+    pub fn name(self) -> &'static str {
+        match self {
+            TechniqueId::Flat => "flat",
+            TechniqueId::Phong => "phong",
+            TechniqueId::Pn => "pn",
+            TechniqueId::Bft => "bft",
+        }
+    }
+}
+
+impl std::fmt::Display for TechniqueId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The type of the patches of one array: decides the domain, the shader stages and the
+/// pipeline. Future techniques add theirs (regular B-spline, Gregory, ...).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PatchType {
+    /// A base triangle (or fan triangle of a polygon), three control points.
+    Triangle,
+    /// A base quad, four control points.
+    Quad,
+    /// A level-1 Loop face evaluated from basis-function tables: one control point (the face).
+    LoopBft,
+}
+
+impl PatchType {
+    pub fn domain(self) -> Domain {
+        match self {
+            PatchType::Quad => Domain::Quad,
+            PatchType::Triangle | PatchType::LoopBft => Domain::Triangle,
+        }
+    }
+}
+
+/// One array of patches of one type.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PatchArray {
+    pub patch: PatchType,
+    pub patches: u32,
+    pub control_points: u32,
+    /// Frame-wide id of the array's first patch.
+    pub first_patch: u32,
+}
+
+/// Numbers arrays frame-wide from `(type, patches, control points)`, leaving out empty ones.
+pub fn number_arrays(arrays: &[(PatchType, u32, u32)]) -> Vec<PatchArray> {
+    let mut first_patch = 0;
+    let mut out = Vec::new();
+    for &(patch, patches, control_points) in arrays {
+        if patches > 0 {
+            out.push(PatchArray {
+                patch,
+                patches,
+                control_points,
+                first_patch,
+            });
+            first_patch += patches;
+        }
+    }
+    out
+}
+
+/// Which pass a pipeline draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Pass {
+    /// Filled and shaded (pushed back slightly so the overlay wins the depth test).
+    Shaded,
+    /// Wireframe overlay (lines, no depth writes).
+    Wireframe,
+    /// No attachments, rasterizer discard; the TES's `-DCAPTURE` build writes transform
+    /// feedback records.
+    Capture,
+}
+
+impl Pass {
+    /// The `mode` the shaders read from their push constants (0 shaded, 1 wireframe).
+    pub fn mode(self) -> u32 {
+        (self == Pass::Wireframe) as u32
+    }
+}
+
+/// How a draw chooses its tessellation factors. Every technique takes `Uniform`; the adaptive
+/// ones are declared in [`Features::adaptive_factors`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FactorPolicy {
+    /// `segments` per base edge (the outer and inner level of a base-face patch).
+    Uniform { segments: f32 },
+    /// Edge factor = projected edge length / `pixels` per segment.
+    Screen { pixels: f32 },
+    /// An edge at `reference` distance from the eye gets the maximum level; the factor halves
+    /// each time the distance doubles.
+    Distance { reference: f32 },
+}
+
+impl Default for FactorPolicy {
+    fn default() -> Self {
+        FactorPolicy::Uniform { segments: 4.0 }
+    }
+}
+
+impl std::fmt::Display for FactorPolicy {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FactorPolicy::Uniform { segments } => write!(f, "{segments} segments per edge"),
+            FactorPolicy::Screen { pixels } => write!(f, "screen-space, {pixels} px per segment"),
+            FactorPolicy::Distance { reference } => {
+                write!(f, "distance, maximum level at {reference}")
+            }
+        }
+    }
+}
+
+/// Whether tessellated draws are split for drivers that need it. `Off` exists only so a test can
+/// show the driver bug the split works around.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum DrawSplit {
+    #[default]
+    Auto,
+    Off,
+    /// One patch per draw: the slowest and surest reference.
+    PerPatch,
+}
+
+/// Everything that decides what one frame shows, for every technique.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameParams {
+    pub factors: FactorPolicy,
+    pub spacing: Spacing,
+    pub wireframe: bool,
+    pub camera: Camera,
+    /// Phong tessellation shape factor α (read by Phong only).
+    pub phong_alpha: f32,
+    /// Normals from the surface's parametric derivatives instead of its shading normals.
+    pub geometric_normals: bool,
+    /// Colour patches by type.
+    pub patch_colours: bool,
+    pub split: DrawSplit,
+    pub base_color: [f32; 3],
+    pub clear_color: [f32; 4],
+}
+
+impl Default for FrameParams {
+    fn default() -> Self {
+        Self {
+            factors: FactorPolicy::default(),
+            spacing: Spacing::Equal,
+            wireframe: false,
+            camera: Camera::default(),
+            phong_alpha: 0.75,
+            geometric_normals: false,
+            patch_colours: false,
+            split: DrawSplit::Auto,
+            base_color: [0.85, 0.72, 0.55],
+            clear_color: [0.12, 0.13, 0.16, 1.0],
+        }
+    }
+}
+
+impl FrameParams {
+    /// Uniform factors of `segments` per base edge.
+    pub fn uniform(segments: f32) -> Self {
+        Self {
+            factors: FactorPolicy::Uniform { segments },
+            ..Self::default()
+        }
+    }
+
+    /// The uniform level, if the factors are uniform.
+    pub fn uniform_segments(&self) -> Option<f32> {
+        match self.factors {
+            FactorPolicy::Uniform { segments } => Some(segments),
+            _ => None,
+        }
+    }
+}
+
+/// What a technique accepts beyond uniform factors, declared once per technique.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Features {
+    /// Screen-space and distance factor policies.
+    pub adaptive_factors: bool,
+    /// Which spacings: (equal, fractional even, fractional odd).
+    pub spacings: [bool; 3],
+    /// Base positions may change every frame ([`Technique::update_base`]).
+    pub animation: bool,
+    pub patch_colours: bool,
+    pub geometric_normals: bool,
+    /// The Phong shape factor.
+    pub phong_alpha: bool,
+    /// Basis-function table level.
+    pub table_level: bool,
+    /// Needs triangles (polygons are fan-triangulated first, with a note).
+    pub triangles_only: bool,
+}
+
+impl Features {
+    pub fn spacing(&self, s: Spacing) -> bool {
+        self.spacings[match s {
+            Spacing::Equal => 0,
+            Spacing::FractionalEven => 1,
+            Spacing::FractionalOdd => 2,
+        }]
+    }
+}
+
+/// The stages and fixed state of one patch type's pipelines. The evaluation stage is picked
+/// per spacing and (for capture) its `-DCAPTURE` build; capture pipelines drop the fragment
+/// stage.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PatchPipeline {
+    pub vertex: Stage,
+    pub control: Stage,
+    pub evaluation: Stage,
+    pub fragment: Stage,
+    pub control_points: u32,
+    /// Reads the interleaved [`crate::gpu::Vertex`] buffer at binding 0.
+    pub mesh_vertex_input: bool,
+    /// Bytes of the push-constant block every stage shares.
+    pub push_constant_bytes: u32,
+}
+
+/// How many draws and patches one recorded pass issued (for tests of the draw split).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DrawCounts {
+    pub draws: u32,
+    pub patches: u32,
+}
+
+impl std::ops::AddAssign for DrawCounts {
+    fn add_assign(&mut self, o: Self) {
+        self.draws += o.draws;
+        self.patches += o.patches;
+    }
+}
+
+/// A technique, as every caller sees it. Object safe: callers hold `Box<dyn Technique>`.
+pub trait Technique {
+    fn id(&self) -> TechniqueId;
+
+    /// Axis-aligned bounds of the current base positions (frames the camera).
+    fn bbox(&self) -> ([f32; 3], [f32; 3]);
+
+    /// The patch arrays, frame-wide numbered (see [`number_arrays`]).
+    fn patch_arrays(&self) -> &[PatchArray];
+
+    /// Checks `params` against what this technique and this surface can draw; errors name the
+    /// option at fault. Called before anything is recorded.
+    fn check(&self, params: &FrameParams) -> Result<()>;
+
+    /// Stages of one of its patch types.
+    fn patch_pipeline(&self, patch: PatchType) -> PatchPipeline;
+
+    /// Descriptor-set layout of its set 1, if its pipelines have one (set 0 is the frame's).
+    /// One layout per technique type, made by the context ([`crate::Context::set_layout`]).
+    fn set_layout_bindings(&self) -> &'static [vk_core::descriptor::BindingDesc] {
+        &[]
+    }
+
+    /// Its set 1 for frame slot `slot`, when it has one.
+    fn descriptor_set(&self, slot: usize) -> Option<&DescriptorSet> {
+        let _ = slot;
+        None
+    }
+
+    /// Vertices one patch of `array` emits at most under `params` (sizes draw splits).
+    fn max_vertices_per_patch(&self, params: &FrameParams, array: usize) -> u64;
+
+    /// Triangles `array` emits under `params` when the CPU knows it exactly (uniform factors),
+    /// else `None` (a capture then measures first).
+    fn triangles(&self, params: &FrameParams, array: usize) -> Option<u64>;
+
+    /// The control mesh whose positions [`Technique::update_base`] replaces (in its vertex
+    /// order), for techniques with [`Features::animation`].
+    fn base_mesh(&self) -> Option<&topology::ControlMesh> {
+        None
+    }
+
+    /// Uploads new base positions for frame slot `slot` (animation). Techniques without
+    /// [`Features::animation`] refuse.
+    fn update_base(&mut self, slot: usize, positions: &[[f32; 3]]) -> Result<()> {
+        let _ = (slot, positions);
+        Err(TessError::Unsupported {
+            technique: self.id(),
+            what: "animated base positions",
+        })
+    }
+
+    /// Commands before the rendering scope (compute kernels) for frame slot `slot`, with the
+    /// barriers that order them after the previous frame's reads and before this frame's
+    /// tessellation stages.
+    fn record_pre_pass<'a>(
+        &'a self,
+        enc: &mut Encoder<'a>,
+        frame_set: &'a DescriptorSet,
+        slot: usize,
+    ) -> Result<()> {
+        let _ = (enc, frame_set, slot);
+        Ok(())
+    }
+
+    /// Records the draws of `array` with its pipeline and sets already bound by the context,
+    /// `per_draw` patches at most per draw, each draw's first patch id in its push constants.
+    fn record_array<'a>(
+        &'a self,
+        enc: &mut Encoder<'a>,
+        array: usize,
+        params: &FrameParams,
+        pass: Pass,
+        per_draw: u32,
+    ) -> Result<DrawCounts>;
+
+    /// Maps a captured (patch id, `gl_TessCoord.xy`) to a point of a base face, in
+    /// [`crate::capture::face_corner_uv`]'s convention; `None` for an id it never drew.
+    fn face_point(&self, patch: u32, domain: [f32; 2]) -> Option<FacePoint>;
+
+    /// Lines for reports (e.g. the memory of its tables).
+    fn report_notes(&self) -> Vec<String> {
+        Vec::new()
+    }
+}
+
+/// Splits patches `0..patches` of an array into draws of at most `per_draw`, calling
+/// `draw(first, count)` for each: the loop every technique's `record_array` shares.
+pub fn for_each_draw(
+    patches: u32,
+    per_draw: u32,
+    mut draw: impl FnMut(u32, u32) -> Result<()>,
+) -> Result<DrawCounts> {
+    let per_draw = per_draw.max(1);
+    let mut counts = DrawCounts::default();
+    let mut first = 0;
+    while first < patches {
+        let n = per_draw.min(patches - first);
+        draw(first, n)?;
+        counts.draws += 1;
+        counts.patches += n;
+        first += n;
+    }
+    Ok(counts)
+}

@@ -1,0 +1,176 @@
+//! Every technique, and the registry that builds one by name: the only place that knows
+//! which techniques exist. Callers (viewer, bench, export, C ABI) build through [`build`] and
+//! check options against [`TechniqueInfo::features`].
+pub mod bft;
+pub mod face_patches;
+pub mod flat;
+pub mod phong;
+pub mod pn;
+
+use crate::context::Context;
+use crate::error::{Result, TessError};
+use crate::technique::{Features, Technique, TechniqueId};
+use topology::ControlMesh;
+
+/// What the registry says of one technique.
+#[derive(Clone, Copy, Debug)]
+pub struct TechniqueInfo {
+    pub id: TechniqueId,
+    /// One line for `--help` and reports.
+    pub help: &'static str,
+    pub features: Features,
+    /// The subdivision scheme whose limit surface it draws (None: not a subdivision surface).
+    pub scheme: Option<topology::Scheme>,
+}
+
+const BASE_FACES: Features = Features {
+    adaptive_factors: false,
+    spacings: [true, true, true],
+    animation: false,
+    patch_colours: false,
+    geometric_normals: false,
+    phong_alpha: false,
+    table_level: false,
+    triangles_only: false,
+};
+
+static REGISTRY: [TechniqueInfo; 4] = [
+    TechniqueInfo {
+        id: TechniqueId::Flat,
+        help: "flat tessellation of each base face (quads as quad patches)",
+        features: BASE_FACES,
+        scheme: None,
+    },
+    TechniqueInfo {
+        id: TechniqueId::Phong,
+        help: "Phong tessellation (Boubekeur & Alexa 2008) of the fan triangles",
+        features: Features {
+            phong_alpha: true,
+            ..BASE_FACES
+        },
+        scheme: None,
+    },
+    TechniqueInfo {
+        id: TechniqueId::Pn,
+        help: "curved PN triangles with the corrected normal field",
+        features: BASE_FACES,
+        scheme: None,
+    },
+    TechniqueInfo {
+        id: TechniqueId::Bft,
+        help: "exact Loop limit surface from basis-function tables (Holländer & Boubekeur)",
+        features: Features {
+            adaptive_factors: true,
+            spacings: [true, true, false],
+            animation: true,
+            patch_colours: true,
+            geometric_normals: true,
+            phong_alpha: false,
+            table_level: true,
+            triangles_only: true,
+        },
+        scheme: Some(topology::Scheme::Loop),
+    },
+];
+
+/// Every technique, in the order reports list them (flat first: ratios divide by it).
+pub fn registry() -> &'static [TechniqueInfo] {
+    &REGISTRY
+}
+
+/// The registry entry of `id`.
+pub fn info(id: TechniqueId) -> &'static TechniqueInfo {
+    REGISTRY
+        .iter()
+        .find(|i| i.id == id)
+        .unwrap_or(&REGISTRY[0])
+}
+
+/// The techniques that have a feature, by name, for messages ("needs --method bft").
+pub fn names_with(feature: impl Fn(&Features) -> bool) -> Vec<&'static str> {
+    REGISTRY
+        .iter()
+        .filter(|i| feature(&i.features))
+        .map(|i| i.id.name())
+        .collect()
+}
+
+impl std::str::FromStr for TechniqueId {
+    type Err = TessError;
+    fn from_str(s: &str) -> Result<Self> {
+        REGISTRY
+            .iter()
+            .find(|i| i.id.name() == s)
+            .map(|i| i.id)
+            .ok_or_else(|| TessError::UnknownTechnique {
+                name: s.to_string(),
+                known: REGISTRY
+                    .iter()
+                    .map(|i| i.id.name())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })
+    }
+}
+
+/// How a surface is built (per-frame choices are [`crate::FrameParams`]).
+#[derive(Clone, Debug)]
+pub struct BuildOptions {
+    /// Name for messages (the mesh's file).
+    pub name: String,
+    /// Basis-function table level (techniques with [`Features::table_level`]).
+    pub table_level: u32,
+    /// Build what geometric normals need (techniques with [`Features::geometric_normals`]).
+    pub tangents: bool,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        Self {
+            name: "mesh".into(),
+            table_level: bft::DEFAULT_TABLE_LEVEL,
+            tangents: false,
+        }
+    }
+}
+
+/// A built technique and what the caller should tell the user about how it took the mesh.
+pub struct Built {
+    pub technique: Box<dyn Technique>,
+    pub notes: Vec<String>,
+}
+
+/// Builds technique `id` for `mesh` on `ctx`'s device, with one frame slot per slot of `ctx`.
+pub fn build(
+    ctx: &mut Context,
+    id: TechniqueId,
+    mesh: &ControlMesh,
+    options: &BuildOptions,
+) -> Result<Built> {
+    let device = ctx.device().clone();
+    let technique: Box<dyn Technique> = match id {
+        TechniqueId::Flat => Box::new(flat::Flat::new(&device, mesh)?),
+        TechniqueId::Phong => Box::new(phong::Phong::new(&device, mesh)?),
+        TechniqueId::Pn => Box::new(pn::Pn::new(&device, mesh)?),
+        TechniqueId::Bft => {
+            let b = bft::Bft::new(
+                ctx,
+                mesh,
+                &bft::BftOptions {
+                    table_level: options.table_level,
+                    tangents: options.tangents,
+                    name: options.name.clone(),
+                },
+            )?;
+            let notes = b.notes.clone();
+            return Ok(Built {
+                technique: Box::new(b),
+                notes,
+            });
+        }
+    };
+    Ok(Built {
+        technique,
+        notes: Vec::new(),
+    })
+}
