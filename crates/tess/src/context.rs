@@ -322,7 +322,7 @@ impl Context {
         Ok(counts)
     }
 
-    /// Records one pass of one patch array (binds its pipeline and sets).
+    /// Records one pass of one patch array: [`Self::bind_array`], then its draws.
     pub fn record_array<'a>(
         &'a self,
         enc: &mut Encoder<'a>,
@@ -332,6 +332,21 @@ impl Context {
         pass: Pass,
         array: usize,
     ) -> Result<DrawCounts> {
+        self.bind_array(enc, technique, slot, params, pass, array)?;
+        self.draw_array(enc, technique, params, pass, array)
+    }
+
+    /// Binds the pipeline and sets of one pass of one patch array (a capture begins transform
+    /// feedback after this: Vulkan wants the pipeline bound first).
+    pub fn bind_array<'a>(
+        &'a self,
+        enc: &mut Encoder<'a>,
+        technique: &'a dyn Technique,
+        slot: usize,
+        params: &FrameParams,
+        pass: Pass,
+        array: usize,
+    ) -> Result<()> {
         let a = technique
             .patch_arrays()
             .get(array)
@@ -349,13 +364,29 @@ impl Context {
                 technique: key.technique,
                 pass,
             })?;
-        enc.begin_label(&format!("{} {:?} {:?}", key.technique, a.patch, pass));
         enc.bind_pipeline(pipeline);
         let frame_set = self.frame_set(slot)?;
         match technique.descriptor_set(slot) {
             Some(set) => enc.bind_descriptor_sets(0, &[frame_set, set])?,
             None => enc.bind_descriptor_sets(0, &[frame_set])?,
         }
+        Ok(())
+    }
+
+    /// The draws of one pass of one patch array, after [`Self::bind_array`].
+    pub fn draw_array<'a>(
+        &'a self,
+        enc: &mut Encoder<'a>,
+        technique: &'a dyn Technique,
+        params: &FrameParams,
+        pass: Pass,
+        array: usize,
+    ) -> Result<DrawCounts> {
+        let a = technique
+            .patch_arrays()
+            .get(array)
+            .ok_or(TessError::NoPatchArray { array })?;
+        enc.begin_label(&format!("{} {:?} {:?}", technique.id(), a.patch, pass));
         let per_draw = self.patches_per_draw(technique, params, array);
         let counts = technique.record_array(enc, array, params, pass, per_draw)?;
         enc.end_label();

@@ -92,9 +92,8 @@ pub enum TessError {
     /// A benchmark setting that cannot run (the message names the option).
     #[error("{option}: {reason}")]
     BenchConfig { option: String, reason: String },
-    #[error("{path}:{line}: bad {column} '{value}'")]
+    #[error("CSV line {line}: bad {column} '{value}'")]
     Csv {
-        path: String,
         line: usize,
         column: String,
         value: String,

@@ -123,12 +123,6 @@ impl DescriptorPool {
     }
 }
 
-impl DescriptorPool {
-    pub(crate) fn device_shared(&self) -> &Arc<DeviceShared> {
-        &self.device
-    }
-}
-
 impl Drop for DescriptorPool {
     fn drop(&mut self) {
         // SAFETY: owners drop pools after the GPU finished using their sets.

@@ -87,7 +87,6 @@ pub struct Pipeline {
     pub raw: vk::Pipeline,
     pub layout: vk::PipelineLayout,
     pub bind_point: vk::PipelineBindPoint,
-    pub push_constant_bytes: u32,
     device: Arc<DeviceShared>,
 }
 
@@ -265,7 +264,6 @@ impl Pipeline {
                     raw: p[0],
                     layout,
                     bind_point: vk::PipelineBindPoint::GRAPHICS,
-                    push_constant_bytes: desc.push_constant_bytes,
                     device: device.shared.clone(),
                 })
             }
@@ -318,7 +316,6 @@ impl Pipeline {
                     raw: p[0],
                     layout,
                     bind_point: vk::PipelineBindPoint::COMPUTE,
-                    push_constant_bytes,
                     device: device.shared.clone(),
                 })
             }

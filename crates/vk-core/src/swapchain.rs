@@ -56,7 +56,7 @@ pub struct Swapchain {
     loader: ash::khr::swapchain::Device,
     surface: vk::SurfaceKHR,
     surface_loader: ash::khr::surface::Instance,
-    pub(crate) device: Device,
+    device: Device,
     _instance: Arc<Instance>,
 }
 

@@ -270,7 +270,6 @@ pub fn parse_csv(text: &str) -> Result<Vec<BenchRow>> {
     let header = lines.next().unwrap_or_default();
     if header.trim_end() != CSV_HEADER {
         return Err(TessError::Csv {
-            path: "CSV".into(),
             line: 1,
             column: "header".into(),
             value: header.to_string(),
@@ -285,14 +284,12 @@ pub fn parse_csv(text: &str) -> Result<Vec<BenchRow>> {
         let f = split_csv_line(line);
         if f.len() != 18 {
             return Err(TessError::Csv {
-                path: "CSV".into(),
-                line: line_no,
+                    line: line_no,
                 column: "field count (expected 18)".into(),
                 value: f.len().to_string(),
             });
         }
         let err = |col: &str, v: &str| TessError::Csv {
-            path: "CSV".into(),
             line: line_no,
             column: col.into(),
             value: v.into(),

@@ -232,9 +232,10 @@ impl Capturer {
                     width: 1,
                     height: 1,
                 });
+                ctx.bind_array(enc, technique, 0, params, Pass::Capture, i)?;
                 enc.begin_transform_feedback(&[buffer], &[])?;
                 enc.begin_query_stream(&query, i as u32, 0)?;
-                counts += ctx.record_array(enc, technique, 0, params, Pass::Capture, i)?;
+                counts += ctx.draw_array(enc, technique, params, Pass::Capture, i)?;
                 enc.end_query_stream(&query, i as u32, 0)?;
                 enc.end_transform_feedback(&[])?;
                 enc.end_rendering();
