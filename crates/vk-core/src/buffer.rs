@@ -1,10 +1,20 @@
 //! Buffers with their gpu-allocator memory; uploads go through a staging buffer when the memory
 //! is not host-visible.
+//!
+//! Design decisions:
+//! - The handle and its memory live in a shared `BufferShared`: a [`crate::DescriptorSet`] that
+//!   points at the buffer keeps it alive, so dropping the `Buffer` first cannot leave the set
+//!   pointing at a destroyed buffer. The last owner hands handle and memory to the device's
+//!   retire queue, which destroys them once no submission that could use them is pending.
+//! - Host access (mapped slices) belongs to the `Buffer` alone, through `&self` / `&mut self`;
+//!   descriptor sets never touch the memory.
 use crate::device::{Device, DeviceShared};
 use crate::error::{Result, VkContext, VkError};
+use crate::retire::Retired;
 use ash::vk;
 use gpu_allocator::vulkan::Allocation;
 use gpu_allocator::MemoryLocation;
+use std::ptr::NonNull;
 use std::sync::Arc;
 
 #[derive(Clone, Debug)]
@@ -15,14 +25,41 @@ pub struct BufferDesc<'a> {
     pub location: MemoryLocation,
 }
 
-/// A buffer and its memory. Drop order: buffer handle, then the allocation is handed back.
-pub struct Buffer {
-    pub raw: vk::Buffer,
-    pub size: u64,
+/// The handle and memory, shared by the [`Buffer`] and the descriptor sets that point at it.
+pub(crate) struct BufferShared {
+    pub(crate) raw: vk::Buffer,
+    pub(crate) usage: vk::BufferUsageFlags,
+    pub(crate) name: String,
     allocation: Option<Allocation>,
-    name: String,
     device: Arc<DeviceShared>,
 }
+
+impl Drop for BufferShared {
+    fn drop(&mut self) {
+        self.device.retire(Retired::Buffer {
+            raw: self.raw,
+            allocation: self.allocation.take(),
+        });
+    }
+}
+
+/// A buffer and its memory.
+pub struct Buffer {
+    // LEGACY: removed once tess records through Encoder (raw handles are for legacy recording).
+    #[doc(hidden)]
+    pub raw: vk::Buffer,
+    pub size: u64,
+    /// The mapping of host-visible memory: `size` bytes owned by `shared`'s allocation.
+    mapped: Option<NonNull<u8>>,
+    pub(crate) shared: Arc<BufferShared>,
+}
+
+// SAFETY: `mapped` points into the allocation that `shared` keeps alive; slices of it are only
+// made through `&self` (shared) and `&mut self` (exclusive), so Rust's borrow rules on `Buffer`
+// are the synchronization, exactly as for a `Vec<u8>`.
+unsafe impl Send for Buffer {}
+// SAFETY: as above; `&Buffer` only gives shared slices.
+unsafe impl Sync for Buffer {}
 
 impl Buffer {
     pub fn new(device: &Device, desc: &BufferDesc<'_>) -> Result<Self> {
@@ -43,18 +80,27 @@ impl Buffer {
             match device.allocate_bound(desc.name, requirements, desc.location, true, bind) {
                 Ok(a) => a,
                 Err(e) => {
-                    // SAFETY: raw is unused.
+                    // SAFETY: raw was never used by any command.
                     unsafe { device.raw.destroy_buffer(raw, None) };
                     return Err(e);
                 }
             };
         device.set_name(raw, desc.name);
+        let mapped = allocation
+            .mapped_ptr()
+            .filter(|_| allocation.size() >= size)
+            .map(|p| p.cast::<u8>());
         Ok(Self {
             raw,
             size,
-            allocation: Some(allocation),
-            name: desc.name.to_owned(),
-            device: device.shared.clone(),
+            mapped,
+            shared: Arc::new(BufferShared {
+                raw,
+                usage: desc.usage,
+                name: desc.name.to_owned(),
+                allocation: Some(allocation),
+                device: device.shared.clone(),
+            }),
         })
     }
 
@@ -74,11 +120,11 @@ impl Buffer {
                 location: MemoryLocation::GpuOnly,
             },
         )?;
-        if buffer.mapped_mut().is_some() {
+        if buffer.mapped.is_some() {
             buffer.write(0, data)?;
             return Ok(buffer);
         }
-        let staging = Self::new(
+        let mut staging = Self::new(
             device,
             &BufferDesc {
                 name: &format!("{name} (staging)"),
@@ -87,48 +133,53 @@ impl Buffer {
                 location: MemoryLocation::CpuToGpu,
             },
         )?;
-        let mut staging = staging;
         staging.write(0, data)?;
-        let size = data.len() as u64;
-        device.one_shot(|cmd| {
-            let region = [vk::BufferCopy::default().size(size.max(4))];
-            // SAFETY: both buffers are live and large enough; cmd is recording.
-            unsafe {
-                device
-                    .raw
-                    .cmd_copy_buffer(cmd, staging.raw, buffer.raw, &region)
-            };
-        })?;
+        device.submit_once(|enc| enc.copy_buffer(&staging, &buffer))??;
         Ok(buffer)
     }
 
     pub fn name(&self) -> &str {
-        &self.name
+        &self.shared.name
+    }
+
+    pub fn size(&self) -> u64 {
+        self.size
+    }
+
+    pub fn usage(&self) -> vk::BufferUsageFlags {
+        self.shared.usage
     }
 
     pub fn mapped(&self) -> Option<&[u8]> {
-        self.allocation.as_ref()?.mapped_slice()
+        let p = self.mapped?;
+        // SAFETY: `p` maps `size` bytes of the allocation `shared` keeps alive; `&self` makes
+        // the slice shared (see the Send/Sync note on `Buffer`).
+        Some(unsafe { std::slice::from_raw_parts(p.as_ptr(), self.size as usize) })
     }
 
     pub fn mapped_mut(&mut self) -> Option<&mut [u8]> {
-        self.allocation.as_mut()?.mapped_slice_mut()
+        let p = self.mapped?;
+        // SAFETY: as in `mapped`; `&mut self` makes the slice exclusive.
+        Some(unsafe { std::slice::from_raw_parts_mut(p.as_ptr(), self.size as usize) })
     }
 
     /// Copies bytes into a host-visible buffer at `offset`.
     pub fn write(&mut self, offset: u64, data: &[u8]) -> Result<()> {
-        let name = self.name.clone();
-        let slice = self
-            .mapped_mut()
-            .ok_or_else(|| VkError::Invalid(format!("buffer {name} is not host-visible")))?;
-        let start = offset as usize;
+        let size = self.size;
+        let name = self.shared.name.clone();
+        let slice = self.mapped_mut().ok_or_else(|| VkError::NotHostVisible {
+            buffer: name.clone(),
+        })?;
+        let start = usize::try_from(offset).unwrap_or(usize::MAX);
         let end = start
             .checked_add(data.len())
             .filter(|&e| e <= slice.len())
-            .ok_or_else(|| {
-                VkError::Invalid(format!(
-                    "write of {} bytes at {offset} overflows buffer {name}",
-                    data.len()
-                ))
+            .ok_or(VkError::OutOfBounds {
+                object: name,
+                what: "host write",
+                offset,
+                len: data.len() as u64,
+                size,
             })?;
         slice[start..end].copy_from_slice(data);
         Ok(())
@@ -136,31 +187,22 @@ impl Buffer {
 
     /// Reads a host-visible buffer as `T`s (the buffer's whole size, rounded down).
     pub fn read<T: bytemuck::Pod>(&self) -> Result<Vec<T>> {
-        let slice = self
-            .mapped()
-            .ok_or_else(|| VkError::Invalid(format!("buffer {} is not host-visible", self.name)))?;
-        let n = slice.len() / std::mem::size_of::<T>();
+        let slice = self.mapped().ok_or_else(|| VkError::NotHostVisible {
+            buffer: self.shared.name.clone(),
+        })?;
+        let n = slice.len() / std::mem::size_of::<T>().max(1);
         let mut out = vec![T::zeroed(); n];
         bytemuck::cast_slice_mut::<T, u8>(&mut out)
             .copy_from_slice(&slice[..n * std::mem::size_of::<T>()]);
         Ok(out)
     }
 
+    // LEGACY: removed once tess records through Encoder (DescriptorPool::write_buffers).
+    #[doc(hidden)]
     pub fn descriptor(&self) -> vk::DescriptorBufferInfo {
         vk::DescriptorBufferInfo::default()
             .buffer(self.raw)
             .offset(0)
             .range(vk::WHOLE_SIZE)
-    }
-}
-
-impl Drop for Buffer {
-    fn drop(&mut self) {
-        // SAFETY: owners keep buffers alive until the GPU finished with them (one-shot submits
-        // wait; frame resources are dropped after a wait for their fence).
-        unsafe { self.device.raw.destroy_buffer(self.raw, None) };
-        if let Some(a) = self.allocation.take() {
-            self.device.free(a);
-        }
     }
 }

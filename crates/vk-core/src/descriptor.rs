@@ -1,21 +1,45 @@
-//! Descriptor-set layouts and a small pool that owns the sets it hands out.
+//! Descriptor-set layouts, pools, and typed descriptor sets.
+//!
+//! Design decisions:
+//! - A [`DescriptorSet`] is owned and typed: it keeps its pool, its layout and every buffer
+//!   written into it alive (Vulkan forbids destroying any of them while the set may be used, and
+//!   updating a set whose layout is gone), and is freed with its pool once the last set and the
+//!   pool handle are dropped.
+//! - [`DescriptorSet::write_buffer`] checks what Vulkan would otherwise leave to the caller: the
+//!   binding exists with that type, the buffer has the matching usage, the range fits the device's
+//!   limit, and the set is not in use (bound in a recording that was not submitted: refused; used
+//!   by submissions still pending: waited for).
+use crate::buffer::{Buffer, BufferShared};
 use crate::device::{Device, DeviceShared};
-use crate::error::{Result, VkContext};
+use crate::error::{DescriptorError, Result, VkContext, VkError};
+use crate::retire::Retired;
 use ash::vk;
-use std::sync::Arc;
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
 
 /// One binding of a set: (binding index, type, stages).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BindingDesc {
     pub binding: u32,
     pub ty: vk::DescriptorType,
     pub stages: vk::ShaderStageFlags,
 }
 
+struct LayoutShared {
+    raw: vk::DescriptorSetLayout,
+    device: Arc<DeviceShared>,
+}
+
+impl Drop for LayoutShared {
+    fn drop(&mut self) {
+        self.device.retire(Retired::DescriptorSetLayout(self.raw));
+    }
+}
+
 pub struct DescriptorSetLayout {
     pub raw: vk::DescriptorSetLayout,
     pub bindings: Vec<BindingDesc>,
-    device: Arc<DeviceShared>,
+    shared: Arc<LayoutShared>,
 }
 
 impl DescriptorSetLayout {
@@ -31,33 +55,43 @@ impl DescriptorSetLayout {
             })
             .collect();
         let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&vk_bindings);
-        // SAFETY: device live.
+        // SAFETY: device live; the info references live locals.
         let raw = unsafe { device.raw.create_descriptor_set_layout(&info, None) }
             .ctx("vkCreateDescriptorSetLayout")?;
         device.set_name(raw, name);
         Ok(Self {
             raw,
             bindings: bindings.to_vec(),
-            device: device.shared.clone(),
+            shared: Arc::new(LayoutShared {
+                raw,
+                device: device.shared.clone(),
+            }),
         })
     }
 }
 
-impl Drop for DescriptorSetLayout {
+struct PoolShared {
+    raw: vk::DescriptorPool,
+    name: String,
+    /// Allocation from a pool is externally synchronized.
+    lock: Mutex<()>,
+    device: Arc<DeviceShared>,
+}
+
+impl Drop for PoolShared {
     fn drop(&mut self) {
-        // SAFETY: pipelines using the layout were created already; layouts may be destroyed then.
-        unsafe {
-            self.device
-                .raw
-                .destroy_descriptor_set_layout(self.raw, None)
-        };
+        self.device.retire(Retired::DescriptorPool(self.raw));
     }
 }
 
-/// A pool sized for `max_sets` sets of a layout; freeing the pool frees its sets.
+/// A pool sized for `max_sets` sets of a layout; its sets are freed with it.
 pub struct DescriptorPool {
+    // LEGACY: removed once tess records through Encoder (raw handle for legacy recording).
+    #[doc(hidden)]
     pub raw: vk::DescriptorPool,
-    device: Arc<DeviceShared>,
+    shared: Arc<PoolShared>,
+    /// Sets handed out so far, for their names.
+    allocated: AtomicU32,
 }
 
 impl DescriptorPool {
@@ -80,27 +114,65 @@ impl DescriptorPool {
         let info = vk::DescriptorPoolCreateInfo::default()
             .max_sets(max_sets)
             .pool_sizes(&sizes);
-        // SAFETY: device live.
+        // SAFETY: device live; the info references live locals.
         let raw = unsafe { device.raw.create_descriptor_pool(&info, None) }
             .ctx("vkCreateDescriptorPool")?;
         device.set_name(raw, name);
         Ok(Self {
             raw,
-            device: device.shared.clone(),
+            shared: Arc::new(PoolShared {
+                raw,
+                name: name.to_owned(),
+                lock: Mutex::new(()),
+                device: device.shared.clone(),
+            }),
+            allocated: AtomicU32::new(0),
         })
     }
 
-    pub fn allocate(&self, layout: &DescriptorSetLayout) -> Result<vk::DescriptorSet> {
+    fn allocate_raw(&self, layout: &DescriptorSetLayout) -> Result<vk::DescriptorSet> {
         let layouts = [layout.raw];
         let info = vk::DescriptorSetAllocateInfo::default()
             .descriptor_pool(self.raw)
             .set_layouts(&layouts);
-        // SAFETY: pool and layout are live and from this device.
-        Ok(unsafe { self.device.raw.allocate_descriptor_sets(&info) }
-            .ctx("vkAllocateDescriptorSets")?[0])
+        let _guard = self.shared.lock.lock().map_err(|_| VkError::LockPoisoned {
+            what: "descriptor pool",
+        })?;
+        // SAFETY: pool and layout are live and from this device; allocations from the pool are
+        // serialized by its lock.
+        Ok(
+            unsafe { self.shared.device.raw.allocate_descriptor_sets(&info) }
+                .ctx("vkAllocateDescriptorSets")?[0],
+        )
     }
 
-    /// Points each listed binding of `set` at a whole buffer.
+    /// A set of `layout`, owned; the pool lives as long as any of its sets.
+    pub fn allocate_set(&self, layout: &DescriptorSetLayout) -> Result<DescriptorSet> {
+        let raw = self.allocate_raw(layout)?;
+        let n = self.allocated.fetch_add(1, Ordering::Relaxed);
+        let name = format!("{} set {n}", self.shared.name);
+        self.shared.device.set_name(raw, &name);
+        Ok(DescriptorSet {
+            raw,
+            name,
+            bindings: layout.bindings.clone(),
+            written: Mutex::new(vec![None; layout.bindings.len()]),
+            recordings: AtomicU32::new(0),
+            last_use: AtomicU64::new(0),
+            _layout: layout.shared.clone(),
+            pool: self.shared.clone(),
+        })
+    }
+
+    // LEGACY: removed once tess records through Encoder (use DescriptorPool::allocate_set).
+    #[doc(hidden)]
+    pub fn allocate(&self, layout: &DescriptorSetLayout) -> Result<vk::DescriptorSet> {
+        self.allocate_raw(layout)
+    }
+
+    // LEGACY: removed once tess records through Encoder (use DescriptorSet::write_buffer). The
+    // legacy caller keeps the buffers alive and the set idle while it updates it.
+    #[doc(hidden)]
     pub fn write_buffers(
         &self,
         set: vk::DescriptorSet,
@@ -118,14 +190,145 @@ impl DescriptorPool {
                     .buffer_info(info)
             })
             .collect();
-        // SAFETY: the set is not in use by pending command buffers when updated.
-        unsafe { self.device.raw.update_descriptor_sets(&vk_writes, &[]) };
+        // SAFETY: legacy contract (see above).
+        unsafe {
+            self.shared
+                .device
+                .raw
+                .update_descriptor_sets(&vk_writes, &[])
+        };
     }
 }
 
-impl Drop for DescriptorPool {
-    fn drop(&mut self) {
-        // SAFETY: owners drop pools after the GPU finished using their sets.
-        unsafe { self.device.raw.destroy_descriptor_pool(self.raw, None) };
+/// A descriptor set from a [`DescriptorPool`]: owned, typed by its layout's bindings.
+pub struct DescriptorSet {
+    pub(crate) raw: vk::DescriptorSet,
+    name: String,
+    bindings: Vec<BindingDesc>,
+    /// The buffer written into each binding (in `bindings` order), kept alive by the set.
+    written: Mutex<Vec<Option<Arc<BufferShared>>>>,
+    /// Unsubmitted recordings that bound the set (each bind counts once).
+    recordings: AtomicU32,
+    /// The newest submission that used the set.
+    last_use: AtomicU64,
+    /// Drop order: the set's references, then its layout and pool (freed with the pool).
+    _layout: Arc<LayoutShared>,
+    pool: Arc<PoolShared>,
+}
+
+impl DescriptorSet {
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    pub(crate) fn layout_raw(&self) -> vk::DescriptorSetLayout {
+        self._layout.raw
+    }
+
+    /// Counts a recording in, so writes are refused until it is submitted or abandoned; or the
+    /// first binding never written (then nothing is counted). Under the write lock, so a write
+    /// either completes before the recording binds the set or sees it counted.
+    pub(crate) fn enter_recording(&self) -> std::result::Result<(), u32> {
+        let Ok(written) = self.written.lock() else {
+            return Err(self.bindings.first().map_or(0, |b| b.binding));
+        };
+        if let Some((b, _)) = self
+            .bindings
+            .iter()
+            .zip(written.iter())
+            .find(|(_, w)| w.is_none())
+        {
+            return Err(b.binding);
+        }
+        self.recordings.fetch_add(1, Ordering::SeqCst);
+        Ok(())
+    }
+
+    pub(crate) fn leave_recording(&self) {
+        self.recordings.fetch_sub(1, Ordering::SeqCst);
+    }
+
+    pub(crate) fn used_by(&self, serial: u64) {
+        self.last_use.fetch_max(serial, Ordering::SeqCst);
+    }
+
+    /// Safe: checks binding exists in the layout with that type, buffer usage matches, range within the buffer and within the device's maxStorageBufferRange/maxUniformBufferRange (typed error otherwise).
+    ///
+    /// Points `binding` at the whole of `buffer`, which the set then keeps alive. Refused while
+    /// the set is bound in an unsubmitted recording; waits for submissions that used it.
+    pub fn write_buffer(
+        &self,
+        binding: u32,
+        ty: vk::DescriptorType,
+        buffer: &Buffer,
+    ) -> Result<()> {
+        let fail = |problem| VkError::Descriptor {
+            set: self.name.clone(),
+            binding,
+            problem,
+        };
+        let device = &self.pool.device;
+        let slot = self
+            .bindings
+            .iter()
+            .position(|b| b.binding == binding)
+            .ok_or_else(|| fail(DescriptorError::NoSuchBinding))?;
+        let layout_ty = self.bindings[slot].ty;
+        if layout_ty != ty {
+            return Err(fail(DescriptorError::Type {
+                layout: layout_ty,
+                given: ty,
+            }));
+        }
+        let caps = &device.info.caps;
+        let (usage, max) = match ty {
+            vk::DescriptorType::UNIFORM_BUFFER => (
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+                caps.max_uniform_buffer_range,
+            ),
+            vk::DescriptorType::STORAGE_BUFFER => (
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                caps.max_storage_buffer_range,
+            ),
+            other => return Err(fail(DescriptorError::UnsupportedType(other))),
+        };
+        if !buffer.usage().contains(usage) {
+            return Err(fail(DescriptorError::Usage {
+                buffer: buffer.name().to_owned(),
+                needed: usage,
+            }));
+        }
+        if buffer.size() > max as u64 {
+            return Err(fail(DescriptorError::Range {
+                buffer: buffer.name().to_owned(),
+                size: buffer.size(),
+                max: max as u64,
+            }));
+        }
+        let mut written = self.written.lock().map_err(|_| VkError::LockPoisoned {
+            what: "descriptor set",
+        })?;
+        // Checked under the lock: the encoder counts itself in before recording the bind, and a
+        // set already counted in is never updated (that would invalidate the recording).
+        if self.recordings.load(Ordering::SeqCst) > 0 {
+            return Err(fail(DescriptorError::InUse));
+        }
+        device.wait_serial(self.last_use.load(Ordering::SeqCst))?;
+        let info = [vk::DescriptorBufferInfo::default()
+            .buffer(buffer.raw)
+            .offset(0)
+            .range(buffer.size())];
+        let write = vk::WriteDescriptorSet::default()
+            .dst_set(self.raw)
+            .dst_binding(binding)
+            .descriptor_type(ty)
+            .buffer_info(&info);
+        // SAFETY: the binding exists with this type; the buffer has the usage and its size fits
+        // the device's range; the set's layout is alive (held); no recording holds the set and
+        // every submission that used it completed (waited above); updates of this set are
+        // serialized by `written`'s lock. The buffer is kept alive below for as long as the set.
+        unsafe { device.raw.update_descriptor_sets(&[write], &[]) };
+        written[slot] = Some(buffer.shared.clone());
+        Ok(())
     }
 }

@@ -1,6 +1,7 @@
 //! Physical-device choice (deterministic, overridable) and the logical device with its allocator.
 use crate::error::{Result, VkContext, VkError};
 use crate::instance::Instance;
+use crate::retire::RetireQueue;
 use crate::workarounds::Workarounds;
 use ash::vk;
 use gpu_allocator::vulkan::{
@@ -54,6 +55,18 @@ pub struct Capabilities {
     pub max_transform_feedback_buffer_size: u64,
     /// Largest transform-feedback vertex stride, in bytes (0 without the extension).
     pub max_transform_feedback_stride: u32,
+    /// Transform-feedback buffer bindings (0 without the extension).
+    pub max_transform_feedback_buffers: u32,
+    /// Vertex streams transform feedback can count (0 without the extension).
+    pub max_transform_feedback_streams: u32,
+    /// Largest uniform-buffer descriptor range, in bytes.
+    pub max_uniform_buffer_range: u32,
+    /// Largest storage-buffer descriptor range, in bytes.
+    pub max_storage_buffer_range: u32,
+    /// Largest dispatch, in workgroups per dimension.
+    pub max_compute_work_group_count: [u32; 3],
+    /// Timeline semaphores (core in Vulkan 1.2): how vk-core counts submissions.
+    pub timeline_semaphore: bool,
 }
 
 /// One physical device as seen at start-up: identity, capabilities, and what it lacks.
@@ -153,9 +166,12 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
         if has_xfb_extension {
             props2 = props2.push_next(&mut xfb_props);
         }
+        let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
         let mut xfb_feats = vk::PhysicalDeviceTransformFeedbackFeaturesEXT::default();
-        let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+        let mut features2 = vk::PhysicalDeviceFeatures2::default()
+            .push_next(&mut f12)
+            .push_next(&mut f13);
         if has_xfb_extension {
             features2 = features2.push_next(&mut xfb_feats);
         }
@@ -212,6 +228,20 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
             } else {
                 0
             },
+            max_transform_feedback_buffers: if has_xfb_extension {
+                xfb_props.max_transform_feedback_buffers
+            } else {
+                0
+            },
+            max_transform_feedback_streams: if has_xfb_extension {
+                xfb_props.max_transform_feedback_streams
+            } else {
+                0
+            },
+            max_uniform_buffer_range: props.limits.max_uniform_buffer_range,
+            max_storage_buffer_range: props.limits.max_storage_buffer_range,
+            max_compute_work_group_count: props.limits.max_compute_work_group_count,
+            timeline_semaphore: f12.timeline_semaphore == vk::TRUE,
         };
         let mut missing = Vec::new();
         if props.api_version < vk::API_VERSION_1_3 {
@@ -225,6 +255,9 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
         }
         if !caps.dynamic_rendering {
             missing.push("dynamicRendering".to_owned());
+        }
+        if !caps.timeline_semaphore {
+            missing.push("timelineSemaphore".to_owned());
         }
         if caps.tessellation_shader && caps.max_tessellation_generation_level < 64 {
             missing.push(format!(
@@ -314,22 +347,34 @@ pub struct DeviceDesc {
     pub without_transform_feedback: bool,
 }
 
-/// The state every resource shares. Drop order: idle wait, pipeline cache, command pool,
-/// allocator (all allocations already freed by their owners), device; then the instance Arc.
+/// The state every resource shares. Drop order: idle wait, retired objects, one-shot command
+/// pools, timeline semaphore, pipeline cache, allocator (every allocation already handed back),
+/// device; then the instance Arc.
 pub struct DeviceShared {
+    // LEGACY: removed once tess records through Encoder. The new API never hands out the
+    // `ash::Device`: every command goes through vk-core's types.
+    #[doc(hidden)]
     pub raw: ash::Device,
     pub physical: vk::PhysicalDevice,
     pub queue: vk::Queue,
     pub queue_family: u32,
     pub info: AdapterInfo,
     pub workarounds: Workarounds,
-    pub debug_utils: Option<ash::ext::debug_utils::Device>,
+    pub(crate) debug_utils: Option<ash::ext::debug_utils::Device>,
     /// VK_EXT_transform_feedback's commands; `None` when the device lacks the extension or the
     /// feature (see [`DeviceShared::transform_feedback`] for a typed error instead).
+    // LEGACY: removed once tess records through Encoder (tests/capture.rs reads it).
+    #[doc(hidden)]
     pub transform_feedback: Option<ash::ext::transform_feedback::Device>,
     pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
-    pub(crate) one_shot_pool: Mutex<vk::CommandPool>,
+    /// Command pools (each with its one command buffer) free for one-shot recordings: a pool is
+    /// taken for the whole recording, so recordings on several threads never share one.
+    pub(crate) once_pools: Mutex<Vec<(vk::CommandPool, vk::CommandBuffer)>>,
+    /// Serializes queue access (vkQueueSubmit, vkQueuePresentKHR, vkDeviceWaitIdle).
     pub(crate) queue_lock: Mutex<()>,
+    /// Signalled with each submission's serial when it completes (see [`crate::retire`]).
+    pub(crate) timeline: vk::Semaphore,
+    pub(crate) retired: Mutex<RetireQueue>,
     pub(crate) pipeline_cache: vk::PipelineCache,
     pub(crate) pipeline_cache_path: Option<std::path::PathBuf>,
     pub instance: Arc<Instance>,
@@ -362,7 +407,7 @@ impl DeviceShared {
         let allocation = self
             .allocator
             .lock()
-            .map_err(|_| VkError::Invalid("allocator lock poisoned".into()))?
+            .map_err(|_| VkError::LockPoisoned { what: "allocator" })?
             .allocate(&AllocationCreateDesc {
                 name,
                 requirements,
@@ -410,6 +455,7 @@ impl Device {
             .fill_mode_non_solid(true)
             .pipeline_statistics_query(info.caps.pipeline_statistics_query)
             .vertex_pipeline_stores_and_atomics(info.caps.vertex_pipeline_stores_and_atomics);
+        let mut f12 = vk::PhysicalDeviceVulkan12Features::default().timeline_semaphore(true);
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true);
         // Transform feedback is enabled whenever the device has it: capture is optional, and
         // enabling it costs nothing when unused.
@@ -425,6 +471,7 @@ impl Device {
             .queue_create_infos(&queue_info)
             .enabled_features(&features)
             .enabled_extension_names(&ext_names)
+            .push_next(&mut f12)
             .push_next(&mut f13);
         if xfb {
             create = create.push_next(&mut xfb_feats);
@@ -450,15 +497,23 @@ impl Device {
                 return Err(e.into());
             }
         };
-        let pool_info = vk::CommandPoolCreateInfo::default()
-            .queue_family_index(queue_family)
-            .flags(
-                vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER
-                    | vk::CommandPoolCreateFlags::TRANSIENT,
-            );
-        // SAFETY: raw is a live device.
-        let pool =
-            unsafe { raw.create_command_pool(&pool_info, None) }.ctx("vkCreateCommandPool")?;
+        let mut timeline_info = vk::SemaphoreTypeCreateInfo::default()
+            .semaphore_type(vk::SemaphoreType::TIMELINE)
+            .initial_value(0);
+        let semaphore_info = vk::SemaphoreCreateInfo::default().push_next(&mut timeline_info);
+        // SAFETY: raw is a live device with the timelineSemaphore feature enabled above.
+        let timeline = match unsafe { raw.create_semaphore(&semaphore_info, None) } {
+            Ok(s) => s,
+            Err(result) => {
+                drop(allocator);
+                // SAFETY: nothing else was created on the device yet.
+                unsafe { raw.destroy_device(None) };
+                return Err(VkError::Call {
+                    call: "vkCreateSemaphore",
+                    result,
+                });
+            }
+        };
         let initial = desc
             .pipeline_cache_path
             .as_ref()
@@ -493,8 +548,10 @@ impl Device {
             debug_utils,
             transform_feedback,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
-            one_shot_pool: Mutex::new(pool),
+            once_pools: Mutex::new(Vec::new()),
             queue_lock: Mutex::new(()),
+            timeline,
+            retired: Mutex::new(RetireQueue::default()),
             pipeline_cache,
             pipeline_cache_path: desc.pipeline_cache_path.clone(),
             instance: instance.clone(),
@@ -503,6 +560,7 @@ impl Device {
             shared: Arc::new(shared),
         };
         device.set_name(device.queue, "main queue");
+        device.set_name(timeline, "submission timeline");
         Ok(device)
     }
 
@@ -525,7 +583,9 @@ impl DeviceShared {
         let _ = unsafe { du.set_debug_utils_object_name(&info) };
     }
 
-    /// The transform-feedback commands, or a typed error naming the device when it has none.
+    // LEGACY: removed once tess records through Encoder (hands out ash's extension loader; the
+    // encoder's transform-feedback methods return the same typed error).
+    #[doc(hidden)]
     pub fn transform_feedback(&self) -> Result<&ash::ext::transform_feedback::Device> {
         self.transform_feedback
             .as_ref()
@@ -535,18 +595,24 @@ impl DeviceShared {
             })
     }
 
-    /// Bytes still held by the allocator: zero once every resource is dropped.
+    /// Bytes still held by the allocator, after destroying what completed submissions freed:
+    /// zero once every resource is dropped and the GPU finished with it.
     pub fn allocated_bytes(&self) -> u64 {
+        self.collect_retired();
         self.allocator
             .lock()
             .map(|a| a.generate_report().total_allocated_bytes)
             .unwrap_or(0)
     }
 
+    /// Waits until the queue is idle, then destroys every retired object.
     pub fn wait_idle(&self) {
-        let _q = self.queue_lock.lock();
-        // SAFETY: raw is live; waiting has no other effect.
-        let _ = unsafe { self.raw.device_wait_idle() };
+        {
+            let _q = self.queue_lock.lock();
+            // SAFETY: raw is live; queue access is serialized by queue_lock.
+            let _ = unsafe { self.raw.device_wait_idle() };
+        }
+        self.collect_retired();
     }
 
     pub fn pipeline_cache(&self) -> vk::PipelineCache {
@@ -576,13 +642,24 @@ impl DeviceShared {
 impl Drop for DeviceShared {
     fn drop(&mut self) {
         self.save_pipeline_cache();
-        // SAFETY: the last Arc is gone, so no resource of this device remains; we wait for the
-        // queue, then destroy children before the device. The allocator must go before the device.
+        // SAFETY: the last Arc is gone, so no resource of this device remains except what waits
+        // in the retire queue; after the idle wait no submission is pending, so those and the
+        // one-shot pools are unused. Children go before the device, the allocator too.
         unsafe {
             let _ = self.raw.device_wait_idle();
-            if let Ok(pool) = self.one_shot_pool.lock() {
-                self.raw.destroy_command_pool(*pool, None);
+            let waiting = match self.retired.get_mut() {
+                Ok(q) => std::mem::take(&mut q.waiting),
+                Err(p) => std::mem::take(&mut p.into_inner().waiting),
+            };
+            for (_, item) in waiting {
+                self.destroy_retired(item);
             }
+            if let Ok(pools) = self.once_pools.get_mut() {
+                for (pool, _) in pools.drain(..) {
+                    self.raw.destroy_command_pool(pool, None);
+                }
+            }
+            self.raw.destroy_semaphore(self.timeline, None);
             self.raw.destroy_pipeline_cache(self.pipeline_cache, None);
             if let Ok(a) = self.allocator.lock() {
                 let report = a.generate_report();

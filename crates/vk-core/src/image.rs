@@ -1,6 +1,7 @@
 //! 2D images with one view, for render targets and depth.
 use crate::device::{Device, DeviceShared};
 use crate::error::{Result, VkContext};
+use crate::retire::Retired;
 use ash::vk;
 use gpu_allocator::vulkan::Allocation;
 use gpu_allocator::MemoryLocation;
@@ -15,7 +16,8 @@ pub struct ImageDesc<'a> {
     pub aspect: vk::ImageAspectFlags,
 }
 
-/// Drop order: view, image, then the allocation.
+/// An image with one view; view, image and memory are destroyed together through the retire
+/// queue.
 pub struct Image {
     pub view: vk::ImageView,
     pub raw: vk::Image,
@@ -104,19 +106,20 @@ pub fn subresource_range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRa
 
 impl Drop for Image {
     fn drop(&mut self) {
-        // SAFETY: owners drop images only after the GPU is done with them.
-        unsafe {
-            self.device.raw.destroy_image_view(self.view, None);
-            self.device.raw.destroy_image(self.raw, None);
-        }
-        if let Some(a) = self.allocation.take() {
-            self.device.free(a);
-        }
+        self.device.retire(Retired::Image {
+            view: self.view,
+            raw: self.raw,
+            allocation: self.allocation.take(),
+        });
     }
 }
 
 /// Records a whole-image layout transition with a conservative all-commands barrier.
-pub fn transition(
+///
+/// # Safety
+/// `cmd` is recording outside a rendering scope; `image` lives until the submission completed,
+/// has `aspect`, and is in layout `from` (or `from` is UNDEFINED).
+pub(crate) unsafe fn transition(
     device: &ash::Device,
     cmd: vk::CommandBuffer,
     image: vk::Image,
@@ -133,7 +136,7 @@ pub fn transition(
         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .subresource_range(subresource_range(aspect));
-    // SAFETY: cmd is recording; image is live.
+    // SAFETY: the caller's contract.
     unsafe {
         device.cmd_pipeline_barrier(
             cmd,
@@ -143,42 +146,6 @@ pub fn transition(
             &[],
             &[],
             &[barrier],
-        )
-    };
-}
-
-/// Records the copy of a whole colour `image` (in `TRANSFER_SRC_OPTIMAL`, tightly packed
-/// 4-byte texels) into `buffer`: the readback of offscreen targets and swapchain screenshots.
-///
-/// # Safety
-/// `cmd` is recording outside a rendering scope; `image` is in `TRANSFER_SRC_OPTIMAL` and has
-/// `extent`; `buffer` holds at least `extent.width · extent.height · 4` bytes.
-pub unsafe fn cmd_copy_color_to_buffer(
-    device: &ash::Device,
-    cmd: vk::CommandBuffer,
-    image: vk::Image,
-    extent: vk::Extent2D,
-    buffer: vk::Buffer,
-) {
-    let region = vk::BufferImageCopy::default()
-        .image_subresource(
-            vk::ImageSubresourceLayers::default()
-                .aspect_mask(vk::ImageAspectFlags::COLOR)
-                .layer_count(1),
-        )
-        .image_extent(vk::Extent3D {
-            width: extent.width,
-            height: extent.height,
-            depth: 1,
-        });
-    // SAFETY: the caller's contract.
-    unsafe {
-        device.cmd_copy_image_to_buffer(
-            cmd,
-            image,
-            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-            buffer,
-            &[region],
         )
     };
 }

@@ -10,25 +10,40 @@
 //! - Optional features (VK_EXT_transform_feedback, for captures) are detected and enabled when
 //!   present; what needs them returns [`VkError::Unsupported`] where they are absent.
 //! - Driver bugs are worked around through [`workarounds`], a documented list keyed by driver.
+//! - Commands are recorded through [`Encoder`], whose module states the `unsafe` contracts once
+//!   and why its safe methods uphold them; crates above vk-core need no `unsafe`.
+//! - Objects are destroyed through the device's retire queue ([`retire`]): never while a
+//!   submission that could use them is pending, so frames need not be waited for.
+#![deny(unsafe_op_in_unsafe_fn)]
 pub mod buffer;
 pub mod command;
 pub mod descriptor;
 pub mod device;
+pub mod encoder;
 pub mod error;
 pub mod image;
 pub mod instance;
 pub mod pipeline;
 pub mod query;
+pub mod retire;
 pub mod swapchain;
 pub mod target;
 pub mod transform_feedback;
 pub mod workarounds;
 
+// LEGACY: removed once tess records through Encoder (tess names ash's transform-feedback type).
+#[doc(hidden)]
 pub use ash;
 pub use ash::vk;
 pub use buffer::{Buffer, BufferDesc};
+pub use descriptor::{BindingDesc, DescriptorPool, DescriptorSet, DescriptorSetLayout};
 pub use device::{AdapterInfo, Device, DeviceDesc, DeviceSelector, DeviceShared};
-pub use error::{Result, VkError};
+pub use encoder::Encoder;
+pub use error::{DescriptorError, RecordingError, Result, VkError};
 pub use gpu_allocator::MemoryLocation;
 pub use image::{Image, ImageDesc};
 pub use instance::{Instance, InstanceDesc, MessageCounts, Validation};
+pub use pipeline::Pipeline;
+pub use query::QueryPool;
+pub use swapchain::{Swapchain, SwapchainFrame};
+pub use target::OffscreenTarget;

@@ -1,7 +1,12 @@
 //! Graphics pipelines with tessellation stages, and compute pipelines. All go through the
 //! device's pipeline cache (kept on disk when the device was given a path).
+//!
+//! A pipeline remembers what an [`crate::Encoder`] needs to check commands against it: its bind
+//! point, layout, set layouts, push-constant range, attachment formats, vertex bindings, and
+//! whether its shaders write transform feedback (the SPIR-V's Xfb execution mode).
 use crate::device::{Device, DeviceShared};
 use crate::error::{Result, VkContext, VkError};
+use crate::retire::Retired;
 use ash::vk;
 use std::sync::Arc;
 
@@ -82,12 +87,91 @@ impl<'a> GraphicsPipelineDesc<'a> {
     }
 }
 
-/// A pipeline and its layout. Drop order: pipeline, then layout.
+/// What draws need of one vertex binding: its stride, and the bytes its last vertex spans.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct VertexBinding {
+    pub(crate) binding: u32,
+    pub(crate) stride: u32,
+    pub(crate) per_vertex: bool,
+    pub(crate) element_bytes: u32,
+}
+
+/// A pipeline and its layout, destroyed together through the retire queue.
 pub struct Pipeline {
+    // LEGACY: removed once tess records through Encoder (raw handles for legacy recording).
+    #[doc(hidden)]
     pub raw: vk::Pipeline,
+    // LEGACY: removed once tess records through Encoder.
+    #[doc(hidden)]
     pub layout: vk::PipelineLayout,
     pub bind_point: vk::PipelineBindPoint,
+    pub(crate) name: String,
+    pub(crate) set_layouts: Vec<vk::DescriptorSetLayout>,
+    pub(crate) push_constant_bytes: u32,
+    /// (colour, depth) formats; `UNDEFINED` for none (and for compute pipelines).
+    pub(crate) attachment_formats: [vk::Format; 2],
+    pub(crate) vertex_bindings: Vec<VertexBinding>,
+    pub(crate) transform_feedback_output: bool,
     device: Arc<DeviceShared>,
+}
+
+impl Pipeline {
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Bytes of push constants the layout declares.
+    pub fn push_constant_bytes(&self) -> u32 {
+        self.push_constant_bytes
+    }
+}
+
+/// Whether a SPIR-V module declares the Xfb execution mode (it writes transform feedback).
+fn writes_transform_feedback(spirv: &[u32]) -> bool {
+    const OP_EXECUTION_MODE: u32 = 16;
+    const XFB: u32 = 11;
+    let mut i = 5; // after the header
+    while i < spirv.len() {
+        let count = (spirv[i] >> 16) as usize;
+        let opcode = spirv[i] & 0xffff;
+        if opcode == OP_EXECUTION_MODE && count >= 3 && spirv.get(i + 2) == Some(&XFB) {
+            return true;
+        }
+        i += count.max(1);
+    }
+    false
+}
+
+/// Bytes one attribute of `format` reads (the formats vertex input uses; others count as 16).
+fn format_bytes(format: vk::Format) -> u32 {
+    use vk::Format as F;
+    match format {
+        F::R32_SFLOAT | F::R32_UINT | F::R32_SINT | F::R8G8B8A8_UNORM | F::R8G8B8A8_SNORM => 4,
+        F::R32G32_SFLOAT | F::R32G32_UINT | F::R32G32_SINT | F::R16G16B16A16_SFLOAT => 8,
+        F::R32G32B32_SFLOAT | F::R32G32B32_UINT | F::R32G32B32_SINT => 12,
+        _ => 16,
+    }
+}
+
+fn vertex_bindings(desc: &GraphicsPipelineDesc<'_>) -> Vec<VertexBinding> {
+    desc.vertex_bindings
+        .iter()
+        .map(|b| {
+            let element_bytes = desc
+                .vertex_attributes
+                .iter()
+                .filter(|a| a.binding == b.binding)
+                .map(|a| a.offset + format_bytes(a.format))
+                .max()
+                .unwrap_or(0);
+            VertexBinding {
+                binding: b.binding,
+                stride: b.stride,
+                per_vertex: b.input_rate == vk::VertexInputRate::VERTEX,
+                element_bytes,
+            }
+        })
+        .collect()
 }
 
 fn shader_modules(
@@ -264,6 +348,15 @@ impl Pipeline {
                     raw: p[0],
                     layout,
                     bind_point: vk::PipelineBindPoint::GRAPHICS,
+                    name: desc.name.to_owned(),
+                    set_layouts: desc.set_layouts.clone(),
+                    push_constant_bytes: desc.push_constant_bytes,
+                    attachment_formats: [desc.color_format, desc.depth_format],
+                    vertex_bindings: vertex_bindings(desc),
+                    transform_feedback_output: desc
+                        .stages
+                        .iter()
+                        .any(|s| writes_transform_feedback(s.spirv)),
                     device: device.shared.clone(),
                 })
             }
@@ -286,7 +379,14 @@ impl Pipeline {
         push_constant_bytes: u32,
     ) -> Result<Self> {
         let layout = pipeline_layout(device, name, set_layouts, push_constant_bytes)?;
-        let modules = shader_modules(device, name, &[stage])?;
+        let modules = match shader_modules(device, name, &[stage]) {
+            Ok(m) => m,
+            Err(e) => {
+                // SAFETY: the layout was never used.
+                unsafe { device.raw.destroy_pipeline_layout(layout, None) };
+                return Err(e);
+            }
+        };
         let spec = stage.specialization.map(|(entries, data)| {
             vk::SpecializationInfo::default()
                 .map_entries(entries)
@@ -316,6 +416,12 @@ impl Pipeline {
                     raw: p[0],
                     layout,
                     bind_point: vk::PipelineBindPoint::COMPUTE,
+                    name: name.to_owned(),
+                    set_layouts: set_layouts.to_vec(),
+                    push_constant_bytes,
+                    attachment_formats: [vk::Format::UNDEFINED; 2],
+                    vertex_bindings: Vec::new(),
+                    transform_feedback_output: false,
                     device: device.shared.clone(),
                 })
             }
@@ -333,10 +439,25 @@ impl Pipeline {
 
 impl Drop for Pipeline {
     fn drop(&mut self) {
-        // SAFETY: owners drop pipelines after the GPU is done with them.
-        unsafe {
-            self.device.raw.destroy_pipeline(self.raw, None);
-            self.device.raw.destroy_pipeline_layout(self.layout, None);
-        }
+        self.device.retire(Retired::Pipeline {
+            raw: self.raw,
+            layout: self.layout,
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn xfb_execution_mode_is_found_in_spirv() {
+        // Header, then OpExecutionMode %main Xfb (3 words), then OpNop-sized filler.
+        let mut words = vec![0x0723_0203, 0x0001_0000, 0, 10, 0];
+        words.extend([(3 << 16) | 16, 1, 11]);
+        assert!(writes_transform_feedback(&words));
+        words[7] = 7; // another mode (OriginUpperLeft)
+        assert!(!writes_transform_feedback(&words));
+        assert!(!writes_transform_feedback(&words[..5]));
     }
 }

@@ -2,6 +2,7 @@
 //! transform-feedback stream counts (primitives written / needed, to size and check captures).
 use crate::device::{Device, DeviceShared};
 use crate::error::{Result, VkContext, VkError};
+use crate::retire::Retired;
 use crate::transform_feedback::TransformFeedbackCommands;
 use ash::vk;
 use std::sync::Arc;
@@ -41,19 +42,22 @@ pub struct TransformFeedbackCounts {
 
 /// A pool of `count` timestamp, pipeline-statistics or transform-feedback stream queries.
 pub struct QueryPool {
+    // LEGACY: removed once tess records through Encoder (raw handle for legacy recording).
+    #[doc(hidden)]
     pub raw: vk::QueryPool,
     pub ty: vk::QueryType,
     pub count: u32,
+    pub(crate) name: String,
     device: Arc<DeviceShared>,
 }
 
 impl QueryPool {
     pub fn timestamps(device: &Device, name: &str, count: u32) -> Result<Self> {
         if !device.info.caps.timestamps {
-            return Err(VkError::Invalid(format!(
-                "{} has no timestamp queries on its queue",
-                device.info.name
-            )));
+            return Err(VkError::Unsupported {
+                device: device.info.name.clone(),
+                what: "timestamp queries on its queue",
+            });
         }
         Self::new(
             device,
@@ -66,10 +70,10 @@ impl QueryPool {
 
     pub fn statistics(device: &Device, name: &str, count: u32) -> Result<Self> {
         if !device.info.caps.pipeline_statistics_query {
-            return Err(VkError::Invalid(format!(
-                "{} has no pipeline-statistics queries",
-                device.info.name
-            )));
+            return Err(VkError::Unsupported {
+                device: device.info.name.clone(),
+                what: "pipeline-statistics queries (pipelineStatisticsQuery)",
+            });
         }
         Self::new(
             device,
@@ -117,11 +121,17 @@ impl QueryPool {
             raw,
             ty,
             count,
+            name: name.to_owned(),
             device: device.shared.clone(),
         })
     }
 
-    /// Records a reset of all queries (must precede their first use in a submission).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    // LEGACY: removed once tess records through Encoder (use Encoder::reset_queries).
+    #[doc(hidden)]
     pub fn cmd_reset(&self, cmd: vk::CommandBuffer) {
         // SAFETY: cmd is recording outside a render pass.
         unsafe {
@@ -131,28 +141,42 @@ impl QueryPool {
         };
     }
 
-    fn check_index(&self, query: u32) -> Result<()> {
+    pub(crate) fn check_index(&self, call: &'static str, query: u32) -> Result<()> {
         if query < self.count {
             Ok(())
         } else {
-            Err(VkError::Invalid(format!(
-                "query {query} is outside a pool of {}",
-                self.count
-            )))
+            Err(VkError::QueryIndex {
+                call,
+                pool: self.name.clone(),
+                index: query,
+                count: self.count,
+            })
         }
     }
 
-    /// Records a timestamp write at `stage` into query `query` (reset earlier in the submission).
+    fn check_type(&self, call: &'static str, expected: vk::QueryType) -> Result<()> {
+        if self.ty == expected {
+            Ok(())
+        } else {
+            Err(VkError::QueryType {
+                call,
+                pool: self.name.clone(),
+                expected,
+                found: self.ty,
+            })
+        }
+    }
+
+    // LEGACY: removed once tess records through Encoder (use Encoder::write_timestamp).
+    #[doc(hidden)]
     pub fn cmd_write_timestamp(
         &self,
         cmd: vk::CommandBuffer,
         stage: vk::PipelineStageFlags,
         query: u32,
     ) -> Result<()> {
-        if self.ty != vk::QueryType::TIMESTAMP {
-            return Err(VkError::Invalid("not a timestamp pool".into()));
-        }
-        self.check_index(query)?;
+        self.check_type("vkCmdWriteTimestamp", vk::QueryType::TIMESTAMP)?;
+        self.check_index("vkCmdWriteTimestamp", query)?;
         // SAFETY: cmd is recording; the index is inside the pool; the caller reset the query.
         unsafe {
             self.device
@@ -162,10 +186,10 @@ impl QueryPool {
         Ok(())
     }
 
-    /// Begins query `query` (pipeline statistics). A query begun outside a rendering scope must
-    /// end outside it too (it may span whole rendering scopes and compute dispatches).
+    // LEGACY: removed once tess records through Encoder (use Encoder::begin_query).
+    #[doc(hidden)]
     pub fn cmd_begin(&self, cmd: vk::CommandBuffer, query: u32) -> Result<()> {
-        self.check_index(query)?;
+        self.check_index("vkCmdBeginQuery", query)?;
         // SAFETY: cmd is recording; the index is inside the pool; the caller reset the query.
         unsafe {
             self.device
@@ -175,9 +199,10 @@ impl QueryPool {
         Ok(())
     }
 
-    /// Ends query `query`, begun by [`QueryPool::cmd_begin`] in the same command buffer.
+    // LEGACY: removed once tess records through Encoder (use Encoder::end_query).
+    #[doc(hidden)]
     pub fn cmd_end(&self, cmd: vk::CommandBuffer, query: u32) -> Result<()> {
-        self.check_index(query)?;
+        self.check_index("vkCmdEndQuery", query)?;
         // SAFETY: cmd is recording and the query is active (begun above by the caller).
         unsafe { self.device.raw.cmd_end_query(cmd, self.raw, query) };
         Ok(())
@@ -201,9 +226,7 @@ impl QueryPool {
     }
 
     pub fn statistics_results(&self) -> Result<Vec<PipelineStatistics>> {
-        if self.ty != vk::QueryType::PIPELINE_STATISTICS {
-            return Err(VkError::Invalid("not a pipeline-statistics pool".into()));
-        }
+        self.check_type("vkGetQueryPoolResults", vk::QueryType::PIPELINE_STATISTICS)?;
         Ok(self
             .results::<7>()?
             .into_iter()
@@ -219,8 +242,8 @@ impl QueryPool {
             .collect())
     }
 
-    /// Begins query `query` counting vertex stream `stream` (`vkCmdBeginQueryIndexedEXT`; the
-    /// plain begin would count stream 0 only, and says nothing of which stream is meant).
+    // LEGACY: removed once tess records through Encoder (use Encoder::begin_query_stream).
+    #[doc(hidden)]
     pub fn cmd_begin_stream(&self, cmd: vk::CommandBuffer, query: u32, stream: u32) -> Result<()> {
         let xfb = self.stream_pool_commands()?;
         // SAFETY: cmd is recording; the query was reset earlier in submission order; the pool is
@@ -237,7 +260,8 @@ impl QueryPool {
         Ok(())
     }
 
-    /// Ends what [`QueryPool::cmd_begin_stream`] began.
+    // LEGACY: removed once tess records through Encoder (use Encoder::end_query_stream).
+    #[doc(hidden)]
     pub fn cmd_end_stream(&self, cmd: vk::CommandBuffer, query: u32, stream: u32) -> Result<()> {
         let xfb = self.stream_pool_commands()?;
         // SAFETY: matches cmd_begin_stream on the same command buffer, query and stream.
@@ -246,21 +270,19 @@ impl QueryPool {
     }
 
     fn stream_pool_commands(&self) -> Result<&ash::ext::transform_feedback::Device> {
-        if self.ty != vk::QueryType::TRANSFORM_FEEDBACK_STREAM_EXT {
-            return Err(VkError::Invalid(
-                "not a transform-feedback stream pool".into(),
-            ));
-        }
+        self.check_type(
+            "vkCmdBeginQueryIndexedEXT",
+            vk::QueryType::TRANSFORM_FEEDBACK_STREAM_EXT,
+        )?;
         self.device.transform_feedback()
     }
 
     /// Waits for and reads every query's (primitives written, primitives needed).
     pub fn transform_feedback_results(&self) -> Result<Vec<TransformFeedbackCounts>> {
-        if self.ty != vk::QueryType::TRANSFORM_FEEDBACK_STREAM_EXT {
-            return Err(VkError::Invalid(
-                "not a transform-feedback stream pool".into(),
-            ));
-        }
+        self.check_type(
+            "vkGetQueryPoolResults",
+            vk::QueryType::TRANSFORM_FEEDBACK_STREAM_EXT,
+        )?;
         Ok(self
             .results::<2>()?
             .into_iter()
@@ -274,9 +296,7 @@ impl QueryPool {
     /// Timestamp differences in nanoseconds between consecutive pairs (0–1, 2–3, …).
     pub fn durations_ns(&self) -> Result<Vec<f64>> {
         let period = self.device.info.caps.timestamp_period_ns as f64;
-        if self.ty != vk::QueryType::TIMESTAMP {
-            return Err(VkError::Invalid("not a timestamp pool".into()));
-        }
+        self.check_type("vkGetQueryPoolResults", vk::QueryType::TIMESTAMP)?;
         let raw = self.results::<1>()?;
         Ok(raw
             .chunks_exact(2)
@@ -287,7 +307,6 @@ impl QueryPool {
 
 impl Drop for QueryPool {
     fn drop(&mut self) {
-        // SAFETY: results were read (or the pool unused) before the owner drops it.
-        unsafe { self.device.raw.destroy_query_pool(self.raw, None) };
+        self.device.retire(Retired::QueryPool(self.raw));
     }
 }

@@ -1,11 +1,24 @@
 //! Window target: surface + swapchain that survives resize, minimise and out-of-date, with
 //! per-frame synchronisation and an optional readback of the presented image (screenshots).
+//!
+//! Design decisions:
+//! - [`Swapchain::acquire`] hands out a [`SwapchainFrame`] that borrows the swapchain mutably and
+//!   derefs to an [`Encoder`]: while it lives the swapchain cannot be rebuilt or dropped, so the
+//!   images it records into stay alive; [`SwapchainFrame::present`] takes it by value, so what
+//!   its encoder borrowed outlives the submission (afterwards the retire queue takes over).
+//! - A frame dropped (or a present that fails its checks) is abandoned: its recording is never
+//!   submitted, the acquire semaphore is consumed by an empty submission, and the swapchain is
+//!   rebuilt before the next frame (the acquired image cannot be presented unrendered). A frame
+//!   leaked with `mem::forget` is noticed at the next acquire, which recovers after an idle wait.
+//! - Screenshots copy from the swapchain image, which needs TRANSFER_SRC usage: requested when
+//!   the surface supports it, and a typed [`VkError::Unsupported`] otherwise.
 use crate::buffer::{Buffer, BufferDesc};
 use crate::device::Device;
-use crate::error::{Result, VkContext, VkError};
+use crate::encoder::{record_copy_to_buffer, Encoder, Origin};
+use crate::error::{RecordingError, Result, VkContext, VkError};
 use crate::image::{transition, Image, ImageDesc};
 use crate::instance::Instance;
-use crate::target::{begin_rendering_view, Rgba8, DEPTH_FORMAT};
+use crate::target::{Rgba8, DEPTH_FORMAT};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use raw_window_handle::{RawDisplayHandle, RawWindowHandle};
@@ -31,7 +44,8 @@ struct FrameSync {
     cmd: vk::CommandBuffer,
 }
 
-/// What a frame records into: the command buffer, the swapchain image, its extent and slot.
+// LEGACY: removed once tess records through Encoder (use Swapchain::acquire and SwapchainFrame).
+#[doc(hidden)]
 pub struct Frame {
     pub cmd: vk::CommandBuffer,
     pub slot: usize,
@@ -53,6 +67,10 @@ pub struct Swapchain {
     pub extent: vk::Extent2D,
     pub format: vk::Format,
     needs_rebuild: bool,
+    /// The images have TRANSFER_SRC usage (screenshots possible).
+    screenshots: bool,
+    /// A frame was acquired and neither presented nor abandoned (it was leaked).
+    outstanding: bool,
     loader: ash::khr::swapchain::Device,
     surface: vk::SurfaceKHR,
     surface_loader: ash::khr::surface::Instance,
@@ -159,6 +177,8 @@ impl Swapchain {
             extent,
             format,
             needs_rebuild: true,
+            screenshots: false,
+            outstanding: false,
             loader,
             surface,
             surface_loader,
@@ -220,6 +240,9 @@ impl Swapchain {
         if caps.max_image_count > 0 {
             count = count.min(caps.max_image_count);
         }
+        self.screenshots = caps
+            .supported_usage_flags
+            .contains(vk::ImageUsageFlags::TRANSFER_SRC);
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
             | (caps.supported_usage_flags & vk::ImageUsageFlags::TRANSFER_SRC);
         let info = vk::SwapchainCreateInfoKHR::default()
@@ -284,22 +307,27 @@ impl Swapchain {
         Ok(true)
     }
 
-    /// Waits for the slot's previous frame, acquires an image and begins its command buffer.
-    /// `None` when there is nothing to draw into now (minimised, or rebuilt: try next frame).
-    pub fn begin_frame(&mut self) -> Result<Option<Frame>> {
+    /// Waits for the slot's previous frame and acquires an image. `None` when there is nothing
+    /// to draw into now (minimised, or rebuilt: try next frame). Shared by the frame API and the
+    /// legacy one; the slot's fence is left signalled, for whoever submits to reset.
+    fn acquire_image(&mut self) -> Result<Option<(usize, u32)>> {
+        if self.outstanding {
+            self.recover_leaked_frame()?;
+        }
         if self.needs_rebuild && !self.rebuild(self.extent)? {
             return Ok(None);
         }
         let slot = self.frame_index % FRAMES_IN_FLIGHT;
         let sync = &self.frames[slot];
-        // SAFETY: fence belongs to this device.
+        // SAFETY: the fence belongs to this device.
         unsafe {
             self.device
                 .raw
                 .wait_for_fences(&[sync.in_flight], true, u64::MAX)
         }
         .ctx("vkWaitForFences")?;
-        // SAFETY: swapchain and semaphore are live; the semaphore is unsignaled (its last wait completed with the fence).
+        // SAFETY: swapchain and semaphore are live; the semaphore is unsignalled (its last wait
+        // completed with the fence, or it was never used).
         let acquired = unsafe {
             self.loader.acquire_next_image(
                 self.raw,
@@ -326,16 +354,261 @@ impl Swapchain {
                 })
             }
         };
-        // SAFETY: the fence wait above guarantees the command buffer is no longer in use.
+        // SAFETY: the fence wait above guarantees the command buffer is not pending; the pool
+        // is used by this swapchain only, which `&mut self` holds.
+        unsafe {
+            self.device
+                .raw
+                .reset_command_buffer(sync.cmd, vk::CommandBufferResetFlags::empty())
+        }
+        .ctx("vkResetCommandBuffer")?;
+        Ok(Some((slot, image_index)))
+    }
+
+    /// A frame was leaked (`mem::forget`) after its acquire: its semaphore may still be pending.
+    /// After an idle wait, every acquire semaphore is replaced and the swapchain rebuilt (which
+    /// releases the acquired image).
+    fn recover_leaked_frame(&mut self) -> Result<()> {
+        self.device.wait_idle();
+        for f in &mut self.frames {
+            // SAFETY: device live.
+            let fresh = unsafe {
+                self.device
+                    .raw
+                    .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
+            }
+            .ctx("vkCreateSemaphore")?;
+            let old = std::mem::replace(&mut f.image_available, fresh);
+            // SAFETY: the device is idle, so no queue operation waits on the old semaphore.
+            unsafe { self.device.raw.destroy_semaphore(old, None) };
+        }
+        self.outstanding = false;
+        self.needs_rebuild = true;
+        Ok(())
+    }
+
+    /// Whether [`SwapchainFrame::present`] can take a screenshot (the surface allows copying
+    /// from its images).
+    pub fn supports_screenshots(&self) -> bool {
+        self.screenshots
+    }
+
+    /// Waits for the slot's previous frame, acquires an image and begins recording a frame into
+    /// it. `None` when there is nothing to draw into now (minimised, or rebuilt: try again).
+    pub fn acquire(&mut self) -> Result<Option<SwapchainFrame<'_>>> {
+        let Some((slot, image_index)) = self.acquire_image()? else {
+            return Ok(None);
+        };
+        let cmd = self.frames[slot].cmd;
+        self.outstanding = true;
+        let encoder = match Encoder::begin(&self.device, cmd, Origin::Frame) {
+            Ok(e) => e,
+            Err(e) => {
+                self.abandon(slot);
+                return Err(e);
+            }
+        };
+        let extent = self.extent;
+        Ok(Some(SwapchainFrame {
+            encoder_id: encoder.id(),
+            encoder,
+            guard: FrameGuard {
+                swapchain: self,
+                slot,
+                image_index,
+                done: false,
+            },
+            extent,
+            rendered: false,
+        }))
+    }
+
+    /// Gives up the frame in `slot`: its recording is never submitted; an empty submission
+    /// consumes the acquire semaphore, and the swapchain is rebuilt before the next frame.
+    fn abandon(&mut self, slot: usize) {
+        let sync = &self.frames[slot];
+        // SAFETY: the fence is signalled (waited for in acquire_image, reset nowhere since); the
+        // submission waits on the semaphore the acquire will signal and has no command buffers.
+        let consumed = unsafe {
+            self.device
+                .raw
+                .reset_fences(&[sync.in_flight])
+                .ctx("vkResetFences")
+                .and_then(|()| {
+                    self.device.submit(
+                        &[],
+                        &[(sync.image_available, vk::PipelineStageFlags::ALL_COMMANDS)],
+                        &[],
+                        sync.in_flight,
+                    )
+                })
+        };
+        if let Err(e) = consumed {
+            log::error!("abandoned frame not retired cleanly: {e}");
+        }
+        self.outstanding = false;
+        self.needs_rebuild = true;
+    }
+
+    /// Records the end of the frame (screenshot copy and transition for presentation), submits
+    /// and presents. The encoder must be ready (nothing open, no deferred error).
+    fn present_frame(
+        &mut self,
+        mut encoder: Encoder<'_>,
+        (slot, image_index): (usize, u32),
+        rendered: bool,
+        screenshot: bool,
+    ) -> Result<Option<Rgba8>> {
+        if let Some(e) = encoder.take_unready() {
+            return Err(e);
+        }
+        if screenshot && !self.screenshots {
+            return Err(VkError::Unsupported {
+                device: self.device.info.name.clone(),
+                what: "TRANSFER_SRC usage on this surface's swapchain images (screenshots)",
+            });
+        }
+        let device = self.device.clone();
+        let i = image_index as usize;
+        let image = self.images[i];
+        let extent = self.extent;
+        let from = if rendered {
+            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL
+        } else {
+            vk::ImageLayout::UNDEFINED
+        };
+        let cmd = encoder.raw_cmd();
+        let readback = if screenshot {
+            let buffer = Buffer::new(
+                &device,
+                &BufferDesc {
+                    name: "screenshot readback",
+                    size: extent.width as u64 * extent.height as u64 * 4,
+                    usage: vk::BufferUsageFlags::TRANSFER_DST,
+                    location: MemoryLocation::GpuToCpu,
+                },
+            )?;
+            // SAFETY: outside any scope (the encoder is ready); the image has TRANSFER_SRC
+            // usage (checked above), is in `from` and the buffer holds the extent's texels; both
+            // live until the wait below.
+            unsafe {
+                record_copy_to_buffer(&device, cmd, image, from, extent, buffer.raw);
+                transition(
+                    &device.raw,
+                    cmd,
+                    image,
+                    vk::ImageAspectFlags::COLOR,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    vk::ImageLayout::PRESENT_SRC_KHR,
+                );
+            }
+            Some(buffer)
+        } else {
+            // SAFETY: outside any scope; the image is in `from` and lives until presented.
+            unsafe {
+                transition(
+                    &device.raw,
+                    cmd,
+                    image,
+                    vk::ImageAspectFlags::COLOR,
+                    from,
+                    vk::ImageLayout::PRESENT_SRC_KHR,
+                )
+            };
+            None
+        };
+        let sync = &self.frames[slot];
+        // SAFETY: the fence is signalled and no submission uses it (acquire_image waited).
+        unsafe { device.raw.reset_fences(&[sync.in_flight]) }.ctx("vkResetFences")?;
+        let wait = [(
+            sync.image_available,
+            vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT,
+        )];
+        let signal = [self.render_finished[i]];
+        // SAFETY: the acquire semaphore will be signalled by the acquire, the present semaphore
+        // is unsignalled (its last present waited on it), the fence was reset above; the
+        // swapchain's images live until a rebuild or drop, both of which wait for the device.
+        let submitted = unsafe { encoder.submit(&wait, &signal, sync.in_flight) };
+        let serial = match submitted {
+            Ok((serial, _)) => serial,
+            Err(e) => {
+                // Nothing was submitted: let the fence signal again through abandon.
+                // SAFETY: the fence is unsignalled and unused; an empty signal restores it.
+                let _ = unsafe { device.submit(&[], &[], &[], sync.in_flight) };
+                return Err(e);
+            }
+        };
+        self.outstanding = false;
+        self.frame_index += 1;
+        let swapchains = [self.raw];
+        let indices = [image_index];
+        let present = vk::PresentInfoKHR::default()
+            .wait_semaphores(&signal)
+            .swapchains(&swapchains)
+            .image_indices(&indices);
+        {
+            let _q = device
+                .queue_lock
+                .lock()
+                .map_err(|_| VkError::LockPoisoned { what: "queue" })?;
+            // SAFETY: the image was acquired and its rendering submitted above, signalling the
+            // semaphore presentation waits on; the queue is serialized by queue_lock.
+            match unsafe { self.loader.queue_present(device.queue, &present) } {
+                Ok(false) => {}
+                Ok(true) | Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => self.needs_rebuild = true,
+                Err(e) => {
+                    return Err(VkError::Call {
+                        call: "vkQueuePresentKHR",
+                        result: e,
+                    })
+                }
+            }
+        }
+        match readback {
+            Some(buffer) => {
+                device.wait_serial(serial)?;
+                Ok(Some(self.screenshot_pixels(&buffer, extent)?))
+            }
+            None => Ok(None),
+        }
+    }
+
+    /// The screenshot buffer as RGBA8 (BGRA swapchain formats swizzled).
+    fn screenshot_pixels(&self, buffer: &Buffer, extent: vk::Extent2D) -> Result<Rgba8> {
+        let n = extent.width as usize * extent.height as usize * 4;
+        let bytes =
+            buffer
+                .mapped()
+                .filter(|b| b.len() >= n)
+                .ok_or_else(|| VkError::NotHostVisible {
+                    buffer: buffer.name().to_owned(),
+                })?;
+        let mut pixels = bytes[..n].to_vec();
+        if self.format == vk::Format::B8G8R8A8_UNORM || self.format == vk::Format::B8G8R8A8_SRGB {
+            for px in pixels.chunks_exact_mut(4) {
+                px.swap(0, 2);
+            }
+        }
+        Ok(Rgba8 {
+            width: extent.width,
+            height: extent.height,
+            pixels,
+        })
+    }
+
+    // LEGACY: removed once tess records through Encoder (use Swapchain::acquire).
+    #[doc(hidden)]
+    pub fn begin_frame(&mut self) -> Result<Option<Frame>> {
+        let Some((slot, image_index)) = self.acquire_image()? else {
+            return Ok(None);
+        };
+        let sync = &self.frames[slot];
+        // SAFETY: the fence is signalled and unused (waited for); the command buffer was reset.
         unsafe {
             self.device
                 .raw
                 .reset_fences(&[sync.in_flight])
                 .ctx("vkResetFences")?;
-            self.device
-                .raw
-                .reset_command_buffer(sync.cmd, vk::CommandBufferResetFlags::empty())
-                .ctx("vkResetCommandBuffer")?;
             self.device
                 .raw
                 .begin_command_buffer(
@@ -353,33 +626,44 @@ impl Swapchain {
         }))
     }
 
-    /// Begins rendering into the frame's image with a clear.
+    // LEGACY: removed once tess records through Encoder (use SwapchainFrame::begin_frame_rendering).
+    #[doc(hidden)]
     pub fn cmd_begin_rendering(&self, frame: &Frame, clear: [f32; 4]) -> Result<()> {
-        let depth = self
-            .depth
-            .as_ref()
-            .ok_or_else(|| VkError::Invalid("swapchain has no depth image".into()))?;
+        let Some(depth) = self.depth.as_ref() else {
+            return Err(VkError::Surface("the swapchain has no depth image".into()));
+        };
         let i = frame.image_index as usize;
-        begin_rendering_view(
-            &self.device,
-            frame.cmd,
-            self.images[i],
-            self.views[i],
-            vk::ImageLayout::UNDEFINED,
-            depth,
-            frame.extent,
-            clear,
-        );
+        // SAFETY: legacy contract: the frame's command buffer is recording outside a scope; the
+        // images live until the frame's fence (rebuild and drop wait for the device).
+        unsafe {
+            crate::encoder::record_begin_rendering(
+                &self.device,
+                frame.cmd,
+                (self.images[i], self.views[i]),
+                (depth.raw, depth.view),
+                frame.extent,
+                clear,
+            )
+        };
         Ok(())
     }
 
-    /// Ends rendering, optionally copies the image for a screenshot, submits and presents.
-    /// With a screenshot the frame is waited for and read back.
+    // LEGACY: removed once tess records through Encoder (use SwapchainFrame::present).
+    #[doc(hidden)]
     pub fn end_frame(&mut self, frame: Frame, screenshot: bool) -> Result<Option<Rgba8>> {
         let device = self.device.clone();
         let i = frame.image_index as usize;
-        // SAFETY: rendering was begun by cmd_begin_rendering on this command buffer.
+        // SAFETY: legacy contract: rendering was begun by cmd_begin_rendering on this buffer.
         unsafe { device.raw.cmd_end_rendering(frame.cmd) };
+        if screenshot && !self.screenshots {
+            // Still submit and present what was rendered, so the swapchain stays consistent.
+            self.end_frame(frame, false)?;
+            return Err(VkError::Unsupported {
+                device: device.info.name.clone(),
+                what: "TRANSFER_SRC usage on this surface's swapchain images (screenshots)",
+            });
+        }
+        let image = self.images[i];
         let readback = if screenshot {
             let buffer = Buffer::new(
                 &device,
@@ -390,72 +674,62 @@ impl Swapchain {
                     location: MemoryLocation::GpuToCpu,
                 },
             )?;
-            transition(
-                &device.raw,
-                frame.cmd,
-                self.images[i],
-                vk::ImageAspectFlags::COLOR,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-            );
-            // SAFETY: image in TRANSFER_SRC layout (swapchain created with TRANSFER_SRC when
-            // supported); the buffer was sized for the extent above.
+            // SAFETY: outside a scope; the image has TRANSFER_SRC usage (checked above).
             unsafe {
-                crate::image::cmd_copy_color_to_buffer(
-                    &device.raw,
+                record_copy_to_buffer(
+                    &device,
                     frame.cmd,
-                    self.images[i],
+                    image,
+                    vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
                     frame.extent,
                     buffer.raw,
-                )
-            };
-            transition(
-                &device.raw,
-                frame.cmd,
-                self.images[i],
-                vk::ImageAspectFlags::COLOR,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                vk::ImageLayout::PRESENT_SRC_KHR,
-            );
+                );
+                transition(
+                    &device.raw,
+                    frame.cmd,
+                    image,
+                    vk::ImageAspectFlags::COLOR,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    vk::ImageLayout::PRESENT_SRC_KHR,
+                );
+            }
             Some(buffer)
         } else {
-            transition(
-                &device.raw,
-                frame.cmd,
-                self.images[i],
-                vk::ImageAspectFlags::COLOR,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                vk::ImageLayout::PRESENT_SRC_KHR,
-            );
+            // SAFETY: outside a scope; the image is in COLOR_ATTACHMENT_OPTIMAL.
+            unsafe {
+                transition(
+                    &device.raw,
+                    frame.cmd,
+                    image,
+                    vk::ImageAspectFlags::COLOR,
+                    vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                    vk::ImageLayout::PRESENT_SRC_KHR,
+                )
+            };
             None
         };
         let sync = &self.frames[frame.slot];
         // SAFETY: recording began in begin_frame.
         unsafe { device.raw.end_command_buffer(frame.cmd) }.ctx("vkEndCommandBuffer")?;
-        let wait = [sync.image_available];
-        let stages = [vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT];
+        let wait = [(
+            sync.image_available,
+            vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT,
+        )];
         let signal = [self.render_finished[i]];
-        let cmds = [frame.cmd];
-        let submit = [vk::SubmitInfo::default()
-            .wait_semaphores(&wait)
-            .wait_dst_stage_mask(&stages)
-            .command_buffers(&cmds)
-            .signal_semaphores(&signal)];
+        // SAFETY: legacy contract: what the frame recorded lives until its fence; semaphores as
+        // in present_frame.
+        let serial = unsafe { device.submit(&[frame.cmd], &wait, &signal, sync.in_flight) }?;
+        let swapchains = [self.raw];
+        let indices = [frame.image_index];
+        let present = vk::PresentInfoKHR::default()
+            .wait_semaphores(&signal)
+            .swapchains(&swapchains)
+            .image_indices(&indices);
         {
-            let _q = device.queue_lock.lock();
-            // SAFETY: queue access serialized; all objects live.
-            unsafe {
-                device
-                    .raw
-                    .queue_submit(device.queue, &submit, sync.in_flight)
-            }
-            .ctx("vkQueueSubmit")?;
-            let swapchains = [self.raw];
-            let indices = [frame.image_index];
-            let present = vk::PresentInfoKHR::default()
-                .wait_semaphores(&signal)
-                .swapchains(&swapchains)
-                .image_indices(&indices);
+            let _q = device
+                .queue_lock
+                .lock()
+                .map_err(|_| VkError::LockPoisoned { what: "queue" })?;
             // SAFETY: the image was acquired in begin_frame and rendered above.
             match unsafe { self.loader.queue_present(device.queue, &present) } {
                 Ok(false) => {}
@@ -471,33 +745,120 @@ impl Swapchain {
         self.frame_index += 1;
         match readback {
             Some(buffer) => {
-                // SAFETY: fence submitted above.
-                unsafe {
-                    device
-                        .raw
-                        .wait_for_fences(&[sync.in_flight], true, u64::MAX)
-                }
-                .ctx("vkWaitForFences")?;
-                let bytes = buffer
-                    .mapped()
-                    .ok_or_else(|| VkError::Invalid("screenshot buffer not mapped".into()))?;
-                let mut pixels =
-                    bytes[..(frame.extent.width * frame.extent.height * 4) as usize].to_vec();
-                if self.format == vk::Format::B8G8R8A8_UNORM
-                    || self.format == vk::Format::B8G8R8A8_SRGB
-                {
-                    for px in pixels.chunks_exact_mut(4) {
-                        px.swap(0, 2);
-                    }
-                }
-                Ok(Some(Rgba8 {
-                    width: frame.extent.width,
-                    height: frame.extent.height,
-                    pixels,
-                }))
+                device.wait_serial(serial)?;
+                Ok(Some(self.screenshot_pixels(&buffer, frame.extent)?))
             }
             None => Ok(None),
         }
+    }
+}
+
+/// Abandons the frame when it is dropped unpresented (see the module header).
+struct FrameGuard<'a> {
+    swapchain: &'a mut Swapchain,
+    slot: usize,
+    image_index: u32,
+    done: bool,
+}
+
+impl Drop for FrameGuard<'_> {
+    fn drop(&mut self) {
+        if !self.done {
+            self.swapchain.abandon(self.slot);
+        }
+    }
+}
+
+/// A frame being recorded into an acquired swapchain image: an [`Encoder`] (through `Deref`)
+/// plus the image. Present it with [`SwapchainFrame::present`]; dropping it abandons the frame.
+pub struct SwapchainFrame<'a> {
+    // Field order is drop order: the encoder (never submitted, if still here) before the guard
+    // that abandons the frame.
+    encoder: Encoder<'a>,
+    encoder_id: u64,
+    guard: FrameGuard<'a>,
+    extent: vk::Extent2D,
+    rendered: bool,
+}
+
+impl<'a> SwapchainFrame<'a> {
+    /// Which of the [`FRAMES_IN_FLIGHT`] slots this frame uses (index per-frame resources).
+    pub fn slot(&self) -> usize {
+        self.guard.slot
+    }
+
+    pub fn extent(&self) -> vk::Extent2D {
+        self.extent
+    }
+
+    pub fn encoder(&mut self) -> &mut Encoder<'a> {
+        &mut self.encoder
+    }
+
+    /// Begins rendering into the frame's image and the swapchain's depth image (both cleared),
+    /// with the full viewport and scissor set. End it with [`Encoder::end_rendering`].
+    pub fn begin_frame_rendering(&mut self, clear: [f32; 4]) {
+        let sc = &*self.guard.swapchain;
+        let i = self.guard.image_index as usize;
+        let Some(depth) = sc.depth.as_ref() else {
+            // rebuild always makes a depth image before a frame can be acquired.
+            return;
+        };
+        // SAFETY: the frame borrows the swapchain mutably until it is presented or abandoned,
+        // so neither a rebuild nor a drop can destroy the images before the submission, after
+        // which both wait for the device; the image is the frame's acquired one, of the
+        // swapchain's format and extent, and the depth image matches.
+        let opened = unsafe {
+            self.encoder.begin_frame_scope(
+                (sc.images[i], sc.views[i]),
+                sc.format,
+                (depth.raw, depth.view),
+                self.extent,
+                clear,
+            )
+        };
+        self.rendered |= opened;
+    }
+
+    /// Submits the frame and presents it; with `screenshot`, waits and returns the image read
+    /// back (a typed [`VkError::Unsupported`] where the surface does not allow it). The frame
+    /// must have ended its rendering scope; an invalid recording is abandoned, not submitted.
+    pub fn present(self, screenshot: bool) -> Result<Option<Rgba8>> {
+        let SwapchainFrame {
+            encoder,
+            encoder_id,
+            mut guard,
+            rendered,
+            ..
+        } = self;
+        if encoder.id() != encoder_id {
+            // Exchanged with another encoder: dropping both (here) abandons the frame.
+            return Err(VkError::recording(
+                "vkQueueSubmit",
+                RecordingError::Exchanged,
+            ));
+        }
+        let slot = (guard.slot, guard.image_index);
+        let result = guard
+            .swapchain
+            .present_frame(encoder, slot, rendered, screenshot);
+        // present_frame either submitted (the frame is done) or failed before submitting, in
+        // which case the guard abandons the frame when dropped.
+        guard.done = !guard.swapchain.outstanding;
+        result
+    }
+}
+
+impl<'a> std::ops::Deref for SwapchainFrame<'a> {
+    type Target = Encoder<'a>;
+    fn deref(&self) -> &Encoder<'a> {
+        &self.encoder
+    }
+}
+
+impl std::ops::DerefMut for SwapchainFrame<'_> {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.encoder
     }
 }
 

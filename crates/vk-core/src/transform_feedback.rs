@@ -4,7 +4,8 @@
 //! the raw pointers.
 use ash::vk;
 
-/// The transform-feedback commands Tessera records, on ash's loader.
+// LEGACY: removed once tess records through Encoder (Encoder::begin_transform_feedback etc.).
+#[doc(hidden)]
 pub trait TransformFeedbackCommands {
     /// `vkCmdBindTransformFeedbackBuffersEXT` for one binding (all Tessera captures use one).
     ///
