@@ -145,38 +145,29 @@ impl App {
         let surface = surfaces
             .get_mut(&self.setup.technique)
             .context("the surface built above")?;
-        let Some(frame) = swapchain.begin_frame()? else {
+        let Some(mut frame) = swapchain.acquire()? else {
             return Ok(());
         };
+        let (slot, extent) = (frame.slot(), frame.extent());
         let dt = self.last_frame.elapsed().as_secs_f32();
         if self.setup.animate {
             self.time += dt;
             self.moved = true;
         }
         if let (true, Some(wave)) = (self.moved, &surface.wave) {
-            surface
-                .technique
-                .update_base(frame.slot, &wave.at(self.time))?;
+            surface.technique.update_base(slot, &wave.at(self.time))?;
         }
         let technique = surface.technique.as_ref();
         let params = self.setup.world_params(technique.bbox());
         context.prepare(technique, &params, Context::frame_passes(&params))?;
-        context.write_frame(frame.slot, technique.bbox(), &params, frame.extent)?;
+        context.write_frame(slot, technique.bbox(), &params, extent)?;
         let last = self.args.frames.is_some_and(|n| self.frames_drawn + 1 >= n);
         let context = &*context;
-        let shot = swapchain.present(
-            frame,
-            last && self.args.screenshot.is_some(),
-            params.clear_color,
-            |enc, slot| -> Result<()> {
-                context.record_pre_pass(enc, technique, slot)?;
-                Ok(())
-            },
-            |enc, slot| -> Result<()> {
-                context.record_frame(enc, technique, slot, &params)?;
-                Ok(())
-            },
-        )?;
+        context.record_pre_pass(frame.encoder(), technique, slot)?;
+        frame.begin_frame_rendering(params.clear_color);
+        context.record_frame(frame.encoder(), technique, slot, &params)?;
+        frame.encoder().end_rendering();
+        let shot = frame.present(last && self.args.screenshot.is_some())?;
         self.frames_drawn += 1;
         let now = Instant::now();
         self.frame_ms = 0.9 * self.frame_ms + 0.1 * (now - self.last_frame).as_secs_f64() * 1e3;
