@@ -280,7 +280,8 @@ impl std::ops::AddAssign for DrawCounts {
 pub trait Technique {
     fn id(&self) -> TechniqueId;
 
-    /// Axis-aligned bounds of the current base positions (frames the camera).
+    /// Axis-aligned bounds of the base mesh at rest (frames the camera; an animated base does
+    /// not move it).
     fn bbox(&self) -> ([f32; 3], [f32; 3]);
 
     /// The patch arrays, frame-wide numbered (see [`number_arrays`]).

@@ -103,7 +103,12 @@ impl SurfaceArgs {
         if let Some(scheme) = &self.scheme {
             let wanted = crate::topo_cmds::parse_scheme(scheme)
                 .map_err(|e| anyhow::anyhow!("--scheme {scheme}: {e}"))?;
-            if info.scheme != Some(wanted) {
+            // A technique without a scheme of its own (the base faces as patches) takes any
+            // scheme some technique draws; one with a scheme takes only its own.
+            let drawn_by_any = techniques::registry()
+                .iter()
+                .any(|i| i.scheme == Some(wanted));
+            if info.scheme.map_or(!drawn_by_any, |s| s != wanted) {
                 let drawn: Vec<String> = techniques::registry()
                     .iter()
                     .filter_map(|i| {

@@ -105,8 +105,10 @@ pub struct Bft {
     /// The triangle mesh Loop subdivides (the input, or its fan triangulation): the positions
     /// [`Technique::update_base`] replaces.
     pub loop_mesh: ControlMesh,
-    /// Base positions as last uploaded (for the bounding box and the CPU reference).
+    /// Base positions as last uploaded (the CPU reference).
     pub base_positions: Vec<[f32; 3]>,
+    /// Bounds of the rest pose: an animated surface keeps its camera framing.
+    rest_bbox: ([f32; 3], [f32; 3]),
     /// How the input was taken (fan triangulation), for the caller to show.
     pub notes: Vec<String>,
 }
@@ -272,6 +274,7 @@ impl Bft {
             bft,
             fans,
             loop_mesh,
+            rest_bbox: bbox(&base_positions),
             base_positions,
             notes: note.into_iter().collect(),
         })
@@ -320,7 +323,7 @@ impl Technique for Bft {
     }
 
     fn bbox(&self) -> ([f32; 3], [f32; 3]) {
-        bbox(&self.base_positions)
+        self.rest_bbox
     }
 
     fn patch_arrays(&self) -> &[PatchArray] {
