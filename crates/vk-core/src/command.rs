@@ -7,18 +7,20 @@ use crate::error::{Result, VkContext, VkError};
 use crate::retire::Retired;
 use ash::vk;
 
-/// A binary semaphore a submission waits for, and the stages that wait.
-pub(crate) type Wait = (vk::Semaphore, vk::PipelineStageFlags);
+/// A semaphore a submission waits for, the stages that wait, and (for a timeline semaphore)
+/// the value waited for; binary semaphores ignore the value.
+pub(crate) type Wait = (vk::Semaphore, vk::PipelineStageFlags, u64);
 
 impl DeviceShared {
     /// Submits `cmds` (ended command buffers), signalling the timeline with the returned serial
-    /// on completion, plus `signal` (binary semaphores) and `fence`.
+    /// on completion, plus `signal` (binary semaphores) and `fence`, after `wait`.
     ///
     /// # Safety
     /// Every command buffer is executable, was recorded on this device, is not pending, and
     /// everything it references stays alive until the returned serial completed (the retire
     /// queue keeps objects dropped after this call alive long enough). `wait` and `signal` are
-    /// binary semaphores in the states vkQueueSubmit requires; `fence` is null or unsignalled.
+    /// semaphores in the states vkQueueSubmit requires (`signal` binary); `fence` is null or
+    /// unsignalled.
     pub(crate) unsafe fn submit(
         &self,
         cmds: &[vk::CommandBuffer],
@@ -41,7 +43,7 @@ impl DeviceShared {
         // Binary semaphores ignore their value; the timeline's comes last.
         let mut signal_values = vec![0u64; signal.len()];
         signal_values.push(serial);
-        let wait_values = vec![0u64; wait.len()];
+        let wait_values: Vec<_> = wait.iter().map(|w| w.2).collect();
         let mut timeline_info = vk::TimelineSemaphoreSubmitInfo::default()
             .wait_semaphore_values(&wait_values)
             .signal_semaphore_values(&signal_values);
@@ -153,6 +155,7 @@ impl DeviceShared {
                 Retired::DescriptorPool(p) => self.raw.destroy_descriptor_pool(p, None),
                 Retired::DescriptorSetLayout(l) => self.raw.destroy_descriptor_set_layout(l, None),
                 Retired::QueryPool(p) => self.raw.destroy_query_pool(p, None),
+                Retired::CommandPool { pool, cmd } => self.recycle_once_pool(pool, cmd),
             }
         }
     }
@@ -219,7 +222,8 @@ impl Device {
     /// (see [`Encoder`]) is not submitted: its first error is returned.
     pub fn submit_once<'a, R>(&self, record: impl FnOnce(&mut Encoder<'a>) -> R) -> Result<R> {
         let (pool, cmd) = self.take_once_pool()?;
-        let mut encoder = match Encoder::begin(self, cmd, Origin::Once { pool }) {
+        // SAFETY: the pool was just taken from the free list, so this encoder owns it.
+        let mut encoder = match unsafe { Encoder::begin(self, cmd, Origin::Once { pool }) } {
             Ok(e) => e,
             Err(e) => {
                 // SAFETY: the command buffer was never submitted.
@@ -239,7 +243,7 @@ impl Device {
         }
         // SAFETY: no semaphores or fence; the encoder's borrows ('a) outlive this call, which
         // returns only after the wait below (or leaks the pool when the wait fails).
-        let (serial, origin) = unsafe { encoder.submit(&[], &[], vk::Fence::null()) }?;
+        let (serial, origin) = unsafe { encoder.submit_with(&[], &[], vk::Fence::null()) }?;
         self.wait_serial(serial)?;
         if let Origin::Once { pool } = origin {
             // SAFETY: the submission completed.
@@ -247,6 +251,17 @@ impl Device {
         }
         self.collect_retired();
         Ok(r)
+    }
+
+    /// An encoder whose recording [`Encoder::submit`] hands to the queue without waiting (work
+    /// whose results are read later, e.g. through [`crate::encoder::Submission::wait`]).
+    pub fn encoder<'a>(&self) -> Result<Encoder<'a>> {
+        let (pool, cmd) = self.take_once_pool()?;
+        // SAFETY: the pool was just taken from the free list, so the encoder owns it.
+        unsafe { Encoder::begin(self, cmd, Origin::Unwaited { pool }) }.inspect_err(|_| {
+            // SAFETY: the command buffer was never submitted.
+            unsafe { self.recycle_once_pool(pool, cmd) };
+        })
     }
 
     // LEGACY: removed once tess records through Encoder (use Device::submit_once).

@@ -42,6 +42,7 @@ use crate::error::{RecordingError as E, Result, VkContext, VkError};
 use crate::image::transition;
 use crate::pipeline::Pipeline;
 use crate::query::QueryPool;
+use crate::retire::Retired;
 use crate::target::{OffscreenTarget, COLOR_FORMAT, DEPTH_FORMAT};
 use ash::vk;
 use std::marker::PhantomData;
@@ -54,6 +55,8 @@ static NEXT_ENCODER_ID: AtomicU64 = AtomicU64::new(1);
 pub(crate) enum Origin {
     /// A one-shot pool taken from the device, owned by the encoder until submitted.
     Once { pool: vk::CommandPool },
+    /// As `Once`, handed out by [`Device::encoder`]: submitted without waiting.
+    Unwaited { pool: vk::CommandPool },
     /// A swapchain slot's command buffer (the swapchain resets it).
     Frame,
 }
@@ -115,10 +118,18 @@ pub struct Encoder<'a> {
 }
 
 impl<'a> Encoder<'a> {
-    /// Begins `cmd` (in the initial state, owned by the caller as `origin` says).
-    pub(crate) fn begin(device: &Device, cmd: vk::CommandBuffer, origin: Origin) -> Result<Self> {
-        // SAFETY: the caller hands over a command buffer in the initial state whose pool no one
-        // else uses while this encoder lives.
+    /// Begins recording into `cmd`.
+    ///
+    /// # Safety
+    /// `cmd` is a primary command buffer of `device` in the initial state, handed over with its
+    /// pool as `origin` says: no one else records into, resets or frees either while the encoder
+    /// lives, and a `Once`/`Unwaited` pool is the encoder's to recycle.
+    pub(crate) unsafe fn begin(
+        device: &Device,
+        cmd: vk::CommandBuffer,
+        origin: Origin,
+    ) -> Result<Self> {
+        // SAFETY: the caller's contract.
         unsafe {
             device.raw.begin_command_buffer(
                 cmd,
@@ -1128,6 +1139,26 @@ impl<'a> Encoder<'a> {
         self.cmd
     }
 
+    /// Ends the recording and hands it to the queue without waiting (an encoder from
+    /// [`Device::encoder`]). Sound because submission takes the encoder by value: what it
+    /// borrowed can be dropped only after this returns, and the retire queue then keeps it
+    /// until the GPU finished. A recording found invalid is not submitted: its error is returned.
+    pub fn submit(mut self) -> Result<Submission> {
+        let Some(Origin::Unwaited { pool }) = self.origin.take() else {
+            // An encoder of submit_once or of a frame, exchanged into this one's place: it is
+            // abandoned here (its own submitter reports the exchange too).
+            return Err(VkError::recording("vkQueueSubmit", E::Exchanged));
+        };
+        self.origin = Some(Origin::Unwaited { pool });
+        let device = self.device.clone();
+        let cmd = self.cmd;
+        // SAFETY: no semaphores or fence; the command buffer's pool is retired below with the
+        // serial, so it is recycled only after the submission completed.
+        let (serial, _) = unsafe { self.submit_with(&[], &[], vk::Fence::null()) }?;
+        device.retire(Retired::CommandPool { pool, cmd });
+        Ok(Submission { serial, device })
+    }
+
     /// Ends and submits the recording. Returns the serial and the origin (for the caller to
     /// recycle once the serial completed). A deferred error, or anything left open, returns the
     /// error instead and the encoder is abandoned unsubmitted.
@@ -1135,7 +1166,7 @@ impl<'a> Encoder<'a> {
     /// # Safety
     /// As [`DeviceShared::submit`](crate::DeviceShared) for `wait`, `signal` and `fence`; the
     /// caller keeps whatever it recorded outside the encoder's borrows alive until the serial.
-    pub(crate) unsafe fn submit(
+    pub(crate) unsafe fn submit_with(
         mut self,
         wait: &[crate::command::Wait],
         signal: &[vk::Semaphore],
@@ -1158,13 +1189,32 @@ impl<'a> Encoder<'a> {
     }
 }
 
+/// A recording handed to the queue by [`Encoder::submit`].
+pub struct Submission {
+    serial: u64,
+    device: Device,
+}
+
+impl Submission {
+    /// Blocks until the GPU finished this submission (and every earlier one).
+    pub fn wait(&self) -> Result<()> {
+        self.device.wait_serial(self.serial)?;
+        self.device.collect_retired();
+        Ok(())
+    }
+
+    pub fn is_complete(&self) -> bool {
+        self.device.completed_serial() >= self.serial
+    }
+}
+
 impl Drop for Encoder<'_> {
     fn drop(&mut self) {
         for set in &self.bound_sets {
             set.leave_recording();
         }
         // Still owning a one-shot pool means the recording was never submitted: hand it back.
-        if let Some(Origin::Once { pool }) = self.origin.take() {
+        if let Some(Origin::Once { pool } | Origin::Unwaited { pool }) = self.origin.take() {
             // SAFETY: never submitted, so not pending.
             unsafe { self.device.recycle_once_pool(pool, self.cmd) };
         }

@@ -31,6 +31,9 @@ pub mod target;
 pub mod transform_feedback;
 pub mod workarounds;
 
+#[cfg(test)]
+mod tests;
+
 // LEGACY: removed once tess records through Encoder (tess names ash's transform-feedback type).
 #[doc(hidden)]
 pub use ash;
@@ -38,7 +41,7 @@ pub use ash::vk;
 pub use buffer::{Buffer, BufferDesc};
 pub use descriptor::{BindingDesc, DescriptorPool, DescriptorSet, DescriptorSetLayout};
 pub use device::{AdapterInfo, Device, DeviceDesc, DeviceSelector, DeviceShared};
-pub use encoder::Encoder;
+pub use encoder::{Encoder, Submission};
 pub use error::{DescriptorError, RecordingError, Result, VkError};
 pub use gpu_allocator::MemoryLocation;
 pub use image::{Image, ImageDesc};

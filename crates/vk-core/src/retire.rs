@@ -34,6 +34,11 @@ pub(crate) enum Retired {
     DescriptorPool(vk::DescriptorPool),
     DescriptorSetLayout(vk::DescriptorSetLayout),
     QueryPool(vk::QueryPool),
+    /// A one-shot command pool whose submission was not waited for: recycled, not destroyed.
+    CommandPool {
+        pool: vk::CommandPool,
+        cmd: vk::CommandBuffer,
+    },
 }
 
 /// The serials handed out and the objects waiting for them (guarded by the device's lock).

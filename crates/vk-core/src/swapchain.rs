@@ -21,7 +21,7 @@ use crate::instance::Instance;
 use crate::target::{Rgba8, DEPTH_FORMAT};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-use raw_window_handle::{RawDisplayHandle, RawWindowHandle};
+use raw_window_handle::{HasDisplayHandle, HasWindowHandle, RawDisplayHandle, RawWindowHandle};
 use std::ffi::CStr;
 use std::sync::Arc;
 
@@ -75,6 +75,9 @@ pub struct Swapchain {
     surface: vk::SurfaceKHR,
     surface_loader: ash::khr::surface::Instance,
     device: Device,
+    /// The window the surface presents to, kept alive until the surface is destroyed (in
+    /// `drop`, before the fields); `None` for the legacy constructor.
+    _window: Option<Arc<dyn std::any::Any + Send + Sync>>,
     _instance: Arc<Instance>,
 }
 
@@ -82,15 +85,49 @@ impl Swapchain {
     /// Device extension a swapchain needs.
     pub const DEVICE_EXTENSION: &'static CStr = ash::khr::swapchain::NAME;
 
+    /// A swapchain presenting to `window`, which it keeps alive as long as its surface.
+    pub fn for_window<W>(device: &Device, window: Arc<W>, extent: vk::Extent2D) -> Result<Self>
+    where
+        W: HasWindowHandle + HasDisplayHandle + Send + Sync + 'static,
+    {
+        let display = window
+            .display_handle()
+            .map_err(|e| VkError::Surface(e.to_string()))?
+            .as_raw();
+        let handle = window
+            .window_handle()
+            .map_err(|e| VkError::Surface(e.to_string()))?
+            .as_raw();
+        // SAFETY: the handles come from `window`, which the swapchain keeps (as `_window`) until
+        // after it destroyed the surface.
+        unsafe { Self::create(device, display, handle, extent, Some(window)) }
+    }
+
+    // LEGACY: removed once the viewer uses Swapchain::for_window. The caller keeps the window
+    // alive until the swapchain is dropped, an obligation this safe function cannot check.
+    #[doc(hidden)]
     pub fn new(
         device: &Device,
         display: RawDisplayHandle,
         window: RawWindowHandle,
         extent: vk::Extent2D,
     ) -> Result<Self> {
+        // SAFETY: legacy contract (see above): the viewer drops the swapchain before the window.
+        unsafe { Self::create(device, display, window, extent, None) }
+    }
+
+    /// # Safety
+    /// `display` and `window` are handles of a live window that outlives the swapchain (or is
+    /// kept alive by `keep`).
+    unsafe fn create(
+        device: &Device,
+        display: RawDisplayHandle,
+        window: RawWindowHandle,
+        extent: vk::Extent2D,
+        keep: Option<Arc<dyn std::any::Any + Send + Sync>>,
+    ) -> Result<Self> {
         let instance = device.instance.clone();
-        // SAFETY: the handles come from a live winit window that outlives this swapchain (the
-        // viewer drops the swapchain before the window).
+        // SAFETY: the caller's contract on the handles.
         let surface = unsafe {
             ash_window::create_surface(&instance.entry, &instance.raw, display, window, None)
         }
@@ -183,6 +220,7 @@ impl Swapchain {
             surface,
             surface_loader,
             device: device.clone(),
+            _window: keep,
             _instance: instance,
         };
         sc.rebuild(extent)?;
@@ -401,7 +439,9 @@ impl Swapchain {
         };
         let cmd = self.frames[slot].cmd;
         self.outstanding = true;
-        let encoder = match Encoder::begin(&self.device, cmd, Origin::Frame) {
+        // SAFETY: the slot's command buffer was reset by acquire_image (not pending: its fence
+        // was waited for); its pool is this swapchain's, which the frame borrows mutably.
+        let encoder = match unsafe { Encoder::begin(&self.device, cmd, Origin::Frame) } {
             Ok(e) => e,
             Err(e) => {
                 self.abandon(slot);
@@ -437,7 +477,11 @@ impl Swapchain {
                 .and_then(|()| {
                     self.device.submit(
                         &[],
-                        &[(sync.image_available, vk::PipelineStageFlags::ALL_COMMANDS)],
+                        &[(
+                            sync.image_available,
+                            vk::PipelineStageFlags::ALL_COMMANDS,
+                            0,
+                        )],
                         &[],
                         sync.in_flight,
                     )
@@ -523,12 +567,13 @@ impl Swapchain {
         let wait = [(
             sync.image_available,
             vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT,
+            0,
         )];
         let signal = [self.render_finished[i]];
         // SAFETY: the acquire semaphore will be signalled by the acquire, the present semaphore
         // is unsignalled (its last present waited on it), the fence was reset above; the
         // swapchain's images live until a rebuild or drop, both of which wait for the device.
-        let submitted = unsafe { encoder.submit(&wait, &signal, sync.in_flight) };
+        let submitted = unsafe { encoder.submit_with(&wait, &signal, sync.in_flight) };
         let serial = match submitted {
             Ok((serial, _)) => serial,
             Err(e) => {
@@ -714,6 +759,7 @@ impl Swapchain {
         let wait = [(
             sync.image_available,
             vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT,
+            0,
         )];
         let signal = [self.render_finished[i]];
         // SAFETY: legacy contract: what the frame recorded lives until its fence; semaphores as
