@@ -565,13 +565,14 @@ impl Device {
     }
 
     /// Names a Vulkan object for debug-utils (validation messages and capture tools show it).
-    pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
+    /// Crate-private: naming a handle that is not a live object of this device is invalid.
+    pub(crate) fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
         self.shared.set_name(handle, name)
     }
 }
 
 impl DeviceShared {
-    pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
+    pub(crate) fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
         let Some(du) = &self.debug_utils else { return };
         let Ok(name) = std::ffi::CString::new(name) else {
             return;

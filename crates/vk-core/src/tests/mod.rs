@@ -573,3 +573,112 @@ fn objects_dropped_after_an_unwaited_submission_outlive_it() {
     assert!(submission.is_complete());
     assert_eq!(device.allocated_bytes(), baseline);
 }
+
+/// The capture pattern (today's tess/src/capture.rs): an attachment-less scope, transform
+/// feedback into a region of a buffer, a stream query counting what was written, and the
+/// barrier that makes the writes visible to the host.
+#[test]
+fn transform_feedback_captures_through_the_encoder() {
+    let gpu = Gpu::new();
+    let device = gpu.device();
+    let (vb, _ib) = triangle(device);
+    let Ok(query) = QueryPool::transform_feedback_stream(device, "test captured", 1) else {
+        // Without the extension the encoder's commands are typed errors.
+        let e = device
+            .submit_once(|enc| enc.begin_transform_feedback(&[&vb], &[]))
+            .unwrap()
+            .unwrap_err();
+        assert!(matches!(e, VkError::Unsupported { .. }), "{e}");
+        return;
+    };
+    let mut desc =
+        GraphicsPipelineDesc::new("test capture", vk::Format::UNDEFINED, vk::Format::UNDEFINED);
+    desc.stages = vec![ShaderStage::new(
+        vk::ShaderStageFlags::VERTEX,
+        spirv::XFB_VERT,
+    )];
+    desc.vertex_bindings = vec![vk::VertexInputBindingDescription {
+        binding: 0,
+        stride: 12,
+        input_rate: vk::VertexInputRate::VERTEX,
+    }];
+    desc.vertex_attributes = vec![vk::VertexInputAttributeDescription {
+        location: 0,
+        binding: 0,
+        format: vk::Format::R32G32B32_SFLOAT,
+        offset: 0,
+    }];
+    desc.rasterizer_discard = true;
+    desc.depth_test = false;
+    desc.depth_write = false;
+    let pipeline = Pipeline::graphics(device, &desc).unwrap();
+    let plain = Fixture::new(device);
+    let captured = Buffer::new(
+        device,
+        &BufferDesc {
+            name: "test capture",
+            size: 64 + 48,
+            usage: vk::BufferUsageFlags::TRANSFORM_FEEDBACK_BUFFER_EXT,
+            location: MemoryLocation::GpuToCpu,
+        },
+    )
+    .unwrap();
+    let one_pixel = vk::Extent2D {
+        width: 1,
+        height: 1,
+    };
+    let refused = device
+        .submit_once(|enc| {
+            enc.begin_rendering_without_attachments(one_pixel);
+            enc.bind_pipeline(&plain.graphics);
+            let wrong_pipeline = enc.begin_transform_feedback(&[&captured], &[]);
+            enc.bind_pipeline(&pipeline);
+            enc.bind_vertex_buffer(0, &vb);
+            let misaligned = enc.begin_transform_feedback_ranges(&[(&captured, 2, 48)], &[]);
+            let past_end = enc.begin_transform_feedback_ranges(&[(&captured, 64, 64)], &[]);
+            enc.end_rendering();
+            [wrong_pipeline, misaligned, past_end]
+        })
+        .unwrap();
+    let [wrong_pipeline, misaligned, past_end] = refused.map(|r| problem(r.unwrap_err()));
+    assert!(matches!(
+        wrong_pipeline,
+        RecordingError::AttachmentFormats { .. }
+    ));
+    assert!(matches!(
+        misaligned,
+        RecordingError::TransformFeedbackRange { offset: 2, .. }
+    ));
+    assert!(matches!(
+        past_end,
+        RecordingError::TransformFeedbackRange { offset: 64, .. }
+    ));
+    device
+        .submit_once(|enc| -> crate::Result<()> {
+            enc.reset_queries(&query);
+            enc.begin_rendering_without_attachments(one_pixel);
+            enc.bind_pipeline(&pipeline);
+            enc.bind_vertex_buffer(0, &vb);
+            enc.begin_transform_feedback_ranges(&[(&captured, 64, 48)], &[])?;
+            enc.begin_query_stream(&query, 0, 0)?;
+            enc.draw(0..3)?;
+            enc.end_query_stream(&query, 0, 0)?;
+            enc.end_transform_feedback(&[])?;
+            enc.end_rendering();
+            enc.memory_barrier(
+                (
+                    vk::PipelineStageFlags::TRANSFORM_FEEDBACK_EXT,
+                    vk::AccessFlags::TRANSFORM_FEEDBACK_WRITE_EXT,
+                ),
+                (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
+            );
+            Ok(())
+        })
+        .unwrap()
+        .unwrap();
+    let counts = query.transform_feedback_results().unwrap();
+    assert_eq!(counts[0].primitives_written, 1);
+    let words: Vec<f32> = captured.read().unwrap();
+    assert_eq!(&words[16..20], &[-0.9, -0.9, 0.5, 1.0]);
+    assert_eq!(&words[24..28], &[0.0, 0.9, 0.5, 1.0]);
+}

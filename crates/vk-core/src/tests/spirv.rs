@@ -114,3 +114,56 @@ pub const COMP: &[u32] = &[
     0x00000006, 0x000200f8, 0x0000000c, 0x00060041, 0x00000009, 0x0000000d, 0x00000004, 0x0000000a,
     0x0000000a, 0x0003003e, 0x0000000d, 0x0000000b, 0x000100fd, 0x00010038,
 ];
+
+/// Assembled (spirv-as --target-env vulkan1.1) from:
+/// OpCapability Shader
+/// OpCapability TransformFeedback
+/// OpMemoryModel Logical GLSL450
+/// OpEntryPoint Vertex %main "main" %pos %out %cap
+/// OpExecutionMode %main Xfb
+/// OpDecorate %pos Location 0
+/// OpDecorate %out BuiltIn Position
+/// OpDecorate %cap Location 0
+/// OpDecorate %cap XfbBuffer 0
+/// OpDecorate %cap XfbStride 16
+/// OpDecorate %cap Offset 0
+/// %void = OpTypeVoid
+/// %fn = OpTypeFunction %void
+/// %float = OpTypeFloat 32
+/// %v3 = OpTypeVector %float 3
+/// %v4 = OpTypeVector %float 4
+/// %pv3 = OpTypePointer Input %v3
+/// %pv4 = OpTypePointer Output %v4
+/// %pos = OpVariable %pv3 Input
+/// %out = OpVariable %pv4 Output
+/// %cap = OpVariable %pv4 Output
+/// %one = OpConstant %float 1
+/// %main = OpFunction %void None %fn
+/// %l = OpLabel
+/// %p = OpLoad %v3 %pos
+/// %x = OpCompositeExtract %float %p 0
+/// %y = OpCompositeExtract %float %p 1
+/// %z = OpCompositeExtract %float %p 2
+/// %v = OpCompositeConstruct %v4 %x %y %z %one
+/// OpStore %out %v
+/// OpStore %cap %v
+/// OpReturn
+/// OpFunctionEnd
+pub const XFB_VERT: &[u32] = &[
+    0x07230203, 0x00010300, 0x00070000, 0x00000013, 0x00000000, 0x00020011, 0x00000001, 0x00020011,
+    0x00000035, 0x0003000e, 0x00000000, 0x00000001, 0x0008000f, 0x00000000, 0x00000001, 0x6e69616d,
+    0x00000000, 0x00000002, 0x00000003, 0x00000004, 0x00030010, 0x00000001, 0x0000000b, 0x00040047,
+    0x00000002, 0x0000001e, 0x00000000, 0x00040047, 0x00000003, 0x0000000b, 0x00000000, 0x00040047,
+    0x00000004, 0x0000001e, 0x00000000, 0x00040047, 0x00000004, 0x00000024, 0x00000000, 0x00040047,
+    0x00000004, 0x00000025, 0x00000010, 0x00040047, 0x00000004, 0x00000023, 0x00000000, 0x00020013,
+    0x00000005, 0x00030021, 0x00000006, 0x00000005, 0x00030016, 0x00000007, 0x00000020, 0x00040017,
+    0x00000008, 0x00000007, 0x00000003, 0x00040017, 0x00000009, 0x00000007, 0x00000004, 0x00040020,
+    0x0000000a, 0x00000001, 0x00000008, 0x00040020, 0x0000000b, 0x00000003, 0x00000009, 0x0004003b,
+    0x0000000a, 0x00000002, 0x00000001, 0x0004003b, 0x0000000b, 0x00000003, 0x00000003, 0x0004003b,
+    0x0000000b, 0x00000004, 0x00000003, 0x0004002b, 0x00000007, 0x0000000c, 0x3f800000, 0x00050036,
+    0x00000005, 0x00000001, 0x00000000, 0x00000006, 0x000200f8, 0x0000000d, 0x0004003d, 0x00000008,
+    0x0000000e, 0x00000002, 0x00050051, 0x00000007, 0x0000000f, 0x0000000e, 0x00000000, 0x00050051,
+    0x00000007, 0x00000010, 0x0000000e, 0x00000001, 0x00050051, 0x00000007, 0x00000011, 0x0000000e,
+    0x00000002, 0x00070050, 0x00000009, 0x00000012, 0x0000000f, 0x00000010, 0x00000011, 0x0000000c,
+    0x0003003e, 0x00000003, 0x00000012, 0x0003003e, 0x00000004, 0x00000012, 0x000100fd, 0x00010038,
+];
