@@ -2,13 +2,16 @@
 //! Boubekeur, the paper's Fig. 2):
 //!
 //! 1. **Initial GPU subdivision step** (compute, every frame): level-1 positions as stencils over
-//!    the base positions (`bft_subdivide.comp`), then level-1 limit normals from the limit
-//!    tangent masks (`bft_normals.comp`). An animated base mesh costs one upload of its
+//!    the base positions (`bft/subdivide.comp`), then level-1 limit normals from the limit
+//!    tangent masks (`bft/normals.comp`). An animated base mesh costs one upload of its
 //!    positions per frame; stencils, patch records and tables never change.
 //! 2. **Main pass**: one patch (one control point carrying the face index) per level-1 face.
 //!    `bft.tesc` sets power-of-two (or fractional) edge factors from each edge's two endpoints
 //!    only; `bft.tese` evaluates the table row of each tess coordinate (see
-//!    `glsl/include/bft.glsl`, mirrored in f32 by `topology::bft::GpuBft::eval_tess`).
+//!    `glsl/bft/bft.glsl`, mirrored in f32 by [`GpuBft::eval_tess`]).
+//!
+//! The GPU data (named structs for every buffer, bindings, packing, validation) is
+//! [`crate::techniques::bft::layout`], re-exported here.
 use crate::capture::{
     begin_capture_scope, capture_to_host_barrier, end_capture_scope, CaptureRecord, CapturedSoup,
     FacePoint, CAPTURE_STRIDE,
@@ -16,10 +19,17 @@ use crate::capture::{
 use crate::error::{Result, TessError};
 use crate::gpu::BftPush;
 use crate::renderer::{set_pass_style, DrawCounts, DrawSplit, Renderer};
-use crate::shaders;
+use crate::gpu::bindings::{
+    BFT_BASE_POSITIONS_BINDING, BFT_FACTORS_DISTANCE, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM,
+    BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING,
+    BFT_OPTION_FRACTIONAL, BFT_OPTION_GEOMETRIC_NORMALS, BFT_OPTION_PATCH_COLOURS,
+};
+use crate::shaders::{spirv, Stage, Variant};
 use crate::tessellator::{uniform_vertex_count, Domain, Spacing};
 use std::collections::HashMap;
-use topology::bft::{prepare_loop_bft, GpuBft, LoopBft};
+use topology::bft::{prepare_loop_bft, LoopBft};
+
+pub use crate::techniques::bft::layout::*;
 use topology::ControlMesh;
 use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
 use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage, TessellationDesc};
@@ -115,6 +125,22 @@ fn storage(device: &Device, name: &str, bytes: &[u8]) -> Result<Buffer> {
     )?)
 }
 
+/// `bit` when `on`.
+fn flag(on: bool, bit: u32) -> u32 {
+    if on {
+        bit
+    } else {
+        0
+    }
+}
+
+/// Base positions as the `BasePositions` buffer holds them.
+fn as_base_positions(positions: &[[f32; 3]]) -> &[u8] {
+    bytemuck::cast_slice::<BasePosition, u8>(bytemuck::cast_slice::<[f32; 3], BasePosition>(
+        positions,
+    ))
+}
+
 /// The base positions of `mesh` in f32.
 pub fn base_positions(mesh: &ControlMesh) -> Vec<[f32; 3]> {
     mesh.positions
@@ -145,14 +171,15 @@ impl BftSurface {
         }
         let bft = prepare_loop_bft(mesh, table_level, tangents)
             .map_err(|e| TessError::Invalid(format!("{name}: {e}")))?;
-        let gpu = GpuBft::new(&bft).map_err(|e| TessError::Invalid(format!("{name}: {e}")))?;
+        let gpu = GpuBft::new(&bft)?;
         let stages = vk::ShaderStageFlags::COMPUTE
             | vk::ShaderStageFlags::VERTEX
             | vk::ShaderStageFlags::TESSELLATION_CONTROL
             | vk::ShaderStageFlags::TESSELLATION_EVALUATION
             | vk::ShaderStageFlags::FRAGMENT;
-        let bindings: Vec<BindingDesc> = (0..12)
-            .map(|binding| BindingDesc {
+        let bindings: Vec<BindingDesc> = STORAGE_BINDINGS
+            .iter()
+            .map(|&binding| BindingDesc {
                 binding,
                 ty: vk::DescriptorType::STORAGE_BUFFER,
                 stages,
@@ -165,34 +192,23 @@ impl BftSurface {
             &set_layout,
             frames_in_flight as u32,
         )?;
-        let b = bytemuck::cast_slice::<u32, u8>;
-        let f = bytemuck::cast_slice::<f32, u8>;
-        let level1_bytes = 16 * gpu.level1_vertices.max(1) as u64;
-        let level1 = |name: &str| {
-            Buffer::new(
-                &device,
-                &BufferDesc {
-                    name,
-                    size: level1_bytes,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-                    location: MemoryLocation::GpuOnly,
-                },
-            )
+        let level1_bytes = gpu.level1_bytes();
+        let level1 = |binding: u32, name: &str| -> Result<(u32, Buffer)> {
+            let desc = BufferDesc {
+                name,
+                size: level1_bytes,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::GpuOnly,
+            };
+            Ok((binding, Buffer::new(&device, &desc)?))
         };
-        let tw: Vec<f32> = gpu.tangent_weights.iter().flatten().copied().collect();
-        let statics = vec![
-            storage(&device, "bft stencil offsets", b(&gpu.stencil_offsets))?,
-            storage(&device, "bft stencil indices", b(&gpu.stencil_indices))?,
-            storage(&device, "bft stencil weights", f(&gpu.stencil_weights))?,
-            storage(&device, "bft tangent offsets", b(&gpu.tangent_offsets))?,
-            storage(&device, "bft tangent indices", b(&gpu.tangent_indices))?,
-            storage(&device, "bft tangent weights", f(&tw))?,
-            level1("bft level-1 positions")?,
-            level1("bft level-1 normals")?,
-            storage(&device, "bft patches", b(&gpu.patches))?,
-            storage(&device, "bft table words", b(&gpu.table_words))?,
-            storage(&device, "bft table weights", f(&gpu.table_weights))?,
+        let mut statics = vec![
+            level1(BFT_LEVEL1_POSITIONS_BINDING, "bft level-1 positions")?,
+            level1(BFT_LEVEL1_NORMALS_BINDING, "bft level-1 normals")?,
         ];
+        for (binding, name, bytes) in gpu.static_buffers() {
+            statics.push((binding, storage(&device, name, &bytes)?));
+        }
         let base_positions = base_positions(mesh);
         let mut base = Vec::new();
         let mut sets = Vec::new();
@@ -201,20 +217,21 @@ impl BftSurface {
                 &device,
                 &BufferDesc {
                     name: &format!("bft base positions {i}"),
-                    size: (12 * base_positions.len().max(1)) as u64,
+                    size: (std::mem::size_of::<BasePosition>() * base_positions.len().max(1))
+                        as u64,
                     usage: vk::BufferUsageFlags::STORAGE_BUFFER,
                     location: MemoryLocation::CpuToGpu,
                 },
             )?;
-            buf.write(0, bytemuck::cast_slice(&base_positions))?;
+            buf.write(0, as_base_positions(&base_positions))?;
             let set = pool.allocate(&set_layout)?;
-            let mut writes = vec![(0, vk::DescriptorType::STORAGE_BUFFER, buf.descriptor())];
-            for (k, s) in statics.iter().enumerate() {
-                writes.push((
-                    k as u32 + 1,
-                    vk::DescriptorType::STORAGE_BUFFER,
-                    s.descriptor(),
-                ));
+            let mut writes = vec![(
+                BFT_BASE_POSITIONS_BINDING,
+                vk::DescriptorType::STORAGE_BUFFER,
+                buf.descriptor(),
+            )];
+            for (binding, s) in &statics {
+                writes.push((*binding, vk::DescriptorType::STORAGE_BUFFER, s.descriptor()));
             }
             pool.write_buffers(set, &writes);
             base.push(buf);
@@ -225,14 +242,20 @@ impl BftSurface {
         let subdivide = Pipeline::compute(
             &device,
             "bft subdivide",
-            ShaderStage::new(vk::ShaderStageFlags::COMPUTE, shaders::BFT_SUBDIVIDE_COMP),
+            ShaderStage::new(
+                vk::ShaderStageFlags::COMPUTE,
+                spirv(Stage::BftSubdivideComp, Variant::default())?,
+            ),
             &layouts,
             push,
         )?;
         let normals = Pipeline::compute(
             &device,
             "bft normals",
-            ShaderStage::new(vk::ShaderStageFlags::COMPUTE, shaders::BFT_NORMALS_COMP),
+            ShaderStage::new(
+                vk::ShaderStageFlags::COMPUTE,
+                spirv(Stage::BftNormalsComp, Variant::default())?,
+            ),
             &layouts,
             push,
         )?;
@@ -247,7 +270,7 @@ impl BftSurface {
             set_layout,
             sets,
             base,
-            _static: statics,
+            _static: statics.into_iter().map(|(_, b)| b).collect(),
             gpu,
             bft,
             base_positions,
@@ -259,9 +282,9 @@ impl BftSurface {
         })
     }
 
-    /// Bytes of basis-function tables on the GPU (weights, table words).
+    /// Bytes of basis-function tables on the GPU ([`GpuBft::table_bytes`]).
     pub fn table_bytes(&self) -> usize {
-        4 * (self.gpu.table_weights.len() + self.gpu.table_words.len())
+        self.gpu.table_bytes()
     }
 
     /// Level-1 faces: patches per frame.
@@ -282,7 +305,7 @@ impl BftSurface {
             .base
             .get_mut(slot)
             .ok_or_else(|| TessError::Invalid(format!("no frame slot {slot}")))?;
-        buf.write(0, bytemuck::cast_slice(positions))?;
+        buf.write(0, as_base_positions(positions))?;
         self.base_positions = positions.to_vec();
         Ok(())
     }
@@ -296,10 +319,9 @@ impl BftSurface {
     }
 
     fn build_pipeline(&self, renderer: &Renderer, key: BftPipelineKey) -> Result<Pipeline> {
-        let tese = match key.spacing {
-            Spacing::Equal => shaders::BFT_TESE_EQUAL,
-            Spacing::FractionalEven => shaders::BFT_TESE_FRACTIONAL_EVEN,
-            Spacing::FractionalOdd => shaders::BFT_TESE_FRACTIONAL_ODD,
+        let variant = Variant {
+            spacing: Some(key.spacing),
+            capture: false,
         };
         let name = format!(
             "bft {:?}{}",
@@ -307,15 +329,15 @@ impl BftSurface {
             if key.wireframe { " wireframe" } else { "" }
         );
         let mut desc = GraphicsPipelineDesc::new(&name, self.color_format, self.depth_format);
-        desc.stages = vec![
-            ShaderStage::new(vk::ShaderStageFlags::VERTEX, shaders::BFT_VERT),
-            ShaderStage::new(
-                vk::ShaderStageFlags::TESSELLATION_CONTROL,
-                shaders::BFT_TESC,
-            ),
-            ShaderStage::new(vk::ShaderStageFlags::TESSELLATION_EVALUATION, tese),
-            ShaderStage::new(vk::ShaderStageFlags::FRAGMENT, shaders::BFT_FRAG),
-        ];
+        desc.stages = [
+            Stage::BftBftVert,
+            Stage::BftBftTesc,
+            Stage::BftBftTese,
+            Stage::BftBftFrag,
+        ]
+        .into_iter()
+        .map(|s| Ok(ShaderStage::new(s.vk_stage(), spirv(s, variant)?)))
+        .collect::<Result<_>>()?;
         desc.topology = vk::PrimitiveTopology::PATCH_LIST;
         desc.tessellation = Some(TessellationDesc {
             patch_control_points: 1,
@@ -328,19 +350,23 @@ impl BftSurface {
     }
 
     fn push(&self, params: &BftParams, mode: u32) -> BftPush {
-        let max_level = self.gpu.table_words[1] as f32;
+        let max_level = self.gpu.table.segments as f32;
         let (factor_mode, uniform_level, pixels, reference) = match params.factors {
-            FactorPolicy::Uniform { segments } => (0, segments as f32 * 0.5, 0.0, 0.0),
-            FactorPolicy::Screen { pixels } => (1, 0.0, pixels.max(0.01), 0.0),
-            FactorPolicy::Distance { reference } => (2, 0.0, 0.0, reference.max(1e-6)),
+            FactorPolicy::Uniform { segments } => {
+                (BFT_FACTORS_UNIFORM, segments as f32 * 0.5, 0.0, 0.0)
+            }
+            FactorPolicy::Screen { pixels } => (BFT_FACTORS_SCREEN, 0.0, pixels.max(0.01), 0.0),
+            FactorPolicy::Distance { reference } => {
+                (BFT_FACTORS_DISTANCE, 0.0, 0.0, reference.max(1e-6))
+            }
         };
         BftPush {
             mode,
             first_patch: 0,
             factor_mode,
-            options: params.geometric_normals as u32
-                | (params.patch_colours as u32) << 1
-                | (params.fractional as u32) << 2,
+            options: flag(params.geometric_normals, BFT_OPTION_GEOMETRIC_NORMALS)
+                | flag(params.patch_colours, BFT_OPTION_PATCH_COLOURS)
+                | flag(params.fractional, BFT_OPTION_FRACTIONAL),
             uniform_level,
             pixels_per_segment: pixels,
             distance_ref: reference,
@@ -359,14 +385,14 @@ impl BftSurface {
                     .into(),
             ));
         }
-        let max = 2 * self.gpu.table_words[1];
+        let max = 2 * self.gpu.table.segments;
         if let FactorPolicy::Uniform { segments } = params.factors {
             if segments < 2 || segments > max || (!params.fractional && !segments.is_power_of_two())
             {
                 return Err(TessError::Invalid(format!(
                     "--segments {segments}: BFT takes a power of two in 2..={max} segments per base edge \
                      (tables at level {}; raise --table-level for more)",
-                    self.gpu.table_words[0]
+                    self.gpu.table.level
                 )));
             }
         }
@@ -465,7 +491,7 @@ impl BftSurface {
             DrawSplit::Auto => {
                 let max = match params.factors {
                     FactorPolicy::Uniform { segments } => segments as f32 * 0.5,
-                    _ => self.gpu.table_words[1] as f32,
+                    _ => self.gpu.table.segments as f32,
                 };
                 let verts = uniform_vertex_count(Domain::Triangle, params.spacing(), max);
                 self.device.workarounds.max_patches_per_draw(verts)
@@ -690,21 +716,16 @@ impl BftSurface {
         if let Some(p) = self.capture_pipelines.get(&spacing) {
             return Ok((p.raw, p.layout));
         }
-        let tese = match spacing {
-            Spacing::Equal => shaders::BFT_TESE_EQUAL_CAPTURE,
-            Spacing::FractionalEven => shaders::BFT_TESE_FRACTIONAL_EVEN_CAPTURE,
-            Spacing::FractionalOdd => shaders::BFT_TESE_FRACTIONAL_ODD_CAPTURE,
+        let variant = Variant {
+            spacing: Some(spacing),
+            capture: true,
         };
         let mut desc =
             GraphicsPipelineDesc::new("bft capture", vk::Format::UNDEFINED, vk::Format::UNDEFINED);
-        desc.stages = vec![
-            ShaderStage::new(vk::ShaderStageFlags::VERTEX, shaders::BFT_VERT),
-            ShaderStage::new(
-                vk::ShaderStageFlags::TESSELLATION_CONTROL,
-                shaders::BFT_TESC,
-            ),
-            ShaderStage::new(vk::ShaderStageFlags::TESSELLATION_EVALUATION, tese),
-        ];
+        desc.stages = [Stage::BftBftVert, Stage::BftBftTesc, Stage::BftBftTese]
+            .into_iter()
+            .map(|s| Ok(ShaderStage::new(s.vk_stage(), spirv(s, variant)?)))
+            .collect::<Result<_>>()?;
         desc.topology = vk::PrimitiveTopology::PATCH_LIST;
         desc.tessellation = Some(TessellationDesc {
             patch_control_points: 1,

@@ -5,7 +5,7 @@
 //! [`Capturer::capture`] records a frame's draws (the same patch lists, draw splits and frame
 //! uniforms as [`crate::Renderer`]) with the `-DCAPTURE` TES builds and rasterizer discard. Every
 //! emitted triangle corner becomes one [`CaptureRecord`] (the 40-byte contract of
-//! `glsl/include/tese_out.glsl`). Each patch list writes its own region of the buffer, sized by
+//! `glsl/common/tese_out.glsl`). Each patch list writes its own region of the buffer, sized by
 //! the CPU tessellator's exact triangle count; a transform-feedback stream query per list counts
 //! primitives written and needed, and if a region overflowed (a TCS that sets other levels than
 //! the CPU assumed) a second pass runs with the measured sizes, so no triangle is lost silently.
@@ -52,10 +52,8 @@ use crate::renderer::{
     technique_stages, DrawCounts, DrawParams, FrameSets, GpuMesh, Method,
 };
 use crate::tessellator::{uniform_triangle_count, Domain, Spacing};
-use bytemuck::{Pod, Zeroable};
 use std::collections::HashMap;
 use std::io::Write as _;
-use std::mem::{offset_of, size_of};
 use std::path::Path;
 use topology::ControlMesh;
 use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage};
@@ -63,32 +61,7 @@ use vk_core::query::{QueryPool, TransformFeedbackCounts};
 use vk_core::transform_feedback::TransformFeedbackCommands;
 use vk_core::{vk, Buffer, BufferDesc, Device, MemoryLocation};
 
-/// One captured triangle corner: the transform-feedback record of `tese_out.glsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct CaptureRecord {
-    /// World position as the TES computed it.
-    pub position: [f32; 3],
-    /// Normal as shaded.
-    pub normal: [f32; 3],
-    /// Frame-wide patch id.
-    pub patch: u32,
-    /// Technique-defined flags (0 for the triangle/quad techniques).
-    pub flags: u32,
-    /// `gl_TessCoord.xy` as the fixed-function tessellator produced it.
-    pub domain: [f32; 2],
-}
-
-/// Bytes per record: the `xfb_stride` of `tese_out.glsl`.
-pub const CAPTURE_STRIDE: u64 = 40;
-
-const _: () = {
-    assert!(size_of::<CaptureRecord>() == CAPTURE_STRIDE as usize);
-    assert!(offset_of!(CaptureRecord, normal) == 12);
-    assert!(offset_of!(CaptureRecord, patch) == 24);
-    assert!(offset_of!(CaptureRecord, flags) == 28);
-    assert!(offset_of!(CaptureRecord, domain) == 32);
-};
+pub use crate::gpu::{CaptureRecord, CAPTURE_STRIDE};
 
 /// Bytes of one captured triangle.
 const TRIANGLE_BYTES: u64 = 3 * CAPTURE_STRIDE;
@@ -526,7 +499,13 @@ impl Capturer {
             let mut desc =
                 GraphicsPipelineDesc::new(&name, vk::Format::UNDEFINED, vk::Format::UNDEFINED);
             desc.stages = vec![
-                ShaderStage::new(vk::ShaderStageFlags::VERTEX, crate::shaders::MESH_VERT),
+                ShaderStage::new(
+                    vk::ShaderStageFlags::VERTEX,
+                    crate::shaders::spirv(
+                        crate::shaders::Stage::CommonMeshVert,
+                        crate::shaders::Variant::default(),
+                    )?,
+                ),
                 ShaderStage::new(vk::ShaderStageFlags::TESSELLATION_CONTROL, tesc),
                 ShaderStage::new(vk::ShaderStageFlags::TESSELLATION_EVALUATION, tese),
             ];

@@ -16,6 +16,15 @@ pub enum TessError {
         bytes: u64,
         limit: u64,
     },
+    /// A shader variant `glsl/manifest.toml` does not declare.
+    #[error("shader {} has no variant {variant:?} (see glsl/manifest.toml)", stage.path())]
+    ShaderVariant {
+        stage: crate::shaders::Stage,
+        variant: crate::shaders::Variant,
+    },
+    /// BFT data that cannot be laid out for the GPU.
+    #[error(transparent)]
+    BftLayout(#[from] crate::bft::LayoutError),
     #[error("I/O on {path}: {source}")]
     Io {
         path: String,

@@ -4,7 +4,7 @@
 use crate::error::{Result, TessError};
 use crate::gpu::{DrawPush, Vertex};
 use crate::renderer::{frame_uniforms_for, set_vertex_input, DrawParams, FrameSets};
-use crate::shaders;
+use crate::shaders::{spirv, Stage, Variant};
 use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage};
 use vk_core::{vk, Buffer, BufferDesc, Device, MemoryLocation};
 
@@ -139,8 +139,14 @@ impl PlainRenderer {
         let frame = FrameSets::new(device, "plain", 1)?;
         let mut desc = GraphicsPipelineDesc::new("plain triangles", color_format, depth_format);
         desc.stages = vec![
-            ShaderStage::new(vk::ShaderStageFlags::VERTEX, shaders::PLAIN_VERT),
-            ShaderStage::new(vk::ShaderStageFlags::FRAGMENT, shaders::SHADE_FRAG),
+            ShaderStage::new(
+                vk::ShaderStageFlags::VERTEX,
+                spirv(Stage::PlainPlainVert, Variant::default())?,
+            ),
+            ShaderStage::new(
+                vk::ShaderStageFlags::FRAGMENT,
+                spirv(Stage::CommonShadeFrag, Variant::default())?,
+            ),
         ];
         set_vertex_input(&mut desc);
         desc.set_layouts = vec![frame.layout()];

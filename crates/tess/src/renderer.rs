@@ -5,7 +5,8 @@ use crate::camera::Camera;
 use crate::error::{Result, TessError};
 use crate::gpu::{DrawPush, FrameUniforms, Vertex};
 use crate::render_mesh::RenderMesh;
-use crate::shaders;
+use crate::gpu::bindings::FRAME_UNIFORMS_BINDING;
+use crate::shaders::{spirv, Stage, Variant};
 use crate::tessellator::{uniform_vertex_count, Domain, Spacing};
 use std::collections::HashMap;
 use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
@@ -177,7 +178,7 @@ impl FrameSets {
             device,
             &format!("{name} frame set layout"),
             &[BindingDesc {
-                binding: 0,
+                binding: FRAME_UNIFORMS_BINDING,
                 ty: vk::DescriptorType::UNIFORM_BUFFER,
                 stages: vk::ShaderStageFlags::ALL_GRAPHICS,
             }],
@@ -202,7 +203,11 @@ impl FrameSets {
             let set = pool.allocate(&layout)?;
             pool.write_buffers(
                 set,
-                &[(0, vk::DescriptorType::UNIFORM_BUFFER, uniforms.descriptor())],
+                &[(
+                    FRAME_UNIFORMS_BINDING,
+                    vk::DescriptorType::UNIFORM_BUFFER,
+                    uniforms.descriptor(),
+                )],
             );
             out.push((uniforms, set));
         }
@@ -312,10 +317,16 @@ impl Renderer {
         );
         let mut desc = GraphicsPipelineDesc::new(&name, self.color_format, self.depth_format);
         desc.stages = vec![
-            ShaderStage::new(vk::ShaderStageFlags::VERTEX, shaders::MESH_VERT),
+            ShaderStage::new(
+                vk::ShaderStageFlags::VERTEX,
+                spirv(Stage::CommonMeshVert, Variant::default())?,
+            ),
             ShaderStage::new(vk::ShaderStageFlags::TESSELLATION_CONTROL, tesc),
             ShaderStage::new(vk::ShaderStageFlags::TESSELLATION_EVALUATION, tese),
-            ShaderStage::new(vk::ShaderStageFlags::FRAGMENT, shaders::SHADE_FRAG),
+            ShaderStage::new(
+                vk::ShaderStageFlags::FRAGMENT,
+                spirv(Stage::CommonShadeFrag, Variant::default())?,
+            ),
         ];
         set_patch_input(&mut desc, cp, self.frames.layout());
         set_pass_style(&mut desc, key.wireframe);
@@ -535,90 +546,22 @@ pub(crate) fn technique_stages(
     spacing: Spacing,
     capture: bool,
 ) -> Result<(&'static [u32], &'static [u32], u32)> {
-    use Spacing::*;
-    // (equal, fractional even, fractional odd), each (render, capture).
-    type Variants = [(&'static [u32], &'static [u32]); 3];
-    let pick = |v: Variants| {
-        let (render, cap) = match spacing {
-            Equal => v[0],
-            FractionalEven => v[1],
-            FractionalOdd => v[2],
-        };
-        if capture {
-            cap
-        } else {
-            render
-        }
+    // (method, domain) → (TCS, TES, control points per patch); the variant picks the build.
+    const STAGES: [(Method, Domain, Stage, Stage, u32); 4] = [
+        (Method::Flat, Domain::Quad, Stage::CommonQuadTesc, Stage::FlatQuadTese, 4),
+        (Method::Flat, Domain::Triangle, Stage::CommonTriTesc, Stage::FlatTriTese, 3),
+        (Method::Phong, Domain::Triangle, Stage::CommonTriTesc, Stage::PhongTriTese, 3),
+        (Method::Pn, Domain::Triangle, Stage::PnTriTesc, Stage::PnTriTese, 3),
+    ];
+    let &(_, _, tesc, tese, control_points) = STAGES
+        .iter()
+        .find(|s| s.0 == method && s.1 == domain)
+        .ok_or_else(|| TessError::Invalid(format!("{method:?} has no {domain:?} patches")))?;
+    let variant = Variant {
+        spacing: Some(spacing),
+        capture,
     };
-    Ok(match (method, domain) {
-        (Method::Flat, Domain::Quad) => (
-            shaders::QUAD_TESC,
-            pick([
-                (
-                    shaders::FLAT_QUAD_TESE_EQUAL,
-                    shaders::FLAT_QUAD_TESE_EQUAL_CAPTURE,
-                ),
-                (
-                    shaders::FLAT_QUAD_TESE_FRACTIONAL_EVEN,
-                    shaders::FLAT_QUAD_TESE_FRACTIONAL_EVEN_CAPTURE,
-                ),
-                (
-                    shaders::FLAT_QUAD_TESE_FRACTIONAL_ODD,
-                    shaders::FLAT_QUAD_TESE_FRACTIONAL_ODD_CAPTURE,
-                ),
-            ]),
-            4,
-        ),
-        (Method::Flat, Domain::Triangle) => (
-            shaders::TRI_TESC,
-            pick([
-                (
-                    shaders::FLAT_TRI_TESE_EQUAL,
-                    shaders::FLAT_TRI_TESE_EQUAL_CAPTURE,
-                ),
-                (
-                    shaders::FLAT_TRI_TESE_FRACTIONAL_EVEN,
-                    shaders::FLAT_TRI_TESE_FRACTIONAL_EVEN_CAPTURE,
-                ),
-                (
-                    shaders::FLAT_TRI_TESE_FRACTIONAL_ODD,
-                    shaders::FLAT_TRI_TESE_FRACTIONAL_ODD_CAPTURE,
-                ),
-            ]),
-            3,
-        ),
-        (Method::Phong, Domain::Triangle) => (
-            shaders::TRI_TESC,
-            pick([
-                (shaders::PHONG_TESE_EQUAL, shaders::PHONG_TESE_EQUAL_CAPTURE),
-                (
-                    shaders::PHONG_TESE_FRACTIONAL_EVEN,
-                    shaders::PHONG_TESE_FRACTIONAL_EVEN_CAPTURE,
-                ),
-                (
-                    shaders::PHONG_TESE_FRACTIONAL_ODD,
-                    shaders::PHONG_TESE_FRACTIONAL_ODD_CAPTURE,
-                ),
-            ]),
-            3,
-        ),
-        (Method::Pn, Domain::Triangle) => (
-            shaders::PN_TESC,
-            pick([
-                (shaders::PN_TESE_EQUAL, shaders::PN_TESE_EQUAL_CAPTURE),
-                (
-                    shaders::PN_TESE_FRACTIONAL_EVEN,
-                    shaders::PN_TESE_FRACTIONAL_EVEN_CAPTURE,
-                ),
-                (
-                    shaders::PN_TESE_FRACTIONAL_ODD,
-                    shaders::PN_TESE_FRACTIONAL_ODD_CAPTURE,
-                ),
-            ]),
-            3,
-        ),
-        (m, d) => return Err(TessError::Invalid(format!("{m:?} has no {d:?} patches"))),
-    })
+    Ok((spirv(tesc, variant)?, spirv(tese, variant)?, control_points))
 }
 
 /// Shaded pass or wireframe overlay: the overlay draws lines without writing depth, the shaded
@@ -636,25 +579,8 @@ pub(crate) fn set_pass_style(desc: &mut GraphicsPipelineDesc<'_>, wireframe: boo
 /// Vertex input of the interleaved [`Vertex`] (position at location 0, normal at 1): what mesh.vert
 /// and plain.vert read.
 pub(crate) fn set_vertex_input(desc: &mut GraphicsPipelineDesc<'_>) {
-    desc.vertex_bindings = vec![vk::VertexInputBindingDescription {
-        binding: 0,
-        stride: std::mem::size_of::<Vertex>() as u32,
-        input_rate: vk::VertexInputRate::VERTEX,
-    }];
-    desc.vertex_attributes = vec![
-        vk::VertexInputAttributeDescription {
-            location: 0,
-            binding: 0,
-            format: vk::Format::R32G32B32_SFLOAT,
-            offset: 0,
-        },
-        vk::VertexInputAttributeDescription {
-            location: 1,
-            binding: 0,
-            format: vk::Format::R32G32B32_SFLOAT,
-            offset: 12,
-        },
-    ];
+    desc.vertex_bindings = vec![Vertex::BINDING];
+    desc.vertex_attributes = Vertex::ATTRIBUTES.to_vec();
 }
 
 /// Vertex input (the mesh's interleaved [`Vertex`]), patch topology, the frame set and the

@@ -331,17 +331,14 @@ impl BenchMethod for BftMethod {
 
     fn report_notes(&self) -> Vec<String> {
         let g = &self.surface.gpu;
-        let words = |n: usize| 4 * n;
-        let stencils =
-            words(g.stencil_offsets.len() + g.stencil_indices.len() + g.stencil_weights.len());
         vec![format!(
             "{}: BFT tables {} bytes at level {} (the valences and cases present in the mesh), \
              patch records {} bytes, base-to-level-1 stencils {} bytes",
             self.mesh_name,
             self.surface.table_bytes(),
-            g.table_words[0],
-            words(g.patches.len()),
-            stencils
+            g.table.level,
+            g.patch_bytes(),
+            g.stencil_bytes()
         )]
     }
 
