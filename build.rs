@@ -112,8 +112,8 @@ fn run() -> Result<(), String> {
     std::fs::write(generated_dir.join("bindings.glsl"), bindings_glsl)
         .map_err(|e| e.to_string())?;
 
-    let compiler =
-        shaderc::Compiler::new().map_err(|e| format!("shaderc compiler could not be created: {e}"))?;
+    let compiler = shaderc::Compiler::new()
+        .map_err(|e| format!("shaderc compiler could not be created: {e}"))?;
     let mut code = Code::new(&manifest);
     let mut failures = Vec::new();
     for stage in &manifest.stage {
@@ -226,7 +226,10 @@ fn check_manifest(manifest: &Manifest, glsl: &Path) -> Result<(), String> {
         }
         let path = glsl.join(&stage.file);
         if !path.is_file() {
-            errors.push(format!("{}: listed in the manifest, no such file", stage.file));
+            errors.push(format!(
+                "{}: listed in the manifest, no such file",
+                stage.file
+            ));
         } else if stage_kind(&path).is_none() {
             errors.push(format!("{}: not a shader stage extension", stage.file));
         }

@@ -17,13 +17,13 @@ use crate::capture::{
     FacePoint, CAPTURE_STRIDE,
 };
 use crate::error::{Result, TessError};
-use crate::gpu::BftPush;
-use crate::renderer::{set_pass_style, DrawCounts, DrawSplit, Renderer};
 use crate::gpu::bindings::{
     BFT_BASE_POSITIONS_BINDING, BFT_FACTORS_DISTANCE, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM,
-    BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING,
-    BFT_OPTION_FRACTIONAL, BFT_OPTION_GEOMETRIC_NORMALS, BFT_OPTION_PATCH_COLOURS,
+    BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING, BFT_OPTION_FRACTIONAL,
+    BFT_OPTION_GEOMETRIC_NORMALS, BFT_OPTION_PATCH_COLOURS,
 };
+use crate::gpu::BftPush;
+use crate::renderer::{set_pass_style, DrawCounts, DrawSplit, Renderer};
 use crate::shaders::{spirv, Stage, Variant};
 use crate::tessellator::{uniform_vertex_count, Domain, Spacing};
 use std::collections::HashMap;

@@ -3,9 +3,9 @@
 //! [`PipelineKey`]; spacing variants are separate TES binaries (a layout qualifier).
 use crate::camera::Camera;
 use crate::error::{Result, TessError};
+use crate::gpu::bindings::FRAME_UNIFORMS_BINDING;
 use crate::gpu::{DrawPush, FrameUniforms, Vertex};
 use crate::render_mesh::RenderMesh;
-use crate::gpu::bindings::FRAME_UNIFORMS_BINDING;
 use crate::shaders::{spirv, Stage, Variant};
 use crate::tessellator::{uniform_vertex_count, Domain, Spacing};
 use std::collections::HashMap;
@@ -548,10 +548,34 @@ pub(crate) fn technique_stages(
 ) -> Result<(&'static [u32], &'static [u32], u32)> {
     // (method, domain) → (TCS, TES, control points per patch); the variant picks the build.
     const STAGES: [(Method, Domain, Stage, Stage, u32); 4] = [
-        (Method::Flat, Domain::Quad, Stage::CommonQuadTesc, Stage::FlatQuadTese, 4),
-        (Method::Flat, Domain::Triangle, Stage::CommonTriTesc, Stage::FlatTriTese, 3),
-        (Method::Phong, Domain::Triangle, Stage::CommonTriTesc, Stage::PhongTriTese, 3),
-        (Method::Pn, Domain::Triangle, Stage::PnTriTesc, Stage::PnTriTese, 3),
+        (
+            Method::Flat,
+            Domain::Quad,
+            Stage::CommonQuadTesc,
+            Stage::FlatQuadTese,
+            4,
+        ),
+        (
+            Method::Flat,
+            Domain::Triangle,
+            Stage::CommonTriTesc,
+            Stage::FlatTriTese,
+            3,
+        ),
+        (
+            Method::Phong,
+            Domain::Triangle,
+            Stage::CommonTriTesc,
+            Stage::PhongTriTese,
+            3,
+        ),
+        (
+            Method::Pn,
+            Domain::Triangle,
+            Stage::PnTriTesc,
+            Stage::PnTriTese,
+            3,
+        ),
     ];
     let &(_, _, tesc, tese, control_points) = STAGES
         .iter()

@@ -279,8 +279,14 @@ fn prepare_and_pack_for_the_gpu() {
     assert_eq!(packed.patches.len(), bft.records.len());
     for (h, r) in packed.patches.iter().zip(&bft.records) {
         assert_eq!(h.edge_owner, r.edge_owner.map(|(f, k)| pack_owner(f, k)));
-        assert_eq!(h.corner_owner, r.corner_owner.map(|(f, k)| pack_owner(f, k)));
-        assert!(h.corner_owner.iter().all(|&o| (owner_face(o) as usize) < bft.records.len()));
+        assert_eq!(
+            h.corner_owner,
+            r.corner_owner.map(|(f, k)| pack_owner(f, k))
+        );
+        assert!(h
+            .corner_owner
+            .iter()
+            .all(|&o| (owner_face(o) as usize) < bft.records.len()));
     }
     let total: usize = bft.records.iter().map(|r| r.ring.len()).sum();
     assert_eq!(packed.patch_rings.len(), total);

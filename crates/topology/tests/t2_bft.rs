@@ -5,8 +5,7 @@ use std::collections::HashMap;
 
 use topology::bft::{
     bft_face_ring, build_patch_records, classify_face, configuration_mesh, face_control_ring,
-    memory_for, prepare_loop_bft, shader_eval, shader_eval_full, BasisTables,
-    BftCase, BftKey,
+    memory_for, prepare_loop_bft, shader_eval, shader_eval_full, BasisTables, BftCase, BftKey,
 };
 use topology::eval::{LimitScheme, LocalMesh};
 use topology::refine::refine_uniform;

@@ -272,7 +272,10 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
     for (stage, v) in [
         (Stage::BftBftTesc, PLAIN),
         (Stage::BftBftTese, variant(equal, false)),
-        (Stage::BftBftTese, variant(Some(Spacing::FractionalEven), true)),
+        (
+            Stage::BftBftTese,
+            variant(Some(Spacing::FractionalEven), true),
+        ),
     ] {
         rows.push((
             stage,
@@ -392,7 +395,9 @@ fn check(stage: Stage, v: Variant, check: &Check) -> Result<(), String> {
                 return Err(format!("{name}: no laid-out struct"));
             }
             if found.iter().any(|f| f != offsets) {
-                return Err(format!("{name}: SPIR-V offsets {found:?}, Rust {offsets:?}"));
+                return Err(format!(
+                    "{name}: SPIR-V offsets {found:?}, Rust {offsets:?}"
+                ));
             }
             match r.struct_size(name) {
                 Some(s) if s as usize == *size => Ok(()),
@@ -416,7 +421,9 @@ fn check(stage: Stage, v: Variant, check: &Check) -> Result<(), String> {
             }
             let found = r.member_offsets(block);
             if found != [members.clone()] {
-                return Err(format!("{block}: member offsets {found:?}, Rust {members:?}"));
+                return Err(format!(
+                    "{block}: member offsets {found:?}, Rust {members:?}"
+                ));
             }
             match r.runtime_array_stride(block) {
                 Some(s) if s as usize == *stride => Ok(()),
@@ -429,7 +436,9 @@ fn check(stage: Stage, v: Variant, check: &Check) -> Result<(), String> {
             stride,
         } => match r.member_array_stride(name, *member) {
             Some(s) if s as usize == *stride => Ok(()),
-            s => Err(format!("{name}.{member}: array stride {s:?}, Rust {stride}")),
+            s => Err(format!(
+                "{name}.{member}: array stride {s:?}, Rust {stride}"
+            )),
         },
         Check::Uniform {
             block,
@@ -530,7 +539,12 @@ fn a_wrong_offset_or_binding_is_caught() {
         members: vec![0],
         stride: 4,
     };
-    assert!(check(Stage::BftBftTese, variant(Some(Spacing::Equal), false), &wrong).is_err());
+    assert!(check(
+        Stage::BftBftTese,
+        variant(Some(Spacing::Equal), false),
+        &wrong
+    )
+    .is_err());
     let missing = Check::Layout {
         name: "NoSuchBlock",
         offsets: vec![0],

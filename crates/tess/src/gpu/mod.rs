@@ -15,9 +15,9 @@ use std::mem::{offset_of, size_of};
 use vk_core::vk;
 
 pub mod bindings;
-pub mod reflect;
 #[cfg(test)]
 mod layout_tests;
+pub mod reflect;
 
 /// `Frame` uniform block (std140), `glsl/common/frame.glsl`; set [`bindings::FRAME_SET`],
 /// binding [`bindings::FRAME_UNIFORMS_BINDING`].
@@ -150,4 +150,3 @@ const _: () = {
     assert!(offset_of!(CaptureRecord, flags) == bindings::CAPTURE_OFFSET_PATCH as usize + 4);
     assert!(offset_of!(CaptureRecord, domain) == bindings::CAPTURE_OFFSET_DOMAIN as usize);
 };
-

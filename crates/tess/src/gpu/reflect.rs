@@ -100,8 +100,7 @@ impl Reflection {
                     r.names.insert(arg(1)?, string(&ins[2..]));
                 }
                 OP_TYPE_INT | OP_TYPE_FLOAT => {
-                    r.types
-                        .insert(arg(1)?, Type::Scalar { bytes: arg(2)? / 8 });
+                    r.types.insert(arg(1)?, Type::Scalar { bytes: arg(2)? / 8 });
                 }
                 OP_TYPE_VECTOR => {
                     r.types.insert(
@@ -213,9 +212,9 @@ impl Reflection {
         match self.types.get(&id)? {
             Type::Scalar { bytes } => Some(*bytes),
             Type::Vector { component, count } => Some(self.type_size(*component)? * count),
-            Type::Array { length_id, .. } => {
-                Some(self.decoration(id, DECORATION_ARRAY_STRIDE)? * self.constants.get(length_id)?)
-            }
+            Type::Array { length_id, .. } => Some(
+                self.decoration(id, DECORATION_ARRAY_STRIDE)? * self.constants.get(length_id)?,
+            ),
             Type::Struct { members } => {
                 let last = members.len().checked_sub(1)? as u32;
                 let offset = self
@@ -325,8 +324,7 @@ impl Reflection {
     /// Location and size in bytes of the input variable named `name`.
     pub fn input(&self, name: &str) -> Option<(u32, u32)> {
         self.variables.iter().find_map(|&(var, ty, storage)| {
-            if storage != STORAGE_INPUT || self.names.get(&var).map(String::as_str) != Some(name)
-            {
+            if storage != STORAGE_INPUT || self.names.get(&var).map(String::as_str) != Some(name) {
                 return None;
             }
             let location = self.decoration(var, DECORATION_LOCATION)?;

@@ -20,12 +20,12 @@
 //! - [`GpuBft::eval_tess`] is the f32 mirror of `bft.glsl`'s evaluation, operation for operation
 //!   (the shader sums with `precise`), so tests can demand the GPU's bits.
 use crate::gpu::bindings::{
-    BFT_BASE_POSITIONS_BINDING, BFT_SET, FRAME_SET, BFT_KIND_BOUNDARY, BFT_KIND_EXTRAORDINARY, BFT_KIND_PRIVATE,
+    BFT_BASE_POSITIONS_BINDING, BFT_KIND_BOUNDARY, BFT_KIND_EXTRAORDINARY, BFT_KIND_PRIVATE,
     BFT_KIND_REGULAR, BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING,
     BFT_MIRROR_PERMS_BINDING, BFT_OWNER_LOCAL_MASK, BFT_OWNER_SHIFT, BFT_PATCH_HEADERS_BINDING,
-    BFT_PATCH_RINGS_BINDING, BFT_ROW_MAPS_BINDING, BFT_STENCIL_OFFSETS_BINDING,
+    BFT_PATCH_RINGS_BINDING, BFT_ROW_MAPS_BINDING, BFT_SET, BFT_STENCIL_OFFSETS_BINDING,
     BFT_STENCIL_TERMS_BINDING, BFT_TABLES_BINDING, BFT_TABLE_WEIGHTS_BINDING,
-    BFT_TANGENT_OFFSETS_BINDING, BFT_TANGENT_TERMS_BINDING,
+    BFT_TANGENT_OFFSETS_BINDING, BFT_TANGENT_TERMS_BINDING, FRAME_SET,
 };
 use bytemuck::{Pod, Zeroable};
 use std::borrow::Cow;
@@ -367,7 +367,11 @@ impl GpuBft {
                 "bft patch headers",
                 Cow::Borrowed(bytemuck::cast_slice(&self.patches)),
             ),
-            (BFT_PATCH_RINGS_BINDING, "bft patch rings", b(&self.patch_rings)),
+            (
+                BFT_PATCH_RINGS_BINDING,
+                "bft patch rings",
+                b(&self.patch_rings),
+            ),
             (BFT_TABLES_BINDING, "bft tables", Cow::Owned(tables)),
             (
                 BFT_MIRROR_PERMS_BINDING,
@@ -440,7 +444,10 @@ impl GpuBft {
         for (e, ent) in self.table_entries.iter().enumerate() {
             let (rs, rows) = (ent.ring_size as usize, ent.rows as usize);
             if ent.position_offset == NO_WEIGHTS {
-                return Err(invalid("Tables", format!("entry {e} has no position weights")));
+                return Err(invalid(
+                    "Tables",
+                    format!("entry {e} has no position weights"),
+                ));
             }
             for off in [ent.position_offset, ent.du_offset, ent.dv_offset] {
                 if off != NO_WEIGHTS && off as usize + rows * rs > self.table_weights.len() {
@@ -486,10 +493,7 @@ impl GpuBft {
                 _ => return Err(invalid("PatchHeaders", format!("patch {f} table entry"))),
             }
             if let Some(&x) = ring.iter().find(|&&x| x >= self.level1_vertices) {
-                return Err(invalid(
-                    "PatchRings",
-                    format!("patch {f} ring index {x}"),
-                ));
+                return Err(invalid("PatchRings", format!("patch {f} ring index {x}")));
             }
             for (k, &o) in h.edge_owner.iter().chain(&h.corner_owner).enumerate() {
                 if owner_face(o) as usize >= nf || owner_local(o) > 2 {
