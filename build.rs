@@ -1,151 +1,304 @@
-//! Compiles every shader in `glsl/` to SPIR-V with shaderc (glslang) and generates
-//! `$OUT_DIR/shaders.rs`: one typed `pub static NAME: &[u32]` per stage file, so no shader file is
-//! needed at run time and a missing shader is a compile error, not a run-time path lookup.
+//! Compiles the shader stages declared in `glsl/manifest.toml` to SPIR-V with shaderc (glslang)
+//! and generates `$OUT_DIR/shaders.rs`, the typed lookup behind `tess::shaders`:
+//! - `Stage`, one variant per stage file (`pn/tri.tese` → `Stage::PnTriTese`);
+//! - `Variant`, one field per manifest axis (spacing, capture, ...);
+//! - the SPIR-V words of every (stage, declared variant), so no shader file is read at run time.
 //!
-//! Stage files are named `technique.stage` (`.vert .tesc .tese .frag .comp`); shared includes live
-//! in `glsl/include` and are resolved by `#include "name.glsl"`. Warnings are errors; a failed
-//! compile fails the build with glslang's file:line message.
-//!
-//! Generated names: `pn.tese` → `PN_TESE`, then one suffix per variant axis, in this order:
-//! - a stage whose source names `SPACING` is built once per spacing (a layout qualifier, so not a
-//!   specialization constant): `_EQUAL`, `_FRACTIONAL_EVEN`, `_FRACTIONAL_ODD`;
-//! - a stage whose source names `CAPTURE` is additionally built with `-DCAPTURE` (transform
-//!   feedback outputs, `glsl/include/tese_out.glsl`): `_CAPTURE`.
-//!
-//! So `pn.tese` yields `PN_TESE_EQUAL`, `PN_TESE_EQUAL_CAPTURE`, `PN_TESE_FRACTIONAL_EVEN`, …;
-//! a stage naming neither keeps its bare name (`MESH_VERT`).
+//! Design decisions:
+//! - **Declared, not guessed.** What is compiled comes from the manifest only, never from the
+//!   text of a shader (a word in a comment used to decide). A stage file the manifest does not
+//!   list, or a listed file that does not exist, fails the build.
+//! - **Variants are defines.** An axis value is a set of `#define`s; a stage is compiled once
+//!   per combination of the values of the axes it names. Axes are data, so the next techniques
+//!   add patch types or end caps in the manifest, not here.
+//! - **Numbers written once.** `crates/tess/src/gpu/bindings.rs` is `include!`d here and each of
+//!   its constants written as a `#define` into `$OUT_DIR/bindings.glsl`, which stages include.
+//! - Warnings are errors; a failed compile fails the build with glslang's file:line message.
+use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-fn main() {
-    let root =
-        PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
-    // The script runs for crates/tess; the shaders sit at the workspace root.
-    let glsl = root.join("../../glsl");
-    let glsl = glsl.canonicalize().unwrap_or(glsl);
-    let include_dir = glsl.join("include");
-    let out = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
-    // Listing any path turns off cargo's default of rerunning on any package change, and this
-    // script lives outside the package, so it names itself too.
-    println!(
-        "cargo:rerun-if-changed={}",
-        root.join("../../build.rs").display()
-    );
-    println!("cargo:rerun-if-changed={}", glsl.display());
-    println!("cargo:rerun-if-changed={}", include_dir.display());
+/// The binding numbers and flags shared with GLSL (the same file is `tess::gpu::bindings`).
+#[allow(dead_code)]
+mod bindings {
+    include!("crates/tess/src/gpu/bindings.rs");
+}
 
-    let compiler = shaderc::Compiler::new().expect("shaderc compiler could not be created");
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(&glsl)
-        .expect("glsl/ folder is missing")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| stage_of(p).is_some())
-        .collect();
-    entries.sort();
-    for p in std::fs::read_dir(&include_dir)
-        .into_iter()
-        .flatten()
-        .flatten()
-    {
-        println!("cargo:rerun-if-changed={}", p.path().display());
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Manifest {
+    axis: Vec<Axis>,
+    stage: Vec<StageEntry>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Axis {
+    /// Field of `Variant`.
+    name: String,
+    /// Its Rust type (must implement `Default`, `Copy`, `Eq`, `Hash`, `Debug`).
+    #[serde(rename = "type")]
+    ty: String,
+    /// The field's value (a constant expression) in builds of stages that do not vary along
+    /// the axis; it must equal the type's `Default` (a generated test checks).
+    default: String,
+    values: Vec<AxisValue>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AxisValue {
+    /// The field's value in Rust (a constant expression).
+    rust: String,
+    /// Part of the `.spv` file name; absent for the default value.
+    #[serde(default)]
+    tag: Option<String>,
+    /// `NAME = "value"` (`""`: defined without a value).
+    #[serde(default)]
+    defines: BTreeMap<String, String>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StageEntry {
+    /// Path under `glsl/`, `technique/name.ext`.
+    file: String,
+    /// Names of the axes the stage varies along.
+    #[serde(default)]
+    axes: Vec<String>,
+}
+
+fn main() {
+    if let Err(e) = run() {
+        panic!("{e}");
+    }
+}
+
+fn run() -> Result<(), String> {
+    let root = PathBuf::from(env("CARGO_MANIFEST_DIR")?);
+    // The script runs for crates/tess; the shaders sit at the workspace root.
+    let workspace = root.join("../..");
+    let workspace = workspace.canonicalize().unwrap_or(workspace);
+    let glsl = workspace.join("glsl");
+    let out = PathBuf::from(env("OUT_DIR")?);
+    // Listing any path turns off cargo's default of rerunning on any package change, and this
+    // script lives outside the package, so it names itself and what it includes. A folder is
+    // scanned whole.
+    for p in [
+        workspace.join("build.rs"),
+        workspace.join("crates/tess/src/gpu/bindings.rs"),
+        glsl.clone(),
+    ] {
+        println!("cargo:rerun-if-changed={}", p.display());
     }
 
-    let mut generated =
-        String::from("// @generated by build.rs from glsl/: SPIR-V words of each shader.\n");
+    let manifest_path = glsl.join("manifest.toml");
+    let text = std::fs::read_to_string(&manifest_path)
+        .map_err(|e| format!("{}: {e}", manifest_path.display()))?;
+    let manifest: Manifest =
+        toml::from_str(&text).map_err(|e| format!("{}: {e}", manifest_path.display()))?;
+    check_manifest(&manifest, &glsl)?;
+
+    let mut bindings_glsl = String::from(
+        "// @generated by build.rs from crates/tess/src/gpu/bindings.rs: do not edit.\n\
+         #ifndef TESSERA_BINDINGS_GLSL\n#define TESSERA_BINDINGS_GLSL\n",
+    );
+    for (name, value) in bindings::ALL {
+        writeln!(bindings_glsl, "#define {name} {value}").unwrap();
+    }
+    bindings_glsl += "#endif\n";
+    let generated_dir = out.join("glsl");
+    std::fs::create_dir_all(&generated_dir).map_err(|e| e.to_string())?;
+    std::fs::write(generated_dir.join("bindings.glsl"), bindings_glsl)
+        .map_err(|e| e.to_string())?;
+
+    let compiler = shaderc::Compiler::new()
+        .map_err(|e| format!("shaderc compiler could not be created: {e}"))?;
+    let mut code = Code::new(&manifest);
     let mut failures = Vec::new();
-    for path in &entries {
-        println!("cargo:rerun-if-changed={}", path.display());
-        let kind = stage_of(path).expect("filtered above");
-        let source = std::fs::read_to_string(path).expect("shader source readable");
-        let file_name = path.file_name().unwrap().to_string_lossy().into_owned();
-        let mut options = shaderc::CompileOptions::new().expect("shaderc options");
-        options.set_target_env(
-            shaderc::TargetEnv::Vulkan,
-            shaderc::EnvVersion::Vulkan1_1 as u32,
-        );
-        options.set_source_language(shaderc::SourceLanguage::GLSL);
-        options.set_warnings_as_errors();
-        options.set_generate_debug_info();
-        options.set_optimization_level(shaderc::OptimizationLevel::Performance);
-        let inc = include_dir.clone();
-        let here = glsl.clone();
-        options.set_include_callback(move |name, _ty, _from, _depth| {
-            for dir in [&inc, &here] {
-                let candidate = dir.join(name);
-                if let Ok(content) = std::fs::read_to_string(&candidate) {
-                    return Ok(shaderc::ResolvedInclude {
-                        resolved_name: candidate.display().to_string(),
-                        content,
-                    });
+    for stage in &manifest.stage {
+        let path = glsl.join(&stage.file);
+        let kind = stage_kind(&path).ok_or_else(|| format!("{}: not a stage", stage.file))?;
+        let source = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", stage.file))?;
+        let own_dir = path.parent().unwrap_or(&glsl).to_path_buf();
+        let dirs = [own_dir, glsl.join("common"), generated_dir.clone()];
+        let mut variants = Vec::new();
+        for combo in combinations(&manifest, stage) {
+            let mut options = shaderc::CompileOptions::new()
+                .map_err(|e| format!("shaderc options could not be created: {e}"))?;
+            options.set_target_env(
+                shaderc::TargetEnv::Vulkan,
+                shaderc::EnvVersion::Vulkan1_1 as u32,
+            );
+            options.set_source_language(shaderc::SourceLanguage::GLSL);
+            options.set_warnings_as_errors();
+            options.set_generate_debug_info();
+            options.set_optimization_level(shaderc::OptimizationLevel::Performance);
+            let dirs = dirs.clone();
+            options.set_include_callback(move |name, _ty, _from, _depth| include(&dirs, name));
+            let mut tags = Vec::new();
+            for value in &combo {
+                for (name, v) in &value.defines {
+                    options.add_macro_definition(name, (!v.is_empty()).then_some(v.as_str()));
                 }
+                tags.extend(value.tag.clone());
             }
-            Err(format!(
-                "include \"{name}\" not found in glsl/include or glsl/"
-            ))
-        });
-        // Tessellation spacing is a layout qualifier, not a specialization constant: a stage that
-        // names `SPACING` is compiled once per spacing, as NAME_EQUAL / _FRACTIONAL_EVEN / _ODD.
-        let spacings: Vec<(&str, Option<&str>)> = if source.contains("SPACING") {
-            vec![
-                ("_EQUAL", Some("equal_spacing")),
-                ("_FRACTIONAL_EVEN", Some("fractional_even_spacing")),
-                ("_FRACTIONAL_ODD", Some("fractional_odd_spacing")),
-            ]
-        } else {
-            vec![("", None)]
-        };
-        // A stage that names `CAPTURE` also gets a transform-feedback build, NAME…_CAPTURE.
-        let captures: &[bool] = if source.contains("CAPTURE") {
-            &[false, true]
-        } else {
-            &[false]
-        };
-        let variants = spacings
-            .iter()
-            .flat_map(|&s| captures.iter().map(move |&c| (s, c)));
-        for ((spacing_suffix, spacing), capture) in variants {
-            let mut opts = options.clone();
-            if let Some(spacing) = spacing {
-                opts.add_macro_definition("SPACING", Some(spacing));
-            }
-            if capture {
-                opts.add_macro_definition("CAPTURE", None);
-            }
-            let suffix = format!("{spacing_suffix}{}", if capture { "_CAPTURE" } else { "" });
             match compiler.compile_into_spirv(
                 &source,
                 kind,
                 &path.display().to_string(),
                 "main",
-                Some(&opts),
+                Some(&options),
             ) {
                 Ok(artifact) => {
-                    let words = artifact.as_binary();
-                    let ident = format!("{}{suffix}", const_name(&file_name));
-                    let spv = out.join(format!("{ident}.spv"));
-                    std::fs::write(&spv, artifact.as_binary_u8()).expect("write spv");
-                    writeln!(
-                        generated,
-                        "/// SPIR-V of `glsl/{file_name}` ({}{}).",
-                        spacing.unwrap_or("single variant"),
-                        if capture { ", -DCAPTURE" } else { "" }
-                    )
-                    .unwrap();
-                    writeln!(generated, "pub static {ident}: &[u32] = &{words:?};").unwrap();
+                    let file = format!(
+                        "{}{}.spv",
+                        stage.file.replace(['/', '.'], "_"),
+                        tags.iter().map(|t| format!("_{t}")).collect::<String>()
+                    );
+                    std::fs::write(out.join(file), artifact.as_binary_u8())
+                        .map_err(|e| e.to_string())?;
+                    variants.push((combo, artifact.as_binary().to_vec()));
                 }
-                Err(e) => failures.push(format!("{e}")),
+                Err(e) => failures.push(e.to_string()),
+            }
+        }
+        code.stage(stage, variants);
+    }
+    if !failures.is_empty() {
+        return Err(format!(
+            "shader compilation failed:\n{}",
+            failures.join("\n")
+        ));
+    }
+    std::fs::write(out.join("shaders.rs"), code.finish()).map_err(|e| e.to_string())?;
+    Ok(())
+}
+
+fn env(name: &str) -> Result<String, String> {
+    std::env::var(name).map_err(|_| format!("cargo did not set {name}"))
+}
+
+/// `#include "name"` from the first folder that has it.
+fn include(dirs: &[PathBuf], name: &str) -> Result<shaderc::ResolvedInclude, String> {
+    for dir in dirs {
+        let candidate = dir.join(name);
+        if let Ok(content) = std::fs::read_to_string(&candidate) {
+            return Ok(shaderc::ResolvedInclude {
+                resolved_name: candidate.display().to_string(),
+                content,
+            });
+        }
+    }
+    Err(format!(
+        "include \"{name}\" not found in the stage's folder, glsl/common or the generated includes"
+    ))
+}
+
+/// The manifest against itself and against the files under `glsl/`.
+fn check_manifest(manifest: &Manifest, glsl: &Path) -> Result<(), String> {
+    let mut errors = Vec::new();
+    let mut axis_names = BTreeSet::new();
+    for axis in &manifest.axis {
+        if !axis_names.insert(axis.name.as_str()) {
+            errors.push(format!("axis {} declared twice", axis.name));
+        }
+        if axis.values.is_empty() {
+            errors.push(format!("axis {} has no values", axis.name));
+        }
+        for v in axis.values.iter().filter(|v| v.defines.is_empty()) {
+            if v.rust != axis.default {
+                errors.push(format!(
+                    "axis {}: value {} has no defines, so it must be the axis default {}",
+                    axis.name, v.rust, axis.default
+                ));
             }
         }
     }
-    if !failures.is_empty() {
-        for f in &failures {
-            eprintln!("{f}");
+    let mut listed = BTreeSet::new();
+    let mut names = BTreeSet::new();
+    for stage in &manifest.stage {
+        if !listed.insert(stage.file.clone()) {
+            errors.push(format!("{}: listed twice", stage.file));
         }
-        panic!("shader compilation failed:\n{}", failures.join("\n"));
+        if !names.insert(stage_ident(&stage.file)) {
+            errors.push(format!("{}: its Stage name is taken", stage.file));
+        }
+        let path = glsl.join(&stage.file);
+        if !path.is_file() {
+            errors.push(format!(
+                "{}: listed in the manifest, no such file",
+                stage.file
+            ));
+        } else if stage_kind(&path).is_none() {
+            errors.push(format!("{}: not a shader stage extension", stage.file));
+        }
+        for a in &stage.axes {
+            if !axis_names.contains(a.as_str()) {
+                errors.push(format!("{}: unknown axis {a}", stage.file));
+            }
+        }
     }
-    std::fs::write(out.join("shaders.rs"), generated).expect("write shaders.rs");
+    let mut on_disk = Vec::new();
+    stage_files(glsl, glsl, &mut on_disk);
+    for file in on_disk {
+        if !listed.contains(&file) {
+            errors.push(format!(
+                "glsl/{file}: a shader stage missing from glsl/manifest.toml"
+            ));
+        }
+    }
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(format!("glsl/manifest.toml:\n{}", errors.join("\n")))
+    }
 }
 
-fn stage_of(path: &Path) -> Option<shaderc::ShaderKind> {
+/// Stage files under `dir`, as paths relative to `glsl/` with `/` separators.
+fn stage_files(glsl: &Path, dir: &Path, out: &mut Vec<String>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            stage_files(glsl, &path, out);
+        } else if stage_kind(&path).is_some() {
+            if let Ok(rel) = path.strip_prefix(glsl) {
+                let parts: Vec<String> = rel
+                    .components()
+                    .map(|c| c.as_os_str().to_string_lossy().into_owned())
+                    .collect();
+                out.push(parts.join("/"));
+            }
+        }
+    }
+}
+
+/// Every combination of the values of the axes `stage` names, in manifest axis order; an axis
+/// the stage does not name contributes nothing (its field keeps the default).
+fn combinations<'m>(manifest: &'m Manifest, stage: &StageEntry) -> Vec<Vec<&'m AxisValue>> {
+    let mut combos: Vec<Vec<&AxisValue>> = vec![Vec::new()];
+    for axis in &manifest.axis {
+        if !stage.axes.contains(&axis.name) {
+            continue;
+        }
+        combos = combos
+            .into_iter()
+            .flat_map(|c| {
+                axis.values.iter().map(move |v| {
+                    let mut c = c.clone();
+                    c.push(v);
+                    c
+                })
+            })
+            .collect();
+    }
+    combos
+}
+
+fn stage_kind(path: &Path) -> Option<shaderc::ShaderKind> {
     Some(match path.extension()?.to_str()? {
         "vert" => shaderc::ShaderKind::Vertex,
         "tesc" => shaderc::ShaderKind::TessControl,
@@ -156,15 +309,173 @@ fn stage_of(path: &Path) -> Option<shaderc::ShaderKind> {
     })
 }
 
-/// `pn.tesc` → `PN_TESC`.
-fn const_name(file: &str) -> String {
-    file.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() {
-                c.to_ascii_uppercase()
-            } else {
-                '_'
-            }
+fn vk_stage_flag(file: &str) -> &'static str {
+    match file.rsplit('.').next() {
+        Some("vert") => "VERTEX",
+        Some("tesc") => "TESSELLATION_CONTROL",
+        Some("tese") => "TESSELLATION_EVALUATION",
+        Some("frag") => "FRAGMENT",
+        _ => "COMPUTE",
+    }
+}
+
+/// `pn/tri.tese` → `PnTriTese`; `bft/subdivide.comp` → `BftSubdivideComp`.
+fn stage_ident(file: &str) -> String {
+    file.split(['/', '.', '_', '-'])
+        .filter(|w| !w.is_empty())
+        .map(|w| {
+            let mut c = w.chars();
+            c.next()
+                .map(|f| f.to_ascii_uppercase().to_string() + c.as_str())
+                .unwrap_or_default()
         })
         .collect()
+}
+
+/// The generated `shaders.rs`.
+struct Code<'m> {
+    manifest: &'m Manifest,
+    tables: String,
+    stages: Vec<(String, String, Vec<String>)>,
+}
+
+impl<'m> Code<'m> {
+    fn new(manifest: &'m Manifest) -> Self {
+        Self {
+            manifest,
+            tables: String::new(),
+            stages: Vec::new(),
+        }
+    }
+
+    /// The Rust value of a variant: declared axes from `combo`, the others at their default.
+    fn variant(&self, stage: &StageEntry, combo: &[&AxisValue]) -> String {
+        let mut fields = Vec::new();
+        let mut next = combo.iter();
+        for axis in &self.manifest.axis {
+            let value = if stage.axes.contains(&axis.name) {
+                next.next().map(|v| v.rust.clone()).unwrap_or_default()
+            } else {
+                axis.default.clone()
+            };
+            fields.push(format!("{}: {value}", axis.name));
+        }
+        format!("Variant {{ {} }}", fields.join(", "))
+    }
+
+    fn stage(&mut self, stage: &StageEntry, variants: Vec<(Vec<&AxisValue>, Vec<u32>)>) {
+        let ident = stage_ident(&stage.file);
+        let table = format!("VARIANTS_{}", ident.to_ascii_uppercase());
+        writeln!(
+            self.tables,
+            "/// Every declared variant of `glsl/{}`.\nstatic {table}: &[(Variant, &[u32])] = &[",
+            stage.file
+        )
+        .unwrap();
+        for (combo, words) in &variants {
+            writeln!(
+                self.tables,
+                "    ({}, &{words:?}),",
+                self.variant(stage, combo)
+            )
+            .unwrap();
+        }
+        writeln!(self.tables, "];").unwrap();
+        self.stages
+            .push((ident, stage.file.clone(), stage.axes.clone()));
+    }
+
+    fn finish(self) -> String {
+        let mut s = String::from(
+            "// @generated by build.rs from glsl/manifest.toml: do not edit.\n\n\
+             /// A shader stage file of `glsl/`, named `{Folder}{Stem}{Extension}`.\n\
+             #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]\npub enum Stage {\n",
+        );
+        for (ident, file, _) in &self.stages {
+            writeln!(s, "    /// `glsl/{file}`.\n    {ident},").unwrap();
+        }
+        s += "}\n\n";
+        writeln!(
+            s,
+            "impl Stage {{\n    /// Every stage, in manifest order.\n    pub const ALL: [Stage; {}] = [{}];\n",
+            self.stages.len(),
+            self.stages
+                .iter()
+                .map(|(i, _, _)| format!("Stage::{i}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+        .unwrap();
+        s += "    /// The stage's file, relative to `glsl/`.\n    pub fn path(self) -> &'static str {\n        match self {\n";
+        for (ident, file, _) in &self.stages {
+            writeln!(s, "            Stage::{ident} => \"{file}\",").unwrap();
+        }
+        s += "        }\n    }\n\n";
+        s += "    /// The manifest axes the stage varies along.\n    pub fn axes(self) -> &'static [&'static str] {\n        match self {\n";
+        for (ident, _, axes) in &self.stages {
+            writeln!(s, "            Stage::{ident} => &{axes:?},").unwrap();
+        }
+        s += "        }\n    }\n\n";
+        s += "    /// Every declared variant with its SPIR-V words.\n    pub fn compiled(self) -> &'static [(Variant, &'static [u32])] {\n        match self {\n";
+        for (ident, _, _) in &self.stages {
+            writeln!(
+                s,
+                "            Stage::{ident} => VARIANTS_{},",
+                ident.to_ascii_uppercase()
+            )
+            .unwrap();
+        }
+        s += "        }\n    }\n\n";
+        s += "    /// The pipeline stage, from the file's extension.\n    pub fn vk_stage(self) -> vk::ShaderStageFlags {\n        match self {\n";
+        for (ident, file, _) in &self.stages {
+            writeln!(
+                s,
+                "            Stage::{ident} => vk::ShaderStageFlags::{},",
+                vk_stage_flag(file)
+            )
+            .unwrap();
+        }
+        s += "        }\n    }\n\n";
+        s += "    /// `variant` with the axes this stage does not vary along set to their default:\n    /// the key of the stage's compiled variants.\n    pub fn project(self, variant: Variant) -> Variant {\n        #[allow(unused_mut)]\n        let mut v = Variant::default();\n";
+        for axis in &self.manifest.axis {
+            let stages: Vec<String> = self
+                .stages
+                .iter()
+                .filter(|(_, _, axes)| axes.contains(&axis.name))
+                .map(|(i, _, _)| format!("Stage::{i}"))
+                .collect();
+            if !stages.is_empty() {
+                writeln!(
+                    s,
+                    "        if matches!(self, {}) {{\n            v.{} = variant.{};\n        }}",
+                    stages.join(" | "),
+                    axis.name,
+                    axis.name
+                )
+                .unwrap();
+            }
+        }
+        s += "        v\n    }\n}\n\n";
+        s += "/// One value on every manifest axis. A stage ignores the axes it does not vary along\n\
+               /// ([`Stage::project`]); `Default` is the value a stage without the axis is built with.\n\
+               #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]\npub struct Variant {\n";
+        for axis in &self.manifest.axis {
+            writeln!(s, "    pub {}: {},", axis.name, axis.ty).unwrap();
+        }
+        s += "}\n\n";
+        writeln!(
+            s,
+            "/// Every axis at its `default` in the manifest (equal to `Variant::default()`).\n\
+             pub const DEFAULT_VARIANT: Variant = Variant {{ {} }};\n",
+            self.manifest
+                .axis
+                .iter()
+                .map(|a| format!("{}: {}", a.name, a.default))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+        .unwrap();
+        s += &self.tables;
+        s
+    }
 }

@@ -69,9 +69,12 @@ pub enum TessError {
     /// Recording before [`crate::Context::prepare`] built the pass's pipelines.
     #[error("{technique}: no {pass:?} pipeline was prepared before recording")]
     PipelineNotPrepared { technique: TechniqueId, pass: Pass },
-    /// The shader manifest declares no such variant.
-    #[error("shader {stage:?} has no variant {variant:?}")]
-    MissingShaderVariant { stage: Stage, variant: Variant },
+    /// A shader variant `glsl/manifest.toml` does not declare.
+    #[error("shader {} has no variant {variant:?} (see glsl/manifest.toml)", stage.path())]
+    ShaderVariant { stage: Stage, variant: Variant },
+    /// BFT data that cannot be laid out for the GPU.
+    #[error(transparent)]
+    BftLayout(#[from] crate::techniques::bft::layout::LayoutError),
     /// A capture larger than the transform-feedback buffer limit or the caller's budget.
     #[error("capturing {triangles} triangles needs {bytes} bytes of transform feedback, over the limit of {limit} bytes (lower the level or raise the limit)")]
     CaptureTooLarge {

@@ -1,96 +1,80 @@
-//! SPIR-V of every shader in `glsl/`, compiled by the build script. TEMPORARY shim over the
-//! old generated constants until the manifest lands.
-#![allow(missing_docs)]
-use crate::error::{Result, TessError};
-use crate::tessellator::Spacing;
+//! SPIR-V of every shader stage declared in `glsl/manifest.toml`, compiled by the build script
+//! in every declared variant, and looked up by a typed key:
+//!
+//! ```
+//! use tess::shaders::{spirv, Stage, Variant};
+//! use tess::Spacing;
+//! let capture = Variant { spacing: Some(Spacing::FractionalOdd), capture: true };
+//! let words = spirv(Stage::PnTriTese, capture).unwrap();
+//! assert_eq!(words[0], 0x0723_0203); // the SPIR-V magic number
+//! // A stage ignores the axes it does not vary along: the TCS has one build.
+//! assert_eq!(spirv(Stage::PnTriTesc, capture).unwrap(), spirv(Stage::PnTriTesc, Variant::default()).unwrap());
+//! // A variant the manifest does not declare is an error: every TES needs a spacing.
+//! assert!(spirv(Stage::PnTriTese, Variant::default()).is_err());
+//! ```
+use vk_core::vk;
+include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 
-pub mod generated {
-    include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
-}
-use generated as g;
-pub use generated::*;
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Stage {
-    CommonMeshVert,
-    CommonShadeFrag,
-    CommonTriTesc,
-    CommonQuadTesc,
-    FlatTriTese,
-    FlatQuadTese,
-    PhongTriTese,
-    PnTriTesc,
-    PnTriTese,
-    BftBftVert,
-    BftBftTesc,
-    BftBftTese,
-    BftBftFrag,
-    BftSubdivideComp,
-    BftNormalsComp,
-    PlainPlainVert,
+/// The SPIR-V of `stage` built as `variant` (on the axes the stage varies along; the others
+/// are ignored, see [`Stage::project`]); [`crate::TessError::ShaderVariant`] when the
+/// manifest does not declare that build.
+pub fn spirv(stage: Stage, variant: Variant) -> crate::Result<&'static [u32]> {
+    let key = stage.project(variant);
+    stage
+        .compiled()
+        .iter()
+        .find(|(v, _)| *v == key)
+        .map(|&(_, words)| words)
+        .ok_or(crate::TessError::ShaderVariant { stage, variant })
 }
 
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub struct Variant {
-    pub spacing: Option<Spacing>,
-    pub capture: bool,
+/// The pipeline stage of `stage` (from its file extension).
+pub fn vk_stage(stage: Stage) -> vk::ShaderStageFlags {
+    stage.vk_stage()
 }
 
-pub fn spirv(stage: Stage, variant: Variant) -> Result<&'static [u32]> {
-    use Spacing::*;
-    use Stage::*;
-    let missing = || TessError::MissingShaderVariant { stage, variant };
-    let sp = |v: [(&'static [u32], &'static [u32]); 3]| -> Result<&'static [u32]> {
-        let (r, c) = match variant.spacing.ok_or_else(missing)? {
-            Equal => v[0],
-            FractionalEven => v[1],
-            FractionalOdd => v[2],
-        };
-        Ok(if variant.capture { c } else { r })
-    };
-    let single = |w: &'static [u32]| -> Result<&'static [u32]> {
-        if variant.spacing.is_some() || variant.capture {
-            Err(missing())
-        } else {
-            Ok(w)
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn manifest_defaults_are_the_variant_default() {
+        assert_eq!(DEFAULT_VARIANT, Variant::default());
+    }
+
+    #[test]
+    fn every_stage_is_built_and_named_after_its_file() {
+        for stage in Stage::ALL {
+            assert!(!stage.compiled().is_empty(), "{stage:?}");
+            let camel: String = stage
+                .path()
+                .split(['/', '.'])
+                .map(|w| w[..1].to_uppercase() + &w[1..])
+                .collect();
+            assert_eq!(format!("{stage:?}"), camel);
+            // Every declared build is reachable through the lookup, as itself.
+            for &(v, words) in stage.compiled() {
+                assert_eq!(stage.project(v), v);
+                assert_eq!(spirv(stage, v).expect("declared"), words);
+            }
         }
-    };
-    match stage {
-        CommonMeshVert => single(g::MESH_VERT),
-        CommonShadeFrag => single(g::SHADE_FRAG),
-        CommonTriTesc => single(g::TRI_TESC),
-        CommonQuadTesc => single(g::QUAD_TESC),
-        PnTriTesc => single(g::PN_TESC),
-        BftBftVert => single(g::BFT_VERT),
-        BftBftTesc => single(g::BFT_TESC),
-        BftBftFrag => single(g::BFT_FRAG),
-        BftSubdivideComp => single(g::BFT_SUBDIVIDE_COMP),
-        BftNormalsComp => single(g::BFT_NORMALS_COMP),
-        PlainPlainVert => single(g::PLAIN_VERT),
-        FlatTriTese => sp([
-            (g::FLAT_TRI_TESE_EQUAL, g::FLAT_TRI_TESE_EQUAL_CAPTURE),
-            (g::FLAT_TRI_TESE_FRACTIONAL_EVEN, g::FLAT_TRI_TESE_FRACTIONAL_EVEN_CAPTURE),
-            (g::FLAT_TRI_TESE_FRACTIONAL_ODD, g::FLAT_TRI_TESE_FRACTIONAL_ODD_CAPTURE),
-        ]),
-        FlatQuadTese => sp([
-            (g::FLAT_QUAD_TESE_EQUAL, g::FLAT_QUAD_TESE_EQUAL_CAPTURE),
-            (g::FLAT_QUAD_TESE_FRACTIONAL_EVEN, g::FLAT_QUAD_TESE_FRACTIONAL_EVEN_CAPTURE),
-            (g::FLAT_QUAD_TESE_FRACTIONAL_ODD, g::FLAT_QUAD_TESE_FRACTIONAL_ODD_CAPTURE),
-        ]),
-        PhongTriTese => sp([
-            (g::PHONG_TESE_EQUAL, g::PHONG_TESE_EQUAL_CAPTURE),
-            (g::PHONG_TESE_FRACTIONAL_EVEN, g::PHONG_TESE_FRACTIONAL_EVEN_CAPTURE),
-            (g::PHONG_TESE_FRACTIONAL_ODD, g::PHONG_TESE_FRACTIONAL_ODD_CAPTURE),
-        ]),
-        PnTriTese => sp([
-            (g::PN_TESE_EQUAL, g::PN_TESE_EQUAL_CAPTURE),
-            (g::PN_TESE_FRACTIONAL_EVEN, g::PN_TESE_FRACTIONAL_EVEN_CAPTURE),
-            (g::PN_TESE_FRACTIONAL_ODD, g::PN_TESE_FRACTIONAL_ODD_CAPTURE),
-        ]),
-        BftBftTese => sp([
-            (g::BFT_TESE_EQUAL, g::BFT_TESE_EQUAL_CAPTURE),
-            (g::BFT_TESE_FRACTIONAL_EVEN, g::BFT_TESE_FRACTIONAL_EVEN_CAPTURE),
-            (g::BFT_TESE_FRACTIONAL_ODD, g::BFT_TESE_FRACTIONAL_ODD_CAPTURE),
-        ]),
+        let tese = Stage::ALL
+            .iter()
+            .filter(|s| vk_stage(**s) == vk::ShaderStageFlags::TESSELLATION_EVALUATION)
+            .count();
+        assert_eq!(tese, 5);
+    }
+
+    #[test]
+    fn an_undeclared_variant_is_a_typed_error() {
+        let e = spirv(Stage::FlatTriTese, Variant::default()).expect_err("no spacing");
+        assert!(matches!(
+            e,
+            crate::TessError::ShaderVariant {
+                stage: Stage::FlatTriTese,
+                ..
+            }
+        ));
+        assert!(e.to_string().contains("flat/tri.tese"), "{e}");
     }
 }

@@ -8,13 +8,23 @@
 //! 2. **Main pass**: one patch (one control point carrying the face index) per level-1 face.
 //!    `bft.tesc` sets power-of-two (or fractional) edge factors from each edge's two endpoints
 //!    only; `bft.tese` evaluates the table row of each tess coordinate (see
-//!    `glsl/bft/bft.glsl`, mirrored in f32 by [`GpuBft::eval_tess`]).
+//!    `glsl/bft/bft.glsl`, mirrored in f32 by [`layout::GpuBft::eval_tess`]).
+//!
+//! The GPU data (named structs for every buffer, bindings, packing, validation, and the f32
+//! mirror of the TES) is [`layout`].
 //!
 //! Polygons are fan-triangulated first (Loop needs triangles); captured points map back into
 //! the input's polygons, so callers never see the triangulation.
 use crate::capture::{face_corner_uv, FacePoint};
 use crate::context::Context;
 use crate::error::{Result, TessError};
+pub mod layout;
+
+use crate::gpu::bindings::{
+    BFT_BASE_POSITIONS_BINDING, BFT_FACTORS_DISTANCE, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM,
+    BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING, BFT_LOCAL_SIZE,
+    BFT_OPTION_FRACTIONAL, BFT_OPTION_GEOMETRIC_NORMALS, BFT_OPTION_PATCH_COLOURS,
+};
 use crate::gpu::BftPush;
 use crate::shaders::{self, Stage, Variant};
 use crate::technique::{
@@ -22,7 +32,8 @@ use crate::technique::{
     PatchPipeline, PatchType, Technique, TechniqueId,
 };
 use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, Domain, Spacing};
-use topology::bft::{prepare_loop_bft, GpuBft, LoopBft};
+use layout::{BasePosition, GpuBft, STORAGE_BINDINGS};
+use topology::bft::{prepare_loop_bft, LoopBft};
 use topology::ControlMesh;
 use vk_core::descriptor::{BindingDesc, DescriptorPool};
 use vk_core::pipeline::{Pipeline, ShaderStage};
@@ -31,8 +42,6 @@ use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Device, Encoder, MemoryLoca
 /// Default maximum table level: 32 segments per level-1 edge, 64 per base edge.
 pub const DEFAULT_TABLE_LEVEL: u32 = 5;
 
-/// Storage buffers of set 1, in binding order (binding 0: the base positions of the slot).
-const STORAGE_BUFFERS: u32 = 12;
 
 const STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
     vk::ShaderStageFlags::COMPUTE.as_raw()
@@ -50,20 +59,32 @@ const fn storage_binding(binding: u32) -> BindingDesc {
     }
 }
 
-static SET_BINDINGS: [BindingDesc; STORAGE_BUFFERS as usize] = [
-    storage_binding(0),
-    storage_binding(1),
-    storage_binding(2),
-    storage_binding(3),
-    storage_binding(4),
-    storage_binding(5),
-    storage_binding(6),
-    storage_binding(7),
-    storage_binding(8),
-    storage_binding(9),
-    storage_binding(10),
-    storage_binding(11),
-];
+/// Set 1 of every BFT pipeline: the storage buffers of [`STORAGE_BINDINGS`].
+static SET_BINDINGS: [BindingDesc; STORAGE_BINDINGS.len()] = {
+    let mut out = [storage_binding(0); STORAGE_BINDINGS.len()];
+    let mut i = 0;
+    while i < out.len() {
+        out[i] = storage_binding(STORAGE_BINDINGS[i]);
+        i += 1;
+    }
+    out
+};
+
+/// `bit` when `on`.
+fn flag(on: bool, bit: u32) -> u32 {
+    if on {
+        bit
+    } else {
+        0
+    }
+}
+
+/// Base positions as the `BasePositions` buffer holds them.
+fn as_base_positions(positions: &[[f32; 3]]) -> &[u8] {
+    bytemuck::cast_slice::<BasePosition, u8>(bytemuck::cast_slice::<[f32; 3], BasePosition>(
+        positions,
+    ))
+}
 
 /// How a BFT surface is built (the per-frame choices are in [`FrameParams`]).
 #[derive(Clone, Debug)]
@@ -187,42 +208,28 @@ impl Bft {
                     source: e.into(),
                 }
             })?;
-        let gpu = GpuBft::new(&bft).map_err(|e| TessError::Mesh {
-            name: options.name.clone(),
-            source: e.into(),
-        })?;
+        let gpu = GpuBft::new(&bft)?;
         let frames = ctx.frames_in_flight();
         ctx.ensure_set_layout(TechniqueId::Bft, &SET_BINDINGS)?;
         let set_layout = ctx.set_layout(TechniqueId::Bft)?;
         let pool = DescriptorPool::new(&device, "bft descriptor pool", set_layout, frames as u32)?;
-        let b = bytemuck::cast_slice::<u32, u8>;
-        let f = bytemuck::cast_slice::<f32, u8>;
-        let level1_bytes = 16 * gpu.level1_vertices.max(1) as u64;
-        let level1 = |name: &str| {
-            Buffer::new(
-                &device,
-                &BufferDesc {
-                    name,
-                    size: level1_bytes,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-                    location: MemoryLocation::GpuOnly,
-                },
-            )
+        let level1_bytes = gpu.level1_bytes();
+        let level1 = |binding: u32, name: &str| -> Result<(u32, Buffer)> {
+            let desc = BufferDesc {
+                name,
+                size: level1_bytes,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::GpuOnly,
+            };
+            Ok((binding, Buffer::new(&device, &desc)?))
         };
-        let tw: Vec<f32> = gpu.tangent_weights.iter().flatten().copied().collect();
-        let statics = vec![
-            storage(&device, "bft stencil offsets", b(&gpu.stencil_offsets))?,
-            storage(&device, "bft stencil indices", b(&gpu.stencil_indices))?,
-            storage(&device, "bft stencil weights", f(&gpu.stencil_weights))?,
-            storage(&device, "bft tangent offsets", b(&gpu.tangent_offsets))?,
-            storage(&device, "bft tangent indices", b(&gpu.tangent_indices))?,
-            storage(&device, "bft tangent weights", f(&tw))?,
-            level1("bft level-1 positions")?,
-            level1("bft level-1 normals")?,
-            storage(&device, "bft patches", b(&gpu.patches))?,
-            storage(&device, "bft table words", b(&gpu.table_words))?,
-            storage(&device, "bft table weights", f(&gpu.table_weights))?,
+        let mut statics = vec![
+            level1(BFT_LEVEL1_POSITIONS_BINDING, "bft level-1 positions")?,
+            level1(BFT_LEVEL1_NORMALS_BINDING, "bft level-1 normals")?,
         ];
+        for (binding, name, bytes) in gpu.static_buffers() {
+            statics.push((binding, storage(&device, name, &bytes)?));
+        }
         let base_positions = base_positions(&loop_mesh);
         let mut base = Vec::new();
         let mut sets = Vec::new();
@@ -231,16 +238,21 @@ impl Bft {
                 &device,
                 &BufferDesc {
                     name: &format!("bft base positions {i}"),
-                    size: (12 * base_positions.len().max(1)) as u64,
+                    size: (std::mem::size_of::<BasePosition>() * base_positions.len().max(1))
+                        as u64,
                     usage: vk::BufferUsageFlags::STORAGE_BUFFER,
                     location: MemoryLocation::CpuToGpu,
                 },
             )?;
-            buf.write(0, bytemuck::cast_slice(&base_positions))?;
+            buf.write(0, as_base_positions(&base_positions))?;
             let set = pool.allocate_set(set_layout)?;
-            set.write_buffer(0, vk::DescriptorType::STORAGE_BUFFER, &buf)?;
-            for (k, s) in statics.iter().enumerate() {
-                set.write_buffer(k as u32 + 1, vk::DescriptorType::STORAGE_BUFFER, s)?;
+            set.write_buffer(
+                BFT_BASE_POSITIONS_BINDING,
+                vk::DescriptorType::STORAGE_BUFFER,
+                &buf,
+            )?;
+            for (binding, s) in &statics {
+                set.write_buffer(*binding, vk::DescriptorType::STORAGE_BUFFER, s)?;
             }
             base.push(buf);
             sets.push(set);
@@ -268,7 +280,7 @@ impl Bft {
             sets,
             _pool: pool,
             base,
-            _static: statics,
+            _static: statics.into_iter().map(|(_, b)| b).collect(),
             arrays,
             gpu,
             bft,
@@ -280,9 +292,9 @@ impl Bft {
         })
     }
 
-    /// Bytes of basis-function tables on the GPU (weights, table words).
+    /// Bytes of basis-function tables on the GPU ([`GpuBft::table_bytes`]).
     pub fn table_bytes(&self) -> usize {
-        4 * (self.gpu.table_weights.len() + self.gpu.table_words.len())
+        self.gpu.table_bytes()
     }
 
     /// Level-1 faces: patches per frame.
@@ -292,22 +304,27 @@ impl Bft {
 
     /// Segments per level-1 edge the tables reach (`2^L`).
     fn max_level(&self) -> u32 {
-        self.gpu.table_words[1]
+        self.gpu.table.segments
     }
 
     fn push(&self, params: &FrameParams, mode: u32) -> BftPush {
         let (factor_mode, uniform_level, pixels, reference) = match params.factors {
-            FactorPolicy::Uniform { segments } => (0, segments * 0.5, 0.0, 0.0),
-            FactorPolicy::Screen { pixels } => (1, 0.0, pixels.max(0.01), 0.0),
-            FactorPolicy::Distance { reference } => (2, 0.0, 0.0, reference.max(1e-6)),
+            FactorPolicy::Uniform { segments } => (BFT_FACTORS_UNIFORM, segments * 0.5, 0.0, 0.0),
+            FactorPolicy::Screen { pixels } => (BFT_FACTORS_SCREEN, 0.0, pixels.max(0.01), 0.0),
+            FactorPolicy::Distance { reference } => {
+                (BFT_FACTORS_DISTANCE, 0.0, 0.0, reference.max(1e-6))
+            }
         };
         BftPush {
             mode,
             first_patch: 0,
             factor_mode,
-            options: params.geometric_normals as u32
-                | (params.patch_colours as u32) << 1
-                | ((params.spacing == Spacing::FractionalEven) as u32) << 2,
+            options: flag(params.geometric_normals, BFT_OPTION_GEOMETRIC_NORMALS)
+                | flag(params.patch_colours, BFT_OPTION_PATCH_COLOURS)
+                | flag(
+                    params.spacing == Spacing::FractionalEven,
+                    BFT_OPTION_FRACTIONAL,
+                ),
             uniform_level,
             pixels_per_segment: pixels,
             distance_ref: reference,
@@ -353,7 +370,7 @@ impl Technique for Bft {
                     return Err(TessError::BftSegments {
                         segments,
                         max,
-                        table_level: self.gpu.table_words[0],
+                        table_level: self.gpu.table.level,
                     });
                 }
             }
@@ -433,7 +450,7 @@ impl Technique for Bft {
             .base
             .get_mut(slot)
             .ok_or(TessError::FrameSlot { slot, slots })?;
-        buf.write(0, bytemuck::cast_slice(positions))?;
+        buf.write(0, as_base_positions(positions))?;
         self.base_positions = positions.to_vec();
         Ok(())
     }
@@ -448,7 +465,7 @@ impl Technique for Bft {
             count: self.gpu.level1_vertices,
             ..Default::default()
         };
-        let groups = self.gpu.level1_vertices.div_ceil(64).max(1);
+        let groups = self.gpu.level1_vertices.div_ceil(BFT_LOCAL_SIZE).max(1);
         let tess_stages = vk::PipelineStageFlags::VERTEX_SHADER
             | vk::PipelineStageFlags::TESSELLATION_CONTROL_SHADER
             | vk::PipelineStageFlags::TESSELLATION_EVALUATION_SHADER;
@@ -531,16 +548,13 @@ impl Technique for Bft {
 
     fn report_notes(&self) -> Vec<String> {
         let g = &self.gpu;
-        let words = |n: usize| 4 * n;
-        let stencils =
-            words(g.stencil_offsets.len() + g.stencil_indices.len() + g.stencil_weights.len());
         vec![format!(
             "BFT tables {} bytes at level {} (the valences and cases present in the mesh), \
              patch records {} bytes, base-to-level-1 stencils {} bytes",
             self.table_bytes(),
-            g.table_words[0],
-            words(g.patches.len()),
-            stencils
+            g.table.level,
+            g.patch_bytes(),
+            g.stencil_bytes()
         )]
     }
 }

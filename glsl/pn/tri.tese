@@ -2,7 +2,7 @@
 // Curved PN triangle evaluation: cubic Bézier position (standard Bernstein weights) and the
 // appendix's quadratic normal field n = N1 u^2 + N2 v^2 + N3 w^2 + n110 uv + n011 vw + n101 wu,
 // normalised. Barycentric (u, v, w) = gl_TessCoord weights of corners 0, 1, 2.
-// Built also as a CAPTURE variant (transform feedback of every emitted corner, tese_out.glsl).
+// Built in every spacing, with and without capture (glsl/manifest.toml; tese_out.glsl).
 #include "frame.glsl"
 #include "tese_out.glsl"
 layout(triangles, SPACING, ccw) in;

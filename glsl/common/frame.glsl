@@ -1,6 +1,7 @@
 // Per-frame uniforms shared by every technique. Mirrors `tess::gpu::FrameUniforms` (std140);
 // the Rust side asserts sizes and offsets, and a test reads them back from the SPIR-V.
-layout(std140, set = 0, binding = 0) uniform Frame {
+#include "bindings.glsl"
+layout(std140, set = FRAME_SET, binding = FRAME_UNIFORMS_BINDING) uniform Frame {
     mat4 view_proj;
     mat4 view;
     vec4 camera_pos;   // xyz: eye in world space
@@ -13,10 +14,10 @@ layout(std140, set = 0, binding = 0) uniform Frame {
 
 // Push constant: what a draw is for, and where it starts in the frame's patch numbering.
 // Mirrors `tess::gpu::DrawPush` (std430 offsets checked against the SPIR-V by a test).
-// BFT stages define BFT_PUSH_CONSTANTS and use their own block (bft.glsl).
+// BFT stages define BFT_PUSH_CONSTANTS and use their own block (bft/bft.glsl).
 #ifndef BFT_PUSH_CONSTANTS
 layout(push_constant) uniform Draw {
-    uint mode;         // 0: shaded, 1: wireframe
+    uint mode;         // DRAW_MODE_SHADED or DRAW_MODE_WIREFRAME
     uint first_patch;  // patch id of this draw's first patch (gl_PrimitiveID restarts per draw)
 } draw;
 #endif

@@ -1,6 +1,6 @@
 #version 450
 // Flat tessellation of a quad: the bilinear point at (u, v); v0 (0,0), v1 (1,0), v2 (1,1), v3 (0,1).
-// Built also as a CAPTURE variant (transform feedback of every emitted corner, tese_out.glsl).
+// Built in every spacing, with and without capture (glsl/manifest.toml; tese_out.glsl).
 #include "frame.glsl"
 #include "tese_out.glsl"
 layout(quads, SPACING, ccw) in;

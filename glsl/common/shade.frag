@@ -6,7 +6,7 @@ layout(location = 0) in vec3 in_world;
 layout(location = 1) in vec3 in_normal;
 layout(location = 0) out vec4 out_color;
 void main() {
-    if (draw.mode == 1u) {
+    if (draw.mode == DRAW_MODE_WIREFRAME) {
         out_color = vec4(frame.wire_color.rgb, 1.0);
         return;
     }

@@ -3,15 +3,16 @@
 // (boundary fans use the boundary masks): where subdivision shading starts.
 #define BFT_WRITES_LEVEL1
 #include "bft.glsl"
-layout(local_size_x = 64) in;
+layout(local_size_x = BFT_LOCAL_SIZE) in;
 void main() {
     uint v = gl_GlobalInvocationID.x;
     if (v >= bft.count) return;
     precise vec3 t1 = vec3(0.0), t2 = vec3(0.0);
     for (uint k = tangent_offsets[v]; k < tangent_offsets[v + 1u]; ++k) {
-        vec3 x = level1_pos[tangent_indices[k]].xyz;
-        t1 += tangent_weights[k].x * x;
-        t2 += tangent_weights[k].y * x;
+        TangentTerm t = tangent_terms[k];
+        vec3 x = level1_pos[t.index].xyz;
+        t1 += t.weight_t1 * x;
+        t2 += t.weight_t2 * x;
     }
     vec3 n = cross(t1, t2);
     float l = length(n);

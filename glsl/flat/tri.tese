@@ -1,6 +1,6 @@
 #version 450
 // Flat tessellation of a triangle: the planar point at the barycentric tess coordinate.
-// Built also as a CAPTURE variant (transform feedback of every emitted corner, tese_out.glsl).
+// Built in every spacing, with and without capture (glsl/manifest.toml; tese_out.glsl).
 #include "frame.glsl"
 #include "tese_out.glsl"
 layout(triangles, SPACING, ccw) in;

@@ -1,10 +1,13 @@
-//! The TES's evaluation ([`GpuBft::eval_tess`], the f32 mirror of `glsl/bft.tese`) at the
-//! points the triangle tessellator makes: exact at every vertex of power-of-two factors,
-//! bit-identical across shared edges for any edge parameter, and packing that validates.
+//! The BFT GPU layout ([`GpuBft`], `glsl/bft/bft.glsl`): the TES's evaluation
+//! ([`GpuBft::eval_tess`], the f32 mirror of `glsl/bft/bft.tese`) at the points the triangle
+//! tessellator makes: exact at every vertex of power-of-two factors, bit-identical across shared
+//! edges for any edge parameter; and packing that validates and points every patch at its ring.
+//! (Moved from topology with the packing: topology hands over plain data, tess lays it out.)
 
 use std::collections::HashMap;
-use topology::bft::{prepare_loop_bft, tessellator_interior_points, GpuBft, LoopBft};
-use topology::load_obj;
+use tess::bft::{owner_face, pack_owner, GpuBft};
+use topology::bft::{prepare_loop_bft, tessellator_interior_points, LoopBft};
+use topology::{load_obj, ControlMesh};
 
 const DATA: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -197,15 +200,15 @@ fn compute_pass_mirror_matches_refinement() {
 fn validation_rejects_out_of_range_indices() {
     let (_, mut gpu, _) = load("loop_tetrahedron", 2);
     gpu.validate().expect("valid");
-    let ring_start = gpu.patches[0] as usize;
-    gpu.patches[ring_start] = gpu.level1_vertices;
+    let ring_start = gpu.patches[0].ring_offset as usize;
+    gpu.patch_rings[ring_start] = gpu.level1_vertices;
     assert!(gpu.validate().is_err());
     let (_, mut gpu, _) = load("loop_tetrahedron", 2);
-    let last = gpu.stencil_indices.len() - 1;
-    gpu.stencil_indices[last] = gpu.base_vertices + 7;
+    let last = gpu.stencil_terms.len() - 1;
+    gpu.stencil_terms[last].index = gpu.base_vertices + 7;
     assert!(gpu.validate().is_err());
     let (_, mut gpu, _) = load("loop_tetrahedron", 2);
-    gpu.patches[3] = 9999 << 2;
+    gpu.patches[0].edge_owner[0] = pack_owner(9999, 0);
     assert!(gpu.validate().is_err());
 }
 
@@ -234,4 +237,62 @@ fn every_crease_free_loop_shape_is_covered() {
         assert_eq!(bft.records.len(), 4 * mesh.num_faces(), "{name}");
         GpuBft::new(&bft).unwrap_or_else(|e| panic!("{name}: {e}"));
     }
+}
+
+/// The ridged grid of topology's BFT tests (both diagonals, boundary corners).
+fn grid_mesh(m: u32) -> ControlMesh {
+    let mut pos = Vec::new();
+    for y in 0..=m {
+        for x in 0..=m {
+            let (fx, fy) = (x as f64, y as f64);
+            pos.push([fx, fy, 0.3 * (0.7 * fx).sin() * (0.5 * fy).cos()]);
+        }
+    }
+    let id = |x: u32, y: u32| y * (m + 1) + x;
+    let mut faces = Vec::new();
+    for y in 0..m {
+        for x in 0..m {
+            let (a, b, c, d) = (id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1));
+            let corner_ac = (x == 0 && y == 0) || (x == m - 1 && y == m - 1);
+            let corner_bd = (x == m - 1 && y == 0) || (x == 0 && y == m - 1);
+            let diag_ac = corner_ac || (!corner_bd && (x * 7 + y * 13 + x * y) % 3 != 0);
+            if diag_ac {
+                faces.push(vec![a, b, c]);
+                faces.push(vec![a, c, d]);
+            } else {
+                faces.push(vec![a, b, d]);
+                faces.push(vec![b, c, d]);
+            }
+        }
+    }
+    ControlMesh::from_polygons(pos, &faces)
+}
+
+/// One header per patch with its six owners, every ring back to back, and a header that
+/// points at its own ring (what topology's `pack_patches` test asserted of the packing).
+#[test]
+fn prepare_and_pack_for_the_gpu() {
+    let mesh = grid_mesh(4);
+    let bft = prepare_loop_bft(&mesh, 2, true).expect("grid is covered");
+    assert_eq!(bft.records.len(), bft.level1.num_faces());
+    let packed = GpuBft::new(&bft).expect("packed");
+    assert_eq!(packed.patches.len(), bft.records.len());
+    for (h, r) in packed.patches.iter().zip(&bft.records) {
+        assert_eq!(h.edge_owner, r.edge_owner.map(|(f, k)| pack_owner(f, k)));
+        assert_eq!(
+            h.corner_owner,
+            r.corner_owner.map(|(f, k)| pack_owner(f, k))
+        );
+        assert!(h
+            .corner_owner
+            .iter()
+            .all(|&o| (owner_face(o) as usize) < bft.records.len()));
+    }
+    let total: usize = bft.records.iter().map(|r| r.ring.len()).sum();
+    assert_eq!(packed.patch_rings.len(), total);
+    // Header of face 1 points at its ring.
+    let r = &bft.records[1];
+    let off = packed.patches[1].ring_offset as usize;
+    assert_eq!(packed.patches[1].ring_size as usize, r.ring.len());
+    assert_eq!(&packed.patch_rings[off..off + r.ring.len()], &r.ring[..]);
 }

@@ -13,7 +13,7 @@ float edge_factor(uint a, uint b) {
     uint lo = min(a, b), hi = max(a, b);
     vec3 p = level1_pos[lo].xyz, q = level1_pos[hi].xyz;
     float f;
-    if (bft.factor_mode == 1u) {
+    if (bft.factor_mode == BFT_FACTORS_SCREEN) {
         vec4 cp = frame.view_proj * vec4(p, 1.0), cq = frame.view_proj * vec4(q, 1.0);
         if (cp.w <= 1e-6 || cq.w <= 1e-6) {
             f = bft.max_level; // crosses the eye plane: no screen length, refine fully
@@ -22,7 +22,7 @@ float edge_factor(uint a, uint b) {
             vec2 sq = cq.xy / cq.w * 0.5 * frame.viewport.xy;
             f = length(sp - sq) / bft.pixels_per_segment;
         }
-    } else if (bft.factor_mode == 2u) {
+    } else if (bft.factor_mode == BFT_FACTORS_DISTANCE) {
         float d = distance(frame.camera_pos.xyz, 0.5 * (p + q));
         f = bft.max_level * bft.distance_ref / max(d, 1e-6);
     } else {
@@ -31,15 +31,15 @@ float edge_factor(uint a, uint b) {
     f = clamp(f, 1.0, bft.max_level);
     // Power-of-two factors keep every tess vertex on a table point (exact limit); fractional
     // factors morph continuously on the level-L virtual mesh instead.
-    if ((bft.options & 4u) == 0u) f = exp2(ceil(log2(f) - 1e-4));
+    if ((bft.options & uint(BFT_OPTION_FRACTIONAL)) == 0u) f = exp2(ceil(log2(f) - 1e-4));
     return f;
 }
 
 void main() {
     uint face = in_face[0];
     tc_face = face;
-    uint ring = patch_word(face, 0u);
-    uint v0 = patches[ring], v1 = patches[ring + 1u], v2 = patches[ring + 2u];
+    uint ring = patches[face].ring_offset;
+    uint v0 = patch_rings[ring], v1 = patch_rings[ring + 1u], v2 = patch_rings[ring + 2u];
     // gl_TessLevelOuter[i] is the edge opposite corner i: v1v2, v2v0, v0v1.
     float e0 = edge_factor(v1, v2), e1 = edge_factor(v2, v0), e2 = edge_factor(v0, v1);
     gl_TessLevelOuter[0] = e0;

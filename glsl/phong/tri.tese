@@ -2,7 +2,7 @@
 // Phong tessellation (Boubekeur & Alexa 2008): the linear point projected onto each corner's
 // tangent plane, the projections blended barycentrically, then mixed with the linear point by
 // the shape factor alpha (frame.tess.z, default 3/4). Normals are interpolated linearly.
-// Built also as a CAPTURE variant (transform feedback of every emitted corner, tese_out.glsl).
+// Built in every spacing, with and without capture (glsl/manifest.toml; tese_out.glsl).
 #include "frame.glsl"
 #include "tese_out.glsl"
 layout(triangles, SPACING, ccw) in;

@@ -1,5 +1,5 @@
 #version 450
-// Shading of BFT surfaces: as shade.frag, with the per-patch albedo (patch colouring mode).
+// Shading of BFT surfaces: as common/shade.frag, with the per-patch albedo (patch colouring mode).
 #define BFT_PUSH_CONSTANTS
 #include "frame.glsl"
 #include "bft.glsl"
@@ -9,5 +9,5 @@ layout(location = 1) in vec3 in_normal;
 layout(location = 5) flat in vec3 in_albedo;
 layout(location = 0) out vec4 out_color;
 void main() {
-    out_color = bft.mode == 1u ? vec4(frame.wire_color.rgb, 1.0) : shade(in_world, in_normal, in_albedo);
+    out_color = bft.mode == DRAW_MODE_WIREFRAME ? vec4(frame.wire_color.rgb, 1.0) : shade(in_world, in_normal, in_albedo);
 }

@@ -3,7 +3,7 @@
 // (weights of the face's v0, v1, v2) names a table point (exact limit) or, for fractional
 // factors, a point of the level-L virtual mesh. Normals by subdivision shading (the same
 // weights over the level-1 limit normals, then normalised) or from the tangent tables.
-// Built in SPACING variants and CAPTURE variants (tese_out.glsl).
+// Built in every spacing, with and without capture (glsl/manifest.toml; tese_out.glsl).
 #define BFT_PUSH_CONSTANTS
 #include "frame.glsl"
 #include "bft.glsl"
@@ -17,11 +17,11 @@ const vec3 KIND_COLOURS[4] = vec3[4](vec3(0.55, 0.75, 0.95), vec3(0.95, 0.45, 0.
 
 void main() {
     uint face = tc_face;
-    bool geometric = (bft.options & 1u) != 0u;
+    bool geometric = (bft.options & uint(BFT_OPTION_GEOMETRIC_NORMALS)) != 0u;
     vec3 p, n;
     bool exact = bft_eval(face, gl_TessCoord, geometric, p, n);
-    uint kind = entry_word(patch_word(face, 2u) & 0x7fffffffu, 7u);
-    out_albedo = (bft.options & 2u) != 0u ? KIND_COLOURS[min(kind, 3u)] : frame.base_color.rgb;
+    uint kind = table_entries[patches[face].entry].kind;
+    out_albedo = (bft.options & uint(BFT_OPTION_PATCH_COLOURS)) != 0u ? KIND_COLOURS[min(kind, 3u)] : frame.base_color.rgb;
     float l = length(n);
-    emit_sample(p, l > 0.0 ? n / l : n, face, (exact ? 1u : 0u) | (kind << 1));
+    emit_sample(p, l > 0.0 ? n / l : n, face, (exact ? uint(CAPTURE_FLAG_EXACT) : 0u) | (kind << CAPTURE_FLAG_KIND_SHIFT));
 }

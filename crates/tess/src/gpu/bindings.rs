@@ -1,0 +1,101 @@
+// Numbers the Rust host and the GLSL stages must agree on: descriptor sets and bindings, the
+// transform-feedback buffer, and the small enumerations packed into push constants and records.
+//
+// This file is compiled twice: as `tess::gpu::bindings`, and by the build script, which
+// `include!`s it and writes every constant as `#define NAME value` into `$OUT_DIR/bindings.glsl`,
+// the include the shaders take them from. So a binding number is written here and nowhere else,
+// and the file must stay plain: `u32` literals, no paths into the crate, no inner attributes.
+macro_rules! gpu_constants {
+    ($($(#[doc = $doc:literal])* $name:ident = $value:literal;)*) => {
+        $($(#[doc = $doc])* pub const $name: u32 = $value;)*
+        /// Every constant by name, in declaration order: what `bindings.glsl` defines.
+        pub const ALL: &[(&str, u32)] = &[$((stringify!($name), $name)),*];
+    };
+}
+
+gpu_constants! {
+    /// Descriptor set of the per-frame uniforms, bound by every technique.
+    FRAME_SET = 0;
+    /// The `Frame` uniform block ([`crate::gpu::FrameUniforms`]).
+    FRAME_UNIFORMS_BINDING = 0;
+
+    /// Descriptor set of one BFT surface's storage buffers (`glsl/bft/bft.glsl`).
+    BFT_SET = 1;
+    /// Base positions, one [`crate::techniques::bft::layout::BasePosition`] per base vertex; rewritten per frame.
+    BFT_BASE_POSITIONS_BINDING = 0;
+    /// CSR offsets of the base → level-1 stencils (level-1 vertex count + 1).
+    BFT_STENCIL_OFFSETS_BINDING = 1;
+    /// Base → level-1 stencil terms ([`crate::techniques::bft::layout::StencilTerm`]).
+    BFT_STENCIL_TERMS_BINDING = 2;
+    /// CSR offsets of the level-1 limit-tangent stencils.
+    BFT_TANGENT_OFFSETS_BINDING = 3;
+    /// Level-1 limit-tangent terms ([`crate::techniques::bft::layout::TangentTerm`]).
+    BFT_TANGENT_TERMS_BINDING = 4;
+    /// Level-1 positions (`vec4`), written by `subdivide.comp`.
+    BFT_LEVEL1_POSITIONS_BINDING = 5;
+    /// Level-1 limit normals (`vec4`), written by `normals.comp`.
+    BFT_LEVEL1_NORMALS_BINDING = 6;
+    /// One [`crate::techniques::bft::layout::PatchHeader`] per level-1 face.
+    BFT_PATCH_HEADERS_BINDING = 7;
+    /// Every patch's control ring (level-1 vertex indices), back to back.
+    BFT_PATCH_RINGS_BINDING = 8;
+    /// [`crate::techniques::bft::layout::TableHeader`], then one [`crate::techniques::bft::layout::TableEntry`] per table.
+    BFT_TABLES_BINDING = 9;
+    /// Mirror permutations of the tables' ring slots.
+    BFT_MIRROR_PERMS_BINDING = 10;
+    /// Row maps: grid point → table row, full tables then half tables.
+    BFT_ROW_MAPS_BINDING = 11;
+    /// Basis-function weights of every table.
+    BFT_TABLE_WEIGHTS_BINDING = 12;
+    /// Work-group size of the BFT compute passes.
+    BFT_LOCAL_SIZE = 64;
+
+    /// Transform-feedback buffer the capture variants write ([`crate::gpu::CaptureRecord`]).
+    CAPTURE_XFB_BUFFER = 0;
+    /// Bytes per captured corner: `size_of::<CaptureRecord>()` (asserted in `gpu`).
+    CAPTURE_XFB_STRIDE = 40;
+    /// Offsets of the record's members (`offset_of!` asserted in `gpu`): world position,
+    CAPTURE_OFFSET_POSITION = 0;
+    /// normal,
+    CAPTURE_OFFSET_NORMAL = 12;
+    /// patch id, then flags (one `uvec2` output),
+    CAPTURE_OFFSET_PATCH = 24;
+    /// domain coordinate.
+    CAPTURE_OFFSET_DOMAIN = 32;
+    /// Capture flag: the BFT point was a table point (exact limit), not interpolated.
+    CAPTURE_FLAG_EXACT = 1;
+    /// Capture flags: the BFT patch kind (`BFT_KIND_*`) sits above the exact bit.
+    CAPTURE_FLAG_KIND_SHIFT = 1;
+
+    /// `mode` of [`crate::gpu::DrawPush`] and [`crate::gpu::BftPush`]: shaded surface.
+    DRAW_MODE_SHADED = 0;
+    /// `mode`: the wireframe overlay (flat colour).
+    DRAW_MODE_WIREFRAME = 1;
+
+    /// `factor_mode` of [`crate::gpu::BftPush`]: one level everywhere.
+    BFT_FACTORS_UNIFORM = 0;
+    /// `factor_mode`: projected edge length over pixels per segment.
+    BFT_FACTORS_SCREEN = 1;
+    /// `factor_mode`: by distance from the eye.
+    BFT_FACTORS_DISTANCE = 2;
+    /// `options` bit of [`crate::gpu::BftPush`]: normals from the tangent tables (`du × dv`).
+    BFT_OPTION_GEOMETRIC_NORMALS = 1;
+    /// `options` bit: colour patches by kind.
+    BFT_OPTION_PATCH_COLOURS = 2;
+    /// `options` bit: fractional factors (no power-of-two rounding).
+    BFT_OPTION_FRACTIONAL = 4;
+
+    /// `kind` of a BFT table entry ([`crate::techniques::bft::layout::TableEntry`]): regular interior (valence 6).
+    BFT_KIND_REGULAR = 0;
+    /// Interior, extraordinary.
+    BFT_KIND_EXTRAORDINARY = 1;
+    /// On a boundary.
+    BFT_KIND_BOUNDARY = 2;
+    /// A face-private table (no shared configuration covers it).
+    BFT_KIND_PRIVATE = 3;
+
+    /// Patch owners pack `face << BFT_OWNER_SHIFT | local index` ([`crate::techniques::bft::layout::pack_owner`]).
+    BFT_OWNER_SHIFT = 2;
+    /// Mask of an owner's local edge or corner index.
+    BFT_OWNER_LOCAL_MASK = 3;
+}

@@ -1,0 +1,581 @@
+//! Every block shared with GLSL, held against the compiled SPIR-V: one table of (stage and
+//! variant, what to read, what the Rust side says). glslang's optimizer drops blocks a stage
+//! does not use, so each row names a build where its block is live; a row whose block is
+//! missing fails.
+use super::bindings::*;
+use super::reflect::Reflection;
+use super::{BftPush, CaptureRecord, DrawPush, FrameUniforms, Vertex};
+use crate::shaders::{spirv, Stage, Variant};
+use crate::techniques::bft::layout::{
+    BasePosition, Level1Point, PatchHeader, StencilTerm, TableEntry, TableHeader, TangentTerm,
+    STORAGE_BINDINGS,
+};
+use crate::tessellator::Spacing;
+use std::mem::{offset_of, size_of};
+
+/// Member offsets of a Rust struct, in declaration order.
+macro_rules! offsets {
+    ($ty:ty: $($field:ident),+) => {
+        vec![$(offset_of!($ty, $field) as u32),+]
+    };
+}
+
+/// What one row checks.
+enum Check {
+    /// A uniform or push-constant block, or a struct: member offsets and size.
+    Layout {
+        name: &'static str,
+        offsets: Vec<u32>,
+        size: usize,
+    },
+    /// A storage buffer: set and binding of the block, its members' offsets, and the stride of
+    /// the runtime array that ends it.
+    Buffer {
+        block: &'static str,
+        binding: u32,
+        members: Vec<u32>,
+        stride: usize,
+    },
+    /// An array member of a struct: its stride.
+    MemberArray {
+        name: &'static str,
+        member: u32,
+        stride: usize,
+    },
+    /// A uniform block's set and binding.
+    Uniform {
+        block: &'static str,
+        set: u32,
+        binding: u32,
+    },
+    /// The transform-feedback outputs: (output name, offset), buffer, stride.
+    Xfb {
+        outputs: Vec<(&'static str, u32)>,
+        buffer: u32,
+        stride: usize,
+    },
+    /// A vertex input: (input name, location, byte size) against the attribute with that
+    /// location in [`Vertex::ATTRIBUTES`] and the Rust field's offset and size.
+    Input {
+        name: &'static str,
+        offset: usize,
+        size: usize,
+    },
+}
+
+fn variant(spacing: Option<Spacing>, capture: bool) -> Variant {
+    Variant { spacing, capture }
+}
+
+const PLAIN: Variant = Variant {
+    spacing: None,
+    capture: false,
+};
+
+/// The table. Each BFT storage buffer appears with a stage that reads or writes it.
+fn rows() -> Vec<(Stage, Variant, Check)> {
+    use Check::*;
+    let equal = Some(Spacing::Equal);
+    let frame = || Layout {
+        name: "Frame",
+        offsets: offsets!(FrameUniforms: view_proj, view, camera_pos, light_dir, tess, base_color, wire_color, viewport),
+        size: size_of::<FrameUniforms>(),
+    };
+    let draw = || Layout {
+        name: "Draw",
+        offsets: offsets!(DrawPush: mode, first_patch),
+        size: size_of::<DrawPush>(),
+    };
+    let bft_push = || Layout {
+        name: "BftPush",
+        offsets: offsets!(BftPush: mode, first_patch, factor_mode, options, uniform_level, pixels_per_segment, distance_ref, max_level, count),
+        size: size_of::<BftPush>(),
+    };
+    let frame_binding = || Uniform {
+        block: "Frame",
+        set: FRAME_SET,
+        binding: FRAME_UNIFORMS_BINDING,
+    };
+    let capture = || Xfb {
+        outputs: vec![
+            ("out_world", offset_of!(CaptureRecord, position) as u32),
+            ("out_normal", offset_of!(CaptureRecord, normal) as u32),
+            ("out_patch_flags", offset_of!(CaptureRecord, patch) as u32),
+            ("out_domain", offset_of!(CaptureRecord, domain) as u32),
+        ],
+        buffer: CAPTURE_XFB_BUFFER,
+        stride: size_of::<CaptureRecord>(),
+    };
+    let level1 = |block, binding| Buffer {
+        block,
+        binding,
+        members: vec![0],
+        stride: size_of::<Level1Point>(),
+    };
+    let words = |block, binding| Buffer {
+        block,
+        binding,
+        members: vec![0],
+        stride: size_of::<u32>(),
+    };
+    let mut rows = vec![
+        (Stage::CommonShadeFrag, PLAIN, frame()),
+        (Stage::CommonShadeFrag, PLAIN, frame_binding()),
+        (Stage::CommonShadeFrag, PLAIN, draw()),
+        (Stage::CommonTriTesc, PLAIN, frame()),
+        (Stage::CommonQuadTesc, PLAIN, frame_binding()),
+        (Stage::PlainPlainVert, PLAIN, frame()),
+        (Stage::BftBftTesc, PLAIN, frame()),
+        (Stage::BftBftTesc, PLAIN, frame_binding()),
+        (Stage::BftBftTesc, PLAIN, bft_push()),
+        (Stage::BftBftTese, variant(equal, false), bft_push()),
+        (Stage::BftBftFrag, PLAIN, bft_push()),
+        (Stage::BftSubdivideComp, PLAIN, bft_push()),
+        (Stage::BftNormalsComp, PLAIN, bft_push()),
+        // Vertex input.
+        (
+            Stage::CommonMeshVert,
+            PLAIN,
+            Input {
+                name: "in_position",
+                offset: offset_of!(Vertex, position),
+                size: size_of::<[f32; 3]>(),
+            },
+        ),
+        (
+            Stage::CommonMeshVert,
+            PLAIN,
+            Input {
+                name: "in_normal",
+                offset: offset_of!(Vertex, normal),
+                size: size_of::<[f32; 3]>(),
+            },
+        ),
+        (
+            Stage::PlainPlainVert,
+            PLAIN,
+            Input {
+                name: "in_position",
+                offset: offset_of!(Vertex, position),
+                size: size_of::<[f32; 3]>(),
+            },
+        ),
+        (
+            Stage::PlainPlainVert,
+            PLAIN,
+            Input {
+                name: "in_normal",
+                offset: offset_of!(Vertex, normal),
+                size: size_of::<[f32; 3]>(),
+            },
+        ),
+        // BFT storage buffers: the compute passes.
+        (
+            Stage::BftSubdivideComp,
+            PLAIN,
+            Buffer {
+                block: "BasePositions",
+                binding: BFT_BASE_POSITIONS_BINDING,
+                members: vec![0],
+                stride: size_of::<BasePosition>(),
+            },
+        ),
+        (
+            Stage::BftSubdivideComp,
+            PLAIN,
+            Layout {
+                name: "BasePosition",
+                offsets: offsets!(BasePosition: x, y, z),
+                size: size_of::<BasePosition>(),
+            },
+        ),
+        (
+            Stage::BftSubdivideComp,
+            PLAIN,
+            words("StencilOffsets", BFT_STENCIL_OFFSETS_BINDING),
+        ),
+        (
+            Stage::BftSubdivideComp,
+            PLAIN,
+            Buffer {
+                block: "StencilTerms",
+                binding: BFT_STENCIL_TERMS_BINDING,
+                members: vec![0],
+                stride: size_of::<StencilTerm>(),
+            },
+        ),
+        (
+            Stage::BftSubdivideComp,
+            PLAIN,
+            Layout {
+                name: "StencilTerm",
+                offsets: offsets!(StencilTerm: index, weight),
+                size: size_of::<StencilTerm>(),
+            },
+        ),
+        (
+            Stage::BftSubdivideComp,
+            PLAIN,
+            level1("Level1Positions", BFT_LEVEL1_POSITIONS_BINDING),
+        ),
+        (
+            Stage::BftNormalsComp,
+            PLAIN,
+            words("TangentOffsets", BFT_TANGENT_OFFSETS_BINDING),
+        ),
+        (
+            Stage::BftNormalsComp,
+            PLAIN,
+            Buffer {
+                block: "TangentTerms",
+                binding: BFT_TANGENT_TERMS_BINDING,
+                members: vec![0],
+                stride: size_of::<TangentTerm>(),
+            },
+        ),
+        (
+            Stage::BftNormalsComp,
+            PLAIN,
+            Layout {
+                name: "TangentTerm",
+                offsets: offsets!(TangentTerm: index, weight_t1, weight_t2),
+                size: size_of::<TangentTerm>(),
+            },
+        ),
+        (
+            Stage::BftNormalsComp,
+            PLAIN,
+            level1("Level1Positions", BFT_LEVEL1_POSITIONS_BINDING),
+        ),
+        (
+            Stage::BftNormalsComp,
+            PLAIN,
+            level1("Level1Normals", BFT_LEVEL1_NORMALS_BINDING),
+        ),
+        // BFT storage buffers: the main pass.
+        (
+            Stage::BftBftTesc,
+            PLAIN,
+            level1("Level1Positions", BFT_LEVEL1_POSITIONS_BINDING),
+        ),
+        (
+            Stage::BftBftTesc,
+            PLAIN,
+            words("PatchRings", BFT_PATCH_RINGS_BINDING),
+        ),
+        (
+            Stage::BftBftTese,
+            variant(equal, false),
+            level1("Level1Normals", BFT_LEVEL1_NORMALS_BINDING),
+        ),
+    ];
+    for (stage, v) in [
+        (Stage::BftBftTesc, PLAIN),
+        (Stage::BftBftTese, variant(equal, false)),
+        (
+            Stage::BftBftTese,
+            variant(Some(Spacing::FractionalEven), true),
+        ),
+    ] {
+        rows.push((
+            stage,
+            v,
+            Buffer {
+                block: "PatchHeaders",
+                binding: BFT_PATCH_HEADERS_BINDING,
+                members: vec![0],
+                stride: size_of::<PatchHeader>(),
+            },
+        ));
+        rows.push((
+            stage,
+            v,
+            Layout {
+                name: "PatchHeader",
+                offsets: offsets!(PatchHeader: ring_offset, ring_size, entry, mirrored, edge_owner, corner_owner),
+                size: size_of::<PatchHeader>(),
+            },
+        ));
+        for member in [4, 5] {
+            rows.push((
+                stage,
+                v,
+                MemberArray {
+                    name: "PatchHeader",
+                    member,
+                    stride: size_of::<u32>(),
+                },
+            ));
+        }
+    }
+    for v in [
+        variant(equal, false),
+        variant(Some(Spacing::FractionalOdd), true),
+    ] {
+        let tese = Stage::BftBftTese;
+        rows.extend([
+            (tese, v, words("PatchRings", BFT_PATCH_RINGS_BINDING)),
+            (
+                tese,
+                v,
+                Buffer {
+                    block: "Tables",
+                    binding: BFT_TABLES_BINDING,
+                    members: vec![0, size_of::<TableHeader>() as u32],
+                    stride: size_of::<TableEntry>(),
+                },
+            ),
+            (
+                tese,
+                v,
+                Layout {
+                    name: "TableHeader",
+                    offsets: offsets!(TableHeader: level, segments, grid, entry_count, full_map_offset, half_map_offset),
+                    size: size_of::<TableHeader>(),
+                },
+            ),
+            (
+                tese,
+                v,
+                Layout {
+                    name: "TableEntry",
+                    offsets: offsets!(TableEntry: ring_size, half_table, rows, position_offset, du_offset, dv_offset, perm_offset, kind),
+                    size: size_of::<TableEntry>(),
+                },
+            ),
+            (
+                tese,
+                v,
+                words("MirrorPerms", BFT_MIRROR_PERMS_BINDING),
+            ),
+            (tese, v, words("RowMaps", BFT_ROW_MAPS_BINDING)),
+            (
+                tese,
+                v,
+                Buffer {
+                    block: "TableWeights",
+                    binding: BFT_TABLE_WEIGHTS_BINDING,
+                    members: vec![0],
+                    stride: size_of::<f32>(),
+                },
+            ),
+            (
+                tese,
+                v,
+                level1("Level1Positions", BFT_LEVEL1_POSITIONS_BINDING),
+            ),
+        ]);
+    }
+    // The capture record and the Draw push constant of every capture build (the optimizer
+    // keeps `draw` only where the patch id is written).
+    for stage in Stage::ALL {
+        for &(v, _) in stage.compiled() {
+            if v.capture {
+                rows.push((stage, v, capture()));
+                if stage != Stage::BftBftTese {
+                    rows.push((stage, v, draw()));
+                }
+            }
+        }
+    }
+    rows
+}
+
+fn check(stage: Stage, v: Variant, check: &Check) -> Result<(), String> {
+    let words = spirv(stage, v).map_err(|e| e.to_string())?;
+    let r = Reflection::new(words).map_err(|e| e.to_string())?;
+    match check {
+        Check::Layout {
+            name,
+            offsets,
+            size,
+        } => {
+            let found = r.member_offsets(name);
+            if found.is_empty() {
+                return Err(format!("{name}: no laid-out struct"));
+            }
+            if found.iter().any(|f| f != offsets) {
+                return Err(format!(
+                    "{name}: SPIR-V offsets {found:?}, Rust {offsets:?}"
+                ));
+            }
+            match r.struct_size(name) {
+                Some(s) if s as usize == *size => Ok(()),
+                s => Err(format!("{name}: SPIR-V size {s:?}, Rust {size}")),
+            }
+        }
+        Check::Buffer {
+            block,
+            binding,
+            members,
+            stride,
+        } => {
+            let b = r
+                .binding(block)
+                .ok_or_else(|| format!("{block}: no bound block"))?;
+            if (b.set, b.binding) != (BFT_SET, *binding) {
+                return Err(format!(
+                    "{block}: set {} binding {}, Rust set {BFT_SET} binding {binding}",
+                    b.set, b.binding
+                ));
+            }
+            let found = r.member_offsets(block);
+            if found != [members.clone()] {
+                return Err(format!(
+                    "{block}: member offsets {found:?}, Rust {members:?}"
+                ));
+            }
+            match r.runtime_array_stride(block) {
+                Some(s) if s as usize == *stride => Ok(()),
+                s => Err(format!("{block}: array stride {s:?}, Rust {stride}")),
+            }
+        }
+        Check::MemberArray {
+            name,
+            member,
+            stride,
+        } => match r.member_array_stride(name, *member) {
+            Some(s) if s as usize == *stride => Ok(()),
+            s => Err(format!(
+                "{name}.{member}: array stride {s:?}, Rust {stride}"
+            )),
+        },
+        Check::Uniform {
+            block,
+            set,
+            binding,
+        } => match r.binding(block) {
+            Some(b) if (b.set, b.binding) == (*set, *binding) => Ok(()),
+            b => Err(format!("{block}: {b:?}, Rust set {set} binding {binding}")),
+        },
+        Check::Xfb {
+            outputs,
+            buffer,
+            stride,
+        } => {
+            let found = r.xfb_outputs();
+            let got: Vec<(&str, u32)> = found.iter().map(|o| (o.name.as_str(), o.offset)).collect();
+            if got != *outputs {
+                return Err(format!("xfb outputs {got:?}, Rust {outputs:?}"));
+            }
+            if let Some(o) = found
+                .iter()
+                .find(|o| o.buffer != *buffer || o.stride as usize != *stride)
+            {
+                return Err(format!(
+                    "{}: xfb buffer {} stride {}, Rust buffer {buffer} stride {stride}",
+                    o.name, o.buffer, o.stride
+                ));
+            }
+            Ok(())
+        }
+        Check::Input { name, offset, size } => {
+            let (location, bytes) = r.input(name).ok_or_else(|| format!("no input {name}"))?;
+            let attr = Vertex::ATTRIBUTES
+                .iter()
+                .find(|a| a.location == location)
+                .ok_or_else(|| format!("{name}: location {location} has no vertex attribute"))?;
+            // Every attribute is R32G32B32_SFLOAT: 12 bytes.
+            if attr.offset as usize != *offset || bytes as usize != *size || *size != 12 {
+                return Err(format!(
+                    "{name}: attribute offset {} input {bytes} bytes, Rust field at {offset} of {size} bytes",
+                    attr.offset
+                ));
+            }
+            Ok(())
+        }
+    }
+}
+
+#[test]
+fn every_gpu_block_matches_its_rust_mirror() {
+    let failures: Vec<String> = rows()
+        .iter()
+        .filter_map(|(stage, v, c)| {
+            check(*stage, *v, c)
+                .err()
+                .map(|e| format!("{} {v:?}: {e}", stage.path()))
+        })
+        .collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn the_table_covers_every_bft_binding_and_capture_build() {
+    let rows = rows();
+    for binding in STORAGE_BINDINGS {
+        assert!(
+            rows.iter()
+                .any(|(_, _, c)| matches!(c, Check::Buffer { binding: b, .. } if *b == binding)),
+            "BFT binding {binding} is not checked"
+        );
+    }
+    let capture_builds = Stage::ALL
+        .iter()
+        .flat_map(|s| s.compiled())
+        .filter(|(v, _)| v.capture)
+        .count();
+    let xfb_rows = rows
+        .iter()
+        .filter(|(_, _, c)| matches!(c, Check::Xfb { .. }))
+        .count();
+    // Five TESs in three spacings.
+    assert_eq!(capture_builds, 15);
+    assert_eq!(xfb_rows, capture_builds);
+}
+
+/// A row that does not hold is reported: the checker is not vacuous.
+#[test]
+fn a_wrong_offset_or_binding_is_caught() {
+    let wrong = Check::Layout {
+        name: "Frame",
+        offsets: offsets!(FrameUniforms: view, view_proj, camera_pos, light_dir, tess, base_color, wire_color, viewport),
+        size: size_of::<FrameUniforms>(),
+    };
+    assert!(check(Stage::CommonShadeFrag, PLAIN, &wrong).is_err());
+    let wrong = Check::Buffer {
+        block: "RowMaps",
+        binding: BFT_TABLE_WEIGHTS_BINDING,
+        members: vec![0],
+        stride: 4,
+    };
+    assert!(check(
+        Stage::BftBftTese,
+        variant(Some(Spacing::Equal), false),
+        &wrong
+    )
+    .is_err());
+    let missing = Check::Layout {
+        name: "NoSuchBlock",
+        offsets: vec![0],
+        size: 4,
+    };
+    assert!(check(Stage::CommonShadeFrag, PLAIN, &missing).is_err());
+}
+
+/// `-DCAPTURE` really changes the build: every capture variant writes transform feedback, and
+/// no other build does.
+#[test]
+fn capture_variants_and_only_they_have_xfb() {
+    let mut captures = 0;
+    for stage in Stage::ALL {
+        for &(v, words) in stage.compiled() {
+            let r = Reflection::new(words).expect("SPIR-V");
+            assert_eq!(
+                r.has_xfb(),
+                v.capture,
+                "{} {v:?}: XfbBuffer decorations {}",
+                stage.path(),
+                r.has_xfb()
+            );
+            captures += v.capture as usize;
+        }
+    }
+    assert_eq!(captures, 15);
+}
+
+#[test]
+fn reflection_rejects_what_is_not_spirv() {
+    assert!(Reflection::new(&[1, 2, 3]).is_err());
+    assert!(Reflection::new(&[0x0723_0203, 0, 0, 0, 0, 0x0005_0000]).is_err());
+}

@@ -1,0 +1,152 @@
+//! Rust mirrors of every block shared with GLSL: uniforms, push constants, the
+//! transform-feedback record and the vertex input (the BFT storage buffers' structs live with
+//! their technique, [`crate::techniques::bft::layout`]).
+//!
+//! Design decisions:
+//! - `#[repr(C)]` + `Pod` with named fields, no `Vec3` (std140/std430 would pad it); sizes and
+//!   offsets asserted at compile time where GLSL fixes them.
+//! - Set, binding and transform-feedback numbers live in [`bindings`], from which the build
+//!   script generates the `bindings.glsl` every shader includes.
+//! - One table-driven test (`layout_tests`) reads every block, binding, array stride and
+//!   transform-feedback decoration back from the compiled SPIR-V ([`reflect`]) and compares
+//!   them with `offset_of!` / `size_of` of these structs.
+use bytemuck::{Pod, Zeroable};
+use std::mem::{offset_of, size_of};
+use vk_core::vk;
+
+pub mod bindings;
+#[cfg(test)]
+mod layout_tests;
+pub mod reflect;
+
+/// `Frame` uniform block (std140), `glsl/common/frame.glsl`; set [`bindings::FRAME_SET`],
+/// binding [`bindings::FRAME_UNIFORMS_BINDING`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FrameUniforms {
+    pub view_proj: [[f32; 4]; 4],
+    pub view: [[f32; 4]; 4],
+    pub camera_pos: [f32; 4],
+    pub light_dir: [f32; 4],
+    /// x: outer level, y: inner level, z: Phong shape factor.
+    pub tess: [f32; 4],
+    pub base_color: [f32; 4],
+    pub wire_color: [f32; 4],
+    pub viewport: [f32; 4],
+}
+
+const _: () = {
+    assert!(size_of::<FrameUniforms>() == 224);
+    assert!(offset_of!(FrameUniforms, view) == 64);
+    assert!(offset_of!(FrameUniforms, camera_pos) == 128);
+    assert!(offset_of!(FrameUniforms, light_dir) == 144);
+    assert!(offset_of!(FrameUniforms, tess) == 160);
+    assert!(offset_of!(FrameUniforms, base_color) == 176);
+    assert!(offset_of!(FrameUniforms, wire_color) == 192);
+    assert!(offset_of!(FrameUniforms, viewport) == 208);
+};
+
+/// `Draw` push constant (std430), `glsl/common/frame.glsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct DrawPush {
+    /// [`bindings::DRAW_MODE_SHADED`] or [`bindings::DRAW_MODE_WIREFRAME`].
+    pub mode: u32,
+    /// Patch id of the draw's first patch: `gl_PrimitiveID` restarts at 0 in every draw, and
+    /// draws are split on some drivers, so the TES adds this to number patches frame-wide.
+    pub first_patch: u32,
+}
+
+const _: () = {
+    assert!(size_of::<DrawPush>() == 8);
+    assert!(offset_of!(DrawPush, first_patch) == 4);
+};
+
+/// `BftPush` push constant of every BFT stage, `glsl/bft/bft.glsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct BftPush {
+    /// [`bindings::DRAW_MODE_SHADED`] or [`bindings::DRAW_MODE_WIREFRAME`].
+    pub mode: u32,
+    /// Patch (level-1 face) index of the draw's first patch.
+    pub first_patch: u32,
+    /// `BFT_FACTORS_UNIFORM`, `_SCREEN` or `_DISTANCE` ([`bindings`]).
+    pub factor_mode: u32,
+    /// `BFT_OPTION_*` bits ([`bindings`]): geometric normals, patch colours, fractional factors.
+    pub options: u32,
+    pub uniform_level: f32,
+    pub pixels_per_segment: f32,
+    pub distance_ref: f32,
+    pub max_level: f32,
+    /// Compute passes: level-1 vertex count.
+    pub count: u32,
+}
+
+const _: () = assert!(size_of::<BftPush>() == 36);
+
+/// Interleaved vertex of the mesh vertex buffer (`common/mesh.vert` and `plain/plain.vert`
+/// locations 0 and 1).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Vertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+}
+
+const _: () = assert!(size_of::<Vertex>() == 24);
+
+impl Vertex {
+    /// The vertex buffer binding of the interleaved vertices.
+    pub const BINDING: vk::VertexInputBindingDescription = vk::VertexInputBindingDescription {
+        binding: 0,
+        stride: size_of::<Vertex>() as u32,
+        input_rate: vk::VertexInputRate::VERTEX,
+    };
+
+    /// Position at location 0, normal at 1, at their `offset_of!`.
+    pub const ATTRIBUTES: [vk::VertexInputAttributeDescription; 2] = [
+        vk::VertexInputAttributeDescription {
+            location: 0,
+            binding: 0,
+            format: vk::Format::R32G32B32_SFLOAT,
+            offset: offset_of!(Vertex, position) as u32,
+        },
+        vk::VertexInputAttributeDescription {
+            location: 1,
+            binding: 0,
+            format: vk::Format::R32G32B32_SFLOAT,
+            offset: offset_of!(Vertex, normal) as u32,
+        },
+    ];
+}
+
+/// One captured triangle corner: the transform-feedback record of `glsl/common/tese_out.glsl`
+/// (buffer [`bindings::CAPTURE_XFB_BUFFER`], stride [`bindings::CAPTURE_XFB_STRIDE`]).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CaptureRecord {
+    /// World position as the TES computed it.
+    pub position: [f32; 3],
+    /// Normal as shaded.
+    pub normal: [f32; 3],
+    /// Frame-wide patch id.
+    pub patch: u32,
+    /// Technique-defined flags (0 for the triangle/quad techniques).
+    pub flags: u32,
+    /// `gl_TessCoord.xy` as the fixed-function tessellator produced it.
+    pub domain: [f32; 2],
+}
+
+/// Bytes per record: the `xfb_stride` of `tese_out.glsl`.
+pub const CAPTURE_STRIDE: u64 = size_of::<CaptureRecord>() as u64;
+
+// GLSL writes the record from the numbers in `bindings`; the Rust struct must agree with them.
+const _: () = {
+    assert!(size_of::<CaptureRecord>() == bindings::CAPTURE_XFB_STRIDE as usize);
+    assert!(offset_of!(CaptureRecord, position) == bindings::CAPTURE_OFFSET_POSITION as usize);
+    assert!(offset_of!(CaptureRecord, normal) == bindings::CAPTURE_OFFSET_NORMAL as usize);
+    assert!(offset_of!(CaptureRecord, patch) == bindings::CAPTURE_OFFSET_PATCH as usize);
+    // patch and flags are one `uvec2` output.
+    assert!(offset_of!(CaptureRecord, flags) == bindings::CAPTURE_OFFSET_PATCH as usize + 4);
+    assert!(offset_of!(CaptureRecord, domain) == bindings::CAPTURE_OFFSET_DOMAIN as usize);
+};

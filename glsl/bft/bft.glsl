@@ -1,0 +1,191 @@
+// Loop limit surfaces from basis-function tables (Holländer & Boubekeur): the buffers of the
+// BFT pipeline and the evaluation every BFT stage shares.
+//
+// Every struct here mirrors one of `tess::bft` (crates/tess/src/techniques/bft/layout.rs) and is
+// read by field name; set and binding numbers come from bindings.glsl; a test checks each
+// block's binding, member offsets and array stride in the SPIR-V against the Rust structs.
+// `GpuBft::eval_tess` is this file's f32 mirror, kept in step.
+#include "bindings.glsl"
+
+struct BasePosition { float x; float y; float z; };
+// One term of a CSR stencil row.
+struct StencilTerm { uint index; float weight; };
+// One term of the two limit-tangent masks of a level-1 vertex (same control points).
+struct TangentTerm { uint index; float weight_t1; float weight_t2; };
+// Owners pack `face << BFT_OWNER_SHIFT | local index` (owner_face, owner_local); edge e runs
+// v_e → v_(e+1), corner c is v_c.
+struct PatchHeader {
+    uint ring_offset;     // first slot of the patch's ring in patch_rings
+    uint ring_size;
+    uint entry;           // its table in table_entries
+    uint mirrored;        // 1: the table is the mirror image (rows read transposed)
+    uint edge_owner[3];
+    uint corner_owner[3];
+};
+struct TableHeader {
+    uint level;           // L: the tables' level
+    uint segments;        // 2^L segments per patch edge
+    uint grid;            // 3 * 2^L: the grid the row maps are indexed on
+    uint entry_count;
+    uint full_map_offset; // row map of full tables in row_maps
+    uint half_map_offset; // row map of half (mirror-symmetric) tables
+};
+struct TableEntry {
+    uint ring_size;
+    uint half_table;      // 1: only the a >= b half is stored
+    uint rows;
+    uint position_offset; // weight blocks in table_weights (du/dv: 0xffffffff without tangents)
+    uint du_offset;
+    uint dv_offset;
+    uint perm_offset;     // mirror permutation in mirror_perms
+    uint kind;            // BFT_KIND_*: regular, extraordinary, boundary, private
+};
+
+layout(std430, set = BFT_SET, binding = BFT_BASE_POSITIONS_BINDING) readonly buffer BasePositions { BasePosition base_positions[]; };
+layout(std430, set = BFT_SET, binding = BFT_STENCIL_OFFSETS_BINDING) readonly buffer StencilOffsets { uint stencil_offsets[]; };
+layout(std430, set = BFT_SET, binding = BFT_STENCIL_TERMS_BINDING) readonly buffer StencilTerms { StencilTerm stencil_terms[]; };
+layout(std430, set = BFT_SET, binding = BFT_TANGENT_OFFSETS_BINDING) readonly buffer TangentOffsets { uint tangent_offsets[]; };
+layout(std430, set = BFT_SET, binding = BFT_TANGENT_TERMS_BINDING) readonly buffer TangentTerms { TangentTerm tangent_terms[]; };
+#ifdef BFT_WRITES_LEVEL1
+layout(std430, set = BFT_SET, binding = BFT_LEVEL1_POSITIONS_BINDING) buffer Level1Positions { vec4 level1_pos[]; };
+layout(std430, set = BFT_SET, binding = BFT_LEVEL1_NORMALS_BINDING) buffer Level1Normals { vec4 level1_nrm[]; };
+#else
+layout(std430, set = BFT_SET, binding = BFT_LEVEL1_POSITIONS_BINDING) readonly buffer Level1Positions { vec4 level1_pos[]; };
+layout(std430, set = BFT_SET, binding = BFT_LEVEL1_NORMALS_BINDING) readonly buffer Level1Normals { vec4 level1_nrm[]; };
+#endif
+layout(std430, set = BFT_SET, binding = BFT_PATCH_HEADERS_BINDING) readonly buffer PatchHeaders { PatchHeader patches[]; };
+layout(std430, set = BFT_SET, binding = BFT_PATCH_RINGS_BINDING) readonly buffer PatchRings { uint patch_rings[]; };
+layout(std430, set = BFT_SET, binding = BFT_TABLES_BINDING) readonly buffer Tables { TableHeader table; TableEntry table_entries[]; };
+layout(std430, set = BFT_SET, binding = BFT_MIRROR_PERMS_BINDING) readonly buffer MirrorPerms { uint mirror_perms[]; };
+layout(std430, set = BFT_SET, binding = BFT_ROW_MAPS_BINDING) readonly buffer RowMaps { uint row_maps[]; };
+layout(std430, set = BFT_SET, binding = BFT_TABLE_WEIGHTS_BINDING) readonly buffer TableWeights { float table_weights[]; };
+
+// Push constant of every BFT pipeline (`tess::gpu::BftPush`).
+layout(push_constant) uniform BftPush {
+    uint mode;            // DRAW_MODE_SHADED or DRAW_MODE_WIREFRAME
+    uint first_patch;     // patch index of this draw's first patch (draw splits)
+    uint factor_mode;     // BFT_FACTORS_UNIFORM, _SCREEN or _DISTANCE
+    uint options;         // BFT_OPTION_* bits
+    float uniform_level;  // segments per level-1 edge (uniform mode)
+    float pixels_per_segment;
+    float distance_ref;   // distance at which an edge gets max_level segments
+    float max_level;      // 2^L: the tables' level
+    uint count;           // compute passes: number of level-1 vertices
+} bft;
+
+const uint NO_ROW = 0xffffffffu;
+
+uint owner_face(uint owner) { return owner >> BFT_OWNER_SHIFT; }
+uint owner_local(uint owner) { return owner & uint(BFT_OWNER_LOCAL_MASK); }
+
+// Row of grid point (a, b) in the face's table and whether the slots are mirrored; NO_ROW when
+// the point carries no row.
+uint bft_row(uint face, uint a, uint b, out bool flip) {
+    bool mirrored = patches[face].mirrored != 0u;
+    uint entry = patches[face].entry;
+    bool half_table = table_entries[entry].half_table != 0u;
+    uint grid = table.grid;
+    flip = mirrored;
+    if (mirrored) { uint t = a; a = b; b = t; }
+    if (half_table && a < b) { uint t = a; a = b; b = t; flip = !flip; }
+    uint map = half_table ? table.half_map_offset : table.full_map_offset;
+    return row_maps[map + a * (grid + 1u) + b];
+}
+
+// Sums one row's weights over the face's ring, slot by slot (one code path, `precise`, so two
+// faces evaluating the same owner row produce the same bits). p: position; q: subdivision-
+// shading normal, or du when geometric; r: dv when geometric.
+void bft_accumulate(uint face, uint row, bool flip, bool geometric,
+                    out vec3 p, out vec3 q, out vec3 r) {
+    uint ring = patches[face].ring_offset;
+    uint rs = patches[face].ring_size;
+    uint entry = patches[face].entry;
+    uint perm = table_entries[entry].perm_offset;
+    uint off_pos = table_entries[entry].position_offset;
+    uint off_du = flip ? table_entries[entry].dv_offset : table_entries[entry].du_offset;
+    uint off_dv = flip ? table_entries[entry].du_offset : table_entries[entry].dv_offset;
+    precise vec3 ap = vec3(0.0), aq = vec3(0.0), ar = vec3(0.0);
+    for (uint s = 0u; s < rs; ++s) {
+        uint slot = flip ? mirror_perms[perm + s] : s;
+        uint base = row * rs + slot;
+        uint v = patch_rings[ring + s];
+        vec3 x = level1_pos[v].xyz;
+        float w = table_weights[off_pos + base];
+        ap += w * x;
+        if (geometric) {
+            aq += table_weights[off_du + base] * x;
+            ar += table_weights[off_dv + base] * x;
+        } else {
+            aq += w * level1_nrm[v].xyz;
+        }
+    }
+    p = ap; q = aq; r = ar;
+}
+
+// The limit point (and normal source) at tess coordinate b (weights of v0, v1, v2) of `face`.
+// Edge and corner points are evaluated by their owner face in the owner's frame; grid points
+// with a row exactly; any other point by linear interpolation on the level-L lattice (the
+// paper's virtual mesh at maximum level: fractional factors morph linearly). Returns whether
+// the point was a table point.
+bool bft_eval(uint face, vec3 b, bool geometric, out vec3 p, out vec3 n) {
+    uint g = face;
+    float u = b.y, v = b.z;
+    int corner = b.x == 1.0 ? 0 : (b.y == 1.0 ? 1 : (b.z == 1.0 ? 2 : -1));
+    int edge = b.z == 0.0 ? 0 : (b.x == 0.0 ? 1 : (b.y == 0.0 ? 2 : -1));
+    if (corner >= 0) {
+        uint o = patches[face].corner_owner[corner];
+        g = owner_face(o);
+        uint c = owner_local(o);
+        u = c == 1u ? 1.0 : 0.0;
+        v = c == 2u ? 1.0 : 0.0;
+    } else if (edge >= 0) {
+        float t = edge == 0 ? b.y : (edge == 1 ? b.z : b.x);
+        uint o = patches[face].edge_owner[edge];
+        g = owner_face(o);
+        if (g != face) t = 1.0 - t;
+        uint ge = owner_local(o);
+        u = ge == 0u ? t : (ge == 1u ? 1.0 - t : 0.0);
+        v = ge == 0u ? 0.0 : (ge == 1u ? t : 1.0 - t);
+    }
+    float grid = float(table.grid);
+    float nseg = float(table.segments);
+    vec2 ga = vec2(u, v) * grid;
+    vec2 ra = floor(ga + 0.5);
+    vec3 q, r;
+    if (all(lessThan(abs(ga - ra), vec2(0.02)))) {
+        bool flip;
+        uint row = bft_row(g, uint(ra.x), uint(ra.y), flip);
+        if (row != NO_ROW) {
+            bft_accumulate(g, row, flip, geometric, p, q, r);
+            n = geometric ? cross(q, r) : q;
+            return true;
+        }
+    }
+    float x = u * nseg, y = v * nseg;
+    float i0 = min(floor(x), nseg - 1.0);
+    float j0 = min(floor(y), nseg - 1.0 - i0);
+    float fx = x - i0, fy = y - j0;
+    uvec2 c0, c1, c2;
+    vec3 w;
+    if (fx + fy <= 1.0) {
+        c0 = uvec2(i0, j0); c1 = uvec2(i0 + 1.0, j0); c2 = uvec2(i0, j0 + 1.0);
+        w = vec3(1.0 - fx - fy, fx, fy);
+    } else {
+        c0 = uvec2(i0 + 1.0, j0 + 1.0); c1 = uvec2(i0, j0 + 1.0); c2 = uvec2(i0 + 1.0, j0);
+        w = vec3(fx + fy - 1.0, 1.0 - fx, 1.0 - fy);
+    }
+    precise vec3 sp = vec3(0.0), sq = vec3(0.0), sr = vec3(0.0);
+    uvec2 cs[3] = uvec2[3](c0, c1, c2);
+    for (int k = 0; k < 3; ++k) {
+        bool flip;
+        uint row = bft_row(g, 3u * cs[k].x, 3u * cs[k].y, flip);
+        vec3 pk, qk, rk;
+        bft_accumulate(g, row, flip, geometric, pk, qk, rk);
+        sp += w[k] * pk;
+        sq += w[k] * qk;
+        sr += w[k] * rk;
+    }
+    p = sp;
+    n = geometric ? cross(sq, sr) : sq;
+    return false;
+}
