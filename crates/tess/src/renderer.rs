@@ -547,35 +547,12 @@ pub(crate) fn technique_stages(
     capture: bool,
 ) -> Result<(&'static [u32], &'static [u32], u32)> {
     // (method, domain) → (TCS, TES, control points per patch); the variant picks the build.
+    #[rustfmt::skip]
     const STAGES: [(Method, Domain, Stage, Stage, u32); 4] = [
-        (
-            Method::Flat,
-            Domain::Quad,
-            Stage::CommonQuadTesc,
-            Stage::FlatQuadTese,
-            4,
-        ),
-        (
-            Method::Flat,
-            Domain::Triangle,
-            Stage::CommonTriTesc,
-            Stage::FlatTriTese,
-            3,
-        ),
-        (
-            Method::Phong,
-            Domain::Triangle,
-            Stage::CommonTriTesc,
-            Stage::PhongTriTese,
-            3,
-        ),
-        (
-            Method::Pn,
-            Domain::Triangle,
-            Stage::PnTriTesc,
-            Stage::PnTriTese,
-            3,
-        ),
+        (Method::Flat, Domain::Quad, Stage::CommonQuadTesc, Stage::FlatQuadTese, 4),
+        (Method::Flat, Domain::Triangle, Stage::CommonTriTesc, Stage::FlatTriTese, 3),
+        (Method::Phong, Domain::Triangle, Stage::CommonTriTesc, Stage::PhongTriTese, 3),
+        (Method::Pn, Domain::Triangle, Stage::PnTriTesc, Stage::PnTriTese, 3),
     ];
     let &(_, _, tesc, tese, control_points) = STAGES
         .iter()
