@@ -5,7 +5,7 @@
 //! (Moved from topology with the packing: topology hands over plain data, tess lays it out.)
 
 use std::collections::HashMap;
-use tess::bft::{owner_face, pack_owner, GpuBft};
+use tess::techniques::bft::layout::{owner_face, pack_owner, GpuBft};
 use topology::bft::{prepare_loop_bft, tessellator_interior_points, LoopBft};
 use topology::{load_obj, ControlMesh};
 
