@@ -8,6 +8,7 @@
 //!
 //! Drop order (field order): pipelines, set layouts, frame sets, device handle.
 use crate::error::{Result, TessError};
+use crate::gpu::bindings::FRAME_UNIFORMS_BINDING;
 use crate::gpu::{FrameUniforms, Vertex};
 use crate::shaders::{self, Variant};
 use crate::technique::{
@@ -15,7 +16,7 @@ use crate::technique::{
 };
 use crate::tessellator::{Spacing, MAX_LEVEL};
 use std::collections::HashMap;
-use std::mem::{offset_of, size_of};
+use std::mem::size_of;
 use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
 use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage, TessellationDesc};
 use vk_core::query::{PipelineStatistics, QueryPool};
@@ -46,7 +47,7 @@ impl FrameSets {
             device,
             "frame set layout",
             &[BindingDesc {
-                binding: 0,
+                binding: FRAME_UNIFORMS_BINDING,
                 ty: vk::DescriptorType::UNIFORM_BUFFER,
                 stages: vk::ShaderStageFlags::ALL_GRAPHICS | vk::ShaderStageFlags::COMPUTE,
             }],
@@ -64,7 +65,11 @@ impl FrameSets {
                 },
             )?;
             let set = pool.allocate_set(&layout)?;
-            set.write_buffer(0, vk::DescriptorType::UNIFORM_BUFFER, &uniforms)?;
+            set.write_buffer(
+                FRAME_UNIFORMS_BINDING,
+                vk::DescriptorType::UNIFORM_BUFFER,
+                &uniforms,
+            )?;
             out.push((set, uniforms));
         }
         Ok(Self {
@@ -559,23 +564,6 @@ pub(crate) fn set_pass_style(desc: &mut GraphicsPipelineDesc<'_>, pass: Pass) {
 /// Vertex input of the interleaved [`Vertex`] (position at location 0, normal at 1): what
 /// `mesh.vert` and `plain.vert` read.
 pub(crate) fn set_vertex_input(desc: &mut GraphicsPipelineDesc<'_>) {
-    desc.vertex_bindings = vec![vk::VertexInputBindingDescription {
-        binding: 0,
-        stride: size_of::<Vertex>() as u32,
-        input_rate: vk::VertexInputRate::VERTEX,
-    }];
-    desc.vertex_attributes = vec![
-        vk::VertexInputAttributeDescription {
-            location: 0,
-            binding: 0,
-            format: vk::Format::R32G32B32_SFLOAT,
-            offset: offset_of!(Vertex, position) as u32,
-        },
-        vk::VertexInputAttributeDescription {
-            location: 1,
-            binding: 0,
-            format: vk::Format::R32G32B32_SFLOAT,
-            offset: offset_of!(Vertex, normal) as u32,
-        },
-    ];
+    desc.vertex_bindings = vec![Vertex::BINDING];
+    desc.vertex_attributes = Vertex::ATTRIBUTES.to_vec();
 }

@@ -116,9 +116,12 @@ pub enum Pass {
 }
 
 impl Pass {
-    /// The `mode` the shaders read from their push constants (0 shaded, 1 wireframe).
+    /// The `mode` the shaders read from their push constants.
     pub fn mode(self) -> u32 {
-        (self == Pass::Wireframe) as u32
+        match self {
+            Pass::Wireframe => crate::gpu::bindings::DRAW_MODE_WIREFRAME,
+            Pass::Shaded | Pass::Capture => crate::gpu::bindings::DRAW_MODE_SHADED,
+        }
     }
 }
 
