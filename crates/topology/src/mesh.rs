@@ -190,8 +190,9 @@ impl Topology {
             || mesh.face_offsets.windows(2).any(|w| w[0] > w[1])
             || *mesh.face_offsets.last().unwrap_or(&0) as usize != mesh.face_vertices.len()
         {
-            return Err(TopologyError::InvalidTag {
-                message: "face_offsets is not a valid prefix table over face_vertices".into(),
+            return Err(TopologyError::MalformedFaceTable {
+                faces: mesh.num_faces(),
+                corners: mesh.face_vertices.len(),
             });
         }
         if let Some((vertex, p)) = mesh
@@ -255,9 +256,7 @@ impl Topology {
             return Err(e);
         }
         if corners >= INVALID as usize / 4 {
-            return Err(TopologyError::TooLarge {
-                what: format!("{corners} face corners"),
-            });
+            return Err(TopologyError::TooManyCorners { corners });
         }
         let topo = Topology::build(nv, mesh.face_offsets.clone(), mesh.face_vertices.clone())?;
         topo.check_manifold_vertices()?;
@@ -401,6 +400,52 @@ impl Topology {
         };
         topo.build_vertex_incidence();
         topo
+    }
+
+    /// The sub-mesh made of `faces` (in that order): vertices and edges numbered by first
+    /// occurrence, so the first face's corners come first. Vertices on the border of the
+    /// selection may have several unconnected fans there; that is a property of the selection,
+    /// not an error.
+    pub fn sub_topology(&self, faces: &[u32]) -> SubTopology {
+        let mut vertex_map: std::collections::HashMap<u32, u32> = Default::default();
+        let mut edge_map: std::collections::HashMap<u32, u32> = Default::default();
+        let mut vertices = Vec::new();
+        let mut edges = Vec::new();
+        let mut face_offsets = Vec::with_capacity(faces.len() + 1);
+        let mut face_verts = Vec::new();
+        let mut face_edges = Vec::new();
+        face_offsets.push(0);
+        for &f in faces {
+            let f = f as usize;
+            for (&v, &e) in self.face_vertices(f).iter().zip(self.face_edge_list(f)) {
+                let lv = *vertex_map.entry(v).or_insert_with(|| {
+                    vertices.push(v);
+                    (vertices.len() - 1) as u32
+                });
+                let le = *edge_map.entry(e).or_insert_with(|| {
+                    edges.push(e);
+                    (edges.len() - 1) as u32
+                });
+                face_verts.push(lv);
+                face_edges.push(le);
+            }
+            face_offsets.push(face_verts.len() as u32);
+        }
+        let edge_verts = edges
+            .iter()
+            .map(|&e| self.edge_verts[e as usize].map(|v| vertex_map[&v]))
+            .collect();
+        SubTopology {
+            topology: Topology::from_parts(
+                vertices.len(),
+                face_offsets,
+                face_verts,
+                face_edges,
+                edge_verts,
+            ),
+            vertices,
+            edges,
+        }
     }
 
     /// Counting-sort the vertex→edge and vertex→face incidence lists.
@@ -580,6 +625,17 @@ impl Topology {
             (x == a && y == b) || (x == b && y == a)
         })
     }
+}
+
+/// A sub-mesh cut out of a [`Topology`] ([`Topology::sub_topology`]) and where its parts come
+/// from.
+#[derive(Clone, Debug)]
+pub struct SubTopology {
+    pub topology: Topology,
+    /// Per sub-mesh vertex: its vertex in the source.
+    pub vertices: Vec<u32>,
+    /// Per sub-mesh edge: its edge in the source.
+    pub edges: Vec<u32>,
 }
 
 fn prefix_sum(v: &mut [u32]) {
