@@ -104,7 +104,11 @@ pub enum EvalError {
         need: usize,
     },
     #[error("sub-face {sub} out of range: face {face} has {size} corners")]
-    SubfaceOutOfRange { face: usize, sub: usize, size: usize },
+    SubfaceOutOfRange {
+        face: usize,
+        sub: usize,
+        size: usize,
+    },
     #[error("sub-faces are a Catmull-Clark parameterisation; {scheme:?} has none")]
     SubfaceNeedsCatmullClark { scheme: LimitScheme },
     #[error("{scheme} has no limit evaluation here (use loop or catmull-clark)")]
@@ -961,12 +965,7 @@ fn evaluate_local(
                 return Ok(chain(s.position, s.du, s.dv, &jac));
             }
         }
-        let step = refine_sparse(
-            level.view(),
-            scheme.scheme(),
-            &mesh.options,
-            &[face as u32],
-        )?;
+        let step = refine_sparse(level.view(), scheme.scheme(), &mesh.options, &[face as u32])?;
         let (k, nu, nv, l) = child_of(quad, u, v);
         u = nu;
         v = nv;
@@ -1040,7 +1039,12 @@ fn child_of(quad: bool, u: f64, v: f64) -> (usize, f64, f64, [[f64; 2]; 2]) {
         (2, 2.0 * (1.0 - u - v), 2.0 * u, [[-2.0, -2.0], [2.0, 0.0]])
     } else {
         // [e01, e12, e20].
-        (3, 2.0 * (u + v) - 1.0, 1.0 - 2.0 * u, [[2.0, 2.0], [-2.0, 0.0]])
+        (
+            3,
+            2.0 * (u + v) - 1.0,
+            1.0 - 2.0 * u,
+            [[2.0, 2.0], [-2.0, 0.0]],
+        )
     }
 }
 

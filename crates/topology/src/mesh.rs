@@ -114,9 +114,12 @@ impl ControlMesh {
     }
 
     /// The mesh with every polygon of more than three sides fan-triangulated from its first
-    /// corner (Loop needs triangles). Vertex indices, creases, corners and options are kept;
-    /// per-corner uvs and normals follow their corners; hole tags are dropped. Also returns,
-    /// per new face, the face it came from.
+    /// corner (Loop needs triangles; the techniques draw triangles). Vertex indices, creases,
+    /// corners and options are kept (fans only add diagonals, so crease tags keep naming the
+    /// same edges); per-corner uvs and normals follow their corners (and are dropped if they do
+    /// not have one value per corner); a hole tag becomes all triangles of the holed face;
+    /// faces of fewer than three corners make no triangle. Also returns, per new face, the
+    /// face it came from.
     pub fn triangulated(&self) -> (ControlMesh, Vec<u32>) {
         let mut out = ControlMesh {
             positions: self.positions.clone(),
@@ -126,24 +129,40 @@ impl ControlMesh {
             options: self.options,
             ..ControlMesh::default()
         };
-        let mut uvs = self.uvs.as_ref().map(|_| Vec::new());
-        let mut normals = self.normals.as_ref().map(|_| Vec::new());
+        let corners = self.face_vertices.len();
+        let (src_uvs, src_normals) = (
+            self.uvs.as_ref().filter(|a| a.len() == corners),
+            self.normals.as_ref().filter(|a| a.len() == corners),
+        );
+        let mut uvs = src_uvs.map(|_| Vec::new());
+        let mut normals = src_normals.map(|_| Vec::new());
         let mut origin = Vec::new();
+        let mut first_triangle = Vec::with_capacity(self.num_faces() + 1);
         for f in 0..self.num_faces() {
             let start = self.face_offsets[f] as usize;
             let n = self.face(f).len();
+            first_triangle.push(origin.len() as u32);
             for k in 1..n.saturating_sub(1) {
                 for c in [start, start + k, start + k + 1] {
                     out.face_vertices.push(self.face_vertices[c]);
-                    if let (Some(o), Some(src)) = (uvs.as_mut(), self.uvs.as_ref()) {
+                    if let (Some(o), Some(src)) = (uvs.as_mut(), src_uvs) {
                         o.push(src[c]);
                     }
-                    if let (Some(o), Some(src)) = (normals.as_mut(), self.normals.as_ref()) {
+                    if let (Some(o), Some(src)) = (normals.as_mut(), src_normals) {
                         o.push(src[c]);
                     }
                 }
                 out.face_offsets.push(out.face_vertices.len() as u32);
                 origin.push(f as u32);
+            }
+        }
+        first_triangle.push(origin.len() as u32);
+        for &h in &self.holes {
+            if let (Some(&a), Some(&b)) = (
+                first_triangle.get(h as usize),
+                first_triangle.get(h as usize + 1),
+            ) {
+                out.holes.extend(a..b);
             }
         }
         out.uvs = uvs;

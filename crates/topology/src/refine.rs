@@ -1,13 +1,52 @@
-//! Uniform refinement for Catmull-Clark, Loop, bilinear and Doo-Sabin with OpenSubdiv's
-//! semi-sharp crease, corner and boundary rules.
+//! The crate's one refiner: Catmull-Clark, Loop, bilinear and Doo-Sabin with OpenSubdiv's
+//! semi-sharp crease, corner and boundary rules (all taken from [`crate::sdc`]), in the spirit of
+//! OpenSubdiv's `Vtr::Refinement` (sdc rules → one topology representation → stencil tables).
 //!
-//! Each step produces the child topology, the child sharpness values and one stencil per child
-//! vertex over the parent vertices. Composing the steps gives stencils over the base vertices.
+//! # Levels and steps
+//! A level is a [`Topology`] plus per-edge and per-vertex sharpness ([`LevelTopology`], borrowed
+//! as [`LevelRef`]); [`Level`] adds 3D positions for the uniform API. A step reads a parent level
+//! and produces the child topology, the child sharpness (uniform or Chaikin decay) and one
+//! stencil per child vertex over the parent vertices; vertex data of any dimension is refined by
+//! applying the stencils, and composing steps gives stencils over the base vertices. The masks
+//! (`MaskContext`) are written once and serve both kinds of step.
 //!
-//! Child vertex numbering (all schemes but Doo-Sabin): first one vertex-vertex per parent vertex
-//! (same index as its parent, so base indices persist), then one edge-vertex per parent edge,
-//! then (Catmull-Clark, bilinear) one face-vertex per parent face. Doo-Sabin makes one child
-//! vertex per parent face corner.
+//! # Uniform and sparse steps
+//! * [`refine_level`] / [`refine_uniform`] / [`uniform_stencils`] refine every face. Their child
+//!   topology is written directly from the parent's adjacency, in parallel, for speed on large
+//!   meshes.
+//! * [`refine_sparse`] refines a selection of faces plus the one-ring of the selection (every
+//!   face sharing a vertex with a selected face), as OpenSubdiv's `Vtr::SparseSelector` and
+//!   `Far::TopologyRefiner::RefineAdaptive` do for feature-adaptive refinement. The one-ring is
+//!   what the children need: the limit surface over a face depends on the faces around its
+//!   corners, and the children of a face's one-ring contain the one-ring of each of its
+//!   children. So if the parent holds the complete one-ring of each selected face, every child
+//!   of a selected face has its complete one-ring in the child level, with exactly the uniform
+//!   refiner's stencils, and the next step can select those children again (isolating a
+//!   feature level by level, or following a point as [`crate::eval`] does). Child vertices on
+//!   the border of the refined region are still computed (from what the parent has), but their
+//!   masks see only part of their neighbourhood and are not those of a uniform refinement.
+//!   The step returns [`ChildMaps`]: parent → child (vertex-, edge-, face-vertex and first child
+//!   face per parent component) and child → parent ([`ChildOrigin`] per child vertex, parent
+//!   face per child face). Selecting every face reproduces [`refine_level`] exactly (same
+//!   numbering, same stencils).
+//!
+//! # Numbering of a child level (all schemes but Doo-Sabin)
+//! Vertices: first one vertex-vertex per refined parent vertex, then one edge-vertex per refined
+//! parent edge, then (Catmull-Clark, bilinear) one face-vertex per refined parent face, each
+//! group in ascending parent order. In a uniform step every component is refined, so a
+//! vertex-vertex keeps its parent's index (base indices persist), edge `e` gives vertex
+//! `nv + e` and face `f` vertex `nv + ne + f`.
+//! Faces: the children of each refined parent face, consecutively, parent faces ascending. A
+//! Catmull-Clark / bilinear face with `n` corners has `n` quad children, child `i` being
+//! `[v_i', e_{i,i+1}, f, e_{i−1,i}]`; a Loop triangle has four, child `j < 3` being
+//! `[v_j', e_{j,j+1}, e_{j−1,j}]` and child 3 `[e_01, e_12, e_20]`.
+//! Edges: the two halves of each refined parent edge (`2k` at the parent edge's first end,
+//! `2k + 1` at its second, `k` its rank among refined edges), then the interior edges of each
+//! refined face (one per corner for quads, joining the corner's edge-vertex to the
+//! face-vertex; three per triangle for Loop, inner edge `j` joining the edge-vertices at
+//! corner `j`).
+//!
+//! Doo-Sabin makes one child vertex per parent face corner and is uniform only.
 
 use crate::error::{TagKind, TopologyError};
 use crate::mesh::{
@@ -531,7 +570,10 @@ pub fn refine_sparse(
     faces.sort_unstable();
     faces.dedup();
     if !quads {
-        if let Some(&f) = faces.iter().find(|&&f| p.face_vertices(f as usize).len() != 3) {
+        if let Some(&f) = faces
+            .iter()
+            .find(|&&f| p.face_vertices(f as usize).len() != 3)
+        {
             return Err(TopologyError::LoopRequiresTriangles {
                 face: f as usize,
                 size: p.face_vertices(f as usize).len(),
@@ -570,13 +612,17 @@ pub fn refine_sparse(
         }
     }
 
-    // Sharpness of the edge halves in the parent's numbering (2e, 2e + 1), as the masks read it.
+    // Sharpness of the edge halves in the parent's numbering (2e, 2e + 1), as the masks read
+    // it: a vertex-vertex's rule reads the halves of all its edges, also those leaving the
+    // region, so every edge at a refined vertex gets its halves.
     let mut halves = vec![0.0f32; 2 * ne];
     let mut scratch = Vec::new();
-    for &e in &edges {
-        let e = e as usize;
-        let pair = half_edge_sharpness(p, parent.edge_sharpness, options, e, &mut scratch);
-        halves[2 * e..2 * e + 2].copy_from_slice(&pair);
+    for &v in &verts {
+        for &e in p.vertex_edges(v as usize) {
+            let e = e as usize;
+            let pair = half_edge_sharpness(p, parent.edge_sharpness, options, e, &mut scratch);
+            halves[2 * e..2 * e + 2].copy_from_slice(&pair);
+        }
     }
     let decayed: Vec<f32> = parent
         .vertex_sharpness
