@@ -14,12 +14,16 @@
 //!   boundary edge). `n = 4` covers every face that touches the boundary without an
 //!   extraordinary vertex, `n = 2` the corner child of a triangle with two boundary edges.
 //!
-//! Together these cover every face of a once-refined Loop mesh with "edges only" boundaries
-//! and no creases, except the centre child of a base triangle with two or three boundary edges
-//! (three boundary corners, none joined by a boundary edge): [`classify_face`] returns `None`
-//! there. Not tabulated either (use [`crate::eval`], or refine once more): infinitely sharp or
-//! semi-sharp creases, "edges and corners" corner vertices, faces with two extraordinary
-//! vertices.
+//! * `Private { face }`: every other face gets a table of its own, exact limit weights over its
+//!   one-ring neighbourhood ([`private_table`], [`neighbourhood_vertices`]), built by the same
+//!   evaluator. This covers what the shared cases leave out: infinitely sharp and semi-sharp
+//!   creases, "edges and corners" corner vertices, faces with two extraordinary vertices and the
+//!   centre child of a base triangle with two or three boundary edges.
+//!
+//! The shared cases cover every face of a once-refined Loop mesh with "edges only" boundaries
+//! and no creases except that centre child ([`classify_face`] returns `None` for it and for the
+//! other faces above); [`build_patch_records`] gives each such face a `Private` key, so every
+//! face of a level-1 Loop mesh is tabulated.
 //!
 //! # Control-point ordering ([`bft_face_ring`] / [`face_control_ring`]; shaders index by slot)
 //! `v0` (the extraordinary vertex, else a boundary vertex, else corner 0), `v1`, `v2` in the
@@ -68,7 +72,7 @@
 use std::collections::HashMap;
 
 use crate::eval::{EvalError, LimitScheme, LocalMesh};
-use crate::mesh::{BoundaryInterpolation, CreaseMethod};
+use crate::mesh::SubdivOptions;
 
 /// Configuration of a face around its (possibly) extraordinary vertex `v0`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -142,7 +146,7 @@ const RADIUS: u32 = 2;
 /// and the face index.
 pub fn configuration_mesh(key: BftKey, identity: bool) -> Result<(LocalMesh, usize), EvalError> {
     if !key.valid() {
-        return Err(EvalError::Unsupported(format!("no BFT case {key:?}")));
+        return Err(EvalError::NoBftCase { key });
     }
     let n = key.valence;
     let boundary = matches!(key.case, BftCase::Boundary { .. });
@@ -222,16 +226,13 @@ pub fn configuration_mesh(key: BftKey, identity: bool) -> Result<(LocalMesh, usi
         }
         (3, p)
     };
-    let mesh = LocalMesh::new(
+    let mesh = LocalMesh::from_faces(
         LimitScheme::Loop,
+        SubdivOptions::default(),
         dim,
         points,
         fo,
         fv,
-        HashMap::new(),
-        vec![0.0; nv],
-        BoundaryInterpolation::EdgesOnly,
-        CreaseMethod::Uniform,
     )?;
     Ok((mesh, face))
 }
@@ -484,16 +485,13 @@ fn table_rows(key: BftKey, level: u32, half: bool) -> Result<(Rows, Vec<u32>), E
         fo.push(fvs.len() as u32);
     }
     let nv = mesh.num_vertices();
-    let reflected = LocalMesh::new(
+    let reflected = LocalMesh::from_faces(
         LimitScheme::Loop,
+        SubdivOptions::default(),
         1,
         vec![0.0; nv],
         fo,
         fvs,
-        HashMap::new(),
-        vec![0.0; nv],
-        BoundaryInterpolation::EdgesOnly,
-        CreaseMethod::Uniform,
     )?;
     let rring = face_control_ring(&reflected, face, 0);
     let perm: Vec<u32> = rring
@@ -538,9 +536,7 @@ impl BasisTables {
         tangents: bool,
     ) -> Result<BasisTables, EvalError> {
         if !(1..=6).contains(&level) {
-            return Err(EvalError::Unsupported(format!(
-                "BFT level {level} not in 1..=6"
-            )));
+            return Err(EvalError::BftLevel { level });
         }
         let mut stored: Vec<BftKey> = keys
             .iter()
@@ -763,7 +759,7 @@ impl BftCache {
 
     /// Tables covering `keys` (rebuilt only when a new key appears).
     pub fn tables_for(&mut self, keys: &[BftKey]) -> Result<&BasisTables, EvalError> {
-        let mut changed = self.tables.is_none();
+        let mut changed = false;
         for k in keys {
             let c = k.canonical().0;
             if !self.keys.contains(&c) {
@@ -771,12 +767,11 @@ impl BftCache {
                 changed = true;
             }
         }
-        if changed {
-            self.tables = Some(BasisTables::build(&self.keys, self.level)?);
-        }
-        self.tables
-            .as_ref()
-            .ok_or_else(|| EvalError::Unsupported("no tables".into()))
+        let tables = match self.tables.take() {
+            Some(t) if !changed => t,
+            _ => BasisTables::build(&self.keys, self.level)?,
+        };
+        Ok(self.tables.insert(tables))
     }
 }
 
@@ -795,18 +790,21 @@ pub struct PatchRecord {
     pub corner_owner: [(u32, u8); 3],
 }
 
-/// Patch records of every face of a Loop mesh (typically level 1), or the first face not
-/// covered by the tables.
+/// Patch records of every face of a Loop mesh (typically level 1): a shared table key where
+/// [`classify_face`] finds one, else a [`BftCase::Private`] key whose ring is the face's
+/// neighbourhood. Fails only on a face that is not a triangle.
 pub fn build_patch_records(mesh: &LocalMesh) -> Result<Vec<PatchRecord>, EvalError> {
     let nf = mesh.num_faces();
     let mut recs = Vec::with_capacity(nf);
     for f in 0..nf {
         let fv = mesh.face(f);
         if fv.len() != 3 {
-            return Err(EvalError::Unsupported(format!(
-                "face {f} has {} sides; Loop patches are triangles",
-                fv.len()
-            )));
+            return Err(EvalError::FaceSize {
+                face: f,
+                size: fv.len(),
+                scheme: LimitScheme::Loop,
+                need: 3,
+            });
         }
         let (key, first, ring) = match classify_face(mesh, f) {
             Some((key, first)) => (key, first, face_control_ring(mesh, f, first)),
@@ -857,16 +855,8 @@ pub fn build_patch_records(mesh: &LocalMesh) -> Result<Vec<PatchRecord>, EvalErr
 /// The vertices of `face` and of every face touching one of its corners, in the order
 /// [`LocalMesh::face_neighbourhood`] numbers them (the face's corners first).
 pub fn neighbourhood_vertices(mesh: &LocalMesh, face: usize) -> Vec<u32> {
-    let mut faces = vec![face as u32];
-    for &v in mesh.face(face) {
-        for f in mesh.vertex_faces(v) {
-            if !faces.contains(&f) {
-                faces.push(f);
-            }
-        }
-    }
     let mut out: Vec<u32> = Vec::new();
-    for &f in &faces {
+    for f in mesh.neighbourhood_faces(face) {
         for &v in mesh.face(f as usize) {
             if !out.contains(&v) {
                 out.push(v);
@@ -889,17 +879,7 @@ pub fn private_table(
     for v in 0..k {
         pts[v * k + v] = 1.0;
     }
-    let id = LocalMesh::new(
-        nb.scheme,
-        k,
-        pts,
-        nb.face_offsets.clone(),
-        nb.face_verts.clone(),
-        nb.edge_sharpness.clone(),
-        nb.vertex_sharpness.clone(),
-        nb.boundary,
-        nb.crease_method,
-    )?;
+    let id = nb.with_points(k, pts)?;
     let m = grid_size(level) as f64;
     let mut rows = Vec::new();
     for (a, b) in table_points(level) {
@@ -1069,7 +1049,7 @@ pub struct LoopBft {
     pub base_faces: usize,
 }
 
-/// Refine `mesh` once (T1's uniform refinement), classify every level-1 face and build the
+/// Refine `mesh` once (uniform refinement), classify every level-1 face and build the
 /// tables it needs.
 pub fn prepare_loop_bft(
     mesh: &crate::mesh::ControlMesh,

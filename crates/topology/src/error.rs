@@ -62,9 +62,18 @@ pub enum TopologyError {
     /// Loop subdivision was asked for a mesh with non-triangular faces.
     #[error("Loop subdivision needs triangles, but face {face} has {size} vertices")]
     LoopRequiresTriangles { face: usize, size: usize },
-    /// A crease, corner or hole tag that cannot apply to this mesh.
-    #[error("invalid tag: {message}")]
-    InvalidTag { message: String },
+    /// A crease, corner or hole tag naming a vertex or face the mesh does not have.
+    #[error("invalid tag: {tag} names {} {index}, mesh has {count} {}s", tag.element(), tag.element())]
+    TagOutOfRange {
+        tag: TagKind,
+        index: u32,
+        count: usize,
+    },
+    /// `face_offsets` does not start at 0, decreases, or does not end at the corner count.
+    #[error(
+        "malformed face table: face_offsets ({faces} faces) is not a valid prefix table over {corners} face_vertices"
+    )]
+    MalformedFaceTable { faces: usize, corners: usize },
     /// Per-corner attribute arrays (normals, UVs) whose length does not match the faces.
     #[error("{attribute}: {len} values but the faces have {expected} corners")]
     AttributeLength {
@@ -72,9 +81,52 @@ pub enum TopologyError {
         len: usize,
         expected: usize,
     },
-    /// The refinement would not fit 32-bit indices.
-    #[error("refinement too large: {what}")]
-    TooLarge { what: String },
+    /// The control mesh has too many face corners for 32-bit refinement indices.
+    #[error("refinement too large: {corners} face corners")]
+    TooManyCorners { corners: usize },
+    /// One more refinement step of a level with `faces` faces would overflow 32-bit indices.
+    #[error("refinement too large: refining {faces} faces would overflow 32-bit indices")]
+    RefinementTooLarge { faces: usize },
+    /// A scheme name no parser knows.
+    #[error("unknown scheme '{name}' (loop, catmull-clark, doo-sabin, bilinear)")]
+    UnknownScheme { name: String },
+    /// An operation the scheme does not support (Doo-Sabin has no sparse refinement).
+    #[error("{scheme} does not support {operation}")]
+    UnsupportedScheme {
+        scheme: crate::sdc::Scheme,
+        operation: &'static str,
+    },
+    /// A face index (e.g. in a refinement selection) beyond the level's faces.
+    #[error("face {face} out of range (the level has {count} faces)")]
+    FaceOutOfRange { face: usize, count: usize },
+}
+
+/// Which OBJ tag a [`TopologyError::TagOutOfRange`] comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TagKind {
+    Crease,
+    Corner,
+    Hole,
+}
+
+impl TagKind {
+    /// What the tag's indices name.
+    pub fn element(self) -> &'static str {
+        match self {
+            TagKind::Crease | TagKind::Corner => "vertex",
+            TagKind::Hole => "face",
+        }
+    }
+}
+
+impl std::fmt::Display for TagKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            TagKind::Crease => "crease",
+            TagKind::Corner => "corner",
+            TagKind::Hole => "hole",
+        })
+    }
 }
 
 impl TopologyError {

@@ -11,8 +11,15 @@
 //!    corner), evaluate the box spline / bicubic B-spline in closed form;
 //! 3. if `(u, v)` is exactly a corner, apply the vertex's limit masks ([`crate::limit`]) as soon
 //!    as no semi-sharp feature remains there;
-//! 4. otherwise refine the neighbourhood once (OpenSubdiv rules, semi-sharp creases included),
-//!    pick the child face containing the point, and repeat.
+//! 4. otherwise refine the face and its one-ring once with the crate's one refiner
+//!    ([`crate::refine::refine_sparse`]: OpenSubdiv rules, semi-sharp creases included), pick
+//!    the child face containing the point, and repeat on it.
+//!
+//! This module has no subdivision rule of its own: sharpness tests and rules come from
+//! [`crate::sdc`], refinement and its masks from [`crate::refine`], and the level type is the
+//! refiner's [`LevelTopology`]; [`LocalMesh`] only adds per-vertex data of any dimension (3
+//! for geometry, one per basis function for tables) and the ordered vertex fans the limit
+//! masks and regular patches read.
 //!
 //! Because the one-ring of a face refines into a superset of the one-ring of each child face,
 //! the local refinement is exact. At dyadic parameters the recursion ends after at most
@@ -26,40 +33,69 @@
 //! Holes are evaluated like ordinary faces; Loop needs triangles, Catmull-Clark quads (use
 //! [`LocalMesh::evaluate_subface`] for other faces).
 
-use std::collections::HashMap;
+use std::borrow::Cow;
 use std::fmt;
 
+use crate::error::TopologyError;
 use crate::limit::{
     catmark_limit_masks, loop_limit_masks, smooth_directional_tangent, LimitRule, LimitVertex,
 };
-use crate::mesh::{BoundaryInterpolation, ControlMesh, CreaseMethod};
+use crate::mesh::{ControlMesh, SubdivOptions, Topology, INVALID};
 use crate::patch::{catmark_regular_weights, loop_regular_weights};
+use crate::refine::{refine_sparse, Level, LevelTopology};
+use crate::sdc::{is_infinite, is_semi_sharp, is_sharp, vertex_rule, Rule, Scheme};
 
-/// Which subdivision surface is evaluated.
+/// The schemes with a limit surface here: a restricted view of [`Scheme`], parsed by
+/// [`Scheme`]'s one parser.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum LimitScheme {
     Loop,
     CatmullClark,
 }
 
-impl std::str::FromStr for LimitScheme {
-    type Err = EvalError;
-    fn from_str(s: &str) -> Result<Self, EvalError> {
-        match s {
-            "loop" => Ok(LimitScheme::Loop),
-            "catmull-clark" | "catmark" | "cc" => Ok(LimitScheme::CatmullClark),
-            _ => Err(EvalError::Unsupported(format!("unknown scheme {s:?}"))),
+impl LimitScheme {
+    /// The refinement scheme.
+    pub fn scheme(self) -> Scheme {
+        match self {
+            LimitScheme::Loop => Scheme::Loop,
+            LimitScheme::CatmullClark => Scheme::CatmullClark,
+        }
+    }
+
+    /// Corners of the faces this scheme evaluates directly.
+    fn face_size(self) -> usize {
+        match self {
+            LimitScheme::Loop => 3,
+            LimitScheme::CatmullClark => 4,
         }
     }
 }
 
-/// Why a limit evaluation could not be done.
-#[derive(Debug, thiserror::Error, PartialEq)]
+impl TryFrom<Scheme> for LimitScheme {
+    type Error = EvalError;
+    fn try_from(scheme: Scheme) -> Result<LimitScheme, EvalError> {
+        match scheme {
+            Scheme::Loop => Ok(LimitScheme::Loop),
+            Scheme::CatmullClark => Ok(LimitScheme::CatmullClark),
+            other => Err(EvalError::NoLimitEvaluation { scheme: other }),
+        }
+    }
+}
+
+impl std::str::FromStr for LimitScheme {
+    type Err = EvalError;
+    fn from_str(s: &str) -> Result<Self, EvalError> {
+        LimitScheme::try_from(s.parse::<Scheme>()?)
+    }
+}
+
+/// Why a limit evaluation (or a table built from it) could not be done.
+#[derive(Debug, thiserror::Error)]
 pub enum EvalError {
-    #[error("face {0} out of range")]
-    FaceOutOfRange(usize),
-    #[error("parameter ({0}, {1}) outside the face domain")]
-    ParamOutOfRange(f64, f64),
+    #[error("face {face} out of range (the mesh has {count} faces)")]
+    FaceOutOfRange { face: usize, count: usize },
+    #[error("parameter ({u}, {v}) outside the face domain")]
+    ParamOutOfRange { u: f64, v: f64 },
     #[error("face {face} has {size} corners; {scheme:?} evaluation needs {need}")]
     FaceSize {
         face: usize,
@@ -67,69 +103,117 @@ pub enum EvalError {
         scheme: LimitScheme,
         need: usize,
     },
-    #[error("non-manifold or inconsistently oriented mesh at vertex {0}")]
-    NonManifold(u32),
+    #[error("sub-face {sub} out of range: face {face} has {size} corners")]
+    SubfaceOutOfRange {
+        face: usize,
+        sub: usize,
+        size: usize,
+    },
+    #[error("sub-faces are a Catmull-Clark parameterisation; {scheme:?} has none")]
+    SubfaceNeedsCatmullClark { scheme: LimitScheme },
+    #[error("{scheme} has no limit evaluation here (use loop or catmull-clark)")]
+    NoLimitEvaluation { scheme: Scheme },
+    #[error("{count} values are not {dim} per vertex for {vertices} vertices")]
+    PointCount {
+        count: usize,
+        dim: usize,
+        vertices: usize,
+    },
+    #[error("evaluation of face {face} at ({u}, {v}) did not converge")]
+    NotConverged { face: usize, u: f64, v: f64 },
+    #[error("no basis-function table case {key:?}")]
+    NoBftCase { key: crate::bft::BftKey },
+    #[error("BFT level {level} not in 1..=6")]
+    BftLevel { level: u32 },
+    /// The mesh or a refinement step failed (names the face, edge or vertex at fault).
+    #[error(transparent)]
+    Topology(#[from] TopologyError),
+    /// Reserved for the GPU packing code of [`crate::bft`], which is moving to the `tess`
+    /// crate; nothing else returns it.
     #[error("{0}")]
     Unsupported(String),
 }
 
-/// Infinite sharpness (OpenSubdiv: 10 and above).
-const INF: f32 = 10.0;
-
-fn is_sharp(s: f32) -> bool {
-    s > 0.0
-}
-
-fn decrement(s: f32) -> f32 {
-    if s >= INF {
-        INF
-    } else if s > 1.0 {
-        s - 1.0
-    } else {
-        0.0
-    }
-}
-
-/// OpenSubdiv vertex rule from the vertex sharpness and the number of sharp incident edges.
-fn rule_of(vs: f32, sharp_edges: usize) -> u8 {
-    if is_sharp(vs) {
-        return 3;
-    }
-    match sharp_edges {
-        0 | 1 => 0,
-        2 => 2,
-        _ => 3,
-    }
-}
-
-/// Ordered neighbourhood of one vertex: faces CCW, and the edge-neighbours `ring[i]` =
-/// the vertex after the centre in face `i` (plus the last boundary neighbour for a fan).
+/// Ordered neighbourhood of one vertex: faces CCW with the vertex's corner index in each, the
+/// edge-neighbours `ring[i]` = the vertex after the centre in face `i` (plus the last boundary
+/// neighbour for a boundary fan) and the edge to each ring vertex.
 #[derive(Clone, Debug, Default)]
 struct Fan {
     faces: Vec<(u32, u32)>,
     ring: Vec<u32>,
+    edges: Vec<u32>,
     boundary: bool,
+    /// All incident faces were reached; false on the border of a refined region, where a
+    /// vertex may keep several unconnected fans.
+    complete: bool,
 }
 
-/// A small (or whole) polygon mesh with points of any dimension and OpenSubdiv sharpness tags:
-/// the working set of the evaluator and of the basis-function-table generator.
+/// The fan of `v` in `t`: it starts at the face whose edge leaving `v` is a boundary edge, else
+/// at the lowest-numbered face, and turns across the edge entering `v` in each face.
+fn build_fan(t: &Topology, v: u32) -> Fan {
+    let vf = t.vertex_faces(v as usize);
+    let Some(&first) = vf.first() else {
+        return Fan {
+            complete: true,
+            ..Fan::default()
+        };
+    };
+    let corner = |g: u32| {
+        t.face_vertices(g as usize)
+            .iter()
+            .position(|&x| x == v)
+            .unwrap_or(0)
+    };
+    let start = vf
+        .iter()
+        .copied()
+        .find(|&g| t.is_boundary_edge(t.face_edge_list(g as usize)[corner(g)] as usize))
+        .unwrap_or(first);
+    let boundary = t.is_boundary_edge(t.face_edge_list(start as usize)[corner(start)] as usize);
+    let mut fan = Fan {
+        boundary,
+        ..Fan::default()
+    };
+    let mut g = start;
+    loop {
+        let c = corner(g);
+        let fv = t.face_vertices(g as usize);
+        let fe = t.face_edge_list(g as usize);
+        let n = fv.len();
+        fan.faces.push((g, c as u32));
+        fan.ring.push(fv[(c + 1) % n]);
+        fan.edges.push(fe[c]);
+        let entering = fe[(c + n - 1) % n];
+        let [a, b] = t.edge_faces(entering as usize);
+        let h = if a == g { b } else { a };
+        if h == INVALID {
+            fan.ring.push(fv[(c + n - 1) % n]);
+            fan.edges.push(entering);
+            break;
+        }
+        if h == start || fan.faces.len() >= vf.len() {
+            break;
+        }
+        g = h;
+    }
+    fan.complete = fan.faces.len() == vf.len();
+    fan
+}
+
+/// A polygon mesh level with points of any dimension: the working set of the evaluator and of
+/// the basis-function-table generator. Topology and sharpness are the refiner's
+/// [`LevelTopology`]; this view adds the points and the ordered vertex fans.
 #[derive(Clone, Debug)]
 pub struct LocalMesh {
     pub scheme: LimitScheme,
+    /// Boundary interpolation, crease method and triangle rule the refiner applies.
+    pub options: SubdivOptions,
+    pub level: LevelTopology,
     /// Dimension of each point (3 for geometry; the number of basis functions for tables).
     pub dim: usize,
     /// `dim` values per vertex.
     pub points: Vec<f64>,
-    pub face_offsets: Vec<u32>,
-    pub face_verts: Vec<u32>,
-    /// Sharpness of tagged edges, keyed by `(min, max)` vertex pair (boundary edges are
-    /// infinitely sharp without being listed).
-    pub edge_sharpness: HashMap<(u32, u32), f32>,
-    pub vertex_sharpness: Vec<f32>,
-    pub boundary: BoundaryInterpolation,
-    pub crease_method: CreaseMethod,
     fans: Vec<Fan>,
-    halfedges: HashMap<(u32, u32), u32>,
 }
 
 /// Limit position and first derivatives (any dimension).
@@ -140,126 +224,117 @@ pub struct LimitSample {
     pub dv: Vec<f64>,
 }
 
-fn key(a: u32, b: u32) -> (u32, u32) {
-    if a < b {
-        (a, b)
-    } else {
-        (b, a)
-    }
-}
-
 fn axpy(out: &mut [f64], w: f64, x: &[f64]) {
     for (o, v) in out.iter_mut().zip(x) {
         *o += w * v;
     }
 }
 
+fn flatten(positions: &[[f64; 3]]) -> Vec<f64> {
+    positions.iter().flat_map(|p| p.iter().copied()).collect()
+}
+
 impl LocalMesh {
-    /// Build from flat faces and points; computes the ordered vertex neighbourhoods.
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
+    /// A view of `level` with `dim` values per vertex in `points`.
+    pub fn from_level(
+        level: LevelTopology,
         scheme: LimitScheme,
+        options: SubdivOptions,
+        dim: usize,
+        points: Vec<f64>,
+    ) -> Result<LocalMesh, EvalError> {
+        let vertices = level.topology.num_vertices();
+        if points.len() != vertices * dim {
+            return Err(EvalError::PointCount {
+                count: points.len(),
+                dim,
+                vertices,
+            });
+        }
+        let fans = (0..vertices as u32)
+            .map(|v| build_fan(&level.topology, v))
+            .collect();
+        Ok(LocalMesh {
+            scheme,
+            options,
+            level,
+            dim,
+            points,
+            fans,
+        })
+    }
+
+    /// An untagged mesh from flat faces and points (validated like any control mesh; boundary
+    /// rules from `options`).
+    pub fn from_faces(
+        scheme: LimitScheme,
+        options: SubdivOptions,
         dim: usize,
         points: Vec<f64>,
         face_offsets: Vec<u32>,
         face_verts: Vec<u32>,
-        edge_sharpness: HashMap<(u32, u32), f32>,
-        vertex_sharpness: Vec<f32>,
-        boundary: BoundaryInterpolation,
-        crease_method: CreaseMethod,
     ) -> Result<LocalMesh, EvalError> {
-        let nv = points.len() / dim.max(1);
-        let mut m = LocalMesh {
-            scheme,
+        let vertices = points.len() / dim.max(1);
+        let mut mesh = ControlMesh::from_polygons(vec![[0.0; 3]; vertices], &[] as &[[u32; 3]]);
+        mesh.face_offsets = face_offsets;
+        mesh.face_vertices = face_verts;
+        mesh.options = options;
+        let level = LevelTopology::from_mesh(&mesh, scheme.scheme())?;
+        LocalMesh::from_level(level, scheme, options, dim, points)
+    }
+
+    /// The same mesh carrying other per-vertex data (`dim` values per vertex).
+    pub fn with_points(&self, dim: usize, points: Vec<f64>) -> Result<LocalMesh, EvalError> {
+        let vertices = self.num_vertices();
+        if points.len() != vertices * dim {
+            return Err(EvalError::PointCount {
+                count: points.len(),
+                dim,
+                vertices,
+            });
+        }
+        Ok(LocalMesh {
             dim,
             points,
-            face_offsets,
-            face_verts,
-            edge_sharpness,
-            vertex_sharpness,
-            boundary,
-            crease_method,
-            fans: Vec::new(),
-            halfedges: HashMap::new(),
-        };
-        m.vertex_sharpness.resize(nv, 0.0);
-        m.build_fans(nv)?;
-        Ok(m)
+            ..self.clone()
+        })
     }
 
     /// Geometry of a [`ControlMesh`] (holes are refined like ordinary faces).
     pub fn from_control_mesh(mesh: &ControlMesh, scheme: LimitScheme) -> Result<Self, EvalError> {
-        let mut es = HashMap::new();
-        for c in &mesh.creases {
-            if c.sharpness > 0.0 {
-                es.insert(key(c.vertices[0], c.vertices[1]), c.sharpness);
-            }
-        }
-        let mut vs = vec![0.0f32; mesh.positions.len()];
-        for c in &mesh.corners {
-            if let Some(s) = vs.get_mut(c.vertex as usize) {
-                *s = c.sharpness;
-            }
-        }
-        let points = mesh
-            .positions
-            .iter()
-            .flat_map(|p| p.iter().copied())
-            .collect();
-        LocalMesh::new(
-            scheme,
-            3,
-            points,
-            mesh.face_offsets.clone(),
-            mesh.face_vertices.clone(),
-            es,
-            vs,
-            mesh.options.boundary,
-            mesh.options.crease_method,
-        )
+        let level = LevelTopology::from_mesh(mesh, scheme.scheme())?;
+        LocalMesh::from_level(level, scheme, mesh.options, 3, flatten(&mesh.positions))
     }
 
-    /// A level of T1's uniform refinement (e.g. the level-1 mesh the BFT pipeline starts from).
+    /// A level of a uniform refinement (e.g. the level-1 mesh the BFT pipeline starts from).
     pub fn from_refined_level(
-        level: &crate::refine::Level,
+        level: &Level,
         scheme: LimitScheme,
-        options: &crate::mesh::SubdivOptions,
+        options: &SubdivOptions,
     ) -> Result<Self, EvalError> {
-        let mut es = HashMap::new();
-        for e in 0..level.topology.num_edges() {
-            let s = level.edge_sharpness[e];
-            if s > 0.0 && !level.topology.is_boundary_edge(e) {
-                let [a, b] = level.topology.edge_vertices(e);
-                es.insert(key(a, b), s);
-            }
-        }
-        LocalMesh::new(
-            scheme,
-            3,
-            level
-                .positions
-                .iter()
-                .flat_map(|p| p.iter().copied())
-                .collect(),
-            level.face_offsets().to_vec(),
-            level.face_vertices().to_vec(),
-            es,
-            level.vertex_sharpness.clone(),
-            options.boundary,
-            options.crease_method,
-        )
+        let topology = LevelTopology {
+            topology: level.topology.clone(),
+            edge_sharpness: level.edge_sharpness.clone(),
+            vertex_sharpness: level.vertex_sharpness.clone(),
+        };
+        LocalMesh::from_level(topology, scheme, *options, 3, flatten(&level.positions))
     }
 
     pub fn num_vertices(&self) -> usize {
-        self.fans.len()
+        self.level.topology.num_vertices()
     }
 
     pub fn num_faces(&self) -> usize {
-        self.face_offsets.len().saturating_sub(1)
+        self.level.topology.num_faces()
     }
 
     pub fn face(&self, f: usize) -> &[u32] {
-        &self.face_verts[self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize]
+        self.level.topology.face_vertices(f)
+    }
+
+    /// Flat face tables: offsets (len faces + 1) and corner vertices.
+    pub fn face_tables(&self) -> (&[u32], &[u32]) {
+        self.level.topology.face_tables()
     }
 
     pub fn point(&self, v: u32) -> &[f64] {
@@ -281,466 +356,239 @@ impl LocalMesh {
         self.fans[v as usize].faces.iter().map(|&(f, _)| f)
     }
 
-    fn build_fans(&mut self, nv: usize) -> Result<(), EvalError> {
-        let mut he = HashMap::with_capacity(self.face_verts.len());
-        let mut corners: Vec<Vec<(u32, u32)>> = vec![Vec::new(); nv];
-        for f in 0..self.num_faces() {
-            let fv = self.face(f);
-            let n = fv.len();
-            for c in 0..n {
-                let (a, b) = (fv[c], fv[(c + 1) % n]);
-                if he.insert((a, b), f as u32).is_some() {
-                    return Err(EvalError::NonManifold(a));
-                }
-                corners[a as usize].push((f as u32, c as u32));
-            }
-        }
-        let mut fans = Vec::with_capacity(nv);
-        for (v, cs) in corners.iter().enumerate() {
-            let v = v as u32;
-            if cs.is_empty() {
-                fans.push(Fan::default());
-                continue;
-            }
-            let next_of = |&(f, c): &(u32, u32)| {
-                let fv = self.face(f as usize);
-                fv[(c as usize + 1) % fv.len()]
-            };
-            let prev_of = |&(f, c): &(u32, u32)| {
-                let fv = self.face(f as usize);
-                fv[(c as usize + fv.len() - 1) % fv.len()]
-            };
-            // Start at a face whose leading edge has no twin (boundary), else anywhere.
-            let start = cs
-                .iter()
-                .position(|fc| !he.contains_key(&(next_of(fc), v)))
-                .unwrap_or(0);
-            let boundary = !he.contains_key(&(next_of(&cs[start]), v));
-            let mut fan = Fan {
-                boundary,
-                ..Fan::default()
-            };
-            let mut cur = cs[start];
-            loop {
-                fan.faces.push(cur);
-                fan.ring.push(next_of(&cur));
-                let p = prev_of(&cur);
-                match he.get(&(v, p)) {
-                    Some(&f2) => {
-                        let fv = self.face(f2 as usize);
-                        let c2 = fv.iter().position(|&x| x == v).unwrap_or(0) as u32;
-                        if f2 == cs[start].0 {
-                            break;
-                        }
-                        cur = (f2, c2);
-                    }
-                    None => {
-                        fan.ring.push(p);
-                        break;
-                    }
-                }
-                if fan.faces.len() > cs.len() {
-                    return Err(EvalError::NonManifold(v));
-                }
-            }
-            if fan.faces.len() != cs.len() {
-                return Err(EvalError::NonManifold(v));
-            }
-            fans.push(fan);
-        }
-        self.fans = fans;
-        self.halfedges = he;
-        Ok(())
-    }
-
-    /// True if edge `a–b` has a face on one side only.
+    /// True if edge `a–b` has a face on one side only (or is no edge).
     pub fn is_boundary_edge(&self, a: u32, b: u32) -> bool {
-        !(self.halfedges.contains_key(&(a, b)) && self.halfedges.contains_key(&(b, a)))
+        let t = &self.level.topology;
+        t.find_edge(a, b)
+            .is_none_or(|e| t.is_boundary_edge(e as usize))
     }
 
     /// Sharpness of edge `a–b` (boundary edges are infinitely sharp).
     pub fn edge_sharp(&self, a: u32, b: u32) -> f32 {
-        if self.is_boundary_edge(a, b) {
-            INF
-        } else {
-            self.edge_sharpness.get(&key(a, b)).copied().unwrap_or(0.0)
+        match self.level.topology.find_edge(a, b) {
+            Some(e) => self.view().edge_sharp(e),
+            None => 0.0,
         }
     }
 
     /// Vertex sharpness, including OpenSubdiv's "edges and corners" boundary corners.
     pub fn vert_sharp(&self, v: u32) -> f32 {
-        let fan = &self.fans[v as usize];
-        if self.boundary == BoundaryInterpolation::EdgesAndCorners
-            && fan.boundary
-            && fan.faces.len() == 1
-        {
-            return INF;
-        }
-        self.vertex_sharpness[v as usize]
+        self.level.vertex_sharpness[v as usize]
     }
 
-    fn incident_sharpness(&self, v: u32) -> Vec<f32> {
-        self.fans[v as usize]
-            .ring
-            .iter()
-            .map(|&w| self.edge_sharp(v, w))
-            .collect()
-    }
-
-    fn child_edge_sharpness(&self, s: f32, at: u32) -> f32 {
-        match self.crease_method {
-            CreaseMethod::Uniform => decrement(s),
-            CreaseMethod::Chaikin => {
-                if !is_sharp(s) {
-                    return 0.0;
-                }
-                if s >= INF {
-                    return INF;
-                }
-                let inc = self.incident_sharpness(at);
-                let semi: Vec<f32> = inc
-                    .iter()
-                    .copied()
-                    .filter(|&x| is_sharp(x) && x < INF)
-                    .collect();
-                let mut t = s;
-                if semi.len() > 1 && inc.len() >= 2 {
-                    let others = (semi.iter().sum::<f32>() - s) / (semi.len() - 1) as f32;
-                    t = 0.75 * s + 0.25 * others;
-                }
-                t -= 1.0;
-                if is_sharp(t) {
-                    t
-                } else {
-                    0.0
-                }
-            }
+    fn view(&self) -> View<'_> {
+        View {
+            scheme: self.scheme,
+            level: &self.level,
+            dim: self.dim,
+            points: &self.points,
+            fans: Some(&self.fans),
         }
     }
 
-    /// One level of uniform refinement with OpenSubdiv's rules (uniform or Chaikin decay,
-    /// fractional rule blending). Child faces: Loop `4f + [corner v0, corner v1, corner v2,
-    /// centre]`, child `k<3` = `[v_k', e_{k,k+1}, e_{k−1,k}]` rotated so the param map is as in
-    /// [`LocalMesh::evaluate`]; Catmull-Clark: the face's corners in order,
-    /// `[v_i', e_{i,i+1}, f, e_{i−1,i}]`, numbered consecutively per parent face.
-    pub fn refine(&self) -> Result<LocalMesh, EvalError> {
-        let d = self.dim;
-        let nv = self.num_vertices();
-        let nf = self.num_faces();
-        let quad = self.scheme == LimitScheme::CatmullClark;
-        if !quad {
-            if let Some(f) = (0..nf).find(|&f| self.face(f).len() != 3) {
-                return Err(EvalError::FaceSize {
-                    face: f,
-                    size: self.face(f).len(),
-                    scheme: self.scheme,
-                    need: 3,
-                });
-            }
-        }
-        // Number edges.
-        let mut edge_id: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut edges: Vec<(u32, u32)> = Vec::new();
-        for f in 0..nf {
-            let fv = self.face(f);
-            for c in 0..fv.len() {
-                let k = key(fv[c], fv[(c + 1) % fv.len()]);
-                edge_id.entry(k).or_insert_with(|| {
-                    edges.push(k);
-                    (edges.len() - 1) as u32
-                });
-            }
-        }
-        let ne = edges.len();
-        let e_base = nv as u32;
-        let f_base = (nv + ne) as u32;
-        let n_child = nv + ne + if quad { nf } else { 0 };
-        let mut pts = vec![0.0; n_child * d];
-        // Face points.
-        if quad {
-            for f in 0..nf {
-                let fv = self.face(f);
-                let w = 1.0 / fv.len() as f64;
-                let o = (f_base as usize + f) * d;
-                for &v in fv {
-                    axpy(&mut pts[o..o + d], w, self.point(v));
-                }
-            }
-        }
-        // Edge points.
-        for (ei, &(a, b)) in edges.iter().enumerate() {
-            let s = self.edge_sharp(a, b);
-            let mut mid = vec![0.0; d];
-            axpy(&mut mid, 0.5, self.point(a));
-            axpy(&mut mid, 0.5, self.point(b));
-            let out = if s >= 1.0 {
-                mid
-            } else {
-                let mut sm = vec![0.0; d];
-                let fa = self.halfedges[&(a, b)];
-                let fb = self.halfedges[&(b, a)];
-                if quad {
-                    axpy(&mut sm, 0.25, self.point(a));
-                    axpy(&mut sm, 0.25, self.point(b));
-                    for f in [fa, fb] {
-                        let o = (f_base + f) as usize * d;
-                        let fp: Vec<f64> = pts[o..o + d].to_vec();
-                        axpy(&mut sm, 0.25, &fp);
-                    }
-                } else {
-                    axpy(&mut sm, 0.375, self.point(a));
-                    axpy(&mut sm, 0.375, self.point(b));
-                    for f in [fa, fb] {
-                        let opp = self
-                            .face(f as usize)
-                            .iter()
-                            .copied()
-                            .find(|&x| x != a && x != b);
-                        axpy(&mut sm, 0.125, self.point(opp.unwrap_or(a)));
-                    }
-                }
-                if s > 0.0 {
-                    let s = s as f64;
-                    sm.iter_mut()
-                        .zip(&mid)
-                        .for_each(|(x, m)| *x = (1.0 - s) * *x + s * m);
-                }
-                sm
-            };
-            let o = (nv + ei) * d;
-            pts[o..o + d].copy_from_slice(&out);
-        }
-        // Vertex points.
-        for v in 0..nv as u32 {
-            let fan = &self.fans[v as usize];
-            let o = v as usize * d;
-            if fan.faces.is_empty() {
-                let p = self.point(v).to_vec();
-                pts[o..o + d].copy_from_slice(&p);
-                continue;
-            }
-            let inc = self.incident_sharpness(v);
-            let p_vs = self.vert_sharp(v);
-            let p_sharp: Vec<usize> = (0..inc.len()).filter(|&i| is_sharp(inc[i])).collect();
-            let p_rule = rule_of(p_vs, p_sharp.len());
-            let c_inc: Vec<f32> = inc
-                .iter()
-                .map(|&s| self.child_edge_sharpness(s, v))
-                .collect();
-            let c_vs = decrement(p_vs);
-            let c_sharp: Vec<usize> = (0..c_inc.len()).filter(|&i| is_sharp(c_inc[i])).collect();
-            let c_rule = rule_of(c_vs, c_sharp.len());
-            let p_mask = self.vertex_rule_point(v, p_rule, &p_sharp, f_base, &pts);
-            let out = if p_rule == 0 || p_rule == c_rule {
-                p_mask
-            } else {
-                // OpenSubdiv's fractional weight: mean sharpness of what decayed this level.
-                let (mut cnt, mut sum) = (0usize, 0.0f32);
-                if is_sharp(p_vs) && !is_sharp(c_vs) {
-                    cnt = 1;
-                    sum = p_vs;
-                }
-                for i in 0..inc.len() {
-                    let decayed = match self.crease_method {
-                        CreaseMethod::Uniform => is_sharp(inc[i]) && inc[i] <= 1.0,
-                        CreaseMethod::Chaikin => is_sharp(inc[i]) && !is_sharp(c_inc[i]),
-                    };
-                    if decayed {
-                        sum += inc[i];
-                        cnt += 1;
-                    }
-                }
-                let pw = if cnt == 0 {
-                    0.0
-                } else {
-                    (sum / cnt as f32).min(1.0) as f64
-                };
-                let c_mask = self.vertex_rule_point(v, c_rule, &c_sharp, f_base, &pts);
-                p_mask
-                    .iter()
-                    .zip(&c_mask)
-                    .map(|(p, c)| pw * p + (1.0 - pw) * c)
-                    .collect()
-            };
-            pts[o..o + d].copy_from_slice(&out);
-        }
-        // Child topology and sharpness.
-        let mut fo = vec![0u32];
-        let mut fvs = Vec::new();
-        let ev = |a: u32, b: u32| e_base + edge_id[&key(a, b)];
-        for f in 0..nf {
-            let fv = self.face(f);
-            let n = fv.len();
-            if quad {
-                for i in 0..n {
-                    let v = fv[i];
-                    let nx = fv[(i + 1) % n];
-                    let pv = fv[(i + n - 1) % n];
-                    fvs.extend_from_slice(&[v, ev(v, nx), f_base + f as u32, ev(pv, v)]);
-                    fo.push(fvs.len() as u32);
-                }
-            } else {
-                let (a, b, c) = (fv[0], fv[1], fv[2]);
-                let (ab, bc, ca) = (ev(a, b), ev(b, c), ev(c, a));
-                for t in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]] {
-                    fvs.extend_from_slice(&t);
-                    fo.push(fvs.len() as u32);
-                }
-            }
-        }
-        let mut es = HashMap::new();
-        for (&(a, b), &s) in &self.edge_sharpness {
-            if !is_sharp(s) {
-                continue;
-            }
-            if let Some(&id) = edge_id.get(&(a, b)) {
-                let e = e_base + id;
-                let sa = self.child_edge_sharpness(s, a);
-                let sb = self.child_edge_sharpness(s, b);
-                if is_sharp(sa) {
-                    es.insert(key(a, e), sa);
-                }
-                if is_sharp(sb) {
-                    es.insert(key(b, e), sb);
-                }
-            }
-        }
-        let mut vs = vec![0.0f32; n_child];
-        for (c, &p) in vs.iter_mut().zip(&self.vertex_sharpness) {
-            *c = decrement(p);
-        }
-        LocalMesh::new(
-            self.scheme,
-            d,
-            pts,
-            fo,
-            fvs,
-            es,
-            vs,
-            self.boundary,
-            self.crease_method,
-        )
-    }
-
-    /// The new position of vertex `v` under one rule (0 smooth, 2 crease, 3 corner).
-    fn vertex_rule_point(
-        &self,
-        v: u32,
-        rule: u8,
-        sharp: &[usize],
-        f_base: u32,
-        child_pts: &[f64],
-    ) -> Vec<f64> {
-        let d = self.dim;
-        let fan = &self.fans[v as usize];
-        let mut out = vec![0.0; d];
-        match rule {
-            2 => {
-                axpy(&mut out, 0.75, self.point(v));
-                for &i in sharp {
-                    axpy(&mut out, 0.125, self.point(fan.ring[i]));
-                }
-            }
-            3 => axpy(&mut out, 1.0, self.point(v)),
-            _ => {
-                let n = fan.ring.len();
-                let nf = n as f64;
-                if self.scheme == LimitScheme::Loop {
-                    let beta = 0.25 * (2.0 * std::f64::consts::PI / nf).cos() + 0.375;
-                    let e = (0.625 - beta * beta) / nf;
-                    axpy(&mut out, 1.0 - e * nf, self.point(v));
-                    for &w in &fan.ring {
-                        axpy(&mut out, e, self.point(w));
-                    }
-                } else {
-                    axpy(&mut out, (nf - 2.0) / nf, self.point(v));
-                    let w = 1.0 / (nf * nf);
-                    for &x in &fan.ring {
-                        axpy(&mut out, w, self.point(x));
-                    }
-                    for &(f, _) in &fan.faces {
-                        let o = (f_base + f) as usize * d;
-                        axpy(&mut out, w, &child_pts[o..o + d]);
-                    }
-                }
-            }
-        }
-        out
-    }
-
-    /// The face plus every face touching one of its vertices, as a new mesh; returns it and the
-    /// face's index there (always 0).
-    pub fn face_neighbourhood(&self, face: usize) -> Result<LocalMesh, EvalError> {
+    /// The face and every face touching one of its corners: the face first, then each corner's
+    /// fan in CCW order, each face once.
+    pub fn neighbourhood_faces(&self, face: usize) -> Vec<u32> {
         let mut faces = vec![face as u32];
         for &v in self.face(face) {
-            for (f, _) in &self.fans[v as usize].faces {
-                if !faces.contains(f) {
-                    faces.push(*f);
+            for f in self.vertex_faces(v) {
+                if !faces.contains(&f) {
+                    faces.push(f);
                 }
             }
         }
-        let mut remap: HashMap<u32, u32> = HashMap::new();
-        let mut pts = Vec::new();
-        let mut vs = Vec::new();
-        let mut fo = vec![0u32];
-        let mut fvs = Vec::new();
-        for &f in &faces {
-            for &v in self.face(f as usize) {
-                let id = *remap.entry(v).or_insert_with(|| {
-                    pts.extend_from_slice(self.point(v));
-                    vs.push(self.vertex_sharpness[v as usize]);
-                    (vs.len() - 1) as u32
-                });
-                fvs.push(id);
-            }
-            fo.push(fvs.len() as u32);
+        faces
+    }
+
+    /// The neighbourhood of [`Self::neighbourhood_faces`] as a mesh of its own (vertices
+    /// numbered by first occurrence, so the face's corners come first; sharpness carried
+    /// over); the face is face 0 there.
+    pub fn face_neighbourhood(&self, face: usize) -> Result<LocalMesh, EvalError> {
+        let faces = self.neighbourhood_faces(face);
+        let sub = self.level.topology.sub_topology(&faces);
+        let level = LevelTopology {
+            edge_sharpness: sub
+                .edges
+                .iter()
+                .map(|&e| self.view().edge_sharp(e))
+                .collect(),
+            vertex_sharpness: sub
+                .vertices
+                .iter()
+                .map(|&v| self.level.vertex_sharpness[v as usize])
+                .collect(),
+            topology: sub.topology,
+        };
+        let mut points = Vec::with_capacity(sub.vertices.len() * self.dim);
+        for &v in &sub.vertices {
+            points.extend_from_slice(self.point(v));
         }
-        let mut es = HashMap::new();
-        for &f in &faces {
-            let fv = self.face(f as usize);
-            for c in 0..fv.len() {
-                let (a, b) = (fv[c], fv[(c + 1) % fv.len()]);
-                let s = self.edge_sharp(a, b);
-                if is_sharp(s) {
-                    es.insert(key(remap[&a], remap[&b]), s);
-                }
-            }
+        LocalMesh::from_level(level, self.scheme, self.options, self.dim, points)
+    }
+
+    /// Limit position of vertex `v` by its limit mask, if no semi-sharp feature remains and (for
+    /// Catmull-Clark smooth vertices) all incident faces are quads.
+    pub fn vertex_limit_position(&self, v: u32) -> Option<Vec<f64>> {
+        let view = self.view();
+        view.vertex_limit(v, &view.fan(v), None).map(|(p, _, _)| p)
+    }
+
+    /// Loop limit tangent masks of vertex `v` as stencils: control indices `[v, ring…]` and the
+    /// weights of `tangent1` and `tangent2` over them (`tangent1 × tangent2` points outward).
+    /// For the GPU's limit normals of the once-refined mesh. `None` for Catmull-Clark meshes
+    /// and where [`Self::vertex_limit_position`] has no mask.
+    pub fn loop_tangent_stencils(&self, v: u32) -> Option<(Vec<u32>, Vec<f64>, Vec<f64>)> {
+        if self.scheme != LimitScheme::Loop {
+            return None;
         }
-        // Boundary corners of the original mesh stay corners: carry their sharpness.
-        for (&v, &id) in &remap {
-            let s = self.vert_sharp(v);
-            vs[id as usize] = s;
+        let fan = &self.fans[v as usize];
+        let lv = self.view().limit_vertex(v, fan, None)?;
+        let masks = loop_limit_masks(&lv);
+        let mut idx = vec![v];
+        idx.extend_from_slice(&fan.ring);
+        let flat = |m: &crate::limit::Mask| {
+            let mut w = vec![m.vertex];
+            w.extend_from_slice(&m.edges);
+            w
+        };
+        Some((idx, flat(&masks.tangent1), flat(&masks.tangent2)))
+    }
+
+    /// Control points of face `f` as a regular patch (ordering of [`crate::patch`]), or `None`.
+    pub fn regular_patch(&self, f: usize) -> Option<Vec<Vec<f64>>> {
+        self.view().regular_patch(f)
+    }
+
+    /// Exact limit position and parametric derivatives at `(face, u, v)`.
+    pub fn evaluate(&self, face: usize, u: f64, v: f64) -> Result<LimitSample, EvalError> {
+        if face >= self.num_faces() {
+            return Err(EvalError::FaceOutOfRange {
+                face,
+                count: self.num_faces(),
+            });
         }
-        LocalMesh::new(
-            self.scheme,
-            self.dim,
-            pts,
-            fo,
-            fvs,
-            es,
-            vs,
-            self.boundary,
-            self.crease_method,
-        )
+        let quad = self.scheme == LimitScheme::CatmullClark;
+        let size = self.face(face).len();
+        let need = self.scheme.face_size();
+        if size != need {
+            return Err(EvalError::FaceSize {
+                face,
+                size,
+                scheme: self.scheme,
+                need,
+            });
+        }
+        let bad = !(u.is_finite() && v.is_finite())
+            || u < 0.0
+            || v < 0.0
+            || if quad {
+                u > 1.0 || v > 1.0
+            } else {
+                u + v > 1.0
+            };
+        if bad {
+            return Err(EvalError::ParamOutOfRange { u, v });
+        }
+        let mesh = self.face_neighbourhood(face)?;
+        evaluate_local(&mesh, mesh.level.clone(), mesh.points.clone(), 0, u, v)
+    }
+
+    /// Catmull-Clark faces of any size: `(u, v) ∈ [0,1]²` on sub-quad `sub` of `face` after one
+    /// refinement (`[v_sub', e_{sub,sub+1}, face point, e_{sub−1,sub}]`, `v_sub'` at `(0,0)`, the
+    /// face point at `(1,1)`), as OpenSubdiv parameterises non-quads. Derivatives are with
+    /// respect to the sub-quad's parameters.
+    pub fn evaluate_subface(
+        &self,
+        face: usize,
+        sub: usize,
+        u: f64,
+        v: f64,
+    ) -> Result<LimitSample, EvalError> {
+        if face >= self.num_faces() {
+            return Err(EvalError::FaceOutOfRange {
+                face,
+                count: self.num_faces(),
+            });
+        }
+        let size = self.face(face).len();
+        if self.scheme != LimitScheme::CatmullClark {
+            return Err(EvalError::SubfaceNeedsCatmullClark {
+                scheme: self.scheme,
+            });
+        }
+        if sub >= size {
+            return Err(EvalError::SubfaceOutOfRange { face, sub, size });
+        }
+        if !(u.is_finite() && v.is_finite() && (0.0..=1.0).contains(&u) && (0.0..=1.0).contains(&v))
+        {
+            return Err(EvalError::ParamOutOfRange { u, v });
+        }
+        let nb = self.face_neighbourhood(face)?;
+        let r = refine_sparse(nb.level.view(), nb.scheme.scheme(), &nb.options, &[0])?;
+        let points = r.stencils.apply_flat(&nb.points, nb.dim);
+        let child = r.maps.child_faces(0).start + sub;
+        evaluate_local(&nb, r.child, points, child, u, v)
+    }
+}
+
+/// What the limit masks and regular patches read at one level: topology, sharpness, points and
+/// (when the whole level is a [`LocalMesh`]) its cached fans.
+struct View<'a> {
+    scheme: LimitScheme,
+    level: &'a LevelTopology,
+    dim: usize,
+    points: &'a [f64],
+    fans: Option<&'a [Fan]>,
+}
+
+impl View<'_> {
+    fn face(&self, f: usize) -> &[u32] {
+        self.level.topology.face_vertices(f)
+    }
+
+    fn point(&self, v: u32) -> &[f64] {
+        &self.points[v as usize * self.dim..(v as usize + 1) * self.dim]
+    }
+
+    fn fan(&self, v: u32) -> Cow<'_, Fan> {
+        match self.fans {
+            Some(f) => Cow::Borrowed(&f[v as usize]),
+            None => Cow::Owned(build_fan(&self.level.topology, v)),
+        }
+    }
+
+    /// Sharpness of edge `e`; an edge with one face is infinitely sharp.
+    fn edge_sharp(&self, e: u32) -> f32 {
+        if self.level.topology.is_boundary_edge(e as usize) {
+            crate::sdc::boundary_edge_sharpness()
+        } else {
+            self.level.edge_sharpness[e as usize]
+        }
+    }
+
+    fn incident_sharpness(&self, fan: &Fan) -> Vec<f32> {
+        fan.edges.iter().map(|&e| self.edge_sharp(e)).collect()
     }
 
     /// Limit rule of `v` if no semi-sharp feature is left there (else `None`: refine first).
     /// Crease ends are oriented so the CCW span `ends[0] → ends[1]` contains face `face`.
-    fn limit_vertex(&self, v: u32, face: Option<u32>) -> Option<LimitVertex> {
-        let fan = &self.fans[v as usize];
-        let vs = self.vert_sharp(v);
-        if is_sharp(vs) && vs < INF {
+    fn limit_vertex(&self, v: u32, fan: &Fan, face: Option<u32>) -> Option<LimitVertex> {
+        if !fan.complete {
             return None;
         }
-        let inc = self.incident_sharpness(v);
-        if inc.iter().any(|&s| is_sharp(s) && s < INF) {
+        let vs = self.level.vertex_sharpness[v as usize];
+        if is_semi_sharp(vs) {
             return None;
         }
-        let sharp: Vec<usize> = (0..inc.len()).filter(|&i| inc[i] >= INF).collect();
+        let inc = self.incident_sharpness(fan);
+        if inc.iter().any(|&s| is_semi_sharp(s)) {
+            return None;
+        }
+        let sharp: Vec<usize> = (0..inc.len()).filter(|&i| is_infinite(inc[i])).collect();
         let n = fan.ring.len();
-        let rule = match rule_of(vs, sharp.len()) {
-            0 => LimitRule::Smooth,
-            2 => {
+        let rule = match vertex_rule(vs, sharp.len()) {
+            Rule::Smooth | Rule::Dart => LimitRule::Smooth,
+            Rule::Crease => {
                 let (a, b) = (sharp[0], sharp[1]);
                 let ends = if fan.boundary {
                     [0, n - 1]
@@ -757,7 +605,7 @@ impl LocalMesh {
                 };
                 LimitRule::Crease { ends }
             }
-            _ => LimitRule::Corner,
+            Rule::Corner => LimitRule::Corner,
         };
         Some(LimitVertex {
             valence: n,
@@ -766,16 +614,14 @@ impl LocalMesh {
         })
     }
 
-    /// Limit position of vertex `v` by its limit mask, if no semi-sharp feature remains and (for
-    /// Catmull-Clark smooth vertices) all incident faces are quads.
-    pub fn vertex_limit_position(&self, v: u32) -> Option<Vec<f64>> {
-        self.vertex_limit(v, None).map(|(p, _, _)| p)
-    }
-
     /// Limit position and the two mask tangents (see [`crate::limit`]) of vertex `v`.
-    fn vertex_limit(&self, v: u32, face: Option<u32>) -> Option<(Vec<f64>, Vec<f64>, Vec<f64>)> {
-        let lv = self.limit_vertex(v, face)?;
-        let fan = &self.fans[v as usize];
+    fn vertex_limit(
+        &self,
+        v: u32,
+        fan: &Fan,
+        face: Option<u32>,
+    ) -> Option<(Vec<f64>, Vec<f64>, Vec<f64>)> {
+        let lv = self.limit_vertex(v, fan, face)?;
         let quad = self.scheme == LimitScheme::CatmullClark;
         let masks = if quad {
             if lv.rule != LimitRule::Corner
@@ -815,30 +661,8 @@ impl LocalMesh {
         Some((p, t1, t2))
     }
 
-    /// Loop limit tangent masks of vertex `v` as stencils: control indices `[v, ring…]` and the
-    /// weights of `tangent1` and `tangent2` over them (`tangent1 × tangent2` points outward).
-    /// For the GPU's limit normals of the once-refined mesh. `None` for Catmull-Clark meshes
-    /// and where [`Self::vertex_limit_position`] has no mask.
-    pub fn loop_tangent_stencils(&self, v: u32) -> Option<(Vec<u32>, Vec<f64>, Vec<f64>)> {
-        if self.scheme != LimitScheme::Loop {
-            return None;
-        }
-        let lv = self.limit_vertex(v, None)?;
-        let masks = loop_limit_masks(&lv);
-        let fan = &self.fans[v as usize];
-        let mut idx = vec![v];
-        idx.extend_from_slice(&fan.ring);
-        let flat = |m: &crate::limit::Mask| {
-            let mut w = vec![m.vertex];
-            w.extend_from_slice(&m.edges);
-            w
-        };
-        Some((idx, flat(&masks.tangent1), flat(&masks.tangent2)))
-    }
-
     /// Smooth directional tangent of `v` along its ring neighbour index `k`.
-    fn directional(&self, v: u32, k: usize) -> Vec<f64> {
-        let fan = &self.fans[v as usize];
+    fn directional(&self, fan: &Fan, k: usize) -> Vec<f64> {
         let n = fan.ring.len();
         let quad = self.scheme == LimitScheme::CatmullClark;
         let (ew, fw) = smooth_directional_tangent(!quad, n, k);
@@ -861,14 +685,14 @@ impl LocalMesh {
     fn corner_limit(&self, f: usize, c: usize) -> Option<LimitSample> {
         let fv = self.face(f);
         let v = fv[c];
-        let (p, t1, t2) = self.vertex_limit(v, Some(f as u32))?;
-        let lv = self.limit_vertex(v, Some(f as u32))?;
-        let fan = &self.fans[v as usize];
+        let fan = self.fan(v);
+        let (p, t1, t2) = self.vertex_limit(v, &fan, Some(f as u32))?;
+        let lv = self.limit_vertex(v, &fan, Some(f as u32))?;
         let n = fan.ring.len();
         let j = fan.faces.iter().position(|&(g, _)| g == f as u32)?;
         let dir = |k: usize| -> Vec<f64> {
             match lv.rule {
-                LimitRule::Smooth => self.directional(v, k % n),
+                LimitRule::Smooth => self.directional(&fan, k % n),
                 LimitRule::Crease { ends } => {
                     let m = ((ends[1] + n - ends[0]) % n).max(1);
                     let th = std::f64::consts::PI * ((k + n - ends[0]) % n) as f64 / m as f64;
@@ -921,17 +745,20 @@ impl LocalMesh {
         let quad = self.scheme == LimitScheme::CatmullClark;
         let fv = self.face(f);
         let v = fv[c];
-        let fan = &self.fans[v as usize];
+        let fan = self.fan(v);
+        if !fan.complete {
+            return None;
+        }
         let n = fan.ring.len();
-        let vs = self.vert_sharp(v);
-        if is_sharp(vs) && vs < INF {
+        let vs = self.level.vertex_sharpness[v as usize];
+        if is_semi_sharp(vs) {
             return None;
         }
-        let inc = self.incident_sharpness(v);
-        if inc.iter().any(|&s| is_sharp(s) && s < INF) {
+        let inc = self.incident_sharpness(&fan);
+        if inc.iter().any(|&s| is_semi_sharp(s)) {
             return None;
         }
-        let need = if quad { 4 } else { 3 };
+        let need = self.scheme.face_size();
         if fan
             .faces
             .iter()
@@ -940,7 +767,7 @@ impl LocalMesh {
             return None;
         }
         let j = fan.faces.iter().position(|&(g, _)| g == f as u32)?;
-        let sharp: Vec<usize> = (0..n).filter(|&i| inc[i] >= INF).collect();
+        let sharp: Vec<usize> = (0..n).filter(|&i| is_infinite(inc[i])).collect();
         let opp = |i: usize| {
             let (g, cc) = fan.faces[i];
             let gv = self.face(g as usize);
@@ -1032,7 +859,7 @@ impl LocalMesh {
     }
 
     /// Control points of face `f` as a regular patch (ordering of [`crate::patch`]), or `None`.
-    pub fn regular_patch(&self, f: usize) -> Option<Vec<Vec<f64>>> {
+    fn regular_patch(&self, f: usize) -> Option<Vec<Vec<f64>>> {
         let quad = self.scheme == LimitScheme::CatmullClark;
         let fv = self.face(f);
         let (corner_slots, ring_slots): (&[usize], &[&[usize]]) = if quad {
@@ -1076,130 +903,91 @@ impl LocalMesh {
         }
         net.into_iter().collect()
     }
-
-    /// Exact limit position and parametric derivatives at `(face, u, v)`.
-    pub fn evaluate(&self, face: usize, u: f64, v: f64) -> Result<LimitSample, EvalError> {
-        if face >= self.num_faces() {
-            return Err(EvalError::FaceOutOfRange(face));
-        }
-        let quad = self.scheme == LimitScheme::CatmullClark;
-        let size = self.face(face).len();
-        let need = if quad { 4 } else { 3 };
-        if size != need {
-            return Err(EvalError::FaceSize {
-                face,
-                size,
-                scheme: self.scheme,
-                need,
-            });
-        }
-        let bad = !(u.is_finite() && v.is_finite())
-            || u < 0.0
-            || v < 0.0
-            || if quad {
-                u > 1.0 || v > 1.0
-            } else {
-                u + v > 1.0
-            };
-        if bad {
-            return Err(EvalError::ParamOutOfRange(u, v));
-        }
-        let mesh = self.face_neighbourhood(face)?;
-        evaluate_local(mesh, u, v)
-    }
-
-    /// Catmull-Clark faces of any size: `(u, v) ∈ [0,1]²` on sub-quad `sub` of `face` after one
-    /// refinement (`[v_sub', e_{sub,sub+1}, face point, e_{sub−1,sub}]`, `v_sub'` at `(0,0)`, the
-    /// face point at `(1,1)`), as OpenSubdiv parameterises non-quads. Derivatives are with
-    /// respect to the sub-quad's parameters.
-    pub fn evaluate_subface(
-        &self,
-        face: usize,
-        sub: usize,
-        u: f64,
-        v: f64,
-    ) -> Result<LimitSample, EvalError> {
-        if face >= self.num_faces() {
-            return Err(EvalError::FaceOutOfRange(face));
-        }
-        let size = self.face(face).len();
-        if self.scheme != LimitScheme::CatmullClark || sub >= size {
-            return Err(EvalError::Unsupported(format!(
-                "sub-face {sub} of a {size}-sided {:?} face",
-                self.scheme
-            )));
-        }
-        if !(u.is_finite() && v.is_finite() && (0.0..=1.0).contains(&u) && (0.0..=1.0).contains(&v))
-        {
-            return Err(EvalError::ParamOutOfRange(u, v));
-        }
-        let child = self.face_neighbourhood(face)?.refine()?;
-        evaluate_local(child.face_neighbourhood(sub)?, u, v)
-    }
 }
 
-/// The recursion of [`LocalMesh::evaluate`] on a neighbourhood whose face 0 holds the point.
-fn evaluate_local(mut mesh: LocalMesh, u: f64, v: f64) -> Result<LimitSample, EvalError> {
-    let quad = mesh.scheme == LimitScheme::CatmullClark;
+/// The recursion of [`LocalMesh::evaluate`]: `face` of `level` (whose one-ring is complete,
+/// with `points`) holds the point.
+fn evaluate_local(
+    mesh: &LocalMesh,
+    mut level: LevelTopology,
+    mut points: Vec<f64>,
+    mut face: usize,
+    u: f64,
+    v: f64,
+) -> Result<LimitSample, EvalError> {
+    let (scheme, dim) = (mesh.scheme, mesh.dim);
+    let quad = scheme == LimitScheme::CatmullClark;
+    let (start_face, u0, v0) = (face, u, v);
     let (mut u, mut v) = (u, v);
-    {
-        let mut jac = [[1.0, 0.0], [0.0, 1.0]];
-        const MAX_DEPTH: usize = 56;
-        for depth in 0..=MAX_DEPTH {
-            if depth == MAX_DEPTH {
-                // 2^-56 from a corner: snap (far below f64 resolution of the surface).
-                u = u.round();
-                v = v.round();
-                if !quad && u + v > 1.0 {
-                    v = 0.0;
-                }
+    let mut jac = [[1.0, 0.0], [0.0, 1.0]];
+    const MAX_DEPTH: usize = 56;
+    for depth in 0..=MAX_DEPTH {
+        if depth == MAX_DEPTH {
+            // 2^-56 from a corner: snap (far below f64 resolution of the surface).
+            u = u.round();
+            v = v.round();
+            if !quad && u + v > 1.0 {
+                v = 0.0;
             }
-            if let Some(net) = mesh.regular_patch(0) {
-                let (w, wu, wv) = if quad {
-                    let w = catmark_regular_weights(u, v);
-                    (w.point.to_vec(), w.du.to_vec(), w.dv.to_vec())
-                } else {
-                    let w = loop_regular_weights(u, v);
-                    (w.point.to_vec(), w.du.to_vec(), w.dv.to_vec())
-                };
-                let mut p = vec![0.0; mesh.dim];
-                let mut du = vec![0.0; mesh.dim];
-                let mut dv = vec![0.0; mesh.dim];
-                for (i, x) in net.iter().enumerate() {
-                    axpy(&mut p, w[i], x);
-                    axpy(&mut du, wu[i], x);
-                    axpy(&mut dv, wv[i], x);
-                }
-                return Ok(chain(p, du, dv, &jac));
-            }
-            let corners: &[(f64, f64)] = if quad {
-                &[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
-            } else {
-                &[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]
-            };
-            if let Some(c) = corners.iter().position(|&(a, b)| a == u && b == v) {
-                if let Some(s) = mesh.corner_limit(0, c) {
-                    return Ok(chain(s.position, s.du, s.dv, &jac));
-                }
-            }
-            let child = mesh.refine()?;
-            let (k, nu, nv, l) = child_of(quad, u, v);
-            u = nu;
-            v = nv;
-            jac = [
-                [
-                    l[0][0] * jac[0][0] + l[0][1] * jac[1][0],
-                    l[0][0] * jac[0][1] + l[0][1] * jac[1][1],
-                ],
-                [
-                    l[1][0] * jac[0][0] + l[1][1] * jac[1][0],
-                    l[1][0] * jac[0][1] + l[1][1] * jac[1][1],
-                ],
-            ];
-            mesh = child.face_neighbourhood(k)?;
         }
-        Err(EvalError::Unsupported("evaluation did not converge".into()))
+        let view = View {
+            scheme,
+            level: &level,
+            dim,
+            points: &points,
+            fans: None,
+        };
+        if let Some(net) = view.regular_patch(face) {
+            let (w, wu, wv) = if quad {
+                let w = catmark_regular_weights(u, v);
+                (w.point.to_vec(), w.du.to_vec(), w.dv.to_vec())
+            } else {
+                let w = loop_regular_weights(u, v);
+                (w.point.to_vec(), w.du.to_vec(), w.dv.to_vec())
+            };
+            let mut p = vec![0.0; dim];
+            let mut du = vec![0.0; dim];
+            let mut dv = vec![0.0; dim];
+            for (i, x) in net.iter().enumerate() {
+                axpy(&mut p, w[i], x);
+                axpy(&mut du, wu[i], x);
+                axpy(&mut dv, wv[i], x);
+            }
+            return Ok(chain(p, du, dv, &jac));
+        }
+        let corners: &[(f64, f64)] = if quad {
+            &[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+        } else {
+            &[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]
+        };
+        if let Some(c) = corners.iter().position(|&(a, b)| a == u && b == v) {
+            if let Some(s) = view.corner_limit(face, c) {
+                return Ok(chain(s.position, s.du, s.dv, &jac));
+            }
+        }
+        let step = refine_sparse(level.view(), scheme.scheme(), &mesh.options, &[face as u32])?;
+        let (k, nu, nv, l) = child_of(quad, u, v);
+        u = nu;
+        v = nv;
+        jac = [
+            [
+                l[0][0] * jac[0][0] + l[0][1] * jac[1][0],
+                l[0][0] * jac[0][1] + l[0][1] * jac[1][1],
+            ],
+            [
+                l[1][0] * jac[0][0] + l[1][1] * jac[1][0],
+                l[1][0] * jac[0][1] + l[1][1] * jac[1][1],
+            ],
+        ];
+        points = step.stencils.apply_flat(&points, dim);
+        face = step.maps.child_faces(face).start + k;
+        level = step.child;
     }
+    Err(EvalError::NotConverged {
+        face: start_face,
+        u: u0,
+        v: v0,
+    })
 }
 
 /// Derivatives with respect to the original parameters.
@@ -1221,8 +1009,10 @@ fn chain(p: Vec<f64>, du: Vec<f64>, dv: Vec<f64>, jac: &[[f64; 2]; 2]) -> LimitS
     }
 }
 
-/// Child face (index among the face's children, which are the first children of face 0),
-/// child parameters and the Jacobian d(u',v')/d(u,v).
+/// Child face (index among the face's children in the refiner's order, see
+/// [`crate::refine`]), child parameters and the Jacobian d(u',v')/d(u,v). Catmull-Clark child
+/// `i` has its corner 0 at parent corner `i`; Loop child `j < 3` is `[v_j, e_{j,j+1}, e_{j−1,j}]`
+/// and child 3 is `[e_01, e_12, e_20]`.
 fn child_of(quad: bool, u: f64, v: f64) -> (usize, f64, f64, [[f64; 2]; 2]) {
     if quad {
         if u <= 0.5 && v <= 0.5 {
@@ -1242,11 +1032,19 @@ fn child_of(quad: bool, u: f64, v: f64) -> (usize, f64, f64, [[f64; 2]; 2]) {
     } else if u + v <= 0.5 {
         (0, 2.0 * u, 2.0 * v, [[2.0, 0.0], [0.0, 2.0]])
     } else if u >= 0.5 {
-        (1, 2.0 * u - 1.0, 2.0 * v, [[2.0, 0.0], [0.0, 2.0]])
+        // [v1, e12, e01]: P = v1 + u'·(e12 − v1) + v'·(e01 − v1).
+        (1, 2.0 * v, 2.0 * (1.0 - u - v), [[0.0, 2.0], [-2.0, -2.0]])
     } else if v >= 0.5 {
-        (2, 2.0 * u, 2.0 * v - 1.0, [[2.0, 0.0], [0.0, 2.0]])
+        // [v2, e20, e12].
+        (2, 2.0 * (1.0 - u - v), 2.0 * u, [[-2.0, -2.0], [2.0, 0.0]])
     } else {
-        (3, 1.0 - 2.0 * u, 1.0 - 2.0 * v, [[-2.0, 0.0], [0.0, -2.0]])
+        // [e01, e12, e20].
+        (
+            3,
+            2.0 * (u + v) - 1.0,
+            1.0 - 2.0 * u,
+            [[2.0, 2.0], [-2.0, 0.0]],
+        )
     }
 }
 

@@ -12,12 +12,15 @@ pub mod refine;
 pub mod sdc;
 pub mod stencil;
 
-pub use error::TopologyError;
+pub use error::{TagKind, TopologyError};
 pub use mesh::{
     BoundaryInterpolation, ControlMesh, CreaseMethod, EdgeCrease, SubdivOptions, Topology,
     TriangleSubdivision, VertexCorner,
 };
 pub use obj::{load_obj, parse_obj, write_control_mesh, write_obj};
-pub use refine::{refine_level, refine_uniform, uniform_stencils, Level, UniformRefinement};
+pub use refine::{
+    refine_level, refine_sparse, refine_uniform, uniform_stencils, ChildMaps, ChildOrigin, Level,
+    LevelRef, LevelTopology, SparseRefinement, UniformRefinement,
+};
 pub use sdc::{Rule, Scheme};
 pub use stencil::{StencilTable, StencilTableF32};

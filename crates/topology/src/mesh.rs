@@ -114,9 +114,12 @@ impl ControlMesh {
     }
 
     /// The mesh with every polygon of more than three sides fan-triangulated from its first
-    /// corner (Loop needs triangles). Vertex indices, creases, corners and options are kept;
-    /// per-corner uvs and normals follow their corners; hole tags are dropped. Also returns,
-    /// per new face, the face it came from.
+    /// corner (Loop needs triangles; the techniques draw triangles). Vertex indices, creases,
+    /// corners and options are kept (fans only add diagonals, so crease tags keep naming the
+    /// same edges); per-corner uvs and normals follow their corners (and are dropped if they do
+    /// not have one value per corner); a hole tag becomes all triangles of the holed face;
+    /// faces of fewer than three corners make no triangle. Also returns, per new face, the
+    /// face it came from.
     pub fn triangulated(&self) -> (ControlMesh, Vec<u32>) {
         let mut out = ControlMesh {
             positions: self.positions.clone(),
@@ -126,24 +129,40 @@ impl ControlMesh {
             options: self.options,
             ..ControlMesh::default()
         };
-        let mut uvs = self.uvs.as_ref().map(|_| Vec::new());
-        let mut normals = self.normals.as_ref().map(|_| Vec::new());
+        let corners = self.face_vertices.len();
+        let (src_uvs, src_normals) = (
+            self.uvs.as_ref().filter(|a| a.len() == corners),
+            self.normals.as_ref().filter(|a| a.len() == corners),
+        );
+        let mut uvs = src_uvs.map(|_| Vec::new());
+        let mut normals = src_normals.map(|_| Vec::new());
         let mut origin = Vec::new();
+        let mut first_triangle = Vec::with_capacity(self.num_faces() + 1);
         for f in 0..self.num_faces() {
             let start = self.face_offsets[f] as usize;
             let n = self.face(f).len();
+            first_triangle.push(origin.len() as u32);
             for k in 1..n.saturating_sub(1) {
                 for c in [start, start + k, start + k + 1] {
                     out.face_vertices.push(self.face_vertices[c]);
-                    if let (Some(o), Some(src)) = (uvs.as_mut(), self.uvs.as_ref()) {
+                    if let (Some(o), Some(src)) = (uvs.as_mut(), src_uvs) {
                         o.push(src[c]);
                     }
-                    if let (Some(o), Some(src)) = (normals.as_mut(), self.normals.as_ref()) {
+                    if let (Some(o), Some(src)) = (normals.as_mut(), src_normals) {
                         o.push(src[c]);
                     }
                 }
                 out.face_offsets.push(out.face_vertices.len() as u32);
                 origin.push(f as u32);
+            }
+        }
+        first_triangle.push(origin.len() as u32);
+        for &h in &self.holes {
+            if let (Some(&a), Some(&b)) = (
+                first_triangle.get(h as usize),
+                first_triangle.get(h as usize + 1),
+            ) {
+                out.holes.extend(a..b);
             }
         }
         out.uvs = uvs;
@@ -190,8 +209,9 @@ impl Topology {
             || mesh.face_offsets.windows(2).any(|w| w[0] > w[1])
             || *mesh.face_offsets.last().unwrap_or(&0) as usize != mesh.face_vertices.len()
         {
-            return Err(TopologyError::InvalidTag {
-                message: "face_offsets is not a valid prefix table over face_vertices".into(),
+            return Err(TopologyError::MalformedFaceTable {
+                faces: mesh.num_faces(),
+                corners: mesh.face_vertices.len(),
             });
         }
         if let Some((vertex, p)) = mesh
@@ -255,9 +275,7 @@ impl Topology {
             return Err(e);
         }
         if corners >= INVALID as usize / 4 {
-            return Err(TopologyError::TooLarge {
-                what: format!("{corners} face corners"),
-            });
+            return Err(TopologyError::TooManyCorners { corners });
         }
         let topo = Topology::build(nv, mesh.face_offsets.clone(), mesh.face_vertices.clone())?;
         topo.check_manifold_vertices()?;
@@ -401,6 +419,52 @@ impl Topology {
         };
         topo.build_vertex_incidence();
         topo
+    }
+
+    /// The sub-mesh made of `faces` (in that order): vertices and edges numbered by first
+    /// occurrence, so the first face's corners come first. Vertices on the border of the
+    /// selection may have several unconnected fans there; that is a property of the selection,
+    /// not an error.
+    pub fn sub_topology(&self, faces: &[u32]) -> SubTopology {
+        let mut vertex_map: std::collections::HashMap<u32, u32> = Default::default();
+        let mut edge_map: std::collections::HashMap<u32, u32> = Default::default();
+        let mut vertices = Vec::new();
+        let mut edges = Vec::new();
+        let mut face_offsets = Vec::with_capacity(faces.len() + 1);
+        let mut face_verts = Vec::new();
+        let mut face_edges = Vec::new();
+        face_offsets.push(0);
+        for &f in faces {
+            let f = f as usize;
+            for (&v, &e) in self.face_vertices(f).iter().zip(self.face_edge_list(f)) {
+                let lv = *vertex_map.entry(v).or_insert_with(|| {
+                    vertices.push(v);
+                    (vertices.len() - 1) as u32
+                });
+                let le = *edge_map.entry(e).or_insert_with(|| {
+                    edges.push(e);
+                    (edges.len() - 1) as u32
+                });
+                face_verts.push(lv);
+                face_edges.push(le);
+            }
+            face_offsets.push(face_verts.len() as u32);
+        }
+        let edge_verts = edges
+            .iter()
+            .map(|&e| self.edge_verts[e as usize].map(|v| vertex_map[&v]))
+            .collect();
+        SubTopology {
+            topology: Topology::from_parts(
+                vertices.len(),
+                face_offsets,
+                face_verts,
+                face_edges,
+                edge_verts,
+            ),
+            vertices,
+            edges,
+        }
     }
 
     /// Counting-sort the vertex→edge and vertex→face incidence lists.
@@ -580,6 +644,17 @@ impl Topology {
             (x == a && y == b) || (x == b && y == a)
         })
     }
+}
+
+/// A sub-mesh cut out of a [`Topology`] ([`Topology::sub_topology`]) and where its parts come
+/// from.
+#[derive(Clone, Debug)]
+pub struct SubTopology {
+    pub topology: Topology,
+    /// Per sub-mesh vertex: its vertex in the source.
+    pub vertices: Vec<u32>,
+    /// Per sub-mesh edge: its edge in the source.
+    pub edges: Vec<u32>,
 }
 
 fn prefix_sum(v: &mut [u32]) {

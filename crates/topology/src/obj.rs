@@ -5,7 +5,7 @@
 //! vertices by their index in the file, and refinement works in f64. Faces keep their size
 //! (nothing is triangulated).
 
-use crate::error::TopologyError;
+use crate::error::{TagKind, TopologyError};
 use crate::mesh::{
     BoundaryInterpolation, ControlMesh, CreaseMethod, EdgeCrease, TriangleSubdivision, VertexCorner,
 };
@@ -325,22 +325,28 @@ fn check_tags(mesh: &ControlMesh) -> Result<(), TopologyError> {
     let nv = mesh.positions.len() as u32;
     for c in &mesh.creases {
         if let Some(&v) = c.vertices.iter().find(|&&v| v >= nv) {
-            return Err(TopologyError::InvalidTag {
-                message: format!("crease names vertex {v}, mesh has {nv} vertices"),
+            return Err(TopologyError::TagOutOfRange {
+                tag: TagKind::Crease,
+                index: v,
+                count: nv as usize,
             });
         }
     }
     for c in &mesh.corners {
         if c.vertex >= nv {
-            return Err(TopologyError::InvalidTag {
-                message: format!("corner names vertex {}, mesh has {nv} vertices", c.vertex),
+            return Err(TopologyError::TagOutOfRange {
+                tag: TagKind::Corner,
+                index: c.vertex,
+                count: nv as usize,
             });
         }
     }
     let nf = mesh.num_faces() as u32;
     if let Some(&f) = mesh.holes.iter().find(|&&f| f >= nf) {
-        return Err(TopologyError::InvalidTag {
-            message: format!("hole names face {f}, mesh has {nf} faces"),
+        return Err(TopologyError::TagOutOfRange {
+            tag: TagKind::Hole,
+            index: f,
+            count: nf as usize,
         });
     }
     Ok(())

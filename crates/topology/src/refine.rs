@@ -1,22 +1,61 @@
-//! Uniform refinement for Catmull-Clark, Loop, bilinear and Doo-Sabin with OpenSubdiv's
-//! semi-sharp crease, corner and boundary rules.
+//! The crate's one refiner: Catmull-Clark, Loop, bilinear and Doo-Sabin with OpenSubdiv's
+//! semi-sharp crease, corner and boundary rules (all taken from [`crate::sdc`]), in the spirit of
+//! OpenSubdiv's `Vtr::Refinement` (sdc rules → one topology representation → stencil tables).
 //!
-//! Each step produces the child topology, the child sharpness values and one stencil per child
-//! vertex over the parent vertices. Composing the steps gives stencils over the base vertices.
+//! # Levels and steps
+//! A level is a [`Topology`] plus per-edge and per-vertex sharpness ([`LevelTopology`], borrowed
+//! as [`LevelRef`]); [`Level`] adds 3D positions for the uniform API. A step reads a parent level
+//! and produces the child topology, the child sharpness (uniform or Chaikin decay) and one
+//! stencil per child vertex over the parent vertices; vertex data of any dimension is refined by
+//! applying the stencils, and composing steps gives stencils over the base vertices. The masks
+//! (`MaskContext`) are written once and serve both kinds of step.
 //!
-//! Child vertex numbering (all schemes but Doo-Sabin): first one vertex-vertex per parent vertex
-//! (same index as its parent, so base indices persist), then one edge-vertex per parent edge,
-//! then (Catmull-Clark, bilinear) one face-vertex per parent face. Doo-Sabin makes one child
-//! vertex per parent face corner.
+//! # Uniform and sparse steps
+//! * [`refine_level`] / [`refine_uniform`] / [`uniform_stencils`] refine every face. Their child
+//!   topology is written directly from the parent's adjacency, in parallel, for speed on large
+//!   meshes.
+//! * [`refine_sparse`] refines a selection of faces plus the one-ring of the selection (every
+//!   face sharing a vertex with a selected face), as OpenSubdiv's `Vtr::SparseSelector` and
+//!   `Far::TopologyRefiner::RefineAdaptive` do for feature-adaptive refinement. The one-ring is
+//!   what the children need: the limit surface over a face depends on the faces around its
+//!   corners, and the children of a face's one-ring contain the one-ring of each of its
+//!   children. So if the parent holds the complete one-ring of each selected face, every child
+//!   of a selected face has its complete one-ring in the child level, with exactly the uniform
+//!   refiner's stencils, and the next step can select those children again (isolating a
+//!   feature level by level, or following a point as [`crate::eval`] does). Child vertices on
+//!   the border of the refined region are still computed (from what the parent has), but their
+//!   masks see only part of their neighbourhood and are not those of a uniform refinement.
+//!   The step returns [`ChildMaps`]: parent → child (vertex-, edge-, face-vertex and first child
+//!   face per parent component) and child → parent ([`ChildOrigin`] per child vertex, parent
+//!   face per child face). Selecting every face reproduces [`refine_level`] exactly (same
+//!   numbering, same stencils).
+//!
+//! # Numbering of a child level (all schemes but Doo-Sabin)
+//! Vertices: first one vertex-vertex per refined parent vertex, then one edge-vertex per refined
+//! parent edge, then (Catmull-Clark, bilinear) one face-vertex per refined parent face, each
+//! group in ascending parent order. In a uniform step every component is refined, so a
+//! vertex-vertex keeps its parent's index (base indices persist), edge `e` gives vertex
+//! `nv + e` and face `f` vertex `nv + ne + f`.
+//! Faces: the children of each refined parent face, consecutively, parent faces ascending. A
+//! Catmull-Clark / bilinear face with `n` corners has `n` quad children, child `i` being
+//! `[v_i', e_{i,i+1}, f, e_{i−1,i}]`; a Loop triangle has four, child `j < 3` being
+//! `[v_j', e_{j,j+1}, e_{j−1,j}]` and child 3 `[e_01, e_12, e_20]`.
+//! Edges: the two halves of each refined parent edge (`2k` at the parent edge's first end,
+//! `2k + 1` at its second, `k` its rank among refined edges), then the interior edges of each
+//! refined face (one per corner for quads, joining the corner's edge-vertex to the
+//! face-vertex; three per triangle for Loop, inner edge `j` joining the edge-vertices at
+//! corner `j`).
+//!
+//! Doo-Sabin makes one child vertex per parent face corner and is uniform only.
 
-use crate::error::TopologyError;
+use crate::error::{TagKind, TopologyError};
 use crate::mesh::{
     corner_faces, par_fill_ragged, BoundaryInterpolation, ControlMesh, SubdivOptions, Topology,
     TriangleSubdivision, INVALID,
 };
 use crate::sdc::{
-    decrement_sharpness, fractional_weight, is_sharp, subdivide_edge_sharpness_at_vertex,
-    vertex_rule, Rule, Scheme, SHARPNESS_INFINITE,
+    boundary_edge_sharpness, boundary_vertex_sharpness, decrement_sharpness, fractional_weight,
+    is_sharp, subdivide_edge_sharpness_at_vertex, vertex_rule, Rule, Scheme,
 };
 use crate::stencil::{build_rows, compose_rows, RowKind, StencilTable};
 use rayon::prelude::*;
@@ -87,8 +126,10 @@ fn base_sharpness(
     for c in &mesh.creases {
         let [a, b] = c.vertices;
         if a as usize >= nv || b as usize >= nv {
-            return Err(TopologyError::InvalidTag {
-                message: format!("crease names vertex {}, mesh has {nv} vertices", a.max(b)),
+            return Err(TopologyError::TagOutOfRange {
+                tag: TagKind::Crease,
+                index: a.max(b),
+                count: nv,
             });
         }
         match topology.find_edge(a, b) {
@@ -99,26 +140,47 @@ fn base_sharpness(
     let mut vertex_sharpness = vec![0.0f32; nv];
     for c in &mesh.corners {
         if c.vertex as usize >= nv {
-            return Err(TopologyError::InvalidTag {
-                message: format!("corner names vertex {}, mesh has {nv} vertices", c.vertex),
+            return Err(TopologyError::TagOutOfRange {
+                tag: TagKind::Corner,
+                index: c.vertex,
+                count: nv,
             });
         }
         vertex_sharpness[c.vertex as usize] = c.sharpness.max(0.0);
     }
-    // Boundary edges are always infinitely sharp (OpenSubdiv does this for every rule).
+    apply_boundary_rules(
+        topology,
+        mesh.options.boundary,
+        &mut edge_sharpness,
+        &mut vertex_sharpness,
+    );
+    Ok((edge_sharpness, vertex_sharpness))
+}
+
+/// Boundary edges become infinitely sharp and, with "edges and corners", boundary corners too
+/// (the rules are [`crate::sdc::boundary_edge_sharpness`] and
+/// [`crate::sdc::boundary_vertex_sharpness`]). Applied to a base level only: refinement
+/// propagates infinite sharpness unchanged.
+pub(crate) fn apply_boundary_rules(
+    topology: &Topology,
+    boundary: BoundaryInterpolation,
+    edge_sharpness: &mut [f32],
+    vertex_sharpness: &mut [f32],
+) {
     for (e, s) in edge_sharpness.iter_mut().enumerate() {
         if topology.is_boundary_edge(e) {
-            *s = SHARPNESS_INFINITE;
+            *s = boundary_edge_sharpness();
         }
     }
-    if mesh.options.boundary == BoundaryInterpolation::EdgesAndCorners {
-        for (v, s) in vertex_sharpness.iter_mut().enumerate() {
-            if topology.vertex_faces(v).len() == 1 && topology.vertex_edges(v).len() == 2 {
-                *s = SHARPNESS_INFINITE;
-            }
+    for (v, s) in vertex_sharpness.iter_mut().enumerate() {
+        let (faces, edges) = (
+            topology.vertex_faces(v).len(),
+            topology.vertex_edges(v).len(),
+        );
+        if let Some(b) = boundary_vertex_sharpness(boundary, faces, edges) {
+            *s = b;
         }
     }
-    Ok((edge_sharpness, vertex_sharpness))
 }
 
 /// Result of [`refine_uniform`]: every level from the base (index 0) to the requested one,
@@ -254,11 +316,8 @@ fn check_size(p: &Topology, scheme: Scheme) -> Result<(), TopologyError> {
         _ => p.num_vertices() + p.num_edges() * 3 + corners * 4,
     };
     if max_children >= (INVALID / 2) as usize {
-        return Err(TopologyError::TooLarge {
-            what: format!(
-                "refining {} faces would overflow 32-bit indices",
-                p.num_faces()
-            ),
+        return Err(TopologyError::RefinementTooLarge {
+            faces: p.num_faces(),
         });
     }
     Ok(())
@@ -336,6 +395,352 @@ pub fn refine_level(
     ))
 }
 
+/// Borrowed view of one level: the topology and the sharpness the rules read. Vertex data
+/// (positions, or any per-vertex values) stays with the caller and goes through the stencils.
+#[derive(Clone, Copy, Debug)]
+pub struct LevelRef<'a> {
+    pub topology: &'a Topology,
+    /// Per edge; boundary edges of a base level are infinitely sharp.
+    pub edge_sharpness: &'a [f32],
+    /// Per vertex.
+    pub vertex_sharpness: &'a [f32],
+}
+
+/// Topology and sharpness of one level without vertex data: what [`refine_sparse`] consumes and
+/// produces, and the level type of [`crate::eval`] and [`crate::bft`].
+#[derive(Clone, Debug, Default)]
+pub struct LevelTopology {
+    pub topology: Topology,
+    pub edge_sharpness: Vec<f32>,
+    pub vertex_sharpness: Vec<f32>,
+}
+
+impl LevelTopology {
+    /// Base level of `mesh`: validated topology plus sharpness from tags and boundary rules
+    /// (Loop needs triangles).
+    pub fn from_mesh(mesh: &ControlMesh, scheme: Scheme) -> Result<LevelTopology, TopologyError> {
+        let topology = base_topology(mesh, scheme)?;
+        let (edge_sharpness, vertex_sharpness) = base_sharpness(mesh, &topology)?;
+        Ok(LevelTopology {
+            topology,
+            edge_sharpness,
+            vertex_sharpness,
+        })
+    }
+
+    /// A base level from a validated topology and tagged sharpness; the boundary rules are
+    /// applied here (boundary edges infinitely sharp, "edges and corners" corners too).
+    pub fn with_boundary_rules(
+        topology: Topology,
+        mut edge_sharpness: Vec<f32>,
+        mut vertex_sharpness: Vec<f32>,
+        boundary: BoundaryInterpolation,
+    ) -> LevelTopology {
+        edge_sharpness.resize(topology.num_edges(), 0.0);
+        vertex_sharpness.resize(topology.num_vertices(), 0.0);
+        apply_boundary_rules(
+            &topology,
+            boundary,
+            &mut edge_sharpness,
+            &mut vertex_sharpness,
+        );
+        LevelTopology {
+            topology,
+            edge_sharpness,
+            vertex_sharpness,
+        }
+    }
+
+    /// The borrowed view the refiner reads.
+    pub fn view(&self) -> LevelRef<'_> {
+        LevelRef {
+            topology: &self.topology,
+            edge_sharpness: &self.edge_sharpness,
+            vertex_sharpness: &self.vertex_sharpness,
+        }
+    }
+}
+
+impl Level {
+    /// The borrowed view the refiner reads (positions stay here).
+    pub fn view(&self) -> LevelRef<'_> {
+        LevelRef {
+            topology: &self.topology,
+            edge_sharpness: &self.edge_sharpness,
+            vertex_sharpness: &self.vertex_sharpness,
+        }
+    }
+}
+
+/// The parent component a child vertex comes from (OpenSubdiv: vertex-vertex, edge-vertex,
+/// face-vertex).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ChildOrigin {
+    Vertex(u32),
+    Edge(u32),
+    Face(u32),
+}
+
+/// Parent → child and child → parent maps of one [`refine_sparse`] step (`INVALID` where a
+/// parent component was not refined).
+#[derive(Clone, Debug, Default)]
+pub struct ChildMaps {
+    /// The refined parent faces, ascending: the selection and its one-ring.
+    pub refined_faces: Vec<u32>,
+    /// Per parent vertex: its vertex-vertex.
+    pub vertex_child_vertex: Vec<u32>,
+    /// Per parent edge: its edge-vertex.
+    pub edge_child_vertex: Vec<u32>,
+    /// Per parent face: its face-vertex (quad-splitting schemes only).
+    pub face_child_vertex: Vec<u32>,
+    /// Per parent face: its first child face; its children are consecutive (see the module
+    /// docs for their order).
+    pub face_first_child: Vec<u32>,
+    /// Per child vertex: the parent component it refines.
+    pub child_vertex_origin: Vec<ChildOrigin>,
+    /// Per child face: its parent face.
+    pub child_face_parent: Vec<u32>,
+}
+
+impl ChildMaps {
+    /// The child faces of parent face `f` (empty if `f` was not refined).
+    pub fn child_faces(&self, f: usize) -> std::ops::Range<usize> {
+        let first = self.face_first_child.get(f).copied().unwrap_or(INVALID);
+        if first == INVALID {
+            return 0..0;
+        }
+        let first = first as usize;
+        let count = self.child_face_parent[first..]
+            .iter()
+            .take_while(|&&p| p as usize == f)
+            .count();
+        first..first + count
+    }
+}
+
+/// One [`refine_sparse`] step: the child level, its stencils over the parent vertices (one row
+/// per child vertex, in child order) and the maps between the two levels.
+#[derive(Clone, Debug)]
+pub struct SparseRefinement {
+    pub child: LevelTopology,
+    pub stencils: StencilTable,
+    pub maps: ChildMaps,
+}
+
+/// Refine the faces `selected` of `parent` and every face sharing a vertex with one of them
+/// (their one-ring), as OpenSubdiv's sparse selection does for feature-adaptive refinement.
+///
+/// If `parent` holds the complete one-ring of every selected face (all faces around each of
+/// their corners, with exact vertex data), the child level holds the complete one-ring of
+/// every child of a selected face, and the stencils of those child vertices are exactly the
+/// uniform refiner's. Child vertices on the border of the refined region are computed from
+/// the neighbourhood the parent has and may differ from a uniform refinement; topological
+/// boundaries there are not mesh boundaries. With every face selected (and no isolated
+/// vertex) the child is numbered exactly as [`refine_level`] numbers it.
+pub fn refine_sparse(
+    parent: LevelRef<'_>,
+    scheme: Scheme,
+    options: &SubdivOptions,
+    selected: &[u32],
+) -> Result<SparseRefinement, TopologyError> {
+    let p = parent.topology;
+    let (nv, ne, nf) = (p.num_vertices(), p.num_edges(), p.num_faces());
+    if scheme == Scheme::DooSabin {
+        return Err(TopologyError::UnsupportedScheme {
+            scheme,
+            operation: "sparse refinement",
+        });
+    }
+    if let Some(&f) = selected.iter().find(|&&f| f as usize >= nf) {
+        return Err(TopologyError::FaceOutOfRange {
+            face: f as usize,
+            count: nf,
+        });
+    }
+    check_size(p, scheme)?;
+    let quads = scheme.splits_into_quads();
+
+    // The region: the selected faces and their one-ring, then its vertices and edges.
+    let mut faces: Vec<u32> = Vec::new();
+    for &f in selected {
+        for &v in p.face_vertices(f as usize) {
+            faces.extend_from_slice(p.vertex_faces(v as usize));
+        }
+    }
+    faces.sort_unstable();
+    faces.dedup();
+    if !quads {
+        if let Some(&f) = faces
+            .iter()
+            .find(|&&f| p.face_vertices(f as usize).len() != 3)
+        {
+            return Err(TopologyError::LoopRequiresTriangles {
+                face: f as usize,
+                size: p.face_vertices(f as usize).len(),
+            });
+        }
+    }
+    let mut verts: Vec<u32> = Vec::new();
+    let mut edges: Vec<u32> = Vec::new();
+    for &f in &faces {
+        verts.extend_from_slice(p.face_vertices(f as usize));
+        edges.extend_from_slice(p.face_edge_list(f as usize));
+    }
+    verts.sort_unstable();
+    verts.dedup();
+    edges.sort_unstable();
+    edges.dedup();
+
+    // Child numbering: vertex-vertices, edge-vertices, face-vertices, each in parent order.
+    let (kv, ke) = (verts.len(), edges.len());
+    let mut vertex_child_vertex = vec![INVALID; nv];
+    let mut edge_child_vertex = vec![INVALID; ne];
+    let mut face_child_vertex = vec![INVALID; nf];
+    let mut origin = Vec::with_capacity(kv + ke + faces.len());
+    for (i, &v) in verts.iter().enumerate() {
+        vertex_child_vertex[v as usize] = i as u32;
+        origin.push(ChildOrigin::Vertex(v));
+    }
+    for (i, &e) in edges.iter().enumerate() {
+        edge_child_vertex[e as usize] = (kv + i) as u32;
+        origin.push(ChildOrigin::Edge(e));
+    }
+    if quads {
+        for (i, &f) in faces.iter().enumerate() {
+            face_child_vertex[f as usize] = (kv + ke + i) as u32;
+            origin.push(ChildOrigin::Face(f));
+        }
+    }
+
+    // Sharpness of the edge halves in the parent's numbering (2e, 2e + 1), as the masks read
+    // it: a vertex-vertex's rule reads the halves of all its edges, also those leaving the
+    // region, so every edge at a refined vertex gets its halves.
+    let mut halves = vec![0.0f32; 2 * ne];
+    let mut scratch = Vec::new();
+    for &v in &verts {
+        for &e in p.vertex_edges(v as usize) {
+            let e = e as usize;
+            let pair = half_edge_sharpness(p, parent.edge_sharpness, options, e, &mut scratch);
+            halves[2 * e..2 * e + 2].copy_from_slice(&pair);
+        }
+    }
+    let decayed: Vec<f32> = parent
+        .vertex_sharpness
+        .iter()
+        .map(|&s| decrement_sharpness(s))
+        .collect();
+    let ctx = MaskContext {
+        p,
+        es: parent.edge_sharpness,
+        vs: parent.vertex_sharpness,
+        scheme,
+        options,
+        child_edge_sharpness: &halves,
+        child_vertex_sharpness: &decayed,
+    };
+    let stencils = build_rows(origin.len(), nv, |i, out| {
+        let uniform_index = match origin[i] {
+            ChildOrigin::Vertex(v) => v as usize,
+            ChildOrigin::Edge(e) => nv + e as usize,
+            ChildOrigin::Face(f) => nv + ne + f as usize,
+        };
+        ctx.row(uniform_index, out)
+    });
+
+    // Child edges: the two halves of each refined edge, then the interior edges of each
+    // refined face (one per corner for quads, three per triangle for Loop).
+    let vc = |v: u32| vertex_child_vertex[v as usize];
+    let ec = |e: u32| edge_child_vertex[e as usize];
+    let half_at =
+        |e: u32, v: u32| 2 * (ec(e) - kv as u32) + u32::from(p.edge_verts[e as usize][0] != v);
+    let mut edge_verts: Vec<[u32; 2]> = Vec::with_capacity(2 * ke + 3 * faces.len());
+    let mut edge_sharpness: Vec<f32> = Vec::with_capacity(edge_verts.capacity());
+    for &e in &edges {
+        let [a, b] = p.edge_verts[e as usize];
+        edge_verts.push([vc(a), ec(e)]);
+        edge_verts.push([ec(e), vc(b)]);
+        edge_sharpness.extend_from_slice(&halves[2 * e as usize..2 * e as usize + 2]);
+    }
+    let mut face_first_child = vec![INVALID; nf];
+    let mut child_face_parent = Vec::new();
+    let mut face_offsets = vec![0u32];
+    let mut face_verts = Vec::new();
+    let mut face_edges = Vec::new();
+    for &f in &faces {
+        let fv = p.face_vertices(f as usize);
+        let fe = p.face_edge_list(f as usize);
+        let n = fv.len();
+        let inner = edge_verts.len() as u32;
+        face_first_child[f as usize] = child_face_parent.len() as u32;
+        if quads {
+            let fc = face_child_vertex[f as usize];
+            for &e in fe {
+                edge_verts.push([ec(e), fc]);
+            }
+            for i in 0..n {
+                let prev = (i + n - 1) % n;
+                let (v, e, ep) = (fv[i], fe[i], fe[prev]);
+                face_verts.extend_from_slice(&[vc(v), ec(e), fc, ec(ep)]);
+                face_edges.extend_from_slice(&[
+                    half_at(e, v),
+                    inner + i as u32,
+                    inner + prev as u32,
+                    half_at(ep, v),
+                ]);
+                face_offsets.push(face_verts.len() as u32);
+                child_face_parent.push(f);
+            }
+        } else {
+            for j in 0..3 {
+                let prev = (j + 2) % 3;
+                // Inner edge j joins the midpoints of the two edges at corner j.
+                edge_verts.push([ec(fe[j]), ec(fe[prev])]);
+                face_verts.extend_from_slice(&[vc(fv[j]), ec(fe[j]), ec(fe[prev])]);
+                face_edges.extend_from_slice(&[
+                    half_at(fe[j], fv[j]),
+                    inner + j as u32,
+                    half_at(fe[prev], fv[j]),
+                ]);
+                face_offsets.push(face_verts.len() as u32);
+                child_face_parent.push(f);
+            }
+            face_verts.extend_from_slice(&[ec(fe[0]), ec(fe[1]), ec(fe[2])]);
+            face_edges.extend_from_slice(&[inner + 1, inner + 2, inner]);
+            face_offsets.push(face_verts.len() as u32);
+            child_face_parent.push(f);
+        }
+    }
+    edge_sharpness.resize(edge_verts.len(), 0.0);
+    let mut vertex_sharpness = vec![0.0f32; origin.len()];
+    for (slot, &v) in vertex_sharpness.iter_mut().zip(&verts) {
+        *slot = decayed[v as usize];
+    }
+    let topology = Topology::from_parts(
+        origin.len(),
+        face_offsets,
+        face_verts,
+        face_edges,
+        edge_verts,
+    );
+    Ok(SparseRefinement {
+        child: LevelTopology {
+            topology,
+            edge_sharpness,
+            vertex_sharpness,
+        },
+        stencils,
+        maps: ChildMaps {
+            refined_faces: faces,
+            vertex_child_vertex,
+            edge_child_vertex,
+            face_child_vertex,
+            face_first_child,
+            child_vertex_origin: origin,
+            child_face_parent,
+        },
+    })
+}
+
 /// Child edge index of parent edge `e` at its end vertex `v`.
 #[inline]
 fn child_edge_at(p: &Topology, e: u32, v: u32) -> u32 {
@@ -356,22 +761,39 @@ fn child_edge_sharpness(
         .enumerate()
         .with_min_len(4096)
         .for_each(|(e, pair)| {
-            let s = edge_sharpness[e];
-            if !is_sharp(s) {
-                return;
-            }
-            let mut incident: Vec<f32> = Vec::new();
-            for (k, slot) in pair.iter_mut().enumerate() {
-                let v = p.edge_verts[e][k] as usize;
-                incident.clear();
-                incident.extend(
-                    p.vertex_edges(v)
-                        .iter()
-                        .map(|&x| edge_sharpness[x as usize]),
-                );
-                *slot = subdivide_edge_sharpness_at_vertex(options.crease_method, s, &incident);
+            if is_sharp(edge_sharpness[e]) {
+                let halves = half_edge_sharpness(p, edge_sharpness, options, e, &mut Vec::new());
+                pair.copy_from_slice(&halves);
             }
         });
+    out
+}
+
+/// Sharpness of the two halves of edge `e` (at end 0, at end 1): each decays with the rule of
+/// [`subdivide_edge_sharpness_at_vertex`] over the edges incident to its end vertex.
+/// `incident` is scratch space.
+fn half_edge_sharpness(
+    p: &Topology,
+    edge_sharpness: &[f32],
+    options: &SubdivOptions,
+    e: usize,
+    incident: &mut Vec<f32>,
+) -> [f32; 2] {
+    let s = edge_sharpness[e];
+    let mut out = [0.0f32; 2];
+    if !is_sharp(s) {
+        return out;
+    }
+    for (k, slot) in out.iter_mut().enumerate() {
+        let v = p.edge_verts[e][k] as usize;
+        incident.clear();
+        incident.extend(
+            p.vertex_edges(v)
+                .iter()
+                .map(|&x| edge_sharpness[x as usize]),
+        );
+        *slot = subdivide_edge_sharpness_at_vertex(options.crease_method, s, incident);
+    }
     out
 }
 
@@ -939,7 +1361,7 @@ fn refine_doo_sabin(parent: &Level) -> Result<(Level, StencilTable), TopologyErr
     let edge_sharpness = (0..topology.num_edges())
         .map(|e| {
             if topology.is_boundary_edge(e) {
-                SHARPNESS_INFINITE
+                boundary_edge_sharpness()
             } else {
                 0.0
             }

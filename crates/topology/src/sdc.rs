@@ -1,9 +1,15 @@
-//! Scheme-independent sharpness rules, following OpenSubdiv's `Sdc::Crease`.
+//! The subdivision rules every other module calls: scheme names, sharpness tests, decay
+//! (uniform and Chaikin), the vertex rule, the fractional weight of a rule transition and the
+//! boundary-interpolation corner rule, following OpenSubdiv's `Sdc::Crease` and
+//! `Sdc::Options`.
 //!
 //! Sharpness is kept in `f32` like OpenSubdiv, so decay and rule transitions happen at the same
-//! levels as in the reference implementation.
+//! levels as in the reference implementation. Nothing here knows a mesh representation: the
+//! refiner ([`crate::refine`]) gathers the incident sharpness values and calls these functions,
+//! and the evaluator ([`crate::eval`]) refines through the refiner, so a crease fix is made once.
 
-use crate::mesh::CreaseMethod;
+use crate::error::TopologyError;
+use crate::mesh::{BoundaryInterpolation, CreaseMethod};
 
 /// The subdivision schemes this crate refines.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -21,17 +27,49 @@ pub enum Scheme {
 }
 
 impl Scheme {
-    /// Scheme from OpenSubdiv's shape-name prefix (`catmark_`, `loop_`, `bilinear_`).
+    /// Scheme from an OpenSubdiv shape name: the part before the first `_` (`catmark_cube`,
+    /// `loop_saddle_edgecorner`, `bilinear_nonplanar`), read by [`Scheme::from_str`].
     pub fn from_shape_name(name: &str) -> Option<Scheme> {
-        if name.starts_with("catmark") {
-            Some(Scheme::CatmullClark)
-        } else if name.starts_with("loop") {
-            Some(Scheme::Loop)
-        } else if name.starts_with("bilinear") {
-            Some(Scheme::Bilinear)
-        } else {
-            None
+        name.split('_').next()?.parse().ok()
+    }
+
+    /// The canonical command-line name (what [`Scheme::from_str`] reads back).
+    pub fn name(self) -> &'static str {
+        match self {
+            Scheme::Loop => "loop",
+            Scheme::CatmullClark => "catmull-clark",
+            Scheme::DooSabin => "doo-sabin",
+            Scheme::Bilinear => "bilinear",
         }
+    }
+
+    /// Whether the scheme splits faces into quads around a face point (Catmull-Clark,
+    /// bilinear) rather than triangles (Loop).
+    pub fn splits_into_quads(self) -> bool {
+        matches!(self, Scheme::CatmullClark | Scheme::Bilinear)
+    }
+}
+
+/// The one scheme parser: `loop`, `catmull-clark` (also `catmark`, OpenSubdiv's name, and
+/// `cc`), `doo-sabin`, `bilinear`.
+impl std::str::FromStr for Scheme {
+    type Err = TopologyError;
+    fn from_str(s: &str) -> Result<Scheme, TopologyError> {
+        match s {
+            "loop" => Ok(Scheme::Loop),
+            "catmull-clark" | "catmark" | "cc" => Ok(Scheme::CatmullClark),
+            "doo-sabin" => Ok(Scheme::DooSabin),
+            "bilinear" => Ok(Scheme::Bilinear),
+            _ => Err(TopologyError::UnknownScheme {
+                name: s.to_string(),
+            }),
+        }
+    }
+}
+
+impl std::fmt::Display for Scheme {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
     }
 }
 
@@ -51,6 +89,25 @@ pub fn is_infinite(s: f32) -> bool {
 /// Sharp but not infinitely so: it decays with refinement.
 pub fn is_semi_sharp(s: f32) -> bool {
     SHARPNESS_SMOOTH < s && s < SHARPNESS_INFINITE
+}
+
+/// Sharpness a vertex gets from the boundary rule alone: with
+/// [`BoundaryInterpolation::EdgesAndCorners`] a boundary corner (a vertex with one face, hence
+/// two boundary edges) is infinitely sharp, so it stays put. Boundary *edges* are infinitely
+/// sharp under every rule ([`boundary_edge_sharpness`]).
+pub fn boundary_vertex_sharpness(
+    boundary: BoundaryInterpolation,
+    num_faces: usize,
+    num_edges: usize,
+) -> Option<f32> {
+    (boundary == BoundaryInterpolation::EdgesAndCorners && num_faces == 1 && num_edges == 2)
+        .then_some(SHARPNESS_INFINITE)
+}
+
+/// Sharpness of an edge with a single face: infinite, whatever its tag (OpenSubdiv does this for
+/// every boundary rule, so the boundary curve is the B-spline of its control polygon).
+pub fn boundary_edge_sharpness() -> f32 {
+    SHARPNESS_INFINITE
 }
 
 /// The vertex rule chosen from a vertex's sharpness and its sharp incident edges.

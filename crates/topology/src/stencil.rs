@@ -85,6 +85,23 @@ impl StencilTable {
             .collect()
     }
 
+    /// Evaluate every stencil on flat per-vertex data of any dimension (`dim` values per
+    /// source vertex, e.g. one per basis function), serially: for the small levels of local
+    /// refinement.
+    pub fn apply_flat(&self, data: &[f64], dim: usize) -> Vec<f64> {
+        let mut out = vec![0.0; self.len() * dim];
+        for (i, row) in out.chunks_exact_mut(dim.max(1)).enumerate() {
+            let (idx, w) = self.stencil(i);
+            for (&j, &wj) in idx.iter().zip(w) {
+                let src = &data[j as usize * dim..(j as usize + 1) * dim];
+                for (o, x) in row.iter_mut().zip(src) {
+                    *o += wj * x;
+                }
+            }
+        }
+        out
+    }
+
     /// Stencils of `self` (over the vertices `parent` produces) re-expressed over `parent`'s
     /// sources: `result_i = Σ_j w_ij · parent_j`.
     pub fn compose(&self, parent: &StencilTable) -> StencilTable {

@@ -2,65 +2,28 @@
 use crate::cli::{LimitArgs, SubdivideArgs};
 use anyhow::{bail, Context, Result};
 use topology::eval::{limit_point, LimitScheme, LocalMesh};
-use topology::{
-    refine_level, refine_uniform, ControlMesh, EdgeCrease, Level, Scheme, VertexCorner,
-};
+use topology::{refine_level, refine_uniform, ControlMesh, Level, Scheme};
 
+/// Clap's value parser for `--scheme`: topology's one scheme parser.
 pub fn parse_scheme(s: &str) -> Result<Scheme, String> {
-    match s {
-        "loop" => Ok(Scheme::Loop),
-        "catmull-clark" | "catmark" => Ok(Scheme::CatmullClark),
-        "doo-sabin" => Ok(Scheme::DooSabin),
-        "bilinear" => Ok(Scheme::Bilinear),
-        _ => Err(format!(
-            "unknown scheme '{s}' (loop, catmull-clark, doo-sabin, bilinear)"
-        )),
-    }
-}
-
-/// A refined level as a control mesh, its propagated sharpness written back as tags.
-fn level_as_mesh(level: &Level, base: &ControlMesh) -> ControlMesh {
-    let (offsets, verts) = level.topology.face_tables();
-    let mut m = ControlMesh::from_polygons(level.positions.clone(), &[] as &[[u32; 3]]);
-    m.face_offsets = offsets.to_vec();
-    m.face_vertices = verts.to_vec();
-    m.options = base.options;
-    for (e, &s) in level.edge_sharpness.iter().enumerate() {
-        if s > 0.0 && !level.topology.is_boundary_edge(e) {
-            m.creases.push(EdgeCrease {
-                vertices: level.topology.edge_vertices(e),
-                sharpness: s,
-            });
-        }
-    }
-    for (v, &s) in level.vertex_sharpness.iter().enumerate() {
-        if s > 0.0 {
-            m.corners.push(VertexCorner {
-                vertex: v as u32,
-                sharpness: s,
-            });
-        }
-    }
-    m
+    s.parse::<Scheme>().map_err(|e| e.to_string())
 }
 
 /// Limit positions of every vertex of `level`: by limit masks where no semi-sharp feature is
 /// left, else after further refinement (vertex indices persist across levels).
 fn limit_positions(level: &Level, base: &ControlMesh, scheme: Scheme) -> Result<Vec<[f64; 3]>> {
     let ls = match scheme {
-        Scheme::Loop => LimitScheme::Loop,
-        Scheme::CatmullClark => LimitScheme::CatmullClark,
         Scheme::Bilinear => return Ok(level.positions.clone()),
         Scheme::DooSabin => bail!(
             "--limit is supported for loop and catmull-clark (Doo-Sabin has no limit masks here)"
         ),
+        other => LimitScheme::try_from(other)?,
     };
     let n = level.positions.len();
     let mut out: Vec<Option<[f64; 3]>> = vec![None; n];
     let mut current = level.clone();
     for _ in 0..12 {
-        let lm = LocalMesh::from_control_mesh(&level_as_mesh(&current, base), ls)
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        let lm = LocalMesh::from_refined_level(&current, ls, &base.options)?;
         for (v, slot) in out.iter_mut().enumerate() {
             if slot.is_none() {
                 if let Some(p) = lm.vertex_limit_position(v as u32) {
@@ -113,9 +76,9 @@ pub fn subdivide(a: SubdivideArgs) -> Result<()> {
 
 pub fn limit(a: LimitArgs) -> Result<()> {
     let mesh = topology::load_obj(&a.input)?;
-    let scheme: LimitScheme = a.scheme.parse().map_err(|e| anyhow::anyhow!("{e}"))?;
+    let scheme: LimitScheme = a.scheme.parse()?;
     let p = limit_point(&mesh, scheme, a.face, a.uv.0, a.uv.1)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
+        .with_context(|| a.input.display().to_string())?;
     println!("{p}");
     Ok(())
 }

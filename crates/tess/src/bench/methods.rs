@@ -380,8 +380,7 @@ pub fn cpu_loop_limit_mesh(mesh: &ControlMesh, level: usize) -> Result<CpuLimitM
 /// semi-sharp feature is left (its vertices need more refinement first).
 pub fn loop_limit_positions(level: &Level) -> Option<Vec<[f64; 3]>> {
     use topology::limit::{loop_limit_masks, LimitRule, LimitVertex};
-    const INF: f32 = topology::sdc::SHARPNESS_INFINITE;
-    let semi = |s: f32| s > 0.0 && s < INF;
+    use topology::sdc::{is_infinite, is_semi_sharp as semi};
     let t = &level.topology;
     // Smooth weights (vertex, each neighbour) depend on the valence only.
     let mut smooth: std::collections::HashMap<usize, (f64, f64)> = Default::default();
@@ -399,13 +398,13 @@ pub fn loop_limit_positions(level: &Level) -> Option<Vec<[f64; 3]>> {
             if semi(s) {
                 return None;
             }
-            if s >= INF {
+            if is_infinite(s) {
                 let [a, b] = t.edge_vertices(e as usize);
                 sharp.push(if a as usize == v { b } else { a });
             }
         }
         let n = edges.len();
-        let q = if vs >= INF || sharp.len() > 2 {
+        let q = if is_infinite(vs) || sharp.len() > 2 {
             p
         } else if sharp.len() == 2 {
             // Crease (boundaries included): only the two crease neighbours weigh.

@@ -116,64 +116,22 @@ pub struct TriangulationSummary {
     pub polygons: usize,
 }
 
-/// Splits every face of more than three corners into a fan from its first corner. Corner
-/// attributes (normals, UVs) follow their corners; crease tags keep naming the same edges
-/// (fans only add diagonals); holes become all triangles of the holed face.
+/// [`ControlMesh::triangulated`] (fans from each face's first corner; corner attributes follow
+/// their corners, crease tags keep naming the same edges, holes become all triangles of the
+/// holed face), refusing faces of fewer than three corners and counting the faces it split.
 pub fn fan_triangulate(mesh: &ControlMesh) -> Result<(ControlMesh, TriangulationSummary)> {
-    let mut out = ControlMesh {
-        positions: mesh.positions.clone(),
-        face_offsets: vec![0],
-        creases: mesh.creases.clone(),
-        corners: mesh.corners.clone(),
-        options: mesh.options,
-        ..ControlMesh::default()
+    if let Some(face) = (0..mesh.num_faces()).find(|&f| mesh.face(f).len() < 3) {
+        return Err(TessError::Topology(
+            topology::TopologyError::DegenerateFace {
+                face,
+                size: mesh.face(face).len(),
+            },
+        ));
+    }
+    let summary = TriangulationSummary {
+        polygons: mesh.faces().filter(|f| f.len() > 3).count(),
     };
-    let mut normals = mesh.normals.as_ref().map(|_| Vec::new());
-    let mut uvs = mesh.uvs.as_ref().map(|_| Vec::new());
-    let mut summary = TriangulationSummary::default();
-    let mut first_triangle = Vec::with_capacity(mesh.num_faces() + 1);
-    for f in 0..mesh.num_faces() {
-        let start = mesh.face_offsets[f] as usize;
-        let face = mesh.face(f);
-        if face.len() < 3 {
-            return Err(TessError::Topology(
-                topology::TopologyError::DegenerateFace {
-                    face: f,
-                    size: face.len(),
-                },
-            ));
-        }
-        if face.len() > 3 {
-            summary.polygons += 1;
-        }
-        first_triangle.push(out.num_faces() as u32);
-        for i in 1..face.len() - 1 {
-            for c in [0, i, i + 1] {
-                out.face_vertices.push(face[c]);
-                if let (Some(dst), Some(src)) = (normals.as_mut(), mesh.normals.as_ref()) {
-                    dst.push(*src.get(start + c).unwrap_or(&[0.0, 0.0, 0.0]));
-                }
-                if let (Some(dst), Some(src)) = (uvs.as_mut(), mesh.uvs.as_ref()) {
-                    dst.push(*src.get(start + c).unwrap_or(&[0.0, 0.0]));
-                }
-            }
-            out.face_offsets.push(out.face_vertices.len() as u32);
-        }
-    }
-    first_triangle.push(out.num_faces() as u32);
-    // Attributes are per corner only when the source had one per corner.
-    out.normals =
-        normals.filter(|_| mesh.normals.as_ref().map(Vec::len) == Some(mesh.face_vertices.len()));
-    out.uvs = uvs.filter(|_| mesh.uvs.as_ref().map(Vec::len) == Some(mesh.face_vertices.len()));
-    for &h in &mesh.holes {
-        if let (Some(&a), Some(&b)) = (
-            first_triangle.get(h as usize),
-            first_triangle.get(h as usize + 1),
-        ) {
-            out.holes.extend(a..b);
-        }
-    }
-    Ok((out, summary))
+    Ok((mesh.triangulated().0, summary))
 }
 
 /// Where a row's triangle count comes from.

@@ -1,7 +1,7 @@
 //! OBJ parsing, OpenSubdiv tags and every validation error on small inline meshes.
 
 use topology::{
-    parse_obj, BoundaryInterpolation, CreaseMethod, TopologyError, TriangleSubdivision,
+    parse_obj, BoundaryInterpolation, CreaseMethod, TagKind, TopologyError, TriangleSubdivision,
 };
 
 const QUAD_PAIR: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\n";
@@ -188,9 +188,23 @@ fn non_finite_positions() {
 #[test]
 fn tags_naming_missing_vertices() {
     let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nt corner 1/1/0 7 1.0\n");
-    assert!(matches!(e.root(), TopologyError::InvalidTag { .. }));
+    assert!(matches!(
+        e.root(),
+        TopologyError::TagOutOfRange {
+            tag: TagKind::Corner,
+            index: 7,
+            count: 3
+        }
+    ));
     let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nt crease 2/1/0 0 5 1.0\n");
-    assert!(matches!(e.root(), TopologyError::InvalidTag { .. }));
+    assert!(matches!(
+        e.root(),
+        TopologyError::TagOutOfRange {
+            tag: TagKind::Crease,
+            index: 5,
+            count: 3
+        }
+    ));
 }
 
 #[test]

@@ -1,7 +1,5 @@
 //! Limit masks, regular patch bases and exact limit evaluation, checked against direct spline
-//! algebra and against uniform refinement (T1's refiner) pushed to the limit by masks.
-
-use std::collections::HashMap;
+//! algebra and against uniform refinement pushed to the limit by masks.
 
 use topology::eval::{limit_point, limit_point_subface, LimitScheme, LocalMesh};
 use topology::patch::{
@@ -81,30 +79,7 @@ fn bspline_patch_precision() {
 }
 
 fn local_from_level(level: &Level, scheme: LimitScheme, mesh: &ControlMesh) -> LocalMesh {
-    let mut es = HashMap::new();
-    for e in 0..level.topology.num_edges() {
-        let s = level.edge_sharpness[e];
-        if s > 0.0 && !level.topology.is_boundary_edge(e) {
-            let [a, b] = level.topology.edge_vertices(e);
-            es.insert((a.min(b), a.max(b)), s);
-        }
-    }
-    LocalMesh::new(
-        scheme,
-        3,
-        level
-            .positions
-            .iter()
-            .flat_map(|p| p.iter().copied())
-            .collect(),
-        level.face_offsets().to_vec(),
-        level.face_vertices().to_vec(),
-        es,
-        level.vertex_sharpness.clone(),
-        mesh.options.boundary,
-        mesh.options.crease_method,
-    )
-    .expect("refined level is manifold")
+    LocalMesh::from_refined_level(level, scheme, &mesh.options).expect("refined level is manifold")
 }
 
 fn max_sharpness(mesh: &ControlMesh) -> f32 {
@@ -141,14 +116,14 @@ fn dyadic_params(quad: bool, level: u32) -> Vec<(f64, f64)> {
 fn check_shape(name: &str, level: u32) {
     let mesh = load_obj(format!("{DATA}{name}.obj")).expect("shape loads");
     let quad = name.starts_with("catmark");
-    let (scheme, t1) = if quad {
+    let (scheme, refine_scheme) = if quad {
         (LimitScheme::CatmullClark, Scheme::CatmullClark)
     } else {
         (LimitScheme::Loop, Scheme::Loop)
     };
     let extra = max_sharpness(&mesh).ceil() as u32;
     let depth = (level + 1).max(extra + 1);
-    let refined = refine_uniform(&mesh, t1, depth as usize).expect("T1 refines");
+    let refined = refine_uniform(&mesh, refine_scheme, depth as usize).expect("refines");
     let fine = local_from_level(refined.level(depth as usize), scheme, &mesh);
     let limits: Vec<[f64; 3]> = (0..fine.num_vertices() as u32)
         .filter_map(|v| fine.vertex_limit_position(v).map(|p| [p[0], p[1], p[2]]))

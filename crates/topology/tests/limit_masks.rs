@@ -84,12 +84,12 @@ fn check_vertex(name: &str, v: u32, levels: usize, plane: bool) {
 
 fn check_mesh_vertex(name: &str, mesh: &ControlMesh, v: u32, levels: usize, plane: bool) {
     let quad = name.starts_with("catmark");
-    let (scheme, t1) = if quad {
+    let (scheme, refine_scheme) = if quad {
         (LimitScheme::CatmullClark, Scheme::CatmullClark)
     } else {
         (LimitScheme::Loop, Scheme::Loop)
     };
-    let r = refine_uniform(mesh, t1, levels).expect("refine");
+    let r = refine_uniform(mesh, refine_scheme, levels).expect("refine");
     // Limit from level 1 (all-quad rings for Catmull-Clark).
     let l1 = LocalMesh::from_refined_level(r.level(1), scheme, &mesh.options).expect("level 1");
     let limit = l1.vertex_limit_position(v).expect("mask applies");

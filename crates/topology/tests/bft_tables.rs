@@ -32,19 +32,8 @@ fn random_config(key: BftKey, rng: &mut Rng) -> (LocalMesh, usize) {
     for x in m.points.iter_mut() {
         *x += 0.3 * rng.next();
     }
-    // Rebuild so the jittered points are used (topology unchanged).
-    let m2 = LocalMesh::new(
-        m.scheme,
-        3,
-        m.points.clone(),
-        m.face_offsets.clone(),
-        m.face_verts.clone(),
-        HashMap::new(),
-        vec![0.0; m.num_vertices()],
-        m.boundary,
-        m.crease_method,
-    )
-    .expect("config mesh");
+    // The same topology carrying the jittered points.
+    let m2 = m.with_points(3, m.points.clone()).expect("config mesh");
     (m2, f)
 }
 
@@ -166,16 +155,15 @@ fn level1(name: &str) -> (ControlMesh, LocalMesh) {
     };
     let r = refine_uniform(&mesh, Scheme::Loop, 1).expect("refine");
     let l = r.level(1);
-    let lm = LocalMesh::new(
+    let (offsets, verts) = l.topology.face_tables();
+    // Untagged (no creases) with the mesh's boundary rule.
+    let lm = LocalMesh::from_faces(
         LimitScheme::Loop,
+        mesh.options,
         3,
         l.positions.iter().flat_map(|p| p.iter().copied()).collect(),
-        l.face_offsets().to_vec(),
-        l.face_vertices().to_vec(),
-        HashMap::new(),
-        vec![0.0; l.positions.len()],
-        mesh.options.boundary,
-        mesh.options.crease_method,
+        offsets.to_vec(),
+        verts.to_vec(),
     )
     .expect("level 1");
     (mesh, lm)
