@@ -28,17 +28,7 @@ fn strip(k: u32, triangles: bool) -> ControlMesh {
         pos.push([x, -0.5, 0.3 * (x * 0.9).sin()]);
         pos.push([x, 0.75, 0.2 * (x * 0.7).cos()]);
     }
-    let mut faces: Vec<Vec<u32>> = Vec::new();
-    for i in 0..k {
-        let (a, b, c, d) = (2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1);
-        if triangles {
-            faces.push(vec![a, b, c]);
-            faces.push(vec![a, c, d]);
-        } else {
-            faces.push(vec![a, b, c, d]);
-        }
-    }
-    ControlMesh::from_polygons(pos, &faces)
+    ControlMesh::from_polygons(pos, &common::strip_faces(k, triangles))
 }
 
 fn load(path: &str) -> ControlMesh {

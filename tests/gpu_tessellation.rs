@@ -18,17 +18,7 @@ fn strip(k: u32, triangles: bool) -> ControlMesh {
         pos.push([i as f64, 0.0, 0.0]);
         pos.push([i as f64, 1.0, 0.0]);
     }
-    let mut faces: Vec<Vec<u32>> = Vec::new();
-    for i in 0..k {
-        let (a, b, c, d) = (2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1);
-        if triangles {
-            faces.push(vec![a, b, c]);
-            faces.push(vec![a, c, d]);
-        } else {
-            faces.push(vec![a, b, c, d]);
-        }
-    }
-    ControlMesh::from_polygons(pos, &faces)
+    ControlMesh::from_polygons(pos, &common::strip_faces(k, triangles))
 }
 
 #[test]

@@ -108,3 +108,19 @@ pub fn build_with(
     .unwrap_or_else(|e| panic!("building {id}: {e}"))
     .technique
 }
+
+/// Faces of a strip of `k` quads over `2k + 2` vertices laid out in pairs (bottom, top), or of
+/// its `2k` triangles when `triangles`.
+pub fn strip_faces(k: u32, triangles: bool) -> Vec<Vec<u32>> {
+    let mut faces = Vec::new();
+    for i in 0..k {
+        let (a, b, c, d) = (2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1);
+        if triangles {
+            faces.push(vec![a, b, c]);
+            faces.push(vec![a, c, d]);
+        } else {
+            faces.push(vec![a, b, c, d]);
+        }
+    }
+    faces
+}

@@ -4,7 +4,6 @@
 //! the pipelines (one cache for all techniques), the frame uniforms and the recording of a
 //! frame; [`capture`] reads back exactly what any technique's TES emitted (transform feedback)
 //! and checks it for cracks. Techniques are built by name from [`techniques::registry`].
-//! Recording goes through `vk_core::Encoder`, so this crate has no `unsafe`.
 #![forbid(unsafe_code)]
 pub mod bench;
 pub mod camera;

@@ -9,7 +9,7 @@ use crate::cli::ViewArgs;
 use crate::commands::{check_validation, load_mesh, mesh_name, open_device, scene_setup};
 use crate::technique::{describe, Setup};
 use anyhow::{Context as _, Result};
-use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+use raw_window_handle::HasDisplayHandle;
 use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Instant;
@@ -75,17 +75,15 @@ impl App {
                 .context("creating the window")?,
         );
         let display = window.display_handle().context("display handle")?.as_raw();
-        let handle = window.window_handle().context("window handle")?.as_raw();
         let (instance, device) = open_device(
             &self.args.scene.gpu,
             required_surface_extensions(display)?,
             &[Swapchain::DEVICE_EXTENSION],
         )?;
         let size = window.inner_size();
-        let swapchain = Swapchain::new(
+        let swapchain = Swapchain::for_window(
             &device,
-            display,
-            handle,
+            window.clone(),
             vk::Extent2D {
                 width: size.width,
                 height: size.height,

@@ -2,41 +2,12 @@
 //! use and the OBJ writer.
 use super::domain::PatchToFace;
 use crate::error::{Result, TessError};
-use bytemuck::{Pod, Zeroable};
+pub use crate::gpu::{CaptureRecord, CAPTURE_STRIDE};
 use std::collections::HashMap;
 use std::io::Write as _;
-use std::mem::{offset_of, size_of};
 use std::path::Path;
 
-/// One captured triangle corner: the transform-feedback record of `tese_out.glsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct CaptureRecord {
-    /// World position as the TES computed it.
-    pub position: [f32; 3],
-    /// Normal as shaded.
-    pub normal: [f32; 3],
-    /// Frame-wide patch id.
-    pub patch: u32,
-    /// Technique-defined flags (0 for the triangle/quad techniques).
-    pub flags: u32,
-    /// `gl_TessCoord.xy` as the fixed-function tessellator produced it.
-    pub domain: [f32; 2],
-}
-
-/// Bytes per record: the `xfb_stride` of `tese_out.glsl`.
-pub const CAPTURE_STRIDE: u64 = 40;
-
-const _: () = {
-    assert!(size_of::<CaptureRecord>() == CAPTURE_STRIDE as usize);
-    assert!(offset_of!(CaptureRecord, normal) == 12);
-    assert!(offset_of!(CaptureRecord, patch) == 24);
-    assert!(offset_of!(CaptureRecord, flags) == 28);
-    assert!(offset_of!(CaptureRecord, domain) == 32);
-};
-
 /// Every corner the TES emitted, three per triangle, in the order the GPU wrote them.
-
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CapturedSoup {
     pub records: Vec<CaptureRecord>,
