@@ -574,15 +574,9 @@ impl Swapchain {
         // is unsignalled (its last present waited on it), the fence was reset above; the
         // swapchain's images live until a rebuild or drop, both of which wait for the device.
         let submitted = unsafe { encoder.submit_with(&wait, &signal, sync.in_flight) };
-        let serial = match submitted {
-            Ok((serial, _)) => serial,
-            Err(e) => {
-                // Nothing was submitted: let the fence signal again through abandon.
-                // SAFETY: the fence is unsignalled and unused; an empty signal restores it.
-                let _ = unsafe { device.submit(&[], &[], &[], sync.in_flight) };
-                return Err(e);
-            }
-        };
+        // On failure nothing was submitted: the frame stays outstanding and its guard abandons
+        // it, which consumes the acquire semaphore and signals the (reset, unused) fence.
+        let (serial, _) = submitted?;
         self.outstanding = false;
         self.frame_index += 1;
         let swapchains = [self.raw];
