@@ -158,7 +158,11 @@ fn bft_is_watertight_under_every_factor_policy() {
         for (name, mesh) in meshes {
             let surf = surface(&mut ctx, &mesh, name, 5, false);
             let policies = [
-                ("uniform 16", FactorPolicy::Uniform { segments: 16.0 }, false),
+                (
+                    "uniform 16",
+                    FactorPolicy::Uniform { segments: 16.0 },
+                    false,
+                ),
                 ("screen 6px", FactorPolicy::Screen { pixels: 6.0 }, false),
                 (
                     "distance",
@@ -235,8 +239,7 @@ fn animated_base_mesh_gives_the_deformed_limit() {
         for frame in 0..5 {
             deformed = wave(&base, &normals, lo, hi, frame as f32 * 0.1);
             surf.update_base(0, &deformed).expect("upload");
-            ctx.render_offscreen(&surf, &params, EXTENT)
-                .expect("frame");
+            ctx.render_offscreen(&surf, &params, EXTENT).expect("frame");
         }
         let (soup, _) = capturer
             .capture(&mut ctx, &surf, &params, EXTENT)

@@ -8,9 +8,7 @@ use tessera::tess::capture::{
     classify_open_edges, CaptureStats, CapturedSoup, Capturer, OpenEdgeClasses,
 };
 use tessera::tess::tessellator::{uniform_triangle_count, Domain};
-use tessera::tess::{
-    Context, DrawSplit, FrameParams, RenderMesh, Spacing, Technique, TechniqueId,
-};
+use tessera::tess::{Context, DrawSplit, FrameParams, RenderMesh, Spacing, Technique, TechniqueId};
 use tessera::topology::ControlMesh;
 use tessera::vk_core::vk;
 
@@ -354,7 +352,12 @@ fn open_strip_edges_are_base_boundary() {
     for triangles in [true, false] {
         let base = strip(3, triangles);
         for level in [1.0f32, 4.0, 7.0] {
-            let c = capture(&mut h, &base, TechniqueId::Flat, &FrameParams::uniform(level));
+            let c = capture(
+                &mut h,
+                &base,
+                TechniqueId::Flat,
+                &FrameParams::uniform(level),
+            );
             let (classes, ..) = watertightness(&c, &base);
             // The strip's outline: 2 long sides of 3 faces and 2 ends, each base edge cut into
             // `level` segments.
@@ -440,7 +443,7 @@ fn capture_without_transform_feedback_is_a_typed_error() {
         without_transform_feedback: true,
         ..DeviceDesc::default()
     });
-    assert!(gpu.device().transform_feedback.is_none());
+    assert!(!gpu.device().has_transform_feedback());
     let mut ctx = Context::offscreen(gpu.device()).unwrap();
     let e = Capturer::new(&ctx).err().expect("no capturer");
     assert!(

@@ -1,9 +1,9 @@
 //! Command-line definition.
 use crate::technique::SurfaceArgs;
-use tess::TechniqueId;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use tess::Spacing;
+use tess::TechniqueId;
 
 #[derive(Parser, Debug)]
 #[command(

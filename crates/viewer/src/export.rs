@@ -5,7 +5,9 @@
 //! (`Technique::face_point`) and everything after (weld, edge report, classification, OBJ) are
 //! shared, so a new technique needs nothing here.
 use crate::cli::ExportArgs;
-use crate::commands::{build_technique, camera, check_validation, load_mesh, mesh_name, open_device};
+use crate::commands::{
+    build_technique, camera, check_validation, load_mesh, mesh_name, open_device,
+};
 use crate::technique::describe;
 use anyhow::{bail, Context as _, Result};
 use tess::capture::{classify_open_edges, Capturer, Winding};

@@ -248,7 +248,8 @@ impl App {
             Key::Character(c) => match c.as_str() {
                 d if d.len() == 1 && d.as_bytes()[0].is_ascii_digit() => {
                     let k = (d.as_bytes()[0] - b'0') as usize;
-                    if let Some(info) = k.checked_sub(1).and_then(|i| techniques::registry().get(i)) {
+                    if let Some(info) = k.checked_sub(1).and_then(|i| techniques::registry().get(i))
+                    {
                         self.switch_technique(info.id);
                     }
                 }

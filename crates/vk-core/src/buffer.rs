@@ -45,9 +45,7 @@ impl Drop for BufferShared {
 
 /// A buffer and its memory.
 pub struct Buffer {
-    // LEGACY: removed once tess records through Encoder (raw handles are for legacy recording).
-    #[doc(hidden)]
-    pub raw: vk::Buffer,
+    pub(crate) raw: vk::Buffer,
     pub size: u64,
     /// The mapping of host-visible memory: `size` bytes owned by `shared`'s allocation.
     mapped: Option<NonNull<u8>>,
@@ -195,14 +193,5 @@ impl Buffer {
         bytemuck::cast_slice_mut::<T, u8>(&mut out)
             .copy_from_slice(&slice[..n * std::mem::size_of::<T>()]);
         Ok(out)
-    }
-
-    // LEGACY: removed once tess records through Encoder (DescriptorPool::write_buffers).
-    #[doc(hidden)]
-    pub fn descriptor(&self) -> vk::DescriptorBufferInfo {
-        vk::DescriptorBufferInfo::default()
-            .buffer(self.raw)
-            .offset(0)
-            .range(vk::WHOLE_SIZE)
     }
 }

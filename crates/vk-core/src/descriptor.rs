@@ -86,9 +86,7 @@ impl Drop for PoolShared {
 
 /// A pool sized for `max_sets` sets of a layout; its sets are freed with it.
 pub struct DescriptorPool {
-    // LEGACY: removed once tess records through Encoder (raw handle for legacy recording).
-    #[doc(hidden)]
-    pub raw: vk::DescriptorPool,
+    pub(crate) raw: vk::DescriptorPool,
     shared: Arc<PoolShared>,
     /// Sets handed out so far, for their names.
     allocated: AtomicU32,
@@ -162,41 +160,6 @@ impl DescriptorPool {
             _layout: layout.shared.clone(),
             pool: self.shared.clone(),
         })
-    }
-
-    // LEGACY: removed once tess records through Encoder (use DescriptorPool::allocate_set).
-    #[doc(hidden)]
-    pub fn allocate(&self, layout: &DescriptorSetLayout) -> Result<vk::DescriptorSet> {
-        self.allocate_raw(layout)
-    }
-
-    // LEGACY: removed once tess records through Encoder (use DescriptorSet::write_buffer). The
-    // legacy caller keeps the buffers alive and the set idle while it updates it.
-    #[doc(hidden)]
-    pub fn write_buffers(
-        &self,
-        set: vk::DescriptorSet,
-        writes: &[(u32, vk::DescriptorType, vk::DescriptorBufferInfo)],
-    ) {
-        let infos: Vec<[vk::DescriptorBufferInfo; 1]> = writes.iter().map(|w| [w.2]).collect();
-        let vk_writes: Vec<_> = writes
-            .iter()
-            .zip(&infos)
-            .map(|(w, info)| {
-                vk::WriteDescriptorSet::default()
-                    .dst_set(set)
-                    .dst_binding(w.0)
-                    .descriptor_type(w.1)
-                    .buffer_info(info)
-            })
-            .collect();
-        // SAFETY: legacy contract (see above).
-        unsafe {
-            self.shared
-                .device
-                .raw
-                .update_descriptor_sets(&vk_writes, &[])
-        };
     }
 }
 

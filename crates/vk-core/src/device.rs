@@ -351,10 +351,7 @@ pub struct DeviceDesc {
 /// pools, timeline semaphore, pipeline cache, allocator (every allocation already handed back),
 /// device; then the instance Arc.
 pub struct DeviceShared {
-    // LEGACY: removed once tess records through Encoder. The new API never hands out the
-    // `ash::Device`: every command goes through vk-core's types.
-    #[doc(hidden)]
-    pub raw: ash::Device,
+    pub(crate) raw: ash::Device,
     pub physical: vk::PhysicalDevice,
     pub queue: vk::Queue,
     pub queue_family: u32,
@@ -363,9 +360,7 @@ pub struct DeviceShared {
     pub(crate) debug_utils: Option<ash::ext::debug_utils::Device>,
     /// VK_EXT_transform_feedback's commands; `None` when the device lacks the extension or the
     /// feature (see [`DeviceShared::transform_feedback`] for a typed error instead).
-    // LEGACY: removed once tess records through Encoder (tests/capture.rs reads it).
-    #[doc(hidden)]
-    pub transform_feedback: Option<ash::ext::transform_feedback::Device>,
+    pub(crate) transform_feedback: Option<ash::ext::transform_feedback::Device>,
     pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
     /// Command pools (each with its one command buffer) free for one-shot recordings: a pool is
     /// taken for the whole recording, so recordings on several threads never share one.
@@ -584,10 +579,19 @@ impl DeviceShared {
         let _ = unsafe { du.set_debug_utils_object_name(&info) };
     }
 
-    // LEGACY: removed once tess records through Encoder (hands out ash's extension loader; the
-    // encoder's transform-feedback methods return the same typed error).
-    #[doc(hidden)]
-    pub fn transform_feedback(&self) -> Result<&ash::ext::transform_feedback::Device> {
+    /// A typed [`VkError::Unsupported`] unless VK_EXT_transform_feedback is enabled on this
+    /// device: what captures check before any work.
+    pub fn require_transform_feedback(&self) -> Result<()> {
+        self.transform_feedback().map(|_| ())
+    }
+
+    /// Whether VK_EXT_transform_feedback is enabled (present, and not turned off by
+    /// [`DeviceDesc::without_transform_feedback`]).
+    pub fn has_transform_feedback(&self) -> bool {
+        self.transform_feedback.is_some()
+    }
+
+    pub(crate) fn transform_feedback(&self) -> Result<&ash::ext::transform_feedback::Device> {
         self.transform_feedback
             .as_ref()
             .ok_or_else(|| VkError::Unsupported {

@@ -28,15 +28,11 @@ pub mod query;
 pub mod retire;
 pub mod swapchain;
 pub mod target;
-pub mod transform_feedback;
 pub mod workarounds;
 
 #[cfg(test)]
 mod tests;
 
-// LEGACY: removed once tess records through Encoder (tess names ash's transform-feedback type).
-#[doc(hidden)]
-pub use ash;
 pub use ash::vk;
 pub use buffer::{Buffer, BufferDesc};
 pub use descriptor::{BindingDesc, DescriptorPool, DescriptorSet, DescriptorSetLayout};

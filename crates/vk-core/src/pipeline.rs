@@ -98,12 +98,8 @@ pub(crate) struct VertexBinding {
 
 /// A pipeline and its layout, destroyed together through the retire queue.
 pub struct Pipeline {
-    // LEGACY: removed once tess records through Encoder (raw handles for legacy recording).
-    #[doc(hidden)]
-    pub raw: vk::Pipeline,
-    // LEGACY: removed once tess records through Encoder.
-    #[doc(hidden)]
-    pub layout: vk::PipelineLayout,
+    pub(crate) raw: vk::Pipeline,
+    pub(crate) layout: vk::PipelineLayout,
     pub bind_point: vk::PipelineBindPoint,
     pub(crate) name: String,
     pub(crate) set_layouts: Vec<vk::DescriptorSetLayout>,

@@ -3,7 +3,6 @@
 use crate::device::{Device, DeviceShared};
 use crate::error::{Result, VkContext, VkError};
 use crate::retire::Retired;
-use crate::transform_feedback::TransformFeedbackCommands;
 use ash::vk;
 use std::sync::Arc;
 
@@ -42,9 +41,7 @@ pub struct TransformFeedbackCounts {
 
 /// A pool of `count` timestamp, pipeline-statistics or transform-feedback stream queries.
 pub struct QueryPool {
-    // LEGACY: removed once tess records through Encoder (raw handle for legacy recording).
-    #[doc(hidden)]
-    pub raw: vk::QueryPool,
+    pub(crate) raw: vk::QueryPool,
     pub ty: vk::QueryType,
     pub count: u32,
     pub(crate) name: String,
@@ -130,17 +127,6 @@ impl QueryPool {
         &self.name
     }
 
-    // LEGACY: removed once tess records through Encoder (use Encoder::reset_queries).
-    #[doc(hidden)]
-    pub fn cmd_reset(&self, cmd: vk::CommandBuffer) {
-        // SAFETY: cmd is recording outside a render pass.
-        unsafe {
-            self.device
-                .raw
-                .cmd_reset_query_pool(cmd, self.raw, 0, self.count)
-        };
-    }
-
     pub(crate) fn check_index(&self, call: &'static str, query: u32) -> Result<()> {
         if query < self.count {
             Ok(())
@@ -165,47 +151,6 @@ impl QueryPool {
                 found: self.ty,
             })
         }
-    }
-
-    // LEGACY: removed once tess records through Encoder (use Encoder::write_timestamp).
-    #[doc(hidden)]
-    pub fn cmd_write_timestamp(
-        &self,
-        cmd: vk::CommandBuffer,
-        stage: vk::PipelineStageFlags,
-        query: u32,
-    ) -> Result<()> {
-        self.check_type("vkCmdWriteTimestamp", vk::QueryType::TIMESTAMP)?;
-        self.check_index("vkCmdWriteTimestamp", query)?;
-        // SAFETY: cmd is recording; the index is inside the pool; the caller reset the query.
-        unsafe {
-            self.device
-                .raw
-                .cmd_write_timestamp(cmd, stage, self.raw, query)
-        };
-        Ok(())
-    }
-
-    // LEGACY: removed once tess records through Encoder (use Encoder::begin_query).
-    #[doc(hidden)]
-    pub fn cmd_begin(&self, cmd: vk::CommandBuffer, query: u32) -> Result<()> {
-        self.check_index("vkCmdBeginQuery", query)?;
-        // SAFETY: cmd is recording; the index is inside the pool; the caller reset the query.
-        unsafe {
-            self.device
-                .raw
-                .cmd_begin_query(cmd, self.raw, query, vk::QueryControlFlags::empty())
-        };
-        Ok(())
-    }
-
-    // LEGACY: removed once tess records through Encoder (use Encoder::end_query).
-    #[doc(hidden)]
-    pub fn cmd_end(&self, cmd: vk::CommandBuffer, query: u32) -> Result<()> {
-        self.check_index("vkCmdEndQuery", query)?;
-        // SAFETY: cmd is recording and the query is active (begun above by the caller).
-        unsafe { self.device.raw.cmd_end_query(cmd, self.raw, query) };
-        Ok(())
     }
 
     /// Waits for and reads `N` 64-bit values per query (ash takes one `T` per query: its size
@@ -240,41 +185,6 @@ impl QueryPool {
                 tess_evaluation_invocations: c[6],
             })
             .collect())
-    }
-
-    // LEGACY: removed once tess records through Encoder (use Encoder::begin_query_stream).
-    #[doc(hidden)]
-    pub fn cmd_begin_stream(&self, cmd: vk::CommandBuffer, query: u32, stream: u32) -> Result<()> {
-        let xfb = self.stream_pool_commands()?;
-        // SAFETY: cmd is recording; the query was reset earlier in submission order; the pool is
-        // a transform-feedback stream pool of this device.
-        unsafe {
-            xfb.cmd_begin_query_indexed(
-                cmd,
-                self.raw,
-                query,
-                vk::QueryControlFlags::empty(),
-                stream,
-            )
-        };
-        Ok(())
-    }
-
-    // LEGACY: removed once tess records through Encoder (use Encoder::end_query_stream).
-    #[doc(hidden)]
-    pub fn cmd_end_stream(&self, cmd: vk::CommandBuffer, query: u32, stream: u32) -> Result<()> {
-        let xfb = self.stream_pool_commands()?;
-        // SAFETY: matches cmd_begin_stream on the same command buffer, query and stream.
-        unsafe { xfb.cmd_end_query_indexed(cmd, self.raw, query, stream) };
-        Ok(())
-    }
-
-    fn stream_pool_commands(&self) -> Result<&ash::ext::transform_feedback::Device> {
-        self.check_type(
-            "vkCmdBeginQueryIndexedEXT",
-            vk::QueryType::TRANSFORM_FEEDBACK_STREAM_EXT,
-        )?;
-        self.device.transform_feedback()
     }
 
     /// Waits for and reads every query's (primitives written, primitives needed).

@@ -44,15 +44,6 @@ struct FrameSync {
     cmd: vk::CommandBuffer,
 }
 
-// LEGACY: removed once tess records through Encoder (use Swapchain::acquire and SwapchainFrame).
-#[doc(hidden)]
-pub struct Frame {
-    pub cmd: vk::CommandBuffer,
-    pub slot: usize,
-    pub image_index: u32,
-    pub extent: vk::Extent2D,
-}
-
 /// Drop order: wait idle, per-image objects (views, depth, semaphores), swapchain, frame sync,
 /// command pool, surface; the instance Arc last.
 pub struct Swapchain {
@@ -101,19 +92,6 @@ impl Swapchain {
         // SAFETY: the handles come from `window`, which the swapchain keeps (as `_window`) until
         // after it destroyed the surface.
         unsafe { Self::create(device, display, handle, extent, Some(window)) }
-    }
-
-    // LEGACY: removed once the viewer uses Swapchain::for_window. The caller keeps the window
-    // alive until the swapchain is dropped, an obligation this safe function cannot check.
-    #[doc(hidden)]
-    pub fn new(
-        device: &Device,
-        display: RawDisplayHandle,
-        window: RawWindowHandle,
-        extent: vk::Extent2D,
-    ) -> Result<Self> {
-        // SAFETY: legacy contract (see above): the viewer drops the swapchain before the window.
-        unsafe { Self::create(device, display, window, extent, None) }
     }
 
     /// # Safety
@@ -633,163 +611,6 @@ impl Swapchain {
             height: extent.height,
             pixels,
         })
-    }
-
-    // LEGACY: removed once tess records through Encoder (use Swapchain::acquire).
-    #[doc(hidden)]
-    pub fn begin_frame(&mut self) -> Result<Option<Frame>> {
-        let Some((slot, image_index)) = self.acquire_image()? else {
-            return Ok(None);
-        };
-        let sync = &self.frames[slot];
-        // SAFETY: the fence is signalled and unused (waited for); the command buffer was reset.
-        unsafe {
-            self.device
-                .raw
-                .reset_fences(&[sync.in_flight])
-                .ctx("vkResetFences")?;
-            self.device
-                .raw
-                .begin_command_buffer(
-                    sync.cmd,
-                    &vk::CommandBufferBeginInfo::default()
-                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-                )
-                .ctx("vkBeginCommandBuffer")?;
-        }
-        Ok(Some(Frame {
-            cmd: sync.cmd,
-            slot,
-            image_index,
-            extent: self.extent,
-        }))
-    }
-
-    // LEGACY: removed once tess records through Encoder (use SwapchainFrame::begin_frame_rendering).
-    #[doc(hidden)]
-    pub fn cmd_begin_rendering(&self, frame: &Frame, clear: [f32; 4]) -> Result<()> {
-        let Some(depth) = self.depth.as_ref() else {
-            return Err(VkError::Surface("the swapchain has no depth image".into()));
-        };
-        let i = frame.image_index as usize;
-        // SAFETY: legacy contract: the frame's command buffer is recording outside a scope; the
-        // images live until the frame's fence (rebuild and drop wait for the device).
-        unsafe {
-            crate::encoder::record_begin_rendering(
-                &self.device,
-                frame.cmd,
-                (self.images[i], self.views[i]),
-                (depth.raw, depth.view),
-                frame.extent,
-                clear,
-            )
-        };
-        Ok(())
-    }
-
-    // LEGACY: removed once tess records through Encoder (use SwapchainFrame::present).
-    #[doc(hidden)]
-    pub fn end_frame(&mut self, frame: Frame, screenshot: bool) -> Result<Option<Rgba8>> {
-        let device = self.device.clone();
-        let i = frame.image_index as usize;
-        // SAFETY: legacy contract: rendering was begun by cmd_begin_rendering on this buffer.
-        unsafe { device.raw.cmd_end_rendering(frame.cmd) };
-        if screenshot && !self.screenshots {
-            // Still submit and present what was rendered, so the swapchain stays consistent.
-            self.end_frame(frame, false)?;
-            return Err(VkError::Unsupported {
-                device: device.info.name.clone(),
-                what: "TRANSFER_SRC usage on this surface's swapchain images (screenshots)",
-            });
-        }
-        let image = self.images[i];
-        let readback = if screenshot {
-            let buffer = Buffer::new(
-                &device,
-                &BufferDesc {
-                    name: "screenshot readback",
-                    size: frame.extent.width as u64 * frame.extent.height as u64 * 4,
-                    usage: vk::BufferUsageFlags::TRANSFER_DST,
-                    location: MemoryLocation::GpuToCpu,
-                },
-            )?;
-            // SAFETY: outside a scope; the image has TRANSFER_SRC usage (checked above).
-            unsafe {
-                record_copy_to_buffer(
-                    &device,
-                    frame.cmd,
-                    image,
-                    vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                    frame.extent,
-                    buffer.raw,
-                );
-                transition(
-                    &device.raw,
-                    frame.cmd,
-                    image,
-                    vk::ImageAspectFlags::COLOR,
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    vk::ImageLayout::PRESENT_SRC_KHR,
-                );
-            }
-            Some(buffer)
-        } else {
-            // SAFETY: outside a scope; the image is in COLOR_ATTACHMENT_OPTIMAL.
-            unsafe {
-                transition(
-                    &device.raw,
-                    frame.cmd,
-                    image,
-                    vk::ImageAspectFlags::COLOR,
-                    vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                    vk::ImageLayout::PRESENT_SRC_KHR,
-                )
-            };
-            None
-        };
-        let sync = &self.frames[frame.slot];
-        // SAFETY: recording began in begin_frame.
-        unsafe { device.raw.end_command_buffer(frame.cmd) }.ctx("vkEndCommandBuffer")?;
-        let wait = [(
-            sync.image_available,
-            vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT,
-            0,
-        )];
-        let signal = [self.render_finished[i]];
-        // SAFETY: legacy contract: what the frame recorded lives until its fence; semaphores as
-        // in present_frame.
-        let serial = unsafe { device.submit(&[frame.cmd], &wait, &signal, sync.in_flight) }?;
-        let swapchains = [self.raw];
-        let indices = [frame.image_index];
-        let present = vk::PresentInfoKHR::default()
-            .wait_semaphores(&signal)
-            .swapchains(&swapchains)
-            .image_indices(&indices);
-        {
-            let _q = device
-                .queue_lock
-                .lock()
-                .map_err(|_| VkError::LockPoisoned { what: "queue" })?;
-            // SAFETY: the image was acquired in begin_frame and rendered above.
-            match unsafe { self.loader.queue_present(device.queue, &present) } {
-                Ok(false) => {}
-                Ok(true) | Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => self.needs_rebuild = true,
-                Err(e) => {
-                    return Err(VkError::Call {
-                        call: "vkQueuePresentKHR",
-                        result: e,
-                    })
-                }
-            }
-        }
-        self.frame_index += 1;
-        match readback {
-            Some(buffer) => {
-                device.wait_serial(serial)?;
-                Ok(Some(self.screenshot_pixels(&buffer, frame.extent)?))
-            }
-            None => Ok(None),
-        }
     }
 }
 

@@ -1,7 +1,7 @@
 //! Offscreen render target: RGBA8 color + 32-bit float depth, read back to an RGBA8 image.
 use crate::buffer::{Buffer, BufferDesc};
 use crate::device::Device;
-use crate::encoder::{record_begin_rendering, record_copy_to_buffer};
+
 use crate::error::{Result, VkError};
 use crate::image::{Image, ImageDesc};
 use ash::vk;
@@ -91,56 +91,6 @@ impl OffscreenTarget {
             depth,
             extent,
         })
-    }
-
-    // LEGACY: removed once tess records through Encoder (use Encoder::begin_offscreen).
-    #[doc(hidden)]
-    pub fn cmd_begin(&self, device: &Device, cmd: vk::CommandBuffer, clear: [f32; 4]) {
-        // SAFETY: legacy contract: cmd is recording outside a rendering scope and the target
-        // lives until its submission completed.
-        unsafe {
-            record_begin_rendering(
-                device,
-                cmd,
-                (self.color.raw, self.color.view),
-                (self.depth.raw, self.depth.view),
-                self.extent,
-                clear,
-            )
-        }
-    }
-
-    // LEGACY: removed once tess records through Encoder (use Encoder::end_offscreen_and_copy).
-    #[doc(hidden)]
-    pub fn cmd_end_and_copy(&self, device: &Device, cmd: vk::CommandBuffer, readback: &Buffer) {
-        // SAFETY: legacy contract: rendering was begun by cmd_begin on this command buffer, and
-        // readback is this target's readback_buffer.
-        unsafe {
-            device.raw.cmd_end_rendering(cmd);
-            record_copy_to_buffer(
-                device,
-                cmd,
-                self.color.raw,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                self.extent,
-                readback.raw,
-            );
-        }
-        let barrier = vk::MemoryBarrier::default()
-            .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-            .dst_access_mask(vk::AccessFlags::HOST_READ);
-        // SAFETY: cmd is recording.
-        unsafe {
-            device.raw.cmd_pipeline_barrier(
-                cmd,
-                vk::PipelineStageFlags::TRANSFER,
-                vk::PipelineStageFlags::HOST,
-                vk::DependencyFlags::empty(),
-                &[barrier],
-                &[],
-                &[],
-            )
-        };
     }
 
     pub fn readback_buffer(&self, device: &Device) -> Result<Buffer> {

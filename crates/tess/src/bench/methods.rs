@@ -135,7 +135,8 @@ fn technique_rows_named(
     ctx: &MethodContext<'_>,
     info: &'static TechniqueInfo,
 ) -> Result<Vec<Box<dyn BenchMethod>>> {
-    let mut rows: Vec<Box<dyn BenchMethod>> = vec![Box::new(TechniqueMethod::new(ctx, info, false)?)];
+    let mut rows: Vec<Box<dyn BenchMethod>> =
+        vec![Box::new(TechniqueMethod::new(ctx, info, false)?)];
     if info.features.animation {
         rows.push(Box::new(TechniqueMethod::new(ctx, info, true)?));
     }
@@ -144,12 +145,10 @@ fn technique_rows_named(
 
 /// [`MethodFactory`] of the technique rows; the entry's name picks the technique.
 fn technique_rows(ctx: &MethodContext<'_>) -> Result<Vec<Box<dyn BenchMethod>>> {
-    let info = ctx
-        .technique
-        .ok_or_else(|| TessError::BenchConfig {
-            option: "--methods".into(),
-            reason: "a technique row was built without its technique".into(),
-        })?;
+    let info = ctx.technique.ok_or_else(|| TessError::BenchConfig {
+        option: "--methods".into(),
+        reason: "a technique row was built without its technique".into(),
+    })?;
     technique_rows_named(ctx, info)
 }
 
@@ -179,7 +178,9 @@ pub fn build_methods(
     let mut out = Vec::new();
     for e in entries.iter().filter(|e| names.iter().any(|n| n == e.name)) {
         let ctx = MethodContext {
-            technique: techniques::registry().iter().find(|i| i.id.name() == e.name),
+            technique: techniques::registry()
+                .iter()
+                .find(|i| i.id.name() == e.name),
             ..*ctx
         };
         out.extend((e.build)(&ctx)?);
@@ -453,22 +454,25 @@ fn evaluator_limit_positions(
     level: usize,
     options: &topology::SubdivOptions,
 ) -> Result<Vec<[f64; 3]>> {
-    let local = LocalMesh::from_refined_level(current, LimitScheme::Loop, options)
-        .map_err(|e| TessError::Mesh {
-            name: format!("Loop level {level}"),
-            source: e.into(),
+    let local =
+        LocalMesh::from_refined_level(current, LimitScheme::Loop, options).map_err(|e| {
+            TessError::Mesh {
+                name: format!("Loop level {level}"),
+                source: e.into(),
+            }
         })?;
     (0..current.num_vertices())
         .map(|v| {
-            let p = local.vertex_limit_position(v as u32).ok_or_else(|| {
-                TessError::BenchConfig {
-                    option: "--mesh".into(),
-                    reason: format!(
+            let p =
+                local
+                    .vertex_limit_position(v as u32)
+                    .ok_or_else(|| TessError::BenchConfig {
+                        option: "--mesh".into(),
+                        reason: format!(
                         "vertex {v} of level {level} has no limit mask (a semi-sharp crease is \
                          left); bench meshes must be crease-free"
                     ),
-                }
-            })?;
+                    })?;
             Ok([p[0], p[1], p[2]])
         })
         .collect()
@@ -592,12 +596,8 @@ impl BenchMethod for CpuLoopMethod {
                 camera: frame.camera,
                 ..FrameParams::default()
             };
-            self.context.write_frame(
-                0,
-                (mesh.bbox_min, mesh.bbox_max),
-                &params,
-                frame.extent,
-            )?;
+            self.context
+                .write_frame(0, (mesh.bbox_min, mesh.bbox_max), &params, frame.extent)?;
         }
         Ok(cpu_ms)
     }

@@ -284,7 +284,7 @@ pub fn parse_csv(text: &str) -> Result<Vec<BenchRow>> {
         let f = split_csv_line(line);
         if f.len() != 18 {
             return Err(TessError::Csv {
-                    line: line_no,
+                line: line_no,
                 column: "field count (expected 18)".into(),
                 value: f.len().to_string(),
             });

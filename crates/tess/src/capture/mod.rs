@@ -48,8 +48,8 @@ mod domain;
 mod soup;
 
 pub use domain::{
-    classify_open_edges, face_corner_uv, face_edges_at, FacePoint, OpenEdgeClasses,
-    PatchFaceTable, PatchToFace,
+    classify_open_edges, face_corner_uv, face_edges_at, FacePoint, OpenEdgeClasses, PatchFaceTable,
+    PatchToFace,
 };
 pub use soup::{
     CaptureRecord, CapturedSoup, EdgeReport, OpenEdge, WeldedMesh, Winding, CAPTURE_STRIDE,
@@ -117,7 +117,7 @@ impl Capturer {
     /// A capturer for `ctx`'s device; a typed error ([`vk_core::VkError`]) on a device
     /// without transform feedback, before any work.
     pub fn new(ctx: &Context) -> Result<Self> {
-        ctx.device().transform_feedback()?;
+        ctx.device().require_transform_feedback()?;
         QueryPool::transform_feedback_stream(ctx.device(), "capture query probe", 1)?;
         Ok(Self::default())
     }
@@ -222,7 +222,8 @@ impl Capturer {
                 )
             })
             .collect::<std::result::Result<Vec<_>, _>>()?;
-        let query = QueryPool::transform_feedback_stream(&device, "capture primitives", arrays as u32)?;
+        let query =
+            QueryPool::transform_feedback_stream(&device, "capture primitives", arrays as u32)?;
         let counts = device.submit_once(|enc| -> Result<DrawCounts> {
             enc.reset_queries(&query);
             ctx.record_pre_pass(enc, technique, 0)?;
@@ -428,4 +429,3 @@ mod tests {
         assert_eq!(face_edges_at(5, [p.u, p.v]), vec![0, 4], "corner 0");
     }
 }
-

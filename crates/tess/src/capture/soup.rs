@@ -193,4 +193,3 @@ impl From<std::io::Error> for ObjWriteError {
         ObjWriteError::Io(e)
     }
 }
-

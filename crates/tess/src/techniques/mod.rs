@@ -80,10 +80,7 @@ pub fn registry() -> &'static [TechniqueInfo] {
 
 /// The registry entry of `id`.
 pub fn info(id: TechniqueId) -> &'static TechniqueInfo {
-    REGISTRY
-        .iter()
-        .find(|i| i.id == id)
-        .unwrap_or(&REGISTRY[0])
+    REGISTRY.iter().find(|i| i.id == id).unwrap_or(&REGISTRY[0])
 }
 
 /// The techniques that have a feature, by name, for messages ("needs --method bft").

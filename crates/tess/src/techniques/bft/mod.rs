@@ -42,7 +42,6 @@ use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Device, Encoder, MemoryLoca
 /// Default maximum table level: 32 segments per level-1 edge, 64 per base edge.
 pub const DEFAULT_TABLE_LEVEL: u32 = 5;
 
-
 const STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
     vk::ShaderStageFlags::COMPUTE.as_raw()
         | vk::ShaderStageFlags::VERTEX.as_raw()
@@ -201,13 +200,12 @@ impl Bft {
             });
         }
         let (loop_mesh, fans, note) = loop_control_mesh(mesh, &options.name);
-        let bft =
-            prepare_loop_bft(&loop_mesh, table_level, options.tangents).map_err(|e| {
-                TessError::Mesh {
-                    name: options.name.clone(),
-                    source: e.into(),
-                }
-            })?;
+        let bft = prepare_loop_bft(&loop_mesh, table_level, options.tangents).map_err(|e| {
+            TessError::Mesh {
+                name: options.name.clone(),
+                source: e.into(),
+            }
+        })?;
         let gpu = GpuBft::new(&bft)?;
         let frames = ctx.frames_in_flight();
         ctx.ensure_set_layout(TechniqueId::Bft, &SET_BINDINGS)?;
