@@ -11,11 +11,11 @@ pub enum TopologyError {
         source: std::io::Error,
     },
     /// A line of OBJ text could not be understood.
-    #[error("{file}:{line}: {message}")]
+    #[error("{file}:{line}: {kind}")]
     Parse {
         file: String,
         line: usize,
-        message: String,
+        kind: ObjSyntax,
     },
     /// A validation error found in a named file (the inner error says what and where).
     #[error("{file}: {source}")]
@@ -150,4 +150,62 @@ impl TopologyError {
             },
         }
     }
+}
+
+/// What is wrong on an OBJ line ([`TopologyError::Parse`] names the file and line).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ObjSyntax {
+    #[error("'{statement}' needs at least {min} numbers, found {found}")]
+    TooFewNumbers {
+        statement: &'static str,
+        min: usize,
+        found: usize,
+    },
+    #[error("'{statement}': '{word}' is not a number")]
+    NotANumber {
+        statement: &'static str,
+        word: String,
+    },
+    #[error("face without vertices")]
+    FaceWithoutVertices,
+    #[error("bad face index '{word}'")]
+    BadFaceIndex { word: String },
+    #[error("face index 0 in '{word}' (OBJ is 1-based)")]
+    ZeroFaceIndex { word: String },
+    #[error("relative index '{word}' points before the start")]
+    IndexBeforeStart { word: String },
+    #[error("face corner '{word}' has no vertex")]
+    CornerWithoutVertex { word: String },
+    #[error("texture index {index} out of range")]
+    TextureIndexOutOfRange { index: i64 },
+    #[error("normal index {index} out of range")]
+    NormalIndexOutOfRange { index: i64 },
+    #[error("tag line needs a name and counts")]
+    TagWithoutCounts,
+    #[error("bad tag counts '{counts}'")]
+    BadTagCounts { counts: String },
+    #[error("tag '{tag}': counts '{counts}' do not match the values")]
+    TagCountMismatch { tag: String, counts: String },
+    #[error("tag '{tag}': bad integer")]
+    BadTagInteger { tag: String },
+    #[error("tag '{tag}': bad float")]
+    BadTagFloat { tag: String },
+    #[error("tag '{tag}': negative index {index}")]
+    NegativeTagIndex { tag: String, index: i64 },
+    #[error("tag '{tag}' needs a sharpness value")]
+    MissingSharpness { tag: String },
+    #[error("tag '{tag}': {values} values for {elements} elements")]
+    SharpnessCount {
+        tag: String,
+        values: usize,
+        elements: usize,
+    },
+    #[error("tag '{tag}': sharpness {value} is not finite")]
+    NonFiniteSharpness { tag: String, value: f32 },
+    #[error("crease tag needs vertex pairs")]
+    CreaseNeedsPairs,
+    #[error("corner tag needs vertices")]
+    CornerNeedsVertices,
+    #[error("{option}: bad value {value}")]
+    BadOptionValue { option: &'static str, value: String },
 }

@@ -230,6 +230,19 @@ fn axpy(out: &mut [f64], w: f64, x: &[f64]) {
     }
 }
 
+/// `dim` values for each of `vertices` vertices.
+fn check_point_count(points: &[f64], dim: usize, vertices: usize) -> Result<(), EvalError> {
+    if points.len() == vertices * dim {
+        Ok(())
+    } else {
+        Err(EvalError::PointCount {
+            count: points.len(),
+            dim,
+            vertices,
+        })
+    }
+}
+
 fn flatten(positions: &[[f64; 3]]) -> Vec<f64> {
     positions.iter().flat_map(|p| p.iter().copied()).collect()
 }
@@ -244,13 +257,7 @@ impl LocalMesh {
         points: Vec<f64>,
     ) -> Result<LocalMesh, EvalError> {
         let vertices = level.topology.num_vertices();
-        if points.len() != vertices * dim {
-            return Err(EvalError::PointCount {
-                count: points.len(),
-                dim,
-                vertices,
-            });
-        }
+        check_point_count(&points, dim, vertices)?;
         let fans = (0..vertices as u32)
             .map(|v| build_fan(&level.topology, v))
             .collect();
@@ -285,14 +292,7 @@ impl LocalMesh {
 
     /// The same mesh carrying other per-vertex data (`dim` values per vertex).
     pub fn with_points(&self, dim: usize, points: Vec<f64>) -> Result<LocalMesh, EvalError> {
-        let vertices = self.num_vertices();
-        if points.len() != vertices * dim {
-            return Err(EvalError::PointCount {
-                count: points.len(),
-                dim,
-                vertices,
-            });
-        }
+        check_point_count(&points, dim, self.num_vertices())?;
         Ok(LocalMesh {
             dim,
             points,

@@ -12,7 +12,7 @@ pub mod refine;
 pub mod sdc;
 pub mod stencil;
 
-pub use error::{TagKind, TopologyError};
+pub use error::{ObjSyntax, TagKind, TopologyError};
 pub use mesh::{
     BoundaryInterpolation, ControlMesh, CreaseMethod, EdgeCrease, SubdivOptions, Topology,
     TriangleSubdivision, VertexCorner,

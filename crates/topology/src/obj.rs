@@ -5,7 +5,7 @@
 //! vertices by their index in the file, and refinement works in f64. Faces keep their size
 //! (nothing is triangulated).
 
-use crate::error::{TagKind, TopologyError};
+use crate::error::{ObjSyntax, TagKind, TopologyError};
 use crate::mesh::{
     BoundaryInterpolation, ControlMesh, CreaseMethod, EdgeCrease, TriangleSubdivision, VertexCorner,
 };
@@ -35,10 +35,10 @@ pub fn parse_obj(text: &str, name: &str) -> Result<ControlMesh, TopologyError> {
     let mut face_lines: Vec<usize> = Vec::new();
     mesh.face_offsets.push(0);
 
-    let perr = |line: usize, message: String| TopologyError::Parse {
+    let perr = |line: usize, kind: ObjSyntax| TopologyError::Parse {
         file: name.to_string(),
         line,
-        message,
+        kind,
     };
 
     for (lineno, raw) in text.lines().enumerate() {
@@ -65,7 +65,7 @@ pub fn parse_obj(text: &str, name: &str) -> Result<ControlMesh, TopologyError> {
             }
             "f" => {
                 if rest.is_empty() {
-                    return Err(perr(line, "face without vertices".into()));
+                    return Err(perr(line, ObjSyntax::FaceWithoutVertices));
                 }
                 for word in &rest {
                     corners.push(parse_corner(
@@ -110,14 +110,17 @@ pub fn parse_obj(text: &str, name: &str) -> Result<ControlMesh, TopologyError> {
                 let t = t.unwrap_or(-1);
                 let uv = usize::try_from(t).ok().and_then(|t| uvs.get(t));
                 corner_uvs.push(*uv.ok_or_else(|| {
-                    perr(face_line, format!("texture index {} out of range", t + 1))
+                    perr(
+                        face_line,
+                        ObjSyntax::TextureIndexOutOfRange { index: t + 1 },
+                    )
                 })?);
             }
             if all_n {
                 let n = n.unwrap_or(-1);
                 let nn = usize::try_from(n).ok().and_then(|n| normals.get(n));
                 corner_normals.push(*nn.ok_or_else(|| {
-                    perr(face_line, format!("normal index {} out of range", n + 1))
+                    perr(face_line, ObjSyntax::NormalIndexOutOfRange { index: n + 1 })
                 })?);
             }
         }
@@ -133,33 +136,41 @@ pub fn parse_obj(text: &str, name: &str) -> Result<ControlMesh, TopologyError> {
     Ok(mesh)
 }
 
-fn parse_floats<E: Fn(usize, String) -> TopologyError>(
+fn parse_floats<E: Fn(usize, ObjSyntax) -> TopologyError>(
     words: &[&str],
     min: usize,
     line: usize,
-    what: &str,
+    what: &'static str,
     perr: &E,
 ) -> Result<Vec<f64>, TopologyError> {
     if words.len() < min {
         return Err(perr(
             line,
-            format!(
-                "'{what}' needs at least {min} numbers, found {}",
-                words.len()
-            ),
+            ObjSyntax::TooFewNumbers {
+                statement: what,
+                min,
+                found: words.len(),
+            },
         ));
     }
     words
         .iter()
         .map(|w| {
-            w.parse::<f64>()
-                .map_err(|_| perr(line, format!("'{what}': '{w}' is not a number")))
+            w.parse::<f64>().map_err(|_| {
+                perr(
+                    line,
+                    ObjSyntax::NotANumber {
+                        statement: what,
+                        word: w.to_string(),
+                    },
+                )
+            })
         })
         .collect()
 }
 
 /// Parse `v`, `v/t`, `v//n` or `v/t/n`; negative indices count back from the current end.
-fn parse_corner<E: Fn(usize, String) -> TopologyError>(
+fn parse_corner<E: Fn(usize, ObjSyntax) -> TopologyError>(
     word: &str,
     counts: [usize; 3],
     line: usize,
@@ -172,32 +183,30 @@ fn parse_corner<E: Fn(usize, String) -> TopologyError>(
             Some(p) => {
                 let i: i64 = p
                     .parse()
-                    .map_err(|_| perr(line, format!("bad face index '{word}'")))?;
+                    .map_err(|_| perr(line, ObjSyntax::BadFaceIndex { word: word.into() }))?;
                 if i == 0 {
-                    return Err(perr(
-                        line,
-                        format!("face index 0 in '{word}' (OBJ is 1-based)"),
-                    ));
+                    return Err(perr(line, ObjSyntax::ZeroFaceIndex { word: word.into() }));
                 }
                 let r = if i > 0 { i - 1 } else { counts[k] as i64 + i };
                 if r < 0 {
                     return Err(perr(
                         line,
-                        format!("relative index '{word}' points before the start"),
+                        ObjSyntax::IndexBeforeStart { word: word.into() },
                     ));
                 }
                 Ok(Some(r))
             }
         }
     };
-    let v = idx(0)?.ok_or_else(|| perr(line, format!("face corner '{word}' has no vertex")))?;
+    let v =
+        idx(0)?.ok_or_else(|| perr(line, ObjSyntax::CornerWithoutVertex { word: word.into() }))?;
     let t = idx(1)?;
     let n = idx(2)?;
     Ok((v, t, n))
 }
 
 /// `t <name> <nints>/<nfloats>/<nstrings> ints... floats... strings...`
-fn parse_tag<E: Fn(usize, String) -> TopologyError>(
+fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
     words: &[&str],
     line: usize,
     file: &str,
@@ -205,17 +214,27 @@ fn parse_tag<E: Fn(usize, String) -> TopologyError>(
     perr: &E,
 ) -> Result<(), TopologyError> {
     let (Some(&tag), Some(&counts)) = (words.first(), words.get(1)) else {
-        return Err(perr(line, "tag line needs a name and counts".into()));
+        return Err(perr(line, ObjSyntax::TagWithoutCounts));
     };
     let nums: Vec<usize> = counts
         .split('/')
         .map(|c| c.parse::<usize>())
         .collect::<Result<_, _>>()
-        .map_err(|_| perr(line, format!("bad tag counts '{counts}'")))?;
+        .map_err(|_| {
+            perr(
+                line,
+                ObjSyntax::BadTagCounts {
+                    counts: counts.into(),
+                },
+            )
+        })?;
     if nums.len() != 3 || words.len() < 2 + nums[0] + nums[1] + nums[2] {
         return Err(perr(
             line,
-            format!("tag '{tag}': counts '{counts}' do not match the values"),
+            ObjSyntax::TagCountMismatch {
+                tag: tag.into(),
+                counts: counts.into(),
+            },
         ));
     }
     let vals = &words[2..];
@@ -223,33 +242,48 @@ fn parse_tag<E: Fn(usize, String) -> TopologyError>(
         .iter()
         .map(|w| w.parse::<i64>())
         .collect::<Result<_, _>>()
-        .map_err(|_| perr(line, format!("tag '{tag}': bad integer")))?;
+        .map_err(|_| perr(line, ObjSyntax::BadTagInteger { tag: tag.into() }))?;
     let floats: Vec<f32> = vals[nums[0]..nums[0] + nums[1]]
         .iter()
         .map(|w| w.parse::<f32>())
         .collect::<Result<_, _>>()
-        .map_err(|_| perr(line, format!("tag '{tag}': bad float")))?;
+        .map_err(|_| perr(line, ObjSyntax::BadTagFloat { tag: tag.into() }))?;
     let strings = &vals[nums[0] + nums[1]..nums[0] + nums[1] + nums[2]];
     let to_u32 = |i: i64| -> Result<u32, TopologyError> {
-        u32::try_from(i).map_err(|_| perr(line, format!("tag '{tag}': negative index {i}")))
+        u32::try_from(i).map_err(|_| {
+            perr(
+                line,
+                ObjSyntax::NegativeTagIndex {
+                    tag: tag.into(),
+                    index: i,
+                },
+            )
+        })
     };
     // One float for all elements, or one per element.
     let sharp_for = |k: usize, n: usize| -> Result<f32, TopologyError> {
         let s = match floats.len() {
-            0 => return Err(perr(line, format!("tag '{tag}' needs a sharpness value"))),
+            0 => return Err(perr(line, ObjSyntax::MissingSharpness { tag: tag.into() })),
             1 => floats[0],
             m if m == n => floats[k],
             _ => {
                 return Err(perr(
                     line,
-                    format!("tag '{tag}': {} values for {n} elements", floats.len()),
+                    ObjSyntax::SharpnessCount {
+                        tag: tag.into(),
+                        values: floats.len(),
+                        elements: n,
+                    },
                 ))
             }
         };
         if !s.is_finite() {
             return Err(perr(
                 line,
-                format!("tag '{tag}': sharpness {s} is not finite"),
+                ObjSyntax::NonFiniteSharpness {
+                    tag: tag.into(),
+                    value: s,
+                },
             ));
         }
         Ok(s.max(0.0))
@@ -257,7 +291,7 @@ fn parse_tag<E: Fn(usize, String) -> TopologyError>(
     match tag {
         "crease" => {
             if ints.len() < 2 || ints.len() & 1 != 0 {
-                return Err(perr(line, "crease tag needs vertex pairs".into()));
+                return Err(perr(line, ObjSyntax::CreaseNeedsPairs));
             }
             let pairs = ints.len() / 2;
             for k in 0..pairs {
@@ -269,7 +303,7 @@ fn parse_tag<E: Fn(usize, String) -> TopologyError>(
         }
         "corner" => {
             if ints.is_empty() {
-                return Err(perr(line, "corner tag needs vertices".into()));
+                return Err(perr(line, ObjSyntax::CornerNeedsVertices));
             }
             for (k, &v) in ints.iter().enumerate() {
                 mesh.corners.push(VertexCorner {
@@ -286,7 +320,10 @@ fn parse_tag<E: Fn(usize, String) -> TopologyError>(
                 other => {
                     return Err(perr(
                         line,
-                        format!("interpolateboundary: bad value {other:?}"),
+                        ObjSyntax::BadOptionValue {
+                            option: "interpolateboundary",
+                            value: format!("{other:?}"),
+                        },
                     ))
                 }
             }
@@ -295,14 +332,30 @@ fn parse_tag<E: Fn(usize, String) -> TopologyError>(
             mesh.options.crease_method = match strings.first().copied() {
                 Some("chaikin") => CreaseMethod::Chaikin,
                 Some("normal") | Some("uniform") => CreaseMethod::Uniform,
-                other => return Err(perr(line, format!("creasemethod: bad value {other:?}"))),
+                other => {
+                    return Err(perr(
+                        line,
+                        ObjSyntax::BadOptionValue {
+                            option: "creasemethod",
+                            value: format!("{other:?}"),
+                        },
+                    ))
+                }
             }
         }
         "smoothtriangles" => {
             let smooth = match (strings.first().copied(), ints.first()) {
                 (Some("smooth"), _) | (None, Some(1)) => true,
                 (Some("catmark"), _) | (None, Some(0)) => false,
-                other => return Err(perr(line, format!("smoothtriangles: bad value {other:?}"))),
+                other => {
+                    return Err(perr(
+                        line,
+                        ObjSyntax::BadOptionValue {
+                            option: "smoothtriangles",
+                            value: format!("{other:?}"),
+                        },
+                    ))
+                }
             };
             mesh.options.triangle_subdivision = if smooth {
                 TriangleSubdivision::Smooth

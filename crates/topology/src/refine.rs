@@ -27,8 +27,9 @@
 //!   masks see only part of their neighbourhood and are not those of a uniform refinement.
 //!   The step returns [`ChildMaps`]: parent → child (vertex-, edge-, face-vertex and first child
 //!   face per parent component) and child → parent ([`ChildOrigin`] per child vertex, parent
-//!   face per child face). Selecting every face reproduces [`refine_level`] exactly (same
-//!   numbering, same stencils).
+//!   face per child face). Selecting every face of a mesh without isolated vertices reproduces
+//!   [`refine_level`] exactly (same numbering, same stencils); isolated vertices belong to no
+//!   face, so a sparse step does not carry them.
 //!
 //! # Numbering of a child level (all schemes but Doo-Sabin)
 //! Vertices: first one vertex-vertex per refined parent vertex, then one edge-vertex per refined
