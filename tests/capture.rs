@@ -445,7 +445,7 @@ fn capture_without_transform_feedback_is_a_typed_error() {
     });
     assert!(!gpu.device().has_transform_feedback());
     let mut ctx = Context::offscreen(gpu.device()).unwrap();
-    let e = Capturer::new(&ctx).err().expect("no capturer");
+    let e = Capturer::new(&ctx).expect_err("no capturer");
     assert!(
         matches!(
             e,

@@ -1056,8 +1056,7 @@ pub fn prepare_loop_bft(
     level: u32,
     tangents: bool,
 ) -> Result<LoopBft, EvalError> {
-    let r = crate::refine::refine_uniform(mesh, crate::sdc::Scheme::Loop, 1)
-        .map_err(|e| EvalError::Unsupported(e.to_string()))?;
+    let r = crate::refine::refine_uniform(mesh, crate::sdc::Scheme::Loop, 1)?;
     let level1 = LocalMesh::from_refined_level(r.level(1), LimitScheme::Loop, &mesh.options)?;
     let records = build_patch_records(&level1)?;
     let keys: Vec<BftKey> = records.iter().map(|r| r.key).collect();

@@ -128,10 +128,6 @@ pub enum EvalError {
     /// The mesh or a refinement step failed (names the face, edge or vertex at fault).
     #[error(transparent)]
     Topology(#[from] TopologyError),
-    /// Reserved for the GPU packing code of [`crate::bft`], which is moving to the `tess`
-    /// crate; nothing else returns it.
-    #[error("{0}")]
-    Unsupported(String),
 }
 
 /// Ordered neighbourhood of one vertex: faces CCW with the vertex's corner index in each, the
