@@ -56,32 +56,19 @@ impl PlainMesh {
     /// Uploads once into device-local memory (a static refined mesh).
     pub fn upload(device: &Device, vertices: &[Vertex], indices: &[u32]) -> Result<Self> {
         check(vertices, indices)?;
-        let (bbox_min, bbox_max) = bbox(vertices);
-        Ok(Self {
-            vertices: Buffer::with_data(
-                device,
-                "plain vertices",
-                vk::BufferUsageFlags::VERTEX_BUFFER,
-                bytemuck::cast_slice(vertices),
-            )?,
-            indices: Buffer::with_data(
-                device,
-                "plain indices",
-                vk::BufferUsageFlags::INDEX_BUFFER,
-                bytemuck::cast_slice(indices),
-            )?,
-            index_count: indices.len() as u32,
-            vertex_count: vertices.len() as u32,
-            bbox_min,
-            bbox_max,
-        })
+        let vb = Buffer::with_data(
+            device,
+            "plain vertices",
+            vk::BufferUsageFlags::VERTEX_BUFFER,
+            bytemuck::cast_slice(vertices),
+        )?;
+        Self::with_vertex_buffer(device, vb, vertices, indices)
     }
 
     /// Vertices in host-visible memory, rewritten every frame by [`PlainMesh::write_vertices`]
     /// (an animated mesh re-subdivided on the CPU); the connectivity does not change.
     pub fn dynamic(device: &Device, vertices: &[Vertex], indices: &[u32]) -> Result<Self> {
         check(vertices, indices)?;
-        let (bbox_min, bbox_max) = bbox(vertices);
         let mut vb = Buffer::new(
             device,
             &BufferDesc {
@@ -92,6 +79,17 @@ impl PlainMesh {
             },
         )?;
         vb.write(0, bytemuck::cast_slice(vertices))?;
+        Self::with_vertex_buffer(device, vb, vertices, indices)
+    }
+
+    /// The mesh around an uploaded vertex buffer (checked vertices and indices).
+    fn with_vertex_buffer(
+        device: &Device,
+        vb: Buffer,
+        vertices: &[Vertex],
+        indices: &[u32],
+    ) -> Result<Self> {
+        let (bbox_min, bbox_max) = bbox(vertices);
         Ok(Self {
             vertices: vb,
             indices: Buffer::with_data(
