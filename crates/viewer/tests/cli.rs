@@ -213,15 +213,7 @@ fn window_without_screenshot_exits_validation_clean() {
     for method in ["flat", "pn", "bft"] {
         let o = tessera(
             &[
-                "view",
-                "--method",
-                method,
-                "--level",
-                "4",
-                "--size",
-                "160x120",
-                "--frames",
-                "5",
+                "view", "--method", method, "--level", "4", "--size", "160x120", "--frames", "5",
             ],
             &[("DISPLAY", &display), ("WAYLAND_DISPLAY", "")],
         );
