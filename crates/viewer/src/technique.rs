@@ -170,8 +170,9 @@ impl SurfaceArgs {
             }
             let names: Vec<&str> = refused.iter().map(|u| u.name).collect();
             bail!(
-                "{} only apply to --method {} (not to --method {technique})",
+                "{} only {} to --method {} (not to --method {technique})",
                 names.join(", "),
+                if names.len() == 1 { "applies" } else { "apply" },
                 takers.join(" or --method ")
             );
         }
