@@ -7,7 +7,11 @@
 use std::collections::HashMap;
 use tess::techniques::bft::layout::{owner_face, pack_owner, GpuBft};
 use topology::bft::{prepare_loop_bft, tessellator_interior_points, LoopBft};
-use topology::{load_obj, ControlMesh};
+use topology::load_obj;
+
+#[path = "../../../tests/support/loop_grid.rs"]
+mod loop_grid;
+use loop_grid::grid_mesh;
 
 const DATA: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -237,35 +241,6 @@ fn every_crease_free_loop_shape_is_covered() {
         assert_eq!(bft.records.len(), 4 * mesh.num_faces(), "{name}");
         GpuBft::new(&bft).unwrap_or_else(|e| panic!("{name}: {e}"));
     }
-}
-
-/// The ridged grid of topology's BFT tests (both diagonals, boundary corners).
-fn grid_mesh(m: u32) -> ControlMesh {
-    let mut pos = Vec::new();
-    for y in 0..=m {
-        for x in 0..=m {
-            let (fx, fy) = (x as f64, y as f64);
-            pos.push([fx, fy, 0.3 * (0.7 * fx).sin() * (0.5 * fy).cos()]);
-        }
-    }
-    let id = |x: u32, y: u32| y * (m + 1) + x;
-    let mut faces = Vec::new();
-    for y in 0..m {
-        for x in 0..m {
-            let (a, b, c, d) = (id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1));
-            let corner_ac = (x == 0 && y == 0) || (x == m - 1 && y == m - 1);
-            let corner_bd = (x == m - 1 && y == 0) || (x == 0 && y == m - 1);
-            let diag_ac = corner_ac || (!corner_bd && (x * 7 + y * 13 + x * y) % 3 != 0);
-            if diag_ac {
-                faces.push(vec![a, b, c]);
-                faces.push(vec![a, c, d]);
-            } else {
-                faces.push(vec![a, b, d]);
-                faces.push(vec![b, c, d]);
-            }
-        }
-    }
-    ControlMesh::from_polygons(pos, &faces)
 }
 
 /// One header per patch with its six owners, every ring back to back, and a header that

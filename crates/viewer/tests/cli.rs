@@ -3,6 +3,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+#[path = "../../../tests/support/xvfb.rs"]
+mod xvfb;
+
 fn tessera(args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_tessera"));
     c.args(args);
@@ -143,44 +146,6 @@ fn info_lists_devices_and_choice() {
     );
 }
 
-/// Starts Xvfb on a free display; None when Xvfb is not installed (the README's test command
-/// installs it, and CI sets TESSERA_REQUIRE_XVFB=1 so a missing Xvfb fails there).
-fn xvfb() -> Option<(std::process::Child, String)> {
-    for n in 90..120 {
-        if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
-            || Path::new(&format!("/tmp/.X{n}-lock")).exists()
-        {
-            continue;
-        }
-        let display = format!(":{n}");
-        let child = Command::new("Xvfb")
-            .args([&display, "-screen", "0", "640x480x24", "-nolisten", "tcp"])
-            .spawn()
-            .ok()?;
-        for _ in 0..100 {
-            if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
-                return Some((child, display));
-            }
-            std::thread::sleep(std::time::Duration::from_millis(50));
-        }
-        return Some((child, display));
-    }
-    None
-}
-
-/// [`xvfb`], or None after saying the test is skipped; fails where Xvfb is required.
-fn xvfb_or_skip() -> Option<(std::process::Child, String)> {
-    let server = xvfb();
-    if server.is_none() {
-        assert!(
-            std::env::var_os("TESSERA_REQUIRE_XVFB").is_none(),
-            "Xvfb is required here but not installed"
-        );
-        eprintln!("skipping: Xvfb not installed");
-    }
-    server
-}
-
 /// Pixels whose colour (RGB) differs by more than 24/255 in some channel.
 fn differing_pixels(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
     assert_eq!(a.dimensions(), b.dimensions());
@@ -206,7 +171,7 @@ fn differing_fraction(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
 /// VUID-vkDestroyPipeline-pipeline-00765 and friends.
 #[test]
 fn window_without_screenshot_exits_validation_clean() {
-    let Some((mut server, display)) = xvfb_or_skip() else {
+    let Some(server) = xvfb::start_or_skip(90..120) else {
         return;
     };
     let mut failures = Vec::new();
@@ -215,20 +180,19 @@ fn window_without_screenshot_exits_validation_clean() {
             &[
                 "view", "--method", method, "--level", "4", "--size", "160x120", "--frames", "5",
             ],
-            &[("DISPLAY", &display), ("WAYLAND_DISPLAY", "")],
+            &[("DISPLAY", &server.display), ("WAYLAND_DISPLAY", "")],
         );
         if !o.status.success() {
             failures.push(format!("{method}: {}", stderr(&o)));
         }
     }
-    let _ = server.kill();
-    let _ = server.wait();
+    drop(server);
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
 #[test]
 fn window_screenshot_matches_offscreen_render() {
-    let Some((mut server, display)) = xvfb_or_skip() else {
+    let Some(server) = xvfb::start_or_skip(90..120) else {
         return;
     };
     let shot = tmp("window.png");
@@ -251,10 +215,9 @@ fn window_screenshot_matches_offscreen_render() {
             &["--frames", "30", "--screenshot", shot.to_str().unwrap()],
         ]
         .concat(),
-        &[("DISPLAY", &display), ("WAYLAND_DISPLAY", "")],
+        &[("DISPLAY", &server.display), ("WAYLAND_DISPLAY", "")],
     );
-    let _ = server.kill();
-    let _ = server.wait();
+    drop(server);
     assert!(o.status.success(), "view failed: {}", stderr(&o));
     let r = tessera(
         &[
@@ -845,7 +808,7 @@ fn render_bft_patch_colours_and_animation_frames() {
 /// The window shows BFT as the offscreen renderer does, and animates without errors.
 #[test]
 fn window_shows_bft_like_offscreen_and_animates() {
-    let Some((mut server, display)) = xvfb_or_skip() else {
+    let Some(server) = xvfb::start_or_skip(90..120) else {
         return;
     };
     let shot = tmp("window_bft.png");
@@ -861,7 +824,10 @@ fn window_shows_bft_like_offscreen_and_animates() {
         "--size",
         "320x240",
     ];
-    let env = [("DISPLAY", display.as_str()), ("WAYLAND_DISPLAY", "")];
+    let env = [
+        ("DISPLAY", server.display.as_str()),
+        ("WAYLAND_DISPLAY", ""),
+    ];
     let o = tessera(
         &[
             &["view"][..],
@@ -888,8 +854,7 @@ fn window_shows_bft_like_offscreen_and_animates() {
         .concat(),
         &env,
     );
-    let _ = server.kill();
-    let _ = server.wait();
+    drop(server);
     assert!(o.status.success(), "view failed: {}", stderr(&o));
     assert!(a.status.success(), "animated view failed: {}", stderr(&a));
     let still = tmp("offscreen_bft_still.png");

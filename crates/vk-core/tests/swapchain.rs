@@ -6,8 +6,9 @@
 #[allow(dead_code)]
 mod spirv;
 
-use std::path::Path;
-use std::process::{Child, Command};
+#[path = "../../../tests/support/xvfb.rs"]
+mod xvfb;
+
 use std::sync::Arc;
 use vk_core::pipeline::{GraphicsPipelineDesc, ShaderStage};
 use vk_core::swapchain::{required_surface_extensions, SwapchainFrame};
@@ -22,38 +23,6 @@ use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::platform::x11::EventLoopBuilderExtX11;
 use winit::raw_window_handle::HasDisplayHandle;
 use winit::window::{Window, WindowId};
-
-struct Xvfb(Child);
-
-impl Drop for Xvfb {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-fn xvfb() -> Option<(Xvfb, String)> {
-    for n in 140..170 {
-        if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
-            || Path::new(&format!("/tmp/.X{n}-lock")).exists()
-        {
-            continue;
-        }
-        let display = format!(":{n}");
-        let child = Command::new("Xvfb")
-            .args([&display, "-screen", "0", "640x480x24", "-nolisten", "tcp"])
-            .spawn()
-            .ok()?;
-        for _ in 0..100 {
-            if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
-                break;
-            }
-            std::thread::sleep(std::time::Duration::from_millis(50));
-        }
-        return Some((Xvfb(child), display));
-    }
-    None
-}
 
 /// Acquires a frame (on Xvfb the surface never goes out of date or minimised, so an acquire
 /// after a rebuild succeeds at once).
@@ -199,15 +168,10 @@ impl ApplicationHandler for App {
 
 #[test]
 fn swapchain_frames_record_through_the_encoder() {
-    let Some((_server, display)) = xvfb() else {
-        assert!(
-            std::env::var_os("TESSERA_REQUIRE_XVFB").is_none(),
-            "Xvfb is required here but not installed"
-        );
-        eprintln!("skipping: Xvfb not installed");
+    let Some(server) = xvfb::start_or_skip(140..170) else {
         return;
     };
-    std::env::set_var("DISPLAY", &display);
+    std::env::set_var("DISPLAY", &server.display);
     std::env::remove_var("WAYLAND_DISPLAY");
     let event_loop = EventLoop::builder()
         .with_any_thread(true)

@@ -230,10 +230,10 @@ impl TechniqueMethod {
         })
     }
 
-    fn params(frame: &BenchFrame) -> FrameParams {
+    fn params(segments: u32, camera: Camera) -> FrameParams {
         FrameParams {
-            camera: frame.camera,
-            ..FrameParams::uniform(frame.segments as f32)
+            camera,
+            ..FrameParams::uniform(segments as f32)
         }
     }
 }
@@ -244,24 +244,14 @@ impl BenchMethod for TechniqueMethod {
     }
 
     fn skip_reason(&self, segments: u32) -> Option<String> {
-        let probe = BenchFrame {
-            index: 0,
-            warmup: true,
-            segments,
-            extent: vk::Extent2D {
-                width: 1,
-                height: 1,
-            },
-            camera: Camera::default(),
-        };
         self.technique
-            .check(&Self::params(&probe))
+            .check(&Self::params(segments, Camera::default()))
             .err()
             .map(|e| e.to_string())
     }
 
     fn begin_frame(&mut self, frame: &BenchFrame) -> Result<Option<f64>> {
-        let params = Self::params(frame);
+        let params = Self::params(frame.segments, frame.camera);
         self.context
             .prepare(self.technique.as_ref(), &params, &[crate::Pass::Shaded])?;
         let cpu = match (&self.wave, self.animated) {
@@ -285,7 +275,7 @@ impl BenchMethod for TechniqueMethod {
     }
 
     fn record<'a>(&'a self, enc: &mut Encoder<'a>, frame: &BenchFrame) -> Result<u64> {
-        let params = Self::params(frame);
+        let params = Self::params(frame.segments, frame.camera);
         let t = self.technique.as_ref();
         self.context
             .record_pass(enc, t, 0, &params, crate::Pass::Shaded)?;

@@ -171,3 +171,22 @@ pub fn build(
         notes: Vec::new(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_technique_has_its_own_registry_entry() {
+        for id in [
+            TechniqueId::Flat,
+            TechniqueId::Phong,
+            TechniqueId::Pn,
+            TechniqueId::Bft,
+        ] {
+            assert_eq!(info(id).id, id);
+            assert_eq!(id.name().parse::<TechniqueId>().unwrap(), id);
+        }
+        assert!("gregory".parse::<TechniqueId>().is_err());
+    }
+}
