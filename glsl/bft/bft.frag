@@ -1,6 +1,6 @@
 #version 450
 // Shading of BFT surfaces: as common/shade.frag, with the per-patch albedo (patch colouring mode).
-#define BFT_PUSH_CONSTANTS
+#define TECHNIQUE_PUSH_CONSTANTS
 #include "frame.glsl"
 #include "bft.glsl"
 #include "shading.glsl"

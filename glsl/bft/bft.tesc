@@ -2,7 +2,7 @@
 // Tessellation factors of a level-1 face. Every edge factor is computed from the edge's two
 // endpoints only, taken in global index order, so both faces of an edge compute the same bits
 // and the tessellator makes the same points on it: no cracks by construction.
-#define BFT_PUSH_CONSTANTS
+#define TECHNIQUE_PUSH_CONSTANTS
 #include "frame.glsl"
 #include "bft.glsl"
 layout(vertices = 1) out;

@@ -4,7 +4,7 @@
 // factors, a point of the level-L virtual mesh. Normals by subdivision shading (the same
 // weights over the level-1 limit normals, then normalised) or from the tangent tables.
 // Built in every spacing, with and without capture (glsl/manifest.toml; tese_out.glsl).
-#define BFT_PUSH_CONSTANTS
+#define TECHNIQUE_PUSH_CONSTANTS
 #include "frame.glsl"
 #include "bft.glsl"
 #include "tese_out.glsl"

@@ -14,8 +14,9 @@ layout(std140, set = FRAME_SET, binding = FRAME_UNIFORMS_BINDING) uniform Frame 
 
 // Push constant: what a draw is for, and where it starts in the frame's patch numbering.
 // Mirrors `tess::gpu::DrawPush` (std430 offsets checked against the SPIR-V by a test).
-// BFT stages define BFT_PUSH_CONSTANTS and use their own block (bft/bft.glsl).
-#ifndef BFT_PUSH_CONSTANTS
+// Techniques with their own push block (bft/bft.glsl, adaptive/adaptive.glsl) define
+// TECHNIQUE_PUSH_CONSTANTS first.
+#ifndef TECHNIQUE_PUSH_CONSTANTS
 layout(push_constant) uniform Draw {
     uint mode;         // DRAW_MODE_SHADED or DRAW_MODE_WIREFRAME
     uint first_patch;  // patch id of this draw's first patch (gl_PrimitiveID restarts per draw)

@@ -103,6 +103,7 @@ pub fn build_with(
             name: "test mesh".into(),
             table_level,
             tangents,
+            ..Default::default()
         },
     )
     .unwrap_or_else(|e| panic!("building {id}: {e}"))

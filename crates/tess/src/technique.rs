@@ -34,6 +34,7 @@ pub enum TechniqueId {
     Phong,
     Pn,
     Bft,
+    Adaptive,
 }
 
 impl TechniqueId {
@@ -44,6 +45,7 @@ impl TechniqueId {
             TechniqueId::Phong => "phong",
             TechniqueId::Pn => "pn",
             TechniqueId::Bft => "bft",
+            TechniqueId::Adaptive => "adaptive",
         }
     }
 }
@@ -64,12 +66,21 @@ pub enum PatchType {
     Quad,
     /// A level-1 Loop face evaluated from basis-function tables: one control point (the face).
     LoopBft,
+    /// A regular bicubic B-spline patch of the feature-adaptive plan (16 control points,
+    /// fetched by the TES; one control point carries the patch).
+    BSpline,
+    /// A Gregory end cap (20 control points, fetched by the TES).
+    Gregory,
+    /// A bilinear (Coons) end cap over its four canonical boundary curves.
+    Bilinear,
 }
 
 impl PatchType {
     pub fn domain(self) -> Domain {
         match self {
-            PatchType::Quad => Domain::Quad,
+            PatchType::Quad | PatchType::BSpline | PatchType::Gregory | PatchType::Bilinear => {
+                Domain::Quad
+            }
             PatchType::Triangle | PatchType::LoopBft => Domain::Triangle,
         }
     }
@@ -237,6 +248,8 @@ pub struct Features {
     pub table_level: bool,
     /// Needs triangles (polygons are fan-triangulated first, with a note).
     pub triangles_only: bool,
+    /// Feature-adaptive refinement: isolation level, end-cap type, sharpness scale.
+    pub isolation: bool,
 }
 
 impl Features {

@@ -57,6 +57,9 @@ fn config(a: &BenchArgs) -> Result<BenchConfig> {
             bail!("unknown method '{m}' (known: {})", known.join(", "));
         }
     }
+    if !(1..=8).contains(&a.isolation) {
+        bail!("--isolation {} is outside 1..8", a.isolation);
+    }
     if a.frames == 0 {
         bail!("--frames must be at least 1");
     }
@@ -76,6 +79,7 @@ fn config(a: &BenchArgs) -> Result<BenchConfig> {
         row_budget_s: a.row_budget,
         min_frames: a.min_frames.max(1),
         cpu_max_vertices: a.cpu_max_vertices,
+        isolation: a.isolation,
     })
 }
 

@@ -43,9 +43,10 @@ pub enum Command {
 pub struct ExportArgs {
     /// OBJ control mesh.
     pub input: PathBuf,
-    /// flat, phong, pn or bft.
+    /// flat, phong, pn, bft (Loop limit) or adaptive (Catmull-Clark limit); by default the
+    /// limit surface of --scheme (Catmull-Clark unless every face is a triangle).
     #[arg(long, value_parser = crate::technique::parse_technique)]
-    pub method: TechniqueId,
+    pub method: Option<TechniqueId>,
     /// Segments per base edge (tessellation level of flat, phong and pn: 1 to 64; bft: a power
     /// of two from 2 to 2^(table level + 1) unless --fractional). Ignored with --adaptive.
     #[arg(long, default_value_t = 8.0)]
@@ -104,6 +105,9 @@ pub struct BenchArgs {
     /// of the quadrangulated spot, 3.0 M vertices, peaks at about 1.6 GB of memory).
     #[arg(long, default_value_t = 4_000_000)]
     pub cpu_max_vertices: u64,
+    /// Isolation level of the adaptive rows (segments are then per patch edge).
+    #[arg(long, default_value_t = tess::techniques::adaptive::DEFAULT_ISOLATION)]
+    pub isolation: u32,
     /// Write the rows as CSV.
     #[arg(long)]
     pub csv: Option<PathBuf>,
@@ -177,12 +181,15 @@ pub struct CameraArgs {
 pub struct SceneArgs {
     /// OBJ control mesh; the embedded spot control mesh when absent.
     pub mesh: Option<PathBuf>,
-    /// flat, phong, pn (the base faces as patches) or bft (the Loop limit surface from
-    /// basis-function tables).
-    #[arg(long, default_value = "flat", value_parser = crate::technique::parse_technique)]
-    pub method: TechniqueId,
+    /// flat, phong, pn (the base faces as patches), bft (the Loop limit surface from
+    /// basis-function tables) or adaptive (the Catmull-Clark limit surface by feature-adaptive
+    /// refinement). By default the limit surface of --scheme, which defaults to Catmull-Clark
+    /// unless every face is a triangle (then Loop).
+    #[arg(long, value_parser = crate::technique::parse_technique)]
+    pub method: Option<TechniqueId>,
     /// Tessellation level: segments per base edge (outer and inner), 1 to 64; bft takes powers
-    /// of two from 2 to 2^(table level + 1) unless --fractional.
+    /// of two from 2 to 2^(table level + 1) unless --fractional; adaptive: segments per patch
+    /// edge, 1 to 32 (a coarse transition edge gets twice as many).
     #[arg(long, alias = "segments", default_value_t = 8.0)]
     pub level: f32,
     #[arg(long, default_value = "equal", value_parser = parse_spacing)]
@@ -197,7 +204,7 @@ pub struct SceneArgs {
     pub alpha: f32,
     #[command(flatten)]
     pub surface: SurfaceArgs,
-    /// Move the base vertices along their normals with a travelling wave (bft): only the base
+    /// Move the base vertices along their normals with a travelling wave (bft, adaptive): only the base
     /// positions are uploaded per frame. `render` shows time --frame (default 0).
     #[arg(long)]
     pub animate: bool,

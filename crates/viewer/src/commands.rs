@@ -64,7 +64,8 @@ pub fn camera(c: &CameraArgs) -> Camera {
 
 /// What `render` and `view` draw: the technique, how to build it and each frame's
 /// parameters, checked against the technique's features (before any device is opened).
-pub fn scene_setup(s: &SceneArgs, name: &str) -> Result<Setup> {
+pub fn scene_setup(s: &SceneArgs, name: &str, mesh: &topology::ControlMesh) -> Result<Setup> {
+    let method = crate::technique::resolve_method(s.method, s.surface.scheme.as_deref(), mesh)?;
     let params = FrameParams {
         wireframe: s.wireframe,
         camera: camera(&s.camera),
@@ -73,7 +74,7 @@ pub fn scene_setup(s: &SceneArgs, name: &str) -> Result<Setup> {
     };
     let mut setup = s
         .surface
-        .setup(s.method, s.level, s.spacing, s.animate, params)?;
+        .setup(method, s.level, s.spacing, s.animate, params)?;
     setup.build.name = name.to_string();
     Ok(setup)
 }
@@ -144,7 +145,7 @@ pub fn check_validation(instance: &Instance) -> Result<()> {
 
 fn render(a: RenderArgs) -> Result<()> {
     let mesh = load_mesh(a.scene.mesh.as_deref())?;
-    let setup = scene_setup(&a.scene, &mesh_name(a.scene.mesh.as_deref()))?;
+    let setup = scene_setup(&a.scene, &mesh_name(a.scene.mesh.as_deref()), &mesh)?;
     let extent = vk::Extent2D {
         width: a.size.0,
         height: a.size.1,

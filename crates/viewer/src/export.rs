@@ -37,10 +37,12 @@ pub fn run(a: ExportArgs) -> Result<()> {
         phong_alpha: a.alpha,
         ..FrameParams::default()
     };
+    let base = load_mesh(Some(&a.input))?;
+    let method =
+        crate::technique::resolve_method(a.method, a.surface.scheme.as_deref(), &base)?;
     let mut setup = a
         .surface
-        .setup(a.method, a.segments, a.spacing, false, params)?;
-    let base = load_mesh(Some(&a.input))?;
+        .setup(method, a.segments, a.spacing, false, params)?;
     setup.build.name = mesh_name(Some(&a.input));
     let extent = vk::Extent2D {
         width: a.size.0,

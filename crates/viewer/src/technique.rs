@@ -3,11 +3,57 @@
 //! no per-technique code here, so a new technique needs no change in the viewer.
 use anyhow::{bail, Result};
 use clap::Args;
-use tess::techniques::{self, bft::DEFAULT_TABLE_LEVEL, BuildOptions};
+use tess::techniques::{self, adaptive::DEFAULT_ISOLATION, bft::DEFAULT_TABLE_LEVEL, BuildOptions};
+use topology::adaptive::EndCap;
 use tess::{FactorPolicy, Features, FrameParams, Spacing, TechniqueId};
 
 pub fn parse_technique(s: &str) -> Result<TechniqueId, String> {
     s.parse::<TechniqueId>().map_err(|e| e.to_string())
+}
+
+pub fn parse_end_cap(s: &str) -> Result<EndCap, String> {
+    match s {
+        "gregory" => Ok(EndCap::Gregory),
+        "bilinear" => Ok(EndCap::Bilinear),
+        _ => Err(format!("unknown end cap '{s}' (gregory, bilinear)")),
+    }
+}
+
+/// The scheme a mesh is drawn with when `--scheme` is absent: Catmull-Clark unless every face
+/// is a triangle (then Loop).
+pub fn default_scheme(mesh: &topology::ControlMesh) -> topology::Scheme {
+    if mesh.faces().all(|f| f.len() == 3) {
+        topology::Scheme::Loop
+    } else {
+        topology::Scheme::CatmullClark
+    }
+}
+
+/// `--method`, or by default the technique that draws the limit surface of `--scheme` (or of
+/// the mesh's default scheme).
+pub fn resolve_method(
+    method: Option<TechniqueId>,
+    scheme: Option<&str>,
+    mesh: &topology::ControlMesh,
+) -> Result<TechniqueId> {
+    if let Some(m) = method {
+        return Ok(m);
+    }
+    let scheme = match scheme {
+        Some(s) => crate::topo_cmds::parse_scheme(s)
+            .map_err(|e| anyhow::anyhow!("--scheme {s}: {e}"))?,
+        None => default_scheme(mesh),
+    };
+    techniques::registry()
+        .iter()
+        .find(|i| i.scheme == Some(scheme))
+        .map(|i| i.id)
+        .ok_or_else(|| {
+            anyhow::anyhow!(
+                "--scheme {}: no technique draws its limit surface yet (catmull-clark: --method adaptive, loop: --method bft)",
+                scheme_name(scheme)
+            )
+        })
 }
 
 /// Adaptive factor policies.
@@ -28,10 +74,21 @@ fn parse_adaptive(s: &str) -> Result<Adaptive, String> {
 /// Options of the subdivision-surface techniques; techniques that do not take one refuse it.
 #[derive(Args, Debug, Clone)]
 pub struct SurfaceArgs {
-    /// Subdivision scheme whose limit surface is drawn (bft: loop, its only scheme, the
-    /// default). Polygons of more than three sides are fan-triangulated first.
+    /// Subdivision scheme whose limit surface is drawn: catmull-clark (--method adaptive) or
+    /// loop (--method bft; polygons are fan-triangulated first). Defaults to catmull-clark
+    /// unless every face is a triangle.
     #[arg(long)]
     pub scheme: Option<String>,
+    /// Isolation level of feature-adaptive refinement (adaptive): 1 to 8.
+    #[arg(long, default_value_t = DEFAULT_ISOLATION)]
+    pub isolation: u32,
+    /// End caps of faces still irregular at the isolation level (adaptive): gregory or
+    /// bilinear.
+    #[arg(long, default_value = "gregory", value_parser = parse_end_cap)]
+    pub end_cap: EndCap,
+    /// Multiplies every crease and corner sharpness (adaptive), without reloading the mesh.
+    #[arg(long, default_value_t = 1.0)]
+    pub sharpness_scale: f32,
     /// Adaptive edge factors (bft): screen (projected edge length / --pixels) or distance
     /// (halving each time the eye's distance doubles past --distance). Powers of two, or any
     /// value with --fractional; computed from an edge's two endpoints only, so no cracks.
@@ -56,7 +113,8 @@ pub struct SurfaceArgs {
     #[arg(long)]
     pub geometric_normals: bool,
     /// Colour patches by type (bft: regular blue, extraordinary red, boundary green, private
-    /// table violet).
+    /// table violet; adaptive: regular blue, Gregory red, bilinear yellow, lighter per level,
+    /// transition patches darker, boundary and crease patches greener).
     #[arg(long, alias = "patch-colors")]
     pub patch_colours: bool,
     /// Time T of the --animate wave (base vertices moved along their normals), in seconds.
@@ -150,6 +208,21 @@ impl SurfaceArgs {
                 feature: |f| f.animation,
             },
             OptionUse {
+                name: "--isolation",
+                given: self.isolation != DEFAULT_ISOLATION,
+                feature: |f| f.isolation,
+            },
+            OptionUse {
+                name: "--end-cap",
+                given: self.end_cap != EndCap::Gregory,
+                feature: |f| f.isolation,
+            },
+            OptionUse {
+                name: "--sharpness-scale",
+                given: self.sharpness_scale != 1.0,
+                feature: |f| f.isolation,
+            },
+            OptionUse {
                 name: "--table-level",
                 given: self.table_level != DEFAULT_TABLE_LEVEL,
                 feature: |f| f.table_level,
@@ -186,6 +259,15 @@ impl SurfaceArgs {
                 "--spacing {}: --method {technique} does not take it (--fractional is \
                  fractional-even)",
                 spacing_name(spacing)
+            );
+        }
+        if f.isolation && !(1..=8).contains(&self.isolation) {
+            bail!("--isolation {} is outside 1..8", self.isolation);
+        }
+        if f.isolation && !(self.sharpness_scale.is_finite() && self.sharpness_scale >= 0.0) {
+            bail!(
+                "--sharpness-scale {}: give a finite, non-negative factor",
+                self.sharpness_scale
             );
         }
         if f.table_level && !(1..=6).contains(&self.table_level) {
@@ -225,6 +307,9 @@ impl SurfaceArgs {
                 name: String::new(),
                 table_level: self.table_level,
                 tangents: self.geometric_normals,
+                isolation: self.isolation,
+                end_cap: self.end_cap,
+                sharpness_scale: self.sharpness_scale,
             },
             params,
             distance_diagonals: (self.adaptive == Some(Adaptive::Distance))

@@ -2,7 +2,10 @@
 //! switch technique in the registry's order (flat, Phong, PN, BFT), +/- raise/lower the level
 //! to the next one the technique takes (BFT: the next power of two unless fractional), arrows
 //! double/halve it, W toggles the wireframe; where the technique takes them, A toggles the
-//! animation, C the patch colours, F fractional factors, G geometric normals. Esc quits. The
+//! animation, C the patch colours, F fractional factors, G geometric normals, and for the
+//! feature-adaptive surface I / Shift+I raise / lower the isolation level, E switches the end
+//! caps (Gregory, bilinear), S / Shift+S scale every crease's sharpness up / down (the surface
+//! is re-planned on the CPU; the mesh is not reloaded). Esc quits. The
 //! title shows the frame time. `--frames N --screenshot out.png` renders N frames, saves the
 //! last and exits. Techniques are built on first use and kept.
 use crate::cli::ViewArgs;
@@ -51,6 +54,8 @@ struct App {
     moved: bool,
     /// A level to snap once the technique switched to is built.
     pending_level: Option<f32>,
+    /// The current surface must be built again (isolation, end caps or sharpness changed).
+    rebuild: bool,
     gpu: Option<Gpu>,
     window: Option<Arc<Window>>,
     frames_drawn: u32,
@@ -127,6 +132,10 @@ impl App {
         let Some(gpu) = self.gpu.as_mut() else {
             return Ok(());
         };
+        if std::mem::take(&mut self.rebuild) {
+            // Frames in flight keep their buffers alive (vk-core defers destruction).
+            gpu.surfaces.remove(&self.setup.technique);
+        }
         Self::surface(gpu, &self.mesh, &self.setup)?;
         if let Some(l) = self.pending_level.take() {
             self.set_level(l, true);
@@ -172,8 +181,17 @@ impl App {
         self.last_frame = now;
         if let Some(w) = &self.window {
             w.set_title(&format!(
-                "tessera — {}{} — {:.2} ms/frame",
+                "tessera — {}{}{} — {:.2} ms/frame",
                 describe(self.setup.technique, &params),
+                if techniques::info(self.setup.technique).features.isolation {
+                    let b = &self.setup.build;
+                    format!(
+                        ", isolation {}, {:?} end caps, sharpness ×{:.2}",
+                        b.isolation, b.end_cap, b.sharpness_scale
+                    )
+                } else {
+                    String::new()
+                },
                 if self.setup.animate { ", animated" } else { "" },
                 self.frame_ms
             ));
@@ -272,6 +290,33 @@ impl App {
                 "g" | "G" if features.geometric_normals => {
                     p.geometric_normals = !p.geometric_normals
                 }
+                "i" | "I" if features.isolation => {
+                    let b = &mut self.setup.build;
+                    let next = if c.as_str() == "i" {
+                        (b.isolation + 1).min(8)
+                    } else {
+                        b.isolation.saturating_sub(1).max(1)
+                    };
+                    self.rebuild |= next != b.isolation;
+                    b.isolation = next;
+                }
+                "e" | "E" if features.isolation => {
+                    let b = &mut self.setup.build;
+                    b.end_cap = match b.end_cap {
+                        topology::adaptive::EndCap::Gregory => topology::adaptive::EndCap::Bilinear,
+                        topology::adaptive::EndCap::Bilinear => topology::adaptive::EndCap::Gregory,
+                    };
+                    self.rebuild = true;
+                }
+                "s" | "S" if features.isolation => {
+                    let b = &mut self.setup.build;
+                    b.sharpness_scale = if c.as_str() == "s" {
+                        (b.sharpness_scale * 1.25).min(64.0)
+                    } else {
+                        b.sharpness_scale / 1.25
+                    };
+                    self.rebuild = true;
+                }
                 _ => {}
             },
             Key::Named(NamedKey::ArrowUp) => self.set_level(level * 2.0, true),
@@ -358,7 +403,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         anyhow::bail!("--screenshot needs --frames N");
     }
     let mesh = load_mesh(args.scene.mesh.as_deref())?;
-    let setup = scene_setup(&args.scene, &mesh_name(args.scene.mesh.as_deref()))?;
+    let setup = scene_setup(&args.scene, &mesh_name(args.scene.mesh.as_deref()), &mesh)?;
     let event_loop = EventLoop::new().context(
         "no window system (set DISPLAY or WAYLAND_DISPLAY; use `tessera render` headless)",
     )?;
@@ -370,6 +415,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         args,
         mesh,
         pending_level: None,
+        rebuild: false,
         gpu: None,
         window: None,
         frames_drawn: 0,

@@ -209,6 +209,7 @@ impl TechniqueMethod {
             &ctx.mesh.mesh,
             &BuildOptions {
                 name: ctx.mesh.name.clone(),
+                isolation: ctx.config.isolation,
                 ..BuildOptions::default()
             },
         )?;

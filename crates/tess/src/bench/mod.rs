@@ -48,6 +48,8 @@ pub struct BenchConfig {
     /// The CPU baseline skips levels with more vertices than this (3 M vertices peak at about
     /// 1.6 GB of host memory).
     pub cpu_max_vertices: u64,
+    /// Isolation level of the feature-adaptive rows.
+    pub isolation: u32,
 }
 
 impl Default for BenchConfig {
@@ -67,6 +69,7 @@ impl Default for BenchConfig {
             row_budget_s: None,
             min_frames: 5,
             cpu_max_vertices: 4_000_000,
+            isolation: crate::techniques::adaptive::DEFAULT_ISOLATION,
         }
     }
 }

@@ -98,4 +98,45 @@ gpu_constants! {
     BFT_OWNER_SHIFT = 2;
     /// Mask of an owner's local edge or corner index.
     BFT_OWNER_LOCAL_MASK = 3;
+
+    /// Descriptor set of one feature-adaptive Catmull-Clark surface (`glsl/adaptive/adaptive.glsl`).
+    ADAPTIVE_SET = 1;
+    /// Base positions (three floats per base vertex), one buffer per frame slot; rewritten per frame when animated.
+    ADAPTIVE_BASE_POSITIONS_BINDING = 0;
+    /// CSR offsets of every refined vertex's stencil (levels, then local points), over the global vertex buffer.
+    ADAPTIVE_STENCIL_OFFSETS_BINDING = 1;
+    /// Stencil terms (`StencilTerm`: global vertex, weight).
+    ADAPTIVE_STENCIL_TERMS_BINDING = 2;
+    /// The global vertex buffer (`vec4`): base, level 1..L, local points; written by `stencil.comp`.
+    ADAPTIVE_VERTICES_BINDING = 3;
+    /// One `AdaptivePatch` record per patch, in frame-wide patch order.
+    ADAPTIVE_PATCHES_BINDING = 4;
+    /// Control-point indices (global vertices) of every patch, back to back.
+    ADAPTIVE_CONTROL_POINTS_BINDING = 5;
+    /// Canonical boundary curves: four global vertices (cubic Bezier) each.
+    ADAPTIVE_CURVES_BINDING = 6;
+    /// Work-group size of the adaptive stencil kernel.
+    ADAPTIVE_LOCAL_SIZE = 64;
+    /// Patch kinds (low 4 bits of `AdaptivePatch::info`): bicubic B-spline,
+    ADAPTIVE_KIND_REGULAR = 0;
+    /// Gregory end cap,
+    ADAPTIVE_KIND_GREGORY = 1;
+    /// bilinearly blended (Coons) end cap over its four boundary curves.
+    ADAPTIVE_KIND_BILINEAR = 2;
+    /// Edge kinds (2 bits per edge in `AdaptivePatch::edge_info`): same level on both sides,
+    ADAPTIVE_EDGE_PLAIN = 0;
+    /// this patch is the coarse side of a transition (its factor is doubled),
+    ADAPTIVE_EDGE_COARSE = 1;
+    /// this patch is one fine half of a transition.
+    ADAPTIVE_EDGE_FINE = 2;
+    /// `options` bit of `AdaptivePush`: colour patches by kind and level.
+    ADAPTIVE_OPTION_PATCH_COLOURS = 1;
+    /// `options` bit: fractional-even factors (transition edges stay even integers).
+    ADAPTIVE_OPTION_FRACTIONAL = 2;
+    /// `options` bit: round adaptive factors up to powers of two.
+    ADAPTIVE_OPTION_POW2 = 4;
+    /// Capture flags of the adaptive TES: patch kind in bits 0..3, level above.
+    ADAPTIVE_FLAG_LEVEL_SHIFT = 4;
+    /// Capture flag: the point lies on a patch boundary and came from its canonical curve.
+    ADAPTIVE_FLAG_CANONICAL = 256;
 }

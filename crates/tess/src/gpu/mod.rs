@@ -84,6 +84,35 @@ pub struct BftPush {
 
 const _: () = assert!(size_of::<BftPush>() == 36);
 
+/// `AdaptivePush` push constant of every feature-adaptive stage, `glsl/adaptive/adaptive.glsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct AdaptivePush {
+    /// [`bindings::DRAW_MODE_SHADED`] or [`bindings::DRAW_MODE_WIREFRAME`]; the stencil kernel:
+    /// 0 applies stencil rows, 1 copies the base positions.
+    pub mode: u32,
+    /// Frame-wide id of the drawn array's first patch.
+    pub first_patch: u32,
+    /// `BFT_FACTORS_UNIFORM`, `_SCREEN` or `_DISTANCE` ([`bindings`]).
+    pub factor_mode: u32,
+    /// `ADAPTIVE_OPTION_*` bits ([`bindings`]).
+    pub options: u32,
+    /// Segments per patch edge (uniform factors).
+    pub uniform_level: f32,
+    pub pixels_per_segment: f32,
+    pub distance_ref: f32,
+    /// The device's maximum tessellation level.
+    pub max_level: f32,
+    /// Stencil kernel: first row of the dispatch.
+    pub first_row: u32,
+    /// Stencil kernel: rows (or base vertices) in the dispatch.
+    pub count: u32,
+    /// Stencil kernel: base vertices; row `r` writes global vertex `base_count + r`.
+    pub base_count: u32,
+}
+
+const _: () = assert!(size_of::<AdaptivePush>() == 44);
+
 /// Interleaved vertex of the mesh vertex buffer (`common/mesh.vert` and `plain/plain.vert`
 /// locations 0 and 1).
 #[repr(C)]

@@ -1,6 +1,7 @@
 //! Every technique, and the registry that builds one by name: the only place that knows
 //! which techniques exist. Callers (viewer, bench, export, C ABI) build through [`build`] and
 //! check options against [`TechniqueInfo::features`].
+pub mod adaptive;
 pub mod bft;
 pub mod face_patches;
 pub mod flat;
@@ -32,9 +33,10 @@ const BASE_FACES: Features = Features {
     phong_alpha: false,
     table_level: false,
     triangles_only: false,
+    isolation: false,
 };
 
-static REGISTRY: [TechniqueInfo; 4] = [
+static REGISTRY: [TechniqueInfo; 5] = [
     TechniqueInfo {
         id: TechniqueId::Flat,
         help: "flat tessellation of each base face (quads as quad patches)",
@@ -68,8 +70,25 @@ static REGISTRY: [TechniqueInfo; 4] = [
             phong_alpha: false,
             table_level: true,
             triangles_only: true,
+            isolation: false,
         },
         scheme: Some(topology::Scheme::Loop),
+    },
+    TechniqueInfo {
+        id: TechniqueId::Adaptive,
+        help: "exact Catmull-Clark limit surface by feature-adaptive refinement (Niessner et al.), Gregory or bilinear end caps",
+        features: Features {
+            adaptive_factors: true,
+            spacings: [true, true, false],
+            animation: true,
+            patch_colours: true,
+            geometric_normals: false,
+            phong_alpha: false,
+            table_level: false,
+            triangles_only: false,
+            isolation: true,
+        },
+        scheme: Some(topology::Scheme::CatmullClark),
     },
 ];
 
@@ -119,6 +138,12 @@ pub struct BuildOptions {
     pub table_level: u32,
     /// Build what geometric normals need (techniques with [`Features::geometric_normals`]).
     pub tangents: bool,
+    /// Isolation level (techniques with [`Features::isolation`]).
+    pub isolation: u32,
+    /// End caps of faces still irregular at the isolation level.
+    pub end_cap: topology::adaptive::EndCap,
+    /// Scales every crease and corner sharpness.
+    pub sharpness_scale: f32,
 }
 
 impl Default for BuildOptions {
@@ -127,6 +152,9 @@ impl Default for BuildOptions {
             name: "mesh".into(),
             table_level: bft::DEFAULT_TABLE_LEVEL,
             tangents: false,
+            isolation: adaptive::DEFAULT_ISOLATION,
+            end_cap: topology::adaptive::EndCap::Gregory,
+            sharpness_scale: 1.0,
         }
     }
 }
@@ -165,6 +193,16 @@ pub fn build(
                 notes,
             });
         }
+        TechniqueId::Adaptive => Box::new(adaptive::Adaptive::new(
+            ctx,
+            mesh,
+            &adaptive::AdaptiveBuild {
+                isolation: options.isolation,
+                end_cap: options.end_cap,
+                sharpness_scale: options.sharpness_scale,
+                name: options.name.clone(),
+            },
+        )?),
     };
     Ok(Built {
         technique,
@@ -183,6 +221,7 @@ mod tests {
             TechniqueId::Phong,
             TechniqueId::Pn,
             TechniqueId::Bft,
+            TechniqueId::Adaptive,
         ] {
             assert_eq!(info(id).id, id);
             assert_eq!(id.name().parse::<TechniqueId>().unwrap(), id);

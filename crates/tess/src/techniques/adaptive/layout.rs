@@ -1,0 +1,270 @@
+//! The adaptive technique's GPU data: every storage buffer `glsl/adaptive/adaptive.glsl` reads,
+//! as named `#[repr(C)]` + `Pod` structs, and the packing of `topology`'s plan
+//! ([`AdaptivePlan`]: stencil blocks, patches, canonical curves) into them.
+//!
+//! Design decisions:
+//! - **One global vertex buffer** (`vec4`): base vertices, then each level's refined vertices,
+//!   then the local points (phantom points, Gregory points, limit corners, curve Bezier
+//!   points). Every stencil row is over global vertices, so one kernel applies every block;
+//!   a block's rows read only earlier blocks, so each block is one dispatch.
+//! - **Patches in array order** (regular, Gregory, bilinear): a patch's record index is its
+//!   frame-wide id, what the TES captures and [`crate::Technique::face_point`] maps back.
+//! - **Checked before upload**: [`GpuAdaptive::new`] proves every index a shader can form is
+//!   in range and every row reads only earlier blocks, so a bad plan fails here, not as an
+//!   out-of-bounds read on the device.
+use crate::gpu::bindings::{
+    ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_FINE, ADAPTIVE_EDGE_PLAIN, ADAPTIVE_KIND_BILINEAR,
+    ADAPTIVE_KIND_GREGORY, ADAPTIVE_KIND_REGULAR,
+};
+use bytemuck::{Pod, Zeroable};
+use std::mem::size_of;
+use topology::adaptive::{AdaptivePlan, EdgeKind, PatchKind};
+
+/// `StencilTerm` of `adaptive.glsl`: one term of a stencil row.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct StencilTerm {
+    /// Global vertex.
+    pub index: u32,
+    pub weight: f32,
+}
+
+/// `AdaptivePatch` of `adaptive.glsl`: one patch.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct PatchRecord {
+    /// First control-point index in the control-point buffer.
+    pub cp_offset: u32,
+    /// `kind | level << 4 | boundary mask << 8 | transition mask << 12`.
+    pub info: u32,
+    /// Per edge `i`, four bits at `4i`: edge kind (2 bits), reversed[0], reversed[1].
+    pub edge_info: u32,
+    pub pad: u32,
+    /// Edge `i`: `curves[2i]`, `curves[2i + 1]`.
+    pub curves: [u32; 8],
+}
+
+const _: () = {
+    assert!(size_of::<StencilTerm>() == 8);
+    assert!(size_of::<PatchRecord>() == 48);
+};
+
+/// Why a plan cannot go to the GPU.
+#[derive(Debug, thiserror::Error)]
+pub enum LayoutError {
+    #[error("adaptive plan: {what} {index} is out of range of {len}")]
+    Index {
+        what: &'static str,
+        index: u64,
+        len: u64,
+    },
+    #[error("adaptive plan: stencil row of vertex {vertex} reads vertex {reads}, which its own block (from {block_start}) writes")]
+    BlockOrder {
+        vertex: u32,
+        reads: u32,
+        block_start: u32,
+    },
+    #[error("adaptive plan: {what} ({value}) does not fit the GPU layout")]
+    TooLarge { what: &'static str, value: u64 },
+}
+
+/// The GPU kind of a patch.
+pub fn kind_code(kind: PatchKind) -> u32 {
+    match kind {
+        PatchKind::Regular => ADAPTIVE_KIND_REGULAR,
+        PatchKind::Gregory => ADAPTIVE_KIND_GREGORY,
+        PatchKind::Bilinear => ADAPTIVE_KIND_BILINEAR,
+    }
+}
+
+/// Control points of a patch kind.
+pub fn control_point_count(kind: PatchKind) -> usize {
+    match kind {
+        PatchKind::Regular => 16,
+        PatchKind::Gregory => 20,
+        PatchKind::Bilinear => 4,
+    }
+}
+
+/// One dispatch of the stencil kernel: rows `first_row .. first_row + rows`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Dispatch {
+    pub first_row: u32,
+    pub rows: u32,
+}
+
+/// Everything the adaptive buffers hold, packed.
+pub struct GpuAdaptive {
+    pub num_base_vertices: u32,
+    pub num_vertices: u32,
+    /// CSR offsets, one per refined vertex (global vertex − base count) plus one.
+    pub stencil_offsets: Vec<u32>,
+    pub stencil_terms: Vec<StencilTerm>,
+    /// One per block: the levels in order, then the local points.
+    pub dispatches: Vec<Dispatch>,
+    /// Records in array order (see [`GpuAdaptive::order`]).
+    pub patches: Vec<PatchRecord>,
+    pub control_points: Vec<u32>,
+    pub curves: Vec<[u32; 4]>,
+    /// Frame-wide patch id → index in the plan's patches.
+    pub order: Vec<u32>,
+    /// Patches per kind: regular, Gregory, bilinear.
+    pub counts: [u32; 3],
+}
+
+fn check(what: &'static str, index: u64, len: u64) -> Result<(), LayoutError> {
+    if index < len {
+        Ok(())
+    } else {
+        Err(LayoutError::Index { what, index, len })
+    }
+}
+
+fn edge_code(kind: EdgeKind) -> u32 {
+    match kind {
+        EdgeKind::Plain => ADAPTIVE_EDGE_PLAIN,
+        EdgeKind::Coarse => ADAPTIVE_EDGE_COARSE,
+        EdgeKind::Fine => ADAPTIVE_EDGE_FINE,
+    }
+}
+
+impl GpuAdaptive {
+    pub fn new(plan: &AdaptivePlan) -> Result<GpuAdaptive, LayoutError> {
+        let nb = plan.num_base_vertices;
+        let nv = plan.num_vertices;
+        let mut stencil_offsets = vec![0u32];
+        let mut stencil_terms = Vec::new();
+        let mut dispatches = Vec::new();
+        let mut next = nb;
+        for block in plan.steps.iter().chain(std::iter::once(&plan.local_points)) {
+            // Blocks must tile the refined part of the vertex buffer in order.
+            if block.first_vertex != next {
+                return Err(LayoutError::Index {
+                    what: "stencil block start",
+                    index: block.first_vertex as u64,
+                    len: next as u64,
+                });
+            }
+            let t = &block.table;
+            let rows = t.len() as u32;
+            for r in 0..t.len() {
+                let (idx, w) = t.stencil(r);
+                for (&i, &wt) in idx.iter().zip(w) {
+                    if i >= block.first_vertex {
+                        return Err(LayoutError::BlockOrder {
+                            vertex: block.first_vertex + r as u32,
+                            reads: i,
+                            block_start: block.first_vertex,
+                        });
+                    }
+                    stencil_terms.push(StencilTerm {
+                        index: i,
+                        weight: wt as f32,
+                    });
+                }
+                let len = u32::try_from(stencil_terms.len()).map_err(|_| LayoutError::TooLarge {
+                    what: "stencil terms",
+                    value: stencil_terms.len() as u64,
+                })?;
+                stencil_offsets.push(len);
+            }
+            if rows > 0 {
+                dispatches.push(Dispatch {
+                    first_row: block.first_vertex - nb,
+                    rows,
+                });
+            }
+            next = block.first_vertex + rows;
+        }
+        if next != nv {
+            return Err(LayoutError::Index {
+                what: "vertex count",
+                index: next as u64,
+                len: nv as u64,
+            });
+        }
+        let mut order: Vec<u32> = (0..plan.patches.len() as u32).collect();
+        order.sort_by_key(|&i| kind_code(plan.patches[i as usize].kind));
+        let mut counts = [0u32; 3];
+        let mut patches = Vec::with_capacity(order.len());
+        let mut control_points = Vec::new();
+        let ncurves = plan.curves.len() as u64;
+        for &pi in &order {
+            let p = &plan.patches[pi as usize];
+            counts[kind_code(p.kind) as usize] += 1;
+            let need = control_point_count(p.kind);
+            if p.control_points.len() != need {
+                return Err(LayoutError::Index {
+                    what: "control points of a patch",
+                    index: p.control_points.len() as u64,
+                    len: need as u64,
+                });
+            }
+            let cp_offset = control_points.len() as u32;
+            for &c in &p.control_points {
+                check("control point", c as u64, nv as u64)?;
+                control_points.push(c);
+            }
+            let mut edge_info = 0u32;
+            let mut curves = [0u32; 8];
+            for (e, edge) in p.edges.iter().enumerate() {
+                let bits = edge_code(edge.kind)
+                    | (edge.reversed[0] as u32) << 2
+                    | (edge.reversed[1] as u32) << 3;
+                edge_info |= bits << (4 * e);
+                for h in 0..2 {
+                    check("curve", edge.curves[h] as u64, ncurves)?;
+                    curves[2 * e + h] = edge.curves[h];
+                }
+            }
+            if p.level > 15 {
+                return Err(LayoutError::TooLarge {
+                    what: "patch level",
+                    value: p.level as u64,
+                });
+            }
+            patches.push(PatchRecord {
+                cp_offset,
+                info: kind_code(p.kind)
+                    | (p.level as u32) << 4
+                    | ((p.boundary_mask & 15) as u32) << 8
+                    | ((p.transition_mask & 15) as u32) << 12,
+                edge_info,
+                pad: 0,
+                curves,
+            });
+        }
+        for c in &plan.curves {
+            for &v in c {
+                check("curve point", v as u64, nv as u64)?;
+            }
+        }
+        Ok(GpuAdaptive {
+            num_base_vertices: nb,
+            num_vertices: nv,
+            stencil_offsets,
+            stencil_terms,
+            dispatches,
+            patches,
+            control_points,
+            curves: plan.curves.clone(),
+            order,
+            counts,
+        })
+    }
+
+    /// Bytes of tables on the GPU (stencils, patch records, control points, curves), without
+    /// the vertex buffer.
+    pub fn table_bytes(&self) -> usize {
+        self.stencil_offsets.len() * 4
+            + self.stencil_terms.len() * size_of::<StencilTerm>()
+            + self.patches.len() * size_of::<PatchRecord>()
+            + self.control_points.len() * 4
+            + self.curves.len() * 16
+    }
+
+    /// Bytes of the global vertex buffer.
+    pub fn vertex_bytes(&self) -> u64 {
+        self.num_vertices.max(1) as u64 * 16
+    }
+}

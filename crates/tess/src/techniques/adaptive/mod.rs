@@ -1,0 +1,585 @@
+//! Feature-adaptive Catmull-Clark on the tessellation stage (Nießner et al. 2012; the seed's
+//! §3–4), exact where patches are regular and watertight everywhere:
+//!
+//! 1. **Plan (CPU, once; again when the sharpness scale changes):** `topology::adaptive`
+//!    isolates extraordinary vertices, non-quads and semi-sharp creases level by level with
+//!    the crate's one sparse refiner, and flattens the result into stencil blocks (one per
+//!    level, then the local points), patches (regular B-spline, Gregory or bilinear end caps)
+//!    and canonical boundary curves.
+//! 2. **Every frame (GPU):** the stencil kernel (`glsl/adaptive/stencil.comp`) copies the base
+//!    positions and applies one block per dispatch (an animated base costs one upload of its
+//!    positions); then one draw per patch kind, one control point per patch.
+//! 3. **Crack-free by construction:** every edge level comes from the edge's canonical
+//!    curve(s) only, a coarse transition edge gets twice its fine halves' level (the seed's
+//!    doubled factors: the tessellator makes the missing vertices, no T-junction), and every
+//!    boundary vertex is evaluated on its canonical curve at a parameter both sides derive
+//!    identically (see `glsl/adaptive/adaptive.glsl`), so shared edges are bit-identical
+//!    under every factor policy, across transitions and end caps.
+//!
+//! The GPU data is [`layout`].
+pub mod layout;
+
+use crate::techniques::bft::{base_positions, bbox};
+use crate::capture::{face_corner_uv, FacePoint};
+use crate::context::Context;
+use crate::error::{Result, TessError};
+use crate::gpu::bindings::{
+    ADAPTIVE_BASE_POSITIONS_BINDING, ADAPTIVE_CONTROL_POINTS_BINDING, ADAPTIVE_CURVES_BINDING,
+    ADAPTIVE_LOCAL_SIZE, ADAPTIVE_OPTION_FRACTIONAL, ADAPTIVE_OPTION_PATCH_COLOURS,
+    ADAPTIVE_OPTION_POW2, ADAPTIVE_PATCHES_BINDING, ADAPTIVE_STENCIL_OFFSETS_BINDING,
+    ADAPTIVE_STENCIL_TERMS_BINDING, ADAPTIVE_VERTICES_BINDING, BFT_FACTORS_DISTANCE,
+    BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM,
+};
+use crate::gpu::AdaptivePush;
+use crate::shaders::{self, Stage, Variant};
+use crate::technique::{
+    for_each_draw, number_arrays, DrawCounts, FactorPolicy, FrameParams, Pass, PatchArray,
+    PatchPipeline, PatchType, Technique, TechniqueId,
+};
+use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, Domain, Spacing};
+use layout::GpuAdaptive;
+use topology::adaptive::{plan_adaptive, AdaptiveOptions, AdaptivePlan, EndCap};
+use topology::ControlMesh;
+use vk_core::descriptor::{BindingDesc, DescriptorPool};
+use vk_core::pipeline::{Pipeline, ShaderStage};
+use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Encoder, MemoryLocation};
+
+/// Default isolation level (OpenSubdiv's and the issue's).
+pub const DEFAULT_ISOLATION: u32 = 4;
+
+const STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
+    vk::ShaderStageFlags::COMPUTE.as_raw()
+        | vk::ShaderStageFlags::VERTEX.as_raw()
+        | vk::ShaderStageFlags::TESSELLATION_CONTROL.as_raw()
+        | vk::ShaderStageFlags::TESSELLATION_EVALUATION.as_raw()
+        | vk::ShaderStageFlags::FRAGMENT.as_raw(),
+);
+
+const fn storage_binding(binding: u32) -> BindingDesc {
+    BindingDesc {
+        binding,
+        ty: vk::DescriptorType::STORAGE_BUFFER,
+        stages: STAGES,
+    }
+}
+
+/// Set 1 of every adaptive pipeline.
+static SET_BINDINGS: [BindingDesc; 7] = [
+    storage_binding(ADAPTIVE_BASE_POSITIONS_BINDING),
+    storage_binding(ADAPTIVE_STENCIL_OFFSETS_BINDING),
+    storage_binding(ADAPTIVE_STENCIL_TERMS_BINDING),
+    storage_binding(ADAPTIVE_VERTICES_BINDING),
+    storage_binding(ADAPTIVE_PATCHES_BINDING),
+    storage_binding(ADAPTIVE_CONTROL_POINTS_BINDING),
+    storage_binding(ADAPTIVE_CURVES_BINDING),
+];
+
+/// How an adaptive surface is built (the per-frame choices are in [`FrameParams`]).
+#[derive(Clone, Debug)]
+pub struct AdaptiveBuild {
+    pub isolation: u32,
+    pub end_cap: EndCap,
+    /// Multiplies every crease and corner sharpness (the seed's run-time sharpness change).
+    pub sharpness_scale: f32,
+    /// Name for messages (the mesh's file).
+    pub name: String,
+}
+
+impl Default for AdaptiveBuild {
+    fn default() -> Self {
+        Self {
+            isolation: DEFAULT_ISOLATION,
+            end_cap: EndCap::Gregory,
+            sharpness_scale: 1.0,
+            name: "mesh".into(),
+        }
+    }
+}
+
+fn storage(device: &vk_core::Device, name: &str, bytes: &[u8]) -> Result<Buffer> {
+    // Zero-length storage buffers are invalid; pad empty arrays to one word.
+    let pad = [0u8; 4];
+    let data = if bytes.is_empty() { &pad[..] } else { bytes };
+    Ok(Buffer::with_data(
+        device,
+        name,
+        vk::BufferUsageFlags::STORAGE_BUFFER,
+        data,
+    )?)
+}
+
+/// One feature-adaptive Catmull-Clark surface on the GPU. Drop order: pipeline, sets (they
+/// keep their pool alive), pool, buffers.
+pub struct Adaptive {
+    stencil: Pipeline,
+    sets: Vec<DescriptorSet>,
+    _pool: DescriptorPool,
+    base: Vec<Buffer>,
+    _static: Vec<Buffer>,
+    arrays: Vec<PatchArray>,
+    pub gpu: GpuAdaptive,
+    pub plan: AdaptivePlan,
+    pub mesh: ControlMesh,
+    pub base_positions: Vec<[f32; 3]>,
+    rest_bbox: ([f32; 3], [f32; 3]),
+    pub options: AdaptiveBuild,
+    max_level: f32,
+}
+
+impl Adaptive {
+    /// Plans `mesh` (Catmull-Clark, any faces, boundaries, creases) and uploads it, with one
+    /// base-position buffer per frame slot of `ctx`.
+    pub fn new(ctx: &mut Context, mesh: &ControlMesh, options: &AdaptiveBuild) -> Result<Self> {
+        let device = ctx.device().clone();
+        let plan = plan_adaptive(
+            mesh,
+            &AdaptiveOptions {
+                isolation: options.isolation,
+                end_cap: options.end_cap,
+                sharpness_scale: options.sharpness_scale,
+            },
+        )
+        .map_err(|e| TessError::Mesh {
+            name: options.name.clone(),
+            source: e.into(),
+        })?;
+        let gpu = GpuAdaptive::new(&plan).map_err(|e| TessError::Mesh {
+            name: options.name.clone(),
+            source: e.into(),
+        })?;
+        let frames = ctx.frames_in_flight();
+        ctx.ensure_set_layout(TechniqueId::Adaptive, &SET_BINDINGS)?;
+        let set_layout = ctx.set_layout(TechniqueId::Adaptive)?;
+        let pool = DescriptorPool::new(
+            &device,
+            "adaptive descriptor pool",
+            set_layout,
+            frames as u32,
+        )?;
+        let vertices = Buffer::new(
+            &device,
+            &BufferDesc {
+                name: "adaptive vertices",
+                size: gpu.vertex_bytes(),
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::GpuOnly,
+            },
+        )?;
+        let statics = vec![
+            (ADAPTIVE_VERTICES_BINDING, vertices),
+            (
+                ADAPTIVE_STENCIL_OFFSETS_BINDING,
+                storage(
+                    &device,
+                    "adaptive stencil offsets",
+                    bytemuck::cast_slice(&gpu.stencil_offsets),
+                )?,
+            ),
+            (
+                ADAPTIVE_STENCIL_TERMS_BINDING,
+                storage(
+                    &device,
+                    "adaptive stencil terms",
+                    bytemuck::cast_slice(&gpu.stencil_terms),
+                )?,
+            ),
+            (
+                ADAPTIVE_PATCHES_BINDING,
+                storage(
+                    &device,
+                    "adaptive patches",
+                    bytemuck::cast_slice(&gpu.patches),
+                )?,
+            ),
+            (
+                ADAPTIVE_CONTROL_POINTS_BINDING,
+                storage(
+                    &device,
+                    "adaptive control points",
+                    bytemuck::cast_slice(&gpu.control_points),
+                )?,
+            ),
+            (
+                ADAPTIVE_CURVES_BINDING,
+                storage(
+                    &device,
+                    "adaptive curves",
+                    bytemuck::cast_slice(&gpu.curves),
+                )?,
+            ),
+        ];
+        let base_positions = base_positions(mesh);
+        let mut base = Vec::new();
+        let mut sets = Vec::new();
+        for i in 0..frames {
+            let mut buf = Buffer::new(
+                &device,
+                &BufferDesc {
+                    name: &format!("adaptive base positions {i}"),
+                    size: (12 * base_positions.len().max(1)) as u64,
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                    location: MemoryLocation::CpuToGpu,
+                },
+            )?;
+            buf.write(0, bytemuck::cast_slice(&base_positions))?;
+            let set = pool.allocate_set(set_layout)?;
+            set.write_buffer(
+                ADAPTIVE_BASE_POSITIONS_BINDING,
+                vk::DescriptorType::STORAGE_BUFFER,
+                &buf,
+            )?;
+            for (binding, s) in &statics {
+                set.write_buffer(*binding, vk::DescriptorType::STORAGE_BUFFER, s)?;
+            }
+            base.push(buf);
+            sets.push(set);
+        }
+        let layouts = [ctx.frame_set_layout().raw, set_layout.raw];
+        let stencil = Pipeline::compute(
+            &device,
+            "adaptive stencils",
+            ShaderStage::new(
+                vk::ShaderStageFlags::COMPUTE,
+                shaders::spirv(Stage::AdaptiveStencilComp, Variant::default())?,
+            ),
+            &layouts,
+            std::mem::size_of::<AdaptivePush>() as u32,
+        )?;
+        let [regular, gregory, bilinear] = gpu.counts;
+        let arrays = number_arrays(&[
+            (PatchType::BSpline, regular, 1),
+            (PatchType::Gregory, gregory, 1),
+            (PatchType::Bilinear, bilinear, 1),
+        ]);
+        let max_level = device.info.caps.max_tessellation_generation_level as f32;
+        Ok(Self {
+            stencil,
+            sets,
+            _pool: pool,
+            base,
+            _static: statics.into_iter().map(|(_, b)| b).collect(),
+            arrays,
+            gpu,
+            plan,
+            mesh: mesh.clone(),
+            rest_bbox: bbox(&base_positions),
+            base_positions,
+            options: options.clone(),
+            max_level,
+        })
+    }
+
+    /// Patches of each kind: regular, Gregory, bilinear.
+    pub fn patch_counts(&self) -> [u32; 3] {
+        self.gpu.counts
+    }
+
+    /// The largest per-edge level a policy can ask for (transition edges take half of it).
+    fn factor_limit(&self) -> f32 {
+        self.max_level
+    }
+
+    fn push(&self, params: &FrameParams, mode: u32) -> AdaptivePush {
+        let (factor_mode, uniform_level, pixels, reference) = match params.factors {
+            FactorPolicy::Uniform { segments } => (BFT_FACTORS_UNIFORM, segments, 0.0, 0.0),
+            FactorPolicy::Screen { pixels } => (BFT_FACTORS_SCREEN, 0.0, pixels.max(0.01), 0.0),
+            FactorPolicy::Distance { reference } => {
+                (BFT_FACTORS_DISTANCE, 0.0, 0.0, reference.max(1e-6))
+            }
+        };
+        let fractional = params.spacing == Spacing::FractionalEven;
+        let adaptive = !matches!(params.factors, FactorPolicy::Uniform { .. });
+        let mut options = 0;
+        if params.patch_colours {
+            options |= ADAPTIVE_OPTION_PATCH_COLOURS;
+        }
+        if fractional {
+            options |= ADAPTIVE_OPTION_FRACTIONAL;
+        } else if adaptive {
+            options |= ADAPTIVE_OPTION_POW2;
+        }
+        AdaptivePush {
+            mode,
+            first_patch: 0,
+            factor_mode,
+            options,
+            uniform_level,
+            pixels_per_segment: pixels,
+            distance_ref: reference,
+            max_level: self.factor_limit(),
+            first_row: 0,
+            count: 0,
+            base_count: self.gpu.num_base_vertices,
+        }
+    }
+
+    /// Where patch `patch` (frame-wide id) at patch coordinate `(u, v)` lies in its base face:
+    /// `(base face, sub-face, u, v)` in `topology::eval`'s convention (sub-quads of
+    /// non-quads as `LocalMesh::evaluate_subface` numbers them).
+    pub fn base_param(&self, patch: u32, u: f64, v: f64) -> Option<(u32, u8, f64, f64)> {
+        let pi = *self.gpu.order.get(patch as usize)?;
+        let p = self.plan.patches.get(pi as usize)?;
+        Some((
+            p.base_face,
+            p.sub_face,
+            p.origin[0] + p.size * u,
+            p.origin[1] + p.size * v,
+        ))
+    }
+}
+
+impl Technique for Adaptive {
+    fn id(&self) -> TechniqueId {
+        TechniqueId::Adaptive
+    }
+
+    fn bbox(&self) -> ([f32; 3], [f32; 3]) {
+        self.rest_bbox
+    }
+
+    fn patch_arrays(&self) -> &[PatchArray] {
+        &self.arrays
+    }
+
+    /// Uniform factors are whole segments per patch edge, at most half the device's maximum
+    /// (a coarse transition edge doubles them); spacing equal or fractional even.
+    fn check(&self, params: &FrameParams) -> Result<()> {
+        if params.spacing == Spacing::FractionalOdd {
+            return Err(TessError::Unsupported {
+                technique: TechniqueId::Adaptive,
+                what: "--spacing fractional-odd (transition edges need even levels: use --fractional, i.e. fractional-even)",
+            });
+        }
+        let half = (self.factor_limit() * 0.5).floor();
+        match params.factors {
+            FactorPolicy::Uniform { segments } => {
+                let whole = segments.fract() == 0.0;
+                if !whole || segments < 1.0 || segments > half {
+                    return Err(TessError::OutOfRange {
+                        option: "--segments",
+                        value: segments.to_string(),
+                        range: "whole segments per patch edge, 1 up to half the device's maximum tessellation level (transition edges double it)",
+                    });
+                }
+            }
+            FactorPolicy::Screen { pixels } if !(pixels.is_finite() && pixels >= 0.5) => {
+                return Err(TessError::OutOfRange {
+                    option: "--pixels",
+                    value: pixels.to_string(),
+                    range: "at least 0.5 pixels per segment",
+                })
+            }
+            FactorPolicy::Distance { reference } if !(reference.is_finite() && reference > 0.0) => {
+                return Err(TessError::OutOfRange {
+                    option: "--distance",
+                    value: reference.to_string(),
+                    range: "a positive distance",
+                })
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    fn patch_pipeline(&self, patch: PatchType) -> PatchPipeline {
+        let evaluation = match patch {
+            PatchType::Gregory => Stage::AdaptiveGregoryTese,
+            PatchType::Bilinear => Stage::AdaptiveBilinearTese,
+            _ => Stage::AdaptiveRegularTese,
+        };
+        PatchPipeline {
+            vertex: Stage::AdaptivePatchVert,
+            control: Stage::AdaptivePatchTesc,
+            evaluation,
+            fragment: Stage::AdaptiveAdaptiveFrag,
+            control_points: 1,
+            mesh_vertex_input: false,
+            push_constant_bytes: std::mem::size_of::<AdaptivePush>() as u32,
+        }
+    }
+
+    fn set_layout_bindings(&self) -> &'static [BindingDesc] {
+        &SET_BINDINGS
+    }
+
+    fn descriptor_set(&self, slot: usize) -> Option<&DescriptorSet> {
+        self.sets.get(slot.min(self.sets.len().saturating_sub(1)))
+    }
+
+    /// At the largest level an edge can get (a coarse transition edge's doubled level).
+    fn max_vertices_per_patch(&self, params: &FrameParams, _array: usize) -> u64 {
+        let max = match params.factors {
+            FactorPolicy::Uniform { segments } => 2.0 * segments,
+            _ => self.factor_limit(),
+        };
+        uniform_vertex_count(Domain::Quad, params.spacing, max.min(self.factor_limit()))
+    }
+
+    /// Exact for uniform factors without transitions (every edge at `segments`); with
+    /// transitions the coarse edges add triangles, so a capture measures.
+    fn triangles(&self, params: &FrameParams, array: usize) -> Option<u64> {
+        let a = self.arrays.get(array)?;
+        let transitions = self.gpu.patches[a.first_patch as usize..(a.first_patch + a.patches) as usize]
+            .iter()
+            .any(|p| (p.info >> 12) & 15 != 0);
+        match params.factors {
+            FactorPolicy::Uniform { segments } if !transitions => Some(
+                a.patches as u64 * uniform_triangle_count(Domain::Quad, params.spacing, segments),
+            ),
+            _ => None,
+        }
+    }
+
+    fn base_mesh(&self) -> Option<&ControlMesh> {
+        Some(&self.mesh)
+    }
+
+    fn update_base(&mut self, slot: usize, positions: &[[f32; 3]]) -> Result<()> {
+        if positions.len() != self.base_positions.len() {
+            return Err(TessError::BasePositionCount {
+                given: positions.len(),
+                expected: self.base_positions.len(),
+            });
+        }
+        if let Some(v) = positions.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+            return Err(TessError::NonFiniteVertex { vertex: v });
+        }
+        let slots = self.base.len();
+        let buf = self
+            .base
+            .get_mut(slot)
+            .ok_or(TessError::FrameSlot { slot, slots })?;
+        buf.write(0, bytemuck::cast_slice(positions))?;
+        self.base_positions = positions.to_vec();
+        Ok(())
+    }
+
+    fn record_pre_pass<'a>(
+        &'a self,
+        enc: &mut Encoder<'a>,
+        frame_set: &'a DescriptorSet,
+        slot: usize,
+    ) -> Result<()> {
+        let set = self
+            .descriptor_set(slot)
+            .ok_or(TessError::FrameSlot { slot, slots: 0 })?;
+        let tess_stages = vk::PipelineStageFlags::VERTEX_SHADER
+            | vk::PipelineStageFlags::TESSELLATION_CONTROL_SHADER
+            | vk::PipelineStageFlags::TESSELLATION_EVALUATION_SHADER;
+        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        enc.begin_label("adaptive subdivision tables");
+        // The previous frame's tessellation stages read the vertices before we overwrite them;
+        // host writes of the base positions are visible at submit.
+        enc.memory_barrier(
+            (tess_stages, vk::AccessFlags::SHADER_READ),
+            (compute, vk::AccessFlags::SHADER_WRITE),
+        );
+        enc.bind_pipeline(&self.stencil);
+        enc.bind_descriptor_sets(0, &[frame_set, set])?;
+        let base = AdaptivePush {
+            mode: 1,
+            count: self.gpu.num_base_vertices,
+            base_count: self.gpu.num_base_vertices,
+            ..Default::default()
+        };
+        let mut steps = vec![base];
+        for d in &self.gpu.dispatches {
+            steps.push(AdaptivePush {
+                mode: 0,
+                first_row: d.first_row,
+                count: d.rows,
+                base_count: self.gpu.num_base_vertices,
+                ..Default::default()
+            });
+        }
+        let n = steps.len();
+        for (i, push) in steps.iter().enumerate() {
+            if push.count == 0 {
+                continue;
+            }
+            enc.push_constants(push)?;
+            enc.dispatch([push.count.div_ceil(ADAPTIVE_LOCAL_SIZE), 1, 1])?;
+            // Each block reads the ones before it; the last feeds the tessellation stages.
+            let next = if i + 1 == n {
+                (tess_stages, vk::AccessFlags::SHADER_READ)
+            } else {
+                (
+                    compute,
+                    vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
+                )
+            };
+            enc.memory_barrier((compute, vk::AccessFlags::SHADER_WRITE), next);
+        }
+        enc.end_label();
+        Ok(())
+    }
+
+    fn record_array<'a>(
+        &'a self,
+        enc: &mut Encoder<'a>,
+        array: usize,
+        params: &FrameParams,
+        pass: Pass,
+        per_draw: u32,
+    ) -> Result<DrawCounts> {
+        let a = *self
+            .arrays
+            .get(array)
+            .ok_or(TessError::NoPatchArray { array })?;
+        let mut push = self.push(params, pass.mode());
+        push.first_patch = a.first_patch;
+        enc.push_constants(&push)?;
+        for_each_draw(a.patches, per_draw, |first, n| {
+            enc.draw(first..first + n)?;
+            Ok(())
+        })
+    }
+
+    /// The patch's point in its base face; a sub-quad of a non-quad maps bilinearly into the
+    /// face's domain ([`face_corner_uv`]): corner, edge midpoint, centre, edge midpoint.
+    fn face_point(&self, patch: u32, domain: [f32; 2]) -> Option<FacePoint> {
+        let (face, sub, u, v) = self.base_param(patch, domain[0] as f64, domain[1] as f64)?;
+        let n = self.mesh.face(face as usize).len() as u32;
+        if n == 4 {
+            return Some(FacePoint {
+                face,
+                u: u as f32,
+                v: v as f32,
+            });
+        }
+        let k = sub as u32;
+        let c = |i: u32| face_corner_uv(n, i % n);
+        let corner = c(k);
+        let next = c(k + 1);
+        let prev = c(k + n - 1);
+        let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) * 0.5, (a[1] + b[1]) * 0.5];
+        let centre = (0..n).fold([0.0, 0.0], |s, i| {
+            let p = c(i);
+            [s[0] + p[0] / n as f64, s[1] + p[1] / n as f64]
+        });
+        let q = [corner, mid(corner, next), centre, mid(prev, corner)];
+        let w = [(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v];
+        let mut uv = [0.0; 2];
+        for (p, w) in q.iter().zip(w) {
+            uv[0] += w * p[0];
+            uv[1] += w * p[1];
+        }
+        Some(FacePoint {
+            face,
+            u: uv[0] as f32,
+            v: uv[1] as f32,
+        })
+    }
+
+    fn report_notes(&self) -> Vec<String> {
+        let [r, g, b] = self.gpu.counts;
+        vec![format!(
+            "adaptive: isolation {}, {r} regular patches, {g} Gregory and {b} bilinear end caps, \
+             {} vertices ({} refined + local), tables {} bytes",
+            self.plan.isolation,
+            self.gpu.num_vertices,
+            self.gpu.num_vertices - self.gpu.num_base_vertices,
+            self.gpu.table_bytes()
+        )]
+    }
+}

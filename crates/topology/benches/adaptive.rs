@@ -1,0 +1,71 @@
+//! The feature-adaptive plan (sparse refinement to the isolation level, patches, end caps,
+//! stencil blocks, local points and curves) against uniform stencils, on the shapes the issue
+//! compares with OpenSubdiv's `far_perf` (catmark_car, catmark_bishop, catmark_pawn) and spot.
+//!
+//! `RAYON_NUM_THREADS=1 cargo bench -p topology --bench adaptive` for the single-threaded
+//! figures; `TESSERA_BENCH_FACES=1` prints the face counts per level instead (the seed's
+//! Fig. 5.2: regular, end caps, faces held, uniform).
+use criterion::Criterion;
+use std::path::PathBuf;
+use std::time::Duration;
+use topology::adaptive::{plan_adaptive, AdaptiveOptions, EndCap};
+use topology::{load_obj, uniform_stencils, ControlMesh, Scheme};
+
+fn mesh(rel: &str) -> ControlMesh {
+    load_obj(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..").join(rel)).unwrap()
+}
+
+fn shapes() -> Vec<(&'static str, ControlMesh)> {
+    vec![
+        ("spot", mesh("assets/spot_control_mesh.obj")),
+        ("catmark_car", mesh("tests/data/opensubdiv/shapes/catmark_car.obj")),
+        ("catmark_bishop", mesh("tests/data/opensubdiv/shapes/catmark_bishop.obj")),
+        ("catmark_pawn", mesh("tests/data/opensubdiv/shapes/catmark_pawn.obj")),
+    ]
+}
+
+fn options(isolation: u32) -> AdaptiveOptions {
+    AdaptiveOptions {
+        isolation,
+        end_cap: EndCap::Gregory,
+        sharpness_scale: 1.0,
+    }
+}
+
+fn print_face_counts() {
+    for (name, m) in shapes() {
+        let plan = plan_adaptive(&m, &options(4)).unwrap();
+        println!("{name} (isolation 4): level | regular | end caps | faces held | uniform");
+        for (l, s) in plan.level_stats.iter().enumerate() {
+            println!("  {l} | {} | {} | {} | {}", s.regular, s.end_caps, s.faces, s.uniform_faces);
+        }
+    }
+}
+
+fn bench(c: &mut Criterion) {
+    let mut g = c.benchmark_group("plan");
+    g.sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(3));
+    for (name, m) in shapes() {
+        g.bench_function(format!("{name}_adaptive4"), |b| {
+            b.iter(|| plan_adaptive(&m, &options(4)).unwrap())
+        });
+        if name == "catmark_car" {
+            g.bench_function(format!("{name}_uniform3_stencils"), |b| {
+                b.iter(|| uniform_stencils(&m, Scheme::CatmullClark, 3).unwrap())
+            });
+        }
+    }
+    g.finish();
+}
+
+fn main() {
+    if std::env::var_os("TESSERA_BENCH_FACES").is_some() {
+        print_face_counts();
+        return;
+    }
+    let mut c = Criterion::default().configure_from_args();
+    bench(&mut c);
+    c.final_summary();
+}

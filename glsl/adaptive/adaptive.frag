@@ -1,0 +1,13 @@
+#version 450
+// Shading of adaptive surfaces: as common/shade.frag, with the per-patch albedo (patch colours).
+#define TECHNIQUE_PUSH_CONSTANTS
+#include "frame.glsl"
+#include "adaptive.glsl"
+#include "shading.glsl"
+layout(location = 0) in vec3 in_world;
+layout(location = 1) in vec3 in_normal;
+layout(location = 5) flat in vec3 in_albedo;
+layout(location = 0) out vec4 out_color;
+void main() {
+    out_color = adaptive.mode == DRAW_MODE_WIREFRAME ? vec4(frame.wire_color.rgb, 1.0) : shade(in_world, in_normal, in_albedo);
+}

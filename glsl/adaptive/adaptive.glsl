@@ -1,0 +1,161 @@
+// Feature-adaptive Catmull-Clark (crates/tess/src/techniques/adaptive): the storage buffers,
+// push constants and the evaluation every stage shares. Mirrors
+// `tess::techniques::adaptive::layout` (offsets checked against the SPIR-V by a test).
+//
+// Watertightness by canonical curves: every patch boundary edge is one cubic Bezier curve of
+// the global vertex buffer (computed once per frame by the stencil kernel, from one owner
+// patch). A TES vertex on a patch boundary is evaluated from that curve, at a parameter both
+// sides of the edge derive identically (from the vertex's index along the edge when the
+// factor is an integer, else from the mirrored tess coordinate), with `precise` arithmetic in
+// one fixed operand order. So the two sides produce the same bits, across level transitions
+// and end caps too.
+#include "bindings.glsl"
+
+struct StencilTerm {
+    uint index;   // global vertex
+    float weight;
+};
+
+struct AdaptivePatch {
+    uint cp_offset;   // first control-point index in control_points[]
+    uint info;        // kind | level << 4 | boundary mask << 8 | transition mask << 12
+    uint edge_info;   // per edge i, 4 bits at 4i: kind (2 bits), reversed[0], reversed[1]
+    uint pad;
+    uint curves[8];   // edge i: curves[2i], curves[2i + 1]
+};
+
+layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_BASE_POSITIONS_BINDING) readonly buffer BasePositions { float base_positions[]; };
+layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_STENCIL_OFFSETS_BINDING) readonly buffer StencilOffsets { uint stencil_offsets[]; };
+layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_STENCIL_TERMS_BINDING) readonly buffer StencilTerms { StencilTerm stencil_terms[]; };
+#ifdef ADAPTIVE_WRITES_VERTICES
+layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_VERTICES_BINDING) buffer Vertices { vec4 vertices[]; };
+#else
+layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_VERTICES_BINDING) readonly buffer Vertices { vec4 vertices[]; };
+#endif
+layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_PATCHES_BINDING) readonly buffer Patches { AdaptivePatch patches[]; };
+layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_CONTROL_POINTS_BINDING) readonly buffer ControlPoints { uint control_points[]; };
+layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_CURVES_BINDING) readonly buffer Curves { uvec4 curves[]; };
+
+// Push constant of every adaptive pipeline (`tess::gpu::AdaptivePush`).
+layout(push_constant) uniform AdaptivePush {
+    uint mode;             // DRAW_MODE_SHADED or DRAW_MODE_WIREFRAME
+    uint first_patch;      // frame-wide id of the array's first patch
+    uint factor_mode;      // BFT_FACTORS_UNIFORM, _SCREEN or _DISTANCE
+    uint options;          // ADAPTIVE_OPTION_* bits
+    float uniform_level;   // segments per patch edge (uniform mode)
+    float pixels_per_segment;
+    float distance_ref;    // distance at which an edge gets max_level segments
+    float max_level;       // the device's maximum tessellation level
+    uint first_row;        // compute: first stencil row of this dispatch (global vertex - base count)
+    uint count;            // compute: rows in this dispatch (or base vertices to copy)
+    uint base_count;       // compute: base vertices (row r writes vertex base_count + r)
+} adaptive;
+
+uint patch_kind(AdaptivePatch p) { return p.info & 15u; }
+uint patch_level(AdaptivePatch p) { return (p.info >> 4) & 15u; }
+uint edge_kind(AdaptivePatch p, uint e) { return (p.edge_info >> (4u * e)) & 3u; }
+bool edge_reversed(AdaptivePatch p, uint e, uint half_) { return ((p.edge_info >> (4u * e + 2u + half_)) & 1u) != 0u; }
+
+vec3 vtx(uint i) { return vertices[i].xyz; }
+
+// The canonical curve evaluation: one formula, one operand order, `precise`, so every patch
+// that reads a curve at the same parameter gets the same bits. s = 0 and s = 1 give the end
+// points exactly (the weights are exactly 1, 0, 0, 0).
+vec3 curve_point(uint c, float s) {
+    uvec4 b = curves[c];
+    precise float r = 1.0 - s;
+    precise float w0 = r * r * r;
+    precise float w1 = 3.0 * s * r * r;
+    precise float w2 = 3.0 * s * s * r;
+    precise float w3 = s * s * s;
+    precise vec3 p = w0 * vtx(b.x) + w1 * vtx(b.y) + w2 * vtx(b.z) + w3 * vtx(b.w);
+    return p;
+}
+
+// Where patch edge e is at parameter t along the patch's edge direction (e runs v_e -> v_e+1),
+// for interior blends (not canonical).
+vec3 edge_point(AdaptivePatch p, uint e, float t) {
+    uint kind = edge_kind(p, e);
+    uint h = 0u;
+    float s = t;
+    if (kind == ADAPTIVE_EDGE_COARSE) {
+        h = t < 0.5 ? 0u : 1u;
+        s = h == 0u ? 2.0 * t : 2.0 * t - 1.0;
+    }
+    if (edge_reversed(p, e, h)) s = 1.0 - s;
+    return curve_point(p.curves[2u * e + h], s);
+}
+
+// The canonical boundary point of patch edge e at parameter t (as above) with the edge's
+// tessellation level n: integer levels name the vertex k = round(t n) and both sides evaluate
+// k / n on the curve in its own direction; fractional levels mirror t exactly (1 - t is exact
+// for tess coordinates).
+vec3 canonical_edge_point(AdaptivePatch p, uint e, float t, float n, bool integer_level) {
+    uint kind = edge_kind(p, e);
+    if (!integer_level) {
+        bool rev = edge_reversed(p, e, 0u);
+        return curve_point(p.curves[2u * e], rev ? 1.0 - t : t);
+    }
+    uint k = uint(round(t * n));
+    uint segs = uint(round(n));
+    uint h = 0u;
+    if (kind == ADAPTIVE_EDGE_COARSE) {
+        segs /= 2u;
+        if (k > segs) { h = 1u; k -= segs; }
+    }
+    if (edge_reversed(p, e, h)) k = segs - k;
+    return curve_point(p.curves[2u * e + h], float(k) / float(segs));
+}
+
+// The factor one curve asks for under the frame's policy: computed from the curve's own four
+// points (data both sides of an edge share), in the curve's order.
+float curve_factor(uint c) {
+    uvec4 b = curves[c];
+    vec3 p0 = vtx(b.x), p1 = vtx(b.y), p2 = vtx(b.z), p3 = vtx(b.w);
+    float f;
+    if (adaptive.factor_mode == BFT_FACTORS_SCREEN) {
+        vec4 c0 = frame.view_proj * vec4(p0, 1.0), c1 = frame.view_proj * vec4(p1, 1.0);
+        vec4 c2 = frame.view_proj * vec4(p2, 1.0), c3 = frame.view_proj * vec4(p3, 1.0);
+        if (min(min(c0.w, c1.w), min(c2.w, c3.w)) <= 1e-6) {
+            f = adaptive.max_level; // crosses the eye plane: no screen length, refine fully
+        } else {
+            vec2 h = 0.5 * frame.viewport.xy;
+            vec2 s0 = c0.xy / c0.w * h, s1 = c1.xy / c1.w * h, s2 = c2.xy / c2.w * h, s3 = c3.xy / c3.w * h;
+            // The control polygon bounds the curve's length.
+            f = (distance(s0, s1) + distance(s1, s2) + distance(s2, s3)) / adaptive.pixels_per_segment;
+        }
+    } else if (adaptive.factor_mode == BFT_FACTORS_DISTANCE) {
+        float d = distance(frame.camera_pos.xyz, 0.5 * (p0 + p3));
+        f = adaptive.max_level * adaptive.distance_ref / max(d, 1e-6);
+    } else {
+        f = adaptive.uniform_level;
+    }
+    return f;
+}
+
+bool fractional_factors() { return (adaptive.options & uint(ADAPTIVE_OPTION_FRACTIONAL)) != 0u; }
+
+// Level of patch edge e. Transition edges (both halves and the coarse side) take F from both
+// half curves (max is symmetric), F an integer (even when fractional) so the coarse side's
+// 2F puts a vertex at every fine vertex; the coarse side doubles it.
+float edge_level(AdaptivePatch p, uint e) {
+    uint kind = edge_kind(p, e);
+    float lim = adaptive.max_level;
+    if (kind == ADAPTIVE_EDGE_PLAIN) {
+        float f = curve_factor(p.curves[2u * e]);
+        if (fractional_factors()) return clamp(f, 2.0, lim);
+        f = clamp(f, 1.0, lim);
+        if ((adaptive.options & uint(ADAPTIVE_OPTION_POW2)) != 0u) f = exp2(ceil(log2(f) - 1e-4));
+        return min(ceil(f), lim);
+    }
+    float f = max(curve_factor(p.curves[2u * e]), curve_factor(p.curves[2u * e + 1u]));
+    float half_lim = floor(lim * 0.5);
+    if (fractional_factors()) {
+        f = 2.0 * ceil(clamp(f, 2.0, half_lim) * 0.5);
+    } else {
+        f = clamp(f, 1.0, half_lim);
+        if ((adaptive.options & uint(ADAPTIVE_OPTION_POW2)) != 0u) f = exp2(ceil(log2(f) - 1e-4));
+        f = min(ceil(f), half_lim);
+    }
+    return kind == ADAPTIVE_EDGE_COARSE ? 2.0 * f : f;
+}

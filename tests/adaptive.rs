@@ -1,0 +1,352 @@
+//! Feature-adaptive Catmull-Clark on the tessellation stage, checked from the GPU's own output
+//! (transform feedback): captured vertices against the CPU exact limit at their (base face,
+//! sub-face, u, v), watertightness (weld by bits) under every factor policy, across level
+//! transitions and end caps, with an animated base, and bad input. Validation is on and any
+//! error fails (tests/common).
+mod common;
+use common::Gpu;
+use tessera::tess::capture::{classify_open_edges, CapturedSoup, Capturer};
+use tessera::tess::gpu::bindings::{ADAPTIVE_FLAG_LEVEL_SHIFT, ADAPTIVE_KIND_REGULAR};
+use tessera::tess::techniques::adaptive::{Adaptive, AdaptiveBuild};
+use tessera::tess::techniques::bft::{base_normals, base_positions, wave};
+use tessera::tess::{Camera, Context, FactorPolicy, FrameParams, Spacing, Technique};
+use tessera::topology::adaptive::EndCap;
+use tessera::topology::eval::{LimitScheme, LocalMesh};
+use tessera::topology::{self, ControlMesh};
+use tessera::vk_core::vk;
+
+const EXTENT: vk::Extent2D = vk::Extent2D {
+    width: 640,
+    height: 480,
+};
+
+fn shape(name: &str) -> ControlMesh {
+    topology::load_obj(common::data(&format!(
+        "tests/data/opensubdiv/shapes/{name}.obj"
+    )))
+    .expect("shape")
+}
+
+fn spot() -> ControlMesh {
+    topology::load_obj(common::data("assets/spot_control_mesh.obj")).expect("spot")
+}
+
+/// Every Catmull-Clark shape of tests/data (hierarchical edits aside) and spot.
+fn catmark_shapes() -> Vec<(String, ControlMesh)> {
+    let dir = common::data("tests/data/opensubdiv/shapes");
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .expect("shapes")
+        .filter_map(|e| {
+            let n = e.ok()?.file_name().to_string_lossy().into_owned();
+            let stem = n.strip_suffix(".obj")?.to_string();
+            (stem.starts_with("catmark_") && !stem.contains("hedit")).then_some(stem)
+        })
+        .collect();
+    names.sort();
+    let mut out: Vec<(String, ControlMesh)> =
+        names.into_iter().map(|n| (n.clone(), shape(&n))).collect();
+    out.push(("spot".into(), spot()));
+    out
+}
+
+fn diag(m: &ControlMesh) -> f64 {
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in &m.positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+}
+
+fn surface(ctx: &mut Context, mesh: &ControlMesh, name: &str, isolation: u32, end_cap: EndCap) -> Adaptive {
+    Adaptive::new(
+        ctx,
+        mesh,
+        &AdaptiveBuild {
+            isolation,
+            end_cap,
+            sharpness_scale: 1.0,
+            name: name.into(),
+        },
+    )
+    .unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// Worst distance over the bbox diagonal between captured vertices and the exact limit at
+/// their base point: (regular patches, end caps), over at most `samples` welded vertices.
+fn deviation(surf: &Adaptive, soup: &CapturedSoup, mesh: &ControlMesh, samples: usize) -> (f64, f64) {
+    let cpu = LocalMesh::from_control_mesh(mesh, LimitScheme::CatmullClark).expect("cpu mesh");
+    let welded = soup.weld().expect("weld");
+    let n = welded.positions.len();
+    let stride = n.div_ceil(samples).max(1);
+    let d = diag(mesh);
+    let (mut regular, mut caps) = (0.0f64, 0.0f64);
+    for i in (0..n).step_by(stride) {
+        let [u, v] = welded.domain[i].map(f64::from);
+        let (f, sub, bu, bv) = surf.base_param(welded.patch[i], u, v).expect("patch");
+        let quad = mesh.face(f as usize).len() == 4;
+        let e = if quad {
+            cpu.evaluate(f as usize, bu, bv)
+        } else {
+            cpu.evaluate_subface(f as usize, sub as usize, bu, bv)
+        }
+        .expect("exact limit");
+        let err = (0..3)
+            .map(|k| (welded.positions[i][k] as f64 - e.position[k]).abs())
+            .fold(0.0, f64::max)
+            / d;
+        if welded.flags[i] & 15 == ADAPTIVE_KIND_REGULAR {
+            regular = regular.max(err);
+        } else {
+            caps = caps.max(err);
+        }
+    }
+    (regular, caps)
+}
+
+fn cracks(surf: &Adaptive, soup: &CapturedSoup, mesh: &ControlMesh) -> (usize, usize, usize) {
+    let welded = soup.weld().expect("weld");
+    let report = welded.open_edges();
+    let map = |p: u32, d: [f32; 2]| surf.face_point(p, d);
+    let c = classify_open_edges(soup, &welded, &report, &map, mesh);
+    (
+        c.cracks + c.unmapped,
+        c.on_base_boundary,
+        report.non_manifold.len(),
+    )
+}
+
+/// Regular patches are the exact limit (≤ 1e-5 of the diagonal, f32 on the GPU); the whole
+/// surface with Gregory end caps at isolation 4 is within 5e-5.
+#[test]
+fn captured_vertices_are_the_exact_limit() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
+        for (name, mesh) in catmark_shapes() {
+            let surf = surface(&mut ctx, &mesh, &name, 4, EndCap::Gregory);
+            let (soup, _) = capturer
+                .capture(&mut ctx, &surf, &FrameParams::uniform(3.0), EXTENT)
+                .expect("capture");
+            let (regular, caps) = deviation(&surf, &soup, &mesh, 3000);
+            let [r, g, b] = surf.patch_counts();
+            println!("{name}: {r} regular, {g} Gregory, {b} bilinear: regular {regular:.2e}, end caps {caps:.2e}");
+            assert!(regular <= 1e-5, "{name}: regular patches off by {regular:.2e}");
+            assert!(caps <= 5e-5, "{name}: end caps off by {caps:.2e}");
+        }
+    }
+}
+
+/// The end caps' deviation from the exact limit shrinks as the isolation level rises.
+#[test]
+fn end_cap_deviation_shrinks_with_isolation() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
+        for (name, mesh) in [("spot".to_string(), spot()), ("catmark_cube".into(), shape("catmark_cube"))] {
+            for end_cap in [EndCap::Gregory, EndCap::Bilinear] {
+                let mut devs = Vec::new();
+                for isolation in 1..=6 {
+                    let surf = surface(&mut ctx, &mesh, &name, isolation, end_cap);
+                    let (soup, _) = capturer
+                        .capture(&mut ctx, &surf, &FrameParams::uniform(2.0), EXTENT)
+                        .expect("capture");
+                    let (regular, caps) = deviation(&surf, &soup, &mesh, 4000);
+                    assert!(regular <= 1e-5, "{name} isolation {isolation}: regular {regular:.2e}");
+                    devs.push(caps);
+                }
+                println!("{name} {end_cap:?} end-cap deviation, isolation 1..6: {devs:.2e?}");
+                assert!(devs[5] < 0.25 * devs[0], "{name} {end_cap:?}: {devs:?} does not shrink");
+                for w in devs.windows(2) {
+                    assert!(w[1] <= w[0] * 1.05, "{name} {end_cap:?}: {devs:?} grows");
+                }
+            }
+        }
+    }
+}
+
+/// 0 cracks beyond the base boundary under uniform, screen, distance and fractional factors,
+/// across transitions, with Gregory and bilinear end caps (positions welded only when
+/// bit-identical).
+#[test]
+fn watertight_under_every_factor_policy() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
+        let camera = Camera {
+            zoom: 2.5,
+            yaw: 30.0,
+            ..Default::default()
+        };
+        for name in [
+            "catmark_cube",
+            "catmark_pyramid",
+            "catmark_tent_creases1",
+            "catmark_edgecorner",
+            "catmark_chaikin1",
+            "catmark_flap",
+            "spot",
+        ] {
+            let mesh = if name == "spot" { spot() } else { shape(name) };
+            for end_cap in [EndCap::Gregory, EndCap::Bilinear] {
+                let surf = surface(&mut ctx, &mesh, name, 3, end_cap);
+                let policies = [
+                    ("uniform 5", FactorPolicy::Uniform { segments: 5.0 }, false),
+                    ("screen 6px", FactorPolicy::Screen { pixels: 6.0 }, false),
+                    (
+                        "distance",
+                        FactorPolicy::Distance {
+                            reference: 0.6 * diag(&mesh) as f32,
+                        },
+                        false,
+                    ),
+                    ("screen 6px fractional", FactorPolicy::Screen { pixels: 6.0 }, true),
+                    (
+                        "distance fractional",
+                        FactorPolicy::Distance {
+                            reference: 0.45 * diag(&mesh) as f32,
+                        },
+                        true,
+                    ),
+                ];
+                for (label, factors, fractional) in policies {
+                    let params = FrameParams {
+                        factors,
+                        spacing: if fractional { Spacing::FractionalEven } else { Spacing::Equal },
+                        camera,
+                        ..FrameParams::default()
+                    };
+                    let (soup, _) = capturer
+                        .capture(&mut ctx, &surf, &params, EXTENT)
+                        .expect("capture");
+                    let (cracks, boundary, nonmanifold) = cracks(&surf, &soup, &mesh);
+                    println!(
+                        "{name} {end_cap:?} {label}: {} triangles, {cracks} cracks, {boundary} boundary edges",
+                        soup.triangle_count()
+                    );
+                    assert_eq!(cracks, 0, "{name} {end_cap:?} {label}: open edges beyond the base boundary");
+                    assert_eq!(nonmanifold, 0, "{name} {end_cap:?} {label}");
+                }
+            }
+        }
+    }
+}
+
+/// After uploading the `--animate` wave (base positions only), the captured surface is the
+/// exact limit of the deformed base mesh, still watertight.
+#[test]
+fn animated_base_mesh_gives_the_deformed_limit() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
+        let mesh = spot();
+        let mut surf = surface(&mut ctx, &mesh, "spot", 3, EndCap::Gregory);
+        let rest = base_positions(&mesh);
+        let (lo, hi) = surf.bbox();
+        let posed = wave(&rest, &base_normals(&mesh), lo, hi, 0.37);
+        surf.update_base(0, &posed).expect("upload");
+        let mut deformed = mesh.clone();
+        deformed.positions = posed.iter().map(|p| p.map(f64::from)).collect();
+        let (soup, _) = capturer
+            .capture(&mut ctx, &surf, &FrameParams::uniform(4.0), EXTENT)
+            .expect("capture");
+        let (regular, caps) = deviation(&surf, &soup, &deformed, 3000);
+        let (rest_regular, _) = deviation(&surf, &soup, &mesh, 3000);
+        println!("animated spot: regular {regular:.2e}, end caps {caps:.2e}; vs rest pose {rest_regular:.2e}");
+        assert!(regular <= 1e-5 && caps <= 2e-4, "{regular:.2e} {caps:.2e}");
+        assert!(rest_regular > 1e-3, "the surface did not move");
+        assert_eq!(cracks(&surf, &soup, &deformed).0, 0);
+    }
+}
+
+/// Patch kinds and levels come back in the capture flags: isolation raises the deepest level.
+#[test]
+fn isolation_level_shows_in_the_captured_levels() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
+        let mesh = spot();
+        for isolation in [1, 2, 5] {
+            let surf = surface(&mut ctx, &mesh, "spot", isolation, EndCap::Gregory);
+            let (soup, _) = capturer
+                .capture(&mut ctx, &surf, &FrameParams::uniform(1.0), EXTENT)
+                .expect("capture");
+            let deepest = soup
+                .records
+                .iter()
+                .map(|r| (r.flags >> ADAPTIVE_FLAG_LEVEL_SHIFT) & 15)
+                .max()
+                .unwrap();
+            assert_eq!(deepest, isolation, "isolation {isolation}");
+        }
+    }
+}
+
+/// Bad options and meshes give named errors, never a panic.
+#[test]
+fn bad_input_gives_named_errors() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let mesh = shape("catmark_cube");
+        for isolation in [0, 9] {
+            let e = Adaptive::new(
+                &mut ctx,
+                &mesh,
+                &AdaptiveBuild {
+                    isolation,
+                    name: "cube".into(),
+                    ..Default::default()
+                },
+            )
+            .err()
+            .expect("refused");
+            assert!(e.to_string().contains("isolation"), "{e}");
+        }
+        for scale in [f32::NAN, -1.0] {
+            let e = Adaptive::new(
+                &mut ctx,
+                &mesh,
+                &AdaptiveBuild {
+                    sharpness_scale: scale,
+                    name: "cube".into(),
+                    ..Default::default()
+                },
+            )
+            .err()
+            .expect("refused");
+            assert!(e.to_string().contains("sharpness"), "{e}");
+        }
+        let mut creased = shape("catmark_cube_creases1");
+        creased.creases[0].sharpness = f32::NAN;
+        let e = Adaptive::new(&mut ctx, &creased, &AdaptiveBuild::default())
+            .err()
+            .expect("NaN sharpness refused");
+        assert!(e.to_string().contains("sharpness"), "{e}");
+        // Three quads on one edge: non-manifold.
+        let fan = ControlMesh::from_polygons(
+            vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, -1.0, 0.0], [1.0, -1.0, 0.0]],
+            &[vec![0u32, 1, 3, 2], vec![1, 0, 4, 5], vec![0, 1, 7, 6]],
+        );
+        assert!(Adaptive::new(&mut ctx, &fan, &AdaptiveBuild::default()).is_err());
+        let ok = surface(&mut ctx, &mesh, "cube", 2, EndCap::Gregory);
+        for bad in [
+            FrameParams::uniform(0.0),
+            FrameParams::uniform(2.5),
+            FrameParams::uniform(40.0),
+            FrameParams {
+                spacing: Spacing::FractionalOdd,
+                ..FrameParams::uniform(4.0)
+            },
+        ] {
+            assert!(ok.check(&bad).is_err(), "{bad:?}");
+        }
+    }
+}
