@@ -99,6 +99,12 @@ pub enum TopologyError {
     /// A face index (e.g. in a refinement selection) beyond the level's faces.
     #[error("face {face} out of range (the level has {count} faces)")]
     FaceOutOfRange { face: usize, count: usize },
+    /// A Gregory end cap cannot be built on this face ([`crate::gregory::gregory_basis`]).
+    #[error("Gregory patch of face {face}: {problem}")]
+    GregoryPatch {
+        face: usize,
+        problem: crate::gregory::GregoryProblem,
+    },
 }
 
 /// Which OBJ tag a [`TopologyError::TagOutOfRange`] comes from.

@@ -4,6 +4,7 @@
 pub mod bft;
 pub mod error;
 pub mod eval;
+pub mod gregory;
 pub mod limit;
 pub mod mesh;
 pub mod obj;
