@@ -99,6 +99,32 @@ pub enum TopologyError {
     /// A face index (e.g. in a refinement selection) beyond the level's faces.
     #[error("face {face} out of range (the level has {count} faces)")]
     FaceOutOfRange { face: usize, count: usize },
+    /// A Gregory end cap cannot be built on this face ([`crate::gregory::gregory_basis`]).
+    #[error("Gregory patch of face {face}: {problem}")]
+    GregoryPatch {
+        face: usize,
+        problem: crate::gregory::GregoryProblem,
+    },
+    /// An adaptive isolation level outside `1..=8`.
+    #[error("isolation level {isolation} is outside 1..=8")]
+    IsolationOutOfRange { isolation: u32 },
+    /// A sharpness scale that is NaN, infinite or negative.
+    #[error("sharpness scale {scale} must be finite and non-negative")]
+    BadSharpnessScale { scale: f32 },
+    /// A crease tag whose sharpness is NaN or negative.
+    #[error("crease {v0}-{v1}: sharpness {sharpness} is NaN or negative")]
+    BadEdgeSharpness { v0: u32, v1: u32, sharpness: f32 },
+    /// A corner tag whose sharpness is NaN or negative.
+    #[error("corner at vertex {vertex}: sharpness {sharpness} is NaN or negative")]
+    BadVertexSharpness { vertex: u32, sharpness: f32 },
+    /// A face of an adaptive plan that should be a regular patch but is not (its corners do
+    /// not form the 4×4 B-spline net).
+    #[error("adaptive plan: face {face} of level {level} is not a regular patch")]
+    AdaptivePatch { level: u32, face: usize },
+    /// An adaptive patch whose neighbour is more than one level coarser or finer (drawing it
+    /// would leave a crack).
+    #[error("adaptive plan: face {face} of level {level} borders a face more than one level away")]
+    AdaptiveUnbalanced { level: u32, face: usize },
 }
 
 /// Which OBJ tag a [`TopologyError::TagOutOfRange`] comes from.

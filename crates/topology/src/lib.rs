@@ -1,9 +1,11 @@
 //! CPU truth for every GPU technique: control meshes, subdivision, stencils, limit evaluation.
 #![forbid(unsafe_code)]
 
+pub mod adaptive;
 pub mod bft;
 pub mod error;
 pub mod eval;
+pub mod gregory;
 pub mod limit;
 pub mod mesh;
 pub mod obj;
@@ -12,6 +14,10 @@ pub mod refine;
 pub mod sdc;
 pub mod stencil;
 
+pub use adaptive::{
+    plan_adaptive, AdaptiveOptions, AdaptivePatch, AdaptivePlan, EdgeKind, EndCap, LevelStats,
+    PatchEdge, PatchKind, PatchSample, StencilBlock,
+};
 pub use error::{ObjSyntax, TagKind, TopologyError};
 pub use mesh::{
     BoundaryInterpolation, ControlMesh, CreaseMethod, EdgeCrease, SubdivOptions, Topology,

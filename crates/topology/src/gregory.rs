@@ -1,0 +1,731 @@
+//! Gregory end caps for Catmull-Clark (Loop, Schaefer, Ni, Castaño 2009, "Approximating
+//! subdivision surfaces with Gregory patches for hardware tessellation"): the 20 control points
+//! of a quad that is still irregular at the last isolation level, as stencils over that level's
+//! vertices, and the rational basis that evaluates them.
+//!
+//! # Control points and their order
+//!
+//! Face corners `i = 0..3` follow the face's vertex order: corner 0 at `(u,v) = (0,0)`, 1 at
+//! `(1,0)`, 2 at `(1,1)`, 3 at `(0,1)` (the domain of [`crate::patch`]). Each corner owns five
+//! points, slot `5·i + s`:
+//!
+//! | s | name   | meaning                                                               |
+//! |---|--------|-----------------------------------------------------------------------|
+//! | 0 | `P_i`  | limit position of the corner vertex                                   |
+//! | 1 | `Ep_i` | edge point on the edge toward corner `i+1`: `P_i + T_i(i+1) / 3`       |
+//! | 2 | `Em_i` | edge point on the edge toward corner `i−1`: `P_i + T_i(i−1) / 3`       |
+//! | 3 | `Fp_i` | interior (face) point paired with `Ep_i`                              |
+//! | 4 | `Fm_i` | interior (face) point paired with `Em_i`                              |
+//!
+//! `T_i(w)` is the limit tangent of the corner vertex toward its edge-neighbour `w`, scaled as a
+//! parametric derivative (exactly the B-spline derivative at a regular vertex):
+//! * smooth vertex (also a dart) of valence `n`: [`smooth_directional_tangent`] (Halstead's
+//!   eigenvector masks rotated onto edge `k`, `1/(3n)` of the mask);
+//! * crease (two sharp edges, boundary edges count), sector of `m` faces between the sharp
+//!   edges `a` and `b` (CCW, the face inside): `T(k) = cos θ·T_along + sin θ·T_across`,
+//!   `θ = π·(k−a)/m`, with `T_along = (e_a − e_b)/2` and the cross tangent of
+//!   [`catmark_limit_masks`]; along the sharp edges themselves `T = ±T_along` exactly;
+//! * corner (sharp vertex or more than two sharp edges), sector of `m` faces between sharp
+//!   edges `a` and `b`: the vertex stays, `T(a) = e_a − v`, `T(b) = e_b − v`, interior edges
+//!   `T(k) = sin((m−t)φ)·T(a) + sin(tφ)·T(b)`, `t = k−a`, `φ = π/(2m)`.
+//!
+//! Each of `P`, `Ep`, `Em` depends only on the vertex's one-ring and the edge, never on the
+//! face asking, and is accumulated in the same order for every face: two patches sharing an
+//! edge get bit-identical stencils for the boundary curve `P_i, Ep_i, Em_{i+1}, P_{i+1}`
+//! (watertight end caps).
+//!
+//! Face points (Loop et al.'s formula; `c` = cosine of the corner's characteristic angle per
+//! face: `cos(2π/n)` smooth, `cos(π/m)` crease sector, `cos(π/(2m))` corner sector, 0 where
+//! the vertex is regular). For `Fp_i` on the edge from `v_i` to `v_{i+1}`, with `x_in`/`x_out`
+//! the edge-neighbours of `v_i` next to that edge inside/outside the face and `d_in`/`d_out`
+//! the diagonal vertices of the two faces on the edge:
+//!
+//! ```text
+//! Fp_i = c_{i+1}/3 · P_i + (3 − 2c_i − c_{i+1})/3 · Ep_i + 2c_i/3 · Em_{i+1}
+//!        + (x_in − x_out)/9 + (d_in − d_out)/18
+//! ```
+//!
+//! and symmetrically `Fm_i` with `Em_i`, `Ep_{i−1}`, `c_{i−1}`. Where both corners of the edge
+//! are regular (valence-4 smooth, crease sector of 2 faces, corner sector of 1 face) the point
+//! is the B-spline's Bézier interior point `(4v_i + 2v_{i+1} + 2v_{i−1} + v_{i+2})/9`, so
+//! regular, boundary and corner patches are exactly their bicubic B-splines. On a sharp edge
+//! (no continuity to keep across it) the face point copies the corner's other face point
+//! (the face mask if both edges are sharp).
+//!
+//! # Evaluation ([`gregory_weights`]), written to be ported line by line
+//!
+//! Cubic Bernstein `B0 = (1−t)³, B1 = 3t(1−t)², B2 = 3t²(1−t), B3 = t³` and derivatives
+//! `B0' = −3(1−t)², B1' = 3(1−t)(1−3t), B2' = 3t(2−3t), B3' = 3t²`. The patch is the bicubic
+//! Bézier `Σ Bj(u)·Bk(v)·b[j][k]` (`j` along `u`) with
+//!
+//! ```text
+//! b00 = P0   b10 = Ep0  b01 = Em0     b30 = P1   b31 = Ep1  b20 = Em1
+//! b33 = P2   b23 = Ep2  b32 = Em2     b03 = P3   b02 = Ep3  b13 = Em3
+//! b11 = gp0·Fp0 + gm0·Fm0   b21 = gp1·Fp1 + gm1·Fm1
+//! b22 = gp2·Fp2 + gm2·Fm2   b12 = gp3·Fp3 + gm3·Fm3
+//! ```
+//!
+//! At corner `i`, `dp` is the distance to the edge holding `Ep_i` and `dm` to the edge holding
+//! `Em_i`; `Fp_i` is weighted by `dm`, so it alone counts on its own edge:
+//!
+//! ```text
+//! corner 0: dp = v,    dm = u      gp0 = u/(u+v)            gm0 = v/(u+v)
+//! corner 1: dp = 1−u,  dm = v      gp1 = v/(1−u+v)          gm1 = (1−u)/(1−u+v)
+//! corner 2: dp = 1−v,  dm = 1−u    gp2 = (1−u)/(2−u−v)      gm2 = (1−v)/(2−u−v)
+//! corner 3: dp = u,    dm = 1−v    gp3 = (1−v)/(1+u−v)      gm3 = u/(1+u−v)
+//! gp = dm/D, gm = dp/D, D = dp + dm; where D = 0 (the corner itself) gp = gm = 1/2.
+//! ```
+//!
+//! Derivatives are exact (quotient rule, not the Bézier approximation): with `B = Bj(u)Bk(v)`
+//! the interior point's Bernstein product, `∂gp/∂t = (dp·∂dm/∂t − dm·∂dp/∂t)/D²` and
+//! `∂gm/∂t = −∂gp/∂t`. The product `B·∂gp/∂t` stays bounded at the corner because
+//! `B = 9·dp·dm·h` (`h = (1−u)²(1−v)²`, `u²(1−v)²`, `u²v²`, `(1−u)²v²` at corners 0..3), so the
+//! code computes it as `9·h·gp·gm·(dp·∂dm/∂t − dm·∂dp/∂t)` — no division by a vanishing `D²`,
+//! no NaN anywhere on `[0,1]²`:
+//!
+//! ```text
+//! w(Fp) = B·gp                 w(Fm) = B·gm
+//! ∂w(Fp)/∂t = ∂B/∂t·gp + G_t   ∂w(Fm)/∂t = ∂B/∂t·gm − G_t
+//! G_t = 9·h·gp·gm·(dp·∂dm/∂t − dm·∂dp/∂t)
+//! ```
+//!
+//! # Not exact / not handled
+//! * Tangent magnitudes at extraordinary vertices are a choice (the directional masks'); the
+//!   tangent *plane* is exact for smooth and crease vertices. At a corner vertex whose sector
+//!   has 3 or more faces the interior edges' tangent directions are interpolated between the
+//!   two sharp edges (in the exact tangent plane, direction approximate). A sharp vertex with
+//!   fewer than two sharp edges (a cone) and an interior vertex of valence 2 get the edge
+//!   vectors `e_k − v` as tangents and `c = 0`.
+//! * Semi-sharp edges and vertices are treated as infinitely sharp (this is the last level).
+//! * Every face around each of the four corners must be a quad (true from level 1 on).
+
+use thiserror::Error;
+
+use crate::error::TopologyError;
+use crate::limit::{catmark_limit_masks, smooth_directional_tangent, LimitRule, LimitVertex, Mask};
+use crate::mesh::{SubdivOptions, Topology};
+use crate::patch::PatchWeights;
+use crate::refine::LevelRef;
+use crate::sdc::{boundary_edge_sharpness, boundary_vertex_sharpness, is_sharp, vertex_rule, Rule};
+
+use std::f64::consts::PI;
+
+/// Weights over a level's vertex indices (ascending, no zero weights).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Stencil {
+    pub indices: Vec<u32>,
+    pub weights: Vec<f64>,
+}
+
+impl Stencil {
+    /// Apply to 3D points indexed like the level's vertices.
+    pub fn apply(&self, points: &[[f64; 3]]) -> [f64; 3] {
+        let mut out = [0.0; 3];
+        for (&i, &w) in self.indices.iter().zip(&self.weights) {
+            if let Some(p) = points.get(i as usize) {
+                for k in 0..3 {
+                    out[k] += w * p[k];
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Why a Gregory patch cannot be built on a face ([`TopologyError::GregoryPatch`]).
+#[derive(Clone, Debug, PartialEq, Eq, Error)]
+pub enum GregoryProblem {
+    #[error("the face has {size} corners, a Gregory patch needs a quad")]
+    NotQuad { size: usize },
+    #[error("the faces around vertex {vertex} do not form one complete fan in this level")]
+    IncompleteRing { vertex: u32 },
+    #[error("a face around vertex {vertex} is not a quad (refine once first)")]
+    NonQuadRing { vertex: u32 },
+    #[error("the level's sharpness tables do not match its topology")]
+    SharpnessLength,
+}
+
+/// Sparse row under construction. Entries keep their first-insertion order until
+/// [`Row::into_stencil`], so equal inputs built in the same order give bit-equal sums.
+#[derive(Clone, Debug, Default)]
+struct Row(Vec<(u32, f64)>);
+
+impl Row {
+    fn add(&mut self, i: u32, w: f64) {
+        match self.0.iter_mut().find(|e| e.0 == i) {
+            Some(e) => e.1 += w,
+            None => self.0.push((i, w)),
+        }
+    }
+
+    fn add_row(&mut self, r: &Row, s: f64) {
+        for &(i, w) in &r.0 {
+            self.add(i, s * w);
+        }
+    }
+
+    fn into_stencil(mut self) -> Stencil {
+        self.0.retain(|e| e.1 != 0.0);
+        self.0.sort_by_key(|e| e.0);
+        Stencil {
+            indices: self.0.iter().map(|e| e.0).collect(),
+            weights: self.0.iter().map(|e| e.1).collect(),
+        }
+    }
+}
+
+/// Ordered one-ring of a vertex: `faces[i] = (face, corner of v in it)`, `ring[i]` the vertex
+/// after `v` in face `i` (plus the last neighbour of a boundary fan), `edges[i]` the edge to
+/// `ring[i]`. Starts at the face whose leaving edge is a boundary edge, else at the first face
+/// the topology lists, so the order is a property of the vertex alone.
+struct Fan {
+    faces: Vec<(u32, usize)>,
+    ring: Vec<u32>,
+    edges: Vec<u32>,
+    boundary: bool,
+}
+
+fn build_fan(t: &Topology, v: u32) -> Option<Fan> {
+    let vf = t.vertex_faces(v as usize);
+    let corner = |g: u32| t.face_vertices(g as usize).iter().position(|&x| x == v);
+    let leaving_boundary = |g: u32| -> Option<bool> {
+        let c = corner(g)?;
+        Some(t.is_boundary_edge(*t.face_edge_list(g as usize).get(c)? as usize))
+    };
+    let mut start = *vf.first()?;
+    for &g in vf {
+        if leaving_boundary(g)? {
+            start = g;
+            break;
+        }
+    }
+    let boundary = leaving_boundary(start)?;
+    let mut fan = Fan {
+        faces: Vec::with_capacity(vf.len()),
+        ring: Vec::with_capacity(vf.len() + 1),
+        edges: Vec::with_capacity(vf.len() + 1),
+        boundary,
+    };
+    let mut g = start;
+    loop {
+        let c = corner(g)?;
+        let fv = t.face_vertices(g as usize);
+        let fe = t.face_edge_list(g as usize);
+        let n = fv.len();
+        fan.faces.push((g, c));
+        fan.ring.push(fv[(c + 1) % n]);
+        fan.edges.push(fe[c]);
+        let entering = fe[(c + n - 1) % n];
+        let [a, b] = t.edge_faces(entering as usize);
+        let h = if a == g { b } else { a };
+        if t.is_boundary_edge(entering as usize) {
+            fan.ring.push(fv[(c + n - 1) % n]);
+            fan.edges.push(entering);
+            break;
+        }
+        if h == start || fan.faces.len() > vf.len() {
+            break;
+        }
+        g = h;
+    }
+    (fan.faces.len() == vf.len()).then_some(fan)
+}
+
+/// The limit rule of a corner vertex as seen from the face (sector of the face for creases
+/// and corners).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Kind {
+    Smooth,
+    /// Sharp edges `a`, `b` (ring indices) bound the face's sector of `m` faces, CCW a → b.
+    Crease {
+        a: usize,
+        b: usize,
+        m: usize,
+    },
+    Corner {
+        a: usize,
+        b: usize,
+        m: usize,
+    },
+    /// Sharp vertex without a sector, or interior valence 2: edge vectors as tangents.
+    Cone,
+}
+
+/// One corner of the patch: its vertex, ring, rule and limit data.
+struct Corner {
+    v: u32,
+    fan: Fan,
+    /// Position of the patch face in the fan.
+    j: usize,
+    sharp: Vec<bool>,
+    kind: Kind,
+    regular: bool,
+    c: f64,
+    p: Row,
+    /// Cross tangent of a crease sector (rows over the level's vertices).
+    across: Row,
+}
+
+impl Corner {
+    fn n(&self) -> usize {
+        self.fan.ring.len()
+    }
+
+    /// Diagonal vertex of fan face `i` (quads only, checked when the corner is built).
+    fn diag(&self, t: &Topology, i: usize) -> u32 {
+        let (g, c) = self.fan.faces[i % self.fan.faces.len()];
+        t.face_vertices(g as usize)[(c + 2) % 4]
+    }
+
+    fn mask_row(&self, t: &Topology, m: &Mask) -> Row {
+        let mut r = Row::default();
+        r.add(self.v, m.vertex);
+        for (i, &w) in m.edges.iter().enumerate() {
+            r.add(self.fan.ring[i], w);
+        }
+        for (i, &w) in m.faces.iter().enumerate().take(self.fan.faces.len()) {
+            r.add(self.diag(t, i), w);
+        }
+        r
+    }
+
+    /// `e_k − v`.
+    fn edge_vector(&self, k: usize) -> Row {
+        let mut r = Row::default();
+        r.add(self.fan.ring[k], 1.0);
+        r.add(self.v, -1.0);
+        r
+    }
+
+    /// Crease tangent along the sharp edges, toward `toward` (one of the two ends), built in
+    /// ascending ring order so both sectors produce the same row.
+    fn along(&self, a: usize, b: usize, toward: usize) -> Row {
+        let (lo, hi) = (a.min(b), a.max(b));
+        let mut r = Row::default();
+        r.add(self.fan.ring[lo], if toward == lo { 0.5 } else { -0.5 });
+        r.add(self.fan.ring[hi], if toward == hi { 0.5 } else { -0.5 });
+        r
+    }
+
+    /// Parametric limit tangent toward ring neighbour `k` (see the module docs).
+    fn tangent(&self, t: &Topology, k: usize) -> Row {
+        let n = self.n();
+        match self.kind {
+            Kind::Smooth => {
+                let (ew, fw) = smooth_directional_tangent(false, n, k);
+                let mut r = Row::default();
+                for (i, &w) in ew.iter().enumerate() {
+                    r.add(self.fan.ring[i], w);
+                }
+                for (i, &w) in fw.iter().enumerate() {
+                    r.add(self.diag(t, i), w);
+                }
+                r
+            }
+            Kind::Crease { a, b, m } => {
+                if k == a || k == b {
+                    return self.along(a, b, k);
+                }
+                let s = (k + n - a) % n;
+                let t1 = self.along(a, b, a);
+                if 2 * s == m {
+                    return self.across.clone();
+                }
+                let th = PI * s as f64 / m as f64;
+                let mut r = Row::default();
+                r.add_row(&t1, th.cos());
+                r.add_row(&self.across, th.sin());
+                r
+            }
+            Kind::Corner { a, b, m } => {
+                if k == a || k == b {
+                    return self.edge_vector(k);
+                }
+                let s = (k + n - a) % n;
+                let phi = PI / (2.0 * m as f64);
+                let mut r = Row::default();
+                r.add_row(&self.edge_vector(a), ((m - s) as f64 * phi).sin());
+                r.add_row(&self.edge_vector(b), (s as f64 * phi).sin());
+                r
+            }
+            Kind::Cone => self.edge_vector(k),
+        }
+    }
+}
+
+/// Sharpness of edge `e` at the last level: boundary edges are infinitely sharp.
+fn edge_sharp(level: &LevelRef<'_>, e: u32) -> f32 {
+    if level.topology.is_boundary_edge(e as usize) {
+        boundary_edge_sharpness()
+    } else {
+        level.edge_sharpness[e as usize]
+    }
+}
+
+/// The sector of fan face `j` between the nearest sharp edges (ring indices) before and after
+/// it, CCW; `None` with fewer than two sharp edges.
+fn sector(sharp: &[bool], j: usize, boundary: bool) -> Option<(usize, usize, usize)> {
+    let n = sharp.len();
+    if sharp.iter().filter(|&&s| s).count() < 2 {
+        return None;
+    }
+    let a = (0..n).map(|d| (j + n - d) % n).find(|&k| sharp[k])?;
+    let b = (0..n).map(|d| (j + 1 + d) % n).find(|&k| sharp[k])?;
+    let m = if boundary { b - a } else { (b + n - a) % n };
+    (m > 0).then_some((a, b, m))
+}
+
+fn build_corner(
+    level: &LevelRef<'_>,
+    options: &SubdivOptions,
+    face: usize,
+    v: u32,
+) -> Result<Corner, TopologyError> {
+    let t = level.topology;
+    let problem = |problem| TopologyError::GregoryPatch { face, problem };
+    let fan = build_fan(t, v).ok_or(problem(GregoryProblem::IncompleteRing { vertex: v }))?;
+    if fan
+        .faces
+        .iter()
+        .any(|&(g, _)| t.face_vertices(g as usize).len() != 4)
+    {
+        return Err(problem(GregoryProblem::NonQuadRing { vertex: v }));
+    }
+    let j = fan
+        .faces
+        .iter()
+        .position(|&(g, _)| g as usize == face)
+        .ok_or(problem(GregoryProblem::IncompleteRing { vertex: v }))?;
+    let n = fan.ring.len();
+    let sharp: Vec<bool> = fan
+        .edges
+        .iter()
+        .map(|&e| is_sharp(edge_sharp(level, e)))
+        .collect();
+    let mut vs = level.vertex_sharpness[v as usize];
+    if let Some(s) = boundary_vertex_sharpness(
+        options.boundary,
+        t.vertex_faces(v as usize).len(),
+        t.vertex_edges(v as usize).len(),
+    ) {
+        vs = vs.max(s);
+    }
+    let sharp_count = sharp.iter().filter(|&&s| s).count();
+    let kind = match vertex_rule(vs, sharp_count) {
+        Rule::Smooth | Rule::Dart if n >= 3 => Kind::Smooth,
+        Rule::Smooth | Rule::Dart => Kind::Cone,
+        Rule::Crease => match sector(&sharp, j, fan.boundary) {
+            Some((a, b, m)) => Kind::Crease { a, b, m },
+            None => Kind::Cone,
+        },
+        Rule::Corner => match sector(&sharp, j, fan.boundary) {
+            Some((a, b, m)) => Kind::Corner { a, b, m },
+            None => Kind::Cone,
+        },
+    };
+    let (regular, c) = match kind {
+        Kind::Smooth => (
+            n == 4 && sharp_count == 0,
+            if n == 4 {
+                0.0
+            } else {
+                (2.0 * PI / n as f64).cos()
+            },
+        ),
+        Kind::Crease { m, .. } => (m == 2, if m == 2 { 0.0 } else { (PI / m as f64).cos() }),
+        Kind::Corner { m, .. } => (
+            m == 1,
+            if m == 1 {
+                0.0
+            } else {
+                (PI / (2.0 * m as f64)).cos()
+            },
+        ),
+        Kind::Cone => (false, 0.0),
+    };
+    let mut corner = Corner {
+        v,
+        fan,
+        j,
+        sharp,
+        kind,
+        regular,
+        c,
+        p: Row::default(),
+        across: Row::default(),
+    };
+    match kind {
+        Kind::Smooth | Kind::Crease { .. } => {
+            let rule = match kind {
+                Kind::Crease { a, b, .. } => LimitRule::Crease { ends: [a, b] },
+                _ => LimitRule::Smooth,
+            };
+            let masks = catmark_limit_masks(&LimitVertex {
+                valence: n,
+                boundary: corner.fan.boundary,
+                rule,
+            });
+            corner.p = corner.mask_row(t, &masks.position);
+            if matches!(kind, Kind::Crease { .. }) {
+                corner.across = corner.mask_row(t, &masks.tangent2);
+            }
+        }
+        Kind::Corner { .. } | Kind::Cone => corner.p.add(v, 1.0),
+    }
+    Ok(corner)
+}
+
+/// The Bézier interior point of a regular patch: `(4v_i + 2v_{i+1} + 2v_{i−1} + v_{i+2})/9`.
+fn face_mask(fv: &[u32], i: usize) -> Row {
+    let mut r = Row::default();
+    r.add(fv[i], 4.0 / 9.0);
+    r.add(fv[(i + 1) % 4], 2.0 / 9.0);
+    r.add(fv[(i + 3) % 4], 2.0 / 9.0);
+    r.add(fv[(i + 2) % 4], 1.0 / 9.0);
+    r
+}
+
+/// The 20 Gregory control points of quad `face` of `level` as stencils over the level's vertex
+/// indices, in the order of the module docs (`5·corner + {P, Ep, Em, Fp, Fm}`).
+///
+/// The face needs its complete one-ring in `level` (every face around each of its corners, all
+/// quads), which [`crate::refine::refine_sparse`] guarantees for the children of selected faces.
+/// Semi-sharp creases are treated as infinitely sharp: this is meant for the last level.
+///
+/// ```
+/// use topology::gregory::{gregory_basis, gregory_weights};
+/// use topology::refine::refine_uniform;
+/// use topology::{ControlMesh, Scheme};
+/// let mesh = ControlMesh::from_polygons(
+///     vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]],
+///     &[[0u32, 1, 2, 3]],
+/// );
+/// let r = refine_uniform(&mesh, Scheme::CatmullClark, 1).unwrap();
+/// let level = r.level(1);
+/// let cps = gregory_basis(level.view(), 0, &mesh.options).unwrap();
+/// let w = gregory_weights(0.5, 0.5);
+/// let p: f64 = (0..20).map(|i| w.point[i] * cps[i].apply(&level.positions)[2]).sum();
+/// assert!(p.abs() < 1e-12);
+/// ```
+pub fn gregory_basis(
+    level: LevelRef<'_>,
+    face: usize,
+    options: &SubdivOptions,
+) -> Result<[Stencil; 20], TopologyError> {
+    let t = level.topology;
+    if face >= t.num_faces() {
+        return Err(TopologyError::FaceOutOfRange {
+            face,
+            count: t.num_faces(),
+        });
+    }
+    if level.edge_sharpness.len() != t.num_edges()
+        || level.vertex_sharpness.len() != t.num_vertices()
+    {
+        return Err(TopologyError::GregoryPatch {
+            face,
+            problem: GregoryProblem::SharpnessLength,
+        });
+    }
+    let fv = t.face_vertices(face);
+    if fv.len() != 4 {
+        return Err(TopologyError::GregoryPatch {
+            face,
+            problem: GregoryProblem::NotQuad { size: fv.len() },
+        });
+    }
+    let mut corners = Vec::with_capacity(4);
+    for &v in fv {
+        corners.push(build_corner(&level, options, face, v)?);
+    }
+    // Edge points: index k of the ring is the edge toward the face's next (j) or previous
+    // (j + 1) corner.
+    let mut ep = Vec::with_capacity(4);
+    let mut em = Vec::with_capacity(4);
+    for c in &corners {
+        let n = c.n();
+        let mut p = c.p.clone();
+        p.add_row(&c.tangent(t, c.j), 1.0 / 3.0);
+        ep.push(p);
+        let mut m = c.p.clone();
+        m.add_row(&c.tangent(t, (c.j + 1) % n), 1.0 / 3.0);
+        em.push(m);
+    }
+    let face_point = |i: usize, plus: bool| -> Row {
+        let near = &corners[i];
+        let n = near.n();
+        let j = near.j;
+        let (k, other, far_i) = if plus {
+            (j, (j + 1) % n, (i + 1) % 4)
+        } else {
+            ((j + 1) % n, j, (i + 3) % 4)
+        };
+        let far = &corners[far_i];
+        if near.regular && far.regular {
+            return face_mask(fv, i);
+        }
+        let formula = |k: usize, far_i: usize, plus: bool| -> Row {
+            let far = &corners[far_i];
+            let (e_near, e_far) = if plus {
+                (&ep[i], &em[far_i])
+            } else {
+                (&em[i], &ep[far_i])
+            };
+            let (cn, cf) = (near.c, far.c);
+            let mut r = Row::default();
+            r.add_row(&near.p, cf / 3.0);
+            r.add_row(e_near, (3.0 - 2.0 * cn - cf) / 3.0);
+            r.add_row(e_far, 2.0 * cn / 3.0);
+            // Ring neighbours and diagonals on either side of edge k (inside: our face j).
+            let (x_in, x_out, d_out) = if plus {
+                (
+                    near.fan.ring[(k + 1) % n],
+                    near.fan.ring[(k + n - 1) % n],
+                    (k + n - 1) % n,
+                )
+            } else {
+                (
+                    near.fan.ring[(k + n - 1) % n],
+                    near.fan.ring[(k + 1) % n],
+                    k,
+                )
+            };
+            r.add(x_in, 1.0 / 9.0);
+            r.add(x_out, -1.0 / 9.0);
+            r.add(near.diag(t, j), 1.0 / 18.0);
+            r.add(near.diag(t, d_out), -1.0 / 18.0);
+            r
+        };
+        if !near.sharp[k] {
+            return formula(k, far_i, plus);
+        }
+        // Sharp edge: nothing to match across it; take the corner's other face point.
+        if near.sharp[other] {
+            return face_mask(fv, i);
+        }
+        let other_far = if plus { (i + 3) % 4 } else { (i + 1) % 4 };
+        if near.regular && corners[other_far].regular {
+            return face_mask(fv, i);
+        }
+        formula(other, other_far, !plus)
+    };
+    let mut out: [Stencil; 20] = Default::default();
+    for i in 0..4 {
+        out[5 * i] = corners[i].p.clone().into_stencil();
+        out[5 * i + 1] = ep[i].clone().into_stencil();
+        out[5 * i + 2] = em[i].clone().into_stencil();
+        out[5 * i + 3] = face_point(i, true).into_stencil();
+        out[5 * i + 4] = face_point(i, false).into_stencil();
+    }
+    Ok(out)
+}
+
+/// One corner's interior point in [`gregory_weights`]: Bézier indices `(j, k)`, then `dp` and
+/// `dm` each as `[value, ∂/∂u, ∂/∂v]`, then `h` (the Bernstein product is `9·dp·dm·h`).
+type InteriorBlend = (usize, usize, [f64; 3], [f64; 3], f64);
+
+/// Cubic Bernstein basis and its derivative at `t`.
+fn bernstein3(t: f64) -> ([f64; 4], [f64; 4]) {
+    let s = 1.0 - t;
+    (
+        [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t],
+        [
+            -3.0 * s * s,
+            3.0 * s * (1.0 - 3.0 * t),
+            3.0 * t * (2.0 - 3.0 * t),
+            3.0 * t * t,
+        ],
+    )
+}
+
+/// Value and parametric derivative weights of the 20 Gregory points at `(u, v) ∈ [0,1]²`
+/// (formulas in the module docs; finite everywhere on the square, corners included).
+pub fn gregory_weights(u: f64, v: f64) -> PatchWeights<20> {
+    let (bu, dbu) = bernstein3(u);
+    let (bv, dbv) = bernstein3(v);
+    let mut w = PatchWeights {
+        point: [0.0; 20],
+        du: [0.0; 20],
+        dv: [0.0; 20],
+    };
+    // (slot, j, k): P, Ep, Em of each corner at Bézier point b[j][k].
+    const BOUNDARY: [(usize, usize, usize); 12] = [
+        (0, 0, 0),
+        (1, 1, 0),
+        (2, 0, 1),
+        (5, 3, 0),
+        (6, 3, 1),
+        (7, 2, 0),
+        (10, 3, 3),
+        (11, 2, 3),
+        (12, 3, 2),
+        (15, 0, 3),
+        (16, 0, 2),
+        (17, 1, 3),
+    ];
+    for &(s, j, k) in &BOUNDARY {
+        w.point[s] = bu[j] * bv[k];
+        w.du[s] = dbu[j] * bv[k];
+        w.dv[s] = bu[j] * dbv[k];
+    }
+    let (iu, iv) = (1.0 - u, 1.0 - v);
+    // Per corner: Bézier interior (j, k); dp, ∂dp/∂u, ∂dp/∂v; dm, ∂dm/∂u, ∂dm/∂v; h.
+    let interior: [InteriorBlend; 4] = [
+        (1, 1, [v, 0.0, 1.0], [u, 1.0, 0.0], iu * iu * iv * iv),
+        (2, 1, [iu, -1.0, 0.0], [v, 0.0, 1.0], u * u * iv * iv),
+        (2, 2, [iv, 0.0, -1.0], [iu, -1.0, 0.0], u * u * v * v),
+        (1, 2, [u, 1.0, 0.0], [iv, 0.0, -1.0], iu * iu * v * v),
+    ];
+    for (i, &(j, k, dp, dm, h)) in interior.iter().enumerate() {
+        let d = dp[0] + dm[0];
+        let (gp, gm) = if d > 0.0 {
+            (dm[0] / d, dp[0] / d)
+        } else {
+            (0.5, 0.5)
+        };
+        let b = bu[j] * bv[k];
+        let b_u = dbu[j] * bv[k];
+        let b_v = bu[j] * dbv[k];
+        let q = 9.0 * h * gp * gm;
+        let g_u = q * (dp[0] * dm[1] - dm[0] * dp[1]);
+        let g_v = q * (dp[0] * dm[2] - dm[0] * dp[2]);
+        let (fp, fm) = (5 * i + 3, 5 * i + 4);
+        w.point[fp] = b * gp;
+        w.point[fm] = b * gm;
+        w.du[fp] = b_u * gp + g_u;
+        w.du[fm] = b_u * gm - g_u;
+        w.dv[fp] = b_v * gp + g_v;
+        w.dv[fm] = b_v * gm - g_v;
+    }
+    w
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn weights_sum_to_one_and_derivatives_to_zero() {
+        for a in 0..=10 {
+            for b in 0..=10 {
+                let w = gregory_weights(a as f64 / 10.0, b as f64 / 10.0);
+                let s: f64 = w.point.iter().sum();
+                let su: f64 = w.du.iter().sum();
+                let sv: f64 = w.dv.iter().sum();
+                assert!((s - 1.0).abs() < 1e-14 && su.abs() < 1e-13 && sv.abs() < 1e-13);
+            }
+        }
+    }
+
+    #[test]
+    fn sector_bounds() {
+        // Interior vertex, sharp edges 1 and 4 of 6; face 2 lies in 1..4.
+        let sharp = [false, true, false, false, true, false];
+        assert_eq!(sector(&sharp, 2, false), Some((1, 4, 3)));
+        assert_eq!(sector(&sharp, 5, false), Some((4, 1, 3)));
+        assert_eq!(sector(&sharp, 1, false), Some((1, 4, 3)));
+        // Boundary fan of 3 faces: edges 0 and 3 are the boundary.
+        let sharp = [true, false, false, true];
+        assert_eq!(sector(&sharp, 1, true), Some((0, 3, 3)));
+    }
+}

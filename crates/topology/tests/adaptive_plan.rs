@@ -1,0 +1,529 @@
+//! The feature-adaptive plan against the exact limit ([`topology::eval`]) on every OpenSubdiv
+//! `catmark_*` shape in tests/data and on spot: regular patches exact, end caps converging with
+//! the isolation level, canonical curves equal to each patch's own edges (transitions
+//! included), balance, uniform counts and errors.
+
+use std::collections::HashMap;
+
+use topology::eval::{LimitScheme, LocalMesh};
+use topology::{
+    load_obj, plan_adaptive, AdaptiveOptions, AdaptivePlan, ControlMesh, EdgeCrease, EdgeKind,
+    EndCap, PatchKind, TopologyError, VertexCorner,
+};
+
+const SHAPES: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../tests/data/opensubdiv/shapes/"
+);
+const SPOT: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../assets/spot_control_mesh.obj"
+);
+
+/// Every catmark shape in tests/data (or in the folder `ADAPTIVE_SHAPES_DIR` names, for runs
+/// on OpenSubdiv's whole shape set), then spot. Shapes that are not manifold are skipped.
+fn shapes() -> Vec<(String, ControlMesh)> {
+    let dir = std::env::var("ADAPTIVE_SHAPES_DIR").unwrap_or_else(|_| SHAPES.to_string());
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .expect("shape folder")
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("catmark_") && n.ends_with(".obj"))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 15, "catmark shapes missing: {names:?}");
+    let mut out: Vec<(String, ControlMesh)> = names
+        .into_iter()
+        .filter_map(|n| {
+            let mesh = load_obj(format!("{dir}/{n}"));
+            if dir == SHAPES {
+                Some((n, mesh.expect("shape loads")))
+            } else {
+                mesh.ok().map(|m| (n, m))
+            }
+        })
+        .collect();
+    out.push(("spot".into(), load_obj(SPOT).expect("spot loads")));
+    out
+}
+
+fn diag(mesh: &ControlMesh) -> f64 {
+    let mut lo = [f64::MAX; 3];
+    let mut hi = [f64::MIN; 3];
+    for p in &mesh.positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+}
+
+fn dist(a: &[f64; 3], b: &[f64]) -> f64 {
+    (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// Largest finite tag sharpness: a patch at a level at or above it sees no semi-sharp feature.
+fn max_semi_sharpness(mesh: &ControlMesh) -> f32 {
+    mesh.creases
+        .iter()
+        .map(|c| c.sharpness)
+        .chain(mesh.corners.iter().map(|c| c.sharpness))
+        .filter(|&s| s < 10.0)
+        .fold(0.0, f32::max)
+}
+
+fn options(isolation: u32, end_cap: EndCap) -> AdaptiveOptions {
+    AdaptiveOptions {
+        isolation,
+        end_cap,
+        sharpness_scale: 1.0,
+    }
+}
+
+/// Exact limit at a patch's `(u, v)`.
+fn exact(lm: &LocalMesh, plan: &AdaptivePlan, p: usize, u: f64, v: f64) -> Vec<f64> {
+    let pa = &plan.patches[p];
+    let (s, t) = (pa.origin[0] + pa.size * u, pa.origin[1] + pa.size * v);
+    let face = pa.base_face as usize;
+    let sample = if lm.face(face).len() == 4 {
+        lm.evaluate(face, s, t)
+    } else {
+        lm.evaluate_subface(face, pa.sub_face as usize, s, t)
+    };
+    sample.expect("exact limit").position
+}
+
+/// At most `n` patch indices of `kind`, spread over the plan.
+fn sample_patches(plan: &AdaptivePlan, kinds: &[PatchKind], n: usize) -> Vec<usize> {
+    let all: Vec<usize> = (0..plan.patches.len())
+        .filter(|&p| kinds.contains(&plan.patches[p].kind))
+        .collect();
+    let stride = all.len().div_ceil(n.max(1)).max(1);
+    all.into_iter().step_by(stride).collect()
+}
+
+const GRID: [f64; 3] = [0.0, 0.37, 1.0];
+
+#[test]
+fn regular_patches_are_the_exact_limit() {
+    for (name, mesh) in shapes() {
+        let lm = LocalMesh::from_control_mesh(&mesh, LimitScheme::CatmullClark).expect("mesh");
+        let d = diag(&mesh);
+        let semi = max_semi_sharpness(&mesh);
+        for iso in 1..=4 {
+            let plan = plan_adaptive(&mesh, &options(iso, EndCap::Bilinear))
+                .unwrap_or_else(|e| panic!("{name} iso {iso}: {e}"));
+            let verts = plan.apply(&mesh.positions);
+            let mut worst = 0.0f64;
+            let (mut checked, mut skipped) = (0, 0);
+            for p in sample_patches(&plan, &[PatchKind::Regular], 250) {
+                let pa = &plan.patches[p];
+                // At the isolation level leftover semi-sharpness is treated as infinite.
+                if pa.level as u32 == iso && semi > pa.level as f32 {
+                    skipped += 1;
+                    continue;
+                }
+                for &u in &GRID {
+                    for &v in &GRID {
+                        let got = plan.evaluate(&verts, p, u, v).position;
+                        let want = exact(&lm, &plan, p, u, v);
+                        worst = worst.max(dist(&got, &want));
+                    }
+                }
+                checked += 1;
+            }
+            assert!(
+                worst <= 1e-9 * d,
+                "{name} iso {iso}: regular patch off the limit by {worst:e} (diag {d})"
+            );
+            assert!(
+                checked > 0 || skipped > 0 || plan.level_stats.iter().all(|s| s.regular == 0),
+                "{name}: no regular patch checked"
+            );
+        }
+    }
+}
+
+/// Largest distance of the end caps (and of everything) from the exact limit.
+fn deviations(mesh: &ControlMesh, iso: u32, end_cap: EndCap) -> (f64, f64) {
+    let lm = LocalMesh::from_control_mesh(mesh, LimitScheme::CatmullClark).expect("mesh");
+    let plan = plan_adaptive(mesh, &options(iso, end_cap)).expect("plan");
+    let verts = plan.apply(&mesh.positions);
+    let grid = [0.0, 0.25, 0.5, 0.75, 1.0];
+    let mut caps = 0.0f64;
+    for p in sample_patches(&plan, &[PatchKind::Gregory, PatchKind::Bilinear], 400) {
+        for &u in &grid {
+            for &v in &grid {
+                let got = plan.evaluate(&verts, p, u, v).position;
+                caps = caps.max(dist(&got, &exact(&lm, &plan, p, u, v)));
+            }
+        }
+    }
+    let mut all = caps;
+    for p in sample_patches(&plan, &[PatchKind::Regular], 200) {
+        let got = plan.evaluate(&verts, p, 0.5, 0.5).position;
+        all = all.max(dist(&got, &exact(&lm, &plan, p, 0.5, 0.5)));
+    }
+    (caps / diag(mesh), all / diag(mesh))
+}
+
+#[test]
+fn end_caps_converge_with_isolation() {
+    for name in ["catmark_cube.obj", "catmark_pyramid.obj", "spot"] {
+        let mesh = if name == "spot" {
+            load_obj(SPOT).expect("spot")
+        } else {
+            load_obj(format!("{SHAPES}{name}")).expect("shape")
+        };
+        for end_cap in [EndCap::Bilinear, EndCap::Gregory] {
+            let devs: Vec<(f64, f64)> =
+                (1..=4).map(|iso| deviations(&mesh, iso, end_cap)).collect();
+            for (iso, (caps, all)) in devs.iter().enumerate() {
+                println!(
+                    "{name} {end_cap:?} isolation {}: end caps {caps:.3e}, whole surface {all:.3e} of the diagonal",
+                    iso + 1
+                );
+            }
+            assert!(
+                devs[3].0 < devs[0].0 && devs[3].0 < 0.5 * devs[1].0,
+                "{name} {end_cap:?}: end-cap deviation does not shrink: {devs:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn curves_are_each_patch_edge_and_corners_are_shared() {
+    for (name, mesh) in shapes() {
+        let d = diag(&mesh);
+        for iso in 1..=4 {
+            for end_cap in [EndCap::Bilinear, EndCap::Gregory] {
+                let plan = plan_adaptive(&mesh, &options(iso, end_cap))
+                    .unwrap_or_else(|e| panic!("{name} iso {iso}: {e}"));
+                check_curves(&name, &plan, &mesh, d);
+            }
+        }
+    }
+}
+
+fn check_curves(name: &str, plan: &AdaptivePlan, mesh: &ControlMesh, d: f64) {
+    let verts = plan.apply(&mesh.positions);
+    let mut refs = vec![0u32; plan.curves.len()];
+    let mut levels: Vec<Vec<u8>> = vec![Vec::new(); plan.curves.len()];
+    for (p, pa) in plan.patches.iter().enumerate() {
+        // Each corner: the end of one edge's curve is the start of the next one's.
+        let ends: Vec<(u32, u32)> = pa
+            .edges
+            .iter()
+            .map(|e| {
+                let (first, last) = match e.kind {
+                    EdgeKind::Coarse => (0, 1),
+                    _ => (0, 0),
+                };
+                let start = |k: usize| {
+                    let c = plan.curves[e.curves[k] as usize];
+                    if e.reversed[k] {
+                        c[3]
+                    } else {
+                        c[0]
+                    }
+                };
+                let end = |k: usize| {
+                    let c = plan.curves[e.curves[k] as usize];
+                    if e.reversed[k] {
+                        c[0]
+                    } else {
+                        c[3]
+                    }
+                };
+                (start(first), end(last))
+            })
+            .collect();
+        for k in 0..4 {
+            assert_eq!(
+                ends[k].1,
+                ends[(k + 1) % 4].0,
+                "{name}: patch {p} corner {} differs between its edges",
+                (k + 1) % 4
+            );
+        }
+        if pa.kind == PatchKind::Bilinear {
+            for (cp, end) in pa.control_points.iter().zip(&ends) {
+                assert_eq!(*cp, end.0, "{name}: bilinear corner");
+            }
+        }
+        for (k, e) in pa.edges.iter().enumerate() {
+            match e.kind {
+                EdgeKind::Plain => {
+                    assert_eq!(e.curves[0], e.curves[1]);
+                    refs[e.curves[0] as usize] += 1;
+                }
+                EdgeKind::Coarse => {
+                    assert!(pa.transition_mask & (1 << k) != 0);
+                    assert_ne!(e.curves[0], e.curves[1]);
+                    refs[e.curves[0] as usize] += 1;
+                    refs[e.curves[1] as usize] += 1;
+                }
+                EdgeKind::Fine => refs[e.curves[0] as usize] += 1,
+            }
+            if e.kind != EdgeKind::Coarse {
+                assert!(pa.transition_mask & (1 << k) == 0);
+            }
+            for c in e.curves {
+                levels[c as usize].push(pa.level);
+            }
+            // The curves are the patch's own edge (Coons patches reproduce theirs exactly).
+            for t in [0.0, 0.2, 0.5, 0.7, 1.0] {
+                let (u, v) = match k {
+                    0 => (t, 0.0),
+                    1 => (1.0, t),
+                    2 => (1.0 - t, 1.0),
+                    _ => (0.0, 1.0 - t),
+                };
+                let own = plan.evaluate(&verts, p, u, v).position;
+                let (curve, _) = plan.edge_sample(&verts, p, k, t);
+                let err = dist(&own, &curve);
+                assert!(
+                    err <= 1e-9 * d,
+                    "{name}: patch {p} ({:?}, level {}) edge {k} ({:?}) at {t}: curve off by {err:e}",
+                    pa.kind,
+                    pa.level,
+                    e.kind
+                );
+            }
+            if e.kind == EdgeKind::Plain {
+                let c = plan.curves[e.curves[0] as usize];
+                let at = |t: f64| plan.curve_point(&verts, e.curves[0] as usize, t);
+                let own =
+                    plan.evaluate(&verts, p, [0.5, 1.0, 0.5, 0.0][k], [0.0, 0.5, 1.0, 0.5][k]);
+                assert!(dist(&own.position, &at(0.5)) <= 1e-9 * d);
+                assert!(c[0] < c[3], "{name}: curve ends not ascending");
+            }
+        }
+    }
+    // Every curve is used by one side (boundary) or two sides, within one level.
+    let closed = mesh.holes.is_empty()
+        && topology::Topology::from_mesh(mesh)
+            .map(|t| (0..t.num_edges()).all(|e| !t.is_boundary_edge(e)))
+            .unwrap_or(false);
+    for (c, &n) in refs.iter().enumerate() {
+        assert!(
+            n == 2 || (n == 1 && !closed),
+            "{name}: curve {c} used by {n} patch sides"
+        );
+        let lv = &levels[c];
+        let (lo, hi) = (lv.iter().min().unwrap(), lv.iter().max().unwrap());
+        assert!(hi - lo <= 1, "{name}: curve {c} joins levels {lo} and {hi}");
+    }
+    // Distinct canonical corners are distinct limit points (one id per point), except on
+    // OpenSubdiv's degenerate valence-2 shapes, where two sheets share their limit points.
+    if name.contains("val2") {
+        return;
+    }
+    let mut corner_ids: Vec<u32> = plan.curves.iter().flat_map(|c| [c[0], c[3]]).collect();
+    corner_ids.sort_unstable();
+    corner_ids.dedup();
+    let mut pts: Vec<([f64; 3], u32)> =
+        corner_ids.iter().map(|&i| (verts[i as usize], i)).collect();
+    pts.sort_by(|a, b| a.0[0].total_cmp(&b.0[0]));
+    for i in 0..pts.len() {
+        for j in i + 1..pts.len() {
+            if pts[j].0[0] - pts[i].0[0] > 1e-12 * d {
+                break;
+            }
+            assert!(
+                dist(&pts[i].0, &pts[j].0) > 1e-12 * d,
+                "{name}: corner ids {} and {} are the same limit point",
+                pts[i].1,
+                pts[j].1
+            );
+        }
+    }
+}
+
+#[test]
+fn blocks_read_only_earlier_vertices() {
+    for (name, mesh) in shapes() {
+        let plan = plan_adaptive(&mesh, &options(3, EndCap::Gregory)).expect("plan");
+        assert_eq!(plan.num_base_vertices as usize, mesh.positions.len());
+        let mut next = plan.num_base_vertices;
+        for b in plan.steps.iter().chain(std::iter::once(&plan.local_points)) {
+            assert_eq!(b.first_vertex, next, "{name}: blocks are contiguous");
+            assert!(
+                b.table.indices.iter().all(|&i| i < b.first_vertex),
+                "{name}: a block reads itself"
+            );
+            next += b.table.len() as u32;
+        }
+        assert_eq!(next, plan.num_vertices);
+        assert_eq!(plan.steps.len(), 3);
+        for pa in &plan.patches {
+            let n = match pa.kind {
+                PatchKind::Regular => 16,
+                PatchKind::Gregory => 20,
+                PatchKind::Bilinear => 4,
+            };
+            assert_eq!(pa.control_points.len(), n);
+            assert!(pa.control_points.iter().all(|&i| i < plan.num_vertices));
+        }
+        for c in &plan.curves {
+            assert!(c.iter().all(|&i| i < plan.num_vertices));
+        }
+    }
+}
+
+#[test]
+fn patches_tile_each_base_face() {
+    // The patches of each (sub)face cover its unit square exactly once.
+    for (name, mesh) in shapes() {
+        let plan = plan_adaptive(&mesh, &options(4, EndCap::Bilinear)).expect("plan");
+        let mut area: HashMap<(u32, u8), f64> = HashMap::new();
+        for pa in &plan.patches {
+            *area.entry((pa.base_face, pa.sub_face)).or_default() += pa.size * pa.size;
+            assert!(pa.origin[0] >= 0.0 && pa.origin[0] + pa.size <= 1.0);
+            assert!(pa.origin[1] >= 0.0 && pa.origin[1] + pa.size <= 1.0);
+        }
+        let holes: Vec<u32> = mesh.holes.clone();
+        for f in 0..mesh.num_faces() as u32 {
+            if holes.contains(&f) {
+                continue;
+            }
+            let n = mesh.face(f as usize).len();
+            let subs = if n == 4 { 1 } else { n };
+            for s in 0..subs {
+                let a = area.get(&(f, s as u8)).copied().unwrap_or(0.0);
+                assert!((a - 1.0).abs() < 1e-12, "{name}: face {f}.{s} covered {a}");
+            }
+        }
+    }
+}
+
+#[test]
+fn full_isolation_of_the_cube_is_uniform() {
+    let mesh = load_obj(format!("{SHAPES}catmark_cube.obj")).expect("cube");
+    let plan = plan_adaptive(&mesh, &options(4, EndCap::Bilinear)).expect("plan");
+    // Every face of levels 0 and 1 touches a valence-3 vertex, so levels 1 and 2 are uniform.
+    for l in 0..=2 {
+        let s = plan.level_stats[l];
+        assert_eq!(s.faces as u64, s.uniform_faces, "level {l}: {s:?}");
+    }
+    assert_eq!(plan.level_stats[1].uniform_faces, 24);
+    assert_eq!(plan.level_stats[2].uniform_faces, 96);
+    assert_eq!(plan.steps[0].table.len(), 26);
+    assert_eq!(plan.steps[1].table.len(), 98);
+    // Level 3 still holds every face (the corners' one-rings cover the cube), level 4 not.
+    assert!((plan.level_stats[4].faces as u64) < plan.level_stats[4].uniform_faces);
+    // The cube's regular patches: none at levels 0 and 1 (every face touches a corner).
+    assert_eq!(plan.level_stats[0].regular + plan.level_stats[1].regular, 0);
+    assert_eq!(plan.level_stats[4].end_caps, 8 * 3);
+}
+
+#[test]
+fn spot_face_counts_per_level() {
+    let mesh = load_obj(SPOT).expect("spot");
+    for iso in [4, 6] {
+        let t = std::time::Instant::now();
+        let plan = plan_adaptive(&mesh, &options(iso, EndCap::Gregory)).expect("plan");
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        println!("spot, isolation {iso} ({ms:.1} ms, this build):");
+        println!("level  regular  end caps  faces held  uniform faces");
+        for (l, s) in plan.level_stats.iter().enumerate() {
+            println!(
+                "{l:5}  {:7}  {:8}  {:10}  {:13}",
+                s.regular, s.end_caps, s.faces, s.uniform_faces
+            );
+            assert!(s.faces as u64 <= s.uniform_faces);
+        }
+        assert_eq!(plan.level_stats.len(), iso as usize + 1);
+        // Spot has triangles and pentagons: nothing is a patch at level 0 around them, and the
+        // end caps sit at the isolation level only.
+        assert!(plan.level_stats[..iso as usize]
+            .iter()
+            .all(|s| s.end_caps == 0));
+        assert!(plan.level_stats[iso as usize].end_caps > 0);
+    }
+}
+
+#[test]
+fn sharpness_scale_changes_the_plan() {
+    let mesh = load_obj(format!("{SHAPES}catmark_cube_creases1.obj")).expect("shape");
+    let lm_smooth = {
+        let mut m = mesh.clone();
+        m.creases.clear();
+        m.corners.clear();
+        m
+    };
+    let zero = AdaptiveOptions {
+        sharpness_scale: 0.0,
+        ..options(3, EndCap::Bilinear)
+    };
+    let a = plan_adaptive(&mesh, &zero).expect("plan");
+    let b = plan_adaptive(&lm_smooth, &options(3, EndCap::Bilinear)).expect("plan");
+    assert_eq!(a.level_stats, b.level_stats, "scale 0 removes the creases");
+    let c = plan_adaptive(&mesh, &options(3, EndCap::Bilinear)).expect("plan");
+    assert_ne!(a.level_stats, c.level_stats);
+}
+
+#[test]
+fn bad_options_and_meshes_are_named_errors() {
+    let mesh = load_obj(format!("{SHAPES}catmark_cube.obj")).expect("cube");
+    for iso in [0, 9, 100] {
+        let e = plan_adaptive(&mesh, &options(iso, EndCap::Gregory)).unwrap_err();
+        assert!(
+            matches!(e, TopologyError::IsolationOutOfRange { isolation } if isolation == iso),
+            "{e}"
+        );
+    }
+    for scale in [f32::NAN, -1.0, f32::INFINITY] {
+        let o = AdaptiveOptions {
+            sharpness_scale: scale,
+            ..AdaptiveOptions::default()
+        };
+        let e = plan_adaptive(&mesh, &o).unwrap_err();
+        assert!(matches!(e, TopologyError::BadSharpnessScale { .. }), "{e}");
+    }
+    for s in [f32::NAN, -0.5] {
+        let mut m = mesh.clone();
+        m.creases.push(EdgeCrease {
+            vertices: [0, 1],
+            sharpness: s,
+        });
+        let e = plan_adaptive(&m, &AdaptiveOptions::default()).unwrap_err();
+        assert!(
+            matches!(e, TopologyError::BadEdgeSharpness { v0: 0, v1: 1, .. }),
+            "{e}"
+        );
+        let mut m = mesh.clone();
+        m.corners.push(VertexCorner {
+            vertex: 3,
+            sharpness: s,
+        });
+        let e = plan_adaptive(&m, &AdaptiveOptions::default()).unwrap_err();
+        assert!(
+            matches!(e, TopologyError::BadVertexSharpness { vertex: 3, .. }),
+            "{e}"
+        );
+    }
+    // Three quads on one edge.
+    let nonmanifold = ControlMesh::from_polygons(
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, -1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [1.0, 0.0, 1.0],
+            [0.0, 0.0, 1.0],
+        ],
+        &[[0u32, 1, 2, 3], [1, 0, 5, 4], [0, 1, 6, 7]],
+    );
+    let e = plan_adaptive(&nonmanifold, &AdaptiveOptions::default()).unwrap_err();
+    assert!(
+        matches!(e.root(), TopologyError::NonManifoldEdge { .. }),
+        "{e}"
+    );
+    let empty = ControlMesh::default();
+    assert!(plan_adaptive(&empty, &AdaptiveOptions::default()).is_err());
+}
