@@ -74,6 +74,75 @@ fn surface(ctx: &mut Context, mesh: &ControlMesh, name: &str, isolation: u32, en
     .unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
+/// Distance from `p` to the exact limit surface near base point `(face, sub, s, t)`: a few
+/// Gauss-Newton steps on the (sub)face's parameters from there, clamped to the (sub)face. An
+/// end cap's parameterization differs from the limit's near extraordinary vertices (the
+/// Gregory patch is polynomial, the characteristic map is not), so this geometric distance is
+/// what tells how close the surface is, the parametric one how close its parameterization is.
+fn geometric_distance(cpu: &LocalMesh, quad: bool, face: usize, sub: usize, st: (f64, f64), p: [f64; 3]) -> f64 {
+    let eval = |s: f64, t: f64| {
+        if quad {
+            cpu.evaluate(face, s, t)
+        } else {
+            cpu.evaluate_subface(face, sub, s, t)
+        }
+        .expect("exact limit")
+    };
+    let (mut s, mut t) = st;
+    let mut best = f64::MAX;
+    for _ in 0..6 {
+        let e = eval(s, t);
+        let r: Vec<f64> = (0..3).map(|k| e.position[k] - p[k]).collect();
+        best = best.min(r.iter().map(|x| x * x).sum::<f64>().sqrt());
+        let (a, b) = (e.du, e.dv);
+        let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(x, y)| x * y).sum::<f64>();
+        let (aa, ab, bb) = (dot(&a, &a), dot(&a, &b), dot(&b, &b));
+        let (ar, br) = (dot(&a, &r), dot(&b, &r));
+        let det = aa * bb - ab * ab;
+        if det.abs() < 1e-300 {
+            break;
+        }
+        s = (s - (bb * ar - ab * br) / det).clamp(0.0, 1.0);
+        t = (t - (aa * br - ab * ar) / det).clamp(0.0, 1.0);
+    }
+    best
+}
+
+/// Worst distances over the bbox diagonal between captured vertices and the exact limit, over
+/// at most `samples` welded vertices: (regular patches at their base point, end caps at their
+/// base point, end caps to the nearest limit point).
+fn deviations(surf: &Adaptive, soup: &CapturedSoup, mesh: &ControlMesh, samples: usize) -> (f64, f64, f64) {
+    let cpu = LocalMesh::from_control_mesh(mesh, LimitScheme::CatmullClark).expect("cpu mesh");
+    let welded = soup.weld().expect("weld");
+    let n = welded.positions.len();
+    let stride = n.div_ceil(samples).max(1);
+    let d = diag(mesh);
+    let (mut regular, mut caps, mut caps_geometric) = (0.0f64, 0.0f64, 0.0f64);
+    for i in (0..n).step_by(stride) {
+        let [u, v] = welded.domain[i].map(f64::from);
+        let (f, sub, bu, bv) = surf.base_param(welded.patch[i], u, v).expect("patch");
+        let quad = mesh.face(f as usize).len() == 4;
+        let e = if quad {
+            cpu.evaluate(f as usize, bu, bv)
+        } else {
+            cpu.evaluate_subface(f as usize, sub as usize, bu, bv)
+        }
+        .expect("exact limit");
+        let p = welded.positions[i].map(f64::from);
+        let err = (0..3).map(|k| (p[k] - e.position[k]).abs()).fold(0.0, f64::max) / d;
+        if welded.flags[i] & 15 == ADAPTIVE_KIND_REGULAR {
+            regular = regular.max(err);
+        } else {
+            caps = caps.max(err);
+            if err * d > 1e-7 {
+                let g = geometric_distance(&cpu, quad, f as usize, sub as usize, (bu, bv), p) / d;
+                caps_geometric = caps_geometric.max(g);
+            }
+        }
+    }
+    (regular, caps, caps_geometric)
+}
+
 /// Worst distance over the bbox diagonal between captured vertices and the exact limit at
 /// their base point: (regular patches, end caps), over at most `samples` welded vertices.
 fn deviation(surf: &Adaptive, soup: &CapturedSoup, mesh: &ControlMesh, samples: usize) -> (f64, f64) {
@@ -126,17 +195,20 @@ fn captured_vertices_are_the_exact_limit() {
     {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let capturer = Capturer::new(&ctx).expect("capturer");
+        let mut failures = Vec::new();
         for (name, mesh) in catmark_shapes() {
             let surf = surface(&mut ctx, &mesh, &name, 4, EndCap::Gregory);
             let (soup, _) = capturer
                 .capture(&mut ctx, &surf, &FrameParams::uniform(3.0), EXTENT)
                 .expect("capture");
-            let (regular, caps) = deviation(&surf, &soup, &mesh, 3000);
+            let (regular, caps, geometric) = deviations(&surf, &soup, &mesh, 3000);
             let [r, g, b] = surf.patch_counts();
-            println!("{name}: {r} regular, {g} Gregory, {b} bilinear: regular {regular:.2e}, end caps {caps:.2e}");
-            assert!(regular <= 1e-5, "{name}: regular patches off by {regular:.2e}");
-            assert!(caps <= 5e-5, "{name}: end caps off by {caps:.2e}");
+            println!("{name}: {r} regular, {g} Gregory, {b} bilinear: regular {regular:.2e}, end caps {caps:.2e} (parametric), {geometric:.2e} (to the surface)");
+            if regular > 1e-5 || geometric > 5e-5 {
+                failures.push(format!("{name}: regular {regular:.2e}, end caps {caps:.2e} / {geometric:.2e}"));
+            }
         }
+        assert!(failures.is_empty(), "off the exact limit: {failures:#?}");
     }
 }
 
@@ -159,7 +231,7 @@ fn end_cap_deviation_shrinks_with_isolation() {
                     assert!(regular <= 1e-5, "{name} isolation {isolation}: regular {regular:.2e}");
                     devs.push(caps);
                 }
-                println!("{name} {end_cap:?} end-cap deviation, isolation 1..6: {devs:.2e?}");
+                println!("{name} {end_cap:?} end-cap deviation, isolation 1..6: {:?}", devs.iter().map(|d| format!("{d:.2e}")).collect::<Vec<_>>());
                 assert!(devs[5] < 0.25 * devs[0], "{name} {end_cap:?}: {devs:?} does not shrink");
                 for w in devs.windows(2) {
                     assert!(w[1] <= w[0] * 1.05, "{name} {end_cap:?}: {devs:?} grows");
@@ -193,15 +265,20 @@ fn watertight_under_every_factor_policy() {
             "spot",
         ] {
             let mesh = if name == "spot" { spot() } else { shape(name) };
-            for end_cap in [EndCap::Gregory, EndCap::Bilinear] {
+            let caps: &[EndCap] = if matches!(name, "catmark_cube" | "spot") {
+                &[EndCap::Gregory, EndCap::Bilinear]
+            } else {
+                &[EndCap::Gregory]
+            };
+            for &end_cap in caps {
                 let surf = surface(&mut ctx, &mesh, name, 3, end_cap);
                 let policies = [
-                    ("uniform 5", FactorPolicy::Uniform { segments: 5.0 }, false),
+                    ("uniform 3", FactorPolicy::Uniform { segments: 3.0 }, false),
                     ("screen 6px", FactorPolicy::Screen { pixels: 6.0 }, false),
                     (
                         "distance",
                         FactorPolicy::Distance {
-                            reference: 0.6 * diag(&mesh) as f32,
+                            reference: 0.12 * diag(&mesh) as f32,
                         },
                         false,
                     ),
@@ -209,7 +286,7 @@ fn watertight_under_every_factor_policy() {
                     (
                         "distance fractional",
                         FactorPolicy::Distance {
-                            reference: 0.45 * diag(&mesh) as f32,
+                            reference: 0.1 * diag(&mesh) as f32,
                         },
                         true,
                     ),
@@ -256,10 +333,10 @@ fn animated_base_mesh_gives_the_deformed_limit() {
         let (soup, _) = capturer
             .capture(&mut ctx, &surf, &FrameParams::uniform(4.0), EXTENT)
             .expect("capture");
-        let (regular, caps) = deviation(&surf, &soup, &deformed, 3000);
+        let (regular, caps, geometric) = deviations(&surf, &soup, &deformed, 3000);
         let (rest_regular, _) = deviation(&surf, &soup, &mesh, 3000);
-        println!("animated spot: regular {regular:.2e}, end caps {caps:.2e}; vs rest pose {rest_regular:.2e}");
-        assert!(regular <= 1e-5 && caps <= 2e-4, "{regular:.2e} {caps:.2e}");
+        println!("animated spot: regular {regular:.2e}, end caps {caps:.2e} (parametric), {geometric:.2e} (to the surface); vs rest pose {rest_regular:.2e}");
+        assert!(regular <= 1e-5 && geometric <= 2e-4, "{regular:.2e} {geometric:.2e}");
         assert!(rest_regular > 1e-3, "the surface did not move");
         assert_eq!(cracks(&surf, &soup, &deformed).0, 0);
     }
@@ -347,6 +424,38 @@ fn bad_input_gives_named_errors() {
             },
         ] {
             assert!(ok.check(&bad).is_err(), "{bad:?}");
+        }
+    }
+}
+
+/// The GPU (stencil kernel, TES) draws what the CPU plan evaluates (f64), on every patch kind:
+/// the oracle chain is GPU → plan → exact limit.
+#[test]
+fn gpu_matches_the_cpu_plan() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
+        for (name, end_cap) in [("catmark_chaikin0", EndCap::Gregory), ("catmark_pyramid", EndCap::Bilinear)] {
+            let mesh = shape(name);
+            let surf = surface(&mut ctx, &mesh, name, 3, end_cap);
+            let (soup, _) = capturer
+                .capture(&mut ctx, &surf, &FrameParams::uniform(3.0), EXTENT)
+                .expect("capture");
+            let welded = soup.weld().unwrap();
+            let verts = surf.plan.apply(&mesh.positions);
+            let mut worst = 0.0f64;
+            for i in 0..welded.positions.len() {
+                let [u, v] = welded.domain[i].map(f64::from);
+                let pi = surf.gpu.order[welded.patch[i] as usize] as usize;
+                let s = surf.plan.evaluate(&verts, pi, u, v);
+                let e = (0..3)
+                    .map(|k| (welded.positions[i][k] as f64 - s.position[k]).abs())
+                    .fold(0.0, f64::max);
+                worst = worst.max(e / diag(&mesh));
+            }
+            println!("{name} {end_cap:?}: GPU vs CPU plan {worst:.2e}");
+            assert!(worst <= 1e-5, "{name}: GPU off the CPU plan by {worst:.2e}");
         }
     }
 }

@@ -5,7 +5,7 @@
 layout(location = 0) patch in uint tc_patch;
 layout(location = 5) flat out vec3 out_albedo;
 
-// Regular, Gregory, bilinear; lighter with each level.
+// Regular, Gregory, bilinear.
 const vec3 KIND_COLOURS[3] = vec3[3](vec3(0.45, 0.65, 0.95), vec3(0.95, 0.45, 0.35), vec3(0.95, 0.8, 0.3));
 
 void main() {
@@ -33,7 +33,10 @@ void main() {
     uint kind = patch_kind(p), level = patch_level(p);
     vec3 albedo = frame.base_color.rgb;
     if ((adaptive.options & uint(ADAPTIVE_OPTION_PATCH_COLOURS)) != 0u) {
-        albedo = mix(KIND_COLOURS[min(kind, 2u)], vec3(1.0), 0.12 * float(level));
+        // Odd levels lighter, even levels darker, a little lighter with depth: adjacent
+        // levels always differ.
+        albedo = KIND_COLOURS[min(kind, 2u)] * ((level & 1u) == 1u ? 1.0 : 0.62);
+        albedo = mix(albedo, vec3(1.0), 0.05 * float(level));
         // Transition patches (a finer neighbour) darker, boundary / crease patches greener.
         if (((p.info >> 12) & 15u) != 0u) albedo *= 0.7;
         if (((p.info >> 8) & 15u) != 0u) albedo = mix(albedo, vec3(0.3, 0.8, 0.35), 0.5);
