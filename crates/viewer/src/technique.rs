@@ -87,7 +87,7 @@ pub struct SurfaceArgs {
     #[arg(long, default_value = "gregory", value_parser = parse_end_cap)]
     pub end_cap: EndCap,
     /// Multiplies every crease and corner sharpness (adaptive), without reloading the mesh.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub sharpness_scale: f32,
     /// Adaptive edge factors (bft): screen (projected edge length / --pixels) or distance
     /// (halving each time the eye's distance doubles past --distance). Powers of two, or any

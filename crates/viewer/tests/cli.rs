@@ -1110,3 +1110,71 @@ fn window_shows_bft_like_offscreen_and_animates() {
         differ(&c, &d)
     );
 }
+
+/// With no arguments `render` draws spot's Catmull-Clark limit surface by feature-adaptive
+/// refinement; `--scheme` defaults by mesh (Loop when every face is a triangle) and picks the
+/// technique that draws it.
+#[test]
+fn render_draws_the_limit_surface_of_the_mesh_scheme_by_default() {
+    let out = tmp("default_adaptive.png");
+    let o = tessera(&["render", "--size", "160x120", "-o", out.to_str().unwrap()], &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = String::from_utf8_lossy(&o.stdout);
+    assert!(s.contains("adaptive"), "{s}");
+    let ico = data("tests/data/opensubdiv/shapes/loop_icosahedron.obj");
+    for (extra, want) in [(&[][..], "bft"), (&["--scheme", "catmull-clark"][..], "adaptive")] {
+        let o = tessera(
+            &[&["render", ico.as_str(), "--size", "160x120", "-o", out.to_str().unwrap()][..], extra].concat(),
+            &[],
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        let s = String::from_utf8_lossy(&o.stdout);
+        assert!(s.contains(want), "{extra:?}: {s}");
+    }
+}
+
+/// Adaptive options out of range, or given to a technique that does not take them, are named.
+#[test]
+fn adaptive_options_are_checked() {
+    fails_with(&["render", "--isolation", "9", "-o", "/tmp/x.png"], &[], &["--isolation 9"]);
+    fails_with(&["render", "--isolation", "0", "-o", "/tmp/x.png"], &[], &["--isolation 0"]);
+    fails_with(
+        &["render", "--sharpness-scale", "-1", "-o", "/tmp/x.png"],
+        &[],
+        &["--sharpness-scale"],
+    );
+    let o = tessera(&["render", "--end-cap", "cubic", "-o", "/tmp/x.png"], &[]);
+    assert!(!o.status.success() && stderr(&o).contains("unknown end cap 'cubic'"), "{}", stderr(&o));
+    fails_with(
+        &["render", "--method", "flat", "--isolation", "3", "-o", "/tmp/x.png"],
+        &[],
+        &["--isolation", "--method adaptive"],
+    );
+    fails_with(&["render", "--level", "33", "-o", "/tmp/x.png"], &[], &["--segments 33"]);
+}
+
+/// `export` of the adaptive surface: every captured vertex mapped to a base face, watertight
+/// (bit-identical shared edges), on a mesh with triangles, creases and a boundary.
+#[test]
+fn export_adaptive_is_watertight_and_mapped() {
+    for shape in ["catmark_pyramid_creases1", "catmark_tent_creases1"] {
+        let out = tmp(&format!("{shape}_adaptive.obj"));
+        let s = export_ok(&[
+            "export",
+            &data(&format!("tests/data/opensubdiv/shapes/{shape}.obj")),
+            "--segments",
+            "3",
+            "--isolation",
+            "3",
+            "--fail-on-cracks",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(s.contains("adaptive"), "{s}");
+        assert!(s.contains(" 0 cracks"), "{s}");
+        let text = std::fs::read_to_string(&out).unwrap();
+        let v = text.lines().filter(|l| l.starts_with("v ")).count();
+        let p = text.lines().filter(|l| l.starts_with("# p ")).count();
+        assert!(v > 0 && v == p, "{shape}: {v} vertices, {p} base points");
+    }
+}
