@@ -30,11 +30,14 @@
 //! * **Patches.** A complete non-selected face is a Regular patch (16 control points gathered
 //!   around its corners, rows across a boundary or infinitely sharp edge replaced by phantom
 //!   points `2·P_edge − P_inner`, the corner by `4·P − 2·E₀ − 2·E₁ + F`, as OpenSubdiv does).
-//!   At the isolation level an irregular complete face is an end cap (Gregory or bilinear).
-//!   Semi-sharp sharpness still positive at the isolation level is treated as infinite there
-//!   (as the seed does): a regular crease becomes a crease patch, anything else an end cap. This
-//!   is the one approximation besides the end caps; it vanishes once the isolation level
-//!   exceeds the sharpness. Holes make no patches and are never selected.
+//!   At the isolation level an irregular complete face is an end cap: Gregory (the 20 points
+//!   of [`crate::gregory::gregory_basis`] on that level, its four `P` replaced by the
+//!   canonical corners below, which are the same limit points) or bilinear. Semi-sharp
+//!   sharpness still positive at the isolation level is treated as infinite there, for the
+//!   classification, the phantoms, the Gregory points and the corner masks alike (as the seed
+//!   does): a regular crease becomes a crease patch, anything else an end cap. This is the one
+//!   approximation besides the end caps; it vanishes once the isolation level reaches the
+//!   sharpness. Holes make no patches and are never selected.
 //! * **Parameterisation.** Each patch knows its base face (and sub-quad of a non-quad base
 //!   face, numbered as [`crate::eval::LocalMesh::evaluate_subface`] does) and the square
 //!   `origin + size·[0,1]²` of that (sub-)face's domain it covers. Its corners are rotated so
@@ -58,7 +61,12 @@
 //! * **One global vertex buffer.** Base vertices first, then one [`StencilBlock`] per level (its
 //!   rows read only the previous level), then one block of local points (phantoms, Gregory
 //!   points, canonical corners, curve points) that reads only refined vertices, so each block
-//!   can run as one parallel kernel.
+//!   can run as one parallel kernel. Local points are not shared between patches except the
+//!   canonical corners and curves (two boundary patches each have their own phantoms).
+//! * **Cost.** Faces are drafted in parallel per level, canonical corner and curve stencils in
+//!   parallel chunks appended in order, so the plan is the same with any thread count. Most of
+//!   the remaining time is the sparse refinement itself and first-touch page faults of the
+//!   stencil tables.
 
 use crate::error::TopologyError;
 use crate::limit::{catmark_limit_masks, LimitRule, LimitVertex};
@@ -210,6 +218,21 @@ fn slot(a: i32, b: i32) -> usize {
 }
 
 /// Plan the feature-adaptive refinement and patches of `mesh` (Catmull-Clark).
+///
+/// ```
+/// use topology::{plan_adaptive, AdaptiveOptions, ControlMesh, EndCap};
+/// // A cube: eight valence-3 vertices, isolated to level 2.
+/// let p = [[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.],
+///          [0., 0., 1.], [1., 0., 1.], [1., 1., 1.], [0., 1., 1.]];
+/// let faces = [[0u32, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]];
+/// let mesh = ControlMesh::from_polygons(p.to_vec(), &faces);
+/// let opts = AdaptiveOptions { isolation: 2, end_cap: EndCap::Gregory, sharpness_scale: 1.0 };
+/// let plan = plan_adaptive(&mesh, &opts).unwrap();
+/// assert_eq!(plan.level_stats[2].end_caps, 24); // three per corner
+/// let verts = plan.apply(&mesh.positions);
+/// let centre = plan.evaluate(&verts, 0, 0.5, 0.5).position;
+/// assert!(centre.iter().all(|x| x.is_finite()));
+/// ```
 pub fn plan_adaptive(
     mesh: &ControlMesh,
     opts: &AdaptiveOptions,
@@ -483,17 +506,16 @@ impl Combo {
             w: [1.0, 0.0, 0.0, 0.0],
         }
     }
-    /// `2·a − b`.
+    /// `2·a − b`. Phantoms extrapolate gathered points (one term each) or, at a corner,
+    /// extrapolated ones (two terms each), so four terms always suffice.
     fn extrapolate(a: &Combo, b: &Combo) -> Combo {
         let mut c = Combo::default();
-        for (k, (x, s)) in [(a, 2.0), (b, -1.0)]
-            .into_iter()
-            .flat_map(|(x, s)| (0..x.n as usize).map(move |k| (x.idx[k], s * x.w[k])))
-            .enumerate()
-            .take(4)
-        {
-            c.idx[k] = x;
-            c.w[k] = s;
+        let terms = (0..a.n as usize)
+            .map(|k| (a.idx[k], 2.0 * a.w[k]))
+            .chain((0..b.n as usize).map(|k| (b.idx[k], -b.w[k])));
+        for (k, (i, w)) in terms.take(4).enumerate() {
+            c.idx[k] = i;
+            c.w[k] = w;
             c.n = k as u8 + 1;
         }
         c
@@ -507,8 +529,8 @@ struct Draft {
     shift: u8,
     kind: PatchKind,
     boundary_mask: u8,
-    /// Regular: the 16 gathered points.
-    grid: Option<Box<[Combo; 16]>>,
+    /// Regular: the 16 gathered ids (`INVALID` where a phantom goes).
+    grid: Option<[u32; 16]>,
     /// Gregory: 20 stencils over global ids, patch corner order.
     gregory: Option<Vec<Vec<(u32, f64)>>>,
     base_face: u32,
@@ -568,24 +590,24 @@ fn corner_in(t: &Topology, g: u32, v: u32) -> Option<usize> {
 }
 
 /// The 4×4 points of a regular patch (level-local ids) with phantoms for the masked edges.
-fn gather_regular(lvl: &Lvl, f: usize, shift: u8) -> Option<(Box<[Combo; 16]>, u8)> {
+/// Returns the gathered global ids (`INVALID` where a phantom goes) and the boundary mask;
+/// [`phantom_grid`] completes them.
+fn gather_regular(lvl: &Lvl, f: usize, shift: u8) -> Option<([u32; 16], u8)> {
     let t = lvl.t();
     let (fv, fe) = rotated(t, f, shift);
-    let mut known = [false; 16];
-    let mut grid = Box::new([Combo::default(); 16]);
+    let mut ids = [INVALID; 16];
     let base = lvl.base;
-    let mut set = |a: i32, b: i32, v: u32, grid: &mut [Combo; 16]| -> bool {
+    let set = |a: i32, b: i32, v: u32, grid: &mut [u32; 16]| -> bool {
         let s = slot(a, b);
-        if known[s] {
-            return grid[s].idx[0] == base + v;
+        if grid[s] != INVALID {
+            return grid[s] == base + v;
         }
-        known[s] = true;
-        grid[s] = Combo::one(base + v);
+        grid[s] = base + v;
         true
     };
     for p in 0..4 {
         let (ox, oy) = POS[p];
-        if !set(ox, oy, fv[p], &mut grid) {
+        if !set(ox, oy, fv[p], &mut ids) {
             return None;
         }
     }
@@ -616,9 +638,9 @@ fn gather_regular(lvl: &Lvl, f: usize, shift: u8) -> Option<(Box<[Combo; 16]>, u
             let hv = t.face_vertices(h as usize);
             let (d0, d1) = (DIR[step % 4], DIR[(step + 1) % 4]);
             let (a0, a1, a2) = (at(d0), at(add(d0, d1)), at(d1));
-            if !(set(a0.0, a0.1, hv[(kh + 1) % 4], &mut grid)
-                && set(a1.0, a1.1, hv[(kh + 2) % 4], &mut grid)
-                && set(a2.0, a2.1, hv[(kh + 3) % 4], &mut grid))
+            if !(set(a0.0, a0.1, hv[(kh + 1) % 4], &mut ids)
+                && set(a1.0, a1.1, hv[(kh + 2) % 4], &mut ids)
+                && set(a2.0, a2.1, hv[(kh + 3) % 4], &mut ids))
             {
                 return None;
             }
@@ -643,9 +665,9 @@ fn gather_regular(lvl: &Lvl, f: usize, shift: u8) -> Option<(Box<[Combo; 16]>, u
             let ds = DIR[(4 - step % 4) % 4];
             let ds1 = DIR[(5 - step % 4) % 4];
             let (a0, a1, a2) = (at(ds1), at(add(ds1, ds)), at(ds));
-            if !(set(a0.0, a0.1, hv[(kh + 3) % 4], &mut grid)
-                && set(a1.0, a1.1, hv[(kh + 2) % 4], &mut grid)
-                && set(a2.0, a2.1, hv[(kh + 1) % 4], &mut grid))
+            if !(set(a0.0, a0.1, hv[(kh + 3) % 4], &mut ids)
+                && set(a1.0, a1.1, hv[(kh + 2) % 4], &mut ids)
+                && set(a2.0, a2.1, hv[(kh + 1) % 4], &mut ids))
             {
                 return None;
             }
@@ -659,7 +681,23 @@ fn gather_regular(lvl: &Lvl, f: usize, shift: u8) -> Option<(Box<[Combo; 16]>, u
             mask |= 1 << p;
         }
     }
-    // Phantoms: columns (edges 3 and 1) where their rows exist, then rows (edges 0 and 2).
+    phantom_grid(&ids, mask)?;
+    Some((ids, mask))
+}
+
+/// The 16 points of a regular patch from its gathered ids: rows and columns across the
+/// masked edges extrapolated (`2·P_edge − P_inner`), columns (edges 3 and 1) first where
+/// their rows exist, then rows (edges 0 and 2), which gives the corner rule where two masked
+/// edges meet. `None` if a point is missing.
+fn phantom_grid(ids: &[u32; 16], mask: u8) -> Option<[Combo; 16]> {
+    let mut grid = [Combo::default(); 16];
+    let mut known = [false; 16];
+    for (s, &id) in ids.iter().enumerate() {
+        if id != INVALID {
+            grid[s] = Combo::one(id);
+            known[s] = true;
+        }
+    }
     for b in -1..=2 {
         if (b == -1 && mask & 1 != 0) || (b == 2 && mask & 4 != 0) {
             continue;
@@ -687,10 +725,10 @@ fn gather_regular(lvl: &Lvl, f: usize, shift: u8) -> Option<(Box<[Combo; 16]>, u
             }
         }
     }
-    known.iter().all(|&k| k).then_some((grid, mask))
+    known.iter().all(|&k| k).then_some(grid)
 }
 
-/// Build a stencil row: sort, merge duplicate indices, drop exact zeros.
+/// Append a stencil row: indices sorted, duplicates merged.
 fn push_row(table: &mut StencilTable, terms: &mut [(u32, f64)]) {
     terms.sort_unstable_by_key(|t| t.0);
     let mut last = INVALID;
@@ -861,6 +899,9 @@ fn kind_rank(k: PatchKind) -> u8 {
     }
 }
 
+/// Rows per parallel chunk of local points.
+const CHUNK: usize = 2048;
+
 /// Numbered local points.
 struct Locals {
     first: u32,
@@ -871,6 +912,17 @@ impl Locals {
     fn push(&mut self, terms: &mut [(u32, f64)]) -> u32 {
         let id = self.first + self.table.len() as u32;
         push_row(&mut self.table, terms);
+        id
+    }
+    /// Append the rows of `table` (built by [`push_row`]); returns the id of its first row.
+    fn append(&mut self, table: &StencilTable) -> u32 {
+        let id = self.first + self.table.len() as u32;
+        let shift = self.table.indices.len() as u32;
+        self.table.indices.extend_from_slice(&table.indices);
+        self.table.weights.extend_from_slice(&table.weights);
+        self.table
+            .offsets
+            .extend(table.offsets[1..].iter().map(|&o| o + shift));
         id
     }
     /// Expand a global id into refined-vertex terms (local points by their rows).
@@ -887,7 +939,7 @@ impl Locals {
 fn assemble(
     mesh: &ControlMesh,
     opts: &AdaptiveOptions,
-    levels: Vec<Lvl>,
+    mut levels: Vec<Lvl>,
 ) -> Result<AdaptivePlan, TopologyError> {
     let iso = opts.isolation as usize;
     let last = levels.last().expect("levels");
@@ -905,13 +957,14 @@ fn assemble(
     let mut drafts: Vec<Draft> = Vec::new();
     for (l, lvl) in levels.iter().enumerate() {
         let is_last = l == iso;
-        let found: Result<Vec<Option<Draft>>, TopologyError> = (0..lvl.t().num_faces())
+        let candidates: Vec<usize> = (0..lvl.t().num_faces())
+            .filter(|&f| lvl.complete[f] && !lvl.hole[f] && !lvl.selected[f])
+            .collect();
+        // An indexed collect writes the drafts in place (no per-face option, no list merge).
+        let found: Vec<Result<Draft, TopologyError>> = candidates
             .into_par_iter()
             .with_min_len(256)
             .map(|f| {
-                if !lvl.complete[f] || lvl.hole[f] || lvl.selected[f] {
-                    return Ok(None);
-                }
                 let irregular = lvl
                     .t()
                     .face_vertices(f)
@@ -954,12 +1007,20 @@ fn assemble(
                     d.grid = Some(grid);
                     d.boundary_mask = mask;
                 }
-                Ok(Some(d))
+                Ok(d)
             })
             .collect();
-        drafts.extend(found?.into_iter().flatten());
+        drafts.reserve(found.len());
+        for d in found {
+            drafts.push(d?);
+        }
     }
 
+    // Local points come to about 7 rows of 45 entries per patch on OpenSubdiv's shapes
+    // (corners, curve points, phantoms, Gregory points): reserve once instead of regrowing.
+    locals.table.offsets.reserve(7 * drafts.len());
+    locals.table.indices.reserve(45 * drafts.len());
+    locals.table.weights.reserve(45 * drafts.len());
     // Control points (phantoms and Gregory points become local points).
     let mut terms: Vec<(u32, f64)> = Vec::with_capacity(64);
     let mut patches: Vec<AdaptivePatch> = Vec::with_capacity(drafts.len());
@@ -970,7 +1031,11 @@ fn assemble(
     };
     for d in &drafts {
         let mut cps = Vec::with_capacity(20);
-        if let Some(grid) = &d.grid {
+        if let Some(ids) = &d.grid {
+            let grid = phantom_grid(ids, d.boundary_mask).ok_or(TopologyError::AdaptivePatch {
+                level: d.level as u32,
+                face: d.face as usize,
+            })?;
             for c in grid.iter() {
                 if c.n == 1 && c.w[0] == 1.0 {
                     cps.push(c.idx[0]);
@@ -1009,9 +1074,12 @@ fn assemble(
     }
 
     // Canonical corners, at the coarsest level each is a patch corner (drafts are level-ordered).
+    // First the numbering (sequential, cheap), then the limit stencils (in parallel chunks,
+    // appended in order).
     let mut canon = vec![INVALID; first_local as usize];
-    let mut mask_cache = Vec::new();
+    let mut needed: Vec<(u8, u32)> = Vec::new();
     let mut corners: Vec<[u32; 4]> = Vec::with_capacity(drafts.len());
+    let first_canon = first_local + locals.table.len() as u32;
     for (d, patch) in drafts.iter().zip(patches.iter_mut()) {
         let lvl = &levels[d.level as usize];
         let (fv, _) = rotated(lvl.t(), d.face as usize, d.shift);
@@ -1019,12 +1087,8 @@ fn assemble(
         for (p, &v) in fv.iter().enumerate() {
             let key = lvl.anc[v as usize] as usize;
             if canon[key] == INVALID {
-                terms.clear();
-                limit_stencil(lvl, v as usize, &mut mask_cache, &mut terms);
-                for t in terms.iter_mut() {
-                    t.0 += lvl.base;
-                }
-                canon[key] = locals.push(&mut terms);
+                canon[key] = first_canon + needed.len() as u32;
+                needed.push((d.level, v));
             }
             ids[p] = canon[key];
             match patch.kind {
@@ -1034,6 +1098,30 @@ fn assemble(
             }
         }
         corners.push(ids);
+    }
+    let chunks: Vec<StencilTable> = needed
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let mut table = StencilTable {
+                offsets: vec![0],
+                ..StencilTable::default()
+            };
+            let mut cache = Vec::new();
+            let mut terms = Vec::with_capacity(32);
+            for &(l, v) in chunk {
+                let lvl = &levels[l as usize];
+                terms.clear();
+                limit_stencil(lvl, v as usize, &mut cache, &mut terms);
+                for t in terms.iter_mut() {
+                    t.0 += lvl.base;
+                }
+                push_row(&mut table, &mut terms);
+            }
+            table
+        })
+        .collect();
+    for c in &chunks {
+        locals.append(c);
     }
     let canon_of = |l: usize, v: u32, face: u32| -> Result<u32, TopologyError> {
         let c = canon[levels[l].anc[v as usize] as usize];
@@ -1193,58 +1281,80 @@ fn assemble(
             })
         })
     });
-    let mut scratch: Vec<(u32, f64)> = Vec::with_capacity(128);
-    for (ci, &(_, pi, p, part)) in owners.iter().enumerate() {
-        if pi == u32::MAX {
-            return Err(TopologyError::AdaptiveUnbalanced { level: 0, face: ci });
-        }
-        let patch = &patches[pi as usize];
-        let (p, part) = (p as usize, part as usize);
-        let ids = corners[pi as usize];
-        // Orient: the segment runs in the patch's edge direction from `start_id`.
-        let start_id = if part == 2 {
-            // The midpoint: whichever end of the curve is not the patch corner.
-            let c = curves[ci];
-            if c[0] == ids[(p + 1) % 4] {
-                c[3]
-            } else {
-                c[0]
-            }
-        } else {
-            ids[p]
-        };
-        let forward = start_id == curves[ci][0];
-        for (slot, k) in [(1usize, 1usize), (2, 2)] {
-            // Bézier point `k` of the segment in patch direction lands in curve slot `slot`
-            // when the directions agree, in `3 - slot` otherwise.
-            let target = if forward { slot } else { 3 - slot };
-            scratch.clear();
-            match patch.kind {
-                PatchKind::Regular => {
-                    for (s, &w) in edge_rows[p][part][k].iter().enumerate() {
-                        if w != 0.0 {
-                            locals.expand(patch.control_points[s], w, &mut scratch);
+    // Curve `c` gets rows `2c` (its point 1) and `2c + 1` (its point 2) of this run of local
+    // points, computed in parallel chunks and appended in order.
+    if let Some(ci) = owners.iter().position(|o| o.1 == u32::MAX) {
+        // A sibling half no patch has as its own edge: a level jump the checks missed.
+        return Err(TopologyError::AdaptiveUnbalanced { level: 0, face: ci });
+    }
+    let first_curve_row = first_local + locals.table.len() as u32;
+    let chunks: Vec<StencilTable> = owners
+        .par_chunks(CHUNK)
+        .enumerate()
+        .map(|(chunk_index, chunk)| {
+            let mut table = StencilTable {
+                offsets: vec![0],
+                ..StencilTable::default()
+            };
+            let mut scratch: Vec<(u32, f64)> = Vec::with_capacity(128);
+            for (j, &(_, pi, p, part)) in chunk.iter().enumerate() {
+                let ci = chunk_index * CHUNK + j;
+                let patch = &patches[pi as usize];
+                let (p, part) = (p as usize, part as usize);
+                let ids = corners[pi as usize];
+                // The segment runs in the patch's edge direction from `start_id`.
+                let c = curves[ci];
+                let start_id = if part == 2 {
+                    // The midpoint: whichever end of the curve is not the patch corner.
+                    if c[0] == ids[(p + 1) % 4] {
+                        c[3]
+                    } else {
+                        c[0]
+                    }
+                } else {
+                    ids[p]
+                };
+                let forward = start_id == c[0];
+                for slot in [1usize, 2] {
+                    // Curve point `slot` is the segment's Bézier point `k`.
+                    let k = if forward { slot } else { 3 - slot };
+                    scratch.clear();
+                    match patch.kind {
+                        PatchKind::Regular => {
+                            for (s, &w) in edge_rows[p][part][k].iter().enumerate() {
+                                if w != 0.0 {
+                                    locals.expand(patch.control_points[s], w, &mut scratch);
+                                }
+                            }
+                        }
+                        PatchKind::Gregory => {
+                            let cp = &patch.control_points;
+                            let id = if k == 1 {
+                                cp[5 * p + 1]
+                            } else {
+                                cp[5 * ((p + 1) % 4) + 2]
+                            };
+                            locals.expand(id, 1.0, &mut scratch);
+                        }
+                        PatchKind::Bilinear => {
+                            let (c0, c3) = (ids[p], ids[(p + 1) % 4]);
+                            let w = if k == 1 { 2.0 / 3.0 } else { 1.0 / 3.0 };
+                            locals.expand(c0, w, &mut scratch);
+                            locals.expand(c3, 1.0 - w, &mut scratch);
                         }
                     }
-                }
-                PatchKind::Gregory => {
-                    let cp = &patch.control_points;
-                    let id = if k == 1 {
-                        cp[5 * p + 1]
-                    } else {
-                        cp[5 * ((p + 1) % 4) + 2]
-                    };
-                    locals.expand(id, 1.0, &mut scratch);
-                }
-                PatchKind::Bilinear => {
-                    let (c0, c3) = (ids[p], ids[(p + 1) % 4]);
-                    let w = if k == 1 { 2.0 / 3.0 } else { 1.0 / 3.0 };
-                    locals.expand(c0, w, &mut scratch);
-                    locals.expand(c3, 1.0 - w, &mut scratch);
+                    push_row(&mut table, &mut scratch);
                 }
             }
-            curves[ci][target] = locals.push(&mut scratch);
-        }
+            table
+        })
+        .collect();
+    for c in &chunks {
+        locals.append(c);
+    }
+    for (ci, c) in curves.iter_mut().enumerate() {
+        c[1] = first_curve_row + 2 * ci as u32;
+        c[2] = c[1] + 1;
     }
 
     // Statistics.
@@ -1272,14 +1382,15 @@ fn assemble(
         }
     }
 
+    let bases: Vec<u32> = levels.iter().map(|l| l.base).collect();
     let steps = levels
-        .iter()
+        .iter_mut()
         .skip(1)
-        .zip(levels.iter())
-        .map(|(child, parent)| {
-            let mut table = child.stencils.clone().unwrap_or_default();
+        .zip(bases)
+        .map(|(child, parent_base)| {
+            let mut table = child.stencils.take().unwrap_or_default();
             for i in table.indices.iter_mut() {
-                *i += parent.base;
+                *i += parent_base;
             }
             table.num_sources = child.base as usize;
             StencilBlock {

@@ -436,6 +436,20 @@ fn spot_face_counts_per_level() {
             assert!(s.faces as u64 <= s.uniform_faces);
         }
         assert_eq!(plan.level_stats.len(), iso as usize + 1);
+        // Transitions exist on both sides, and each coarse edge faces fine ones.
+        let count = |k: EdgeKind| {
+            plan.patches
+                .iter()
+                .flat_map(|p| p.edges.iter())
+                .filter(|e| e.kind == k)
+                .count()
+        };
+        let (coarse, fine) = (count(EdgeKind::Coarse), count(EdgeKind::Fine));
+        println!("{coarse} coarse and {fine} fine transition edges");
+        assert!(
+            coarse > 0 && fine == 2 * coarse,
+            "{coarse} coarse, {fine} fine"
+        );
         // Spot has triangles and pentagons: nothing is a patch at level 0 around them, and the
         // end caps sit at the isolation level only.
         assert!(plan.level_stats[..iso as usize]
@@ -443,6 +457,32 @@ fn spot_face_counts_per_level() {
             .all(|s| s.end_caps == 0));
         assert!(plan.level_stats[iso as usize].end_caps > 0);
     }
+}
+
+#[test]
+fn holes_make_no_patches() {
+    let mut mesh = load_obj(format!("{SHAPES}catmark_cube.obj")).expect("cube");
+    mesh.holes = vec![0];
+    let lm = LocalMesh::from_control_mesh(&mesh, LimitScheme::CatmullClark).expect("mesh");
+    let d = diag(&mesh);
+    for iso in 1..=3 {
+        let plan = plan_adaptive(&mesh, &options(iso, EndCap::Gregory)).expect("plan");
+        assert!(plan.patches.iter().all(|p| p.base_face != 0));
+        assert!(plan.patches.iter().any(|p| p.base_face == 1));
+        check_curves("cube with a hole", &plan, &mesh, d);
+        let verts = plan.apply(&mesh.positions);
+        for p in sample_patches(&plan, &[PatchKind::Regular], 100) {
+            let got = plan.evaluate(&verts, p, 0.3, 0.6).position;
+            assert!(dist(&got, &exact(&lm, &plan, p, 0.3, 0.6)) <= 1e-9 * d);
+        }
+    }
+    let mut bad = mesh.clone();
+    bad.holes = vec![6];
+    let e = plan_adaptive(&bad, &AdaptiveOptions::default()).unwrap_err();
+    assert!(
+        matches!(e.root(), TopologyError::TagOutOfRange { .. }),
+        "{e}"
+    );
 }
 
 #[test]
