@@ -172,7 +172,8 @@ pub struct AdaptivePatch {
     /// Patch `(u, v)` covers `(sub)face parameter origin + size·(u, v)`.
     pub origin: [f64; 2],
     pub size: f64,
-    /// Bit `i`: edge `i` is a boundary or infinitely sharp crease handled in the patch.
+    /// Bit `i`: edge `i` is a boundary or infinitely sharp crease handled in the patch (for
+    /// end caps too, where it only informs: their points already account for it).
     pub boundary_mask: u8,
     /// Bit `i`: the neighbour across edge `i` is one level finer.
     pub transition_mask: u8,

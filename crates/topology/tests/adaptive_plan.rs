@@ -564,6 +564,23 @@ fn bad_options_and_meshes_are_named_errors() {
         matches!(e.root(), TopologyError::NonManifoldEdge { .. }),
         "{e}"
     );
+    // A 300-gon: sub-faces are numbered with 8 bits.
+    let n = 300;
+    let ring: Vec<[f64; 3]> = (0..n)
+        .map(|i| {
+            let a = i as f64 * std::f64::consts::TAU / n as f64;
+            [a.cos(), a.sin(), 0.0]
+        })
+        .collect();
+    let big = ControlMesh::from_polygons(ring, &[(0..n as u32).collect::<Vec<u32>>()]);
+    let e = plan_adaptive(&big, &AdaptiveOptions::default()).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            TopologyError::AdaptiveFaceTooLarge { face: 0, size: 300 }
+        ),
+        "{e}"
+    );
     let empty = ControlMesh::default();
     assert!(plan_adaptive(&empty, &AdaptiveOptions::default()).is_err());
 }

@@ -103,6 +103,13 @@ pub(super) fn assemble(
                     if d.kind == PatchKind::Gregory {
                         d.gregory = Some(gregory_points(mesh, lvl, f, shift)?);
                     }
+                    // The end cap handles its sharp edges itself; the mask says which.
+                    let (_, fe) = rotated(lvl.t(), f, shift);
+                    for (p, &e) in fe.iter().enumerate() {
+                        if lvl.sharp_edge(e as usize) {
+                            d.boundary_mask |= 1 << p;
+                        }
+                    }
                 } else {
                     let (grid, mask) =
                         gather_regular(lvl, f, shift).ok_or(TopologyError::AdaptivePatch {

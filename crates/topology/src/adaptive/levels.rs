@@ -69,6 +69,12 @@ impl Lvl {
 
 pub(super) fn build_levels(mesh: &ControlMesh, iso: usize) -> Result<Vec<Lvl>, TopologyError> {
     let topo = LevelTopology::from_mesh(mesh, Scheme::CatmullClark)?;
+    if let Some((face, size)) = (0..topo.topology.num_faces())
+        .map(|f| (f, topo.topology.face_vertices(f).len()))
+        .find(|&(_, n)| n > 256)
+    {
+        return Err(TopologyError::AdaptiveFaceTooLarge { face, size });
+    }
     let nf = topo.topology.num_faces();
     let nv = topo.topology.num_vertices();
     let mut hole = vec![false; nf];
