@@ -460,6 +460,49 @@ fn spot_face_counts_per_level() {
 }
 
 #[test]
+fn a_regular_torus_is_one_level_of_patches() {
+    // 6×5 quads on a torus: every vertex has valence 4, nothing to isolate.
+    let (n, m) = (6usize, 5usize);
+    let mut positions = Vec::new();
+    for i in 0..n {
+        for j in 0..m {
+            let (a, b) = (
+                i as f64 * std::f64::consts::TAU / n as f64,
+                j as f64 * std::f64::consts::TAU / m as f64,
+            );
+            let r = 2.0 + 0.7 * b.cos();
+            positions.push([r * a.cos(), r * a.sin(), 0.7 * b.sin()]);
+        }
+    }
+    let id = |i: usize, j: usize| ((i % n) * m + (j % m)) as u32;
+    let faces: Vec<[u32; 4]> = (0..n)
+        .flat_map(|i| (0..m).map(move |j| (i, j)))
+        .map(|(i, j)| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
+        .collect();
+    let mesh = ControlMesh::from_polygons(positions, &faces);
+    let plan = plan_adaptive(&mesh, &options(3, EndCap::Gregory)).expect("plan");
+    assert_eq!(plan.patches.len(), n * m);
+    assert!(plan.patches.iter().all(|p| p.level == 0
+        && p.kind == PatchKind::Regular
+        && p.edges.iter().all(|e| e.kind == EdgeKind::Plain)));
+    assert_eq!(plan.steps.len(), 3);
+    assert!(plan.steps.iter().all(|s| s.table.is_empty()));
+    // Every patch point is a base vertex; the local points are corners and curve points.
+    assert!(plan
+        .patches
+        .iter()
+        .all(|p| p.control_points.iter().all(|&i| i < plan.num_base_vertices)));
+    assert_eq!(plan.curves.len(), 2 * n * m);
+    let lm = LocalMesh::from_control_mesh(&mesh, LimitScheme::CatmullClark).expect("mesh");
+    let verts = plan.apply(&mesh.positions);
+    for p in 0..plan.patches.len() {
+        let got = plan.evaluate(&verts, p, 0.25, 0.6).position;
+        assert!(dist(&got, &exact(&lm, &plan, p, 0.25, 0.6)) < 1e-12);
+    }
+    check_curves("torus", &plan, &mesh, diag(&mesh));
+}
+
+#[test]
 fn holes_make_no_patches() {
     let mut mesh = load_obj(format!("{SHAPES}catmark_cube.obj")).expect("cube");
     mesh.holes = vec![0];
