@@ -324,8 +324,9 @@ pub(super) fn assemble(
                         return Err(unbalanced());
                     };
                     let (cs, ce) = (canon_of(l, start, d.face)?, canon_of(l, end, d.face)?);
-                    // The sibling's owner is its own fine patch; this one never computes it.
-                    let sc = curve_id(l, sib, [cs, ce], (u8::MAX, u32::MAX, 0, 0), &mut curves);
+                    // The sibling's owner is its own fine patch; this one only holds the place
+                    // (rank u8::MAX) until that patch registers it.
+                    let sc = curve_id(l, sib, [cs, ce], (u8::MAX, pi as u32, 0, 0), &mut curves);
                     pe.curves = [c, sc];
                     pe.reversed = [ca > cb, cs > ce];
                 }
@@ -395,9 +396,13 @@ pub(super) fn assemble(
     });
     // Curve `c` gets rows `2c` (its point 1) and `2c + 1` (its point 2) of this run of local
     // points, computed in parallel chunks and appended in order.
-    if let Some(ci) = owners.iter().position(|o| o.1 == u32::MAX) {
-        // A sibling half no patch has as its own edge: a level jump the checks missed.
-        return Err(TopologyError::AdaptiveUnbalanced { level: 0, face: ci });
+    if let Some(o) = owners.iter().find(|o| o.0 == u8::MAX) {
+        // A sibling half no patch has as its own edge: a level jump next to this patch.
+        let d = &drafts[o.1 as usize];
+        return Err(TopologyError::AdaptiveUnbalanced {
+            level: d.level as u32,
+            face: d.face as usize,
+        });
     }
     let first_curve_row = first_local + locals.table.len() as u32;
     let chunks: Vec<StencilTable> = owners
