@@ -121,6 +121,9 @@ pub enum TopologyError {
     /// not form the 4×4 B-spline net).
     #[error("adaptive plan: face {face} of level {level} is not a regular patch")]
     AdaptivePatch { level: u32, face: usize },
+    /// A face with more corners than an adaptive patch's 8-bit sub-face number can name.
+    #[error("adaptive plan: face {face} has {size} corners (at most 256)")]
+    AdaptiveFaceTooLarge { face: usize, size: usize },
     /// An adaptive patch whose neighbour is more than one level coarser or finer (drawing it
     /// would leave a crack).
     #[error("adaptive plan: face {face} of level {level} borders a face more than one level away")]

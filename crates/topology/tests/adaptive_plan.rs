@@ -436,6 +436,20 @@ fn spot_face_counts_per_level() {
             assert!(s.faces as u64 <= s.uniform_faces);
         }
         assert_eq!(plan.level_stats.len(), iso as usize + 1);
+        // Transitions exist on both sides, and each coarse edge faces fine ones.
+        let count = |k: EdgeKind| {
+            plan.patches
+                .iter()
+                .flat_map(|p| p.edges.iter())
+                .filter(|e| e.kind == k)
+                .count()
+        };
+        let (coarse, fine) = (count(EdgeKind::Coarse), count(EdgeKind::Fine));
+        println!("{coarse} coarse and {fine} fine transition edges");
+        assert!(
+            coarse > 0 && fine == 2 * coarse,
+            "{coarse} coarse, {fine} fine"
+        );
         // Spot has triangles and pentagons: nothing is a patch at level 0 around them, and the
         // end caps sit at the isolation level only.
         assert!(plan.level_stats[..iso as usize]
@@ -443,6 +457,75 @@ fn spot_face_counts_per_level() {
             .all(|s| s.end_caps == 0));
         assert!(plan.level_stats[iso as usize].end_caps > 0);
     }
+}
+
+#[test]
+fn a_regular_torus_is_one_level_of_patches() {
+    // 6×5 quads on a torus: every vertex has valence 4, nothing to isolate.
+    let (n, m) = (6usize, 5usize);
+    let mut positions = Vec::new();
+    for i in 0..n {
+        for j in 0..m {
+            let (a, b) = (
+                i as f64 * std::f64::consts::TAU / n as f64,
+                j as f64 * std::f64::consts::TAU / m as f64,
+            );
+            let r = 2.0 + 0.7 * b.cos();
+            positions.push([r * a.cos(), r * a.sin(), 0.7 * b.sin()]);
+        }
+    }
+    let id = |i: usize, j: usize| ((i % n) * m + (j % m)) as u32;
+    let faces: Vec<[u32; 4]> = (0..n)
+        .flat_map(|i| (0..m).map(move |j| (i, j)))
+        .map(|(i, j)| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
+        .collect();
+    let mesh = ControlMesh::from_polygons(positions, &faces);
+    let plan = plan_adaptive(&mesh, &options(3, EndCap::Gregory)).expect("plan");
+    assert_eq!(plan.patches.len(), n * m);
+    assert!(plan.patches.iter().all(|p| p.level == 0
+        && p.kind == PatchKind::Regular
+        && p.edges.iter().all(|e| e.kind == EdgeKind::Plain)));
+    assert_eq!(plan.steps.len(), 3);
+    assert!(plan.steps.iter().all(|s| s.table.is_empty()));
+    // Every patch point is a base vertex; the local points are corners and curve points.
+    assert!(plan
+        .patches
+        .iter()
+        .all(|p| p.control_points.iter().all(|&i| i < plan.num_base_vertices)));
+    assert_eq!(plan.curves.len(), 2 * n * m);
+    let lm = LocalMesh::from_control_mesh(&mesh, LimitScheme::CatmullClark).expect("mesh");
+    let verts = plan.apply(&mesh.positions);
+    for p in 0..plan.patches.len() {
+        let got = plan.evaluate(&verts, p, 0.25, 0.6).position;
+        assert!(dist(&got, &exact(&lm, &plan, p, 0.25, 0.6)) < 1e-12);
+    }
+    check_curves("torus", &plan, &mesh, diag(&mesh));
+}
+
+#[test]
+fn holes_make_no_patches() {
+    let mut mesh = load_obj(format!("{SHAPES}catmark_cube.obj")).expect("cube");
+    mesh.holes = vec![0];
+    let lm = LocalMesh::from_control_mesh(&mesh, LimitScheme::CatmullClark).expect("mesh");
+    let d = diag(&mesh);
+    for iso in 1..=3 {
+        let plan = plan_adaptive(&mesh, &options(iso, EndCap::Gregory)).expect("plan");
+        assert!(plan.patches.iter().all(|p| p.base_face != 0));
+        assert!(plan.patches.iter().any(|p| p.base_face == 1));
+        check_curves("cube with a hole", &plan, &mesh, d);
+        let verts = plan.apply(&mesh.positions);
+        for p in sample_patches(&plan, &[PatchKind::Regular], 100) {
+            let got = plan.evaluate(&verts, p, 0.3, 0.6).position;
+            assert!(dist(&got, &exact(&lm, &plan, p, 0.3, 0.6)) <= 1e-9 * d);
+        }
+    }
+    let mut bad = mesh.clone();
+    bad.holes = vec![6];
+    let e = plan_adaptive(&bad, &AdaptiveOptions::default()).unwrap_err();
+    assert!(
+        matches!(e.root(), TopologyError::TagOutOfRange { .. }),
+        "{e}"
+    );
 }
 
 #[test]
@@ -522,6 +605,23 @@ fn bad_options_and_meshes_are_named_errors() {
     let e = plan_adaptive(&nonmanifold, &AdaptiveOptions::default()).unwrap_err();
     assert!(
         matches!(e.root(), TopologyError::NonManifoldEdge { .. }),
+        "{e}"
+    );
+    // A 300-gon: sub-faces are numbered with 8 bits.
+    let n = 300;
+    let ring: Vec<[f64; 3]> = (0..n)
+        .map(|i| {
+            let a = i as f64 * std::f64::consts::TAU / n as f64;
+            [a.cos(), a.sin(), 0.0]
+        })
+        .collect();
+    let big = ControlMesh::from_polygons(ring, &[(0..n as u32).collect::<Vec<u32>>()]);
+    let e = plan_adaptive(&big, &AdaptiveOptions::default()).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            TopologyError::AdaptiveFaceTooLarge { face: 0, size: 300 }
+        ),
         "{e}"
     );
     let empty = ControlMesh::default();

@@ -1,0 +1,555 @@
+//! Assembly: patches per level, local points, canonical corners, transitions and curves.
+
+use super::levels::Lvl;
+use super::nets::*;
+use super::*;
+
+/// Rows per parallel chunk of local points.
+pub(super) const CHUNK: usize = 2048;
+
+/// Numbered local points.
+pub(super) struct Locals {
+    pub(super) first: u32,
+    pub(super) table: StencilTable,
+}
+
+impl Locals {
+    pub(super) fn push(&mut self, terms: &mut [(u32, f64)]) -> u32 {
+        let id = self.first + self.table.len() as u32;
+        push_row(&mut self.table, terms);
+        id
+    }
+    /// Append the rows of `table` (built by [`push_row`]); returns the id of its first row.
+    pub(super) fn append(&mut self, table: &StencilTable) -> u32 {
+        let id = self.first + self.table.len() as u32;
+        let shift = self.table.indices.len() as u32;
+        self.table.indices.extend_from_slice(&table.indices);
+        self.table.weights.extend_from_slice(&table.weights);
+        self.table
+            .offsets
+            .extend(table.offsets[1..].iter().map(|&o| o + shift));
+        id
+    }
+    /// Expand a global id into refined-vertex terms (local points by their rows).
+    pub(super) fn expand(&self, id: u32, w: f64, out: &mut Vec<(u32, f64)>) {
+        if id < self.first {
+            out.push((id, w));
+        } else {
+            let (idx, ws) = self.table.stencil((id - self.first) as usize);
+            out.extend(idx.iter().zip(ws).map(|(&i, &x)| (i, w * x)));
+        }
+    }
+}
+
+pub(super) fn assemble(
+    mesh: &ControlMesh,
+    opts: &AdaptiveOptions,
+    mut levels: Vec<Lvl>,
+) -> Result<AdaptivePlan, TopologyError> {
+    let iso = opts.isolation as usize;
+    let last = levels.last().expect("levels");
+    let first_local = last.base + last.t().num_vertices() as u32;
+    let mut locals = Locals {
+        first: first_local,
+        table: StencilTable {
+            offsets: vec![0],
+            num_sources: first_local as usize,
+            ..StencilTable::default()
+        },
+    };
+
+    // Patches, level by level (faces in parallel).
+    let mut drafts: Vec<Draft> = Vec::new();
+    for (l, lvl) in levels.iter().enumerate() {
+        let is_last = l == iso;
+        let candidates: Vec<usize> = (0..lvl.t().num_faces())
+            .filter(|&f| lvl.complete[f] && !lvl.hole[f] && !lvl.selected[f])
+            .collect();
+        // An indexed collect writes the drafts in place (no per-face option, no list merge).
+        let found: Vec<Result<Draft, TopologyError>> = candidates
+            .into_par_iter()
+            .with_min_len(256)
+            .map(|f| {
+                let irregular = lvl
+                    .t()
+                    .face_vertices(f)
+                    .iter()
+                    .any(|&v| lvl.irregular[v as usize]);
+                if irregular && !is_last {
+                    return Err(TopologyError::AdaptivePatch {
+                        level: l as u32,
+                        face: f,
+                    });
+                }
+                let (base_face, sub_face, origin, size, shift) = frame(&levels, l, f);
+                let mut d = Draft {
+                    level: l as u8,
+                    face: f as u32,
+                    shift,
+                    kind: PatchKind::Regular,
+                    boundary_mask: 0,
+                    grid: None,
+                    gregory: None,
+                    base_face,
+                    sub_face,
+                    origin,
+                    size,
+                };
+                if irregular {
+                    d.kind = match opts.end_cap {
+                        EndCap::Gregory => PatchKind::Gregory,
+                        EndCap::Bilinear => PatchKind::Bilinear,
+                    };
+                    if d.kind == PatchKind::Gregory {
+                        d.gregory = Some(gregory_points(mesh, lvl, f, shift)?);
+                    }
+                    // The end cap handles its sharp edges itself; the mask says which.
+                    let (_, fe) = rotated(lvl.t(), f, shift);
+                    for (p, &e) in fe.iter().enumerate() {
+                        if lvl.sharp_edge(e as usize) {
+                            d.boundary_mask |= 1 << p;
+                        }
+                    }
+                } else {
+                    let (grid, mask) =
+                        gather_regular(lvl, f, shift).ok_or(TopologyError::AdaptivePatch {
+                            level: l as u32,
+                            face: f,
+                        })?;
+                    d.grid = Some(grid);
+                    d.boundary_mask = mask;
+                }
+                Ok(d)
+            })
+            .collect();
+        drafts.reserve(found.len());
+        for d in found {
+            drafts.push(d?);
+        }
+    }
+
+    // Local points come to about 7 rows of 45 entries per patch on OpenSubdiv's shapes
+    // (corners, curve points, phantoms, Gregory points): reserve once instead of regrowing.
+    locals.table.offsets.reserve(7 * drafts.len());
+    locals.table.indices.reserve(45 * drafts.len());
+    locals.table.weights.reserve(45 * drafts.len());
+    // Control points (phantoms and Gregory points become local points).
+    let mut terms: Vec<(u32, f64)> = Vec::with_capacity(64);
+    let mut patches: Vec<AdaptivePatch> = Vec::with_capacity(drafts.len());
+    let blank_edge = PatchEdge {
+        kind: EdgeKind::Plain,
+        curves: [INVALID; 2],
+        reversed: [false; 2],
+    };
+    for d in &drafts {
+        let mut cps = Vec::with_capacity(20);
+        if let Some(ids) = &d.grid {
+            let grid = phantom_grid(ids, d.boundary_mask).ok_or(TopologyError::AdaptivePatch {
+                level: d.level as u32,
+                face: d.face as usize,
+            })?;
+            for c in grid.iter() {
+                if c.n == 1 && c.w[0] == 1.0 {
+                    cps.push(c.idx[0]);
+                } else {
+                    terms.clear();
+                    terms.extend((0..c.n as usize).map(|k| (c.idx[k], c.w[k])));
+                    cps.push(locals.push(&mut terms));
+                }
+            }
+        } else if let Some(g) = &d.gregory {
+            for (k, row) in g.iter().enumerate() {
+                if k % 5 == 0 {
+                    // P: the canonical corner, filled below.
+                    cps.push(INVALID);
+                } else {
+                    terms.clear();
+                    terms.extend_from_slice(row);
+                    cps.push(locals.push(&mut terms));
+                }
+            }
+        } else {
+            cps.extend_from_slice(&[INVALID; 4]);
+        }
+        patches.push(AdaptivePatch {
+            kind: d.kind,
+            level: d.level,
+            control_points: cps,
+            base_face: d.base_face,
+            sub_face: d.sub_face,
+            origin: d.origin,
+            size: d.size,
+            boundary_mask: d.boundary_mask,
+            transition_mask: 0,
+            edges: [blank_edge; 4],
+        });
+    }
+
+    // Canonical corners, at the coarsest level each is a patch corner (drafts are level-ordered).
+    // First the numbering (sequential, cheap), then the limit stencils (in parallel chunks,
+    // appended in order).
+    let mut canon = vec![INVALID; first_local as usize];
+    let mut needed: Vec<(u8, u32)> = Vec::new();
+    let mut corners: Vec<[u32; 4]> = Vec::with_capacity(drafts.len());
+    let first_canon = first_local + locals.table.len() as u32;
+    for (d, patch) in drafts.iter().zip(patches.iter_mut()) {
+        let lvl = &levels[d.level as usize];
+        let (fv, _) = rotated(lvl.t(), d.face as usize, d.shift);
+        let mut ids = [0u32; 4];
+        for (p, &v) in fv.iter().enumerate() {
+            let key = lvl.anc[v as usize] as usize;
+            if canon[key] == INVALID {
+                canon[key] = first_canon + needed.len() as u32;
+                needed.push((d.level, v));
+            }
+            ids[p] = canon[key];
+            match patch.kind {
+                PatchKind::Gregory => patch.control_points[5 * p] = ids[p],
+                PatchKind::Bilinear => patch.control_points[p] = ids[p],
+                PatchKind::Regular => {}
+            }
+        }
+        corners.push(ids);
+    }
+    let chunks: Vec<StencilTable> = needed
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let mut table = StencilTable {
+                offsets: vec![0],
+                ..StencilTable::default()
+            };
+            let mut cache = Vec::new();
+            let mut terms = Vec::with_capacity(32);
+            for &(l, v) in chunk {
+                let lvl = &levels[l as usize];
+                terms.clear();
+                limit_stencil(lvl, v as usize, &mut cache, &mut terms);
+                for t in terms.iter_mut() {
+                    t.0 += lvl.base;
+                }
+                push_row(&mut table, &mut terms);
+            }
+            table
+        })
+        .collect();
+    for c in &chunks {
+        locals.append(c);
+    }
+    let canon_of = |l: usize, v: u32, face: u32| -> Result<u32, TopologyError> {
+        let c = canon[levels[l].anc[v as usize] as usize];
+        if c == INVALID {
+            Err(TopologyError::AdaptiveUnbalanced {
+                level: l as u32,
+                face: face as usize,
+            })
+        } else {
+            Ok(c)
+        }
+    };
+
+    // Edges: neighbour levels, balance, curves.
+    let mut curve_of: Vec<Vec<u32>> = levels
+        .iter()
+        .map(|l| vec![INVALID; l.t().num_edges()])
+        .collect();
+    let mut curves: Vec<[u32; 4]> = Vec::new();
+    let mut owners: Vec<Owner> = Vec::new();
+    let mut curve_id =
+        |l: usize, e: u32, ends: [u32; 2], owner: Owner, curves: &mut Vec<[u32; 4]>| -> u32 {
+            let slot = &mut curve_of[l][e as usize];
+            if *slot == INVALID {
+                *slot = curves.len() as u32;
+                let (a, b) = (ends[0].min(ends[1]), ends[0].max(ends[1]));
+                curves.push([a, INVALID, INVALID, b]);
+                owners.push(owner);
+            } else if owner < owners[*slot as usize] {
+                owners[*slot as usize] = owner;
+            }
+            *slot
+        };
+    for (pi, (d, patch)) in drafts.iter().zip(patches.iter_mut()).enumerate() {
+        let l = d.level as usize;
+        let lvl = &levels[l];
+        let t = lvl.t();
+        let (fv, fe) = rotated(t, d.face as usize, d.shift);
+        let rank = kind_rank(d.kind);
+        let unbalanced = || TopologyError::AdaptiveUnbalanced {
+            level: l as u32,
+            face: d.face as usize,
+        };
+        for p in 0..4 {
+            let e = fe[p];
+            let (a, b) = (fv[p], fv[(p + 1) % 4]);
+            let [x, y] = t.edge_faces(e as usize);
+            let g = if x == d.face { y } else { x };
+            let kind = if g == INVALID || lvl.hole[g as usize] {
+                EdgeKind::Plain
+            } else if lvl.complete[g as usize] {
+                if lvl.selected[g as usize] {
+                    EdgeKind::Coarse
+                } else {
+                    EdgeKind::Plain
+                }
+            } else {
+                let maps = lvl.maps.as_ref().ok_or_else(unbalanced)?;
+                let gp = maps.child_face_parent[g as usize] as usize;
+                let parent = &levels[l - 1];
+                if parent.hole[gp] {
+                    EdgeKind::Plain
+                } else if parent.complete[gp] && !parent.selected[gp] {
+                    EdgeKind::Fine
+                } else {
+                    return Err(unbalanced());
+                }
+            };
+            let (ca, cb) = (canon_of(l, a, d.face)?, canon_of(l, b, d.face)?);
+            let pe = &mut patch.edges[p];
+            pe.kind = kind;
+            match kind {
+                EdgeKind::Plain => {
+                    let c = curve_id(l, e, [ca, cb], (rank, pi as u32, p as u8, 0), &mut curves);
+                    pe.curves = [c, c];
+                    pe.reversed = [ca > cb; 2];
+                }
+                EdgeKind::Fine => {
+                    let c = curve_id(l, e, [ca, cb], (rank, pi as u32, p as u8, 0), &mut curves);
+                    let sib = e ^ 1;
+                    let [s0, s1] = t.edge_vertices(sib as usize);
+                    // The shared end is the midpoint of the coarse edge.
+                    let (start, end) = if s0 == a || s1 == a {
+                        (if s0 == a { s1 } else { s0 }, a)
+                    } else if s0 == b || s1 == b {
+                        (b, if s0 == b { s1 } else { s0 })
+                    } else {
+                        return Err(unbalanced());
+                    };
+                    let (cs, ce) = (canon_of(l, start, d.face)?, canon_of(l, end, d.face)?);
+                    // The sibling's owner is its own fine patch; this one only holds the place
+                    // (rank u8::MAX) until that patch registers it.
+                    let sc = curve_id(l, sib, [cs, ce], (u8::MAX, pi as u32, 0, 0), &mut curves);
+                    pe.curves = [c, sc];
+                    pe.reversed = [ca > cb, cs > ce];
+                }
+                EdgeKind::Coarse => {
+                    patch.transition_mask |= 1 << p;
+                    let next = &levels[l + 1];
+                    let maps = next.maps.as_ref().ok_or_else(unbalanced)?;
+                    let m = maps.edge_child_vertex[e as usize];
+                    if m == INVALID || (m as usize) < next.kv {
+                        return Err(unbalanced());
+                    }
+                    let r = m - next.kv as u32;
+                    let h0 = 2 * r + u32::from(t.edge_vertices(e as usize)[0] != a);
+                    let h1 = h0 ^ 1;
+                    // Both halves must be patches of level l + 1.
+                    for h in [h0, h1] {
+                        for cf in next.t().edge_faces(h as usize) {
+                            if cf != INVALID
+                                && next.complete[cf as usize]
+                                && next.selected.get(cf as usize).copied().unwrap_or(false)
+                            {
+                                return Err(unbalanced());
+                            }
+                        }
+                    }
+                    let cm = canon_of(l + 1, m, d.face)?;
+                    let c0 = curve_id(
+                        l + 1,
+                        h0,
+                        [ca, cm],
+                        (rank, pi as u32, p as u8, 1),
+                        &mut curves,
+                    );
+                    let c1 = curve_id(
+                        l + 1,
+                        h1,
+                        [cm, cb],
+                        (rank, pi as u32, p as u8, 2),
+                        &mut curves,
+                    );
+                    pe.curves = [c0, c1];
+                    pe.reversed = [ca > cm, cm > cb];
+                }
+            }
+        }
+    }
+
+    // Inner Bézier points of each curve from its owner.
+    // Per patch edge and part (whole, first half, second half): Bézier weights over the slots.
+    let edge_rows: [[[[f64; 16]; 4]; 3]; 4] = std::array::from_fn(|p| {
+        let whole = regular_edge_bezier(p);
+        std::array::from_fn(|part| {
+            if part == 0 {
+                return whole;
+            }
+            let h = bezier_half(part - 1);
+            std::array::from_fn(|k| {
+                let mut w = [0.0; 16];
+                for (j, &s) in h[k].iter().enumerate() {
+                    for (o, x) in w.iter_mut().zip(&whole[j]) {
+                        *o += s * x;
+                    }
+                }
+                w
+            })
+        })
+    });
+    // Curve `c` gets rows `2c` (its point 1) and `2c + 1` (its point 2) of this run of local
+    // points, computed in parallel chunks and appended in order.
+    if let Some(o) = owners.iter().find(|o| o.0 == u8::MAX) {
+        // A sibling half no patch has as its own edge: a level jump next to this patch.
+        let d = &drafts[o.1 as usize];
+        return Err(TopologyError::AdaptiveUnbalanced {
+            level: d.level as u32,
+            face: d.face as usize,
+        });
+    }
+    let first_curve_row = first_local + locals.table.len() as u32;
+    let chunks: Vec<StencilTable> = owners
+        .par_chunks(CHUNK)
+        .enumerate()
+        .map(|(chunk_index, chunk)| {
+            let mut table = StencilTable {
+                offsets: vec![0],
+                ..StencilTable::default()
+            };
+            let mut scratch: Vec<(u32, f64)> = Vec::with_capacity(128);
+            for (j, &(_, pi, p, part)) in chunk.iter().enumerate() {
+                let ci = chunk_index * CHUNK + j;
+                let patch = &patches[pi as usize];
+                let (p, part) = (p as usize, part as usize);
+                let ids = corners[pi as usize];
+                // The segment runs in the patch's edge direction from `start_id`.
+                let c = curves[ci];
+                let start_id = if part == 2 {
+                    // The midpoint: whichever end of the curve is not the patch corner.
+                    if c[0] == ids[(p + 1) % 4] {
+                        c[3]
+                    } else {
+                        c[0]
+                    }
+                } else {
+                    ids[p]
+                };
+                let forward = start_id == c[0];
+                for slot in [1usize, 2] {
+                    // Curve point `slot` is the segment's Bézier point `k`.
+                    let k = if forward { slot } else { 3 - slot };
+                    scratch.clear();
+                    match patch.kind {
+                        PatchKind::Regular => {
+                            for (s, &w) in edge_rows[p][part][k].iter().enumerate() {
+                                if w != 0.0 {
+                                    locals.expand(patch.control_points[s], w, &mut scratch);
+                                }
+                            }
+                        }
+                        PatchKind::Gregory => {
+                            let cp = &patch.control_points;
+                            let id = if k == 1 {
+                                cp[5 * p + 1]
+                            } else {
+                                cp[5 * ((p + 1) % 4) + 2]
+                            };
+                            locals.expand(id, 1.0, &mut scratch);
+                        }
+                        PatchKind::Bilinear => {
+                            let (c0, c3) = (ids[p], ids[(p + 1) % 4]);
+                            let w = if k == 1 { 2.0 / 3.0 } else { 1.0 / 3.0 };
+                            locals.expand(c0, w, &mut scratch);
+                            locals.expand(c3, 1.0 - w, &mut scratch);
+                        }
+                    }
+                    push_row(&mut table, &mut scratch);
+                }
+            }
+            table
+        })
+        .collect();
+    for c in &chunks {
+        locals.append(c);
+    }
+    for (ci, c) in curves.iter_mut().enumerate() {
+        c[1] = first_curve_row + 2 * ci as u32;
+        c[2] = c[1] + 1;
+    }
+
+    // Statistics.
+    let mut level_stats: Vec<LevelStats> = Vec::with_capacity(iso + 1);
+    let corners0 = levels[0].t().face_tables().1.len() as u64;
+    for (l, lvl) in levels.iter().enumerate() {
+        let uniform_faces = if l == 0 {
+            levels[0].t().num_faces() as u64
+        } else {
+            corners0.saturating_mul(4u64.saturating_pow(l as u32 - 1))
+        };
+        level_stats.push(LevelStats {
+            regular: 0,
+            end_caps: 0,
+            faces: lvl.t().num_faces() as u32,
+            uniform_faces,
+        });
+    }
+    for p in &patches {
+        let s = &mut level_stats[p.level as usize];
+        if p.kind == PatchKind::Regular {
+            s.regular += 1;
+        } else {
+            s.end_caps += 1;
+        }
+    }
+
+    let bases: Vec<u32> = levels.iter().map(|l| l.base).collect();
+    let steps = levels
+        .iter_mut()
+        .skip(1)
+        .zip(bases)
+        .map(|(child, parent_base)| {
+            let mut table = child.stencils.take().unwrap_or_default();
+            for i in table.indices.iter_mut() {
+                *i += parent_base;
+            }
+            table.num_sources = child.base as usize;
+            StencilBlock {
+                first_vertex: child.base,
+                table,
+            }
+        })
+        .collect();
+    let num_vertices = first_local + locals.table.len() as u32;
+    Ok(AdaptivePlan {
+        num_base_vertices: levels[0].t().num_vertices() as u32,
+        num_vertices,
+        steps,
+        local_points: StencilBlock {
+            first_vertex: first_local,
+            table: locals.table,
+        },
+        patches,
+        curves,
+        level_stats,
+        isolation: opts.isolation,
+    })
+}
+
+/// Gregory points of face `f` (global ids, patch corner order).
+pub(super) fn gregory_points(
+    mesh: &ControlMesh,
+    lvl: &Lvl,
+    f: usize,
+    shift: u8,
+) -> Result<Vec<Vec<(u32, f64)>>, TopologyError> {
+    let basis = crate::gregory::gregory_basis(lvl.topo.view(), f, &mesh.options)?;
+    let s = shift as usize;
+    Ok((0..20)
+        .map(|k| {
+            let (p, j) = (k / 5, k % 5);
+            let st = &basis[5 * ((p + s) % 4) + j];
+            st.indices
+                .iter()
+                .zip(&st.weights)
+                .map(|(&i, &w)| (i + lvl.base, w))
+                .collect()
+        })
+        .collect())
+}

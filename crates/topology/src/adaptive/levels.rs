@@ -1,0 +1,249 @@
+//! Levels of the plan: scaled sharpness, sparse refinement level by level, irregular
+//! vertices and the selection (see the parent module for the design).
+
+use super::*;
+
+/// A copy of `mesh` with tag sharpness scaled (infinite tags stay infinite); rejects NaN or
+/// negative sharpness.
+pub(super) fn scaled_mesh(mesh: &ControlMesh, scale: f32) -> Result<ControlMesh, TopologyError> {
+    let scale_one = |s: f32| {
+        if is_infinite(s) {
+            s
+        } else {
+            s * scale
+        }
+    };
+    let mut out = mesh.clone();
+    for c in &mut out.creases {
+        if c.sharpness.is_nan() || c.sharpness < 0.0 {
+            return Err(TopologyError::BadEdgeSharpness {
+                v0: c.vertices[0],
+                v1: c.vertices[1],
+                sharpness: c.sharpness,
+            });
+        }
+        c.sharpness = scale_one(c.sharpness);
+    }
+    for c in &mut out.corners {
+        if c.sharpness.is_nan() || c.sharpness < 0.0 {
+            return Err(TopologyError::BadVertexSharpness {
+                vertex: c.vertex,
+                sharpness: c.sharpness,
+            });
+        }
+        c.sharpness = scale_one(c.sharpness);
+    }
+    Ok(out)
+}
+
+/// One level of the plan.
+pub(super) struct Lvl {
+    /// Topology and sharpness; at the isolation level the sharpness is the *effective* one
+    /// (every positive value infinite).
+    pub(super) topo: LevelTopology,
+    /// Global id of vertex 0 of this level.
+    pub(super) base: u32,
+    pub(super) complete: Vec<bool>,
+    pub(super) hole: Vec<bool>,
+    pub(super) selected: Vec<bool>,
+    pub(super) irregular: Vec<bool>,
+    /// Per vertex: global id of its coarsest vertex-vertex ancestor (the canonical key).
+    pub(super) anc: Vec<u32>,
+    /// Maps of the step that made this level (none for level 0).
+    pub(super) maps: Option<ChildMaps>,
+    /// Stencils of this level's vertices over the parent's (level ≥ 1).
+    pub(super) stencils: Option<StencilTable>,
+    /// Number of vertex-vertex children in this level (its edge-vertices follow).
+    pub(super) kv: usize,
+}
+
+impl Lvl {
+    pub(super) fn t(&self) -> &Topology {
+        &self.topo.topology
+    }
+    /// Sharp for the patch: positive sharpness or a single face.
+    pub(super) fn sharp_edge(&self, e: usize) -> bool {
+        self.topo.edge_sharpness[e] > 0.0 || self.t().is_boundary_edge(e)
+    }
+}
+
+pub(super) fn build_levels(mesh: &ControlMesh, iso: usize) -> Result<Vec<Lvl>, TopologyError> {
+    let topo = LevelTopology::from_mesh(mesh, Scheme::CatmullClark)?;
+    if let Some((face, size)) = (0..topo.topology.num_faces())
+        .map(|f| (f, topo.topology.face_vertices(f).len()))
+        .find(|&(_, n)| n > 256)
+    {
+        return Err(TopologyError::AdaptiveFaceTooLarge { face, size });
+    }
+    let nf = topo.topology.num_faces();
+    let nv = topo.topology.num_vertices();
+    let mut hole = vec![false; nf];
+    for &h in &mesh.holes {
+        match hole.get_mut(h as usize) {
+            Some(x) => *x = true,
+            None => {
+                return Err(TopologyError::TagOutOfRange {
+                    tag: crate::error::TagKind::Hole,
+                    index: h,
+                    count: nf,
+                })
+            }
+        }
+    }
+    let mut levels = vec![Lvl {
+        topo,
+        base: 0,
+        complete: vec![true; nf],
+        hole,
+        selected: Vec::new(),
+        irregular: Vec::new(),
+        anc: (0..nv as u32).collect(),
+        maps: None,
+        stencils: None,
+        kv: 0,
+    }];
+    for l in 0..=iso {
+        let last = l == iso;
+        let lvl = levels.last_mut().expect("level present");
+        if last {
+            for s in lvl
+                .topo
+                .edge_sharpness
+                .iter_mut()
+                .chain(lvl.topo.vertex_sharpness.iter_mut())
+            {
+                if *s > 0.0 {
+                    *s = SHARPNESS_INFINITE;
+                }
+            }
+        }
+        let irregular: Vec<bool> = (0..lvl.t().num_vertices())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|v| vertex_irregular(lvl, v))
+            .collect();
+        lvl.irregular = irregular;
+        let t = &lvl.topo.topology;
+        lvl.selected = (0..t.num_faces())
+            .map(|f| {
+                !last
+                    && lvl.complete[f]
+                    && !lvl.hole[f]
+                    && t.face_vertices(f)
+                        .iter()
+                        .any(|&v| lvl.irregular[v as usize])
+            })
+            .collect();
+        if last {
+            break;
+        }
+        let selection: Vec<u32> = (0..t.num_faces() as u32)
+            .filter(|&f| lvl.selected[f as usize])
+            .collect();
+        let r = refine_sparse(
+            lvl.topo.view(),
+            Scheme::CatmullClark,
+            &mesh.options,
+            &selection,
+        )?;
+        let base = lvl
+            .base
+            .checked_add(t.num_vertices() as u32)
+            .filter(|b| {
+                b.checked_add(r.child.topology.num_vertices() as u32)
+                    .is_some()
+            })
+            .ok_or(TopologyError::RefinementTooLarge {
+                faces: t.num_faces(),
+            })?;
+        let maps = r.maps;
+        let complete = maps
+            .child_face_parent
+            .iter()
+            .map(|&p| lvl.selected[p as usize])
+            .collect();
+        let hole = maps
+            .child_face_parent
+            .iter()
+            .map(|&p| lvl.hole[p as usize])
+            .collect();
+        let anc = maps
+            .child_vertex_origin
+            .iter()
+            .enumerate()
+            .map(|(c, o)| match *o {
+                ChildOrigin::Vertex(p) => lvl.anc[p as usize],
+                _ => base + c as u32,
+            })
+            .collect();
+        let kv = maps
+            .child_vertex_origin
+            .iter()
+            .take_while(|o| matches!(o, ChildOrigin::Vertex(_)))
+            .count();
+        levels.push(Lvl {
+            topo: r.child,
+            base,
+            complete,
+            hole,
+            selected: Vec::new(),
+            irregular: Vec::new(),
+            anc,
+            maps: Some(maps),
+            stencils: Some(r.stencils),
+            kv,
+        });
+    }
+    Ok(levels)
+}
+
+/// Whether vertex `v` (of a complete face) needs isolating: see the module docs.
+pub(super) fn vertex_irregular(lvl: &Lvl, v: usize) -> bool {
+    let t = lvl.t();
+    let faces = t.vertex_faces(v);
+    let edges = t.vertex_edges(v);
+    if faces
+        .iter()
+        .any(|&f| t.face_vertices(f as usize).len() != 4)
+    {
+        return true;
+    }
+    let vs = lvl.topo.vertex_sharpness[v];
+    let (nf, ne) = (faces.len(), edges.len());
+    let sharp = |e: u32| lvl.sharp_edge(e as usize);
+    let infinite =
+        |e: u32| t.is_boundary_edge(e as usize) || is_infinite(lvl.topo.edge_sharpness[e as usize]);
+    if ne == nf {
+        if vs > 0.0 || ne != 4 {
+            return true;
+        }
+        let mut sharp_edges = edges.iter().copied().filter(|&e| sharp(e));
+        match (sharp_edges.next(), sharp_edges.next(), sharp_edges.next()) {
+            (None, _, _) => false,
+            (Some(a), Some(b), None) => {
+                if !(infinite(a) && infinite(b)) {
+                    return true;
+                }
+                // Consecutive edges share a face; a regular crease runs straight through.
+                let fa = t.edge_faces(a as usize);
+                let fb = t.edge_faces(b as usize);
+                fa.iter().any(|&x| x != INVALID && fb.contains(&x))
+            }
+            _ => true,
+        }
+    } else if ne == nf + 1 {
+        match nf {
+            2 => {
+                vs > 0.0
+                    || edges.iter().any(|&e| {
+                        let boundary = t.is_boundary_edge(e as usize);
+                        boundary != sharp(e) || (boundary && !infinite(e))
+                    })
+            }
+            1 => !is_infinite(vs),
+            _ => true,
+        }
+    } else {
+        true
+    }
+}

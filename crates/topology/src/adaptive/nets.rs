@@ -1,0 +1,424 @@
+//! Patch nets: the frame of a face in its base face, the 4×4 regular net with phantoms, limit
+//! stencils of corners, Bézier weights of patch edges.
+
+use super::levels::Lvl;
+use super::*;
+
+/// Corner positions of the unit square, patch corner order.
+pub(super) const POS: [(i32, i32); 4] = [(0, 0), (1, 0), (1, 1), (0, 1)];
+/// Directions around a corner in its local frame (x toward the next corner, y the previous).
+pub(super) const DIR: [(i32, i32); 4] = [(1, 0), (0, 1), (-1, 0), (0, -1)];
+
+#[inline]
+pub(super) fn slot(a: i32, b: i32) -> usize {
+    (4 * (b + 1) + (a + 1)) as usize
+}
+
+/// A linear combination of at most four global vertices (a gathered or phantom point).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Combo {
+    pub(super) n: u8,
+    pub(super) idx: [u32; 4],
+    pub(super) w: [f64; 4],
+}
+
+impl Combo {
+    pub(super) fn one(i: u32) -> Combo {
+        Combo {
+            n: 1,
+            idx: [i, 0, 0, 0],
+            w: [1.0, 0.0, 0.0, 0.0],
+        }
+    }
+    /// `2·a − b`. Phantoms extrapolate gathered points (one term each) or, at a corner,
+    /// extrapolated ones (two terms each), so four terms always suffice.
+    pub(super) fn extrapolate(a: &Combo, b: &Combo) -> Combo {
+        let mut c = Combo::default();
+        let terms = (0..a.n as usize)
+            .map(|k| (a.idx[k], 2.0 * a.w[k]))
+            .chain((0..b.n as usize).map(|k| (b.idx[k], -b.w[k])));
+        for (k, (i, w)) in terms.take(4).enumerate() {
+            c.idx[k] = i;
+            c.w[k] = w;
+            c.n = k as u8 + 1;
+        }
+        c
+    }
+}
+
+/// A patch before local points are numbered.
+pub(super) struct Draft {
+    pub(super) level: u8,
+    pub(super) face: u32,
+    pub(super) shift: u8,
+    pub(super) kind: PatchKind,
+    pub(super) boundary_mask: u8,
+    /// Regular: the 16 gathered ids (`INVALID` where a phantom goes).
+    pub(super) grid: Option<[u32; 16]>,
+    /// Gregory: 20 stencils over global ids, patch corner order.
+    pub(super) gregory: Option<Vec<Vec<(u32, f64)>>>,
+    pub(super) base_face: u32,
+    pub(super) sub_face: u8,
+    pub(super) origin: [f64; 2],
+    pub(super) size: f64,
+}
+
+/// Base face, sub-face, origin, size and corner shift of face `f` of level `l`.
+pub(super) fn frame(levels: &[Lvl], l: usize, f: usize) -> (u32, u8, [f64; 2], f64, u8) {
+    let mut chain = [0u8; 16];
+    let mut n = 0;
+    let mut g = f;
+    for k in (1..=l).rev() {
+        let maps = levels[k].maps.as_ref().expect("refined level has maps");
+        let p = maps.child_face_parent[g] as usize;
+        chain[n] = (g - maps.face_first_child[p] as usize) as u8;
+        n += 1;
+        g = p;
+    }
+    let quad = levels[0].t().face_vertices(g).len() == 4;
+    let (mut origin, mut size, mut shift, mut sub) = ([0.0, 0.0], 1.0, 0u8, 0u8);
+    let mut children = chain[..n].iter().rev();
+    if !quad {
+        sub = children.next().copied().unwrap_or(0);
+    }
+    for &c in children {
+        let pc = (c + 4 - shift) % 4;
+        let (a, b) = POS[pc as usize];
+        origin = [
+            origin[0] + 0.5 * size * a as f64,
+            origin[1] + 0.5 * size * b as f64,
+        ];
+        size *= 0.5;
+        shift = (shift + 4 - c) % 4;
+    }
+    (g as u32, sub, origin, size, shift)
+}
+
+/// The face corners and edges of `f` rotated into patch order.
+pub(super) fn rotated(t: &Topology, f: usize, shift: u8) -> ([u32; 4], [u32; 4]) {
+    let fv = t.face_vertices(f);
+    let fe = t.face_edge_list(f);
+    let s = shift as usize;
+    (
+        std::array::from_fn(|p| fv[(p + s) % 4]),
+        std::array::from_fn(|p| fe[(p + s) % 4]),
+    )
+}
+
+pub(super) fn corner_in(t: &Topology, g: u32, v: u32) -> Option<usize> {
+    let fv = t.face_vertices(g as usize);
+    if fv.len() != 4 {
+        return None;
+    }
+    fv.iter().position(|&x| x == v)
+}
+
+/// The 4×4 points of a regular patch (level-local ids) with phantoms for the masked edges.
+/// Returns the gathered global ids (`INVALID` where a phantom goes) and the boundary mask;
+/// [`phantom_grid`] completes them.
+pub(super) fn gather_regular(lvl: &Lvl, f: usize, shift: u8) -> Option<([u32; 16], u8)> {
+    let t = lvl.t();
+    let (fv, fe) = rotated(t, f, shift);
+    let mut ids = [INVALID; 16];
+    let base = lvl.base;
+    let set = |a: i32, b: i32, v: u32, grid: &mut [u32; 16]| -> bool {
+        let s = slot(a, b);
+        if grid[s] != INVALID {
+            return grid[s] == base + v;
+        }
+        grid[s] = base + v;
+        true
+    };
+    for p in 0..4 {
+        let (ox, oy) = POS[p];
+        if !set(ox, oy, fv[p], &mut ids) {
+            return None;
+        }
+    }
+    for p in 0..4 {
+        let v = fv[p];
+        let (ox, oy) = POS[p];
+        let (nx, ny) = POS[(p + 1) % 4];
+        let (px, py) = POS[(p + 3) % 4];
+        let (xx, xy) = (nx - ox, ny - oy);
+        let (yx, yy) = (px - ox, py - oy);
+        let at = |d: (i32, i32)| (ox + d.0 * xx + d.1 * yx, oy + d.0 * xy + d.1 * yy);
+        let add = |a: (i32, i32), b: (i32, i32)| (a.0 + b.0, a.1 + b.1);
+        let start = corner_in(t, f as u32, v)?;
+        let mut steps = 0;
+        // Forward: across the edge entering v.
+        let (mut g, mut k) = (f as u32, start);
+        for step in 1..=3usize {
+            let e = t.face_edge_list(g as usize)[(k + 3) % 4];
+            if lvl.sharp_edge(e as usize) {
+                break;
+            }
+            let [x, y] = t.edge_faces(e as usize);
+            let h = if x == g { y } else { x };
+            if h == INVALID || h == f as u32 {
+                break;
+            }
+            let kh = corner_in(t, h, v)?;
+            let hv = t.face_vertices(h as usize);
+            let (d0, d1) = (DIR[step % 4], DIR[(step + 1) % 4]);
+            let (a0, a1, a2) = (at(d0), at(add(d0, d1)), at(d1));
+            if !(set(a0.0, a0.1, hv[(kh + 1) % 4], &mut ids)
+                && set(a1.0, a1.1, hv[(kh + 2) % 4], &mut ids)
+                && set(a2.0, a2.1, hv[(kh + 3) % 4], &mut ids))
+            {
+                return None;
+            }
+            g = h;
+            k = kh;
+            steps = step;
+        }
+        // Backward: across the edge leaving v, for what the forward walk could not reach.
+        let (mut g, mut k) = (f as u32, start);
+        for step in 1..=(3 - steps) {
+            let e = t.face_edge_list(g as usize)[k];
+            if lvl.sharp_edge(e as usize) {
+                break;
+            }
+            let [x, y] = t.edge_faces(e as usize);
+            let h = if x == g { y } else { x };
+            if h == INVALID || h == f as u32 {
+                break;
+            }
+            let kh = corner_in(t, h, v)?;
+            let hv = t.face_vertices(h as usize);
+            let ds = DIR[(4 - step % 4) % 4];
+            let ds1 = DIR[(5 - step % 4) % 4];
+            let (a0, a1, a2) = (at(ds1), at(add(ds1, ds)), at(ds));
+            if !(set(a0.0, a0.1, hv[(kh + 3) % 4], &mut ids)
+                && set(a1.0, a1.1, hv[(kh + 2) % 4], &mut ids)
+                && set(a2.0, a2.1, hv[(kh + 1) % 4], &mut ids))
+            {
+                return None;
+            }
+            g = h;
+            k = kh;
+        }
+    }
+    let mut mask = 0u8;
+    for (p, &e) in fe.iter().enumerate() {
+        if lvl.sharp_edge(e as usize) {
+            mask |= 1 << p;
+        }
+    }
+    phantom_grid(&ids, mask)?;
+    Some((ids, mask))
+}
+
+/// The 16 points of a regular patch from its gathered ids: rows and columns across the
+/// masked edges extrapolated (`2·P_edge − P_inner`), columns (edges 3 and 1) first where
+/// their rows exist, then rows (edges 0 and 2), which gives the corner rule where two masked
+/// edges meet. `None` if a point is missing.
+pub(super) fn phantom_grid(ids: &[u32; 16], mask: u8) -> Option<[Combo; 16]> {
+    let mut grid = [Combo::default(); 16];
+    let mut known = [false; 16];
+    for (s, &id) in ids.iter().enumerate() {
+        if id != INVALID {
+            grid[s] = Combo::one(id);
+            known[s] = true;
+        }
+    }
+    for b in -1..=2 {
+        if (b == -1 && mask & 1 != 0) || (b == 2 && mask & 4 != 0) {
+            continue;
+        }
+        for (bit, out, e, i) in [(8u8, -1, 0, 1), (2u8, 2, 1, 0)] {
+            if mask & bit != 0 {
+                let (se, si) = (slot(e, b), slot(i, b));
+                if !(known[se] && known[si]) {
+                    return None;
+                }
+                grid[slot(out, b)] = Combo::extrapolate(&grid[se], &grid[si]);
+                known[slot(out, b)] = true;
+            }
+        }
+    }
+    for a in -1..=2 {
+        for (bit, out, e, i) in [(1u8, -1, 0, 1), (4u8, 2, 1, 0)] {
+            if mask & bit != 0 {
+                let (se, si) = (slot(a, e), slot(a, i));
+                if !(known[se] && known[si]) {
+                    return None;
+                }
+                grid[slot(a, out)] = Combo::extrapolate(&grid[se], &grid[si]);
+                known[slot(a, out)] = true;
+            }
+        }
+    }
+    known.iter().all(|&k| k).then_some(grid)
+}
+
+/// Append a stencil row: indices sorted, duplicates merged.
+pub(super) fn push_row(table: &mut StencilTable, terms: &mut [(u32, f64)]) {
+    terms.sort_unstable_by_key(|t| t.0);
+    let mut last = INVALID;
+    for &(i, w) in terms.iter() {
+        if i == last {
+            if let Some(x) = table.weights.last_mut() {
+                *x += w;
+            }
+        } else {
+            table.indices.push(i);
+            table.weights.push(w);
+            last = i;
+        }
+    }
+    table.offsets.push(table.indices.len() as u32);
+}
+
+/// Weights (vertex, each edge-neighbour, each face-opposite vertex) of the smooth
+/// Catmull-Clark limit position mask of valence `n` ([`crate::limit`]), cached per valence.
+pub(super) fn smooth_mask(cache: &mut Vec<Option<[f64; 3]>>, n: usize) -> [f64; 3] {
+    if cache.len() <= n {
+        cache.resize(n + 1, None);
+    }
+    *cache[n].get_or_insert_with(|| {
+        let m = catmark_limit_masks(&LimitVertex {
+            valence: n,
+            boundary: false,
+            rule: LimitRule::Smooth,
+        })
+        .position;
+        [
+            m.vertex,
+            m.edges.first().copied().unwrap_or(0.0),
+            m.faces.first().copied().unwrap_or(0.0),
+        ]
+    })
+}
+
+/// Limit-position stencil (level-local ids) of vertex `v` of `lvl` (its ring complete).
+/// Only positions are needed, and their masks do not depend on the ring's order.
+pub(super) fn limit_stencil(
+    lvl: &Lvl,
+    v: usize,
+    cache: &mut Vec<Option<[f64; 3]>>,
+    out: &mut Vec<(u32, f64)>,
+) {
+    let t = lvl.t();
+    let edges = t.vertex_edges(v);
+    let faces = t.vertex_faces(v);
+    let other = |e: u32| {
+        let [a, b] = t.edge_vertices(e as usize);
+        if a as usize == v {
+            b
+        } else {
+            a
+        }
+    };
+    let mut sharp = [0u32; 2];
+    let mut count = 0;
+    for &e in edges {
+        if lvl.sharp_edge(e as usize) {
+            if count < 2 {
+                sharp[count] = e;
+            }
+            count += 1;
+        }
+    }
+    let vs = lvl.topo.vertex_sharpness[v];
+    let boundary = edges.len() != faces.len();
+    let rule = if boundary && count < 2 {
+        Rule::Corner
+    } else {
+        vertex_rule(vs, count)
+    };
+    match rule {
+        Rule::Corner => out.push((v as u32, 1.0)),
+        Rule::Crease => {
+            out.push((v as u32, 2.0 / 3.0));
+            for &e in &sharp {
+                out.push((other(e), 1.0 / 6.0));
+            }
+        }
+        Rule::Smooth | Rule::Dart => {
+            let [wv, we, wf] = smooth_mask(cache, edges.len());
+            out.push((v as u32, wv));
+            for &e in edges {
+                out.push((other(e), we));
+            }
+            for &f in faces {
+                let fv = t.face_vertices(f as usize);
+                let c = fv.iter().position(|&x| x as usize == v).unwrap_or(0);
+                out.push((fv[(c + 2) % fv.len()], wf));
+            }
+        }
+    }
+}
+
+/// Weights over the 16 slots of the Bézier points of regular patch edge `p`, in the edge's
+/// direction.
+pub(super) fn regular_edge_bezier(p: usize) -> [[f64; 16]; 4] {
+    // The four B-spline points along the edge (limit across it), in edge direction.
+    let line: [(i32, i32); 4] = match p {
+        0 => [(-1, 0), (0, 0), (1, 0), (2, 0)],
+        1 => [(1, -1), (1, 0), (1, 1), (1, 2)],
+        2 => [(2, 1), (1, 1), (0, 1), (-1, 1)],
+        _ => [(0, 2), (0, 1), (0, 0), (0, -1)],
+    };
+    let across: (i32, i32) = if p.is_multiple_of(2) { (0, 1) } else { (1, 0) };
+    let q: Vec<[f64; 16]> = line
+        .iter()
+        .map(|&(a, b)| {
+            let mut w = [0.0; 16];
+            w[slot(a - across.0, b - across.1)] += 1.0 / 6.0;
+            w[slot(a, b)] += 4.0 / 6.0;
+            w[slot(a + across.0, b + across.1)] += 1.0 / 6.0;
+            w
+        })
+        .collect();
+    let mix = |terms: &[(f64, usize)]| {
+        let mut w = [0.0; 16];
+        for &(s, i) in terms {
+            for (o, x) in w.iter_mut().zip(&q[i]) {
+                *o += s * x;
+            }
+        }
+        w
+    };
+    [
+        mix(&[(1.0 / 6.0, 0), (4.0 / 6.0, 1), (1.0 / 6.0, 2)]),
+        mix(&[(2.0 / 3.0, 1), (1.0 / 3.0, 2)]),
+        mix(&[(1.0 / 3.0, 1), (2.0 / 3.0, 2)]),
+        mix(&[(1.0 / 6.0, 1), (4.0 / 6.0, 2), (1.0 / 6.0, 3)]),
+    ]
+}
+
+/// Half `h` (0: first, 1: second) of a Bézier curve by de Casteljau, as weights over the
+/// curve's four points.
+pub(super) fn bezier_half(h: usize) -> [[f64; 4]; 4] {
+    let first = [
+        [1.0, 0.0, 0.0, 0.0],
+        [0.5, 0.5, 0.0, 0.0],
+        [0.25, 0.5, 0.25, 0.0],
+        [0.125, 0.375, 0.375, 0.125],
+    ];
+    if h == 0 {
+        first
+    } else {
+        // Mirror: the second half read backwards is the first half of the reversed curve.
+        let mut out = [[0.0; 4]; 4];
+        for (k, row) in first.iter().enumerate() {
+            for (j, &w) in row.iter().enumerate() {
+                out[3 - k][3 - j] = w;
+            }
+        }
+        out
+    }
+}
+
+/// Who computes a curve's inner points: (kind rank, patch, patch edge, part: 0 whole edge,
+/// 1/2 first/second half of a coarse edge).
+pub(super) type Owner = (u8, u32, u8, u8);
+
+pub(super) fn kind_rank(k: PatchKind) -> u8 {
+    match k {
+        PatchKind::Regular => 0,
+        PatchKind::Gregory => 1,
+        PatchKind::Bilinear => 2,
+    }
+}
