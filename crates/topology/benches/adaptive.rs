@@ -24,17 +24,20 @@ fn shapes() -> Vec<(&'static str, ControlMesh)> {
     ]
 }
 
-fn options(isolation: u32) -> AdaptiveOptions {
+/// `follow_semi_sharp` off is what OpenSubdiv's `far_perf -a -l N` does (leftover sharpness
+/// at the isolation level treated as infinite); on is Tessera's default (exact beside creases).
+fn options(isolation: u32, follow_semi_sharp: bool) -> AdaptiveOptions {
     AdaptiveOptions {
         isolation,
         end_cap: EndCap::Gregory,
         sharpness_scale: 1.0,
+        follow_semi_sharp,
     }
 }
 
 fn print_face_counts() {
     for (name, m) in shapes() {
-        let plan = plan_adaptive(&m, &options(4)).unwrap();
+        let plan = plan_adaptive(&m, &options(4, true)).unwrap();
         println!("{name} (isolation 4): level | regular | end caps | faces held | uniform");
         for (l, s) in plan.level_stats.iter().enumerate() {
             println!("  {l} | {} | {} | {} | {}", s.regular, s.end_caps, s.faces, s.uniform_faces);
@@ -49,7 +52,10 @@ fn bench(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(3));
     for (name, m) in shapes() {
         g.bench_function(format!("{name}_adaptive4"), |b| {
-            b.iter(|| plan_adaptive(&m, &options(4)).unwrap())
+            b.iter(|| plan_adaptive(&m, &options(4, false)).unwrap())
+        });
+        g.bench_function(format!("{name}_adaptive4_follow_creases"), |b| {
+            b.iter(|| plan_adaptive(&m, &options(4, true)).unwrap())
         });
         if name == "catmark_car" {
             g.bench_function(format!("{name}_uniform3_stencils"), |b| {

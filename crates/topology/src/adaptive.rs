@@ -96,6 +96,11 @@ pub struct AdaptiveOptions {
     /// Multiplies every tagged edge and vertex sharpness before planning (finite, ≥ 0);
     /// infinite tags and boundary edges stay infinitely sharp.
     pub sharpness_scale: f32,
+    /// Follow semi-sharp creases and corners past the isolation level until their sharpness
+    /// has decayed (at most level 10), so the surface beside them is exact; off, leftover
+    /// sharpness at the isolation level is treated as infinite (OpenSubdiv's and the seed's
+    /// behaviour).
+    pub follow_semi_sharp: bool,
 }
 
 impl Default for AdaptiveOptions {
@@ -104,6 +109,7 @@ impl Default for AdaptiveOptions {
             isolation: 4,
             end_cap: EndCap::Gregory,
             sharpness_scale: 1.0,
+            follow_semi_sharp: true,
         }
     }
 }
@@ -221,7 +227,7 @@ mod nets;
 ///          [0., 0., 1.], [1., 0., 1.], [1., 1., 1.], [0., 1., 1.]];
 /// let faces = [[0u32, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]];
 /// let mesh = ControlMesh::from_polygons(p.to_vec(), &faces);
-/// let opts = AdaptiveOptions { isolation: 2, end_cap: EndCap::Gregory, sharpness_scale: 1.0 };
+/// let opts = AdaptiveOptions { isolation: 2, ..AdaptiveOptions::default() };
 /// let plan = plan_adaptive(&mesh, &opts).unwrap();
 /// assert_eq!(plan.level_stats[2].end_caps, 24); // three per corner
 /// let verts = plan.apply(&mesh.positions);
@@ -242,7 +248,7 @@ pub fn plan_adaptive(
         return Err(TopologyError::BadSharpnessScale { scale });
     }
     let scaled = levels::scaled_mesh(mesh, scale)?;
-    let levels = levels::build_levels(&scaled, opts.isolation as usize)?;
+    let levels = levels::build_levels(&scaled, opts.isolation as usize, opts.follow_semi_sharp)?;
     assemble::assemble(&scaled, opts, levels)
 }
 

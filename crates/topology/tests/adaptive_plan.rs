@@ -78,6 +78,7 @@ fn options(isolation: u32, end_cap: EndCap) -> AdaptiveOptions {
         isolation,
         end_cap,
         sharpness_scale: 1.0,
+        follow_semi_sharp: true,
     }
 }
 
@@ -274,6 +275,12 @@ fn check_curves(name: &str, plan: &AdaptivePlan, mesh: &ControlMesh, d: f64) {
                 levels[c as usize].push(pa.level);
             }
             // The curves are the patch's own edge (Coons patches reproduce theirs exactly).
+            // A Gregory cap across a transition (next to finer patches that follow a
+            // semi-sharp crease, or to a coarser regular patch) takes the regular side's exact
+            // boundary instead: no crack, but not its own boundary.
+            if pa.kind == PatchKind::Gregory && e.kind != EdgeKind::Plain {
+                continue;
+            }
             for t in [0.0, 0.2, 0.5, 0.7, 1.0] {
                 let (u, v) = match k {
                     0 => (t, 0.0),
@@ -357,7 +364,8 @@ fn blocks_read_only_earlier_vertices() {
             next += b.table.len() as u32;
         }
         assert_eq!(next, plan.num_vertices);
-        assert_eq!(plan.steps.len(), 3);
+        // Semi-sharp features are followed past the isolation level until they decay.
+        assert!((3..=10).contains(&plan.steps.len()), "{name}: {} steps", plan.steps.len());
         for pa in &plan.patches {
             let n = match pa.kind {
                 PatchKind::Regular => 16,

@@ -61,7 +61,8 @@ pub(super) fn assemble(
     // Patches, level by level (faces in parallel).
     let mut drafts: Vec<Draft> = Vec::new();
     for (l, lvl) in levels.iter().enumerate() {
-        let is_last = l == iso;
+        // End caps from the isolation level on (deeper levels follow semi-sharp features).
+        let is_last = l >= iso;
         let candidates: Vec<usize> = (0..lvl.t().num_faces())
             .filter(|&f| lvl.complete[f] && !lvl.hole[f] && !lvl.selected[f])
             .collect();
@@ -475,7 +476,7 @@ pub(super) fn assemble(
     }
 
     // Statistics.
-    let mut level_stats: Vec<LevelStats> = Vec::with_capacity(iso + 1);
+    let mut level_stats: Vec<LevelStats> = Vec::with_capacity(levels.len());
     let corners0 = levels[0].t().face_tables().1.len() as u64;
     for (l, lvl) in levels.iter().enumerate() {
         let uniform_faces = if l == 0 {

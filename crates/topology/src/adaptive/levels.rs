@@ -67,7 +67,32 @@ impl Lvl {
     }
 }
 
-pub(super) fn build_levels(mesh: &ControlMesh, iso: usize) -> Result<Vec<Lvl>, TopologyError> {
+/// Deepest level semi-sharp features are followed to: sharpness 10 is infinite, so every
+/// finite sharpness has decayed by then (uniform or Chaikin).
+pub(super) const SEMI_SHARP_LIMIT: usize = 10;
+
+/// Whether vertex `v` carries a semi-sharp feature (a finite positive sharpness on an incident
+/// edge or on itself) that has not decayed yet.
+fn semi_sharp(lvl: &Lvl, v: usize) -> bool {
+    let finite = |s: f32| s > 0.0 && !is_infinite(s);
+    finite(lvl.topo.vertex_sharpness[v])
+        || lvl
+            .t()
+            .vertex_edges(v)
+            .iter()
+            .any(|&e| finite(lvl.topo.edge_sharpness[e as usize]))
+}
+
+/// The plan's levels: irregular faces isolated to `iso`; with `follow_semi_sharp`, faces at
+/// semi-sharp features further, until the sharpness has decayed (at most
+/// [`SEMI_SHARP_LIMIT`]), so the patches beside a crease of sharpness 7.5 are exact instead of
+/// treating the leftover sharpness as infinite. Faces that stop being selected at or past
+/// `iso` while still irregular become end caps at their level.
+pub(super) fn build_levels(
+    mesh: &ControlMesh,
+    iso: usize,
+    follow_semi_sharp: bool,
+) -> Result<Vec<Lvl>, TopologyError> {
     let topo = LevelTopology::from_mesh(mesh, Scheme::CatmullClark)?;
     if let Some((face, size)) = (0..topo.topology.num_faces())
         .map(|f| (f, topo.topology.face_vertices(f).len()))
@@ -102,8 +127,13 @@ pub(super) fn build_levels(mesh: &ControlMesh, iso: usize) -> Result<Vec<Lvl>, T
         stencils: None,
         kv: 0,
     }];
-    for l in 0..=iso {
-        let last = l == iso;
+    let deepest = if follow_semi_sharp {
+        SEMI_SHARP_LIMIT.max(iso)
+    } else {
+        iso
+    };
+    for l in 0..=deepest {
+        let last = l == deepest;
         let lvl = levels.last_mut().expect("level present");
         if last {
             for s in lvl
@@ -123,18 +153,24 @@ pub(super) fn build_levels(mesh: &ControlMesh, iso: usize) -> Result<Vec<Lvl>, T
             .map(|v| vertex_irregular(lvl, v))
             .collect();
         lvl.irregular = irregular;
+        // Past the isolation level only semi-sharp features are followed.
+        let follow: Vec<bool> = if l < iso {
+            lvl.irregular.clone()
+        } else {
+            (0..lvl.t().num_vertices())
+                .map(|v| lvl.irregular[v] && semi_sharp(lvl, v))
+                .collect()
+        };
         let t = &lvl.topo.topology;
         lvl.selected = (0..t.num_faces())
             .map(|f| {
                 !last
                     && lvl.complete[f]
                     && !lvl.hole[f]
-                    && t.face_vertices(f)
-                        .iter()
-                        .any(|&v| lvl.irregular[v as usize])
+                    && t.face_vertices(f).iter().any(|&v| follow[v as usize])
             })
             .collect();
-        if last {
+        if last || (l >= iso && !lvl.selected.iter().any(|&x| x)) {
             break;
         }
         let selection: Vec<u32> = (0..t.num_faces() as u32)

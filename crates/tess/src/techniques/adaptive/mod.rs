@@ -137,6 +137,7 @@ impl Adaptive {
                 isolation: options.isolation,
                 end_cap: options.end_cap,
                 sharpness_scale: options.sharpness_scale,
+                follow_semi_sharp: true,
             },
         )
         .map_err(|e| TessError::Mesh {
