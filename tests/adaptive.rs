@@ -67,8 +67,8 @@ fn surface(ctx: &mut Context, mesh: &ControlMesh, name: &str, isolation: u32, en
         &AdaptiveBuild {
             isolation,
             end_cap,
-            sharpness_scale: 1.0,
             name: name.into(),
+            ..Default::default()
         },
     )
     .unwrap_or_else(|e| panic!("{name}: {e}"))
@@ -465,6 +465,32 @@ fn gpu_matches_the_cpu_plan() {
             }
             println!("{name} {end_cap:?}: GPU vs CPU plan {worst:.2e}");
             assert!(worst <= 1e-5, "{name}: GPU off the CPU plan by {worst:.2e}");
+        }
+    }
+}
+
+/// Under uniform factors the CPU knows the triangle count exactly (coarse transition edges
+/// doubled): it equals what the GPU emitted, equal and fractional spacing.
+#[test]
+fn uniform_triangle_count_matches_the_capture() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
+        let mesh = spot();
+        let surf = surface(&mut ctx, &mesh, "spot", 3, EndCap::Gregory);
+        for (s, spacing) in [(1.0, Spacing::Equal), (3.0, Spacing::Equal), (3.0, Spacing::FractionalEven)] {
+            let params = FrameParams {
+                spacing,
+                ..FrameParams::uniform(s)
+            };
+            let expected: u64 = (0..surf.patch_arrays().len())
+                .map(|a| surf.triangles(&params, a).expect("uniform count"))
+                .sum();
+            let (soup, _) = capturer
+                .capture(&mut ctx, &surf, &params, EXTENT)
+                .expect("capture");
+            assert_eq!(soup.triangle_count() as u64, expected, "S = {s} {spacing:?}");
         }
     }
 }

@@ -30,9 +30,11 @@ void blend(float a, float b, vec3 f, vec3 g, out vec3 x, out vec3 dx_da, out vec
     dx_db = a * (g - f) / (d * d);
 }
 
-void evaluate(AdaptivePatch p, vec2 uv, out vec3 pos, out vec3 du, out vec3 dv) {
+layout(location = 1) in vec3 tc_points[];
+
+void evaluate(uint id, vec2 uv, out vec3 pos, out vec3 du, out vec3 dv) {
     vec3 c[20];
-    for (int i = 0; i < 20; ++i) c[i] = vtx(control_points[p.cp_offset + uint(i)]);
+    for (int i = 0; i < 20; ++i) c[i] = tc_points[i];
     float u = uv.x, v = uv.y;
     // The 4x4 Bezier net b[i + 4 j] (i along u, j along v) and the interior derivatives.
     vec3 b[16];

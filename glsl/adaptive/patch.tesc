@@ -1,23 +1,18 @@
 #version 450
-// Edge levels of one patch from its canonical curves only (see adaptive.glsl): the two sides
-// of every edge compute the same level; a coarse transition edge gets twice its fine halves'.
+// Bilinear (Coons) end caps: one output point carries the patch; the TES reads the cap's
+// canonical curves itself.
 #define TECHNIQUE_PUSH_CONSTANTS
 #include "frame.glsl"
 #include "adaptive.glsl"
+#include "tesc_levels.glsl"
 layout(vertices = 1) out;
 layout(location = 0) flat in uint in_patch[];
 layout(location = 0) patch out uint tc_patch;
+layout(location = 2) patch out uint tc_info;
 void main() {
     uint id = in_patch[0];
     tc_patch = id;
     AdaptivePatch p = patches[id];
-    float e0 = edge_level(p, 0u), e1 = edge_level(p, 1u), e2 = edge_level(p, 2u), e3 = edge_level(p, 3u);
-    // Quad domain: outer 0 is the edge u = 0 (patch edge 3), 1 is v = 0 (edge 0), 2 is u = 1
-    // (edge 1), 3 is v = 1 (edge 2).
-    gl_TessLevelOuter[0] = e3;
-    gl_TessLevelOuter[1] = e0;
-    gl_TessLevelOuter[2] = e1;
-    gl_TessLevelOuter[3] = e2;
-    gl_TessLevelInner[0] = max(e0, e2);
-    gl_TessLevelInner[1] = max(e1, e3);
+    tc_info = p.info;
+    set_patch_levels(p);
 }

@@ -1,19 +1,21 @@
 // The main of every adaptive TES; the including file defines
-// `void evaluate(AdaptivePatch p, vec2 uv, out vec3 pos, out vec3 du, out vec3 dv)` for its
-// patch kind. Points on the patch boundary come from the canonical curves instead (see
+// `void evaluate(uint id, vec2 uv, out vec3 pos, out vec3 du, out vec3 dv)` for its patch kind
+// (patch `id`). Only boundary vertices read the patch record (its curves). Points on the patch boundary come from the canonical curves instead (see
 // adaptive.glsl), so shared edges are bit-identical; normals always come from the patch.
 layout(location = 0) patch in uint tc_patch;
+layout(location = 2) patch in uint tc_info;
 layout(location = 5) flat out vec3 out_albedo;
 
 // Regular, Gregory, bilinear.
 const vec3 KIND_COLOURS[3] = vec3[3](vec3(0.45, 0.65, 0.95), vec3(0.95, 0.45, 0.35), vec3(0.95, 0.8, 0.3));
 
 void main() {
-    AdaptivePatch p = patches[tc_patch];
     vec2 uv = gl_TessCoord.xy;
     vec3 pos, du, dv;
-    evaluate(p, uv, pos, du, dv);
-    bool canonical = true;
+    evaluate(tc_patch, uv, pos, du, dv);
+    bool canonical = uv.x == 0.0 || uv.x == 1.0 || uv.y == 0.0 || uv.y == 1.0;
+    AdaptivePatch p;
+    if (canonical) p = patches[tc_patch];
     // Patch edge e and the parameter along it (edges run v0 -> v1 -> v2 -> v3 -> v0);
     // 1 - x is exact for tess coordinates. Corners take either edge: both give the curve's end
     // point, the same global vertex.
@@ -25,12 +27,10 @@ void main() {
         pos = canonical_edge_point(p, 2u, 1.0 - uv.x, gl_TessLevelOuter[3], !fractional_factors() || edge_kind(p, 2u) != ADAPTIVE_EDGE_PLAIN);
     } else if (uv.x == 0.0) {
         pos = canonical_edge_point(p, 3u, 1.0 - uv.y, gl_TessLevelOuter[0], !fractional_factors() || edge_kind(p, 3u) != ADAPTIVE_EDGE_PLAIN);
-    } else {
-        canonical = false;
     }
     vec3 n = cross(du, dv);
     float l = length(n);
-    uint kind = patch_kind(p), level = patch_level(p);
+    uint kind = tc_info & 15u, level = (tc_info >> 4) & 15u;
     vec3 albedo = frame.base_color.rgb;
     if ((adaptive.options & uint(ADAPTIVE_OPTION_PATCH_COLOURS)) != 0u) {
         // Odd levels lighter, even levels darker, a little lighter with depth: adjacent
@@ -38,8 +38,8 @@ void main() {
         albedo = KIND_COLOURS[min(kind, 2u)] * ((level & 1u) == 1u ? 1.0 : 0.62);
         albedo = mix(albedo, vec3(1.0), 0.05 * float(level));
         // Transition patches (a finer neighbour) darker, boundary / crease patches greener.
-        if (((p.info >> 12) & 15u) != 0u) albedo *= 0.7;
-        if (((p.info >> 8) & 15u) != 0u) albedo = mix(albedo, vec3(0.3, 0.8, 0.35), 0.5);
+        if (((tc_info >> 12) & 15u) != 0u) albedo *= 0.7;
+        if (((tc_info >> 8) & 15u) != 0u) albedo = mix(albedo, vec3(0.3, 0.8, 0.35), 0.5);
     }
     out_albedo = albedo;
     emit_sample(pos, l > 0.0 ? n / l : vec3(0.0, 0.0, 1.0), tc_patch,

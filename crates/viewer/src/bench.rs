@@ -80,6 +80,7 @@ fn config(a: &BenchArgs) -> Result<BenchConfig> {
         min_frames: a.min_frames.max(1),
         cpu_max_vertices: a.cpu_max_vertices,
         isolation: a.isolation,
+        follow_semi_sharp: !a.creases_at_isolation,
     })
 }
 

@@ -108,6 +108,9 @@ pub struct BenchArgs {
     /// Isolation level of the adaptive rows (segments are then per patch edge).
     #[arg(long, default_value_t = tess::techniques::adaptive::DEFAULT_ISOLATION)]
     pub isolation: u32,
+    /// Adaptive rows stop semi-sharp creases at the isolation level (OpenSubdiv's behaviour).
+    #[arg(long)]
+    pub creases_at_isolation: bool,
     /// Write the rows as CSV.
     #[arg(long)]
     pub csv: Option<PathBuf>,

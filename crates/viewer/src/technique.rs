@@ -89,6 +89,11 @@ pub struct SurfaceArgs {
     /// Multiplies every crease and corner sharpness (adaptive), without reloading the mesh.
     #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub sharpness_scale: f32,
+    /// Stop semi-sharp creases at the isolation level, their leftover sharpness treated as
+    /// infinite there (adaptive; OpenSubdiv's behaviour). By default they are followed until
+    /// they decay, so the surface beside them is exact.
+    #[arg(long)]
+    pub creases_at_isolation: bool,
     /// Adaptive edge factors (bft): screen (projected edge length / --pixels) or distance
     /// (halving each time the eye's distance doubles past --distance). Powers of two, or any
     /// value with --fractional; computed from an edge's two endpoints only, so no cracks.
@@ -223,6 +228,11 @@ impl SurfaceArgs {
                 feature: |f| f.isolation,
             },
             OptionUse {
+                name: "--creases-at-isolation",
+                given: self.creases_at_isolation,
+                feature: |f| f.isolation,
+            },
+            OptionUse {
                 name: "--table-level",
                 given: self.table_level != DEFAULT_TABLE_LEVEL,
                 feature: |f| f.table_level,
@@ -310,6 +320,7 @@ impl SurfaceArgs {
                 isolation: self.isolation,
                 end_cap: self.end_cap,
                 sharpness_scale: self.sharpness_scale,
+                follow_semi_sharp: !self.creases_at_isolation,
             },
             params,
             distance_diagonals: (self.adaptive == Some(Adaptive::Distance))

@@ -210,6 +210,7 @@ impl TechniqueMethod {
             &BuildOptions {
                 name: ctx.mesh.name.clone(),
                 isolation: ctx.config.isolation,
+                follow_semi_sharp: ctx.config.follow_semi_sharp,
                 ..BuildOptions::default()
             },
         )?;

@@ -50,6 +50,8 @@ pub struct BenchConfig {
     pub cpu_max_vertices: u64,
     /// Isolation level of the feature-adaptive rows.
     pub isolation: u32,
+    /// Follow semi-sharp creases past it until they decay.
+    pub follow_semi_sharp: bool,
 }
 
 impl Default for BenchConfig {
@@ -70,6 +72,7 @@ impl Default for BenchConfig {
             min_frames: 5,
             cpu_max_vertices: 4_000_000,
             isolation: crate::techniques::adaptive::DEFAULT_ISOLATION,
+            follow_semi_sharp: true,
         }
     }
 }

@@ -144,6 +144,8 @@ pub struct BuildOptions {
     pub end_cap: topology::adaptive::EndCap,
     /// Scales every crease and corner sharpness.
     pub sharpness_scale: f32,
+    /// Follow semi-sharp creases past the isolation level until they decay.
+    pub follow_semi_sharp: bool,
 }
 
 impl Default for BuildOptions {
@@ -155,6 +157,7 @@ impl Default for BuildOptions {
             isolation: adaptive::DEFAULT_ISOLATION,
             end_cap: topology::adaptive::EndCap::Gregory,
             sharpness_scale: 1.0,
+            follow_semi_sharp: true,
         }
     }
 }
@@ -200,6 +203,7 @@ pub fn build(
                 isolation: options.isolation,
                 end_cap: options.end_cap,
                 sharpness_scale: options.sharpness_scale,
+                follow_semi_sharp: options.follow_semi_sharp,
                 name: options.name.clone(),
             },
         )?),

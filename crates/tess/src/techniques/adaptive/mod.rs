@@ -25,7 +25,7 @@ use crate::context::Context;
 use crate::error::{Result, TessError};
 use crate::gpu::bindings::{
     ADAPTIVE_BASE_POSITIONS_BINDING, ADAPTIVE_CONTROL_POINTS_BINDING, ADAPTIVE_CURVES_BINDING,
-    ADAPTIVE_LOCAL_SIZE, ADAPTIVE_OPTION_FRACTIONAL, ADAPTIVE_OPTION_PATCH_COLOURS,
+    ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_PLAIN, ADAPTIVE_LOCAL_SIZE, ADAPTIVE_OPTION_FRACTIONAL, ADAPTIVE_OPTION_PATCH_COLOURS,
     ADAPTIVE_OPTION_POW2, ADAPTIVE_PATCHES_BINDING, ADAPTIVE_STENCIL_OFFSETS_BINDING,
     ADAPTIVE_STENCIL_TERMS_BINDING, ADAPTIVE_VERTICES_BINDING, BFT_FACTORS_DISTANCE,
     BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM,
@@ -36,7 +36,7 @@ use crate::technique::{
     for_each_draw, number_arrays, DrawCounts, FactorPolicy, FrameParams, Pass, PatchArray,
     PatchPipeline, PatchType, Technique, TechniqueId,
 };
-use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, Domain, Spacing};
+use crate::tessellator::{quad_triangle_count, uniform_vertex_count, Domain, Spacing};
 use layout::GpuAdaptive;
 use topology::adaptive::{plan_adaptive, AdaptiveOptions, AdaptivePlan, EndCap};
 use topology::ControlMesh;
@@ -81,6 +81,10 @@ pub struct AdaptiveBuild {
     pub end_cap: EndCap,
     /// Multiplies every crease and corner sharpness (the seed's run-time sharpness change).
     pub sharpness_scale: f32,
+    /// Follow semi-sharp creases past the isolation level until they decay (exact beside
+    /// them); off, leftover sharpness is treated as infinite at the isolation level
+    /// (OpenSubdiv's behaviour).
+    pub follow_semi_sharp: bool,
     /// Name for messages (the mesh's file).
     pub name: String,
 }
@@ -91,6 +95,7 @@ impl Default for AdaptiveBuild {
             isolation: DEFAULT_ISOLATION,
             end_cap: EndCap::Gregory,
             sharpness_scale: 1.0,
+            follow_semi_sharp: true,
             name: "mesh".into(),
         }
     }
@@ -137,7 +142,7 @@ impl Adaptive {
                 isolation: options.isolation,
                 end_cap: options.end_cap,
                 sharpness_scale: options.sharpness_scale,
-                follow_semi_sharp: true,
+                follow_semi_sharp: options.follow_semi_sharp,
             },
         )
         .map_err(|e| TessError::Mesh {
@@ -314,6 +319,30 @@ impl Adaptive {
         }
     }
 
+    /// The level `edge_level` in `adaptive.glsl` gives an edge of kind `kind` under uniform
+    /// factors of `segments` per patch edge (mirrored operation for operation).
+    fn uniform_edge_level(&self, segments: f32, spacing: Spacing, kind: u32) -> f32 {
+        let lim = self.factor_limit();
+        let fractional = spacing == Spacing::FractionalEven;
+        if kind == ADAPTIVE_EDGE_PLAIN {
+            if fractional {
+                return segments.clamp(2.0, lim);
+            }
+            return segments.clamp(1.0, lim).ceil().min(lim);
+        }
+        let half = (lim * 0.5).floor();
+        let f = if fractional {
+            2.0 * (segments.clamp(2.0, half) * 0.5).ceil()
+        } else {
+            segments.clamp(1.0, half).ceil().min(half)
+        };
+        if kind == ADAPTIVE_EDGE_COARSE {
+            2.0 * f
+        } else {
+            f
+        }
+    }
+
     /// Where patch `patch` (frame-wide id) at patch coordinate `(u, v)` lies in its base face:
     /// `(base face, sub-face, u, v)` in `topology::eval`'s convention (sub-quads of
     /// non-quads as `LocalMesh::evaluate_subface` numbers them).
@@ -383,14 +412,16 @@ impl Technique for Adaptive {
     }
 
     fn patch_pipeline(&self, patch: PatchType) -> PatchPipeline {
-        let evaluation = match patch {
-            PatchType::Gregory => Stage::AdaptiveGregoryTese,
-            PatchType::Bilinear => Stage::AdaptiveBilinearTese,
-            _ => Stage::AdaptiveRegularTese,
+        // Regular and Gregory control stages fetch the patch's points once (Bezier net,
+        // Gregory points); the bilinear cap reads only its curves.
+        let (control, evaluation) = match patch {
+            PatchType::Gregory => (Stage::AdaptiveGregoryTesc, Stage::AdaptiveGregoryTese),
+            PatchType::Bilinear => (Stage::AdaptivePatchTesc, Stage::AdaptiveBilinearTese),
+            _ => (Stage::AdaptiveRegularTesc, Stage::AdaptiveRegularTese),
         };
         PatchPipeline {
             vertex: Stage::AdaptivePatchVert,
-            control: Stage::AdaptivePatchTesc,
+            control,
             evaluation,
             fragment: Stage::AdaptiveAdaptiveFrag,
             control_points: 1,
@@ -416,19 +447,37 @@ impl Technique for Adaptive {
         uniform_vertex_count(Domain::Quad, params.spacing, max.min(self.factor_limit()))
     }
 
-    /// Exact for uniform factors without transitions (every edge at `segments`); with
-    /// transitions the coarse edges add triangles, so a capture measures.
+    /// Exact for uniform factors: each patch's edge levels as `patch.tesc` sets them (a
+    /// coarse transition edge doubled), counted by the tessellator's arithmetic.
     fn triangles(&self, params: &FrameParams, array: usize) -> Option<u64> {
         let a = self.arrays.get(array)?;
-        let transitions = self.gpu.patches[a.first_patch as usize..(a.first_patch + a.patches) as usize]
-            .iter()
-            .any(|p| (p.info >> 12) & 15 != 0);
-        match params.factors {
-            FactorPolicy::Uniform { segments } if !transitions => Some(
-                a.patches as u64 * uniform_triangle_count(Domain::Quad, params.spacing, segments),
-            ),
-            _ => None,
+        let FactorPolicy::Uniform { segments } = params.factors else {
+            return None;
+        };
+        let patches = self
+            .gpu
+            .patches
+            .get(a.first_patch as usize..(a.first_patch + a.patches) as usize)?;
+        let mut counts = std::collections::HashMap::new();
+        for p in patches {
+            *counts.entry(p.edge_info & 0x3333).or_insert(0u64) += 1;
         }
+        Some(
+            counts
+                .into_iter()
+                .map(|(kinds, n)| {
+                    let e = |k: u32| {
+                        self.uniform_edge_level(segments, params.spacing, (kinds >> (4 * k)) & 3)
+                    };
+                    let (e0, e1, e2, e3) = (e(0), e(1), e(2), e(3));
+                    n * quad_triangle_count(
+                        params.spacing,
+                        [e3, e0, e1, e2],
+                        [e0.max(e2), e1.max(e3)],
+                    )
+                })
+                .sum(),
+        )
     }
 
     fn base_mesh(&self) -> Option<&ControlMesh> {
