@@ -5,22 +5,43 @@
 //! `RAYON_NUM_THREADS=1 cargo bench -p topology --bench adaptive` for the single-threaded
 //! figures; `TESSERA_BENCH_FACES=1` prints the face counts per level instead (the seed's
 //! Fig. 5.2: regular, end caps, faces held, uniform).
+//!
+//! `TESSERA_BENCH_TIME=row,row,... [TESSERA_BENCH_REPS=n]` times the named rows outside
+//! criterion (one untimed warm-up run, then `n` timed runs, each printed in ms, the result
+//! dropped outside the timer), so a script can interleave them with OpenSubdiv's `far_perf`,
+//! which prints one time per level and process. Rows: `<shape>_adaptive4`,
+//! `<shape>_adaptive4_follow_creases`, `<shape>_uniform3_stencils`, `<shape>_base_topology`
+//! (the base level alone, which `far_perf` builds outside its timers).
 use criterion::Criterion;
 use std::path::PathBuf;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 use topology::adaptive::{plan_adaptive, AdaptiveOptions, EndCap};
-use topology::{load_obj, uniform_stencils, ControlMesh, Scheme};
+use topology::{load_obj, uniform_stencils, ControlMesh, LevelTopology, Scheme};
 
 fn mesh(rel: &str) -> ControlMesh {
-    load_obj(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..").join(rel)).unwrap()
+    load_obj(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../..")
+            .join(rel),
+    )
+    .unwrap()
 }
 
 fn shapes() -> Vec<(&'static str, ControlMesh)> {
     vec![
         ("spot", mesh("assets/spot_control_mesh.obj")),
-        ("catmark_car", mesh("tests/data/opensubdiv/shapes/catmark_car.obj")),
-        ("catmark_bishop", mesh("tests/data/opensubdiv/shapes/catmark_bishop.obj")),
-        ("catmark_pawn", mesh("tests/data/opensubdiv/shapes/catmark_pawn.obj")),
+        (
+            "catmark_car",
+            mesh("tests/data/opensubdiv/shapes/catmark_car.obj"),
+        ),
+        (
+            "catmark_bishop",
+            mesh("tests/data/opensubdiv/shapes/catmark_bishop.obj"),
+        ),
+        (
+            "catmark_pawn",
+            mesh("tests/data/opensubdiv/shapes/catmark_pawn.obj"),
+        ),
     ]
 }
 
@@ -37,11 +58,60 @@ fn options(isolation: u32, follow_semi_sharp: bool) -> AdaptiveOptions {
 
 fn print_face_counts() {
     for (name, m) in shapes() {
-        let plan = plan_adaptive(&m, &options(4, true)).unwrap();
-        println!("{name} (isolation 4): level | regular | end caps | faces held | uniform");
-        for (l, s) in plan.level_stats.iter().enumerate() {
-            println!("  {l} | {} | {} | {} | {}", s.regular, s.end_caps, s.faces, s.uniform_faces);
+        for follow in [false, true] {
+            let plan = plan_adaptive(&m, &options(4, follow)).unwrap();
+            println!(
+                "{name} (isolation 4, follow_semi_sharp {follow}, {} patches, {} vertices): \
+                 level | regular | end caps | faces held | uniform",
+                plan.patches.len(),
+                plan.num_vertices
+            );
+            for (l, s) in plan.level_stats.iter().enumerate() {
+                println!(
+                    "  {l} | {} | {} | {} | {}",
+                    s.regular, s.end_caps, s.faces, s.uniform_faces
+                );
+            }
         }
+    }
+}
+
+/// One run of a named row; the result is returned so that its drop is not timed.
+fn run_row(row: &str, m: &ControlMesh) -> Box<dyn std::any::Any> {
+    if row.ends_with("_adaptive4_follow_creases") {
+        Box::new(plan_adaptive(m, &options(4, true)).unwrap())
+    } else if row.ends_with("_adaptive4") {
+        Box::new(plan_adaptive(m, &options(4, false)).unwrap())
+    } else if row.ends_with("_uniform3_stencils") {
+        Box::new(uniform_stencils(m, Scheme::CatmullClark, 3).unwrap())
+    } else if row.ends_with("_base_topology") {
+        Box::new(LevelTopology::from_mesh(m, Scheme::CatmullClark).unwrap())
+    } else {
+        panic!("unknown row {row}")
+    }
+}
+
+fn time_rows(rows: &str) {
+    let reps: usize = std::env::var("TESSERA_BENCH_REPS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(1);
+    let shapes = shapes();
+    for row in rows.split(',') {
+        let (_, m) = shapes
+            .iter()
+            .find(|(name, _)| row.starts_with(&format!("{name}_")))
+            .unwrap_or_else(|| panic!("no shape for row {row}"));
+        drop(run_row(row, m));
+        let mut ms = Vec::with_capacity(reps);
+        for _ in 0..reps {
+            let t = Instant::now();
+            let out = run_row(row, m);
+            ms.push(t.elapsed().as_secs_f64() * 1e3);
+            drop(out);
+        }
+        let list: Vec<String> = ms.iter().map(|t| format!("{t:.3}")).collect();
+        println!("{row} ms {}", list.join(" "));
     }
 }
 
@@ -69,6 +139,10 @@ fn bench(c: &mut Criterion) {
 fn main() {
     if std::env::var_os("TESSERA_BENCH_FACES").is_some() {
         print_face_counts();
+        return;
+    }
+    if let Ok(rows) = std::env::var("TESSERA_BENCH_TIME") {
+        time_rows(&rows);
         return;
     }
     let mut c = Criterion::default().configure_from_args();
