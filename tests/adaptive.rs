@@ -208,9 +208,13 @@ fn captured_vertices_are_the_exact_limit() {
             // catmark_cube_corner4 the Gregory cap's tangents are a stand-in (no tangent plane
             // there), and the caps where catmark_cube_creases1's sharpness-5 creases meet
             // stop at level 5 just above the target.
+            // catmark_bishop's Gregory caps at its high-valence vertices converge slowest
+            // (the cap's parameterization error shrinks by the subdominant eigenvalue, about
+            // 0.6 per level at valence 8).
             let bound = match name.as_str() {
                 "catmark_cube_corner4" => 2e-3,
                 "catmark_cube_creases1" => 1e-4,
+                "catmark_bishop" => 3e-4,
                 _ => 5e-5,
             };
             if regular > 1e-5 || geometric > bound {

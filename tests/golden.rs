@@ -185,7 +185,7 @@ fn bft_golden_images_match_and_detect_changes() {
 
 const ADAPTIVE_MESHES: [&str; 3] = [
     "assets/spot_control_mesh.obj",
-    "tests/data/opensubdiv/shapes/catmark_cube_creases1.obj",
+    "tests/data/opensubdiv/shapes/catmark_cube_creases0.obj",
     "tests/data/opensubdiv/shapes/catmark_pyramid.obj",
 ];
 

@@ -4,7 +4,8 @@
 //! missing fails.
 use super::bindings::*;
 use super::reflect::Reflection;
-use super::{BftPush, CaptureRecord, DrawPush, FrameUniforms, Vertex};
+use super::{AdaptivePush, BftPush, CaptureRecord, DrawPush, FrameUniforms, Vertex};
+use crate::techniques::adaptive::layout::{PatchRecord, StencilTerm as AdaptiveTerm};
 use crate::shaders::{spirv, Stage, Variant};
 use crate::techniques::bft::layout::{
     BasePosition, Level1Point, PatchHeader, StencilTerm, TableEntry, TableHeader, TangentTerm,
@@ -366,13 +367,137 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
             ),
         ]);
     }
-    // The capture record and the Draw push constant of every capture build (the optimizer
-    // keeps `draw` only where the patch id is written).
+    // Feature-adaptive Catmull-Clark: push constants, the stencil kernel's buffers, the
+    // patch records, control points and curves.
+    let adaptive_push = || Layout {
+        name: "AdaptivePush",
+        offsets: offsets!(AdaptivePush: mode, first_patch, factor_mode, options, uniform_level, pixels_per_segment, distance_ref, max_level, first_row, count, base_count),
+        size: size_of::<AdaptivePush>(),
+    };
+    let adaptive_tese = [
+        Stage::AdaptiveRegularTese,
+        Stage::AdaptiveGregoryTese,
+        Stage::AdaptiveBilinearTese,
+    ];
+    rows.extend([
+        (Stage::AdaptiveStencilComp, PLAIN, adaptive_push()),
+        (Stage::AdaptivePatchVert, PLAIN, adaptive_push()),
+        (Stage::AdaptivePatchTesc, PLAIN, adaptive_push()),
+        (Stage::AdaptiveRegularTesc, PLAIN, adaptive_push()),
+        (Stage::AdaptiveGregoryTesc, PLAIN, adaptive_push()),
+        (Stage::AdaptiveAdaptiveFrag, PLAIN, adaptive_push()),
+        (
+            Stage::AdaptiveStencilComp,
+            PLAIN,
+            Buffer {
+                block: "BasePositions",
+                binding: ADAPTIVE_BASE_POSITIONS_BINDING,
+                members: vec![0],
+                stride: size_of::<f32>(),
+            },
+        ),
+        (
+            Stage::AdaptiveStencilComp,
+            PLAIN,
+            words("StencilOffsets", ADAPTIVE_STENCIL_OFFSETS_BINDING),
+        ),
+        (
+            Stage::AdaptiveStencilComp,
+            PLAIN,
+            Buffer {
+                block: "StencilTerms",
+                binding: ADAPTIVE_STENCIL_TERMS_BINDING,
+                members: vec![0],
+                stride: size_of::<AdaptiveTerm>(),
+            },
+        ),
+        (
+            Stage::AdaptiveStencilComp,
+            PLAIN,
+            Layout {
+                name: "StencilTerm",
+                offsets: offsets!(AdaptiveTerm: index, weight),
+                size: size_of::<AdaptiveTerm>(),
+            },
+        ),
+        (
+            Stage::AdaptiveStencilComp,
+            PLAIN,
+            Buffer {
+                block: "Vertices",
+                binding: ADAPTIVE_VERTICES_BINDING,
+                members: vec![0],
+                stride: size_of::<[f32; 4]>(),
+            },
+        ),
+        (
+            Stage::AdaptiveRegularTesc,
+            PLAIN,
+            Buffer {
+                block: "Patches",
+                binding: ADAPTIVE_PATCHES_BINDING,
+                members: vec![0],
+                stride: size_of::<PatchRecord>(),
+            },
+        ),
+        (
+            Stage::AdaptiveRegularTesc,
+            PLAIN,
+            Layout {
+                name: "AdaptivePatch",
+                offsets: offsets!(PatchRecord: cp_offset, info, edge_info, pad, curves),
+                size: size_of::<PatchRecord>(),
+            },
+        ),
+        (
+            Stage::AdaptiveRegularTesc,
+            PLAIN,
+            MemberArray {
+                name: "AdaptivePatch",
+                member: 4,
+                stride: size_of::<u32>(),
+            },
+        ),
+        (
+            Stage::AdaptiveGregoryTesc,
+            PLAIN,
+            words("ControlPoints", ADAPTIVE_CONTROL_POINTS_BINDING),
+        ),
+        (
+            Stage::AdaptivePatchTesc,
+            PLAIN,
+            Buffer {
+                block: "Curves",
+                binding: ADAPTIVE_CURVES_BINDING,
+                members: vec![0],
+                stride: size_of::<[u32; 4]>(),
+            },
+        ),
+        (
+            Stage::AdaptivePatchTesc,
+            PLAIN,
+            Buffer {
+                block: "Vertices",
+                binding: ADAPTIVE_VERTICES_BINDING,
+                members: vec![0],
+                stride: size_of::<[f32; 4]>(),
+            },
+        ),
+    ]);
+    for stage in adaptive_tese {
+        for spacing in [Spacing::Equal, Spacing::FractionalEven] {
+            rows.push((stage, variant(Some(spacing), false), adaptive_push()));
+        }
+    }
+    // The capture record and the push constant of every capture build (the optimizer keeps
+    // `draw` only where the patch id is written).
     for stage in Stage::ALL {
         for &(v, _) in stage.compiled() {
             if v.capture {
                 rows.push((stage, v, capture()));
-                if stage != Stage::BftBftTese {
+                if adaptive_tese.contains(&stage) {
+                    rows.push((stage, v, adaptive_push()));
+                } else if stage != Stage::BftBftTese {
                     rows.push((stage, v, draw()));
                 }
             }
@@ -510,6 +635,21 @@ fn the_table_covers_every_bft_binding_and_capture_build() {
             "BFT binding {binding} is not checked"
         );
     }
+    for binding in [
+        ADAPTIVE_BASE_POSITIONS_BINDING,
+        ADAPTIVE_STENCIL_OFFSETS_BINDING,
+        ADAPTIVE_STENCIL_TERMS_BINDING,
+        ADAPTIVE_VERTICES_BINDING,
+        ADAPTIVE_PATCHES_BINDING,
+        ADAPTIVE_CONTROL_POINTS_BINDING,
+        ADAPTIVE_CURVES_BINDING,
+    ] {
+        assert!(
+            rows.iter().any(|(s, _, c)| format!("{s:?}").starts_with("Adaptive")
+                && matches!(c, Check::Buffer { binding: b, .. } if *b == binding)),
+            "adaptive binding {binding} is not checked"
+        );
+    }
     let capture_builds = Stage::ALL
         .iter()
         .flat_map(|s| s.compiled())
@@ -520,7 +660,7 @@ fn the_table_covers_every_bft_binding_and_capture_build() {
         .filter(|(_, _, c)| matches!(c, Check::Xfb { .. }))
         .count();
     // Five TESs in three spacings.
-    assert_eq!(capture_builds, 15);
+    assert_eq!(capture_builds, 24);
     assert_eq!(xfb_rows, capture_builds);
 }
 
@@ -571,7 +711,7 @@ fn capture_variants_and_only_they_have_xfb() {
             captures += v.capture as usize;
         }
     }
-    assert_eq!(captures, 15);
+    assert_eq!(captures, 24);
 }
 
 #[test]
