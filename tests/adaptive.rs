@@ -60,7 +60,13 @@ fn diag(m: &ControlMesh) -> f64 {
     (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
 }
 
-fn surface(ctx: &mut Context, mesh: &ControlMesh, name: &str, isolation: u32, end_cap: EndCap) -> Adaptive {
+fn surface(
+    ctx: &mut Context,
+    mesh: &ControlMesh,
+    name: &str,
+    isolation: u32,
+    end_cap: EndCap,
+) -> Adaptive {
     Adaptive::new(
         ctx,
         mesh,
@@ -79,7 +85,14 @@ fn surface(ctx: &mut Context, mesh: &ControlMesh, name: &str, isolation: u32, en
 /// end cap's parameterization differs from the limit's near extraordinary vertices (the
 /// Gregory patch is polynomial, the characteristic map is not), so this geometric distance is
 /// what tells how close the surface is, the parametric one how close its parameterization is.
-fn geometric_distance(cpu: &LocalMesh, quad: bool, face: usize, sub: usize, st: (f64, f64), p: [f64; 3]) -> f64 {
+fn geometric_distance(
+    cpu: &LocalMesh,
+    quad: bool,
+    face: usize,
+    sub: usize,
+    st: (f64, f64),
+    p: [f64; 3],
+) -> f64 {
     let eval = |s: f64, t: f64| {
         if quad {
             cpu.evaluate(face, s, t)
@@ -111,7 +124,12 @@ fn geometric_distance(cpu: &LocalMesh, quad: bool, face: usize, sub: usize, st: 
 /// Worst distances over the bbox diagonal between captured vertices and the exact limit, over
 /// at most `samples` welded vertices: (regular patches at their base point, end caps at their
 /// base point, end caps to the nearest limit point).
-fn deviations(surf: &Adaptive, soup: &CapturedSoup, mesh: &ControlMesh, samples: usize) -> (f64, f64, f64) {
+fn deviations(
+    surf: &Adaptive,
+    soup: &CapturedSoup,
+    mesh: &ControlMesh,
+    samples: usize,
+) -> (f64, f64, f64) {
     let cpu = LocalMesh::from_control_mesh(mesh, LimitScheme::CatmullClark).expect("cpu mesh");
     let welded = soup.weld().expect("weld");
     let n = welded.positions.len();
@@ -129,7 +147,10 @@ fn deviations(surf: &Adaptive, soup: &CapturedSoup, mesh: &ControlMesh, samples:
         }
         .expect("exact limit");
         let p = welded.positions[i].map(f64::from);
-        let err = (0..3).map(|k| (p[k] - e.position[k]).abs()).fold(0.0, f64::max) / d;
+        let err = (0..3)
+            .map(|k| (p[k] - e.position[k]).abs())
+            .fold(0.0, f64::max)
+            / d;
         if welded.flags[i] & 15 == ADAPTIVE_KIND_REGULAR {
             regular = regular.max(err);
         } else {
@@ -145,7 +166,12 @@ fn deviations(surf: &Adaptive, soup: &CapturedSoup, mesh: &ControlMesh, samples:
 
 /// Worst distance over the bbox diagonal between captured vertices and the exact limit at
 /// their base point: (regular patches, end caps), over at most `samples` welded vertices.
-fn deviation(surf: &Adaptive, soup: &CapturedSoup, mesh: &ControlMesh, samples: usize) -> (f64, f64) {
+fn deviation(
+    surf: &Adaptive,
+    soup: &CapturedSoup,
+    mesh: &ControlMesh,
+    samples: usize,
+) -> (f64, f64) {
     let cpu = LocalMesh::from_control_mesh(mesh, LimitScheme::CatmullClark).expect("cpu mesh");
     let welded = soup.weld().expect("weld");
     let n = welded.positions.len();
@@ -218,7 +244,9 @@ fn captured_vertices_are_the_exact_limit() {
                 _ => 5e-5,
             };
             if regular > 1e-5 || geometric > bound {
-                failures.push(format!("{name}: regular {regular:.2e}, end caps {caps:.2e} / {geometric:.2e}"));
+                failures.push(format!(
+                    "{name}: regular {regular:.2e}, end caps {caps:.2e} / {geometric:.2e}"
+                ));
             }
         }
         assert!(failures.is_empty(), "off the exact limit: {failures:#?}");
@@ -232,7 +260,10 @@ fn end_cap_deviation_shrinks_with_isolation() {
     {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let capturer = Capturer::new(&ctx).expect("capturer");
-        for (name, mesh) in [("spot".to_string(), spot()), ("catmark_cube".into(), shape("catmark_cube"))] {
+        for (name, mesh) in [
+            ("spot".to_string(), spot()),
+            ("catmark_cube".into(), shape("catmark_cube")),
+        ] {
             for end_cap in [EndCap::Gregory, EndCap::Bilinear] {
                 let mut devs = Vec::new();
                 for isolation in 1..=6 {
@@ -241,11 +272,20 @@ fn end_cap_deviation_shrinks_with_isolation() {
                         .capture(&mut ctx, &surf, &FrameParams::uniform(2.0), EXTENT)
                         .expect("capture");
                     let (regular, caps) = deviation(&surf, &soup, &mesh, 4000);
-                    assert!(regular <= 1e-5, "{name} isolation {isolation}: regular {regular:.2e}");
+                    assert!(
+                        regular <= 1e-5,
+                        "{name} isolation {isolation}: regular {regular:.2e}"
+                    );
                     devs.push(caps);
                 }
-                println!("{name} {end_cap:?} end-cap deviation, isolation 1..6: {:?}", devs.iter().map(|d| format!("{d:.2e}")).collect::<Vec<_>>());
-                assert!(devs[5] < 0.25 * devs[0], "{name} {end_cap:?}: {devs:?} does not shrink");
+                println!(
+                    "{name} {end_cap:?} end-cap deviation, isolation 1..6: {:?}",
+                    devs.iter().map(|d| format!("{d:.2e}")).collect::<Vec<_>>()
+                );
+                assert!(
+                    devs[5] < 0.25 * devs[0],
+                    "{name} {end_cap:?}: {devs:?} does not shrink"
+                );
                 for w in devs.windows(2) {
                     assert!(w[1] <= w[0] * 1.05, "{name} {end_cap:?}: {devs:?} grows");
                 }
@@ -295,7 +335,11 @@ fn watertight_under_every_factor_policy() {
                         },
                         false,
                     ),
-                    ("screen 6px fractional", FactorPolicy::Screen { pixels: 6.0 }, true),
+                    (
+                        "screen 6px fractional",
+                        FactorPolicy::Screen { pixels: 6.0 },
+                        true,
+                    ),
                     (
                         "distance fractional",
                         FactorPolicy::Distance {
@@ -307,7 +351,11 @@ fn watertight_under_every_factor_policy() {
                 for (label, factors, fractional) in policies {
                     let params = FrameParams {
                         factors,
-                        spacing: if fractional { Spacing::FractionalEven } else { Spacing::Equal },
+                        spacing: if fractional {
+                            Spacing::FractionalEven
+                        } else {
+                            Spacing::Equal
+                        },
                         camera,
                         ..FrameParams::default()
                     };
@@ -319,7 +367,10 @@ fn watertight_under_every_factor_policy() {
                         "{name} {end_cap:?} {label}: {} triangles, {cracks} cracks, {boundary} boundary edges",
                         soup.triangle_count()
                     );
-                    assert_eq!(cracks, 0, "{name} {end_cap:?} {label}: open edges beyond the base boundary");
+                    assert_eq!(
+                        cracks, 0,
+                        "{name} {end_cap:?} {label}: open edges beyond the base boundary"
+                    );
                     assert_eq!(nonmanifold, 0, "{name} {end_cap:?} {label}");
                 }
             }
@@ -349,7 +400,10 @@ fn animated_base_mesh_gives_the_deformed_limit() {
         let (regular, caps, geometric) = deviations(&surf, &soup, &deformed, 3000);
         let (rest_regular, _) = deviation(&surf, &soup, &mesh, 3000);
         println!("animated spot: regular {regular:.2e}, end caps {caps:.2e} (parametric), {geometric:.2e} (to the surface); vs rest pose {rest_regular:.2e}");
-        assert!(regular <= 1e-5 && geometric <= 2e-4, "{regular:.2e} {geometric:.2e}");
+        assert!(
+            regular <= 1e-5 && geometric <= 2e-4,
+            "{regular:.2e} {geometric:.2e}"
+        );
         assert!(rest_regular > 1e-3, "the surface did not move");
         assert_eq!(cracks(&surf, &soup, &deformed).0, 0);
     }
@@ -422,7 +476,16 @@ fn bad_input_gives_named_errors() {
         assert!(e.to_string().contains("sharpness"), "{e}");
         // Three quads on one edge: non-manifold.
         let fan = ControlMesh::from_polygons(
-            vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, -1.0, 0.0], [1.0, -1.0, 0.0]],
+            vec![
+                [0.0; 3],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [1.0, 0.0, 1.0],
+                [0.0, -1.0, 0.0],
+                [1.0, -1.0, 0.0],
+            ],
             &[vec![0u32, 1, 3, 2], vec![1, 0, 4, 5], vec![0, 1, 7, 6]],
         );
         assert!(Adaptive::new(&mut ctx, &fan, &AdaptiveBuild::default()).is_err());
@@ -449,7 +512,10 @@ fn gpu_matches_the_cpu_plan() {
     {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let capturer = Capturer::new(&ctx).expect("capturer");
-        for (name, end_cap) in [("catmark_chaikin0", EndCap::Gregory), ("catmark_pyramid", EndCap::Bilinear)] {
+        for (name, end_cap) in [
+            ("catmark_chaikin0", EndCap::Gregory),
+            ("catmark_pyramid", EndCap::Bilinear),
+        ] {
             let mesh = shape(name);
             let surf = surface(&mut ctx, &mesh, name, 3, end_cap);
             let (soup, _) = capturer
@@ -483,7 +549,11 @@ fn uniform_triangle_count_matches_the_capture() {
         let capturer = Capturer::new(&ctx).expect("capturer");
         let mesh = spot();
         let surf = surface(&mut ctx, &mesh, "spot", 3, EndCap::Gregory);
-        for (s, spacing) in [(1.0, Spacing::Equal), (3.0, Spacing::Equal), (3.0, Spacing::FractionalEven)] {
+        for (s, spacing) in [
+            (1.0, Spacing::Equal),
+            (3.0, Spacing::Equal),
+            (3.0, Spacing::FractionalEven),
+        ] {
             let params = FrameParams {
                 spacing,
                 ..FrameParams::uniform(s)
@@ -494,7 +564,11 @@ fn uniform_triangle_count_matches_the_capture() {
             let (soup, _) = capturer
                 .capture(&mut ctx, &surf, &params, EXTENT)
                 .expect("capture");
-            assert_eq!(soup.triangle_count() as u64, expected, "S = {s} {spacing:?}");
+            assert_eq!(
+                soup.triangle_count() as u64,
+                expected,
+                "S = {s} {spacing:?}"
+            );
         }
     }
 }

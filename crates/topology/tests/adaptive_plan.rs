@@ -365,7 +365,11 @@ fn blocks_read_only_earlier_vertices() {
         }
         assert_eq!(next, plan.num_vertices);
         // Semi-sharp features are followed past the isolation level until they decay.
-        assert!((3..=10).contains(&plan.steps.len()), "{name}: {} steps", plan.steps.len());
+        assert!(
+            (3..=10).contains(&plan.steps.len()),
+            "{name}: {} steps",
+            plan.steps.len()
+        );
         for pa in &plan.patches {
             let n = match pa.kind {
                 PatchKind::Regular => 16,

@@ -38,8 +38,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
         ..FrameParams::default()
     };
     let base = load_mesh(Some(&a.input))?;
-    let method =
-        crate::technique::resolve_method(a.method, a.surface.scheme.as_deref(), &base)?;
+    let method = crate::technique::resolve_method(a.method, a.surface.scheme.as_deref(), &base)?;
     let mut setup = a
         .surface
         .setup(method, a.segments, a.spacing, false, params)?;

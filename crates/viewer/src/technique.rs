@@ -4,8 +4,8 @@
 use anyhow::{bail, Result};
 use clap::Args;
 use tess::techniques::{self, adaptive::DEFAULT_ISOLATION, bft::DEFAULT_TABLE_LEVEL, BuildOptions};
-use topology::adaptive::EndCap;
 use tess::{FactorPolicy, Features, FrameParams, Spacing, TechniqueId};
+use topology::adaptive::EndCap;
 
 pub fn parse_technique(s: &str) -> Result<TechniqueId, String> {
     s.parse::<TechniqueId>().map_err(|e| e.to_string())
@@ -40,8 +40,9 @@ pub fn resolve_method(
         return Ok(m);
     }
     let scheme = match scheme {
-        Some(s) => crate::topo_cmds::parse_scheme(s)
-            .map_err(|e| anyhow::anyhow!("--scheme {s}: {e}"))?,
+        Some(s) => {
+            crate::topo_cmds::parse_scheme(s).map_err(|e| anyhow::anyhow!("--scheme {s}: {e}"))?
+        }
         None => default_scheme(mesh),
     };
     techniques::registry()

@@ -1117,14 +1117,31 @@ fn window_shows_bft_like_offscreen_and_animates() {
 #[test]
 fn render_draws_the_limit_surface_of_the_mesh_scheme_by_default() {
     let out = tmp("default_adaptive.png");
-    let o = tessera(&["render", "--size", "160x120", "-o", out.to_str().unwrap()], &[]);
+    let o = tessera(
+        &["render", "--size", "160x120", "-o", out.to_str().unwrap()],
+        &[],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let s = String::from_utf8_lossy(&o.stdout);
     assert!(s.contains("adaptive"), "{s}");
     let ico = data("tests/data/opensubdiv/shapes/loop_icosahedron.obj");
-    for (extra, want) in [(&[][..], "bft"), (&["--scheme", "catmull-clark"][..], "adaptive")] {
+    for (extra, want) in [
+        (&[][..], "bft"),
+        (&["--scheme", "catmull-clark"][..], "adaptive"),
+    ] {
         let o = tessera(
-            &[&["render", ico.as_str(), "--size", "160x120", "-o", out.to_str().unwrap()][..], extra].concat(),
+            &[
+                &[
+                    "render",
+                    ico.as_str(),
+                    "--size",
+                    "160x120",
+                    "-o",
+                    out.to_str().unwrap(),
+                ][..],
+                extra,
+            ]
+            .concat(),
             &[],
         );
         assert!(o.status.success(), "{}", stderr(&o));
@@ -1136,21 +1153,45 @@ fn render_draws_the_limit_surface_of_the_mesh_scheme_by_default() {
 /// Adaptive options out of range, or given to a technique that does not take them, are named.
 #[test]
 fn adaptive_options_are_checked() {
-    fails_with(&["render", "--isolation", "9", "-o", "/tmp/x.png"], &[], &["--isolation 9"]);
-    fails_with(&["render", "--isolation", "0", "-o", "/tmp/x.png"], &[], &["--isolation 0"]);
+    fails_with(
+        &["render", "--isolation", "9", "-o", "/tmp/x.png"],
+        &[],
+        &["--isolation 9"],
+    );
+    fails_with(
+        &["render", "--isolation", "0", "-o", "/tmp/x.png"],
+        &[],
+        &["--isolation 0"],
+    );
     fails_with(
         &["render", "--sharpness-scale", "-1", "-o", "/tmp/x.png"],
         &[],
         &["--sharpness-scale"],
     );
     let o = tessera(&["render", "--end-cap", "cubic", "-o", "/tmp/x.png"], &[]);
-    assert!(!o.status.success() && stderr(&o).contains("unknown end cap 'cubic'"), "{}", stderr(&o));
+    assert!(
+        !o.status.success() && stderr(&o).contains("unknown end cap 'cubic'"),
+        "{}",
+        stderr(&o)
+    );
     fails_with(
-        &["render", "--method", "flat", "--isolation", "3", "-o", "/tmp/x.png"],
+        &[
+            "render",
+            "--method",
+            "flat",
+            "--isolation",
+            "3",
+            "-o",
+            "/tmp/x.png",
+        ],
         &[],
         &["--isolation", "--method adaptive"],
     );
-    fails_with(&["render", "--level", "33", "-o", "/tmp/x.png"], &[], &["--segments 33"]);
+    fails_with(
+        &["render", "--level", "33", "-o", "/tmp/x.png"],
+        &[],
+        &["--segments 33"],
+    );
 }
 
 /// `export` of the adaptive surface: every captured vertex mapped to a base face, watertight

@@ -5,8 +5,8 @@
 use super::bindings::*;
 use super::reflect::Reflection;
 use super::{AdaptivePush, BftPush, CaptureRecord, DrawPush, FrameUniforms, Vertex};
-use crate::techniques::adaptive::layout::{PatchRecord, StencilTerm as AdaptiveTerm};
 use crate::shaders::{spirv, Stage, Variant};
+use crate::techniques::adaptive::layout::{PatchRecord, StencilTerm as AdaptiveTerm};
 use crate::techniques::bft::layout::{
     BasePosition, Level1Point, PatchHeader, StencilTerm, TableEntry, TableHeader, TangentTerm,
     STORAGE_BINDINGS,
@@ -645,8 +645,9 @@ fn the_table_covers_every_bft_binding_and_capture_build() {
         ADAPTIVE_CURVES_BINDING,
     ] {
         assert!(
-            rows.iter().any(|(s, _, c)| format!("{s:?}").starts_with("Adaptive")
-                && matches!(c, Check::Buffer { binding: b, .. } if *b == binding)),
+            rows.iter()
+                .any(|(s, _, c)| format!("{s:?}").starts_with("Adaptive")
+                    && matches!(c, Check::Buffer { binding: b, .. } if *b == binding)),
             "adaptive binding {binding} is not checked"
         );
     }

@@ -162,10 +162,11 @@ impl GpuAdaptive {
                         weight: wt as f32,
                     });
                 }
-                let len = u32::try_from(stencil_terms.len()).map_err(|_| LayoutError::TooLarge {
-                    what: "stencil terms",
-                    value: stencil_terms.len() as u64,
-                })?;
+                let len =
+                    u32::try_from(stencil_terms.len()).map_err(|_| LayoutError::TooLarge {
+                        what: "stencil terms",
+                        value: stencil_terms.len() as u64,
+                    })?;
                 stencil_offsets.push(len);
             }
             if rows > 0 {

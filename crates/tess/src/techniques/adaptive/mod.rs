@@ -19,16 +19,15 @@
 //! The GPU data is [`layout`].
 pub mod layout;
 
-use crate::techniques::bft::{base_positions, bbox};
 use crate::capture::{face_corner_uv, FacePoint};
 use crate::context::Context;
 use crate::error::{Result, TessError};
 use crate::gpu::bindings::{
     ADAPTIVE_BASE_POSITIONS_BINDING, ADAPTIVE_CONTROL_POINTS_BINDING, ADAPTIVE_CURVES_BINDING,
-    ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_PLAIN, ADAPTIVE_LOCAL_SIZE, ADAPTIVE_OPTION_FRACTIONAL, ADAPTIVE_OPTION_PATCH_COLOURS,
-    ADAPTIVE_OPTION_POW2, ADAPTIVE_PATCHES_BINDING, ADAPTIVE_STENCIL_OFFSETS_BINDING,
-    ADAPTIVE_STENCIL_TERMS_BINDING, ADAPTIVE_VERTICES_BINDING, BFT_FACTORS_DISTANCE,
-    BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM,
+    ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_PLAIN, ADAPTIVE_LOCAL_SIZE, ADAPTIVE_OPTION_FRACTIONAL,
+    ADAPTIVE_OPTION_PATCH_COLOURS, ADAPTIVE_OPTION_POW2, ADAPTIVE_PATCHES_BINDING,
+    ADAPTIVE_STENCIL_OFFSETS_BINDING, ADAPTIVE_STENCIL_TERMS_BINDING, ADAPTIVE_VERTICES_BINDING,
+    BFT_FACTORS_DISTANCE, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM,
 };
 use crate::gpu::AdaptivePush;
 use crate::shaders::{self, Stage, Variant};
@@ -36,6 +35,7 @@ use crate::technique::{
     for_each_draw, number_arrays, DrawCounts, FactorPolicy, FrameParams, Pass, PatchArray,
     PatchPipeline, PatchType, Technique, TechniqueId,
 };
+use crate::techniques::bft::{base_positions, bbox};
 use crate::tessellator::{quad_triangle_count, uniform_vertex_count, Domain, Spacing};
 use layout::GpuAdaptive;
 use topology::adaptive::{plan_adaptive, AdaptiveOptions, AdaptivePlan, EndCap};
@@ -491,7 +491,10 @@ impl Technique for Adaptive {
                 expected: self.base_positions.len(),
             });
         }
-        if let Some(v) = positions.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+        if let Some(v) = positions
+            .iter()
+            .position(|p| p.iter().any(|c| !c.is_finite()))
+        {
             return Err(TessError::NonFiniteVertex { vertex: v });
         }
         let slots = self.base.len();
