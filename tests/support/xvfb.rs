@@ -14,6 +14,23 @@ impl Drop for Xvfb {
     fn drop(&mut self) {
         let _ = self.child.kill();
         let _ = self.child.wait();
+        // A killed server leaves its lock and socket behind; remove them so the display is
+        // free for the next run.
+        let n = self.display.trim_start_matches(':');
+        let _ = std::fs::remove_file(format!("/tmp/.X{n}-lock"));
+        let _ = std::fs::remove_file(format!("/tmp/.X11-unix/X{n}"));
+    }
+}
+
+/// Whether display `n` is held by a live server: a lock file naming a running process (a
+/// lock left by a killed server does not count; Xvfb replaces it).
+fn display_taken(n: u32) -> bool {
+    let Ok(text) = std::fs::read_to_string(format!("/tmp/.X{n}-lock")) else {
+        return Path::new(&format!("/tmp/.X11-unix/X{n}")).exists();
+    };
+    match text.trim().parse::<u32>() {
+        Ok(pid) => Path::new(&format!("/proc/{pid}")).exists(),
+        Err(_) => true,
     }
 }
 
@@ -22,9 +39,12 @@ impl Drop for Xvfb {
 pub fn start(displays: std::ops::Range<u32>) -> Option<Xvfb> {
     for n in displays {
         let socket = format!("/tmp/.X11-unix/X{n}");
-        if Path::new(&socket).exists() || Path::new(&format!("/tmp/.X{n}-lock")).exists() {
+        if display_taken(n) {
             continue;
         }
+        // Stale files of a killed server.
+        let _ = std::fs::remove_file(format!("/tmp/.X{n}-lock"));
+        let _ = std::fs::remove_file(&socket);
         let display = format!(":{n}");
         let child = Command::new("Xvfb")
             .args([&display, "-screen", "0", "640x480x24", "-nolisten", "tcp"])
@@ -44,13 +64,14 @@ pub fn start(displays: std::ops::Range<u32>) -> Option<Xvfb> {
 /// [`start`], or None after saying the test is skipped; fails where `TESSERA_REQUIRE_XVFB` is
 /// set (the README's test command installs Xvfb and sets it, so CI never skips).
 pub fn start_or_skip(displays: std::ops::Range<u32>) -> Option<Xvfb> {
-    let server = start(displays);
+    let server = start(displays.clone());
     if server.is_none() {
         assert!(
             std::env::var_os("TESSERA_REQUIRE_XVFB").is_none(),
-            "Xvfb is required here but not installed"
+            "Xvfb is required here but is not installed or every display of {displays:?} is held \
+             by a running server"
         );
-        eprintln!("skipping: Xvfb not installed");
+        eprintln!("skipping: Xvfb not installed or no free display");
     }
     server
 }

@@ -716,12 +716,16 @@ fn export_bad_inputs_are_named_errors() {
             "--segments",
             "4",
             "--scheme",
-            "catmull-clark",
+            "doo-sabin",
             "-o",
             out,
         ],
         &[],
-        &["--scheme catmull-clark", "loop"],
+        &[
+            "--scheme doo-sabin",
+            "loop (--method bft)",
+            "catmull-clark (--method adaptive)",
+        ],
     );
     fails_with(
         &[
