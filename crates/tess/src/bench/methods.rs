@@ -203,10 +203,17 @@ pub struct TechniqueMethod {
 impl TechniqueMethod {
     pub fn new(ctx: &MethodContext<'_>, info: &TechniqueInfo, animated: bool) -> Result<Self> {
         let mut context = Context::new(ctx.device, ctx.color_format, ctx.depth_format, 1)?;
+        // Catmull-Clark techniques take the mesh as loaded; the others its fan triangulation
+        // (the paper's Table I).
+        let mesh = if info.scheme == Some(topology::Scheme::CatmullClark) {
+            &ctx.mesh.input
+        } else {
+            &ctx.mesh.mesh
+        };
         let built = techniques::build(
             &mut context,
             info.id,
-            &ctx.mesh.mesh,
+            mesh,
             &BuildOptions {
                 name: ctx.mesh.name.clone(),
                 isolation: ctx.config.isolation,

@@ -83,6 +83,9 @@ impl Default for BenchConfig {
 pub struct BenchMesh {
     pub name: String,
     pub mesh: ControlMesh,
+    /// The mesh as loaded: what Catmull-Clark techniques subdivide (a fan triangulation is a
+    /// different surface for them).
+    pub input: ControlMesh,
     pub render: RenderMesh,
     /// How the mesh was changed on load (fan triangulation), for the report.
     pub notes: Vec<String>,
@@ -106,6 +109,7 @@ impl BenchMesh {
         Ok(Self {
             name: name.to_owned(),
             mesh: tri,
+            input: mesh.clone(),
             render,
             notes,
         })
