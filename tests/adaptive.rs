@@ -572,3 +572,51 @@ fn uniform_triangle_count_matches_the_capture() {
         }
     }
 }
+
+/// `--sharpness-scale`: 0 draws the smooth surface (the exact limit of the mesh without its
+/// creases), 1 the creased one; the plan is rebuilt, the mesh not reloaded.
+#[test]
+fn sharpness_scale_reshapes_the_surface() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
+        let mesh = shape("catmark_cube_creases0");
+        let mut smooth = mesh.clone();
+        smooth.creases.clear();
+        smooth.corners.clear();
+        let mut results = Vec::new();
+        for scale in [0.0f32, 1.0] {
+            let surf = Adaptive::new(
+                &mut ctx,
+                &mesh,
+                &AdaptiveBuild {
+                    isolation: 3,
+                    sharpness_scale: scale,
+                    name: "creases0".into(),
+                    ..Default::default()
+                },
+            )
+            .expect("surface");
+            let (soup, _) = capturer
+                .capture(&mut ctx, &surf, &FrameParams::uniform(2.0), EXTENT)
+                .expect("capture");
+            let (vs_smooth, _) = deviation(&surf, &soup, &smooth, 2000);
+            let (vs_creased, _) = deviation(&surf, &soup, &mesh, 2000);
+            println!(
+                "scale {scale}: regular vs smooth {vs_smooth:.2e}, vs creased {vs_creased:.2e}"
+            );
+            results.push((vs_smooth, vs_creased));
+        }
+        assert!(
+            results[0].0 <= 1e-5 && results[0].1 > 1e-3,
+            "scale 0: {:?}",
+            results[0]
+        );
+        assert!(
+            results[1].1 <= 1e-5 && results[1].0 > 1e-3,
+            "scale 1: {:?}",
+            results[1]
+        );
+    }
+}
