@@ -119,6 +119,8 @@ pub enum EvalError {
         dim: usize,
         vertices: usize,
     },
+    #[error("vertex {vertex} belongs to no face: it has no limit position")]
+    IsolatedVertex { vertex: u32 },
     #[error("evaluation of face {face} at ({u}, {v}) did not converge")]
     NotConverged { face: usize, u: f64, v: f64 },
     #[error("no basis-function table case {key:?}")]
@@ -427,6 +429,47 @@ impl LocalMesh {
     pub fn vertex_limit_position(&self, v: u32) -> Option<Vec<f64>> {
         let view = self.view();
         view.vertex_limit(v, &view.fan(v), None).map(|(p, _, _)| p)
+    }
+
+    /// Exact limit position of vertex `v`: its limit mask where no semi-sharp feature is left
+    /// (and its ring allows one), else the exact evaluator at the vertex's corner of its first
+    /// face, which refines only that neighbourhood until the sharpness has decayed. A mask
+    /// applied where a semi-sharp crease is left (OpenSubdiv's `PrimvarRefiner::Limit`) treats
+    /// it as infinitely sharp and misses the limit.
+    pub fn vertex_limit_exact(&self, v: u32) -> Result<Vec<f64>, EvalError> {
+        if let Some(p) = self.vertex_limit_position(v) {
+            return Ok(p);
+        }
+        const QUAD: [(f64, f64); 4] = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+        const TRIANGLE: [(f64, f64); 3] = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)];
+        let f = self
+            .vertex_faces(v)
+            .next()
+            .ok_or(EvalError::IsolatedVertex { vertex: v })? as usize;
+        let corner = self
+            .face(f)
+            .iter()
+            .position(|&w| w == v)
+            .ok_or(EvalError::IsolatedVertex { vertex: v })?;
+        let sample = match (self.scheme, self.face(f).len()) {
+            (LimitScheme::CatmullClark, 4) => {
+                let (a, b) = QUAD[corner];
+                self.evaluate(f, a, b)
+            }
+            // Sub-quad `corner` of an n-gon has the vertex at its (0, 0).
+            (LimitScheme::CatmullClark, _) => self.evaluate_subface(f, corner, 0.0, 0.0),
+            (LimitScheme::Loop, 3) => {
+                let (a, b) = TRIANGLE[corner];
+                self.evaluate(f, a, b)
+            }
+            (LimitScheme::Loop, size) => Err(EvalError::FaceSize {
+                face: f,
+                size,
+                scheme: LimitScheme::Loop,
+                need: 3,
+            }),
+        }?;
+        Ok(sample.position)
     }
 
     /// Loop limit tangent masks of vertex `v` as stencils: control indices `[v, ring…]` and the

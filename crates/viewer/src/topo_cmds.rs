@@ -9,12 +9,9 @@ pub fn parse_scheme(s: &str) -> Result<Scheme, String> {
     s.parse::<Scheme>().map_err(|e| e.to_string())
 }
 
-/// Limit positions of every vertex of `level`: by the vertex's limit mask where no semi-sharp
-/// feature is left there, else by the exact evaluator at the vertex's corner of one of its
-/// faces. The evaluator refines only that face's neighbourhood until the sharpness has decayed
-/// (a mask applied at this level, as OpenSubdiv's `PrimvarRefiner::Limit` does, treats a
-/// semi-sharp crease as infinitely sharp and misses the limit). Refining the whole level
-/// instead would cost 4× per extra level, and sharpness just below 10 needs 9 more.
+/// Limit positions of every vertex of `level` ([`LocalMesh::vertex_limit_exact`]: masks, or
+/// the exact evaluator next to semi-sharp features). Refining the whole level further instead
+/// would cost 4× per extra level, and sharpness just below 10 needs 9 more.
 fn limit_positions(level: &Level, base: &ControlMesh, scheme: Scheme) -> Result<Vec<[f64; 3]>> {
     let ls = match scheme {
         Scheme::Bilinear => return Ok(level.positions.clone()),
@@ -26,44 +23,12 @@ fn limit_positions(level: &Level, base: &ControlMesh, scheme: Scheme) -> Result<
     let lm = LocalMesh::from_refined_level(level, ls, &base.options)?;
     (0..lm.num_vertices() as u32)
         .map(|v| {
-            let p = match lm.vertex_limit_position(v) {
-                Some(p) => p,
-                None => corner_limit(&lm, v)?,
-            };
+            let p = lm
+                .vertex_limit_exact(v)
+                .with_context(|| format!("limit position of vertex {v}"))?;
             Ok([p[0], p[1], p[2]])
         })
         .collect()
-}
-
-/// The exact limit at vertex `v` of `lm`, evaluated at its corner of its first face.
-fn corner_limit(lm: &LocalMesh, v: u32) -> Result<Vec<f64>> {
-    const QUAD: [(f64, f64); 4] = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
-    const TRIANGLE: [(f64, f64); 3] = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)];
-    let f = lm
-        .vertex_faces(v)
-        .next()
-        .with_context(|| format!("vertex {v} belongs to no face"))? as usize;
-    let corners = lm.face(f);
-    let corner = corners
-        .iter()
-        .position(|&w| w == v)
-        .with_context(|| format!("vertex {v} is not a corner of face {f}"))?;
-    let sample = match (lm.scheme, corners.len()) {
-        (LimitScheme::CatmullClark, 4) => {
-            let (a, b) = QUAD[corner];
-            lm.evaluate(f, a, b)
-        }
-        // Sub-quad `corner` of an n-gon has the vertex at its (0, 0).
-        (LimitScheme::CatmullClark, _) => lm.evaluate_subface(f, corner, 0.0, 0.0),
-        (LimitScheme::Loop, 3) => {
-            let (a, b) = TRIANGLE[corner];
-            lm.evaluate(f, a, b)
-        }
-        (LimitScheme::Loop, n) => bail!("face {f} has {n} corners: Loop needs triangles"),
-    };
-    Ok(sample
-        .with_context(|| format!("limit position of vertex {v}"))?
-        .position)
 }
 
 pub fn subdivide(a: SubdivideArgs) -> Result<()> {

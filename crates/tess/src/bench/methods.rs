@@ -122,8 +122,19 @@ pub fn registry() -> Vec<MethodEntry> {
                cpu-static (drawn only) and cpu-animated (re-subdivided and uploaded every frame)",
         build: |c| {
             Ok(vec![
-                Box::new(CpuLoopMethod::new(c, false)?),
-                Box::new(CpuLoopMethod::new(c, true)?),
+                Box::new(CpuLoopMethod::new(c, false, Scheme::Loop)?),
+                Box::new(CpuLoopMethod::new(c, true, Scheme::Loop)?),
+            ])
+        },
+    });
+    out.push(MethodEntry {
+        name: "cpu-catmark",
+        help: "CPU Catmull-Clark subdivision of the mesh as loaded to level log2 S at the limit, \
+               drawn as plain triangles: cpu-catmark-static and cpu-catmark-animated",
+        build: |c| {
+            Ok(vec![
+                Box::new(CpuLoopMethod::new(c, false, Scheme::CatmullClark)?),
+                Box::new(CpuLoopMethod::new(c, true, Scheme::CatmullClark)?),
             ])
         },
     });
@@ -340,6 +351,19 @@ pub fn loop_level_size(mesh: &ControlMesh, level: usize) -> (u64, u64, u64) {
     (v, e, f)
 }
 
+/// Vertices, edges and faces after `level` Catmull-Clark steps: V' = V + E + F,
+/// E' = 2E + (face corners), F' = face corners (every face splits into one quad per corner).
+pub fn catmark_level_size(mesh: &ControlMesh, level: usize) -> (u64, u64, u64) {
+    let (v, e, _) = loop_level_size(mesh, 0);
+    let (mut v, mut e, mut f) = (v, e, mesh.num_faces() as u64);
+    let mut corners = mesh.faces().map(|f| f.len() as u64).sum::<u64>();
+    for _ in 0..level {
+        (v, e, f) = (v + e + f, 2 * e + corners, corners);
+        corners = 4 * f;
+    }
+    (v, e, f)
+}
+
 /// The CPU result for one frame: the refined mesh at the limit, ready to draw.
 pub struct CpuLimitMesh {
     pub vertices: Vec<Vertex>,
@@ -350,13 +374,27 @@ pub struct CpuLimitMesh {
 /// every vertex moved to its limit position by the limit masks, normals angle-weighted over the
 /// limit positions: M^k on the limit surface, as a CPU application would produce it.
 pub fn cpu_loop_limit_mesh(mesh: &ControlMesh, level: usize) -> Result<CpuLimitMesh> {
-    let mut current = Level::from_mesh(mesh, Scheme::Loop)?;
+    cpu_limit_mesh(mesh, Scheme::Loop, level)
+}
+
+/// [`cpu_loop_limit_mesh`] for Loop or Catmull-Clark; Catmull-Clark quads (and the base
+/// polygons at level 0) are drawn as fan triangles.
+pub fn cpu_limit_mesh(mesh: &ControlMesh, scheme: Scheme, level: usize) -> Result<CpuLimitMesh> {
+    let mut current = Level::from_mesh(mesh, scheme)?;
     for _ in 0..level {
-        current = refine_level(&current, Scheme::Loop, &mesh.options)?.0;
+        current = refine_level(&current, scheme, &mesh.options)?.0;
     }
-    let positions = match loop_limit_positions(&current) {
+    let limit_scheme = if scheme == Scheme::Loop {
+        LimitScheme::Loop
+    } else {
+        LimitScheme::CatmullClark
+    };
+    let positions = match (scheme == Scheme::Loop)
+        .then(|| loop_limit_positions(&current))
+        .flatten()
+    {
         Some(p) => p,
-        None => evaluator_limit_positions(&current, level, &mesh.options)?,
+        None => evaluator_limit_positions(&current, level, &mesh.options, limit_scheme)?,
     };
     let normals =
         angle_weighted_normals(&positions, current.face_offsets(), current.face_vertices());
@@ -368,10 +406,20 @@ pub fn cpu_loop_limit_mesh(mesh: &ControlMesh, level: usize) -> Result<CpuLimitM
             normal: n.map(|c| c as f32),
         })
         .collect();
-    Ok(CpuLimitMesh {
-        vertices,
-        indices: current.face_vertices().to_vec(),
-    })
+    let indices = if scheme == Scheme::Loop {
+        current.face_vertices().to_vec()
+    } else {
+        let (offsets, verts) = current.topology.face_tables();
+        let mut out = Vec::with_capacity(verts.len() * 3 / 2);
+        for w in offsets.windows(2) {
+            let f = &verts[w[0] as usize..w[1] as usize];
+            for k in 1..f.len().saturating_sub(1) {
+                out.extend_from_slice(&[f[0], f[k], f[k + 1]]);
+            }
+        }
+        out
+    };
+    Ok(CpuLimitMesh { vertices, indices })
 }
 
 /// Limit positions of every vertex of a Loop level by the limit masks of
@@ -446,32 +494,28 @@ pub fn loop_limit_positions(level: &Level) -> Option<Vec<[f64; 3]>> {
     Some(out)
 }
 
-/// Limit positions through the general evaluator ([`LocalMesh::vertex_limit_position`]), for
-/// levels [`loop_limit_positions`] declines.
+/// Limit positions through the general evaluator ([`LocalMesh::vertex_limit_exact`]: masks,
+/// or exact evaluation next to semi-sharp features), for levels [`loop_limit_positions`]
+/// declines.
 fn evaluator_limit_positions(
     current: &Level,
     level: usize,
     options: &topology::SubdivOptions,
+    scheme: LimitScheme,
 ) -> Result<Vec<[f64; 3]>> {
     let local =
-        LocalMesh::from_refined_level(current, LimitScheme::Loop, options).map_err(|e| {
-            TessError::Mesh {
-                name: format!("Loop level {level}"),
-                source: e.into(),
-            }
+        LocalMesh::from_refined_level(current, scheme, options).map_err(|e| TessError::Mesh {
+            name: format!("{scheme:?} level {level}"),
+            source: e.into(),
         })?;
     (0..current.num_vertices())
         .map(|v| {
-            let p =
-                local
-                    .vertex_limit_position(v as u32)
-                    .ok_or_else(|| TessError::BenchConfig {
-                        option: "--mesh".into(),
-                        reason: format!(
-                        "vertex {v} of level {level} has no limit mask (a semi-sharp crease is \
-                         left); bench meshes must be crease-free"
-                    ),
-                    })?;
+            let p = local
+                .vertex_limit_exact(v as u32)
+                .map_err(|e| TessError::Mesh {
+                    name: format!("{scheme:?} level {level}, vertex {v}"),
+                    source: e.into(),
+                })?;
             Ok([p[0], p[1], p[2]])
         })
         .collect()
@@ -482,6 +526,7 @@ fn evaluator_limit_positions(
 /// control mesh moves, is subdivided again and uploaded (both timed on the CPU), then drawn.
 pub struct CpuLoopMethod {
     animated: bool,
+    scheme: Scheme,
     base: ControlMesh,
     max_vertices: u64,
     renderer: PlainRenderer,
@@ -494,11 +539,17 @@ pub struct CpuLoopMethod {
 }
 
 impl CpuLoopMethod {
-    pub fn new(ctx: &MethodContext<'_>, animated: bool) -> Result<Self> {
+    /// Loop subdivides the fan-triangulated mesh (Table I); Catmull-Clark the mesh as loaded.
+    pub fn new(ctx: &MethodContext<'_>, animated: bool, scheme: Scheme) -> Result<Self> {
         let context = Context::new(ctx.device, ctx.color_format, ctx.depth_format, 1)?;
         Ok(Self {
             animated,
-            base: ctx.mesh.mesh.clone(),
+            scheme,
+            base: if scheme == Scheme::Loop {
+                ctx.mesh.mesh.clone()
+            } else {
+                ctx.mesh.input.clone()
+            },
             max_vertices: ctx.config.cpu_max_vertices,
             renderer: PlainRenderer::new(&context)?,
             context,
@@ -533,10 +584,11 @@ impl CpuLoopMethod {
 
 impl BenchMethod for CpuLoopMethod {
     fn label(&self) -> &str {
-        if self.animated {
-            "cpu-animated"
-        } else {
-            "cpu-static"
+        match (self.scheme, self.animated) {
+            (Scheme::Loop, true) => "cpu-animated",
+            (Scheme::Loop, false) => "cpu-static",
+            (_, true) => "cpu-catmark-animated",
+            (_, false) => "cpu-catmark-static",
         }
     }
 
@@ -545,12 +597,16 @@ impl BenchMethod for CpuLoopMethod {
             Ok(l) => l,
             Err(e) => return Some(e),
         };
-        let (v, _, f) = loop_level_size(&self.base, level);
+        let (v, _, f) = if self.scheme == Scheme::Loop {
+            loop_level_size(&self.base, level)
+        } else {
+            catmark_level_size(&self.base, level)
+        };
         (v > self.max_vertices).then(|| {
             format!(
-                "Loop level {level} would have {v} vertices and {f} triangles, above the CPU \
+                "{:?} level {level} would have {v} vertices and {f} faces, above the CPU \
                  baseline's limit of {} vertices (--cpu-max-vertices)",
-                self.max_vertices
+                self.scheme, self.max_vertices
             )
         })
     }
@@ -563,7 +619,7 @@ impl BenchMethod for CpuLoopMethod {
         if self.mesh.as_ref().map(|(k, _)| *k) != Some(level) {
             // Not timed: the static mesh is built once, and the animated one needs its buffers.
             self.mesh = None;
-            let cpu = cpu_loop_limit_mesh(&self.base, level)?;
+            let cpu = cpu_limit_mesh(&self.base, self.scheme, level)?;
             let gpu = if self.animated {
                 PlainMesh::dynamic(&self.device, &cpu.vertices, &cpu.indices)?
             } else {
@@ -574,7 +630,7 @@ impl BenchMethod for CpuLoopMethod {
         let cpu_ms = if self.animated {
             let start = Instant::now();
             let base = self.animated_base(frame.index);
-            let cpu = cpu_loop_limit_mesh(&base, level)?;
+            let cpu = cpu_limit_mesh(&base, self.scheme, level)?;
             let subdivided = Instant::now();
             if let Some((_, mesh)) = &mut self.mesh {
                 mesh.write_vertices(&cpu.vertices)?;
@@ -613,7 +669,8 @@ impl BenchMethod for CpuLoopMethod {
         let mut notes = Vec::new();
         if let Some((level, mesh)) = &self.mesh {
             notes.push(format!(
-                "Loop level {level}: {} vertices, {} KiB of vertices + indices on the GPU",
+                "{:?} level {level}: {} vertices, {} KiB of vertices + indices on the GPU",
+                self.scheme,
                 mesh.vertex_count,
                 (mesh.vertex_count as u64 * std::mem::size_of::<Vertex>() as u64
                     + mesh.index_count as u64 * 4)
@@ -691,7 +748,8 @@ mod tests {
             let mut level = Level::from_mesh(&mesh, Scheme::Loop).unwrap();
             for k in 0..3 {
                 let fast = loop_limit_positions(&level).expect("no semi-sharp features");
-                let slow = evaluator_limit_positions(&level, k, &mesh.options).unwrap();
+                let slow =
+                    evaluator_limit_positions(&level, k, &mesh.options, LimitScheme::Loop).unwrap();
                 assert_eq!(fast.len(), slow.len());
                 for (v, (a, b)) in fast.iter().zip(&slow).enumerate() {
                     for c in 0..3 {

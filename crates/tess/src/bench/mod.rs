@@ -12,9 +12,9 @@ mod report;
 pub mod stats;
 
 pub use methods::{
-    build_methods, cpu_loop_limit_mesh, loop_level_for, loop_level_size, method_names, one,
-    registry, BenchFrame, BenchMethod, CpuLimitMesh, CpuLoopMethod, MethodContext, MethodEntry,
-    MethodFactory, TechniqueMethod,
+    build_methods, catmark_level_size, cpu_limit_mesh, cpu_loop_limit_mesh, loop_level_for,
+    loop_level_size, method_names, one, registry, BenchFrame, BenchMethod, CpuLimitMesh,
+    CpuLoopMethod, MethodContext, MethodEntry, MethodFactory, TechniqueMethod,
 };
 pub use report::{parse_csv, CSV_HEADER};
 
@@ -729,5 +729,55 @@ mod tests {
         assert_eq!(cpu.indices.len() as u64, 3 * f);
         assert_eq!(loop_level_for(32), Ok(5));
         assert!(loop_level_for(12).is_err());
+    }
+
+    /// The Catmull-Clark baseline: sizes known before refining, every vertex on the limit
+    /// surface (the exact evaluator at the base vertices' corners), quads drawn as 2 triangles.
+    #[test]
+    fn catmark_baseline_sizes_and_limit() {
+        // Two quads and two triangles sharing edges: an open mixed mesh.
+        let mesh = ControlMesh::from_polygons(
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.1],
+                [2.0, 0.0, 0.0],
+                [0.0, 1.0, 0.2],
+                [1.0, 1.0, 0.0],
+                [2.0, 1.0, 0.3],
+                [1.5, 1.8, 0.1],
+            ],
+            &[
+                vec![0u32, 1, 4, 3],
+                vec![1, 2, 5, 4],
+                vec![4, 5, 6],
+                vec![3, 4, 6],
+            ],
+        );
+        assert_eq!(catmark_level_size(&mesh, 0), (7, 10, 4));
+        for level in 0..=3 {
+            let cpu = cpu_limit_mesh(&mesh, topology::Scheme::CatmullClark, level).unwrap();
+            let (v, _, f) = catmark_level_size(&mesh, level);
+            assert_eq!(cpu.vertices.len() as u64, v, "level {level}");
+            // Level 0 draws its polygons as fans (2 + 2 + 1 + 1 triangles), then quads.
+            let triangles = if level == 0 { 6 } else { 2 * f };
+            assert_eq!(cpu.indices.len() as u64, 3 * triangles, "level {level}");
+            // Base vertex 4 keeps its index; its limit is face 0's corner 2.
+            let want = topology::eval::limit_point(
+                &mesh,
+                topology::eval::LimitScheme::CatmullClark,
+                0,
+                1.0,
+                1.0,
+            )
+            .unwrap()
+            .position;
+            let got = cpu.vertices[4].position;
+            for k in 0..3 {
+                assert!(
+                    (got[k] as f64 - want[k]).abs() < 1e-6,
+                    "level {level}: {got:?} {want:?}"
+                );
+            }
+        }
     }
 }
