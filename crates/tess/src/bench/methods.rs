@@ -762,7 +762,7 @@ mod tests {
     }
 
     #[test]
-    fn semi_sharp_creases_are_declined_until_decayed() {
+    fn semi_sharp_creases_are_evaluated_exactly_until_decayed() {
         let mut mesh = tetrahedron();
         mesh.creases.push(topology::EdgeCrease {
             vertices: [0, 1],
@@ -770,12 +770,18 @@ mod tests {
         });
         let level = Level::from_mesh(&mesh, Scheme::Loop).unwrap();
         assert!(loop_limit_positions(&level).is_none());
-        // One level later it is 0.5: still semi-sharp, a typed error, no panic.
-        let e = cpu_loop_limit_mesh(&mesh, 1)
-            .err()
-            .expect("semi-sharp")
-            .to_string();
-        assert!(e.contains("semi-sharp"), "{e}");
+        // One level later it is 0.5: still semi-sharp, so the masks decline and the exact
+        // evaluator places the vertices: base vertex 0 (it keeps its index) lands on the limit
+        // the evaluator finds on the control mesh itself, at the vertex's corner of face 0.
+        let cpu = cpu_loop_limit_mesh(&mesh, 1).expect("exact beside the crease");
+        let corner = mesh.face(0).iter().position(|&v| v == 0).unwrap();
+        let (u, v) = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)][corner];
+        let want = topology::eval::limit_point(&mesh, LimitScheme::Loop, 0, u, v)
+            .unwrap()
+            .position;
+        for c in 0..3 {
+            assert!((cpu.vertices[0].position[c] as f64 - want[c]).abs() < 1e-6);
+        }
         // Two levels later the crease has decayed and the masks apply.
         let cpu = cpu_loop_limit_mesh(&mesh, 2).unwrap();
         assert_eq!(cpu.indices.len(), 3 * 4 * 16);
