@@ -779,8 +779,8 @@ mod tests {
         let want = topology::eval::limit_point(&mesh, LimitScheme::Loop, 0, u, v)
             .unwrap()
             .position;
-        for c in 0..3 {
-            assert!((cpu.vertices[0].position[c] as f64 - want[c]).abs() < 1e-6);
+        for (got, want) in cpu.vertices[0].position.iter().zip(&want) {
+            assert!((*got as f64 - want).abs() < 1e-6, "{got} vs {want}");
         }
         // Two levels later the crease has decayed and the masks apply.
         let cpu = cpu_loop_limit_mesh(&mesh, 2).unwrap();
