@@ -7,6 +7,7 @@ pub mod face_patches;
 pub mod flat;
 pub mod phong;
 pub mod pn;
+pub mod shared;
 
 use crate::context::Context;
 use crate::error::{Result, TessError};

@@ -19,6 +19,7 @@
 //! The GPU data is [`layout`].
 pub mod layout;
 
+use super::shared::{check_adaptive_policy, factor_fields, storage, storage_binding};
 use crate::capture::{face_corner_uv, FacePoint};
 use crate::context::Context;
 use crate::error::{Result, TessError};
@@ -27,7 +28,6 @@ use crate::gpu::bindings::{
     ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_PLAIN, ADAPTIVE_LOCAL_SIZE, ADAPTIVE_OPTION_FRACTIONAL,
     ADAPTIVE_OPTION_PATCH_COLOURS, ADAPTIVE_OPTION_POW2, ADAPTIVE_PATCHES_BINDING,
     ADAPTIVE_STENCIL_OFFSETS_BINDING, ADAPTIVE_STENCIL_TERMS_BINDING, ADAPTIVE_VERTICES_BINDING,
-    BFT_FACTORS_DISTANCE, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM,
 };
 use crate::gpu::AdaptivePush;
 use crate::shaders::{self, Stage, Variant};
@@ -46,22 +46,6 @@ use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Encoder, MemoryLocation};
 
 /// Default isolation level (OpenSubdiv's and the issue's).
 pub const DEFAULT_ISOLATION: u32 = 4;
-
-const STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
-    vk::ShaderStageFlags::COMPUTE.as_raw()
-        | vk::ShaderStageFlags::VERTEX.as_raw()
-        | vk::ShaderStageFlags::TESSELLATION_CONTROL.as_raw()
-        | vk::ShaderStageFlags::TESSELLATION_EVALUATION.as_raw()
-        | vk::ShaderStageFlags::FRAGMENT.as_raw(),
-);
-
-const fn storage_binding(binding: u32) -> BindingDesc {
-    BindingDesc {
-        binding,
-        ty: vk::DescriptorType::STORAGE_BUFFER,
-        stages: STAGES,
-    }
-}
 
 /// Set 1 of every adaptive pipeline.
 static SET_BINDINGS: [BindingDesc; 7] = [
@@ -99,18 +83,6 @@ impl Default for AdaptiveBuild {
             name: "mesh".into(),
         }
     }
-}
-
-fn storage(device: &vk_core::Device, name: &str, bytes: &[u8]) -> Result<Buffer> {
-    // Zero-length storage buffers are invalid; pad empty arrays to one word.
-    let pad = [0u8; 4];
-    let data = if bytes.is_empty() { &pad[..] } else { bytes };
-    Ok(Buffer::with_data(
-        device,
-        name,
-        vk::BufferUsageFlags::STORAGE_BUFFER,
-        data,
-    )?)
 }
 
 /// One feature-adaptive Catmull-Clark surface on the GPU. Drop order: pipeline, sets (they
@@ -286,13 +258,7 @@ impl Adaptive {
     }
 
     fn push(&self, params: &FrameParams, mode: u32) -> AdaptivePush {
-        let (factor_mode, uniform_level, pixels, reference) = match params.factors {
-            FactorPolicy::Uniform { segments } => (BFT_FACTORS_UNIFORM, segments, 0.0, 0.0),
-            FactorPolicy::Screen { pixels } => (BFT_FACTORS_SCREEN, 0.0, pixels.max(0.01), 0.0),
-            FactorPolicy::Distance { reference } => {
-                (BFT_FACTORS_DISTANCE, 0.0, 0.0, reference.max(1e-6))
-            }
-        };
+        let (factor_mode, uniform_level, pixels, reference) = factor_fields(params.factors);
         let fractional = params.spacing == Spacing::FractionalEven;
         let adaptive = !matches!(params.factors, FactorPolicy::Uniform { .. });
         let mut options = 0;
@@ -392,23 +358,9 @@ impl Technique for Adaptive {
                     });
                 }
             }
-            FactorPolicy::Screen { pixels } if !(pixels.is_finite() && pixels >= 0.5) => {
-                return Err(TessError::OutOfRange {
-                    option: "--pixels",
-                    value: pixels.to_string(),
-                    range: "at least 0.5 pixels per segment",
-                })
-            }
-            FactorPolicy::Distance { reference } if !(reference.is_finite() && reference > 0.0) => {
-                return Err(TessError::OutOfRange {
-                    option: "--distance",
-                    value: reference.to_string(),
-                    range: "a positive distance",
-                })
-            }
             _ => {}
         }
-        Ok(())
+        check_adaptive_policy(params)
     }
 
     fn patch_pipeline(&self, patch: PatchType) -> PatchPipeline {

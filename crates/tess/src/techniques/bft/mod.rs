@@ -20,10 +20,10 @@ use crate::context::Context;
 use crate::error::{Result, TessError};
 pub mod layout;
 
+use super::shared::{check_adaptive_policy, factor_fields, storage, storage_binding};
 use crate::gpu::bindings::{
-    BFT_BASE_POSITIONS_BINDING, BFT_FACTORS_DISTANCE, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM,
-    BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING, BFT_LOCAL_SIZE,
-    BFT_OPTION_FRACTIONAL, BFT_OPTION_GEOMETRIC_NORMALS, BFT_OPTION_PATCH_COLOURS,
+    BFT_BASE_POSITIONS_BINDING, BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING,
+    BFT_LOCAL_SIZE, BFT_OPTION_FRACTIONAL, BFT_OPTION_GEOMETRIC_NORMALS, BFT_OPTION_PATCH_COLOURS,
 };
 use crate::gpu::BftPush;
 use crate::shaders::{self, Stage, Variant};
@@ -37,26 +37,10 @@ use topology::bft::{prepare_loop_bft, LoopBft};
 use topology::ControlMesh;
 use vk_core::descriptor::{BindingDesc, DescriptorPool};
 use vk_core::pipeline::{Pipeline, ShaderStage};
-use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Device, Encoder, MemoryLocation};
+use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Encoder, MemoryLocation};
 
 /// Default maximum table level: 32 segments per level-1 edge, 64 per base edge.
 pub const DEFAULT_TABLE_LEVEL: u32 = 5;
-
-const STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
-    vk::ShaderStageFlags::COMPUTE.as_raw()
-        | vk::ShaderStageFlags::VERTEX.as_raw()
-        | vk::ShaderStageFlags::TESSELLATION_CONTROL.as_raw()
-        | vk::ShaderStageFlags::TESSELLATION_EVALUATION.as_raw()
-        | vk::ShaderStageFlags::FRAGMENT.as_raw(),
-);
-
-const fn storage_binding(binding: u32) -> BindingDesc {
-    BindingDesc {
-        binding,
-        ty: vk::DescriptorType::STORAGE_BUFFER,
-        stages: STAGES,
-    }
-}
 
 /// Set 1 of every BFT pipeline: the storage buffers of [`STORAGE_BINDINGS`].
 static SET_BINDINGS: [BindingDesc; STORAGE_BINDINGS.len()] = {
@@ -131,18 +115,6 @@ pub struct Bft {
     rest_bbox: ([f32; 3], [f32; 3]),
     /// How the input was taken (fan triangulation), for the caller to show.
     pub notes: Vec<String>,
-}
-
-fn storage(device: &Device, name: &str, bytes: &[u8]) -> Result<Buffer> {
-    // Zero-length storage buffers are invalid; pad empty arrays to one word.
-    let pad = [0u8; 4];
-    let data = if bytes.is_empty() { &pad[..] } else { bytes };
-    Ok(Buffer::with_data(
-        device,
-        name,
-        vk::BufferUsageFlags::STORAGE_BUFFER,
-        data,
-    )?)
 }
 
 /// The base positions of `mesh` in f32.
@@ -306,13 +278,9 @@ impl Bft {
     }
 
     fn push(&self, params: &FrameParams, mode: u32) -> BftPush {
-        let (factor_mode, uniform_level, pixels, reference) = match params.factors {
-            FactorPolicy::Uniform { segments } => (BFT_FACTORS_UNIFORM, segments * 0.5, 0.0, 0.0),
-            FactorPolicy::Screen { pixels } => (BFT_FACTORS_SCREEN, 0.0, pixels.max(0.01), 0.0),
-            FactorPolicy::Distance { reference } => {
-                (BFT_FACTORS_DISTANCE, 0.0, 0.0, reference.max(1e-6))
-            }
-        };
+        let (factor_mode, segments, pixels, reference) = factor_fields(params.factors);
+        // The tables count segments per level-1 edge: half a base edge.
+        let uniform_level = segments * 0.5;
         BftPush {
             mode,
             first_patch: 0,
@@ -372,23 +340,9 @@ impl Technique for Bft {
                     });
                 }
             }
-            FactorPolicy::Screen { pixels } if !(pixels.is_finite() && pixels >= 0.5) => {
-                return Err(TessError::OutOfRange {
-                    option: "--pixels",
-                    value: pixels.to_string(),
-                    range: "at least 0.5 pixels per segment",
-                })
-            }
-            FactorPolicy::Distance { reference } if !(reference.is_finite() && reference > 0.0) => {
-                return Err(TessError::OutOfRange {
-                    option: "--distance",
-                    value: reference.to_string(),
-                    range: "a positive distance",
-                })
-            }
             _ => {}
         }
-        Ok(())
+        check_adaptive_policy(params)
     }
 
     fn patch_pipeline(&self, _patch: PatchType) -> PatchPipeline {

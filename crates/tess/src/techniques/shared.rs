@@ -1,0 +1,72 @@
+//! What the techniques with storage-buffer sets and adaptive factors (BFT, adaptive) share:
+//! the stages their sets are visible to, static storage buffers, and the factor-policy fields
+//! and checks of their push constants.
+use crate::error::{Result, TessError};
+use crate::gpu::bindings::{BFT_FACTORS_DISTANCE, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM};
+use crate::technique::{FactorPolicy, FrameParams};
+use vk_core::descriptor::BindingDesc;
+use vk_core::{vk, Buffer, Device};
+
+/// Every stage a technique's set 1 is read from (the compute pre-pass and the draw).
+pub const STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
+    vk::ShaderStageFlags::COMPUTE.as_raw()
+        | vk::ShaderStageFlags::VERTEX.as_raw()
+        | vk::ShaderStageFlags::TESSELLATION_CONTROL.as_raw()
+        | vk::ShaderStageFlags::TESSELLATION_EVALUATION.as_raw()
+        | vk::ShaderStageFlags::FRAGMENT.as_raw(),
+);
+
+/// A storage buffer at `binding`, visible to [`STAGES`].
+pub const fn storage_binding(binding: u32) -> BindingDesc {
+    BindingDesc {
+        binding,
+        ty: vk::DescriptorType::STORAGE_BUFFER,
+        stages: STAGES,
+    }
+}
+
+/// A GPU-only storage buffer holding `bytes`; an empty array is padded to one word
+/// (zero-length buffers are invalid).
+pub fn storage(device: &Device, name: &str, bytes: &[u8]) -> Result<Buffer> {
+    let pad = [0u8; 4];
+    let data = if bytes.is_empty() { &pad[..] } else { bytes };
+    Ok(Buffer::with_data(
+        device,
+        name,
+        vk::BufferUsageFlags::STORAGE_BUFFER,
+        data,
+    )?)
+}
+
+/// The push-constant fields of a factor policy: (`BFT_FACTORS_*` mode, uniform segments,
+/// pixels per segment, reference distance), the segments as the policy gives them.
+pub fn factor_fields(factors: FactorPolicy) -> (u32, f32, f32, f32) {
+    match factors {
+        FactorPolicy::Uniform { segments } => (BFT_FACTORS_UNIFORM, segments, 0.0, 0.0),
+        FactorPolicy::Screen { pixels } => (BFT_FACTORS_SCREEN, 0.0, pixels.max(0.01), 0.0),
+        FactorPolicy::Distance { reference } => {
+            (BFT_FACTORS_DISTANCE, 0.0, 0.0, reference.max(1e-6))
+        }
+    }
+}
+
+/// The screen and distance policies' own ranges (techniques check their uniform levels).
+pub fn check_adaptive_policy(params: &FrameParams) -> Result<()> {
+    match params.factors {
+        FactorPolicy::Screen { pixels } if !(pixels.is_finite() && pixels >= 0.5) => {
+            Err(TessError::OutOfRange {
+                option: "--pixels",
+                value: pixels.to_string(),
+                range: "at least 0.5 pixels per segment",
+            })
+        }
+        FactorPolicy::Distance { reference } if !(reference.is_finite() && reference > 0.0) => {
+            Err(TessError::OutOfRange {
+                option: "--distance",
+                value: reference.to_string(),
+                range: "a positive distance",
+            })
+        }
+        _ => Ok(()),
+    }
+}
