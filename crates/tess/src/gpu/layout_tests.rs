@@ -506,6 +506,15 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
     rows
 }
 
+/// The set a stage's storage buffers live in: its technique's.
+fn technique_set(stage: Stage) -> u32 {
+    if stage.path().starts_with("adaptive/") {
+        ADAPTIVE_SET
+    } else {
+        BFT_SET
+    }
+}
+
 fn check(stage: Stage, v: Variant, check: &Check) -> Result<(), String> {
     let words = spirv(stage, v).map_err(|e| e.to_string())?;
     let r = Reflection::new(words).map_err(|e| e.to_string())?;
@@ -538,9 +547,10 @@ fn check(stage: Stage, v: Variant, check: &Check) -> Result<(), String> {
             let b = r
                 .binding(block)
                 .ok_or_else(|| format!("{block}: no bound block"))?;
-            if (b.set, b.binding) != (BFT_SET, *binding) {
+            let set = technique_set(stage);
+            if (b.set, b.binding) != (set, *binding) {
                 return Err(format!(
-                    "{block}: set {} binding {}, Rust set {BFT_SET} binding {binding}",
+                    "{block}: set {} binding {}, Rust set {set} binding {binding}",
                     b.set, b.binding
                 ));
             }
