@@ -94,6 +94,9 @@ pub struct Adaptive {
     base: Vec<Buffer>,
     _static: Vec<Buffer>,
     arrays: Vec<PatchArray>,
+    /// Per array: how many patches have each combination of edge kinds (the 2-bit kinds of
+    /// `edge_info`), counted once so uniform triangle counts cost a few entries per call.
+    edge_kinds: Vec<Vec<(u32, u64)>>,
     pub gpu: GpuAdaptive,
     pub plan: AdaptivePlan,
     pub mesh: ControlMesh,
@@ -229,6 +232,17 @@ impl Adaptive {
             (PatchType::Gregory, gregory, 1),
             (PatchType::Bilinear, bilinear, 1),
         ]);
+        let edge_kinds = arrays
+            .iter()
+            .map(|a| {
+                let mut counts = std::collections::BTreeMap::new();
+                let range = a.first_patch as usize..(a.first_patch + a.patches) as usize;
+                for p in &gpu.patches[range] {
+                    *counts.entry(p.edge_info & 0x3333).or_insert(0u64) += 1;
+                }
+                counts.into_iter().collect()
+            })
+            .collect();
         let max_level = device.info.caps.max_tessellation_generation_level as f32;
         Ok(Self {
             stencil,
@@ -237,6 +251,7 @@ impl Adaptive {
             base,
             _static: statics.into_iter().map(|(_, b)| b).collect(),
             arrays,
+            edge_kinds,
             gpu,
             plan,
             mesh: mesh.clone(),
@@ -347,18 +362,14 @@ impl Technique for Adaptive {
             });
         }
         let half = (self.factor_limit() * 0.5).floor();
-        match params.factors {
-            FactorPolicy::Uniform { segments } => {
-                let whole = segments.fract() == 0.0;
-                if !whole || segments < 1.0 || segments > half {
-                    return Err(TessError::OutOfRange {
-                        option: "--segments",
-                        value: segments.to_string(),
-                        range: "whole segments per patch edge, 1 up to half the device's maximum tessellation level (transition edges double it)",
-                    });
-                }
+        if let FactorPolicy::Uniform { segments } = params.factors {
+            if segments.fract() != 0.0 || segments < 1.0 || segments > half {
+                return Err(TessError::OutOfRange {
+                    option: "--segments",
+                    value: segments.to_string(),
+                    range: "whole segments per patch edge, 1 up to half the device's maximum tessellation level (transition edges double it)",
+                });
             }
-            _ => {}
         }
         check_adaptive_policy(params)
     }
@@ -402,22 +413,14 @@ impl Technique for Adaptive {
     /// Exact for uniform factors: each patch's edge levels as `patch.tesc` sets them (a
     /// coarse transition edge doubled), counted by the tessellator's arithmetic.
     fn triangles(&self, params: &FrameParams, array: usize) -> Option<u64> {
-        let a = self.arrays.get(array)?;
         let FactorPolicy::Uniform { segments } = params.factors else {
             return None;
         };
-        let patches = self
-            .gpu
-            .patches
-            .get(a.first_patch as usize..(a.first_patch + a.patches) as usize)?;
-        let mut counts = std::collections::HashMap::new();
-        for p in patches {
-            *counts.entry(p.edge_info & 0x3333).or_insert(0u64) += 1;
-        }
         Some(
-            counts
-                .into_iter()
-                .map(|(kinds, n)| {
+            self.edge_kinds
+                .get(array)?
+                .iter()
+                .map(|&(kinds, n)| {
                     let e = |k: u32| {
                         self.uniform_edge_level(segments, params.spacing, (kinds >> (4 * k)) & 3)
                     };

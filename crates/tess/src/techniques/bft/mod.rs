@@ -328,19 +328,16 @@ impl Technique for Bft {
         }
         let fractional = params.spacing == Spacing::FractionalEven;
         let max = 2 * self.max_level();
-        match params.factors {
-            FactorPolicy::Uniform { segments } => {
-                let whole = segments.fract() == 0.0 && segments >= 1.0;
-                let s = segments as u32;
-                if !whole || s < 2 || s > max || (!fractional && !s.is_power_of_two()) {
-                    return Err(TessError::BftSegments {
-                        segments,
-                        max,
-                        table_level: self.gpu.table.level,
-                    });
-                }
+        if let FactorPolicy::Uniform { segments } = params.factors {
+            let whole = segments.fract() == 0.0 && segments >= 1.0;
+            let s = segments as u32;
+            if !whole || s < 2 || s > max || (!fractional && !s.is_power_of_two()) {
+                return Err(TessError::BftSegments {
+                    segments,
+                    max,
+                    table_level: self.gpu.table.level,
+                });
             }
-            _ => {}
         }
         check_adaptive_policy(params)
     }
