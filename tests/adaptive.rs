@@ -123,12 +123,13 @@ fn geometric_distance(
 
 /// Worst distances over the bbox diagonal between captured vertices and the exact limit, over
 /// at most `samples` welded vertices: (regular patches at their base point, end caps at their
-/// base point, end caps to the nearest limit point).
-fn deviations(
+/// base point, end caps to the nearest limit point when `geometric`, else 0).
+fn deviations_with(
     surf: &Adaptive,
     soup: &CapturedSoup,
     mesh: &ControlMesh,
     samples: usize,
+    geometric: bool,
 ) -> (f64, f64, f64) {
     let cpu = LocalMesh::from_control_mesh(mesh, LimitScheme::CatmullClark).expect("cpu mesh");
     let welded = soup.weld().expect("weld");
@@ -155,7 +156,7 @@ fn deviations(
             regular = regular.max(err);
         } else {
             caps = caps.max(err);
-            if err * d > 1e-7 {
+            if geometric && err * d > 1e-7 {
                 let g = geometric_distance(&cpu, quad, f as usize, sub as usize, (bu, bv), p) / d;
                 caps_geometric = caps_geometric.max(g);
             }
@@ -164,40 +165,24 @@ fn deviations(
     (regular, caps, caps_geometric)
 }
 
-/// Worst distance over the bbox diagonal between captured vertices and the exact limit at
-/// their base point: (regular patches, end caps), over at most `samples` welded vertices.
+/// [`deviations_with`], the distance to the surface included.
+fn deviations(
+    surf: &Adaptive,
+    soup: &CapturedSoup,
+    mesh: &ControlMesh,
+    samples: usize,
+) -> (f64, f64, f64) {
+    deviations_with(surf, soup, mesh, samples, true)
+}
+
+/// [`deviations_with`] at the base points only: (regular patches, end caps).
 fn deviation(
     surf: &Adaptive,
     soup: &CapturedSoup,
     mesh: &ControlMesh,
     samples: usize,
 ) -> (f64, f64) {
-    let cpu = LocalMesh::from_control_mesh(mesh, LimitScheme::CatmullClark).expect("cpu mesh");
-    let welded = soup.weld().expect("weld");
-    let n = welded.positions.len();
-    let stride = n.div_ceil(samples).max(1);
-    let d = diag(mesh);
-    let (mut regular, mut caps) = (0.0f64, 0.0f64);
-    for i in (0..n).step_by(stride) {
-        let [u, v] = welded.domain[i].map(f64::from);
-        let (f, sub, bu, bv) = surf.base_param(welded.patch[i], u, v).expect("patch");
-        let quad = mesh.face(f as usize).len() == 4;
-        let e = if quad {
-            cpu.evaluate(f as usize, bu, bv)
-        } else {
-            cpu.evaluate_subface(f as usize, sub as usize, bu, bv)
-        }
-        .expect("exact limit");
-        let err = (0..3)
-            .map(|k| (welded.positions[i][k] as f64 - e.position[k]).abs())
-            .fold(0.0, f64::max)
-            / d;
-        if welded.flags[i] & 15 == ADAPTIVE_KIND_REGULAR {
-            regular = regular.max(err);
-        } else {
-            caps = caps.max(err);
-        }
-    }
+    let (regular, caps, _) = deviations_with(surf, soup, mesh, samples, false);
     (regular, caps)
 }
 
