@@ -3,13 +3,10 @@
 /// Everything that can go wrong while loading, validating or refining a control mesh.
 #[derive(Debug, thiserror::Error)]
 pub enum TopologyError {
-    /// The OBJ file could not be read.
-    #[error("{file}: cannot read file: {source}")]
-    Io {
-        file: String,
-        #[source]
-        source: std::io::Error,
-    },
+    /// The OBJ file could not be read. The I/O error is said in the message, not chained
+    /// (`error`, not `source`), so `{:#}` chains say it once.
+    #[error("{file}: cannot read file: {error}")]
+    Io { file: String, error: std::io::Error },
     /// A line of OBJ text could not be understood.
     #[error("{file}:{line}: {kind}")]
     Parse {
@@ -17,12 +14,15 @@ pub enum TopologyError {
         line: usize,
         kind: ObjSyntax,
     },
-    /// A validation error found in a named file (the inner error says what and where).
-    #[error("{file}: {source}")]
+    /// A validation error found in an OBJ file: shown in the file's own terms (1-based vertex
+    /// and face numbers, the line that made the element at fault when there is one), while
+    /// `error` keeps the 0-based numbers of the loaded [`crate::ControlMesh`] for code that
+    /// matches on it ([`TopologyError::root`]). Said in the message, not chained.
+    #[error("{file}{}: {}", at_line(*.line), ObjTerms(.error))]
     InFile {
         file: String,
-        #[source]
-        source: Box<TopologyError>,
+        line: Option<usize>,
+        error: Box<TopologyError>,
     },
     /// The mesh has no faces (or no vertices): there is nothing to subdivide.
     #[error("empty mesh: {what}")]
@@ -57,13 +57,22 @@ pub enum TopologyError {
         v1: u32,
     },
     /// A vertex position with NaN or infinite coordinates.
-    #[error("vertex {vertex} has a non-finite position {position:?}")]
+    #[error("vertex {vertex} has a non-finite position ({})", xyz(position))]
     NonFinitePosition { vertex: usize, position: [f64; 3] },
+    /// A finite vertex position with a coordinate beyond [`crate::MAX_COORDINATE`], where
+    /// intermediates of the f32 GPU path would overflow (see there).
+    #[error(
+        "vertex {vertex} at ({}) has a coordinate beyond ±{:e}, the largest the GPU's f32 \
+         arithmetic keeps finite (scale the mesh down)",
+        xyz(position),
+        crate::MAX_COORDINATE
+    )]
+    CoordinateOutOfRange { vertex: usize, position: [f64; 3] },
     /// Loop subdivision was asked for a mesh with non-triangular faces.
     #[error("Loop subdivision needs triangles, but face {face} has {size} vertices")]
     LoopRequiresTriangles { face: usize, size: usize },
     /// A crease, corner or hole tag naming a vertex or face the mesh does not have.
-    #[error("invalid tag: {tag} names {} {index}, mesh has {count} {}s", tag.element(), tag.element())]
+    #[error("invalid tag: {tag} names {} {index}, mesh has {count} {}", tag.element(), tag.elements())]
     TagOutOfRange {
         tag: TagKind,
         index: u32,
@@ -146,6 +155,14 @@ impl TagKind {
             TagKind::Hole => "face",
         }
     }
+
+    /// [`TagKind::element`] in the plural.
+    pub fn elements(self) -> &'static str {
+        match self {
+            TagKind::Crease | TagKind::Corner => "vertices",
+            TagKind::Hole => "faces",
+        }
+    }
 }
 
 impl std::fmt::Display for TagKind {
@@ -162,21 +179,123 @@ impl TopologyError {
     /// The underlying error with any file wrapper removed (useful to match on the kind).
     pub fn root(&self) -> &TopologyError {
         match self {
-            TopologyError::InFile { source, .. } => source.root(),
+            TopologyError::InFile { error, .. } => error.root(),
             other => other,
         }
     }
 
-    /// Attach a file name to a validation error, so the user knows which file is broken.
-    pub(crate) fn in_file(self, file: &str) -> TopologyError {
+    /// Attach an OBJ file's name (and the line at fault, when known) to an error about a
+    /// mesh loaded from it, so its message uses the file's 1-based numbering. Errors that
+    /// already name a file are returned as they are. Callers that refine or evaluate a mesh
+    /// loaded from OBJ use this to report later errors in the same terms.
+    pub fn in_file(self, file: &str, line: Option<usize>) -> TopologyError {
         match self {
             e @ (TopologyError::Io { .. }
             | TopologyError::Parse { .. }
             | TopologyError::InFile { .. }) => e,
             other => TopologyError::InFile {
                 file: file.to_string(),
-                source: Box::new(other),
+                line,
+                error: Box::new(other),
             },
+        }
+    }
+}
+
+fn at_line(line: Option<usize>) -> String {
+    line.map(|l| format!(":{l}")).unwrap_or_default()
+}
+
+/// `x, y, z` as a user would write them: shortest round-trip digits, in exponent form when
+/// very large or small (3e38, not 39 digits).
+pub(crate) fn xyz(p: &[f64; 3]) -> String {
+    let num = |x: f64| {
+        if x != 0.0 && x.is_finite() && !(1e-6..1e16).contains(&x.abs()) {
+            format!("{x:e}")
+        } else {
+            format!("{x}")
+        }
+    };
+    format!("{}, {}, {}", num(p[0]), num(p[1]), num(p[2]))
+}
+
+/// A [`TopologyError`] about a mesh read from OBJ, worded with the file's 1-based vertex and
+/// face numbers (`f 1 2 3` names vertices 1..3; a mesh's arrays count from 0). Tag indices are
+/// 0-based in the file already (OpenSubdiv's `t` lines) and are shown as written.
+struct ObjTerms<'a>(&'a TopologyError);
+
+impl std::fmt::Display for ObjTerms<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use TopologyError as E;
+        match self.0 {
+            E::IndexOutOfRange { face, index, count } => write!(
+                f,
+                "face {} names vertex {}, but the file has {count} vertices",
+                face + 1,
+                index + 1
+            ),
+            E::DegenerateFace { face, size } => write!(
+                f,
+                "face {} has {size} vertices; a face needs at least 3",
+                face + 1
+            ),
+            E::RepeatedVertex { face, vertex } => write!(
+                f,
+                "face {} uses vertex {} more than once",
+                face + 1,
+                vertex + 1
+            ),
+            E::NonManifoldEdge { v0, v1, faces } => write!(
+                f,
+                "edge {}-{} is shared by {faces} faces (non-manifold edge)",
+                v0 + 1,
+                v1 + 1
+            ),
+            E::NonManifoldVertex { vertex, fans } => write!(
+                f,
+                "vertex {}: its faces form {fans} separate fans (non-manifold vertex)",
+                vertex + 1
+            ),
+            E::InconsistentOrientation {
+                face0,
+                face1,
+                v0,
+                v1,
+            } => write!(
+                f,
+                "faces {} and {} both traverse edge {}->{} in the same direction \
+                 (inconsistent orientation)",
+                face0 + 1,
+                face1 + 1,
+                v0 + 1,
+                v1 + 1
+            ),
+            E::NonFinitePosition { vertex, position } => write!(
+                f,
+                "vertex {} has a non-finite position ({})",
+                vertex + 1,
+                xyz(position)
+            ),
+            E::CoordinateOutOfRange { vertex, position } => write!(
+                f,
+                "vertex {} at ({}) has a coordinate beyond ±{:e}, the largest the GPU's f32 \
+                 arithmetic keeps finite (scale the mesh down)",
+                vertex + 1,
+                xyz(position),
+                crate::MAX_COORDINATE
+            ),
+            E::LoopRequiresTriangles { face, size } => write!(
+                f,
+                "Loop subdivision needs triangles, but face {} has {size} vertices",
+                face + 1
+            ),
+            E::TagOutOfRange { tag, index, count } => write!(
+                f,
+                "invalid tag: {tag} names {} {index} (tags count from 0), the file has {count} {}",
+                tag.element(),
+                tag.elements()
+            ),
+            other => std::fmt::Display::fmt(other, f),
         }
     }
 }
@@ -228,6 +347,11 @@ pub enum ObjSyntax {
         tag: String,
         values: usize,
         elements: usize,
+    },
+    #[error("'{statement}': '{word}' is not a finite number")]
+    NonFiniteNumber {
+        statement: &'static str,
+        word: String,
     },
     #[error("tag '{tag}': sharpness {value} is not finite")]
     NonFiniteSharpness { tag: String, value: f32 },

@@ -20,8 +20,8 @@ pub use adaptive::{
 };
 pub use error::{ObjSyntax, TagKind, TopologyError};
 pub use mesh::{
-    BoundaryInterpolation, ControlMesh, CreaseMethod, EdgeCrease, SubdivOptions, Topology,
-    TriangleSubdivision, VertexCorner,
+    check_positions, BoundaryInterpolation, ControlMesh, CreaseMethod, EdgeCrease, SubdivOptions,
+    Topology, TriangleSubdivision, VertexCorner, MAX_COORDINATE,
 };
 pub use obj::{load_obj, parse_obj, write_control_mesh, write_obj};
 pub use refine::{

@@ -6,6 +6,60 @@ use rayon::prelude::*;
 /// Sentinel for "no face" / "no edge" in adjacency tables.
 pub const INVALID: u32 = u32::MAX;
 
+/// The largest coordinate magnitude a control mesh may have: 10¹² (about 2^39.9).
+/// [`ControlMesh::validate`] rejects positions beyond it ([`TopologyError::CoordinateOutOfRange`]),
+/// so every intermediate of every technique stays finite in f32 on the GPU and in f64 on the CPU.
+///
+/// Why this bound, with R the largest |coordinate| and f32's largest value about 2^128:
+/// - *Points* (subdivision, limit masks, BFT point weights, B-spline and Bézier patches, the
+///   f32 upload): refinement and limit rules of Loop, Catmull-Clark, creases and smooth
+///   triangles have non-negative weights, so refined and limit points stay in the control
+///   hull (|x| ≤ R); Gregory end caps and Bézier conversions use signed weights whose absolute
+///   sum is a small constant (< 2^5). Linear in R: finite while R < 2^123.
+/// - *Tangents* (limit tangent masks, BFT tangent tables, patch derivatives): weights summing
+///   to zero, with an absolute sum that grows with valence, times up to 2^8 (derivatives with
+///   respect to a base face's domain at isolation level 8) times the mesh's diameter 2R. Bounding
+///   that factor by 2^20 gives |tangent| ≤ 2^21·R.
+/// - *Normals*: `du × dv` has components ≤ 2·|du|·|dv| ≤ 2^43·R², finite while R < 2^42.5
+///   (about 6·10¹²). The length of that cross product would square it again (2^86·R⁴, which
+///   overflows f32 already for R ≈ 2^10), so the shaders scale a normal by its largest
+///   component before normalising (`glsl/common/normals.glsl`) and the CPU works in f64
+///   (2^86·R⁴ ≈ 2^246 there, far below f64's 2^1024).
+/// - *View transform*: the camera fits the bounding box, whose diagonal length squares
+///   coordinates once (12·R² ≈ 2^83.6 for R = 10¹²); the projection and the clip coordinates
+///   are linear in R.
+///
+/// 10¹² leaves a factor of about 2^5 below the tightest of these (the normals), and is far
+/// beyond any model's units (10¹² mm is a million km). There is no lower bound: tiny or
+/// coincident coordinates give zero-length tangents and normals, which every normalisation
+/// (GPU and CPU) turns into a fixed fallback instead of NaN.
+pub const MAX_COORDINATE: f64 = 1e12;
+
+/// Checks that every position is finite and within ±[`MAX_COORDINATE`]; the error names the
+/// first vertex (0-based) that is not. Part of [`ControlMesh::validate`]; callers that replace
+/// positions of a validated mesh (animation, a C ABI's position update) check them with this.
+pub fn check_positions(positions: &[[f64; 3]]) -> Result<(), TopologyError> {
+    // `!(|c| <= MAX)` is also true for NaN.
+    let bad = positions
+        .par_iter()
+        .enumerate()
+        .with_min_len(4096)
+        .find_first(|(_, p)| !p.iter().all(|c| c.abs() <= MAX_COORDINATE));
+    match bad {
+        None => Ok(()),
+        Some((vertex, p)) if p.iter().all(|c| c.is_finite()) => {
+            Err(TopologyError::CoordinateOutOfRange {
+                vertex,
+                position: *p,
+            })
+        }
+        Some((vertex, p)) => Err(TopologyError::NonFinitePosition {
+            vertex,
+            position: *p,
+        }),
+    }
+}
+
 /// How boundary vertices are treated (OpenSubdiv `VtxBoundaryInterpolation`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum BoundaryInterpolation {
@@ -214,18 +268,7 @@ impl Topology {
                 corners: mesh.face_vertices.len(),
             });
         }
-        if let Some((vertex, p)) = mesh
-            .positions
-            .par_iter()
-            .enumerate()
-            .with_min_len(4096)
-            .find_first(|(_, p)| !p.iter().all(|c| c.is_finite()))
-        {
-            return Err(TopologyError::NonFinitePosition {
-                vertex,
-                position: *p,
-            });
-        }
+        check_positions(&mesh.positions)?;
         let corners = mesh.face_vertices.len();
         if let Some(n) = &mesh.normals {
             if n.len() != corners {

@@ -4,6 +4,12 @@
 //! group in order of first use and stores them as f32, but the `t crease`/`t corner` tags name
 //! vertices by their index in the file, and refinement works in f64. Faces keep their size
 //! (nothing is triangulated).
+//!
+//! Errors speak the file's language: a parse error names its line; a validation error found
+//! after parsing (an index out of range, a non-manifold edge, a coordinate beyond
+//! [`crate::MAX_COORDINATE`]) is located on the line that made the vertex, face or tag at fault
+//! and worded with the file's 1-based numbers ([`TopologyError::InFile`]). The parser keeps the
+//! line of every vertex, face and tag for that (a few bytes each).
 
 use crate::error::{ObjSyntax, TagKind, TopologyError};
 use crate::mesh::{
@@ -16,9 +22,9 @@ use std::path::Path;
 pub fn load_obj(path: impl AsRef<Path>) -> Result<ControlMesh, TopologyError> {
     let path = path.as_ref();
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| TopologyError::Io {
+    let text = std::fs::read_to_string(path).map_err(|error| TopologyError::Io {
         file: name.clone(),
-        source,
+        error,
     })?;
     parse_obj(&text, &name)
 }
@@ -26,13 +32,58 @@ pub fn load_obj(path: impl AsRef<Path>) -> Result<ControlMesh, TopologyError> {
 /// One face corner as written in the file: (vertex, uv, normal), already 0-based.
 type RawCorner = (i64, Option<i64>, Option<i64>);
 
+/// The line that made each element, for locating validation errors.
+#[derive(Default)]
+struct Lines {
+    vertices: Vec<usize>,
+    faces: Vec<usize>,
+    creases: Vec<usize>,
+    corners: Vec<usize>,
+    holes: Vec<usize>,
+}
+
+impl Lines {
+    /// The line a validation error of `mesh` is about: the vertex's `v` line, the face's `f`
+    /// line (for an edge, the face that made it non-manifold or flipped it), the tag's `t` line.
+    fn locate(&self, e: &TopologyError, mesh: &ControlMesh) -> Option<usize> {
+        use TopologyError as E;
+        let face = |f: usize| self.faces.get(f).copied();
+        match *e {
+            E::NonFinitePosition { vertex, .. } | E::CoordinateOutOfRange { vertex, .. } => {
+                self.vertices.get(vertex).copied()
+            }
+            E::NonManifoldVertex { vertex, .. } => self.vertices.get(vertex as usize).copied(),
+            E::IndexOutOfRange { face: f, .. }
+            | E::DegenerateFace { face: f, .. }
+            | E::RepeatedVertex { face: f, .. } => face(f),
+            E::InconsistentOrientation { face1, .. } => face(face1),
+            E::NonManifoldEdge { v0, v1, .. } => {
+                // The third face on the edge (the first two are a manifold edge).
+                let on_edge = |fv: &[u32]| {
+                    (0..fv.len()).any(|i| {
+                        let (a, b) = (fv[i], fv[(i + 1) % fv.len()]);
+                        (a, b) == (v0, v1) || (a, b) == (v1, v0)
+                    })
+                };
+                let f = (0..mesh.num_faces())
+                    .filter(|&f| on_edge(mesh.face(f)))
+                    .nth(2)?;
+                face(f)
+            }
+            _ => None,
+        }
+    }
+}
+
 /// Parse and validate OBJ text; `name` is used in error messages (usually the file name).
+/// A UTF-8 byte-order mark at the start is skipped.
 pub fn parse_obj(text: &str, name: &str) -> Result<ControlMesh, TopologyError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut mesh = ControlMesh::default();
+    let mut lines = Lines::default();
     let mut uvs: Vec<[f64; 2]> = Vec::new();
     let mut normals: Vec<[f64; 3]> = Vec::new();
     let mut corners: Vec<RawCorner> = Vec::new();
-    let mut face_lines: Vec<usize> = Vec::new();
     mesh.face_offsets.push(0);
 
     let perr = |line: usize, kind: ObjSyntax| TopologyError::Parse {
@@ -52,15 +103,17 @@ pub fn parse_obj(text: &str, name: &str) -> Result<ControlMesh, TopologyError> {
         let rest: Vec<&str> = words.collect();
         match keyword {
             "v" => {
+                // Range and finiteness are checked by validation (it names the vertex).
                 let p = parse_floats(&rest, 3, line, "v", &perr)?;
                 mesh.positions.push([p[0], p[1], p[2]]);
+                lines.vertices.push(line);
             }
             "vt" => {
-                let p = parse_floats(&rest, 1, line, "vt", &perr)?;
+                let p = parse_finite(&rest, 1, line, "vt", &perr)?;
                 uvs.push([p[0], p.get(1).copied().unwrap_or(0.0)]);
             }
             "vn" => {
-                let p = parse_floats(&rest, 3, line, "vn", &perr)?;
+                let p = parse_finite(&rest, 3, line, "vn", &perr)?;
                 normals.push([p[0], p[1], p[2]]);
             }
             "f" => {
@@ -76,9 +129,9 @@ pub fn parse_obj(text: &str, name: &str) -> Result<ControlMesh, TopologyError> {
                     )?);
                 }
                 mesh.face_offsets.push(corners.len() as u32);
-                face_lines.push(line);
+                lines.faces.push(line);
             }
-            "t" => parse_tag(&rest, line, name, &mut mesh, &perr)?,
+            "t" => parse_tag(&rest, line, name, &mut mesh, &mut lines, &perr)?,
             "o" | "g" | "s" | "usemtl" | "mtllib" | "l" | "p" | "vp" => {}
             other => log::warn!("{name}:{line}: ignoring unknown OBJ statement '{other}'"),
         }
@@ -91,7 +144,7 @@ pub fn parse_obj(text: &str, name: &str) -> Result<ControlMesh, TopologyError> {
     let all_n = !corners.is_empty() && corners.iter().all(|c| c.2.is_some());
     let mut corner_uvs = Vec::with_capacity(if all_uv { corners.len() } else { 0 });
     let mut corner_normals = Vec::with_capacity(if all_n { corners.len() } else { 0 });
-    for (f, &face_line) in face_lines.iter().enumerate() {
+    for (f, &face_line) in lines.faces.iter().enumerate() {
         let (s, e) = (
             mesh.face_offsets[f] as usize,
             mesh.face_offsets[f + 1] as usize,
@@ -103,7 +156,7 @@ pub fn parse_obj(text: &str, name: &str) -> Result<ControlMesh, TopologyError> {
                     index: v,
                     count: nv,
                 }
-                .in_file(name));
+                .in_file(name, Some(face_line)));
             }
             mesh.face_vertices.push(v as u32);
             if all_uv {
@@ -131,8 +184,11 @@ pub fn parse_obj(text: &str, name: &str) -> Result<ControlMesh, TopologyError> {
     if all_n {
         mesh.normals = Some(corner_normals);
     }
-    check_tags(&mesh).map_err(|e| e.in_file(name))?;
-    mesh.validate().map_err(|e| e.in_file(name))?;
+    check_tags(&mesh, &lines).map_err(|(e, line)| e.in_file(name, Some(line)))?;
+    mesh.validate().map_err(|e| {
+        let line = lines.locate(&e, &mesh);
+        e.in_file(name, line)
+    })?;
     Ok(mesh)
 }
 
@@ -167,6 +223,28 @@ fn parse_floats<E: Fn(usize, ObjSyntax) -> TopologyError>(
             })
         })
         .collect()
+}
+
+/// [`parse_floats`] for attributes, which validation does not see: NaN and infinity are
+/// refused here.
+fn parse_finite<E: Fn(usize, ObjSyntax) -> TopologyError>(
+    words: &[&str],
+    min: usize,
+    line: usize,
+    what: &'static str,
+    perr: &E,
+) -> Result<Vec<f64>, TopologyError> {
+    let p = parse_floats(words, min, line, what, perr)?;
+    if let Some(k) = p.iter().position(|x| !x.is_finite()) {
+        return Err(perr(
+            line,
+            ObjSyntax::NonFiniteNumber {
+                statement: what,
+                word: words[k].to_string(),
+            },
+        ));
+    }
+    Ok(p)
 }
 
 /// Parse `v`, `v/t`, `v//n` or `v/t/n`; negative indices count back from the current end.
@@ -211,6 +289,7 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
     line: usize,
     file: &str,
     mesh: &mut ControlMesh,
+    lines: &mut Lines,
     perr: &E,
 ) -> Result<(), TopologyError> {
     let (Some(&tag), Some(&counts)) = (words.first(), words.get(1)) else {
@@ -286,6 +365,13 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
                 },
             ));
         }
+        if s < 0.0 {
+            // OpenSubdiv treats sharpness ≤ 0 as smooth; say so rather than drop it silently.
+            log::warn!(
+                "{file}:{line}: tag '{tag}': negative sharpness {s} is treated as 0 (smooth), \
+                 as OpenSubdiv does"
+            );
+        }
         Ok(s.max(0.0))
     };
     match tag {
@@ -299,6 +385,7 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
                     vertices: [to_u32(ints[2 * k])?, to_u32(ints[2 * k + 1])?],
                     sharpness: sharp_for(k, pairs)?,
                 });
+                lines.creases.push(line);
             }
         }
         "corner" => {
@@ -310,6 +397,7 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
                     vertex: to_u32(v)?,
                     sharpness: sharp_for(k, ints.len())?,
                 });
+                lines.corners.push(line);
             }
         }
         "interpolateboundary" => {
@@ -322,7 +410,7 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
                         line,
                         ObjSyntax::BadOptionValue {
                             option: "interpolateboundary",
-                            value: format!("{other:?}"),
+                            value: other.map_or_else(|| "(none)".into(), |v| v.to_string()),
                         },
                     ))
                 }
@@ -337,7 +425,7 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
                         line,
                         ObjSyntax::BadOptionValue {
                             option: "creasemethod",
-                            value: format!("{other:?}"),
+                            value: other.unwrap_or("(none)").to_string(),
                         },
                     ))
                 }
@@ -347,12 +435,15 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
             let smooth = match (strings.first().copied(), ints.first()) {
                 (Some("smooth"), _) | (None, Some(1)) => true,
                 (Some("catmark"), _) | (None, Some(0)) => false,
-                other => {
+                (s, i) => {
                     return Err(perr(
                         line,
                         ObjSyntax::BadOptionValue {
                             option: "smoothtriangles",
-                            value: format!("{other:?}"),
+                            value: s
+                                .map(str::to_string)
+                                .or(i.map(|i| i.to_string()))
+                                .unwrap_or_else(|| "(none)".into()),
                         },
                     ))
                 }
@@ -366,6 +457,7 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
         "hole" => {
             for &f in &ints {
                 mesh.holes.push(to_u32(f)?);
+                lines.holes.push(line);
             }
         }
         other => log::warn!("{file}:{line}: ignoring unsupported tag '{other}'"),
@@ -373,34 +465,26 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
     Ok(())
 }
 
-/// Tags must name existing vertices/faces.
-fn check_tags(mesh: &ControlMesh) -> Result<(), TopologyError> {
+/// Tags must name existing vertices/faces; the error comes with the tag's line.
+fn check_tags(mesh: &ControlMesh, lines: &Lines) -> Result<(), (TopologyError, usize)> {
     let nv = mesh.positions.len() as u32;
-    for c in &mesh.creases {
+    let out_of_range =
+        |tag, index, count, line| (TopologyError::TagOutOfRange { tag, index, count }, line);
+    for (c, &line) in mesh.creases.iter().zip(&lines.creases) {
         if let Some(&v) = c.vertices.iter().find(|&&v| v >= nv) {
-            return Err(TopologyError::TagOutOfRange {
-                tag: TagKind::Crease,
-                index: v,
-                count: nv as usize,
-            });
+            return Err(out_of_range(TagKind::Crease, v, nv as usize, line));
         }
     }
-    for c in &mesh.corners {
+    for (c, &line) in mesh.corners.iter().zip(&lines.corners) {
         if c.vertex >= nv {
-            return Err(TopologyError::TagOutOfRange {
-                tag: TagKind::Corner,
-                index: c.vertex,
-                count: nv as usize,
-            });
+            return Err(out_of_range(TagKind::Corner, c.vertex, nv as usize, line));
         }
     }
     let nf = mesh.num_faces() as u32;
-    if let Some(&f) = mesh.holes.iter().find(|&&f| f >= nf) {
-        return Err(TopologyError::TagOutOfRange {
-            tag: TagKind::Hole,
-            index: f,
-            count: nf as usize,
-        });
+    for (&f, &line) in mesh.holes.iter().zip(&lines.holes) {
+        if f >= nf {
+            return Err(out_of_range(TagKind::Hole, f, nf as usize, line));
+        }
     }
     Ok(())
 }
@@ -445,4 +529,136 @@ pub fn write_control_mesh<W: Write>(mut out: W, mesh: &ControlMesh) -> std::io::
         writeln!(out, "t corner 1/1/0 {} {}", c.vertex, c.sharpness)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::MAX_COORDINATE;
+    use std::error::Error as _;
+
+    fn err(text: &str) -> TopologyError {
+        parse_obj(text, "t.obj").expect_err("mesh should be rejected")
+    }
+
+    const TRI: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+
+    /// The issue's repro: a finite coordinate whose f32 intermediates overflow is refused, with
+    /// the file, the line and the 1-based vertex number.
+    #[test]
+    fn coordinates_beyond_the_bound_name_line_and_vertex() {
+        let e = err("v 3e38 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n");
+        assert!(matches!(
+            e.root(),
+            TopologyError::CoordinateOutOfRange { vertex: 0, .. }
+        ));
+        let m = e.to_string();
+        assert!(m.starts_with("t.obj:1: vertex 1 at (3e38, 0, 0) "), "{m}");
+        assert!(m.contains("1e12"), "{m}");
+        // 1e39 overflows f32 but not f64: still refused, on its own line.
+        let e = err(&format!("{TRI}v 0 0 1e39\nf 1 2 3\n"));
+        assert!(e.to_string().starts_with("t.obj:4: vertex 4 "), "{e}");
+        let e = err(&format!("{TRI}v 0 -1.0000001e12 0\nf 1 2 3\n"));
+        assert!(matches!(
+            e.root(),
+            TopologyError::CoordinateOutOfRange { vertex: 3, .. }
+        ));
+        // NaN keeps its own error, worded in the file's numbers.
+        let e = err("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
+        assert_eq!(
+            e.to_string(),
+            "t.obj:2: vertex 2 has a non-finite position (NaN, 0, 0)"
+        );
+    }
+
+    #[test]
+    fn coordinates_at_the_bound_are_accepted() {
+        let m = MAX_COORDINATE;
+        let text = format!("v {m} {m} {m}\nv -{m} {m} -{m}\nv 0 -{m} {m}\nf 1 2 3\n");
+        let mesh = parse_obj(&text, "t.obj").unwrap();
+        assert_eq!(mesh.positions[1], [-m, m, -m]);
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let mesh = parse_obj(&format!("\u{feff}{TRI}f 1 2 3\n"), "bom.obj").unwrap();
+        assert_eq!(mesh.positions.len(), 3);
+        assert_eq!(mesh.positions[0], [0.0, 0.0, 0.0]);
+    }
+
+    /// Validation errors speak the file's language: 1-based numbers and the line that made
+    /// the element at fault; the root keeps the mesh's 0-based numbers.
+    #[test]
+    fn validation_errors_use_obj_numbers_and_lines() {
+        let e = err(&format!("{TRI}f 1 2 4\n"));
+        assert_eq!(
+            e.to_string(),
+            "t.obj:4: face 1 names vertex 4, but the file has 3 vertices"
+        );
+        assert!(matches!(
+            e.root(),
+            TopologyError::IndexOutOfRange {
+                face: 0,
+                index: 3,
+                count: 3
+            }
+        ));
+        let e = err(&format!("{TRI}# comment\nf 1 2 3\nf 1 2 2\n"));
+        assert_eq!(
+            e.to_string(),
+            "t.obj:6: face 2 uses vertex 2 more than once"
+        );
+        let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n");
+        assert_eq!(
+            e.to_string(),
+            "t.obj:8: edge 1-2 is shared by 3 faces (non-manifold edge)"
+        );
+        let e = err("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nf 1 2 3 4\nf 2 3 6 5\n");
+        assert_eq!(
+            e.to_string(),
+            "t.obj:8: faces 1 and 2 both traverse edge 2->3 in the same direction \
+             (inconsistent orientation)"
+        );
+        let e = err(&format!("{TRI}f 1 2 3\nt crease 2/1/0 0 7 2\n"));
+        assert_eq!(
+            e.to_string(),
+            "t.obj:5: invalid tag: crease names vertex 7 (tags count from 0), the file has 3 vertices"
+        );
+        let e = err("v 0 0 0\n");
+        assert_eq!(e.to_string(), "t.obj: empty mesh: no faces");
+    }
+
+    /// Each cause is said once: file errors embed their cause and do not chain it too.
+    #[test]
+    fn causes_are_said_once() {
+        let e = crate::load_obj("/nonexistent/dir/m.obj").unwrap_err();
+        assert!(e.source().is_none());
+        let m = e.to_string();
+        assert_eq!(m.matches("os error").count(), 1, "{m}");
+        let e = err("v 0 0 0\n");
+        assert!(e.source().is_none(), "{e}");
+    }
+
+    #[test]
+    fn bad_option_values_are_shown_as_written() {
+        let e = err(&format!("{TRI}f 1 2 3\nt interpolateboundary 1/0/0 7\n"));
+        assert_eq!(e.to_string(), "t.obj:5: interpolateboundary: bad value 7");
+        let e = err(&format!("{TRI}f 1 2 3\nt creasemethod 0/0/1 sharp\n"));
+        assert_eq!(e.to_string(), "t.obj:5: creasemethod: bad value sharp");
+        let e = err(&format!("{TRI}f 1 2 3\nt smoothtriangles 0/0/0\n"));
+        assert_eq!(e.to_string(), "t.obj:5: smoothtriangles: bad value (none)");
+    }
+
+    #[test]
+    fn non_finite_attributes_name_their_line() {
+        let e = err(&format!("{TRI}vn 0 nan 1\nf 1//1 2//1 3//1\n"));
+        assert_eq!(e.to_string(), "t.obj:4: 'vn': 'nan' is not a finite number");
+    }
+
+    /// Negative sharpness is smooth (OpenSubdiv); the loader keeps it at 0 (and warns).
+    #[test]
+    fn negative_sharpness_is_smooth() {
+        let m = parse_obj(&format!("{TRI}f 1 2 3\nt crease 2/1/0 0 1 -2\n"), "t.obj").unwrap();
+        assert_eq!(m.creases[0].sharpness, 0.0);
+    }
 }
