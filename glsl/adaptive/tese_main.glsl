@@ -2,6 +2,7 @@
 // `void evaluate(uint id, vec2 uv, out vec3 pos, out vec3 du, out vec3 dv)` for its patch kind
 // (patch `id`). Only boundary vertices read the patch record (its curves). Points on the patch boundary come from the canonical curves instead (see
 // adaptive.glsl), so shared edges are bit-identical; normals always come from the patch.
+#include "normals.glsl"
 layout(location = 0) patch in uint tc_patch;
 layout(location = 2) patch in uint tc_info;
 layout(location = 5) flat out vec3 out_albedo;
@@ -28,8 +29,7 @@ void main() {
     } else if (uv.x == 0.0) {
         pos = canonical_edge_point(p, 3u, 1.0 - uv.y, gl_TessLevelOuter[0], !fractional_factors() || edge_kind(p, 3u) != ADAPTIVE_EDGE_PLAIN);
     }
-    vec3 n = cross(du, dv);
-    float l = length(n);
+    vec3 n = safe_normalize(cross(du, dv), vec3(0.0, 0.0, 1.0));
     uint kind = tc_info & 15u, level = (tc_info >> 4) & 15u;
     vec3 albedo = frame.base_color.rgb;
     if ((adaptive.options & uint(ADAPTIVE_OPTION_PATCH_COLOURS)) != 0u) {
@@ -42,6 +42,6 @@ void main() {
         if (((tc_info >> 8) & 15u) != 0u) albedo = mix(albedo, vec3(0.3, 0.8, 0.35), 0.5);
     }
     out_albedo = albedo;
-    emit_sample(pos, l > 0.0 ? n / l : vec3(0.0, 0.0, 1.0), tc_patch,
+    emit_sample(pos, n, tc_patch,
                 kind | (level << ADAPTIVE_FLAG_LEVEL_SHIFT) | (canonical ? uint(ADAPTIVE_FLAG_CANONICAL) : 0u));
 }

@@ -8,6 +8,7 @@
 #include "frame.glsl"
 #include "bft.glsl"
 #include "tese_out.glsl"
+#include "normals.glsl"
 layout(triangles, SPACING, ccw) in;
 layout(location = 0) patch in uint tc_face;
 layout(location = 5) flat out vec3 out_albedo;
@@ -22,6 +23,5 @@ void main() {
     bool exact = bft_eval(face, gl_TessCoord, geometric, p, n);
     uint kind = table_entries[patches[face].entry].kind;
     out_albedo = (bft.options & uint(BFT_OPTION_PATCH_COLOURS)) != 0u ? KIND_COLOURS[min(kind, 3u)] : frame.base_color.rgb;
-    float l = length(n);
-    emit_sample(p, l > 0.0 ? n / l : n, face, (exact ? uint(CAPTURE_FLAG_EXACT) : 0u) | (kind << CAPTURE_FLAG_KIND_SHIFT));
+    emit_sample(p, safe_normalize(n, vec3(0.0)), face, (exact ? uint(CAPTURE_FLAG_EXACT) : 0u) | (kind << CAPTURE_FLAG_KIND_SHIFT));
 }

@@ -3,6 +3,7 @@
 // (boundary fans use the boundary masks): where subdivision shading starts.
 #define BFT_WRITES_LEVEL1
 #include "bft.glsl"
+#include "normals.glsl"
 layout(local_size_x = BFT_LOCAL_SIZE) in;
 void main() {
     uint v = gl_GlobalInvocationID.x;
@@ -14,7 +15,5 @@ void main() {
         t1 += t.weight_t1 * x;
         t2 += t.weight_t2 * x;
     }
-    vec3 n = cross(t1, t2);
-    float l = length(n);
-    level1_nrm[v] = vec4(l > 0.0 ? n / l : vec3(0.0), 0.0);
+    level1_nrm[v] = vec4(safe_normalize(cross(t1, t2), vec3(0.0)), 0.0);
 }

@@ -5,6 +5,7 @@
 // Built in every spacing, with and without capture (glsl/manifest.toml; tese_out.glsl).
 #include "frame.glsl"
 #include "tese_out.glsl"
+#include "normals.glsl"
 layout(triangles, SPACING, ccw) in;
 layout(location = 0) in vec3 in_position[];
 layout(location = 1) in vec3 in_normal[];
@@ -20,5 +21,5 @@ void main() {
         + b111 * (6.0 * u * v * w);
     vec3 n = in_normal[0] * (u * u) + in_normal[1] * (v * v) + in_normal[2] * (w * w)
         + n_edge[0] * (u * v) + n_edge[1] * (v * w) + n_edge[2] * (w * u);
-    emit_sample(p, normalize(n), draw.first_patch + uint(gl_PrimitiveID), 0u);
+    emit_sample(p, safe_normalize(n, vec3(0.0)), draw.first_patch + uint(gl_PrimitiveID), 0u);
 }
