@@ -55,8 +55,8 @@ pub struct ExportArgs {
     pub spacing: Spacing,
     #[command(flatten)]
     pub surface: SurfaceArgs,
-    /// Phong tessellation shape factor α.
-    #[arg(long, default_value_t = 0.75)]
+    /// Phong tessellation shape factor α, 0 to 1.
+    #[arg(long, default_value_t = 0.75, value_parser = parse_alpha)]
     pub alpha: f32,
     /// The view --adaptive screen and distance see.
     #[command(flatten)]
@@ -83,8 +83,8 @@ pub struct BenchArgs {
     /// cpu (CPU Loop subdivision: cpu-static and cpu-animated rows).
     #[arg(long, value_delimiter = ',', default_value = "flat,phong,pn,bft,cpu")]
     pub methods: Vec<String>,
-    /// Timed frames per row.
-    #[arg(long, default_value_t = 30)]
+    /// Timed frames per row (at least 1).
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..))]
     pub frames: u32,
     /// Untimed frames before them.
     #[arg(long, default_value_t = 5)]
@@ -96,7 +96,7 @@ pub struct BenchArgs {
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
     /// Seconds a row's timed frames may take; slower rows get fewer frames (noted in the row).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_row_budget)]
     pub row_budget: Option<f64>,
     /// The fewest timed frames --row-budget may leave.
     #[arg(long, default_value_t = 5)]
@@ -157,6 +157,17 @@ fn parse_uv(s: &str) -> Result<(f64, f64), String> {
     Ok((u, v))
 }
 
+fn parse_row_budget(s: &str) -> Result<f64, String> {
+    let x: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| "--row-budget takes seconds".to_string())?;
+    if !(x.is_finite() && x > 0.0) {
+        return Err("--row-budget must be a positive, finite number of seconds".into());
+    }
+    Ok(x)
+}
+
 #[derive(Args, Debug, Clone)]
 pub struct GpuArgs {
     /// Device to use: an index from `tessera info` or a name substring.
@@ -172,12 +183,47 @@ pub struct GpuArgs {
 
 #[derive(Args, Debug, Clone)]
 pub struct CameraArgs {
-    #[arg(long, default_value_t = 145.0, allow_hyphen_values = true)]
+    /// Orbit angle around the vertical axis, degrees (-360 to 360).
+    #[arg(long, default_value_t = 145.0, allow_hyphen_values = true, value_parser = parse_yaw)]
     pub yaw: f32,
-    #[arg(long, default_value_t = 20.0, allow_hyphen_values = true)]
+    /// Elevation of the eye, degrees (-90 to 90).
+    #[arg(long, default_value_t = 20.0, allow_hyphen_values = true, value_parser = parse_pitch)]
     pub pitch: f32,
-    #[arg(long, default_value_t = 1.0)]
+    /// Closer (> 1) or farther (< 1) than the fitted view: 0.1 to 20, the window's wheel range.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true, value_parser = parse_zoom)]
     pub zoom: f32,
+}
+
+/// A finite `f32` in `lo..=hi`; the message names the option (clap prefixes it with the value
+/// and the option too, so the range is what it adds).
+fn float_in(s: &str, option: &str, lo: f32, hi: f32) -> Result<f32, String> {
+    let x: f32 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{option} takes a number"))?;
+    if !(x.is_finite() && (lo..=hi).contains(&x)) {
+        return Err(format!(
+            "{option} must be a finite number from {lo} to {hi}"
+        ));
+    }
+    Ok(x)
+}
+
+fn parse_yaw(s: &str) -> Result<f32, String> {
+    float_in(s, "--yaw", -360.0, 360.0)
+}
+
+fn parse_pitch(s: &str) -> Result<f32, String> {
+    float_in(s, "--pitch", -90.0, 90.0)
+}
+
+fn parse_zoom(s: &str) -> Result<f32, String> {
+    float_in(s, "--zoom", 0.1, 20.0)
+}
+
+/// Phong tessellation's shape factor: 0 (flat) to 1 (full projection), Boubekeur & Alexa.
+pub fn parse_alpha(s: &str) -> Result<f32, String> {
+    float_in(s, "--alpha", 0.0, 1.0)
 }
 
 #[derive(Args, Debug, Clone)]
@@ -202,8 +248,8 @@ pub struct SceneArgs {
     pub wireframe: bool,
     #[command(flatten)]
     pub camera: CameraArgs,
-    /// Phong tessellation shape factor α.
-    #[arg(long, default_value_t = 0.75)]
+    /// Phong tessellation shape factor α, 0 to 1.
+    #[arg(long, default_value_t = 0.75, value_parser = parse_alpha)]
     pub alpha: f32,
     #[command(flatten)]
     pub surface: SurfaceArgs,
@@ -233,8 +279,8 @@ pub struct ViewArgs {
     pub scene: SceneArgs,
     #[arg(long, default_value = "1024x768", value_parser = parse_size)]
     pub size: (u32, u32),
-    /// Render this many frames, then exit (with --screenshot: save the last one).
-    #[arg(long)]
+    /// Render this many frames (at least 1), then exit (with --screenshot: save the last one).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub frames: Option<u32>,
     /// PNG to save the last frame to (needs --frames).
     #[arg(long)]

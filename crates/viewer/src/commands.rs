@@ -33,6 +33,8 @@ pub fn validation(g: &GpuArgs) -> Validation {
     }
 }
 
+/// Loads and validates the mesh (the embedded spot without a path); errors say the file, the
+/// line and the OBJ's 1-based numbers (`topology::obj`).
 pub fn load_mesh(path: Option<&std::path::Path>) -> Result<topology::ControlMesh> {
     let mesh = match path {
         Some(p) => topology::load_obj(p)?,
@@ -75,6 +77,7 @@ pub fn scene_setup(s: &SceneArgs, name: &str, mesh: &topology::ControlMesh) -> R
     let mut setup = s
         .surface
         .setup(method, s.level, s.spacing, s.animate, params)?;
+    crate::technique::check_segments("--level", &setup)?;
     setup.build.name = name.to_string();
     Ok(setup)
 }
@@ -102,6 +105,22 @@ pub fn build_technique(
     Ok(technique)
 }
 
+/// `--device` resolved against the adapters the instance sees: the adapter's index, or an
+/// error naming the option as given (with the devices seen).
+fn choose_device(g: &GpuArgs, instance: &Instance) -> Result<vk_core::DeviceSelector> {
+    let selector: vk_core::DeviceSelector = g.device.parse().unwrap_or_default();
+    let adapters = vk_core::device::enumerate_adapters(instance)?;
+    match vk_core::device::choose_adapter(&adapters, &selector) {
+        Ok(i) => Ok(vk_core::DeviceSelector::Index(adapters[i].index)),
+        Err(vk_core::VkError::NoSuchDevice { devices, .. }) => bail!(
+            "--device {}: no device has that index or name (see `tessera info`); devices \
+             seen:\n{devices}",
+            g.device
+        ),
+        Err(e) => Err(e.into()),
+    }
+}
+
 /// Instance + device as the command line asks; errors list the devices seen.
 pub fn open_device(
     g: &GpuArgs,
@@ -113,7 +132,7 @@ pub fn open_device(
         validation: validation(g),
         surface_extensions,
     })?;
-    let selector = g.device.parse().unwrap_or_default();
+    let selector = choose_device(g, &instance)?;
     let cache = std::env::var_os("XDG_CACHE_HOME")
         .map(std::path::PathBuf::from)
         .or_else(|| std::env::var_os("HOME").map(|h| std::path::PathBuf::from(h).join(".cache")))
@@ -136,8 +155,8 @@ pub fn check_validation(instance: &Instance) -> Result<()> {
     let n = instance.messages().error_count();
     if n > 0 {
         bail!(
-            "the Vulkan validation layer reported {n} error(s): {:#?}",
-            instance.messages().error_messages()
+            "the Vulkan validation layer reported {n} error(s):\n{}",
+            instance.messages().error_messages().join("\n")
         );
     }
     Ok(())
@@ -224,13 +243,24 @@ fn info(g: &GpuArgs) -> Result<()> {
             let a = &adapters[i];
             let why = match selector {
                 vk_core::DeviceSelector::Auto => format!("highest score ({}: discrete 4 > integrated 3 > virtual 2 > CPU 1; ties by lowest index)", a.type_name()),
-                s => format!("selected by --device {s:?}"),
+                _ => format!("selected by --device {}", g.device),
             };
             println!("chosen: [{}] {} — {why}", a.index, a.name);
             let w = vk_core::workarounds::Workarounds::for_adapter(a);
             for w in w.active() {
                 println!("    workaround: {}", w.summary);
             }
+        }
+        // Asked for a device that is not there (or cannot be used): a failure, after the
+        // listing that shows what is.
+        Err(vk_core::VkError::NoSuchDevice { .. }) => {
+            bail!(
+                "--device {}: no device has that index or name (listed above)",
+                g.device
+            )
+        }
+        Err(e) if !matches!(selector, vk_core::DeviceSelector::Auto) => {
+            bail!("--device {}: {e}", g.device)
         }
         Err(e) => println!("chosen: none — {e}"),
     }

@@ -28,6 +28,36 @@ pub struct ExportReport {
     pub zero_area: usize,
 }
 
+/// Refuses to write a capture with a NaN or infinite position or normal: validated input
+/// (coordinates within `topology::MAX_COORDINATE`) never makes one, so one is a bug to report,
+/// not a file to write.
+fn check_finite(welded: &tess::WeldedMesh) -> Result<()> {
+    let bad = |v: &[[f32; 3]]| v.iter().position(|p| !p.iter().all(|c| c.is_finite()));
+    if let Some(i) = bad(&welded.positions) {
+        let p = welded.positions[i];
+        bail!(
+            "the GPU emitted a non-finite position ({}, {}, {}) at captured vertex {}; \
+             nothing written",
+            p[0],
+            p[1],
+            p[2],
+            i + 1
+        );
+    }
+    if let Some(i) = bad(&welded.normals) {
+        let n = welded.normals[i];
+        bail!(
+            "the GPU emitted a non-finite normal ({}, {}, {}) at captured vertex {}; \
+             nothing written",
+            n[0],
+            n[1],
+            n[2],
+            i + 1
+        );
+    }
+    Ok(())
+}
+
 /// (patch id, domain bits) → base-face point of each welded vertex.
 type FaceMap = std::collections::HashMap<(u32, [u32; 2]), tess::capture::FacePoint>;
 
@@ -42,6 +72,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
     let mut setup = a
         .surface
         .setup(method, a.segments, a.spacing, false, params)?;
+    crate::technique::check_segments("--segments", &setup)?;
     setup.build.name = mesh_name(Some(&a.input));
     let extent = vk::Extent2D {
         width: a.size.0,
@@ -92,6 +123,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
     drop(device);
     check_validation(&instance)?;
     let (r, summary, welded, faces) = result?;
+    check_finite(&welded)?;
     let map = |patch: u32, domain: [f32; 2]| faces.get(&(patch, domain.map(f32::to_bits))).copied();
     // Every TES declares `ccw` in the upper-left domain: clockwise seen from outside.
     welded.write_obj(&a.output, &map, Winding::Reversed)?;

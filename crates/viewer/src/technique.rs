@@ -368,6 +368,27 @@ impl Setup {
     }
 }
 
+/// The most uniform segments per base edge any technique takes: BFT at table level 6 draws
+/// level-1 faces at tessellation level 64, i.e. 2^(6+1) per base edge.
+const MAX_SEGMENTS: f32 = 128.0;
+
+/// The uniform segments option as the command names it (`--level` of render and view,
+/// `--segments` of export), checked before any device is opened: a finite number of segments
+/// from 1 to [`MAX_SEGMENTS`]. What depends on the technique (flat, phong and pn up to 64,
+/// BFT's powers of two, adaptive's whole numbers up to half the device's level) is checked by
+/// the technique itself, which names `--segments` (an alias of `--level`).
+pub fn check_segments(option: &str, setup: &Setup) -> Result<()> {
+    if let FactorPolicy::Uniform { segments } = setup.params.factors {
+        if !(segments.is_finite() && (1.0..=MAX_SEGMENTS).contains(&segments)) {
+            bail!(
+                "{option} {segments}: give a number of segments per edge from 1 to 64 \
+                 (--method bft: up to 2^(--table-level + 1))"
+            );
+        }
+    }
+    Ok(())
+}
+
 /// A one-line summary of what a frame shows, for messages and the window title.
 pub fn describe(technique: TechniqueId, p: &FrameParams) -> String {
     let mut s = format!("{technique}, {}", p.factors);

@@ -1,4 +1,7 @@
 //! `tessera subdivide` and `tessera limit`: the CPU reference, from the command line.
+//!
+//! Options are checked before the mesh is read; errors about the mesh use the OBJ's 1-based
+//! numbers ([`topology::TopologyError::in_file`]); nothing non-finite is written or printed.
 use crate::cli::{LimitArgs, SubdivideArgs};
 use anyhow::{bail, Context, Result};
 use topology::eval::{limit_point, LimitScheme, LocalMesh};
@@ -31,26 +34,40 @@ fn limit_positions(level: &Level, base: &ControlMesh, scheme: Scheme) -> Result<
         .collect()
 }
 
+/// The first vertex (1-based, as in the written OBJ) with a NaN or infinite coordinate.
+fn non_finite(positions: &[[f64; 3]]) -> Option<usize> {
+    positions
+        .iter()
+        .position(|p| !p.iter().all(|c| c.is_finite()))
+        .map(|i| i + 1)
+}
+
 pub fn subdivide(a: SubdivideArgs) -> Result<()> {
-    let mesh = topology::load_obj(&a.input)?;
     if a.level > 6 {
         bail!("--level {} is above 6 (meshes grow 4× per level)", a.level);
     }
-    let r = refine_uniform(&mesh, a.scheme, a.level)
-        .with_context(|| format!("{}", a.input.display()))?;
+    let name = a.input.display().to_string();
+    let mesh = topology::load_obj(&a.input)?;
+    let r = refine_uniform(&mesh, a.scheme, a.level).map_err(|e| e.in_file(&name, None))?;
     let level = r.level(a.level);
     let positions = if a.limit {
         limit_positions(level, &mesh, a.scheme)?
     } else {
         level.positions.clone()
     };
+    if let Some(v) = non_finite(&positions) {
+        bail!(
+            "{name}: level {} vertex {v} is not finite; nothing written",
+            a.level
+        );
+    }
     let (offsets, verts) = level.topology.face_tables();
     let file = std::fs::File::create(&a.output)
         .with_context(|| format!("creating {}", a.output.display()))?;
     topology::write_obj(file, &positions, offsets, verts)
         .with_context(|| format!("writing {}", a.output.display()))?;
     println!(
-        "wrote {}: {} vertices, {} faces (level {}, {:?}{})",
+        "wrote {}: {} vertices, {} faces (level {}, {}{})",
         a.output.display(),
         positions.len(),
         level.num_faces(),
@@ -62,10 +79,22 @@ pub fn subdivide(a: SubdivideArgs) -> Result<()> {
 }
 
 pub fn limit(a: LimitArgs) -> Result<()> {
+    let scheme: LimitScheme = a
+        .scheme
+        .parse()
+        .map_err(|e| anyhow::anyhow!("--scheme {}: {e}", a.scheme))?;
     let mesh = topology::load_obj(&a.input)?;
-    let scheme: LimitScheme = a.scheme.parse()?;
     let p = limit_point(&mesh, scheme, a.face, a.uv.0, a.uv.1)
         .with_context(|| a.input.display().to_string())?;
+    if non_finite(&[p.position, p.du, p.dv, p.normal]).is_some() {
+        bail!(
+            "{}: the limit at face {} ({}, {}) is not finite",
+            a.input.display(),
+            a.face,
+            a.uv.0,
+            a.uv.1
+        );
+    }
     println!("{p}");
     Ok(())
 }

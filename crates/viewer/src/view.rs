@@ -404,9 +404,13 @@ pub fn run(args: ViewArgs) -> Result<()> {
     }
     let mesh = load_mesh(args.scene.mesh.as_deref())?;
     let setup = scene_setup(&args.scene, &mesh_name(args.scene.mesh.as_deref()), &mesh)?;
-    let event_loop = EventLoop::new().context(
-        "no window system (set DISPLAY or WAYLAND_DISPLAY; use `tessera render` headless)",
-    )?;
+    // winit's OS errors name a source file of winit itself: not for users.
+    let event_loop = EventLoop::new().map_err(|e| match e {
+        winit::error::EventLoopError::Os(_) => anyhow::anyhow!(
+            "no window system (set DISPLAY or WAYLAND_DISPLAY; use `tessera render` headless)"
+        ),
+        other => anyhow::anyhow!("cannot open the window system: {other}"),
+    })?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
         time: setup.frame.unwrap_or(0.0),

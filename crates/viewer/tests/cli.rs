@@ -92,7 +92,7 @@ fn out_of_range_face_names_the_face() {
     fails_with(
         &["render", p.to_str().unwrap()],
         &[],
-        &["range.obj", "face 1"],
+        &["range.obj:5", "face 2 names vertex 9"],
     );
 }
 

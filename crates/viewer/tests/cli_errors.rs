@@ -1,0 +1,614 @@
+//! Issue 15, as a hostile user would try it: input whose f32 intermediates overflow is refused
+//! with its line and vertex, degenerate input gives finite output through every technique,
+//! view options are checked when parsed, a UTF-8 BOM is skipped, and every message says its
+//! cause once, in the OBJ's own numbers, before any device is opened. Also runs each CPU and
+//! GPU command path (render, export, bench, info, subdivide, limit) with validation on.
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Runs `tessera`; GPU commands get `--validation` (their runs fail on any validation error).
+fn tessera(args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_tessera"));
+    c.args(args);
+    if matches!(
+        args.first(),
+        Some(&"render" | &"view" | &"info" | &"export" | &"bench")
+    ) {
+        c.arg("--validation");
+    }
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    c.output().expect("tessera runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tessera-cli-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn write(name: &str, text: &str) -> String {
+    let p = tmp(name);
+    std::fs::write(&p, text).unwrap();
+    p.to_str().unwrap().to_owned()
+}
+
+fn data(p: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(p)
+        .to_str()
+        .unwrap()
+        .to_owned()
+}
+
+/// Fails with exit status `code` (1: our error, 2: clap's usage error), no panic, and a
+/// message containing every needle; returns the message.
+fn fails(args: &[&str], env: &[(&str, &str)], code: i32, needles: &[&str]) -> String {
+    let o = tessera(args, env);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(code), "{args:?}: {e}");
+    assert!(!e.contains("panicked"), "{args:?} panicked: {e}");
+    for n in needles {
+        assert!(e.contains(n), "{args:?}: error should mention {n:?}: {e}");
+    }
+    e
+}
+
+fn succeeds(args: &[&str]) -> Output {
+    let o = tessera(args, &[]);
+    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    o
+}
+
+/// Every number on the `v`, `vn` and `# p` lines of an OBJ (panics on a word that is not one).
+fn obj_numbers(path: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(path).unwrap();
+    text.lines()
+        .filter_map(|l| {
+            l.strip_prefix("v ")
+                .or_else(|| l.strip_prefix("vn "))
+                .or_else(|| l.strip_prefix("# p "))
+        })
+        .flat_map(|rest| rest.split_whitespace())
+        .map(|w| w.parse::<f64>().unwrap_or_else(|_| panic!("{path}: '{w}'")))
+        .collect()
+}
+
+/// The `vn` lines of an OBJ.
+fn obj_normals(path: &str) -> Vec<[f64; 3]> {
+    let text = std::fs::read_to_string(path).unwrap();
+    text.lines()
+        .filter_map(|l| l.strip_prefix("vn "))
+        .map(|rest| {
+            let w: Vec<f64> = rest
+                .split_whitespace()
+                .map(|w| w.parse().unwrap())
+                .collect();
+            [w[0], w[1], w[2]]
+        })
+        .collect()
+}
+
+/// A tool that makes sure a run used no loader: options refused with this set were checked
+/// before any Vulkan call.
+const NO_LOADER: (&str, &str) = ("TESSERA_VULKAN_LIBRARY", "/nonexistent/libvulkan.so.1");
+
+const REPRO: &str = "v 3e38 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
+
+#[test]
+fn coordinates_beyond_the_f32_safe_range_are_refused_with_line_and_vertex() {
+    let p = write("repro.obj", REPRO);
+    let out = tmp("never.obj");
+    let out = out.to_str().unwrap();
+    for args in [
+        vec!["export", &p, "--method", "bft", "-o", out],
+        vec!["render", &p, "-o", out],
+        vec![
+            "subdivide",
+            &p,
+            "--scheme",
+            "loop",
+            "--level",
+            "1",
+            "-o",
+            out,
+        ],
+        vec![
+            "limit", &p, "--scheme", "loop", "--face", "0", "--uv", "0.2,0.2",
+        ],
+    ] {
+        fails(
+            &args,
+            &[],
+            1,
+            &["repro.obj:1: vertex 1 at (3e38, 0, 0)", "±1e12"],
+        );
+    }
+    // 1e39 overflows f32 (it used to pass as a finite f64).
+    let p = write(
+        "f32_overflow.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1e39 0\nf 1 2 3\n",
+    );
+    fails(
+        &[
+            "subdivide",
+            &p,
+            "--scheme",
+            "loop",
+            "--level",
+            "1",
+            "-o",
+            out,
+        ],
+        &[],
+        1,
+        &["f32_overflow.obj:3: vertex 3 at (0, 1e39, 0)"],
+    );
+    assert!(!Path::new(out).exists(), "no output on error");
+}
+
+/// A closed octahedron with its vertices at ±`s` on the axes (triangles, so every technique
+/// takes it).
+fn octahedron(s: f64) -> String {
+    let mut t = String::new();
+    for p in [
+        [s, 0.0, 0.0],
+        [-s, 0.0, 0.0],
+        [0.0, s, 0.0],
+        [0.0, -s, 0.0],
+        [0.0, 0.0, s],
+        [0.0, 0.0, -s],
+    ] {
+        t.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2]));
+    }
+    t.push_str("f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n");
+    t
+}
+
+/// The same octahedron's faces over other positions: all coincident, collinear, tiny.
+fn octahedron_faces_over(positions: &[[f64; 3]; 6]) -> String {
+    let mut t = String::new();
+    for p in positions {
+        t.push_str(&format!("v {:e} {:e} {:e}\n", p[0], p[1], p[2]));
+    }
+    t.push_str("f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n");
+    t
+}
+
+/// At the accepted bound and on degenerate (but finite) meshes, every technique exports finite
+/// positions, normals and domain points, validation-clean. At the bound, the surface
+/// techniques' normals are unit vectors: `|du × dv|²` overflows f32 there, so the shaders scale
+/// before normalising (before, BFT and adaptive wrote `vn 0 0 0`). Opposite corner normals make
+/// PN's quadratic normal field vanish at the edge midpoint (before, `normalize` wrote NaN).
+#[test]
+fn bound_and_degenerate_meshes_export_finite_through_every_technique() {
+    let meshes = [
+        ("at_bound", octahedron(1e12)),
+        ("coincident", octahedron_faces_over(&[[0.5, 0.5, 0.5]; 6])),
+        (
+            "collinear",
+            octahedron_faces_over(&[
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [2.0, 0.0, 0.0],
+                [3.0, 0.0, 0.0],
+                [4.0, 0.0, 0.0],
+                [5.0, 0.0, 0.0],
+            ]),
+        ),
+        ("tiny", octahedron(1e-30)),
+        (
+            "opposite_normals",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 -1\nf 1//1 2//2 3//1\n".to_string(),
+        ),
+        (
+            // Face `f 3 1 6` of zero area (vertex 6 halfway between 1 and 3).
+            "zero_area",
+            octahedron_faces_over(&[
+                [1.0, 0.0, 0.0],
+                [-1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, -1.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [0.5, 0.5, 0.0],
+            ]),
+        ),
+    ];
+    let mut failures = Vec::new();
+    for (name, text) in &meshes {
+        let input = write(&format!("{name}.obj"), text);
+        for method in ["flat", "phong", "pn", "bft", "adaptive"] {
+            let out = tmp(&format!("{name}_{method}_out.obj"));
+            let out = out.to_str().unwrap();
+            let o = tessera(
+                &[
+                    "export",
+                    &input,
+                    "--method",
+                    method,
+                    "--segments",
+                    "4",
+                    "-o",
+                    out,
+                ],
+                &[],
+            );
+            if !o.status.success() {
+                failures.push(format!("{name} {method}: {}", stderr(&o)));
+                continue;
+            }
+            let numbers = obj_numbers(out);
+            if numbers.is_empty() || !numbers.iter().all(|x| x.is_finite()) {
+                failures.push(format!(
+                    "{name} {method}: {} numbers, non-finite: {:?}",
+                    numbers.len(),
+                    numbers
+                        .iter()
+                        .filter(|x| !x.is_finite())
+                        .take(4)
+                        .collect::<Vec<_>>()
+                ));
+            }
+            if *name == "at_bound" && ["pn", "bft", "adaptive"].contains(&method) {
+                let not_unit = obj_normals(out)
+                    .into_iter()
+                    .filter(|n| {
+                        ((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() - 1.0).abs() > 1e-3
+                    })
+                    .count();
+                if not_unit > 0 {
+                    failures.push(format!(
+                        "{name} {method}: {not_unit} normals not of unit length"
+                    ));
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The CPU commands at the bound: subdivided, limit and printed limit values are all finite.
+#[test]
+fn subdivide_and_limit_at_the_bound_are_finite() {
+    let input = write("bound_cpu.obj", &octahedron(1e12));
+    for (scheme, limit) in [("loop", true), ("catmull-clark", true), ("loop", false)] {
+        let out = tmp(&format!("bound_{scheme}_{limit}.obj"));
+        let out = out.to_str().unwrap();
+        let mut args = vec![
+            "subdivide",
+            &input,
+            "--scheme",
+            scheme,
+            "--level",
+            "2",
+            "-o",
+            out,
+        ];
+        if limit {
+            args.push("--limit");
+        }
+        succeeds(&args);
+        let numbers = obj_numbers(out);
+        assert!(!numbers.is_empty() && numbers.iter().all(|x| x.is_finite()));
+    }
+    let o = succeeds(&[
+        "limit", &input, "--scheme", "loop", "--face", "3", "--uv", "0.25,0.5",
+    ]);
+    let s = stdout(&o);
+    let values: Vec<f64> = s
+        .lines()
+        .filter(|l| {
+            ["position", "du", "dv", "normal"]
+                .iter()
+                .any(|k| l.starts_with(k))
+        })
+        .flat_map(|l| l.split_whitespace().skip(1))
+        .map(|w| w.parse().unwrap())
+        .collect();
+    assert_eq!(values.len(), 12, "{s}");
+    assert!(values.iter().all(|x| x.is_finite()), "{s}");
+    // The normal is a unit vector, not zero: the f64 path keeps its squares.
+    let n = &values[9..12];
+    assert!(
+        ((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() - 1.0).abs() < 1e-9,
+        "{s}"
+    );
+}
+
+#[test]
+fn view_options_are_checked_when_parsed() {
+    let out = tmp("never_view.png");
+    let out = out.to_str().unwrap();
+    for (option, value) in [
+        ("--zoom", "0"),
+        ("--zoom", "-1"),
+        ("--zoom", "nan"),
+        ("--zoom", "1e30"),
+        ("--yaw", "nan"),
+        ("--yaw", "inf"),
+        ("--pitch", "100"),
+        ("--alpha", "nan"),
+        ("--alpha", "2"),
+    ] {
+        fails(&["render", option, value, "-o", out], &[], 2, &[option]);
+    }
+    // export shares the camera options and α.
+    let cube = data("tests/data/meshes/cube.obj");
+    fails(
+        &[
+            "export", &cube, "--method", "flat", "--zoom", "nan", "-o", out,
+        ],
+        &[],
+        2,
+        &["--zoom"],
+    );
+    fails(&["view", "--frames", "0"], &[], 2, &["--frames"]);
+    fails(&["bench", "--frames", "0"], &[], 2, &["--frames"]);
+    assert!(!Path::new(out).exists());
+}
+
+#[test]
+fn a_utf8_byte_order_mark_is_skipped() {
+    let p = write(
+        "bom.obj",
+        "\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n",
+    );
+    let out = tmp("bom_out.obj");
+    let o = succeeds(&[
+        "subdivide",
+        &p,
+        "--scheme",
+        "loop",
+        "--level",
+        "1",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!stderr(&o).contains("unknown"), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("10 vertices, 16 faces"),
+        "{}",
+        stdout(&o)
+    );
+}
+
+/// Each cause is said once; topology errors use the OBJ's numbers and line.
+#[test]
+fn messages_say_each_cause_once_in_obj_terms() {
+    let out = tmp("never_msg.png");
+    let out = out.to_str().unwrap();
+    let e = fails(
+        &["render", "/nonexistent/cow.obj", "-o", out],
+        &[],
+        1,
+        &["/nonexistent/cow.obj"],
+    );
+    assert_eq!(e.matches("os error").count(), 1, "{e}");
+    let p = write("empty.obj", "v 0 0 0\n");
+    let e = fails(
+        &["render", &p, "-o", out],
+        &[],
+        1,
+        &["empty.obj: empty mesh: no faces"],
+    );
+    assert_eq!(e.matches("empty mesh").count(), 1, "{e}");
+    let p = write("index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+    fails(
+        &["render", &p, "-o", out],
+        &[],
+        1,
+        &["index.obj:4: face 1 names vertex 4, but the file has 3 vertices"],
+    );
+    let p = write(
+        "tag.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nt crease 2/1/0 0 7 2\n",
+    );
+    fails(
+        &["render", &p, "-o", out],
+        &[],
+        1,
+        &[
+            "tag.obj:5: invalid tag: crease names vertex 7",
+            "3 vertices",
+        ],
+    );
+    // Refinement errors after loading speak the same language (Loop on a quad).
+    let quad = write(
+        "quad.obj",
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n",
+    );
+    fails(
+        &[
+            "subdivide",
+            &quad,
+            "--scheme",
+            "loop",
+            "--level",
+            "1",
+            "-o",
+            out,
+        ],
+        &[],
+        1,
+        &["quad.obj: Loop subdivision needs triangles, but face 1 has 4 vertices"],
+    );
+}
+
+/// Segment counts are checked before any device (no loader is even looked for), and named as
+/// the command names them.
+#[test]
+fn segments_are_checked_before_the_device_and_named_as_given() {
+    let cube = data("tests/data/meshes/cube.obj");
+    let out = tmp("never_seg.obj");
+    let out = out.to_str().unwrap();
+    for method in ["flat", "bft", "adaptive"] {
+        let e = fails(
+            &[
+                "export",
+                &cube,
+                "--method",
+                method,
+                "--segments",
+                "0",
+                "-o",
+                out,
+            ],
+            &[NO_LOADER],
+            1,
+            &["--segments 0", "from 1 to 64"],
+        );
+        assert!(
+            !e.contains("whole segments") && !e.contains("loader"),
+            "{e}"
+        );
+        for bad in ["nan", "1e30", "-3"] {
+            let segments = format!("--segments={bad}");
+            fails(
+                &["export", &cube, "--method", method, &segments, "-o", out],
+                &[NO_LOADER],
+                1,
+                &["--segments"],
+            );
+        }
+        let e = fails(
+            &["render", "--method", method, "--level", "0", "-o", out],
+            &[NO_LOADER],
+            1,
+            &["--level 0"],
+        );
+        assert!(!e.contains("--segments"), "{e}");
+    }
+    assert!(!Path::new(out).exists());
+}
+
+#[test]
+fn device_selectors_are_named_as_given_and_info_fails_on_a_missing_one() {
+    let out = tmp("never_dev.png");
+    let e = fails(
+        &["render", "--device", "99", "-o", out.to_str().unwrap()],
+        &[],
+        1,
+        &["--device 99", "devices seen"],
+    );
+    assert!(!e.contains("Index("), "{e}");
+    let e = fails(&["info", "--device", "99"], &[], 1, &["--device 99"]);
+    assert!(!e.contains("Index("), "{e}");
+    let e = fails(
+        &[
+            "render",
+            "--device",
+            "no-such-gpu",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[],
+        1,
+        &["--device no-such-gpu"],
+    );
+    assert!(!e.contains("Name("), "{e}");
+}
+
+#[test]
+fn negative_crease_sharpness_is_reported_as_smooth() {
+    let p = write(
+        "negative.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\nt crease 2/1/0 0 1 -2\n",
+    );
+    let out = tmp("negative_out.obj");
+    let o = succeeds(&[
+        "subdivide",
+        &p,
+        "--scheme",
+        "loop",
+        "--level",
+        "1",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let e = stderr(&o);
+    assert!(
+        e.contains("negative.obj:9") && e.contains("-2 is treated as 0 (smooth)"),
+        "{e}"
+    );
+}
+
+#[test]
+fn no_window_system_error_names_no_source_path() {
+    let e = fails(
+        &["view", "--frames", "1"],
+        &[("DISPLAY", ""), ("WAYLAND_DISPLAY", "")],
+        1,
+        &["no window system", "DISPLAY"],
+    );
+    assert!(!e.contains(".cargo") && !e.contains(".rs:"), "{e}");
+}
+
+/// Every command path, GPU ones with the validation layer on (their runs fail on any
+/// validation error): render, export, bench, info, subdivide, limit.
+#[test]
+fn every_command_path_runs_with_validation_on() {
+    let cube = data("tests/data/meshes/cube.obj");
+    let png = tmp("paths.png");
+    let obj = tmp("paths.obj");
+    let (png, obj) = (png.to_str().unwrap(), obj.to_str().unwrap());
+    succeeds(&["render", &cube, "--size", "64x48", "-o", png]);
+    succeeds(&[
+        "export",
+        &cube,
+        "--method",
+        "pn",
+        "--segments",
+        "3",
+        "-o",
+        obj,
+    ]);
+    let o = succeeds(&[
+        "bench",
+        "--mesh",
+        &cube,
+        "--methods",
+        "flat,bft",
+        "--segments",
+        "4",
+        "--frames",
+        "2",
+        "--warmup",
+        "1",
+        "--size",
+        "64x48",
+    ]);
+    assert!(stdout(&o).contains("flat"), "{}", stdout(&o));
+    let o = succeeds(&["info"]);
+    assert!(stdout(&o).contains("validation layer"), "{}", stdout(&o));
+    succeeds(&[
+        "subdivide",
+        &cube,
+        "--scheme",
+        "catmull-clark",
+        "--level",
+        "1",
+        "-o",
+        obj,
+    ]);
+    let o = succeeds(&[
+        "limit",
+        &cube,
+        "--scheme",
+        "catmull-clark",
+        "--face",
+        "0",
+        "--uv",
+        "0.5,0.5",
+    ]);
+    assert!(stdout(&o).contains("normal"), "{}", stdout(&o));
+}
