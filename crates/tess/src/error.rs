@@ -1,10 +1,5 @@
 //! The crate's error type. Each variant is one class of failure a caller (the CLI, a C ABI)
 //! can map to a status code, with fields naming the option, technique, file or index at fault.
-//!
-//! Each cause is said once: a variant that wraps another error (`source`) names only what it
-//! adds (the mesh, the path) and leaves the cause to the error chain, which `anyhow`'s `{:#}`
-//! and a C ABI's last-error string print after it. Embedding `{source}` as well would say it
-//! twice.
 use crate::shaders::{Stage, Variant};
 use crate::technique::{Pass, TechniqueId};
 
@@ -16,8 +11,8 @@ pub enum TessError {
     Vulkan(#[from] vk_core::VkError),
     #[error(transparent)]
     Topology(#[from] topology::TopologyError),
-    /// The mesh `name` could not be prepared (its topology error, the source, says where).
-    #[error("{name}")]
+    /// The mesh `name` could not be prepared (its topology error says where).
+    #[error("{name}: {source}")]
     Mesh {
         name: String,
         source: Box<dyn std::error::Error + Send + Sync>,
@@ -106,7 +101,7 @@ pub enum TessError {
         column: String,
         value: String,
     },
-    #[error("I/O on {path}")]
+    #[error("I/O on {path}: {source}")]
     Io {
         path: String,
         source: std::io::Error,

@@ -19,8 +19,27 @@ fn main() -> std::process::ExitCode {
     match commands::run(args) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", message(&e));
             std::process::ExitCode::FAILURE
         }
     }
+}
+
+/// `e` and its causes joined by ": " (anyhow's `{:#}`), leaving out a cause whose text the
+/// message already shows: an error that embeds its source in its own message and also returns
+/// it from `source()` (thiserror does both for a field named `source`) would otherwise say it
+/// twice.
+fn message(e: &anyhow::Error) -> String {
+    let mut out = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if out.contains(&text) {
+            continue;
+        }
+        if !out.is_empty() {
+            out.push_str(": ");
+        }
+        out.push_str(&text);
+    }
+    out
 }

@@ -422,6 +422,26 @@ fn messages_say_each_cause_once_in_obj_terms() {
             "3 vertices",
         ],
     );
+    // A technique's error wrapping the mesh's (thiserror embeds and chains a `source` field):
+    // said once.
+    let mut ngon = String::new();
+    for i in 0..300 {
+        let a = i as f64 * std::f64::consts::TAU / 300.0;
+        ngon.push_str(&format!("v {} {} 0\n", a.cos(), a.sin()));
+    }
+    ngon.push('f');
+    for i in 1..=300 {
+        ngon.push_str(&format!(" {i}"));
+    }
+    ngon.push('\n');
+    let p = write("ngon.obj", &ngon);
+    let e = fails(
+        &["render", &p, "--method", "adaptive", "-o", out],
+        &[],
+        1,
+        &["ngon.obj: adaptive plan: "],
+    );
+    assert_eq!(e.matches("300 corners").count(), 1, "{e}");
     // Refinement errors after loading speak the same language (Loop on a quad).
     let quad = write(
         "quad.obj",
