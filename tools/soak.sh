@@ -7,6 +7,7 @@
 #   tools/soak.sh [FRAMES] [extra `tessera view` options...]
 #   TESSERA_BIN=target/debug/tessera tools/soak.sh 2000      # another build
 #   SOAK_VALIDATION=--sync-validation tools/soak.sh          # synchronization validation too
+#   SOAK_SIZE=160x120 SOAK_LEVEL=4 tools/soak.sh             # a smaller window and level
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export PATH="$HOME/.cargo/bin:$PATH"
@@ -20,8 +21,8 @@ fi
 log="$(mktemp -d)/soak"
 start=$(date +%s.%N)
 status=0
-xvfb-run -a "$bin" view ${SOAK_VALIDATION:---validation} --method bft --animate --level 8 \
-    --size 640x480 --frames "$frames" --stats "$@" >"$log.out" 2>"$log.err" || status=$?
+xvfb-run -a "$bin" view ${SOAK_VALIDATION:---validation} --method bft --animate \
+    --level "${SOAK_LEVEL:-8}" --size "${SOAK_SIZE:-640x480}" --frames "$frames" --stats "$@" >"$log.out" 2>"$log.err" || status=$?
 end=$(date +%s.%N)
 cat "$log.out"
 errors=$(grep -c -E 'VUID|SYNC-|Validation Error' "$log.err" || true)

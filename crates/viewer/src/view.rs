@@ -192,7 +192,7 @@ impl App {
         self.frames_drawn += 1;
         let started = *self.started.get_or_insert_with(Instant::now);
         let n = self.frames_drawn;
-        if self.args.stats && (n == WARM_UP || n % 1000 == 0 || last) {
+        if self.args.stats && (n == WARM_UP || n.is_multiple_of(1000) || last) {
             device.wait_idle();
             print_stats(&format!("frame {n}"), device, started);
         }
