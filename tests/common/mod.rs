@@ -1,4 +1,6 @@
-//! Shared GPU test harness: a device with the validation layer forced on, and a guard that
+//! Shared GPU test harness: a device with the validation layer forced on, synchronization
+//! validation included (missing barriers between the compute pre-passes, draws, uploads and
+//! capture copies are errors too), and a guard that
 //! fails the test on any error-severity validation message (checked when the guard drops, after
 //! every resource is gone, so leaks reported at device destruction count too).
 #![allow(dead_code)]
@@ -20,13 +22,13 @@ impl Gpu {
         let _ = env_logger_init();
         let instance = Instance::new(&InstanceDesc {
             app_name: "tessera-tests".into(),
-            validation: Validation::On,
+            validation: Validation::Synchronization,
             surface_extensions: vec![],
         })
         .expect("Vulkan instance (install mesa-vulkan-drivers and vulkan-validationlayers)");
         assert_eq!(
             instance.validation(),
-            Validation::On,
+            Validation::Synchronization,
             "tests need VK_LAYER_KHRONOS_validation (package vulkan-validationlayers)"
         );
         let device = Device::new(&instance, desc, &[]).expect("a Vulkan device with tessellation");

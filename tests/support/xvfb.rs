@@ -46,8 +46,19 @@ pub fn start(displays: std::ops::Range<u32>) -> Option<Xvfb> {
         let _ = std::fs::remove_file(format!("/tmp/.X{n}-lock"));
         let _ = std::fs::remove_file(&socket);
         let display = format!(":{n}");
+        // -noreset: by default the server resets when its last client disconnects, and a
+        // client connecting during the reset fails ("Failed to open connection to X server"),
+        // which tests running the binary several times in a row hit.
         let child = Command::new("Xvfb")
-            .args([&display, "-screen", "0", "640x480x24", "-nolisten", "tcp"])
+            .args([
+                &display,
+                "-screen",
+                "0",
+                "640x480x24",
+                "-nolisten",
+                "tcp",
+                "-noreset",
+            ])
             .spawn()
             .ok()?;
         for _ in 0..100 {

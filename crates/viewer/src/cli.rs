@@ -285,6 +285,10 @@ pub struct ViewArgs {
     /// PNG to save the last frame to (needs --frames).
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
+    /// Print the GPU memory allocated and the live Vulkan objects after a warm-up, every 1,000
+    /// frames and at exit (for soak runs: tools/soak.sh).
+    #[arg(long)]
+    pub stats: bool,
 }
 
 fn parse_spacing(s: &str) -> Result<Spacing, String> {

@@ -7,7 +7,14 @@
 //! caps (Gregory, bilinear), S / Shift+S scale every crease's sharpness up / down (the surface
 //! is re-planned on the CPU; the mesh is not reloaded). Esc quits. The
 //! title shows the frame time. `--frames N --screenshot out.png` renders N frames, saves the
-//! last and exits. Techniques are built on first use and kept.
+//! last and exits. Techniques are built on first use and kept. `--stats` prints the GPU memory
+//! allocated and the live Vulkan objects after [`WARM_UP`] frames, every 1,000 frames and at
+//! exit (each after an idle wait, so objects retired by finished frames are counted as gone):
+//! what a soak run (tools/soak.sh, the window tests) checks stays constant.
+//!
+//! Teardown: nothing waits for the frames in flight before the technique, context and swapchain
+//! drop; vk-core's retire queue destroys each object only after the submissions that could use
+//! it completed (the swapchain's own objects after an idle wait in its drop).
 use crate::cli::ViewArgs;
 use crate::commands::{check_validation, load_mesh, mesh_name, open_device, scene_setup};
 use crate::technique::{describe, Setup};
@@ -27,6 +34,10 @@ use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
+
+/// Frames after which `--stats` first reports: every frame slot has been used and every
+/// per-slot resource made, so later figures must equal this one.
+pub const WARM_UP: u32 = 10;
 
 /// A technique built for the window, with its animation wave.
 struct Surface {
@@ -63,6 +74,8 @@ struct App {
     last_cursor: Option<(f64, f64)>,
     last_frame: Instant,
     frame_ms: f64,
+    /// When the first frame was drawn (`--stats` reports the time since).
+    started: Option<Instant>,
     error: Option<anyhow::Error>,
 }
 
@@ -147,6 +160,7 @@ impl App {
             surfaces,
             context,
             swapchain,
+            device,
             ..
         } = gpu;
         let surface = surfaces
@@ -176,6 +190,12 @@ impl App {
         frame.encoder().end_rendering();
         let shot = frame.present(last && self.args.screenshot.is_some())?;
         self.frames_drawn += 1;
+        let started = *self.started.get_or_insert_with(Instant::now);
+        let n = self.frames_drawn;
+        if self.args.stats && (n == WARM_UP || n.is_multiple_of(1000) || last) {
+            device.wait_idle();
+            print_stats(&format!("frame {n}"), device, started);
+        }
         let now = Instant::now();
         self.frame_ms = 0.9 * self.frame_ms + 0.1 * (now - self.last_frame).as_secs_f64() * 1e3;
         self.last_frame = now;
@@ -427,6 +447,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         last_cursor: None,
         last_frame: Instant::now(),
         frame_ms: 0.0,
+        started: None,
         error: None,
     };
     event_loop.run_app(&mut app).context("event loop")?;
@@ -440,6 +461,11 @@ pub fn run(args: ViewArgs) -> Result<()> {
             instance,
         }) => {
             drop((surfaces, context, swapchain));
+            if app.args.stats {
+                // What outlives every frame resource: idle one-shot command pools only.
+                device.wait_idle();
+                print_stats("exit", &device, app.started.unwrap_or_else(Instant::now));
+            }
             drop(device);
             check_validation(&instance)
         }
@@ -450,4 +476,14 @@ pub fn run(args: ViewArgs) -> Result<()> {
         return Err(e);
     }
     result
+}
+
+/// One `--stats` line: `stats: <when>: <bytes> bytes allocated, <n> live Vulkan objects, <s> s`.
+fn print_stats(when: &str, device: &Device, started: Instant) {
+    println!(
+        "stats: {when}: {} bytes allocated, {} live Vulkan objects, {:.1} s",
+        device.allocated_bytes(),
+        device.live_objects(),
+        started.elapsed().as_secs_f64()
+    );
 }

@@ -68,6 +68,7 @@ impl Buffer {
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: device is live; info is valid.
         let raw = unsafe { device.raw.create_buffer(&info, None) }.ctx("vkCreateBuffer")?;
+        device.created(1);
         // SAFETY: raw was just created on this device.
         let requirements = unsafe { device.raw.get_buffer_memory_requirements(raw) };
         let bind = |memory, offset| {
@@ -80,6 +81,7 @@ impl Buffer {
                 Err(e) => {
                     // SAFETY: raw was never used by any command.
                     unsafe { device.raw.destroy_buffer(raw, None) };
+                    device.destroyed(1);
                     return Err(e);
                 }
             };

@@ -133,6 +133,7 @@ impl DeviceShared {
             match item {
                 Retired::Buffer { raw, allocation } => {
                     self.raw.destroy_buffer(raw, None);
+                    self.destroyed(1);
                     if let Some(a) = allocation {
                         self.free(a);
                     }
@@ -144,6 +145,7 @@ impl DeviceShared {
                 } => {
                     self.raw.destroy_image_view(view, None);
                     self.raw.destroy_image(raw, None);
+                    self.destroyed(2);
                     if let Some(a) = allocation {
                         self.free(a);
                     }
@@ -151,10 +153,20 @@ impl DeviceShared {
                 Retired::Pipeline { raw, layout } => {
                     self.raw.destroy_pipeline(raw, None);
                     self.raw.destroy_pipeline_layout(layout, None);
+                    self.destroyed(2);
                 }
-                Retired::DescriptorPool(p) => self.raw.destroy_descriptor_pool(p, None),
-                Retired::DescriptorSetLayout(l) => self.raw.destroy_descriptor_set_layout(l, None),
-                Retired::QueryPool(p) => self.raw.destroy_query_pool(p, None),
+                Retired::DescriptorPool(p) => {
+                    self.raw.destroy_descriptor_pool(p, None);
+                    self.destroyed(1);
+                }
+                Retired::DescriptorSetLayout(l) => {
+                    self.raw.destroy_descriptor_set_layout(l, None);
+                    self.destroyed(1);
+                }
+                Retired::QueryPool(p) => {
+                    self.raw.destroy_query_pool(p, None);
+                    self.destroyed(1);
+                }
                 Retired::CommandPool { pool, cmd } => self.recycle_once_pool(pool, cmd),
             }
         }
@@ -178,6 +190,7 @@ impl DeviceShared {
         // SAFETY: the device is live.
         let pool =
             unsafe { self.raw.create_command_pool(&info, None) }.ctx("vkCreateCommandPool")?;
+        self.created(1);
         let alloc = vk::CommandBufferAllocateInfo::default()
             .command_pool(pool)
             .level(vk::CommandBufferLevel::PRIMARY)
@@ -188,6 +201,7 @@ impl DeviceShared {
             Err(result) => {
                 // SAFETY: the pool has no command buffers.
                 unsafe { self.raw.destroy_command_pool(pool, None) };
+                self.destroyed(1);
                 Err(VkError::Call {
                     call: "vkAllocateCommandBuffers",
                     result,
@@ -208,8 +222,11 @@ impl DeviceShared {
         };
         match (reset, self.once_pools.lock()) {
             (Ok(()), Ok(mut pools)) => pools.push((pool, cmd)),
-            // SAFETY: as above; a pool that cannot be reset or kept is destroyed instead.
-            _ => unsafe { self.raw.destroy_command_pool(pool, None) },
+            _ => {
+                // SAFETY: as above; a pool that cannot be reset or kept is destroyed instead.
+                unsafe { self.raw.destroy_command_pool(pool, None) };
+                self.destroyed(1);
+            }
         }
     }
 }

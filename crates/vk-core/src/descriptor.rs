@@ -58,6 +58,7 @@ impl DescriptorSetLayout {
         // SAFETY: device live; the info references live locals.
         let raw = unsafe { device.raw.create_descriptor_set_layout(&info, None) }
             .ctx("vkCreateDescriptorSetLayout")?;
+        device.created(1);
         device.set_name(raw, name);
         Ok(Self {
             raw,
@@ -115,6 +116,7 @@ impl DescriptorPool {
         // SAFETY: device live; the info references live locals.
         let raw = unsafe { device.raw.create_descriptor_pool(&info, None) }
             .ctx("vkCreateDescriptorPool")?;
+        device.created(1);
         device.set_name(raw, name);
         Ok(Self {
             raw,

@@ -46,6 +46,7 @@ impl Image {
             .initial_layout(vk::ImageLayout::UNDEFINED);
         // SAFETY: device live; info valid.
         let raw = unsafe { device.raw.create_image(&info, None) }.ctx("vkCreateImage")?;
+        device.created(1);
         // SAFETY: raw just created.
         let requirements = unsafe { device.raw.get_image_memory_requirements(raw) };
         let bind = |memory, offset| {
@@ -63,6 +64,7 @@ impl Image {
             Err(e) => {
                 // SAFETY: raw is unused.
                 unsafe { device.raw.destroy_image(raw, None) };
+                device.destroyed(1);
                 return Err(e);
             }
         };
@@ -75,10 +77,14 @@ impl Image {
         let view = match unsafe { device.raw.create_image_view(&view_info, None) }
             .ctx("vkCreateImageView")
         {
-            Ok(v) => v,
+            Ok(v) => {
+                device.created(1);
+                v
+            }
             Err(e) => {
                 // SAFETY: raw has no view and was never used.
                 unsafe { device.raw.destroy_image(raw, None) };
+                device.destroyed(1);
                 device.free(allocation);
                 return Err(e);
             }

@@ -14,6 +14,9 @@
 //!   and why its safe methods uphold them; crates above vk-core need no `unsafe`.
 //! - Objects are destroyed through the device's retire queue ([`retire`]): never while a
 //!   submission that could use them is pending, so frames need not be waited for.
+//! - Every handle vk-core creates is counted where it is created and where it is destroyed
+//!   ([`DeviceShared::live_objects`]), next to gpu-allocator's bytes
+//!   ([`DeviceShared::allocated_bytes`]): soak runs assert both constant after warm-up.
 #![deny(unsafe_op_in_unsafe_fn)]
 pub mod buffer;
 pub mod command;

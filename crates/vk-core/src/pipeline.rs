@@ -181,6 +181,7 @@ fn shader_modules(
         // SAFETY: SPIR-V comes from the build-time compiler.
         match unsafe { device.raw.create_shader_module(&info, None) } {
             Ok(m) => {
+                device.created(1);
                 device.set_name(m, &format!("{name} {:?}", s.stage));
                 modules.push(m)
             }
@@ -200,6 +201,7 @@ fn destroy_modules(device: &Device, modules: &[vk::ShaderModule]) {
     for &m in modules {
         // SAFETY: modules are only needed during pipeline creation.
         unsafe { device.raw.destroy_shader_module(m, None) };
+        device.destroyed(1);
     }
 }
 
@@ -219,6 +221,7 @@ fn pipeline_layout(
     // SAFETY: set layouts are live.
     let layout =
         unsafe { device.raw.create_pipeline_layout(&info, None) }.ctx("vkCreatePipelineLayout")?;
+    device.created(1);
     device.set_name(layout, &format!("{name} layout"));
     Ok(layout)
 }
@@ -236,6 +239,7 @@ impl Pipeline {
             Err(e) => {
                 // SAFETY: layout unused.
                 unsafe { device.raw.destroy_pipeline_layout(layout, None) };
+                device.destroyed(1);
                 return Err(e);
             }
         };
@@ -339,6 +343,7 @@ impl Pipeline {
         destroy_modules(device, &modules);
         match result {
             Ok(p) => {
+                device.created(1);
                 device.set_name(p[0], desc.name);
                 Ok(Self {
                     raw: p[0],
@@ -359,6 +364,7 @@ impl Pipeline {
             Err((_, e)) => {
                 // SAFETY: layout unused.
                 unsafe { device.raw.destroy_pipeline_layout(layout, None) };
+                device.destroyed(1);
                 Err(VkError::Call {
                     call: "vkCreateGraphicsPipelines",
                     result: e,
@@ -380,6 +386,7 @@ impl Pipeline {
             Err(e) => {
                 // SAFETY: the layout was never used.
                 unsafe { device.raw.destroy_pipeline_layout(layout, None) };
+                device.destroyed(1);
                 return Err(e);
             }
         };
@@ -407,6 +414,7 @@ impl Pipeline {
         destroy_modules(device, &modules);
         match result {
             Ok(p) => {
+                device.created(1);
                 device.set_name(p[0], name);
                 Ok(Self {
                     raw: p[0],
@@ -424,6 +432,7 @@ impl Pipeline {
             Err((_, e)) => {
                 // SAFETY: layout unused.
                 unsafe { device.raw.destroy_pipeline_layout(layout, None) };
+                device.destroyed(1);
                 Err(VkError::Call {
                     call: "vkCreateComputePipelines",
                     result: e,

@@ -113,6 +113,7 @@ impl QueryPool {
             .pipeline_statistics(stats);
         // SAFETY: device live; the feature was checked above.
         let raw = unsafe { device.raw.create_query_pool(&info, None) }.ctx("vkCreateQueryPool")?;
+        device.created(1);
         device.set_name(raw, name);
         Ok(Self {
             raw,

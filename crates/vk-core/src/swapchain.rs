@@ -110,6 +110,7 @@ impl Swapchain {
             ash_window::create_surface(&instance.entry, &instance.raw, display, window, None)
         }
         .ctx("vkCreate*SurfaceKHR")?;
+        device.created(1);
         let surface_loader = ash::khr::surface::Instance::new(&instance.entry, &instance.raw);
         // SAFETY: surface and physical device are live.
         let supported = unsafe {
@@ -123,6 +124,7 @@ impl Swapchain {
         if !supported {
             // SAFETY: surface unused.
             unsafe { surface_loader.destroy_surface(surface, None) };
+            device.destroyed(1);
             return Err(VkError::Surface(format!(
                 "{} cannot present to this window",
                 device.info.name
@@ -148,6 +150,7 @@ impl Swapchain {
         // SAFETY: device live.
         let pool = unsafe { device.raw.create_command_pool(&pool_info, None) }
             .ctx("vkCreateCommandPool")?;
+        device.created(1);
         let alloc = vk::CommandBufferAllocateInfo::default()
             .command_pool(pool)
             .level(vk::CommandBufferLevel::PRIMARY)
@@ -173,6 +176,7 @@ impl Swapchain {
                         .ctx("vkCreateFence")?,
                 )
             };
+            device.created(2);
             device.set_name(cmd, &format!("frame {i} commands"));
             frames.push(FrameSync {
                 image_available,
@@ -221,6 +225,8 @@ impl Swapchain {
                 self.device.raw.destroy_semaphore(s, None);
             }
         }
+        self.device
+            .destroyed((self.views.len() + self.render_finished.len()) as u64);
         self.views.clear();
         self.render_finished.clear();
         self.images.clear();
@@ -278,9 +284,11 @@ impl Swapchain {
         // SAFETY: the old swapchain is retired by this call and destroyed right after.
         let raw =
             unsafe { self.loader.create_swapchain(&info, None) }.ctx("vkCreateSwapchainKHR")?;
+        self.device.created(1);
         if self.raw != vk::SwapchainKHR::null() {
             // SAFETY: the device is idle; the old swapchain's images are no longer used.
             unsafe { self.loader.destroy_swapchain(self.raw, None) };
+            self.device.destroyed(1);
         }
         self.raw = raw;
         // SAFETY: raw is live.
@@ -297,6 +305,7 @@ impl Swapchain {
                 unsafe { self.device.raw.create_image_view(&view_info, None) }
                     .ctx("vkCreateImageView")?,
             );
+            self.device.created(1);
             // SAFETY: device live.
             self.render_finished.push(
                 unsafe {
@@ -306,6 +315,7 @@ impl Swapchain {
                 }
                 .ctx("vkCreateSemaphore")?,
             );
+            self.device.created(1);
             self.device.set_name(image, &format!("swapchain image {i}"));
         }
         self.depth = Some(Image::new(
@@ -737,5 +747,9 @@ impl Drop for Swapchain {
             self.device.raw.destroy_command_pool(self.pool, None);
             self.surface_loader.destroy_surface(self.surface, None);
         }
+        // The swapchain (when made), the frames' semaphores and fences, the pool, the surface.
+        let swapchain = u64::from(self.raw != vk::SwapchainKHR::null());
+        self.device
+            .destroyed(swapchain + 2 * self.frames.len() as u64 + 2);
     }
 }

@@ -1,4 +1,5 @@
-//! Swapchain frames through the encoder, in a window on Xvfb with the validation layer on: a
+//! Swapchain frames through the encoder, in a window on Xvfb with the validation layer on
+//! (synchronization validation included): a
 //! rendered frame with a screenshot, objects dropped right after an unwaited present, an
 //! abandoned (dropped) frame, and a present refused for an open rendering scope. Skipped where
 //! Xvfb is not installed (CI sets TESSERA_REQUIRE_XVFB=1 so a missing Xvfb fails there).
@@ -36,11 +37,11 @@ fn run(window: Arc<Window>) -> Result<(), String> {
     let display = window.display_handle().map_err(|e| e.to_string())?.as_raw();
     let instance = Instance::new(&InstanceDesc {
         app_name: "vk-core-swapchain-test".into(),
-        validation: Validation::On,
+        validation: Validation::Synchronization,
         surface_extensions: required_surface_extensions(display).map_err(|e| e.to_string())?,
     })
     .map_err(|e| e.to_string())?;
-    if instance.validation() != Validation::On {
+    if instance.validation() != Validation::Synchronization {
         return Err("the validation layer is not installed".into());
     }
     let device = Device::new(
