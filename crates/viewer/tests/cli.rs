@@ -610,13 +610,76 @@ fn export_writes_a_watertight_outward_obj_for_flat() {
     assert!((volume - 8.0).abs() < 1e-9, "volume {volume}");
 }
 
+/// The unit cube of `tests/data/meshes/cube.obj` with a normal per face corner (hard edges):
+/// each face's corner normals lean from the face normal towards the corner, so the two PN
+/// patches of an edge have different normals at its ends and curve it differently.
+fn hard_normal_cube() -> String {
+    let p: [[f64; 3]; 8] = [
+        [-1., -1., -1.],
+        [1., -1., -1.],
+        [1., 1., -1.],
+        [-1., 1., -1.],
+        [-1., -1., 1.],
+        [1., -1., 1.],
+        [1., 1., 1.],
+        [-1., 1., 1.],
+    ];
+    let faces = [
+        [1, 4, 3, 2],
+        [5, 6, 7, 8],
+        [1, 2, 6, 5],
+        [2, 3, 7, 6],
+        [3, 4, 8, 7],
+        [4, 1, 5, 8],
+    ];
+    let mut obj = String::new();
+    for v in p {
+        obj += &format!("v {} {} {}\n", v[0], v[1], v[2]);
+    }
+    let mut f = String::new();
+    for (i, face) in faces.iter().enumerate() {
+        // The face normal: the coordinate all four corners share.
+        let c = |k: usize| face.map(|v| p[v - 1][k]);
+        let axis = (0..3)
+            .find(|&k| c(k).iter().all(|&x| x == c(k)[0]))
+            .unwrap();
+        f += "f";
+        for (j, &v) in face.iter().enumerate() {
+            let mut n = p[v - 1];
+            n[axis] *= 3.0;
+            let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            obj += &format!("vn {} {} {}\n", n[0] / l, n[1] / l, n[2] / l);
+            f += &format!(" {v}//{}", 4 * i + j + 1);
+        }
+        f += "\n";
+    }
+    obj + &f
+}
+
 #[test]
 fn export_reports_pn_cracks_and_fails_on_them_when_asked() {
     let out = tmp("cube_pn.obj");
     let cube = data("tests/data/meshes/cube.obj");
-    let args = [
+    // PN evaluates every shared edge from the edge's own data in one order: watertight by bits
+    // where patches share their corners (tests/watertight.rs), so --fail-on-cracks passes.
+    let s = export_ok(&[
         "export",
         &cube,
+        "--method",
+        "pn",
+        "--segments",
+        "5",
+        "--fail-on-cracks",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(s.contains("0 on the base mesh's boundary, 0 cracks"), "{s}");
+    // A normal per face corner gives each side of an edge its own curve: real gaps, reported
+    // (exit 0) unless --fail-on-cracks.
+    let hard = write("cube_hard_normals.obj", &hard_normal_cube());
+    let args = [
+        "export",
+        hard.to_str().unwrap(),
         "--method",
         "pn",
         "--segments",
@@ -624,8 +687,6 @@ fn export_reports_pn_cracks_and_fails_on_them_when_asked() {
         "-o",
         out.to_str().unwrap(),
     ];
-    // PN evaluates shared edges in a different float order from each side: bit-level cracks,
-    // reported (exit 0) unless --fail-on-cracks.
     let s = export_ok(&args);
     let open = reported(&s, "open edges:");
     assert!(

@@ -1,5 +1,11 @@
-//! Curved PN triangles with the corrected quadratic normal field of Boubekeur et al. 2005,
-//! appendix A (`glsl/pn/tri.tesc` explains the choice of its t).
+//! Curved PN triangles (Vlachos et al. 2001) with the corrected quadratic normal field of
+//! Boubekeur et al. 2005, appendix A (`glsl/pn/pn.glsl` explains the choice of its t).
+//!
+//! Watertight by canonical edges: a tess coordinate on a patch edge is evaluated from that
+//! edge's two corners and two edge control points only, starting from the corner with the
+//! lower position (then normal) bits, with `precise` arithmetic; corners are the control points
+//! themselves. Both patches of a shared edge thus emit the same position and normal bits
+//! (`tests/watertight.rs`), without vertex indices: repeated vertices with equal data weld too.
 use crate::gpu::DrawPush;
 use crate::shaders::Stage;
 use crate::technique::{PatchPipeline, PatchType, TechniqueId};
