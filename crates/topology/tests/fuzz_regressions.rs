@@ -30,3 +30,31 @@ fn tag_counts_that_overflow_are_a_count_mismatch() {
         );
     }
 }
+
+/// Validation accepts vertices no face uses; their limit masks divided by valence 0 and
+/// `vertex_limit_exact` returned NaN (limit target: "non-finite vertex limit 0: [NaN, NaN,
+/// NaN]"). They have no limit point: the mask is `None` and the exact limit an error.
+#[test]
+fn isolated_vertex_has_no_limit_point() {
+    use topology::eval::{EvalError, LimitScheme, LocalMesh};
+    use topology::ControlMesh;
+    let positions = vec![[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
+    for (scheme, face) in [
+        (LimitScheme::CatmullClark, vec![[1u32, 2, 3]]),
+        (LimitScheme::Loop, vec![[1u32, 2, 3]]),
+    ] {
+        let mesh = ControlMesh::from_polygons(positions.clone(), &face);
+        mesh.validate().expect("isolated vertices are allowed");
+        let lm = LocalMesh::from_control_mesh(&mesh, scheme).unwrap();
+        assert_eq!(lm.vertex_limit_position(0), None, "{scheme:?}");
+        assert!(matches!(
+            lm.vertex_limit_exact(0),
+            Err(EvalError::IsolatedVertex { vertex: 0 })
+        ));
+        assert_eq!(lm.loop_tangent_stencils(0), None);
+        for v in 1..4 {
+            let p = lm.vertex_limit_exact(v).unwrap();
+            assert!(p.iter().all(|x| x.is_finite()), "{scheme:?} vertex {v}: {p:?}");
+        }
+    }
+}
