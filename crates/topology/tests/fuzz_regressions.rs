@@ -38,13 +38,16 @@ fn tag_counts_that_overflow_are_a_count_mismatch() {
 fn isolated_vertex_has_no_limit_point() {
     use topology::eval::{EvalError, LimitScheme, LocalMesh};
     use topology::ControlMesh;
-    let positions = vec![[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
-    for (scheme, face) in [
-        (LimitScheme::CatmullClark, vec![[1u32, 2, 3]]),
-        (LimitScheme::Loop, vec![[1u32, 2, 3]]),
-    ] {
-        let mesh = ControlMesh::from_polygons(positions.clone(), &face);
-        mesh.validate().expect("isolated vertices are allowed");
+    let positions = vec![
+        [0.0, 1.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 1.0, 1.0],
+    ];
+    // Vertex 0 is in no face.
+    let mesh = ControlMesh::from_polygons(positions, &[[1u32, 2, 3]]);
+    mesh.validate().expect("isolated vertices are allowed");
+    for scheme in [LimitScheme::CatmullClark, LimitScheme::Loop] {
         let lm = LocalMesh::from_control_mesh(&mesh, scheme).unwrap();
         assert_eq!(lm.vertex_limit_position(0), None, "{scheme:?}");
         assert!(matches!(
@@ -54,7 +57,10 @@ fn isolated_vertex_has_no_limit_point() {
         assert_eq!(lm.loop_tangent_stencils(0), None);
         for v in 1..4 {
             let p = lm.vertex_limit_exact(v).unwrap();
-            assert!(p.iter().all(|x| x.is_finite()), "{scheme:?} vertex {v}: {p:?}");
+            assert!(
+                p.iter().all(|x| x.is_finite()),
+                "{scheme:?} vertex {v}: {p:?}"
+            );
         }
     }
 }
