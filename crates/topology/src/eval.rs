@@ -612,7 +612,9 @@ impl View<'_> {
     /// Limit rule of `v` if no semi-sharp feature is left there (else `None`: refine first).
     /// Crease ends are oriented so the CCW span `ends[0] → ends[1]` contains face `face`.
     fn limit_vertex(&self, v: u32, fan: &Fan, face: Option<u32>) -> Option<LimitVertex> {
-        if !fan.complete {
+        // An isolated vertex (validation allows them) has an empty ring: no limit point, and
+        // the masks would divide by its valence 0.
+        if !fan.complete || fan.ring.is_empty() {
             return None;
         }
         let vs = self.level.vertex_sharpness[v as usize];

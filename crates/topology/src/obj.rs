@@ -307,7 +307,9 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
                 },
             )
         })?;
-    if nums.len() != 3 || words.len() < 2 + nums[0] + nums[1] + nums[2] {
+    // Checked: counts near usize::MAX would wrap the sum and pass the length test.
+    let needed = nums.iter().try_fold(2usize, |sum, &n| sum.checked_add(n));
+    if nums.len() != 3 || needed.is_none_or(|needed| words.len() < needed) {
         return Err(perr(
             line,
             ObjSyntax::TagCountMismatch {

@@ -1,0 +1,93 @@
+//! Feature-adaptive Catmull-Clark plan (`plan_adaptive`) of structured meshes with creases,
+//! corners, holes, both end caps and any sharpness scale. For accepted input: every stencil
+//! reads only earlier vertices, every patch and curve names existing vertices, the global
+//! vertex buffer is finite, and every patch evaluates to a finite point and derivatives.
+//! Bounds: `MeshSpec` (≤ 72 faces), coordinates within `MAX_COORD`, isolation 1..=3; with
+//! `follow_semi_sharp`, inputs whose scaled semi-sharp sharpness exceeds 4 are skipped (the
+//! plan would follow them to level 10, thousands of faces per crease edge).
+#![no_main]
+
+use arbitrary::Unstructured;
+use libfuzzer_sys::fuzz_target;
+use tessera_fuzz::{all_finite, param, positions_in_range, MeshSpec};
+use topology::{plan_adaptive, AdaptiveOptions, EndCap};
+
+fuzz_target!(
+    init: tessera_fuzz::single_thread_rayon(),
+    |data: &[u8]| {
+        if data.len() < 8 {
+            return;
+        }
+        let (head, rest) = data.split_at(8);
+        let Some(spec) = MeshSpec::from_bytes(rest) else {
+            return;
+        };
+        let mut u = Unstructured::new(head);
+        let knobs: u8 = u.arbitrary().unwrap_or(0);
+        let scale = match u.arbitrary::<u8>().unwrap_or(0) % 6 {
+            0 => 0.0,
+            1 => 0.5,
+            2 => 2.0,
+            3 => f32::from_bits(u.arbitrary().unwrap_or(0)),
+            _ => 1.0,
+        };
+        let mesh = spec.build();
+        if !positions_in_range(&mesh) {
+            return;
+        }
+        let opts = AdaptiveOptions {
+            isolation: 1 + (knobs & 3) as u32 % 3,
+            end_cap: if knobs & 4 == 0 {
+                EndCap::Gregory
+            } else {
+                EndCap::Bilinear
+            },
+            sharpness_scale: scale,
+            follow_semi_sharp: knobs & 8 != 0,
+        };
+        let deep = |s: f32| {
+            let t = s * scale;
+            s < 10.0 && t > 4.0 && t < 10.0
+        };
+        if opts.follow_semi_sharp
+            && (mesh.creases.iter().any(|c| deep(c.sharpness))
+                || mesh.corners.iter().any(|c| deep(c.sharpness)))
+        {
+            return;
+        }
+        let Ok(plan) = plan_adaptive(&mesh, &opts) else {
+            return;
+        };
+        assert_eq!(plan.num_base_vertices as usize, mesh.positions.len());
+        for block in plan.steps.iter().chain(std::iter::once(&plan.local_points)) {
+            for r in 0..block.table.len() {
+                let (idx, w) = block.table.stencil(r);
+                assert!(idx.iter().all(|&v| v < block.first_vertex));
+                assert!(all_finite(w));
+            }
+        }
+        let nv = plan.num_vertices;
+        for p in &plan.patches {
+            assert!(p.control_points.iter().all(|&v| v < nv));
+        }
+        for c in &plan.curves {
+            assert!(c.iter().all(|&v| v < nv));
+        }
+        let verts = plan.apply(&mesh.positions);
+        assert_eq!(verts.len(), nv as usize);
+        assert!(
+            verts.iter().flatten().all(|x| x.is_finite()),
+            "non-finite plan vertex"
+        );
+        let extra = (param(&mut u), param(&mut u));
+        for k in 0..plan.patches.len() {
+            for (a, b) in [(0.0, 0.0), (1.0, 1.0), (0.5, 0.5), extra] {
+                let s = plan.evaluate(&verts, k, a, b);
+                assert!(
+                    all_finite(&s.position) && all_finite(&s.du) && all_finite(&s.dv),
+                    "non-finite patch {k} at ({a}, {b}): {s:?}"
+                );
+            }
+        }
+    }
+);
