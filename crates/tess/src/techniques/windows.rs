@@ -125,7 +125,7 @@ pub fn plan<const K: usize>(
             (w.start - (w.start as u64 % steps[k]) as u32)..w.end
         }
     };
-    let fits = |ws: &[Range<u32>; K]| -> Option<usize> {
+    let overflow = |ws: &[Range<u32>; K]| -> Option<usize> {
         (0..K).find(|&k| spaces[k].bytes(&aligned(&ws[k], k)) > limits.max_range)
     };
     let mut chunks = Vec::new();
@@ -134,12 +134,12 @@ pub fn plan<const K: usize>(
     for i in 0..n {
         let fp = footprint(i);
         let trial: [Range<u32>; K] = std::array::from_fn(|k| hull(&cur[k], &fp[k]));
-        if fits(&trial).is_none() {
+        if overflow(&trial).is_none() {
             cur = trial;
             continue;
         }
         // The item does not fit with the chunk; alone it must.
-        if let Some(k) = fits(&fp) {
+        if let Some(k) = overflow(&fp) {
             return Err(TessError::StorageWindow {
                 what,
                 item: i,
