@@ -70,8 +70,23 @@ layout(push_constant) uniform BftPush {
     float pixels_per_segment;
     float distance_ref;   // distance at which an edge gets max_level segments
     float max_level;      // 2^L: the tables' level
-    uint count;           // compute passes: number of level-1 vertices
+    uint count;           // compute passes: level-1 vertices of this chunk
+    uint first_vertex;    // compute passes: the chunk's first level-1 vertex
+    // Window bases of the chunk (tess::techniques::windows): every index into a windowed
+    // buffer is global and has its space's base subtracted (the PATCH/RING/L1/... macros).
+    uint patch_base;      // patches
+    uint ring_base;       // patch_rings
+    uint level1_base;     // level1_pos, level1_nrm, stencil_offsets, tangent_offsets
+    uint stencil_base;    // stencil_terms
+    uint tangent_base;    // tangent_terms
+    uint base_vertex_base; // base_positions
 } bft;
+
+// Windowed reads by global index.
+#define PATCH(f) patches[(f) - bft.patch_base]
+#define RING(i) patch_rings[(i) - bft.ring_base]
+#define L1_POS(v) level1_pos[(v) - bft.level1_base]
+#define L1_NRM(v) level1_nrm[(v) - bft.level1_base]
 
 const uint NO_ROW = 0xffffffffu;
 
@@ -81,8 +96,8 @@ uint owner_local(uint owner) { return owner & uint(BFT_OWNER_LOCAL_MASK); }
 // Row of grid point (a, b) in the face's table and whether the slots are mirrored; NO_ROW when
 // the point carries no row.
 uint bft_row(uint face, uint a, uint b, out bool flip) {
-    bool mirrored = patches[face].mirrored != 0u;
-    uint entry = patches[face].entry;
+    bool mirrored = PATCH(face).mirrored != 0u;
+    uint entry = PATCH(face).entry;
     bool half_table = table_entries[entry].half_table != 0u;
     uint grid = table.grid;
     flip = mirrored;
@@ -97,9 +112,9 @@ uint bft_row(uint face, uint a, uint b, out bool flip) {
 // shading normal, or du when geometric; r: dv when geometric.
 void bft_accumulate(uint face, uint row, bool flip, bool geometric,
                     out vec3 p, out vec3 q, out vec3 r) {
-    uint ring = patches[face].ring_offset;
-    uint rs = patches[face].ring_size;
-    uint entry = patches[face].entry;
+    uint ring = PATCH(face).ring_offset;
+    uint rs = PATCH(face).ring_size;
+    uint entry = PATCH(face).entry;
     uint perm = table_entries[entry].perm_offset;
     uint off_pos = table_entries[entry].position_offset;
     uint off_du = flip ? table_entries[entry].dv_offset : table_entries[entry].du_offset;
@@ -108,15 +123,15 @@ void bft_accumulate(uint face, uint row, bool flip, bool geometric,
     for (uint s = 0u; s < rs; ++s) {
         uint slot = flip ? mirror_perms[perm + s] : s;
         uint base = row * rs + slot;
-        uint v = patch_rings[ring + s];
-        vec3 x = level1_pos[v].xyz;
+        uint v = RING(ring + s);
+        vec3 x = L1_POS(v).xyz;
         float w = table_weights[off_pos + base];
         ap += w * x;
         if (geometric) {
             aq += table_weights[off_du + base] * x;
             ar += table_weights[off_dv + base] * x;
         } else {
-            aq += w * level1_nrm[v].xyz;
+            aq += w * L1_NRM(v).xyz;
         }
     }
     p = ap; q = aq; r = ar;
@@ -133,14 +148,14 @@ bool bft_eval(uint face, vec3 b, bool geometric, out vec3 p, out vec3 n) {
     int corner = b.x == 1.0 ? 0 : (b.y == 1.0 ? 1 : (b.z == 1.0 ? 2 : -1));
     int edge = b.z == 0.0 ? 0 : (b.x == 0.0 ? 1 : (b.y == 0.0 ? 2 : -1));
     if (corner >= 0) {
-        uint o = patches[face].corner_owner[corner];
+        uint o = PATCH(face).corner_owner[corner];
         g = owner_face(o);
         uint c = owner_local(o);
         u = c == 1u ? 1.0 : 0.0;
         v = c == 2u ? 1.0 : 0.0;
     } else if (edge >= 0) {
         float t = edge == 0 ? b.y : (edge == 1 ? b.z : b.x);
-        uint o = patches[face].edge_owner[edge];
+        uint o = PATCH(face).edge_owner[edge];
         g = owner_face(o);
         if (g != face) t = 1.0 - t;
         uint ge = owner_local(o);

@@ -11,7 +11,7 @@ layout(location = 0) patch out uint tc_face;
 
 float edge_factor(uint a, uint b) {
     uint lo = min(a, b), hi = max(a, b);
-    vec3 p = level1_pos[lo].xyz, q = level1_pos[hi].xyz;
+    vec3 p = L1_POS(lo).xyz, q = L1_POS(hi).xyz;
     float f;
     if (bft.factor_mode == BFT_FACTORS_SCREEN) {
         vec4 cp = frame.view_proj * vec4(p, 1.0), cq = frame.view_proj * vec4(q, 1.0);
@@ -38,8 +38,8 @@ float edge_factor(uint a, uint b) {
 void main() {
     uint face = in_face[0];
     tc_face = face;
-    uint ring = patches[face].ring_offset;
-    uint v0 = patch_rings[ring], v1 = patch_rings[ring + 1u], v2 = patch_rings[ring + 2u];
+    uint ring = PATCH(face).ring_offset;
+    uint v0 = RING(ring), v1 = RING(ring + 1u), v2 = RING(ring + 2u);
     // gl_TessLevelOuter[i] is the edge opposite corner i: v1v2, v2v0, v0v1.
     float e0 = edge_factor(v1, v2), e1 = edge_factor(v2, v0), e2 = edge_factor(v0, v1);
     gl_TessLevelOuter[0] = e0;

@@ -21,7 +21,7 @@ void main() {
     bool geometric = (bft.options & uint(BFT_OPTION_GEOMETRIC_NORMALS)) != 0u;
     vec3 p, n;
     bool exact = bft_eval(face, gl_TessCoord, geometric, p, n);
-    uint kind = table_entries[patches[face].entry].kind;
+    uint kind = table_entries[PATCH(face).entry].kind;
     out_albedo = (bft.options & uint(BFT_OPTION_PATCH_COLOURS)) != 0u ? KIND_COLOURS[min(kind, 3u)] : frame.base_color.rgb;
     emit_sample(p, safe_normalize(n, vec3(0.0)), face, (exact ? uint(CAPTURE_FLAG_EXACT) : 0u) | (kind << CAPTURE_FLAG_KIND_SHIFT));
 }

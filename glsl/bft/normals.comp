@@ -6,14 +6,16 @@
 #include "normals.glsl"
 layout(local_size_x = BFT_LOCAL_SIZE) in;
 void main() {
-    uint v = gl_GlobalInvocationID.x;
-    if (v >= bft.count) return;
+    if (gl_GlobalInvocationID.x >= bft.count) return;
+    // Global indices, less each windowed buffer's base (the chunk's windows).
+    uint v = bft.first_vertex + gl_GlobalInvocationID.x;
+    uint row = v - bft.level1_base;
     precise vec3 t1 = vec3(0.0), t2 = vec3(0.0);
-    for (uint k = tangent_offsets[v]; k < tangent_offsets[v + 1u]; ++k) {
-        TangentTerm t = tangent_terms[k];
-        vec3 x = level1_pos[t.index].xyz;
+    for (uint k = tangent_offsets[row]; k < tangent_offsets[row + 1u]; ++k) {
+        TangentTerm t = tangent_terms[k - bft.tangent_base];
+        vec3 x = L1_POS(t.index).xyz;
         t1 += t.weight_t1 * x;
         t2 += t.weight_t2 * x;
     }
-    level1_nrm[v] = vec4(safe_normalize(cross(t1, t2), vec3(0.0)), 0.0);
+    L1_NRM(v) = vec4(safe_normalize(cross(t1, t2), vec3(0.0)), 0.0);
 }

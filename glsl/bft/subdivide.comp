@@ -5,13 +5,15 @@
 #include "bft.glsl"
 layout(local_size_x = BFT_LOCAL_SIZE) in;
 void main() {
-    uint v = gl_GlobalInvocationID.x;
-    if (v >= bft.count) return;
+    if (gl_GlobalInvocationID.x >= bft.count) return;
+    // Global indices, less each windowed buffer's base (the chunk's windows).
+    uint v = bft.first_vertex + gl_GlobalInvocationID.x;
+    uint row = v - bft.level1_base;
     precise vec3 p = vec3(0.0);
-    for (uint k = stencil_offsets[v]; k < stencil_offsets[v + 1u]; ++k) {
-        StencilTerm t = stencil_terms[k];
-        BasePosition b = base_positions[t.index];
+    for (uint k = stencil_offsets[row]; k < stencil_offsets[row + 1u]; ++k) {
+        StencilTerm t = stencil_terms[k - bft.stencil_base];
+        BasePosition b = base_positions[t.index - bft.base_vertex_base];
         p += t.weight * vec3(b.x, b.y, b.z);
     }
-    level1_pos[v] = vec4(p, 1.0);
+    L1_POS(v) = vec4(p, 1.0);
 }

@@ -52,6 +52,19 @@ pub enum TessError {
     },
     #[error("geometric normals need the tangent tables (this surface was built without them)")]
     NeedsTangentTables,
+    /// One item's reach in a buffer exceeds the device's storage-buffer range: it cannot be
+    /// windowed (see `techniques::windows`).
+    #[error(
+        "{what} {item} reaches {bytes} bytes of its {space} buffers, more than the device's \
+         storage-buffer range of {max} bytes"
+    )]
+    StorageWindow {
+        what: &'static str,
+        item: u32,
+        space: &'static str,
+        bytes: u64,
+        max: u64,
+    },
     #[error("{given} base positions given, the mesh has {expected}")]
     BasePositionCount { given: usize, expected: usize },
     #[error("no frame slot {slot} (the context has {slots})")]

@@ -69,6 +69,7 @@
 //! shader must run one code path for this sum (one function; `precise` keeps the compiler from
 //! contracting it differently at different call sites). Tests emulate this in f32.
 
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 use crate::eval::{EvalError, LimitScheme, LocalMesh};
@@ -237,17 +238,19 @@ pub fn configuration_mesh(key: BftKey, identity: bool) -> Result<(LocalMesh, usi
     Ok((mesh, face))
 }
 
-fn ring_from(mesh: &LocalMesh, v: u32, start: u32) -> Vec<u32> {
+/// The one-ring of `v` rotated to begin at `start` (no allocation: this runs per face).
+fn ring_from(mesh: &LocalMesh, v: u32, start: u32) -> impl Iterator<Item = u32> + '_ {
     let ring = mesh.vertex_ring(v);
     let k = ring.iter().position(|&x| x == start).unwrap_or(0);
-    ring[k..].iter().chain(&ring[..k]).copied().collect()
+    ring[k..].iter().chain(&ring[..k]).copied()
 }
 
 /// Ordered control points of triangle `face` with corner `first` as `v0` (see module docs).
 pub fn face_control_ring(mesh: &LocalMesh, face: usize, first: usize) -> Vec<u32> {
     let f = mesh.face(face);
     let (v0, v1, v2) = (f[first % 3], f[(first + 1) % 3], f[(first + 2) % 3]);
-    let mut out = vec![v0, v1, v2];
+    let mut out = Vec::with_capacity(16);
+    out.extend([v0, v1, v2]);
     for (c, s) in [(v0, v1), (v1, v2), (v2, v0)] {
         for x in ring_from(mesh, c, s) {
             if !out.contains(&x) {
@@ -285,9 +288,49 @@ fn corner_signature(mesh: &LocalMesh, face: usize, first: usize) -> [(usize, boo
     out
 }
 
+/// Per table key, what its configuration mesh's face looks like: corner signature and control
+/// ring size (`None`: no configuration mesh). Building a configuration mesh per face dominated
+/// preparation on large meshes (every face asked again for the same few keys).
+type ConfigShapes = HashMap<BftKey, Option<([(usize, bool, usize); 3], usize)>>;
+
+fn config_shape(
+    cache: &mut ConfigShapes,
+    key: BftKey,
+) -> Option<([(usize, bool, usize); 3], usize)> {
+    *cache.entry(key).or_insert_with(|| {
+        let (cfg, cf) = configuration_mesh(key, false).ok()?;
+        Some((
+            corner_signature(&cfg, cf, 0),
+            face_control_ring(&cfg, cf, 0).len(),
+        ))
+    })
+}
+
 /// The BFT case of a triangle of a Loop mesh and the corner to use as `v0`, or `None` when the
 /// face is not covered by a table (see the module docs).
 pub fn classify_face(mesh: &LocalMesh, face: usize) -> Option<(BftKey, usize)> {
+    let creases = has_interior_creases(mesh);
+    classify_face_cached(mesh, face, &mut ConfigShapes::new(), creases).map(|(k, c, _)| (k, c))
+}
+
+/// Whether any edge that is not a boundary edge has a sharpness: without one, the per-face
+/// crease test (an edge search per ring neighbour) cannot fail and is skipped.
+fn has_interior_creases(mesh: &LocalMesh) -> bool {
+    let t = &mesh.level.topology;
+    mesh.level
+        .edge_sharpness
+        .iter()
+        .enumerate()
+        .any(|(e, &s)| s > 0.0 && !t.is_boundary_edge(e))
+}
+
+/// [`classify_face`] with the configuration shapes cached, and the face's control ring.
+fn classify_face_cached(
+    mesh: &LocalMesh,
+    face: usize,
+    shapes: &mut ConfigShapes,
+    creases: bool,
+) -> Option<(BftKey, usize, Vec<u32>)> {
     let f = mesh.face(face);
     if f.len() != 3 || mesh.scheme != LimitScheme::Loop {
         return None;
@@ -295,6 +338,9 @@ pub fn classify_face(mesh: &LocalMesh, face: usize) -> Option<(BftKey, usize)> {
     for &v in f {
         if mesh.vert_sharp(v) > 0.0 {
             return None;
+        }
+        if !creases {
+            continue;
         }
         for &w in mesh.vertex_ring(v) {
             let s = mesh.edge_sharp(v, w);
@@ -321,7 +367,8 @@ pub fn classify_face(mesh: &LocalMesh, face: usize) -> Option<(BftKey, usize)> {
         }
     }
     for c in candidates {
-        let s = corner_signature(mesh, face, c);
+        // The signature from corner c: the one above, rotated.
+        let s = [sig[c % 3], sig[(c + 1) % 3], sig[(c + 2) % 3]];
         let key = BftKey {
             valence: s[0].0 as u32,
             case: if s[0].1 {
@@ -332,14 +379,17 @@ pub fn classify_face(mesh: &LocalMesh, face: usize) -> Option<(BftKey, usize)> {
                 BftCase::Interior
             },
         };
-        let Ok((cfg, cf)) = configuration_mesh(key, false) else {
+        let Some((cs, ring_len)) = config_shape(shapes, key) else {
             continue;
         };
-        let cs = corner_signature(&cfg, cf, 0);
         let same = (0..3)
             .all(|k| s[k].0 == cs[k].0 && s[k].1 == cs[k].1 && (!s[k].1 || s[k].2 == cs[k].2));
-        if same && face_control_ring(mesh, face, c).len() == face_control_ring(&cfg, cf, 0).len() {
-            return Some((key, c));
+        if !same {
+            continue;
+        }
+        let ring = face_control_ring(mesh, face, c);
+        if ring.len() == ring_len {
+            return Some((key, c, ring));
         }
     }
     None
@@ -795,60 +845,62 @@ pub struct PatchRecord {
 /// neighbourhood. Fails only on a face that is not a triangle.
 pub fn build_patch_records(mesh: &LocalMesh) -> Result<Vec<PatchRecord>, EvalError> {
     let nf = mesh.num_faces();
-    let mut recs = Vec::with_capacity(nf);
-    for f in 0..nf {
-        let fv = mesh.face(f);
-        if fv.len() != 3 {
-            return Err(EvalError::FaceSize {
-                face: f,
-                size: fv.len(),
-                scheme: LimitScheme::Loop,
-                need: 3,
-            });
-        }
-        let (key, first, ring) = match classify_face(mesh, f) {
-            Some((key, first)) => (key, first, face_control_ring(mesh, f, first)),
-            None => (
-                BftKey {
-                    valence: 0,
-                    case: BftCase::Private { face: f as u32 },
-                },
-                0,
-                neighbourhood_vertices(mesh, f),
-            ),
-        };
-        let corners = [fv[first], fv[(first + 1) % 3], fv[(first + 2) % 3]];
-        recs.push(PatchRecord {
-            key,
-            ring,
-            corners,
-            edge_owner: [(0, 0); 3],
-            corner_owner: [(0, 0); 3],
+    if let Some(f) = (0..nf).find(|&f| mesh.face(f).len() != 3) {
+        return Err(EvalError::FaceSize {
+            face: f,
+            size: mesh.face(f).len(),
+            scheme: LimitScheme::Loop,
+            need: 3,
         });
     }
-    let mut edge_faces: HashMap<(u32, u32), Vec<(u32, u8)>> = HashMap::new();
-    let mut vert_faces: HashMap<u32, Vec<(u32, u8)>> = HashMap::new();
-    for (f, r) in recs.iter().enumerate() {
+    let creases = has_interior_creases(mesh);
+    // Faces are independent: classified in parallel, a shape cache per rayon job.
+    let mut recs: Vec<PatchRecord> = (0..nf)
+        .into_par_iter()
+        .map_init(ConfigShapes::new, |shapes, f| {
+            let fv = mesh.face(f);
+            let (key, first, ring) = match classify_face_cached(mesh, f, shapes, creases) {
+                Some(found) => found,
+                None => (
+                    BftKey {
+                        valence: 0,
+                        case: BftCase::Private { face: f as u32 },
+                    },
+                    0,
+                    neighbourhood_vertices(mesh, f),
+                ),
+            };
+            PatchRecord {
+                key,
+                ring,
+                corners: [fv[first], fv[(first + 1) % 3], fv[(first + 2) % 3]],
+                edge_owner: [(0, 0); 3],
+                corner_owner: [(0, 0); 3],
+            }
+        })
+        .collect();
+    // Owners: the smallest (face, local index) among the faces around the corner (sharing the
+    // edge), found from the mesh's vertex-face adjacency instead of global edge maps.
+    let corners: Vec<[u32; 3]> = recs.iter().map(|r| r.corners).collect();
+    let local = |g: u32, x: u32| corners[g as usize].iter().position(|&c| c == x);
+    recs.par_iter_mut().enumerate().for_each(|(f, r)| {
         for e in 0..3 {
             let (a, b) = (r.corners[e], r.corners[(e + 1) % 3]);
-            edge_faces
-                .entry((a.min(b), a.max(b)))
-                .or_default()
-                .push((f as u32, e as u8));
-            vert_faces.entry(a).or_default().push((f as u32, e as u8));
+            let mut edge = (f as u32, e as u8);
+            let mut corner = (f as u32, e as u8);
+            for g in mesh.vertex_faces(a) {
+                let Some(ka) = local(g, a) else { continue };
+                corner = corner.min((g, ka as u8));
+                if let Some(kb) = local(g, b) {
+                    // The edge's index in g: it starts at whichever of a, b the other follows.
+                    let k = if (ka + 1) % 3 == kb { ka } else { kb };
+                    edge = edge.min((g, k as u8));
+                }
+            }
+            r.edge_owner[e] = edge;
+            r.corner_owner[e] = corner;
         }
-    }
-    for r in recs.iter_mut() {
-        for e in 0..3 {
-            let (a, b) = (r.corners[e], r.corners[(e + 1) % 3]);
-            r.edge_owner[e] = edge_faces[&(a.min(b), a.max(b))]
-                .iter()
-                .copied()
-                .min()
-                .unwrap_or((0, 0));
-            r.corner_owner[e] = vert_faces[&a].iter().copied().min().unwrap_or((0, 0));
-        }
-    }
+    });
     Ok(recs)
 }
 
@@ -1033,6 +1085,98 @@ pub fn shader_eval_full(
     Some((p, nrm))
 }
 
+/// The level-1 limit-tangent stencils as one CSR table (one allocation per array, not three
+/// per vertex: a 1M-triangle mesh has 2M level-1 vertices): row `v` is
+/// `offsets[v]..offsets[v + 1]` of `indices` (level-1 vertices) and both weight rows.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TangentStencils {
+    pub offsets: Vec<u32>,
+    pub indices: Vec<u32>,
+    pub t1: Vec<f64>,
+    pub t2: Vec<f64>,
+}
+
+impl TangentStencils {
+    pub fn len(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Row `v`: (indices, first tangent weights, second tangent weights).
+    pub fn row(&self, v: usize) -> (&[u32], &[f64], &[f64]) {
+        let r = self.offsets[v] as usize..self.offsets[v + 1] as usize;
+        (&self.indices[r.clone()], &self.t1[r.clone()], &self.t2[r])
+    }
+
+    fn push(&mut self, idx: &[u32], t1: &[f64], t2: &[f64]) {
+        if self.offsets.is_empty() {
+            self.offsets.push(0);
+        }
+        self.indices.extend_from_slice(idx);
+        self.t1.extend_from_slice(t1);
+        self.t2.extend_from_slice(t2);
+        self.offsets.push(self.indices.len() as u32);
+    }
+
+    fn append(&mut self, other: TangentStencils) {
+        if self.offsets.is_empty() {
+            self.offsets.push(0);
+        }
+        let base = self.indices.len() as u32;
+        self.offsets
+            .extend(other.offsets.iter().skip(1).map(|&o| base + o));
+        self.indices.extend(other.indices);
+        self.t1.extend(other.t1);
+        self.t2.extend(other.t2);
+    }
+}
+
+/// Limit-tangent stencils of every level-1 vertex, in parallel blocks.
+fn tangent_stencils(level1: &LocalMesh) -> TangentStencils {
+    let n = level1.num_vertices();
+    let block = 1 << 15;
+    let blocks: Vec<TangentStencils> = (0..n.div_ceil(block))
+        .into_par_iter()
+        .map(|b| {
+            let mut out = TangentStencils::default();
+            for v in (b * block..((b + 1) * block).min(n)).map(|v| v as u32) {
+                match level1.loop_tangent_stencils(v) {
+                    Some((idx, t1, t2)) => out.push(&idx, &t1, &t2),
+                    None => {
+                        // No limit mask (e.g. a valence-2 corner under "edges only"): the
+                        // fan's chord tangents, first and last ring neighbour, still give the
+                        // outward side.
+                        let ring = level1.vertex_ring(v);
+                        let mut idx = vec![v];
+                        idx.extend_from_slice(ring);
+                        let mut t1 = vec![0.0; idx.len()];
+                        let mut t2 = vec![0.0; idx.len()];
+                        if idx.len() >= 3 {
+                            t1[0] = -1.0;
+                            t1[1] = 1.0;
+                            t2[0] = -1.0;
+                            t2[idx.len() - 1] = 1.0;
+                        }
+                        out.push(&idx, &t1, &t2);
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    let mut all = TangentStencils {
+        offsets: vec![0],
+        ..Default::default()
+    };
+    for b in blocks {
+        all.append(b);
+    }
+    all
+}
+
 /// Everything the BFT pipeline needs for a Loop control mesh: the once-refined mesh (its
 /// positions are what the shader combines), the base → level-1 stencils that produce them, the
 /// level-1 limit-tangent stencils (for the normals subdivision shading starts from), per-face
@@ -1042,7 +1186,7 @@ pub struct LoopBft {
     pub level1: LocalMesh,
     pub stencils: crate::stencil::StencilTable,
     /// Per level-1 vertex: control indices and the two tangent weight rows.
-    pub tangent_stencils: Vec<(Vec<u32>, Vec<f64>, Vec<f64>)>,
+    pub tangent_stencils: TangentStencils,
     pub records: Vec<PatchRecord>,
     pub tables: BasisTables,
     pub base_vertices: usize,
@@ -1056,11 +1200,25 @@ pub fn prepare_loop_bft(
     level: u32,
     tangents: bool,
 ) -> Result<LoopBft, EvalError> {
+    let t = std::time::Instant::now();
+    let lap = |what: &str| {
+        log::debug!(
+            "prepare_loop_bft: {what} at {:.2} s",
+            t.elapsed().as_secs_f64()
+        )
+    };
     let r = crate::refine::refine_uniform(mesh, crate::sdc::Scheme::Loop, 1)?;
+    lap("refined");
     let level1 = LocalMesh::from_refined_level(r.level(1), LimitScheme::Loop, &mesh.options)?;
+    lap("level-1 mesh");
+    // The refiner's levels are not needed past here: freed before the records are built.
+    let stencils = r.stencils(1);
+    drop(r);
     let records = build_patch_records(&level1)?;
+    lap("records");
     let keys: Vec<BftKey> = records.iter().map(|r| r.key).collect();
     let mut tables = BasisTables::build_with(&keys, level, tangents)?;
+    lap("tables");
     for (f, r) in records.iter().enumerate() {
         if matches!(r.key.case, BftCase::Private { .. }) {
             let (rows, k) = private_table(&level1, f, level)?;
@@ -1068,28 +1226,11 @@ pub fn prepare_loop_bft(
             tables.add_private(r.key, &rows, k);
         }
     }
-    let tangent_stencils = (0..level1.num_vertices() as u32)
-        .map(|v| {
-            level1.loop_tangent_stencils(v).unwrap_or_else(|| {
-                // No limit mask (e.g. a valence-2 corner under "edges only"): the fan's
-                // chord tangents, first and last ring neighbour, still give the outward side.
-                let ring = level1.vertex_ring(v);
-                let mut idx = vec![v];
-                idx.extend_from_slice(ring);
-                let mut t1 = vec![0.0; idx.len()];
-                let mut t2 = vec![0.0; idx.len()];
-                if idx.len() >= 3 {
-                    t1[0] = -1.0;
-                    t1[1] = 1.0;
-                    t2[0] = -1.0;
-                    t2[idx.len() - 1] = 1.0;
-                }
-                (idx, t1, t2)
-            })
-        })
-        .collect::<Vec<_>>();
+    lap("private tables");
+    let tangent_stencils = tangent_stencils(&level1);
+    lap("tangent stencils");
     Ok(LoopBft {
-        stencils: r.stencils(1),
+        stencils,
         level1,
         tangent_stencils,
         records,

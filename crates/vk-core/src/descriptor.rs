@@ -5,10 +5,14 @@
 //!   written into it alive (Vulkan forbids destroying any of them while the set may be used, and
 //!   updating a set whose layout is gone), and is freed with its pool once the last set and the
 //!   pool handle are dropped.
-//! - [`DescriptorSet::write_buffer`] checks what Vulkan would otherwise leave to the caller: the
-//!   binding exists with that type, the buffer has the matching usage, the range fits the device's
-//!   limit, and the set is not in use (bound in a recording that was not submitted: refused; used
-//!   by submissions still pending: waited for).
+//! - [`DescriptorSet::write_buffer_range`] (and [`DescriptorSet::write_buffer`], the whole
+//!   buffer) checks what Vulkan would otherwise leave to the caller: the binding exists with that
+//!   type, the buffer has the matching usage, the range lies inside the buffer at an aligned
+//!   offset and fits the device's `max*BufferRange` (as capped by
+//!   [`crate::DeviceDesc::storage_buffer_range_cap`]), and the set is not in use (bound in a
+//!   recording that was not submitted: refused; used by submissions still pending: waited for).
+//!   A range beyond the limit is a typed error, never a silent overrun: callers with larger
+//!   buffers bind windows of them (`tess`'s techniques split their draws so).
 use crate::buffer::{Buffer, BufferShared};
 use crate::device::{Device, DeviceShared};
 use crate::error::{DescriptorError, Result, VkContext, VkError};
@@ -217,15 +221,30 @@ impl DescriptorSet {
         self.last_use.fetch_max(serial, Ordering::SeqCst);
     }
 
-    /// Safe: checks binding exists in the layout with that type, buffer usage matches, range within the buffer and within the device's maxStorageBufferRange/maxUniformBufferRange (typed error otherwise).
-    ///
-    /// Points `binding` at the whole of `buffer`, which the set then keeps alive. Refused while
-    /// the set is bound in an unsubmitted recording; waits for submissions that used it.
+    /// Points `binding` at the whole of `buffer`: [`Self::write_buffer_range`] over all of it.
     pub fn write_buffer(
         &self,
         binding: u32,
         ty: vk::DescriptorType,
         buffer: &Buffer,
+    ) -> Result<()> {
+        self.write_buffer_range(binding, ty, buffer, 0, buffer.size())
+    }
+
+    /// Points `binding` at `range` bytes of `buffer` from `offset`; the set then keeps the buffer
+    /// alive. Typed errors: no such binding or another type, the buffer lacks the usage, the
+    /// range is empty or leaves the buffer, the offset is not a multiple of the device's
+    /// alignment (storage: `minStorageBufferOffsetAlignment`; uniform: 256, the largest the
+    /// spec allows), or the range exceeds `maxStorageBufferRange` / `maxUniformBufferRange`.
+    /// Refused while the set is bound in an unsubmitted recording; waits for submissions that
+    /// used it.
+    pub fn write_buffer_range(
+        &self,
+        binding: u32,
+        ty: vk::DescriptorType,
+        buffer: &Buffer,
+        offset: u64,
+        range: u64,
     ) -> Result<()> {
         let fail = |problem| VkError::Descriptor {
             set: self.name.clone(),
@@ -246,14 +265,16 @@ impl DescriptorSet {
             }));
         }
         let caps = &device.info.caps;
-        let (usage, max) = match ty {
+        let (usage, max, alignment) = match ty {
             vk::DescriptorType::UNIFORM_BUFFER => (
                 vk::BufferUsageFlags::UNIFORM_BUFFER,
                 caps.max_uniform_buffer_range,
+                256,
             ),
             vk::DescriptorType::STORAGE_BUFFER => (
                 vk::BufferUsageFlags::STORAGE_BUFFER,
                 caps.max_storage_buffer_range,
+                caps.min_storage_buffer_offset_alignment,
             ),
             other => return Err(fail(DescriptorError::UnsupportedType(other))),
         };
@@ -263,10 +284,26 @@ impl DescriptorSet {
                 needed: usage,
             }));
         }
-        if buffer.size() > max as u64 {
+        let inside = matches!(offset.checked_add(range), Some(end) if end <= buffer.size());
+        if range == 0 || !inside {
+            return Err(fail(DescriptorError::Window {
+                buffer: buffer.name().to_owned(),
+                offset,
+                range,
+                size: buffer.size(),
+            }));
+        }
+        if offset % alignment.max(1) != 0 {
+            return Err(fail(DescriptorError::Offset {
+                buffer: buffer.name().to_owned(),
+                offset,
+                alignment,
+            }));
+        }
+        if range > max as u64 {
             return Err(fail(DescriptorError::Range {
                 buffer: buffer.name().to_owned(),
-                size: buffer.size(),
+                size: range,
                 max: max as u64,
             }));
         }
@@ -281,15 +318,15 @@ impl DescriptorSet {
         device.wait_serial(self.last_use.load(Ordering::SeqCst))?;
         let info = [vk::DescriptorBufferInfo::default()
             .buffer(buffer.raw)
-            .offset(0)
-            .range(buffer.size())];
+            .offset(offset)
+            .range(range)];
         let write = vk::WriteDescriptorSet::default()
             .dst_set(self.raw)
             .dst_binding(binding)
             .descriptor_type(ty)
             .buffer_info(&info);
-        // SAFETY: the binding exists with this type; the buffer has the usage and its size fits
-        // the device's range; the set's layout is alive (held); no recording holds the set and
+        // SAFETY: the binding exists with this type; the buffer has the usage; the range lies
+        // inside it at an aligned offset and fits the device's limit; the set's layout is alive (held); no recording holds the set and
         // every submission that used it completed (waited above); updates of this set are
         // serialized by `written`'s lock. The buffer is kept alive below for as long as the set.
         unsafe { device.raw.update_descriptor_sets(&[write], &[]) };

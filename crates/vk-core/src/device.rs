@@ -62,8 +62,12 @@ pub struct Capabilities {
     pub max_transform_feedback_streams: u32,
     /// Largest uniform-buffer descriptor range, in bytes.
     pub max_uniform_buffer_range: u32,
-    /// Largest storage-buffer descriptor range, in bytes.
+    /// Largest storage-buffer descriptor range, in bytes: the device's, or less under
+    /// [`DeviceDesc::storage_buffer_range_cap`]. Every storage descriptor write is checked
+    /// against it, and techniques split their buffers and draws by it.
     pub max_storage_buffer_range: u32,
+    /// Alignment of a storage-buffer descriptor's offset, in bytes.
+    pub min_storage_buffer_offset_alignment: u64,
     /// Largest dispatch, in workgroups per dimension.
     pub max_compute_work_group_count: [u32; 3],
     /// Timeline semaphores (core in Vulkan 1.2): how vk-core counts submissions.
@@ -241,6 +245,10 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
             },
             max_uniform_buffer_range: props.limits.max_uniform_buffer_range,
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
+            min_storage_buffer_offset_alignment: props
+                .limits
+                .min_storage_buffer_offset_alignment
+                .max(1),
             max_compute_work_group_count: props.limits.max_compute_work_group_count,
             timeline_semaphore: f12.timeline_semaphore == vk::TRUE,
         };
@@ -346,6 +354,9 @@ pub struct DeviceDesc {
     /// Leaves VK_EXT_transform_feedback off even where the device has it, so the path of devices
     /// without it (typed errors from captures) can be tested on any device.
     pub without_transform_feedback: bool,
+    /// Caps the storage-buffer range Tessera uses at `min(device limit, cap)` bytes, so the
+    /// paths that split buffers larger than the limit can be tested with small meshes.
+    pub storage_buffer_range_cap: Option<u32>,
 }
 
 /// The state every resource shares. Drop order: idle wait, retired objects, one-shot command
@@ -440,7 +451,10 @@ impl Device {
     ) -> Result<Self> {
         let adapters = enumerate_adapters(instance)?;
         let chosen = choose_adapter(&adapters, &desc.selector)?;
-        let info = adapters[chosen].clone();
+        let mut info = adapters[chosen].clone();
+        if let Some(cap) = desc.storage_buffer_range_cap {
+            info.caps.max_storage_buffer_range = info.caps.max_storage_buffer_range.min(cap);
+        }
         let physical = info.physical;
         let queue_family = info
             .queue_family

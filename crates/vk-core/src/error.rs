@@ -221,8 +221,23 @@ pub enum DescriptorError {
         buffer: String,
         needed: vk::BufferUsageFlags,
     },
-    #[error("buffer {buffer} of {size} bytes exceeds the device's range of {max} bytes")]
+    #[error(
+        "a range of {size} bytes of buffer {buffer} exceeds the device's limit of {max} bytes"
+    )]
     Range { buffer: String, size: u64, max: u64 },
+    #[error("offset {offset} into buffer {buffer} is not a multiple of the device's {alignment}")]
+    Offset {
+        buffer: String,
+        offset: u64,
+        alignment: u64,
+    },
+    #[error("the range {offset}..{offset}+{range} lies outside buffer {buffer} of {size} bytes")]
+    Window {
+        buffer: String,
+        offset: u64,
+        range: u64,
+        size: u64,
+    },
     #[error("the set is bound in a command buffer that is still recording")]
     InUse,
 }

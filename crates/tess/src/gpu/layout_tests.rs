@@ -89,7 +89,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
     };
     let bft_push = || Layout {
         name: "BftPush",
-        offsets: offsets!(BftPush: mode, first_patch, factor_mode, options, uniform_level, pixels_per_segment, distance_ref, max_level, count),
+        offsets: offsets!(BftPush: mode, first_patch, factor_mode, options, uniform_level, pixels_per_segment, distance_ref, max_level, count, first_vertex, patch_base, ring_base, level1_base, stencil_base, tangent_base, base_vertex_base),
         size: size_of::<BftPush>(),
     };
     let frame_binding = || Uniform {

@@ -78,11 +78,26 @@ pub struct BftPush {
     pub pixels_per_segment: f32,
     pub distance_ref: f32,
     pub max_level: f32,
-    /// Compute passes: level-1 vertex count.
+    /// Compute passes: level-1 vertex count (of this chunk).
     pub count: u32,
+    /// Compute passes: the chunk's first level-1 vertex.
+    pub first_vertex: u32,
+    /// The chunk's window bases (`techniques::windows`): every index into a windowed buffer
+    /// has its space's base subtracted. Patch headers.
+    pub patch_base: u32,
+    /// Patch rings.
+    pub ring_base: u32,
+    /// Level-1 positions, normals, and the stencil and tangent CSR offsets.
+    pub level1_base: u32,
+    /// Stencil terms.
+    pub stencil_base: u32,
+    /// Tangent terms.
+    pub tangent_base: u32,
+    /// Base positions.
+    pub base_vertex_base: u32,
 }
 
-const _: () = assert!(size_of::<BftPush>() == 36);
+const _: () = assert!(size_of::<BftPush>() == 64);
 
 /// `AdaptivePush` push constant of every feature-adaptive stage, `glsl/adaptive/adaptive.glsl`.
 #[repr(C)]

@@ -8,6 +8,7 @@ pub mod flat;
 pub mod phong;
 pub mod pn;
 pub mod shared;
+pub mod windows;
 
 use crate::context::Context;
 use crate::error::{Result, TessError};

@@ -260,18 +260,22 @@ impl GpuBft {
                 weight: w as f32,
             })
             .collect();
-        let mut tangent_offsets = vec![0u32];
-        let mut tangent_terms = Vec::new();
-        for (idx, t1, t2) in &bft.tangent_stencils {
-            tangent_terms.extend(idx.iter().zip(t1.iter().zip(t2)).map(|(&index, (&a, &b))| {
-                TangentTerm {
-                    index,
-                    weight_t1: a as f32,
-                    weight_t2: b as f32,
-                }
-            }));
-            tangent_offsets.push(tangent_terms.len() as u32);
-        }
+        let ts = &bft.tangent_stencils;
+        let tangent_offsets = if ts.offsets.is_empty() {
+            vec![0u32]
+        } else {
+            ts.offsets.clone()
+        };
+        let tangent_terms = ts
+            .indices
+            .iter()
+            .zip(ts.t1.iter().zip(&ts.t2))
+            .map(|(&index, (&a, &b))| TangentTerm {
+                index,
+                weight_t1: a as f32,
+                weight_t2: b as f32,
+            })
+            .collect();
         let t = &bft.tables;
         let mut patches = Vec::with_capacity(bft.records.len());
         let mut patch_rings = Vec::new();

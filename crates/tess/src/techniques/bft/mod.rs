@@ -15,15 +15,26 @@
 //!
 //! Polygons are fan-triangulated first (Loop needs triangles); captured points map back into
 //! the input's polygons, so callers never see the triangulation.
+//!
+//! **Buffers beyond `maxStorageBufferRange`** (a 1M-triangle mesh has 4M level-1 faces: 160 MB
+//! of patch headers, 190 MB of rings, more than lavapipe's 128 MiB): the pre-pass runs in
+//! chunks of level-1 vertices and the draw in chunks of patches, each with its own descriptor
+//! set of windows into the shared buffers and its bases in the push constants
+//! ([`super::windows`]). A patch's footprint includes its edge and corner owners' headers,
+//! rings and ring vertices, since the TES evaluates shared points in the owner's frame. A mesh
+//! that fits is one chunk with bases 0: the same draw as before.
 use crate::capture::{face_corner_uv, FacePoint};
 use crate::context::Context;
 use crate::error::{Result, TessError};
 pub mod layout;
 
 use super::shared::{check_adaptive_policy, factor_fields, storage, storage_binding};
+use super::windows::{self, Chunk, Limits, Member, Space};
 use crate::gpu::bindings::{
     BFT_BASE_POSITIONS_BINDING, BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING,
     BFT_LOCAL_SIZE, BFT_OPTION_FRACTIONAL, BFT_OPTION_GEOMETRIC_NORMALS, BFT_OPTION_PATCH_COLOURS,
+    BFT_PATCH_HEADERS_BINDING, BFT_PATCH_RINGS_BINDING, BFT_STENCIL_OFFSETS_BINDING,
+    BFT_STENCIL_TERMS_BINDING, BFT_TANGENT_OFFSETS_BINDING, BFT_TANGENT_TERMS_BINDING,
 };
 use crate::gpu::BftPush;
 use crate::shaders::{self, Stage, Variant};
@@ -32,7 +43,8 @@ use crate::technique::{
     PatchPipeline, PatchType, Technique, TechniqueId,
 };
 use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, Domain, Spacing};
-use layout::{BasePosition, GpuBft, STORAGE_BINDINGS};
+use layout::{BasePosition, GpuBft, PatchHeader, StencilTerm, TangentTerm, STORAGE_BINDINGS};
+use std::ops::Range;
 use topology::bft::{prepare_loop_bft, LoopBft};
 use topology::ControlMesh;
 use vk_core::descriptor::{BindingDesc, DescriptorPool};
@@ -52,6 +64,176 @@ static SET_BINDINGS: [BindingDesc; STORAGE_BINDINGS.len()] = {
     }
     out
 };
+
+const fn member(stride: usize, extra: u32) -> Member {
+    Member {
+        stride: stride as u64,
+        extra,
+    }
+}
+/// Level-1 positions and normals (`vec4`) and the stencil and tangent CSR offsets (one past).
+const LEVEL1_MEMBERS: [Member; 2] = [member(16, 0), member(4, 1)];
+const LEVEL1: Space = Space {
+    name: "level-1 vertex",
+    members: &LEVEL1_MEMBERS,
+};
+const STENCIL: Space = Space {
+    name: "stencil term",
+    members: &[member(std::mem::size_of::<StencilTerm>(), 0)],
+};
+const TANGENT: Space = Space {
+    name: "tangent term",
+    members: &[member(std::mem::size_of::<TangentTerm>(), 0)],
+};
+const BASE: Space = Space {
+    name: "base position",
+    members: &[member(std::mem::size_of::<BasePosition>(), 0)],
+};
+const PATCHES: Space = Space {
+    name: "patch header",
+    members: &[member(std::mem::size_of::<PatchHeader>(), 0)],
+};
+const RINGS: Space = Space {
+    name: "patch ring",
+    members: &[member(4, 0)],
+};
+
+/// A chunk's window in every space (empty: the chunk's shaders never index that buffer).
+#[derive(Clone, Debug, Default)]
+struct SetWindows {
+    level1: Range<u32>,
+    stencil: Range<u32>,
+    tangent: Range<u32>,
+    base: Range<u32>,
+    patches: Range<u32>,
+    rings: Range<u32>,
+}
+
+impl SetWindows {
+    /// The push constants' bases.
+    fn apply(&self, push: &mut BftPush) {
+        push.level1_base = self.level1.start;
+        push.stencil_base = self.stencil.start;
+        push.tangent_base = self.tangent.start;
+        push.base_vertex_base = self.base.start;
+        push.patch_base = self.patches.start;
+        push.ring_base = self.rings.start;
+    }
+}
+
+/// Hull of a non-empty index set.
+fn span(indices: impl IntoIterator<Item = u32>) -> Range<u32> {
+    let mut it = indices.into_iter();
+    let Some(first) = it.next() else { return 0..0 };
+    let (lo, hi) = it.fold((first, first), |(lo, hi), x| (lo.min(x), hi.max(x)));
+    lo..hi + 1
+}
+
+/// Chunks of level-1 vertices for the pre-pass: each reads its stencil rows, their base
+/// vertices, its tangent rows and their level-1 vertices; at most `max_items` per dispatch.
+fn plan_pre_pass(
+    g: &GpuBft,
+    limits: Limits,
+    max_items: u32,
+) -> Result<Vec<(Range<u32>, SetWindows)>> {
+    let chunks = windows::plan(
+        "level-1 vertex",
+        g.level1_vertices,
+        &[LEVEL1, STENCIL, TANGENT, BASE],
+        limits,
+        |v| {
+            let i = v as usize;
+            let (s0, s1) = (g.stencil_offsets[i], g.stencil_offsets[i + 1]);
+            let (t0, t1) = (g.tangent_offsets[i], g.tangent_offsets[i + 1]);
+            let tangent = &g.tangent_terms[t0 as usize..t1 as usize];
+            let stencil = &g.stencil_terms[s0 as usize..s1 as usize];
+            [
+                span(std::iter::once(v).chain(tangent.iter().map(|t| t.index))),
+                s0..s1,
+                t0..t1,
+                span(stencil.iter().map(|t| t.index)),
+            ]
+        },
+    )?;
+    let mut out = Vec::new();
+    for Chunk { items, windows } in chunks {
+        let [level1, stencil, tangent, base] = windows;
+        let w = SetWindows {
+            level1,
+            stencil,
+            tangent,
+            base,
+            ..Default::default()
+        };
+        let mut first = items.start;
+        while first < items.end {
+            let end = items.end.min(first.saturating_add(max_items.max(1)));
+            out.push((first..end, w.clone()));
+            first = end;
+        }
+    }
+    Ok(out)
+}
+
+/// Chunks of patches for the draw: each reads its header, ring and ring vertices, and those of
+/// its edge and corner owners (shared points are evaluated in the owner's frame).
+fn plan_draw(g: &GpuBft, limits: Limits) -> Result<Vec<(Range<u32>, SetWindows)>> {
+    let chunks = windows::plan(
+        "patch",
+        g.patch_count,
+        &[PATCHES, RINGS, LEVEL1],
+        limits,
+        |p| {
+            let h = &g.patches[p as usize];
+            let faces = std::iter::once(p).chain(
+                h.edge_owner
+                    .iter()
+                    .chain(&h.corner_owner)
+                    .map(|&o| layout::owner_face(o)),
+            );
+            let (mut rings, mut verts) = (0..0, 0..0);
+            let mut lo_f = p;
+            let mut hi_f = p;
+            for f in faces {
+                lo_f = lo_f.min(f);
+                hi_f = hi_f.max(f);
+                let o = &g.patches[f as usize];
+                let r = o.ring_offset..o.ring_offset + o.ring_size;
+                let v = span(
+                    g.patch_rings[r.start as usize..r.end as usize]
+                        .iter()
+                        .copied(),
+                );
+                rings = if rings.is_empty() {
+                    r
+                } else {
+                    rings.start.min(r.start)..rings.end.max(r.end)
+                };
+                verts = if verts.is_empty() {
+                    v
+                } else {
+                    verts.start.min(v.start)..verts.end.max(v.end)
+                };
+            }
+            [lo_f..hi_f + 1, rings, verts]
+        },
+    )?;
+    Ok(chunks
+        .into_iter()
+        .map(|Chunk { items, windows }| {
+            let [patches, rings, level1] = windows;
+            (
+                items,
+                SetWindows {
+                    level1,
+                    patches,
+                    rings,
+                    ..Default::default()
+                },
+            )
+        })
+        .collect())
+}
 
 /// `bit` when `on`.
 fn flag(on: bool, bit: u32) -> u32 {
@@ -95,13 +277,21 @@ impl Default for BftOptions {
 pub struct Bft {
     subdivide: Pipeline,
     normals: Pipeline,
-    /// One set per frame slot (they differ only in the base-position buffer).
-    sets: Vec<DescriptorSet>,
+    /// Per frame slot, one set per pre-pass chunk (slots differ only in the base positions).
+    pre_sets: Vec<Vec<DescriptorSet>>,
+    /// Level-1 vertices of each pre-pass chunk, and its windows.
+    pre_chunks: Vec<(Range<u32>, SetWindows)>,
+    /// One set per draw chunk (the draw never reads base positions: shared by every slot).
+    draw_sets: Vec<DescriptorSet>,
+    /// Patches of each draw chunk, and its windows.
+    draw_chunks: Vec<(Range<u32>, SetWindows)>,
     _pool: DescriptorPool,
     base: Vec<Buffer>,
     _static: Vec<Buffer>,
     arrays: Vec<PatchArray>,
     pub gpu: GpuBft,
+    /// The CPU surface: level-1 mesh, records and tables. Its base → level-1 and tangent
+    /// stencils are emptied once packed: read them from [`Bft::gpu`].
     pub bft: LoopBft,
     /// Per Loop triangle: its input face, the face's side count and its fan index (corners
     /// 0, j + 1, j + 2); identity for a triangle mesh.
@@ -171,18 +361,30 @@ impl Bft {
                 max_tessellation_level: max_level,
             });
         }
+        let started = std::time::Instant::now();
         let (loop_mesh, fans, note) = loop_control_mesh(mesh, &options.name);
-        let bft = prepare_loop_bft(&loop_mesh, table_level, options.tangents).map_err(|e| {
+        let mut bft = prepare_loop_bft(&loop_mesh, table_level, options.tangents).map_err(|e| {
             TessError::Mesh {
                 name: options.name.clone(),
                 source: e.into(),
             }
         })?;
+        let prepared = started.elapsed();
         let gpu = GpuBft::new(&bft)?;
+        let packed = started.elapsed();
+        // Packed into `gpu`: not kept twice (hundreds of MB on a 1M-face mesh).
+        bft.stencils = Default::default();
+        bft.tangent_stencils = Default::default();
         let frames = ctx.frames_in_flight();
         ctx.ensure_set_layout(TechniqueId::Bft, &SET_BINDINGS)?;
         let set_layout = ctx.set_layout(TechniqueId::Bft)?;
-        let pool = DescriptorPool::new(&device, "bft descriptor pool", set_layout, frames as u32)?;
+        let limits = Limits::of(&device);
+        let max_groups = device.info.caps.max_compute_work_group_count[0];
+        let pre_chunks = plan_pre_pass(&gpu, limits, max_groups.saturating_mul(BFT_LOCAL_SIZE))?;
+        let draw_chunks = plan_draw(&gpu, limits)?;
+        let max_sets = frames * pre_chunks.len() + draw_chunks.len();
+        let pool =
+            DescriptorPool::new(&device, "bft descriptor pool", set_layout, max_sets as u32)?;
         let level1_bytes = gpu.level1_bytes();
         let level1 = |binding: u32, name: &str| -> Result<(u32, Buffer)> {
             let desc = BufferDesc {
@@ -202,7 +404,6 @@ impl Bft {
         }
         let base_positions = base_positions(&loop_mesh);
         let mut base = Vec::new();
-        let mut sets = Vec::new();
         for i in 0..frames {
             let mut buf = Buffer::new(
                 &device,
@@ -215,18 +416,66 @@ impl Bft {
                 },
             )?;
             buf.write(0, as_base_positions(&base_positions))?;
-            let set = pool.allocate_set(set_layout)?;
-            set.write_buffer(
-                BFT_BASE_POSITIONS_BINDING,
-                vk::DescriptorType::STORAGE_BUFFER,
-                &buf,
-            )?;
-            for (binding, s) in &statics {
-                set.write_buffer(*binding, vk::DescriptorType::STORAGE_BUFFER, s)?;
-            }
             base.push(buf);
-            sets.push(set);
         }
+        // Every binding of a set: windowed buffers as the chunk's windows, the tables whole.
+        let (n1, nv) = (gpu.level1_vertices as u64, gpu.base_vertices as u64);
+        let write_set = |base: &Buffer, w: &SetWindows| -> Result<DescriptorSet> {
+            let set = pool.allocate_set(set_layout)?;
+            let csr = LEVEL1_MEMBERS[1];
+            windows::write_window(
+                &set,
+                BFT_BASE_POSITIONS_BINDING,
+                base,
+                BASE.members[0],
+                nv,
+                &w.base,
+            )?;
+            for (binding, buf) in &statics {
+                let (m, len, win) = match *binding {
+                    BFT_LEVEL1_POSITIONS_BINDING | BFT_LEVEL1_NORMALS_BINDING => {
+                        (LEVEL1_MEMBERS[0], n1, &w.level1)
+                    }
+                    BFT_STENCIL_OFFSETS_BINDING | BFT_TANGENT_OFFSETS_BINDING => {
+                        (csr, n1 + 1, &w.level1)
+                    }
+                    BFT_STENCIL_TERMS_BINDING => (
+                        STENCIL.members[0],
+                        gpu.stencil_terms.len() as u64,
+                        &w.stencil,
+                    ),
+                    BFT_TANGENT_TERMS_BINDING => (
+                        TANGENT.members[0],
+                        gpu.tangent_terms.len() as u64,
+                        &w.tangent,
+                    ),
+                    BFT_PATCH_HEADERS_BINDING => {
+                        (PATCHES.members[0], gpu.patches.len() as u64, &w.patches)
+                    }
+                    BFT_PATCH_RINGS_BINDING => {
+                        (RINGS.members[0], gpu.patch_rings.len() as u64, &w.rings)
+                    }
+                    _ => {
+                        windows::write_whole(&set, *binding, buf)?;
+                        continue;
+                    }
+                };
+                windows::write_window(&set, *binding, buf, m, len, win)?;
+            }
+            Ok(set)
+        };
+        let mut pre_sets = Vec::new();
+        for b in &base {
+            let sets: Result<Vec<_>> = pre_chunks.iter().map(|(_, w)| write_set(b, w)).collect();
+            pre_sets.push(sets?);
+        }
+        let draw_base = base
+            .first()
+            .ok_or(TessError::FrameSlot { slot: 0, slots: 0 })?;
+        let draw_sets = draw_chunks
+            .iter()
+            .map(|(_, w)| write_set(draw_base, w))
+            .collect::<Result<Vec<_>>>()?;
         let layouts = [ctx.frame_set_layout().raw, set_layout.raw];
         let push = std::mem::size_of::<BftPush>() as u32;
         let compute = |name: &str, stage: Stage| -> Result<Pipeline> {
@@ -244,10 +493,23 @@ impl Bft {
         let subdivide = compute("bft subdivide", Stage::BftSubdivideComp)?;
         let normals = compute("bft normals", Stage::BftNormalsComp)?;
         let arrays = number_arrays(&[(PatchType::LoopBft, gpu.patch_count, 1)]);
+        log::info!(
+            "bft {}: topology {:.2} s, packing {:.2} s, upload and sets {:.2} s; {} pre-pass and \
+             {} draw chunks",
+            options.name,
+            prepared.as_secs_f64(),
+            (packed - prepared).as_secs_f64(),
+            (started.elapsed() - packed).as_secs_f64(),
+            pre_chunks.len(),
+            draw_chunks.len()
+        );
         Ok(Self {
             subdivide,
             normals,
-            sets,
+            pre_sets,
+            pre_chunks,
+            draw_sets,
+            draw_chunks,
             _pool: pool,
             base,
             _static: statics.into_iter().map(|(_, b)| b).collect(),
@@ -265,6 +527,12 @@ impl Bft {
     /// Bytes of basis-function tables on the GPU ([`GpuBft::table_bytes`]).
     pub fn table_bytes(&self) -> usize {
         self.gpu.table_bytes()
+    }
+
+    /// Chunks of the pre-pass and of the draw (one each unless a buffer exceeds the device's
+    /// storage-buffer range: see the module header).
+    pub fn chunk_counts(&self) -> (usize, usize) {
+        (self.pre_chunks.len(), self.draw_chunks.len())
     }
 
     /// Level-1 faces: patches per frame.
@@ -296,6 +564,8 @@ impl Bft {
             distance_ref: reference,
             max_level: self.max_level() as f32,
             count: self.gpu.level1_vertices,
+            // Bases: set per draw chunk.
+            ..Default::default()
         }
     }
 }
@@ -358,8 +628,10 @@ impl Technique for Bft {
         &SET_BINDINGS
     }
 
-    fn descriptor_set(&self, slot: usize) -> Option<&DescriptorSet> {
-        self.sets.get(slot.min(self.sets.len().saturating_sub(1)))
+    /// The first draw chunk's set (the same for every slot); the others are bound by
+    /// [`Technique::record_array`].
+    fn descriptor_set(&self, _slot: usize) -> Option<&DescriptorSet> {
+        self.draw_sets.first()
     }
 
     /// At the largest factor the policy can reach.
@@ -410,34 +682,41 @@ impl Technique for Bft {
         frame_set: &'a DescriptorSet,
         slot: usize,
     ) -> Result<()> {
-        let push = BftPush {
-            count: self.gpu.level1_vertices,
-            ..Default::default()
-        };
-        let groups = self.gpu.level1_vertices.div_ceil(BFT_LOCAL_SIZE).max(1);
+        let sets = self.pre_sets.get(slot).ok_or(TessError::FrameSlot {
+            slot,
+            slots: self.pre_sets.len(),
+        })?;
         let tess_stages = vk::PipelineStageFlags::VERTEX_SHADER
             | vk::PipelineStageFlags::TESSELLATION_CONTROL_SHADER
             | vk::PipelineStageFlags::TESSELLATION_EVALUATION_SHADER;
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
-        let set = self
-            .descriptor_set(slot)
-            .ok_or(TessError::FrameSlot { slot, slots: 0 })?;
+        let write = (compute, vk::AccessFlags::SHADER_WRITE);
         enc.begin_label("bft initial subdivision step");
         // The previous frame's tessellation stages read level 1 before we overwrite it; host
         // writes of the base positions are visible at submit.
-        enc.memory_barrier(
-            (tess_stages, vk::AccessFlags::SHADER_READ),
-            (compute, vk::AccessFlags::SHADER_WRITE),
-        );
+        enc.memory_barrier((tess_stages, vk::AccessFlags::SHADER_READ), write);
         for (pipeline, next) in [
             (&self.subdivide, (compute, vk::AccessFlags::SHADER_READ)),
             (&self.normals, (tess_stages, vk::AccessFlags::SHADER_READ)),
         ] {
             enc.bind_pipeline(pipeline);
-            enc.bind_descriptor_sets(0, &[frame_set, set])?;
-            enc.push_constants(&push)?;
-            enc.dispatch([groups, 1, 1])?;
-            enc.memory_barrier((compute, vk::AccessFlags::SHADER_WRITE), next);
+            for (k, ((items, w), set)) in self.pre_chunks.iter().zip(sets).enumerate() {
+                // Chunks write disjoint vertices, but their windows overlap (synchronization
+                // validation sees whole ranges): order them.
+                if k > 0 {
+                    enc.memory_barrier(write, write);
+                }
+                let mut push = BftPush {
+                    count: items.end - items.start,
+                    first_vertex: items.start,
+                    ..Default::default()
+                };
+                w.apply(&mut push);
+                enc.bind_descriptor_sets(0, &[frame_set, set])?;
+                enc.push_constants(&push)?;
+                enc.dispatch([push.count.div_ceil(BFT_LOCAL_SIZE).max(1), 1, 1])?;
+            }
+            enc.memory_barrier(write, next);
         }
         enc.end_label();
         Ok(())
@@ -456,12 +735,28 @@ impl Technique for Bft {
             .get(array)
             .ok_or(TessError::NoPatchArray { array })?;
         let mut push = self.push(params, pass.mode());
-        for_each_draw(a.patches, per_draw, |first, n| {
-            push.first_patch = a.first_patch + first;
-            enc.push_constants(&push)?;
-            enc.draw(first..first + n)?;
-            Ok(())
-        })
+        let mut counts = DrawCounts::default();
+        let array_end = a.first_patch + a.patches;
+        for (k, ((items, w), set)) in self.draw_chunks.iter().zip(&self.draw_sets).enumerate() {
+            let start = items.start.max(a.first_patch);
+            let end = items.end.min(array_end);
+            if start >= end {
+                continue;
+            }
+            // The context bound the first chunk's set.
+            if k > 0 {
+                enc.bind_descriptor_sets(1, &[set])?;
+            }
+            w.apply(&mut push);
+            counts += for_each_draw(end - start, per_draw, |first, n| {
+                let first = start - a.first_patch + first;
+                push.first_patch = a.first_patch + first;
+                enc.push_constants(&push)?;
+                enc.draw(first..first + n)?;
+                Ok(())
+            })?;
+        }
+        Ok(counts)
     }
 
     /// The level-1 face's point in its base triangle, then (for a fan-triangulated polygon)
