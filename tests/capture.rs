@@ -230,8 +230,8 @@ fn cpu_interpolation_check_detects_a_swapped_domain() {
     assert!(off > c.soup.records.len() / 2, "only {off} corners differ");
 }
 
-/// (c) Watertightness of closed meshes after welding by position bits, for every technique at
-/// every level and spacing: `tests/watertight.rs`.
+// (c) Watertightness of closed meshes after welding by position bits, for every technique at
+// every level and spacing: `tests/watertight.rs`.
 
 /// A mesh with a boundary: its open edges are all on the base boundary, none are cracks.
 #[test]
