@@ -22,9 +22,9 @@ use topology::{
     BoundaryInterpolation, ControlMesh, CreaseMethod, EdgeCrease, TriangleSubdivision, VertexCorner,
 };
 
-/// Largest coordinate magnitude the topology targets feed in.
-// TODO(merge): use topology's bound
-pub const MAX_COORD: f64 = 1e6;
+/// Largest coordinate magnitude the topology targets feed in: the library's own bound, within
+/// which it promises finite output (`ControlMesh::validate` refuses the rest).
+pub const MAX_COORD: f64 = topology::MAX_COORDINATE;
 pub const MAX_VERTICES: usize = 64;
 pub const MAX_FACES: usize = 72;
 
