@@ -265,7 +265,10 @@ fn one_million_faces_through_every_technique() {
         )
         .map(|_| ())
         .expect_err("adaptive stencil terms beyond the range are refused");
-        println!("adaptive: refused in {:.1} s: {e}", t.elapsed().as_secs_f64());
+        println!(
+            "adaptive: refused in {:.1} s: {e}",
+            t.elapsed().as_secs_f64()
+        );
         assert!(
             matches!(
                 e,

@@ -249,10 +249,7 @@ fn base_face_techniques_are_watertight_on_spot() {
     let mut h = Harness::new(&gpu);
     let meshes = [("spot", load("assets/spot_control_mesh.obj"))];
     for (id, levels) in [
-        (
-            TechniqueId::Pn,
-            &[1.0f32, 2.0, 5.0, 5.5, 8.0, 21.0][..],
-        ),
+        (TechniqueId::Pn, &[1.0f32, 2.0, 5.0, 5.5, 8.0, 21.0][..]),
         (TechniqueId::Flat, &[1.0, 5.0, 8.0][..]),
         (TechniqueId::Phong, &[1.0, 5.0, 8.0][..]),
     ] {

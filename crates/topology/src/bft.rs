@@ -291,12 +291,12 @@ fn corner_signature(mesh: &LocalMesh, face: usize, first: usize) -> [(usize, boo
 /// Per table key, what its configuration mesh's face looks like: corner signature and control
 /// ring size (`None`: no configuration mesh). Building a configuration mesh per face dominated
 /// preparation on large meshes (every face asked again for the same few keys).
-type ConfigShapes = HashMap<BftKey, Option<([(usize, bool, usize); 3], usize)>>;
+type ConfigShapes = HashMap<BftKey, Option<ConfigShape>>;
 
-fn config_shape(
-    cache: &mut ConfigShapes,
-    key: BftKey,
-) -> Option<([(usize, bool, usize); 3], usize)> {
+/// A configuration mesh face's corner signature and its control ring size.
+type ConfigShape = ([(usize, bool, usize); 3], usize);
+
+fn config_shape(cache: &mut ConfigShapes, key: BftKey) -> Option<ConfigShape> {
     *cache.entry(key).or_insert_with(|| {
         let (cfg, cf) = configuration_mesh(key, false).ok()?;
         Some((

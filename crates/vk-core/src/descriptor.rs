@@ -293,7 +293,7 @@ impl DescriptorSet {
                 size: buffer.size(),
             }));
         }
-        if offset % alignment.max(1) != 0 {
+        if !offset.is_multiple_of(alignment.max(1)) {
             return Err(fail(DescriptorError::Offset {
                 buffer: buffer.name().to_owned(),
                 offset,
