@@ -36,7 +36,11 @@ impl Camera {
         let lo = Vec3::from(bbox_min);
         let hi = Vec3::from(bbox_max);
         let center = (lo + hi) * 0.5;
-        let radius = ((hi - lo).length() * 0.5).max(1e-6);
+        // A box that is a point (or thinner than f32 resolves at its distance from the origin)
+        // would put the eye on the centre after rounding: NaN view. The radius is kept to a
+        // few hundred ulps of the centre's largest coordinate.
+        let resolution = center.abs().max_element() * 1e-4;
+        let radius = ((hi - lo).length() * 0.5).max(resolution).max(1e-6);
         let fov = self.fov_y_degrees.to_radians();
         let half = (fov * 0.5).tan().min((fov * 0.5).tan() * aspect.max(1e-3));
         let distance = radius / half.atan().sin() / self.zoom.max(1e-3);
@@ -55,5 +59,31 @@ impl Camera {
         let far = distance + radius * 1.5;
         let proj = Mat4::perspective_rh(fov, aspect.max(1e-3), near, far);
         CameraMatrices { view, proj, eye }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn finite(m: &CameraMatrices) -> bool {
+        m.view.is_finite() && m.proj.is_finite() && m.eye.is_finite()
+    }
+
+    #[test]
+    fn degenerate_boxes_give_finite_matrices() {
+        let cam = Camera::default();
+        for (lo, hi) in [
+            ([0.0; 3], [0.0; 3]),
+            ([1e6; 3], [1e6; 3]),
+            ([1e12, -1e12, 3.0], [1e12, -1e12, 3.0]),
+            ([-1e12; 3], [1e12; 3]),
+            ([1e-30; 3], [2e-30; 3]),
+            ([5e5, 0.0, 0.0], [5e5 + 0.0625, 0.0, 0.0]),
+        ] {
+            let m = cam.matrices(lo, hi, 4.0 / 3.0);
+            assert!(finite(&m), "{lo:?}..{hi:?}: {m:?}");
+            assert_ne!(m.eye, Vec3::from(lo), "{lo:?}: eye on the centre");
+        }
     }
 }
