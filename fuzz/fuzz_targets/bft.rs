@@ -39,11 +39,15 @@ fuzz_target!(
         for i in 0..bft.stencils.len() {
             assert!(all_finite(bft.stencils.stencil(i).1));
         }
-        for (idx, t1, t2) in &bft.tangent_stencils {
-            assert_eq!(idx.len(), t1.len());
-            assert_eq!(idx.len(), t2.len());
-            assert!(all_finite(t1) && all_finite(t2));
-        }
+        let ts = &bft.tangent_stencils;
+        assert_eq!(ts.indices.len(), ts.t1.len());
+        assert_eq!(ts.indices.len(), ts.t2.len());
+        assert!(ts.offsets.windows(2).all(|w| w[0] <= w[1]));
+        assert!(ts
+            .offsets
+            .last()
+            .is_none_or(|&end| end as usize == ts.indices.len()));
+        assert!(all_finite(&ts.t1) && all_finite(&ts.t2));
         assert!(
             bft.tables.weights.iter().all(|w| w.is_finite()),
             "non-finite table weight"
