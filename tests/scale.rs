@@ -266,7 +266,8 @@ fn grid(nx: u32, ny: u32, triangles: bool) -> ControlMesh {
 /// Flat, Phong, PN and BFT draw the 1,001,112-triangle grid validation-clean at a
 /// small viewport (BFT's tangent terms, patch headers and rings exceed lavapipe's 128 MiB
 /// storage range: the windowed path), and adaptive the 1M-quad grid (its stencil terms, 264 MB,
-/// are windowed by rows). One test, so the meshes are built once and the runs never overlap
+/// are windowed by rows); adaptive on the triangle grid is refused by the plan's size bound
+/// with a typed error naming the mesh size and the isolation. One test, so the meshes are built once and the runs never overlap
 /// in memory. Prints each build and frame time (the CI cost).
 #[test]
 fn one_million_faces_through_every_technique() {
@@ -362,6 +363,38 @@ fn one_million_faces_through_every_technique() {
         assert!(
             chunks.1 > 1,
             "the stencil terms exceed 128 MiB: several window sets"
+        );
+        drop(surf);
+        // Adaptive on the 1M-triangle grid (every vertex extraordinary under Catmull-Clark):
+        // refused by the plan's size bound before refining, never an allocation abort.
+        let t = std::time::Instant::now();
+        let e = Adaptive::new(
+            &mut ctx,
+            &tri,
+            &AdaptiveBuild {
+                name: "1M triangle grid".into(),
+                ..Default::default()
+            },
+        )
+        .map(|_| ())
+        .expect_err("the 1M-triangle grid at isolation 4 is beyond the bound");
+        println!(
+            "adaptive on triangles: refused in {:.1} s: {e}",
+            t.elapsed().as_secs_f64()
+        );
+        let tessera::tess::TessError::Mesh { source, .. } = &e else {
+            panic!("not a mesh error: {e}")
+        };
+        assert!(
+            matches!(
+                source.downcast_ref::<tessera::topology::TopologyError>(),
+                Some(tessera::topology::TopologyError::AdaptiveTooLarge {
+                    faces: 1_001_112,
+                    isolation: 4,
+                    ..
+                })
+            ),
+            "{e}"
         );
     }
     drop(gpu);
