@@ -722,3 +722,68 @@ impl Technique for Adaptive {
         )]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Under a small range and a small group count, the steps run every row exactly once, in
+    /// block order (a block's rows read only earlier blocks), each inside its set's windows,
+    /// with aligned window starts; the base copy comes first.
+    #[test]
+    fn pre_pass_chunks_cover_every_row_once_inside_their_windows() {
+        let mesh = topology::load_obj(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../tests/data/opensubdiv/shapes/catmark_cube_creases0.obj"
+        ))
+        .expect("cube");
+        let plan = plan_adaptive(
+            &mesh,
+            &AdaptiveOptions {
+                isolation: 2,
+                ..Default::default()
+            },
+        )
+        .expect("plan");
+        let g = GpuAdaptive::new(&plan).expect("layout");
+        let whole = plan_pre_pass(&g, limits(1 << 30), u32::MAX).expect("whole");
+        assert_eq!(whole.1.len(), 1, "everything fits: one set");
+        let (steps, sets) = plan_pre_pass(&g, limits(4096), 100).expect("chunked");
+        assert!(sets.len() > 3, "{} sets", sets.len());
+        assert_eq!(steps[0].mode, 1);
+        assert_eq!(steps[0].items.start, 0);
+        let copied: u32 = steps
+            .iter()
+            .filter(|s| s.mode == 1)
+            .map(|s| s.items.len() as u32)
+            .sum();
+        assert_eq!(copied, g.num_base_vertices);
+        let mut next = 0;
+        for s in steps.iter().filter(|s| s.mode == 0) {
+            assert_eq!(s.items.start, next, "in order, no gap or overlap");
+            assert!(s.items.len() <= 100);
+            next = s.items.end;
+            let [rows, terms] = &sets[s.set];
+            assert_eq!(rows.start % 4, 0, "row window start aligned to 16 bytes");
+            assert_eq!(terms.start % 2, 0, "term window start aligned to 16 bytes");
+            assert!((rows.end - rows.start + 1) * 4 <= 4096);
+            assert!((terms.end - terms.start) * 8 <= 4096);
+            for r in s.items.clone() {
+                let (k0, k1) = (
+                    g.stencil_offsets[r as usize],
+                    g.stencil_offsets[r as usize + 1],
+                );
+                assert!(rows.start <= r && r < rows.end);
+                assert!(k0 == k1 || (terms.start <= k0 && k1 <= terms.end));
+            }
+        }
+        assert_eq!(next as usize, g.stencil_offsets.len() - 1);
+    }
+
+    fn limits(max_range: u64) -> Limits {
+        Limits {
+            max_range,
+            alignment: 16,
+        }
+    }
+}
