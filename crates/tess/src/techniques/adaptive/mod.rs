@@ -86,6 +86,9 @@ const TERMS: Space = Space {
     }],
 };
 
+/// A set's windows of the stencil offsets (rows) and terms.
+type RowWindows = [Range<u32>; 2];
+
 /// One dispatch of the stencil kernel: rows (mode 0) or base vertices (mode 1) and the
 /// windows of the offsets and terms its set binds.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -104,7 +107,7 @@ fn plan_pre_pass(
     g: &GpuAdaptive,
     limits: Limits,
     max_items: u32,
-) -> Result<(Vec<Step>, Vec<[Range<u32>; 2]>)> {
+) -> Result<(Vec<Step>, Vec<RowWindows>)> {
     let max_items = max_items.max(1);
     let rows = g.stencil_offsets.len().saturating_sub(1) as u32;
     let chunks = windows::plan("stencil row", rows, &[ROWS, TERMS], limits, |r| {
@@ -179,7 +182,7 @@ pub struct Adaptive {
     /// The stencil kernel's dispatches, in order.
     steps: Vec<Step>,
     /// Per set: its windows of the stencil offsets and terms.
-    windows: Vec<[Range<u32>; 2]>,
+    windows: Vec<RowWindows>,
     _pool: DescriptorPool,
     base: Vec<Buffer>,
     _static: Vec<Buffer>,
