@@ -9,6 +9,7 @@ mod common;
 mod loop_grid;
 use common::Gpu;
 use tessera::tess::capture::Capturer;
+use tessera::tess::techniques::adaptive::{Adaptive, AdaptiveBuild};
 use tessera::tess::techniques::bft::{Bft, BftOptions};
 use tessera::tess::{Context, FrameParams, Technique};
 use tessera::topology::ControlMesh;
@@ -83,6 +84,80 @@ fn bft_under_a_tiny_storage_range_matches_the_whole_buffer_run() {
         assert_eq!(capture.len(), capture_w.len());
         assert!(capture == capture_w, "captures differ");
     }
+}
+
+/// What an adaptive run gives: image, capture, (stencil dispatches, window sets), and the
+/// bytes of (the largest buffer bound whole, the stencil terms).
+type AdaptiveRun = (
+    Vec<u8>,
+    Vec<tessera::tess::gpu::CaptureRecord>,
+    (usize, usize),
+    (u64, u64),
+);
+
+fn adaptive_run(cap: Option<u32>, mesh: &ControlMesh, params: &FrameParams) -> AdaptiveRun {
+    let gpu = capped(cap);
+    let out = {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
+        let surf = Adaptive::new(
+            &mut ctx,
+            mesh,
+            &AdaptiveBuild {
+                isolation: 2,
+                name: "creases0".into(),
+                ..Default::default()
+            },
+        )
+        .expect("adaptive");
+        let image = ctx.render_offscreen(&surf, params, SMALL).expect("render");
+        let (soup, _) = capturer
+            .capture(&mut ctx, &surf, params, SMALL)
+            .expect("capture");
+        let g = &surf.gpu;
+        let whole = [
+            g.vertex_bytes(),
+            g.patches.len() as u64 * 48,
+            g.control_points.len() as u64 * 4,
+            g.curves.len() as u64 * 16,
+            g.num_base_vertices as u64 * 12,
+        ];
+        let sizes = (
+            whole.into_iter().max().unwrap_or(0),
+            g.stencil_terms.len() as u64 * 8,
+        );
+        (image.pixels, soup.records, surf.chunk_counts(), sizes)
+    };
+    drop(gpu);
+    out
+}
+
+/// Adaptive's stencil kernel under a storage range smaller than its stencil terms (chunks of
+/// rows, each bound to its windows of the offsets and terms, non-zero bases) computes exactly
+/// the vertices of the whole-buffer run: the images and captures are bit-identical.
+#[test]
+fn adaptive_under_a_small_storage_range_matches_the_whole_buffer_run() {
+    let mesh = tessera::topology::load_obj(common::data(
+        "tests/data/opensubdiv/shapes/catmark_cube_creases0.obj",
+    ))
+    .expect("shape");
+    let params = FrameParams::uniform(4.0);
+    let (image, capture, chunks, (whole, terms)) = adaptive_run(None, &mesh, &params);
+    assert_eq!(chunks.1, 1, "uncapped: one window set");
+    // The smallest range that still holds every buffer bound whole, rounded up to 256 bytes.
+    let cap = whole.div_ceil(256) * 256;
+    println!("largest whole buffer {whole} B, stencil terms {terms} B, cap {cap} B");
+    assert!(
+        terms > 3 * cap,
+        "the terms ({terms} B) need several windows of {cap} B"
+    );
+    let (image_w, capture_w, chunks_w, _) = adaptive_run(Some(cap as u32), &mesh, &params);
+    println!("chunks under a {cap} B range: {chunks_w:?} (uncapped {chunks:?})");
+    assert!(chunks_w.1 > 3 && chunks_w.0 > chunks.0, "{chunks_w:?}");
+    assert!(image.iter().any(|&b| b != 0), "something is drawn");
+    assert!(image == image_w, "images differ");
+    assert_eq!(capture.len(), capture_w.len());
+    assert!(capture == capture_w, "captures differ");
 }
 
 /// A descriptor write whose range exceeds the (capped) device limit is a typed error, and one
@@ -190,9 +265,9 @@ fn grid(nx: u32, ny: u32, triangles: bool) -> ControlMesh {
 
 /// Flat, Phong, PN and BFT draw the issue's 1,001,112-triangle grid validation-clean at a
 /// small viewport (BFT's tangent terms, patch headers and rings exceed lavapipe's 128 MiB
-/// storage range: the windowed path). Adaptive on a 1M-quad grid is still refused with a typed
-/// range error (its stencil terms are 264 MB and not yet windowed: docs/benchmarks.md, "Scale"),
-/// never a silent overrun. One test, so the meshes are built once and the runs never overlap
+/// storage range: the windowed path), and adaptive the 1M-quad grid (its stencil terms, 264 MB,
+/// are windowed by rows); adaptive on the triangle grid is refused by the plan's size bound
+/// with a typed error naming the mesh size and the isolation. One test, so the meshes are built once and the runs never overlap
 /// in memory. Prints each build and frame time (the CI cost).
 #[test]
 fn one_million_faces_through_every_technique() {
@@ -256,24 +331,66 @@ fn one_million_faces_through_every_technique() {
                 );
             }
         }
+        // Adaptive on the 1M-quad grid: its stencil terms exceed the range (several window
+        // sets); the vertex and patch buffers are bound whole.
         let t = std::time::Instant::now();
-        let e = tessera::tess::build(
+        let surf = Adaptive::new(
             &mut ctx,
-            TechniqueId::Adaptive,
             &quad,
-            &tessera::tess::BuildOptions::default(),
+            &AdaptiveBuild {
+                name: "1M quad grid".into(),
+                ..Default::default()
+            },
+        )
+        .expect("adaptive");
+        let built = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
+        let image = ctx
+            .render_offscreen(&surf, &FrameParams::uniform(1.0), tiny)
+            .expect("adaptive render");
+        let frame = t.elapsed().as_secs_f64();
+        let chunks = surf.chunk_counts();
+        println!(
+            "adaptive: {} faces, isolation {}, build {built:.1} s, frame {frame:.1} s, \
+             stencil terms {} B, (dispatches, window sets) {chunks:?}",
+            quad.num_faces(),
+            surf.plan.isolation,
+            surf.gpu.stencil_terms.len() * 8,
+        );
+        let clear = &image.pixels[..4];
+        let lit = image.pixels.chunks_exact(4).filter(|p| p != &clear).count();
+        assert!(lit > 64 * 48 / 8, "adaptive: the grid covers {lit} pixels");
+        assert!(
+            chunks.1 > 1,
+            "the stencil terms exceed 128 MiB: several window sets"
+        );
+        drop(surf);
+        // Adaptive on the 1M-triangle grid (every vertex extraordinary under Catmull-Clark):
+        // refused by the plan's size bound before refining, never an allocation abort.
+        let t = std::time::Instant::now();
+        let e = Adaptive::new(
+            &mut ctx,
+            &tri,
+            &AdaptiveBuild {
+                name: "1M triangle grid".into(),
+                ..Default::default()
+            },
         )
         .map(|_| ())
-        .expect_err("adaptive stencil terms beyond the range are refused");
+        .expect_err("the 1M-triangle grid at isolation 4 is beyond the bound");
         println!(
-            "adaptive: refused in {:.1} s: {e}",
+            "adaptive on triangles: refused in {:.1} s: {e}",
             t.elapsed().as_secs_f64()
         );
+        let tessera::tess::TessError::Mesh { source, .. } = &e else {
+            panic!("not a mesh error: {e}")
+        };
         assert!(
             matches!(
-                e,
-                tessera::tess::TessError::Vulkan(VkError::Descriptor {
-                    problem: DescriptorError::Range { .. },
+                source.downcast_ref::<tessera::topology::TopologyError>(),
+                Some(tessera::topology::TopologyError::AdaptiveTooLarge {
+                    faces: 1_001_112,
+                    isolation: 4,
                     ..
                 })
             ),

@@ -46,9 +46,11 @@ layout(push_constant) uniform AdaptivePush {
     float pixels_per_segment;
     float distance_ref;    // distance at which an edge gets max_level segments
     float max_level;       // the device's maximum tessellation level
-    uint first_row;        // compute: first stencil row of this dispatch (global vertex - base count)
+    uint first_row;        // compute: first stencil row of this dispatch (global vertex - base count; mode 1: first base vertex)
     uint count;            // compute: rows in this dispatch (or base vertices to copy)
     uint base_count;       // compute: base vertices (row r writes vertex base_count + r)
+    uint row_base;         // compute: the chunk's first stencil_offsets element (window base)
+    uint term_base;        // compute: the chunk's first stencil_terms element (window base)
 } adaptive;
 
 uint patch_kind(AdaptivePatch p) { return p.info & 15u; }

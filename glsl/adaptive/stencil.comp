@@ -3,6 +3,9 @@
 // read only earlier levels), then one for the local points (phantom B-spline points, Gregory
 // points, limit corners, curve Bezier points). `mode` 1 copies the base positions in first.
 // Rows are stencils over the global vertex buffer, summed in table order with `precise`.
+// A block larger than the storage range runs as several dispatches (chunks of rows), each
+// bound to a window of the stencil offsets and terms: indices into them subtract the window
+// bases (`row_base`, `term_base`); the vertex buffer is bound whole.
 #define ADAPTIVE_WRITES_VERTICES
 #define TECHNIQUE_PUSH_CONSTANTS
 #include "frame.glsl"
@@ -12,13 +15,16 @@ void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= adaptive.count) return;
     if (adaptive.mode == 1u) {
-        vertices[i] = vec4(base_positions[3u * i], base_positions[3u * i + 1u], base_positions[3u * i + 2u], 1.0);
+        uint v = adaptive.first_row + i;
+        vertices[v] = vec4(base_positions[3u * v], base_positions[3u * v + 1u], base_positions[3u * v + 2u], 1.0);
         return;
     }
     uint r = adaptive.first_row + i;
+    uint k0 = stencil_offsets[r - adaptive.row_base];
+    uint k1 = stencil_offsets[r + 1u - adaptive.row_base];
     precise vec3 p = vec3(0.0);
-    for (uint k = stencil_offsets[r]; k < stencil_offsets[r + 1u]; ++k) {
-        StencilTerm t = stencil_terms[k];
+    for (uint k = k0; k < k1; ++k) {
+        StencilTerm t = stencil_terms[k - adaptive.term_base];
         p += t.weight * vertices[t.index].xyz;
     }
     vertices[adaptive.base_count + r] = vec4(p, 1.0);

@@ -63,6 +63,16 @@
 //!   points, canonical corners, curve points) that reads only refined vertices, so each block
 //!   can run as one parallel kernel. Local points are not shared between patches except the
 //!   canonical corners and curves (two boundary patches each have their own phantoms).
+//! * **Size bound.** Every vertex of a triangle mesh is extraordinary under Catmull-Clark (and
+//!   so is every face centre of level 1), so isolation refines nearly everything at every
+//!   level: a 1M-triangle grid at isolation 4 is tens of millions of refined faces and
+//!   aborted on allocation at 5–7 GB. Before each refinement step the plan projects the
+//!   refined faces it will hold, those made so far plus the selected faces' children times the
+//!   levels left to the isolation level (the selection of an irregular mesh does not shrink
+//!   from level to level), and returns [`TopologyError::AdaptiveTooLarge`] (mesh size,
+//!   isolation, estimate) when that exceeds the bound, [`MAX_REFINED_FACES`] by default
+//!   ([`plan_adaptive_within`] takes another). The projection is taken before the step's
+//!   allocation, so the plan never holds more than the bound's refined faces.
 //! * **Cost.** Faces are drafted in parallel per level, canonical corner and curve stencils in
 //!   parallel chunks appended in order, so the plan is the same with any thread count. Most of
 //!   the remaining time is the sparse refinement itself and first-touch page faults of the
@@ -76,6 +86,13 @@ use crate::refine::{refine_sparse, ChildMaps, ChildOrigin, LevelTopology};
 use crate::sdc::{is_infinite, vertex_rule, Rule, Scheme, SHARPNESS_INFINITE};
 use crate::stencil::StencilTable;
 use rayon::prelude::*;
+
+/// Default bound on the refined faces of an adaptive plan (summed over its levels), 2²³: a
+/// few GB of levels, stencils and patches (not measured per face; the 1M-triangle grid that
+/// aborted at 5–7 GB had refined past it). A 1M-quad grid at isolation 4 refines only around
+/// its four corners; a 1M-triangle grid at isolation 4 projects 12M (3M children × 4 levels)
+/// before its first step and is refused there.
+pub const MAX_REFINED_FACES: u64 = 1 << 23;
 
 /// How faces still irregular at the isolation level are drawn.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -238,6 +255,17 @@ pub fn plan_adaptive(
     mesh: &ControlMesh,
     opts: &AdaptiveOptions,
 ) -> Result<AdaptivePlan, TopologyError> {
+    plan_adaptive_within(mesh, opts, MAX_REFINED_FACES)
+}
+
+/// [`plan_adaptive`] under a bound on the refined faces other than [`MAX_REFINED_FACES`]: a
+/// plan projected past it is [`TopologyError::AdaptiveTooLarge`], returned before the
+/// refinement step that would exceed it.
+pub fn plan_adaptive_within(
+    mesh: &ControlMesh,
+    opts: &AdaptiveOptions,
+    max_refined_faces: u64,
+) -> Result<AdaptivePlan, TopologyError> {
     if !(1..=8).contains(&opts.isolation) {
         return Err(TopologyError::IsolationOutOfRange {
             isolation: opts.isolation,
@@ -248,7 +276,12 @@ pub fn plan_adaptive(
         return Err(TopologyError::BadSharpnessScale { scale });
     }
     let scaled = levels::scaled_mesh(mesh, scale)?;
-    let levels = levels::build_levels(&scaled, opts.isolation as usize, opts.follow_semi_sharp)?;
+    let levels = levels::build_levels(
+        &scaled,
+        opts.isolation as usize,
+        opts.follow_semi_sharp,
+        max_refined_faces,
+    )?;
     assemble::assemble(&scaled, opts, levels)
 }
 

@@ -133,6 +133,16 @@ pub enum TopologyError {
     /// A face with more corners than an adaptive patch's 8-bit sub-face number can name.
     #[error("adaptive plan: face {face} has {size} corners (at most 256)")]
     AdaptiveFaceTooLarge { face: usize, size: usize },
+    /// An adaptive plan projected to refine more faces than its bound (checked before each
+    /// refinement step, so the plan stops before allocating them).
+    #[error("adaptive plan of a {faces}-face mesh at isolation {isolation}: about {estimate} refined faces projected at level {level}, above the bound of {bound} (lower the isolation)")]
+    AdaptiveTooLarge {
+        faces: usize,
+        isolation: u32,
+        level: usize,
+        estimate: u64,
+        bound: u64,
+    },
     /// An adaptive patch whose neighbour is more than one level coarser or finer (drawing it
     /// would leave a crack).
     #[error("adaptive plan: face {face} of level {level} borders a face more than one level away")]

@@ -639,3 +639,28 @@ fn bad_options_and_meshes_are_named_errors() {
     let empty = ControlMesh::default();
     assert!(plan_adaptive(&empty, &AdaptiveOptions::default()).is_err());
 }
+
+/// The size bound is checked before each refinement step: the cube (6 quads, every corner
+/// extraordinary) at isolation 3 projects 24 children × 3 levels = 72 refined faces at level
+/// 0, then 24 + 96 × 2 = 216 at level 1; a bound below either is a named error carrying the
+/// mesh size and the isolation, and the default bound plans it.
+#[test]
+fn a_plan_projected_past_its_bound_is_refused_before_refining() {
+    use topology::adaptive::plan_adaptive_within;
+    let mesh = load_obj(format!("{SHAPES}catmark_cube.obj")).expect("cube");
+    let opts = options(3, EndCap::Gregory);
+    for (bound, level, estimate) in [(71, 0, 72), (72, 1, 216)] {
+        let e = plan_adaptive_within(&mesh, &opts, bound).unwrap_err();
+        println!("{e}");
+        assert!(
+            matches!(
+                e,
+                TopologyError::AdaptiveTooLarge { faces: 6, isolation: 3, level: l, estimate: x, bound: b }
+                    if l == level && x == estimate && b == bound
+            ),
+            "{e}"
+        );
+    }
+    let plan = plan_adaptive_within(&mesh, &opts, 216).expect("within 216");
+    assert_eq!(plan, plan_adaptive(&mesh, &opts).expect("default bound"));
+}

@@ -118,15 +118,19 @@ pub struct AdaptivePush {
     pub distance_ref: f32,
     /// The device's maximum tessellation level.
     pub max_level: f32,
-    /// Stencil kernel: first row of the dispatch.
+    /// Stencil kernel: first row of the dispatch (copying: first base vertex).
     pub first_row: u32,
     /// Stencil kernel: rows (or base vertices) in the dispatch.
     pub count: u32,
     /// Stencil kernel: base vertices; row `r` writes global vertex `base_count + r`.
     pub base_count: u32,
+    /// Stencil kernel: the chunk's window bases (`techniques::windows`), subtracted from
+    /// every index into the stencil offsets (a row) and the stencil terms.
+    pub row_base: u32,
+    pub term_base: u32,
 }
 
-const _: () = assert!(size_of::<AdaptivePush>() == 44);
+const _: () = assert!(size_of::<AdaptivePush>() == 52);
 
 /// Interleaved vertex of the mesh vertex buffer (`common/mesh.vert` and `plain/plain.vert`
 /// locations 0 and 1).

@@ -92,6 +92,7 @@ pub(super) fn build_levels(
     mesh: &ControlMesh,
     iso: usize,
     follow_semi_sharp: bool,
+    max_refined_faces: u64,
 ) -> Result<Vec<Lvl>, TopologyError> {
     let topo = LevelTopology::from_mesh(mesh, Scheme::CatmullClark)?;
     if let Some((face, size)) = (0..topo.topology.num_faces())
@@ -127,6 +128,8 @@ pub(super) fn build_levels(
         stencils: None,
         kv: 0,
     }];
+    // Refined faces held so far (every level past 0); see "Size bound" in the module docs.
+    let mut refined = 0u64;
     let deepest = if follow_semi_sharp {
         SEMI_SHARP_LIMIT.max(iso)
     } else {
@@ -176,6 +179,21 @@ pub(super) fn build_levels(
         let selection: Vec<u32> = (0..t.num_faces() as u32)
             .filter(|&f| lvl.selected[f as usize])
             .collect();
+        let children: u64 = selection
+            .iter()
+            .map(|&f| t.face_vertices(f as usize).len() as u64)
+            .sum();
+        let estimate =
+            refined.saturating_add(children.saturating_mul(iso.saturating_sub(l).max(1) as u64));
+        if estimate > max_refined_faces {
+            return Err(TopologyError::AdaptiveTooLarge {
+                faces: nf,
+                isolation: iso as u32,
+                level: l,
+                estimate,
+                bound: max_refined_faces,
+            });
+        }
         let r = refine_sparse(
             lvl.topo.view(),
             Scheme::CatmullClark,
@@ -192,6 +210,7 @@ pub(super) fn build_levels(
             .ok_or(TopologyError::RefinementTooLarge {
                 faces: t.num_faces(),
             })?;
+        refined = refined.saturating_add(r.child.topology.num_faces() as u64);
         let maps = r.maps;
         let complete = maps
             .child_face_parent

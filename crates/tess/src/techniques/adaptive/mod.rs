@@ -16,10 +16,20 @@
 //!    identically (see `glsl/adaptive/adaptive.glsl`), so shared edges are bit-identical
 //!    under every factor policy, across transitions and end caps.
 //!
+//! 4. **Beyond the storage range:** a block whose stencil terms (or row offsets) exceed
+//!    `maxStorageBufferRange` (a 1M-quad grid's terms are 264 MB; lavapipe allows 128 MiB)
+//!    runs as several dispatches, chunks of rows planned by `techniques::windows`: a row's
+//!    terms are one contiguous run of the term buffer, so each chunk binds only its windows of
+//!    the offsets and the terms and the kernel subtracts the window bases (push constants).
+//!    The vertex buffer, the base positions and the patch buffers (records, control points,
+//!    curves) are bound whole: one that exceeds the range is refused with vk-core's typed
+//!    range error naming the buffer, never a silent overrun.
+//!
 //! The GPU data is [`layout`].
 pub mod layout;
 
 use super::shared::{check_adaptive_policy, factor_fields, storage, storage_binding};
+use super::windows::{self, Limits, Member, Space};
 use crate::capture::{face_corner_uv, FacePoint};
 use crate::context::Context;
 use crate::error::{Result, TessError};
@@ -38,6 +48,7 @@ use crate::technique::{
 use crate::techniques::bft::{base_positions, bbox};
 use crate::tessellator::{quad_triangle_count, uniform_vertex_count, Domain, Spacing};
 use layout::GpuAdaptive;
+use std::ops::Range;
 use topology::adaptive::{plan_adaptive, AdaptiveOptions, AdaptivePlan, EndCap};
 use topology::ControlMesh;
 use vk_core::descriptor::{BindingDesc, DescriptorPool};
@@ -57,6 +68,82 @@ static SET_BINDINGS: [BindingDesc; 7] = [
     storage_binding(ADAPTIVE_CONTROL_POINTS_BINDING),
     storage_binding(ADAPTIVE_CURVES_BINDING),
 ];
+
+/// Stencil rows: their CSR offsets (row `r` reads `offsets[r + 1]`).
+const ROWS: Space = Space {
+    name: "stencil row",
+    members: &[Member {
+        stride: 4,
+        extra: 1,
+    }],
+};
+/// Stencil terms.
+const TERMS: Space = Space {
+    name: "stencil term",
+    members: &[Member {
+        stride: std::mem::size_of::<layout::StencilTerm>() as u64,
+        extra: 0,
+    }],
+};
+
+/// A set's windows of the stencil offsets (rows) and terms.
+type RowWindows = [Range<u32>; 2];
+
+/// One dispatch of the stencil kernel: rows (mode 0) or base vertices (mode 1) and the
+/// windows of the offsets and terms its set binds.
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct Step {
+    mode: u32,
+    items: Range<u32>,
+    /// Index into the slot's sets.
+    set: usize,
+}
+
+/// The pre-pass: chunks of rows (over every block) whose offset and term windows fit
+/// `limits`, one descriptor set each; a block runs as one dispatch per chunk it meets, each at
+/// most `max_items` rows (the dispatch's group count). Returns the steps (the base copy
+/// first) and each set's windows, `[rows, terms]`.
+fn plan_pre_pass(
+    g: &GpuAdaptive,
+    limits: Limits,
+    max_items: u32,
+) -> Result<(Vec<Step>, Vec<RowWindows>)> {
+    let max_items = max_items.max(1);
+    let rows = g.stencil_offsets.len().saturating_sub(1) as u32;
+    let chunks = windows::plan("stencil row", rows, &[ROWS, TERMS], limits, |r| {
+        let (k0, k1) = (
+            g.stencil_offsets[r as usize],
+            g.stencil_offsets[r as usize + 1],
+        );
+        [r..r + 1, k0..k1]
+    })?;
+    let mut steps = Vec::new();
+    let mut split = |mode: u32, items: Range<u32>, set: usize| {
+        let mut first = items.start;
+        while first < items.end {
+            let end = items.end.min(first.saturating_add(max_items));
+            steps.push(Step {
+                mode,
+                items: first..end,
+                set,
+            });
+            first = end;
+        }
+    };
+    // The base copy reads no stencils: any set serves.
+    split(1, 0..g.num_base_vertices, 0);
+    for d in &g.dispatches {
+        let block = d.first_row..d.first_row + d.rows;
+        for (k, c) in chunks.iter().enumerate() {
+            split(
+                0,
+                block.start.max(c.items.start)..block.end.min(c.items.end),
+                k,
+            );
+        }
+    }
+    Ok((steps, chunks.into_iter().map(|c| c.windows).collect()))
+}
 
 /// How an adaptive surface is built (the per-frame choices are in [`FrameParams`]).
 #[derive(Clone, Debug)]
@@ -89,7 +176,13 @@ impl Default for AdaptiveBuild {
 /// keep their pool alive), pool, buffers.
 pub struct Adaptive {
     stencil: Pipeline,
-    sets: Vec<DescriptorSet>,
+    /// Per frame slot, one set per distinct pre-pass window (slots differ only in the base
+    /// positions); the draw binds the slot's first (it reads no stencils).
+    sets: Vec<Vec<DescriptorSet>>,
+    /// The stencil kernel's dispatches, in order.
+    steps: Vec<Step>,
+    /// Per set: its windows of the stencil offsets and terms.
+    windows: Vec<RowWindows>,
     _pool: DescriptorPool,
     base: Vec<Buffer>,
     _static: Vec<Buffer>,
@@ -131,11 +224,17 @@ impl Adaptive {
         let frames = ctx.frames_in_flight();
         ctx.ensure_set_layout(TechniqueId::Adaptive, &SET_BINDINGS)?;
         let set_layout = ctx.set_layout(TechniqueId::Adaptive)?;
+        let max_groups = device.info.caps.max_compute_work_group_count[0];
+        let (steps, windows) = plan_pre_pass(
+            &gpu,
+            Limits::of(&device),
+            max_groups.saturating_mul(ADAPTIVE_LOCAL_SIZE),
+        )?;
         let pool = DescriptorPool::new(
             &device,
             "adaptive descriptor pool",
             set_layout,
-            frames as u32,
+            (frames * windows.len()) as u32,
         )?;
         let vertices = Buffer::new(
             &device,
@@ -203,17 +302,35 @@ impl Adaptive {
                 },
             )?;
             buf.write(0, bytemuck::cast_slice(&base_positions))?;
-            let set = pool.allocate_set(set_layout)?;
-            set.write_buffer(
-                ADAPTIVE_BASE_POSITIONS_BINDING,
-                vk::DescriptorType::STORAGE_BUFFER,
-                &buf,
-            )?;
-            for (binding, s) in &statics {
-                set.write_buffer(*binding, vk::DescriptorType::STORAGE_BUFFER, s)?;
+            let mut slot_sets = Vec::with_capacity(windows.len());
+            for [rows, terms] in &windows {
+                let set = pool.allocate_set(set_layout)?;
+                windows::write_whole(&set, ADAPTIVE_BASE_POSITIONS_BINDING, &buf)?;
+                for (binding, s) in &statics {
+                    match *binding {
+                        ADAPTIVE_STENCIL_OFFSETS_BINDING => windows::write_window(
+                            &set,
+                            *binding,
+                            s,
+                            ROWS.members[0],
+                            gpu.stencil_offsets.len() as u64,
+                            rows,
+                        )?,
+                        ADAPTIVE_STENCIL_TERMS_BINDING => windows::write_window(
+                            &set,
+                            *binding,
+                            s,
+                            TERMS.members[0],
+                            gpu.stencil_terms.len() as u64,
+                            terms,
+                        )?,
+                        _ => windows::write_whole(&set, *binding, s)?,
+                    }
+                }
+                slot_sets.push(set);
             }
             base.push(buf);
-            sets.push(set);
+            sets.push(slot_sets);
         }
         let layouts = [ctx.frame_set_layout().raw, set_layout.raw];
         let stencil = Pipeline::compute(
@@ -247,6 +364,8 @@ impl Adaptive {
         Ok(Self {
             stencil,
             sets,
+            steps,
+            windows,
             _pool: pool,
             base,
             _static: statics.into_iter().map(|(_, b)| b).collect(),
@@ -260,6 +379,12 @@ impl Adaptive {
             options: options.clone(),
             max_level,
         })
+    }
+
+    /// Stencil-kernel dispatches (the base copy included) and distinct window sets: more than
+    /// one set when the stencil tables exceed the storage range.
+    pub fn chunk_counts(&self) -> (usize, usize) {
+        (self.steps.len(), self.windows.len())
     }
 
     /// Patches of each kind: regular, Gregory, bilinear.
@@ -297,6 +422,8 @@ impl Adaptive {
             first_row: 0,
             count: 0,
             base_count: self.gpu.num_base_vertices,
+            row_base: 0,
+            term_base: 0,
         }
     }
 
@@ -398,7 +525,9 @@ impl Technique for Adaptive {
     }
 
     fn descriptor_set(&self, slot: usize) -> Option<&DescriptorSet> {
-        self.sets.get(slot.min(self.sets.len().saturating_sub(1)))
+        self.sets
+            .get(slot.min(self.sets.len().saturating_sub(1)))?
+            .first()
     }
 
     /// At the largest level an edge can get (a coarse transition edge's doubled level).
@@ -468,9 +597,11 @@ impl Technique for Adaptive {
         frame_set: &'a DescriptorSet,
         slot: usize,
     ) -> Result<()> {
-        let set = self
-            .descriptor_set(slot)
-            .ok_or(TessError::FrameSlot { slot, slots: 0 })?;
+        let slots = self.sets.len();
+        let sets = self
+            .sets
+            .get(slot.min(slots.saturating_sub(1)))
+            .ok_or(TessError::FrameSlot { slot, slots })?;
         let tess_stages = vk::PipelineStageFlags::VERTEX_SHADER
             | vk::PipelineStageFlags::TESSELLATION_CONTROL_SHADER
             | vk::PipelineStageFlags::TESSELLATION_EVALUATION_SHADER;
@@ -483,31 +614,34 @@ impl Technique for Adaptive {
             (compute, vk::AccessFlags::SHADER_WRITE),
         );
         enc.bind_pipeline(&self.stencil);
-        enc.bind_descriptor_sets(0, &[frame_set, set])?;
-        let base = AdaptivePush {
-            mode: 1,
-            count: self.gpu.num_base_vertices,
-            base_count: self.gpu.num_base_vertices,
-            ..Default::default()
-        };
-        let mut steps = vec![base];
-        for d in &self.gpu.dispatches {
-            steps.push(AdaptivePush {
-                mode: 0,
-                first_row: d.first_row,
-                count: d.rows,
-                base_count: self.gpu.num_base_vertices,
-                ..Default::default()
-            });
-        }
-        let n = steps.len();
-        for (i, push) in steps.iter().enumerate() {
-            if push.count == 0 {
-                continue;
+        let n = self.steps.len();
+        let mut bound = None;
+        for (i, step) in self.steps.iter().enumerate() {
+            let [rows, terms] = self
+                .windows
+                .get(step.set)
+                .ok_or(TessError::FrameSlot { slot, slots })?;
+            let set = sets
+                .get(step.set)
+                .ok_or(TessError::FrameSlot { slot, slots })?;
+            if bound != Some(step.set) {
+                enc.bind_descriptor_sets(0, &[frame_set, set])?;
+                bound = Some(step.set);
             }
-            enc.push_constants(push)?;
+            let push = AdaptivePush {
+                mode: step.mode,
+                first_row: step.items.start,
+                count: step.items.end - step.items.start,
+                base_count: self.gpu.num_base_vertices,
+                row_base: rows.start,
+                term_base: terms.start,
+                ..Default::default()
+            };
+            enc.push_constants(&push)?;
             enc.dispatch([push.count.div_ceil(ADAPTIVE_LOCAL_SIZE), 1, 1])?;
-            // Each block reads the ones before it; the last feeds the tessellation stages.
+            // Each block reads the ones before it, and chunks of one block write disjoint
+            // vertices of the buffer bound whole (synchronization validation sees the whole
+            // range): every dispatch is ordered; the last feeds the tessellation stages.
             let next = if i + 1 == n {
                 (tess_stages, vk::AccessFlags::SHADER_READ)
             } else {
@@ -589,5 +723,70 @@ impl Technique for Adaptive {
             self.gpu.num_vertices - self.gpu.num_base_vertices,
             self.gpu.table_bytes()
         )]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Under a small range and a small group count, the steps run every row exactly once, in
+    /// block order (a block's rows read only earlier blocks), each inside its set's windows,
+    /// with aligned window starts; the base copy comes first.
+    #[test]
+    fn pre_pass_chunks_cover_every_row_once_inside_their_windows() {
+        let mesh = topology::load_obj(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../tests/data/opensubdiv/shapes/catmark_cube_creases0.obj"
+        ))
+        .expect("cube");
+        let plan = plan_adaptive(
+            &mesh,
+            &AdaptiveOptions {
+                isolation: 2,
+                ..Default::default()
+            },
+        )
+        .expect("plan");
+        let g = GpuAdaptive::new(&plan).expect("layout");
+        let whole = plan_pre_pass(&g, limits(1 << 30), u32::MAX).expect("whole");
+        assert_eq!(whole.1.len(), 1, "everything fits: one set");
+        let (steps, sets) = plan_pre_pass(&g, limits(4096), 100).expect("chunked");
+        assert!(sets.len() > 3, "{} sets", sets.len());
+        assert_eq!(steps[0].mode, 1);
+        assert_eq!(steps[0].items.start, 0);
+        let copied: u32 = steps
+            .iter()
+            .filter(|s| s.mode == 1)
+            .map(|s| s.items.len() as u32)
+            .sum();
+        assert_eq!(copied, g.num_base_vertices);
+        let mut next = 0;
+        for s in steps.iter().filter(|s| s.mode == 0) {
+            assert_eq!(s.items.start, next, "in order, no gap or overlap");
+            assert!(s.items.len() <= 100);
+            next = s.items.end;
+            let [rows, terms] = &sets[s.set];
+            assert_eq!(rows.start % 4, 0, "row window start aligned to 16 bytes");
+            assert_eq!(terms.start % 2, 0, "term window start aligned to 16 bytes");
+            assert!((rows.end - rows.start + 1) * 4 <= 4096);
+            assert!((terms.end - terms.start) * 8 <= 4096);
+            for r in s.items.clone() {
+                let (k0, k1) = (
+                    g.stencil_offsets[r as usize],
+                    g.stencil_offsets[r as usize + 1],
+                );
+                assert!(rows.start <= r && r < rows.end);
+                assert!(k0 == k1 || (terms.start <= k0 && k1 <= terms.end));
+            }
+        }
+        assert_eq!(next as usize, g.stencil_offsets.len() - 1);
+    }
+
+    fn limits(max_range: u64) -> Limits {
+        Limits {
+            max_range,
+            alignment: 16,
+        }
     }
 }
