@@ -138,14 +138,14 @@ pub fn run(a: BenchArgs) -> Result<()> {
     })?;
     drop(device);
     check_validation(&instance)?;
-    println!("{}", report.to_text());
+    out!("{}", report.to_text());
     if let Some(p) = &a.csv {
         write(p, &report.to_csv())?;
-        println!("wrote {}", p.display());
+        out!("wrote {}", p.display());
     }
     if let Some(p) = &a.markdown {
         write(p, &report.to_markdown())?;
-        println!("wrote {}", p.display());
+        out!("wrote {}", p.display());
     }
     Ok(())
 }

@@ -173,7 +173,7 @@ fn render(a: RenderArgs) -> Result<()> {
     let what = render_offscreen(&device, &mesh, &setup, extent, &a.output);
     drop(device);
     check_validation(&instance)?;
-    println!(
+    out!(
         "wrote {} ({}x{}, {})",
         a.output.display(),
         a.size.0,
@@ -210,29 +210,29 @@ fn info(g: &GpuArgs) -> Result<()> {
         surface_extensions: vec![],
     })?;
     let v = instance.api_version;
-    println!(
+    out!(
         "Vulkan loader: {}.{}.{}",
         vk::api_version_major(v),
         vk::api_version_minor(v),
         vk::api_version_patch(v)
     );
-    println!("validation layer: {:?}", instance.validation());
+    out!("validation layer: {:?}", instance.validation());
     let adapters = vk_core::device::enumerate_adapters(&instance)?;
     if adapters.is_empty() {
-        println!("no Vulkan devices");
+        out!("no Vulkan devices");
     }
     for a in &adapters {
-        println!("{a}");
+        out!("{a}");
         let c = &a.caps;
-        println!(
+        out!(
             "    tessellationShader {} fillModeNonSolid {} pipelineStatisticsQuery {} vertexPipelineStoresAndAtomics {} timestamps {}",
             c.tessellation_shader, c.fill_mode_non_solid, c.pipeline_statistics_query, c.vertex_pipeline_stores_and_atomics, c.timestamps
         );
-        println!(
+        out!(
             "    maxTessellationGenerationLevel {} maxTessellationPatchSize {} maxTessellationEvaluationOutputComponents {} score {}",
             c.max_tessellation_generation_level, c.max_tessellation_patch_size, c.max_tess_evaluation_output_components, a.score()
         );
-        println!(
+        out!(
             "    transformFeedback {} (queries {}, maxTransformFeedbackBufferSize {}, stride ≤ {}) — optional, used by `tessera export`",
             c.transform_feedback, c.transform_feedback_queries, c.max_transform_feedback_buffer_size, c.max_transform_feedback_stride
         );
@@ -245,10 +245,10 @@ fn info(g: &GpuArgs) -> Result<()> {
                 vk_core::DeviceSelector::Auto => format!("highest score ({}: discrete 4 > integrated 3 > virtual 2 > CPU 1; ties by lowest index)", a.type_name()),
                 _ => format!("selected by --device {}", g.device),
             };
-            println!("chosen: [{}] {} — {why}", a.index, a.name);
+            out!("chosen: [{}] {} — {why}", a.index, a.name);
             let w = vk_core::workarounds::Workarounds::for_adapter(a);
             for w in w.active() {
-                println!("    workaround: {}", w.summary);
+                out!("    workaround: {}", w.summary);
             }
         }
         // Asked for a device that is not there (or cannot be used): a failure, after the
@@ -262,7 +262,7 @@ fn info(g: &GpuArgs) -> Result<()> {
         Err(e) if !matches!(selector, vk_core::DeviceSelector::Auto) => {
             bail!("--device {}: {e}", g.device)
         }
-        Err(e) => println!("chosen: none — {e}"),
+        Err(e) => out!("chosen: none — {e}"),
     }
     Ok(())
 }

@@ -127,15 +127,17 @@ pub fn run(a: ExportArgs) -> Result<()> {
     let map = |patch: u32, domain: [f32; 2]| faces.get(&(patch, domain.map(f32::to_bits))).copied();
     // Every TES declares `ccw` in the upper-left domain: clockwise seen from outside.
     welded.write_obj(&a.output, &map, Winding::Reversed)?;
-    println!(
+    out!(
         "captured: {} triangles, {} vertices ({})",
-        r.triangles, r.corners, summary
+        r.triangles,
+        r.corners,
+        summary
     );
-    println!(
+    out!(
         "welded: {} vertices (corners merged only when their position bits are identical)",
         r.welded_vertices
     );
-    println!(
+    out!(
         "open edges: {} ({} on the base mesh's boundary, {} cracks{})",
         r.open_edges,
         r.on_base_boundary,
@@ -146,9 +148,9 @@ pub fn run(a: ExportArgs) -> Result<()> {
             String::new()
         }
     );
-    println!("non-manifold edges: {}", r.non_manifold);
-    println!("zero-area triangles: {}", r.zero_area);
-    println!("wrote {}", a.output.display());
+    out!("non-manifold edges: {}", r.non_manifold);
+    out!("zero-area triangles: {}", r.zero_area);
+    out!("wrote {}", a.output.display());
     if a.fail_on_cracks && r.cracks > 0 {
         bail!("{} cracks (--fail-on-cracks)", r.cracks);
     }

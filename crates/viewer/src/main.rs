@@ -1,5 +1,15 @@
 //! `tessera`: render, view and inspect subdivision surfaces drawn on the tessellation stage.
 #![forbid(unsafe_code)]
+
+/// `println!` that does not panic when stdout is closed early (`tessera info | head -1`): a
+/// broken pipe ends the process quietly, as a pipeline expects; another write error ends it
+/// with a message. `println!` panics on both.
+macro_rules! out {
+    ($($arg:tt)*) => {
+        $crate::write_stdout(format_args!($($arg)*))
+    };
+}
+
 mod bench;
 mod cli;
 mod commands;
@@ -9,6 +19,18 @@ mod topo_cmds;
 mod view;
 
 use clap::Parser;
+use std::io::Write;
+
+fn write_stdout(line: std::fmt::Arguments) {
+    let mut stdout = std::io::stdout().lock();
+    if let Err(e) = writeln!(stdout, "{line}").and_then(|()| stdout.flush()) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("error: cannot write to standard output: {e}");
+        std::process::exit(1);
+    }
+}
 
 fn main() -> std::process::ExitCode {
     let args = cli::Cli::parse();

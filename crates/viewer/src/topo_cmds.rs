@@ -66,7 +66,7 @@ pub fn subdivide(a: SubdivideArgs) -> Result<()> {
         .with_context(|| format!("creating {}", a.output.display()))?;
     topology::write_obj(file, &positions, offsets, verts)
         .with_context(|| format!("writing {}", a.output.display()))?;
-    println!(
+    out!(
         "wrote {}: {} vertices, {} faces (level {}, {}{})",
         a.output.display(),
         positions.len(),
@@ -95,6 +95,6 @@ pub fn limit(a: LimitArgs) -> Result<()> {
             a.uv.1
         );
     }
-    println!("{p}");
+    out!("{p}");
     Ok(())
 }

@@ -218,7 +218,7 @@ impl App {
         }
         if let (Some(img), Some(path)) = (shot, &self.args.screenshot) {
             img.save_png(path)?;
-            println!(
+            out!(
                 "wrote {} after {} frames",
                 path.display(),
                 self.frames_drawn
@@ -480,7 +480,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
 
 /// One `--stats` line: `stats: <when>: <bytes> bytes allocated, <n> live Vulkan objects, <s> s`.
 fn print_stats(when: &str, device: &Device, started: Instant) {
-    println!(
+    out!(
         "stats: {when}: {} bytes allocated, {} live Vulkan objects, {:.1} s",
         device.allocated_bytes(),
         device.live_objects(),

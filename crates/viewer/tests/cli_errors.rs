@@ -632,3 +632,28 @@ fn every_command_path_runs_with_validation_on() {
     ]);
     assert!(stdout(&o).contains("normal"), "{}", stdout(&o));
 }
+
+/// `tessera info | head -0`: stdout closed before anything is written. `println!` panicked
+/// (exit 101, "failed printing to stdout"); the command now ends quietly.
+#[test]
+fn closed_stdout_is_not_a_panic() {
+    for args in [&["info"][..], &["limit", "--help"][..]] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_tessera"))
+            .args(args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("tessera runs");
+        // Closing the read end before the child has started writing makes every write fail
+        // with EPIPE.
+        drop(child.stdout.take());
+        let o = child.wait_with_output().expect("tessera ends");
+        let e = stderr(&o);
+        assert!(!e.contains("panicked"), "{args:?} panicked: {e}");
+        assert!(
+            o.status.code() == Some(0) || args[1..].contains(&"--help"),
+            "{args:?}: {:?} {e}",
+            o.status
+        );
+    }
+}
