@@ -32,28 +32,15 @@ pub struct ExportReport {
 /// (coordinates within `topology::MAX_COORDINATE`) never makes one, so one is a bug to report,
 /// not a file to write.
 fn check_finite(welded: &tess::WeldedMesh) -> Result<()> {
-    let bad = |v: &[[f32; 3]]| v.iter().position(|p| !p.iter().all(|c| c.is_finite()));
-    if let Some(i) = bad(&welded.positions) {
-        let p = welded.positions[i];
-        bail!(
-            "the GPU emitted a non-finite position ({}, {}, {}) at captured vertex {}; \
-             nothing written",
-            p[0],
-            p[1],
-            p[2],
-            i + 1
-        );
-    }
-    if let Some(i) = bad(&welded.normals) {
-        let n = welded.normals[i];
-        bail!(
-            "the GPU emitted a non-finite normal ({}, {}, {}) at captured vertex {}; \
-             nothing written",
-            n[0],
-            n[1],
-            n[2],
-            i + 1
-        );
+    for (what, values) in [("position", &welded.positions), ("normal", &welded.normals)] {
+        if let Some(i) = values.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+            let [x, y, z] = values[i];
+            bail!(
+                "the GPU emitted a non-finite {what} ({x}, {y}, {z}) at captured vertex {}; \
+                 nothing written",
+                i + 1
+            );
+        }
     }
     Ok(())
 }
