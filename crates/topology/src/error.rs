@@ -299,6 +299,32 @@ impl std::fmt::Display for ObjTerms<'_> {
                 "Loop subdivision needs triangles, but face {} has {size} vertices",
                 face + 1
             ),
+            E::AdaptiveFaceTooLarge { face, size } => write!(
+                f,
+                "adaptive plan: face {} has {size} corners (at most 256)",
+                face + 1
+            ),
+            // Level-0 faces are the file's; refined faces have no number in the file, so they
+            // keep the refiner's (0-based) one and say which level it is of.
+            E::AdaptivePatch { level: 0, face } => write!(
+                f,
+                "adaptive plan: face {} is not a regular patch",
+                face + 1
+            ),
+            E::AdaptiveUnbalanced { level: 0, face } => write!(
+                f,
+                "adaptive plan: face {} borders a face more than one level away",
+                face + 1
+            ),
+            E::AdaptivePatch { level, face } => write!(
+                f,
+                "adaptive plan: refined face {face} (0-based) of level {level} is not a regular patch"
+            ),
+            E::AdaptiveUnbalanced { level, face } => write!(
+                f,
+                "adaptive plan: refined face {face} (0-based) of level {level} borders a face \
+                 more than one level away"
+            ),
             E::TagOutOfRange { tag, index, count } => write!(
                 f,
                 "invalid tag: {tag} names {} {index} (tags count from 0), the file has {count} {}",

@@ -267,3 +267,34 @@ mod never_panics {
         }
     }
 }
+
+/// Errors raised after loading (here the adaptive plan) still speak the file's 1-based face
+/// numbers once wrapped by `in_file`, like the parser's own.
+#[test]
+fn later_errors_use_the_files_face_numbers() {
+    use topology::{plan_adaptive, AdaptiveOptions};
+    let n = 300;
+    let mut text = String::from("v 5 5 0\nv 6 5 0\nv 5 6 0\nf 1 2 3\n");
+    for i in 0..n {
+        let a = std::f64::consts::TAU * i as f64 / n as f64;
+        text += &format!("v {} {} 0\n", a.cos(), a.sin());
+    }
+    text += "f";
+    for i in 0..n {
+        text += &format!(" {}", i + 4);
+    }
+    text += "\n";
+    let mesh = parse_obj(&text, "inline.obj").expect("valid mesh");
+    let e = plan_adaptive(&mesh, &AdaptiveOptions::default())
+        .expect_err("a 300-gon is beyond the adaptive plan")
+        .in_file("inline.obj", None);
+    match e.root() {
+        TopologyError::AdaptiveFaceTooLarge { face, size } => assert_eq!((*face, *size), (1, n)),
+        other => panic!("unexpected {other:?}"),
+    }
+    let message = e.to_string();
+    assert!(
+        message.contains("inline.obj") && message.contains("face 2 has 300 corners"),
+        "{message}"
+    );
+}
