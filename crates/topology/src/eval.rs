@@ -127,6 +127,9 @@ pub enum EvalError {
     NoBftCase { key: crate::bft::BftKey },
     #[error("BFT level {level} not in 1..=6")]
     BftLevel { level: u32 },
+    /// A characteristic map ([`crate::reparam`]) of a valence below 3.
+    #[error("a characteristic map needs valence 3 or more, not {valence}")]
+    Valence { valence: u32 },
     /// The mesh or a refinement step failed (names the face, edge or vertex at fault).
     #[error(transparent)]
     Topology(#[from] TopologyError),

@@ -11,6 +11,7 @@ pub mod mesh;
 pub mod obj;
 pub mod patch;
 pub mod refine;
+pub mod reparam;
 pub mod sdc;
 pub mod stencil;
 
