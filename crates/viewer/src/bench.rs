@@ -112,11 +112,12 @@ pub fn run(a: BenchArgs) -> Result<()> {
             eprintln!("note: {n}");
         }
     }
+    let segments: Vec<String> = config.segments.iter().map(u32::to_string).collect();
     eprintln!(
-        "measuring {} meshes × S {:?} × {:?}: {} timed frames after {} warm-up frames per row",
+        "measuring {} meshes × segments {} × {}: {} timed frames after {} warm-up frames per row",
         meshes.len(),
-        config.segments,
-        config.methods,
+        segments.join(", "),
+        config.methods.join(", "),
         config.frames,
         config.warmup
     );

@@ -76,8 +76,8 @@ pub fn scene_setup(s: &SceneArgs, name: &str, mesh: &topology::ControlMesh) -> R
     };
     let mut setup = s
         .surface
-        .setup(method, s.level, s.spacing, s.animate, params)?;
-    crate::technique::check_segments("--level", &setup)?;
+        .setup(method, s.segments, s.spacing, s.animate, params)?;
+    crate::technique::check_segments(&setup)?;
     setup.build.name = name.to_string();
     Ok(setup)
 }
@@ -216,7 +216,14 @@ fn info(g: &GpuArgs) -> Result<()> {
         vk::api_version_minor(v),
         vk::api_version_patch(v)
     );
-    out!("validation layer: {:?}", instance.validation());
+    out!(
+        "validation layer: {}",
+        match instance.validation() {
+            Validation::Off => "off",
+            Validation::On => "on",
+            Validation::Synchronization => "on, with synchronization validation",
+        }
+    );
     let adapters = vk_core::device::enumerate_adapters(&instance)?;
     if adapters.is_empty() {
         out!("no Vulkan devices");

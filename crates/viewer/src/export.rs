@@ -54,13 +54,13 @@ pub fn run(a: ExportArgs) -> Result<()> {
         phong_alpha: a.alpha,
         ..FrameParams::default()
     };
-    let base = load_mesh(Some(&a.input))?;
+    let base = load_mesh(a.input.as_deref())?;
     let method = crate::technique::resolve_method(a.method, a.surface.scheme.as_deref(), &base)?;
     let mut setup = a
         .surface
         .setup(method, a.segments, a.spacing, false, params)?;
-    crate::technique::check_segments("--segments", &setup)?;
-    setup.build.name = mesh_name(Some(&a.input));
+    crate::technique::check_segments(&setup)?;
+    setup.build.name = mesh_name(a.input.as_deref());
     let extent = vk::Extent2D {
         width: a.size.0,
         height: a.size.1,

@@ -206,8 +206,10 @@ impl App {
                 if techniques::info(self.setup.technique).features.isolation {
                     let b = &self.setup.build;
                     format!(
-                        ", isolation {}, {:?} end caps, sharpness ×{:.2}",
-                        b.isolation, b.end_cap, b.sharpness_scale
+                        ", isolation {}, {} end caps, sharpness ×{:.2}",
+                        b.isolation,
+                        end_cap_name(b.end_cap),
+                        b.sharpness_scale
                     )
                 } else {
                     String::new()
@@ -476,6 +478,14 @@ pub fn run(args: ViewArgs) -> Result<()> {
         return Err(e);
     }
     result
+}
+
+/// `--end-cap`'s spelling of an end cap.
+fn end_cap_name(e: topology::adaptive::EndCap) -> &'static str {
+    match e {
+        topology::adaptive::EndCap::Gregory => "gregory",
+        topology::adaptive::EndCap::Bilinear => "bilinear",
+    }
 }
 
 /// One `--stats` line: `stats: <when>: <bytes> bytes allocated, <n> live Vulkan objects, <s> s`.

@@ -461,8 +461,13 @@ fn validate(config: &BenchConfig, meshes: &[BenchMesh]) -> Result<()> {
     }
     if config.segments.is_empty() || config.segments.contains(&0) {
         return bad(format!(
-            "segments per edge must be at least 1 (got {:?})",
-            config.segments
+            "segments per edge must be at least 1 (got {})",
+            config
+                .segments
+                .iter()
+                .map(u32::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
         ));
     }
     if config.frames == 0 {
