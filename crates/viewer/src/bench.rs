@@ -32,7 +32,10 @@ fn load_meshes(paths: &[std::path::PathBuf]) -> Result<Vec<BenchMesh>> {
     if paths.is_empty() {
         for (name, text) in DEFAULT_MESHES {
             let mesh = topology::parse_obj(text, &format!("{name}.obj (embedded)"))?;
-            out.push(BenchMesh::new(name, &mesh).with_context(|| format!("preparing {name}"))?);
+            let prepared = crate::progress::during(format!("preparing {name}"), || {
+                BenchMesh::new(name, &mesh)
+            });
+            out.push(prepared.with_context(|| format!("preparing {name}"))?);
         }
     } else {
         for p in paths {
@@ -41,13 +44,58 @@ fn load_meshes(paths: &[std::path::PathBuf]) -> Result<Vec<BenchMesh>> {
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_else(|| p.display().to_string());
-            out.push(
+            let prepared = crate::progress::during(format!("preparing {name}"), || {
                 BenchMesh::new(&name, &mesh)
-                    .with_context(|| format!("preparing {}", p.display()))?,
-            );
+            });
+            out.push(prepared.with_context(|| format!("preparing {}", p.display()))?);
         }
     }
     Ok(out)
+}
+
+/// The run on the terminal: a bar over the groups (mesh × S), and each row as a line (also
+/// without a terminal, as before the bar).
+struct Progress {
+    bar: indicatif::ProgressBar,
+}
+
+impl bench::BenchProgress for Progress {
+    fn start(&mut self, groups: usize) {
+        self.bar.set_length(groups as u64);
+    }
+
+    fn building(&mut self, mesh: &str) {
+        self.bar
+            .set_message(format!("{mesh}: building the techniques"));
+    }
+
+    fn measuring(&mut self, mesh: &str, segments: u32) {
+        self.bar
+            .set_message(format!("{mesh}, {segments} segments per edge"));
+    }
+
+    fn row(&mut self, r: &bench::BenchRow) {
+        self.bar.suspend(|| {
+            eprintln!(
+                "  {}, {} segments, {}: {} triangles, GPU median {:.3} ms{}{}",
+                r.mesh,
+                r.segments,
+                r.method,
+                r.triangles,
+                r.gpu_median_ms,
+                r.cpu_median_ms
+                    .map(|c| format!(", CPU median {c:.3} ms"))
+                    .unwrap_or_default(),
+                r.ratio_to_flat
+                    .map(|x| format!(", {x:.2}× Flat"))
+                    .unwrap_or_default()
+            )
+        });
+    }
+
+    fn group_done(&mut self) {
+        self.bar.inc(1);
+    }
 }
 
 fn config(a: &BenchArgs) -> Result<BenchConfig> {
@@ -121,22 +169,12 @@ pub fn run(a: BenchArgs) -> Result<()> {
         config.frames,
         config.warmup
     );
-    let report = bench::run_bench(&device, &meshes, &config, &mut |r| {
-        eprintln!(
-            "  {} S={} {}: {} triangles, GPU median {:.3} ms{}{}",
-            r.mesh,
-            r.segments,
-            r.method,
-            r.triangles,
-            r.gpu_median_ms,
-            r.cpu_median_ms
-                .map(|c| format!(", CPU median {c:.3} ms"))
-                .unwrap_or_default(),
-            r.ratio_to_flat
-                .map(|x| format!(", {x:.2}× Flat"))
-                .unwrap_or_default()
-        );
-    })?;
+    let mut progress = Progress {
+        bar: crate::progress::bar(0),
+    };
+    let report = bench::run_bench_with_progress(&device, &meshes, &config, &mut progress);
+    progress.bar.finish_and_clear();
+    let report = report?;
     drop(device);
     check_validation(&instance)?;
     out!("{}", report.to_text());

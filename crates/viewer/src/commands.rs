@@ -89,7 +89,10 @@ pub fn build_technique(
     mesh: &topology::ControlMesh,
     setup: &Setup,
 ) -> Result<Box<dyn Technique>> {
-    let built = tess::build(ctx, setup.technique, mesh, &setup.build)?;
+    let built = crate::progress::during(
+        format!("building {} for {}", setup.technique, setup.build.name),
+        || tess::build(ctx, setup.technique, mesh, &setup.build),
+    )?;
     for n in &built.notes {
         eprintln!("{n}");
     }

@@ -74,7 +74,9 @@ pub fn run(a: ExportArgs) -> Result<()> {
             .context("tessera export captures through VK_EXT_transform_feedback")?;
         let technique = build_technique(&mut ctx, &base, &setup)?;
         let params = setup.world_params(technique.bbox());
-        let (soup, stats) = capturer.capture(&mut ctx, technique.as_ref(), &params, extent)?;
+        let (soup, stats) = crate::progress::during("capturing the tessellated triangles", || {
+            capturer.capture(&mut ctx, technique.as_ref(), &params, extent)
+        })?;
         let summary = format!(
             "{}; {} draws over {} patches, {} pass(es)",
             describe(setup.technique, &params),
@@ -83,9 +85,15 @@ pub fn run(a: ExportArgs) -> Result<()> {
             stats.passes
         );
         let map = |patch: u32, domain: [f32; 2]| technique.face_point(patch, domain);
-        let welded = soup.weld()?;
-        let edges = welded.open_edges();
-        let classes = classify_open_edges(&soup, &welded, &edges, &map, &base);
+        let (welded, edges, classes) = crate::progress::during(
+            format!("welding {} triangles", soup.triangle_count()),
+            || -> Result<_> {
+                let welded = soup.weld()?;
+                let edges = welded.open_edges();
+                let classes = classify_open_edges(&soup, &welded, &edges, &map, &base);
+                Ok((welded, edges, classes))
+            },
+        )?;
         let r = ExportReport {
             triangles: soup.triangle_count(),
             corners: soup.records.len(),

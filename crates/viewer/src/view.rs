@@ -125,7 +125,10 @@ impl App {
         if !gpu.surfaces.contains_key(&setup.technique) {
             let mut build = setup.build.clone();
             build.tangents = techniques::info(setup.technique).features.geometric_normals;
-            let built = tess::build(&mut gpu.context, setup.technique, mesh, &build)?;
+            let built = crate::progress::during(
+                format!("building {} for {}", setup.technique, build.name),
+                || tess::build(&mut gpu.context, setup.technique, mesh, &build),
+            )?;
             for n in &built.notes {
                 eprintln!("{n}");
             }
