@@ -1,7 +1,7 @@
 //! `tessera bench`: Table I of Holländer & Boubekeur on this machine. The measuring lives in
 //! `tess::bench` (so GPU tests can drive it); this is the command line around it: the mesh
 //! set, the options, the console table and the CSV / Markdown files.
-use crate::cli::BenchArgs;
+use crate::cli::{BenchArgs, PlotArgs};
 use crate::commands::{check_validation, open_device};
 use anyhow::{bail, Context, Result};
 use tess::bench::{self, BenchConfig, BenchMesh};
@@ -139,7 +139,22 @@ fn write(path: &std::path::Path, text: &str) -> Result<()> {
     std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
 }
 
+/// `tessera plot`: a saved run's CSV as a picture.
+pub fn plot(a: PlotArgs) -> Result<()> {
+    crate::plot::format_of(&a.output)?;
+    let text =
+        std::fs::read_to_string(&a.csv).with_context(|| format!("reading {}", a.csv.display()))?;
+    let rows = bench::parse_csv(&text).with_context(|| a.csv.display().to_string())?;
+    crate::plot::write(&a.output, &rows)?;
+    out!("wrote {} ({} rows)", a.output.display(), rows.len());
+    Ok(())
+}
+
 pub fn run(a: BenchArgs) -> Result<()> {
+    if let Some(p) = &a.plot {
+        // Before minutes of measuring, not after.
+        crate::plot::format_of(p)?;
+    }
     let config = config(&a)?;
     let meshes = load_meshes(&a.mesh)?;
     if bench::build_profile() != "release" {
@@ -184,6 +199,12 @@ pub fn run(a: BenchArgs) -> Result<()> {
     }
     if let Some(p) = &a.markdown {
         write(p, &report.to_markdown())?;
+        out!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.plot {
+        crate::progress::during(format!("plotting {}", p.display()), || {
+            crate::plot::write(p, &report.rows)
+        })?;
         out!("wrote {}", p.display());
     }
     Ok(())

@@ -37,6 +37,18 @@ pub enum Command {
     /// Measure output triangles and GPU frame times per mesh, segments per edge and technique
     /// (Table I of Holländer & Boubekeur), offscreen.
     Bench(BenchArgs),
+    /// Plot a run saved by `bench --csv` (SVG or PNG by the file name), as `bench --plot` does.
+    Plot(PlotArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct PlotArgs {
+    /// CSV written by `tessera bench --csv`.
+    pub csv: PathBuf,
+    /// Output .svg or .png: frame time and ratio to Flat per segments and technique, one row of
+    /// charts per mesh.
+    #[arg(short, long)]
+    pub output: PathBuf,
 }
 
 #[derive(Args, Debug)]
@@ -124,6 +136,10 @@ pub struct BenchArgs {
     /// Write a Markdown report (device, date, build profile, table).
     #[arg(long)]
     pub markdown: Option<PathBuf>,
+    /// Plot the rows, .svg or .png: frame time and ratio to Flat per segments and technique, one
+    /// row of charts per mesh.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
     #[command(flatten)]
     pub gpu: GpuArgs,
 }

@@ -20,6 +20,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Limit(a) => crate::topo_cmds::limit(a),
         Command::Export(a) => crate::export::run(a),
         Command::Bench(a) => crate::bench::run(a),
+        Command::Plot(a) => crate::bench::plot(a),
     }
 }
 
