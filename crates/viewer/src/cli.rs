@@ -23,7 +23,8 @@ pub struct Cli {
 pub enum Command {
     /// Render a mesh (the embedded spot control mesh by default) to a PNG.
     Render(RenderArgs),
-    /// Open a window: drag to orbit, wheel to zoom, 1/2/3 method, +/- segments, W wireframe.
+    /// Open a window: drag to orbit, wheel to zoom, 1/2/3 method, +/- segments, W wireframe, P
+    /// screenshot; drop an OBJ on it to open it.
     View(ViewArgs),
     /// List Vulkan devices, their tessellation features and limits, and which would be chosen.
     Info(GpuArgs),
