@@ -22,7 +22,7 @@ log="$(mktemp -d)/soak"
 start=$(date +%s.%N)
 status=0
 xvfb-run -a "$bin" view ${SOAK_VALIDATION:---validation} --method bft --animate \
-    --level "${SOAK_LEVEL:-8}" --size "${SOAK_SIZE:-640x480}" --frames "$frames" --stats "$@" >"$log.out" 2>"$log.err" || status=$?
+    --segments "${SOAK_LEVEL:-8}" --size "${SOAK_SIZE:-640x480}" --frames "$frames" --stats "$@" >"$log.out" 2>"$log.err" || status=$?
 end=$(date +%s.%N)
 cat "$log.out"
 errors=$(grep -c -E 'VUID|SYNC-|Validation Error' "$log.err" || true)

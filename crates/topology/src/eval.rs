@@ -96,7 +96,7 @@ pub enum EvalError {
     FaceOutOfRange { face: usize, count: usize },
     #[error("parameter ({u}, {v}) outside the face domain")]
     ParamOutOfRange { u: f64, v: f64 },
-    #[error("face {face} has {size} corners; {scheme:?} evaluation needs {need}")]
+    #[error("face {face} has {size} corners; {} evaluation needs {need}", scheme.scheme())]
     FaceSize {
         face: usize,
         size: usize,
@@ -109,7 +109,7 @@ pub enum EvalError {
         sub: usize,
         size: usize,
     },
-    #[error("sub-faces are a Catmull-Clark parameterisation; {scheme:?} has none")]
+    #[error("sub-faces are a Catmull-Clark parameterisation; {} has none", scheme.scheme())]
     SubfaceNeedsCatmullClark { scheme: LimitScheme },
     #[error("{scheme} has no limit evaluation here (use loop or catmull-clark)")]
     NoLimitEvaluation { scheme: Scheme },
@@ -1125,7 +1125,7 @@ pub struct LimitPoint {
 impl fmt::Display for LimitPoint {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let v3 = |a: &[f64; 3]| format!("{:.12} {:.12} {:.12}", a[0], a[1], a[2]);
-        write!(f, "scheme {:?} face {}", self.scheme, self.face)?;
+        write!(f, "scheme {} face {}", self.scheme.scheme(), self.face)?;
         if let Some(s) = self.subface {
             write!(f, " subface {s}")?;
         }

@@ -1,7 +1,7 @@
 //! `tessera bench`: Table I of Holländer & Boubekeur on this machine. The measuring lives in
 //! `tess::bench` (so GPU tests can drive it); this is the command line around it: the mesh
 //! set, the options, the console table and the CSV / Markdown files.
-use crate::cli::BenchArgs;
+use crate::cli::{BenchArgs, PlotArgs};
 use crate::commands::{check_validation, open_device};
 use anyhow::{bail, Context, Result};
 use tess::bench::{self, BenchConfig, BenchMesh};
@@ -32,7 +32,10 @@ fn load_meshes(paths: &[std::path::PathBuf]) -> Result<Vec<BenchMesh>> {
     if paths.is_empty() {
         for (name, text) in DEFAULT_MESHES {
             let mesh = topology::parse_obj(text, &format!("{name}.obj (embedded)"))?;
-            out.push(BenchMesh::new(name, &mesh).with_context(|| format!("preparing {name}"))?);
+            let prepared = crate::progress::during(format!("preparing {name}"), || {
+                BenchMesh::new(name, &mesh)
+            });
+            out.push(prepared.with_context(|| format!("preparing {name}"))?);
         }
     } else {
         for p in paths {
@@ -41,13 +44,58 @@ fn load_meshes(paths: &[std::path::PathBuf]) -> Result<Vec<BenchMesh>> {
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_else(|| p.display().to_string());
-            out.push(
+            let prepared = crate::progress::during(format!("preparing {name}"), || {
                 BenchMesh::new(&name, &mesh)
-                    .with_context(|| format!("preparing {}", p.display()))?,
-            );
+            });
+            out.push(prepared.with_context(|| format!("preparing {}", p.display()))?);
         }
     }
     Ok(out)
+}
+
+/// The run on the terminal: a bar over the groups (mesh × S), and each row as a line (also
+/// without a terminal, as before the bar).
+struct Progress {
+    bar: indicatif::ProgressBar,
+}
+
+impl bench::BenchProgress for Progress {
+    fn start(&mut self, groups: usize) {
+        self.bar.set_length(groups as u64);
+    }
+
+    fn building(&mut self, mesh: &str) {
+        self.bar
+            .set_message(format!("{mesh}: building the techniques"));
+    }
+
+    fn measuring(&mut self, mesh: &str, segments: u32) {
+        self.bar
+            .set_message(format!("{mesh}, {segments} segments per edge"));
+    }
+
+    fn row(&mut self, r: &bench::BenchRow) {
+        self.bar.suspend(|| {
+            eprintln!(
+                "  {}, {} segments, {}: {} triangles, GPU median {:.3} ms{}{}",
+                r.mesh,
+                r.segments,
+                r.method,
+                r.triangles,
+                r.gpu_median_ms,
+                r.cpu_median_ms
+                    .map(|c| format!(", CPU median {c:.3} ms"))
+                    .unwrap_or_default(),
+                r.ratio_to_flat
+                    .map(|x| format!(", {x:.2}× Flat"))
+                    .unwrap_or_default()
+            )
+        });
+    }
+
+    fn group_done(&mut self) {
+        self.bar.inc(1);
+    }
 }
 
 fn config(a: &BenchArgs) -> Result<BenchConfig> {
@@ -91,7 +139,22 @@ fn write(path: &std::path::Path, text: &str) -> Result<()> {
     std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
 }
 
+/// `tessera plot`: a saved run's CSV as a picture.
+pub fn plot(a: PlotArgs) -> Result<()> {
+    crate::plot::format_of(&a.output)?;
+    let text =
+        std::fs::read_to_string(&a.csv).with_context(|| format!("reading {}", a.csv.display()))?;
+    let rows = bench::parse_csv(&text).with_context(|| a.csv.display().to_string())?;
+    crate::plot::write(&a.output, &rows)?;
+    out!("wrote {} ({} rows)", a.output.display(), rows.len());
+    Ok(())
+}
+
 pub fn run(a: BenchArgs) -> Result<()> {
+    if let Some(p) = &a.plot {
+        // Before minutes of measuring, not after.
+        crate::plot::format_of(p)?;
+    }
     let config = config(&a)?;
     let meshes = load_meshes(&a.mesh)?;
     if bench::build_profile() != "release" {
@@ -112,30 +175,21 @@ pub fn run(a: BenchArgs) -> Result<()> {
             eprintln!("note: {n}");
         }
     }
+    let segments: Vec<String> = config.segments.iter().map(u32::to_string).collect();
     eprintln!(
-        "measuring {} meshes × S {:?} × {:?}: {} timed frames after {} warm-up frames per row",
+        "measuring {} meshes × segments {} × {}: {} timed frames after {} warm-up frames per row",
         meshes.len(),
-        config.segments,
-        config.methods,
+        segments.join(", "),
+        config.methods.join(", "),
         config.frames,
         config.warmup
     );
-    let report = bench::run_bench(&device, &meshes, &config, &mut |r| {
-        eprintln!(
-            "  {} S={} {}: {} triangles, GPU median {:.3} ms{}{}",
-            r.mesh,
-            r.segments,
-            r.method,
-            r.triangles,
-            r.gpu_median_ms,
-            r.cpu_median_ms
-                .map(|c| format!(", CPU median {c:.3} ms"))
-                .unwrap_or_default(),
-            r.ratio_to_flat
-                .map(|x| format!(", {x:.2}× Flat"))
-                .unwrap_or_default()
-        );
-    })?;
+    let mut progress = Progress {
+        bar: crate::progress::bar(0),
+    };
+    let report = bench::run_bench_with_progress(&device, &meshes, &config, &mut progress);
+    progress.bar.finish_and_clear();
+    let report = report?;
     drop(device);
     check_validation(&instance)?;
     out!("{}", report.to_text());
@@ -145,6 +199,12 @@ pub fn run(a: BenchArgs) -> Result<()> {
     }
     if let Some(p) = &a.markdown {
         write(p, &report.to_markdown())?;
+        out!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.plot {
+        crate::progress::during(format!("plotting {}", p.display()), || {
+            crate::plot::write(p, &report.rows)
+        })?;
         out!("wrote {}", p.display());
     }
     Ok(())

@@ -23,7 +23,8 @@ pub struct Cli {
 pub enum Command {
     /// Render a mesh (the embedded spot control mesh by default) to a PNG.
     Render(RenderArgs),
-    /// Open a window: drag to orbit, wheel to zoom, 1/2/3 method, +/- level, W wireframe.
+    /// Open a window: drag to orbit, wheel to zoom, 1/2/3 method, +/- segments, W wireframe, P
+    /// screenshot; drop an OBJ on it to open it.
     View(ViewArgs),
     /// List Vulkan devices, their tessellation features and limits, and which would be chosen.
     Info(GpuArgs),
@@ -37,19 +38,32 @@ pub enum Command {
     /// Measure output triangles and GPU frame times per mesh, segments per edge and technique
     /// (Table I of Holländer & Boubekeur), offscreen.
     Bench(BenchArgs),
+    /// Plot a run saved by `bench --csv` (SVG or PNG by the file name), as `bench --plot` does.
+    Plot(PlotArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct PlotArgs {
+    /// CSV written by `tessera bench --csv`.
+    pub csv: PathBuf,
+    /// Output .svg or .png: frame time and ratio to Flat per segments and technique, one row of
+    /// charts per mesh.
+    #[arg(short, long)]
+    pub output: PathBuf,
 }
 
 #[derive(Args, Debug)]
 pub struct ExportArgs {
-    /// OBJ control mesh.
-    pub input: PathBuf,
+    /// OBJ control mesh; the embedded spot control mesh when absent.
+    pub input: Option<PathBuf>,
     /// flat, phong, pn, bft (Loop limit) or adaptive (Catmull-Clark limit); by default the
     /// limit surface of --scheme (Catmull-Clark unless every face is a triangle).
     #[arg(long, value_parser = crate::technique::parse_technique)]
     pub method: Option<TechniqueId>,
-    /// Segments per base edge (tessellation level of flat, phong and pn: 1 to 64; bft: a power
-    /// of two from 2 to 2^(table level + 1) unless --fractional). Ignored with --adaptive.
-    #[arg(long, default_value_t = 8.0)]
+    /// Segments per base edge, the tessellation level (outer and inner): 1 to 64; bft takes
+    /// powers of two from 2 to 2^(table level + 1) unless --fractional; adaptive: segments per
+    /// patch edge, 1 to 32. Ignored with --adaptive.
+    #[arg(long, alias = "level", default_value_t = 8.0)]
     pub segments: f32,
     #[arg(long, default_value = "equal", value_parser = parse_spacing)]
     pub spacing: Spacing,
@@ -76,8 +90,14 @@ pub struct ExportArgs {
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
-    /// Segments per base edge S (4, 16, 32 are the paper's levels 2, 4, 5).
-    #[arg(long, value_delimiter = ',', default_value = "4,16,32")]
+    /// Segments per base edge S, a comma-separated list (4, 16, 32 are the paper's subdivision
+    /// levels 2, 4, 5).
+    #[arg(
+        long,
+        alias = "level",
+        value_delimiter = ',',
+        default_value = "4,16,32"
+    )]
     pub segments: Vec<u32>,
     /// Techniques: flat, phong, pn, bft (Loop basis-function tables: bft and bft-animated rows),
     /// cpu (CPU Loop subdivision: cpu-static and cpu-animated rows).
@@ -117,13 +137,18 @@ pub struct BenchArgs {
     /// Write a Markdown report (device, date, build profile, table).
     #[arg(long)]
     pub markdown: Option<PathBuf>,
+    /// Plot the rows, .svg or .png: frame time and ratio to Flat per segments and technique, one
+    /// row of charts per mesh.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
     #[command(flatten)]
     pub gpu: GpuArgs,
 }
 
 #[derive(Args, Debug)]
 pub struct SubdivideArgs {
-    pub input: PathBuf,
+    /// OBJ control mesh; the embedded spot control mesh when absent.
+    pub input: Option<PathBuf>,
     #[arg(long, value_parser = crate::topo_cmds::parse_scheme)]
     pub scheme: topology::Scheme,
     #[arg(long)]
@@ -137,7 +162,8 @@ pub struct SubdivideArgs {
 
 #[derive(Args, Debug)]
 pub struct LimitArgs {
-    pub input: PathBuf,
+    /// OBJ control mesh; the embedded spot control mesh when absent.
+    pub input: Option<PathBuf>,
     /// loop or catmull-clark
     #[arg(long)]
     pub scheme: String,
@@ -236,11 +262,11 @@ pub struct SceneArgs {
     /// unless every face is a triangle (then Loop).
     #[arg(long, value_parser = crate::technique::parse_technique)]
     pub method: Option<TechniqueId>,
-    /// Tessellation level: segments per base edge (outer and inner), 1 to 64; bft takes powers
-    /// of two from 2 to 2^(table level + 1) unless --fractional; adaptive: segments per patch
-    /// edge, 1 to 32 (a coarse transition edge gets twice as many).
-    #[arg(long, alias = "segments", default_value_t = 8.0)]
-    pub level: f32,
+    /// Segments per base edge, the tessellation level (outer and inner): 1 to 64; bft takes
+    /// powers of two from 2 to 2^(table level + 1) unless --fractional; adaptive: segments per
+    /// patch edge, 1 to 32 (a coarse transition edge gets twice as many).
+    #[arg(long, alias = "level", default_value_t = 8.0)]
+    pub segments: f32,
     #[arg(long, default_value = "equal", value_parser = parse_spacing)]
     pub spacing: Spacing,
     /// Draw the tessellated wireframe over the shaded surface.

@@ -20,6 +20,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Limit(a) => crate::topo_cmds::limit(a),
         Command::Export(a) => crate::export::run(a),
         Command::Bench(a) => crate::bench::run(a),
+        Command::Plot(a) => crate::bench::plot(a),
     }
 }
 
@@ -76,8 +77,8 @@ pub fn scene_setup(s: &SceneArgs, name: &str, mesh: &topology::ControlMesh) -> R
     };
     let mut setup = s
         .surface
-        .setup(method, s.level, s.spacing, s.animate, params)?;
-    crate::technique::check_segments("--level", &setup)?;
+        .setup(method, s.segments, s.spacing, s.animate, params)?;
+    crate::technique::check_segments(&setup)?;
     setup.build.name = name.to_string();
     Ok(setup)
 }
@@ -89,7 +90,10 @@ pub fn build_technique(
     mesh: &topology::ControlMesh,
     setup: &Setup,
 ) -> Result<Box<dyn Technique>> {
-    let built = tess::build(ctx, setup.technique, mesh, &setup.build)?;
+    let built = crate::progress::during(
+        format!("building {} for {}", setup.technique, setup.build.name),
+        || tess::build(ctx, setup.technique, mesh, &setup.build),
+    )?;
     for n in &built.notes {
         eprintln!("{n}");
     }
@@ -216,7 +220,14 @@ fn info(g: &GpuArgs) -> Result<()> {
         vk::api_version_minor(v),
         vk::api_version_patch(v)
     );
-    out!("validation layer: {:?}", instance.validation());
+    out!(
+        "validation layer: {}",
+        match instance.validation() {
+            Validation::Off => "off",
+            Validation::On => "on",
+            Validation::Synchronization => "on, with synchronization validation",
+        }
+    );
     let adapters = vk_core::device::enumerate_adapters(&instance)?;
     if adapters.is_empty() {
         out!("no Vulkan devices");

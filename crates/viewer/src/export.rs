@@ -54,13 +54,13 @@ pub fn run(a: ExportArgs) -> Result<()> {
         phong_alpha: a.alpha,
         ..FrameParams::default()
     };
-    let base = load_mesh(Some(&a.input))?;
+    let base = load_mesh(a.input.as_deref())?;
     let method = crate::technique::resolve_method(a.method, a.surface.scheme.as_deref(), &base)?;
     let mut setup = a
         .surface
         .setup(method, a.segments, a.spacing, false, params)?;
-    crate::technique::check_segments("--segments", &setup)?;
-    setup.build.name = mesh_name(Some(&a.input));
+    crate::technique::check_segments(&setup)?;
+    setup.build.name = mesh_name(a.input.as_deref());
     let extent = vk::Extent2D {
         width: a.size.0,
         height: a.size.1,
@@ -74,7 +74,9 @@ pub fn run(a: ExportArgs) -> Result<()> {
             .context("tessera export captures through VK_EXT_transform_feedback")?;
         let technique = build_technique(&mut ctx, &base, &setup)?;
         let params = setup.world_params(technique.bbox());
-        let (soup, stats) = capturer.capture(&mut ctx, technique.as_ref(), &params, extent)?;
+        let (soup, stats) = crate::progress::during("capturing the tessellated triangles", || {
+            capturer.capture(&mut ctx, technique.as_ref(), &params, extent)
+        })?;
         let summary = format!(
             "{}; {} draws over {} patches, {} pass(es)",
             describe(setup.technique, &params),
@@ -83,9 +85,15 @@ pub fn run(a: ExportArgs) -> Result<()> {
             stats.passes
         );
         let map = |patch: u32, domain: [f32; 2]| technique.face_point(patch, domain);
-        let welded = soup.weld()?;
-        let edges = welded.open_edges();
-        let classes = classify_open_edges(&soup, &welded, &edges, &map, &base);
+        let (welded, edges, classes) = crate::progress::during(
+            format!("welding {} triangles", soup.triangle_count()),
+            || -> Result<_> {
+                let welded = soup.weld()?;
+                let edges = welded.open_edges();
+                let classes = classify_open_edges(&soup, &welded, &edges, &map, &base);
+                Ok((welded, edges, classes))
+            },
+        )?;
         let r = ExportReport {
             triangles: soup.triangle_count(),
             corners: soup.records.len(),

@@ -14,6 +14,8 @@ mod bench;
 mod cli;
 mod commands;
 mod export;
+mod plot;
+mod progress;
 mod technique;
 mod topo_cmds;
 mod view;

@@ -372,17 +372,17 @@ impl Setup {
 /// level-1 faces at tessellation level 64, i.e. 2^(6+1) per base edge.
 const MAX_SEGMENTS: f32 = 128.0;
 
-/// The uniform segments option as the command names it (`--level` of render and view,
-/// `--segments` of export), checked before any device is opened: a finite number of segments
-/// from 1 to [`MAX_SEGMENTS`]. What depends on the technique (flat, phong and pn up to 64,
-/// BFT's powers of two, adaptive's whole numbers up to half the device's level) is checked by
-/// the technique itself, which names `--segments` (an alias of `--level`).
-pub fn check_segments(option: &str, setup: &Setup) -> Result<()> {
+/// `--segments` (every command's name for the uniform segments per edge; `--level` is a hidden
+/// alias), checked before any device is opened: a finite number of segments from 1 to
+/// [`MAX_SEGMENTS`]. What depends on the technique (flat, phong and pn up to 64, BFT's powers
+/// of two, adaptive's whole numbers up to half the device's level) is checked by the technique
+/// itself, which names `--segments` too.
+pub fn check_segments(setup: &Setup) -> Result<()> {
     if let FactorPolicy::Uniform { segments } = setup.params.factors {
         if !(segments.is_finite() && (1.0..=MAX_SEGMENTS).contains(&segments)) {
             bail!(
-                "{option} {segments}: give a number of segments per edge from 1 to 64 \
-                 (--method bft: up to 2^(--table-level + 1))"
+                "--segments {segments}: give a number of segments per edge (the tessellation \
+                 level) from 1 to 64 (--method bft: up to 2^(--table-level + 1))"
             );
         }
     }

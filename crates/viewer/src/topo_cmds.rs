@@ -42,12 +42,21 @@ fn non_finite(positions: &[[f64; 3]]) -> Option<usize> {
         .map(|i| i + 1)
 }
 
+/// The OBJ at `path` as read (an empty mesh included: refining it is not an error here), or the
+/// embedded spot control mesh.
+fn read_mesh(path: Option<&std::path::Path>) -> Result<ControlMesh> {
+    match path {
+        Some(p) => Ok(topology::load_obj(p)?),
+        None => crate::commands::load_mesh(None),
+    }
+}
+
 pub fn subdivide(a: SubdivideArgs) -> Result<()> {
     if a.level > 6 {
         bail!("--level {} is above 6 (meshes grow 4× per level)", a.level);
     }
-    let name = a.input.display().to_string();
-    let mesh = topology::load_obj(&a.input)?;
+    let name = crate::commands::mesh_name(a.input.as_deref());
+    let mesh = read_mesh(a.input.as_deref())?;
     let r = refine_uniform(&mesh, a.scheme, a.level).map_err(|e| e.in_file(&name, None))?;
     let level = r.level(a.level);
     let positions = if a.limit {
@@ -83,13 +92,12 @@ pub fn limit(a: LimitArgs) -> Result<()> {
         .scheme
         .parse()
         .map_err(|e| anyhow::anyhow!("--scheme {}: {e}", a.scheme))?;
-    let mesh = topology::load_obj(&a.input)?;
-    let p = limit_point(&mesh, scheme, a.face, a.uv.0, a.uv.1)
-        .with_context(|| a.input.display().to_string())?;
+    let name = crate::commands::mesh_name(a.input.as_deref());
+    let mesh = read_mesh(a.input.as_deref())?;
+    let p = limit_point(&mesh, scheme, a.face, a.uv.0, a.uv.1).with_context(|| name.clone())?;
     if non_finite(&[p.position, p.du, p.dv, p.normal]).is_some() {
         bail!(
-            "{}: the limit at face {} ({}, {}) is not finite",
-            a.input.display(),
+            "{name}: the limit at face {} ({}, {}) is not finite",
             a.face,
             a.uv.0,
             a.uv.1

@@ -5,9 +5,15 @@
 //! animation, C the patch colours, F fractional factors, G geometric normals, and for the
 //! feature-adaptive surface I / Shift+I raise / lower the isolation level, E switches the end
 //! caps (Gregory, bilinear), S / Shift+S scale every crease's sharpness up / down (the surface
-//! is re-planned on the CPU; the mesh is not reloaded). Esc quits. The
-//! title shows the frame time. `--frames N --screenshot out.png` renders N frames, saves the
-//! last and exits. Techniques are built on first use and kept. `--stats` prints the GPU memory
+//! is re-planned on the CPU; the mesh is not reloaded). P saves the next frame as
+//! `tessera-screenshot-N.png` in the working directory. An OBJ dropped on the window replaces the
+//! mesh. Esc quits. The title shows what is drawn and the frame time. `--frames N --screenshot
+//! out.png` renders N frames, saves the last and exits.
+//!
+//! What the user does in the window never ends it with an error: a technique that cannot be
+//! built for the mesh (after a key) or a dropped file that cannot be read or built is reported
+//! on stderr and in the title, and the window goes on with what it drew before. Only the first
+//! build, which the command line asked for, fails the command as `render` would. Techniques are built on first use and kept. `--stats` prints the GPU memory
 //! allocated and the live Vulkan objects after [`WARM_UP`] frames, every 1,000 frames and at
 //! exit (each after an idle wait, so objects retired by finished frames are counted as gone):
 //! what a soak run (tools/soak.sh, the window tests) checks stays constant.
@@ -59,6 +65,15 @@ struct App {
     args: ViewArgs,
     mesh: ControlMesh,
     setup: Setup,
+    /// The setup of the last frame drawn, to go back to when a key asks for a surface that
+    /// cannot be built.
+    last_good: Option<Setup>,
+    /// What the user should know of the last action that failed (shown in the title).
+    status: Option<String>,
+    /// P was pressed: the next frame is saved.
+    shot_requested: bool,
+    /// Screenshots saved by P so far (numbers the files).
+    shots: u32,
     /// Wave time shown (advances while animating, kept when paused).
     time: f32,
     /// Whether the base has left the rest pose (every frame slot then gets the current pose).
@@ -119,26 +134,71 @@ impl App {
         Ok(())
     }
 
-    /// The current technique's surface, built on first use (with what every key may need,
-    /// e.g. tangent tables for geometric normals).
+    /// `setup`'s technique built for `mesh` (with what every key may need, e.g. tangent tables
+    /// for geometric normals).
+    fn build_surface(gpu: &mut Gpu, mesh: &ControlMesh, setup: &Setup) -> Result<Surface> {
+        let mut build = setup.build.clone();
+        build.tangents = techniques::info(setup.technique).features.geometric_normals;
+        let built = crate::progress::during(
+            format!("building {} for {}", setup.technique, build.name),
+            || tess::build(&mut gpu.context, setup.technique, mesh, &build),
+        )?;
+        for n in &built.notes {
+            eprintln!("{n}");
+        }
+        let wave = built.technique.base_mesh().map(Wave::new);
+        Ok(Surface {
+            technique: built.technique,
+            wave,
+        })
+    }
+
+    /// The current technique's surface, built on first use.
     fn surface(gpu: &mut Gpu, mesh: &ControlMesh, setup: &Setup) -> Result<()> {
         if !gpu.surfaces.contains_key(&setup.technique) {
-            let mut build = setup.build.clone();
-            build.tangents = techniques::info(setup.technique).features.geometric_normals;
-            let built = tess::build(&mut gpu.context, setup.technique, mesh, &build)?;
-            for n in &built.notes {
-                eprintln!("{n}");
-            }
-            let wave = built.technique.base_mesh().map(Wave::new);
-            gpu.surfaces.insert(
-                setup.technique,
-                Surface {
-                    technique: built.technique,
-                    wave,
-                },
-            );
+            let surface = Self::build_surface(gpu, mesh, setup)?;
+            gpu.surfaces.insert(setup.technique, surface);
         }
         Ok(())
+    }
+
+    /// Reports a failed action (stderr and the title) without ending the window.
+    fn report(&mut self, what: String) {
+        eprintln!("{what}");
+        self.status = Some(what);
+    }
+
+    /// Opens the OBJ dropped on the window: read, built with the current setup and shown in
+    /// place of the mesh; on any error the window keeps the mesh it had.
+    fn open_dropped(&mut self, path: &std::path::Path) {
+        let name = path.display().to_string();
+        let mesh = match load_mesh(Some(path)) {
+            Ok(m) => m,
+            Err(e) => return self.report(format!("cannot open {name}: {}", crate::message(&e))),
+        };
+        let Some(gpu) = self.gpu.as_mut() else {
+            return;
+        };
+        let mut setup = self.setup.clone();
+        setup.build.name = name.clone();
+        match Self::build_surface(gpu, &mesh, &setup) {
+            Ok(surface) => {
+                // Frames in flight keep the old surfaces' buffers alive (vk-core defers
+                // destruction).
+                gpu.surfaces.clear();
+                gpu.surfaces.insert(setup.technique, surface);
+                self.mesh = mesh;
+                self.setup = setup;
+                self.moved = self.setup.moved();
+                self.status = None;
+                eprintln!("opened {name}");
+            }
+            Err(e) => self.report(format!(
+                "cannot draw {name} with {}: {}",
+                setup.technique,
+                crate::message(&e)
+            )),
+        }
     }
 
     fn draw(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
@@ -149,7 +209,22 @@ impl App {
             // Frames in flight keep their buffers alive (vk-core defers destruction).
             gpu.surfaces.remove(&self.setup.technique);
         }
-        Self::surface(gpu, &self.mesh, &self.setup)?;
+        if let Err(e) = Self::surface(gpu, &self.mesh, &self.setup) {
+            // A key asked for it: go back to what was drawn. The first build is the command
+            // line's: it fails the command.
+            let Some(good) = self.last_good.clone() else {
+                return Err(e);
+            };
+            let what = format!(
+                "cannot draw {} that way: {}",
+                self.setup.technique,
+                crate::message(&e)
+            );
+            self.setup = good;
+            self.pending_level = None;
+            self.report(what);
+            return Ok(());
+        }
         if let Some(l) = self.pending_level.take() {
             self.set_level(l, true);
         }
@@ -188,8 +263,11 @@ impl App {
         frame.begin_frame_rendering(params.clear_color);
         context.record_frame(frame.encoder(), technique, slot, &params)?;
         frame.encoder().end_rendering();
-        let shot = frame.present(last && self.args.screenshot.is_some())?;
+        let final_shot = last && self.args.screenshot.is_some();
+        let asked = std::mem::take(&mut self.shot_requested);
+        let shot = frame.present(final_shot || asked)?;
         self.frames_drawn += 1;
+        self.last_good = Some(self.setup.clone());
         let started = *self.started.get_or_insert_with(Instant::now);
         let n = self.frames_drawn;
         if self.args.stats && (n == WARM_UP || n.is_multiple_of(1000) || last) {
@@ -201,28 +279,45 @@ impl App {
         self.last_frame = now;
         if let Some(w) = &self.window {
             w.set_title(&format!(
-                "tessera — {}{}{} — {:.2} ms/frame",
+                "tessera — {}{}{} — {:.2} ms/frame{}",
                 describe(self.setup.technique, &params),
                 if techniques::info(self.setup.technique).features.isolation {
                     let b = &self.setup.build;
                     format!(
-                        ", isolation {}, {:?} end caps, sharpness ×{:.2}",
-                        b.isolation, b.end_cap, b.sharpness_scale
+                        ", isolation {}, {} end caps, sharpness ×{:.2}",
+                        b.isolation,
+                        end_cap_name(b.end_cap),
+                        b.sharpness_scale
                     )
                 } else {
                     String::new()
                 },
                 if self.setup.animate { ", animated" } else { "" },
-                self.frame_ms
+                self.frame_ms,
+                self.status
+                    .as_deref()
+                    .map(|s| format!(" — {s}"))
+                    .unwrap_or_default()
             ));
         }
-        if let (Some(img), Some(path)) = (shot, &self.args.screenshot) {
-            img.save_png(path)?;
-            out!(
-                "wrote {} after {} frames",
-                path.display(),
-                self.frames_drawn
-            );
+        if let Some(img) = shot {
+            if asked {
+                self.shots += 1;
+                let path =
+                    std::path::PathBuf::from(format!("tessera-screenshot-{}.png", self.shots));
+                match img.save_png(&path) {
+                    Ok(()) => out!("wrote {} (P)", path.display()),
+                    Err(e) => self.report(format!("cannot save {}: {e}", path.display())),
+                }
+            }
+            if let (true, Some(path)) = (final_shot, &self.args.screenshot) {
+                img.save_png(path)?;
+                out!(
+                    "wrote {} after {} frames",
+                    path.display(),
+                    self.frames_drawn
+                );
+            }
         }
         if last {
             event_loop.exit();
@@ -294,6 +389,7 @@ impl App {
                 "+" | "=" => self.set_level(level + 1.0, true),
                 "-" => self.set_level(level - 1.0, false),
                 "w" | "W" => p.wireframe = !p.wireframe,
+                "p" | "P" => self.shot_requested = true,
                 "a" | "A" if features.animation => self.setup.animate = !self.setup.animate,
                 "c" | "C" if features.patch_colours => p.patch_colours = !p.patch_colours,
                 "f" | "F" => {
@@ -382,6 +478,7 @@ impl ApplicationHandler for App {
                 }
                 self.key(&event.logical_key);
             }
+            WindowEvent::DroppedFile(path) => self.open_dropped(&path),
             WindowEvent::MouseInput {
                 state,
                 button: MouseButton::Left,
@@ -438,6 +535,10 @@ pub fn run(args: ViewArgs) -> Result<()> {
         setup,
         args,
         mesh,
+        last_good: None,
+        status: None,
+        shot_requested: false,
+        shots: 0,
         pending_level: None,
         rebuild: false,
         gpu: None,
@@ -476,6 +577,14 @@ pub fn run(args: ViewArgs) -> Result<()> {
         return Err(e);
     }
     result
+}
+
+/// `--end-cap`'s spelling of an end cap.
+fn end_cap_name(e: topology::adaptive::EndCap) -> &'static str {
+    match e {
+        topology::adaptive::EndCap::Gregory => "gregory",
+        topology::adaptive::EndCap::Bilinear => "bilinear",
+    }
 }
 
 /// One `--stats` line: `stats: <when>: <bytes> bytes allocated, <n> live Vulkan objects, <s> s`.

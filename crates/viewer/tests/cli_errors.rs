@@ -500,13 +500,17 @@ fn segments_are_checked_before_the_device_and_named_as_given() {
                 &["--segments"],
             );
         }
-        let e = fails(
-            &["render", "--method", method, "--level", "0", "-o", out],
-            &[NO_LOADER],
-            1,
-            &["--level 0"],
-        );
-        assert!(!e.contains("--segments"), "{e}");
+        // One vocabulary (issue 14): render says `--segments` too, also when given the old
+        // spelling `--level`, which stays a hidden alias.
+        for option in ["--segments", "--level"] {
+            let e = fails(
+                &["render", "--method", method, option, "0", "-o", out],
+                &[NO_LOADER],
+                1,
+                &["--segments 0", "from 1 to 64"],
+            );
+            assert!(!e.contains("--level"), "{e}");
+        }
     }
     assert!(!Path::new(out).exists());
 }

@@ -1,7 +1,8 @@
 //! The window (`tessera view`) under Xvfb with the validation layer on, synchronization
 //! validation included: runs that end without a screenshot (frames still in flight at exit),
-//! every technique, and a 1,000-frame animated soak whose GPU memory and live Vulkan objects
-//! must stay constant after warm-up.
+//! every technique, a 1,000-frame animated soak whose GPU memory and live Vulkan objects
+//! must stay constant after warm-up, and a window driven by synthetic key presses (xdotool:
+//! P screenshots, the level and the technique changed by keys, Esc).
 //!
 //! The soak runs in the window rather than through an offscreen `tess::Context` loop because
 //! the window is where frames are not waited for (FIFO presentation, two frames in flight, the
@@ -131,4 +132,112 @@ fn thousand_animated_frames_hold_memory_and_objects_constant() {
         s[2].2 < *live && s[2].2 <= 4,
         "objects left at exit beyond the idle command pools: {out}"
     );
+}
+
+/// Runs `xdotool` with `args` (its XTEST input reaches the focused window, as a keyboard's
+/// would); returns its stdout.
+fn xdotool(display: &str, args: &[&str]) -> String {
+    let o = Command::new("timeout")
+        .arg("30")
+        .arg("xdotool")
+        .args(args)
+        .env("DISPLAY", display)
+        .output()
+        .expect("xdotool runs");
+    assert!(
+        o.status.success(),
+        "xdotool {args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// Waits for `path` to be written whole (the PNG decodes).
+fn wait_for_png(path: &std::path::Path) -> image::RgbaImage {
+    let start = std::time::Instant::now();
+    loop {
+        if let Ok(img) = image::open(path) {
+            return img.to_rgba8();
+        }
+        assert!(
+            start.elapsed().as_secs() < 60,
+            "{} was not written",
+            path.display()
+        );
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+}
+
+/// Pixels whose colour differs between `a` and `b`, and the mean brightness of each.
+fn compare(a: &image::RgbaImage, b: &image::RgbaImage) -> (usize, f64, f64) {
+    let mean = |img: &image::RgbaImage| {
+        img.pixels()
+            .map(|p| f64::from(p.0[0]) + f64::from(p.0[1]) + f64::from(p.0[2]))
+            .sum::<f64>()
+            / (3.0 * img.pixels().len() as f64)
+    };
+    let differing = a.pixels().zip(b.pixels()).filter(|(p, q)| p != q).count();
+    (differing, mean(a), mean(b))
+}
+
+/// Synthetic key presses: P saves the frame; ArrowUp doubles the segments (2 → 4, visible as
+/// more wireframe lines: a darker picture); 3 switches to PN (another surface); Esc ends the
+/// window, validation-clean.
+#[test]
+fn keys_change_level_and_technique_and_p_saves_screenshots() {
+    let _one = SERVER.lock().unwrap_or_else(|e| e.into_inner());
+    if Command::new("xdotool").arg("version").output().is_err() {
+        eprintln!("skipped: xdotool is not installed (tools/setup.sh installs it)");
+        return;
+    }
+    let Some(server) = xvfb::start_or_skip(DISPLAYS) else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("tessera-window-keys-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_tessera"))
+        .args(["view", "--method", "flat", "--segments", "2", "--wireframe"])
+        .args(["--validation", "--sync-validation", "--size", "160x120"])
+        .current_dir(&dir)
+        .env("DISPLAY", &server.display)
+        .env("WAYLAND_DISPLAY", "")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("tessera runs");
+    let d = server.display.clone();
+    let window = xdotool(
+        &d,
+        &["search", "--sync", "--onlyvisible", "--name", "tessera"],
+    );
+    let window = window.lines().next().expect("a window").trim().to_owned();
+    xdotool(&d, &["windowfocus", "--sync", &window]);
+    let shot = |n: u32| wait_for_png(&dir.join(format!("tessera-screenshot-{n}.png")));
+    xdotool(&d, &["key", "p"]);
+    let level2 = shot(1);
+    xdotool(&d, &["key", "Up", "p"]);
+    let level4 = shot(2);
+    xdotool(&d, &["key", "3", "p"]);
+    let pn4 = shot(3);
+    xdotool(&d, &["key", "Escape"]);
+    let o = child.wait_with_output().expect("tessera ends");
+    drop(server);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "view failed: {err}");
+    assert!(!err.contains("VUID") && !err.contains("SYNC-"), "{err}");
+    for n in 1..=3 {
+        assert!(
+            out.contains(&format!("wrote tessera-screenshot-{n}.png (P)")),
+            "{out}"
+        );
+    }
+    assert_eq!(level2.dimensions(), (160, 120));
+    let (changed, before, after) = compare(&level2, &level4);
+    assert!(changed > 300, "ArrowUp changed {changed} pixels");
+    assert!(
+        after < before,
+        "4 segments per edge should draw more wireframe (darker) than 2: {after} vs {before}"
+    );
+    let (changed, _, _) = compare(&level4, &pn4);
+    assert!(changed > 100, "key 3 (PN) changed {changed} pixels");
 }

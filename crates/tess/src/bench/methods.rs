@@ -503,9 +503,13 @@ fn evaluator_limit_positions(
     options: &topology::SubdivOptions,
     scheme: LimitScheme,
 ) -> Result<Vec<[f64; 3]>> {
+    let scheme_name = match scheme {
+        LimitScheme::Loop => "loop",
+        LimitScheme::CatmullClark => "catmull-clark",
+    };
     let local =
         LocalMesh::from_refined_level(current, scheme, options).map_err(|e| TessError::Mesh {
-            name: format!("{scheme:?} level {level}"),
+            name: format!("{scheme_name} level {level}"),
             source: e.into(),
         })?;
     (0..current.num_vertices())
@@ -513,7 +517,7 @@ fn evaluator_limit_positions(
             let p = local
                 .vertex_limit_exact(v as u32)
                 .map_err(|e| TessError::Mesh {
-                    name: format!("{scheme:?} level {level}, vertex {v}"),
+                    name: format!("{scheme_name} level {level}, vertex {v}"),
                     source: e.into(),
                 })?;
             Ok([p[0], p[1], p[2]])
@@ -604,7 +608,7 @@ impl BenchMethod for CpuLoopMethod {
         };
         (v > self.max_vertices).then(|| {
             format!(
-                "{:?} level {level} would have {v} vertices and {f} faces, above the CPU \
+                "{} level {level} would have {v} vertices and {f} faces, above the CPU \
                  baseline's limit of {} vertices (--cpu-max-vertices)",
                 self.scheme, self.max_vertices
             )
@@ -669,7 +673,7 @@ impl BenchMethod for CpuLoopMethod {
         let mut notes = Vec::new();
         if let Some((level, mesh)) = &self.mesh {
             notes.push(format!(
-                "{:?} level {level}: {} vertices, {} KiB of vertices + indices on the GPU",
+                "{} level {level}: {} vertices, {} KiB of vertices + indices on the GPU",
                 self.scheme,
                 mesh.vertex_count,
                 (mesh.vertex_count as u64 * std::mem::size_of::<Vertex>() as u64

@@ -369,15 +369,58 @@ impl Harness<'_> {
     }
 }
 
+/// What a benchmark says while it runs, for a progress display: the run is a sequence of
+/// groups (one mesh at one S, every method's frames interleaved), each mesh first building its
+/// methods (tables, plans: the slow part on large meshes). Only `row` must be written; the
+/// library draws nothing itself.
+pub trait BenchProgress {
+    /// The run starts with `groups` groups to measure.
+    fn start(&mut self, groups: usize) {
+        let _ = groups;
+    }
+    /// `mesh`'s methods are being built.
+    fn building(&mut self, mesh: &str) {
+        let _ = mesh;
+    }
+    /// The group `mesh` at `segments` is being measured.
+    fn measuring(&mut self, mesh: &str, segments: u32) {
+        let _ = (mesh, segments);
+    }
+    /// A measured row, as soon as its group is done.
+    fn row(&mut self, row: &BenchRow);
+    /// The group last announced by `measuring` is done.
+    fn group_done(&mut self) {}
+}
+
+/// A row callback as a [`BenchProgress`].
+struct RowsOnly<'a>(&'a mut dyn FnMut(&BenchRow));
+
+impl BenchProgress for RowsOnly<'_> {
+    fn row(&mut self, row: &BenchRow) {
+        (self.0)(row)
+    }
+}
+
 /// Measures every mesh × S × method of `config` on `device`; `on_row` sees each row as soon as
-/// it is measured (long runs print progress).
+/// it is measured.
 pub fn run_bench(
     device: &Device,
     meshes: &[BenchMesh],
     config: &BenchConfig,
     on_row: &mut dyn FnMut(&BenchRow),
 ) -> Result<BenchReport> {
+    run_bench_with_progress(device, meshes, config, &mut RowsOnly(on_row))
+}
+
+/// [`run_bench`], telling `progress` where it is.
+pub fn run_bench_with_progress(
+    device: &Device,
+    meshes: &[BenchMesh],
+    config: &BenchConfig,
+    progress: &mut dyn BenchProgress,
+) -> Result<BenchReport> {
     validate(config, meshes)?;
+    progress.start(meshes.len() * config.segments.len());
     let harness = Harness {
         device,
         target: OffscreenTarget::new(device, config.extent)?,
@@ -413,8 +456,10 @@ pub fn run_bench(
             color_format: COLOR_FORMAT,
             depth_format: DEPTH_FORMAT,
         };
+        progress.building(&mesh.name);
         let mut methods = build_methods(&config.methods, &ctx)?;
         for &segments in &config.segments {
+            progress.measuring(&mesh.name, segments);
             let mut runnable = Vec::new();
             for method in methods.iter_mut() {
                 match method.skip_reason(segments) {
@@ -434,8 +479,9 @@ pub fn run_bench(
                 .map(|r| r.total_median_ms);
             for row in &mut rows {
                 row.ratio_to_flat = flat_total.map(|f| row.total_median_ms / f);
-                on_row(row);
+                progress.row(row);
             }
+            progress.group_done();
             report.rows.extend(rows);
         }
         for m in &methods {
@@ -461,8 +507,13 @@ fn validate(config: &BenchConfig, meshes: &[BenchMesh]) -> Result<()> {
     }
     if config.segments.is_empty() || config.segments.contains(&0) {
         return bad(format!(
-            "segments per edge must be at least 1 (got {:?})",
-            config.segments
+            "segments per edge must be at least 1 (got {})",
+            config
+                .segments
+                .iter()
+                .map(u32::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
         ));
     }
     if config.frames == 0 {

@@ -137,7 +137,7 @@ impl<S: FaceStyle> Technique for FacePatches<S> {
         match params.factors {
             FactorPolicy::Uniform { segments } if (1.0..=MAX_LEVEL).contains(&segments) => Ok(()),
             FactorPolicy::Uniform { segments } => Err(TessError::OutOfRange {
-                option: "--level/--segments",
+                option: "--segments",
                 value: segments.to_string(),
                 range: "1..64",
             }),
