@@ -374,9 +374,10 @@ const MAX_SEGMENTS: f32 = 128.0;
 
 /// `--segments` (every command's name for the uniform segments per edge; `--level` is a hidden
 /// alias), checked before any device is opened: a finite number of segments from 1 to
-/// [`MAX_SEGMENTS`]. What depends on the technique (flat, phong and pn up to 64, BFT's powers
-/// of two, adaptive's whole numbers up to half the device's level) is checked by the technique
-/// itself, which names `--segments` too.
+/// [`MAX_SEGMENTS`], then what the technique refuses without a device or a mesh (BFT's powers
+/// of two up to its table level, adaptive's whole numbers, spacings). What needs the device
+/// (flat, phong and pn up to its level, adaptive up to half of it) is checked by the built
+/// technique, which names `--segments` too.
 pub fn check_segments(setup: &Setup) -> Result<()> {
     if let FactorPolicy::Uniform { segments } = setup.params.factors {
         if !(segments.is_finite() && (1.0..=MAX_SEGMENTS).contains(&segments)) {
@@ -386,6 +387,7 @@ pub fn check_segments(setup: &Setup) -> Result<()> {
             );
         }
     }
+    tess::techniques::check_options(setup.technique, &setup.build, &setup.params)?;
     Ok(())
 }
 

@@ -515,6 +515,44 @@ fn segments_are_checked_before_the_device_and_named_as_given() {
     assert!(!Path::new(out).exists());
 }
 
+/// Technique rules that need no device or mesh (BFT's dyadic segments up to its table level,
+/// adaptive's whole segments, spacings a technique refuses) are checked before the device too:
+/// a bad option on a large mesh must not cost the table build first.
+#[test]
+fn technique_rules_are_checked_before_the_device() {
+    let out = tmp("never_rule.png");
+    let out = out.to_str().unwrap();
+    let cases: [(&[&str], &[&str]); 5] = [
+        (
+            &["--method", "bft", "--segments", "3"],
+            &["--segments 3", "power of two"],
+        ),
+        (
+            &["--method", "bft", "--table-level", "2", "--segments", "16"],
+            &["--segments 16", "2..=8"],
+        ),
+        (
+            &["--method", "adaptive", "--segments", "2.5"],
+            &["--segments", "whole segments"],
+        ),
+        (
+            &["--method", "bft", "--spacing", "fractional-odd"],
+            &["fractional-odd"],
+        ),
+        (
+            &["--method", "adaptive", "--spacing", "fractional-odd"],
+            &["fractional-odd"],
+        ),
+    ];
+    for (options, expected) in cases {
+        let mut args = vec!["render", "-o", out];
+        args.extend_from_slice(options);
+        let e = fails(&args, &[NO_LOADER], 1, expected);
+        assert!(!e.contains("loader"), "{options:?}: {e}");
+    }
+    assert!(!Path::new(out).exists());
+}
+
 #[test]
 fn device_selectors_are_named_as_given_and_info_fails_on_a_missing_one() {
     let out = tmp("never_dev.png");

@@ -170,6 +170,22 @@ pub struct Built {
     pub notes: Vec<String>,
 }
 
+/// Checks `params` against what technique `id` refuses before any device or mesh exists
+/// (spacings, BFT's dyadic segments, adaptive's whole segments), so a bad option is reported
+/// before the device is opened and the surface built. [`Technique::check`] repeats these checks
+/// with what only the built surface and device know (tangent tables, the device's level).
+pub fn check_options(
+    id: TechniqueId,
+    build: &BuildOptions,
+    params: &crate::technique::FrameParams,
+) -> Result<()> {
+    match id {
+        TechniqueId::Bft => bft::check_frame(build.table_level, params),
+        TechniqueId::Adaptive => adaptive::check_frame(None, params),
+        TechniqueId::Flat | TechniqueId::Phong | TechniqueId::Pn => Ok(()),
+    }
+}
+
 /// Builds technique `id` for `mesh` on `ctx`'s device, with one frame slot per slot of `ctx`.
 pub fn build(
     ctx: &mut Context,

@@ -466,6 +466,30 @@ impl Adaptive {
     }
 }
 
+/// What adaptive refuses in `params`: uniform factors are whole segments per patch edge, at most
+/// half the device's maximum `factor_limit` (a coarse transition edge doubles them) when it is
+/// known; spacing equal or fractional even. Without a device ([`crate::techniques::check_options`])
+/// only the bound waits for [`Technique::check`].
+pub fn check_frame(factor_limit: Option<f32>, params: &FrameParams) -> Result<()> {
+    if params.spacing == Spacing::FractionalOdd {
+        return Err(TessError::Unsupported {
+            technique: TechniqueId::Adaptive,
+            what: "--spacing fractional-odd (transition edges need even levels: use --fractional, i.e. fractional-even)",
+        });
+    }
+    let half = factor_limit.map_or(f32::INFINITY, |l| (l * 0.5).floor());
+    if let FactorPolicy::Uniform { segments } = params.factors {
+        if segments.fract() != 0.0 || segments < 1.0 || segments > half {
+            return Err(TessError::OutOfRange {
+                option: "--segments",
+                value: segments.to_string(),
+                range: "whole segments per patch edge, 1 up to half the device's maximum tessellation level (transition edges double it)",
+            });
+        }
+    }
+    check_adaptive_policy(params)
+}
+
 impl Technique for Adaptive {
     fn id(&self) -> TechniqueId {
         TechniqueId::Adaptive
@@ -479,26 +503,9 @@ impl Technique for Adaptive {
         &self.arrays
     }
 
-    /// Uniform factors are whole segments per patch edge, at most half the device's maximum
-    /// (a coarse transition edge doubles them); spacing equal or fractional even.
+    /// [`check_frame`] with the device's maximum level.
     fn check(&self, params: &FrameParams) -> Result<()> {
-        if params.spacing == Spacing::FractionalOdd {
-            return Err(TessError::Unsupported {
-                technique: TechniqueId::Adaptive,
-                what: "--spacing fractional-odd (transition edges need even levels: use --fractional, i.e. fractional-even)",
-            });
-        }
-        let half = (self.factor_limit() * 0.5).floor();
-        if let FactorPolicy::Uniform { segments } = params.factors {
-            if segments.fract() != 0.0 || segments < 1.0 || segments > half {
-                return Err(TessError::OutOfRange {
-                    option: "--segments",
-                    value: segments.to_string(),
-                    range: "whole segments per patch edge, 1 up to half the device's maximum tessellation level (transition edges double it)",
-                });
-            }
-        }
-        check_adaptive_policy(params)
+        check_frame(Some(self.factor_limit()), params)
     }
 
     fn patch_pipeline(&self, patch: PatchType) -> PatchPipeline {

@@ -570,6 +570,34 @@ impl Bft {
     }
 }
 
+/// What BFT refuses in `params` with tables of level `table_level`, known before any device or
+/// mesh exists (so callers check it first, [`crate::techniques::check_options`]): uniform `S`
+/// must be a power of two in `2..=2^(L+1)` unless fractional; spacing equal or fractional even
+/// (the linear geomorph between dyadic levels).
+pub fn check_frame(table_level: u32, params: &FrameParams) -> Result<()> {
+    if params.spacing == Spacing::FractionalOdd {
+        return Err(TessError::Unsupported {
+            technique: TechniqueId::Bft,
+            what: "--spacing fractional-odd (it morphs between dyadic levels: use --fractional, i.e. fractional-even)",
+        });
+    }
+    let fractional = params.spacing == Spacing::FractionalEven;
+    // The tables hold 2^L segments per level-1 edge, half a base edge.
+    let max = 1u32.checked_shl(table_level + 1).unwrap_or(u32::MAX);
+    if let FactorPolicy::Uniform { segments } = params.factors {
+        let whole = segments.fract() == 0.0 && segments >= 1.0;
+        let s = segments as u32;
+        if !whole || s < 2 || s > max || (!fractional && !s.is_power_of_two()) {
+            return Err(TessError::BftSegments {
+                segments,
+                max,
+                table_level,
+            });
+        }
+    }
+    check_adaptive_policy(params)
+}
+
 impl Technique for Bft {
     fn id(&self) -> TechniqueId {
         TechniqueId::Bft
@@ -583,33 +611,13 @@ impl Technique for Bft {
         &self.arrays
     }
 
-    /// Uniform `S` must be a power of two in `2..=2^(L+1)` unless fractional; spacing equal or
-    /// fractional even (the linear geomorph between dyadic levels); geometric normals need
-    /// tangent tables (without them their offsets are `u32::MAX`: the TES must never read them).
+    /// Geometric normals need tangent tables (without them their offsets are `u32::MAX`: the
+    /// TES must never read them); the rest is [`check_frame`].
     fn check(&self, params: &FrameParams) -> Result<()> {
         if params.geometric_normals && !self.bft.tables.tangents {
             return Err(TessError::NeedsTangentTables);
         }
-        if params.spacing == Spacing::FractionalOdd {
-            return Err(TessError::Unsupported {
-                technique: TechniqueId::Bft,
-                what: "--spacing fractional-odd (it morphs between dyadic levels: use --fractional, i.e. fractional-even)",
-            });
-        }
-        let fractional = params.spacing == Spacing::FractionalEven;
-        let max = 2 * self.max_level();
-        if let FactorPolicy::Uniform { segments } = params.factors {
-            let whole = segments.fract() == 0.0 && segments >= 1.0;
-            let s = segments as u32;
-            if !whole || s < 2 || s > max || (!fractional && !s.is_power_of_two()) {
-                return Err(TessError::BftSegments {
-                    segments,
-                    max,
-                    table_level: self.gpu.table.level,
-                });
-            }
-        }
-        check_adaptive_policy(params)
+        check_frame(self.gpu.table.level, params)
     }
 
     fn patch_pipeline(&self, _patch: PatchType) -> PatchPipeline {
