@@ -1125,7 +1125,8 @@ pub struct LimitPoint {
 impl fmt::Display for LimitPoint {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let v3 = |a: &[f64; 3]| format!("{:.12} {:.12} {:.12}", a[0], a[1], a[2]);
-        write!(f, "scheme {} face {}", self.scheme.scheme(), self.face)?;
+        // 1-based, as the OBJ's `f` lines and every message count faces.
+        write!(f, "scheme {} face {}", self.scheme.scheme(), self.face + 1)?;
         if let Some(s) = self.subface {
             write!(f, " subface {s}")?;
         }

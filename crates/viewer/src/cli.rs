@@ -167,6 +167,7 @@ pub struct LimitArgs {
     /// loop or catmull-clark
     #[arg(long)]
     pub scheme: String,
+    /// Face number, 1-based as in the OBJ (the N-th `f` line), like every message.
     #[arg(long)]
     pub face: usize,
     /// Domain coordinate U,V.

@@ -4,7 +4,7 @@
 //! numbers ([`topology::TopologyError::in_file`]); nothing non-finite is written or printed.
 use crate::cli::{LimitArgs, SubdivideArgs};
 use anyhow::{bail, Context, Result};
-use topology::eval::{limit_point, LimitScheme, LocalMesh};
+use topology::eval::{limit_point, EvalError, LimitScheme, LocalMesh};
 use topology::{refine_uniform, ControlMesh, Level, Scheme};
 
 /// Clap's value parser for `--scheme`: topology's one scheme parser.
@@ -87,6 +87,24 @@ pub fn subdivide(a: SubdivideArgs) -> Result<()> {
     Ok(())
 }
 
+/// An evaluation error about a mesh read from `name`, in the OBJ's 1-based face numbers.
+fn eval_in_file(e: EvalError, name: &str) -> anyhow::Error {
+    match e {
+        EvalError::Topology(t) => t.in_file(name, None).into(),
+        EvalError::FaceSize {
+            face,
+            size,
+            scheme,
+            need,
+        } => anyhow::anyhow!(
+            "{name}: face {} has {size} corners; {} evaluation needs {need}",
+            face + 1,
+            scheme.scheme()
+        ),
+        other => anyhow::Error::new(other).context(name.to_string()),
+    }
+}
+
 pub fn limit(a: LimitArgs) -> Result<()> {
     let scheme: LimitScheme = a
         .scheme
@@ -94,7 +112,15 @@ pub fn limit(a: LimitArgs) -> Result<()> {
         .map_err(|e| anyhow::anyhow!("--scheme {}: {e}", a.scheme))?;
     let name = crate::commands::mesh_name(a.input.as_deref());
     let mesh = read_mesh(a.input.as_deref())?;
-    let p = limit_point(&mesh, scheme, a.face, a.uv.0, a.uv.1).with_context(|| name.clone())?;
+    let faces = mesh.num_faces();
+    if a.face == 0 || a.face > faces {
+        bail!(
+            "--face {}: {name} has faces 1 to {faces} (numbered as its `f` lines, from 1)",
+            a.face
+        );
+    }
+    let p = limit_point(&mesh, scheme, a.face - 1, a.uv.0, a.uv.1)
+        .map_err(|e| eval_in_file(e, &name))?;
     if non_finite(&[p.position, p.du, p.dv, p.normal]).is_some() {
         bail!(
             "{name}: the limit at face {} ({}, {}) is not finite",

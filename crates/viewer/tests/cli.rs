@@ -223,7 +223,8 @@ fn data(p: &str) -> String {
 }
 
 /// Base vertices keep their index under refinement, so `subdivide --limit` must put vertex v of
-/// face 0 where `limit` evaluates face 0 at that corner: two independent code paths agree.
+/// face 0 where `limit --face 1` (the first `f` line) evaluates it at that corner: two
+/// independent code paths agree.
 #[test]
 fn subdivide_limit_agrees_with_limit_evaluation() {
     for (shape, scheme, corner_uv) in [
@@ -279,7 +280,7 @@ fn subdivide_limit_agrees_with_limit_evaluation() {
                     "--scheme",
                     scheme,
                     "--face",
-                    "0",
+                    "1",
                     "--uv",
                     &format!("{u},{v}"),
                 ],

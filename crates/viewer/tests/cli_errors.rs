@@ -124,7 +124,7 @@ fn coordinates_beyond_the_f32_safe_range_are_refused_with_line_and_vertex() {
             out,
         ],
         vec![
-            "limit", &p, "--scheme", "loop", "--face", "0", "--uv", "0.2,0.2",
+            "limit", &p, "--scheme", "loop", "--face", "1", "--uv", "0.2,0.2",
         ],
     ] {
         fails(
@@ -302,7 +302,7 @@ fn subdivide_and_limit_at_the_bound_are_finite() {
         assert!(!numbers.is_empty() && numbers.iter().all(|x| x.is_finite()));
     }
     let o = succeeds(&[
-        "limit", &input, "--scheme", "loop", "--face", "3", "--uv", "0.25,0.5",
+        "limit", &input, "--scheme", "loop", "--face", "4", "--uv", "0.25,0.5",
     ]);
     let s = stdout(&o);
     let values: Vec<f64> = s
@@ -668,11 +668,58 @@ fn every_command_path_runs_with_validation_on() {
         "--scheme",
         "catmull-clark",
         "--face",
-        "0",
+        "1",
         "--uv",
         "0.5,0.5",
     ]);
     assert!(stdout(&o).contains("normal"), "{}", stdout(&o));
+}
+
+/// `limit --face` counts like the OBJ's `f` lines and every message: from 1; 0 and numbers past
+/// the last face are named, and evaluation errors speak of the same face.
+#[test]
+fn limit_faces_are_numbered_from_one() {
+    let cube = data("tests/data/meshes/cube.obj");
+    for face in ["0", "7"] {
+        fails(
+            &[
+                "limit",
+                &cube,
+                "--scheme",
+                "catmull-clark",
+                "--face",
+                face,
+                "--uv",
+                "0.5,0.5",
+            ],
+            &[],
+            1,
+            &[&format!("--face {face}"), "faces 1 to 6"],
+        );
+    }
+    let o = succeeds(&[
+        "limit",
+        &cube,
+        "--scheme",
+        "catmull-clark",
+        "--face",
+        "6",
+        "--uv",
+        "0.5,0.5",
+    ]);
+    assert!(stdout(&o).contains("face 6 uv"), "{}", stdout(&o));
+    let quads = write(
+        "two_quads.obj",
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nf 1 2 3 4\nf 2 5 6 3\n",
+    );
+    fails(
+        &[
+            "limit", &quads, "--scheme", "loop", "--face", "2", "--uv", "0.2,0.2",
+        ],
+        &[],
+        1,
+        &["two_quads.obj", "face 1 has 4 vertices"],
+    );
 }
 
 /// `tessera info | head -0`: stdout closed before anything is written. `println!` panicked

@@ -160,7 +160,7 @@ fn commands_default_to_the_embedded_mesh_and_report_in_prose() {
         "--scheme",
         "catmull-clark",
         "--face",
-        "0",
+        "1",
         "--uv",
         "0.5,0.5",
     ]);
