@@ -114,6 +114,12 @@ pub enum TopologyError {
         face: usize,
         problem: crate::gregory::GregoryProblem,
     },
+    /// An ACC-1 patch cannot be built on this face ([`crate::acc::acc1_patch`]).
+    #[error("ACC-1 patch of face {face}: {problem}")]
+    AccPatch {
+        face: usize,
+        problem: crate::acc::AccProblem,
+    },
     /// An adaptive isolation level outside `1..=8`.
     #[error("isolation level {isolation} is outside 1..=8")]
     IsolationOutOfRange { isolation: u32 },

@@ -1,6 +1,7 @@
 //! CPU truth for every GPU technique: control meshes, subdivision, stencils, limit evaluation.
 #![forbid(unsafe_code)]
 
+pub mod acc;
 pub mod adaptive;
 pub mod bft;
 pub mod error;

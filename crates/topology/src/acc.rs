@@ -1,0 +1,177 @@
+//! ACC-1 geometry patches (Loop & Schaefer 2008, "Approximating Catmull-Clark subdivision
+//! surfaces with bicubic patches"; seed 002 §2.2): one bicubic Bézier patch per quad, its 16
+//! points built from the face's neighbourhood by three fixed masks, no refinement.
+//!
+//! Design decisions:
+//! - **The masks.** For a vertex `v` of valence `n` in a quad `G = (v, e0, f, e1)`, the
+//!   *interior point* of `v` in `G` is `(n·v + 2·e0 + 2·e1 + f) / (n + 5)`. A patch's four inner
+//!   Bézier points are its own interior points; each *edge point* is the midpoint of the two
+//!   interior points (this face's and the neighbour's across the edge) of the edge's end; each
+//!   *corner point* is the centroid of the `n` interior points around the vertex, which is the
+//!   vertex's Catmull-Clark limit position. Where every corner has valence 4 the 16 points are
+//!   the B-spline patch's Bézier points, so the patch is exact there.
+//! - **Stencils, not points.** Like [`crate::gregory`], each point is a stencil over the level's
+//!   vertices, so it serves any vertex data (animated positions, texture coordinates) and the
+//!   GPU builds the points from the same weights.
+//! - **Scope.** Interior quads whose corners are smooth (no boundary, crease or corner tag) and
+//!   whose corners' faces are all quads: ACC-1's masks are defined for quad neighbourhoods only.
+//!   Others are refused with [`AccProblem`] naming the vertex; the technique that draws ACC-1
+//!   treats those faces another way (the issue that adds it decides which).
+use crate::error::TopologyError;
+use crate::gregory::Stencil;
+use crate::mesh::INVALID;
+use crate::refine::LevelRef;
+use std::collections::BTreeMap;
+
+/// Why an ACC-1 patch cannot be built on a face ([`TopologyError::AccPatch`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum AccProblem {
+    #[error("the face has {size} corners; ACC-1 patches are quads")]
+    NotQuad { size: usize },
+    #[error("vertex {vertex} is on a boundary")]
+    Boundary { vertex: u32 },
+    #[error("vertex {vertex} has a sharp edge or is a tagged corner")]
+    Sharp { vertex: u32 },
+    #[error("vertex {vertex} has a face that is not a quad")]
+    NonQuadNeighbour { vertex: u32 },
+}
+
+fn add(acc: &mut BTreeMap<u32, f64>, v: u32, w: f64) {
+    *acc.entry(v).or_insert(0.0) += w;
+}
+
+fn to_stencil(acc: BTreeMap<u32, f64>) -> Stencil {
+    let (indices, weights) = acc.into_iter().filter(|&(_, w)| w != 0.0).unzip();
+    Stencil { indices, weights }
+}
+
+/// Interior point of `v` in quad `g` (weights added to `acc`, scaled by `scale`).
+fn interior(level: &LevelRef<'_>, g: usize, v: u32, scale: f64, acc: &mut BTreeMap<u32, f64>) {
+    let t = level.topology;
+    let fv = t.face_vertices(g);
+    let k = fv.iter().position(|&x| x == v).unwrap_or(0);
+    let n = t.vertex_edges(v as usize).len() as f64;
+    let s = scale / (n + 5.0);
+    add(acc, v, n * s);
+    add(acc, fv[(k + 1) % 4], 2.0 * s);
+    add(acc, fv[(k + 3) % 4], 2.0 * s);
+    add(acc, fv[(k + 2) % 4], s);
+}
+
+fn check_corner(level: &LevelRef<'_>, v: u32) -> Result<(), AccProblem> {
+    let t = level.topology;
+    let edges = t.vertex_edges(v as usize);
+    if edges.iter().any(|&e| t.is_boundary_edge(e as usize)) {
+        return Err(AccProblem::Boundary { vertex: v });
+    }
+    if level.vertex_sharpness[v as usize] > 0.0
+        || edges
+            .iter()
+            .any(|&e| level.edge_sharpness[e as usize] > 0.0)
+    {
+        return Err(AccProblem::Sharp { vertex: v });
+    }
+    if t.vertex_faces(v as usize)
+        .iter()
+        .any(|&g| t.face_vertices(g as usize).len() != 4)
+    {
+        return Err(AccProblem::NonQuadNeighbour { vertex: v });
+    }
+    Ok(())
+}
+
+/// The 16 Bézier points of quad `face`'s ACC-1 geometry patch, `[i][j]` = Bernstein index `i` in
+/// `u`, `j` in `v` (corner 0 of the face at `(0,0)`, 1 at `(1,0)`, 2 at `(1,1)`, 3 at `(0,1)`,
+/// the domain of [`crate::patch`]), each a stencil over the level's vertices.
+pub fn acc1_patch(level: LevelRef<'_>, face: usize) -> Result<[[Stencil; 4]; 4], TopologyError> {
+    let t = level.topology;
+    if face >= t.num_faces() {
+        return Err(TopologyError::FaceOutOfRange {
+            face,
+            count: t.num_faces(),
+        });
+    }
+    let problem = |problem| TopologyError::AccPatch { face, problem };
+    let fv = t.face_vertices(face);
+    if fv.len() != 4 {
+        return Err(problem(AccProblem::NotQuad { size: fv.len() }));
+    }
+    for &v in fv {
+        check_corner(&level, v).map_err(problem)?;
+    }
+    let edges = t.face_edge_list(face);
+    // Corner `c` of the face sits at Bézier (a, b), its inner point one step inside.
+    let corner_ij = [(0usize, 0usize), (3, 0), (3, 3), (0, 3)];
+    let inward = |i: usize| if i == 0 { 1 } else { 2 };
+    let mut net: [[BTreeMap<u32, f64>; 4]; 4] = Default::default();
+    for (c, &v) in fv.iter().enumerate() {
+        let (i, j) = corner_ij[c];
+        interior(&level, face, v, 1.0, &mut net[inward(i)][inward(j)]);
+        let around = t.vertex_faces(v as usize);
+        let n = around.len() as f64;
+        for &g in around {
+            interior(&level, g as usize, v, 1.0 / n, &mut net[i][j]);
+        }
+        // The two edge points next to this corner: along the edge to corner c+1 and to c−1.
+        for (edge, toward) in [(edges[c], (c + 1) % 4), (edges[(c + 3) % 4], (c + 3) % 4)] {
+            let [f0, f1] = t.edge_faces(edge as usize);
+            let other = if f0 as usize == face { f1 } else { f0 };
+            if other == INVALID {
+                return Err(problem(AccProblem::Boundary { vertex: v }));
+            }
+            let (ti, tj) = corner_ij[toward];
+            // One third of the way from the corner toward `toward`: index 1 or 2 along the edge.
+            let step = |from: usize, to: usize| match (from, to) {
+                (0, 3) => 1,
+                (3, 0) => 2,
+                _ => from,
+            };
+            let (ei, ej) = (step(i, ti), step(j, tj));
+            interior(&level, face, v, 0.5, &mut net[ei][ej]);
+            interior(&level, other as usize, v, 0.5, &mut net[ei][ej]);
+        }
+    }
+    Ok(net.map(|row| row.map(to_stencil)))
+}
+
+/// Value and derivative weights of the 16 Bézier points at `(u, v)`, in `[i][j]` order.
+pub fn bezier_weights(u: f64, v: f64) -> [[[f64; 3]; 4]; 4] {
+    let b = |t: f64| {
+        let s = 1.0 - t;
+        (
+            [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t],
+            [
+                -3.0 * s * s,
+                3.0 * s * (1.0 - 3.0 * t),
+                3.0 * t * (2.0 - 3.0 * t),
+                3.0 * t * t,
+            ],
+        )
+    };
+    let ((bu, du), (bv, dv)) = (b(u), b(v));
+    let mut w = [[[0.0; 3]; 4]; 4];
+    for i in 0..4 {
+        for j in 0..4 {
+            w[i][j] = [bu[i] * bv[j], du[i] * bv[j], bu[i] * dv[j]];
+        }
+    }
+    w
+}
+
+/// Position and derivatives of an ACC-1 patch at `(u, v)` from its stencils and the level's
+/// points.
+pub fn evaluate(net: &[[Stencil; 4]; 4], points: &[[f64; 3]], u: f64, v: f64) -> [[f64; 3]; 3] {
+    let w = bezier_weights(u, v);
+    let mut out = [[0.0; 3]; 3];
+    for i in 0..4 {
+        for j in 0..4 {
+            let p = net[i][j].apply(points);
+            for (o, wk) in out.iter_mut().zip(w[i][j]) {
+                for d in 0..3 {
+                    o[d] += wk * p[d];
+                }
+            }
+        }
+    }
+    out
+}
