@@ -200,6 +200,63 @@ fn assert_watertight(
     triangles
 }
 
+/// A unit cube whose zero coordinates are `-0.0` (as `v -0 1 0` reads): every technique must
+/// still weld by bits. Flat showed 56 cracked half-edges at 7 segments on such a mesh before
+/// the GPU's coordinates were made `+0.0` (`techniques::shared::gpu_coordinate`).
+#[test]
+fn negative_zero_coordinates_do_not_crack() {
+    use tessera::topology::adaptive::EndCap;
+    let c = |x: u32| if x == 0 { -0.0 } else { 1.0 };
+    let positions = (0..8)
+        .map(|i| [c(i & 1), c((i >> 1) & 1), c((i >> 2) & 1)])
+        .collect();
+    let faces = [
+        [0u32, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let meshes = [(
+        "signed-zero cube",
+        ControlMesh::from_polygons(positions, &faces),
+    )];
+    let gpu = Gpu::new();
+    let mut h = Harness::new(&gpu);
+    let equal = |levels: &[f32]| -> Vec<(Spacing, f32)> {
+        levels.iter().map(|&l| (Spacing::Equal, l)).collect()
+    };
+    for id in [TechniqueId::Flat, TechniqueId::Phong, TechniqueId::Pn] {
+        assert_watertight(
+            &mut h,
+            &meshes,
+            id,
+            &BuildOptions::default(),
+            &equal(&[3.0, 7.0, 8.0]),
+        );
+    }
+    assert_watertight(
+        &mut h,
+        &meshes,
+        TechniqueId::Bft,
+        &BuildOptions::default(),
+        &equal(&[4.0, 8.0]),
+    );
+    let adaptive = BuildOptions {
+        isolation: 2,
+        end_cap: EndCap::Gregory,
+        ..BuildOptions::default()
+    };
+    assert_watertight(
+        &mut h,
+        &meshes,
+        TechniqueId::Adaptive,
+        &adaptive,
+        &equal(&[3.0, 7.0]),
+    );
+}
+
 /// Every integer level 1..=64 and a few fractional ones, in every spacing.
 fn all_levels() -> Vec<(Spacing, f32)> {
     let levels = (1..=64)

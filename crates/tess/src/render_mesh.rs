@@ -3,6 +3,7 @@
 //! for flat quad tessellation, the rest triangulated).
 use crate::error::{Result, TessError};
 use crate::gpu::Vertex;
+use crate::techniques::shared::gpu_coordinate;
 use crate::tessellator::Domain;
 use topology::ControlMesh;
 
@@ -136,8 +137,8 @@ impl RenderMesh {
                 .iter()
                 .zip(&normals)
                 .map(|(p, n)| Vertex {
-                    position: p.map(|c| c as f32),
-                    normal: n.map(|c| c as f32),
+                    position: p.map(gpu_coordinate),
+                    normal: n.map(gpu_coordinate),
                 })
                 .collect(),
             ..Default::default()

@@ -28,7 +28,9 @@
 //! The GPU data is [`layout`].
 pub mod layout;
 
-use super::shared::{check_adaptive_policy, factor_fields, storage, storage_binding};
+use super::shared::{
+    canonical_zero, check_adaptive_policy, factor_fields, storage, storage_binding,
+};
 use super::windows::{self, Limits, Member, Space};
 use crate::capture::{face_corner_uv, FacePoint};
 use crate::context::Context;
@@ -593,8 +595,9 @@ impl Technique for Adaptive {
             .base
             .get_mut(slot)
             .ok_or(TessError::FrameSlot { slot, slots })?;
-        buf.write(0, bytemuck::cast_slice(positions))?;
-        self.base_positions = positions.to_vec();
+        let positions: Vec<[f32; 3]> = positions.iter().map(|p| p.map(canonical_zero)).collect();
+        buf.write(0, bytemuck::cast_slice(&positions))?;
+        self.base_positions = positions;
         Ok(())
     }
 

@@ -28,7 +28,9 @@ use crate::context::Context;
 use crate::error::{Result, TessError};
 pub mod layout;
 
-use super::shared::{check_adaptive_policy, factor_fields, storage, storage_binding};
+use super::shared::{
+    canonical_zero, check_adaptive_policy, factor_fields, gpu_coordinate, storage, storage_binding,
+};
 use super::windows::{self, Chunk, Limits, Member, Space};
 use crate::gpu::bindings::{
     BFT_BASE_POSITIONS_BINDING, BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING,
@@ -311,7 +313,7 @@ pub struct Bft {
 pub fn base_positions(mesh: &ControlMesh) -> Vec<[f32; 3]> {
     mesh.positions
         .iter()
-        .map(|p| [p[0] as f32, p[1] as f32, p[2] as f32])
+        .map(|p| p.map(gpu_coordinate))
         .collect()
 }
 
@@ -679,8 +681,9 @@ impl Technique for Bft {
             .base
             .get_mut(slot)
             .ok_or(TessError::FrameSlot { slot, slots })?;
-        buf.write(0, as_base_positions(positions))?;
-        self.base_positions = positions.to_vec();
+        let positions: Vec<[f32; 3]> = positions.iter().map(|p| p.map(canonical_zero)).collect();
+        buf.write(0, as_base_positions(&positions))?;
+        self.base_positions = positions;
         Ok(())
     }
 
