@@ -39,7 +39,7 @@ mod tests;
 pub use ash::vk;
 pub use buffer::{Buffer, BufferDesc};
 pub use descriptor::{BindingDesc, DescriptorPool, DescriptorSet, DescriptorSetLayout};
-pub use device::{AdapterInfo, Device, DeviceDesc, DeviceSelector, DeviceShared};
+pub use device::{AdapterInfo, Device, DeviceDesc, DeviceSelector, DeviceShared, HostDevice};
 pub use encoder::{Encoder, Submission};
 pub use error::{DescriptorError, RecordingError, Result, VkError};
 pub use gpu_allocator::MemoryLocation;
