@@ -105,6 +105,7 @@ pub unsafe extern "C" fn tessera_context_create_host(
     guard(|| {
         // SAFETY: the caller's contract for `out` and `desc`.
         unsafe { out_write(out, std::ptr::null_mut(), "out") }?;
+        // SAFETY: the caller's contract (see this function's `# Safety`).
         let d = unsafe { read_required(desc, "desc") }?;
         let gipa = d.get_instance_proc_addr.ok_or_else(|| {
             Error::new(TesseraStatus::NullPointer, "get_instance_proc_addr is NULL")
@@ -283,6 +284,7 @@ pub unsafe extern "C" fn tessera_record_draw(
         no_null_cmd(cmd)?;
         // SAFETY: the caller's contract.
         let view = unsafe { read_required(view.cast::<[f32; 16]>(), "view") }?;
+        // SAFETY: the caller's contract (see this function's `# Safety`).
         let proj = unsafe { read_required(proj.cast::<[f32; 16]>(), "proj") }?;
         if let Some(x) = view.iter().chain(&proj).find(|x| !x.is_finite()) {
             return Err(Error::new(

@@ -781,12 +781,18 @@ fn create_surface(
 }
 
 /// The control mesh `d` describes, every count and index checked.
-fn read_mesh(d: &TesseraMeshDesc) -> Result<(topology::ControlMesh, String)> {
-    // SAFETY (every read below): the caller of tessera_surface_create vouches that each
-    // pointer is NULL or addresses the number of elements its count says.
+///
+/// # Safety
+/// Every pointer in `d` is NULL or addresses as many elements as its count says
+/// ([`TesseraMeshDesc`]), and `d.name` is NULL or NUL-terminated.
+unsafe fn read_mesh(d: &TesseraMeshDesc) -> Result<(topology::ControlMesh, String)> {
+    // SAFETY: the caller's contract (see this function's `# Safety`).
     let name = unsafe { read_str(d.name, "name") }?.unwrap_or_else(|| "mesh".into());
+    // SAFETY: the caller's contract (see this function's `# Safety`).
     let positions = unsafe { read_slice(d.positions, d.vertex_count, 3, "positions") }?;
+    // SAFETY: the caller's contract (see this function's `# Safety`).
     let sizes = unsafe { read_slice(d.face_sizes, d.face_count, 1, "face_sizes") }?;
+    // SAFETY: the caller's contract (see this function's `# Safety`).
     let indices = unsafe { read_slice(d.face_indices, d.index_count, 1, "face_indices") }?;
     let total: u64 = sizes.iter().map(|&s| s as u64).sum();
     if total != d.index_count as u64 {
@@ -817,16 +823,62 @@ fn read_mesh(d: &TesseraMeshDesc) -> Result<(topology::ControlMesh, String)> {
         }
     }
     let crease_vertices =
+        // SAFETY: the caller's contract (see this function's `# Safety`).
         unsafe { read_slice(d.crease_vertices, d.crease_count, 2, "crease_vertices") }?;
     let crease_sharpness =
+        // SAFETY: the caller's contract (see this function's `# Safety`).
         unsafe { read_slice(d.crease_sharpness, d.crease_count, 1, "crease_sharpness") }?;
     let corner_vertices =
+        // SAFETY: the caller's contract (see this function's `# Safety`).
         unsafe { read_slice(d.corner_vertices, d.corner_count, 1, "corner_vertices") }?;
     let corner_sharpness =
+        // SAFETY: the caller's contract (see this function's `# Safety`).
         unsafe { read_slice(d.corner_sharpness, d.corner_count, 1, "corner_sharpness") }?;
+    // Tags are checked here, not only by the techniques that read them: a flat surface
+    // ignores creases, but a bad index is the host's bug wherever it is drawn.
+    for (i, &v) in crease_vertices.iter().enumerate() {
+        if v as usize >= d.vertex_count {
+            return Err(Error::new(
+                TesseraStatus::IndexOutOfRange,
+                format!(
+                    "{name}: crease {}: vertex index {v} out of range (mesh has {} vertices)",
+                    i / 2,
+                    d.vertex_count
+                ),
+            ));
+        }
+    }
+    for (i, &v) in corner_vertices.iter().enumerate() {
+        if v as usize >= d.vertex_count {
+            return Err(Error::new(
+                TesseraStatus::IndexOutOfRange,
+                format!(
+                    "{name}: corner {i}: vertex index {v} out of range (mesh has {} vertices)",
+                    d.vertex_count
+                ),
+            ));
+        }
+    }
+    if let Some((i, x)) = crease_sharpness
+        .iter()
+        .chain(corner_sharpness)
+        .enumerate()
+        .find(|(_, x)| !(x.is_finite() && **x >= 0.0))
+    {
+        let what = if i < crease_sharpness.len() {
+            format!("crease {i}")
+        } else {
+            format!("corner {}", i - crease_sharpness.len())
+        };
+        return Err(Error::new(
+            TesseraStatus::InvalidArgument,
+            format!("{name}: {what}: sharpness {x}: expected a finite number of at least 0"),
+        ));
+    }
     let uvs = if d.uvs.is_null() {
         None
     } else {
+        // SAFETY: the caller's contract (see this function's `# Safety`).
         let uv = unsafe { read_slice(d.uvs, d.index_count, 2, "uvs") }?;
         Some(
             uv.chunks_exact(2)
@@ -881,10 +933,14 @@ pub unsafe extern "C" fn tessera_surface_create(
     with_context(ctx, |c| {
         // SAFETY: the caller's contract for `out`, `mesh` and `desc`.
         unsafe { out_write(out, std::ptr::null_mut(), "out") }?;
+        // SAFETY: the caller's contract (see this function's `# Safety`).
         let m = unsafe { ffi::read_required(mesh, "mesh") }?;
+        // SAFETY: the caller's contract (see this function's `# Safety`).
         let d = unsafe { surface_desc(desc) }?;
-        let (mesh, name) = read_mesh(&m)?;
+        // SAFETY: the caller's contract for the arrays `mesh` points to.
+        let (mesh, name) = unsafe { read_mesh(&m) }?;
         let id = create_surface(ctx_id, c, mesh, &d, name)?;
+        // SAFETY: the caller's contract (see this function's `# Safety`).
         unsafe { out_write(out, surface_ptr(id), "out") }
     })
 }
@@ -934,7 +990,9 @@ pub unsafe extern "C" fn tessera_surface_create_obj(
     with_context(ctx, |c| {
         // SAFETY: the caller's contract for every pointer.
         unsafe { out_write(out, std::ptr::null_mut(), "out") }?;
+        // SAFETY: the caller's contract (see this function's `# Safety`).
         let d = unsafe { surface_desc(desc) }?;
+        // SAFETY: the caller's contract (see this function's `# Safety`).
         let given = unsafe { read_str(name, "name") }?;
         let (text, name) = if obj_text.is_null() {
             (
@@ -942,6 +1000,7 @@ pub unsafe extern "C" fn tessera_surface_create_obj(
                 given.unwrap_or_else(|| "spot_control_mesh.obj (embedded)".into()),
             )
         } else {
+            // SAFETY: the caller's contract (see this function's `# Safety`).
             let bytes = unsafe { read_slice(obj_text.cast::<u8>(), obj_len, 1, "obj_text") }?;
             let text = String::from_utf8(bytes.to_vec()).map_err(|e| {
                 Error::new(
@@ -956,6 +1015,7 @@ pub unsafe extern "C" fn tessera_surface_create_obj(
         };
         let mesh = topology::parse_obj(&text, &name)?;
         let id = create_surface(ctx_id, c, mesh, &d, name)?;
+        // SAFETY: the caller's contract (see this function's `# Safety`).
         unsafe { out_write(out, surface_ptr(id), "out") }
     })
 }
@@ -1148,6 +1208,7 @@ pub unsafe extern "C" fn tessera_capture_obj(
         standalone_only(c, "tessera_capture_obj")?;
         // SAFETY: the caller's contract.
         let f = unsafe { ffi::read_required(frame, "frame") }?;
+        // SAFETY: the caller's contract (see this function's `# Safety`).
         let path = unsafe { read_str(path, "path") }?
             .ok_or_else(|| Error::new(TesseraStatus::NullPointer, "path is NULL"))?;
         let (params, extent) = frame_params(&f)?;
