@@ -79,10 +79,8 @@ fn mesh_desc(c: &Cube) -> TesseraMeshDesc {
 fn surface_desc(technique: TesseraTechnique) -> TesseraSurfaceDesc {
     let mut d = std::mem::MaybeUninit::uninit();
     // SAFETY: `d` is writable and filled by the call.
-    assert_eq!(
-        unsafe { tessera_surface_desc_default(d.as_mut_ptr()) },
-        TesseraStatus::Ok
-    );
+    let status = unsafe { tessera_surface_desc_default(d.as_mut_ptr()) };
+    assert_eq!(status, TesseraStatus::Ok);
     // SAFETY: initialized above.
     let mut d = unsafe { d.assume_init() };
     d.technique = technique;
@@ -92,10 +90,8 @@ fn surface_desc(technique: TesseraTechnique) -> TesseraSurfaceDesc {
 fn frame_desc() -> TesseraFrameDesc {
     let mut f = std::mem::MaybeUninit::uninit();
     // SAFETY: `f` is writable and filled by the call.
-    assert_eq!(
-        unsafe { tessera_frame_desc_default(f.as_mut_ptr()) },
-        TesseraStatus::Ok
-    );
+    let status = unsafe { tessera_frame_desc_default(f.as_mut_ptr()) };
+    assert_eq!(status, TesseraStatus::Ok);
     // SAFETY: initialized above.
     let mut f = unsafe { f.assume_init() };
     f.width = W;
@@ -125,8 +121,8 @@ fn render(ctx: *mut TesseraContext, s: *mut TesseraSurface) -> Vec<u8> {
 
 #[test]
 fn misuse_gets_codes_and_messages_never_undefined_behaviour() {
-    // SAFETY (every call below): pointers are null, forged handles (looked up, never
-    // dereferenced), or address live locals of the sizes passed.
+    // SAFETY: every call below passes null pointers, forged handles (looked up, never
+    // dereferenced), or pointers to live locals of the sizes passed.
     unsafe {
         // Handles before any context exists.
         expect(
