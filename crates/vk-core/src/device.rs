@@ -518,10 +518,7 @@ impl Device {
             unsafe { instance.raw.create_device(physical, &create, None) }.ctx("vkCreateDevice")?;
         // SAFETY: the family/index were requested above.
         let queue = unsafe { raw.get_device_queue(queue_family, 0) };
-        let owned = Owned {
-            raw,
-            destroy: true,
-        };
+        let owned = Owned { raw, destroy: true };
         Self::wrap(
             instance,
             info,
@@ -552,10 +549,7 @@ impl Device {
     ///   synchronization of queues).
     pub unsafe fn from_host(instance: &Arc<Instance>, host: &HostDevice) -> Result<Self> {
         let adapters = enumerate_adapters(instance)?;
-        let Some(mut info) = adapters
-            .into_iter()
-            .find(|a| a.physical == host.physical)
-        else {
+        let Some(mut info) = adapters.into_iter().find(|a| a.physical == host.physical) else {
             return Err(VkError::NoSuchDevice {
                 selector: format!("{:?}", host.physical),
                 devices: "the host's physical device is not among the instance's".into(),
