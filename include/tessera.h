@@ -355,6 +355,17 @@ enum TesseraStatus tessera_surface_update_positions(struct TesseraContext *ctx,
                                                     const float *positions,
                                                     size_t vertex_count);
 
+// Copies the surface's base positions (the newest given to
+// [`tessera_surface_update_positions`], else those it was created with) into `positions`:
+// `3 * vertex_count` floats, `vertex_count` the surface's. Thread-safe.
+//
+// # Safety
+// `positions` is NULL or points to `3 * vertex_count` writable floats.
+enum TesseraStatus tessera_surface_positions(const struct TesseraContext *ctx,
+                                             const struct TesseraSurface *surface,
+                                             float *positions,
+                                             size_t vertex_count);
+
 // The view and projection (column-major 4x4) Tessera's standalone camera uses for `frame`
 // on this surface, so a host can draw exactly the view [`tessera_render`] draws.
 // Thread-safe.

@@ -170,6 +170,15 @@ public:
         return pixels;
     }
 
+    // The base positions (x, y, z per vertex): the newest given, else those at creation.
+    std::vector<float> positions() const {
+        size_t n = 0;
+        check(tessera_surface_info(ctx_, raw_, &n, nullptr, nullptr), ctx_);
+        std::vector<float> xyz(n * 3);
+        check(tessera_surface_positions(ctx_, raw_, xyz.data(), n), ctx_);
+        return xyz;
+    }
+
     void update_positions(const std::vector<float> &xyz) {
         check(tessera_surface_update_positions(ctx_, raw_, xyz.data(), xyz.size() / 3), ctx_);
     }

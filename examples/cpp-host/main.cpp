@@ -337,82 +337,87 @@ int run(const std::string &out_dir, bool misuse) {
             // The view `tessera render` uses, so the images can be compared.
             auto camera = surface.camera(frame);
 
-            ctx.begin_frame(frame_index++);
-            VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-            begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-            vk_check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
-            surface.record_pre_pass(cmd);
-            barrier(cmd, color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, 0,
-                    VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                    VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                    VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
-            barrier(cmd, depth.image, VK_IMAGE_ASPECT_DEPTH_BIT,
-                    VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                    VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                    VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+            // One frame: record, submit, wait, read back.
+            auto draw_frame = [&]() {
+                ctx.begin_frame(frame_index++);
+                VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+                begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+                vk_check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
+                surface.record_pre_pass(cmd);
+                barrier(cmd, color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, 0,
+                        VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                        VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                        VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
+                barrier(cmd, depth.image, VK_IMAGE_ASPECT_DEPTH_BIT,
                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                    VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
                         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                    VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
-            VkRenderingAttachmentInfo color_att{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-            color_att.imageView = color.view;
-            color_att.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-            color_att.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-            color_att.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-            std::memcpy(color_att.clearValue.color.float32, frame.clear_color, sizeof(float) * 4);
-            VkRenderingAttachmentInfo depth_att{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-            depth_att.imageView = depth.view;
-            depth_att.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-            depth_att.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-            depth_att.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
-            depth_att.clearValue.depthStencil = {1.0f, 0};
-            VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
-            rendering.renderArea = {{0, 0}, {kWidth, kHeight}};
-            rendering.layerCount = 1;
-            rendering.colorAttachmentCount = 1;
-            rendering.pColorAttachments = &color_att;
-            rendering.pDepthAttachment = &depth_att;
-            vkCmdBeginRendering(cmd, &rendering);
-            // y flipped as Tessera's own targets are (+y up).
-            VkViewport viewport{0, float(kHeight), float(kWidth), -float(kHeight), 0, 1};
-            VkRect2D scissor{{0, 0}, {kWidth, kHeight}};
-            vkCmdSetViewport(cmd, 0, 1, &viewport);
-            vkCmdSetScissor(cmd, 0, 1, &scissor);
-            surface.record_draw(cmd, camera.first.data(), camera.second.data());
-            vkCmdEndRendering(cmd);
-            barrier(cmd, color.image, VK_IMAGE_ASPECT_COLOR_BIT,
-                    VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                    VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
-                    VK_ACCESS_2_TRANSFER_READ_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                    VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
-            VkBufferImageCopy region{};
-            region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-            region.imageExtent = {kWidth, kHeight, 1};
-            vkCmdCopyImageToBuffer(cmd, color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                   readback, 1, &region);
-            VkMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
-            to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-            to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-            to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
-            to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
-            VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-            dep.memoryBarrierCount = 1;
-            dep.pMemoryBarriers = &to_host;
-            vkCmdPipelineBarrier2(cmd, &dep);
-            vk_check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
-            VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-            submit.commandBufferCount = 1;
-            submit.pCommandBuffers = &cmd;
-            vk_check(vkQueueSubmit(queue, 1, &submit, fence), "vkQueueSubmit");
-            vk_check(vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-            vk_check(vkResetFences(device, 1, &fence), "vkResetFences");
+                        VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                            VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                        VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                        VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
+                VkRenderingAttachmentInfo color_att{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+                color_att.imageView = color.view;
+                color_att.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+                color_att.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+                color_att.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+                std::memcpy(color_att.clearValue.color.float32, frame.clear_color, sizeof(float) * 4);
+                VkRenderingAttachmentInfo depth_att{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+                depth_att.imageView = depth.view;
+                depth_att.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+                depth_att.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+                depth_att.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+                depth_att.clearValue.depthStencil = {1.0f, 0};
+                VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
+                rendering.renderArea = {{0, 0}, {kWidth, kHeight}};
+                rendering.layerCount = 1;
+                rendering.colorAttachmentCount = 1;
+                rendering.pColorAttachments = &color_att;
+                rendering.pDepthAttachment = &depth_att;
+                vkCmdBeginRendering(cmd, &rendering);
+                // y flipped as Tessera's own targets are (+y up).
+                VkViewport viewport{0, float(kHeight), float(kWidth), -float(kHeight), 0, 1};
+                VkRect2D scissor{{0, 0}, {kWidth, kHeight}};
+                vkCmdSetViewport(cmd, 0, 1, &viewport);
+                vkCmdSetScissor(cmd, 0, 1, &scissor);
+                surface.record_draw(cmd, camera.first.data(), camera.second.data());
+                vkCmdEndRendering(cmd);
+                barrier(cmd, color.image, VK_IMAGE_ASPECT_COLOR_BIT,
+                        VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                        VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+                        VK_ACCESS_2_TRANSFER_READ_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                        VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+                VkBufferImageCopy region{};
+                region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                region.imageExtent = {kWidth, kHeight, 1};
+                vkCmdCopyImageToBuffer(cmd, color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                       readback, 1, &region);
+                VkMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+                to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+                to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+                to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
+                to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
+                VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+                dep.memoryBarrierCount = 1;
+                dep.pMemoryBarriers = &to_host;
+                vkCmdPipelineBarrier2(cmd, &dep);
+                vk_check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+                VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+                submit.commandBufferCount = 1;
+                submit.pCommandBuffers = &cmd;
+                vk_check(vkQueueSubmit(queue, 1, &submit, fence), "vkQueueSubmit");
+                vk_check(vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+                vk_check(vkResetFences(device, 1, &fence), "vkResetFences");
 
-            void *mapped = nullptr;
-            vk_check(vkMapMemory(device, readback_memory, 0, VK_WHOLE_SIZE, 0, &mapped),
-                     "vkMapMemory");
-            std::vector<uint8_t> pixels(static_cast<uint8_t *>(mapped),
-                                        static_cast<uint8_t *>(mapped) + buffer_info.size);
-            vkUnmapMemory(device, readback_memory);
+                void *mapped = nullptr;
+                vk_check(vkMapMemory(device, readback_memory, 0, VK_WHOLE_SIZE, 0, &mapped),
+                         "vkMapMemory");
+                std::vector<uint8_t> pixels(static_cast<uint8_t *>(mapped),
+                                            static_cast<uint8_t *>(mapped) + buffer_info.size);
+                vkUnmapMemory(device, readback_memory);
+                return pixels;
+            };
+            std::vector<uint8_t> pixels = draw_frame();
             size_t lit = 0;
             for (size_t i = 0; i < size_t(kWidth) * kHeight; i++) {
                 for (int c = 0; c < 3; c++) {
@@ -429,7 +434,25 @@ int run(const std::string &out_dir, bool misuse) {
             }
             std::ofstream(out_dir + "/" + t.name + ".rgba", std::ios::binary)
                 .write(reinterpret_cast<const char *>(pixels.data()), std::streamsize(pixels.size()));
-            // The fence wait above means the GPU finished with the surface: it may go now.
+            // Animation, for the techniques that take it: the base moves once, in frame 2
+            // (slot 1); frame 3 reuses slot 0, which must catch up with the move.
+            if (t.technique == TESSERA_TECHNIQUE_BFT || t.technique == TESSERA_TECHNIQUE_ADAPTIVE) {
+                std::vector<float> moved = surface.positions();
+                for (float &x : moved) x *= 0.6f;
+                ctx.begin_frame(frame_index);
+                surface.update_positions(moved);
+                std::vector<uint8_t> second = draw_frame();
+                std::vector<uint8_t> third = draw_frame();
+                if (second == pixels) {
+                    std::fprintf(stderr, "%s: moving the base changed nothing\n", t.name);
+                    failures++;
+                }
+                if (third != second) {
+                    std::fprintf(stderr, "%s: the next frame slot did not catch up\n", t.name);
+                    failures++;
+                }
+            }
+            // The fence waits above mean the GPU finished with the surface: it may go now.
         }
         if (misuse) failures += check_misuse(ctx);
         // Tessera goes before the device it was given (and destroys nothing of the host's).

@@ -263,6 +263,8 @@ pub(crate) struct SurfaceState {
     technique: Box<dyn Technique>,
     tess: tess::Context,
     vertex_count: usize,
+    /// Base positions at creation ([`tessera_surface_positions`] before any update).
+    rest: Vec<[f32; 3]>,
     /// What host-owned frames draw ([`tessera_surface_set_frame`]).
     frame: (FrameParams, vk::Extent2D),
     /// The newest animated positions and their version; each slot records the version it
@@ -767,6 +769,11 @@ fn create_surface(
         technique: built.technique,
         tess: t,
         vertex_count: mesh.positions.len(),
+        rest: mesh
+            .positions
+            .iter()
+            .map(|p| [p[0] as f32, p[1] as f32, p[2] as f32])
+            .collect(),
         frame: (
             FrameParams::default(),
             vk::Extent2D {
@@ -1117,6 +1124,40 @@ pub unsafe extern "C" fn tessera_surface_update_positions(
             Mode::Standalone => s.sync_positions(0),
             Mode::Host { .. } => s.sync_positions(c.slot()),
         }
+    })
+}
+
+/// Copies the surface's base positions (the newest given to
+/// [`tessera_surface_update_positions`], else those it was created with) into `positions`:
+/// `3 * vertex_count` floats, `vertex_count` the surface's. Thread-safe.
+///
+/// # Safety
+/// `positions` is NULL or points to `3 * vertex_count` writable floats.
+#[no_mangle]
+pub unsafe extern "C" fn tessera_surface_positions(
+    ctx: *const TesseraContext,
+    surface: *const TesseraSurface,
+    positions: *mut f32,
+    vertex_count: usize,
+) -> TesseraStatus {
+    with_surface(ctx, surface, |_, s| {
+        if vertex_count != s.vertex_count {
+            return Err(Error::new(
+                TesseraStatus::WrongSize,
+                format!(
+                    "room for {vertex_count} positions given, the surface has {} vertices",
+                    s.vertex_count
+                ),
+            ));
+        }
+        let current = s.positions.as_ref().map_or(&s.rest, |(_, p)| p);
+        let bytes = vertex_count * 3 * std::mem::size_of::<f32>();
+        // SAFETY: the caller's contract: `3 * vertex_count` writable floats.
+        let out = unsafe { ffi::write_slice(positions.cast::<u8>(), bytes, "positions") }?;
+        for (dst, src) in out.chunks_exact_mut(4).zip(current.iter().flatten()) {
+            dst.copy_from_slice(&src.to_ne_bytes());
+        }
+        Ok(())
     })
 }
 
