@@ -1291,3 +1291,30 @@ fn standalone_only(c: &ContextState, call: &str) -> Result<()> {
 }
 
 pub mod host;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_panic_inside_becomes_a_status_and_a_message() {
+        let status = guard(|| panic!("an invariant broke"));
+        assert_eq!(status, TesseraStatus::Panic);
+        let message = LAST_ERROR.with(|l| l.borrow().clone());
+        assert!(
+            message.contains("an invariant broke") && message.contains("panic"),
+            "{message}"
+        );
+        let status = guard(|| std::panic::panic_any(7u32));
+        assert_eq!(status, TesseraStatus::Panic);
+    }
+
+    #[test]
+    fn every_status_has_a_name() {
+        for v in 0..=TesseraStatus::Internal as u32 {
+            // SAFETY: tessera_status_name returns a static NUL-terminated string.
+            let name = unsafe { std::ffi::CStr::from_ptr(tessera_status_name(v)) };
+            assert_ne!(name.to_str().unwrap(), "unknown status", "status {v}");
+        }
+    }
+}
