@@ -260,6 +260,14 @@ fn misuse_gets_codes_and_messages_never_undefined_behaviour() {
         );
         assert!(last_error(ctx).contains("bad.obj"), "{}", last_error(ctx));
 
+        // Optional UVs: one (u, v) per face corner.
+        let uvs: Vec<f32> = (0..c.indices.len() * 2).map(|i| (i % 2) as f32).collect();
+        let mut with_uvs = mesh_desc(&c);
+        with_uvs.uvs = uvs.as_ptr();
+        let (status, textured) = create_surface(ctx, &with_uvs, &flat);
+        assert_eq!(status, TesseraStatus::Ok, "{}", last_error(ctx));
+        assert_eq!(tessera_surface_destroy(ctx, textured), TesseraStatus::Ok);
+
         // A flat cube: frames, sizes, animation refused.
         let (status, flat_cube) = create_surface(ctx, &mesh_desc(&c), &flat);
         assert_eq!(status, TesseraStatus::Ok, "{}", last_error(ctx));
