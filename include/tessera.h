@@ -325,8 +325,11 @@ enum TesseraStatus tessera_surface_create_obj(struct TesseraContext *ctx,
                                               const struct TesseraSurfaceDesc *desc,
                                               struct TesseraSurface **out);
 
-// Destroys a surface. Standalone: immediate (Tessera's own submissions are waited for).
-// Thread-safe; a second destroy returns DESTROYED_HANDLE.
+// Destroys a surface: its handle is invalid at once. Standalone: its objects are freed at
+// once (Tessera's own submissions are waited for). Host-owned: they are freed by the first
+// [`host::tessera_begin_frame`] whose frame is `frames_in_flight` past the frame current at
+// the destruction (the host then guarantees the frames that could draw it finished), or with
+// the context. Thread-safe; a second destroy returns DESTROYED_HANDLE.
 //
 // # Safety
 // None beyond the handles, which may be anything (they are looked up, never dereferenced).
@@ -441,7 +444,8 @@ enum TesseraStatus tessera_surface_set_frame(struct TesseraContext *ctx,
 // # Safety
 // `cmd` is a primary command buffer of the context's device in the recording state, outside
 // a rendering scope; the host submits it before the draws' command buffer (or it is the same
-// one) and keeps the surface alive until the GPU finished it.
+// one) in the frame named by [`tessera_begin_frame`], and destroys the context only after the
+// GPU finished it.
 enum TesseraStatus tessera_record_pre_pass(struct TesseraContext *ctx,
                                            struct TesseraSurface *surface,
                                            VkCommandBuffer cmd);
@@ -457,8 +461,9 @@ enum TesseraStatus tessera_record_pre_pass(struct TesseraContext *ctx,
 // # Safety
 // `cmd` is a primary command buffer of the context's device in the recording state, inside
 // a rendering scope begun with dynamic rendering and the context's formats, viewport and
-// scissor set; `view` and `proj` point to 16 readable floats each; the host keeps the
-// surface alive until the GPU finished `cmd`.
+// scissor set; `view` and `proj` point to 16 readable floats each; `cmd` is submitted in the
+// frame named by [`tessera_begin_frame`], and the context is destroyed only after the GPU
+// finished it.
 enum TesseraStatus tessera_record_draw(struct TesseraContext *ctx,
                                        struct TesseraSurface *surface,
                                        VkCommandBuffer cmd,

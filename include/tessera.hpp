@@ -10,8 +10,9 @@
 // Ownership: a Surface must not outlive its Context's device use (destroy surfaces before
 // their context, as declaration order in one scope does); a Surface whose Context was
 // destroyed first is harmless: its destroy returns DESTROYED_HANDLE, ignored. In host-owned
-// mode, destroy Tessera objects only after the GPU finished the command buffers they were
-// recorded into (see tessera.h, tessera_record_draw).
+// mode a Surface may be destroyed while frames that drew it are in flight (Tessera frees it
+// frames_in_flight frames later, see tessera_begin_frame); a Context only after the GPU
+// finished every command buffer Tessera recorded into.
 #ifndef TESSERA_HPP
 #define TESSERA_HPP
 

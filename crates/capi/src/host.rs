@@ -37,11 +37,14 @@
 //! before calling it for frame `k`, which it does anyway to reuse its command buffers.
 //!
 //! # Destruction
-//! Tessera cannot see the host's submissions, so destruction is not deferred:
-//! `tessera_surface_destroy` and `tessera_context_destroy` require that the GPU finished every
-//! command buffer into which Tessera recorded for that surface (or context): e.g. the host
-//! waited for its frame fences or called `vkDeviceWaitIdle` first. Tessera then frees its
-//! objects at once and leaves the host's device alive.
+//! Tessera cannot see the host's submissions, so it keys destruction to the frame index the
+//! host advances. `tessera_surface_destroy` invalidates the handle at once but keeps the
+//! surface's objects until [`tessera_begin_frame`] names a frame `frames_in_flight` past the
+//! frame current at the destruction (which the host calls only once the frames that could have
+//! drawn it finished). `tessera_context_destroy` frees everything at once: the host calls it
+//! only after the GPU finished every command buffer Tessera recorded into (its frame fences,
+//! or `vkDeviceWaitIdle`), as it must before destroying its own device. The host's device,
+//! queue and instance are left alive.
 use crate::ffi::{out_write, read_required};
 use crate::registry::lock;
 use crate::status::{Error, Result, TesseraStatus};
@@ -159,6 +162,7 @@ pub unsafe extern "C" fn tessera_context_create_host(
         // SAFETY: as above.
         let device = unsafe { Device::from_host(&instance, &host) }?;
         let id = lock(registry())?.add_context(ContextState {
+            graveyard: Vec::new(),
             device,
             instance,
             mode: Mode::Host {
@@ -196,8 +200,18 @@ pub unsafe extern "C" fn tessera_begin_frame(
 ) -> TesseraStatus {
     with_context(ctx, |c| {
         host_only(c, "tessera_begin_frame")?;
-        if let Mode::Host { frame, .. } = &mut c.mode {
+        if let Mode::Host {
+            frame,
+            frames_in_flight,
+            ..
+        } = &mut c.mode
+        {
             *frame = frame_index;
+            // Frame `frame_index - frames_in_flight` finished, so did every frame before it:
+            // surfaces destroyed while one of those was current are no longer drawn.
+            let n = *frames_in_flight as u64;
+            c.graveyard
+                .retain(|(destroyed_in, _)| destroyed_in.saturating_add(n) > frame_index);
         }
         Ok(())
     })
@@ -236,7 +250,8 @@ pub unsafe extern "C" fn tessera_surface_set_frame(
 /// # Safety
 /// `cmd` is a primary command buffer of the context's device in the recording state, outside
 /// a rendering scope; the host submits it before the draws' command buffer (or it is the same
-/// one) and keeps the surface alive until the GPU finished it.
+/// one) in the frame named by [`tessera_begin_frame`], and destroys the context only after the
+/// GPU finished it.
 #[no_mangle]
 pub unsafe extern "C" fn tessera_record_pre_pass(
     ctx: *mut TesseraContext,
@@ -269,8 +284,9 @@ pub unsafe extern "C" fn tessera_record_pre_pass(
 /// # Safety
 /// `cmd` is a primary command buffer of the context's device in the recording state, inside
 /// a rendering scope begun with dynamic rendering and the context's formats, viewport and
-/// scissor set; `view` and `proj` point to 16 readable floats each; the host keeps the
-/// surface alive until the GPU finished `cmd`.
+/// scissor set; `view` and `proj` point to 16 readable floats each; `cmd` is submitted in the
+/// frame named by [`tessera_begin_frame`], and the context is destroyed only after the GPU
+/// finished it.
 #[no_mangle]
 pub unsafe extern "C" fn tessera_record_draw(
     ctx: *mut TesseraContext,

@@ -224,8 +224,12 @@ thread_local! {
     static LAST_ERROR: RefCell<String> = const { RefCell::new(String::new()) };
 }
 
-/// What a context is. Drop order (field order): the device handle, then the instance.
+/// What a context is. Drop order (field order): surfaces waiting for their last frame, the
+/// device handle, then the instance.
 pub(crate) struct ContextState {
+    /// Host-owned mode: surfaces destroyed by the host while frames that drew them may still
+    /// run, each with the frame that was current at its destruction ([`host`]).
+    graveyard: Vec<(u64, Arc<Mutex<SurfaceState>>)>,
     device: Device,
     /// The validation-message counter of a standalone context's own instance.
     instance: Arc<Instance>,
@@ -625,6 +629,7 @@ pub unsafe extern "C" fn tessera_context_create_standalone(
             &[],
         )?;
         let id = lock(registry())?.add_context(ContextState {
+            graveyard: Vec::new(),
             device,
             instance,
             mode: Mode::Standalone,
@@ -1027,8 +1032,11 @@ pub unsafe extern "C" fn tessera_surface_create_obj(
     })
 }
 
-/// Destroys a surface. Standalone: immediate (Tessera's own submissions are waited for).
-/// Thread-safe; a second destroy returns DESTROYED_HANDLE.
+/// Destroys a surface: its handle is invalid at once. Standalone: its objects are freed at
+/// once (Tessera's own submissions are waited for). Host-owned: they are freed by the first
+/// [`host::tessera_begin_frame`] whose frame is `frames_in_flight` past the frame current at
+/// the destruction (the host then guarantees the frames that could draw it finished), or with
+/// the context. Thread-safe; a second destroy returns DESTROYED_HANDLE.
 ///
 /// # Safety
 /// None beyond the handles, which may be anything (they are looked up, never dereferenced).
@@ -1038,7 +1046,7 @@ pub unsafe extern "C" fn tessera_surface_destroy(
     surface: *mut TesseraSurface,
 ) -> TesseraStatus {
     let ctx_id = handle_id(ctx);
-    with_context(ctx, |_| {
+    with_context(ctx, |c| {
         let mut r = lock(registry())?;
         let (owner, _) = r.surface(handle_id(surface))?;
         if owner != ctx_id {
@@ -1052,7 +1060,11 @@ pub unsafe extern "C" fn tessera_surface_destroy(
         }
         let s = r.remove_surface(handle_id(surface))?;
         drop(r);
-        drop(s);
+        if let Mode::Host { frame, .. } = c.mode {
+            // Frames up to `frame` may still draw it; tessera_begin_frame frees it once the
+            // host says they finished.
+            c.graveyard.push((frame, s));
+        }
         Ok(())
     })
 }
