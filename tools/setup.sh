@@ -1,15 +1,16 @@
 #!/usr/bin/env bash
 # Installs what Tessera needs on Debian/Ubuntu: the Vulkan loader, Mesa's lavapipe (a CPU Vulkan
 # driver, for machines without a GPU), the validation layers, shaderc/glslang static libraries
-# for the build-time shader compiler, Xvfb and xdotool for the window tests, a TrueType font for the text of
-# `tessera bench --plot`, and Rust if missing.
+# for the build-time shader compiler, Xvfb and xdotool for the window tests, a TrueType font for the
+# text of `tessera bench --plot`, CMake and g++ for the C ABI's C/C++ tests (crates/capi), and Rust
+# if missing.
 # Safe to run twice: apt-get and rustup skip what is already there.
 set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 PKGS=(build-essential pkg-config curl ca-certificates libvulkan1 libvulkan-dev mesa-vulkan-drivers
       vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools xvfb xauth libx11-dev libxkbcommon-x11-0
-      fonts-dejavu-core xdotool)
+      fonts-dejavu-core xdotool cmake g++)
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -196,6 +196,18 @@ impl Context {
         Ok(())
     }
 
+    /// Writes the frame uniforms of `slot` as given (see [`frame_uniforms_with`]).
+    pub fn write_frame_uniforms(&mut self, slot: usize, uniforms: &FrameUniforms) -> Result<()> {
+        let slots = self.frames.slots.len();
+        let (_, buffer) = self
+            .frames
+            .slots
+            .get_mut(slot)
+            .ok_or(TessError::FrameSlot { slot, slots })?;
+        buffer.write(0, bytemuck::bytes_of(uniforms))?;
+        Ok(())
+    }
+
     /// Checks `params` and builds the pipelines `passes` need for `technique`. Must precede
     /// recording (which borrows the context immutably for the encoder's lifetime).
     pub fn prepare(
@@ -518,6 +530,18 @@ pub fn frame_uniforms(
 ) -> FrameUniforms {
     let aspect = extent.width as f32 / extent.height.max(1) as f32;
     let m = params.camera.matrices(bbox.0, bbox.1, aspect);
+    frame_uniforms_with(m, bbox, params, extent)
+}
+
+/// [`frame_uniforms`] with the view and projection given (a host that owns its camera, such as
+/// a C++ engine through the C ABI) instead of derived from `params.camera`; the light follows
+/// the eye as it does for Tessera's own camera.
+pub fn frame_uniforms_with(
+    m: crate::camera::CameraMatrices,
+    bbox: ([f32; 3], [f32; 3]),
+    params: &FrameParams,
+    extent: vk::Extent2D,
+) -> FrameUniforms {
     let light =
         (m.eye - glam::Vec3::from(bbox.0).lerp(glam::Vec3::from(bbox.1), 0.5)).normalize_or_zero();
     let light = (light + glam::Vec3::new(0.3, 0.6, 0.2)).normalize_or_zero();

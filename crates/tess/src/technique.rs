@@ -293,7 +293,9 @@ impl std::ops::AddAssign for DrawCounts {
 }
 
 /// A technique, as every caller sees it. Object safe: callers hold `Box<dyn Technique>`.
-pub trait Technique {
+/// `Send`, so a surface built on one thread may be drawn from another (the C ABI's handles
+/// are usable from any host thread).
+pub trait Technique: Send {
     fn id(&self) -> TechniqueId;
 
     /// Axis-aligned bounds of the base mesh at rest (frames the camera; an animated base does

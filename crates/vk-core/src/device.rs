@@ -387,7 +387,31 @@ pub struct DeviceShared {
     pub(crate) live: AtomicU64,
     pub(crate) pipeline_cache: vk::PipelineCache,
     pub(crate) pipeline_cache_path: Option<std::path::PathBuf>,
+    /// False for a host application's device ([`Device::from_host`]): never waited idle or
+    /// destroyed here.
+    pub(crate) owns_device: bool,
     pub instance: Arc<Instance>,
+}
+
+/// A raw device and whether vk-core destroys it.
+struct Owned {
+    raw: ash::Device,
+    destroy: bool,
+}
+
+/// A host application's device and queue, as [`Device::from_host`] wraps them.
+#[derive(Clone, Copy, Debug)]
+pub struct HostDevice {
+    pub physical: vk::PhysicalDevice,
+    pub device: vk::Device,
+    pub queue_family: u32,
+    pub queue: vk::Queue,
+    /// VK_EXT_transform_feedback and its feature were enabled (captures need them).
+    pub transform_feedback: bool,
+    /// `pipelineStatisticsQuery` was enabled.
+    pub pipeline_statistics_query: bool,
+    /// `vertexPipelineStoresAndAtomics` was enabled.
+    pub vertex_pipeline_stores_and_atomics: bool,
 }
 
 /// A handle to the logical device; clones share it.
@@ -494,6 +518,96 @@ impl Device {
             unsafe { instance.raw.create_device(physical, &create, None) }.ctx("vkCreateDevice")?;
         // SAFETY: the family/index were requested above.
         let queue = unsafe { raw.get_device_queue(queue_family, 0) };
+        let owned = Owned { raw, destroy: true };
+        Self::wrap(
+            instance,
+            info,
+            owned,
+            queue,
+            xfb,
+            desc.pipeline_cache_path.clone(),
+        )
+    }
+
+    /// Wraps a host application's device (the C ABI's host-owned mode) without taking
+    /// ownership: dropping the last handle destroys what vk-core created on it (its allocator's
+    /// memory, pipeline cache, timeline semaphore, command pools) but neither waits for the
+    /// device to be idle nor destroys it; it waits only for vk-core's own submissions.
+    ///
+    /// vk-core submits to `host.queue` for one-shot work only (uploads of device-local data,
+    /// offscreen renders and captures), each submission counted on its own timeline semaphore
+    /// and waited for through it, never through `vkDeviceWaitIdle` or `vkQueueWaitIdle`.
+    ///
+    /// # Safety
+    /// - `host.device` is a live device created from `host.physical` of `instance`, with
+    ///   `tessellationShader`, `fillModeNonSolid`, `dynamicRendering` and `timelineSemaphore`
+    ///   enabled, and each optional feature `host` claims enabled (transform feedback with its
+    ///   extension, pipeline statistics queries, vertex-pipeline stores) enabled.
+    /// - `host.queue` is queue 0 of `host.queue_family`, a family with graphics and compute.
+    /// - The device outlives every object made from the result; the host does not use the
+    ///   queue on another thread while a vk-core call that submits runs (Vulkan's external
+    ///   synchronization of queues).
+    pub unsafe fn from_host(instance: &Arc<Instance>, host: &HostDevice) -> Result<Self> {
+        let adapters = enumerate_adapters(instance)?;
+        let Some(mut info) = adapters.into_iter().find(|a| a.physical == host.physical) else {
+            return Err(VkError::NoSuchDevice {
+                selector: format!("{:?}", host.physical),
+                devices: "the host's physical device is not among the instance's".into(),
+            });
+        };
+        if !info.missing.is_empty() {
+            return Err(VkError::MissingFeatures {
+                name: info.name.clone(),
+                missing: info.missing.join(", "),
+            });
+        }
+        // SAFETY: the physical device belongs to the instance (found among its devices).
+        let families = unsafe {
+            instance
+                .raw
+                .get_physical_device_queue_family_properties(info.physical)
+        };
+        let family_ok = families.get(host.queue_family as usize).is_some_and(|q| {
+            q.queue_flags
+                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+        });
+        if !family_ok {
+            return Err(VkError::MissingFeatures {
+                name: info.name.clone(),
+                missing: format!(
+                    "queue family {} with graphics and compute (the host's queue)",
+                    host.queue_family
+                ),
+            });
+        }
+        info.queue_family = Some(host.queue_family);
+        info.caps.pipeline_statistics_query &= host.pipeline_statistics_query;
+        info.caps.vertex_pipeline_stores_and_atomics &= host.vertex_pipeline_stores_and_atomics;
+        let xfb = info.caps.transform_feedback && host.transform_feedback;
+        info.caps.transform_feedback = xfb;
+        // SAFETY: the caller's contract: a live device of this instance.
+        let raw = unsafe { ash::Device::load(instance.raw.fp_v1_0(), host.device) };
+        let owned = Owned {
+            raw,
+            destroy: false,
+        };
+        Self::wrap(instance, info, owned, host.queue, xfb, None)
+    }
+
+    /// Everything after the device and its queue exist, for both owners.
+    fn wrap(
+        instance: &Arc<Instance>,
+        info: AdapterInfo,
+        owned: Owned,
+        queue: vk::Queue,
+        xfb: bool,
+        pipeline_cache_path: Option<std::path::PathBuf>,
+    ) -> Result<Self> {
+        let Owned { raw, destroy: owns } = owned;
+        let physical = info.physical;
+        let queue_family = info
+            .queue_family
+            .ok_or_else(|| VkError::NoSuitableDevice("no queue".into()))?;
         let allocator = Allocator::new(&AllocatorCreateDesc {
             instance: instance.raw.clone(),
             device: raw.clone(),
@@ -505,8 +619,10 @@ impl Device {
         let allocator = match allocator {
             Ok(a) => a,
             Err(e) => {
-                // SAFETY: nothing was created on the device yet.
-                unsafe { raw.destroy_device(None) };
+                if owns {
+                    // SAFETY: nothing was created on the device yet.
+                    unsafe { raw.destroy_device(None) };
+                }
                 return Err(e.into());
             }
         };
@@ -519,16 +635,17 @@ impl Device {
             Ok(s) => s,
             Err(result) => {
                 drop(allocator);
-                // SAFETY: nothing else was created on the device yet.
-                unsafe { raw.destroy_device(None) };
+                if owns {
+                    // SAFETY: nothing else was created on the device yet.
+                    unsafe { raw.destroy_device(None) };
+                }
                 return Err(VkError::Call {
                     call: "vkCreateSemaphore",
                     result,
                 });
             }
         };
-        let initial = desc
-            .pipeline_cache_path
+        let initial = pipeline_cache_path
             .as_ref()
             .and_then(|p| std::fs::read(p).ok())
             .unwrap_or_default();
@@ -567,7 +684,8 @@ impl Device {
             retired: Mutex::new(RetireQueue::default()),
             live: AtomicU64::new(0),
             pipeline_cache,
-            pipeline_cache_path: desc.pipeline_cache_path.clone(),
+            pipeline_cache_path,
+            owns_device: owns,
             instance: instance.clone(),
         };
         let device = Device {
@@ -693,7 +811,14 @@ impl Drop for DeviceShared {
         // in the retire queue; after the idle wait no submission is pending, so those and the
         // one-shot pools are unused. Children go before the device, the allocator too.
         unsafe {
-            let _ = self.raw.device_wait_idle();
+            if self.owns_device {
+                let _ = self.raw.device_wait_idle();
+            } else {
+                // A host's device: wait for vk-core's own submissions only; what the host
+                // recorded is the host's to have waited for (Encoder::record_into).
+                let submitted = self.retired.get_mut().map(|q| q.submitted).unwrap_or(0);
+                let _ = self.wait_serial(submitted);
+            }
             let waiting = match self.retired.get_mut() {
                 Ok(q) => std::mem::take(&mut q.waiting),
                 Err(p) => std::mem::take(&mut p.into_inner().waiting),
@@ -725,7 +850,9 @@ impl Drop for DeviceShared {
                 }
             }
             ManuallyDrop::drop(&mut self.allocator);
-            self.raw.destroy_device(None);
+            if self.owns_device {
+                self.raw.destroy_device(None);
+            }
         }
     }
 }

@@ -59,6 +59,9 @@ pub(crate) enum Origin {
     Unwaited { pool: vk::CommandPool },
     /// A swapchain slot's command buffer (the swapchain resets it).
     Frame,
+    /// A command buffer a host application owns, begun, ended and submitted by it
+    /// ([`Encoder::record_into`]): the encoder only records.
+    Host,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -66,6 +69,9 @@ enum ScopeKind {
     Offscreen(vk::Image),
     Frame,
     Empty,
+    /// A rendering scope the host began before handing its command buffer over, and ends
+    /// after [`Encoder::finish`]: nothing in vk-core ends it.
+    Host,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -138,7 +144,65 @@ impl<'a> Encoder<'a> {
             )
         }
         .ctx("vkBeginCommandBuffer")?;
-        Ok(Self {
+        Ok(Self::recording(device, cmd, origin))
+    }
+
+    /// Records into `cmd`, a command buffer a host application owns and submits itself (the
+    /// C ABI's host-owned mode): the encoder neither begins, ends, submits nor resets it, and
+    /// is closed with [`Encoder::finish`]. With `scope`, the host has begun a dynamic-rendering
+    /// scope with those (colour, depth) formats, which draws are checked against; the host
+    /// also set the viewport and scissor (every vk-core pipeline takes them as dynamic state).
+    ///
+    /// # Safety
+    /// - `cmd` is a primary command buffer of `device`, in the recording state, that nothing
+    ///   else records into, resets or frees until the encoder is finished or dropped.
+    /// - With `scope`, `cmd` is inside a rendering scope begun with dynamic rendering, with
+    ///   exactly those attachment formats (`UNDEFINED` where there is no attachment), viewport
+    ///   and scissor set; without, it is outside any rendering scope.
+    /// - Everything the recording references stays alive until the GPU finished executing
+    ///   `cmd`. vk-core cannot see the host's submissions, so its retire queue does not cover
+    ///   them: the caller destroys what it recorded only after the host waited for them.
+    pub unsafe fn record_into(
+        device: &Device,
+        cmd: vk::CommandBuffer,
+        scope: Option<[vk::Format; 2]>,
+    ) -> Self {
+        let mut e = Self::recording(device, cmd, Origin::Host);
+        if let Some(formats) = scope {
+            e.open_scope("host rendering scope", ScopeKind::Host, formats);
+        }
+        e
+    }
+
+    /// Closes an encoder of [`Encoder::record_into`]: the host's scope (if any) is left open
+    /// for the host to end. Returns the first misuse recorded, or what was left open inside
+    /// (a query, transform feedback, a label, a scope of vk-core's own).
+    pub fn finish(mut self) -> Result<()> {
+        if !matches!(self.origin, Some(Origin::Host)) {
+            return Err(VkError::recording("finish", E::Exchanged));
+        }
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        if self.scope.is_some_and(|s| s.kind == ScopeKind::Host) {
+            if self.transform_feedback {
+                return Err(VkError::recording(
+                    "finish",
+                    E::Unclosed {
+                        open: "transform feedback",
+                    },
+                ));
+            }
+            self.scope = None;
+        }
+        match self.take_unready() {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
+    fn recording(device: &Device, cmd: vk::CommandBuffer, origin: Origin) -> Self {
+        Self {
             device: device.clone(),
             cmd,
             origin: Some(origin),
@@ -155,7 +219,7 @@ impl<'a> Encoder<'a> {
             labels: 0,
             error: None,
             _single_thread: PhantomData,
-        })
+        }
     }
 
     pub(crate) fn id(&self) -> u64 {
@@ -996,7 +1060,8 @@ impl<'a> Encoder<'a> {
             self.defer(command, E::OutsideRendering);
             return false;
         };
-        if kind.is_some_and(|k| k != scope.kind) {
+        // The host's scope is the host's to end (after `finish`).
+        if kind.is_some_and(|k| k != scope.kind) || scope.kind == ScopeKind::Host {
             self.defer(command, E::WrongRenderingScope);
             return false;
         }

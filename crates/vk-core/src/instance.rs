@@ -81,6 +81,8 @@ pub struct Instance {
     pub entry: ash::Entry,
     pub api_version: u32,
     pub has_debug_utils: bool,
+    /// False for a host application's instance ([`Instance::from_host`]): never destroyed here.
+    owned: bool,
 }
 
 unsafe extern "system" fn debug_callback(
@@ -234,6 +236,46 @@ impl Instance {
             entry,
             api_version,
             has_debug_utils,
+            owned: true,
+        }))
+    }
+
+    /// Wraps a host application's instance (the C ABI's host-owned mode) without taking
+    /// ownership: dropping the result destroys nothing. Vulkan is reached through the host's
+    /// `vkGetInstanceProcAddr`, so its loader and layers are the host's; validation messages go
+    /// to the host's own messenger, and [`Instance::messages`] stays empty.
+    ///
+    /// # Safety
+    /// - `get_instance_proc_addr` is a `vkGetInstanceProcAddr` and `raw` a live instance it
+    ///   serves, created for Vulkan 1.3 or later.
+    /// - `raw` outlives the returned instance and every device made from it.
+    /// - `debug_utils` is true only when VK_EXT_debug_utils was enabled on `raw`.
+    pub unsafe fn from_host(
+        get_instance_proc_addr: vk::PFN_vkGetInstanceProcAddr,
+        raw: vk::Instance,
+        debug_utils: bool,
+    ) -> Result<Arc<Self>> {
+        // SAFETY: the caller's contract: a vkGetInstanceProcAddr with the Vulkan ABI.
+        let entry = unsafe {
+            ash::Entry::from_static_fn(ash::StaticFn {
+                get_instance_proc_addr,
+            })
+        };
+        // SAFETY: the caller's contract: `raw` is a live instance of this entry point.
+        let raw = unsafe { ash::Instance::load(entry.static_fn(), raw) };
+        // SAFETY: entry is valid.
+        let api_version = unsafe { entry.try_enumerate_instance_version() }
+            .ctx("vkEnumerateInstanceVersion")?
+            .unwrap_or(vk::API_VERSION_1_0);
+        Ok(Arc::new(Self {
+            debug: None,
+            messages: Arc::new(MessageCounts::default()),
+            validation: Validation::Off,
+            raw,
+            entry,
+            api_version,
+            has_debug_utils: debug_utils,
+            owned: false,
         }))
     }
 
@@ -254,7 +296,9 @@ impl Drop for Instance {
             if let Some((loader, m)) = self.debug.take() {
                 loader.destroy_debug_utils_messenger(m, None);
             }
-            self.raw.destroy_instance(None);
+            if self.owned {
+                self.raw.destroy_instance(None);
+            }
         }
     }
 }

@@ -14,6 +14,10 @@
 //!   and why its safe methods uphold them; crates above vk-core need no `unsafe`.
 //! - Objects are destroyed through the device's retire queue ([`retire`]): never while a
 //!   submission that could use them is pending, so frames need not be waited for.
+//! - A host application's instance and device (the C ABI's host-owned mode) are wrapped, not
+//!   owned ([`Instance::from_host`], [`Device::from_host`]: loaded through the host's
+//!   `vkGetInstanceProcAddr`, never destroyed or waited idle), and [`Encoder::record_into`]
+//!   records into the host's command buffers, inside its rendering scope, without submitting.
 //! - Every handle vk-core creates is counted where it is created and where it is destroyed
 //!   ([`DeviceShared::live_objects`]), next to gpu-allocator's bytes
 //!   ([`DeviceShared::allocated_bytes`]): soak runs assert both constant after warm-up.
@@ -39,7 +43,7 @@ mod tests;
 pub use ash::vk;
 pub use buffer::{Buffer, BufferDesc};
 pub use descriptor::{BindingDesc, DescriptorPool, DescriptorSet, DescriptorSetLayout};
-pub use device::{AdapterInfo, Device, DeviceDesc, DeviceSelector, DeviceShared};
+pub use device::{AdapterInfo, Device, DeviceDesc, DeviceSelector, DeviceShared, HostDevice};
 pub use encoder::{Encoder, Submission};
 pub use error::{DescriptorError, RecordingError, Result, VkError};
 pub use gpu_allocator::MemoryLocation;

@@ -15,7 +15,7 @@ use topology::ControlMesh;
 use vk_core::{vk, Buffer, Device, Encoder};
 
 /// What distinguishes flat, Phong and PN.
-pub trait FaceStyle: 'static {
+pub trait FaceStyle: Send + 'static {
     const ID: TechniqueId;
     /// Flat keeps quads as quad patches; the others draw every face's fan triangles.
     const QUADS: bool;

@@ -1,0 +1,85 @@
+//! Capture through the C ABI: what the GPU's tessellation emitted for one frame, written as
+//! OBJ (as `tessera export` writes it), one face per reported triangle.
+use std::ffi::CString;
+use std::ptr::{null, null_mut};
+use tessera_capi::*;
+
+#[test]
+fn capture_writes_the_triangles_the_gpu_drew() {
+    let dir = std::env::temp_dir().join(format!("tessera-capi-capture-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("spot_flat.obj");
+    let c_path = CString::new(path.to_str().unwrap()).unwrap();
+    // SAFETY: every pointer is null or addresses a live local of the type the call reads.
+    unsafe {
+        let desc = TesseraStandaloneDesc {
+            device: null(),
+            validation: TESSERA_VALIDATION_ON,
+        };
+        let mut ctx = null_mut();
+        assert_eq!(
+            tessera_context_create_standalone(&desc, &mut ctx),
+            TesseraStatus::Ok
+        );
+        let mut sdesc = std::mem::MaybeUninit::uninit();
+        assert_eq!(
+            tessera_surface_desc_default(sdesc.as_mut_ptr()),
+            TesseraStatus::Ok
+        );
+        let mut sdesc = sdesc.assume_init();
+        sdesc.technique = TESSERA_TECHNIQUE_FLAT;
+        let mut surface = null_mut();
+        assert_eq!(
+            tessera_surface_create_obj(ctx, null(), 0, null(), &sdesc, &mut surface),
+            TesseraStatus::Ok
+        );
+        let mut frame = std::mem::MaybeUninit::uninit();
+        assert_eq!(
+            tessera_frame_desc_default(frame.as_mut_ptr()),
+            TesseraStatus::Ok
+        );
+        let mut frame = frame.assume_init();
+        frame.factor = 2.0;
+        let mut triangles = 0u64;
+        let status = tessera_capture_obj(ctx, surface, &frame, c_path.as_ptr(), &mut triangles);
+        let mut buf = vec![0 as std::ffi::c_char; 512];
+        tessera_last_error(ctx, buf.as_mut_ptr(), buf.len());
+        assert_eq!(
+            status,
+            TesseraStatus::Ok,
+            "{:?}",
+            std::ffi::CStr::from_ptr(buf.as_ptr())
+        );
+        let mut vertices = 0usize;
+        assert_eq!(
+            tessera_surface_info(ctx, surface, &mut vertices, null_mut(), null_mut()),
+            TesseraStatus::Ok
+        );
+        let text = std::fs::read_to_string(&path).unwrap();
+        let faces = text.lines().filter(|l| l.starts_with("f ")).count() as u64;
+        assert_eq!(faces, triangles, "OBJ faces and the reported count");
+        // spot's control mesh is mostly quads (2·2² triangles each at 2 segments), plus a few
+        // triangles and fan-triangulated pentagons that add more.
+        let text_mesh = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../assets/spot_control_mesh.obj"
+        ))
+        .unwrap();
+        let quads = text_mesh
+            .lines()
+            .filter(|l| l.starts_with("f ") && l.split_whitespace().count() == 5)
+            .count() as u64;
+        assert!(
+            triangles > quads * 8,
+            "{triangles} triangles for {quads} quads"
+        );
+        let mut errors = 1;
+        assert_eq!(
+            tessera_context_validation_errors(ctx, &mut errors),
+            TesseraStatus::Ok
+        );
+        assert_eq!(errors, 0);
+        assert_eq!(tessera_context_destroy(ctx), TesseraStatus::Ok);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,112 @@
+//! Shared by the C ABI's tests: where cargo put the library, how to build C/C++ against it,
+//! and the Rust-side reference render the C and C++ images are compared with.
+#![allow(dead_code)]
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// `target/<profile>`: the directory holding this test's `deps/` (and the cdylib).
+pub fn profile_dir() -> PathBuf {
+    let exe = std::env::current_exe().expect("test executable path");
+    exe.parent()
+        .and_then(Path::parent)
+        .expect("target/<profile>/deps/<test>")
+        .to_path_buf()
+}
+
+/// The cdylib, next to this test's profile directory. `cargo test` links tests against the
+/// rlib only, so the test asks cargo for the cdylib (already built: a no-op) into the same
+/// target directory; the outer cargo holds no lock while tests run.
+pub fn library() -> PathBuf {
+    static BUILT: std::sync::Once = std::sync::Once::new();
+    let profile = profile_dir();
+    BUILT.call_once(|| {
+        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+        run(Command::new(cargo)
+            .args(["build", "-p", "tessera-capi", "--lib"])
+            .arg("--target-dir")
+            .arg(profile.parent().expect("target directory"))
+            .current_dir(repo()));
+    });
+    let lib = profile.join("libtessera_capi.so");
+    assert!(lib.exists(), "{} was not built", lib.display());
+    lib
+}
+
+pub fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// A fresh directory under the target directory (never the source tree).
+pub fn scratch(name: &str) -> PathBuf {
+    let d = profile_dir().join("capi-tests").join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Runs `cmd`, failing the test with its output when it fails.
+pub fn run(cmd: &mut Command) -> String {
+    let out = cmd
+        .output()
+        .unwrap_or_else(|e| panic!("{cmd:?}: cannot start: {e}"));
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        out.status.success(),
+        "{cmd:?} failed ({}):\n{text}",
+        out.status
+    );
+    text
+}
+
+/// The golden tolerance of the root crate's tests/golden.rs: a pixel differs when a channel
+/// moves by more than 24/255; images match when at most 0.5% of pixels differ.
+pub fn differing_fraction(a: &[u8], b: &[u8], pixels: usize) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let n = a
+        .chunks(4)
+        .zip(b.chunks(4))
+        .filter(|(p, q)| p.iter().zip(q.iter()).any(|(x, y)| x.abs_diff(*y) > 24))
+        .count();
+    n as f64 / pixels as f64
+}
+pub const TOLERANCE: f64 = 0.005;
+
+/// Renders spot (the embedded mesh) with `technique` through tess directly, as `tessera
+/// render --method NAME --level 4` does, on a validated device of our own.
+pub fn reference(technique: tess::TechniqueId, width: u32, height: u32) -> Vec<u8> {
+    use vk_core::{Device, DeviceDesc, Instance, InstanceDesc, Validation};
+    let instance = Instance::new(&InstanceDesc {
+        app_name: "tessera-capi reference".into(),
+        validation: Validation::On,
+        surface_extensions: vec![],
+    })
+    .expect("Vulkan instance");
+    let device = Device::new(&instance, &DeviceDesc::default(), &[]).expect("device");
+    let text = std::fs::read_to_string(repo().join("assets/spot_control_mesh.obj")).unwrap();
+    let mesh = topology::parse_obj(&text, "spot").unwrap();
+    let pixels = {
+        let mut ctx = tess::Context::offscreen(&device).unwrap();
+        let built = tess::build(&mut ctx, technique, &mesh, &tess::BuildOptions::default())
+            .unwrap_or_else(|e| panic!("{technique}: {e}"));
+        let params = tess::FrameParams::uniform(4.0);
+        ctx.render_offscreen(
+            built.technique.as_ref(),
+            &params,
+            vk_core::vk::Extent2D { width, height },
+        )
+        .unwrap()
+        .pixels
+    };
+    drop(device);
+    assert_eq!(
+        instance.messages().error_count(),
+        0,
+        "{:?}",
+        instance.messages().error_messages()
+    );
+    pixels
+}
