@@ -113,32 +113,35 @@ uint bft_row(uint face, uint a, uint b, out bool flip) {
 
 // Sums one row's weights over the face's ring, slot by slot (one code path, `precise`, so two
 // faces evaluating the same owner row produce the same bits). p: position; q: subdivision-
-// shading normal, or du when geometric; r: dv when geometric.
+// shading normal, or du when geometric; r: dv when geometric. One weight block a pass
+// (position, then du and dv when geometric), as bft_accumulate_patch sums them: lavapipe runs
+// a branch's reads even where no lane takes it, so a loop whose trip count the push constants
+// fix costs less than du/dv reads behind an `if` in every slot.
 void bft_accumulate_global(uint face, uint row, bool flip, bool geometric,
                            out vec3 p, out vec3 q, out vec3 r) {
     uint ring = PATCH(face).ring_offset;
     uint rs = PATCH(face).ring_size;
     uint entry = PATCH(face).entry;
     uint perm = table_entries[entry].perm_offset;
-    uint off_pos = table_entries[entry].position_offset;
-    uint off_du = flip ? table_entries[entry].dv_offset : table_entries[entry].du_offset;
-    uint off_dv = flip ? table_entries[entry].du_offset : table_entries[entry].dv_offset;
-    precise vec3 ap = vec3(0.0), aq = vec3(0.0), ar = vec3(0.0);
-    for (uint s = 0u; s < rs; ++s) {
-        uint slot = flip ? mirror_perms[perm + s] : s;
-        uint base = row * rs + slot;
-        uint v = RING(ring + s);
-        vec3 x = L1_POS(v).xyz;
-        float w = table_weights[off_pos + base];
-        ap += w * x;
-        if (geometric) {
-            aq += table_weights[off_du + base] * x;
-            ar += table_weights[off_dv + base] * x;
-        } else {
-            aq += w * L1_NRM(v).xyz;
+    p = vec3(0.0); q = vec3(0.0); r = vec3(0.0);
+    precise vec3 an = vec3(0.0);
+    uint blocks = geometric ? 3u : 1u;
+    for (uint blk = 0u; blk < blocks; ++blk) {
+        // du and dv exchange under the mirror.
+        uint which = blk == 0u ? 0u : (flip ? 3u - blk : blk);
+        uint off = (which == 0u ? table_entries[entry].position_offset
+                    : (which == 1u ? table_entries[entry].du_offset : table_entries[entry].dv_offset)) + row * rs;
+        precise vec3 a = vec3(0.0);
+        for (uint s = 0u; s < rs; ++s) {
+            uint slot = flip ? mirror_perms[perm + s] : s;
+            uint v = RING(ring + s);
+            float w = table_weights[off + slot];
+            a += w * L1_POS(v).xyz;
+            if (!geometric) an += w * L1_NRM(v).xyz;
         }
+        if (blk == 0u) p = a; else if (blk == 1u) q = a; else r = a;
     }
-    p = ap; q = aq; r = ar;
+    if (!geometric) q = an;
 }
 
 // The patch block: what the TCS gathers once per patch for the TES (lavapipe runs the TES on
@@ -173,9 +176,7 @@ float bft_gathered(uint k) { return tc_ring[k >> 2u][k & 3u]; }
 
 // bft_accumulate_global over the gathered ring of this patch: the same products summed in the
 // same order, so the bits equal the global path's (a neighbour evaluating this patch's edge
-// through the global buffers gets the same point). One weight block a pass (position, then du
-// and dv when geometric): lavapipe runs a branch's loads even where no lane takes it, so a
-// loop whose trip count the push constants fix costs less than the du/dv loads behind an `if`.
+// through the global buffers gets the same point).
 void bft_accumulate_patch(uint row, bool flip, bool geometric,
                           out vec3 p, out vec3 q, out vec3 r) {
     uint rs = tc_head.y & BFT_INFO_RING_MASK;
