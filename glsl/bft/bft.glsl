@@ -93,12 +93,9 @@ const uint NO_ROW = 0xffffffffu;
 uint owner_face(uint owner) { return owner >> BFT_OWNER_SHIFT; }
 uint owner_local(uint owner) { return owner & uint(BFT_OWNER_LOCAL_MASK); }
 
-// Row of grid point (a, b) in the face's table and whether the slots are mirrored; NO_ROW when
-// the point carries no row.
-uint bft_row(uint face, uint a, uint b, out bool flip) {
-    bool mirrored = PATCH(face).mirrored != 0u;
-    uint entry = PATCH(face).entry;
-    bool half_table = table_entries[entry].half_table != 0u;
+// Row of grid point (a, b) in a table (mirrored: the face is the table's mirror image; half:
+// only a >= b is stored) and whether the slots are mirrored; NO_ROW when the point has no row.
+uint bft_row_of(bool mirrored, bool half_table, uint a, uint b, out bool flip) {
     uint grid = table.grid;
     flip = mirrored;
     if (mirrored) { uint t = a; a = b; b = t; }
@@ -107,34 +104,121 @@ uint bft_row(uint face, uint a, uint b, out bool flip) {
     return row_maps[map + a * (grid + 1u) + b];
 }
 
+// bft_row_of for `face`, its table read from the headers.
+uint bft_row(uint face, uint a, uint b, out bool flip) {
+    bool mirrored = PATCH(face).mirrored != 0u;
+    bool half_table = table_entries[PATCH(face).entry].half_table != 0u;
+    return bft_row_of(mirrored, half_table, a, b, flip);
+}
+
 // Sums one row's weights over the face's ring, slot by slot (one code path, `precise`, so two
 // faces evaluating the same owner row produce the same bits). p: position; q: subdivision-
-// shading normal, or du when geometric; r: dv when geometric.
-void bft_accumulate(uint face, uint row, bool flip, bool geometric,
-                    out vec3 p, out vec3 q, out vec3 r) {
+// shading normal, or du when geometric; r: dv when geometric. One weight block a pass
+// (position, then du and dv when geometric), as bft_accumulate_patch sums them: lavapipe runs
+// a branch's reads even where no lane takes it, so a loop whose trip count the push constants
+// fix costs less than du/dv reads behind an `if` in every slot.
+void bft_accumulate_global(uint face, uint row, bool flip, bool geometric,
+                           out vec3 p, out vec3 q, out vec3 r) {
     uint ring = PATCH(face).ring_offset;
     uint rs = PATCH(face).ring_size;
     uint entry = PATCH(face).entry;
     uint perm = table_entries[entry].perm_offset;
-    uint off_pos = table_entries[entry].position_offset;
-    uint off_du = flip ? table_entries[entry].dv_offset : table_entries[entry].du_offset;
-    uint off_dv = flip ? table_entries[entry].du_offset : table_entries[entry].dv_offset;
-    precise vec3 ap = vec3(0.0), aq = vec3(0.0), ar = vec3(0.0);
-    for (uint s = 0u; s < rs; ++s) {
-        uint slot = flip ? mirror_perms[perm + s] : s;
-        uint base = row * rs + slot;
-        uint v = RING(ring + s);
-        vec3 x = L1_POS(v).xyz;
-        float w = table_weights[off_pos + base];
-        ap += w * x;
-        if (geometric) {
-            aq += table_weights[off_du + base] * x;
-            ar += table_weights[off_dv + base] * x;
-        } else {
-            aq += w * L1_NRM(v).xyz;
+    p = vec3(0.0); q = vec3(0.0); r = vec3(0.0);
+    precise vec3 an = vec3(0.0);
+    uint blocks = geometric ? 3u : 1u;
+    for (uint blk = 0u; blk < blocks; ++blk) {
+        // du and dv exchange under the mirror.
+        uint which = blk == 0u ? 0u : (flip ? 3u - blk : blk);
+        uint off = (which == 0u ? table_entries[entry].position_offset
+                    : (which == 1u ? table_entries[entry].du_offset : table_entries[entry].dv_offset)) + row * rs;
+        precise vec3 a = vec3(0.0);
+        for (uint s = 0u; s < rs; ++s) {
+            uint slot = flip ? mirror_perms[perm + s] : s;
+            uint v = RING(ring + s);
+            float w = table_weights[off + slot];
+            a += w * L1_POS(v).xyz;
+            if (!geometric) an += w * L1_NRM(v).xyz;
         }
+        if (blk == 0u) p = a; else if (blk == 1u) q = a; else r = a;
     }
-    p = ap; q = aq; r = ar;
+    if (!geometric) q = an;
+}
+
+// The patch block: what the TCS gathers once per patch for the TES (lavapipe runs the TES on
+// the CPU, where every storage-buffer read indexed by the patch is a per-lane gather while a
+// patch input is one load for all of the patch's vertices). Header words, the slot
+// permutation (5 bits a slot), then per ring slot its level-1 position and normal (6 floats),
+// for rings of at most BFT_GATHER_SLOTS slots (valence 12 at an extraordinary vertex); larger
+// rings read the global buffers. 29 locations, 116 components: within the 120 per-patch
+// output components every Vulkan device has.
+#define BFT_GATHER_SLOTS 18u
+#define BFT_GATHER_VEC4 27
+#define BFT_INFO_RING_MASK 0xffu
+#define BFT_INFO_MIRRORED 0x100u
+#define BFT_INFO_HALF 0x200u
+#define BFT_INFO_GATHERED 0x400u
+#define BFT_INFO_KIND_SHIFT 12u
+#if defined(BFT_PATCH_OUT)
+#define BFT_PATCH_QUALIFIER patch out
+#elif defined(BFT_PATCH_IN)
+#define BFT_PATCH_QUALIFIER patch in
+#endif
+#ifdef BFT_PATCH_QUALIFIER
+// x: face, y: info (ring size, BFT_INFO_* bits, kind), z: position_offset, w: du_offset.
+layout(location = 0) BFT_PATCH_QUALIFIER uvec4 tc_head;
+// x: dv_offset, y..w: the mirror permutation, six 5-bit slots a word.
+layout(location = 1) BFT_PATCH_QUALIFIER uvec4 tc_aux;
+layout(location = 2) BFT_PATCH_QUALIFIER vec4 tc_ring[BFT_GATHER_VEC4];
+#endif
+
+#ifdef BFT_PATCH_IN
+float bft_gathered(uint k) { return tc_ring[k >> 2u][k & 3u]; }
+
+// bft_accumulate_global over the gathered ring of this patch: the same products summed in the
+// same order, so the bits equal the global path's (a neighbour evaluating this patch's edge
+// through the global buffers gets the same point).
+void bft_accumulate_patch(uint row, bool flip, bool geometric,
+                          out vec3 p, out vec3 q, out vec3 r) {
+    uint rs = tc_head.y & BFT_INFO_RING_MASK;
+    uint off_du = flip ? tc_aux.x : tc_head.w;
+    uint off_dv = flip ? tc_head.w : tc_aux.x;
+    p = vec3(0.0); q = vec3(0.0); r = vec3(0.0);
+    precise vec3 an = vec3(0.0);
+    uint blocks = geometric ? 3u : 1u;
+    for (uint blk = 0u; blk < blocks; ++blk) {
+        uint off = (blk == 0u ? tc_head.z : (blk == 1u ? off_du : off_dv)) + row * rs;
+        precise vec3 a = vec3(0.0);
+        [[unroll]] for (uint s = 0u; s < BFT_GATHER_SLOTS; ++s) {
+            if (s < rs) {
+                uint mirrored_slot = (tc_aux[1u + s / 6u] >> (5u * (s % 6u))) & 31u;
+                vec3 x = vec3(bft_gathered(6u * s), bft_gathered(6u * s + 1u), bft_gathered(6u * s + 2u));
+                float w = table_weights[off + (flip ? mirrored_slot : s)];
+                a += w * x;
+                an += w * vec3(bft_gathered(6u * s + 3u), bft_gathered(6u * s + 4u), bft_gathered(6u * s + 5u));
+            }
+        }
+        if (blk == 0u) p = a; else if (blk == 1u) q = a; else r = a;
+    }
+    if (!geometric) q = an;
+}
+
+// One row of face g: from the patch block when g is this patch and its ring was gathered,
+// else from the global buffers (the same arithmetic either way).
+uint bft_row_at(uint g, bool local, uint a, uint b, out bool flip) {
+    if (local) {
+        uint info = tc_head.y;
+        return bft_row_of((info & BFT_INFO_MIRRORED) != 0u, (info & BFT_INFO_HALF) != 0u, a, b, flip);
+    }
+    return bft_row(g, a, b, flip);
+}
+
+void bft_accumulate(uint g, bool local, uint row, bool flip, bool geometric,
+                    out vec3 p, out vec3 q, out vec3 r) {
+    if (local) {
+        bft_accumulate_patch(row, flip, geometric, p, q, r);
+    } else {
+        bft_accumulate_global(g, row, flip, geometric, p, q, r);
+    }
 }
 
 // The limit point (and normal source) at tess coordinate b (weights of v0, v1, v2) of `face`.
@@ -162,16 +246,31 @@ bool bft_eval(uint face, vec3 b, bool geometric, out vec3 p, out vec3 n) {
         u = ge == 0u ? t : (ge == 1u ? 1.0 - t : 0.0);
         v = ge == 0u ? 0.0 : (ge == 1u ? t : 1.0 - t);
     }
+    bool local = g == face && (tc_head.y & BFT_INFO_GATHERED) != 0u;
     float grid = float(table.grid);
     float nseg = float(table.segments);
     vec2 ga = vec2(u, v) * grid;
     vec2 ra = floor(ga + 0.5);
     vec3 q, r;
+#ifdef SPACING_EQUAL
+    // Equal spacing: the factors are powers of two (bft.tesc), so every point is a table point
+    // and the virtual-mesh interpolation below is not compiled (lavapipe runs both sides of a
+    // branch, masked: the interpolation's three rows cost three times the one row). A point
+    // without a row (none is made; validate() proves every dyadic point has one) takes the
+    // first row (a finite point, flagged inexact) rather than paying a second lookup per vertex.
+    bool flip;
+    uint row = bft_row_at(g, local, uint(ra.x), uint(ra.y), flip);
+    bool exact = row != NO_ROW && all(lessThan(abs(ga - ra), vec2(0.02)));
+    if (row == NO_ROW) row = 0u;
+    bft_accumulate(g, local, row, flip, geometric, p, q, r);
+    n = geometric ? cross(q, r) : q;
+    return exact;
+#else
     if (all(lessThan(abs(ga - ra), vec2(0.02)))) {
         bool flip;
-        uint row = bft_row(g, uint(ra.x), uint(ra.y), flip);
+        uint row = bft_row_at(g, local, uint(ra.x), uint(ra.y), flip);
         if (row != NO_ROW) {
-            bft_accumulate(g, row, flip, geometric, p, q, r);
+            bft_accumulate(g, local, row, flip, geometric, p, q, r);
             n = geometric ? cross(q, r) : q;
             return true;
         }
@@ -193,9 +292,9 @@ bool bft_eval(uint face, vec3 b, bool geometric, out vec3 p, out vec3 n) {
     uvec2 cs[3] = uvec2[3](c0, c1, c2);
     for (int k = 0; k < 3; ++k) {
         bool flip;
-        uint row = bft_row(g, 3u * cs[k].x, 3u * cs[k].y, flip);
+        uint row = bft_row_at(g, local, 3u * cs[k].x, 3u * cs[k].y, flip);
         vec3 pk, qk, rk;
-        bft_accumulate(g, row, flip, geometric, pk, qk, rk);
+        bft_accumulate(g, local, row, flip, geometric, pk, qk, rk);
         sp += w[k] * pk;
         sq += w[k] * qk;
         sr += w[k] * rk;
@@ -203,4 +302,6 @@ bool bft_eval(uint face, vec3 b, bool geometric, out vec3 p, out vec3 n) {
     p = sp;
     n = geometric ? cross(sq, sr) : sq;
     return false;
+#endif
 }
+#endif

@@ -616,7 +616,9 @@ impl GpuBft {
     /// The TES of `glsl/bft/bft.tese` in f32, for tess coordinate `b` (weights of the patch's
     /// `v0`, `v1`, `v2`) of patch `face`: points on an edge or corner are evaluated by the
     /// owner in its frame, table points exactly, other points by linear interpolation on the
-    /// level-`L` lattice. `pos`/`nrm`: level-1 positions and normals (`w` unused).
+    /// level-`L` lattice. `pos`/`nrm`: level-1 positions and normals (`w` unused). The shader
+    /// sums a row from its patch block or from the global buffers, both in this slot order;
+    /// its equal-spacing variant makes only table points, where it equals this.
     pub fn eval_tess(
         &self,
         pos: &[Level1Point],

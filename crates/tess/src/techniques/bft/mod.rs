@@ -10,6 +10,17 @@
 //!    only; `bft.tese` evaluates the table row of each tess coordinate (see
 //!    `glsl/bft/bft.glsl`, mirrored in f32 by [`layout::GpuBft::eval_tess`]).
 //!
+//! **Cost on a CPU driver** (issue 16; lavapipe runs the TES on the CPU, eight vertices a SIMD
+//! batch, and executes both sides of every branch, masked): a storage-buffer read indexed by
+//! the patch is a per-lane loop there, a patch input one load for the whole patch. So the TCS
+//! gathers the patch's header words, mirror permutation and ring (level-1 positions and
+//! normals, rings up to 18 slots) into a patch block once, and the TES sums each row from it;
+//! only points on an edge or corner owned by another face (and rings past 18 slots) read the
+//! global buffers, with the same products in the same order, so shared points keep their bits.
+//! The equal-spacing TES variant (power-of-two factors: every point is a table point) compiles
+//! out the fractional path's virtual-mesh interpolation, whose three rows it would otherwise
+//! run masked for every vertex.
+//!
 //! The GPU data (named structs for every buffer, bindings, packing, validation, and the f32
 //! mirror of the TES) is [`layout`].
 //!
