@@ -73,7 +73,7 @@ pub struct Hud {
     frame_ms: VecDeque<f32>,
 }
 
-/// The triangles, colours and names of the patch-colour legend of `technique` (empty when it
+/// The colours and names of the patch-colour legend of `technique` (empty when it
 /// has no patch colours).
 fn legend(technique: TechniqueId) -> &'static [([f32; 3], &'static str)] {
     match technique {
