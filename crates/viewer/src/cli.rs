@@ -316,6 +316,10 @@ pub struct ViewArgs {
     /// frames and at exit (for soak runs: tools/soak.sh).
     #[arg(long)]
     pub stats: bool,
+    /// Start with the HUD hidden (H shows it). `--screenshot` runs start with it hidden too:
+    /// their picture is the scene alone, as `tessera render` draws it.
+    #[arg(long)]
+    pub no_hud: bool,
 }
 
 fn parse_spacing(s: &str) -> Result<Spacing, String> {

@@ -14,6 +14,7 @@ mod bench;
 mod cli;
 mod commands;
 mod export;
+mod hud;
 mod plot;
 mod progress;
 mod technique;

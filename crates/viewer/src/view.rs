@@ -10,6 +10,14 @@
 //! mesh. Esc quits. The title shows what is drawn and the frame time. `--frames N --screenshot
 //! out.png` renders N frames, saves the last and exits.
 //!
+//! The HUD (crate::hud, drawn through vk-core's overlay) shows the technique, its scheme, the
+//! factor policy, the options and the patch-colour legend, the triangles and patches drawn, the
+//! GPU time of each pass (timestamp queries, one pool per frame slot, read when the slot comes
+//! round again, so never waited for) and a frame-time graph; each key has a control in it. H
+//! hides and shows it. Screenshots are of the window as shown: with the HUD when it is shown.
+//! It starts hidden with `--no-hud` and in `--screenshot` runs, whose picture is the scene alone
+//! (as `tessera render` draws it).
+//!
 //! What the user does in the window never ends it with an error: a technique that cannot be
 //! built for the mesh (after a key) or a dropped file that cannot be read or built is reported
 //! on stderr and in the title, and the window goes on with what it drew before. Only the first
@@ -23,6 +31,7 @@
 //! it completed (the swapchain's own objects after an idle wait in its drop).
 use crate::cli::ViewArgs;
 use crate::commands::{check_validation, load_mesh, mesh_name, open_device, scene_setup};
+use crate::hud::{Action, Hud, PassTimes, Shown};
 use crate::technique::{describe, Setup};
 use anyhow::{Context as _, Result};
 use raw_window_handle::HasDisplayHandle;
@@ -34,7 +43,7 @@ use tess::{Context, FactorPolicy, Spacing, Technique, TechniqueId};
 use topology::ControlMesh;
 use vk_core::swapchain::{required_surface_extensions, Swapchain, FRAMES_IN_FLIGHT};
 use vk_core::target::DEPTH_FORMAT;
-use vk_core::{vk, Device, Instance};
+use vk_core::{vk, Device, Instance, Overlay, OverlayDesc, QueryPool};
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
@@ -51,10 +60,24 @@ struct Surface {
     wave: Option<Wave>,
 }
 
-/// GPU state that lives while the window does. Drop order: surfaces, context, swapchain, then
-/// the device and instance; the window itself is dropped after all of them.
+/// Timestamps of one frame slot: pre-pass (0, 1), draw (2, 3), HUD (4, 5).
+const TIMESTAMPS: u32 = 6;
+
+/// One timestamp pool per frame slot, each read when its slot is acquired again (its previous
+/// frame has then completed, so the read does not wait).
+struct Timer {
+    pools: Vec<QueryPool>,
+    /// Whether the slot's pool holds a recorded frame's timestamps.
+    written: Vec<bool>,
+}
+
+/// GPU state that lives while the window does. Drop order: surfaces, overlay, timer, context,
+/// swapchain, then the device and instance; the window itself is dropped after all of them.
 struct Gpu {
     surfaces: HashMap<TechniqueId, Surface>,
+    overlay: Overlay,
+    /// `None` where the queue has no timestamps.
+    timer: Option<Timer>,
     context: Context,
     swapchain: Swapchain,
     device: Device,
@@ -92,6 +115,11 @@ struct App {
     /// When the first frame was drawn (`--stats` reports the time since).
     started: Option<Instant>,
     error: Option<anyhow::Error>,
+    hud: Option<Hud>,
+    /// Asked for by the HUD during the frame: applied once it is presented.
+    actions: Vec<Action>,
+    /// The GPU times of the last frame read back.
+    pass_times: Option<PassTimes>,
 }
 
 impl App {
@@ -123,8 +151,35 @@ impl App {
             },
         )?;
         let context = Context::new(&device, swapchain.format, DEPTH_FORMAT, FRAMES_IN_FLIGHT)?;
+        let overlay = Overlay::new(
+            &device,
+            &OverlayDesc {
+                color_format: swapchain.format,
+                depth_format: Some(DEPTH_FORMAT),
+                frames_in_flight: FRAMES_IN_FLIGHT,
+            },
+        )?;
+        let timer = if device.info.caps.timestamps {
+            let pools = (0..FRAMES_IN_FLIGHT)
+                .map(|i| {
+                    QueryPool::timestamps(&device, &format!("frame {i} timestamps"), TIMESTAMPS)
+                })
+                .collect::<vk_core::Result<Vec<_>>>()?;
+            Some(Timer {
+                written: vec![false; pools.len()],
+                pools,
+            })
+        } else {
+            None
+        };
+        self.hud = Some(Hud::new(
+            &window,
+            !self.args.no_hud && self.args.screenshot.is_none(),
+        ));
         self.gpu = Some(Gpu {
             surfaces: HashMap::new(),
+            overlay,
+            timer,
             context,
             swapchain,
             device,
@@ -233,6 +288,8 @@ impl App {
         };
         let Gpu {
             surfaces,
+            overlay,
+            timer,
             context,
             swapchain,
             device,
@@ -241,10 +298,55 @@ impl App {
         let surface = surfaces
             .get_mut(&self.setup.technique)
             .context("the surface built above")?;
+        let params = self.setup.world_params(surface.technique.bbox());
+        // Laid out before the frame is acquired: a texture change waits for the device.
+        let hud = match (&mut self.hud, &self.window) {
+            (Some(hud), Some(window)) => {
+                let technique = surface.technique.as_ref();
+                let arrays = technique.patch_arrays();
+                let shown = Shown {
+                    mesh: &self.setup.build.name,
+                    technique: self.setup.technique,
+                    params: &params,
+                    build: &self.setup.build,
+                    animate: self.setup.animate,
+                    triangles: (0..arrays.len())
+                        .map(|a| technique.triangles(&params, a))
+                        .sum(),
+                    patches: arrays.iter().map(|a| u64::from(a.patches)).sum(),
+                    gpu: self.pass_times,
+                    status: self.status.as_deref(),
+                };
+                match hud.run(window, &shown, &mut self.actions) {
+                    Some(mut out) => {
+                        overlay.update_textures(&mut out.textures_delta)?;
+                        let ppp = out.pixels_per_point;
+                        Some((hud.tessellate(out.shapes, ppp), ppp))
+                    }
+                    None => None,
+                }
+            }
+            _ => None,
+        };
         let Some(mut frame) = swapchain.acquire()? else {
             return Ok(());
         };
         let (slot, extent) = (frame.slot(), frame.extent());
+        if let Some(t) = timer.as_mut() {
+            if t.written[slot] {
+                // The slot's previous frame completed (acquire waited for it): no stall.
+                let d = t.pools[slot].durations_ns()?;
+                if let [pre_pass, draw, hud] = d[..] {
+                    self.pass_times = Some(PassTimes {
+                        pre_pass: pre_pass * 1e-6,
+                        draw: draw * 1e-6,
+                        hud: hud * 1e-6,
+                    });
+                }
+            }
+            t.written[slot] = true;
+        }
+        let pool = timer.as_ref().map(|t| &t.pools[slot]);
         let dt = self.last_frame.elapsed().as_secs_f32();
         if self.setup.animate {
             self.time += dt;
@@ -254,15 +356,30 @@ impl App {
             surface.technique.update_base(slot, &wave.at(self.time))?;
         }
         let technique = surface.technique.as_ref();
-        let params = self.setup.world_params(technique.bbox());
         context.prepare(technique, &params, Context::frame_passes(&params))?;
         context.write_frame(slot, technique.bbox(), &params, extent)?;
         let last = self.args.frames.is_some_and(|n| self.frames_drawn + 1 >= n);
         let context = &*context;
+        let (top, bottom) = (
+            vk::PipelineStageFlags::TOP_OF_PIPE,
+            vk::PipelineStageFlags::BOTTOM_OF_PIPE,
+        );
+        if let Some(pool) = pool {
+            frame.encoder().reset_queries(pool);
+        }
+        stamp(frame.encoder(), pool, 0, top)?;
         context.record_pre_pass(frame.encoder(), technique, slot)?;
+        stamp(frame.encoder(), pool, 1, bottom)?;
+        stamp(frame.encoder(), pool, 2, top)?;
         frame.begin_frame_rendering(params.clear_color);
         context.record_frame(frame.encoder(), technique, slot, &params)?;
+        stamp(frame.encoder(), pool, 3, bottom)?;
+        stamp(frame.encoder(), pool, 4, top)?;
+        if let Some((primitives, ppp)) = &hud {
+            overlay.draw(frame.encoder(), extent, *ppp, primitives)?;
+        }
         frame.encoder().end_rendering();
+        stamp(frame.encoder(), pool, 5, bottom)?;
         let final_shot = last && self.args.screenshot.is_some();
         let asked = std::mem::take(&mut self.shot_requested);
         let shot = frame.present(final_shot || asked)?;
@@ -275,7 +392,11 @@ impl App {
             print_stats(&format!("frame {n}"), device, started);
         }
         let now = Instant::now();
-        self.frame_ms = 0.9 * self.frame_ms + 0.1 * (now - self.last_frame).as_secs_f64() * 1e3;
+        let interval = (now - self.last_frame).as_secs_f64() * 1e3;
+        self.frame_ms = 0.9 * self.frame_ms + 0.1 * interval;
+        if let Some(hud) = &mut self.hud {
+            hud.push_frame_time(interval);
+        }
         self.last_frame = now;
         if let Some(w) = &self.window {
             w.set_title(&format!(
@@ -318,6 +439,9 @@ impl App {
                     self.frames_drawn
                 );
             }
+        }
+        for action in std::mem::take(&mut self.actions) {
+            self.act(action, event_loop);
         }
         if last {
             event_loop.exit();
@@ -373,70 +497,102 @@ impl App {
         }
     }
 
-    fn key(&mut self, key: &Key) {
-        let features = techniques::info(self.setup.technique).features;
-        let level = self.setup.params.uniform_segments().unwrap_or(8.0);
-        let p = &mut self.setup.params;
-        match key {
+    /// The action a key asks for (the HUD's controls ask for the same ones).
+    fn key_action(key: &Key) -> Option<Action> {
+        Some(match key {
             Key::Character(c) => match c.as_str() {
                 d if d.len() == 1 && d.as_bytes()[0].is_ascii_digit() => {
                     let k = (d.as_bytes()[0] - b'0') as usize;
-                    if let Some(info) = k.checked_sub(1).and_then(|i| techniques::registry().get(i))
-                    {
-                        self.switch_technique(info.id);
-                    }
+                    let info = k
+                        .checked_sub(1)
+                        .and_then(|i| techniques::registry().get(i))?;
+                    Action::Technique(info.id)
                 }
-                "+" | "=" => self.set_level(level + 1.0, true),
-                "-" => self.set_level(level - 1.0, false),
-                "w" | "W" => p.wireframe = !p.wireframe,
-                "p" | "P" => self.shot_requested = true,
-                "a" | "A" if features.animation => self.setup.animate = !self.setup.animate,
-                "c" | "C" if features.patch_colours => p.patch_colours = !p.patch_colours,
-                "f" | "F" => {
-                    let next = if p.spacing == Spacing::Equal {
-                        Spacing::FractionalEven
-                    } else {
-                        Spacing::Equal
-                    };
-                    if features.spacing(next) {
-                        p.spacing = next;
-                        self.set_level(level, true);
-                    }
-                }
-                "g" | "G" if features.geometric_normals => {
-                    p.geometric_normals = !p.geometric_normals
-                }
-                "i" | "I" if features.isolation => {
-                    let b = &mut self.setup.build;
-                    let next = if c.as_str() == "i" {
-                        (b.isolation + 1).min(8)
-                    } else {
-                        b.isolation.saturating_sub(1).max(1)
-                    };
-                    self.rebuild |= next != b.isolation;
-                    b.isolation = next;
-                }
-                "e" | "E" if features.isolation => {
-                    let b = &mut self.setup.build;
-                    b.end_cap = match b.end_cap {
-                        topology::adaptive::EndCap::Gregory => topology::adaptive::EndCap::Bilinear,
-                        topology::adaptive::EndCap::Bilinear => topology::adaptive::EndCap::Gregory,
-                    };
-                    self.rebuild = true;
-                }
-                "s" | "S" if features.isolation => {
-                    let b = &mut self.setup.build;
-                    b.sharpness_scale = if c.as_str() == "s" {
-                        (b.sharpness_scale * 1.25).min(64.0)
-                    } else {
-                        b.sharpness_scale / 1.25
-                    };
-                    self.rebuild = true;
-                }
-                _ => {}
+                "+" | "=" => Action::LevelUp,
+                "-" => Action::LevelDown,
+                "w" | "W" => Action::Wireframe,
+                "p" | "P" => Action::Screenshot,
+                "h" | "H" => Action::ToggleHud,
+                "a" | "A" => Action::Animate,
+                "c" | "C" => Action::PatchColours,
+                "f" | "F" => Action::Fractional,
+                "g" | "G" => Action::GeometricNormals,
+                "i" => Action::IsolationUp,
+                "I" => Action::IsolationDown,
+                "e" | "E" => Action::EndCaps,
+                "s" => Action::SharpnessUp,
+                "S" => Action::SharpnessDown,
+                _ => return None,
             },
-            Key::Named(NamedKey::ArrowUp) => self.set_level(level * 2.0, true),
-            Key::Named(NamedKey::ArrowDown) => self.set_level(level * 0.5, false),
+            Key::Named(NamedKey::ArrowUp) => Action::LevelDouble,
+            Key::Named(NamedKey::ArrowDown) => Action::LevelHalve,
+            Key::Named(NamedKey::Escape) => Action::Quit,
+            _ => return None,
+        })
+    }
+
+    /// Carries out `action` where the current technique takes it (otherwise nothing happens).
+    fn act(&mut self, action: Action, event_loop: &ActiveEventLoop) {
+        let features = techniques::info(self.setup.technique).features;
+        let level = self.setup.params.uniform_segments().unwrap_or(8.0);
+        let p = &mut self.setup.params;
+        match action {
+            Action::Technique(id) => self.switch_technique(id),
+            Action::LevelUp => self.set_level(level + 1.0, true),
+            Action::LevelDown => self.set_level(level - 1.0, false),
+            Action::LevelDouble => self.set_level(level * 2.0, true),
+            Action::LevelHalve => self.set_level(level * 0.5, false),
+            Action::Wireframe => p.wireframe = !p.wireframe,
+            Action::Screenshot => self.shot_requested = true,
+            Action::ToggleHud => {
+                if let Some(hud) = &mut self.hud {
+                    hud.visible = !hud.visible;
+                }
+            }
+            Action::Quit => event_loop.exit(),
+            Action::Animate if features.animation => self.setup.animate = !self.setup.animate,
+            Action::PatchColours if features.patch_colours => p.patch_colours = !p.patch_colours,
+            Action::Fractional => {
+                let next = if p.spacing == Spacing::Equal {
+                    Spacing::FractionalEven
+                } else {
+                    Spacing::Equal
+                };
+                if features.spacing(next) {
+                    p.spacing = next;
+                    self.set_level(level, true);
+                }
+            }
+            Action::GeometricNormals if features.geometric_normals => {
+                p.geometric_normals = !p.geometric_normals
+            }
+            Action::IsolationUp | Action::IsolationDown if features.isolation => {
+                let b = &mut self.setup.build;
+                let next = if action == Action::IsolationUp {
+                    (b.isolation + 1).min(8)
+                } else {
+                    b.isolation.saturating_sub(1).max(1)
+                };
+                self.rebuild |= next != b.isolation;
+                b.isolation = next;
+            }
+            Action::EndCaps if features.isolation => {
+                let b = &mut self.setup.build;
+                b.end_cap = match b.end_cap {
+                    topology::adaptive::EndCap::Gregory => topology::adaptive::EndCap::Bilinear,
+                    topology::adaptive::EndCap::Bilinear => topology::adaptive::EndCap::Gregory,
+                };
+                self.rebuild = true;
+            }
+            Action::SharpnessUp | Action::SharpnessDown if features.isolation => {
+                let b = &mut self.setup.build;
+                b.sharpness_scale = if action == Action::SharpnessUp {
+                    (b.sharpness_scale * 1.25).min(64.0)
+                } else {
+                    b.sharpness_scale / 1.25
+                };
+                self.rebuild = true;
+            }
             _ => {}
         }
     }
@@ -457,6 +613,10 @@ impl ApplicationHandler for App {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let taken = match (&mut self.hud, &self.window) {
+            (Some(hud), Some(window)) => hud.on_event(window, &event),
+            _ => false,
+        };
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => {
@@ -472,11 +632,12 @@ impl ApplicationHandler for App {
                     self.fail(event_loop, e);
                 }
             }
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
-                if event.logical_key == Key::Named(NamedKey::Escape) {
-                    event_loop.exit();
+            WindowEvent::KeyboardInput { event, .. }
+                if event.state == ElementState::Pressed && !taken =>
+            {
+                if let Some(action) = Self::key_action(&event.logical_key) {
+                    self.act(action, event_loop);
                 }
-                self.key(&event.logical_key);
             }
             WindowEvent::DroppedFile(path) => self.open_dropped(&path),
             WindowEvent::MouseInput {
@@ -484,7 +645,8 @@ impl ApplicationHandler for App {
                 button: MouseButton::Left,
                 ..
             } => {
-                self.dragging = state == ElementState::Pressed;
+                // A press on the HUD is its own; a release always ends a drag.
+                self.dragging = state == ElementState::Pressed && !taken;
                 self.last_cursor = None;
             }
             WindowEvent::CursorMoved { position, .. } if self.dragging => {
@@ -496,7 +658,7 @@ impl ApplicationHandler for App {
                 }
                 self.last_cursor = Some((position.x, position.y));
             }
-            WindowEvent::MouseWheel { delta, .. } => {
+            WindowEvent::MouseWheel { delta, .. } if !taken => {
                 let steps = match delta {
                     MouseScrollDelta::LineDelta(_, y) => y,
                     MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
@@ -550,18 +712,23 @@ pub fn run(args: ViewArgs) -> Result<()> {
         frame_ms: 0.0,
         started: None,
         error: None,
+        hud: None,
+        actions: Vec::new(),
+        pass_times: None,
     };
     event_loop.run_app(&mut app).context("event loop")?;
     let gpu = app.gpu.take();
     let result = match gpu {
         Some(Gpu {
             surfaces,
+            overlay,
+            timer,
             context,
             swapchain,
             device,
             instance,
         }) => {
-            drop((surfaces, context, swapchain));
+            drop((surfaces, overlay, timer, context, swapchain));
             if app.args.stats {
                 // What outlives every frame resource: idle one-shot command pools only.
                 device.wait_idle();
@@ -579,8 +746,21 @@ pub fn run(args: ViewArgs) -> Result<()> {
     result
 }
 
+/// Writes timestamp `index` of the frame's pool, where the queue has timestamps.
+fn stamp<'a>(
+    encoder: &mut vk_core::Encoder<'a>,
+    pool: Option<&'a QueryPool>,
+    index: u32,
+    stage: vk::PipelineStageFlags,
+) -> vk_core::Result<()> {
+    match pool {
+        Some(pool) => encoder.write_timestamp(pool, stage, index),
+        None => Ok(()),
+    }
+}
+
 /// `--end-cap`'s spelling of an end cap.
-fn end_cap_name(e: topology::adaptive::EndCap) -> &'static str {
+pub(crate) fn end_cap_name(e: topology::adaptive::EndCap) -> &'static str {
     match e {
         topology::adaptive::EndCap::Gregory => "gregory",
         topology::adaptive::EndCap::Bilinear => "bilinear",

@@ -1,8 +1,9 @@
 //! The window (`tessera view`) under Xvfb with the validation layer on, synchronization
 //! validation included: runs that end without a screenshot (frames still in flight at exit),
 //! every technique, a 1,000-frame animated soak whose GPU memory and live Vulkan objects
-//! must stay constant after warm-up, and a window driven by synthetic key presses (xdotool:
-//! P screenshots, the level and the technique changed by keys, Esc).
+//! must stay constant after warm-up (HUD shown), and windows driven by synthetic input
+//! (xdotool: P screenshots, the level and the technique changed by keys, Esc; the HUD drawn,
+//! hidden by H, and its level control clicked).
 //!
 //! The soak runs in the window rather than through an offscreen `tess::Context` loop because
 //! the window is where frames are not waited for (FIFO presentation, two frames in flight, the
@@ -182,7 +183,7 @@ fn compare(a: &image::RgbaImage, b: &image::RgbaImage) -> (usize, f64, f64) {
 
 /// Synthetic key presses: P saves the frame; ArrowUp doubles the segments (2 → 4, visible as
 /// more wireframe lines: a darker picture); 3 switches to PN (another surface); Esc ends the
-/// window, validation-clean.
+/// window, validation-clean. The HUD is off (`--no-hud`): at 160x120 it would cover the scene.
 #[test]
 fn keys_change_level_and_technique_and_p_saves_screenshots() {
     let _one = SERVER.lock().unwrap_or_else(|e| e.into_inner());
@@ -196,7 +197,15 @@ fn keys_change_level_and_technique_and_p_saves_screenshots() {
     let dir = std::env::temp_dir().join(format!("tessera-window-keys-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let child = Command::new(env!("CARGO_BIN_EXE_tessera"))
-        .args(["view", "--method", "flat", "--segments", "2", "--wireframe"])
+        .args([
+            "view",
+            "--method",
+            "flat",
+            "--segments",
+            "2",
+            "--wireframe",
+            "--no-hud",
+        ])
         .args(["--validation", "--sync-validation", "--size", "160x120"])
         .current_dir(&dir)
         .env("DISPLAY", &server.display)
@@ -240,4 +249,94 @@ fn keys_change_level_and_technique_and_p_saves_screenshots() {
     );
     let (changed, _, _) = compare(&level4, &pn4);
     assert!(changed > 100, "key 3 (PN) changed {changed} pixels");
+}
+
+/// Where the HUD's "×2 (Up)" level button is in the window (egui's layout at scale 1, the
+/// panel anchored at (6, 6), Flat's rows): read from a screenshot of the HUD; the test fails if
+/// a click there does not double the level.
+const DOUBLE_LEVEL_BUTTON: (u32, u32) = (155, 117);
+
+/// The HUD: drawn into P screenshots while shown (the panel's region differs from the same frame
+/// with the HUD hidden by H, and the rest of the picture does not); its "×2" control doubles
+/// the level (2 → 4 segments: more wireframe lines, darker); Esc ends the window,
+/// validation-clean (the overlay's texture upload and draws included).
+#[test]
+fn hud_is_drawn_hidden_by_h_and_its_level_control_acts() {
+    let _one = SERVER.lock().unwrap_or_else(|e| e.into_inner());
+    if Command::new("xdotool").arg("version").output().is_err() {
+        eprintln!("skipped: xdotool is not installed (tools/setup.sh installs it)");
+        return;
+    }
+    let Some(server) = xvfb::start_or_skip(DISPLAYS) else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("tessera-window-hud-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_tessera"))
+        .args(["view", "--method", "flat", "--segments", "2", "--wireframe"])
+        .args(["--validation", "--sync-validation", "--size", "640x480"])
+        .current_dir(&dir)
+        .env("DISPLAY", &server.display)
+        .env("WAYLAND_DISPLAY", "")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("tessera runs");
+    let d = server.display.clone();
+    let window = xdotool(
+        &d,
+        &["search", "--sync", "--onlyvisible", "--name", "tessera"],
+    );
+    let window = window.lines().next().expect("a window").trim().to_owned();
+    xdotool(&d, &["windowfocus", "--sync", &window]);
+    let shot = |n: u32| wait_for_png(&dir.join(format!("tessera-screenshot-{n}.png")));
+    xdotool(&d, &["key", "p"]);
+    let with_hud = shot(1);
+    xdotool(&d, &["key", "h", "p"]);
+    let without_hud = shot(2);
+    xdotool(&d, &["key", "h"]);
+    let (x, y) = DOUBLE_LEVEL_BUTTON;
+    let (x, y) = (x.to_string(), y.to_string());
+    xdotool(
+        &d,
+        &["mousemove", "--window", &window, &x, &y, "click", "1"],
+    );
+    xdotool(&d, &["key", "h", "p"]);
+    let doubled = shot(3);
+    xdotool(&d, &["key", "Escape"]);
+    let o = child.wait_with_output().expect("tessera ends");
+    drop(server);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "view failed: {err}");
+    assert!(!err.contains("VUID") && !err.contains("SYNC-"), "{err}");
+    assert_eq!(with_hud.dimensions(), (640, 480));
+    // The HUD's pixels: many, and all inside the panel at the top left.
+    let differing: Vec<(u32, u32)> = with_hud
+        .enumerate_pixels()
+        .filter(|(x, y, p)| without_hud.get_pixel(*x, *y) != *p)
+        .map(|(x, y, _)| (x, y))
+        .collect();
+    assert!(
+        differing.len() > 5000,
+        "the HUD changed only {} pixels",
+        differing.len()
+    );
+    let right = differing.iter().map(|p| p.0).max().unwrap();
+    let (left, top) = (
+        differing.iter().map(|p| p.0).min().unwrap(),
+        differing.iter().map(|p| p.1).min().unwrap(),
+    );
+    assert!(
+        left <= 10 && top <= 10 && right < 320,
+        "HUD pixels from ({left}, {top}) to x = {right}: not a panel at the top left"
+    );
+    let (changed, before, after) = compare(&without_hud, &doubled);
+    assert!(
+        changed > 300,
+        "the HUD's ×2 changed {changed} pixels: {out}"
+    );
+    assert!(
+        after < before,
+        "4 segments per edge should draw more wireframe (darker) than 2: {after} vs {before}"
+    );
 }

@@ -1199,6 +1199,24 @@ impl<'a> Encoder<'a> {
         }
     }
 
+    /// The raw command buffer and the open scope's (colour, depth) formats, for a vk-core
+    /// module that records its own draws inside the scope through ash (the HUD overlay). The
+    /// bindings the encoder tracks are forgotten: the caller binds its own pipeline, sets and
+    /// buffers, so a later draw through the encoder must bind again.
+    pub(crate) fn raw_in_scope(
+        &mut self,
+        command: &'static str,
+    ) -> Result<(vk::CommandBuffer, [vk::Format; 2])> {
+        let Some(scope) = self.scope else {
+            return Err(VkError::recording(command, E::OutsideRendering));
+        };
+        self.pipeline = None;
+        self.sets.clear();
+        self.vertex_buffers.clear();
+        self.index_buffer = None;
+        Ok((self.cmd, scope.formats))
+    }
+
     /// The raw command buffer, for vk-core's own recording (swapchain transitions).
     pub(crate) fn raw_cmd(&self) -> vk::CommandBuffer {
         self.cmd

@@ -30,6 +30,8 @@ pub enum VkError {
     #[error("gpu-allocator: {0}")]
     Allocator(#[from] gpu_allocator::AllocationError),
     /// A lock of the device's shared state was poisoned by a panic on another thread.
+    #[error("HUD overlay: {0}")]
+    Overlay(#[from] egui_ash_renderer::RendererError),
     #[error("the {what} lock was poisoned by a panic on another thread")]
     LockPoisoned { what: &'static str },
     /// Host access to a buffer whose memory is not host-visible.

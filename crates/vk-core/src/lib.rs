@@ -7,6 +7,8 @@
 //!   all of them and the instance outlives the device. Field order states the drop order.
 //! - The validation layer's messages are counted by severity; tests assert no error-severity one.
 //! - Rendering uses Vulkan 1.3 dynamic rendering (no render-pass objects).
+//! - A UI overlay ([`overlay`], egui through egui-ash-renderer) draws into a frame's scope behind
+//!   safe calls, so the window's HUD needs no `unsafe` above vk-core.
 //! - Optional features (VK_EXT_transform_feedback, for captures) are detected and enabled when
 //!   present; what needs them returns [`VkError::Unsupported`] where they are absent.
 //! - Driver bugs are worked around through [`workarounds`], a documented list keyed by driver.
@@ -30,6 +32,7 @@ pub mod encoder;
 pub mod error;
 pub mod image;
 pub mod instance;
+pub mod overlay;
 pub mod pipeline;
 pub mod query;
 pub mod retire;
@@ -49,6 +52,7 @@ pub use error::{DescriptorError, RecordingError, Result, VkError};
 pub use gpu_allocator::MemoryLocation;
 pub use image::{Image, ImageDesc};
 pub use instance::{Instance, InstanceDesc, MessageCounts, Validation};
+pub use overlay::{Overlay, OverlayDesc};
 pub use pipeline::Pipeline;
 pub use query::QueryPool;
 pub use swapchain::{Swapchain, SwapchainFrame};

@@ -1,0 +1,359 @@
+//! The window's HUD: an egui panel drawn over the frame through vk-core's overlay.
+//!
+//! Design decisions:
+//! - The HUD emits the same [`Action`]s as the keys (view.rs maps each key to one), so every
+//!   binding is reachable from either and both go through one `App::act`. Actions take effect
+//!   after the frame is presented, like a key pressed between frames.
+//! - egui is laid out every frame the HUD is shown; hidden, it is not laid out nor drawn, and the
+//!   input egui collected is discarded each frame so nothing accumulates.
+//! - Pointer input over the HUD is egui's (no orbit under a click on a button); keys go to the
+//!   window unless a HUD widget takes typed text (none does today).
+//! - The patch-colour legend mirrors `KIND_COLOURS` in glsl/bft/bft.tese and
+//!   glsl/adaptive/tese_main.glsl (the shaders' colours for each patch kind).
+use egui::{Align2, Color32, Stroke};
+use std::collections::VecDeque;
+use tess::techniques;
+use tess::{FactorPolicy, FrameParams, Spacing, TechniqueId};
+use winit::window::Window;
+
+/// What a key or a HUD control asks for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Action {
+    Technique(TechniqueId),
+    LevelUp,
+    LevelDown,
+    LevelDouble,
+    LevelHalve,
+    Wireframe,
+    Screenshot,
+    Animate,
+    PatchColours,
+    Fractional,
+    GeometricNormals,
+    IsolationUp,
+    IsolationDown,
+    EndCaps,
+    SharpnessUp,
+    SharpnessDown,
+    ToggleHud,
+    Quit,
+}
+
+/// GPU time of each pass of one frame, in milliseconds (timestamp queries).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PassTimes {
+    pub pre_pass: f64,
+    pub draw: f64,
+    pub hud: f64,
+}
+
+/// What the HUD shows of the current frame.
+pub struct Shown<'a> {
+    pub mesh: &'a str,
+    pub technique: TechniqueId,
+    /// The frame parameters as drawn (distances in world units).
+    pub params: &'a FrameParams,
+    pub build: &'a tess::BuildOptions,
+    pub animate: bool,
+    pub triangles: Option<u64>,
+    pub patches: u64,
+    /// `None` where the queue has no timestamps.
+    pub gpu: Option<PassTimes>,
+    pub status: Option<&'a str>,
+}
+
+/// Frame times kept for the graph.
+const HISTORY: usize = 120;
+
+/// egui's context and input, the HUD's visibility and the frame-time history.
+pub struct Hud {
+    ctx: egui::Context,
+    input: egui_winit::State,
+    pub visible: bool,
+    frame_ms: VecDeque<f32>,
+}
+
+/// The colours and names of the patch-colour legend of `technique` (empty when it
+/// has no patch colours).
+fn legend(technique: TechniqueId) -> &'static [([f32; 3], &'static str)] {
+    match technique {
+        TechniqueId::Bft => &[
+            ([0.55, 0.75, 0.95], "regular"),
+            ([0.95, 0.45, 0.35], "extraordinary"),
+            ([0.55, 0.85, 0.45], "boundary"),
+            ([0.75, 0.5, 0.9], "private table"),
+        ],
+        TechniqueId::Adaptive => &[
+            ([0.45, 0.65, 0.95], "B-spline (odd levels lighter)"),
+            ([0.95, 0.45, 0.35], "Gregory end cap"),
+            ([0.95, 0.8, 0.3], "bilinear end cap"),
+            ([0.3, 0.8, 0.35], "boundary / crease (greener)"),
+        ],
+        _ => &[],
+    }
+}
+
+fn colour([r, g, b]: [f32; 3]) -> Color32 {
+    let c = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+    Color32::from_rgb(c(r), c(g), c(b))
+}
+
+impl Hud {
+    pub fn new(window: &Window, visible: bool) -> Self {
+        let ctx = egui::Context::default();
+        // Compact: the whole panel fits a 640x480 window.
+        ctx.all_styles_mut(|style| {
+            for font in style.text_styles.values_mut() {
+                font.size = (font.size * 0.85).round();
+            }
+            style.spacing.item_spacing = egui::vec2(4.0, 2.0);
+            style.spacing.button_padding = egui::vec2(3.0, 0.0);
+        });
+        let input = egui_winit::State::new(
+            ctx.clone(),
+            egui::ViewportId::ROOT,
+            window,
+            Some(window.scale_factor() as f32),
+            None,
+            None,
+        );
+        Self {
+            ctx,
+            input,
+            visible,
+            frame_ms: VecDeque::with_capacity(HISTORY),
+        }
+    }
+
+    /// Hands a window event to egui; true when egui takes it (the window must not act on it).
+    pub fn on_event(&mut self, window: &Window, event: &winit::event::WindowEvent) -> bool {
+        let response = self.input.on_window_event(window, event);
+        if !self.visible {
+            return false;
+        }
+        match event {
+            winit::event::WindowEvent::KeyboardInput { .. } => self.ctx.egui_wants_keyboard_input(),
+            winit::event::WindowEvent::MouseInput { .. }
+            | winit::event::WindowEvent::MouseWheel { .. } => {
+                response.consumed || self.ctx.is_pointer_over_egui()
+            }
+            _ => false,
+        }
+    }
+
+    /// Records a frame interval for the graph.
+    pub fn push_frame_time(&mut self, ms: f64) {
+        if self.frame_ms.len() == HISTORY {
+            self.frame_ms.pop_front();
+        }
+        self.frame_ms.push_back(ms as f32);
+    }
+
+    /// Lays the HUD out for this frame: the actions its controls asked for, and what to draw
+    /// (`None` when hidden).
+    pub fn run(
+        &mut self,
+        window: &Window,
+        shown: &Shown<'_>,
+        actions: &mut Vec<Action>,
+    ) -> Option<egui::FullOutput> {
+        let raw = self.input.take_egui_input(window);
+        if !self.visible {
+            return None;
+        }
+        let history: Vec<f32> = self.frame_ms.iter().copied().collect();
+        let output = self.ctx.run_ui(raw, |ui| {
+            egui::Window::new("tessera")
+                .anchor(Align2::LEFT_TOP, [6.0, 6.0])
+                .resizable(false)
+                .collapsible(false)
+                .default_width(230.0)
+                .show(ui.ctx(), |ui| panel(ui, shown, &history, actions));
+        });
+        self.input
+            .handle_platform_output(window, output.platform_output.clone());
+        Some(output)
+    }
+
+    /// egui's tessellated shapes of `output`, in points, with its pixels per point.
+    pub fn tessellate(
+        &self,
+        shapes: Vec<egui::epaint::ClippedShape>,
+        pixels_per_point: f32,
+    ) -> Vec<egui::ClippedPrimitive> {
+        self.ctx.tessellate(shapes, pixels_per_point)
+    }
+}
+
+/// A toggle showing its state; `None` disables it (the technique does not take it).
+fn toggle(ui: &mut egui::Ui, on: Option<bool>, text: &str) -> bool {
+    ui.add_enabled(
+        on.is_some(),
+        egui::Button::selectable(on.unwrap_or(false), text),
+    )
+    .clicked()
+}
+
+fn panel(ui: &mut egui::Ui, s: &Shown<'_>, history: &[f32], actions: &mut Vec<Action>) {
+    let info = techniques::info(s.technique);
+    let f = info.features;
+    let p = s.params;
+    ui.label(format!("mesh: {}", s.mesh));
+    if let Some(status) = s.status {
+        ui.colored_label(Color32::from_rgb(255, 110, 90), status);
+    }
+    ui.horizontal(|ui| {
+        ui.label("technique (1-5)");
+        egui::ComboBox::from_id_salt("technique")
+            .selected_text(s.technique.name())
+            .show_ui(ui, |ui| {
+                for (i, t) in techniques::registry().iter().enumerate() {
+                    let text = format!("{} {}", i + 1, t.id.name());
+                    if ui.selectable_label(t.id == s.technique, text).clicked() {
+                        actions.push(Action::Technique(t.id));
+                    }
+                }
+            });
+    });
+    ui.label(match info.scheme {
+        Some(scheme) => format!("scheme: {scheme}"),
+        None => "scheme: none (base faces)".to_owned(),
+    });
+    ui.label(format!("factors: {}", p.factors));
+    if let FactorPolicy::Uniform { .. } = p.factors {
+        ui.horizontal(|ui| {
+            for (text, action) in [
+                ("− (-)", Action::LevelDown),
+                ("+ (+)", Action::LevelUp),
+                ("÷2 (Down)", Action::LevelHalve),
+                ("×2 (Up)", Action::LevelDouble),
+            ] {
+                if ui.button(text).clicked() {
+                    actions.push(action);
+                }
+            }
+        });
+    }
+    if f.isolation {
+        let b = s.build;
+        ui.horizontal(|ui| {
+            ui.label(format!("isolation {}", b.isolation));
+            if ui.button("− (Shift+I)").clicked() {
+                actions.push(Action::IsolationDown);
+            }
+            if ui.button("+ (I)").clicked() {
+                actions.push(Action::IsolationUp);
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.label(format!(
+                "end caps: {}",
+                crate::view::end_cap_name(b.end_cap)
+            ));
+            if ui.button("switch (E)").clicked() {
+                actions.push(Action::EndCaps);
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.label(format!("sharpness ×{:.2}", b.sharpness_scale));
+            if ui.button("− (Shift+S)").clicked() {
+                actions.push(Action::SharpnessDown);
+            }
+            if ui.button("+ (S)").clicked() {
+                actions.push(Action::SharpnessUp);
+            }
+        });
+    }
+    let fractional_ok = f.spacing(Spacing::FractionalEven);
+    ui.horizontal_wrapped(|ui| {
+        for (on, text, action) in [
+            (
+                fractional_ok.then_some(p.spacing != Spacing::Equal),
+                "fractional (F)",
+                Action::Fractional,
+            ),
+            (Some(p.wireframe), "wireframe (W)", Action::Wireframe),
+            (
+                f.patch_colours.then_some(p.patch_colours),
+                "patch colours (C)",
+                Action::PatchColours,
+            ),
+            (
+                f.geometric_normals.then_some(p.geometric_normals),
+                "geometric normals (G)",
+                Action::GeometricNormals,
+            ),
+            (
+                f.animation.then_some(s.animate),
+                "animation (A)",
+                Action::Animate,
+            ),
+        ] {
+            if toggle(ui, on, text) {
+                actions.push(action);
+            }
+        }
+    });
+    if p.patch_colours {
+        for &(rgb, name) in legend(s.technique) {
+            ui.horizontal(|ui| {
+                let (rect, _) =
+                    ui.allocate_exact_size(egui::vec2(12.0, 12.0), egui::Sense::hover());
+                ui.painter().rect_filled(rect, 2.0, colour(rgb));
+                ui.label(name);
+            });
+        }
+    }
+    ui.separator();
+    ui.label(format!(
+        "drawn: {} triangles, {} patches",
+        s.triangles
+            .map(|t| t.to_string())
+            .unwrap_or_else(|| "?".into()),
+        s.patches
+    ));
+    match s.gpu {
+        Some(t) => ui.label(format!(
+            "GPU ms: pre-pass {:.3}, draw {:.3}, HUD {:.3}",
+            t.pre_pass, t.draw, t.hud
+        )),
+        None => ui.label("GPU: no timestamps on this queue"),
+    };
+    frame_graph(ui, history);
+    ui.horizontal(|ui| {
+        for (text, action) in [
+            ("screenshot (P)", Action::Screenshot),
+            ("hide (H)", Action::ToggleHud),
+            ("quit (Esc)", Action::Quit),
+        ] {
+            if ui.button(text).clicked() {
+                actions.push(action);
+            }
+        }
+    });
+}
+
+/// The last [`HISTORY`] frame intervals as a line, scaled to the largest.
+fn frame_graph(ui: &mut egui::Ui, history: &[f32]) {
+    let max = history.iter().copied().fold(1.0f32, f32::max);
+    let last = history.last().copied().unwrap_or(0.0);
+    ui.label(format!("frame {last:.2} ms (graph top {max:.1} ms)"));
+    let (rect, _) = ui.allocate_exact_size(egui::vec2(220.0, 40.0), egui::Sense::hover());
+    let painter = ui.painter_at(rect);
+    painter.rect_filled(rect, 2.0, Color32::from_gray(24));
+    if history.len() < 2 {
+        return;
+    }
+    let dx = rect.width() / (HISTORY - 1) as f32;
+    let points = history
+        .iter()
+        .enumerate()
+        .map(|(i, &ms)| {
+            egui::pos2(
+                rect.left() + i as f32 * dx,
+                rect.bottom() - rect.height() * ms / max,
+            )
+        })
+        .collect();
+    painter.line(points, Stroke::new(1.0, Color32::from_rgb(120, 200, 120)));
+}
