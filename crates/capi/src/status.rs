@@ -137,7 +137,8 @@ pub(crate) fn vk_status(e: &VkError) -> TesseraStatus {
         {
             TesseraStatus::OutOfMemory
         }
-        V::Call { .. } | V::Surface(_) => TesseraStatus::Vulkan,
+        // The viewer's HUD overlay: not reachable through the C ABI, a Vulkan failure if it were.
+        V::Call { .. } | V::Surface(_) | V::Overlay(_) => TesseraStatus::Vulkan,
         V::NoSuitableDevice(_) | V::NoSuchDevice { .. } => TesseraStatus::NoDevice,
         V::MissingFeatures { .. } => TesseraStatus::MissingFeatures,
         V::Unsupported { .. } => TesseraStatus::Unsupported,
