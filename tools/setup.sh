@@ -22,3 +22,15 @@ fi
 if ! command -v cargo >/dev/null 2>&1 && [ ! -x "$HOME/.cargo/bin/cargo" ]; then
   curl --proto '=https' --tlsv1.2 -sSf https://sh.rustup.rs | sh -s -- -y --profile minimal --component rustfmt,clippy
 fi
+# The workspace's rust-version (egui needs 1.95): update a rustup toolchain that is older.
+export PATH="$HOME/.cargo/bin:$PATH"
+need=1.95
+have=$(rustc --version 2>/dev/null | awk '{print $2}')
+if [ -n "$have" ] && [ "$(printf '%s\n%s\n' "$need" "$have" | sort -V | head -n1)" != "$need" ]; then
+  if command -v rustup >/dev/null 2>&1; then
+    rustup update stable --no-self-update && rustup default stable
+  else
+    echo "setup: Rust $have is older than $need and was not installed by rustup; install a newer Rust" >&2
+    exit 1
+  fi
+fi
