@@ -24,17 +24,5 @@ fn c99_program_renders_every_technique_like_the_rust_side() {
     );
     let out = common::run(Command::new(&exe).arg(&dir));
     assert!(out.contains("5 techniques rendered"), "{out}");
-    for (name, id) in [
-        ("flat", tess::TechniqueId::Flat),
-        ("phong", tess::TechniqueId::Phong),
-        ("pn", tess::TechniqueId::Pn),
-        ("bft", tess::TechniqueId::Bft),
-        ("adaptive", tess::TechniqueId::Adaptive),
-    ] {
-        let from_c = std::fs::read(dir.join(format!("{name}.rgba"))).unwrap();
-        let reference = common::reference(id, 160, 120);
-        let d = common::differing_fraction(&from_c, &reference, 160 * 120);
-        eprintln!("{name}: {d:.5} of pixels differ from the Rust-side render");
-        assert!(d <= common::TOLERANCE, "{name}: {d:.5} of pixels differ");
-    }
+    common::compare_with_rust_render(&dir);
 }

@@ -6,7 +6,7 @@
 //! message (the layer reports objects leaked at vkDestroyDevice as errors). Its images must
 //! match the Rust-side render of the same view within the golden tolerance.
 mod common;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::Command;
 
 /// Configures and builds the host into `target/<profile>/capi-tests/<name>-build`.
@@ -35,22 +35,6 @@ fn build_host(name: &str, asan: bool) -> PathBuf {
     build.join("cpp-host")
 }
 
-fn compare_with_rust_render(dir: &Path) {
-    for (name, id) in [
-        ("flat", tess::TechniqueId::Flat),
-        ("phong", tess::TechniqueId::Phong),
-        ("pn", tess::TechniqueId::Pn),
-        ("bft", tess::TechniqueId::Bft),
-        ("adaptive", tess::TechniqueId::Adaptive),
-    ] {
-        let host = std::fs::read(dir.join(format!("{name}.rgba"))).unwrap();
-        let reference = common::reference(id, 160, 120);
-        let d = common::differing_fraction(&host, &reference, 160 * 120);
-        eprintln!("{name}: {d:.5} of pixels differ from the Rust-side render");
-        assert!(d <= common::TOLERANCE, "{name}: {d:.5} of pixels differ");
-    }
-}
-
 #[test]
 fn cpp_host_draws_every_technique_in_its_own_device_like_tessera_render() {
     let exe = build_host("cpp-host", false);
@@ -60,7 +44,7 @@ fn cpp_host_draws_every_technique_in_its_own_device_like_tessera_render() {
         out.contains("5 techniques drawn, 0 validation messages"),
         "{out}"
     );
-    compare_with_rust_render(&dir);
+    common::compare_with_rust_render(&dir);
 }
 
 /// The same host built with `-fsanitize=address`: no invalid access, double free or

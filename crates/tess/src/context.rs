@@ -185,15 +185,7 @@ impl Context {
         params: &FrameParams,
         extent: vk::Extent2D,
     ) -> Result<()> {
-        let uniforms = frame_uniforms(bbox, params, extent);
-        let slots = self.frames.slots.len();
-        let (_, buffer) = self
-            .frames
-            .slots
-            .get_mut(slot)
-            .ok_or(TessError::FrameSlot { slot, slots })?;
-        buffer.write(0, bytemuck::bytes_of(&uniforms))?;
-        Ok(())
+        self.write_frame_uniforms(slot, &frame_uniforms(bbox, params, extent))
     }
 
     /// Writes the frame uniforms of `slot` as given (see [`frame_uniforms_with`]).

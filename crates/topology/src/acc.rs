@@ -136,18 +136,7 @@ pub fn acc1_patch(level: LevelRef<'_>, face: usize) -> Result<[[Stencil; 4]; 4],
 
 /// Value and derivative weights of the 16 Bézier points at `(u, v)`, in `[i][j]` order.
 pub fn bezier_weights(u: f64, v: f64) -> [[[f64; 3]; 4]; 4] {
-    let b = |t: f64| {
-        let s = 1.0 - t;
-        (
-            [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t],
-            [
-                -3.0 * s * s,
-                3.0 * s * (1.0 - 3.0 * t),
-                3.0 * t * (2.0 - 3.0 * t),
-                3.0 * t * t,
-            ],
-        )
-    };
+    let b = crate::patch::bezier_curve_weights;
     let ((bu, du), (bv, dv)) = (b(u), b(v));
     let mut w = [[[0.0; 3]; 4]; 4];
     for i in 0..4 {

@@ -624,25 +624,11 @@ pub fn gregory_basis(
 /// `dm` each as `[value, ∂/∂u, ∂/∂v]`, then `h` (the Bernstein product is `9·dp·dm·h`).
 type InteriorBlend = (usize, usize, [f64; 3], [f64; 3], f64);
 
-/// Cubic Bernstein basis and its derivative at `t`.
-fn bernstein3(t: f64) -> ([f64; 4], [f64; 4]) {
-    let s = 1.0 - t;
-    (
-        [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t],
-        [
-            -3.0 * s * s,
-            3.0 * s * (1.0 - 3.0 * t),
-            3.0 * t * (2.0 - 3.0 * t),
-            3.0 * t * t,
-        ],
-    )
-}
-
 /// Value and parametric derivative weights of the 20 Gregory points at `(u, v) ∈ [0,1]²`
 /// (formulas in the module docs; finite everywhere on the square, corners included).
 pub fn gregory_weights(u: f64, v: f64) -> PatchWeights<20> {
-    let (bu, dbu) = bernstein3(u);
-    let (bv, dbv) = bernstein3(v);
+    let (bu, dbu) = crate::patch::bezier_curve_weights(u);
+    let (bv, dbv) = crate::patch::bezier_curve_weights(v);
     let mut w = PatchWeights {
         point: [0.0; 20],
         du: [0.0; 20],

@@ -248,6 +248,21 @@ pub fn loop_regular_weights(u: f64, v: f64) -> PatchWeights<12> {
     out
 }
 
+/// Cubic Bernstein basis and its derivative at `t`: the Bézier patches' curve weights (Gregory
+/// end caps, ACC-1, the reparameterization of [`crate::reparam`]).
+pub fn bezier_curve_weights(t: f64) -> ([f64; 4], [f64; 4]) {
+    let s = 1.0 - t;
+    (
+        [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t],
+        [
+            -3.0 * s * s,
+            3.0 * s * (1.0 - 3.0 * t),
+            3.0 * t * (2.0 - 3.0 * t),
+            3.0 * t * t,
+        ],
+    )
+}
+
 /// Uniform cubic B-spline weights and derivatives at `t ∈ [0,1]` (the middle span).
 pub fn bspline_curve_weights(t: f64) -> ([f64; 4], [f64; 4]) {
     let t2 = t * t;

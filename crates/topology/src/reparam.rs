@@ -29,6 +29,7 @@ use crate::eval::EvalError;
 use crate::eval::{LimitScheme, LocalMesh};
 use crate::gregory::{gregory_basis, gregory_weights, Stencil};
 use crate::mesh::ControlMesh;
+use crate::patch::bezier_curve_weights;
 use crate::refine::{refine_uniform, Level};
 use crate::sdc::Scheme;
 
@@ -102,14 +103,9 @@ pub fn control_net(blocks: &[[f64; 5]; 4]) -> [[[f64; 3]; 4]; 4] {
     net
 }
 
-fn bernstein3(t: f64) -> [f64; 4] {
-    let s = 1.0 - t;
-    [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t]
-}
-
 /// Eq. 3: the texture parameter of the Gregory point at `(u, v)` under the net `net`.
 pub fn reparameterize(net: &[[[f64; 3]; 4]; 4], u: f64, v: f64) -> [f64; 2] {
-    let (bu, bv) = (bernstein3(u), bernstein3(v));
+    let (bu, bv) = (bezier_curve_weights(u).0, bezier_curve_weights(v).0);
     let (mut x, mut y, mut w) = (0.0, 0.0, 0.0);
     for i in 0..4 {
         for j in 0..4 {
