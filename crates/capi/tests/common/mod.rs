@@ -13,22 +13,18 @@ pub fn profile_dir() -> PathBuf {
         .to_path_buf()
 }
 
-/// The cdylib, next to this test's profile directory. `cargo test` links tests against the
-/// rlib only, so the test asks cargo for the cdylib (already built: a no-op) into the same
-/// target directory; the outer cargo holds no lock while tests run.
+/// The cdylib built by this very `cargo test`: the integration tests depend on the library
+/// unit, which cargo compiles once with all of its crate types, so `deps/` holds the cdylib of
+/// the same build. (Asking cargo for it again from here resolved the workspace's features
+/// without the dev-dependencies and rebuilt half the dependency graph on a cold CI machine:
+/// six minutes.)
 pub fn library() -> PathBuf {
-    static BUILT: std::sync::Once = std::sync::Once::new();
-    let profile = profile_dir();
-    BUILT.call_once(|| {
-        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-        run(Command::new(cargo)
-            .args(["build", "-p", "tessera-capi", "--lib"])
-            .arg("--target-dir")
-            .arg(profile.parent().expect("target directory"))
-            .current_dir(repo()));
-    });
-    let lib = profile.join("libtessera_capi.so");
-    assert!(lib.exists(), "{} was not built", lib.display());
+    let lib = profile_dir().join("deps").join("libtessera_capi.so");
+    assert!(
+        lib.exists(),
+        "{} was not built by this cargo test run",
+        lib.display()
+    );
     lib
 }
 
