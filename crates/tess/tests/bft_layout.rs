@@ -252,7 +252,7 @@ fn prepare_and_pack_for_the_gpu() {
     assert_eq!(bft.records.len(), bft.level1.num_faces());
     let packed = GpuBft::new(&bft).expect("packed");
     assert_eq!(packed.patches.len(), bft.records.len());
-    for (h, r) in packed.patches.iter().zip(&bft.records) {
+    for (h, r) in packed.patches.iter().zip(bft.records.iter()) {
         assert_eq!(h.edge_owner, r.edge_owner.map(|(f, k)| pack_owner(f, k)));
         assert_eq!(
             h.corner_owner,
@@ -263,11 +263,11 @@ fn prepare_and_pack_for_the_gpu() {
             .iter()
             .all(|&o| (owner_face(o) as usize) < bft.records.len()));
     }
-    let total: usize = bft.records.iter().map(|r| r.ring.len()).sum();
+    let total: usize = bft.records.iter().map(|r| r.ring_size as usize).sum();
     assert_eq!(packed.patch_rings.len(), total);
     // Header of face 1 points at its ring.
-    let r = &bft.records[1];
+    let r = bft.records.ring(1);
     let off = packed.patches[1].ring_offset as usize;
-    assert_eq!(packed.patches[1].ring_size as usize, r.ring.len());
-    assert_eq!(&packed.patch_rings[off..off + r.ring.len()], &r.ring[..]);
+    assert_eq!(packed.patches[1].ring_size as usize, r.len());
+    assert_eq!(&packed.patch_rings[off..off + r.len()], r);
 }

@@ -247,18 +247,24 @@ fn ring_from(mesh: &LocalMesh, v: u32, start: u32) -> impl Iterator<Item = u32> 
 
 /// Ordered control points of triangle `face` with corner `first` as `v0` (see module docs).
 pub fn face_control_ring(mesh: &LocalMesh, face: usize, first: usize) -> Vec<u32> {
+    let mut out = Vec::with_capacity(16);
+    face_control_ring_into(mesh, face, first, &mut out);
+    out
+}
+
+/// [`face_control_ring`] appended to `out` (the records' rings share one array).
+fn face_control_ring_into(mesh: &LocalMesh, face: usize, first: usize, out: &mut Vec<u32>) {
     let f = mesh.face(face);
     let (v0, v1, v2) = (f[first % 3], f[(first + 1) % 3], f[(first + 2) % 3]);
-    let mut out = Vec::with_capacity(16);
+    let start = out.len();
     out.extend([v0, v1, v2]);
     for (c, s) in [(v0, v1), (v1, v2), (v2, v0)] {
         for x in ring_from(mesh, c, s) {
-            if !out.contains(&x) {
+            if !out[start..].contains(&x) {
                 out.push(x);
             }
         }
     }
-    out
 }
 
 /// The table key of a face and its ordered control-vertex indices (rotated so the
@@ -310,7 +316,13 @@ fn config_shape(cache: &mut ConfigShapes, key: BftKey) -> Option<ConfigShape> {
 /// face is not covered by a table (see the module docs).
 pub fn classify_face(mesh: &LocalMesh, face: usize) -> Option<(BftKey, usize)> {
     let creases = has_interior_creases(mesh);
-    classify_face_cached(mesh, face, &mut ConfigShapes::new(), creases).map(|(k, c, _)| (k, c))
+    classify_face_cached(
+        mesh,
+        face,
+        &mut ConfigShapes::new(),
+        creases,
+        &mut Vec::new(),
+    )
 }
 
 /// Whether any edge that is not a boundary edge has a sharpness: without one, the per-face
@@ -324,13 +336,15 @@ fn has_interior_creases(mesh: &LocalMesh) -> bool {
         .any(|(e, &s)| s > 0.0 && !t.is_boundary_edge(e))
 }
 
-/// [`classify_face`] with the configuration shapes cached, and the face's control ring.
+/// [`classify_face`] with the configuration shapes cached; the face's control ring is appended
+/// to `ring` when a key is found (nothing is appended otherwise).
 fn classify_face_cached(
     mesh: &LocalMesh,
     face: usize,
     shapes: &mut ConfigShapes,
     creases: bool,
-) -> Option<(BftKey, usize, Vec<u32>)> {
+    ring: &mut Vec<u32>,
+) -> Option<(BftKey, usize)> {
     let f = mesh.face(face);
     if f.len() != 3 || mesh.scheme != LimitScheme::Loop {
         return None;
@@ -350,23 +364,30 @@ fn classify_face_cached(
         }
     }
     let sig = corner_signature(mesh, face, 0);
-    let irregular: Vec<usize> = (0..3)
-        .filter(|&k| {
-            let (n, b, _) = sig[k];
-            (b && n != 4) || (!b && n != 6)
-        })
-        .collect();
-    if irregular.len() > 1 {
+    // Candidate corners for v0 (fixed arrays: this runs per face).
+    let pick = |keep: &dyn Fn(usize) -> bool| {
+        let mut out = ([0usize; 3], 0usize);
+        for k in (0..3).filter(|&k| keep(k)) {
+            out.0[out.1] = k;
+            out.1 += 1;
+        }
+        out
+    };
+    let irregular = pick(&|k| {
+        let (n, b, _) = sig[k];
+        (b && n != 4) || (!b && n != 6)
+    });
+    if irregular.1 > 1 {
         return None;
     }
-    let mut candidates: Vec<usize> = irregular.clone();
-    if candidates.is_empty() {
-        candidates = (0..3).filter(|&k| sig[k].1).collect();
-        if candidates.is_empty() {
-            candidates.push(0);
+    let mut candidates = irregular;
+    if candidates.1 == 0 {
+        candidates = pick(&|k| sig[k].1);
+        if candidates.1 == 0 {
+            candidates = ([0; 3], 1);
         }
     }
-    for c in candidates {
+    for &c in &candidates.0[..candidates.1] {
         // The signature from corner c: the one above, rotated.
         let s = [sig[c % 3], sig[(c + 1) % 3], sig[(c + 2) % 3]];
         let key = BftKey {
@@ -387,10 +408,12 @@ fn classify_face_cached(
         if !same {
             continue;
         }
-        let ring = face_control_ring(mesh, face, c);
-        if ring.len() == ring_len {
-            return Some((key, c, ring));
+        let start = ring.len();
+        face_control_ring_into(mesh, face, c, ring);
+        if ring.len() - start == ring_len {
+            return Some((key, c));
         }
+        ring.truncate(start);
     }
     None
 }
@@ -826,11 +849,13 @@ impl BftCache {
 }
 
 /// What the GPU needs per face of the once-refined mesh.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PatchRecord {
     pub key: BftKey,
-    /// Global vertex indices in slot order ([`face_control_ring`]).
-    pub ring: Vec<u32>,
+    /// The face's global vertex indices in slot order ([`face_control_ring`]) are
+    /// `rings[ring_offset..ring_offset + ring_size]` of its [`PatchRecords`].
+    pub ring_offset: u32,
+    pub ring_size: u32,
     /// Global index of the face's `v0`, `v1`, `v2` (rotated order).
     pub corners: [u32; 3],
     /// For local edge `e` (0: v0→v1 where `j = 0`; 1: v1→v2 where `i + j = N`; 2: v2→v0 where
@@ -840,10 +865,46 @@ pub struct PatchRecord {
     pub corner_owner: [(u32, u8); 3],
 }
 
+/// The patch records of every face with their rings back to back in one array (a `Vec` per
+/// face cost a 1M-triangle mesh 4M allocations and ~300 MB at level 1); the GPU's ring
+/// buffer is `rings` as it is.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PatchRecords {
+    pub faces: Vec<PatchRecord>,
+    pub rings: Vec<u32>,
+}
+
+impl PatchRecords {
+    pub fn len(&self) -> usize {
+        self.faces.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.faces.is_empty()
+    }
+
+    /// Face `f`'s control ring, in slot order.
+    pub fn ring(&self, f: usize) -> &[u32] {
+        let r = &self.faces[f];
+        &self.rings[r.ring_offset as usize..(r.ring_offset + r.ring_size) as usize]
+    }
+
+    pub fn iter(&self) -> std::slice::Iter<'_, PatchRecord> {
+        self.faces.iter()
+    }
+}
+
+impl std::ops::Index<usize> for PatchRecords {
+    type Output = PatchRecord;
+    fn index(&self, f: usize) -> &PatchRecord {
+        &self.faces[f]
+    }
+}
+
 /// Patch records of every face of a Loop mesh (typically level 1): a shared table key where
 /// [`classify_face`] finds one, else a [`BftCase::Private`] key whose ring is the face's
 /// neighbourhood. Fails only on a face that is not a triangle.
-pub fn build_patch_records(mesh: &LocalMesh) -> Result<Vec<PatchRecord>, EvalError> {
+pub fn build_patch_records(mesh: &LocalMesh) -> Result<PatchRecords, EvalError> {
     let nf = mesh.num_faces();
     if let Some(f) = (0..nf).find(|&f| mesh.face(f).len() != 3) {
         return Err(EvalError::FaceSize {
@@ -854,36 +915,77 @@ pub fn build_patch_records(mesh: &LocalMesh) -> Result<Vec<PatchRecord>, EvalErr
         });
     }
     let creases = has_interior_creases(mesh);
-    // Faces are independent: classified in parallel, a shape cache per rayon job.
-    let mut recs: Vec<PatchRecord> = (0..nf)
+    // Faces are independent: classified in parallel blocks, a shape cache per rayon job, each
+    // block's rings in one array (offsets made global when the blocks are joined).
+    const BLOCK: usize = 1 << 14;
+    let blocks: Vec<PatchRecords> = (0..nf.div_ceil(BLOCK))
         .into_par_iter()
-        .map_init(ConfigShapes::new, |shapes, f| {
-            let fv = mesh.face(f);
-            let (key, first, ring) = match classify_face_cached(mesh, f, shapes, creases) {
-                Some(found) => found,
-                None => (
-                    BftKey {
-                        valence: 0,
-                        case: BftCase::Private { face: f as u32 },
-                    },
-                    0,
-                    neighbourhood_vertices(mesh, f),
-                ),
+        .map_init(ConfigShapes::new, |shapes, b| {
+            let faces = b * BLOCK..((b + 1) * BLOCK).min(nf);
+            let mut out = PatchRecords {
+                faces: Vec::with_capacity(faces.len()),
+                rings: Vec::with_capacity(12 * faces.len()),
             };
-            PatchRecord {
-                key,
-                ring,
-                corners: [fv[first], fv[(first + 1) % 3], fv[(first + 2) % 3]],
-                edge_owner: [(0, 0); 3],
-                corner_owner: [(0, 0); 3],
+            for f in faces {
+                let fv = mesh.face(f);
+                let start = out.rings.len();
+                let (key, first) =
+                    match classify_face_cached(mesh, f, shapes, creases, &mut out.rings) {
+                        Some(found) => found,
+                        None => {
+                            neighbourhood_vertices_into(mesh, f, &mut out.rings);
+                            (
+                                BftKey {
+                                    valence: 0,
+                                    case: BftCase::Private { face: f as u32 },
+                                },
+                                0,
+                            )
+                        }
+                    };
+                out.faces.push(PatchRecord {
+                    key,
+                    ring_offset: start as u32,
+                    ring_size: (out.rings.len() - start) as u32,
+                    corners: [fv[first], fv[(first + 1) % 3], fv[(first + 2) % 3]],
+                    edge_owner: [(0, 0); 3],
+                    corner_owner: [(0, 0); 3],
+                });
             }
+            out
         })
         .collect();
+    let mut recs = PatchRecords {
+        faces: Vec::with_capacity(nf),
+        rings: Vec::with_capacity(blocks.iter().map(|b| b.rings.len()).sum()),
+    };
+    for b in blocks {
+        let base = recs.rings.len() as u32;
+        recs.faces.extend(b.faces.iter().map(|r| PatchRecord {
+            ring_offset: r.ring_offset + base,
+            ..*r
+        }));
+        recs.rings.extend_from_slice(&b.rings);
+    }
     // Owners: the smallest (face, local index) among the faces around the corner (sharing the
-    // edge), found from the mesh's vertex-face adjacency instead of global edge maps.
-    let corners: Vec<[u32; 3]> = recs.iter().map(|r| r.corners).collect();
-    let local = |g: u32, x: u32| corners[g as usize].iter().position(|&c| c == x);
-    recs.par_iter_mut().enumerate().for_each(|(f, r)| {
+    // edge), found from the mesh's vertex-face adjacency instead of global edge maps. A face's
+    // rotation (its `v0` among its corners) is all a neighbour needs from its record.
+    let first: Vec<u8> = recs
+        .faces
+        .iter()
+        .enumerate()
+        .map(|(f, r)| {
+            mesh.face(f)
+                .iter()
+                .position(|&c| c == r.corners[0])
+                .unwrap_or(0) as u8
+        })
+        .collect();
+    let local = |g: u32, x: u32| {
+        let k = mesh.face(g as usize).iter().position(|&c| c == x)?;
+        Some((k + 3 - first[g as usize] as usize) % 3)
+    };
+    recs.faces.par_iter_mut().enumerate().for_each(|(f, r)| {
         for e in 0..3 {
             let (a, b) = (r.corners[e], r.corners[(e + 1) % 3]);
             let mut edge = (f as u32, e as u8);
@@ -908,14 +1010,20 @@ pub fn build_patch_records(mesh: &LocalMesh) -> Result<Vec<PatchRecord>, EvalErr
 /// [`LocalMesh::face_neighbourhood`] numbers them (the face's corners first).
 pub fn neighbourhood_vertices(mesh: &LocalMesh, face: usize) -> Vec<u32> {
     let mut out: Vec<u32> = Vec::new();
+    neighbourhood_vertices_into(mesh, face, &mut out);
+    out
+}
+
+/// [`neighbourhood_vertices`] appended to `out`.
+fn neighbourhood_vertices_into(mesh: &LocalMesh, face: usize, out: &mut Vec<u32>) {
+    let start = out.len();
     for f in mesh.neighbourhood_faces(face) {
         for &v in mesh.face(f as usize) {
-            if !out.contains(&v) {
+            if !out[start..].contains(&v) {
                 out.push(v);
             }
         }
     }
-    out
 }
 
 /// Exact limit weights of one face over its neighbourhood ([`neighbourhood_vertices`]) at every
@@ -975,7 +1083,7 @@ impl BasisTables {
 /// itself for interior points, else the owner of the edge or corner, with the point's
 /// coordinates in the owner's parameters.
 pub fn resolve_owner(
-    recs: &[PatchRecord],
+    recs: &PatchRecords,
     face: usize,
     i: u32,
     j: u32,
@@ -1029,7 +1137,7 @@ pub fn resolve_owner(
 /// `precise` guarantees) over the owner's control points.
 pub fn shader_eval(
     tables: &BasisTables,
-    recs: &[PatchRecord],
+    recs: &PatchRecords,
     points: &[[f32; 3]],
     face: usize,
     i: u32,
@@ -1055,7 +1163,7 @@ fn dot_rows(w: &[f32], ring: &[u32], points: &[[f32; 3]]) -> [f32; 3] {
 /// across edges as well; both parameterisations are CCW, so the owner's normal is the face's.
 pub fn shader_eval_full(
     tables: &BasisTables,
-    recs: &[PatchRecord],
+    recs: &PatchRecords,
     points: &[[f32; 3]],
     face: usize,
     i: u32,
@@ -1063,14 +1171,14 @@ pub fn shader_eval_full(
 ) -> Option<([f32; 3], [f32; 3])> {
     let n = tables.segments();
     let (g, a, b) = resolve_owner(recs, face, i, j, n);
-    let r = &recs[g];
-    let w = tables.row(r.key, a, b)?;
-    let p = dot_rows(&w.position, &r.ring, points);
+    let w = tables.row(recs[g].key, a, b)?;
+    let ring = recs.ring(g);
+    let p = dot_rows(&w.position, ring, points);
     if w.du.is_empty() {
         return Some((p, [0.0; 3]));
     }
-    let du = dot_rows(&w.du, &r.ring, points);
-    let dv = dot_rows(&w.dv, &r.ring, points);
+    let du = dot_rows(&w.du, ring, points);
+    let dv = dot_rows(&w.dv, ring, points);
     let c = [
         du[1] * dv[2] - du[2] * dv[1],
         du[2] * dv[0] - du[0] * dv[2],
@@ -1111,16 +1219,6 @@ impl TangentStencils {
         (&self.indices[r.clone()], &self.t1[r.clone()], &self.t2[r])
     }
 
-    fn push(&mut self, idx: &[u32], t1: &[f64], t2: &[f64]) {
-        if self.offsets.is_empty() {
-            self.offsets.push(0);
-        }
-        self.indices.extend_from_slice(idx);
-        self.t1.extend_from_slice(t1);
-        self.t2.extend_from_slice(t2);
-        self.offsets.push(self.indices.len() as u32);
-    }
-
     fn append(&mut self, other: TangentStencils) {
         if self.offsets.is_empty() {
             self.offsets.push(0);
@@ -1128,49 +1226,60 @@ impl TangentStencils {
         let base = self.indices.len() as u32;
         self.offsets
             .extend(other.offsets.iter().skip(1).map(|&o| base + o));
-        self.indices.extend(other.indices);
-        self.t1.extend(other.t1);
-        self.t2.extend(other.t2);
+        self.indices.extend_from_slice(&other.indices);
+        self.t1.extend_from_slice(&other.t1);
+        self.t2.extend_from_slice(&other.t2);
     }
 }
 
-/// Limit-tangent stencils of every level-1 vertex, in parallel blocks.
+/// Limit-tangent stencils of every level-1 vertex, in parallel blocks, each row written
+/// straight into its block's arrays ([`LocalMesh::loop_tangent_row`]).
 fn tangent_stencils(level1: &LocalMesh) -> TangentStencils {
     let n = level1.num_vertices();
     let block = 1 << 15;
     let blocks: Vec<TangentStencils> = (0..n.div_ceil(block))
         .into_par_iter()
         .map(|b| {
-            let mut out = TangentStencils::default();
-            for v in (b * block..((b + 1) * block).min(n)).map(|v| v as u32) {
-                match level1.loop_tangent_stencils(v) {
-                    Some((idx, t1, t2)) => out.push(&idx, &t1, &t2),
-                    None => {
-                        // No limit mask (e.g. a valence-2 corner under "edges only"): the
-                        // fan's chord tangents, first and last ring neighbour, still give the
-                        // outward side.
-                        let ring = level1.vertex_ring(v);
-                        let mut idx = vec![v];
-                        idx.extend_from_slice(ring);
-                        let mut t1 = vec![0.0; idx.len()];
-                        let mut t2 = vec![0.0; idx.len()];
-                        if idx.len() >= 3 {
-                            t1[0] = -1.0;
-                            t1[1] = 1.0;
-                            t2[0] = -1.0;
-                            t2[idx.len() - 1] = 1.0;
-                        }
-                        out.push(&idx, &t1, &t2);
+            let rows = b * block..((b + 1) * block).min(n);
+            let mut out = TangentStencils {
+                offsets: Vec::with_capacity(rows.len() + 1),
+                indices: Vec::with_capacity(8 * rows.len()),
+                t1: Vec::with_capacity(8 * rows.len()),
+                t2: Vec::with_capacity(8 * rows.len()),
+            };
+            out.offsets.push(0);
+            for v in rows.map(|v| v as u32) {
+                if !level1.loop_tangent_row(v, &mut out.indices, &mut out.t1, &mut out.t2) {
+                    // No limit mask (e.g. a valence-2 corner under "edges only"): the fan's
+                    // chord tangents, first and last ring neighbour, still give the outward
+                    // side.
+                    let ring = level1.vertex_ring(v);
+                    let len = ring.len() + 1;
+                    out.indices.push(v);
+                    out.indices.extend_from_slice(ring);
+                    let (s1, s2) = (out.t1.len(), out.t2.len());
+                    out.t1.resize(s1 + len, 0.0);
+                    out.t2.resize(s2 + len, 0.0);
+                    if len >= 3 {
+                        out.t1[s1] = -1.0;
+                        out.t1[s1 + 1] = 1.0;
+                        out.t2[s2] = -1.0;
+                        out.t2[s2 + len - 1] = 1.0;
                     }
                 }
+                out.offsets.push(out.indices.len() as u32);
             }
             out
         })
         .collect();
+    let terms: usize = blocks.iter().map(|b| b.indices.len()).sum();
     let mut all = TangentStencils {
-        offsets: vec![0],
-        ..Default::default()
+        offsets: Vec::with_capacity(n + 1),
+        indices: Vec::with_capacity(terms),
+        t1: Vec::with_capacity(terms),
+        t2: Vec::with_capacity(terms),
     };
+    all.offsets.push(0);
     for b in blocks {
         all.append(b);
     }
@@ -1187,7 +1296,7 @@ pub struct LoopBft {
     pub stencils: crate::stencil::StencilTable,
     /// Per level-1 vertex: control indices and the two tangent weight rows.
     pub tangent_stencils: TangentStencils,
-    pub records: Vec<PatchRecord>,
+    pub records: PatchRecords,
     pub tables: BasisTables,
     pub base_vertices: usize,
     pub base_faces: usize,
@@ -1207,22 +1316,49 @@ pub fn prepare_loop_bft(
             t.elapsed().as_secs_f64()
         )
     };
-    let r = crate::refine::refine_uniform(mesh, crate::sdc::Scheme::Loop, 1)?;
+    // One step of the refiner, taken by value: its level-1 topology becomes the local mesh's
+    // without a copy, and its stencils (over the base) are the ones the GPU needs.
+    let (level1, stencils) = {
+        let base = crate::refine::Level::from_mesh(mesh, crate::sdc::Scheme::Loop)?;
+        crate::refine::refine_level(&base, crate::sdc::Scheme::Loop, &mesh.options)?
+    };
     lap("refined");
-    let level1 = LocalMesh::from_refined_level(r.level(1), LimitScheme::Loop, &mesh.options)?;
+    let crate::refine::Level {
+        topology,
+        positions,
+        edge_sharpness,
+        vertex_sharpness,
+    } = level1;
+    let points: Vec<f64> = positions.iter().flatten().copied().collect();
+    drop(positions);
+    let level1 = LocalMesh::from_level(
+        crate::refine::LevelTopology {
+            topology,
+            edge_sharpness,
+            vertex_sharpness,
+        },
+        LimitScheme::Loop,
+        mesh.options,
+        3,
+        points,
+    )?;
     lap("level-1 mesh");
-    // The refiner's levels are not needed past here: freed before the records are built.
-    let stencils = r.stencils(1);
-    drop(r);
     let records = build_patch_records(&level1)?;
     lap("records");
-    let keys: Vec<BftKey> = records.iter().map(|r| r.key).collect();
+    // The distinct shared keys (the tables dedup them too, but not 4M of them).
+    let keys: Vec<BftKey> = records
+        .iter()
+        .filter(|r| !matches!(r.key.case, BftCase::Private { .. }))
+        .map(|r| r.key.canonical().0)
+        .collect::<std::collections::HashSet<_>>()
+        .into_iter()
+        .collect();
     let mut tables = BasisTables::build_with(&keys, level, tangents)?;
     lap("tables");
     for (f, r) in records.iter().enumerate() {
         if matches!(r.key.case, BftCase::Private { .. }) {
             let (rows, k) = private_table(&level1, f, level)?;
-            debug_assert_eq!(k, r.ring.len());
+            debug_assert_eq!(k, r.ring_size as usize);
             tables.add_private(r.key, &rows, k);
         }
     }
@@ -1241,37 +1377,58 @@ pub fn prepare_loop_bft(
 }
 
 impl LoopBft {
+    /// Which corner of level-1 face `face` its record's `v0` is: all [`Self::base_domain`]
+    /// needs of the records and the level-1 mesh (what a GPU surface keeps of them).
+    pub fn face_rotation(&self, face: usize) -> u8 {
+        let v0 = self.records[face].corners[0];
+        self.level1
+            .face(face)
+            .iter()
+            .position(|&x| x == v0)
+            .unwrap_or(0) as u8
+    }
+
     /// Barycentric weights, in the level-1 face's own corner order, of the point with patch
     /// coordinate `(u, v)` (weights of the record's `v1`, `v2`: the TES's frame).
     pub fn face_barycentric(&self, face: usize, u: f64, v: f64) -> [f64; 3] {
-        let r = &self.records[face];
-        let fv = self.level1.face(face);
-        let first = fv.iter().position(|&x| x == r.corners[0]).unwrap_or(0);
-        let mut b = [0.0; 3];
-        b[first] = 1.0 - u - v;
-        b[(first + 1) % 3] = u;
-        b[(first + 2) % 3] = v;
-        b
+        rotated_barycentric(self.face_rotation(face), u, v)
     }
 
     /// The base face and its domain coordinate `(U, V)` (weights of the base face's corners 1
-    /// and 2) of patch coordinate `(u, v)` on level-1 face `face`. Loop's split makes child
-    /// `4f + j` the triangle at corner `j` of base face `f` and child `4f + 3` the middle one.
+    /// and 2) of patch coordinate `(u, v)` on level-1 face `face`.
     pub fn base_domain(&self, face: usize, u: f64, v: f64) -> (usize, f64, f64) {
-        let c = self.face_barycentric(face, u, v);
-        let (f, j) = (face / 4, face % 4);
-        let mut b = [0.0; 3];
-        if j < 3 {
-            let (next, prev) = ((j + 1) % 3, (j + 2) % 3);
-            b[j] += c[0] + 0.5 * (c[1] + c[2]);
-            b[next] += 0.5 * c[1];
-            b[prev] += 0.5 * c[2];
-        } else {
-            for k in 0..3 {
-                b[k] += 0.5 * c[k];
-                b[(k + 1) % 3] += 0.5 * c[k];
-            }
-        }
-        (f, b[1], b[2])
+        level1_base_domain(face, self.face_rotation(face), u, v)
     }
+}
+
+/// Barycentric weights in a level-1 face's own corner order of patch coordinate `(u, v)` on a
+/// record whose `v0` is corner `first` of the face.
+fn rotated_barycentric(first: u8, u: f64, v: f64) -> [f64; 3] {
+    let first = first as usize % 3;
+    let mut b = [0.0; 3];
+    b[first] = 1.0 - u - v;
+    b[(first + 1) % 3] = u;
+    b[(first + 2) % 3] = v;
+    b
+}
+
+/// [`LoopBft::base_domain`] from the face's rotation ([`LoopBft::face_rotation`]) alone. Loop's
+/// split makes child `4f + j` the triangle at corner `j` of base face `f` and child `4f + 3`
+/// the middle one.
+pub fn level1_base_domain(face: usize, rotation: u8, u: f64, v: f64) -> (usize, f64, f64) {
+    let c = rotated_barycentric(rotation, u, v);
+    let (f, j) = (face / 4, face % 4);
+    let mut b = [0.0; 3];
+    if j < 3 {
+        let (next, prev) = ((j + 1) % 3, (j + 2) % 3);
+        b[j] += c[0] + 0.5 * (c[1] + c[2]);
+        b[next] += 0.5 * c[1];
+        b[prev] += 0.5 * c[2];
+    } else {
+        for k in 0..3 {
+            b[k] += 0.5 * c[k];
+            b[(k + 1) % 3] += 0.5 * c[k];
+        }
+    }
+    (f, b[1], b[2])
 }

@@ -33,12 +33,12 @@
 //! Holes are evaluated like ordinary faces; Loop needs triangles, Catmull-Clark quads (use
 //! [`LocalMesh::evaluate_subface`] for other faces).
 
-use std::borrow::Cow;
 use std::fmt;
 
 use crate::error::TopologyError;
 use crate::limit::{
-    catmark_limit_masks, loop_limit_masks, smooth_directional_tangent, LimitRule, LimitVertex,
+    catmark_limit_masks, loop_limit_masks, loop_smooth_tangent_weights, smooth_directional_tangent,
+    LimitRule, LimitVertex,
 };
 use crate::mesh::{ControlMesh, SubdivOptions, Topology, INVALID};
 use crate::patch::{catmark_regular_weights, loop_regular_weights};
@@ -149,15 +149,15 @@ struct Fan {
     complete: bool,
 }
 
-/// The fan of `v` in `t`: it starts at the face whose edge leaving `v` is a boundary edge, else
-/// at the lowest-numbered face, and turns across the edge entering `v` in each face.
-fn build_fan(t: &Topology, v: u32) -> Fan {
+/// Walks the fan of `v` in `t`: it starts at the face whose edge leaving `v` is a boundary
+/// edge, else at the lowest-numbered face, and turns across the edge entering `v` in each face.
+/// `visit(face, corner, ring vertex, edge)` runs per face, then once more with face
+/// [`INVALID`] for the last neighbour of a fan that ends on a boundary edge. Returns
+/// (boundary, complete).
+fn walk_fan(t: &Topology, v: u32, mut visit: impl FnMut(u32, u32, u32, u32)) -> (bool, bool) {
     let vf = t.vertex_faces(v as usize);
     let Some(&first) = vf.first() else {
-        return Fan {
-            complete: true,
-            ..Fan::default()
-        };
+        return (false, true);
     };
     let corner = |g: u32| {
         t.face_vertices(g as usize)
@@ -171,34 +171,174 @@ fn build_fan(t: &Topology, v: u32) -> Fan {
         .find(|&g| t.is_boundary_edge(t.face_edge_list(g as usize)[corner(g)] as usize))
         .unwrap_or(first);
     let boundary = t.is_boundary_edge(t.face_edge_list(start as usize)[corner(start)] as usize);
-    let mut fan = Fan {
-        boundary,
-        ..Fan::default()
-    };
+    let mut count = 0;
     let mut g = start;
     loop {
         let c = corner(g);
         let fv = t.face_vertices(g as usize);
         let fe = t.face_edge_list(g as usize);
         let n = fv.len();
-        fan.faces.push((g, c as u32));
-        fan.ring.push(fv[(c + 1) % n]);
-        fan.edges.push(fe[c]);
+        visit(g, c as u32, fv[(c + 1) % n], fe[c]);
+        count += 1;
         let entering = fe[(c + n - 1) % n];
         let [a, b] = t.edge_faces(entering as usize);
         let h = if a == g { b } else { a };
         if h == INVALID {
-            fan.ring.push(fv[(c + n - 1) % n]);
-            fan.edges.push(entering);
+            visit(INVALID, 0, fv[(c + n - 1) % n], entering);
             break;
         }
-        if h == start || fan.faces.len() >= vf.len() {
+        if h == start || count >= vf.len() {
             break;
         }
         g = h;
     }
-    fan.complete = fan.faces.len() == vf.len();
+    (boundary, count == vf.len())
+}
+
+/// The fan of `v` in `t` ([`walk_fan`]).
+fn build_fan(t: &Topology, v: u32) -> Fan {
+    let mut fan = Fan::default();
+    let (boundary, complete) = walk_fan(t, v, |g, c, w, e| {
+        if g != INVALID {
+            fan.faces.push((g, c));
+        }
+        fan.ring.push(w);
+        fan.edges.push(e);
+    });
+    fan.boundary = boundary;
+    fan.complete = complete;
     fan
+}
+
+/// Every vertex's fan ([`walk_fan`]) flattened: faces and rings in one array each, with offsets
+/// (three `Vec`s per vertex cost a 1M-triangle mesh 2M × 3 allocations and ~400 MB at level
+/// 1). Corner indices and edges are not stored: [`Fans::fan`] finds them in the topology.
+#[derive(Clone, Debug, Default)]
+struct Fans {
+    /// Faces of `v`: `faces[face_start[v]..face_start[v + 1]]`, CCW.
+    face_start: Vec<u32>,
+    faces: Vec<u32>,
+    /// Edge-neighbours of `v`: `ring[ring_start[v]..ring_start[v + 1]]` (one more than its
+    /// faces where the fan ends on a boundary edge).
+    ring_start: Vec<u32>,
+    ring: Vec<u32>,
+    /// Per vertex: bit 0 boundary, bit 1 complete.
+    flags: Vec<u8>,
+}
+
+const FAN_BOUNDARY: u8 = 1;
+const FAN_COMPLETE: u8 = 2;
+
+impl Fans {
+    /// The fans of `vertices`, offsets starting at 0 (one past the end at each vertex).
+    fn build_range(t: &Topology, vertices: std::ops::Range<usize>) -> Fans {
+        let mut out = Fans::default();
+        for v in vertices {
+            let (faces, ring) = (&mut out.faces, &mut out.ring);
+            let (boundary, complete) = walk_fan(t, v as u32, |g, _, w, _| {
+                if g != INVALID {
+                    faces.push(g);
+                }
+                ring.push(w);
+            });
+            out.face_start.push(out.faces.len() as u32);
+            out.ring_start.push(out.ring.len() as u32);
+            out.flags.push(
+                if boundary { FAN_BOUNDARY } else { 0 } | if complete { FAN_COMPLETE } else { 0 },
+            );
+        }
+        out
+    }
+
+    /// The fans of every vertex of `t`, in parallel blocks on large levels.
+    fn build(t: &Topology) -> Fans {
+        const BLOCK: usize = 1 << 15;
+        let n = t.num_vertices();
+        let blocks: Vec<Fans> = if n <= BLOCK {
+            vec![Fans::build_range(t, 0..n)]
+        } else {
+            use rayon::prelude::*;
+            (0..n.div_ceil(BLOCK))
+                .into_par_iter()
+                .map(|b| Fans::build_range(t, b * BLOCK..((b + 1) * BLOCK).min(n)))
+                .collect()
+        };
+        let faces: usize = blocks.iter().map(|b| b.faces.len()).sum();
+        let ring: usize = blocks.iter().map(|b| b.ring.len()).sum();
+        let mut all = Fans {
+            face_start: Vec::with_capacity(n + 1),
+            faces: Vec::with_capacity(faces),
+            ring_start: Vec::with_capacity(n + 1),
+            ring: Vec::with_capacity(ring),
+            flags: Vec::with_capacity(n),
+        };
+        all.face_start.push(0);
+        all.ring_start.push(0);
+        for b in blocks {
+            let (fb, rb) = (all.faces.len() as u32, all.ring.len() as u32);
+            all.face_start.extend(b.face_start.iter().map(|&o| fb + o));
+            all.ring_start.extend(b.ring_start.iter().map(|&o| rb + o));
+            all.faces.extend_from_slice(&b.faces);
+            all.ring.extend_from_slice(&b.ring);
+            all.flags.extend_from_slice(&b.flags);
+        }
+        all
+    }
+
+    fn faces(&self, v: u32) -> &[u32] {
+        let v = v as usize;
+        &self.faces[self.face_start[v] as usize..self.face_start[v + 1] as usize]
+    }
+
+    fn ring(&self, v: u32) -> &[u32] {
+        let v = v as usize;
+        &self.ring[self.ring_start[v] as usize..self.ring_start[v + 1] as usize]
+    }
+
+    fn boundary(&self, v: u32) -> bool {
+        self.flags[v as usize] & FAN_BOUNDARY != 0
+    }
+
+    fn complete(&self, v: u32) -> bool {
+        self.flags[v as usize] & FAN_COMPLETE != 0
+    }
+
+    /// The edge from `v` to its ring vertex `i` (the edge leaving `v` in face `i`, or the edge
+    /// entering `v` in the last face for the extra neighbour of a boundary fan).
+    fn edge(&self, t: &Topology, v: u32, i: usize) -> u32 {
+        let faces = self.faces(v);
+        let (g, leaving) = match faces.get(i) {
+            Some(&g) => (g, true),
+            None => (faces[faces.len() - 1], false),
+        };
+        let fv = t.face_vertices(g as usize);
+        let c = fv.iter().position(|&x| x == v).unwrap_or(0);
+        let n = fv.len();
+        t.face_edge_list(g as usize)[if leaving { c } else { (c + n - 1) % n }]
+    }
+
+    /// The fan of `v` as [`build_fan`] makes it.
+    fn fan(&self, t: &Topology, v: u32) -> Fan {
+        let faces = self.faces(v);
+        let ring = self.ring(v);
+        Fan {
+            faces: faces
+                .iter()
+                .map(|&g| {
+                    let c = t
+                        .face_vertices(g as usize)
+                        .iter()
+                        .position(|&x| x == v)
+                        .unwrap_or(0);
+                    (g, c as u32)
+                })
+                .collect(),
+            ring: ring.to_vec(),
+            edges: (0..ring.len()).map(|i| self.edge(t, v, i)).collect(),
+            boundary: self.boundary(v),
+            complete: self.complete(v),
+        }
+    }
 }
 
 /// A polygon mesh level with points of any dimension: the working set of the evaluator and of
@@ -214,7 +354,7 @@ pub struct LocalMesh {
     pub dim: usize,
     /// `dim` values per vertex.
     pub points: Vec<f64>,
-    fans: Vec<Fan>,
+    fans: Fans,
 }
 
 /// Limit position and first derivatives (any dimension).
@@ -259,9 +399,7 @@ impl LocalMesh {
     ) -> Result<LocalMesh, EvalError> {
         let vertices = level.topology.num_vertices();
         check_point_count(&points, dim, vertices)?;
-        let fans = (0..vertices as u32)
-            .map(|v| build_fan(&level.topology, v))
-            .collect();
+        let fans = Fans::build(&level.topology);
         Ok(LocalMesh {
             scheme,
             options,
@@ -344,17 +482,17 @@ impl LocalMesh {
 
     /// True if `v` lies on the mesh boundary.
     pub fn is_boundary_vertex(&self, v: u32) -> bool {
-        self.fans[v as usize].boundary
+        self.fans.boundary(v)
     }
 
     /// Edge-neighbours of `v` in CCW order (fan order for boundary vertices).
     pub fn vertex_ring(&self, v: u32) -> &[u32] {
-        &self.fans[v as usize].ring
+        self.fans.ring(v)
     }
 
     /// Faces around `v` in CCW order.
     pub fn vertex_faces(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
-        self.fans[v as usize].faces.iter().map(|&(f, _)| f)
+        self.fans.faces(v).iter().copied()
     }
 
     /// True if edge `a–b` has a face on one side only (or is no edge).
@@ -480,20 +618,57 @@ impl LocalMesh {
     /// For the GPU's limit normals of the once-refined mesh. `None` for Catmull-Clark meshes
     /// and where [`Self::vertex_limit_position`] has no mask.
     pub fn loop_tangent_stencils(&self, v: u32) -> Option<(Vec<u32>, Vec<f64>, Vec<f64>)> {
+        let (mut idx, mut t1, mut t2) = (Vec::new(), Vec::new(), Vec::new());
+        self.loop_tangent_row(v, &mut idx, &mut t1, &mut t2)
+            .then_some((idx, t1, t2))
+    }
+
+    /// [`Self::loop_tangent_stencils`] appended to `indices`, `t1` and `t2` (nothing appended
+    /// and `false` where that returns `None`). Allocation-free at smooth vertices: it runs per
+    /// vertex of a level-1 mesh (2M on a 1M-triangle mesh).
+    pub fn loop_tangent_row(
+        &self,
+        v: u32,
+        indices: &mut Vec<u32>,
+        t1: &mut Vec<f64>,
+        t2: &mut Vec<f64>,
+    ) -> bool {
         if self.scheme != LimitScheme::Loop {
-            return None;
+            return false;
         }
-        let fan = &self.fans[v as usize];
-        let lv = self.view().limit_vertex(v, fan, None)?;
-        let masks = loop_limit_masks(&lv);
-        let mut idx = vec![v];
-        idx.extend_from_slice(&fan.ring);
-        let flat = |m: &crate::limit::Mask| {
-            let mut w = vec![m.vertex];
-            w.extend_from_slice(&m.edges);
-            w
+        let ring = self.fans.ring(v);
+        if !self.fans.complete(v) || ring.is_empty() {
+            return false;
+        }
+        let t = &self.level.topology;
+        let view = self.view();
+        let Some(lv) = limit_rule(
+            self.level.vertex_sharpness[v as usize],
+            self.fans.boundary(v),
+            ring.len(),
+            (0..ring.len()).map(|i| view.edge_sharp(self.fans.edge(t, v, i))),
+            None,
+        ) else {
+            return false;
         };
-        Some((idx, flat(&masks.tangent1), flat(&masks.tangent2)))
+        indices.push(v);
+        indices.extend_from_slice(ring);
+        if lv.rule == LimitRule::Smooth {
+            t1.push(0.0);
+            t2.push(0.0);
+            for i in 0..ring.len() {
+                let (c, s) = loop_smooth_tangent_weights(ring.len(), i);
+                t1.push(c);
+                t2.push(s);
+            }
+        } else {
+            let masks = loop_limit_masks(&lv);
+            for (out, m) in [(t1, &masks.tangent1), (t2, &masks.tangent2)] {
+                out.push(m.vertex);
+                out.extend_from_slice(&m.edges);
+            }
+        }
+        true
     }
 
     /// Control points of face `f` as a regular patch (ordering of [`crate::patch`]), or `None`.
@@ -580,7 +755,7 @@ struct View<'a> {
     level: &'a LevelTopology,
     dim: usize,
     points: &'a [f64],
-    fans: Option<&'a [Fan]>,
+    fans: Option<&'a Fans>,
 }
 
 impl View<'_> {
@@ -592,10 +767,10 @@ impl View<'_> {
         &self.points[v as usize * self.dim..(v as usize + 1) * self.dim]
     }
 
-    fn fan(&self, v: u32) -> Cow<'_, Fan> {
+    fn fan(&self, v: u32) -> Fan {
         match self.fans {
-            Some(f) => Cow::Borrowed(&f[v as usize]),
-            None => Cow::Owned(build_fan(&self.level.topology, v)),
+            Some(f) => f.fan(&self.level.topology, v),
+            None => build_fan(&self.level.topology, v),
         }
     }
 
@@ -620,42 +795,14 @@ impl View<'_> {
         if !fan.complete || fan.ring.is_empty() {
             return None;
         }
-        let vs = self.level.vertex_sharpness[v as usize];
-        if is_semi_sharp(vs) {
-            return None;
-        }
-        let inc = self.incident_sharpness(fan);
-        if inc.iter().any(|&s| is_semi_sharp(s)) {
-            return None;
-        }
-        let sharp: Vec<usize> = (0..inc.len()).filter(|&i| is_infinite(inc[i])).collect();
-        let n = fan.ring.len();
-        let rule = match vertex_rule(vs, sharp.len()) {
-            Rule::Smooth | Rule::Dart => LimitRule::Smooth,
-            Rule::Crease => {
-                let (a, b) = (sharp[0], sharp[1]);
-                let ends = if fan.boundary {
-                    [0, n - 1]
-                } else {
-                    // Face j lies between ring[j] and ring[j+1]: inside the CCW span a → b?
-                    let j = face
-                        .and_then(|f| fan.faces.iter().position(|&(g, _)| g == f))
-                        .unwrap_or(a);
-                    if (j + n - a) % n < (b + n - a) % n {
-                        [a, b]
-                    } else {
-                        [b, a]
-                    }
-                };
-                LimitRule::Crease { ends }
-            }
-            Rule::Corner => LimitRule::Corner,
-        };
-        Some(LimitVertex {
-            valence: n,
-            boundary: fan.boundary,
-            rule,
-        })
+        let j = face.and_then(|f| fan.faces.iter().position(|&(g, _)| g == f));
+        limit_rule(
+            self.level.vertex_sharpness[v as usize],
+            fan.boundary,
+            fan.ring.len(),
+            fan.edges.iter().map(|&e| self.edge_sharp(e)),
+            j,
+        )
     }
 
     /// Limit position and the two mask tangents (see [`crate::limit`]) of vertex `v`.
@@ -947,6 +1094,60 @@ impl View<'_> {
         }
         net.into_iter().collect()
     }
+}
+
+/// The limit rule of a vertex of sharpness `vs` with `n` edge-neighbours whose edges have
+/// sharpness `inc` (in ring order), or `None` while a semi-sharp feature is left (refine
+/// first). Crease ends are oriented so the CCW span `ends[0] → ends[1]` contains fan face `j`
+/// (`None`: the span starting at the first sharp edge). Allocation-free: it runs per vertex
+/// of a level-1 mesh.
+fn limit_rule(
+    vs: f32,
+    boundary: bool,
+    n: usize,
+    inc: impl Iterator<Item = f32>,
+    j: Option<usize>,
+) -> Option<LimitVertex> {
+    if is_semi_sharp(vs) {
+        return None;
+    }
+    let mut sharp = [0usize; 2];
+    let mut count = 0;
+    for (i, s) in inc.enumerate() {
+        if is_semi_sharp(s) {
+            return None;
+        }
+        if is_infinite(s) {
+            if count < 2 {
+                sharp[count] = i;
+            }
+            count += 1;
+        }
+    }
+    let rule = match vertex_rule(vs, count) {
+        Rule::Smooth | Rule::Dart => LimitRule::Smooth,
+        Rule::Crease => {
+            let (a, b) = (sharp[0], sharp[1]);
+            let ends = if boundary {
+                [0, n - 1]
+            } else {
+                // Face j lies between ring[j] and ring[j+1]: inside the CCW span a → b?
+                let j = j.unwrap_or(a);
+                if (j + n - a) % n < (b + n - a) % n {
+                    [a, b]
+                } else {
+                    [b, a]
+                }
+            };
+            LimitRule::Crease { ends }
+        }
+        Rule::Corner => LimitRule::Corner,
+    };
+    Some(LimitVertex {
+        valence: n,
+        boundary,
+        rule,
+    })
 }
 
 /// The recursion of [`LocalMesh::evaluate`]: `face` of `level` (whose one-ring is complete,

@@ -108,9 +108,7 @@ pub fn loop_limit_masks(v: &LimitVertex) -> LimitMasks {
             pos.vertex = 1.0 - e * nf;
             pos.edges.iter_mut().for_each(|w| *w = e);
             for i in 0..n {
-                let a = 2.0 * PI * i as f64 / nf;
-                t1.edges[i] = a.cos();
-                t2.edges[i] = a.sin();
+                (t1.edges[i], t2.edges[i]) = loop_smooth_tangent_weights(n, i);
             }
         }
         LimitRule::Crease { ends } => {
@@ -131,6 +129,14 @@ pub fn loop_limit_masks(v: &LimitVertex) -> LimitMasks {
         tangent1: t1,
         tangent2: t2,
     }
+}
+
+/// Weights of edge-neighbour `i` of a smooth Loop vertex of valence `n` in its two tangent
+/// masks (`cos`, `sin` of its angle): one place, so the masks and the allocation-free rows of
+/// [`crate::eval::LocalMesh::loop_tangent_row`] agree to the bit.
+pub fn loop_smooth_tangent_weights(n: usize, i: usize) -> (f64, f64) {
+    let a = 2.0 * PI * i as f64 / n as f64;
+    (a.cos(), a.sin())
 }
 
 /// Cross-crease tangent over the interior edges strictly between `ends[0]` and `ends[1]`

@@ -271,7 +271,10 @@ fn edge_rows_use_only_shared_control_points() {
             let row = tables.row(rf.key, i, j).expect("row");
             for (s, &w) in row.position.iter().enumerate() {
                 if w != 0.0 {
-                    assert!(recs[g].ring.contains(&rf.ring[s]), "slot {s} not shared");
+                    assert!(
+                        recs.ring(g).contains(&recs.ring(f)[s]),
+                        "slot {s} not shared"
+                    );
                 }
             }
         }

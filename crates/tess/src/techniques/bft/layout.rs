@@ -278,21 +278,21 @@ impl GpuBft {
             .collect();
         let t = &bft.tables;
         let mut patches = Vec::with_capacity(bft.records.len());
-        let mut patch_rings = Vec::new();
+        // The records' rings are already one array in slot order: the ring buffer as it is.
+        let patch_rings = bft.records.rings.clone();
         for (face, r) in bft.records.iter().enumerate() {
             let (entry, mirrored) = t
                 .lookup(r.key)
                 .ok_or(LayoutError::NoTable { face, key: r.key })?;
             let owners = |o: &[(u32, u8); 3]| o.map(|(f, k)| pack_owner(f, k));
             patches.push(PatchHeader {
-                ring_offset: patch_rings.len() as u32,
-                ring_size: r.ring.len() as u32,
+                ring_offset: r.ring_offset,
+                ring_size: r.ring_size,
                 entry: entry as u32,
                 mirrored: mirrored as u32,
                 edge_owner: owners(&r.edge_owner),
                 corner_owner: owners(&r.corner_owner),
             });
-            patch_rings.extend_from_slice(&r.ring);
         }
         let table_entries: Vec<TableEntry> = t
             .entries
