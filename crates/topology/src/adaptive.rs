@@ -234,6 +234,7 @@ pub struct PatchSample {
 mod assemble;
 mod levels;
 mod nets;
+pub mod single_pass;
 
 /// Plan the feature-adaptive refinement and patches of `mesh` (Catmull-Clark).
 ///
@@ -281,8 +282,9 @@ pub fn plan_adaptive_within(
         opts.isolation as usize,
         opts.follow_semi_sharp,
         max_refined_faces,
+        false,
     )?;
-    assemble::assemble(&scaled, opts, levels)
+    assemble::assemble(&scaled, opts, levels, opts.isolation as usize, false)
 }
 
 fn bezier(t: f64) -> ([f64; 4], [f64; 4]) {

@@ -41,12 +41,17 @@ impl Locals {
     }
 }
 
+/// `caps_from`: the first level whose irregular faces become end caps (the isolation level;
+/// 0 for single-pass plans). `acc`: irregular faces in ACC-1's scope get ACC-1's Bézier net
+/// instead of Gregory points (see [`super::single_pass`]).
 pub(super) fn assemble(
     mesh: &ControlMesh,
     opts: &AdaptiveOptions,
     mut levels: Vec<Lvl>,
+    caps_from: usize,
+    acc: bool,
 ) -> Result<AdaptivePlan, TopologyError> {
-    let iso = opts.isolation as usize;
+    let iso = caps_from;
     let last = levels.last().expect("levels");
     let first_local = last.base + last.t().num_vertices() as u32;
     let mut locals = Locals {
@@ -102,7 +107,10 @@ pub(super) fn assemble(
                         EndCap::Bilinear => PatchKind::Bilinear,
                     };
                     if d.kind == PatchKind::Gregory {
-                        d.gregory = Some(gregory_points(mesh, lvl, f, shift)?);
+                        d.gregory = Some(match acc.then(|| acc_points(lvl, f, shift)) {
+                            Some(Ok(points)) => points,
+                            _ => gregory_points(mesh, lvl, f, shift)?,
+                        });
                     }
                     // The end cap handles its sharp edges itself; the mask says which.
                     let (_, fe) = rotated(lvl.t(), f, shift);
@@ -548,6 +556,37 @@ pub(super) fn gregory_points(
         .map(|k| {
             let (p, j) = (k / 5, k % 5);
             let st = &basis[5 * ((p + s) % 4) + j];
+            st.indices
+                .iter()
+                .zip(&st.weights)
+                .map(|(&i, &w)| (i + lvl.base, w))
+                .collect()
+        })
+        .collect())
+}
+
+/// ACC-1's 16 Bézier points of face `f` as a Gregory patch's 20 (global ids, patch corner
+/// order): each corner's `Fp` and `Fm` are both its inner Bézier point, which makes the
+/// Gregory patch that bicubic Bézier patch. Fails outside ACC-1's scope ([`crate::acc`]).
+pub(super) fn acc_points(
+    lvl: &Lvl,
+    f: usize,
+    shift: u8,
+) -> Result<Vec<Vec<(u32, f64)>>, TopologyError> {
+    let net = crate::acc::acc1_patch(lvl.topo.view(), f)?;
+    // Per face corner: the Bézier (i, j) of P, Ep, Em, F (module docs of crate::gregory).
+    const SLOTS: [[(usize, usize); 4]; 4] = [
+        [(0, 0), (1, 0), (0, 1), (1, 1)],
+        [(3, 0), (3, 1), (2, 0), (2, 1)],
+        [(3, 3), (2, 3), (3, 2), (2, 2)],
+        [(0, 3), (0, 2), (1, 3), (1, 2)],
+    ];
+    let s = shift as usize;
+    Ok((0..20)
+        .map(|k| {
+            let (p, j) = (k / 5, k % 5);
+            let (bi, bj) = SLOTS[(p + s) % 4][j.min(3)];
+            let st = &net[bi][bj];
             st.indices
                 .iter()
                 .zip(&st.weights)

@@ -88,11 +88,16 @@ fn semi_sharp(lvl: &Lvl, v: usize) -> bool {
 /// [`SEMI_SHARP_LIMIT`]), so the patches beside a crease of sharpness 7.5 are exact instead of
 /// treating the leftover sharpness as infinite. Faces that stop being selected at or past
 /// `iso` while still irregular become end caps at their level.
+///
+/// `single_pass` (the single-pass plans, [`super::single_pass`]) selects at level 0 only the
+/// faces a one-patch-per-face approximation cannot cover (the faces with a corner next to a
+/// non-quad) and never refines past level 1.
 pub(super) fn build_levels(
     mesh: &ControlMesh,
     iso: usize,
     follow_semi_sharp: bool,
     max_refined_faces: u64,
+    single_pass: bool,
 ) -> Result<Vec<Lvl>, TopologyError> {
     let topo = LevelTopology::from_mesh(mesh, Scheme::CatmullClark)?;
     if let Some((face, size)) = (0..topo.topology.num_faces())
@@ -157,7 +162,16 @@ pub(super) fn build_levels(
             .collect();
         lvl.irregular = irregular;
         // Past the isolation level only semi-sharp features are followed.
-        let follow: Vec<bool> = if l < iso {
+        let follow: Vec<bool> = if single_pass {
+            let t = lvl.t();
+            (0..t.num_vertices())
+                .map(|v| {
+                    t.vertex_faces(v)
+                        .iter()
+                        .any(|&f| t.face_vertices(f as usize).len() != 4)
+                })
+                .collect()
+        } else if l < iso {
             lvl.irregular.clone()
         } else {
             (0..lvl.t().num_vertices())
@@ -173,7 +187,8 @@ pub(super) fn build_levels(
                     && t.face_vertices(f).iter().any(|&v| follow[v as usize])
             })
             .collect();
-        if last || (l >= iso && !lvl.selected.iter().any(|&x| x)) {
+        let none = !lvl.selected.iter().any(|&x| x);
+        if last || (none && (l >= iso || single_pass)) {
             break;
         }
         let selection: Vec<u32> = (0..t.num_faces() as u32)
