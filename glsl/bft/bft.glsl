@@ -188,14 +188,16 @@ void bft_accumulate_patch(uint row, bool flip, bool geometric,
     for (uint blk = 0u; blk < blocks; ++blk) {
         uint off = (blk == 0u ? tc_head.z : (blk == 1u ? off_du : off_dv)) + row * rs;
         precise vec3 a = vec3(0.0);
+        // No `if (s < rs)`: slots past the ring hold zero points (bft.tesc) and read a weight
+        // clamped into the row, so their products are ±0, which leave the sum's bits as the
+        // global path's (a running sum that starts at +0 never becomes -0); llvmpipe would run
+        // the masked slots anyway, and the mask bookkeeping is saved.
         [[unroll]] for (uint s = 0u; s < BFT_GATHER_SLOTS; ++s) {
-            if (s < rs) {
-                uint mirrored_slot = (tc_aux[1u + s / 6u] >> (5u * (s % 6u))) & 31u;
-                vec3 x = vec3(bft_gathered(6u * s), bft_gathered(6u * s + 1u), bft_gathered(6u * s + 2u));
-                float w = table_weights[off + (flip ? mirrored_slot : s)];
-                a += w * x;
-                an += w * vec3(bft_gathered(6u * s + 3u), bft_gathered(6u * s + 4u), bft_gathered(6u * s + 5u));
-            }
+            uint mirrored_slot = (tc_aux[1u + s / 6u] >> (5u * (s % 6u))) & 31u;
+            vec3 x = vec3(bft_gathered(6u * s), bft_gathered(6u * s + 1u), bft_gathered(6u * s + 2u));
+            float w = table_weights[off + min(flip ? mirrored_slot : s, rs - 1u)];
+            a += w * x;
+            an += w * vec3(bft_gathered(6u * s + 3u), bft_gathered(6u * s + 4u), bft_gathered(6u * s + 5u));
         }
         if (blk == 0u) p = a; else if (blk == 1u) q = a; else r = a;
     }
