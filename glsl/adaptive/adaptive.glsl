@@ -63,19 +63,50 @@ vec3 vtx(uint i) { return vertices[i].xyz; }
 // The canonical curve evaluation: one formula, one operand order, `precise`, so every patch
 // that reads a curve at the same parameter gets the same bits. s = 0 and s = 1 give the end
 // points exactly (the weights are exactly 1, 0, 0, 0).
-vec3 bezier_curve_point(vec3 a, vec3 b, vec3 c, vec3 d, float s) {
+vec3 curve_point(uint c, float s) {
+    uvec4 b = curves[c];
     precise float r = 1.0 - s;
     precise float w0 = r * r * r;
     precise float w1 = 3.0 * s * r * r;
     precise float w2 = 3.0 * s * s * r;
     precise float w3 = s * s * s;
-    precise vec3 p = w0 * a + w1 * b + w2 * c + w3 * d;
+    precise vec3 p = w0 * vtx(b.x) + w1 * vtx(b.y) + w2 * vtx(b.z) + w3 * vtx(b.w);
     return p;
 }
 
-vec3 curve_point(uint c, float s) {
-    uvec4 b = curves[c];
-    return bezier_curve_point(vtx(b.x), vtx(b.y), vtx(b.z), vtx(b.w), s);
+// Where patch edge e is at parameter t along the patch's edge direction (e runs v_e -> v_e+1),
+// for interior blends (not canonical).
+vec3 edge_point(AdaptivePatch p, uint e, float t) {
+    uint kind = edge_kind(p, e);
+    uint h = 0u;
+    float s = t;
+    if (kind == ADAPTIVE_EDGE_COARSE) {
+        h = t < 0.5 ? 0u : 1u;
+        s = h == 0u ? 2.0 * t : 2.0 * t - 1.0;
+    }
+    if (edge_reversed(p, e, h)) s = 1.0 - s;
+    return curve_point(p.curves[2u * e + h], s);
+}
+
+// The canonical boundary point of patch edge e at parameter t (as above) with the edge's
+// tessellation level n: integer levels name the vertex k = round(t n) and both sides evaluate
+// k / n on the curve in its own direction; fractional levels mirror t exactly (1 - t is exact
+// for tess coordinates).
+vec3 canonical_edge_point(AdaptivePatch p, uint e, float t, float n, bool integer_level) {
+    uint kind = edge_kind(p, e);
+    if (!integer_level) {
+        bool rev = edge_reversed(p, e, 0u);
+        return curve_point(p.curves[2u * e], rev ? 1.0 - t : t);
+    }
+    uint k = uint(round(t * n));
+    uint segs = uint(round(n));
+    uint h = 0u;
+    if (kind == ADAPTIVE_EDGE_COARSE) {
+        segs /= 2u;
+        if (k > segs) { h = 1u; k -= segs; }
+    }
+    if (edge_reversed(p, e, h)) k = segs - k;
+    return curve_point(p.curves[2u * e + h], float(k) / float(segs));
 }
 
 // The factor one curve asks for under the frame's policy: computed from the curve's own four
@@ -130,63 +161,3 @@ float edge_level(AdaptivePatch p, uint e) {
     }
     return kind == ADAPTIVE_EDGE_COARSE ? 2.0 * f : f;
 }
-
-#ifdef ADAPTIVE_TESE
-// What the control stage copied out of the patch record and the curves (tesc_levels.glsl):
-// the patch id, info and edge info, and the 8 curve slots' 32 points packed as floats. The
-// evaluation stage reads patch inputs only: llvmpipe runs every branch masked for every batch,
-// so storage reads behind "is this vertex on the boundary" cost every vertex a gather.
-// The copies carry the vertices' bits, and the formula is `bezier_curve_point`, so both sides
-// of a shared edge still get the same bits.
-layout(location = 0) patch in uvec4 tc_head;
-layout(location = 2) patch in vec4 tc_curve_floats[24];
-
-uint tc_edge_kind(uint e) { return (tc_head.z >> (4u * e)) & 3u; }
-bool tc_edge_reversed(uint e, uint half_) { return ((tc_head.z >> (4u * e + 2u + half_)) & 1u) != 0u; }
-float tc_curve_float(uint f) { return tc_curve_floats[f >> 2][f & 3u]; }
-vec3 tc_slot_point(uint i) {
-    uint f = 3u * i;
-    return vec3(tc_curve_float(f), tc_curve_float(f + 1u), tc_curve_float(f + 2u));
-}
-// Curve slot `slot` (edge e: slots 2e, 2e + 1) at s.
-vec3 tc_curve_point(uint slot, float s) {
-    uint i = 4u * slot;
-    return bezier_curve_point(tc_slot_point(i), tc_slot_point(i + 1u), tc_slot_point(i + 2u), tc_slot_point(i + 3u), s);
-}
-
-// Where patch edge e is at parameter t along the patch's edge direction (e runs v_e -> v_e+1),
-// for interior blends (not canonical).
-vec3 edge_point(uint e, float t) {
-    uint kind = tc_edge_kind(e);
-    uint h = 0u;
-    float s = t;
-    if (kind == ADAPTIVE_EDGE_COARSE) {
-        h = t < 0.5 ? 0u : 1u;
-        s = h == 0u ? 2.0 * t : 2.0 * t - 1.0;
-    }
-    if (tc_edge_reversed(e, h)) s = 1.0 - s;
-    return tc_curve_point(2u * e + h, s);
-}
-
-// The canonical boundary point of patch edge e at parameter t (as above) with the edge's
-// tessellation level n: integer levels name the vertex k = round(t n) and both sides evaluate
-// k / n on the curve in its own direction; fractional levels mirror t exactly (1 - t is exact
-// for tess coordinates).
-vec3 canonical_edge_point(uint e, float t, float n, bool integer_level) {
-    uint kind = tc_edge_kind(e);
-    if (!integer_level) {
-        bool rev = tc_edge_reversed(e, 0u);
-        return tc_curve_point(2u * e, rev ? 1.0 - t : t);
-    }
-    uint k = uint(round(t * n));
-    uint segs = uint(round(n));
-    uint h = 0u;
-    if (kind == ADAPTIVE_EDGE_COARSE) {
-        segs /= 2u;
-        if (k > segs) { h = 1u; k -= segs; }
-    }
-    if (tc_edge_reversed(e, h)) k = segs - k;
-    return tc_curve_point(2u * e + h, float(k) / float(segs));
-}
-
-#endif

@@ -7,13 +7,16 @@
 #include "tesc_levels.glsl"
 layout(vertices = 20) out;
 layout(location = 0) flat in uint in_patch[];
+layout(location = 0) patch out uint tc_patch;
+layout(location = 2) patch out uint tc_info;
 layout(location = 1) out vec3 tc_points[];
 void main() {
     uint id = in_patch[0];
     AdaptivePatch p = patches[id];
     tc_points[gl_InvocationID] = vtx(control_points[p.cp_offset + uint(gl_InvocationID)]);
-    write_patch_block(p, id, uint(gl_InvocationID), 20u);
     if (gl_InvocationID == 0) {
+        tc_patch = id;
+        tc_info = p.info;
         set_patch_levels(p);
     }
 }

@@ -5,7 +5,6 @@
 // interior Bezier points are rational blends of Fp and Fm, so each is the right one on the
 // edge it controls the cross derivative of. Mirrors topology::gregory::gregory_weights.
 #define TECHNIQUE_PUSH_CONSTANTS
-#define ADAPTIVE_TESE
 #include "frame.glsl"
 #include "adaptive.glsl"
 #include "tese_out.glsl"

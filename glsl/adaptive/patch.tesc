@@ -7,9 +7,12 @@
 #include "tesc_levels.glsl"
 layout(vertices = 1) out;
 layout(location = 0) flat in uint in_patch[];
+layout(location = 0) patch out uint tc_patch;
+layout(location = 2) patch out uint tc_info;
 void main() {
     uint id = in_patch[0];
+    tc_patch = id;
     AdaptivePatch p = patches[id];
-    write_patch_block(p, id, 0u, 1u);
+    tc_info = p.info;
     set_patch_levels(p);
 }

@@ -8,6 +8,8 @@
 #include "tesc_levels.glsl"
 layout(vertices = 16) out;
 layout(location = 0) flat in uint in_patch[];
+layout(location = 0) patch out uint tc_patch;
+layout(location = 2) patch out uint tc_info;
 layout(location = 1) out vec3 tc_bezier[];
 
 // Uniform cubic B-spline to Bezier, one row: Bezier point k from B-spline points 0..3.
@@ -34,8 +36,9 @@ void main() {
         b += wv * row;
     }
     tc_bezier[gl_InvocationID] = b;
-    write_patch_block(p, id, uint(gl_InvocationID), 16u);
     if (gl_InvocationID == 0) {
+        tc_patch = id;
+        tc_info = p.info;
         set_patch_levels(p);
     }
 }

@@ -3,7 +3,6 @@
 // face, phantom points already in place for boundaries and infinitely sharp creases), as the
 // Bezier net regular.tesc converted it to.
 #define TECHNIQUE_PUSH_CONSTANTS
-#define ADAPTIVE_TESE
 #include "frame.glsl"
 #include "adaptive.glsl"
 #include "tese_out.glsl"

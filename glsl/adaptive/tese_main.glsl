@@ -1,9 +1,10 @@
 // The main of every adaptive TES; the including file defines
 // `void evaluate(uint id, vec2 uv, out vec3 pos, out vec3 du, out vec3 dv)` for its patch kind
-// (patch `id`). Points on the patch boundary come from the canonical curves instead (see
-// adaptive.glsl), read from the control stage's patch block, so shared edges are
-// bit-identical; normals always come from the patch.
+// (patch `id`). Only boundary vertices read the patch record (its curves). Points on the patch boundary come from the canonical curves instead (see
+// adaptive.glsl), so shared edges are bit-identical; normals always come from the patch.
 #include "normals.glsl"
+layout(location = 0) patch in uint tc_patch;
+layout(location = 2) patch in uint tc_info;
 layout(location = 5) flat out vec3 out_albedo;
 
 // Regular, Gregory, bilinear.
@@ -11,21 +12,22 @@ const vec3 KIND_COLOURS[3] = vec3[3](vec3(0.45, 0.65, 0.95), vec3(0.95, 0.45, 0.
 
 void main() {
     vec2 uv = gl_TessCoord.xy;
-    uint tc_patch = tc_head.x, tc_info = tc_head.y;
     vec3 pos, du, dv;
     evaluate(tc_patch, uv, pos, du, dv);
     bool canonical = uv.x == 0.0 || uv.x == 1.0 || uv.y == 0.0 || uv.y == 1.0;
+    AdaptivePatch p;
+    if (canonical) p = patches[tc_patch];
     // Patch edge e and the parameter along it (edges run v0 -> v1 -> v2 -> v3 -> v0);
     // 1 - x is exact for tess coordinates. Corners take either edge: both give the curve's end
     // point, the same global vertex.
     if (uv.y == 0.0) {
-        pos = canonical_edge_point(0u, uv.x, gl_TessLevelOuter[1], !fractional_factors() || tc_edge_kind(0u) != ADAPTIVE_EDGE_PLAIN);
+        pos = canonical_edge_point(p, 0u, uv.x, gl_TessLevelOuter[1], !fractional_factors() || edge_kind(p, 0u) != ADAPTIVE_EDGE_PLAIN);
     } else if (uv.x == 1.0) {
-        pos = canonical_edge_point(1u, uv.y, gl_TessLevelOuter[2], !fractional_factors() || tc_edge_kind(1u) != ADAPTIVE_EDGE_PLAIN);
+        pos = canonical_edge_point(p, 1u, uv.y, gl_TessLevelOuter[2], !fractional_factors() || edge_kind(p, 1u) != ADAPTIVE_EDGE_PLAIN);
     } else if (uv.y == 1.0) {
-        pos = canonical_edge_point(2u, 1.0 - uv.x, gl_TessLevelOuter[3], !fractional_factors() || tc_edge_kind(2u) != ADAPTIVE_EDGE_PLAIN);
+        pos = canonical_edge_point(p, 2u, 1.0 - uv.x, gl_TessLevelOuter[3], !fractional_factors() || edge_kind(p, 2u) != ADAPTIVE_EDGE_PLAIN);
     } else if (uv.x == 0.0) {
-        pos = canonical_edge_point(3u, 1.0 - uv.y, gl_TessLevelOuter[0], !fractional_factors() || tc_edge_kind(3u) != ADAPTIVE_EDGE_PLAIN);
+        pos = canonical_edge_point(p, 3u, 1.0 - uv.y, gl_TessLevelOuter[0], !fractional_factors() || edge_kind(p, 3u) != ADAPTIVE_EDGE_PLAIN);
     }
     vec3 n = safe_normalize(cross(du, dv), vec3(0.0, 0.0, 1.0));
     uint kind = tc_info & 15u, level = (tc_info >> 4) & 15u;
