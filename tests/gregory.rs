@@ -157,9 +157,23 @@ fn watertight_under_every_factor_policy() {
                 let policies = [
                     ("uniform 3", FactorPolicy::Uniform { segments: 3.0 }, false),
                     ("screen 6px", FactorPolicy::Screen { pixels: 6.0 }, false),
-                    ("distance", FactorPolicy::Distance { reference: 0.12 * d }, false),
-                    ("screen fractional", FactorPolicy::Screen { pixels: 6.0 }, true),
-                    ("distance fractional", FactorPolicy::Distance { reference: 0.1 * d }, true),
+                    (
+                        "distance",
+                        FactorPolicy::Distance {
+                            reference: 0.12 * d,
+                        },
+                        false,
+                    ),
+                    (
+                        "screen fractional",
+                        FactorPolicy::Screen { pixels: 6.0 },
+                        true,
+                    ),
+                    (
+                        "distance fractional",
+                        FactorPolicy::Distance { reference: 0.1 * d },
+                        true,
+                    ),
                 ];
                 for (label, factors, fractional) in policies {
                     let params = FrameParams {
@@ -215,8 +229,8 @@ fn bad_input_gives_named_errors() {
             &[vec![0u32, 1, 3, 2], vec![1, 0, 4, 5], vec![0, 1, 7, 6]],
         );
         assert!(gregory::build(&mut ctx, &fan, SinglePassPatch::Acc1, 1.0, "fan").is_err());
-        let ok = gregory::build(&mut ctx, &mesh, SinglePassPatch::Gregory, 1.0, "cube")
-            .expect("cube");
+        let ok =
+            gregory::build(&mut ctx, &mesh, SinglePassPatch::Gregory, 1.0, "cube").expect("cube");
         for bad in [
             FrameParams::uniform(0.0),
             FrameParams::uniform(2.5),
