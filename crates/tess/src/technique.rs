@@ -35,6 +35,8 @@ pub enum TechniqueId {
     Pn,
     Bft,
     Adaptive,
+    Gregory,
+    Acc,
 }
 
 impl TechniqueId {
@@ -46,6 +48,8 @@ impl TechniqueId {
             TechniqueId::Pn => "pn",
             TechniqueId::Bft => "bft",
             TechniqueId::Adaptive => "adaptive",
+            TechniqueId::Gregory => "gregory",
+            TechniqueId::Acc => "acc",
         }
     }
 }

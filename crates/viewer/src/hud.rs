@@ -83,7 +83,7 @@ fn legend(technique: TechniqueId) -> &'static [([f32; 3], &'static str)] {
             ([0.55, 0.85, 0.45], "boundary"),
             ([0.75, 0.5, 0.9], "private table"),
         ],
-        TechniqueId::Adaptive => &[
+        TechniqueId::Adaptive | TechniqueId::Gregory | TechniqueId::Acc => &[
             ([0.45, 0.65, 0.95], "B-spline (odd levels lighter)"),
             ([0.95, 0.45, 0.35], "Gregory end cap"),
             ([0.95, 0.8, 0.3], "bilinear end cap"),

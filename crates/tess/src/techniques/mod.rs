@@ -5,6 +5,7 @@ pub mod adaptive;
 pub mod bft;
 pub mod face_patches;
 pub mod flat;
+pub mod gregory;
 pub mod phong;
 pub mod pn;
 pub mod shared;
@@ -38,7 +39,7 @@ const BASE_FACES: Features = Features {
     isolation: false,
 };
 
-static REGISTRY: [TechniqueInfo; 5] = [
+static REGISTRY: [TechniqueInfo; 7] = [
     TechniqueInfo {
         id: TechniqueId::Flat,
         help: "flat tessellation of each base face (quads as quad patches)",
@@ -92,7 +93,32 @@ static REGISTRY: [TechniqueInfo; 5] = [
         },
         scheme: Some(topology::Scheme::CatmullClark),
     },
+    TechniqueInfo {
+        id: TechniqueId::Gregory,
+        help: "Catmull-Clark approximated by one Gregory patch per base face, B-spline where regular (Loop, Schaefer, Ni, Castano); faces next to non-quads split once",
+        features: SINGLE_PASS,
+        scheme: Some(topology::Scheme::CatmullClark),
+    },
+    TechniqueInfo {
+        id: TechniqueId::Acc,
+        help: "Catmull-Clark approximated by ACC-1 bicubic patches (Loop & Schaefer), Gregory patches where ACC-1 does not apply",
+        features: SINGLE_PASS,
+        scheme: Some(topology::Scheme::CatmullClark),
+    },
 ];
+
+/// The single-pass approximations: the adaptive machinery without isolation.
+const SINGLE_PASS: Features = Features {
+    adaptive_factors: true,
+    spacings: [true, true, false],
+    animation: true,
+    patch_colours: true,
+    geometric_normals: false,
+    phong_alpha: false,
+    table_level: false,
+    triangles_only: false,
+    isolation: false,
+};
 
 /// Every technique, in the order reports list them (flat first: ratios divide by it).
 pub fn registry() -> &'static [TechniqueInfo] {
@@ -181,7 +207,9 @@ pub fn check_options(
 ) -> Result<()> {
     match id {
         TechniqueId::Bft => bft::check_frame(build.table_level, params),
-        TechniqueId::Adaptive => adaptive::check_frame(None, params),
+        TechniqueId::Adaptive | TechniqueId::Gregory | TechniqueId::Acc => {
+            adaptive::check_frame(None, params)
+        }
         TechniqueId::Flat | TechniqueId::Phong | TechniqueId::Pn => Ok(()),
     }
 }
@@ -225,6 +253,17 @@ pub fn build(
                 name: options.name.clone(),
             },
         )?),
+        TechniqueId::Gregory | TechniqueId::Acc => Box::new(gregory::build(
+            ctx,
+            mesh,
+            if id == TechniqueId::Acc {
+                topology::adaptive::single_pass::SinglePassPatch::Acc1
+            } else {
+                topology::adaptive::single_pass::SinglePassPatch::Gregory
+            },
+            options.sharpness_scale,
+            &options.name,
+        )?),
     };
     Ok(Built {
         technique,
@@ -244,10 +283,12 @@ mod tests {
             TechniqueId::Pn,
             TechniqueId::Bft,
             TechniqueId::Adaptive,
+            TechniqueId::Gregory,
+            TechniqueId::Acc,
         ] {
             assert_eq!(info(id).id, id);
             assert_eq!(id.name().parse::<TechniqueId>().unwrap(), id);
         }
-        assert!("gregory".parse::<TechniqueId>().is_err());
+        assert!("acc2".parse::<TechniqueId>().is_err());
     }
 }

@@ -177,6 +177,8 @@ impl Default for AdaptiveBuild {
 /// One feature-adaptive Catmull-Clark surface on the GPU. Drop order: pipeline, sets (they
 /// keep their pool alive), pool, buffers.
 pub struct Adaptive {
+    /// Adaptive, or a single-pass technique drawing its plan (`crate::techniques::gregory`).
+    id: TechniqueId,
     stencil: Pipeline,
     /// Per frame slot, one set per distinct pre-pass window (slots differ only in the base
     /// positions); the draw binds the slot's first (it reads no stencils).
@@ -205,7 +207,6 @@ impl Adaptive {
     /// Plans `mesh` (Catmull-Clark, any faces, boundaries, creases) and uploads it, with one
     /// base-position buffer per frame slot of `ctx`.
     pub fn new(ctx: &mut Context, mesh: &ControlMesh, options: &AdaptiveBuild) -> Result<Self> {
-        let device = ctx.device().clone();
         let plan = plan_adaptive(
             mesh,
             &AdaptiveOptions {
@@ -219,13 +220,26 @@ impl Adaptive {
             name: options.name.clone(),
             source: e.into(),
         })?;
+        Self::from_plan(ctx, mesh, plan, options, TechniqueId::Adaptive)
+    }
+
+    /// Uploads an already made plan (the single-pass techniques' too,
+    /// `crate::techniques::gregory`), drawn as technique `id`.
+    pub fn from_plan(
+        ctx: &mut Context,
+        mesh: &ControlMesh,
+        plan: AdaptivePlan,
+        options: &AdaptiveBuild,
+        id: TechniqueId,
+    ) -> Result<Self> {
+        let device = ctx.device().clone();
         let gpu = GpuAdaptive::new(&plan).map_err(|e| TessError::Mesh {
             name: options.name.clone(),
             source: e.into(),
         })?;
         let frames = ctx.frames_in_flight();
-        ctx.ensure_set_layout(TechniqueId::Adaptive, &SET_BINDINGS)?;
-        let set_layout = ctx.set_layout(TechniqueId::Adaptive)?;
+        ctx.ensure_set_layout(id, &SET_BINDINGS)?;
+        let set_layout = ctx.set_layout(id)?;
         let max_groups = device.info.caps.max_compute_work_group_count[0];
         let (steps, windows) = plan_pre_pass(
             &gpu,
@@ -364,6 +378,7 @@ impl Adaptive {
             .collect();
         let max_level = device.info.caps.max_tessellation_generation_level as f32;
         Ok(Self {
+            id,
             stencil,
             sets,
             steps,
@@ -494,7 +509,7 @@ pub fn check_frame(factor_limit: Option<f32>, params: &FrameParams) -> Result<()
 
 impl Technique for Adaptive {
     fn id(&self) -> TechniqueId {
-        TechniqueId::Adaptive
+        self.id
     }
 
     fn bbox(&self) -> ([f32; 3], [f32; 3]) {
@@ -725,6 +740,20 @@ impl Technique for Adaptive {
 
     fn report_notes(&self) -> Vec<String> {
         let [r, g, b] = self.gpu.counts;
+        if self.id != TechniqueId::Adaptive {
+            return vec![format!(
+                "{}: {r} B-spline and {g} Gregory/ACC-1 patches for {} base faces ({}), {} vertices, tables {} bytes",
+                self.id,
+                self.mesh.num_faces(),
+                if self.plan.isolation == 0 {
+                    "one patch per face"
+                } else {
+                    "faces next to non-quads split by one step"
+                },
+                self.gpu.num_vertices,
+                self.gpu.table_bytes()
+            )];
+        }
         vec![format!(
             "adaptive: isolation {}, {r} regular patches, {g} Gregory and {b} bilinear end caps, \
              {} vertices ({} refined + local), tables {} bytes",

@@ -1,0 +1,245 @@
+//! Single-pass Catmull-Clark approximations on the tessellation stage (`--method gregory`,
+//! `--method acc`), checked from the GPU's own output (transform feedback): captured vertices
+//! against the exact CPU limit at their (base face, sub-face, u, v) (max and RMS over the bbox
+//! diagonal, regular patches exact), watertightness (weld by bits) under every factor policy on
+//! spot and catmark shapes, and bad input. Validation is on and any error fails (tests/common).
+mod common;
+use common::Gpu;
+use tessera::tess::capture::{classify_open_edges, CapturedSoup, Capturer};
+use tessera::tess::gpu::bindings::ADAPTIVE_KIND_REGULAR;
+use tessera::tess::techniques::adaptive::Adaptive;
+use tessera::tess::techniques::gregory;
+use tessera::tess::{Camera, Context, FactorPolicy, FrameParams, Spacing, Technique};
+use tessera::topology::adaptive::single_pass::SinglePassPatch;
+use tessera::topology::eval::{LimitScheme, LocalMesh};
+use tessera::topology::{self, ControlMesh};
+use tessera::vk_core::vk;
+
+const EXTENT: vk::Extent2D = vk::Extent2D {
+    width: 640,
+    height: 480,
+};
+
+fn shape(name: &str) -> ControlMesh {
+    if name == "spot" {
+        return topology::load_obj(common::data("assets/spot_control_mesh.obj")).expect("spot");
+    }
+    topology::load_obj(common::data(&format!(
+        "tests/data/opensubdiv/shapes/{name}.obj"
+    )))
+    .expect("shape")
+}
+
+fn diag(m: &ControlMesh) -> f64 {
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in &m.positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+}
+
+fn semi_sharp(m: &ControlMesh) -> bool {
+    let finite = |s: f32| s > 0.0 && s < 10.0;
+    m.creases.iter().any(|c| finite(c.sharpness)) || m.corners.iter().any(|c| finite(c.sharpness))
+}
+
+/// (regular max, max, RMS) of captured vertices against the exact limit, over the diagonal.
+fn deviation(surf: &Adaptive, soup: &CapturedSoup, mesh: &ControlMesh) -> (f64, f64, f64) {
+    let cpu = LocalMesh::from_control_mesh(mesh, LimitScheme::CatmullClark).expect("cpu mesh");
+    let welded = soup.weld().expect("weld");
+    let d = diag(mesh);
+    let (mut regular, mut max, mut sq) = (0.0f64, 0.0f64, 0.0f64);
+    let n = welded.positions.len();
+    for i in 0..n {
+        let [u, v] = welded.domain[i].map(f64::from);
+        let (f, sub, bu, bv) = surf.base_param(welded.patch[i], u, v).expect("patch");
+        let e = if mesh.face(f as usize).len() == 4 {
+            cpu.evaluate(f as usize, bu, bv)
+        } else {
+            cpu.evaluate_subface(f as usize, sub as usize, bu, bv)
+        }
+        .expect("exact limit");
+        let p = welded.positions[i].map(f64::from);
+        let err = (0..3)
+            .map(|k| (p[k] - e.position[k]).powi(2))
+            .sum::<f64>()
+            .sqrt()
+            / d;
+        if welded.flags[i] & 15 == ADAPTIVE_KIND_REGULAR {
+            regular = regular.max(err);
+        }
+        max = max.max(err);
+        sq += err * err;
+    }
+    (regular, max, (sq / n.max(1) as f64).sqrt())
+}
+
+fn cracks(surf: &Adaptive, soup: &CapturedSoup, mesh: &ControlMesh) -> (usize, usize) {
+    let welded = soup.weld().expect("weld");
+    let report = welded.open_edges();
+    let map = |p: u32, d: [f32; 2]| surf.face_point(p, d);
+    let c = classify_open_edges(soup, &welded, &report, &map, mesh);
+    (c.cracks + c.unmapped, report.non_manifold.len())
+}
+
+const PATCHES: [SinglePassPatch; 2] = [SinglePassPatch::Gregory, SinglePassPatch::Acc1];
+
+/// Regular patches are the exact limit (≤ 1e-5 of the diagonal) on shapes without semi-sharp
+/// tags (those are rounded); the whole surface stays within a few percent. Prints the table of
+/// docs/approximations.md.
+#[test]
+fn captured_vertices_against_the_exact_limit() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
+        for name in [
+            "spot",
+            "catmark_cube",
+            "catmark_pawn",
+            "catmark_bishop",
+            "catmark_car",
+            "catmark_cube_creases0",
+            "catmark_tent_creases1",
+            "catmark_edgecorner",
+            "catmark_flap",
+            "catmark_pyramid",
+        ] {
+            let mesh = shape(name);
+            for patch in PATCHES {
+                let surf = gregory::build(&mut ctx, &mesh, patch, 1.0, name).expect("build");
+                let (soup, _) = capturer
+                    .capture(&mut ctx, &surf, &FrameParams::uniform(4.0), EXTENT)
+                    .expect("capture");
+                let (regular, max, rms) = deviation(&surf, &soup, &mesh);
+                println!(
+                    "| {name} | {patch:?} | {} | {regular:.2e} | {max:.2e} | {rms:.2e} |",
+                    surf.patch_counts()[1]
+                );
+                if !semi_sharp(&mesh) {
+                    assert!(regular <= 1e-5, "{name} {patch:?}: regular {regular:e}");
+                }
+                assert!(max < 0.05, "{name} {patch:?}: {max:e}");
+            }
+        }
+    }
+}
+
+/// 0 cracks beyond the base boundary (positions welded only when bit-identical) under uniform,
+/// screen, distance and fractional factors, on spot (triangles, quads, pentagons: split faces
+/// and transition edges) and catmark shapes with boundaries and creases.
+#[test]
+fn watertight_under_every_factor_policy() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
+        let camera = Camera {
+            zoom: 2.5,
+            yaw: 30.0,
+            ..Default::default()
+        };
+        for name in [
+            "spot",
+            "catmark_cube",
+            "catmark_pyramid",
+            "catmark_tent_creases1",
+            "catmark_edgecorner",
+            "catmark_flap",
+        ] {
+            let mesh = shape(name);
+            for patch in PATCHES {
+                let surf = gregory::build(&mut ctx, &mesh, patch, 1.0, name).expect("build");
+                let d = diag(&mesh) as f32;
+                let policies = [
+                    ("uniform 3", FactorPolicy::Uniform { segments: 3.0 }, false),
+                    ("screen 6px", FactorPolicy::Screen { pixels: 6.0 }, false),
+                    (
+                        "distance",
+                        FactorPolicy::Distance {
+                            reference: 0.12 * d,
+                        },
+                        false,
+                    ),
+                    (
+                        "screen fractional",
+                        FactorPolicy::Screen { pixels: 6.0 },
+                        true,
+                    ),
+                    (
+                        "distance fractional",
+                        FactorPolicy::Distance { reference: 0.1 * d },
+                        true,
+                    ),
+                ];
+                for (label, factors, fractional) in policies {
+                    let params = FrameParams {
+                        factors,
+                        spacing: if fractional {
+                            Spacing::FractionalEven
+                        } else {
+                            Spacing::Equal
+                        },
+                        camera,
+                        ..FrameParams::default()
+                    };
+                    let (soup, _) = capturer
+                        .capture(&mut ctx, &surf, &params, EXTENT)
+                        .expect("capture");
+                    let (cracks, nonmanifold) = cracks(&surf, &soup, &mesh);
+                    println!(
+                        "{name} {patch:?} {label}: {} triangles, {cracks} cracks",
+                        soup.triangle_count()
+                    );
+                    assert_eq!(cracks, 0, "{name} {patch:?} {label}");
+                    assert_eq!(nonmanifold, 0, "{name} {patch:?} {label}");
+                }
+            }
+        }
+    }
+}
+
+/// Bad sharpness scales, non-manifold meshes and refused frame options are named errors.
+#[test]
+fn bad_input_gives_named_errors() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let mesh = shape("catmark_cube");
+        for scale in [f32::NAN, -1.0] {
+            let e = gregory::build(&mut ctx, &mesh, SinglePassPatch::Gregory, scale, "cube")
+                .err()
+                .expect("refused");
+            assert!(e.to_string().contains("sharpness"), "{e}");
+        }
+        let fan = ControlMesh::from_polygons(
+            vec![
+                [0.0; 3],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [1.0, 0.0, 1.0],
+                [0.0, -1.0, 0.0],
+                [1.0, -1.0, 0.0],
+            ],
+            &[vec![0u32, 1, 3, 2], vec![1, 0, 4, 5], vec![0, 1, 7, 6]],
+        );
+        assert!(gregory::build(&mut ctx, &fan, SinglePassPatch::Acc1, 1.0, "fan").is_err());
+        let ok =
+            gregory::build(&mut ctx, &mesh, SinglePassPatch::Gregory, 1.0, "cube").expect("cube");
+        for bad in [
+            FrameParams::uniform(0.0),
+            FrameParams::uniform(2.5),
+            FrameParams {
+                spacing: Spacing::FractionalOdd,
+                ..FrameParams::uniform(4.0)
+            },
+        ] {
+            assert!(ok.check(&bad).is_err(), "{bad:?}");
+        }
+    }
+}
