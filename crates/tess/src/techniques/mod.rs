@@ -80,17 +80,7 @@ static REGISTRY: [TechniqueInfo; 7] = [
     TechniqueInfo {
         id: TechniqueId::Adaptive,
         help: "exact Catmull-Clark limit surface by feature-adaptive refinement (Niessner et al.), Gregory or bilinear end caps",
-        features: Features {
-            adaptive_factors: true,
-            spacings: [true, true, false],
-            animation: true,
-            patch_colours: true,
-            geometric_normals: false,
-            phong_alpha: false,
-            table_level: false,
-            triangles_only: false,
-            isolation: true,
-        },
+        features: ADAPTIVE,
         scheme: Some(topology::Scheme::CatmullClark),
     },
     TechniqueInfo {
@@ -107,8 +97,7 @@ static REGISTRY: [TechniqueInfo; 7] = [
     },
 ];
 
-/// The single-pass approximations: the adaptive machinery without isolation.
-const SINGLE_PASS: Features = Features {
+const ADAPTIVE: Features = Features {
     adaptive_factors: true,
     spacings: [true, true, false],
     animation: true,
@@ -117,7 +106,13 @@ const SINGLE_PASS: Features = Features {
     phong_alpha: false,
     table_level: false,
     triangles_only: false,
+    isolation: true,
+};
+
+/// The single-pass approximations: the adaptive machinery without isolation.
+const SINGLE_PASS: Features = Features {
     isolation: false,
+    ..ADAPTIVE
 };
 
 /// Every technique, in the order reports list them (flat first: ratios divide by it).

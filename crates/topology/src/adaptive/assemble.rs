@@ -551,18 +551,29 @@ pub(super) fn gregory_points(
     shift: u8,
 ) -> Result<Vec<Vec<(u32, f64)>>, TopologyError> {
     let basis = crate::gregory::gregory_basis(lvl.topo.view(), f, &mesh.options)?;
+    Ok(rotated_points(lvl.base, shift, |corner, j| {
+        &basis[5 * corner + j]
+    }))
+}
+
+/// The 20 Gregory points in patch corner order (patch corner p, point j = P, Ep, Em, Fp, Fm),
+/// where patch corner p is face corner p + `shift`, as weighted global ids (`base` + local).
+fn rotated_points<'a>(
+    base: u32,
+    shift: u8,
+    point: impl Fn(usize, usize) -> &'a crate::gregory::Stencil,
+) -> Vec<Vec<(u32, f64)>> {
     let s = shift as usize;
-    Ok((0..20)
+    (0..20)
         .map(|k| {
-            let (p, j) = (k / 5, k % 5);
-            let st = &basis[5 * ((p + s) % 4) + j];
+            let st = point((k / 5 + s) % 4, k % 5);
             st.indices
                 .iter()
                 .zip(&st.weights)
-                .map(|(&i, &w)| (i + lvl.base, w))
+                .map(|(&i, &w)| (i + base, w))
                 .collect()
         })
-        .collect())
+        .collect()
 }
 
 /// ACC-1's 16 Bézier points of face `f` as a Gregory patch's 20 (global ids, patch corner
@@ -581,17 +592,8 @@ pub(super) fn acc_points(
         [(3, 3), (2, 3), (3, 2), (2, 2)],
         [(0, 3), (0, 2), (1, 3), (1, 2)],
     ];
-    let s = shift as usize;
-    Ok((0..20)
-        .map(|k| {
-            let (p, j) = (k / 5, k % 5);
-            let (bi, bj) = SLOTS[(p + s) % 4][j.min(3)];
-            let st = &net[bi][bj];
-            st.indices
-                .iter()
-                .zip(&st.weights)
-                .map(|(&i, &w)| (i + lvl.base, w))
-                .collect()
-        })
-        .collect())
+    Ok(rotated_points(lvl.base, shift, |corner, j| {
+        let (bi, bj) = SLOTS[corner][j.min(3)];
+        &net[bi][bj]
+    }))
 }
