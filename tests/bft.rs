@@ -4,8 +4,10 @@
 mod common;
 use common::Gpu;
 use tessera::tess::capture::{classify_open_edges, CapturedSoup, Capturer};
+use tessera::tess::techniques::bft::layout::GpuBft;
 use tessera::tess::techniques::bft::{base_normals, patch_uv, wave, Bft, BftOptions};
 use tessera::tess::{Context, FactorPolicy, FrameParams, Spacing, Technique};
+use tessera::topology::bft::prepare_loop_bft;
 use tessera::topology::eval::{LimitScheme, LocalMesh};
 use tessera::topology::{self, ControlMesh};
 use tessera::vk_core::vk;
@@ -69,7 +71,9 @@ fn exactness(surf: &Bft, soup: &CapturedSoup, mesh: &ControlMesh, samples: usize
     let mut worst = 0.0f64;
     for i in (0..n).step_by(stride) {
         let (u, v) = patch_uv(welded.domain[i]);
-        let (f, bu, bv) = surf.bft.base_domain(welded.patch[i] as usize, u, v);
+        let (f, bu, bv) = surf
+            .base_domain(welded.patch[i], u, v)
+            .expect("captured patch");
         let e = cpu.evaluate(f, bu, bv).expect("exact limit");
         for k in 0..3 {
             worst = worst.max((welded.positions[i][k] as f64 - e.position[k]).abs() / d);
@@ -352,7 +356,9 @@ fn normal_angles(
     let corner = |d: [f32; 2]| (d[0] == 0.0 || d[0] == 1.0) && (d[1] == 0.0 || d[1] == 1.0);
     for i in (0..n).filter(|&i| i % stride == 0 || corner(welded.domain[i])) {
         let (u, v) = patch_uv(welded.domain[i]);
-        let (f, bu, bv) = surf.bft.base_domain(welded.patch[i] as usize, u, v);
+        let (f, bu, bv) = surf
+            .base_domain(welded.patch[i], u, v)
+            .expect("captured patch");
         let e = cpu.evaluate(f, bu, bv).expect("exact limit");
         let (a, b) = (&e.du, &e.dv);
         let exact = [
@@ -415,12 +421,17 @@ fn geometric_normals_are_the_exact_limit_normals() {
             .capture(&mut ctx, &surf, &uniform(8), EXTENT)
             .expect("capture");
         let base = tessera::tess::techniques::bft::base_positions(&mesh);
-        let level1 = surf.gpu.subdivide(&base);
-        let normals = surf.gpu.normals(&level1);
+        // The CPU mirror, packed from its own preparation (the surface keeps its arrays only on
+        // the GPU).
+        let loop_mesh = surf.base_mesh().expect("loop mesh");
+        let cpu = prepare_loop_bft(loop_mesh, 5, true).expect("prepare");
+        let mirror = GpuBft::new(&cpu).expect("pack");
+        let level1 = mirror.subdivide(&base);
+        let normals = mirror.normals(&level1);
         let mut mirror_worst = 0.0f64;
         for r in &soup.records {
             let [x, y] = r.domain;
-            let m = surf.gpu.eval_tess(
+            let m = mirror.eval_tess(
                 &level1,
                 &normals,
                 r.patch as usize,

@@ -955,15 +955,17 @@ pub fn build_patch_records(mesh: &LocalMesh) -> Result<PatchRecords, EvalError> 
             out
         })
         .collect();
+    // Joined block by block, each block freed once copied: the peak is the whole plus one
+    // block, not twice the whole.
     let mut recs = PatchRecords {
         faces: Vec::with_capacity(nf),
         rings: Vec::with_capacity(blocks.iter().map(|b| b.rings.len()).sum()),
     };
     for b in blocks {
         let base = recs.rings.len() as u32;
-        recs.faces.extend(b.faces.iter().map(|r| PatchRecord {
+        recs.faces.extend(b.faces.into_iter().map(|r| PatchRecord {
             ring_offset: r.ring_offset + base,
-            ..*r
+            ..r
         }));
         recs.rings.extend_from_slice(&b.rings);
     }
@@ -1232,9 +1234,10 @@ impl TangentStencils {
     }
 }
 
-/// Limit-tangent stencils of every level-1 vertex, in parallel blocks, each row written
+/// Limit-tangent stencils of every level-1 vertex (the normals' pre-pass reads them), in
+/// parallel blocks, each row written
 /// straight into its block's arrays ([`LocalMesh::loop_tangent_row`]).
-fn tangent_stencils(level1: &LocalMesh) -> TangentStencils {
+pub fn loop_tangent_stencils(level1: &LocalMesh) -> TangentStencils {
     let n = level1.num_vertices();
     let block = 1 << 15;
     let blocks: Vec<TangentStencils> = (0..n.div_ceil(block))
@@ -1302,27 +1305,19 @@ pub struct LoopBft {
     pub base_faces: usize,
 }
 
-/// Refine `mesh` once (uniform refinement), classify every level-1 face and build the
-/// tables it needs.
-pub fn prepare_loop_bft(
+/// The stages of [`prepare_loop_bft`], for a caller that packs and frees each product before
+/// the next is built (a 1M-triangle mesh's level-1 data is ~1.5 GB in f64 and `Vec`s).
+///
+/// One step of the refiner, taken by value: the level-1 mesh (its topology becomes the local
+/// mesh's without a copy) and its stencils over the base vertices (what the GPU's pre-pass
+/// applies).
+pub fn loop_level1(
     mesh: &crate::mesh::ControlMesh,
-    level: u32,
-    tangents: bool,
-) -> Result<LoopBft, EvalError> {
-    let t = std::time::Instant::now();
-    let lap = |what: &str| {
-        log::debug!(
-            "prepare_loop_bft: {what} at {:.2} s",
-            t.elapsed().as_secs_f64()
-        )
-    };
-    // One step of the refiner, taken by value: its level-1 topology becomes the local mesh's
-    // without a copy, and its stencils (over the base) are the ones the GPU needs.
+) -> Result<(LocalMesh, crate::stencil::StencilTable), EvalError> {
     let (level1, stencils) = {
         let base = crate::refine::Level::from_mesh(mesh, crate::sdc::Scheme::Loop)?;
         crate::refine::refine_level(&base, crate::sdc::Scheme::Loop, &mesh.options)?
     };
-    lap("refined");
     let crate::refine::Level {
         topology,
         positions,
@@ -1342,9 +1337,17 @@ pub fn prepare_loop_bft(
         3,
         points,
     )?;
-    lap("level-1 mesh");
-    let records = build_patch_records(&level1)?;
-    lap("records");
+    Ok((level1, stencils))
+}
+
+/// The tables at `level` every record of `records` needs: the distinct shared keys, then one
+/// private table per face no shared table serves.
+pub fn loop_tables(
+    level1: &LocalMesh,
+    records: &PatchRecords,
+    level: u32,
+    tangents: bool,
+) -> Result<BasisTables, EvalError> {
     // The distinct shared keys (the tables dedup them too, but not 4M of them).
     let keys: Vec<BftKey> = records
         .iter()
@@ -1354,17 +1357,43 @@ pub fn prepare_loop_bft(
         .into_iter()
         .collect();
     let mut tables = BasisTables::build_with(&keys, level, tangents)?;
-    lap("tables");
     for (f, r) in records.iter().enumerate() {
         if matches!(r.key.case, BftCase::Private { .. }) {
-            let (rows, k) = private_table(&level1, f, level)?;
+            let (rows, k) = private_table(level1, f, level)?;
             debug_assert_eq!(k, r.ring_size as usize);
             tables.add_private(r.key, &rows, k);
         }
     }
-    lap("private tables");
-    let tangent_stencils = tangent_stencils(&level1);
-    lap("tangent stencils");
+    Ok(tables)
+}
+
+/// Which corner of its level-1 face each record's `v0` is: all [`level1_base_domain`] needs
+/// of the records and the level-1 mesh (one byte per face).
+pub fn face_rotations(level1: &LocalMesh, records: &PatchRecords) -> Vec<u8> {
+    records
+        .iter()
+        .enumerate()
+        .map(|(f, r)| {
+            level1
+                .face(f)
+                .iter()
+                .position(|&x| x == r.corners[0])
+                .unwrap_or(0) as u8
+        })
+        .collect()
+}
+
+/// Refine `mesh` once (uniform refinement), classify every level-1 face and build the
+/// tables it needs.
+pub fn prepare_loop_bft(
+    mesh: &crate::mesh::ControlMesh,
+    level: u32,
+    tangents: bool,
+) -> Result<LoopBft, EvalError> {
+    let (level1, stencils) = loop_level1(mesh)?;
+    let records = build_patch_records(&level1)?;
+    let tables = loop_tables(&level1, &records, level, tangents)?;
+    let tangent_stencils = loop_tangent_stencils(&level1);
     Ok(LoopBft {
         stencils,
         level1,

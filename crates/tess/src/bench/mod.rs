@@ -10,6 +10,7 @@
 mod methods;
 mod report;
 pub mod stats;
+pub mod usage;
 
 pub use methods::{
     build_methods, catmark_level_size, cpu_limit_mesh, cpu_loop_limit_mesh, loop_level_for,

@@ -28,9 +28,9 @@ use crate::gpu::bindings::{
     BFT_TANGENT_OFFSETS_BINDING, BFT_TANGENT_TERMS_BINDING, FRAME_SET,
 };
 use bytemuck::{Pod, Zeroable};
-use std::borrow::Cow;
 use std::mem::{offset_of, size_of};
-use topology::bft::{BftCase, BftKey, LoopBft};
+use topology::bft::{BasisTables, BftCase, BftKey, LoopBft, PatchRecords, TangentStencils};
+use topology::stencil::StencilTable;
 
 /// `BasePosition` of `bft.glsl`: one base vertex (binding [`BFT_BASE_POSITIONS_BINDING`]),
 /// rewritten every frame of an animation.
@@ -247,54 +247,22 @@ pub struct TessSample {
 
 type Acc = ([f32; 3], [f32; 3], [f32; 3]);
 
-impl GpuBft {
-    /// Packs `bft` and validates the result.
-    pub fn new(bft: &LoopBft) -> Result<GpuBft, LayoutError> {
-        let st = &bft.stencils;
-        let stencil_terms = st
-            .indices
-            .iter()
-            .zip(&st.weights)
-            .map(|(&index, &w)| StencilTerm {
-                index,
-                weight: w as f32,
-            })
-            .collect();
-        let ts = &bft.tangent_stencils;
-        let tangent_offsets = if ts.offsets.is_empty() {
-            vec![0u32]
-        } else {
-            ts.offsets.clone()
-        };
-        let tangent_terms = ts
-            .indices
-            .iter()
-            .zip(ts.t1.iter().zip(&ts.t2))
-            .map(|(&index, (&a, &b))| TangentTerm {
-                index,
-                weight_t1: a as f32,
-                weight_t2: b as f32,
-            })
-            .collect();
-        let t = &bft.tables;
-        let mut patches = Vec::with_capacity(bft.records.len());
-        // The records' rings are already one array in slot order: the ring buffer as it is.
-        let patch_rings = bft.records.rings.clone();
-        for (face, r) in bft.records.iter().enumerate() {
-            let (entry, mirrored) = t
-                .lookup(r.key)
-                .ok_or(LayoutError::NoTable { face, key: r.key })?;
-            let owners = |o: &[(u32, u8); 3]| o.map(|(f, k)| pack_owner(f, k));
-            patches.push(PatchHeader {
-                ring_offset: r.ring_offset,
-                ring_size: r.ring_size,
-                entry: entry as u32,
-                mirrored: mirrored as u32,
-                edge_owner: owners(&r.edge_owner),
-                corner_owner: owners(&r.corner_owner),
-            });
-        }
-        let table_entries: Vec<TableEntry> = t
+/// The basis-function tables as the shaders read them: the `Tables` block (header and
+/// entries), `MirrorPerms`, `RowMaps` and `TableWeights`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PackedTables {
+    pub table: TableHeader,
+    pub entries: Vec<TableEntry>,
+    pub mirror_perms: Vec<u32>,
+    /// Full tables' row map, then the half tables' (offsets in [`PackedTables::table`]).
+    pub row_maps: Vec<u32>,
+    pub weights: Vec<f32>,
+}
+
+impl PackedTables {
+    /// Packs `t`.
+    pub fn new(t: &BasisTables) -> PackedTables {
+        let entries: Vec<TableEntry> = t
             .entries
             .iter()
             .map(|e| TableEntry {
@@ -310,85 +278,145 @@ impl GpuBft {
             .collect();
         let mut row_maps = t.row_map_full.clone();
         row_maps.extend_from_slice(&t.row_map_half);
+        PackedTables {
+            table: TableHeader {
+                level: t.level,
+                segments: t.segments(),
+                grid: t.grid(),
+                entry_count: entries.len() as u32,
+                full_map_offset: 0,
+                half_map_offset: t.row_map_full.len() as u32,
+            },
+            entries,
+            mirror_perms: t.mirror_perm.clone(),
+            row_maps,
+            weights: t.weights.clone(),
+        }
+    }
+
+    /// The `Tables` block: header, then entries.
+    pub fn header_bytes(&self) -> Vec<u8> {
+        header_bytes(&self.table, &self.entries)
+    }
+
+    /// Bytes on the GPU (header, entries, permutations, row maps, weights).
+    pub fn bytes(&self) -> usize {
+        size_of::<TableHeader>()
+            + size_of::<TableEntry>() * self.entries.len()
+            + 4 * (self.mirror_perms.len() + self.row_maps.len() + self.weights.len())
+    }
+
+    /// Every table read the shaders make is in range, and every dyadic point has a row (the
+    /// interpolating path reads them unchecked).
+    pub fn validate(&self) -> Result<(), LayoutError> {
+        validate_tables(
+            &self.table,
+            &self.entries,
+            &self.mirror_perms,
+            &self.row_maps,
+            &self.weights,
+        )
+    }
+}
+
+/// The `Tables` block's bytes.
+fn header_bytes(table: &TableHeader, entries: &[TableEntry]) -> Vec<u8> {
+    let mut out = bytemuck::bytes_of(table).to_vec();
+    out.extend_from_slice(bytemuck::cast_slice(entries));
+    out
+}
+
+/// The base → level-1 stencils as CSR offsets and f32 terms, taking `st` (its f64 weights are
+/// freed here, not kept beside the packed copy).
+pub fn pack_stencils(st: StencilTable) -> (Vec<u32>, Vec<StencilTerm>) {
+    let terms = st
+        .indices
+        .iter()
+        .zip(&st.weights)
+        .map(|(&index, &w)| StencilTerm {
+            index,
+            weight: w as f32,
+        })
+        .collect();
+    (st.offsets, terms)
+}
+
+/// The level-1 limit-tangent stencils as CSR offsets and f32 terms, taking `ts`.
+pub fn pack_tangents(ts: TangentStencils) -> (Vec<u32>, Vec<TangentTerm>) {
+    let terms = ts
+        .indices
+        .iter()
+        .zip(ts.t1.iter().zip(&ts.t2))
+        .map(|(&index, (&a, &b))| TangentTerm {
+            index,
+            weight_t1: a as f32,
+            weight_t2: b as f32,
+        })
+        .collect();
+    let offsets = if ts.offsets.is_empty() {
+        vec![0u32]
+    } else {
+        ts.offsets
+    };
+    (offsets, terms)
+}
+
+/// One header per record and the ring buffer, taking `records`: the rings are already one
+/// array in slot order, the ring buffer as it is (moved, not copied).
+pub fn pack_patches(
+    records: PatchRecords,
+    tables: &BasisTables,
+) -> Result<(Vec<PatchHeader>, Vec<u32>), LayoutError> {
+    let mut patches = Vec::with_capacity(records.len());
+    for (face, r) in records.faces.iter().enumerate() {
+        let (entry, mirrored) = tables
+            .lookup(r.key)
+            .ok_or(LayoutError::NoTable { face, key: r.key })?;
+        let owners = |o: &[(u32, u8); 3]| o.map(|(f, k)| pack_owner(f, k));
+        patches.push(PatchHeader {
+            ring_offset: r.ring_offset,
+            ring_size: r.ring_size,
+            entry: entry as u32,
+            mirrored: mirrored as u32,
+            edge_owner: owners(&r.edge_owner),
+            corner_owner: owners(&r.corner_owner),
+        });
+    }
+    Ok((patches, records.rings))
+}
+
+impl GpuBft {
+    /// Packs `bft` and validates the result (a copy: `bft` stays whole for the CPU reference;
+    /// the technique packs stage by stage instead, freeing each input once packed).
+    pub fn new(bft: &LoopBft) -> Result<GpuBft, LayoutError> {
+        let (stencil_offsets, stencil_terms) = pack_stencils(bft.stencils.clone());
+        let (tangent_offsets, tangent_terms) = pack_tangents(bft.tangent_stencils.clone());
+        let (patches, patch_rings) = pack_patches(bft.records.clone(), &bft.tables)?;
+        let PackedTables {
+            table,
+            entries,
+            mirror_perms,
+            row_maps,
+            weights,
+        } = PackedTables::new(&bft.tables);
         let g = GpuBft {
-            stencil_offsets: st.offsets.clone(),
+            stencil_offsets,
             stencil_terms,
             tangent_offsets,
             tangent_terms,
             patches,
             patch_rings,
-            table: TableHeader {
-                level: t.level,
-                segments: t.segments(),
-                grid: t.grid(),
-                entry_count: table_entries.len() as u32,
-                full_map_offset: 0,
-                half_map_offset: t.row_map_full.len() as u32,
-            },
-            table_entries,
-            mirror_perms: t.mirror_perm.clone(),
+            table,
+            table_entries: entries,
+            mirror_perms,
             row_maps,
-            table_weights: t.weights.clone(),
+            table_weights: weights,
             base_vertices: bft.base_vertices as u32,
             level1_vertices: bft.level1.num_vertices() as u32,
             patch_count: bft.records.len() as u32,
         };
         g.validate()?;
         Ok(g)
-    }
-
-    /// The bytes of every buffer that never changes, with its binding and a debug name (the
-    /// base positions and the level-1 buffers are per frame / written on the GPU).
-    pub fn static_buffers(&self) -> [(u32, &'static str, Cow<'_, [u8]>); 10] {
-        fn b(v: &[u32]) -> Cow<'_, [u8]> {
-            Cow::Borrowed(bytemuck::cast_slice(v))
-        }
-        let mut tables = bytemuck::bytes_of(&self.table).to_vec();
-        tables.extend_from_slice(bytemuck::cast_slice(&self.table_entries));
-        [
-            (
-                BFT_STENCIL_OFFSETS_BINDING,
-                "bft stencil offsets",
-                b(&self.stencil_offsets),
-            ),
-            (
-                BFT_STENCIL_TERMS_BINDING,
-                "bft stencil terms",
-                Cow::Borrowed(bytemuck::cast_slice(&self.stencil_terms)),
-            ),
-            (
-                BFT_TANGENT_OFFSETS_BINDING,
-                "bft tangent offsets",
-                b(&self.tangent_offsets),
-            ),
-            (
-                BFT_TANGENT_TERMS_BINDING,
-                "bft tangent terms",
-                Cow::Borrowed(bytemuck::cast_slice(&self.tangent_terms)),
-            ),
-            (
-                BFT_PATCH_HEADERS_BINDING,
-                "bft patch headers",
-                Cow::Borrowed(bytemuck::cast_slice(&self.patches)),
-            ),
-            (
-                BFT_PATCH_RINGS_BINDING,
-                "bft patch rings",
-                b(&self.patch_rings),
-            ),
-            (BFT_TABLES_BINDING, "bft tables", Cow::Owned(tables)),
-            (
-                BFT_MIRROR_PERMS_BINDING,
-                "bft mirror permutations",
-                b(&self.mirror_perms),
-            ),
-            (BFT_ROW_MAPS_BINDING, "bft row maps", b(&self.row_maps)),
-            (
-                BFT_TABLE_WEIGHTS_BINDING,
-                "bft table weights",
-                Cow::Borrowed(bytemuck::cast_slice(&self.table_weights)),
-            ),
-        ]
     }
 
     /// Bytes of one level-1 buffer (positions or normals).
@@ -419,94 +447,155 @@ impl GpuBft {
     /// equals the face's, rows and permutations lie inside the weight and permutation arrays,
     /// and every dyadic point has a row (the interpolating path reads them unchecked).
     pub fn validate(&self) -> Result<(), LayoutError> {
-        csr(
+        validate_stencils(
             &self.stencil_offsets,
-            self.stencil_terms.iter().map(|t| t.index),
+            &self.stencil_terms,
             self.level1_vertices,
             self.base_vertices,
-            "StencilTerms",
         )?;
-        csr(
+        validate_tangents(
             &self.tangent_offsets,
-            self.tangent_terms.iter().map(|t| t.index),
+            &self.tangent_terms,
             self.level1_vertices,
-            self.level1_vertices,
-            "TangentTerms",
         )?;
-        let t = &self.table;
-        let grid = t.grid as usize;
-        let map_len = (grid + 1) * (grid + 1);
-        if t.entry_count as usize != self.table_entries.len()
-            || t.full_map_offset as usize + map_len > self.row_maps.len()
-            || t.half_map_offset as usize + map_len > self.row_maps.len()
-            || t.segments as usize * 3 != grid
-        {
-            return Err(invalid("Tables", "table header"));
-        }
-        let full = &self.row_maps[t.full_map_offset as usize..][..map_len];
-        let half = &self.row_maps[t.half_map_offset as usize..][..map_len];
-        for (e, ent) in self.table_entries.iter().enumerate() {
-            let (rs, rows) = (ent.ring_size as usize, ent.rows as usize);
-            if ent.position_offset == NO_WEIGHTS {
-                return Err(invalid(
-                    "Tables",
-                    format!("entry {e} has no position weights"),
-                ));
-            }
-            for off in [ent.position_offset, ent.du_offset, ent.dv_offset] {
-                if off != NO_WEIGHTS && off as usize + rows * rs > self.table_weights.len() {
-                    return Err(invalid("TableWeights", format!("entry {e} weights")));
-                }
-            }
-            let start = ent.perm_offset as usize;
-            let Some(perm) = self.mirror_perms.get(start..start + rs) else {
-                return Err(invalid("MirrorPerms", format!("entry {e} permutation")));
-            };
-            if perm.iter().any(|&p| p as usize >= rs) {
-                return Err(invalid("MirrorPerms", format!("entry {e} permutation")));
-            }
-            let map = if ent.half_table != 0 { half } else { full };
-            if map.iter().any(|&r| r != NO_ROW && r as usize >= rows) {
-                return Err(invalid("RowMaps", format!("entry {e} row map")));
-            }
-        }
-        let n = t.segments as usize;
-        for j in 0..=n {
-            for i in 0..=n - j {
-                let (a, b) = (3 * i, 3 * j);
-                let (ha, hb) = if a >= b { (a, b) } else { (b, a) };
-                if full[a * (grid + 1) + b] == NO_ROW || half[ha * (grid + 1) + hb] == NO_ROW {
-                    return Err(invalid(
-                        "RowMaps",
-                        format!("dyadic point ({i}, {j}) has no row"),
-                    ));
-                }
-            }
-        }
-        let nf = self.patch_count as usize;
-        if self.patches.len() != nf {
+        validate_tables(
+            &self.table,
+            &self.table_entries,
+            &self.mirror_perms,
+            &self.row_maps,
+            &self.table_weights,
+        )?;
+        if self.patches.len() != self.patch_count as usize {
             return Err(invalid("PatchHeaders", "one header per patch"));
         }
-        for (f, h) in self.patches.iter().enumerate() {
-            let (off, rs) = (h.ring_offset as usize, h.ring_size as usize);
-            let Some(ring) = self.patch_rings.get(off..off + rs).filter(|_| rs >= 3) else {
-                return Err(invalid("PatchRings", format!("patch {f} ring")));
-            };
-            match self.table_entries.get(h.entry as usize) {
-                Some(e) if e.ring_size as usize == rs && h.mirrored <= 1 => {}
-                _ => return Err(invalid("PatchHeaders", format!("patch {f} table entry"))),
-            }
-            if let Some(&x) = ring.iter().find(|&&x| x >= self.level1_vertices) {
-                return Err(invalid("PatchRings", format!("patch {f} ring index {x}")));
-            }
-            for (k, &o) in h.edge_owner.iter().chain(&h.corner_owner).enumerate() {
-                if owner_face(o) as usize >= nf || owner_local(o) > 2 {
-                    return Err(invalid("PatchHeaders", format!("patch {f} owner {k}")));
-                }
+        validate_patches(
+            &self.patches,
+            &self.patch_rings,
+            &self.table_entries,
+            self.level1_vertices,
+        )
+    }
+}
+
+/// The base → level-1 stencils: one CSR row per level-1 vertex over the base vertices.
+pub fn validate_stencils(
+    offsets: &[u32],
+    terms: &[StencilTerm],
+    level1_vertices: u32,
+    base_vertices: u32,
+) -> Result<(), LayoutError> {
+    csr(
+        offsets,
+        terms.iter().map(|t| t.index),
+        level1_vertices,
+        base_vertices,
+        "StencilTerms",
+    )
+}
+
+/// The tangent stencils: one CSR row per level-1 vertex over the level-1 vertices.
+pub fn validate_tangents(
+    offsets: &[u32],
+    terms: &[TangentTerm],
+    level1_vertices: u32,
+) -> Result<(), LayoutError> {
+    csr(
+        offsets,
+        terms.iter().map(|t| t.index),
+        level1_vertices,
+        level1_vertices,
+        "TangentTerms",
+    )
+}
+
+/// Every read of the tables in range; every dyadic point has a row.
+fn validate_tables(
+    t: &TableHeader,
+    table_entries: &[TableEntry],
+    mirror_perms: &[u32],
+    row_maps: &[u32],
+    table_weights: &[f32],
+) -> Result<(), LayoutError> {
+    let grid = t.grid as usize;
+    let map_len = (grid + 1) * (grid + 1);
+    if t.entry_count as usize != table_entries.len()
+        || t.full_map_offset as usize + map_len > row_maps.len()
+        || t.half_map_offset as usize + map_len > row_maps.len()
+        || t.segments as usize * 3 != grid
+    {
+        return Err(invalid("Tables", "table header"));
+    }
+    let full = &row_maps[t.full_map_offset as usize..][..map_len];
+    let half = &row_maps[t.half_map_offset as usize..][..map_len];
+    for (e, ent) in table_entries.iter().enumerate() {
+        let (rs, rows) = (ent.ring_size as usize, ent.rows as usize);
+        if ent.position_offset == NO_WEIGHTS {
+            return Err(invalid(
+                "Tables",
+                format!("entry {e} has no position weights"),
+            ));
+        }
+        for off in [ent.position_offset, ent.du_offset, ent.dv_offset] {
+            if off != NO_WEIGHTS && off as usize + rows * rs > table_weights.len() {
+                return Err(invalid("TableWeights", format!("entry {e} weights")));
             }
         }
-        Ok(())
+        let start = ent.perm_offset as usize;
+        let Some(perm) = mirror_perms.get(start..start + rs) else {
+            return Err(invalid("MirrorPerms", format!("entry {e} permutation")));
+        };
+        if perm.iter().any(|&p| p as usize >= rs) {
+            return Err(invalid("MirrorPerms", format!("entry {e} permutation")));
+        }
+        let map = if ent.half_table != 0 { half } else { full };
+        if map.iter().any(|&r| r != NO_ROW && r as usize >= rows) {
+            return Err(invalid("RowMaps", format!("entry {e} row map")));
+        }
     }
+    let n = t.segments as usize;
+    for j in 0..=n {
+        for i in 0..=n - j {
+            let (a, b) = (3 * i, 3 * j);
+            let (ha, hb) = if a >= b { (a, b) } else { (b, a) };
+            if full[a * (grid + 1) + b] == NO_ROW || half[ha * (grid + 1) + hb] == NO_ROW {
+                return Err(invalid(
+                    "RowMaps",
+                    format!("dyadic point ({i}, {j}) has no row"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Every patch: a ring of ≥ 3 level-1 vertices inside the ring buffer, a table entry of the
+/// ring's size, owners naming existing patches and corners.
+pub fn validate_patches(
+    patches: &[PatchHeader],
+    patch_rings: &[u32],
+    table_entries: &[TableEntry],
+    level1_vertices: u32,
+) -> Result<(), LayoutError> {
+    let nf = patches.len();
+    for (f, h) in patches.iter().enumerate() {
+        let (off, rs) = (h.ring_offset as usize, h.ring_size as usize);
+        let Some(ring) = patch_rings.get(off..off + rs).filter(|_| rs >= 3) else {
+            return Err(invalid("PatchRings", format!("patch {f} ring")));
+        };
+        match table_entries.get(h.entry as usize) {
+            Some(e) if e.ring_size as usize == rs && h.mirrored <= 1 => {}
+            _ => return Err(invalid("PatchHeaders", format!("patch {f} table entry"))),
+        }
+        if let Some(&x) = ring.iter().find(|&&x| x >= level1_vertices) {
+            return Err(invalid("PatchRings", format!("patch {f} ring index {x}")));
+        }
+        for (k, &o) in h.edge_owner.iter().chain(&h.corner_owner).enumerate() {
+            if owner_face(o) as usize >= nf || owner_local(o) > 2 {
+                return Err(invalid("PatchHeaders", format!("patch {f} owner {k}")));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A CSR stencil table: `n_rows + 1` non-decreasing offsets ending at the term count, and term

@@ -43,11 +43,14 @@ use super::shared::{
     canonical_zero, check_adaptive_policy, factor_fields, gpu_coordinate, storage, storage_binding,
 };
 use super::windows::{self, Chunk, Limits, Member, Space};
+use crate::bench::usage::Laps;
 use crate::gpu::bindings::{
     BFT_BASE_POSITIONS_BINDING, BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING,
-    BFT_LOCAL_SIZE, BFT_OPTION_FRACTIONAL, BFT_OPTION_GEOMETRIC_NORMALS, BFT_OPTION_PATCH_COLOURS,
-    BFT_PATCH_HEADERS_BINDING, BFT_PATCH_RINGS_BINDING, BFT_STENCIL_OFFSETS_BINDING,
-    BFT_STENCIL_TERMS_BINDING, BFT_TANGENT_OFFSETS_BINDING, BFT_TANGENT_TERMS_BINDING,
+    BFT_LOCAL_SIZE, BFT_MIRROR_PERMS_BINDING, BFT_OPTION_FRACTIONAL, BFT_OPTION_GEOMETRIC_NORMALS,
+    BFT_OPTION_PATCH_COLOURS, BFT_PATCH_HEADERS_BINDING, BFT_PATCH_RINGS_BINDING,
+    BFT_ROW_MAPS_BINDING, BFT_STENCIL_OFFSETS_BINDING, BFT_STENCIL_TERMS_BINDING,
+    BFT_TABLES_BINDING, BFT_TABLE_WEIGHTS_BINDING, BFT_TANGENT_OFFSETS_BINDING,
+    BFT_TANGENT_TERMS_BINDING,
 };
 use crate::gpu::BftPush;
 use crate::shaders::{self, Stage, Variant};
@@ -56,9 +59,12 @@ use crate::technique::{
     PatchPipeline, PatchType, Technique, TechniqueId,
 };
 use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, Domain, Spacing};
-use layout::{BasePosition, GpuBft, PatchHeader, StencilTerm, TangentTerm, STORAGE_BINDINGS};
+use layout::{BasePosition, PackedTables, PatchHeader, StencilTerm, TangentTerm, STORAGE_BINDINGS};
 use std::ops::Range;
-use topology::bft::{prepare_loop_bft, LoopBft};
+use topology::bft::{
+    build_patch_records, face_rotations, level1_base_domain, loop_level1, loop_tables,
+    loop_tangent_stencils,
+};
 use topology::ControlMesh;
 use vk_core::descriptor::{BindingDesc, DescriptorPool};
 use vk_core::pipeline::{Pipeline, ShaderStage};
@@ -142,10 +148,20 @@ fn span(indices: impl IntoIterator<Item = u32>) -> Range<u32> {
     lo..hi + 1
 }
 
+/// The CSR arrays the pre-pass reads, as packed ([`layout::pack_stencils`],
+/// [`layout::pack_tangents`]).
+struct PrePassData<'a> {
+    stencil_offsets: &'a [u32],
+    stencil_terms: &'a [StencilTerm],
+    tangent_offsets: &'a [u32],
+    tangent_terms: &'a [TangentTerm],
+    level1_vertices: u32,
+}
+
 /// Chunks of level-1 vertices for the pre-pass: each reads its stencil rows, their base
 /// vertices, its tangent rows and their level-1 vertices; at most `max_items` per dispatch.
 fn plan_pre_pass(
-    g: &GpuBft,
+    g: &PrePassData,
     limits: Limits,
     max_items: u32,
 ) -> Result<Vec<(Range<u32>, SetWindows)>> {
@@ -190,14 +206,18 @@ fn plan_pre_pass(
 
 /// Chunks of patches for the draw: each reads its header, ring and ring vertices, and those of
 /// its edge and corner owners (shared points are evaluated in the owner's frame).
-fn plan_draw(g: &GpuBft, limits: Limits) -> Result<Vec<(Range<u32>, SetWindows)>> {
+fn plan_draw(
+    patches: &[PatchHeader],
+    patch_rings: &[u32],
+    limits: Limits,
+) -> Result<Vec<(Range<u32>, SetWindows)>> {
     let chunks = windows::plan(
         "patch",
-        g.patch_count,
+        patches.len() as u32,
         &[PATCHES, RINGS, LEVEL1],
         limits,
         |p| {
-            let h = &g.patches[p as usize];
+            let h = &patches[p as usize];
             let faces = std::iter::once(p).chain(
                 h.edge_owner
                     .iter()
@@ -210,10 +230,10 @@ fn plan_draw(g: &GpuBft, limits: Limits) -> Result<Vec<(Range<u32>, SetWindows)>
             for f in faces {
                 lo_f = lo_f.min(f);
                 hi_f = hi_f.max(f);
-                let o = &g.patches[f as usize];
+                let o = &patches[f as usize];
                 let r = o.ring_offset..o.ring_offset + o.ring_size;
                 let v = span(
-                    g.patch_rings[r.start as usize..r.end as usize]
+                    patch_rings[r.start as usize..r.end as usize]
                         .iter()
                         .copied(),
                 );
@@ -302,10 +322,10 @@ pub struct Bft {
     base: Vec<Buffer>,
     _static: Vec<Buffer>,
     arrays: Vec<PatchArray>,
-    pub gpu: GpuBft,
-    /// The CPU surface: level-1 mesh, records and tables. Its base → level-1 and tangent
-    /// stencils are emptied once packed: read them from [`Bft::gpu`].
-    pub bft: LoopBft,
+    summary: BftSummary,
+    /// Per level-1 face, which of its corners its record's `v0` is: all
+    /// [`Bft::base_domain`] keeps of the level-1 mesh and records (freed once packed).
+    rotations: Vec<u8>,
     /// Per Loop triangle: its input face, the face's side count and its fan index (corners
     /// 0, j + 1, j + 2); identity for a triangle mesh.
     fans: Vec<(u32, u32, u32)>,
@@ -360,10 +380,42 @@ fn loop_control_mesh(
     (tri, fans, note)
 }
 
+/// What a [`Bft`] keeps of its packed data once uploaded: counts and byte sizes (the arrays
+/// themselves live only on the GPU; tests build their CPU mirror with [`GpuBft::new`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BftSummary {
+    pub base_vertices: u32,
+    pub level1_vertices: u32,
+    /// Level-1 faces: patches per frame.
+    pub patch_count: u32,
+    pub table: layout::TableHeader,
+    /// The tables hold `du`/`dv` rows (geometric normals).
+    pub tangents: bool,
+    pub stencil_terms: u64,
+    pub tangent_terms: u64,
+    pub ring_slots: u64,
+    /// Bytes on the GPU: base → level-1 stencils, tangent stencils, patch headers and rings,
+    /// tables.
+    pub stencil_bytes: u64,
+    pub tangent_bytes: u64,
+    pub patch_bytes: u64,
+    pub table_bytes: u64,
+}
+
+fn bytes_of<T>(v: &[T]) -> u64 {
+    std::mem::size_of_val(v) as u64
+}
+
 impl Bft {
     /// Prepares `mesh` (fan-triangulated first when it has polygons; refined once on the CPU
     /// for the topology; stencils, patch records and the tables at `options.table_level`) and
     /// uploads it, with one base-position buffer per frame slot of `ctx`.
+    ///
+    /// **Stage by stage** (a 1M-triangle mesh's level-1 data is ~1.5 GB on the CPU): each
+    /// product is packed into its GPU form, checked, uploaded and freed before the next is
+    /// built, and the level-1 mesh is dropped once the records, tables and tangent stencils
+    /// are taken from it. Every array is validated before it is uploaded, as
+    /// [`GpuBft::validate`] does for the whole.
     pub fn new(ctx: &mut Context, mesh: &ControlMesh, options: &BftOptions) -> Result<Self> {
         let device = ctx.device().clone();
         let table_level = options.table_level;
@@ -374,31 +426,169 @@ impl Bft {
                 max_tessellation_level: max_level,
             });
         }
-        let started = std::time::Instant::now();
+        let mut laps = Laps::new();
+        let mut stages = Vec::new();
+        let mesh_error = |e: topology::eval::EvalError| TessError::Mesh {
+            name: options.name.clone(),
+            source: e.into(),
+        };
         let (loop_mesh, fans, note) = loop_control_mesh(mesh, &options.name);
-        let mut bft = prepare_loop_bft(&loop_mesh, table_level, options.tangents).map_err(|e| {
-            TessError::Mesh {
-                name: options.name.clone(),
-                source: e.into(),
-            }
-        })?;
-        let prepared = started.elapsed();
-        let gpu = GpuBft::new(&bft)?;
-        let packed = started.elapsed();
-        // Packed into `gpu`: not kept twice (hundreds of MB on a 1M-face mesh).
-        bft.stencils = Default::default();
-        bft.tangent_stencils = Default::default();
+        let limits = Limits::of(&device);
+        // The level-1 mesh and the base → level-1 stencils, packed at once (f32 terms).
+        let (level1, stencils) = loop_level1(&loop_mesh).map_err(mesh_error)?;
+        let base_vertices = loop_mesh.positions.len() as u32;
+        let level1_vertices = level1.num_vertices() as u32;
+        let (stencil_offsets, stencil_terms) = layout::pack_stencils(stencils);
+        layout::validate_stencils(
+            &stencil_offsets,
+            &stencil_terms,
+            level1_vertices,
+            base_vertices,
+        )?;
+        stages.push(laps.lap("level 1"));
+        // Tangent stencils, then the pre-pass chunks (they window both CSR tables); both
+        // uploaded and freed.
+        let (tangent_offsets, tangent_terms) =
+            layout::pack_tangents(loop_tangent_stencils(&level1));
+        layout::validate_tangents(&tangent_offsets, &tangent_terms, level1_vertices)?;
+        let max_groups = device.info.caps.max_compute_work_group_count[0];
+        let pre_chunks = plan_pre_pass(
+            &PrePassData {
+                stencil_offsets: &stencil_offsets,
+                stencil_terms: &stencil_terms,
+                tangent_offsets: &tangent_offsets,
+                tangent_terms: &tangent_terms,
+                level1_vertices,
+            },
+            limits,
+            max_groups.saturating_mul(BFT_LOCAL_SIZE),
+        )?;
+        let mut statics = vec![
+            (
+                BFT_STENCIL_OFFSETS_BINDING,
+                storage(
+                    &device,
+                    "bft stencil offsets",
+                    bytemuck::cast_slice(&stencil_offsets),
+                )?,
+            ),
+            (
+                BFT_STENCIL_TERMS_BINDING,
+                storage(
+                    &device,
+                    "bft stencil terms",
+                    bytemuck::cast_slice(&stencil_terms),
+                )?,
+            ),
+            (
+                BFT_TANGENT_OFFSETS_BINDING,
+                storage(
+                    &device,
+                    "bft tangent offsets",
+                    bytemuck::cast_slice(&tangent_offsets),
+                )?,
+            ),
+            (
+                BFT_TANGENT_TERMS_BINDING,
+                storage(
+                    &device,
+                    "bft tangent terms",
+                    bytemuck::cast_slice(&tangent_terms),
+                )?,
+            ),
+        ];
+        let (stencil_count, tangent_count) =
+            (stencil_terms.len() as u64, tangent_terms.len() as u64);
+        let stencil_bytes = bytes_of(&stencil_offsets) + bytes_of(&stencil_terms);
+        let tangent_bytes = bytes_of(&tangent_offsets) + bytes_of(&tangent_terms);
+        drop((
+            stencil_offsets,
+            stencil_terms,
+            tangent_offsets,
+            tangent_terms,
+        ));
+        stages.push(laps.lap("tangent stencils and upload"));
+        // Records and tables; then the level-1 mesh is no longer needed.
+        let records = build_patch_records(&level1).map_err(mesh_error)?;
+        let tables =
+            loop_tables(&level1, &records, table_level, options.tangents).map_err(mesh_error)?;
+        let rotations = face_rotations(&level1, &records);
+        drop(level1);
+        stages.push(laps.lap("records and tables"));
+        let packed_tables = PackedTables::new(&tables);
+        packed_tables.validate()?;
+        let (patches, patch_rings) = layout::pack_patches(records, &tables)?;
+        let tangents = tables.tangents;
+        drop(tables);
+        layout::validate_patches(
+            &patches,
+            &patch_rings,
+            &packed_tables.entries,
+            level1_vertices,
+        )?;
+        let draw_chunks = plan_draw(&patches, &patch_rings, limits)?;
+        let patch_count = patches.len() as u32;
+        let ring_slots = patch_rings.len() as u64;
+        let patch_bytes = bytes_of(&patches) + bytes_of(&patch_rings);
+        statics.push((
+            BFT_PATCH_HEADERS_BINDING,
+            storage(&device, "bft patch headers", bytemuck::cast_slice(&patches))?,
+        ));
+        drop(patches);
+        statics.push((
+            BFT_PATCH_RINGS_BINDING,
+            storage(
+                &device,
+                "bft patch rings",
+                bytemuck::cast_slice(&patch_rings),
+            )?,
+        ));
+        drop(patch_rings);
+        let table_header = packed_tables.header_bytes();
+        for (binding, name, bytes) in [
+            (BFT_TABLES_BINDING, "bft tables", &table_header[..]),
+            (
+                BFT_MIRROR_PERMS_BINDING,
+                "bft mirror permutations",
+                bytemuck::cast_slice(&packed_tables.mirror_perms),
+            ),
+            (
+                BFT_ROW_MAPS_BINDING,
+                "bft row maps",
+                bytemuck::cast_slice(&packed_tables.row_maps),
+            ),
+            (
+                BFT_TABLE_WEIGHTS_BINDING,
+                "bft table weights",
+                bytemuck::cast_slice(&packed_tables.weights),
+            ),
+        ] {
+            statics.push((binding, storage(&device, name, bytes)?));
+        }
+        let summary = BftSummary {
+            base_vertices,
+            level1_vertices,
+            patch_count,
+            table: packed_tables.table,
+            tangents,
+            stencil_terms: stencil_count,
+            tangent_terms: tangent_count,
+            ring_slots,
+            stencil_bytes,
+            tangent_bytes,
+            patch_bytes,
+            table_bytes: packed_tables.bytes() as u64,
+        };
+        drop(packed_tables);
+        stages.push(laps.lap("patches and upload"));
         let frames = ctx.frames_in_flight();
         ctx.ensure_set_layout(TechniqueId::Bft, &SET_BINDINGS)?;
         let set_layout = ctx.set_layout(TechniqueId::Bft)?;
-        let limits = Limits::of(&device);
-        let max_groups = device.info.caps.max_compute_work_group_count[0];
-        let pre_chunks = plan_pre_pass(&gpu, limits, max_groups.saturating_mul(BFT_LOCAL_SIZE))?;
-        let draw_chunks = plan_draw(&gpu, limits)?;
         let max_sets = frames * pre_chunks.len() + draw_chunks.len();
         let pool =
             DescriptorPool::new(&device, "bft descriptor pool", set_layout, max_sets as u32)?;
-        let level1_bytes = gpu.level1_bytes();
+        let level1_bytes =
+            (std::mem::size_of::<layout::Level1Point>() * level1_vertices.max(1) as usize) as u64;
         let level1 = |binding: u32, name: &str| -> Result<(u32, Buffer)> {
             let desc = BufferDesc {
                 name,
@@ -408,13 +598,11 @@ impl Bft {
             };
             Ok((binding, Buffer::new(&device, &desc)?))
         };
-        let mut statics = vec![
-            level1(BFT_LEVEL1_POSITIONS_BINDING, "bft level-1 positions")?,
-            level1(BFT_LEVEL1_NORMALS_BINDING, "bft level-1 normals")?,
-        ];
-        for (binding, name, bytes) in gpu.static_buffers() {
-            statics.push((binding, storage(&device, name, &bytes)?));
-        }
+        statics.push(level1(
+            BFT_LEVEL1_POSITIONS_BINDING,
+            "bft level-1 positions",
+        )?);
+        statics.push(level1(BFT_LEVEL1_NORMALS_BINDING, "bft level-1 normals")?);
         let base_positions = base_positions(&loop_mesh);
         let mut base = Vec::new();
         for i in 0..frames {
@@ -432,7 +620,7 @@ impl Bft {
             base.push(buf);
         }
         // Every binding of a set: windowed buffers as the chunk's windows, the tables whole.
-        let (n1, nv) = (gpu.level1_vertices as u64, gpu.base_vertices as u64);
+        let (n1, nv) = (level1_vertices as u64, base_vertices as u64);
         let write_set = |base: &Buffer, w: &SetWindows| -> Result<DescriptorSet> {
             let set = pool.allocate_set(set_layout)?;
             let csr = LEVEL1_MEMBERS[1];
@@ -452,22 +640,12 @@ impl Bft {
                     BFT_STENCIL_OFFSETS_BINDING | BFT_TANGENT_OFFSETS_BINDING => {
                         (csr, n1 + 1, &w.level1)
                     }
-                    BFT_STENCIL_TERMS_BINDING => (
-                        STENCIL.members[0],
-                        gpu.stencil_terms.len() as u64,
-                        &w.stencil,
-                    ),
-                    BFT_TANGENT_TERMS_BINDING => (
-                        TANGENT.members[0],
-                        gpu.tangent_terms.len() as u64,
-                        &w.tangent,
-                    ),
+                    BFT_STENCIL_TERMS_BINDING => (STENCIL.members[0], stencil_count, &w.stencil),
+                    BFT_TANGENT_TERMS_BINDING => (TANGENT.members[0], tangent_count, &w.tangent),
                     BFT_PATCH_HEADERS_BINDING => {
-                        (PATCHES.members[0], gpu.patches.len() as u64, &w.patches)
+                        (PATCHES.members[0], patch_count as u64, &w.patches)
                     }
-                    BFT_PATCH_RINGS_BINDING => {
-                        (RINGS.members[0], gpu.patch_rings.len() as u64, &w.rings)
-                    }
+                    BFT_PATCH_RINGS_BINDING => (RINGS.members[0], ring_slots, &w.rings),
                     _ => {
                         windows::write_whole(&set, *binding, buf)?;
                         continue;
@@ -505,14 +683,12 @@ impl Bft {
         };
         let subdivide = compute("bft subdivide", Stage::BftSubdivideComp)?;
         let normals = compute("bft normals", Stage::BftNormalsComp)?;
-        let arrays = number_arrays(&[(PatchType::LoopBft, gpu.patch_count, 1)]);
+        let arrays = number_arrays(&[(PatchType::LoopBft, patch_count, 1)]);
+        stages.push(laps.lap("sets and pipelines"));
         log::info!(
-            "bft {}: topology {:.2} s, packing {:.2} s, upload and sets {:.2} s; {} pre-pass and \
-             {} draw chunks",
+            "bft {}: {}; {} pre-pass and {} draw chunks",
             options.name,
-            prepared.as_secs_f64(),
-            (packed - prepared).as_secs_f64(),
-            (started.elapsed() - packed).as_secs_f64(),
+            stages.join("; "),
             pre_chunks.len(),
             draw_chunks.len()
         );
@@ -527,8 +703,8 @@ impl Bft {
             base,
             _static: statics.into_iter().map(|(_, b)| b).collect(),
             arrays,
-            gpu,
-            bft,
+            summary,
+            rotations,
             fans,
             loop_mesh,
             rest_bbox: bbox(&base_positions),
@@ -537,9 +713,22 @@ impl Bft {
         })
     }
 
+    /// Counts and GPU byte sizes of what was uploaded.
+    pub fn summary(&self) -> &BftSummary {
+        &self.summary
+    }
+
+    /// The base face and its domain coordinate `(U, V)` (weights of the base face's corners 1
+    /// and 2) of patch coordinate `(u, v)` on level-1 face `patch`
+    /// ([`LoopBft::base_domain`]); `None` past the last patch.
+    pub fn base_domain(&self, patch: u32, u: f64, v: f64) -> Option<(usize, f64, f64)> {
+        let rotation = *self.rotations.get(patch as usize)?;
+        Some(level1_base_domain(patch as usize, rotation, u, v))
+    }
+
     /// Bytes of basis-function tables on the GPU ([`GpuBft::table_bytes`]).
     pub fn table_bytes(&self) -> usize {
-        self.gpu.table_bytes()
+        self.summary.table_bytes as usize
     }
 
     /// Chunks of the pre-pass and of the draw (one each unless a buffer exceeds the device's
@@ -550,12 +739,12 @@ impl Bft {
 
     /// Level-1 faces: patches per frame.
     pub fn patch_count(&self) -> u32 {
-        self.gpu.patch_count
+        self.summary.patch_count
     }
 
     /// Segments per level-1 edge the tables reach (`2^L`).
     fn max_level(&self) -> u32 {
-        self.gpu.table.segments
+        self.summary.table.segments
     }
 
     fn push(&self, params: &FrameParams, mode: u32) -> BftPush {
@@ -576,7 +765,7 @@ impl Bft {
             pixels_per_segment: pixels,
             distance_ref: reference,
             max_level: self.max_level() as f32,
-            count: self.gpu.level1_vertices,
+            count: self.summary.level1_vertices,
             // Bases: set per draw chunk.
             ..Default::default()
         }
@@ -627,10 +816,10 @@ impl Technique for Bft {
     /// Geometric normals need tangent tables (without them their offsets are `u32::MAX`: the
     /// TES must never read them); the rest is [`check_frame`].
     fn check(&self, params: &FrameParams) -> Result<()> {
-        if params.geometric_normals && !self.bft.tables.tangents {
+        if params.geometric_normals && !self.summary.tangents {
             return Err(TessError::NeedsTangentTables);
         }
-        check_frame(self.gpu.table.level, params)
+        check_frame(self.summary.table.level, params)
     }
 
     fn patch_pipeline(&self, _patch: PatchType) -> PatchPipeline {
@@ -667,7 +856,7 @@ impl Technique for Bft {
     fn triangles(&self, params: &FrameParams, _array: usize) -> Option<u64> {
         match params.factors {
             FactorPolicy::Uniform { segments } => Some(
-                self.gpu.patch_count as u64
+                self.summary.patch_count as u64
                     * uniform_triangle_count(Domain::Triangle, params.spacing, segments * 0.5),
             ),
             _ => None,
@@ -784,11 +973,11 @@ impl Technique for Bft {
     /// The level-1 face's point in its base triangle, then (for a fan-triangulated polygon)
     /// linearly into the polygon's domain, as the other techniques map fan triangles.
     fn face_point(&self, patch: u32, domain: [f32; 2]) -> Option<FacePoint> {
-        if patch >= self.gpu.patch_count {
+        if patch >= self.summary.patch_count {
             return None;
         }
         let (u, v) = patch_uv(domain);
-        let (t, bu, bv) = self.bft.base_domain(patch as usize, u, v);
+        let (t, bu, bv) = self.base_domain(patch, u, v)?;
         let &(face, n, j) = self.fans.get(t)?;
         if n == 3 {
             return Some(FacePoint {
@@ -813,14 +1002,11 @@ impl Technique for Bft {
     }
 
     fn report_notes(&self) -> Vec<String> {
-        let g = &self.gpu;
+        let g = &self.summary;
         vec![format!(
             "BFT tables {} bytes at level {} (the valences and cases present in the mesh), \
              patch records {} bytes, base-to-level-1 stencils {} bytes",
-            self.table_bytes(),
-            g.table.level,
-            g.patch_bytes(),
-            g.stencil_bytes()
+            g.table_bytes, g.table.level, g.patch_bytes, g.stencil_bytes
         )]
     }
 }
