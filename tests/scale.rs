@@ -267,7 +267,8 @@ fn grid(nx: u32, ny: u32, triangles: bool) -> ControlMesh {
 /// small viewport (BFT's tangent terms, patch headers and rings exceed lavapipe's 128 MiB
 /// storage range: the windowed path), and adaptive the 1M-quad grid (its stencil terms, 264 MB,
 /// are windowed by rows); adaptive on the triangle grid is refused by the plan's size bound
-/// with a typed error naming the mesh size and the isolation. One test, so the meshes are built once and the runs never overlap
+/// with a typed error naming the mesh size and the isolation; Gregory and ACC-1 draw the
+/// 1M-quad grid and refuse the triangle grid by their end caps' bound. One test, so the meshes are built once and the runs never overlap
 /// in memory. Prints each build and frame time (the CI cost).
 #[test]
 fn one_million_faces_through_every_technique() {
@@ -396,6 +397,52 @@ fn one_million_faces_through_every_technique() {
             ),
             "{e}"
         );
+        // The single-pass approximations: one patch per quad of the 1M-quad grid; on the
+        // triangle grid (3M Gregory patches after the split, ~5.7e8 point-stencil terms, which
+        // took 24 GB before the OOM killer) refused by the Gregory bound before building any.
+        for id in [TechniqueId::Gregory, TechniqueId::Acc] {
+            let t = std::time::Instant::now();
+            let surf = common::build_with(&mut ctx, id, &quad, 1, false);
+            let built = t.elapsed().as_secs_f64();
+            let image = ctx
+                .render_offscreen(surf.as_ref(), &FrameParams::uniform(1.0), tiny)
+                .unwrap_or_else(|e| panic!("{id}: {e}"));
+            println!("{id}: {} faces, build {built:.1} s", quad.num_faces());
+            let clear = &image.pixels[..4];
+            let lit = image.pixels.chunks_exact(4).filter(|p| p != &clear).count();
+            assert!(lit > 64 * 48 / 8, "{id}: the grid covers {lit} pixels");
+            drop(surf);
+            let t = std::time::Instant::now();
+            let e = tessera::tess::build(
+                &mut ctx,
+                id,
+                &tri,
+                &tessera::tess::BuildOptions {
+                    name: "1M triangle grid".into(),
+                    ..Default::default()
+                },
+            )
+            .map(|_| ())
+            .expect_err("3M Gregory patches are beyond the bound");
+            println!(
+                "{id} on triangles: refused in {:.1} s: {e}",
+                t.elapsed().as_secs_f64()
+            );
+            let tessera::tess::TessError::Mesh { source, .. } = &e else {
+                panic!("not a mesh error: {e}")
+            };
+            assert!(
+                matches!(
+                    source.downcast_ref::<tessera::topology::TopologyError>(),
+                    Some(tessera::topology::TopologyError::GregoryTooLarge {
+                        faces: 1_001_112,
+                        patches: 3_003_336,
+                        ..
+                    })
+                ),
+                "{e}"
+            );
+        }
     }
     drop(gpu);
 }

@@ -253,10 +253,13 @@ fn prepare_and_pack_for_the_gpu() {
     let packed = GpuBft::new(&bft).expect("packed");
     assert_eq!(packed.patches.len(), bft.records.len());
     for (h, r) in packed.patches.iter().zip(bft.records.iter()) {
-        assert_eq!(h.edge_owner, r.edge_owner.map(|(f, k)| pack_owner(f, k)));
+        assert_eq!(
+            h.edge_owner,
+            r.edge_owner.map(|o| pack_owner(o.face(), o.local()))
+        );
         assert_eq!(
             h.corner_owner,
-            r.corner_owner.map(|(f, k)| pack_owner(f, k))
+            r.corner_owner.map(|o| pack_owner(o.face(), o.local()))
         );
         assert!(h
             .corner_owner

@@ -235,6 +235,7 @@ mod assemble;
 mod levels;
 mod nets;
 pub mod single_pass;
+pub use assemble::MAX_LOCAL_TERMS;
 
 /// Plan the feature-adaptive refinement and patches of `mesh` (Catmull-Clark).
 ///

@@ -848,6 +848,31 @@ impl BftCache {
     }
 }
 
+/// A face and one of its local edges or corners (0..3) in one word, `face << 2 | local`: the
+/// records of a 1M-triangle mesh hold 24M of them. Ordered as `(face, local)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Owner(u32);
+
+impl Owner {
+    /// Faces an owner can name.
+    pub const MAX_FACES: usize = 1 << 30;
+
+    /// `face < MAX_FACES` and `local < 4` (checked in debug builds; [`build_patch_records`]
+    /// rejects larger meshes).
+    pub fn new(face: u32, local: u8) -> Owner {
+        debug_assert!((face as usize) < Self::MAX_FACES && local < 4);
+        Owner(face << 2 | local as u32)
+    }
+
+    pub fn face(self) -> u32 {
+        self.0 >> 2
+    }
+
+    pub fn local(self) -> u8 {
+        (self.0 & 3) as u8
+    }
+}
+
 /// What the GPU needs per face of the once-refined mesh.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PatchRecord {
@@ -860,9 +885,9 @@ pub struct PatchRecord {
     pub corners: [u32; 3],
     /// For local edge `e` (0: v0→v1 where `j = 0`; 1: v1→v2 where `i + j = N`; 2: v2→v0 where
     /// `i = 0`): the owner face and the edge's index in the owner.
-    pub edge_owner: [(u32, u8); 3],
+    pub edge_owner: [Owner; 3],
     /// For local corner `c`: the owner face and the corner's index in the owner.
-    pub corner_owner: [(u32, u8); 3],
+    pub corner_owner: [Owner; 3],
 }
 
 /// The patch records of every face with their rings back to back in one array (a `Vec` per
@@ -914,6 +939,12 @@ pub fn build_patch_records(mesh: &LocalMesh) -> Result<PatchRecords, EvalError> 
             need: 3,
         });
     }
+    if nf > Owner::MAX_FACES {
+        return Err(EvalError::TooManyPatches {
+            faces: nf,
+            max: Owner::MAX_FACES,
+        });
+    }
     let creases = has_interior_creases(mesh);
     // Faces are independent: classified in parallel blocks, a shape cache per rayon job, each
     // block's rings in one array (offsets made global when the blocks are joined).
@@ -948,8 +979,8 @@ pub fn build_patch_records(mesh: &LocalMesh) -> Result<PatchRecords, EvalError> 
                     ring_offset: start as u32,
                     ring_size: (out.rings.len() - start) as u32,
                     corners: [fv[first], fv[(first + 1) % 3], fv[(first + 2) % 3]],
-                    edge_owner: [(0, 0); 3],
-                    corner_owner: [(0, 0); 3],
+                    edge_owner: [Owner::default(); 3],
+                    corner_owner: [Owner::default(); 3],
                 });
             }
             out
@@ -990,15 +1021,15 @@ pub fn build_patch_records(mesh: &LocalMesh) -> Result<PatchRecords, EvalError> 
     recs.faces.par_iter_mut().enumerate().for_each(|(f, r)| {
         for e in 0..3 {
             let (a, b) = (r.corners[e], r.corners[(e + 1) % 3]);
-            let mut edge = (f as u32, e as u8);
-            let mut corner = (f as u32, e as u8);
+            let mut edge = Owner::new(f as u32, e as u8);
+            let mut corner = edge;
             for g in mesh.vertex_faces(a) {
                 let Some(ka) = local(g, a) else { continue };
-                corner = corner.min((g, ka as u8));
+                corner = corner.min(Owner::new(g, ka as u8));
                 if let Some(kb) = local(g, b) {
                     // The edge's index in g: it starts at whichever of a, b the other follows.
                     let k = if (ka + 1) % 3 == kb { ka } else { kb };
-                    edge = edge.min((g, k as u8));
+                    edge = edge.min(Owner::new(g, k as u8));
                 }
             }
             r.edge_owner[e] = edge;
@@ -1104,7 +1135,7 @@ pub fn resolve_owner(
         _ => (0, n),
     };
     if let Some(c) = corner {
-        let (g, gc) = r.corner_owner[c];
+        let (g, gc) = (r.corner_owner[c].face(), r.corner_owner[c].local());
         let (a, b) = corner_param(gc);
         return (g as usize, a, b);
     }
@@ -1121,7 +1152,7 @@ pub fn resolve_owner(
     match edge {
         None => (face, i, j),
         Some((e, k)) => {
-            let (g, ge) = r.edge_owner[e];
+            let (g, ge) = (r.edge_owner[e].face(), r.edge_owner[e].local());
             // The owner walks the edge the other way unless it is this face.
             let kk = if g as usize == face { k } else { n - k };
             let (a, b) = match ge {

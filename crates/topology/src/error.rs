@@ -149,6 +149,17 @@ pub enum TopologyError {
         estimate: u64,
         bound: u64,
     },
+    /// Gregory end caps whose point stencils were projected past their bound (checked before
+    /// any is built: each of the 20 points is a row over its corners' one-rings, ~200 terms a
+    /// patch, so a mesh made of end caps, such as a triangle mesh under Catmull-Clark, costs
+    /// tens of bytes per term at every stage).
+    #[error("adaptive plan of a {faces}-face mesh: {patches} Gregory patches project about {estimate} local-point stencil terms, above the bound of {bound} (most faces are end caps, as a triangle mesh's are under Catmull-Clark: draw a triangle mesh as Loop, --method bft; adaptive takes --end-cap bilinear or a lower --isolation)")]
+    GregoryTooLarge {
+        faces: usize,
+        patches: u64,
+        estimate: u64,
+        bound: u64,
+    },
     /// An adaptive patch whose neighbour is more than one level coarser or finer (drawing it
     /// would leave a crack).
     #[error("adaptive plan: face {face} of level {level} borders a face more than one level away")]

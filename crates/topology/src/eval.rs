@@ -130,6 +130,9 @@ pub enum EvalError {
     /// A characteristic map ([`crate::reparam`]) of a valence below 3.
     #[error("a characteristic map needs valence 3 or more, not {valence}")]
     Valence { valence: u32 },
+    /// Patch records name a face and a local index in one word ([`crate::bft::Owner`]).
+    #[error("{faces} faces after one refinement step; patch records address at most {max}")]
+    TooManyPatches { faces: usize, max: usize },
     /// The mesh or a refinement step failed (names the face, edge or vertex at fault).
     #[error(transparent)]
     Topology(#[from] TopologyError),

@@ -44,6 +44,60 @@ impl Locals {
 /// `caps_from`: the first level whose irregular faces become end caps (the isolation level;
 /// 0 for single-pass plans). `acc`: irregular faces in ACC-1's scope get ACC-1's Bézier net
 /// instead of Gregory points (see [`super::single_pass`]).
+/// Bound on the Gregory points' projected stencil terms (~0.8 GB as the plan's table, more
+/// while drafted and uploaded): the 1M-triangle grid under Catmull-Clark projects 5.7e8.
+pub const MAX_LOCAL_TERMS: u64 = 1 << 26;
+
+/// Projects the Gregory points' terms before any is built: per end-cap face, five points per
+/// corner, each about the corner's one-ring (`2·valence + 1` vertices). The estimate came within
+/// 10 % of the built count on the meshes measured (docs/benchmarks.md, Scale).
+pub(super) fn check_gregory_size(
+    mesh: &ControlMesh,
+    levels: &[Lvl],
+    iso: usize,
+    bound: u64,
+) -> Result<(), TopologyError> {
+    let (patches, estimate) = project_gregory_terms(levels, iso);
+    if estimate > bound {
+        return Err(TopologyError::GregoryTooLarge {
+            faces: mesh.num_faces(),
+            patches,
+            estimate,
+            bound,
+        });
+    }
+    Ok(())
+}
+
+/// Gregory end caps from level `iso` on and their projected point-stencil terms.
+pub(super) fn project_gregory_terms(levels: &[Lvl], iso: usize) -> (u64, u64) {
+    let (mut patches, mut estimate) = (0u64, 0u64);
+    for lvl in levels.iter().skip(iso) {
+        let t = lvl.t();
+        let (p, e) = (0..t.num_faces())
+            .into_par_iter()
+            .with_min_len(4096)
+            .filter(|&f| lvl.complete[f] && !lvl.hole[f] && !lvl.selected[f])
+            .filter(|&f| {
+                t.face_vertices(f)
+                    .iter()
+                    .any(|&v| lvl.irregular[v as usize])
+            })
+            .map(|f| {
+                let terms: u64 = t
+                    .face_vertices(f)
+                    .iter()
+                    .map(|&v| 5 * (2 * t.vertex_edges(v as usize).len() as u64 + 1))
+                    .sum();
+                (1u64, terms)
+            })
+            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        patches += p;
+        estimate += e;
+    }
+    (patches, estimate)
+}
+
 pub(super) fn assemble(
     mesh: &ControlMesh,
     opts: &AdaptiveOptions,
@@ -62,6 +116,10 @@ pub(super) fn assemble(
             ..StencilTable::default()
         },
     };
+
+    if opts.end_cap == EndCap::Gregory {
+        check_gregory_size(mesh, &levels, iso, MAX_LOCAL_TERMS)?;
+    }
 
     // Patches, level by level (faces in parallel).
     let mut drafts: Vec<Draft> = Vec::new();
@@ -596,4 +654,108 @@ pub(super) fn acc_points(
         let (bi, bj) = SLOTS[corner][j.min(3)];
         &net[bi][bj]
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An `n`×`n` grid of quads, each split into two triangles: under Catmull-Clark every face
+    /// is an end cap's parent (three level-1 quads around an extraordinary vertex).
+    fn triangle_grid(n: u32) -> ControlMesh {
+        let mut p = Vec::new();
+        for y in 0..=n {
+            for x in 0..=n {
+                p.push([x as f64, y as f64, ((x * 7 + y * 3) % 5) as f64 * 0.1]);
+            }
+        }
+        let id = |x: u32, y: u32| y * (n + 1) + x;
+        let mut faces = Vec::new();
+        for y in 0..n {
+            for x in 0..n {
+                faces.push(vec![id(x, y), id(x + 1, y), id(x + 1, y + 1)]);
+                faces.push(vec![id(x, y), id(x + 1, y + 1), id(x, y + 1)]);
+            }
+        }
+        ControlMesh::from_polygons(p, &faces)
+    }
+
+    /// Terms of the rows of every Gregory patch's 20 points as built.
+    fn built_gregory_terms(plan: &AdaptivePlan) -> (u64, u64) {
+        let first = plan.local_points.first_vertex;
+        let mut terms = 0u64;
+        let mut patches = 0u64;
+        for p in plan.patches.iter().filter(|p| p.kind == PatchKind::Gregory) {
+            patches += 1;
+            for &id in &p.control_points {
+                terms += if id >= first {
+                    plan.local_points
+                        .table
+                        .stencil((id - first) as usize)
+                        .0
+                        .len() as u64
+                } else {
+                    1
+                };
+            }
+        }
+        (patches, terms)
+    }
+
+    /// The projection counts the patches the plan builds and is within 2× of their terms, so
+    /// the bound refuses what would be too large and not what fits.
+    #[test]
+    fn gregory_projection_tracks_the_built_terms() {
+        let quads_and_triangles = {
+            let mut m = triangle_grid(3);
+            // A quad region next to the triangles: mixed valences 3 to 8.
+            let base = m.positions.len() as u32;
+            m.positions
+                .extend([[0., -1., 0.], [1., -1., 0.2], [2., -1., 0.]]);
+            let mut faces: Vec<Vec<u32>> = (0..m.num_faces()).map(|f| m.face(f).to_vec()).collect();
+            faces.push(vec![base, base + 1, 1, 0]);
+            faces.push(vec![base + 1, base + 2, 2, 1]);
+            ControlMesh::from_polygons(m.positions.clone(), &faces)
+        };
+        for (name, mesh) in [
+            ("triangle grid", triangle_grid(6)),
+            ("quads and triangles", quads_and_triangles),
+        ] {
+            let levels =
+                levels::build_levels(&mesh, 1, false, MAX_REFINED_FACES, true).expect("levels");
+            let (patches, estimate) = project_gregory_terms(&levels, 0);
+            let plan = single_pass::plan_single_pass(&mesh, &Default::default()).expect("plan");
+            let (built_patches, built) = built_gregory_terms(&plan);
+            assert_eq!(patches, built_patches, "{name}");
+            let ratio = estimate as f64 / built as f64;
+            eprintln!(
+                "{name}: {patches} Gregory patches, projected {estimate} terms, built {built}"
+            );
+            assert!(
+                (0.5..=2.0).contains(&ratio),
+                "{name}: {estimate} vs {built}"
+            );
+        }
+    }
+
+    #[test]
+    fn gregory_past_the_bound_is_a_named_error() {
+        let mesh = triangle_grid(4);
+        let levels =
+            levels::build_levels(&mesh, 1, false, MAX_REFINED_FACES, true).expect("levels");
+        let err = check_gregory_size(&mesh, &levels, 0, 1000).expect_err("over the bound");
+        match err {
+            TopologyError::GregoryTooLarge {
+                faces,
+                patches,
+                estimate,
+                bound,
+            } => {
+                assert_eq!((faces, patches, bound), (32, 96, 1000));
+                assert!(estimate > bound);
+            }
+            e => panic!("unexpected {e}"),
+        }
+        assert!(check_gregory_size(&mesh, &levels, 0, MAX_LOCAL_TERMS).is_ok());
+    }
 }

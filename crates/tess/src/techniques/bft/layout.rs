@@ -29,7 +29,7 @@ use crate::gpu::bindings::{
 };
 use bytemuck::{Pod, Zeroable};
 use std::mem::{offset_of, size_of};
-use topology::bft::{BasisTables, BftCase, BftKey, LoopBft, PatchRecords, TangentStencils};
+use topology::bft::{BasisTables, BftCase, BftKey, LoopBft, Owner, PatchRecords, TangentStencils};
 use topology::stencil::StencilTable;
 
 /// `BasePosition` of `bft.glsl`: one base vertex (binding [`BFT_BASE_POSITIONS_BINDING`]),
@@ -372,7 +372,7 @@ pub fn pack_patches(
         let (entry, mirrored) = tables
             .lookup(r.key)
             .ok_or(LayoutError::NoTable { face, key: r.key })?;
-        let owners = |o: &[(u32, u8); 3]| o.map(|(f, k)| pack_owner(f, k));
+        let owners = |o: &[Owner; 3]| o.map(|o| pack_owner(o.face(), o.local()));
         patches.push(PatchHeader {
             ring_offset: r.ring_offset,
             ring_size: r.ring_size,
