@@ -263,6 +263,14 @@ fn grid(nx: u32, ny: u32, triangles: bool) -> ControlMesh {
     ControlMesh::from_polygons(pos, &faces)
 }
 
+/// The topology error a build failed with, if it failed on the mesh.
+fn topology_error(e: &tessera::tess::TessError) -> Option<&tessera::topology::TopologyError> {
+    let tessera::tess::TessError::Mesh { source, .. } = e else {
+        panic!("not a mesh error: {e}")
+    };
+    source.downcast_ref::<tessera::topology::TopologyError>()
+}
+
 /// Flat, Phong, PN and BFT draw the 1,001,112-triangle grid validation-clean at a
 /// small viewport (BFT's tangent terms, patch headers and rings exceed lavapipe's 128 MiB
 /// storage range: the windowed path), and adaptive the 1M-quad grid (its stencil terms, 264 MB,
@@ -383,12 +391,9 @@ fn one_million_faces_through_every_technique() {
             "adaptive on triangles: refused in {:.1} s: {e}",
             t.elapsed().as_secs_f64()
         );
-        let tessera::tess::TessError::Mesh { source, .. } = &e else {
-            panic!("not a mesh error: {e}")
-        };
         assert!(
             matches!(
-                source.downcast_ref::<tessera::topology::TopologyError>(),
+                topology_error(&e),
                 Some(tessera::topology::TopologyError::AdaptiveTooLarge {
                     faces: 1_001_112,
                     isolation: 4,
@@ -428,12 +433,9 @@ fn one_million_faces_through_every_technique() {
                 "{id} on triangles: refused in {:.1} s: {e}",
                 t.elapsed().as_secs_f64()
             );
-            let tessera::tess::TessError::Mesh { source, .. } = &e else {
-                panic!("not a mesh error: {e}")
-            };
             assert!(
                 matches!(
-                    source.downcast_ref::<tessera::topology::TopologyError>(),
+                    topology_error(&e),
                     Some(tessera::topology::TopologyError::GregoryTooLarge {
                         faces: 1_001_112,
                         patches: 3_003_336,
