@@ -110,7 +110,8 @@ fn captured_vertices_against_the_exact_limit() {
         ] {
             let mesh = shape(name);
             for patch in PATCHES {
-                let surf = gregory::build(&mut ctx, &mesh, patch, 1.0, name).expect("build");
+                let surf = gregory::build(&mut ctx, &mesh, patch, 1.0, name, &Default::default())
+                    .expect("build");
                 let (soup, _) = capturer
                     .capture(&mut ctx, &surf, &FrameParams::uniform(4.0), EXTENT)
                     .expect("capture");
@@ -152,7 +153,9 @@ fn watertight_under_every_factor_policy() {
         ] {
             let mesh = shape(name);
             for patch in PATCHES {
-                let surf = gregory::build(&mut ctx, &mesh, patch, 1.0, name).expect("build");
+                let surf = gregory::build(&mut ctx, &mesh, patch, 1.0, name, &Default::default())
+                    .expect("build");
+                let mut maps_surface = None;
                 let d = diag(&mesh) as f32;
                 let policies = [
                     ("uniform 3", FactorPolicy::Uniform { segments: 3.0 }, false),
@@ -175,8 +178,34 @@ fn watertight_under_every_factor_policy() {
                         true,
                     ),
                 ];
-                for (label, factors, fractional) in policies {
+                // Without and with displacement (procedural heights; spot also with its
+                // height map and texture seams): boundary vertices move by their curve's owner.
+                let displaced = [(0.0, false), (0.03 * d, false), (0.03 * d, true)];
+                for ((label, factors, fractional), (displace, height_map)) in policies
+                    .iter()
+                    .flat_map(|p| displaced.iter().map(move |d| (*p, *d)))
+                {
+                    if height_map && name != "spot" {
+                        continue;
+                    }
+                    let surf = if height_map {
+                        maps_surface.get_or_insert_with(|| {
+                            let maps = tessera::tess::surface::SurfaceMaps {
+                                texture: None,
+                                height: Some(std::sync::Arc::new(
+                                    tessera::tess::surface::load_height(common::data(
+                                        "assets/spot_height.png",
+                                    ))
+                                    .expect("height map"),
+                                )),
+                            };
+                            gregory::build(&mut ctx, &mesh, patch, 1.0, name, &maps).expect("build")
+                        })
+                    } else {
+                        &surf
+                    };
                     let params = FrameParams {
+                        displace,
                         factors,
                         spacing: if fractional {
                             Spacing::FractionalEven
@@ -187,15 +216,18 @@ fn watertight_under_every_factor_policy() {
                         ..FrameParams::default()
                     };
                     let (soup, _) = capturer
-                        .capture(&mut ctx, &surf, &params, EXTENT)
+                        .capture(&mut ctx, surf, &params, EXTENT)
                         .expect("capture");
-                    let (cracks, nonmanifold) = cracks(&surf, &soup, &mesh);
+                    let (cracks, nonmanifold) = cracks(surf, &soup, &mesh);
                     println!(
-                        "{name} {patch:?} {label}: {} triangles, {cracks} cracks",
+                        "{name} {patch:?} {label} displace {displace} (height map {height_map}): {} triangles, {cracks} cracks",
                         soup.triangle_count()
                     );
-                    assert_eq!(cracks, 0, "{name} {patch:?} {label}");
-                    assert_eq!(nonmanifold, 0, "{name} {patch:?} {label}");
+                    assert_eq!(cracks, 0, "{name} {patch:?} {label} displace {displace}");
+                    assert_eq!(
+                        nonmanifold, 0,
+                        "{name} {patch:?} {label} displace {displace}"
+                    );
                 }
             }
         }
@@ -210,9 +242,16 @@ fn bad_input_gives_named_errors() {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let mesh = shape("catmark_cube");
         for scale in [f32::NAN, -1.0] {
-            let e = gregory::build(&mut ctx, &mesh, SinglePassPatch::Gregory, scale, "cube")
-                .err()
-                .expect("refused");
+            let e = gregory::build(
+                &mut ctx,
+                &mesh,
+                SinglePassPatch::Gregory,
+                scale,
+                "cube",
+                &Default::default(),
+            )
+            .err()
+            .expect("refused");
             assert!(e.to_string().contains("sharpness"), "{e}");
         }
         let fan = ControlMesh::from_polygons(
@@ -228,9 +267,24 @@ fn bad_input_gives_named_errors() {
             ],
             &[vec![0u32, 1, 3, 2], vec![1, 0, 4, 5], vec![0, 1, 7, 6]],
         );
-        assert!(gregory::build(&mut ctx, &fan, SinglePassPatch::Acc1, 1.0, "fan").is_err());
-        let ok =
-            gregory::build(&mut ctx, &mesh, SinglePassPatch::Gregory, 1.0, "cube").expect("cube");
+        assert!(gregory::build(
+            &mut ctx,
+            &fan,
+            SinglePassPatch::Acc1,
+            1.0,
+            "fan",
+            &Default::default()
+        )
+        .is_err());
+        let ok = gregory::build(
+            &mut ctx,
+            &mesh,
+            SinglePassPatch::Gregory,
+            1.0,
+            "cube",
+            &Default::default(),
+        )
+        .expect("cube");
         for bad in [
             FrameParams::uniform(0.0),
             FrameParams::uniform(2.5),

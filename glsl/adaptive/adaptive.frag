@@ -7,7 +7,10 @@
 layout(location = 0) in vec3 in_world;
 layout(location = 1) in vec3 in_normal;
 layout(location = 5) flat in vec3 in_albedo;
+layout(location = 6) in vec2 in_texcoord;
 layout(location = 0) out vec4 out_color;
 void main() {
-    out_color = adaptive.mode == DRAW_MODE_WIREFRAME ? vec4(frame.wire_color.rgb, 1.0) : shade(in_world, in_normal, in_albedo);
+    vec3 albedo = in_albedo;
+    if ((adaptive.options & uint(ADAPTIVE_OPTION_TEXTURE)) != 0u) albedo = texture(surface_texture, in_texcoord).rgb;
+    out_color = adaptive.mode == DRAW_MODE_WIREFRAME ? vec4(frame.wire_color.rgb, 1.0) : shade(in_world, in_normal, albedo);
 }

@@ -36,6 +36,31 @@ layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_PATCHES_BINDING) readonly 
 layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_CONTROL_POINTS_BINDING) readonly buffer ControlPoints { uint control_points[]; };
 layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_CURVES_BINDING) readonly buffer Curves { uvec4 curves[]; };
 
+// Texture coordinates (topology::texcoord): per patch, the coordinates at its corners and each
+// corner's row of the reparameterization table; per curve, the patch that defines its normals
+// and coordinates for both sides (seamless displacement).
+struct PatchSurface {
+    vec2 uv[4];         // corners (0,0), (1,0), (1,1), (0,1)
+    uint reparam_rows;  // 8 bits per corner: row of reparam_rows[] (0 = identity)
+    uint pad0;
+    uint pad1;
+    uint pad2;
+};
+struct CurveOwner {
+    uint patch_id;      // frame-wide patch id
+    uint info;          // edge | part << 2 | forward << 4
+};
+struct ReparamRow {
+    vec4 a;             // c0, c1, c2, c3
+    vec4 b;             // c4
+};
+layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_SURFACES_BINDING) readonly buffer Surfaces { PatchSurface surfaces[]; };
+layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_REPARAM_BINDING) readonly buffer Reparam { ReparamRow reparam_table[]; };
+layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_CURVE_OWNERS_BINDING) readonly buffer CurveOwners { CurveOwner curve_owners[]; };
+layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_CORNER_OWNERS_BINDING) readonly buffer CornerOwners { uvec2 corner_owners[]; };
+layout(set = ADAPTIVE_SET, binding = ADAPTIVE_TEXTURE_BINDING) uniform sampler2D surface_texture;
+layout(set = ADAPTIVE_SET, binding = ADAPTIVE_HEIGHT_BINDING) uniform sampler2D height_map;
+
 // Push constant of every adaptive pipeline (`tess::gpu::AdaptivePush`).
 layout(push_constant) uniform AdaptivePush {
     uint mode;             // DRAW_MODE_SHADED or DRAW_MODE_WIREFRAME
@@ -51,6 +76,8 @@ layout(push_constant) uniform AdaptivePush {
     uint base_count;       // compute: base vertices (row r writes vertex base_count + r)
     uint row_base;         // compute: the chunk's first stencil_offsets element (window base)
     uint term_base;        // compute: the chunk's first stencil_terms element (window base)
+    float displace_scale;  // displacement along the normal per unit of height
+    uint first_corner;     // global id of the first canonical corner (corner_owners[0])
 } adaptive;
 
 uint patch_kind(AdaptivePatch p) { return p.info & 15u; }
@@ -92,11 +119,13 @@ vec3 edge_point(AdaptivePatch p, uint e, float t) {
 // tessellation level n: integer levels name the vertex k = round(t n) and both sides evaluate
 // k / n on the curve in its own direction; fractional levels mirror t exactly (1 - t is exact
 // for tess coordinates).
-vec3 canonical_edge_point(AdaptivePatch p, uint e, float t, float n, bool integer_level) {
+vec3 canonical_edge_point(AdaptivePatch p, uint e, float t, float n, bool integer_level, out uint curve, out float s) {
     uint kind = edge_kind(p, e);
     if (!integer_level) {
         bool rev = edge_reversed(p, e, 0u);
-        return curve_point(p.curves[2u * e], rev ? 1.0 - t : t);
+        curve = p.curves[2u * e];
+        s = rev ? 1.0 - t : t;
+        return curve_point(curve, s);
     }
     uint k = uint(round(t * n));
     uint segs = uint(round(n));
@@ -106,7 +135,9 @@ vec3 canonical_edge_point(AdaptivePatch p, uint e, float t, float n, bool intege
         if (k > segs) { h = 1u; k -= segs; }
     }
     if (edge_reversed(p, e, h)) k = segs - k;
-    return curve_point(p.curves[2u * e + h], float(k) / float(segs));
+    curve = p.curves[2u * e + h];
+    s = float(k) / float(segs);
+    return curve_point(curve, s);
 }
 
 // The factor one curve asks for under the frame's policy: computed from the curve's own four

@@ -6,6 +6,8 @@
 layout(location = 0) patch in uint tc_patch;
 layout(location = 2) patch in uint tc_info;
 layout(location = 5) flat out vec3 out_albedo;
+layout(location = 6) out vec2 out_texcoord;
+#include "surface.glsl"
 
 // Regular, Gregory, bilinear.
 const vec3 KIND_COLOURS[3] = vec3[3](vec3(0.45, 0.65, 0.95), vec3(0.95, 0.45, 0.35), vec3(0.95, 0.8, 0.3));
@@ -20,19 +22,38 @@ void main() {
     // Patch edge e and the parameter along it (edges run v0 -> v1 -> v2 -> v3 -> v0);
     // 1 - x is exact for tess coordinates. Corners take either edge: both give the curve's end
     // point, the same global vertex.
+    uint curve = 0u;
+    float s = 0.0;
     if (uv.y == 0.0) {
-        pos = canonical_edge_point(p, 0u, uv.x, gl_TessLevelOuter[1], !fractional_factors() || edge_kind(p, 0u) != ADAPTIVE_EDGE_PLAIN);
+        pos = canonical_edge_point(p, 0u, uv.x, gl_TessLevelOuter[1], !fractional_factors() || edge_kind(p, 0u) != ADAPTIVE_EDGE_PLAIN, curve, s);
     } else if (uv.x == 1.0) {
-        pos = canonical_edge_point(p, 1u, uv.y, gl_TessLevelOuter[2], !fractional_factors() || edge_kind(p, 1u) != ADAPTIVE_EDGE_PLAIN);
+        pos = canonical_edge_point(p, 1u, uv.y, gl_TessLevelOuter[2], !fractional_factors() || edge_kind(p, 1u) != ADAPTIVE_EDGE_PLAIN, curve, s);
     } else if (uv.y == 1.0) {
-        pos = canonical_edge_point(p, 2u, 1.0 - uv.x, gl_TessLevelOuter[3], !fractional_factors() || edge_kind(p, 2u) != ADAPTIVE_EDGE_PLAIN);
+        pos = canonical_edge_point(p, 2u, 1.0 - uv.x, gl_TessLevelOuter[3], !fractional_factors() || edge_kind(p, 2u) != ADAPTIVE_EDGE_PLAIN, curve, s);
     } else if (uv.x == 0.0) {
-        pos = canonical_edge_point(p, 3u, 1.0 - uv.y, gl_TessLevelOuter[0], !fractional_factors() || edge_kind(p, 3u) != ADAPTIVE_EDGE_PLAIN);
+        pos = canonical_edge_point(p, 3u, 1.0 - uv.y, gl_TessLevelOuter[0], !fractional_factors() || edge_kind(p, 3u) != ADAPTIVE_EDGE_PLAIN, curve, s);
     }
     vec3 n = safe_normalize(cross(du, dv), vec3(0.0, 0.0, 1.0));
+    vec2 tex = patch_texcoord(tc_patch, uv);
+    out_texcoord = tex;
+    if ((adaptive.options & uint(ADAPTIVE_OPTION_DISPLACE)) != 0u) {
+        // Interior points by their own patch; boundary points by their curve's owner, so both
+        // sides of every edge move them identically.
+        if (canonical) {
+            pos = displace_canonical(pos, curve, s);
+        } else {
+            pos += n * (adaptive.displace_scale * surface_height(tex));
+        }
+    }
     uint kind = tc_info & 15u, level = (tc_info >> 4) & 15u;
     vec3 albedo = frame.base_color.rgb;
-    if ((adaptive.options & uint(ADAPTIVE_OPTION_PATCH_COLOURS)) != 0u) {
+    if ((adaptive.options & uint(ADAPTIVE_OPTION_SHOW_PARAM_SHIFT)) != 0u) {
+        // How far the reparameterization moves the texture parameter, in patch units: 0 blue,
+        // 0.05 and beyond red.
+        vec2 st = reparameterize(surfaces[tc_patch].reparam_rows, uv);
+        float shift = clamp(length(st - uv) / 0.05, 0.0, 1.0);
+        albedo = mix(vec3(0.2, 0.35, 0.9), vec3(0.95, 0.25, 0.15), shift);
+    } else if ((adaptive.options & uint(ADAPTIVE_OPTION_PATCH_COLOURS)) != 0u) {
         // Odd levels lighter, even levels darker, a little lighter with depth: adjacent
         // levels always differ.
         albedo = KIND_COLOURS[min(kind, 2u)] * ((level & 1u) == 1u ? 1.0 : 0.62);

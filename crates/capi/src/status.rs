@@ -184,7 +184,7 @@ pub(crate) fn tess_status(e: &TessError) -> TesseraStatus {
         E::CaptureTooLarge { .. } | E::CaptureOverflow { .. } | E::PartialTriangle { .. } => {
             TesseraStatus::Capture
         }
-        E::Io { .. } => TesseraStatus::Io,
+        E::Io { .. } | E::Image { .. } => TesseraStatus::Io,
     }
 }
 

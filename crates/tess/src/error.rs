@@ -17,6 +17,9 @@ pub enum TessError {
         name: String,
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+    /// An image (texture or height map) that could not be read.
+    #[error("{file}: {message}")]
+    Image { file: String, message: String },
     /// An option's value outside what it accepts.
     #[error("{option} {value}: expected {range}")]
     OutOfRange {

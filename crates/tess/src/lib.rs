@@ -14,6 +14,7 @@ pub mod gpu;
 pub mod plain;
 pub mod render_mesh;
 pub mod shaders;
+pub mod surface;
 pub mod technique;
 pub mod techniques;
 pub mod tessellator;

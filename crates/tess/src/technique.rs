@@ -195,6 +195,12 @@ pub struct FrameParams {
     pub geometric_normals: bool,
     /// Colour patches by type.
     pub patch_colours: bool,
+    /// Texture coordinates at the reparameterized parameter on Gregory patches (seed 003).
+    pub reparam: bool,
+    /// Displacement along the normal per unit of height (0: none).
+    pub displace: f32,
+    /// Colour by how far the reparameterization moves the texture parameter.
+    pub show_param_shift: bool,
     pub split: DrawSplit,
     pub base_color: [f32; 3],
     pub clear_color: [f32; 4],
@@ -210,6 +216,9 @@ impl Default for FrameParams {
             phong_alpha: 0.75,
             geometric_normals: false,
             patch_colours: false,
+            reparam: true,
+            displace: 0.0,
+            show_param_shift: false,
             split: DrawSplit::Auto,
             base_color: [0.85, 0.72, 0.55],
             clear_color: [0.12, 0.13, 0.16, 1.0],
@@ -254,6 +263,8 @@ pub struct Features {
     pub triangles_only: bool,
     /// Feature-adaptive refinement: isolation level, end-cap type, sharpness scale.
     pub isolation: bool,
+    /// Texture coordinates: colour texture, reparameterization, displacement.
+    pub surface: bool,
 }
 
 impl Features {

@@ -180,6 +180,35 @@ pub struct PatchEdge {
     pub reversed: [bool; 2],
 }
 
+/// The patch that owns a canonical curve: the curve is `part` (0 whole, 1 first half, 2 second
+/// half, in the patch's edge direction) of its edge `edge`, running with the edge's direction
+/// from point 0 to point 3 when `forward`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct CurveOwner {
+    pub patch: u32,
+    pub edge: u8,
+    pub part: u8,
+    pub forward: bool,
+}
+
+impl CurveOwner {
+    /// The owner's patch parameter at curve parameter `s`.
+    pub fn patch_param(&self, s: f64) -> [f64; 2] {
+        let e = if self.forward { s } else { 1.0 - s };
+        let t = match self.part {
+            1 => 0.5 * e,
+            2 => 0.5 + 0.5 * e,
+            _ => e,
+        };
+        match self.edge {
+            0 => [t, 0.0],
+            1 => [1.0, t],
+            2 => [1.0 - t, 1.0],
+            _ => [0.0, 1.0 - t],
+        }
+    }
+}
+
 /// One patch of the plan.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AdaptivePatch {
@@ -202,6 +231,10 @@ pub struct AdaptivePatch {
     pub transition_mask: u8,
     /// Edge 0: v0→v1 (v = 0), 1: v1→v2 (u = 1), 2: v2→v3 (v = 1), 3: v3→v0 (u = 0).
     pub edges: [PatchEdge; 4],
+    /// Per corner: the valence whose texture-reparameterization block applies
+    /// ([`crate::reparam`]), 0 for the identity (regular and ACC-1 patches, boundary, crease and
+    /// corner vertices). Gregory patches only: the table is fitted to them.
+    pub reparam_valences: [u8; 4],
 }
 
 /// Everything a device needs to draw the feature-adaptive limit surface.
@@ -218,6 +251,15 @@ pub struct AdaptivePlan {
     pub patches: Vec<AdaptivePatch>,
     /// Canonical boundary curves: cubic Bézier control points (global ids).
     pub curves: Vec<[u32; 4]>,
+    /// Per curve: the patch that computed its inner points, whose evaluation along the curve
+    /// defines the curve's normals and texture coordinates for both sides.
+    pub curve_owners: Vec<CurveOwner>,
+    /// Global id of the first canonical corner (the limit point of a patch corner; corners are
+    /// numbered consecutively from here).
+    pub first_corner: u32,
+    /// Per canonical corner: `[patch, corner]` of the patch whose evaluation at that corner
+    /// defines its normal and texture coordinate for every patch around it.
+    pub corner_owners: Vec<[u32; 2]>,
     /// Per level 0..=isolation.
     pub level_stats: Vec<LevelStats>,
     pub isolation: u32,

@@ -15,6 +15,7 @@ pub mod refine;
 pub mod reparam;
 pub mod sdc;
 pub mod stencil;
+pub mod texcoord;
 
 pub use adaptive::{
     plan_adaptive, AdaptiveOptions, AdaptivePatch, AdaptivePlan, EdgeKind, EndCap, LevelStats,

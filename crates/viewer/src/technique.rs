@@ -126,6 +126,24 @@ pub struct SurfaceArgs {
     /// Time T of the --animate wave (base vertices moved along their normals), in seconds.
     #[arg(long, allow_hyphen_values = true)]
     pub frame: Option<f32>,
+    /// Colour texture (PNG) shown at the mesh's `vt` coordinates (adaptive, gregory, acc).
+    #[arg(long, value_name = "PNG")]
+    pub texture: Option<std::path::PathBuf>,
+    /// Displace along the normal by S times the height (the --height map's, else a procedural
+    /// bump pattern), seamlessly: shared edges stay bit-identical.
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    pub displace: Option<f32>,
+    /// Height map (PNG, luminance in [0, 1]) for --displace.
+    #[arg(long, value_name = "PNG")]
+    pub height: Option<std::path::PathBuf>,
+    /// Texture coordinates at the Gregory patches' own parameter instead of the rational
+    /// reparameterization of Schäfer et al. (seed 003, Eq. 3).
+    #[arg(long)]
+    pub no_reparam: bool,
+    /// What to colour the surface by: `param-shift` shows how far the reparameterization moves
+    /// the texture parameter (blue 0, red 0.05 of a patch and beyond).
+    #[arg(long, value_name = "VIEW")]
+    pub show: Option<String>,
 }
 
 /// What a command asks of a technique: how to build it, what each frame shows, and the
@@ -234,6 +252,31 @@ impl SurfaceArgs {
                 feature: |f| f.isolation,
             },
             OptionUse {
+                name: "--texture",
+                given: self.texture.is_some(),
+                feature: |f| f.surface,
+            },
+            OptionUse {
+                name: "--displace",
+                given: self.displace.is_some(),
+                feature: |f| f.surface,
+            },
+            OptionUse {
+                name: "--height",
+                given: self.height.is_some(),
+                feature: |f| f.surface,
+            },
+            OptionUse {
+                name: "--no-reparam",
+                given: self.no_reparam,
+                feature: |f| f.surface,
+            },
+            OptionUse {
+                name: "--show",
+                given: self.show.is_some(),
+                feature: |f| f.surface,
+            },
+            OptionUse {
                 name: "--table-level",
                 given: self.table_level != DEFAULT_TABLE_LEVEL,
                 feature: |f| f.table_level,
@@ -284,6 +327,31 @@ impl SurfaceArgs {
         if f.table_level && !(1..=6).contains(&self.table_level) {
             bail!("--table-level {} is outside 1..6", self.table_level);
         }
+        if let Some(s) = self.displace {
+            if !(s.is_finite() && s.abs() <= 1e3) {
+                bail!("--displace {s}: give a finite scale (at most 1000 in magnitude)");
+            }
+        }
+        if self.height.is_some() && self.displace.is_none() {
+            bail!("--height needs --displace S (the scale of the height)");
+        }
+        params.show_param_shift = match self.show.as_deref() {
+            None => false,
+            Some("param-shift") => true,
+            Some(other) => bail!("--show {other}: expected param-shift"),
+        };
+        params.reparam = !self.no_reparam;
+        params.displace = self.displace.unwrap_or(0.0);
+        let maps = tess::surface::SurfaceMaps {
+            texture: match &self.texture {
+                Some(p) => Some(std::sync::Arc::new(tess::surface::load_texture(p)?)),
+                None => None,
+            },
+            height: match &self.height {
+                Some(p) => Some(std::sync::Arc::new(tess::surface::load_height(p)?)),
+                None => None,
+            },
+        };
         params.spacing = spacing;
         params.geometric_normals = self.geometric_normals;
         params.patch_colours = self.patch_colours;
@@ -322,6 +390,7 @@ impl SurfaceArgs {
                 end_cap: self.end_cap,
                 sharpness_scale: self.sharpness_scale,
                 follow_semi_sharp: !self.creases_at_isolation,
+                maps,
             },
             params,
             distance_diagonals: (self.adaptive == Some(Adaptive::Distance))

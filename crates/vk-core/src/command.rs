@@ -155,6 +155,10 @@ impl DeviceShared {
                     self.raw.destroy_pipeline_layout(layout, None);
                     self.destroyed(2);
                 }
+                Retired::Sampler(s) => {
+                    self.raw.destroy_sampler(s, None);
+                    self.destroyed(1);
+                }
                 Retired::DescriptorPool(p) => {
                     self.raw.destroy_descriptor_pool(p, None);
                     self.destroyed(1);

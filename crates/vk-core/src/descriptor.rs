@@ -1,10 +1,10 @@
 //! Descriptor-set layouts, pools, and typed descriptor sets.
 //!
 //! Design decisions:
-//! - A [`DescriptorSet`] is owned and typed: it keeps its pool, its layout and every buffer
-//!   written into it alive (Vulkan forbids destroying any of them while the set may be used, and
-//!   updating a set whose layout is gone), and is freed with its pool once the last set and the
-//!   pool handle are dropped.
+//! - A [`DescriptorSet`] is owned and typed: it keeps its pool, its layout and every buffer and
+//!   texture written into it alive (Vulkan forbids destroying any of them while the set may be
+//!   used, and updating a set whose layout is gone), and is freed with its pool once the last set
+//!   and the pool handle are dropped.
 //! - [`DescriptorSet::write_buffer_range`] (and [`DescriptorSet::write_buffer`], the whole
 //!   buffer) checks what Vulkan would otherwise leave to the caller: the binding exists with that
 //!   type, the buffer has the matching usage, the range lies inside the buffer at an aligned
@@ -13,13 +13,16 @@
 //!   recording that was not submitted: refused; used by submissions still pending: waited for).
 //!   A range beyond the limit is a typed error, never a silent overrun: callers with larger
 //!   buffers bind windows of them (`tess`'s techniques split their draws so).
+//! - [`DescriptorSet::write_texture`] writes a combined image sampler (the texture's view and
+//!   sampler, in its resting layout SHADER_READ_ONLY_OPTIMAL) under the same in-use rules.
 use crate::buffer::{Buffer, BufferShared};
 use crate::device::{Device, DeviceShared};
 use crate::error::{DescriptorError, Result, VkContext, VkError};
 use crate::retire::Retired;
+use crate::texture::{Texture, TextureShared};
 use ash::vk;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, MutexGuard};
 
 /// One binding of a set: (binding index, type, stages).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -169,13 +172,21 @@ impl DescriptorPool {
     }
 }
 
+/// What a binding points at, held only so the set keeps it alive.
+#[derive(Clone)]
+#[expect(dead_code, reason = "the handles are held for their Drop, never read")]
+enum Written {
+    Buffer(Arc<BufferShared>),
+    Texture(Arc<TextureShared>),
+}
+
 /// A descriptor set from a [`DescriptorPool`]: owned, typed by its layout's bindings.
 pub struct DescriptorSet {
     pub(crate) raw: vk::DescriptorSet,
     name: String,
     bindings: Vec<BindingDesc>,
-    /// The buffer written into each binding (in `bindings` order), kept alive by the set.
-    written: Mutex<Vec<Option<Arc<BufferShared>>>>,
+    /// What was written into each binding (in `bindings` order), kept alive by the set.
+    written: Mutex<Vec<Option<Written>>>,
     /// Unsubmitted recordings that bound the set (each bind counts once).
     recordings: AtomicU32,
     /// The newest submission that used the set.
@@ -307,15 +318,7 @@ impl DescriptorSet {
                 max: max as u64,
             }));
         }
-        let mut written = self.written.lock().map_err(|_| VkError::LockPoisoned {
-            what: "descriptor set",
-        })?;
-        // Checked under the lock: the encoder counts itself in before recording the bind, and a
-        // set already counted in is never updated (that would invalidate the recording).
-        if self.recordings.load(Ordering::SeqCst) > 0 {
-            return Err(fail(DescriptorError::InUse));
-        }
-        device.wait_serial(self.last_use.load(Ordering::SeqCst))?;
+        let mut written = self.lock_for_update(binding)?;
         let info = [vk::DescriptorBufferInfo::default()
             .buffer(buffer.raw)
             .offset(offset)
@@ -326,11 +329,76 @@ impl DescriptorSet {
             .descriptor_type(ty)
             .buffer_info(&info);
         // SAFETY: the binding exists with this type; the buffer has the usage; the range lies
-        // inside it at an aligned offset and fits the device's limit; the set's layout is alive (held); no recording holds the set and
-        // every submission that used it completed (waited above); updates of this set are
-        // serialized by `written`'s lock. The buffer is kept alive below for as long as the set.
+        // inside it at an aligned offset and fits the device's limit; the set's layout is alive
+        // (held); no recording holds the set and every submission that used it completed
+        // (lock_for_update); updates of this set are serialized by `written`'s lock. The buffer
+        // is kept alive below for as long as the set.
         unsafe { device.raw.update_descriptor_sets(&[write], &[]) };
-        written[slot] = Some(buffer.shared.clone());
+        written[slot] = Some(Written::Buffer(buffer.shared.clone()));
         Ok(())
+    }
+
+    /// Points `binding` (a COMBINED_IMAGE_SAMPLER) at `texture`'s view and sampler; the set then
+    /// keeps the texture alive. Typed errors: no such binding or another type. Refused while the
+    /// set is bound in an unsubmitted recording; waits for submissions that used it.
+    pub fn write_texture(&self, binding: u32, texture: &Texture) -> Result<()> {
+        const TY: vk::DescriptorType = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
+        let fail = |problem| VkError::Descriptor {
+            set: self.name.clone(),
+            binding,
+            problem,
+        };
+        let slot = self
+            .bindings
+            .iter()
+            .position(|b| b.binding == binding)
+            .ok_or_else(|| fail(DescriptorError::NoSuchBinding))?;
+        let layout_ty = self.bindings[slot].ty;
+        if layout_ty != TY {
+            return Err(fail(DescriptorError::Type {
+                layout: layout_ty,
+                given: TY,
+            }));
+        }
+        let mut written = self.lock_for_update(binding)?;
+        let shared = &texture.shared;
+        let info = [vk::DescriptorImageInfo::default()
+            .sampler(shared.sampler)
+            .image_view(shared.image.view)
+            .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)];
+        let write = vk::WriteDescriptorSet::default()
+            .dst_set(self.raw)
+            .dst_binding(binding)
+            .descriptor_type(TY)
+            .image_info(&info);
+        // SAFETY: the binding exists with this type; the view (of a SAMPLED image) and sampler
+        // are live objects of this device and the image rests in SHADER_READ_ONLY_OPTIMAL
+        // (crate::texture); the set's layout is alive (held); no recording holds the set and
+        // every submission that used it completed (lock_for_update); updates of this set are
+        // serialized by `written`'s lock. The texture is kept alive below for as long as the set.
+        unsafe { self.pool.device.raw.update_descriptor_sets(&[write], &[]) };
+        written[slot] = Some(Written::Texture(shared.clone()));
+        Ok(())
+    }
+
+    /// Locks the written references for an update of `binding`: refused while a recording holds
+    /// the set, after waiting for the submissions that used it.
+    fn lock_for_update(&self, binding: u32) -> Result<MutexGuard<'_, Vec<Option<Written>>>> {
+        let written = self.written.lock().map_err(|_| VkError::LockPoisoned {
+            what: "descriptor set",
+        })?;
+        // Checked under the lock: the encoder counts itself in before recording the bind, and a
+        // set already counted in is never updated (that would invalidate the recording).
+        if self.recordings.load(Ordering::SeqCst) > 0 {
+            return Err(VkError::Descriptor {
+                set: self.name.clone(),
+                binding,
+                problem: DescriptorError::InUse,
+            });
+        }
+        self.pool
+            .device
+            .wait_serial(self.last_use.load(Ordering::SeqCst))?;
+        Ok(written)
     }
 }

@@ -72,6 +72,8 @@ pub struct Capabilities {
     pub max_compute_work_group_count: [u32; 3],
     /// Timeline semaphores (core in Vulkan 1.2): how vk-core counts submissions.
     pub timeline_semaphore: bool,
+    /// Largest width or height of a 2D image, in texels: what textures are checked against.
+    pub max_image_dimension_2d: u32,
 }
 
 /// One physical device as seen at start-up: identity, capabilities, and what it lacks.
@@ -251,6 +253,7 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
                 .max(1),
             max_compute_work_group_count: props.limits.max_compute_work_group_count,
             timeline_semaphore: f12.timeline_semaphore == vk::TRUE,
+            max_image_dimension_2d: props.limits.max_image_dimension2_d,
         };
         let mut missing = Vec::new();
         if props.api_version < vk::API_VERSION_1_3 {

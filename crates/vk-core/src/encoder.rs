@@ -9,7 +9,8 @@
 //!    recorded can be dropped before its submission is queued. Dropped afterwards, every vk-core
 //!    object goes through the device's retire queue ([`crate::retire`]), which destroys it (and
 //!    frees its memory) only once every submission handed out before the drop completed.
-//!    Descriptor sets keep the buffers written into them, their layout and their pool alive.
+//!    Descriptor sets keep the buffers and textures written into them, their layout and their
+//!    pool alive.
 //! 2. **One recorder per command buffer.** An encoder owns its command buffer (and, for
 //!    one-shot work, its whole command pool) exclusively and is neither `Send` nor `Sync`, so
 //!    Vulkan's external-synchronization rules for command buffers and pools hold. Exchanging two
@@ -44,6 +45,7 @@ use crate::pipeline::Pipeline;
 use crate::query::QueryPool;
 use crate::retire::Retired;
 use crate::target::{OffscreenTarget, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::texture::Texture;
 use ash::vk;
 use std::marker::PhantomData;
 use std::ops::Range;
@@ -633,6 +635,247 @@ impl<'a> Encoder<'a> {
                 .raw
                 .cmd_copy_buffer(self.cmd, src.raw, dst.raw, &region)
         };
+        Ok(())
+    }
+
+    /// Uploads level 0 of `texture` from the start of `staging` (tightly packed texels), blits
+    /// the rest of its mip chain from it, and leaves every level in SHADER_READ_ONLY_OPTIMAL.
+    /// The previous contents are discarded; earlier work on the queue that samples the texture
+    /// is waited for by the barriers.
+    pub fn upload_texture(&mut self, staging: &'a Buffer, texture: &'a Texture) -> Result<()> {
+        const CMD: &str = "vkCmdCopyBufferToImage";
+        self.outside_rendering(CMD)?;
+        Self::needs_usage(CMD, staging, vk::BufferUsageFlags::TRANSFER_SRC)?;
+        let bytes = texture.byte_len();
+        if staging.size() < bytes {
+            return Err(VkError::recording(
+                CMD,
+                E::BufferTooSmall {
+                    buffer: staging.name().to_owned(),
+                    needed: bytes,
+                    size: staging.size(),
+                },
+            ));
+        }
+        let device = &self.device.raw;
+        let (cmd, image, levels) = (self.cmd, texture.raw_image(), texture.levels());
+        let transfer = vk::PipelineStageFlags::TRANSFER;
+        let write = vk::AccessFlags::TRANSFER_WRITE;
+        let sampled = (
+            vk::PipelineStageFlags::ALL_COMMANDS,
+            vk::AccessFlags::SHADER_READ,
+        );
+        let extent = texture.extent();
+        let region = vk::BufferImageCopy::default()
+            .image_subresource(color_layers(0))
+            .image_extent(vk::Extent3D {
+                width: extent.width,
+                height: extent.height,
+                depth: 1,
+            });
+        // SAFETY: outside a rendering scope; the texture (borrowed for 'a) has TRANSFER_DST
+        // usage, `levels` levels, and TRANSFER_SRC usage with blit and linear-filter format
+        // features whenever levels > 1 (Texture::new); the staging buffer has TRANSFER_SRC
+        // usage and holds level 0 (checked). The first barrier discards the old contents
+        // (UNDEFINED) after every earlier command on the queue; each level is written before
+        // it is read, and all end in SHADER_READ_ONLY_OPTIMAL, the texture's resting layout.
+        unsafe {
+            image_barrier(
+                device,
+                cmd,
+                image,
+                0..levels,
+                (
+                    vk::ImageLayout::UNDEFINED,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                ),
+                (
+                    vk::PipelineStageFlags::ALL_COMMANDS,
+                    vk::AccessFlags::MEMORY_WRITE,
+                ),
+                (transfer, write),
+            );
+            device.cmd_copy_buffer_to_image(
+                cmd,
+                staging.raw,
+                image,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[region],
+            );
+            for level in 1..levels {
+                image_barrier(
+                    device,
+                    cmd,
+                    image,
+                    level - 1..level,
+                    (
+                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    ),
+                    (transfer, write),
+                    (transfer, vk::AccessFlags::TRANSFER_READ),
+                );
+                let corner = |e: vk::Extent2D| vk::Offset3D {
+                    x: e.width as i32,
+                    y: e.height as i32,
+                    z: 1,
+                };
+                let blit = vk::ImageBlit::default()
+                    .src_subresource(color_layers(level - 1))
+                    .src_offsets([
+                        vk::Offset3D::default(),
+                        corner(texture.level_extent(level - 1)),
+                    ])
+                    .dst_subresource(color_layers(level))
+                    .dst_offsets([vk::Offset3D::default(), corner(texture.level_extent(level))]);
+                device.cmd_blit_image(
+                    cmd,
+                    image,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    image,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &[blit],
+                    vk::Filter::LINEAR,
+                );
+            }
+            if levels > 1 {
+                image_barrier(
+                    device,
+                    cmd,
+                    image,
+                    0..levels - 1,
+                    (
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                        vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                    ),
+                    (transfer, write),
+                    sampled,
+                );
+            }
+            image_barrier(
+                device,
+                cmd,
+                image,
+                levels - 1..levels,
+                (
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                ),
+                (transfer, write),
+                sampled,
+            );
+        }
+        Ok(())
+    }
+
+    /// Copies `level` of `texture` (tightly packed) to the start of `buffer`, then makes the
+    /// buffer readable by the host; the level returns to SHADER_READ_ONLY_OPTIMAL. For tests.
+    #[cfg(test)]
+    pub(crate) fn read_texture_level(
+        &mut self,
+        texture: &'a Texture,
+        level: u32,
+        buffer: &'a Buffer,
+    ) -> Result<()> {
+        const CMD: &str = "vkCmdCopyImageToBuffer";
+        self.outside_rendering(CMD)?;
+        Self::needs_usage(CMD, buffer, vk::BufferUsageFlags::TRANSFER_DST)?;
+        let needed = vk::ImageUsageFlags::TRANSFER_SRC;
+        if !texture.usage().contains(needed) {
+            return Err(VkError::recording(
+                CMD,
+                E::TextureUsage {
+                    texture: texture.name().to_owned(),
+                    needed,
+                },
+            ));
+        }
+        if level >= texture.levels() {
+            return Err(VkError::recording(
+                CMD,
+                E::MipLevel {
+                    texture: texture.name().to_owned(),
+                    level,
+                    levels: texture.levels(),
+                },
+            ));
+        }
+        let extent = texture.level_extent(level);
+        let bytes =
+            extent.width as u64 * extent.height as u64 * texture.format().bytes_per_texel() as u64;
+        if buffer.size() < bytes {
+            return Err(VkError::recording(
+                CMD,
+                E::BufferTooSmall {
+                    buffer: buffer.name().to_owned(),
+                    needed: bytes,
+                    size: buffer.size(),
+                },
+            ));
+        }
+        let device = &self.device.raw;
+        let (cmd, image) = (self.cmd, texture.raw_image());
+        let region = vk::BufferImageCopy::default()
+            .image_subresource(color_layers(level))
+            .image_extent(vk::Extent3D {
+                width: extent.width,
+                height: extent.height,
+                depth: 1,
+            });
+        let transfer = vk::PipelineStageFlags::TRANSFER;
+        // SAFETY: outside a rendering scope; the texture (borrowed for 'a) has TRANSFER_SRC
+        // usage and the level, which rests in SHADER_READ_ONLY_OPTIMAL; the buffer has
+        // TRANSFER_DST usage and holds the level (checked).
+        unsafe {
+            image_barrier(
+                device,
+                cmd,
+                image,
+                level..level + 1,
+                (
+                    vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                ),
+                (
+                    vk::PipelineStageFlags::ALL_COMMANDS,
+                    vk::AccessFlags::MEMORY_WRITE,
+                ),
+                (transfer, vk::AccessFlags::TRANSFER_READ),
+            );
+            device.cmd_copy_image_to_buffer(
+                cmd,
+                image,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                buffer.raw,
+                &[region],
+            );
+            image_barrier(
+                device,
+                cmd,
+                image,
+                level..level + 1,
+                (
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                ),
+                (transfer, vk::AccessFlags::empty()),
+                (
+                    vk::PipelineStageFlags::ALL_COMMANDS,
+                    vk::AccessFlags::SHADER_READ,
+                ),
+            );
+            device.cmd_pipeline_barrier(
+                cmd,
+                transfer,
+                vk::PipelineStageFlags::HOST,
+                vk::DependencyFlags::empty(),
+                &[vk::MemoryBarrier::default()
+                    .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+                    .dst_access_mask(vk::AccessFlags::HOST_READ)],
+                &[],
+                &[],
+            );
+        }
         Ok(())
     }
 
@@ -1302,6 +1545,57 @@ impl Drop for Encoder<'_> {
             unsafe { self.device.recycle_once_pool(pool, self.cmd) };
         }
     }
+}
+
+/// The colour aspect of one mip level (layer 0).
+fn color_layers(level: u32) -> vk::ImageSubresourceLayers {
+    vk::ImageSubresourceLayers::default()
+        .aspect_mask(vk::ImageAspectFlags::COLOR)
+        .mip_level(level)
+        .layer_count(1)
+}
+
+/// Records a layout transition of the colour `levels` of `image` with the given scopes.
+///
+/// # Safety
+/// `cmd` is recording outside a rendering scope; `image` is a colour image with those levels,
+/// in layout `layouts.0` (or that is UNDEFINED), alive until the submission completed.
+unsafe fn image_barrier(
+    device: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: vk::Image,
+    levels: Range<u32>,
+    layouts: (vk::ImageLayout, vk::ImageLayout),
+    src: (vk::PipelineStageFlags, vk::AccessFlags),
+    dst: (vk::PipelineStageFlags, vk::AccessFlags),
+) {
+    let barrier = vk::ImageMemoryBarrier::default()
+        .image(image)
+        .old_layout(layouts.0)
+        .new_layout(layouts.1)
+        .src_access_mask(src.1)
+        .dst_access_mask(dst.1)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .subresource_range(
+            vk::ImageSubresourceRange::default()
+                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                .base_mip_level(levels.start)
+                .level_count(levels.end - levels.start)
+                .layer_count(1),
+        );
+    // SAFETY: the caller's contract.
+    unsafe {
+        device.cmd_pipeline_barrier(
+            cmd,
+            src.0,
+            dst.0,
+            vk::DependencyFlags::empty(),
+            &[],
+            &[],
+            &[barrier],
+        )
+    };
 }
 
 /// Transitions colour and depth into attachment layouts (discarding their contents), begins

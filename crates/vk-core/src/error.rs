@@ -148,6 +148,17 @@ pub enum RecordingError {
         needed: u64,
         size: u64,
     },
+    #[error("texture {texture} lacks usage {needed:?}")]
+    TextureUsage {
+        texture: String,
+        needed: vk::ImageUsageFlags,
+    },
+    #[error("mip level {level} is outside texture {texture}'s {levels} levels")]
+    MipLevel {
+        texture: String,
+        level: u32,
+        levels: u32,
+    },
     #[error("no index buffer is bound")]
     NoIndexBuffer,
     #[error("indices {first}..{end} exceed index buffer {buffer} of {count} indices")]

@@ -30,6 +30,11 @@ pub struct Image {
 
 impl Image {
     pub fn new(device: &Device, desc: &ImageDesc<'_>) -> Result<Self> {
+        Self::with_levels(device, desc, 1)
+    }
+
+    /// As [`Image::new`] with `levels` mip levels, all covered by the view (textures).
+    pub(crate) fn with_levels(device: &Device, desc: &ImageDesc<'_>, levels: u32) -> Result<Self> {
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(desc.format)
@@ -38,7 +43,7 @@ impl Image {
                 height: desc.extent.height.max(1),
                 depth: 1,
             })
-            .mip_levels(1)
+            .mip_levels(levels.max(1))
             .array_layers(1)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
@@ -72,7 +77,7 @@ impl Image {
             .image(raw)
             .view_type(vk::ImageViewType::TYPE_2D)
             .format(desc.format)
-            .subresource_range(subresource_range(desc.aspect));
+            .subresource_range(subresource_range(desc.aspect).level_count(levels.max(1)));
         // SAFETY: image is bound to memory.
         let view = match unsafe { device.raw.create_image_view(&view_info, None) }
             .ctx("vkCreateImageView")

@@ -11,6 +11,8 @@
 //!   safe calls, so the window's HUD needs no `unsafe` above vk-core.
 //! - Optional features (VK_EXT_transform_feedback, for captures) are detected and enabled when
 //!   present; what needs them returns [`VkError::Unsupported`] where they are absent.
+//! - Textures ([`texture`]) are sampled 2D images with their own sampler, uploaded and
+//!   mip-mapped when made, and resting in SHADER_READ_ONLY_OPTIMAL between recordings.
 //! - Driver bugs are worked around through [`workarounds`], a documented list keyed by driver.
 //! - Commands are recorded through [`Encoder`], whose module states the `unsafe` contracts once
 //!   and why its safe methods uphold them; crates above vk-core need no `unsafe`.
@@ -41,6 +43,7 @@ pub mod query;
 pub mod retire;
 pub mod swapchain;
 pub mod target;
+pub mod texture;
 pub mod workarounds;
 
 #[cfg(test)]
@@ -60,3 +63,4 @@ pub use pipeline::Pipeline;
 pub use query::QueryPool;
 pub use swapchain::{Swapchain, SwapchainFrame};
 pub use target::OffscreenTarget;
+pub use texture::{Texture, TextureDesc, TextureFormat};

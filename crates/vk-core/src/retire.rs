@@ -31,6 +31,8 @@ pub(crate) enum Retired {
         raw: vk::Pipeline,
         layout: vk::PipelineLayout,
     },
+    /// A texture's sampler (its image goes as [`Retired::Image`]).
+    Sampler(vk::Sampler),
     DescriptorPool(vk::DescriptorPool),
     DescriptorSetLayout(vk::DescriptorSetLayout),
     QueryPool(vk::QueryPool),

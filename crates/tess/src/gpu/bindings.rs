@@ -115,6 +115,18 @@ gpu_constants! {
     ADAPTIVE_CONTROL_POINTS_BINDING = 5;
     /// Canonical boundary curves: four global vertices (cubic Bezier) each.
     ADAPTIVE_CURVES_BINDING = 6;
+    /// Per patch, in frame-wide order: texture coordinates at its corners and its corners' rows of the reparameterization table (`PatchSurface`).
+    ADAPTIVE_SURFACES_BINDING = 7;
+    /// The texture reparameterization's corner blocks (seed 003, Table 1), two `vec4` per row: row 0 the identity, row `v - 2` valence `v`.
+    ADAPTIVE_REPARAM_BINDING = 8;
+    /// Per canonical curve: the patch whose evaluation defines the curve's normals and texture coordinates (`CurveOwner`).
+    ADAPTIVE_CURVE_OWNERS_BINDING = 9;
+    /// Colour texture (combined image sampler; a 1x1 white texel when none is given).
+    ADAPTIVE_TEXTURE_BINDING = 10;
+    /// Height map (combined image sampler, red channel; a 1x1 texel when none is given).
+    ADAPTIVE_HEIGHT_BINDING = 11;
+    /// Per canonical corner (global vertex - `first_corner`): `uvec2(patch, corner)` of the patch whose evaluation defines its normal and texture coordinate.
+    ADAPTIVE_CORNER_OWNERS_BINDING = 12;
     /// Work-group size of the adaptive stencil kernel.
     ADAPTIVE_LOCAL_SIZE = 64;
     /// Patch kinds (low 4 bits of `AdaptivePatch::info`): bicubic B-spline,
@@ -135,6 +147,16 @@ gpu_constants! {
     ADAPTIVE_OPTION_FRACTIONAL = 2;
     /// `options` bit: round adaptive factors up to powers of two.
     ADAPTIVE_OPTION_POW2 = 4;
+    /// `options` bit: shade with the colour texture at the surface's texture coordinates.
+    ADAPTIVE_OPTION_TEXTURE = 8;
+    /// `options` bit: texture coordinates at the reparameterized parameter s(u, v) (seed 003, Eq. 3) on Gregory patches.
+    ADAPTIVE_OPTION_REPARAM = 16;
+    /// `options` bit: displace along the normal by `displace_scale` times the height.
+    ADAPTIVE_OPTION_DISPLACE = 32;
+    /// `options` bit: the height comes from the height map (else the procedural height).
+    ADAPTIVE_OPTION_HEIGHT_MAP = 64;
+    /// `options` bit: colour by the parameter shift |s(u, v) - (u, v)| of the reparameterization.
+    ADAPTIVE_OPTION_SHOW_PARAM_SHIFT = 128;
     /// Capture flags of the adaptive TES: patch kind in bits 0..3, level above.
     ADAPTIVE_FLAG_LEVEL_SHIFT = 4;
     /// Capture flag: the point lies on a patch boundary and came from its canonical curve.

@@ -371,7 +371,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
     // patch records, control points and curves.
     let adaptive_push = || Layout {
         name: "AdaptivePush",
-        offsets: offsets!(AdaptivePush: mode, first_patch, factor_mode, options, uniform_level, pixels_per_segment, distance_ref, max_level, first_row, count, base_count, row_base, term_base),
+        offsets: offsets!(AdaptivePush: mode, first_patch, factor_mode, options, uniform_level, pixels_per_segment, distance_ref, max_level, first_row, count, base_count, row_base, term_base, displace_scale, first_corner),
         size: size_of::<AdaptivePush>(),
     };
     let adaptive_tese = [

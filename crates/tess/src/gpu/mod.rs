@@ -128,9 +128,13 @@ pub struct AdaptivePush {
     /// every index into the stencil offsets (a row) and the stencil terms.
     pub row_base: u32,
     pub term_base: u32,
+    /// Displacement along the normal per unit of height (`ADAPTIVE_OPTION_DISPLACE`).
+    pub displace_scale: f32,
+    /// Global id of the first canonical corner (`ADAPTIVE_CORNER_OWNERS_BINDING`).
+    pub first_corner: u32,
 }
 
-const _: () = assert!(size_of::<AdaptivePush>() == 52);
+const _: () = assert!(size_of::<AdaptivePush>() == 60);
 
 /// Interleaved vertex of the mesh vertex buffer (`common/mesh.vert` and `plain/plain.vert`
 /// locations 0 and 1).

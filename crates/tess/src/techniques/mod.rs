@@ -37,6 +37,7 @@ const BASE_FACES: Features = Features {
     table_level: false,
     triangles_only: false,
     isolation: false,
+    surface: false,
 };
 
 static REGISTRY: [TechniqueInfo; 7] = [
@@ -74,6 +75,7 @@ static REGISTRY: [TechniqueInfo; 7] = [
             table_level: true,
             triangles_only: true,
             isolation: false,
+            surface: false,
         },
         scheme: Some(topology::Scheme::Loop),
     },
@@ -107,6 +109,7 @@ const ADAPTIVE: Features = Features {
     table_level: false,
     triangles_only: false,
     isolation: true,
+    surface: true,
 };
 
 /// The single-pass approximations: the adaptive machinery without isolation.
@@ -169,6 +172,8 @@ pub struct BuildOptions {
     pub sharpness_scale: f32,
     /// Follow semi-sharp creases past the isolation level until they decay.
     pub follow_semi_sharp: bool,
+    /// Colour texture and height map (techniques with [`Features::surface`]).
+    pub maps: crate::surface::SurfaceMaps,
 }
 
 impl Default for BuildOptions {
@@ -181,6 +186,7 @@ impl Default for BuildOptions {
             end_cap: topology::adaptive::EndCap::Gregory,
             sharpness_scale: 1.0,
             follow_semi_sharp: true,
+            maps: Default::default(),
         }
     }
 }
@@ -246,6 +252,7 @@ pub fn build(
                 sharpness_scale: options.sharpness_scale,
                 follow_semi_sharp: options.follow_semi_sharp,
                 name: options.name.clone(),
+                maps: options.maps.clone(),
             },
         )?),
         TechniqueId::Gregory | TechniqueId::Acc => Box::new(gregory::build(
@@ -258,6 +265,7 @@ pub fn build(
             },
             options.sharpness_scale,
             &options.name,
+            &options.maps,
         )?),
     };
     Ok(Built {

@@ -151,6 +151,7 @@ pub(super) fn assemble(
                     face: f as u32,
                     shift,
                     kind: PatchKind::Regular,
+                    acc: false,
                     boundary_mask: 0,
                     grid: None,
                     gregory: None,
@@ -166,7 +167,10 @@ pub(super) fn assemble(
                     };
                     if d.kind == PatchKind::Gregory {
                         d.gregory = Some(match acc.then(|| acc_points(lvl, f, shift)) {
-                            Some(Ok(points)) => points,
+                            Some(Ok(points)) => {
+                                d.acc = true;
+                                points
+                            }
                             _ => gregory_points(mesh, lvl, f, shift)?,
                         });
                     }
@@ -251,6 +255,11 @@ pub(super) fn assemble(
             boundary_mask: d.boundary_mask,
             transition_mask: 0,
             edges: [blank_edge; 4],
+            reparam_valences: if d.kind == PatchKind::Gregory && !d.acc {
+                reparam_valences(&levels[d.level as usize], d.face as usize, d.shift)
+            } else {
+                [0; 4]
+            },
         });
     }
 
@@ -261,7 +270,8 @@ pub(super) fn assemble(
     let mut needed: Vec<(u8, u32)> = Vec::new();
     let mut corners: Vec<[u32; 4]> = Vec::with_capacity(drafts.len());
     let first_canon = first_local + locals.table.len() as u32;
-    for (d, patch) in drafts.iter().zip(patches.iter_mut()) {
+    let mut corner_owners: Vec<[u32; 2]> = Vec::new();
+    for (pi, (d, patch)) in drafts.iter().zip(patches.iter_mut()).enumerate() {
         let lvl = &levels[d.level as usize];
         let (fv, _) = rotated(lvl.t(), d.face as usize, d.shift);
         let mut ids = [0u32; 4];
@@ -270,6 +280,7 @@ pub(super) fn assemble(
             if canon[key] == INVALID {
                 canon[key] = first_canon + needed.len() as u32;
                 needed.push((d.level, v));
+                corner_owners.push([pi as u32, p as u32]);
             }
             ids[p] = canon[key];
             match patch.kind {
@@ -473,6 +484,31 @@ pub(super) fn assemble(
             face: d.face as usize,
         });
     }
+    // Who defines each curve's normals and texture coordinates (seamless displacement): the
+    // owner patch, its edge, the part of the edge, and whether the curve runs with the edge.
+    let curve_owners: Vec<CurveOwner> = owners
+        .iter()
+        .zip(&curves)
+        .map(|(&(_, pi, p, part), c)| {
+            let ids = corners[pi as usize];
+            let p = p as usize;
+            let start_id = if part == 2 {
+                if c[0] == ids[(p + 1) % 4] {
+                    c[3]
+                } else {
+                    c[0]
+                }
+            } else {
+                ids[p]
+            };
+            CurveOwner {
+                patch: pi,
+                edge: p as u8,
+                part,
+                forward: start_id == c[0],
+            }
+        })
+        .collect();
     let first_curve_row = first_local + locals.table.len() as u32;
     let chunks: Vec<StencilTable> = owners
         .par_chunks(CHUNK)
@@ -596,6 +632,9 @@ pub(super) fn assemble(
         },
         patches,
         curves,
+        curve_owners,
+        first_corner: first_canon,
+        corner_owners,
         level_stats,
         isolation: opts.isolation,
     })
@@ -632,6 +671,24 @@ fn rotated_points<'a>(
                 .collect()
         })
         .collect()
+}
+
+/// Per patch corner (patch order): the valence whose corner block of the texture
+/// reparameterization ([`crate::reparam`]) applies — that of a smooth interior vertex — or 0
+/// (identity) at boundary, crease and corner vertices, where no characteristic map was fitted.
+fn reparam_valences(lvl: &Lvl, f: usize, shift: u8) -> [u8; 4] {
+    let (fv, _) = rotated(lvl.t(), f, shift);
+    fv.map(|v| {
+        let v = v as usize;
+        let edges = lvl.t().vertex_edges(v);
+        let smooth = lvl.topo.vertex_sharpness[v] <= 0.0
+            && edges.iter().all(|&e| !lvl.sharp_edge(e as usize));
+        if smooth {
+            edges.len().min(u8::MAX as usize) as u8
+        } else {
+            0
+        }
+    })
 }
 
 /// ACC-1's 16 Bézier points of face `f` as a Gregory patch's 20 (global ids, patch corner

@@ -52,6 +52,8 @@ pub(super) struct Draft {
     pub(super) face: u32,
     pub(super) shift: u8,
     pub(super) kind: PatchKind,
+    /// An ACC-1 net stored as a Gregory patch (no reparameterization is fitted to it).
+    pub(super) acc: bool,
     pub(super) boundary_mask: u8,
     /// Regular: the 16 gathered ids (`INVALID` where a phantom goes).
     pub(super) grid: Option<[u32; 16]>,

@@ -4,6 +4,7 @@
 //! error-severity validation message and on memory still allocated at its end.
 mod overlay;
 mod spirv;
+mod texture;
 
 use crate::descriptor::{BindingDesc, DescriptorPool, DescriptorSet, DescriptorSetLayout};
 use crate::error::{DescriptorError, RecordingError, VkError};

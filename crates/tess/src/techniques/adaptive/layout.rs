@@ -19,6 +19,7 @@ use crate::gpu::bindings::{
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
 use topology::adaptive::{AdaptivePlan, EdgeKind, PatchKind};
+use topology::ControlMesh;
 
 /// `StencilTerm` of `adaptive.glsl`: one term of a stencil row.
 #[repr(C)]
@@ -44,10 +45,57 @@ pub struct PatchRecord {
     pub curves: [u32; 8],
 }
 
+/// `PatchSurface` of `adaptive.glsl`: what a patch's texture look-ups need.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct PatchSurface {
+    /// Texture coordinates at corners (0,0), (1,0), (1,1), (0,1): the OBJ's `vt`, or the
+    /// (sub)face parameter when the mesh has none.
+    pub uv: [[f32; 2]; 4],
+    /// Per corner `i`, 8 bits at `8i`: its row of the reparameterization table (0 = identity).
+    pub reparam_rows: u32,
+    pub pad: [u32; 3],
+}
+
+/// `CurveOwner` of `adaptive.glsl`: the patch whose evaluation along a canonical curve gives
+/// both sides its normals and texture coordinates (`topology::adaptive::CurveOwner`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct CurveOwner {
+    /// Frame-wide patch id.
+    pub patch: u32,
+    /// `edge | part << 2 | forward << 4`.
+    pub info: u32,
+}
+
+/// `ReparamRow` of `adaptive.glsl`: one corner block `c0..c4` of Eq. 3 (padded to two `vec4`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ReparamRow {
+    pub c: [f32; 8],
+}
+
 const _: () = {
     assert!(size_of::<StencilTerm>() == 8);
     assert!(size_of::<PatchRecord>() == 48);
+    assert!(size_of::<PatchSurface>() == 48);
+    assert!(size_of::<CurveOwner>() == 8);
+    assert!(size_of::<ReparamRow>() == 32);
 };
+
+/// The GPU's reparameterization table (`topology::texcoord::reparam_rows`).
+pub fn reparam_rows() -> Vec<ReparamRow> {
+    topology::texcoord::reparam_rows()
+        .iter()
+        .map(|r| {
+            let mut c = [0.0f32; 8];
+            for (o, &x) in c.iter_mut().zip(r) {
+                *o = x as f32;
+            }
+            ReparamRow { c }
+        })
+        .collect()
+}
 
 /// Why a plan cannot go to the GPU.
 #[derive(Debug, thiserror::Error)]
@@ -110,6 +158,12 @@ pub struct GpuAdaptive {
     pub order: Vec<u32>,
     /// Patches per kind: regular, Gregory, bilinear.
     pub counts: [u32; 3],
+    /// Per curve, its owner patch (frame-wide id).
+    pub curve_owners: Vec<CurveOwner>,
+    /// Global id of the first canonical corner.
+    pub first_corner: u32,
+    /// Per canonical corner: `[frame-wide patch id, corner]` of its owner.
+    pub corner_owners: Vec<[u32; 2]>,
 }
 
 fn check(what: &'static str, index: u64, len: u64) -> Result<(), LayoutError> {
@@ -240,7 +294,52 @@ impl GpuAdaptive {
                 check("curve point", v as u64, nv as u64)?;
             }
         }
+        if plan.curve_owners.len() != plan.curves.len() {
+            return Err(LayoutError::Index {
+                what: "curve owners",
+                index: plan.curve_owners.len() as u64,
+                len: plan.curves.len() as u64,
+            });
+        }
+        let mut frame_id = vec![0u32; order.len()];
+        for (id, &pi) in order.iter().enumerate() {
+            frame_id[pi as usize] = id as u32;
+        }
+        let mut curve_owners = Vec::with_capacity(plan.curve_owners.len());
+        for o in &plan.curve_owners {
+            check("curve owner", o.patch as u64, order.len() as u64)?;
+            check("curve owner edge", o.edge as u64, 4)?;
+            check("curve owner part", o.part as u64, 3)?;
+            curve_owners.push(CurveOwner {
+                patch: frame_id[o.patch as usize],
+                info: o.edge as u32 | (o.part as u32) << 2 | (o.forward as u32) << 4,
+            });
+        }
+        let mut corner_owners = Vec::with_capacity(plan.corner_owners.len());
+        for &[pi, c] in &plan.corner_owners {
+            check("corner owner", pi as u64, order.len() as u64)?;
+            check("corner owner corner", c as u64, 4)?;
+            corner_owners.push([frame_id[pi as usize], c]);
+        }
+        // The TES reads `corner_owners[end - first_corner]` at every curve end.
+        for c in &plan.curves {
+            for v in [c[0], c[3]] {
+                check(
+                    "curve end (canonical corner)",
+                    (v as u64).wrapping_sub(plan.first_corner as u64),
+                    corner_owners.len() as u64,
+                )?;
+            }
+        }
+        check(
+            "last canonical corner",
+            plan.first_corner as u64 + corner_owners.len() as u64,
+            nv as u64 + 1,
+        )?;
         Ok(GpuAdaptive {
+            curve_owners,
+            first_corner: plan.first_corner,
+            corner_owners,
             num_base_vertices: nb,
             num_vertices: nv,
             stencil_offsets,
@@ -254,6 +353,32 @@ impl GpuAdaptive {
         })
     }
 
+    /// Per frame-wide patch: texture coordinates at its corners and its reparameterization
+    /// rows (`topology::texcoord`).
+    pub fn surfaces(&self, plan: &AdaptivePlan, mesh: &ControlMesh) -> Vec<PatchSurface> {
+        let f32x2 = |p: [f64; 2]| [p[0] as f32, p[1] as f32];
+        self.order
+            .iter()
+            .map(|&pi| {
+                let p = &plan.patches[pi as usize];
+                let uv = topology::texcoord::patch_corners(mesh, p).unwrap_or_else(|| {
+                    let [u0, v0] = p.origin;
+                    let h = p.size;
+                    [[u0, v0], [u0 + h, v0], [u0 + h, v0 + h], [u0, v0 + h]]
+                });
+                let mut rows = 0u32;
+                for (i, &v) in p.reparam_valences.iter().enumerate() {
+                    rows |= topology::texcoord::reparam_row(v) << (8 * i);
+                }
+                PatchSurface {
+                    uv: uv.map(f32x2),
+                    reparam_rows: rows,
+                    pad: [0; 3],
+                }
+            })
+            .collect()
+    }
+
     /// Bytes of tables on the GPU (stencils, patch records, control points, curves), without
     /// the vertex buffer.
     pub fn table_bytes(&self) -> usize {
@@ -261,7 +386,9 @@ impl GpuAdaptive {
             + self.stencil_terms.len() * size_of::<StencilTerm>()
             + self.patches.len() * size_of::<PatchRecord>()
             + self.control_points.len() * 4
-            + self.curves.len() * 16
+            + self.curves.len() * (16 + size_of::<CurveOwner>())
+            + self.corner_owners.len() * 8
+            + self.patches.len() * size_of::<PatchSurface>()
     }
 
     /// Bytes of the global vertex buffer.

@@ -41,8 +41,15 @@ use crate::gpu::bindings::{
     ADAPTIVE_OPTION_PATCH_COLOURS, ADAPTIVE_OPTION_POW2, ADAPTIVE_PATCHES_BINDING,
     ADAPTIVE_STENCIL_OFFSETS_BINDING, ADAPTIVE_STENCIL_TERMS_BINDING, ADAPTIVE_VERTICES_BINDING,
 };
+use crate::gpu::bindings::{
+    ADAPTIVE_CORNER_OWNERS_BINDING, ADAPTIVE_CURVE_OWNERS_BINDING, ADAPTIVE_HEIGHT_BINDING,
+    ADAPTIVE_OPTION_DISPLACE, ADAPTIVE_OPTION_HEIGHT_MAP, ADAPTIVE_OPTION_REPARAM,
+    ADAPTIVE_OPTION_SHOW_PARAM_SHIFT, ADAPTIVE_OPTION_TEXTURE, ADAPTIVE_REPARAM_BINDING,
+    ADAPTIVE_SURFACES_BINDING, ADAPTIVE_TEXTURE_BINDING,
+};
 use crate::gpu::AdaptivePush;
 use crate::shaders::{self, Stage, Variant};
+use crate::surface::{SurfaceImage, SurfaceMaps};
 use crate::technique::{
     for_each_draw, number_arrays, DrawCounts, FactorPolicy, FrameParams, Pass, PatchArray,
     PatchPipeline, PatchType, Technique, TechniqueId,
@@ -55,13 +62,14 @@ use topology::adaptive::{plan_adaptive, AdaptiveOptions, AdaptivePlan, EndCap};
 use topology::ControlMesh;
 use vk_core::descriptor::{BindingDesc, DescriptorPool};
 use vk_core::pipeline::{Pipeline, ShaderStage};
+use vk_core::texture::{Texture, TextureDesc, TextureFormat};
 use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Encoder, MemoryLocation};
 
 /// Default isolation level (OpenSubdiv's and the issue's).
 pub const DEFAULT_ISOLATION: u32 = 4;
 
 /// Set 1 of every adaptive pipeline.
-static SET_BINDINGS: [BindingDesc; 7] = [
+static SET_BINDINGS: [BindingDesc; 13] = [
     storage_binding(ADAPTIVE_BASE_POSITIONS_BINDING),
     storage_binding(ADAPTIVE_STENCIL_OFFSETS_BINDING),
     storage_binding(ADAPTIVE_STENCIL_TERMS_BINDING),
@@ -69,7 +77,59 @@ static SET_BINDINGS: [BindingDesc; 7] = [
     storage_binding(ADAPTIVE_PATCHES_BINDING),
     storage_binding(ADAPTIVE_CONTROL_POINTS_BINDING),
     storage_binding(ADAPTIVE_CURVES_BINDING),
+    storage_binding(ADAPTIVE_SURFACES_BINDING),
+    storage_binding(ADAPTIVE_REPARAM_BINDING),
+    storage_binding(ADAPTIVE_CURVE_OWNERS_BINDING),
+    storage_binding(ADAPTIVE_CORNER_OWNERS_BINDING),
+    sampler_binding(ADAPTIVE_TEXTURE_BINDING),
+    sampler_binding(ADAPTIVE_HEIGHT_BINDING),
 ];
+
+/// A combined image sampler of the set (the fragment stage reads the texture, the TES both).
+const fn sampler_binding(binding: u32) -> BindingDesc {
+    BindingDesc {
+        binding,
+        ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+        stages: vk::ShaderStageFlags::from_raw(
+            vk::ShaderStageFlags::TESSELLATION_EVALUATION.as_raw()
+                | vk::ShaderStageFlags::FRAGMENT.as_raw(),
+        ),
+    }
+}
+
+/// The surface's images as textures: the given ones, or a neutral 1×1 texel (white; height 0).
+fn surface_textures(device: &vk_core::Device, maps: &SurfaceMaps) -> Result<[Texture; 2]> {
+    let make = |img: Option<&SurfaceImage>, what: &str, fallback: (TextureFormat, [u8; 4])| {
+        let (name, w, h, format, texels) = match img {
+            Some(i) => (i.name.as_str(), i.width, i.height, i.format, &i.texels[..]),
+            None => (what, 1, 1, fallback.0, &fallback.1[..]),
+        };
+        Texture::new(
+            device,
+            &TextureDesc {
+                name,
+                width: w,
+                height: h,
+                format,
+                mipmaps: format != TextureFormat::R32Float,
+                repeat: true,
+            },
+            texels,
+        )
+    };
+    Ok([
+        make(
+            maps.texture.as_deref(),
+            "adaptive texture (none)",
+            (TextureFormat::Rgba8Unorm, [255; 4]),
+        )?,
+        make(
+            maps.height.as_deref(),
+            "adaptive height map (none)",
+            (TextureFormat::R32Float, 0f32.to_le_bytes()),
+        )?,
+    ])
+}
 
 /// Stencil rows: their CSR offsets (row `r` reads `offsets[r + 1]`).
 const ROWS: Space = Space {
@@ -160,6 +220,8 @@ pub struct AdaptiveBuild {
     pub follow_semi_sharp: bool,
     /// Name for messages (the mesh's file).
     pub name: String,
+    /// Colour texture and height map sampled at the surface's texture coordinates.
+    pub maps: SurfaceMaps,
 }
 
 impl Default for AdaptiveBuild {
@@ -170,6 +232,7 @@ impl Default for AdaptiveBuild {
             sharpness_scale: 1.0,
             follow_semi_sharp: true,
             name: "mesh".into(),
+            maps: SurfaceMaps::default(),
         }
     }
 }
@@ -190,6 +253,7 @@ pub struct Adaptive {
     _pool: DescriptorPool,
     base: Vec<Buffer>,
     _static: Vec<Buffer>,
+    _textures: [Texture; 2],
     arrays: Vec<PatchArray>,
     /// Per array: how many patches have each combination of edge kinds (the 2-bit kinds of
     /// `edge_info`), counted once so uniform triangle counts cost a few entries per call.
@@ -303,7 +367,40 @@ impl Adaptive {
                     bytemuck::cast_slice(&gpu.curves),
                 )?,
             ),
+            (
+                ADAPTIVE_SURFACES_BINDING,
+                storage(
+                    &device,
+                    "adaptive patch surfaces",
+                    bytemuck::cast_slice(&gpu.surfaces(&plan, mesh)),
+                )?,
+            ),
+            (
+                ADAPTIVE_REPARAM_BINDING,
+                storage(
+                    &device,
+                    "adaptive reparameterization table",
+                    bytemuck::cast_slice(&layout::reparam_rows()),
+                )?,
+            ),
+            (
+                ADAPTIVE_CURVE_OWNERS_BINDING,
+                storage(
+                    &device,
+                    "adaptive curve owners",
+                    bytemuck::cast_slice(&gpu.curve_owners),
+                )?,
+            ),
+            (
+                ADAPTIVE_CORNER_OWNERS_BINDING,
+                storage(
+                    &device,
+                    "adaptive corner owners",
+                    bytemuck::cast_slice(&gpu.corner_owners),
+                )?,
+            ),
         ];
+        let textures = surface_textures(&device, &options.maps)?;
         let base_positions = base_positions(mesh);
         let mut base = Vec::new();
         let mut sets = Vec::new();
@@ -343,6 +440,8 @@ impl Adaptive {
                         _ => windows::write_whole(&set, *binding, s)?,
                     }
                 }
+                set.write_texture(ADAPTIVE_TEXTURE_BINDING, &textures[0])?;
+                set.write_texture(ADAPTIVE_HEIGHT_BINDING, &textures[1])?;
                 slot_sets.push(set);
             }
             base.push(buf);
@@ -386,6 +485,7 @@ impl Adaptive {
             _pool: pool,
             base,
             _static: statics.into_iter().map(|(_, b)| b).collect(),
+            _textures: textures,
             arrays,
             edge_kinds,
             gpu,
@@ -422,6 +522,21 @@ impl Adaptive {
         if params.patch_colours {
             options |= ADAPTIVE_OPTION_PATCH_COLOURS;
         }
+        if self.options.maps.texture.is_some() && !params.patch_colours {
+            options |= ADAPTIVE_OPTION_TEXTURE;
+        }
+        if params.reparam {
+            options |= ADAPTIVE_OPTION_REPARAM;
+        }
+        if params.displace != 0.0 {
+            options |= ADAPTIVE_OPTION_DISPLACE;
+        }
+        if self.options.maps.height.is_some() {
+            options |= ADAPTIVE_OPTION_HEIGHT_MAP;
+        }
+        if params.show_param_shift {
+            options |= ADAPTIVE_OPTION_SHOW_PARAM_SHIFT;
+        }
         if fractional {
             options |= ADAPTIVE_OPTION_FRACTIONAL;
         } else if adaptive {
@@ -441,6 +556,8 @@ impl Adaptive {
             base_count: self.gpu.num_base_vertices,
             row_base: 0,
             term_base: 0,
+            displace_scale: params.displace,
+            first_corner: self.gpu.first_corner,
         }
     }
 

@@ -31,6 +31,7 @@ pub fn build(
     patch: SinglePassPatch,
     sharpness_scale: f32,
     name: &str,
+    maps: &crate::surface::SurfaceMaps,
 ) -> Result<Adaptive> {
     let plan = plan_single_pass(
         mesh,
@@ -56,6 +57,7 @@ pub fn build(
             sharpness_scale,
             follow_semi_sharp: false,
             name: name.to_string(),
+            maps: maps.clone(),
             ..AdaptiveBuild::default()
         },
         id,

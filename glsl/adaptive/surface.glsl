@@ -1,0 +1,163 @@
+// Texture coordinates, the texture reparameterization (seed 003, Eq. 3) and seamless
+// displacement for the adaptive TES. Mirrors topology::texcoord (reparameterization) and
+// topology::adaptive::CurveOwner::patch_param (owners).
+//
+// Seamless displacement: a vertex on a patch boundary is displaced along the normal, and by
+// the height at the texture coordinate, of the patch that owns its canonical curve (or its
+// canonical corner), evaluated from the global vertex buffer by one `precise` function. Both
+// sides of an edge therefore compute the same bits even where a texture seam (a `vt`
+// discontinuity) runs along it or the patches differ in kind or level.
+
+// Eq. 3: the rational bicubic s(u, v) of the patch's corner blocks; exactly (u, v) where every
+// corner is the identity (regular patches, valence 4, boundaries).
+vec2 reparameterize(uint rows, vec2 uv) {
+    if (rows == 0u) return uv;
+    vec3 net[16];
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) net[i + 4 * j] = vec3(float(i) / 3.0, float(j) / 3.0, 1.0);
+    for (uint k = 0u; k < 4u; ++k) {
+        uint row = (rows >> (8u * k)) & 255u;
+        if (row == 0u) continue;
+        vec4 a = reparam_table[row].a;
+        float c0 = a.x, c1 = a.y, c2 = a.z, c3 = a.w, c4 = reparam_table[row].b.x;
+        bool cu = k == 1u || k == 2u, cv = k >= 2u;
+        // Local block (a, b): (0,0) -> (0, 0, c0), (0,1) -> (0, c1, c2), (1,0) -> (c1, 0, c2),
+        // (1,1) -> (c3, c3, c4); mirrored into the corner (c -> 1 - c).
+        vec3 local[4] = vec3[4](vec3(0.0, 0.0, c0), vec3(c1, 0.0, c2), vec3(0.0, c1, c2), vec3(c3, c3, c4));
+        for (int b = 0; b < 2; ++b) {
+            for (int a2 = 0; a2 < 2; ++a2) {
+                vec3 l = local[a2 + 2 * b];
+                int i = cu ? 3 - a2 : a2, j = cv ? 3 - b : b;
+                net[i + 4 * j] = vec3(cu ? 1.0 - l.x : l.x, cv ? 1.0 - l.y : l.y, l.z);
+            }
+        }
+    }
+    float s = 1.0 - uv.x, t = 1.0 - uv.y;
+    vec4 bu = vec4(s * s * s, 3.0 * uv.x * s * s, 3.0 * uv.x * uv.x * s, uv.x * uv.x * uv.x);
+    vec4 bv = vec4(t * t * t, 3.0 * uv.y * t * t, 3.0 * uv.y * uv.y * t, uv.y * uv.y * uv.y);
+    vec3 acc = vec3(0.0);
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {
+            vec3 n = net[i + 4 * j];
+            float w = bu[i] * bv[j] * n.z;
+            acc += vec3(w * n.xy, w);
+        }
+    return acc.xy / acc.z;
+}
+
+bool reparam_on() { return (adaptive.options & uint(ADAPTIVE_OPTION_REPARAM)) != 0u; }
+
+// The texture coordinate patch `id` shows at its (u, v).
+vec2 patch_texcoord(uint id, vec2 uv) {
+    PatchSurface sf = surfaces[id];
+    vec2 st = reparam_on() ? reparameterize(sf.reparam_rows, uv) : uv;
+    return mix(mix(sf.uv[0], sf.uv[1], st.x), mix(sf.uv[3], sf.uv[2], st.x), st.y);
+}
+
+// Height at a texture coordinate: the height map's red channel (level 0, so both sides of an
+// edge read the same texels), or a procedural bump pattern.
+float surface_height(vec2 tex) {
+    if ((adaptive.options & uint(ADAPTIVE_OPTION_HEIGHT_MAP)) != 0u) return textureLod(height_map, tex, 0.0).r;
+    vec2 w = 6.2831853 * 8.0 * tex;
+    return 0.5 + 0.25 * (sin(w.x) + sin(w.y));
+}
+
+void bernstein3(float t, out vec4 b, out vec4 d) {
+    float s = 1.0 - t;
+    b = vec4(s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t);
+    d = vec4(-3.0 * s * s, 3.0 * s * s - 6.0 * t * s, 6.0 * t * s - 3.0 * t * t, 3.0 * t * t);
+}
+
+// Uniform cubic B-spline basis and its derivative.
+void bspline3(float t, out vec4 b, out vec4 d) {
+    float s = 1.0 - t;
+    b = vec4(s * s * s, 3.0 * t * t * t - 6.0 * t * t + 4.0, -3.0 * t * t * t + 3.0 * t * t + 3.0 * t + 1.0, t * t * t) / 6.0;
+    d = vec4(-3.0 * s * s, 9.0 * t * t - 12.0 * t, -9.0 * t * t + 6.0 * t + 3.0, 3.0 * t * t) / 6.0;
+}
+
+// The owner evaluation: the normal of patch `id` at `uv`, from the global vertex buffer, one
+// operand order, `precise` (every TES that includes this gets the same bits).
+vec3 owner_normal(uint id, vec2 uv) {
+    AdaptivePatch p = patches[id];
+    uint kind = patch_kind(p);
+    precise vec3 du = vec3(0.0), dv = vec3(0.0);
+    float u = uv.x, v = uv.y;
+    if (kind == ADAPTIVE_KIND_REGULAR) {
+        vec4 bu, bv, du_w, dv_w;
+        bspline3(u, bu, du_w);
+        bspline3(v, bv, dv_w);
+        for (uint j = 0u; j < 4u; ++j)
+            for (uint i = 0u; i < 4u; ++i) {
+                vec3 c = vtx(control_points[p.cp_offset + 4u * j + i]);
+                du += (du_w[i] * bv[j]) * c;
+                dv += (bu[i] * dv_w[j]) * c;
+            }
+    } else if (kind == ADAPTIVE_KIND_GREGORY) {
+        vec3 c[20];
+        for (uint k = 0u; k < 20u; ++k) c[k] = vtx(control_points[p.cp_offset + k]);
+        // The interior Bezier points as gregory.tese blends them (positions only: the normal
+        // of the blended net).
+        vec3 b[16];
+        b[0] = c[0];  b[1] = c[1];  b[2] = c[7];  b[3] = c[5];
+        b[7] = c[6];  b[11] = c[12]; b[15] = c[10];
+        b[14] = c[11]; b[13] = c[17]; b[12] = c[15];
+        b[8] = c[16]; b[4] = c[2];
+        float d0 = u + v, d1 = 1.0 - u + v, d2 = 2.0 - u - v, d3 = 1.0 - v + u;
+        b[5] = d0 < 1e-7 ? 0.5 * (c[3] + c[4]) : (u * c[3] + v * c[4]) / d0;
+        b[6] = d1 < 1e-7 ? 0.5 * (c[9] + c[8]) : ((1.0 - u) * c[9] + v * c[8]) / d1;
+        b[10] = d2 < 1e-7 ? 0.5 * (c[14] + c[13]) : ((1.0 - v) * c[14] + (1.0 - u) * c[13]) / d2;
+        b[9] = d3 < 1e-7 ? 0.5 * (c[18] + c[19]) : ((1.0 - v) * c[18] + u * c[19]) / d3;
+        vec4 bu, bv, du_w, dv_w;
+        bernstein3(u, bu, du_w);
+        bernstein3(v, bv, dv_w);
+        for (int j = 0; j < 4; ++j)
+            for (int i = 0; i < 4; ++i) {
+                du += (du_w[i] * bv[j]) * b[i + 4 * j];
+                dv += (bu[i] * dv_w[j]) * b[i + 4 * j];
+            }
+    } else {
+        // Bilinear caps: the plane of the canonical corners' cross diagonals.
+        vec3 c0 = edge_point(p, 0u, 0.0), c1 = edge_point(p, 1u, 0.0), c2 = edge_point(p, 2u, 0.0), c3 = edge_point(p, 3u, 0.0);
+        du = (1.0 - v) * (c1 - c0) + v * (c2 - c3);
+        dv = (1.0 - u) * (c3 - c0) + u * (c2 - c1);
+    }
+    precise vec3 n = cross(du, dv);
+    float l = length(n);
+    precise vec3 r = l > 1e-30 ? n / l : vec3(0.0, 0.0, 1.0);
+    return r;
+}
+
+// The owner's patch parameter at curve parameter s (CurveOwner::patch_param).
+vec2 owner_param(CurveOwner o, float s) {
+    uint edge = o.info & 3u, part = (o.info >> 2) & 3u;
+    bool forward = ((o.info >> 4) & 1u) != 0u;
+    precise float e = forward ? s : 1.0 - s;
+    precise float t = part == 1u ? 0.5 * e : (part == 2u ? 0.5 + 0.5 * e : e);
+    if (edge == 0u) return vec2(t, 0.0);
+    if (edge == 1u) return vec2(1.0, t);
+    if (edge == 2u) return vec2(1.0 - t, 1.0);
+    return vec2(0.0, 1.0 - t);
+}
+
+const vec2 CORNER_PARAMS[4] = vec2[4](vec2(0.0, 0.0), vec2(1.0, 0.0), vec2(1.0, 1.0), vec2(0.0, 1.0));
+
+// A boundary vertex at curve `curve`, parameter `s`, displaced by its owner (see above); `pos`
+// is the canonical point.
+vec3 displace_canonical(vec3 pos, uint curve, float s) {
+    uint owner;
+    vec2 ouv;
+    if (s == 0.0 || s == 1.0) {
+        uint v = s == 0.0 ? curves[curve].x : curves[curve].w;
+        uvec2 o = corner_owners[v - adaptive.first_corner];
+        owner = o.x;
+        ouv = CORNER_PARAMS[o.y & 3u];
+    } else {
+        CurveOwner o = curve_owners[curve];
+        owner = o.patch_id;
+        ouv = owner_param(o, s);
+    }
+    vec3 n = owner_normal(owner, ouv);
+    float h = surface_height(patch_texcoord(owner, ouv));
+    precise vec3 r = pos + n * (adaptive.displace_scale * h);
+    return r;
+}
