@@ -492,6 +492,8 @@ pub(super) fn assemble(
         .map(|(&(_, pi, p, part), c)| {
             let ids = corners[pi as usize];
             let p = p as usize;
+            // The segment runs in the patch's edge direction from `start_id`; for a second half,
+            // the midpoint: whichever end of the curve is not the patch corner.
             let start_id = if part == 2 {
                 if c[0] == ids[(p + 1) % 4] {
                     c[3]
@@ -510,33 +512,18 @@ pub(super) fn assemble(
         })
         .collect();
     let first_curve_row = first_local + locals.table.len() as u32;
-    let chunks: Vec<StencilTable> = owners
+    let chunks: Vec<StencilTable> = curve_owners
         .par_chunks(CHUNK)
-        .enumerate()
-        .map(|(chunk_index, chunk)| {
+        .map(|chunk| {
             let mut table = StencilTable {
                 offsets: vec![0],
                 ..StencilTable::default()
             };
             let mut scratch: Vec<(u32, f64)> = Vec::with_capacity(128);
-            for (j, &(_, pi, p, part)) in chunk.iter().enumerate() {
-                let ci = chunk_index * CHUNK + j;
-                let patch = &patches[pi as usize];
-                let (p, part) = (p as usize, part as usize);
-                let ids = corners[pi as usize];
-                // The segment runs in the patch's edge direction from `start_id`.
-                let c = curves[ci];
-                let start_id = if part == 2 {
-                    // The midpoint: whichever end of the curve is not the patch corner.
-                    if c[0] == ids[(p + 1) % 4] {
-                        c[3]
-                    } else {
-                        c[0]
-                    }
-                } else {
-                    ids[p]
-                };
-                let forward = start_id == c[0];
+            for o in chunk {
+                let patch = &patches[o.patch as usize];
+                let (p, part, forward) = (o.edge as usize, o.part as usize, o.forward);
+                let ids = corners[o.patch as usize];
                 for slot in [1usize, 2] {
                     // Curve point `slot` is the segment's Bézier point `k`.
                     let k = if forward { slot } else { 3 - slot };
