@@ -7,6 +7,7 @@ mod common;
 use common::Gpu;
 use tessera::tess::capture::{classify_open_edges, CapturedSoup, Capturer};
 use tessera::tess::gpu::bindings::ADAPTIVE_KIND_REGULAR;
+use tessera::tess::surface::{SurfaceMaps, SurfaceShow};
 use tessera::tess::techniques::adaptive::Adaptive;
 use tessera::tess::techniques::gregory;
 use tessera::tess::{Camera, Context, FactorPolicy, FrameParams, Spacing, Technique};
@@ -192,6 +193,7 @@ fn watertight_under_every_factor_policy() {
                         maps_surface.get_or_insert_with(|| {
                             let maps = tessera::tess::surface::SurfaceMaps {
                                 texture: None,
+                                param_error: false,
                                 height: Some(std::sync::Arc::new(
                                     tessera::tess::surface::load_height(common::data(
                                         "assets/spot_height.png",
@@ -294,6 +296,120 @@ fn bad_input_gives_named_errors() {
             },
         ] {
             assert!(ok.check(&bad).is_err(), "{bad:?}");
+        }
+        // The Eq. 1 view needs the lattice, which is built only on request.
+        let e = ok
+            .check(&FrameParams {
+                show: SurfaceShow::ParamError,
+                ..FrameParams::uniform(4.0)
+            })
+            .expect_err("param-error without its lattice");
+        assert!(e.to_string().contains("param-error"), "{e}");
+    }
+}
+
+/// Hue in degrees of the surface pixels of `img` (background black, specular whites skipped).
+fn surface_hues(img: &tessera::vk_core::target::Rgba8) -> Vec<f64> {
+    img.pixels
+        .chunks(4)
+        .filter_map(|p| {
+            let [r, g, b] = [p[0], p[1], p[2]].map(|c| c as f64 / 255.0);
+            let (max, min) = (r.max(g).max(b), r.min(g).min(b));
+            if max < 0.05 || max - min < 0.15 * max {
+                return None;
+            }
+            let d = max - min;
+            let h = if max == r {
+                60.0 * ((g - b) / d).rem_euclid(6.0)
+            } else if max == g {
+                60.0 * ((b - r) / d + 2.0)
+            } else {
+                60.0 * ((r - g) / d + 4.0)
+            };
+            Some(h)
+        })
+        .collect()
+}
+
+/// `--show param-error` (seed 003's Fig. 8) as the GPU draws it: the colour ramp runs from blue
+/// (exact) to red (1e-2 of the diagonal) by hue, so the drawn hues must follow the CPU lattice:
+/// an all-regular mesh is blue everywhere; on spot the reparameterization turns pixels bluer
+/// (the CPU lattice's RMS falls to 0.6x), and warm pixels exist where Gregory patches deviate.
+#[test]
+fn param_error_view_follows_the_cpu_lattice() {
+    let gpu = Gpu::new();
+    let mut ctx = Context::offscreen(gpu.device()).expect("context");
+    let maps = SurfaceMaps {
+        param_error: true,
+        ..Default::default()
+    };
+    let extent = vk::Extent2D {
+        width: 320,
+        height: 240,
+    };
+    let render = |ctx: &mut Context, surf: &Adaptive, reparam: bool| {
+        let params = FrameParams {
+            show: SurfaceShow::ParamError,
+            reparam,
+            clear_color: [0.0, 0.0, 0.0, 1.0],
+            ..FrameParams::uniform(8.0)
+        };
+        surf.check(&params).expect("param-error view");
+        ctx.render_offscreen(surf, &params, extent).expect("frame")
+    };
+    let mean = |h: &[f64]| h.iter().sum::<f64>() / h.len().max(1) as f64;
+    // Exact everywhere: every patch is a B-spline patch of a mesh without semi-sharp tags.
+    let edgecorner = shape("catmark_edgecorner");
+    let surf = gregory::build(
+        &mut ctx,
+        &edgecorner,
+        SinglePassPatch::Gregory,
+        1.0,
+        "edgecorner",
+        &maps,
+    )
+    .expect("build");
+    let hues = surface_hues(&render(&mut ctx, &surf, true));
+    let blue = hues.iter().filter(|&&h| h > 200.0).count();
+    println!(
+        "catmark_edgecorner: {} surface pixels, {blue} blue",
+        hues.len()
+    );
+    assert!(
+        hues.len() > 1000 && blue == hues.len(),
+        "exact surface not blue: {blue} of {}",
+        hues.len()
+    );
+
+    let spot = shape("spot");
+    for patch in [SinglePassPatch::Gregory, SinglePassPatch::Acc1] {
+        let surf = gregory::build(&mut ctx, &spot, patch, 1.0, "spot", &maps).expect("build");
+        let on = surface_hues(&render(&mut ctx, &surf, true));
+        let off = surface_hues(&render(&mut ctx, &surf, false));
+        let warm = |h: &[f64]| h.iter().filter(|&&x| x < 100.0).count();
+        println!(
+            "spot {patch:?}: mean hue reparameterized {:.1} (warm {}), identity {:.1} (warm {}), {} pixels",
+            mean(&on),
+            warm(&on),
+            mean(&off),
+            warm(&off),
+            on.len()
+        );
+        assert!(on.len() > 5000, "spot covers too few pixels");
+        assert!(
+            warm(&off) > 0,
+            "no visible error anywhere on spot's Gregory patches"
+        );
+        match patch {
+            // Reparameterized corners are Gregory corners only (ACC-1's stay the identity).
+            SinglePassPatch::Gregory => assert!(
+                mean(&on) > mean(&off) + 2.0 && warm(&on) < warm(&off),
+                "reparameterization does not lower the drawn error"
+            ),
+            SinglePassPatch::Acc1 => assert!(
+                (mean(&on) - mean(&off)).abs() < 1e-9,
+                "ACC-1 patches have no reparameterized corner, yet the view changed"
+            ),
         }
     }
 }

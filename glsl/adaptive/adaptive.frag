@@ -6,7 +6,8 @@
 #include "shading.glsl"
 layout(location = 0) in vec3 in_world;
 layout(location = 1) in vec3 in_normal;
-layout(location = 5) flat in vec3 in_albedo;
+// Smooth: constant per patch for patch colours, a field for the parameterization views.
+layout(location = 5) in vec3 in_albedo;
 layout(location = 6) in vec2 in_texcoord;
 layout(location = 0) out vec4 out_color;
 void main() {

@@ -58,6 +58,7 @@ layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_SURFACES_BINDING) readonly
 layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_REPARAM_BINDING) readonly buffer Reparam { ReparamRow reparam_table[]; };
 layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_CURVE_OWNERS_BINDING) readonly buffer CurveOwners { CurveOwner curve_owners[]; };
 layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_CORNER_OWNERS_BINDING) readonly buffer CornerOwners { uvec2 corner_owners[]; };
+layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_PARAM_ERROR_BINDING) readonly buffer ParamErrors { float param_errors[]; };
 layout(set = ADAPTIVE_SET, binding = ADAPTIVE_TEXTURE_BINDING) uniform sampler2D surface_texture;
 layout(set = ADAPTIVE_SET, binding = ADAPTIVE_HEIGHT_BINDING) uniform sampler2D height_map;
 

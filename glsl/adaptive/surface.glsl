@@ -47,6 +47,31 @@ vec2 reparameterize(uint rows, vec2 uv) {
 
 bool reparam_on() { return (adaptive.options & uint(ADAPTIVE_OPTION_REPARAM)) != 0u; }
 
+// The pointwise Eq. 1 error of patch `id` at `uv` (over the bbox diagonal), bilinear in its
+// lattice (topology::texcoord::ParamErrorLattice, computed on the CPU for the rest pose), for
+// the current reparameterization setting. 0 outside the buffer (not built).
+float param_error(uint id, vec2 uv) {
+    const uint side = uint(ADAPTIVE_PARAM_ERROR_SIDE), n = side * side;
+    uint base = id * 2u * n + (reparam_on() ? n : 0u);
+    if (base + n > uint(param_errors.length())) return 0.0;
+    vec2 x = clamp(uv, 0.0, 1.0) * float(side - 1u);
+    uvec2 i = min(uvec2(x), uvec2(side - 2u));
+    vec2 f = x - vec2(i);
+    uint k = base + i.x + side * i.y;
+    float a = mix(param_errors[k], param_errors[k + 1u], f.x);
+    float b = mix(param_errors[k + side], param_errors[k + side + 1u], f.x);
+    return mix(a, b, f.y);
+}
+
+// Log-scale ramp of a relative error: blue <= 1e-5, cyan 1e-4.25, green 1e-3.5, yellow
+// 1e-2.75, red >= 1e-2 (a decade per 1.33 colour steps, as a heat map of Fig. 8).
+vec3 param_error_colour(float e) {
+    float t = clamp((log(max(e, 1e-12)) / log(10.0) + 5.0) / 3.0, 0.0, 1.0) * 4.0;
+    const vec3 ramp[5] = vec3[5](vec3(0.15, 0.25, 0.85), vec3(0.1, 0.7, 0.85), vec3(0.2, 0.75, 0.25), vec3(0.95, 0.85, 0.2), vec3(0.9, 0.15, 0.1));
+    uint k = min(uint(t), 3u);
+    return mix(ramp[k], ramp[k + 1u], t - float(k));
+}
+
 // The texture coordinate patch `id` shows at its (u, v).
 vec2 patch_texcoord(uint id, vec2 uv) {
     PatchSurface sf = surfaces[id];

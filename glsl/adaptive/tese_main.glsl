@@ -5,7 +5,7 @@
 #include "normals.glsl"
 layout(location = 0) patch in uint tc_patch;
 layout(location = 2) patch in uint tc_info;
-layout(location = 5) flat out vec3 out_albedo;
+layout(location = 5) out vec3 out_albedo;
 layout(location = 6) out vec2 out_texcoord;
 #include "surface.glsl"
 
@@ -53,6 +53,8 @@ void main() {
         vec2 st = reparameterize(surfaces[tc_patch].reparam_rows, uv);
         float shift = clamp(length(st - uv) / 0.05, 0.0, 1.0);
         albedo = mix(vec3(0.2, 0.35, 0.9), vec3(0.95, 0.25, 0.15), shift);
+    } else if ((adaptive.options & uint(ADAPTIVE_OPTION_SHOW_PARAM_ERROR)) != 0u) {
+        albedo = param_error_colour(param_error(tc_patch, uv));
     } else if ((adaptive.options & uint(ADAPTIVE_OPTION_PATCH_COLOURS)) != 0u) {
         // Odd levels lighter, even levels darker, a little lighter with depth: adjacent
         // levels always differ.

@@ -21,6 +21,39 @@ pub struct SurfaceImage {
 pub struct SurfaceMaps {
     pub texture: Option<Arc<SurfaceImage>>,
     pub height: Option<Arc<SurfaceImage>>,
+    /// Also compute the pointwise Eq. 1 error lattice (`topology::texcoord::ParamErrorLattice`)
+    /// that [`SurfaceShow::ParamError`] draws: exact limit evaluations on the CPU at build
+    /// time (seconds on meshes of thousands of patches), so only on request.
+    pub param_error: bool,
+}
+
+/// What the surface is coloured by (techniques with the `surface` feature).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SurfaceShow {
+    /// Lighting of the albedo (texture, patch colours or base colour).
+    #[default]
+    Shading,
+    /// How far the reparameterization moves the texture parameter, `|s(u, v) − (u, v)|` in
+    /// patch units: blue 0, red 0.05 and beyond.
+    ParamShift,
+    /// The pointwise texture error of Eq. 1 (seed 003, its Fig. 8) with the current
+    /// reparameterization setting, relative to the bounding-box diagonal, on a log scale:
+    /// blue ≤ 1e-5, green 3e-4, yellow 2e-3, red ≥ 1e-2. Needs [`SurfaceMaps::param_error`].
+    ParamError,
+}
+
+impl SurfaceShow {
+    /// The `--show` names.
+    pub const NAMES: &'static str = "param-shift, param-error";
+
+    /// Parses a `--show` value.
+    pub fn parse(name: &str) -> Option<Self> {
+        match name {
+            "param-shift" => Some(Self::ParamShift),
+            "param-error" => Some(Self::ParamError),
+            _ => None,
+        }
+    }
 }
 
 fn open(path: &Path) -> Result<image::DynamicImage> {

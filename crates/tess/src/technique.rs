@@ -199,8 +199,8 @@ pub struct FrameParams {
     pub reparam: bool,
     /// Displacement along the normal per unit of height (0: none).
     pub displace: f32,
-    /// Colour by how far the reparameterization moves the texture parameter.
-    pub show_param_shift: bool,
+    /// What the surface is coloured by (shading, or a view of the texture parameterization).
+    pub show: crate::surface::SurfaceShow,
     pub split: DrawSplit,
     pub base_color: [f32; 3],
     pub clear_color: [f32; 4],
@@ -218,7 +218,7 @@ impl Default for FrameParams {
             patch_colours: false,
             reparam: true,
             displace: 0.0,
-            show_param_shift: false,
+            show: crate::surface::SurfaceShow::Shading,
             split: DrawSplit::Auto,
             base_color: [0.85, 0.72, 0.55],
             clear_color: [0.12, 0.13, 0.16, 1.0],

@@ -749,6 +749,53 @@ impl LocalMesh {
         let child = r.maps.child_faces(0).start + sub;
         evaluate_local(&nb, r.child, points, child, u, v)
     }
+
+    /// Exact limit at many parameters of one face: [`Self::evaluate`] when `sub` is `None`,
+    /// else [`Self::evaluate_subface`]. The face's neighbourhood is gathered (and for a
+    /// sub-face refined once) for all of them, which is most of a single evaluation's cost.
+    pub fn evaluate_many(
+        &self,
+        face: usize,
+        sub: Option<usize>,
+        params: &[[f64; 2]],
+    ) -> Result<Vec<LimitSample>, EvalError> {
+        let Some(&[u0, v0]) = params.first() else {
+            return Ok(Vec::new());
+        };
+        // The single evaluations check the face, the sub-face and the first parameter.
+        match sub {
+            None => self.evaluate(face, u0, v0)?,
+            Some(s) => self.evaluate_subface(face, s, u0, v0)?,
+        };
+        let quad = self.scheme == LimitScheme::CatmullClark;
+        for &[u, v] in params {
+            let inside = u.is_finite()
+                && v.is_finite()
+                && u >= 0.0
+                && v >= 0.0
+                && if quad || sub.is_some() {
+                    u <= 1.0 && v <= 1.0
+                } else {
+                    u + v <= 1.0
+                };
+            if !inside {
+                return Err(EvalError::ParamOutOfRange { u, v });
+            }
+        }
+        let nb = self.face_neighbourhood(face)?;
+        let (level, points, start) = match sub {
+            None => (nb.level.clone(), nb.points.clone(), 0),
+            Some(s) => {
+                let r = refine_sparse(nb.level.view(), nb.scheme.scheme(), &nb.options, &[0])?;
+                let points = r.stencils.apply_flat(&nb.points, nb.dim);
+                (r.child, points, r.maps.child_faces(0).start + s)
+            }
+        };
+        params
+            .iter()
+            .map(|&[u, v]| evaluate_local(&nb, level.clone(), points.clone(), start, u, v))
+            .collect()
+    }
 }
 
 /// What the limit masks and regular patches read at one level: topology, sharpness, points and

@@ -15,8 +15,10 @@
 //!   identity where the valence is 0 (boundary, crease and corner vertices; regular and ACC-1
 //!   patches).
 use crate::adaptive::{AdaptivePatch, AdaptivePlan};
+use crate::eval::{EvalError, LimitScheme, LocalMesh};
 use crate::mesh::ControlMesh;
 use crate::reparam::{control_net, corner_block, reparameterize, IDENTITY_BLOCK, TABLE_VALENCES};
+use rayon::prelude::*;
 
 /// The corner block of Eq. 3 that a patch corner of reparameterization valence `valence`
 /// gets (see the module docs): `None` is the identity.
@@ -147,6 +149,109 @@ pub fn patch_texcoord(
     let corners = patch_corners(mesh, patch)?;
     let [s, t] = patch_parameter(patch, u, v, reparam);
     Some(bilinear(&corners, s, t))
+}
+
+/// The pointwise texture error of Eq. 1 (seed 003) on a lattice of every patch of a plan: at
+/// the displayed point `g(u, v)` the texture shows the texel of base parameter `s(u, v)`,
+/// whose exact limit point is `p(s(u, v))`; the error is `|p(s(u, v)) − g(u, v)|` over the
+/// control mesh's bounding-box diagonal, with (`s` of Eq. 3) and without (`s` the identity)
+/// the reparameterization. It counts the patch's geometric deviation too, which no
+/// reparameterization removes (0 on exact patches). The rest pose only: an animated mesh
+/// moves `g` and `p` but not this table. Drawn by `--show param-error` (the paper's Fig. 8).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParamErrorLattice {
+    /// Lattice points per side: `(u, v) = (i, j) / (side − 1)`.
+    pub side: usize,
+    /// Per patch: the identity's lattice, then the reparameterized one, each indexed
+    /// `i + side · j`.
+    pub errors: Vec<f32>,
+}
+
+impl ParamErrorLattice {
+    /// The error of patch `patch` at lattice point `(i, j)`.
+    pub fn at(&self, patch: usize, reparam: bool, i: usize, j: usize) -> f32 {
+        let n = self.side * self.side;
+        self.errors[patch * 2 * n + usize::from(reparam) * n + i + self.side * j]
+    }
+
+    /// The values of one patch and mode, in lattice order.
+    pub fn patch(&self, patch: usize, reparam: bool) -> &[f32] {
+        let n = self.side * self.side;
+        let start = patch * 2 * n + usize::from(reparam) * n;
+        &self.errors[start..start + n]
+    }
+}
+
+/// [`ParamErrorLattice`] of `plan` (made from `mesh`) with `side` points per patch side (at
+/// least 2). Exact evaluation of the Catmull-Clark limit at every lattice point (one
+/// neighbourhood per patch, patches in parallel): 10-40 µs a point, so seconds on meshes of a
+/// few thousand patches.
+pub fn param_error_lattice(
+    mesh: &ControlMesh,
+    plan: &AdaptivePlan,
+    side: usize,
+) -> Result<ParamErrorLattice, EvalError> {
+    let side = side.max(2);
+    let exact = LocalMesh::from_control_mesh(mesh, LimitScheme::CatmullClark)?;
+    let verts = plan.apply(&mesh.positions);
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in &mesh.positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let diag = (0..3)
+        .map(|k| (hi[k] - lo[k]).powi(2))
+        .sum::<f64>()
+        .sqrt()
+        .max(f64::MIN_POSITIVE);
+    let step = 1.0 / (side - 1) as f64;
+    let per_patch: Vec<Vec<f32>> = plan
+        .patches
+        .par_iter()
+        .enumerate()
+        .map(|(index, patch)| {
+            let lattice: Vec<[f64; 2]> = (0..side * side)
+                .map(|k| [(k % side) as f64 * step, (k / side) as f64 * step])
+                .collect();
+            let base = |st: [f64; 2]| {
+                [
+                    (patch.origin[0] + patch.size * st[0]).clamp(0.0, 1.0),
+                    (patch.origin[1] + patch.size * st[1]).clamp(0.0, 1.0),
+                ]
+            };
+            let reparameterized = patch
+                .reparam_valences
+                .iter()
+                .any(|&v| reparam_block(v).is_some());
+            let mut params: Vec<[f64; 2]> = lattice.iter().map(|&uv| base(uv)).collect();
+            if reparameterized {
+                params.extend(
+                    lattice
+                        .iter()
+                        .map(|&[u, v]| base(patch_parameter(patch, u, v, true))),
+                );
+            }
+            let face = patch.base_face as usize;
+            let sub = (mesh.face(face).len() != 4).then_some(patch.sub_face as usize);
+            let limit = exact.evaluate_many(face, sub, &params)?;
+            let mut out = Vec::with_capacity(2 * lattice.len());
+            for k in 0..2 * lattice.len() {
+                let at = k % lattice.len();
+                let [u, v] = lattice[at];
+                let g = plan.evaluate(&verts, index, u, v).position;
+                let p = &limit[if reparameterized { k } else { at }].position;
+                let d = (0..3).map(|c| (g[c] - p[c]).powi(2)).sum::<f64>().sqrt();
+                out.push((d / diag) as f32);
+            }
+            Ok(out)
+        })
+        .collect::<Result<_, EvalError>>()?;
+    Ok(ParamErrorLattice {
+        side,
+        errors: per_patch.concat(),
+    })
 }
 
 #[cfg(test)]

@@ -246,3 +246,97 @@ fn reparameterization_lowers_the_texture_error_on_meshes() {
         );
     }
 }
+
+/// The lattice behind `--show param-error` is Eq. 1's pointwise error: it matches a direct
+/// evaluation, is exact (≈ 0) on regular patches of a mesh without semi-sharp tags, and its
+/// reparameterized half is lower where the reparameterization applies. Per valence on spot:
+/// each Gregory patch grouped by the largest reparameterized corner valence (printed for
+/// docs/approximations.md; spot has valences 3, 5 and 6, and each must gain).
+#[test]
+fn param_error_lattice_is_eq1_pointwise() {
+    use topology::texcoord::param_error_lattice;
+    let mesh = load_obj(data("assets/spot_control_mesh.obj")).unwrap();
+    let plan = plan_single_pass(&mesh, &SinglePassOptions::default()).unwrap();
+    let lattice = param_error_lattice(&mesh, &plan, 9).unwrap();
+    assert_eq!(lattice.errors.len(), plan.patches.len() * 2 * 81);
+    let exact = LocalMesh::from_control_mesh(&mesh, LimitScheme::CatmullClark).unwrap();
+    let verts = plan.apply(&mesh.positions);
+    let d = diag(&mesh);
+    // Direct evaluation at a few lattice points of every 7th patch.
+    for (pi, p) in plan.patches.iter().enumerate().step_by(7) {
+        for (i, j) in [(0, 0), (3, 5), (8, 2), (4, 4)] {
+            let (u, v) = (i as f64 / 8.0, j as f64 / 8.0);
+            for reparam in [false, true] {
+                let [s, t] = patch_parameter(p, u, v, reparam);
+                let (bs, bt) = (p.origin[0] + p.size * s, p.origin[1] + p.size * t);
+                let face = p.base_face as usize;
+                let e = if mesh.face(face).len() == 4 {
+                    exact.evaluate(face, bs, bt)
+                } else {
+                    exact.evaluate_subface(face, p.sub_face as usize, bs, bt)
+                }
+                .unwrap()
+                .position;
+                let want = dist(plan.evaluate(&verts, pi, u, v).position, e) / d;
+                let got = lattice.at(pi, reparam, i, j) as f64;
+                assert!(
+                    (got - want).abs() <= 1e-6 * want.max(1e-3),
+                    "patch {pi} ({i}, {j}) reparam {reparam}: {got:e} != {want:e}"
+                );
+            }
+        }
+    }
+    let (mut regular_max, mut sq, mut n) = (0.0f32, [0.0f64; 2], 0usize);
+    // Per valence: [sum sq identity, sum sq reparam, max identity, max reparam, points, patches].
+    let mut per_valence = std::collections::BTreeMap::<u8, [f64; 6]>::new();
+    for (pi, p) in plan.patches.iter().enumerate() {
+        if p.kind == PatchKind::Regular {
+            regular_max = lattice
+                .patch(pi, false)
+                .iter()
+                .fold(regular_max, |m, &e| m.max(e));
+            continue;
+        }
+        let valence = *p
+            .reparam_valences
+            .iter()
+            .filter(|&&v| v != 4)
+            .max()
+            .unwrap_or(&0);
+        if valence == 0 {
+            continue;
+        }
+        let row = per_valence.entry(valence).or_default();
+        row[5] += 1.0;
+        for (k, reparam) in [false, true].into_iter().enumerate() {
+            for &e in lattice.patch(pi, reparam) {
+                let e = e as f64;
+                sq[k] += e * e;
+                row[k] += e * e;
+                row[2 + k] = row[2 + k].max(e);
+            }
+        }
+        n += 81;
+        row[4] += 81.0;
+    }
+    assert!(
+        regular_max < 1e-6,
+        "regular patches deviate by {regular_max:e}"
+    );
+    assert!(n > 0 && sq[1] < sq[0], "no gain over the mesh: {sq:?}");
+    println!("| valence | patches | RMS identity | RMS reparameterized | ratio | max identity | max reparameterized |");
+    for (v, r) in per_valence {
+        let (a, b) = ((r[0] / r[4]).sqrt(), (r[1] / r[4]).sqrt());
+        println!(
+            "| {v} | {} | {a:.2e} | {b:.2e} | {:.2} | {:.2e} | {:.2e} |",
+            r[5],
+            b / a,
+            r[2],
+            r[3]
+        );
+        assert!(
+            b < a,
+            "valence {v}: reparameterization raises the RMS error"
+        );
+    }
+}

@@ -141,7 +141,10 @@ pub struct SurfaceArgs {
     #[arg(long)]
     pub no_reparam: bool,
     /// What to colour the surface by: `param-shift` shows how far the reparameterization moves
-    /// the texture parameter (blue 0, red 0.05 of a patch and beyond).
+    /// the texture parameter (blue 0, red 0.05 of a patch and beyond); `param-error` the
+    /// pointwise texture error of Eq. 1 (seed 003's Fig. 8) with or without `--no-reparam`,
+    /// over the bbox diagonal on a log scale (blue 1e-5, green 3e-4, yellow 2e-3, red 1e-2),
+    /// computed on the CPU for the rest pose when the surface is built.
     #[arg(long, value_name = "VIEW")]
     pub show: Option<String>,
 }
@@ -335,10 +338,15 @@ impl SurfaceArgs {
         if self.height.is_some() && self.displace.is_none() {
             bail!("--height needs --displace S (the scale of the height)");
         }
-        params.show_param_shift = match self.show.as_deref() {
-            None => false,
-            Some("param-shift") => true,
-            Some(other) => bail!("--show {other}: expected param-shift"),
+        params.show = match self.show.as_deref() {
+            None => tess::surface::SurfaceShow::Shading,
+            Some(name) => match tess::surface::SurfaceShow::parse(name) {
+                Some(show) => show,
+                None => bail!(
+                    "--show {name}: expected one of {}",
+                    tess::surface::SurfaceShow::NAMES
+                ),
+            },
         };
         params.reparam = !self.no_reparam;
         params.displace = self.displace.unwrap_or(0.0);
@@ -351,6 +359,7 @@ impl SurfaceArgs {
                 Some(p) => Some(std::sync::Arc::new(tess::surface::load_height(p)?)),
                 None => None,
             },
+            param_error: params.show == tess::surface::SurfaceShow::ParamError,
         };
         params.spacing = spacing;
         params.geometric_normals = self.geometric_normals;

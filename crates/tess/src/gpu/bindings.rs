@@ -127,6 +127,10 @@ gpu_constants! {
     ADAPTIVE_HEIGHT_BINDING = 11;
     /// Per canonical corner (global vertex - `first_corner`): `uvec2(patch, corner)` of the patch whose evaluation defines its normal and texture coordinate.
     ADAPTIVE_CORNER_OWNERS_BINDING = 12;
+    /// Per patch: the Eq. 1 error lattice (`float`, `ADAPTIVE_PARAM_ERROR_SIDE`² without then with the reparameterization); one 0 when not built.
+    ADAPTIVE_PARAM_ERROR_BINDING = 13;
+    /// Lattice points per patch side of the Eq. 1 error view.
+    ADAPTIVE_PARAM_ERROR_SIDE = 9;
     /// Work-group size of the adaptive stencil kernel.
     ADAPTIVE_LOCAL_SIZE = 64;
     /// Patch kinds (low 4 bits of `AdaptivePatch::info`): bicubic B-spline,
@@ -157,6 +161,8 @@ gpu_constants! {
     ADAPTIVE_OPTION_HEIGHT_MAP = 64;
     /// `options` bit: colour by the parameter shift |s(u, v) - (u, v)| of the reparameterization.
     ADAPTIVE_OPTION_SHOW_PARAM_SHIFT = 128;
+    /// `options` bit: colour by the pointwise Eq. 1 texture error (seed 003, Fig. 8).
+    ADAPTIVE_OPTION_SHOW_PARAM_ERROR = 256;
     /// Capture flags of the adaptive TES: patch kind in bits 0..3, level above.
     ADAPTIVE_FLAG_LEVEL_SHIFT = 4;
     /// Capture flag: the point lies on a patch boundary and came from its canonical curve.

@@ -379,6 +379,17 @@ impl GpuAdaptive {
             .collect()
     }
 
+    /// The Eq. 1 error lattice (`--show param-error`) in array order: per record, the
+    /// identity's lattice then the reparameterized one.
+    pub fn param_errors(&self, lattice: &topology::texcoord::ParamErrorLattice) -> Vec<f32> {
+        let mut out = Vec::with_capacity(lattice.errors.len());
+        for &pi in &self.order {
+            out.extend_from_slice(lattice.patch(pi as usize, false));
+            out.extend_from_slice(lattice.patch(pi as usize, true));
+        }
+        out
+    }
+
     /// Bytes of tables on the GPU (stencils, patch records, control points, curves), without
     /// the vertex buffer.
     pub fn table_bytes(&self) -> usize {

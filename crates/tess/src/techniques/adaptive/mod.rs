@@ -44,12 +44,13 @@ use crate::gpu::bindings::{
 use crate::gpu::bindings::{
     ADAPTIVE_CORNER_OWNERS_BINDING, ADAPTIVE_CURVE_OWNERS_BINDING, ADAPTIVE_HEIGHT_BINDING,
     ADAPTIVE_OPTION_DISPLACE, ADAPTIVE_OPTION_HEIGHT_MAP, ADAPTIVE_OPTION_REPARAM,
-    ADAPTIVE_OPTION_SHOW_PARAM_SHIFT, ADAPTIVE_OPTION_TEXTURE, ADAPTIVE_REPARAM_BINDING,
+    ADAPTIVE_OPTION_SHOW_PARAM_ERROR, ADAPTIVE_OPTION_SHOW_PARAM_SHIFT, ADAPTIVE_OPTION_TEXTURE,
+    ADAPTIVE_PARAM_ERROR_BINDING, ADAPTIVE_PARAM_ERROR_SIDE, ADAPTIVE_REPARAM_BINDING,
     ADAPTIVE_SURFACES_BINDING, ADAPTIVE_TEXTURE_BINDING,
 };
 use crate::gpu::AdaptivePush;
 use crate::shaders::{self, Stage, Variant};
-use crate::surface::{SurfaceImage, SurfaceMaps};
+use crate::surface::{SurfaceImage, SurfaceMaps, SurfaceShow};
 use crate::technique::{
     for_each_draw, number_arrays, DrawCounts, FactorPolicy, FrameParams, Pass, PatchArray,
     PatchPipeline, PatchType, Technique, TechniqueId,
@@ -69,7 +70,7 @@ use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Encoder, MemoryLocation};
 pub const DEFAULT_ISOLATION: u32 = 4;
 
 /// Set 1 of every adaptive pipeline.
-static SET_BINDINGS: [BindingDesc; 13] = [
+static SET_BINDINGS: [BindingDesc; 14] = [
     storage_binding(ADAPTIVE_BASE_POSITIONS_BINDING),
     storage_binding(ADAPTIVE_STENCIL_OFFSETS_BINDING),
     storage_binding(ADAPTIVE_STENCIL_TERMS_BINDING),
@@ -81,6 +82,7 @@ static SET_BINDINGS: [BindingDesc; 13] = [
     storage_binding(ADAPTIVE_REPARAM_BINDING),
     storage_binding(ADAPTIVE_CURVE_OWNERS_BINDING),
     storage_binding(ADAPTIVE_CORNER_OWNERS_BINDING),
+    storage_binding(ADAPTIVE_PARAM_ERROR_BINDING),
     sampler_binding(ADAPTIVE_TEXTURE_BINDING),
     sampler_binding(ADAPTIVE_HEIGHT_BINDING),
 ];
@@ -265,6 +267,8 @@ pub struct Adaptive {
     rest_bbox: ([f32; 3], [f32; 3]),
     pub options: AdaptiveBuild,
     max_level: f32,
+    /// The Eq. 1 error lattice was built (`SurfaceMaps::param_error`).
+    has_param_errors: bool,
 }
 
 impl Adaptive {
@@ -325,6 +329,27 @@ impl Adaptive {
                 location: MemoryLocation::GpuOnly,
             },
         )?;
+        // One 0 stands in when the lattice is not asked for (the view is then refused).
+        let param_errors = if options.maps.param_error {
+            let lattice = topology::texcoord::param_error_lattice(
+                mesh,
+                &plan,
+                ADAPTIVE_PARAM_ERROR_SIDE as usize,
+            )
+            .map_err(|e| TessError::Mesh {
+                name: options.name.clone(),
+                source: e.into(),
+            })?;
+            gpu.param_errors(&lattice)
+        } else {
+            Vec::new()
+        };
+        let has_param_errors = !param_errors.is_empty();
+        let param_errors = if has_param_errors {
+            param_errors
+        } else {
+            vec![0.0f32]
+        };
         let statics = vec![
             (ADAPTIVE_VERTICES_BINDING, vertices),
             (
@@ -397,6 +422,14 @@ impl Adaptive {
                     &device,
                     "adaptive corner owners",
                     bytemuck::cast_slice(&gpu.corner_owners),
+                )?,
+            ),
+            (
+                ADAPTIVE_PARAM_ERROR_BINDING,
+                storage(
+                    &device,
+                    "adaptive Eq. 1 error lattice",
+                    bytemuck::cast_slice(&param_errors),
                 )?,
             ),
         ];
@@ -495,6 +528,7 @@ impl Adaptive {
             base_positions,
             options: options.clone(),
             max_level,
+            has_param_errors,
         })
     }
 
@@ -522,7 +556,11 @@ impl Adaptive {
         if params.patch_colours {
             options |= ADAPTIVE_OPTION_PATCH_COLOURS;
         }
-        if self.options.maps.texture.is_some() && !params.patch_colours {
+        let show = params.show;
+        if self.options.maps.texture.is_some()
+            && !params.patch_colours
+            && show == SurfaceShow::Shading
+        {
             options |= ADAPTIVE_OPTION_TEXTURE;
         }
         if params.reparam {
@@ -534,8 +572,10 @@ impl Adaptive {
         if self.options.maps.height.is_some() {
             options |= ADAPTIVE_OPTION_HEIGHT_MAP;
         }
-        if params.show_param_shift {
-            options |= ADAPTIVE_OPTION_SHOW_PARAM_SHIFT;
+        match show {
+            SurfaceShow::Shading => {}
+            SurfaceShow::ParamShift => options |= ADAPTIVE_OPTION_SHOW_PARAM_SHIFT,
+            SurfaceShow::ParamError => options |= ADAPTIVE_OPTION_SHOW_PARAM_ERROR,
         }
         if fractional {
             options |= ADAPTIVE_OPTION_FRACTIONAL;
@@ -639,6 +679,12 @@ impl Technique for Adaptive {
 
     /// [`check_frame`] with the device's maximum level.
     fn check(&self, params: &FrameParams) -> Result<()> {
+        if params.show == SurfaceShow::ParamError && !self.has_param_errors {
+            return Err(TessError::Unsupported {
+                technique: self.id,
+                what: "--show param-error on a surface built without its Eq. 1 error lattice (build with SurfaceMaps::param_error)",
+            });
+        }
         check_frame(Some(self.factor_limit()), params)
     }
 
