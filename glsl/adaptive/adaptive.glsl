@@ -42,7 +42,7 @@ layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_CURVES_BINDING) readonly b
 struct PatchSurface {
     vec2 uv[4];         // corners (0,0), (1,0), (1,1), (0,1)
     uint reparam_rows;  // 8 bits per corner: row of reparam_rows[] (0 = identity)
-    uint pad0;
+    uint tangent_valences; // ACC-1: 8 bits per corner, its valence (tangent patches); else 0
     uint pad1;
     uint pad2;
 };

@@ -100,9 +100,66 @@ void bspline3(float t, out vec4 b, out vec4 d) {
     d = vec4(-3.0 * s * s, 9.0 * t * t - 12.0 * t, -9.0 * t * t + 6.0 * t + 3.0, 3.0 * t * t) / 6.0;
 }
 
+// ACC-1 shading normal from the two tangent patches (Loop & Schaefer 2008); mirrors
+// topology::acc::tangent_normal (see there for the construction). Reads the patch's 28 points
+// from the global vertex buffer: the Gregory form of the Bezier net (20), then per corner the
+// limit-tangent points Ep, Em. `valences`: 8 bits per corner.
+vec3 acc_tangent_normal(uint id, uint valences, vec2 uv) {
+    uint o = patches[id].cp_offset;
+    vec3 c[28];
+    for (uint k = 0u; k < 28u; ++k) c[k] = vtx(control_points[o + k]);
+    vec3 b[16];  // b[i + 4 j], i along u
+    b[0] = c[0];  b[1] = c[1];  b[4] = c[2];  b[5] = c[3];
+    b[3] = c[5];  b[7] = c[6];  b[2] = c[7];  b[6] = c[8];
+    b[15] = c[10]; b[14] = c[11]; b[11] = c[12]; b[10] = c[13];
+    b[12] = c[15]; b[8] = c[16]; b[13] = c[17]; b[9] = c[18];
+    // Limit tangents as derivatives along +u / +v at corners 00, 10, 11, 01.
+    vec3 tu00 = 3.0 * (c[20] - c[0]), tv00 = 3.0 * (c[21] - c[0]);
+    vec3 tv10 = 3.0 * (c[22] - c[5]), tu10 = -3.0 * (c[23] - c[5]);
+    vec3 tu11 = -3.0 * (c[24] - c[10]), tv11 = -3.0 * (c[25] - c[10]);
+    vec3 tv01 = -3.0 * (c[26] - c[15]), tu01 = 3.0 * (c[27] - c[15]);
+    vec4 cs;
+    for (uint k = 0u; k < 4u; ++k) {
+        float n = float((valences >> (8u * k)) & 255u);
+        cs[k] = n == 0.0 ? 0.0 : cos(6.28318530718 / n);
+    }
+    float c00 = cs.x, c10 = cs.y, c11 = cs.z, c01 = cs.w;
+    // u-tangent patch U[i][j] (quadratic in u), v-tangent patch V[i][j] (quadratic in v).
+    vec3 U[12], V[12];  // U[i + 3 j], V[i + 4 j]
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 3; ++i) U[i + 3 * j] = 3.0 * (b[i + 1 + 4 * j] - b[i + 4 * j]);
+    for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 4; ++i) V[i + 4 * j] = 3.0 * (b[i + 4 * (j + 1)] - b[i + 4 * j]);
+    U[0] = tu00; U[2] = tu10; U[9] = tu01; U[11] = tu11;
+    V[0] = tv00; V[8] = tv01; V[3] = tv10; V[11] = tv11;
+    // Half of lambda T's inner control vectors: (-c1 T0 + 2 c0 T1) / 3, (-2 c1 T1 + c0 T2) / 3.
+    vec3 m;
+    m = 3.0 * (b[8] - b[4]);
+    U[3] += (-c01 * tv00 + 2.0 * c00 * m) / 3.0;  U[6] += (-2.0 * c01 * m + c00 * tv01) / 3.0;
+    m = 3.0 * (b[11] - b[7]);
+    U[5] -= (-c11 * tv10 + 2.0 * c10 * m) / 3.0;  U[8] -= (-2.0 * c11 * m + c10 * tv11) / 3.0;
+    m = 3.0 * (b[2] - b[1]);
+    V[1] += (-c10 * tu00 + 2.0 * c00 * m) / 3.0;  V[2] += (-2.0 * c10 * m + c00 * tu10) / 3.0;
+    m = 3.0 * (b[14] - b[13]);
+    V[9] -= (-c11 * tu01 + 2.0 * c01 * m) / 3.0;  V[10] -= (-2.0 * c11 * m + c01 * tu11) / 3.0;
+    float u = uv.x, v = uv.y, su = 1.0 - u, sv = 1.0 - v;
+    vec3 qu = vec3(su * su, 2.0 * u * su, u * u), qv = vec3(sv * sv, 2.0 * v * sv, v * v);
+    vec4 cu = vec4(su * su * su, 3.0 * u * su * su, 3.0 * u * u * su, u * u * u);
+    vec4 cv = vec4(sv * sv * sv, 3.0 * v * sv * sv, 3.0 * v * v * sv, v * v * v);
+    // precise: owner_normal returns this, and every TES must get the same bits.
+    precise vec3 du = vec3(0.0), dv = vec3(0.0);
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 3; ++i) du += (qu[i] * cv[j]) * U[i + 3 * j];
+    for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 4; ++i) dv += (cu[i] * qv[j]) * V[i + 4 * j];
+    return safe_normalize(cross(du, dv), vec3(0.0, 0.0, 1.0));
+}
+
 // The owner evaluation: the normal of patch `id` at `uv`, from the global vertex buffer, one
 // operand order, `precise` (every TES that includes this gets the same bits).
 vec3 owner_normal(uint id, vec2 uv) {
+    uint tangent_valences = surfaces[id].tangent_valences;
+    if (tangent_valences != 0u) return acc_tangent_normal(id, tangent_valences, uv);
     AdaptivePatch p = patches[id];
     uint kind = patch_kind(p);
     precise vec3 du = vec3(0.0), dv = vec3(0.0);

@@ -34,6 +34,9 @@ void main() {
         pos = canonical_edge_point(p, 3u, 1.0 - uv.y, gl_TessLevelOuter[0], !fractional_factors() || edge_kind(p, 3u) != ADAPTIVE_EDGE_PLAIN, curve, s);
     }
     vec3 n = safe_normalize(cross(du, dv), vec3(0.0, 0.0, 1.0));
+    // ACC-1 patches shade with their tangent patches' normal field (continuous across edges).
+    uint tangent_valences = surfaces[tc_patch].tangent_valences;
+    if (tangent_valences != 0u) n = acc_tangent_normal(tc_patch, tangent_valences, uv);
     vec2 tex = patch_texcoord(tc_patch, uv);
     out_texcoord = tex;
     if ((adaptive.options & uint(ADAPTIVE_OPTION_DISPLACE)) != 0u) {

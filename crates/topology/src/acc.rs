@@ -164,3 +164,115 @@ pub fn evaluate(net: &[[Stencil; 4]; 4], points: &[[f64; 3]], u: f64, v: f64) ->
     }
     out
 }
+
+/// Bernstein values of degree 2 and 3 at `t`.
+fn bernstein23(t: f64) -> ([f64; 3], [f64; 4]) {
+    let s = 1.0 - t;
+    (
+        [s * s, 2.0 * t * s, t * t],
+        [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t],
+    )
+}
+
+/// The shading normal of an ACC-1 patch from its two tangent patches (Loop & Schaefer 2008):
+/// the `u`-tangent patch is quadratic in `u`, cubic in `v`, the `v`-tangent patch the
+/// transpose, their cross product the normal.
+///
+/// `points` is the patch in the plan's layout (`AdaptivePatch::tangent_valences`): the 20
+/// points of the Gregory form of the Bézier net (per corner `P, Ep, Em, Fp, Fm`), then per
+/// corner the limit-tangent points `Ep, Em` of [`crate::gregory`]; `valences` the corners'.
+///
+/// Construction: start from the geometry patch's derivative. On the patch's own boundary the
+/// tangent along the edge becomes the quadratic [corner limit tangent, middle derivative,
+/// corner limit tangent], shared by both faces of the edge. Across an edge, ACC-1's inner
+/// cross-boundary derivatives of the two faces cancel (an edge point is the midpoint of the
+/// two inner points), while at the ends the limit tangents sum to `2 cos(2π/n)` times the edge
+/// tangent. Each side adds half of `λ(t)·T(t)`, with `λ` linear from `2 cos(2π/n₀)` to
+/// `−2 cos(2π/n₁)` and `T` the edge tangent, so the two cross-boundary derivatives sum to `λ·T`
+/// along the whole edge: the normals of both faces agree there. At valence 4 nothing is added
+/// and the tangent patches are the geometry patch's derivatives.
+pub fn tangent_normal(points: &[[f64; 3]; 28], valences: [u8; 4], u: f64, v: f64) -> [f64; 3] {
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let scale = |a: [f64; 3], s: f64| [a[0] * s, a[1] * s, a[2] * s];
+    let add = |a: [f64; 3], b: [f64; 3]| [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+    // Bézier net b[i][j] from the Gregory form (slots as in the plan's assembly).
+    const SLOTS: [[(usize, usize); 4]; 4] = [
+        [(0, 0), (1, 0), (0, 1), (1, 1)],
+        [(3, 0), (3, 1), (2, 0), (2, 1)],
+        [(3, 3), (2, 3), (3, 2), (2, 2)],
+        [(0, 3), (0, 2), (1, 3), (1, 2)],
+    ];
+    let mut b = [[[0.0; 3]; 4]; 4];
+    for (c, slots) in SLOTS.iter().enumerate() {
+        for (k, &(i, j)) in slots.iter().enumerate() {
+            b[i][j] = points[5 * c + k];
+        }
+    }
+    // Limit tangents per corner, as derivatives along +u / +v.
+    let t = |c: usize, k: usize, sign: f64| {
+        scale(sub(points[20 + 2 * c + k], points[5 * c]), 3.0 * sign)
+    };
+    let (tu00, tv00) = (t(0, 0, 1.0), t(0, 1, 1.0));
+    let (tv10, tu10) = (t(1, 0, 1.0), t(1, 1, -1.0));
+    let (tu11, tv11) = (t(2, 0, -1.0), t(2, 1, -1.0));
+    let (tv01, tu01) = (t(3, 0, -1.0), t(3, 1, 1.0));
+    let c = valences.map(|n| {
+        if n == 0 {
+            0.0
+        } else {
+            (std::f64::consts::TAU / n as f64).cos()
+        }
+    });
+    let (c00, c10, c11, c01) = (c[0], c[1], c[2], c[3]);
+    // Half of λ·T's two inner cubic control vectors, λ from c0 (start) to −c1 (end).
+    let half_lambda_t = |t0: [f64; 3], t1: [f64; 3], t2: [f64; 3], c0: f64, c1: f64| {
+        (
+            scale(add(scale(t0, -c1), scale(t1, 2.0 * c0)), 1.0 / 3.0),
+            scale(add(scale(t1, -2.0 * c1), scale(t2, c0)), 1.0 / 3.0),
+        )
+    };
+    // u-tangent patch U[i][j], i = 0..3 (quadratic in u), j = 0..4.
+    let mut tu = [[[0.0; 3]; 4]; 3];
+    for (i, row) in tu.iter_mut().enumerate() {
+        for (j, x) in row.iter_mut().enumerate() {
+            *x = scale(sub(b[i + 1][j], b[i][j]), 3.0);
+        }
+    }
+    tu[0][0] = tu00;
+    tu[2][0] = tu10;
+    tu[0][3] = tu01;
+    tu[2][3] = tu11;
+    let mid = |a: [f64; 3], b2: [f64; 3]| scale(sub(b2, a), 3.0);
+    let (a1, a2) = half_lambda_t(tv00, mid(b[0][1], b[0][2]), tv01, c00, c01);
+    tu[0][1] = add(tu[0][1], a1);
+    tu[0][2] = add(tu[0][2], a2);
+    let (a1, a2) = half_lambda_t(tv10, mid(b[3][1], b[3][2]), tv11, c10, c11);
+    tu[2][1] = sub(tu[2][1], a1);
+    tu[2][2] = sub(tu[2][2], a2);
+    // v-tangent patch V[i][j], i = 0..4, j = 0..3 (quadratic in v).
+    let mut tv = [[[0.0; 3]; 3]; 4];
+    for (i, col) in tv.iter_mut().enumerate() {
+        for (j, x) in col.iter_mut().enumerate() {
+            *x = scale(sub(b[i][j + 1], b[i][j]), 3.0);
+        }
+    }
+    tv[0][0] = tv00;
+    tv[0][2] = tv01;
+    tv[3][0] = tv10;
+    tv[3][2] = tv11;
+    let (a1, a2) = half_lambda_t(tu00, mid(b[1][0], b[2][0]), tu10, c00, c10);
+    tv[1][0] = add(tv[1][0], a1);
+    tv[2][0] = add(tv[2][0], a2);
+    let (a1, a2) = half_lambda_t(tu01, mid(b[1][3], b[2][3]), tu11, c01, c11);
+    tv[1][2] = sub(tv[1][2], a1);
+    tv[2][2] = sub(tv[2][2], a2);
+    let ((qu, cu), (qv, cv)) = (bernstein23(u), bernstein23(v));
+    let (mut du, mut dv) = ([0.0; 3], [0.0; 3]);
+    for i in 0..3 {
+        for j in 0..4 {
+            du = add(du, scale(tu[i][j], qu[i] * cv[j]));
+            dv = add(dv, scale(tv[j][i], cu[j] * qv[i]));
+        }
+    }
+    crate::eval::normal_of(&du, &dv)
+}

@@ -235,6 +235,10 @@ pub struct AdaptivePatch {
     /// ([`crate::reparam`]), 0 for the identity (regular and ACC-1 patches, boundary, crease and
     /// corner vertices). Gregory patches only: the table is fitted to them.
     pub reparam_valences: [u8; 4],
+    /// ACC-1 patches (Gregory kind, 28 control points: the net's 20, then per corner the limit
+    /// tangent points `Ep, Em` of [`crate::gregory`]): each corner's valence, for the tangent
+    /// patches that shade them ([`crate::acc::tangent_normal`]); `[0; 4]` on every other patch.
+    pub tangent_valences: [u8; 4],
 }
 
 /// Everything a device needs to draw the feature-adaptive limit surface.
@@ -402,6 +406,19 @@ impl AdaptivePlan {
         };
         let (p, d) = self.curve_sample(verts, e.curves[k] as usize, s);
         (p, d.map(|x| x * sign * scale))
+    }
+
+    /// The shading normal of patch `patch` at `(u, v)`: from the tangent patches on ACC-1
+    /// patches ([`crate::acc::tangent_normal`]), else the unit cross product of the
+    /// derivatives of [`Self::evaluate`].
+    pub fn shading_normal(&self, verts: &[[f64; 3]], patch: usize, u: f64, v: f64) -> [f64; 3] {
+        let pa = &self.patches[patch];
+        if pa.tangent_valences != [0; 4] && pa.control_points.len() == 28 {
+            let points = std::array::from_fn(|k| verts[pa.control_points[k] as usize]);
+            return crate::acc::tangent_normal(&points, pa.tangent_valences, u, v);
+        }
+        let s = self.evaluate(verts, patch, u, v);
+        crate::eval::normal_of(&s.du, &s.dv)
     }
 
     /// CPU evaluation of patch `patch` at `(u, v) ∈ [0,1]²` on the global vertex buffer

@@ -166,7 +166,7 @@ pub(super) fn assemble(
                         EndCap::Bilinear => PatchKind::Bilinear,
                     };
                     if d.kind == PatchKind::Gregory {
-                        d.gregory = Some(match acc.then(|| acc_points(lvl, f, shift)) {
+                        d.gregory = Some(match acc.then(|| acc_points(mesh, lvl, f, shift)) {
                             Some(Ok(points)) => {
                                 d.acc = true;
                                 points
@@ -232,7 +232,7 @@ pub(super) fn assemble(
             }
         } else if let Some(g) = &d.gregory {
             for (k, row) in g.iter().enumerate() {
-                if k % 5 == 0 {
+                if k < 20 && k % 5 == 0 {
                     // P: the canonical corner, filled below.
                     cps.push(INVALID);
                 } else {
@@ -257,6 +257,14 @@ pub(super) fn assemble(
             edges: [blank_edge; 4],
             reparam_valences: if d.kind == PatchKind::Gregory && !d.acc {
                 reparam_valences(&levels[d.level as usize], d.face as usize, d.shift)
+            } else {
+                [0; 4]
+            },
+            tangent_valences: if d.acc {
+                let lvl = &levels[d.level as usize];
+                rotated(lvl.t(), d.face as usize, d.shift)
+                    .0
+                    .map(|v| lvl.t().vertex_edges(v as usize).len().min(255) as u8)
             } else {
                 [0; 4]
             },
@@ -680,13 +688,18 @@ fn reparam_valences(lvl: &Lvl, f: usize, shift: u8) -> [u8; 4] {
 
 /// ACC-1's 16 Bézier points of face `f` as a Gregory patch's 20 (global ids, patch corner
 /// order): each corner's `Fp` and `Fm` are both its inner Bézier point, which makes the
-/// Gregory patch that bicubic Bézier patch. Fails outside ACC-1's scope ([`crate::acc`]).
+/// Gregory patch that bicubic Bézier patch. Then 8 more: per patch corner the Gregory edge
+/// points `Ep, Em`, which lie on the limit tangents, for the tangent patches
+/// ([`crate::acc::tangent_normal`]). Fails outside ACC-1's scope ([`crate::acc`]).
 pub(super) fn acc_points(
+    mesh: &ControlMesh,
     lvl: &Lvl,
     f: usize,
     shift: u8,
 ) -> Result<Vec<Vec<(u32, f64)>>, TopologyError> {
     let net = crate::acc::acc1_patch(lvl.topo.view(), f)?;
+    let basis = crate::gregory::gregory_basis(lvl.topo.view(), f, &mesh.options)?;
+    let tangents = rotated_points(lvl.base, shift, |corner, j| &basis[5 * corner + j]);
     // Per face corner: the Bézier (i, j) of P, Ep, Em, F (module docs of crate::gregory).
     const SLOTS: [[(usize, usize); 4]; 4] = [
         [(0, 0), (1, 0), (0, 1), (1, 1)],
@@ -694,10 +707,14 @@ pub(super) fn acc_points(
         [(3, 3), (2, 3), (3, 2), (2, 2)],
         [(0, 3), (0, 2), (1, 3), (1, 2)],
     ];
-    Ok(rotated_points(lvl.base, shift, |corner, j| {
+    let mut points = rotated_points(lvl.base, shift, |corner, j| {
         let (bi, bj) = SLOTS[corner][j.min(3)];
         &net[bi][bj]
-    }))
+    });
+    for corner in 0..4 {
+        points.extend_from_slice(&tangents[5 * corner + 1..5 * corner + 3]);
+    }
+    Ok(points)
 }
 
 #[cfg(test)]

@@ -54,7 +54,10 @@ pub struct PatchSurface {
     pub uv: [[f32; 2]; 4],
     /// Per corner `i`, 8 bits at `8i`: its row of the reparameterization table (0 = identity).
     pub reparam_rows: u32,
-    pub pad: [u32; 3],
+    /// ACC-1 patches: per corner `i`, 8 bits at `8i`, its valence for the tangent patches
+    /// (`topology::acc::tangent_normal`); 0 on every other patch.
+    pub tangent_valences: u32,
+    pub pad: [u32; 2],
 }
 
 /// `CurveOwner` of `adaptive.glsl`: the patch whose evaluation along a canonical curve gives
@@ -247,7 +250,9 @@ impl GpuAdaptive {
         for &pi in &order {
             let p = &plan.patches[pi as usize];
             counts[kind_code(p.kind) as usize] += 1;
-            let need = control_point_count(p.kind);
+            // ACC-1 patches carry 8 limit-tangent points past their 20 (tangent patches).
+            let tangents = p.kind == PatchKind::Gregory && p.tangent_valences != [0; 4];
+            let need = control_point_count(p.kind) + if tangents { 8 } else { 0 };
             if p.control_points.len() != need {
                 return Err(LayoutError::Index {
                     what: "control points of a patch",
@@ -370,10 +375,18 @@ impl GpuAdaptive {
                 for (i, &v) in p.reparam_valences.iter().enumerate() {
                     rows |= topology::texcoord::reparam_row(v) << (8 * i);
                 }
+                // Tangent patches read 8 points past the 20 (checked in `new`).
+                let mut tangent_valences = 0u32;
+                if p.control_points.len() == 28 {
+                    for (i, &v) in p.tangent_valences.iter().enumerate() {
+                        tangent_valences |= (v as u32) << (8 * i);
+                    }
+                }
                 PatchSurface {
                     uv: uv.map(f32x2),
                     reparam_rows: rows,
-                    pad: [0; 3],
+                    tangent_valences,
+                    pad: [0; 2],
                 }
             })
             .collect()
