@@ -295,7 +295,7 @@ fn checker() -> tessera::tess::surface::SurfaceImage {
     let mut texels = Vec::with_capacity((N * N * 4) as usize);
     for y in 0..N {
         for x in 0..N {
-            let v = if (x / CELL + y / CELL) % 2 == 0 {
+            let v = if (x / CELL + y / CELL).is_multiple_of(2) {
                 230
             } else {
                 40
