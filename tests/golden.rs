@@ -1,5 +1,6 @@
 //! Golden images: each method on three meshes at a fixed level, with the wireframe overlay so
-//! the tessellation itself is visible. Regenerate with TESSERA_UPDATE_GOLDEN=1.
+//! the tessellation itself is visible; BFT and adaptive goldens; textured, reparameterized and
+//! displaced spot (gregory). Regenerate with TESSERA_UPDATE_GOLDEN=1.
 mod common;
 use common::Gpu;
 use tessera::tess::{Context, FrameParams, TechniqueId};
@@ -266,4 +267,208 @@ fn adaptive_golden_images_match_and_detect_an_isolation_change() {
             "{name}: an isolation change passed the tolerance ({changed:.5})"
         );
     }
+}
+
+/// Spot through `--method gregory` with a colour texture: its own (assets/spot_texture.png) and
+/// a fine checker (the seed paper's Fig. 1: a checker shows every texel the reparameterization
+/// moves), each with the reparameterization on and off, and displaced by its height map. Zoomed
+/// on the neck and face, where the extraordinary vertices (and the reparameterized Gregory
+/// patches) are.
+const SURFACE_EXTENT: vk::Extent2D = vk::Extent2D {
+    width: 320,
+    height: 240,
+};
+const SURFACE_CAMERA: tessera::tess::Camera = tessera::tess::Camera {
+    yaw: 30.0,
+    pitch: 15.0,
+    zoom: 2.5,
+    fov_y_degrees: 40.0,
+};
+const SURFACE_SEGMENTS: f32 = 8.0;
+/// Displacement scale of the displaced golden, as a fraction of the bbox diagonal (height 1).
+const SURFACE_DISPLACE: f32 = 0.03;
+
+/// A 512 × 512 checker of 4-texel cells (128 across the texture atlas), light and dark grey.
+fn checker() -> tessera::tess::surface::SurfaceImage {
+    const N: u32 = 512;
+    const CELL: u32 = 4;
+    let mut texels = Vec::with_capacity((N * N * 4) as usize);
+    for y in 0..N {
+        for x in 0..N {
+            let v = if (x / CELL + y / CELL).is_multiple_of(2) {
+                230
+            } else {
+                40
+            };
+            texels.extend_from_slice(&[v, v, v, 255]);
+        }
+    }
+    tessera::tess::surface::SurfaceImage {
+        name: "checker".into(),
+        width: N,
+        height: N,
+        format: tessera::vk_core::texture::TextureFormat::Rgba8Srgb,
+        texels,
+    }
+}
+
+/// The surface goldens, in the order: textured, textured without reparameterization,
+/// displaced (textured, height map), checker, checker without reparameterization.
+fn render_surface() -> Vec<(String, Rgba8)> {
+    use std::sync::Arc;
+    use tessera::tess::surface::{load_height, load_texture, SurfaceMaps};
+    let gpu = Gpu::new();
+    let mut ctx = Context::offscreen(gpu.device()).unwrap();
+    let mesh = tessera::topology::load_obj(common::data("assets/spot_control_mesh.obj")).unwrap();
+    let texture = Arc::new(load_texture(common::data("assets/spot_texture.png")).unwrap());
+    let height = Arc::new(load_height(common::data("assets/spot_height.png")).unwrap());
+    let mut build = |maps: SurfaceMaps| {
+        let options = tessera::tess::BuildOptions {
+            name: "spot".into(),
+            maps,
+            ..Default::default()
+        };
+        tessera::tess::build(&mut ctx, TechniqueId::Gregory, &mesh, &options)
+            .unwrap()
+            .technique
+    };
+    let textured = build(SurfaceMaps {
+        texture: Some(texture),
+        height: Some(height),
+    });
+    let checkered = build(SurfaceMaps {
+        texture: Some(Arc::new(checker())),
+        height: None,
+    });
+    let (lo, hi) = textured.bbox();
+    let diag = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f32>().sqrt();
+    let mut out = Vec::new();
+    for (name, surf, reparam, displace) in [
+        ("spot_gregory_textured", &textured, true, 0.0),
+        ("spot_gregory_textured_no_reparam", &textured, false, 0.0),
+        (
+            "spot_gregory_displaced",
+            &textured,
+            true,
+            SURFACE_DISPLACE * diag,
+        ),
+        ("spot_gregory_checker", &checkered, true, 0.0),
+        ("spot_gregory_checker_no_reparam", &checkered, false, 0.0),
+    ] {
+        let params = FrameParams {
+            reparam,
+            displace,
+            camera: SURFACE_CAMERA,
+            ..FrameParams::uniform(SURFACE_SEGMENTS)
+        };
+        let img = ctx
+            .render_offscreen(surf.as_ref(), &params, SURFACE_EXTENT)
+            .unwrap();
+        out.push((name.to_owned(), img));
+    }
+    out
+}
+
+/// The fraction of pixels where any channel moves by more than `threshold`.
+fn fraction_above(a: &Rgba8, b: &Rgba8, threshold: u8) -> f64 {
+    let n = a
+        .pixels
+        .chunks(4)
+        .zip(b.pixels.chunks(4))
+        .filter(|(p, q)| {
+            p.iter()
+                .zip(q.iter())
+                .any(|(x, y)| x.abs_diff(*y) > threshold)
+        })
+        .count();
+    n as f64 / (a.width * a.height) as f64
+}
+
+/// The fraction of pixels covered by the surface in one image and background in the other
+/// (the silhouette moved): background is the clear colour, the top-left pixel of both.
+fn silhouette_change(a: &Rgba8, b: &Rgba8) -> f64 {
+    let bg = &a.pixels[..4];
+    assert_eq!(
+        bg,
+        &b.pixels[..4],
+        "the top-left pixel is background in both"
+    );
+    let n = a
+        .pixels
+        .chunks(4)
+        .zip(b.pixels.chunks(4))
+        .filter(|(p, q)| (*p == bg) != (*q == bg))
+        .count();
+    n as f64 / (a.width * a.height) as f64
+}
+
+/// Surface goldens: each matches its golden run to run; the reparameterization switched off
+/// is seen (the checker's golden fails it under the golden tolerance; spot's own texture moves
+/// fewer pixels, so its pair is compared directly with a finer threshold); displacement moves
+/// the silhouette.
+#[test]
+fn surface_golden_images_match_and_show_reparameterization_and_displacement() {
+    let first = render_surface();
+    let dir = common::data("tests/data/golden");
+    if std::env::var_os("TESSERA_UPDATE_GOLDEN").is_some() {
+        for (name, img) in &first {
+            img.save_png(&dir.join(format!("{name}.png"))).unwrap();
+        }
+    }
+    let second = render_surface();
+    let mut golden = Vec::new();
+    for ((name, a), (_, b)) in first.iter().zip(&second) {
+        let g = Rgba8::load_png(&dir.join(format!("{name}.png")))
+            .unwrap_or_else(|e| panic!("{name}: {e} (TESSERA_UPDATE_GOLDEN=1 writes it)"));
+        let d1 = differing_fraction(a, &g);
+        let d2 = differing_fraction(b, &g);
+        let noise = fraction_above(a, b, 4);
+        eprintln!("{name}: run 1 {d1:.5}, run 2 {d2:.5}; run 1 vs run 2 (> 4/255) {noise:.5}");
+        assert!(
+            d1 <= TOLERANCE && d2 <= TOLERANCE,
+            "{name}: differs from golden ({d1:.5}, {d2:.5})"
+        );
+        golden.push(g);
+    }
+    let [textured, textured_off, displaced, checker, checker_off] = &first[..] else {
+        panic!("five surface images");
+    };
+    // Reparameterization off against the reparameterized golden.
+    let checker_golden = differing_fraction(&checker_off.1, &golden[3]);
+    let textured_golden = differing_fraction(&textured_off.1, &golden[0]);
+    // The pairs within one run (run to run the images are identical on lavapipe).
+    let textured_fine = fraction_above(&textured.1, &textured_off.1, 8);
+    let checker_fine = fraction_above(&checker.1, &checker_off.1, 8);
+    eprintln!(
+        "reparameterization off vs on: checker {checker_golden:.5} against its golden \
+         (> 24/255; tolerance {TOLERANCE}), {checker_fine:.5} (> 8/255); spot texture \
+         {textured_golden:.5} against its golden (> 24/255), {textured_fine:.5} (> 8/255)"
+    );
+    // Measured 0.0094 (> 24/255) and 0.036 (> 8/255) on lavapipe; identical renders give 0.
+    assert!(
+        checker_golden > TOLERANCE && checker_fine > 0.01,
+        "the checker without reparameterization passes the reparameterized golden \
+         ({checker_golden:.5}, {checker_fine:.5}): the reparameterization no longer shows"
+    );
+    // Measured 0.0022 on lavapipe; identical renders give 0.
+    assert!(
+        textured_fine > 0.0005,
+        "spot's texture moves too few pixels without reparameterization ({textured_fine:.5})"
+    );
+    let moved = silhouette_change(&textured.1, &displaced.1);
+    let changed = differing_fraction(&textured.1, &displaced.1);
+    eprintln!("displaced vs undisplaced: silhouette {moved:.5}, pixels (> 24/255) {changed:.5}");
+    // Measured 0.089 and 0.26: a height of up to 3% of the diagonal.
+    assert!(
+        moved > 0.02,
+        "displacement hardly moves the silhouette ({moved:.5})"
+    );
+    assert!(
+        changed > 0.05,
+        "displacement hardly changes the image ({changed:.5})"
+    );
+    assert!(
+        differing_fraction(&displaced.1, &golden[0]) > TOLERANCE,
+        "the displaced image passes the undisplaced golden"
+    );
 }

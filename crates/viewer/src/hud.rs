@@ -35,6 +35,13 @@ pub enum Action {
     EndCaps,
     SharpnessUp,
     SharpnessDown,
+    /// Texture reparameterization on/off (R).
+    Reparam,
+    /// Displacement on/off (D), keeping its scale.
+    Displace,
+    /// Displacement scale ×1.25 (]) and ÷1.25 ([); either turns displacement on.
+    DisplaceUp,
+    DisplaceDown,
     ToggleHud,
     Quit,
 }
@@ -55,6 +62,8 @@ pub struct Shown<'a> {
     pub params: &'a FrameParams,
     pub build: &'a tess::BuildOptions,
     pub animate: bool,
+    /// The displacement scale D turns on (`params.displace` is 0 while it is off).
+    pub displace_scale: f32,
     pub triangles: Option<u64>,
     pub patches: u64,
     /// `None` where the queue has no timestamps.
@@ -203,7 +212,7 @@ fn panel(ui: &mut egui::Ui, s: &Shown<'_>, history: &[f32], actions: &mut Vec<Ac
         ui.colored_label(Color32::from_rgb(255, 110, 90), status);
     }
     ui.horizontal(|ui| {
-        ui.label("technique (1-5)");
+        ui.label(format!("technique (1-{})", techniques::registry().len()));
         egui::ComboBox::from_id_salt("technique")
             .selected_text(s.technique.name())
             .show_ui(ui, |ui| {
@@ -294,6 +303,29 @@ fn panel(ui: &mut egui::Ui, s: &Shown<'_>, history: &[f32], actions: &mut Vec<Ac
             }
         }
     });
+    if f.surface {
+        ui.horizontal_wrapped(|ui| {
+            if toggle(ui, Some(p.reparam), "reparameterization (R)") {
+                actions.push(Action::Reparam);
+            }
+            if toggle(ui, Some(p.displace != 0.0), "displacement (D)") {
+                actions.push(Action::Displace);
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.label(format!(
+                "displacement ×{:.4}{}",
+                s.displace_scale,
+                if p.displace == 0.0 { " (off)" } else { "" }
+            ));
+            if ui.button("÷1.25 ([)").clicked() {
+                actions.push(Action::DisplaceDown);
+            }
+            if ui.button("×1.25 (])").clicked() {
+                actions.push(Action::DisplaceUp);
+            }
+        });
+    }
     if p.patch_colours {
         for &(rgb, name) in legend(s.technique) {
             ui.horizontal(|ui| {

@@ -1,14 +1,17 @@
 //! `tessera view`: a window with an orbit camera. Drag to orbit, wheel to zoom, 1, 2, 3, ...
-//! switch technique in the registry's order (flat, Phong, PN, BFT), +/- raise/lower the level
-//! to the next one the technique takes (BFT: the next power of two unless fractional), arrows
-//! double/halve it, W toggles the wireframe; where the technique takes them, A toggles the
-//! animation, C the patch colours, F fractional factors, G geometric normals, and for the
-//! feature-adaptive surface I / Shift+I raise / lower the isolation level, E switches the end
-//! caps (Gregory, bilinear), S / Shift+S scale every crease's sharpness up / down (the surface
-//! is re-planned on the CPU; the mesh is not reloaded). P saves the next frame as
-//! `tessera-screenshot-N.png` in the working directory. An OBJ dropped on the window replaces the
-//! mesh. Esc quits. The title shows what is drawn and the frame time. `--frames N --screenshot
-//! out.png` renders N frames, saves the last and exits.
+//! switch technique in the registry's order (flat, Phong, PN, BFT, adaptive, gregory, acc),
+//! +/- raise/lower the level to the next one the technique takes (BFT: the next power of two
+//! unless fractional), arrows double/halve it, W toggles the wireframe; where the technique
+//! takes them, A toggles the animation, C the patch colours, F fractional factors, G geometric
+//! normals, and for the feature-adaptive surface I / Shift+I raise / lower the isolation level,
+//! E switches the end caps (Gregory, bilinear), S / Shift+S scale every crease's sharpness up /
+//! down (the surface is re-planned on the CPU; the mesh is not reloaded). On the textured
+//! Catmull-Clark techniques (adaptive, gregory, acc) R toggles the texture reparameterization,
+//! D the displacement, and ] / [ scale the displacement by 1.25 up / down (turning it on);
+//! without `--displace` D starts at [`DEFAULT_DISPLACE`] of the mesh's bounding-box diagonal.
+//! P saves the next frame as `tessera-screenshot-N.png` in the working directory. An OBJ
+//! dropped on the window replaces the mesh. Esc quits. The title shows what is drawn and the
+//! frame time. `--frames N --screenshot out.png` renders N frames, saves the last and exits.
 //!
 //! The HUD (crate::hud, drawn through vk-core's overlay) shows the technique, its scheme, the
 //! factor policy, the options and the patch-colour legend, the triangles and patches drawn, the
@@ -105,6 +108,8 @@ struct App {
     pending_level: Option<f32>,
     /// The current surface must be built again (isolation, end caps or sharpness changed).
     rebuild: bool,
+    /// The displacement scale D turns back on (`params.displace` is 0 while it is off).
+    displace_scale: f32,
     gpu: Option<Gpu>,
     window: Option<Arc<Window>>,
     frames_drawn: u32,
@@ -310,6 +315,7 @@ impl App {
                     params: &params,
                     build: &self.setup.build,
                     animate: self.setup.animate,
+                    displace_scale: self.displace_scale,
                     triangles: (0..arrays.len())
                         .map(|a| technique.triangles(&params, a))
                         .sum(),
@@ -522,6 +528,10 @@ impl App {
                 "e" | "E" => Action::EndCaps,
                 "s" => Action::SharpnessUp,
                 "S" => Action::SharpnessDown,
+                "r" | "R" => Action::Reparam,
+                "d" | "D" => Action::Displace,
+                "]" => Action::DisplaceUp,
+                "[" => Action::DisplaceDown,
                 _ => return None,
             },
             Key::Named(NamedKey::ArrowUp) => Action::LevelDouble,
@@ -592,6 +602,11 @@ impl App {
                     b.sharpness_scale / 1.25
                 };
                 self.rebuild = true;
+            }
+            Action::Reparam | Action::Displace | Action::DisplaceUp | Action::DisplaceDown
+                if features.surface =>
+            {
+                surface_key(p, &mut self.displace_scale, action)
             }
             _ => {}
         }
@@ -691,7 +706,9 @@ pub fn run(args: ViewArgs) -> Result<()> {
         other => anyhow::anyhow!("cannot open the window system: {other}"),
     })?;
     event_loop.set_control_flow(ControlFlow::Poll);
+    let displace_scale = initial_displace_scale(setup.params.displace, &mesh);
     let mut app = App {
+        displace_scale,
         time: setup.frame.unwrap_or(0.0),
         moved: setup.moved(),
         setup,
@@ -746,6 +763,65 @@ pub fn run(args: ViewArgs) -> Result<()> {
     result
 }
 
+/// The displacement scale D turns on where `--displace` gave none (or 0), as a fraction of the
+/// mesh's bounding-box diagonal: a height of 1 lifts the surface by 2% of its size, clearly
+/// visible on spot with its height map or the procedural bumps and far from folding it.
+pub(crate) const DEFAULT_DISPLACE: f32 = 0.02;
+
+/// Keys ] and [ multiply / divide the displacement scale by this.
+const DISPLACE_STEP: f32 = 1.25;
+
+/// The scale magnitudes the keys keep to: `--displace`'s limit above, and well away from 0
+/// below (so [ never turns displacement off by underflow).
+const DISPLACE_RANGE: (f32, f32) = (1e-6, 1e3);
+
+/// The scale D restores at start: `--displace S` where S is not 0, else [`DEFAULT_DISPLACE`]
+/// of `mesh`'s bounding-box diagonal.
+fn initial_displace_scale(displace: f32, mesh: &ControlMesh) -> f32 {
+    if displace != 0.0 {
+        return displace;
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in &mesh.positions {
+        for i in 0..3 {
+            lo[i] = lo[i].min(p[i]);
+            hi[i] = hi[i].max(p[i]);
+        }
+    }
+    let diag = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt();
+    let scale = DEFAULT_DISPLACE * diag as f32;
+    if scale.is_finite() && scale >= DISPLACE_RANGE.0 {
+        scale.min(DISPLACE_RANGE.1)
+    } else {
+        DISPLACE_RANGE.0.max(DEFAULT_DISPLACE)
+    }
+}
+
+/// R, D, ] and [ (techniques with [`tess::Features::surface`]): `scale` is the displacement D
+/// turns back on; it equals `params.displace` whenever displacement is on.
+fn surface_key(params: &mut tess::FrameParams, scale: &mut f32, action: Action) {
+    match action {
+        Action::Reparam => params.reparam = !params.reparam,
+        Action::Displace if params.displace != 0.0 => {
+            *scale = params.displace;
+            params.displace = 0.0;
+        }
+        Action::Displace => params.displace = *scale,
+        Action::DisplaceUp | Action::DisplaceDown => {
+            let factor = if action == Action::DisplaceUp {
+                DISPLACE_STEP
+            } else {
+                DISPLACE_STEP.recip()
+            };
+            let next = *scale * factor;
+            let (min, max) = DISPLACE_RANGE;
+            *scale = next.signum() * next.abs().clamp(min, max);
+            params.displace = *scale;
+        }
+        _ => {}
+    }
+}
+
 /// Writes timestamp `index` of the frame's pool, where the queue has timestamps.
 fn stamp<'a>(
     encoder: &mut vk_core::Encoder<'a>,
@@ -775,4 +851,129 @@ fn print_stats(when: &str, device: &Device, started: Instant) {
         device.live_objects(),
         started.elapsed().as_secs_f64()
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use winit::keyboard::SmolStr;
+
+    fn key(c: &str) -> Option<Action> {
+        App::key_action(&Key::Character(SmolStr::new(c)))
+    }
+
+    #[test]
+    fn keys_map_to_their_actions() {
+        // Method keys: the registry's order, gregory and acc last.
+        let order: Vec<TechniqueId> = techniques::registry().iter().map(|i| i.id).collect();
+        for (i, id) in order.iter().enumerate() {
+            assert_eq!(key(&(i + 1).to_string()), Some(Action::Technique(*id)));
+        }
+        assert_eq!(key("6"), Some(Action::Technique(TechniqueId::Gregory)));
+        assert_eq!(key("7"), Some(Action::Technique(TechniqueId::Acc)));
+        assert_eq!(key("5"), Some(Action::Technique(TechniqueId::Adaptive)));
+        assert_eq!(key("8"), None);
+        assert_eq!(key("0"), None);
+        for (c, action) in [
+            ("r", Action::Reparam),
+            ("R", Action::Reparam),
+            ("d", Action::Displace),
+            ("D", Action::Displace),
+            ("]", Action::DisplaceUp),
+            ("[", Action::DisplaceDown),
+            // The keys that were there before keep their meaning.
+            ("w", Action::Wireframe),
+            ("s", Action::SharpnessUp),
+            ("S", Action::SharpnessDown),
+            ("i", Action::IsolationUp),
+            ("I", Action::IsolationDown),
+            ("e", Action::EndCaps),
+            ("+", Action::LevelUp),
+            ("-", Action::LevelDown),
+        ] {
+            assert_eq!(key(c), Some(action), "key {c}");
+        }
+        assert_eq!(key("x"), None);
+        assert_eq!(
+            App::key_action(&Key::Named(NamedKey::Escape)),
+            Some(Action::Quit)
+        );
+    }
+
+    #[test]
+    fn reparam_key_toggles() {
+        let mut p = tess::FrameParams::default();
+        let mut scale = 0.5;
+        assert!(p.reparam);
+        surface_key(&mut p, &mut scale, Action::Reparam);
+        assert!(!p.reparam);
+        surface_key(&mut p, &mut scale, Action::Reparam);
+        assert!(p.reparam);
+        assert_eq!(
+            (p.displace, scale),
+            (0.0, 0.5),
+            "R leaves displacement alone"
+        );
+    }
+
+    #[test]
+    fn displacement_keys_toggle_and_scale_keeping_the_scale() {
+        let mut p = tess::FrameParams::default();
+        let mut scale = 0.04;
+        // D on at the remembered scale, off again keeping it.
+        surface_key(&mut p, &mut scale, Action::Displace);
+        assert_eq!(p.displace, 0.04);
+        surface_key(&mut p, &mut scale, Action::Displace);
+        assert_eq!((p.displace, scale), (0.0, 0.04));
+        // ] while off: on, 1.25 times larger; [ back.
+        surface_key(&mut p, &mut scale, Action::DisplaceUp);
+        assert!((p.displace - 0.05).abs() < 1e-7 && scale == p.displace);
+        surface_key(&mut p, &mut scale, Action::DisplaceDown);
+        assert!((p.displace - 0.04).abs() < 1e-7 && scale == p.displace);
+        // Off and on again brings the scaled value back.
+        surface_key(&mut p, &mut scale, Action::DisplaceDown);
+        let scaled = p.displace;
+        surface_key(&mut p, &mut scale, Action::Displace);
+        surface_key(&mut p, &mut scale, Action::Displace);
+        assert_eq!(p.displace, scaled);
+        // A --displace given on the command line that differs from the remembered scale is
+        // what D keeps.
+        p.displace = -0.3;
+        surface_key(&mut p, &mut scale, Action::Displace);
+        assert_eq!((p.displace, scale), (0.0, -0.3));
+        // The sign stays; the magnitude keeps to --displace's range and never reaches 0.
+        for _ in 0..100 {
+            surface_key(&mut p, &mut scale, Action::DisplaceUp);
+        }
+        assert_eq!(p.displace, -DISPLACE_RANGE.1);
+        for _ in 0..1000 {
+            surface_key(&mut p, &mut scale, Action::DisplaceDown);
+        }
+        assert_eq!(p.displace, -DISPLACE_RANGE.0);
+        // Other actions are not this function's.
+        let before = p;
+        surface_key(&mut p, &mut scale, Action::Wireframe);
+        assert_eq!(p, before);
+    }
+
+    #[test]
+    fn default_displacement_is_a_fraction_of_the_diagonal() {
+        let cube = ControlMesh::from_polygons(
+            vec![
+                [0.0, 0.0, 0.0],
+                [2.0, 0.0, 0.0],
+                [2.0, 2.0, 0.0],
+                [0.0, 2.0, 2.0],
+            ],
+            &[[0, 1, 2, 3]],
+        );
+        let diag = 12f32.sqrt();
+        assert!((initial_displace_scale(0.0, &cube) - DEFAULT_DISPLACE * diag).abs() < 1e-6);
+        // --displace wins.
+        assert_eq!(initial_displace_scale(0.25, &cube), 0.25);
+        // A mesh without extent still gets a usable scale.
+        let point = ControlMesh::from_polygons(vec![[1.0, 1.0, 1.0]; 3], &[[0, 1, 2]]);
+        assert!(initial_displace_scale(0.0, &point) > 0.0);
+        assert!(initial_displace_scale(0.0, &ControlMesh::default()) > 0.0);
+    }
 }

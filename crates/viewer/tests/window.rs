@@ -2,8 +2,8 @@
 //! validation included: runs that end without a screenshot (frames still in flight at exit),
 //! every technique, a 1,000-frame animated soak whose GPU memory and live Vulkan objects
 //! must stay constant after warm-up (HUD shown), and windows driven by synthetic input
-//! (xdotool: P screenshots, the level and the technique changed by keys, Esc; the HUD drawn,
-//! hidden by H, and its level control clicked).
+//! (xdotool: P screenshots, the level and the technique changed by keys, displacement by D and
+//! ] on textured gregory, Esc; the HUD drawn, hidden by H, and its level control clicked).
 //!
 //! The soak runs in the window rather than through an offscreen `tess::Context` loop because
 //! the window is where frames are not waited for (FIFO presentation, two frames in flight, the
@@ -249,6 +249,70 @@ fn keys_change_level_and_technique_and_p_saves_screenshots() {
     );
     let (changed, _, _) = compare(&level4, &pn4);
     assert!(changed > 100, "key 3 (PN) changed {changed} pixels");
+}
+
+/// The surface keys on textured gregory: D displaces (the default scale, 2% of the diagonal:
+/// the picture changes), D again brings the undisplaced picture back, ] displaces at 1.25 times
+/// the scale (another picture); R switches the reparameterization without error (its effect,
+/// a shift of a few texels, is measured by tests/golden.rs).
+#[test]
+fn surface_keys_displace_and_restore() {
+    let _one = SERVER.lock().unwrap_or_else(|e| e.into_inner());
+    if Command::new("xdotool").arg("version").output().is_err() {
+        eprintln!("skipped: xdotool is not installed (tools/setup.sh installs it)");
+        return;
+    }
+    let Some(server) = xvfb::start_or_skip(DISPLAYS) else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("tessera-window-surface-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let assets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets");
+    let child = Command::new(env!("CARGO_BIN_EXE_tessera"))
+        .arg("view")
+        .arg(assets.join("spot_control_mesh.obj"))
+        .args(["--method", "gregory", "--segments", "4", "--no-hud"])
+        .arg("--texture")
+        .arg(assets.join("spot_texture.png"))
+        .args(["--validation", "--sync-validation", "--size", "160x120"])
+        .current_dir(&dir)
+        .env("DISPLAY", &server.display)
+        .env("WAYLAND_DISPLAY", "")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("tessera runs");
+    let d = server.display.clone();
+    let window = xdotool(
+        &d,
+        &["search", "--sync", "--onlyvisible", "--name", "tessera"],
+    );
+    let window = window.lines().next().expect("a window").trim().to_owned();
+    xdotool(&d, &["windowfocus", "--sync", &window]);
+    let shot = |n: u32| wait_for_png(&dir.join(format!("tessera-screenshot-{n}.png")));
+    xdotool(&d, &["key", "p"]);
+    let plain = shot(1);
+    xdotool(&d, &["key", "d", "p"]);
+    let displaced = shot(2);
+    xdotool(&d, &["key", "d", "p"]);
+    let restored = shot(3);
+    xdotool(&d, &["key", "bracketright", "p"]);
+    let scaled = shot(4);
+    xdotool(&d, &["key", "r", "p"]);
+    shot(5);
+    xdotool(&d, &["key", "Escape"]);
+    let o = child.wait_with_output().expect("tessera ends");
+    drop(server);
+    let (_, err) = text(&o);
+    assert!(o.status.success(), "view failed: {err}");
+    assert!(!err.contains("VUID") && !err.contains("SYNC-"), "{err}");
+    let (on, _, _) = compare(&plain, &displaced);
+    let (back, _, _) = compare(&plain, &restored);
+    let (more, _, _) = compare(&displaced, &scaled);
+    eprintln!("D changed {on} pixels, D again left {back}, ] changed {more}");
+    assert!(on > 300, "D changed {on} pixels");
+    assert_eq!(back, 0, "D twice should give the undisplaced picture back");
+    assert!(more > 100, "] changed {more} pixels");
 }
 
 /// Where the HUD's "×2 (Up)" level button is in the window (egui's layout at scale 1, the
