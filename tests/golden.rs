@@ -335,10 +335,12 @@ fn render_surface() -> Vec<(String, Rgba8)> {
     let textured = build(SurfaceMaps {
         texture: Some(texture),
         height: Some(height),
+        param_error: false,
     });
     let checkered = build(SurfaceMaps {
         texture: Some(Arc::new(checker())),
         height: None,
+        param_error: false,
     });
     let (lo, hi) = textured.bbox();
     let diag = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f32>().sqrt();
