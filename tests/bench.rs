@@ -221,3 +221,208 @@ fn bench_bft_rows_match_flat_triangles() {
         report.extra_notes
     );
 }
+
+/// `--equal-triangles` on a small mixed mesh (catmull-clark pyramid: four triangles and a
+/// quad): Flat keeps S; every other technique draws the whole level per patch edge whose
+/// triangle count is nearest Flat's. Checked from outside the chooser: the GPU's count
+/// (transform feedback's primitives, since lavapipe's pipeline-statistics query is withheld
+/// from one-control-point patches) equals the row's CPU count at its level; no neighbouring level (L - 1, L + 1) of the
+/// same technique, counted again here, is nearer; and the counts land within 1/L of Flat's (the
+/// gap a nearest whole level can leave when the count grows as L², see docs/benchmarks.md).
+/// Memory per base face: the device bytes are positive, do not depend on S or on animation,
+/// Flat's equal its vertex and index buffers, and the single-pass techniques' cover their
+/// tables, vertex buffer and base positions.
+#[test]
+fn bench_equal_triangles_and_memory_per_face() {
+    let gpu = Gpu::new();
+    let pyramid = tessera::topology::load_obj(common::data(
+        "tests/data/opensubdiv/shapes/catmark_pyramid.obj",
+    ))
+    .unwrap();
+    let mesh = BenchMesh::new("pyramid", &pyramid).unwrap();
+    let mut config = tiny_config(vec![4, 16]);
+    config.methods = ["flat", "adaptive", "gregory", "acc"]
+        .map(String::from)
+        .to_vec();
+    config.isolation = 2;
+    config.equal_triangles = true;
+    let report = bench::run_bench(
+        gpu.device(),
+        std::slice::from_ref(&mesh),
+        &config,
+        &mut |_| {},
+    )
+    .unwrap();
+    assert!(report.skipped.is_empty(), "{:?}", report.skipped);
+    // The techniques again, captured at each row's level: the GPU's own triangle count.
+    let mut cap_ctx = tessera::tess::Context::offscreen(gpu.device()).unwrap();
+    let capturer = tessera::tess::Capturer::new(&cap_ctx).unwrap();
+    let surfaces: Vec<(&str, Box<dyn tessera::tess::Technique>)> = ["adaptive", "gregory", "acc"]
+        .into_iter()
+        .map(|name| {
+            let built = tessera::tess::build(
+                &mut cap_ctx,
+                name.parse().unwrap(),
+                &pyramid,
+                &tessera::tess::BuildOptions {
+                    isolation: config.isolation,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            (name, built.technique)
+        })
+        .collect();
+    let mut gpu_count = |name: &str, level: u32| {
+        let surf = &surfaces.iter().find(|(n, _)| *n == name).unwrap().1;
+        let params = tessera::tess::FrameParams::uniform(level as f32);
+        let (_, stats) = capturer
+            .capture(&mut cap_ctx, surf.as_ref(), &params, config.extent)
+            .unwrap();
+        stats.primitives_needed
+    };
+
+    // The same methods again, to count neighbouring levels independently of the run.
+    let ctx = bench::MethodContext {
+        device: gpu.device(),
+        technique: None,
+        mesh: &mesh,
+        config: &config,
+        color_format: tessera::vk_core::target::COLOR_FORMAT,
+        depth_format: tessera::vk_core::target::DEPTH_FORMAT,
+    };
+    let methods = bench::build_methods(&config.methods, &ctx).unwrap();
+    let count = |label: &str, level: u32| {
+        methods
+            .iter()
+            .find(|m| m.label() == label)
+            .unwrap()
+            .triangles_at(level)
+    };
+
+    for s in [4u32, 16] {
+        let flat = report
+            .rows
+            .iter()
+            .find(|r| r.method == "flat" && r.segments == s)
+            .unwrap();
+        assert_eq!(flat.level, s);
+        assert_eq!(flat.triangle_ratio_to_flat, Some(1.0));
+        assert_eq!(
+            flat.triangles,
+            6 * uniform_triangle_count(Domain::Triangle, Spacing::Equal, s as f32)
+        );
+        for name in ["adaptive", "gregory", "acc"] {
+            for label in [name.to_string(), format!("{name}-animated")] {
+                let r = report
+                    .rows
+                    .iter()
+                    .find(|r| r.method == label && r.segments == s)
+                    .unwrap_or_else(|| panic!("{label} at S = {s}"));
+                let l = r.level;
+                assert_eq!(r.triangles_expected, count(name, l).unwrap(), "{r:?}");
+                assert_eq!(r.triangles, r.triangles_expected, "{r:?}");
+                assert_eq!(gpu_count(name, l), r.triangles, "GPU count, {r:?}");
+                let miss = |t: u64| t.abs_diff(flat.triangles);
+                for n in [l.saturating_sub(1), l + 1] {
+                    if let Some(t) = count(name, n).filter(|_| n >= 1) {
+                        assert!(
+                            miss(r.triangles) <= miss(t),
+                            "{label} level {n}: {t}, {r:?}"
+                        );
+                    }
+                }
+                let ratio = r.triangle_ratio_to_flat.unwrap();
+                assert_eq!(ratio, r.triangles as f64 / flat.triangles as f64);
+                assert!(
+                    (ratio - 1.0).abs() <= 1.0 / l as f64,
+                    "{label} S = {s}: level {l}, {} triangles against Flat's {}",
+                    r.triangles,
+                    flat.triangles
+                );
+                eprintln!(
+                    "{label} S = {s}: level {l}, {} triangles, {ratio:.3} × Flat",
+                    r.triangles
+                );
+            }
+        }
+    }
+
+    // Memory per base face (the pyramid's 5 faces as loaded, not its 6 fan triangles).
+    for r in &report.rows {
+        assert_eq!(r.base_faces, 5, "{r:?}");
+        let bytes = r.device_bytes.expect("every technique states its memory");
+        assert!(bytes > 0, "{r:?}");
+        assert_eq!(r.bytes_per_base_face(), Some(bytes as f64 / 5.0));
+        let base = r.method.trim_end_matches("-animated");
+        for o in report.rows.iter().filter(|o| o.method.starts_with(base)) {
+            assert_eq!(o.device_bytes, r.device_bytes, "{r:?} and {o:?}");
+        }
+    }
+    let bytes = |m: &str| {
+        report
+            .rows
+            .iter()
+            .find(|r| r.method == m)
+            .unwrap()
+            .device_bytes
+            .unwrap()
+    };
+    // Flat: 24-byte vertices (position, normal) and 3 indices of 4 bytes per fan triangle.
+    assert_eq!(
+        bytes("flat"),
+        24 * mesh.render.vertices.len() as u64 + 12 * mesh.triangles()
+    );
+    let mut tctx = tessera::tess::Context::new(
+        gpu.device(),
+        tessera::vk_core::target::COLOR_FORMAT,
+        tessera::vk_core::target::DEPTH_FORMAT,
+        1,
+    )
+    .unwrap();
+    use tessera::tess::techniques::gregory;
+    use tessera::tess::Technique;
+    use tessera::topology::adaptive::single_pass::SinglePassPatch;
+    for (name, patch) in [
+        ("gregory", SinglePassPatch::Gregory),
+        ("acc", SinglePassPatch::Acc1),
+    ] {
+        let surf =
+            gregory::build(&mut tctx, &pyramid, patch, 1.0, name, &Default::default()).unwrap();
+        let memory = surf.device_memory();
+        for buffer in [
+            "adaptive stencil terms",
+            "adaptive patches",
+            "adaptive patch surfaces",
+            "adaptive curve owners",
+            "adaptive corner owners",
+            "adaptive vertices",
+        ] {
+            assert!(
+                memory.iter().any(|a| a.name == buffer && a.bytes > 0),
+                "{name}: {buffer} in {memory:?}"
+            );
+        }
+        let total: u64 = memory.iter().map(|a| a.bytes).sum();
+        assert_eq!(total, bytes(name), "{name}");
+        let floor = surf.gpu.table_bytes() as u64
+            + surf.gpu.vertex_bytes()
+            + 12 * pyramid.positions.len() as u64;
+        assert!(total >= floor, "{name}: {total} < {floor}");
+        assert!(total > bytes("flat"), "{name}");
+    }
+}
+
+#[test]
+fn equal_triangles_needs_flat() {
+    let gpu = Gpu::new();
+    let cube = tessera::topology::load_obj(common::data("tests/data/meshes/cube.obj")).unwrap();
+    let mesh = BenchMesh::new("cube", &cube).unwrap();
+    let mut c = tiny_config(vec![4]);
+    c.methods = vec!["gregory".into()];
+    c.equal_triangles = true;
+    let e = bench::run_bench(gpu.device(), &[mesh], &c, &mut |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("--equal-triangles") && e.contains("flat"), "{e}");
+}

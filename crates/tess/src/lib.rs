@@ -25,8 +25,8 @@ pub use context::Context;
 pub use error::{Result, TessError};
 pub use render_mesh::RenderMesh;
 pub use technique::{
-    DrawCounts, DrawSplit, FactorPolicy, Features, FrameParams, Pass, PatchArray, PatchType,
-    Technique, TechniqueId,
+    DeviceAllocation, DrawCounts, DrawSplit, FactorPolicy, Features, FrameParams, Pass, PatchArray,
+    PatchType, Technique, TechniqueId,
 };
 pub use techniques::{build, registry, BuildOptions};
 pub use tessellator::{Domain, Spacing};

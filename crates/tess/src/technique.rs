@@ -394,6 +394,42 @@ pub trait Technique: Send {
     fn report_notes(&self) -> Vec<String> {
         Vec::new()
     }
+
+    /// Every buffer and texture this surface keeps on the device, as created (its debug name
+    /// and size in bytes): what the bench reports as the technique's memory. The frame's
+    /// uniforms, descriptor sets and pipelines (the [`crate::Context`]'s) are not in it.
+    fn device_memory(&self) -> Vec<DeviceAllocation>;
+}
+
+/// One buffer or texture a technique keeps on the device ([`Technique::device_memory`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct DeviceAllocation {
+    /// The debug name it was created with ("adaptive stencil terms", "mesh vertices", ...).
+    pub name: String,
+    pub bytes: u64,
+}
+
+impl DeviceAllocation {
+    pub fn of_buffer(b: &vk_core::Buffer) -> Self {
+        Self {
+            name: b.name().to_owned(),
+            bytes: b.size(),
+        }
+    }
+
+    /// Every mip level, tightly packed (the driver may pad; this is what the texels need).
+    pub fn of_texture(t: &vk_core::Texture) -> Self {
+        let texel = t.format().bytes_per_texel() as u64;
+        Self {
+            name: t.name().to_owned(),
+            bytes: (0..t.levels())
+                .map(|l| {
+                    let e = t.level_extent(l);
+                    e.width as u64 * e.height as u64 * texel
+                })
+                .sum(),
+        }
+    }
 }
 
 /// Splits patches `0..patches` of an array into draws of at most `per_draw`, calling

@@ -77,10 +77,15 @@ impl bench::BenchProgress for Progress {
     fn row(&mut self, r: &bench::BenchRow) {
         self.bar.suspend(|| {
             eprintln!(
-                "  {}, {} segments, {}: {} triangles, GPU median {:.3} ms{}{}",
+                "  {}, {} segments, {}{}: {} triangles, GPU median {:.3} ms{}{}",
                 r.mesh,
                 r.segments,
                 r.method,
+                if r.level == r.segments {
+                    String::new()
+                } else {
+                    format!(" at level {}", r.level)
+                },
                 r.triangles,
                 r.gpu_median_ms,
                 r.cpu_median_ms
@@ -111,6 +116,9 @@ fn config(a: &BenchArgs) -> Result<BenchConfig> {
     if a.frames == 0 {
         bail!("--frames must be at least 1");
     }
+    if a.equal_triangles && !a.methods.iter().any(|m| m == "flat") {
+        bail!("--equal-triangles matches Flat's triangle counts: add flat to --methods");
+    }
     if let Some(&s) = a.segments.iter().find(|&&s| s == 0 || s > 64) {
         bail!("--segments {s} is outside 1..64");
     }
@@ -129,6 +137,7 @@ fn config(a: &BenchArgs) -> Result<BenchConfig> {
         cpu_max_vertices: a.cpu_max_vertices,
         isolation: a.isolation,
         follow_semi_sharp: !a.creases_at_isolation,
+        equal_triangles: a.equal_triangles,
     })
 }
 

@@ -131,6 +131,12 @@ pub struct BenchArgs {
     /// Adaptive rows stop semi-sharp creases at the isolation level (OpenSubdiv's behaviour).
     #[arg(long)]
     pub creases_at_isolation: bool,
+    /// Compare at equal output triangles: at each mesh and S, Flat draws S segments per base
+    /// edge and every other technique the whole segments per (patch) edge whose triangle count
+    /// is nearest Flat's (rows give the level drawn and the triangles over Flat's). Needs flat
+    /// in --methods.
+    #[arg(long)]
+    pub equal_triangles: bool,
     /// Write the rows as CSV.
     #[arg(long)]
     pub csv: Option<PathBuf>,

@@ -22,7 +22,9 @@ pub struct BenchFrame {
     pub index: u32,
     /// A warm-up frame (its times are not in the row).
     pub warmup: bool,
-    /// Segments per base edge S (the paper's 4×4, 16×16, 32×32 splits: S = 4, 16, 32).
+    /// The level this method draws at: segments per base edge S (the paper's 4×4, 16×16,
+    /// 32×32 splits: S = 4, 16, 32), or under [`super::BenchConfig::equal_triangles`] the
+    /// segments per patch edge chosen to match Flat's triangles at S.
     pub segments: u32,
     pub extent: vk::Extent2D,
     pub camera: Camera,
@@ -86,6 +88,20 @@ pub trait BenchMethod {
     /// can forbid it; the row then reports the CPU triangle count).
     fn statistics_query_safe(&self) -> bool {
         true
+    }
+
+    /// Triangles a frame at `segments` would draw, by the same CPU count `record` returns,
+    /// known without drawing; `None` where the method cannot tell beforehand (the CPU
+    /// baselines) or does not draw at that level. The equal-triangle choice searches it.
+    fn triangles_at(&self, segments: u32) -> Option<u64> {
+        let _ = segments;
+        None
+    }
+
+    /// Bytes the method keeps on the device for its mesh (buffers and textures as created),
+    /// called after the row's frames; `None` when unknown.
+    fn device_bytes(&self) -> Option<u64> {
+        None
     }
 }
 
@@ -209,6 +225,8 @@ pub struct TechniqueMethod {
     technique: Box<dyn Technique>,
     wave: Option<Wave>,
     context: Context,
+    /// Faces of the control mesh as loaded (the memory note's denominator).
+    base_faces: usize,
 }
 
 impl TechniqueMethod {
@@ -247,6 +265,7 @@ impl TechniqueMethod {
             technique: built.technique,
             wave,
             context,
+            base_faces: ctx.mesh.input.num_faces(),
         })
     }
 
@@ -308,15 +327,40 @@ impl BenchMethod for TechniqueMethod {
         if self.animated {
             return Vec::new();
         }
+        let memory = self.technique.device_memory();
+        let parts: Vec<String> = memory
+            .iter()
+            .map(|a| format!("{} {}", a.name, a.bytes))
+            .collect();
         self.technique
             .report_notes()
             .into_iter()
+            .chain(std::iter::once(format!(
+                "{} device memory {} bytes for {} base faces: {}",
+                self.technique.id(),
+                memory.iter().map(|a| a.bytes).sum::<u64>(),
+                self.base_faces,
+                parts.join(", ")
+            )))
             .map(|n| format!("{}: {n}", self.mesh_name))
             .collect()
     }
 
     fn statistics_query_safe(&self) -> bool {
         statistics_query_safe(self.context.device(), self.technique.as_ref())
+    }
+
+    fn triangles_at(&self, segments: u32) -> Option<u64> {
+        let params = Self::params(segments, Camera::default());
+        let t = self.technique.as_ref();
+        t.check(&params).ok()?;
+        (0..t.patch_arrays().len())
+            .map(|i| t.triangles(&params, i))
+            .sum()
+    }
+
+    fn device_bytes(&self) -> Option<u64> {
+        Some(self.technique.device_memory().iter().map(|a| a.bytes).sum())
     }
 }
 
@@ -667,6 +711,13 @@ impl BenchMethod for CpuLoopMethod {
             reason: "the CPU baseline was recorded before begin_frame".into(),
         })?;
         self.renderer.record(enc, &self.context, 0, mesh)
+    }
+
+    /// The refined mesh's vertex and index buffers at the level last drawn.
+    fn device_bytes(&self) -> Option<u64> {
+        self.mesh
+            .as_ref()
+            .map(|(_, m)| m.vertices.size() + m.indices.size())
     }
 
     fn row_notes(&mut self) -> Vec<String> {

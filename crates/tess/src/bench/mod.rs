@@ -17,7 +17,7 @@ pub use methods::{
     loop_level_size, method_names, one, registry, BenchFrame, BenchMethod, CpuLimitMesh,
     CpuLoopMethod, MethodContext, MethodEntry, MethodFactory, TechniqueMethod,
 };
-pub use report::{parse_csv, CSV_HEADER};
+pub use report::{parse_csv, CSV_HEADER, CSV_HEADER_V1};
 
 use crate::camera::Camera;
 use crate::error::{Result, TessError};
@@ -53,6 +53,11 @@ pub struct BenchConfig {
     pub isolation: u32,
     /// Follow semi-sharp creases past it until they decay.
     pub follow_semi_sharp: bool,
+    /// Compare at equal output triangles: at each mesh and S, every method whose triangle
+    /// count is known beforehand draws at the whole level (segments per its own edge: per
+    /// patch edge for the patch techniques) whose CPU count is nearest Flat's at S
+    /// ([`nearest_level`]); Flat keeps S. Needs `flat` among the methods.
+    pub equal_triangles: bool,
 }
 
 impl Default for BenchConfig {
@@ -74,6 +79,7 @@ impl Default for BenchConfig {
             cpu_max_vertices: 4_000_000,
             isolation: crate::techniques::adaptive::DEFAULT_ISOLATION,
             follow_semi_sharp: true,
+            equal_triangles: false,
         }
     }
 }
@@ -181,6 +187,9 @@ pub struct BenchRow {
     pub input_triangles: u64,
     pub segments: u32,
     pub method: String,
+    /// The level the method drew at: S, or under [`BenchConfig::equal_triangles`] the whole
+    /// segments per (patch) edge chosen to match Flat's triangles at S.
+    pub level: u32,
     /// Output triangles per frame, as `triangles_source` counted them.
     pub triangles: u64,
     /// The method's own CPU count (the tessellator's arithmetic, or the refined mesh's size).
@@ -202,8 +211,40 @@ pub struct BenchRow {
     pub wall_median_ms: f64,
     /// `total_median_ms` over Flat's at the same mesh and S.
     pub ratio_to_flat: Option<f64>,
+    /// `triangles` over Flat's at the same mesh and S: how equal "equal triangles" was.
+    pub triangle_ratio_to_flat: Option<f64>,
+    /// Faces of the control mesh as loaded (before fan triangulation); 0 when unknown (a CSV
+    /// written before the column existed).
+    pub base_faces: u64,
+    /// Bytes of the buffers and textures the method keeps on the device for this mesh
+    /// ([`crate::Technique::device_memory`]; the CPU baselines' refined mesh at this level).
+    pub device_bytes: Option<u64>,
     pub note: String,
 }
+
+impl BenchRow {
+    /// `device_bytes` per control-mesh face.
+    pub fn bytes_per_base_face(&self) -> Option<f64> {
+        match (self.device_bytes, self.base_faces) {
+            (Some(b), f) if f > 0 => Some(b as f64 / f as f64),
+            _ => None,
+        }
+    }
+}
+
+/// The candidate `(level, triangles)` whose triangle count is nearest `target` (the lower
+/// level on a tie), or `None` when there is no candidate.
+pub fn nearest_level(
+    target: u64,
+    candidates: impl IntoIterator<Item = (u32, u64)>,
+) -> Option<(u32, u64)> {
+    candidates
+        .into_iter()
+        .min_by_key(|&(level, t)| (t.abs_diff(target), level))
+}
+
+/// The highest level the equal-triangle search tries (the tessellator's maximum).
+pub const MAX_EQUAL_TRIANGLE_LEVEL: u32 = crate::tessellator::MAX_LEVEL as u32;
 
 /// A row that was not measured, and why.
 #[derive(Clone, Debug, PartialEq)]
@@ -461,25 +502,29 @@ pub fn run_bench_with_progress(
         let mut methods = build_methods(&config.methods, &ctx)?;
         for &segments in &config.segments {
             progress.measuring(&mesh.name, segments);
+            let levels = group_levels(&methods, segments, config, &mesh.name)?;
             let mut runnable = Vec::new();
-            for method in methods.iter_mut() {
-                match method.skip_reason(segments) {
-                    Some(reason) => report.skipped.push(SkippedRow {
+            for (method, level) in methods.iter_mut().zip(levels) {
+                match level {
+                    Err(reason) => report.skipped.push(SkippedRow {
                         mesh: mesh.name.clone(),
                         segments,
                         method: method.label().to_owned(),
                         reason,
                     }),
-                    None => runnable.push(method),
+                    Ok(level) => runnable.push((method, level)),
                 }
             }
             let mut rows = run_group(&harness, &mut runnable, mesh, segments, config)?;
-            let flat_total = rows
+            let flat = rows
                 .iter()
                 .find(|r| r.method == "flat")
-                .map(|r| r.total_median_ms);
+                .map(|r| (r.total_median_ms, r.triangles));
             for row in &mut rows {
-                row.ratio_to_flat = flat_total.map(|f| row.total_median_ms / f);
+                row.ratio_to_flat = flat.map(|(f, _)| row.total_median_ms / f);
+                row.triangle_ratio_to_flat = flat
+                    .filter(|&(_, t)| t > 0)
+                    .map(|(_, t)| row.triangles as f64 / t as f64);
                 progress.row(row);
             }
             progress.group_done();
@@ -494,6 +539,51 @@ pub fn run_bench_with_progress(
         }
     }
     Ok(report)
+}
+
+/// The level each method draws at in the group at `segments`, or why it is skipped: S (and
+/// the method's own skip reason) by default; under [`BenchConfig::equal_triangles`], for each
+/// method that knows its triangles beforehand, the whole level in
+/// 1..=[`MAX_EQUAL_TRIANGLE_LEVEL`] it accepts whose count is nearest Flat's at S.
+fn group_levels(
+    methods: &[Box<dyn BenchMethod>],
+    segments: u32,
+    config: &BenchConfig,
+    mesh: &str,
+) -> Result<Vec<std::result::Result<u32, String>>> {
+    let at_s = |m: &dyn BenchMethod| match m.skip_reason(segments) {
+        Some(reason) => Err(reason),
+        None => Ok(segments),
+    };
+    if !config.equal_triangles {
+        return Ok(methods.iter().map(|m| at_s(m.as_ref())).collect());
+    }
+    let flat = methods.iter().find(|m| m.label() == "flat");
+    let target = flat
+        .filter(|f| f.skip_reason(segments).is_none())
+        .and_then(|f| f.triangles_at(segments))
+        .ok_or_else(|| TessError::BenchConfig {
+            option: "--equal-triangles".into(),
+            reason: format!("{mesh}: Flat has no triangle count at S = {segments}"),
+        })?;
+    Ok(methods
+        .iter()
+        .map(|m| {
+            let m = m.as_ref();
+            if m.label() == "flat" {
+                return at_s(m);
+            }
+            let candidates = (1..=MAX_EQUAL_TRIANGLE_LEVEL)
+                .filter(|&l| m.skip_reason(l).is_none())
+                .filter_map(|l| m.triangles_at(l).map(|t| (l, t)));
+            match nearest_level(target, candidates) {
+                Some((level, _)) => Ok(level),
+                // No count known beforehand (the CPU baselines: they keep S) or no level
+                // accepted (skipped at S with the method's own reason).
+                None => at_s(m),
+            }
+        })
+        .collect())
 }
 
 fn validate(config: &BenchConfig, meshes: &[BenchMesh]) -> Result<()> {
@@ -535,6 +625,12 @@ fn validate(config: &BenchConfig, meshes: &[BenchMesh]) -> Result<()> {
             names.join(", ")
         ));
     }
+    if config.equal_triangles && !config.methods.iter().any(|m| m == "flat") {
+        return Err(TessError::BenchConfig {
+            option: "--equal-triangles".into(),
+            reason: "the triangle counts to match are Flat's: add flat to --methods".into(),
+        });
+    }
     Ok(())
 }
 
@@ -553,7 +649,7 @@ struct RowState {
 /// changes) spreads over all techniques instead of biasing whichever ran during it.
 fn run_group(
     harness: &Harness<'_>,
-    methods: &mut [&mut Box<dyn BenchMethod>],
+    methods: &mut [(&mut Box<dyn BenchMethod>, u32)],
     mesh: &BenchMesh,
     segments: u32,
     config: &BenchConfig,
@@ -582,7 +678,7 @@ fn run_group(
     loop {
         let is_warmup = index < warmup;
         let mut any = false;
-        for (method, st) in methods.iter_mut().zip(&mut states) {
+        for ((method, level), st) in methods.iter_mut().zip(&mut states) {
             if !is_warmup && index - warmup >= st.frames {
                 continue;
             }
@@ -590,7 +686,7 @@ fn run_group(
             let frame = BenchFrame {
                 index,
                 warmup: is_warmup,
-                segments,
+                segments: *level,
                 extent: config.extent,
                 camera: config.camera,
             };
@@ -646,15 +742,18 @@ fn run_group(
     methods
         .iter_mut()
         .zip(states)
-        .map(|(method, st)| finish_row(method.as_mut(), st, mesh, segments, warmup))
+        .map(|((method, level), st)| {
+            finish_row(method.as_mut(), st, mesh, (segments, *level), warmup)
+        })
         .collect()
 }
 
+/// The row of one method; `(segments, level)`: the group's S and the level it drew at.
 fn finish_row(
     method: &mut dyn BenchMethod,
     st: RowState,
     mesh: &BenchMesh,
-    segments: u32,
+    (segments, level): (u32, u32),
     warmup: u32,
 ) -> Result<BenchRow> {
     let RowState {
@@ -691,6 +790,7 @@ fn finish_row(
         input_triangles: mesh.triangles(),
         segments,
         method: method.label().to_owned(),
+        level,
         triangles,
         triangles_expected: expected,
         triangles_source,
@@ -712,6 +812,9 @@ fn finish_row(
         total_p90_ms: stat(&total, stats::p90)?,
         wall_median_ms: stat(&times.wall_ms, stats::median)?,
         ratio_to_flat: None,
+        triangle_ratio_to_flat: None,
+        base_faces: mesh.input.num_faces() as u64,
+        device_bytes: method.device_bytes(),
         note: notes.join("; "),
     })
 }
@@ -719,6 +822,18 @@ fn finish_row(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn nearest_level_picks_the_closest_count_and_the_lower_level_on_ties() {
+        let quad = |l: u32| (l, 10 * (l as u64).pow(2));
+        // Counts 10, 40, 90, 160: 100 is nearest 90 (level 3), 125 is 35 from 90 and 160.
+        assert_eq!(nearest_level(100, (1..=4).map(quad)), Some((3, 90)));
+        assert_eq!(nearest_level(125, (1..=4).map(quad)), Some((3, 90)));
+        assert_eq!(nearest_level(126, (1..=4).map(quad)), Some((4, 160)));
+        assert_eq!(nearest_level(1, (1..=4).map(quad)), Some((1, 10)));
+        assert_eq!(nearest_level(10_000, (1..=4).map(quad)), Some((4, 160)));
+        assert_eq!(nearest_level(5, std::iter::empty()), None);
+    }
 
     #[test]
     fn utc_dates() {

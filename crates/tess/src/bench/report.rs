@@ -7,6 +7,14 @@ use std::fmt::Write as _;
 /// The CSV columns, in order.
 pub const CSV_HEADER: &str = "mesh,input_triangles,segments,method,triangles,triangles_expected,\
 triangles_source,frames,warmup,gpu_median_ms,gpu_p90_ms,cpu_median_ms,cpu_p90_ms,\
+total_median_ms,total_p90_ms,wall_median_ms,ratio_to_flat,level,triangle_ratio_to_flat,\
+base_faces,device_bytes,note";
+
+/// The columns before `level`, `triangle_ratio_to_flat`, `base_faces` and `device_bytes`
+/// existed: [`parse_csv`] still reads such files (those fields then read S, none, 0, none).
+pub const CSV_HEADER_V1: &str =
+    "mesh,input_triangles,segments,method,triangles,triangles_expected,\
+triangles_source,frames,warmup,gpu_median_ms,gpu_p90_ms,cpu_median_ms,cpu_p90_ms,\
 total_median_ms,total_p90_ms,wall_median_ms,ratio_to_flat,note";
 
 fn csv_field(s: &str) -> String {
@@ -47,6 +55,10 @@ impl BenchReport {
                 r.total_p90_ms.to_string(),
                 r.wall_median_ms.to_string(),
                 opt(r.ratio_to_flat),
+                r.level.to_string(),
+                opt(r.triangle_ratio_to_flat),
+                r.base_faces.to_string(),
+                r.device_bytes.map(|b| b.to_string()).unwrap_or_default(),
                 csv_field(&r.note),
             ];
             out.push_str(&fields.join(","));
@@ -87,7 +99,27 @@ impl BenchReport {
             "Table memory: Flat, Phong and PN keep no tables (only the control mesh); the CPU \
              baseline keeps the refined mesh on the GPU (size in its rows' notes)"
                 .to_owned(),
+            "Memory per base face (B/face): bytes of every buffer and texture the method keeps \
+             on the device for the mesh, as created (frame uniforms and pipelines excluded), \
+             over the faces of the control mesh as loaded. Flat, Phong, PN: the render mesh's \
+             vertex buffer (position + normal per render vertex) and patch index buffers; \
+             adaptive, gregory, acc: base positions, vertex buffer (refined/local points), \
+             stencils, patch records, control points, curves, patch surfaces, \
+             reparameterization table, curve and corner owners, 1x1 textures; bft: base \
+             positions, tables, patch records, stencils, level-1 vertices and normals; CPU \
+             baselines: the refined mesh's vertex and index buffers at the row's level"
+                .to_owned(),
         ];
+        if c.equal_triangles {
+            lines.push(
+                "Equal triangles: at each mesh and S, Flat draws S segments per base edge and \
+                 every other method the whole level (segments per patch edge for the patch \
+                 techniques) whose CPU triangle count is nearest Flat's (lower level on a tie); \
+                 column `level` is the level drawn, `tris × Flat` its counted triangles over \
+                 Flat's, and × Flat is then a cost at (nearly) equal output triangles"
+                    .to_owned(),
+            );
+        }
         lines.extend(self.extra_notes.iter().cloned());
         lines.extend(self.mesh_notes.iter().cloned());
         lines
@@ -127,10 +159,17 @@ impl BenchReport {
                 .map(|x| format!("{x:.2}"))
                 .unwrap_or_else(|| "—".into()),
             r.frames.to_string(),
+            r.level.to_string(),
+            r.triangle_ratio_to_flat
+                .map(|x| format!("{x:.3}"))
+                .unwrap_or_else(|| "—".into()),
+            r.bytes_per_base_face()
+                .map(|x| format!("{x:.0}"))
+                .unwrap_or_else(|| "—".into()),
         ]
     }
 
-    const COLUMNS: [&'static str; 10] = [
+    const COLUMNS: [&'static str; 13] = [
         "mesh",
         "S",
         "method",
@@ -141,6 +180,9 @@ impl BenchReport {
         "total ms",
         "× Flat",
         "frames",
+        "level",
+        "tris × Flat",
+        "B/face",
     ];
 
     /// A console table, aligned, with the header lines and warnings above it.
@@ -268,7 +310,8 @@ fn split_csv_line(line: &str) -> Vec<String> {
 pub fn parse_csv(text: &str) -> Result<Vec<BenchRow>> {
     let mut lines = text.lines();
     let header = lines.next().unwrap_or_default();
-    if header.trim_end() != CSV_HEADER {
+    let current = header.trim_end() == CSV_HEADER;
+    if !current && header.trim_end() != CSV_HEADER_V1 {
         return Err(TessError::Csv {
             line: 1,
             column: "header".into(),
@@ -281,13 +324,20 @@ pub fn parse_csv(text: &str) -> Result<Vec<BenchRow>> {
             continue;
         }
         let line_no = n + 2;
-        let f = split_csv_line(line);
-        if f.len() != 18 {
+        let mut f = split_csv_line(line);
+        let fields = if current { 22 } else { 18 };
+        if f.len() != fields {
             return Err(TessError::Csv {
                 line: line_no,
-                column: "field count (expected 18)".into(),
+                column: format!("field count (expected {fields})"),
                 value: f.len().to_string(),
             });
+        }
+        if !current {
+            // level (S), triangle ratio, base faces (unknown), device bytes before the note.
+            let note = f.pop().unwrap_or_default();
+            let s = f[2].clone();
+            f.extend([s, String::new(), "0".into(), String::new(), note]);
         }
         let err = |col: &str, v: &str| TessError::Csv {
             line: line_no,
@@ -328,7 +378,15 @@ pub fn parse_csv(text: &str) -> Result<Vec<BenchRow>> {
             total_p90_ms: num(14, "total_p90_ms")?,
             wall_median_ms: num(15, "wall_median_ms")?,
             ratio_to_flat: opt_num(16, "ratio_to_flat")?,
-            note: f[17].clone(),
+            level: u32::try_from(int(17, "level")?).map_err(|_| err("level", &f[17]))?,
+            triangle_ratio_to_flat: opt_num(18, "triangle_ratio_to_flat")?,
+            base_faces: int(19, "base_faces")?,
+            device_bytes: if f[20].is_empty() {
+                None
+            } else {
+                Some(int(20, "device_bytes")?)
+            },
+            note: f[21].clone(),
         });
     }
     Ok(rows)
@@ -348,6 +406,26 @@ mod tests {
         );
         assert_eq!(split_csv_line(&line), vec!["a,b", "say \"hi\"", "plain"]);
         assert_eq!(split_csv_line("x,,y"), vec!["x", "", "y"]);
+    }
+
+    /// A CSV written before the level, triangle-ratio and memory columns still reads.
+    #[test]
+    fn first_format_csv_reads_with_defaults() {
+        let text = format!(
+            "{CSV_HEADER_V1}\nspot,372,16,flat,142848,142848,cpu,3,1,1.5,2,,,1.5,2,1.7,1,\"a, b\"\n"
+        );
+        let rows = parse_csv(&text).unwrap();
+        assert_eq!(rows.len(), 1);
+        let r = &rows[0];
+        assert_eq!((r.segments, r.level, r.base_faces), (16, 16, 0));
+        assert_eq!((r.triangle_ratio_to_flat, r.device_bytes), (None, None));
+        assert_eq!(r.bytes_per_base_face(), None);
+        assert_eq!(r.note, "a, b");
+        // A short row is still refused, naming the count the header asks for.
+        let e = parse_csv(&format!("{CSV_HEADER_V1}\na,b\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("expected 18"), "{e}");
     }
 
     #[test]

@@ -7,8 +7,8 @@ use crate::error::{Result, TessError};
 use crate::gpu::DrawPush;
 use crate::render_mesh::{PatchOrigin, RenderMesh};
 use crate::technique::{
-    for_each_draw, number_arrays, DrawCounts, FactorPolicy, FrameParams, Pass, PatchArray,
-    PatchPipeline, PatchType, Technique, TechniqueId,
+    for_each_draw, number_arrays, DeviceAllocation, DrawCounts, FactorPolicy, FrameParams, Pass,
+    PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
 };
 use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, MAX_LEVEL};
 use topology::ControlMesh;
@@ -192,5 +192,13 @@ impl<S: FaceStyle> Technique for FacePatches<S> {
 
     fn face_point(&self, patch: u32, domain: [f32; 2]) -> Option<FacePoint> {
         self.faces.face_point(patch, domain)
+    }
+
+    /// The render mesh's vertex buffer (positions and normals) and the patch index buffers.
+    fn device_memory(&self) -> Vec<DeviceAllocation> {
+        std::iter::once(&self.vertices)
+            .chain(self.indices.iter().map(|a| &a.indices))
+            .map(DeviceAllocation::of_buffer)
+            .collect()
     }
 }

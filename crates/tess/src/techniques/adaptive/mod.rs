@@ -52,8 +52,8 @@ use crate::gpu::AdaptivePush;
 use crate::shaders::{self, Stage, Variant};
 use crate::surface::{SurfaceImage, SurfaceMaps, SurfaceShow};
 use crate::technique::{
-    for_each_draw, number_arrays, DrawCounts, FactorPolicy, FrameParams, Pass, PatchArray,
-    PatchPipeline, PatchType, Technique, TechniqueId,
+    for_each_draw, number_arrays, DeviceAllocation, DrawCounts, FactorPolicy, FrameParams, Pass,
+    PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
 };
 use crate::techniques::bft::{base_positions, bbox};
 use crate::tessellator::{quad_triangle_count, uniform_vertex_count, Domain, Spacing};
@@ -899,6 +899,18 @@ impl Technique for Adaptive {
             u: uv[0] as f32,
             v: uv[1] as f32,
         })
+    }
+
+    /// Per frame slot, the base positions; the vertex buffer (refined and local points), the
+    /// stencils, patch records, control points, curves, patch surfaces, reparameterization
+    /// table and curve and corner owners; the colour texture and height map (1×1 when none).
+    fn device_memory(&self) -> Vec<DeviceAllocation> {
+        self.base
+            .iter()
+            .chain(&self._static)
+            .map(DeviceAllocation::of_buffer)
+            .chain(self._textures.iter().map(DeviceAllocation::of_texture))
+            .collect()
     }
 
     fn report_notes(&self) -> Vec<String> {

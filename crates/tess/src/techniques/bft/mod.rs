@@ -55,8 +55,8 @@ use crate::gpu::bindings::{
 use crate::gpu::BftPush;
 use crate::shaders::{self, Stage, Variant};
 use crate::technique::{
-    for_each_draw, number_arrays, DrawCounts, FactorPolicy, FrameParams, Pass, PatchArray,
-    PatchPipeline, PatchType, Technique, TechniqueId,
+    for_each_draw, number_arrays, DeviceAllocation, DrawCounts, FactorPolicy, FrameParams, Pass,
+    PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
 };
 use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, Domain, Spacing};
 use layout::{BasePosition, PackedTables, PatchHeader, StencilTerm, TangentTerm, STORAGE_BINDINGS};
@@ -999,6 +999,16 @@ impl Technique for Bft {
             u: uv[0] as f32,
             v: uv[1] as f32,
         })
+    }
+
+    /// Per frame slot, the base positions; the tables, patch records, stencils, level-1
+    /// vertices and normals.
+    fn device_memory(&self) -> Vec<DeviceAllocation> {
+        self.base
+            .iter()
+            .chain(&self._static)
+            .map(DeviceAllocation::of_buffer)
+            .collect()
     }
 
     fn report_notes(&self) -> Vec<String> {
