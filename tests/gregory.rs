@@ -510,3 +510,105 @@ fn acc_tangent_patch_normals_on_the_gpu() {
         );
     }
 }
+
+/// Displaced surfaces are shaded with the displaced surface's normal: the captured normals
+/// follow the normals of the captured (welded) triangles far better than the undisplaced
+/// surface's normals at the same (patch, u, v) do, on Gregory, ACC-1 and adaptive surfaces.
+#[test]
+fn displaced_surfaces_shade_with_displaced_normals() {
+    let gpu = Gpu::new();
+    let mut ctx = Context::offscreen(gpu.device()).expect("context");
+    let capturer = Capturer::new(&ctx).expect("capturer");
+    let angle = |a: [f64; 3], b: [f64; 3]| {
+        let d: f64 = (0..3).map(|k| a[k] * b[k]).sum();
+        let c = [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ];
+        (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt().atan2(d)
+    };
+    let mesh = shape("spot");
+    let height = SurfaceMaps {
+        height: Some(std::sync::Arc::new(
+            tessera::tess::surface::load_height(common::data("assets/spot_height.png"))
+                .expect("height map"),
+        )),
+        ..Default::default()
+    };
+    let scale = 0.02 * diag(&mesh) as f32;
+    // The height map's slopes are finer than 16 segments per patch resolve: the mesh's own
+    // normals only approach the shading normals at finer tessellation.
+    for (label, maps, segments, bound) in [
+        ("procedural", SurfaceMaps::default(), 16.0, 0.5),
+        ("height map", height, 32.0, 0.5),
+    ] {
+        for patch in PATCHES {
+            let surf = gregory::build(&mut ctx, &mesh, patch, 1.0, "spot", &maps).expect("build");
+            let capture = |ctx: &mut Context, displace: f32| {
+                capturer
+                    .capture(
+                        ctx,
+                        &surf,
+                        &FrameParams {
+                            displace,
+                            ..FrameParams::uniform(segments)
+                        },
+                        EXTENT,
+                    )
+                    .expect("capture")
+                    .0
+            };
+            let displaced = capture(&mut ctx, scale);
+            let flat = capture(&mut ctx, 0.0);
+            assert_eq!(displaced.records.len(), flat.records.len());
+            // Area-weighted normals of the displaced mesh, welded by bits.
+            let welded = displaced.weld().expect("weld");
+            let mut mesh_normals = vec![[0.0f64; 3]; welded.positions.len()];
+            for t in &welded.triangles {
+                let p = t.map(|i| welded.positions[i as usize].map(f64::from));
+                let (e1, e2) = (
+                    [p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]],
+                    [p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]],
+                );
+                let c = [
+                    e1[1] * e2[2] - e1[2] * e2[1],
+                    e1[2] * e2[0] - e1[0] * e2[2],
+                    e1[0] * e2[1] - e1[1] * e2[0],
+                ];
+                for &i in t {
+                    for k in 0..3 {
+                        mesh_normals[i as usize][k] += c[k];
+                    }
+                }
+            }
+            let index: std::collections::HashMap<[u32; 3], usize> = welded
+                .positions
+                .iter()
+                .enumerate()
+                .map(|(i, p)| (p.map(f32::to_bits), i))
+                .collect();
+            let (mut shaded, mut base, mut n) = (0.0f64, 0.0f64, 0usize);
+            for (r, f) in displaced.records.iter().zip(&flat.records) {
+                // Skip patch boundaries, where the welded normal mixes patches' triangles.
+                if r.domain.iter().any(|&x| x == 0.0 || x == 1.0) {
+                    continue;
+                }
+                let m = mesh_normals[index[&r.position.map(f32::to_bits)]];
+                // Line angle: the capture's winding runs against the normals.
+                let line = |a: f64| a.min(std::f64::consts::PI - a);
+                shaded += line(angle(r.normal.map(f64::from), m));
+                base += line(angle(f.normal.map(f64::from), m));
+                n += 1;
+            }
+            let (shaded, base) = (shaded / n as f64, base / n as f64);
+            println!(
+                "spot {patch:?} {label}, {segments} segments: mean angle to the displaced mesh's normals {shaded:.4} rad (undisplaced normals {base:.4} rad), {n} vertices"
+            );
+            assert!(
+                shaded < bound * base,
+                "{patch:?} {label}: displaced shading normals {shaded} vs undisplaced {base}"
+            );
+        }
+    }
+}

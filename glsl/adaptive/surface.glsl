@@ -225,6 +225,24 @@ const vec2 CORNER_PARAMS[4] = vec2[4](vec2(0.0, 0.0), vec2(1.0, 0.0), vec2(1.0, 
 
 // A boundary vertex at curve `curve`, parameter `s`, displaced by its owner (see above); `pos`
 // is the canonical point.
+// The shading normal of the displaced surface p + k h n (k the scale): its derivatives are
+// p_u + k h_u n and p_v + k h_v n, dropping the k h n_u terms (the curvature of the undisplaced
+// surface times the height: small next to the height's slope). With the base normal `n` (the
+// tangent patches' on ACC-1) standing for p_u x p_v / |p_u x p_v|, the cross product is
+//   |p_u x p_v| n + k h_v (p_u x n) + k h_u (n x p_v),
+// whose direction does not depend on the parameterization, so both sides of an edge agree
+// wherever the height is continuous. h_u, h_v: central differences of the height at the
+// patch's texture coordinates (one-sided at the patch boundary).
+vec3 displaced_normal(uint id, vec2 uv, vec3 n, vec3 du, vec3 dv) {
+    const float h = 1.0 / 1024.0;
+    vec2 lo = max(uv - vec2(h), vec2(0.0)), hi = min(uv + vec2(h), vec2(1.0));
+    float hu = (surface_height(patch_texcoord(id, vec2(hi.x, uv.y))) - surface_height(patch_texcoord(id, vec2(lo.x, uv.y)))) / (hi.x - lo.x);
+    float hv = (surface_height(patch_texcoord(id, vec2(uv.x, hi.y))) - surface_height(patch_texcoord(id, vec2(uv.x, lo.y)))) / (hi.y - lo.y);
+    float k = adaptive.displace_scale;
+    vec3 m = length(cross(du, dv)) * n + (k * hv) * cross(du, n) + (k * hu) * cross(n, dv);
+    return safe_normalize(m, n);
+}
+
 vec3 displace_canonical(vec3 pos, uint curve, float s) {
     uint owner;
     vec2 ouv;

@@ -47,6 +47,8 @@ void main() {
         } else {
             pos += n * (adaptive.displace_scale * surface_height(tex));
         }
+        // Shade the displaced surface, not the base one (positions above are already final).
+        n = displaced_normal(tc_patch, uv, n, du, dv);
     }
     uint kind = tc_info & 15u, level = (tc_info >> 4) & 15u;
     vec3 albedo = frame.base_color.rgb;
