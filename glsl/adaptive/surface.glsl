@@ -177,8 +177,9 @@ vec3 owner_normal(uint id, vec2 uv) {
     } else if (kind == ADAPTIVE_KIND_GREGORY) {
         vec3 c[20];
         for (uint k = 0u; k < 20u; ++k) c[k] = vtx(control_points[p.cp_offset + k]);
-        // The interior Bezier points as gregory.tese blends them (positions only: the normal
-        // of the blended net).
+        // The interior Bezier points as gregory.tese blends them. Their blend derivatives are
+        // left out: they carry B1 or B2 in both directions, which vanish on the patch edges,
+        // the only place an owner is evaluated.
         vec3 b[16];
         b[0] = c[0];  b[1] = c[1];  b[2] = c[7];  b[3] = c[5];
         b[7] = c[6];  b[11] = c[12]; b[15] = c[10];
