@@ -42,6 +42,8 @@ pub enum Action {
     /// Displacement scale ×1.25 (]) and ÷1.25 ([); either turns displacement on.
     DisplaceUp,
     DisplaceDown,
+    /// What the surface is coloured by: shading, parameter shift, Eq. 1 error (V).
+    Show,
     ToggleHud,
     Quit,
 }
@@ -311,6 +313,12 @@ fn panel(ui: &mut egui::Ui, s: &Shown<'_>, history: &[f32], actions: &mut Vec<Ac
             if toggle(ui, Some(p.displace != 0.0), "displacement (D)") {
                 actions.push(Action::Displace);
             }
+            if ui
+                .button(format!("view: {} (V)", show_name(p.show)))
+                .clicked()
+            {
+                actions.push(Action::Show);
+            }
         });
         ui.horizontal(|ui| {
             ui.label(format!(
@@ -388,4 +396,13 @@ fn frame_graph(ui: &mut egui::Ui, history: &[f32]) {
         })
         .collect();
     painter.line(points, Stroke::new(1.0, Color32::from_rgb(120, 200, 120)));
+}
+
+/// The HUD's name of a surface view.
+pub fn show_name(show: tess::surface::SurfaceShow) -> &'static str {
+    match show {
+        tess::surface::SurfaceShow::Shading => "shading",
+        tess::surface::SurfaceShow::ParamShift => "parameter shift",
+        tess::surface::SurfaceShow::ParamError => "Eq. 1 texture error",
+    }
 }

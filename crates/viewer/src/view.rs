@@ -7,7 +7,9 @@
 //! E switches the end caps (Gregory, bilinear), S / Shift+S scale every crease's sharpness up /
 //! down (the surface is re-planned on the CPU; the mesh is not reloaded). On the textured
 //! Catmull-Clark techniques (adaptive, gregory, acc) R toggles the texture reparameterization,
-//! D the displacement, and ] / [ scale the displacement by 1.25 up / down (turning it on);
+//! D the displacement, ] / [ scale the displacement by 1.25 up / down (turning it on), and V
+//! cycles the view: shading, parameter shift, the Eq. 1 texture error (its lattice is built
+//! then, once per surface);
 //! without `--displace` D starts at [`DEFAULT_DISPLACE`] of the mesh's bounding-box diagonal.
 //! P saves the next frame as `tessera-screenshot-N.png` in the working directory. An OBJ
 //! dropped on the window replaces the mesh. Esc quits. The title shows what is drawn and the
@@ -531,6 +533,7 @@ impl App {
                 "r" | "R" => Action::Reparam,
                 "d" | "D" => Action::Displace,
                 "]" => Action::DisplaceUp,
+                "v" | "V" => Action::Show,
                 "[" => Action::DisplaceDown,
                 _ => return None,
             },
@@ -607,6 +610,16 @@ impl App {
                 if features.surface =>
             {
                 surface_key(p, &mut self.displace_scale, action)
+            }
+            Action::Show if features.surface => {
+                p.show = next_show(p.show);
+                // The Eq. 1 lattice is computed when the surface is built, on request.
+                if p.show == tess::surface::SurfaceShow::ParamError
+                    && !self.setup.build.maps.param_error
+                {
+                    self.setup.build.maps.param_error = true;
+                    self.rebuild = true;
+                }
             }
             _ => {}
         }
@@ -797,6 +810,16 @@ fn initial_displace_scale(displace: f32, mesh: &ControlMesh) -> f32 {
     }
 }
 
+/// V: shading, then the reparameterization's parameter shift, then the Eq. 1 texture error.
+fn next_show(show: tess::surface::SurfaceShow) -> tess::surface::SurfaceShow {
+    use tess::surface::SurfaceShow::*;
+    match show {
+        Shading => ParamShift,
+        ParamShift => ParamError,
+        ParamError => Shading,
+    }
+}
+
 /// R, D, ] and [ (techniques with [`tess::Features::surface`]): `scale` is the displacement D
 /// turns back on; it equals `params.displace` whenever displacement is on.
 fn surface_key(params: &mut tess::FrameParams, scale: &mut f32, action: Action) {
@@ -863,6 +886,18 @@ mod tests {
     }
 
     #[test]
+    fn v_cycles_every_surface_view() {
+        use tess::surface::SurfaceShow::*;
+        let mut seen = vec![Shading];
+        let mut show = Shading;
+        for _ in 0..3 {
+            show = next_show(show);
+            seen.push(show);
+        }
+        assert_eq!(seen, [Shading, ParamShift, ParamError, Shading]);
+    }
+
+    #[test]
     fn keys_map_to_their_actions() {
         // Method keys: the registry's order, gregory and acc last.
         let order: Vec<TechniqueId> = techniques::registry().iter().map(|i| i.id).collect();
@@ -881,6 +916,8 @@ mod tests {
             ("D", Action::Displace),
             ("]", Action::DisplaceUp),
             ("[", Action::DisplaceDown),
+            ("v", Action::Show),
+            ("V", Action::Show),
             // The keys that were there before keep their meaning.
             ("w", Action::Wireframe),
             ("s", Action::SharpnessUp),

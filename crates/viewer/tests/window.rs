@@ -254,7 +254,8 @@ fn keys_change_level_and_technique_and_p_saves_screenshots() {
 /// The surface keys on textured gregory: D displaces (the default scale, 2% of the diagonal:
 /// the picture changes), D again brings the undisplaced picture back, ] displaces at 1.25 times
 /// the scale (another picture); R switches the reparameterization without error (its effect,
-/// a shift of a few texels, is measured by tests/golden.rs).
+/// a shift of a few texels, is measured by tests/golden.rs); V recolours the surface by the
+/// parameter shift, V again by the Eq. 1 error (its lattice built on the key).
 #[test]
 fn surface_keys_displace_and_restore() {
     let _one = SERVER.lock().unwrap_or_else(|e| e.into_inner());
@@ -299,7 +300,13 @@ fn surface_keys_displace_and_restore() {
     xdotool(&d, &["key", "bracketright", "p"]);
     let scaled = shot(4);
     xdotool(&d, &["key", "r", "p"]);
-    shot(5);
+    let reparam_off = shot(5);
+    // V twice: the parameter-shift view, then the Eq. 1 error view (the surface is rebuilt
+    // with its error lattice); both recolour the whole surface.
+    xdotool(&d, &["key", "v", "p"]);
+    let shift_view = shot(6);
+    xdotool(&d, &["key", "v", "p"]);
+    let error_view = shot(7);
     xdotool(&d, &["key", "Escape"]);
     let o = child.wait_with_output().expect("tessera ends");
     drop(server);
@@ -313,6 +320,13 @@ fn surface_keys_displace_and_restore() {
     assert!(on > 300, "D changed {on} pixels");
     assert_eq!(back, 0, "D twice should give the undisplaced picture back");
     assert!(more > 100, "] changed {more} pixels");
+    let (shift, _, _) = compare(&reparam_off, &shift_view);
+    let (error, _, _) = compare(&shift_view, &error_view);
+    eprintln!("V changed {shift} pixels, V again {error}");
+    assert!(
+        shift > 300 && error > 300,
+        "V: {shift}, then {error} pixels"
+    );
 }
 
 /// Where the HUD's "×2 (Up)" level button is in the window (egui's layout at scale 1, the
