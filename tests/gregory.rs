@@ -297,6 +297,34 @@ fn bad_input_gives_named_errors() {
         ] {
             assert!(ok.check(&bad).is_err(), "{bad:?}");
         }
+        // A texture on a mesh without `vt` is refused, naming the mesh.
+        let mut bare = mesh.clone();
+        bare.uvs = None;
+        let textured = SurfaceMaps {
+            texture: Some(std::sync::Arc::new(
+                tessera::tess::surface::load_texture(common::data("assets/spot_texture.png"))
+                    .expect("texture"),
+            )),
+            ..Default::default()
+        };
+        for patch in PATCHES {
+            let e = gregory::build(&mut ctx, &bare, patch, 1.0, "bare.obj", &textured)
+                .err()
+                .expect("texture without vt");
+            assert!(
+                e.to_string().contains("bare.obj") && e.to_string().contains("vt"),
+                "{e}"
+            );
+        }
+        assert!(gregory::build(
+            &mut ctx,
+            &mesh,
+            SinglePassPatch::Gregory,
+            1.0,
+            "cube",
+            &textured
+        )
+        .is_ok());
         // The Eq. 1 view needs the lattice, which is built only on request.
         let e = ok
             .check(&FrameParams {

@@ -133,6 +133,28 @@ fn surface_textures(device: &vk_core::Device, maps: &SurfaceMaps) -> Result<[Tex
     ])
 }
 
+/// A colour texture or height map needs the mesh's `vt` at every face corner: without them
+/// each face would show the whole image, which is never what was meant. Checked before the
+/// surface is planned. Procedural displacement works without `vt` (the (sub)face parameter
+/// stands in).
+pub fn check_texcoords(mesh: &ControlMesh, maps: &SurfaceMaps, name: &str) -> Result<()> {
+    let wanted = match (&maps.texture, &maps.height) {
+        (Some(_), _) => "a colour texture",
+        (None, Some(_)) => "a height map",
+        (None, None) => return Ok(()),
+    };
+    if topology::texcoord::has_texcoords(mesh) {
+        return Ok(());
+    }
+    Err(TessError::Mesh {
+        name: name.to_string(),
+        source: format!(
+            "{wanted} was given, but the mesh has no `vt` texture coordinate at every face corner (procedural displacement works without them)"
+        )
+        .into(),
+    })
+}
+
 /// Stencil rows: their CSR offsets (row `r` reads `offsets[r + 1]`).
 const ROWS: Space = Space {
     name: "stencil row",
@@ -275,6 +297,7 @@ impl Adaptive {
     /// Plans `mesh` (Catmull-Clark, any faces, boundaries, creases) and uploads it, with one
     /// base-position buffer per frame slot of `ctx`.
     pub fn new(ctx: &mut Context, mesh: &ControlMesh, options: &AdaptiveBuild) -> Result<Self> {
+        check_texcoords(mesh, &options.maps, &options.name)?;
         let plan = plan_adaptive(
             mesh,
             &AdaptiveOptions {

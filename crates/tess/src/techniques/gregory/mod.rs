@@ -33,6 +33,7 @@ pub fn build(
     name: &str,
     maps: &crate::surface::SurfaceMaps,
 ) -> Result<Adaptive> {
+    crate::techniques::adaptive::check_texcoords(mesh, maps, name)?;
     let plan = plan_single_pass(
         mesh,
         &SinglePassOptions {
