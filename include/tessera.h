@@ -10,6 +10,10 @@
 #include <vulkan/vulkan.h>
 
 
+// The largest texture or height-map side the C ABI takes (the device's
+// `maxImageDimension2D` may lower it).
+#define TESSERA_MAX_IMAGE_SIDE 16384
+
 // What a call did. `TESSERA_STATUS_OK` is zero; every other value is a failure whose message
 // [`crate::tessera_last_error`] returns.
 typedef enum TesseraStatus {
@@ -89,8 +93,24 @@ typedef struct TesseraSurfaceDesc {
   uint32_t isolation;
   // `TESSERA_END_CAP_*` (adaptive).
   TesseraEndCap end_cap;
-  // Scales every crease and corner sharpness (adaptive).
+  // Scales every crease and corner sharpness (adaptive, gregory, acc).
   float sharpness_scale;
+  // Colour texture sampled at the mesh's `uvs` (adaptive, gregory, acc): NULL (none, and
+  // both sizes 0) or `texture_width * texture_height * 4` bytes of RGBA8 sRGB, rows top to
+  // bottom, copied during the call. Sides 1..=`TESSERA_MAX_IMAGE_SIDE` (and the device's
+  // `maxImageDimension2D`).
+  const uint8_t *texture;
+  uint32_t texture_width;
+  uint32_t texture_height;
+  // Height map for the frame's `displace` (adaptive, gregory, acc): NULL (none: a procedural
+  // height) or `height_map_width * height_map_height` finite floats (typically 0..1), rows
+  // top to bottom, copied during the call; sides as the texture's.
+  const float *height_map;
+  uint32_t height_map_width;
+  uint32_t height_map_height;
+  // Compute the texture-error lattice `TESSERA_SHOW_PARAM_ERROR` draws (CPU work at build
+  // time); 0 or 1 (adaptive, gregory, acc).
+  uint32_t param_error;
 } TesseraSurfaceDesc;
 
 // How tessellation factors are chosen (`TESSERA_FACTORS_*`).
@@ -98,6 +118,9 @@ typedef uint32_t TesseraFactorPolicy;
 
 // Tessellation spacing (`TESSERA_SPACING_*`).
 typedef uint32_t TesseraSpacing;
+
+// What a surface is coloured by (`TESSERA_SHOW_*`; adaptive, gregory, acc).
+typedef uint32_t TesseraShow;
 
 // What one frame shows. [`tessera_frame_desc_default`] fills the defaults.
 typedef struct TesseraFrameDesc {
@@ -125,6 +148,15 @@ typedef struct TesseraFrameDesc {
   float base_color[3];
   // Clear colour of the standalone image (RGBA, 0..1).
   float clear_color[4];
+  // Texture coordinates at the reparameterized parameter on Gregory patches; 0 or 1
+  // (default 1; 0 only on adaptive, gregory, acc).
+  uint32_t reparam;
+  // Displacement along the normal by this times the height (the surface's height map, else
+  // a procedural one); finite, at most 1000 in magnitude; nonzero only on adaptive, gregory,
+  // acc.
+  float displace;
+  // `TESSERA_SHOW_*`; other than SHADING only on adaptive, gregory, acc.
+  TesseraShow show;
 } TesseraFrameDesc;
 
 // The Khronos validation layer in standalone mode (`TESSERA_VALIDATION_*`).
@@ -207,6 +239,13 @@ typedef struct TesseraHostDesc {
 
 #define TESSERA_TECHNIQUE_ADAPTIVE 5
 
+// Catmull-Clark approximated in one pass: one Gregory patch per base face (`--method gregory`).
+#define TESSERA_TECHNIQUE_GREGORY 6
+
+// Catmull-Clark approximated in one pass by ACC-1 patches, Gregory where ACC-1 does not apply
+// (`--method acc`).
+#define TESSERA_TECHNIQUE_ACC 7
+
 // Catmull-Clark unless every face is a triangle (then Loop); a Loop technique fan-triangulates.
 #define TESSERA_SCHEME_AUTO 0
 
@@ -234,6 +273,15 @@ typedef struct TesseraHostDesc {
 
 #define TESSERA_END_CAP_BILINEAR 1
 
+// Lighting of the albedo (texture, patch colours or base colour).
+#define TESSERA_SHOW_SHADING 0
+
+// How far the reparameterization moves the texture parameter (blue 0, red 0.05 of a patch).
+#define TESSERA_SHOW_PARAM_SHIFT 1
+
+// The pointwise texture error (log scale); the surface must be built with `param_error` 1.
+#define TESSERA_SHOW_PARAM_ERROR 2
+
 #define TESSERA_VALIDATION_OFF 0
 
 #define TESSERA_VALIDATION_ON 1
@@ -260,14 +308,16 @@ const char *tessera_status_name(uint32_t status);
 size_t tessera_last_error(const struct TesseraContext *ctx, char *buffer, size_t capacity);
 
 // Fills `desc` with the CLI's defaults: technique AUTO, scheme AUTO, bft's default table
-// level, no tangents, adaptive's default isolation, Gregory end caps, sharpness scale 1.
+// level, no tangents, adaptive's default isolation, Gregory end caps, sharpness scale 1, no
+// texture, no height map, no texture-error lattice.
 //
 // # Safety
 // `desc` is NULL (answered with NULL_POINTER) or points to a writable `TesseraSurfaceDesc`.
 enum TesseraStatus tessera_surface_desc_default(struct TesseraSurfaceDesc *desc);
 
 // Fills `desc` with the defaults of `tessera render`: 640x480, 4 uniform segments, equal
-// spacing, no wireframe, the CLI's camera, colours and Phong factor.
+// spacing, no wireframe, the CLI's camera, colours and Phong factor, reparameterization on,
+// no displacement, shading.
 //
 // # Safety
 // `desc` is NULL (answered with NULL_POINTER) or points to a writable `TesseraFrameDesc`.
@@ -303,7 +353,8 @@ enum TesseraStatus tessera_context_validation_errors(const struct TesseraContext
 //
 // # Safety
 // `mesh` and `desc` are NULL (answered with NULL_POINTER; `desc` NULL means defaults) or
-// readable, every array in `mesh` NULL or as long as its count says; `out` points to a
+// readable, every array in `mesh` NULL or as long as its count says, `desc`'s `texture` and
+// `height_map` NULL or as long as their sizes say; `out` points to a
 // writable `TesseraSurface*` (set to NULL on failure).
 enum TesseraStatus tessera_surface_create(struct TesseraContext *ctx,
                                           const struct TesseraMeshDesc *mesh,
@@ -316,7 +367,8 @@ enum TesseraStatus tessera_surface_create(struct TesseraContext *ctx,
 //
 // # Safety
 // `obj_text` is NULL or points to `obj_len` readable bytes (UTF-8, no NUL needed); `name` is
-// NULL or NUL-terminated; `desc` is NULL (defaults) or readable; `out` points to a writable
+// NULL or NUL-terminated; `desc` is NULL (defaults) or readable, its `texture` and
+// `height_map` NULL or as long as their sizes say; `out` points to a writable
 // `TesseraSurface*` (set to NULL on failure).
 enum TesseraStatus tessera_surface_create_obj(struct TesseraContext *ctx,
                                               const char *obj_text,

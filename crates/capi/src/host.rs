@@ -49,8 +49,8 @@ use crate::ffi::{out_write, read_required};
 use crate::registry::lock;
 use crate::status::{Error, Result, TesseraStatus};
 use crate::{
-    context_ptr, flag, frame_params, guard, registry, with_context, with_surface, ContextState,
-    Mode, TesseraContext, TesseraFrameDesc, TesseraSurface,
+    context_ptr, flag, guard, registry, surface_frame_params, with_context, with_surface,
+    ContextState, Mode, TesseraContext, TesseraFrameDesc, TesseraSurface,
 };
 use vk_core::{vk, Device, Encoder, HostDevice, Instance};
 
@@ -234,7 +234,7 @@ pub unsafe extern "C" fn tessera_surface_set_frame(
     with_surface(ctx, surface, |_, s| {
         // SAFETY: the caller's contract.
         let f = unsafe { read_required(frame, "frame") }?;
-        let frame = frame_params(&f)?;
+        let frame = surface_frame_params(s, &f)?;
         s.technique.check(&frame.0)?;
         s.frame = frame;
         Ok(())

@@ -64,6 +64,7 @@ use std::cell::RefCell;
 use std::ffi::c_char;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::{Arc, Mutex, OnceLock};
+use tess::surface::{SurfaceImage, SurfaceMaps, SurfaceShow};
 use tess::{Camera, FactorPolicy, FrameParams, Spacing, Technique, TechniqueId};
 use vk_core::{vk, Device, DeviceDesc, DeviceSelector, Instance, InstanceDesc, Validation};
 
@@ -88,6 +89,11 @@ pub const TESSERA_TECHNIQUE_PHONG: TesseraTechnique = 2;
 pub const TESSERA_TECHNIQUE_PN: TesseraTechnique = 3;
 pub const TESSERA_TECHNIQUE_BFT: TesseraTechnique = 4;
 pub const TESSERA_TECHNIQUE_ADAPTIVE: TesseraTechnique = 5;
+/// Catmull-Clark approximated in one pass: one Gregory patch per base face (`--method gregory`).
+pub const TESSERA_TECHNIQUE_GREGORY: TesseraTechnique = 6;
+/// Catmull-Clark approximated in one pass by ACC-1 patches, Gregory where ACC-1 does not apply
+/// (`--method acc`).
+pub const TESSERA_TECHNIQUE_ACC: TesseraTechnique = 7;
 
 /// The subdivision scheme (`TESSERA_SCHEME_*`).
 pub type TesseraScheme = u32;
@@ -116,6 +122,19 @@ pub const TESSERA_SPACING_FRACTIONAL_ODD: TesseraSpacing = 2;
 pub type TesseraEndCap = u32;
 pub const TESSERA_END_CAP_GREGORY: TesseraEndCap = 0;
 pub const TESSERA_END_CAP_BILINEAR: TesseraEndCap = 1;
+
+/// What a surface is coloured by (`TESSERA_SHOW_*`; adaptive, gregory, acc).
+pub type TesseraShow = u32;
+/// Lighting of the albedo (texture, patch colours or base colour).
+pub const TESSERA_SHOW_SHADING: TesseraShow = 0;
+/// How far the reparameterization moves the texture parameter (blue 0, red 0.05 of a patch).
+pub const TESSERA_SHOW_PARAM_SHIFT: TesseraShow = 1;
+/// The pointwise texture error (log scale); the surface must be built with `param_error` 1.
+pub const TESSERA_SHOW_PARAM_ERROR: TesseraShow = 2;
+
+/// The largest texture or height-map side the C ABI takes (the device's
+/// `maxImageDimension2D` may lower it).
+pub const TESSERA_MAX_IMAGE_SIDE: u32 = 16384;
 
 /// The Khronos validation layer in standalone mode (`TESSERA_VALIDATION_*`).
 pub type TesseraValidation = u32;
@@ -179,8 +198,24 @@ pub struct TesseraSurfaceDesc {
     pub isolation: u32,
     /// `TESSERA_END_CAP_*` (adaptive).
     pub end_cap: TesseraEndCap,
-    /// Scales every crease and corner sharpness (adaptive).
+    /// Scales every crease and corner sharpness (adaptive, gregory, acc).
     pub sharpness_scale: f32,
+    /// Colour texture sampled at the mesh's `uvs` (adaptive, gregory, acc): NULL (none, and
+    /// both sizes 0) or `texture_width * texture_height * 4` bytes of RGBA8 sRGB, rows top to
+    /// bottom, copied during the call. Sides 1..=`TESSERA_MAX_IMAGE_SIDE` (and the device's
+    /// `maxImageDimension2D`).
+    pub texture: *const u8,
+    pub texture_width: u32,
+    pub texture_height: u32,
+    /// Height map for the frame's `displace` (adaptive, gregory, acc): NULL (none: a procedural
+    /// height) or `height_map_width * height_map_height` finite floats (typically 0..1), rows
+    /// top to bottom, copied during the call; sides as the texture's.
+    pub height_map: *const f32,
+    pub height_map_width: u32,
+    pub height_map_height: u32,
+    /// Compute the texture-error lattice `TESSERA_SHOW_PARAM_ERROR` draws (CPU work at build
+    /// time); 0 or 1 (adaptive, gregory, acc).
+    pub param_error: u32,
 }
 
 /// What one frame shows. [`tessera_frame_desc_default`] fills the defaults.
@@ -211,6 +246,15 @@ pub struct TesseraFrameDesc {
     pub base_color: [f32; 3],
     /// Clear colour of the standalone image (RGBA, 0..1).
     pub clear_color: [f32; 4],
+    /// Texture coordinates at the reparameterized parameter on Gregory patches; 0 or 1
+    /// (default 1; 0 only on adaptive, gregory, acc).
+    pub reparam: u32,
+    /// Displacement along the normal by this times the height (the surface's height map, else
+    /// a procedural one); finite, at most 1000 in magnitude; nonzero only on adaptive, gregory,
+    /// acc.
+    pub displace: f32,
+    /// `TESSERA_SHOW_*`; other than SHADING only on adaptive, gregory, acc.
+    pub show: TesseraShow,
 }
 
 type Contexts = Registry<ContextState, SurfaceState>;
@@ -437,7 +481,8 @@ pub unsafe extern "C" fn tessera_last_error(
 }
 
 /// Fills `desc` with the CLI's defaults: technique AUTO, scheme AUTO, bft's default table
-/// level, no tangents, adaptive's default isolation, Gregory end caps, sharpness scale 1.
+/// level, no tangents, adaptive's default isolation, Gregory end caps, sharpness scale 1, no
+/// texture, no height map, no texture-error lattice.
 ///
 /// # Safety
 /// `desc` is NULL (answered with NULL_POINTER) or points to a writable `TesseraSurfaceDesc`.
@@ -455,6 +500,13 @@ pub unsafe extern "C" fn tessera_surface_desc_default(
             isolation: b.isolation,
             end_cap: TESSERA_END_CAP_GREGORY,
             sharpness_scale: b.sharpness_scale,
+            texture: std::ptr::null(),
+            texture_width: 0,
+            texture_height: 0,
+            height_map: std::ptr::null(),
+            height_map_width: 0,
+            height_map_height: 0,
+            param_error: 0,
         };
         // SAFETY: the caller's contract.
         unsafe { out_write(desc, d, "desc") }
@@ -462,7 +514,8 @@ pub unsafe extern "C" fn tessera_surface_desc_default(
 }
 
 /// Fills `desc` with the defaults of `tessera render`: 640x480, 4 uniform segments, equal
-/// spacing, no wireframe, the CLI's camera, colours and Phong factor.
+/// spacing, no wireframe, the CLI's camera, colours and Phong factor, reparameterization on,
+/// no displacement, shading.
 ///
 /// # Safety
 /// `desc` is NULL (answered with NULL_POINTER) or points to a writable `TesseraFrameDesc`.
@@ -485,6 +538,9 @@ pub unsafe extern "C" fn tessera_frame_desc_default(desc: *mut TesseraFrameDesc)
             geometric_normals: 0,
             base_color: p.base_color,
             clear_color: p.clear_color,
+            reparam: u32::from(p.reparam),
+            displace: p.displace,
+            show: TESSERA_SHOW_SHADING,
         };
         // SAFETY: the caller's contract.
         unsafe { out_write(desc, d, "desc") }
@@ -541,7 +597,7 @@ fn frame_params(d: &TesseraFrameDesc) -> Result<(FrameParams, vk::Extent2D)> {
         TESSERA_SPACING_FRACTIONAL_ODD => Spacing::FractionalOdd,
         v => return Err(invalid("spacing", v, "a TESSERA_SPACING_* value")),
     };
-    let numbers = [d.yaw, d.pitch, d.zoom, d.phong_alpha]
+    let numbers = [d.yaw, d.pitch, d.zoom, d.phong_alpha, d.displace]
         .into_iter()
         .chain(d.base_color)
         .chain(d.clear_color);
@@ -551,6 +607,21 @@ fn frame_params(d: &TesseraFrameDesc) -> Result<(FrameParams, vk::Extent2D)> {
             format!("frame description holds a non-finite number ({bad})"),
         ));
     }
+    if d.displace.abs() > 1e3 {
+        return Err(Error::new(
+            TesseraStatus::InvalidArgument,
+            format!(
+                "displace {}: expected a finite scale of at most 1000 in magnitude",
+                d.displace
+            ),
+        ));
+    }
+    let show = match d.show {
+        TESSERA_SHOW_SHADING => SurfaceShow::Shading,
+        TESSERA_SHOW_PARAM_SHIFT => SurfaceShow::ParamShift,
+        TESSERA_SHOW_PARAM_ERROR => SurfaceShow::ParamError,
+        v => return Err(invalid("show", v, "a TESSERA_SHOW_* value")),
+    };
     let params = FrameParams {
         factors,
         spacing,
@@ -566,6 +637,9 @@ fn frame_params(d: &TesseraFrameDesc) -> Result<(FrameParams, vk::Extent2D)> {
         patch_colours: flag(d.patch_colours, "patch_colours")?,
         base_color: d.base_color,
         clear_color: d.clear_color,
+        reparam: flag(d.reparam, "reparam")?,
+        displace: d.displace,
+        show,
         ..FrameParams::default()
     };
     Ok((
@@ -575,6 +649,55 @@ fn frame_params(d: &TesseraFrameDesc) -> Result<(FrameParams, vk::Extent2D)> {
             height: d.height,
         },
     ))
+}
+
+/// "adaptive, gregory or acc": the techniques with the surface feature (textures,
+/// displacement, reparameterization).
+fn surface_techniques() -> String {
+    let names = tess::techniques::names_with(|f| f.surface);
+    match names.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+        _ => names.join(""),
+    }
+}
+
+/// Refuses what `technique` cannot draw among the options `given` (their names and whether
+/// each is set), as the CLI refuses them (`OptionUse`): one message naming every field.
+fn refuse_surface_options(technique: TechniqueId, given: &[(&str, bool)]) -> Result<()> {
+    if tess::techniques::info(technique).features.surface {
+        return Ok(());
+    }
+    let names: Vec<&str> = given.iter().filter(|g| g.1).map(|g| g.0).collect();
+    if names.is_empty() {
+        return Ok(());
+    }
+    Err(Error::new(
+        TesseraStatus::Unsupported,
+        format!(
+            "{} only {} to technique {} (this surface's technique is {technique})",
+            names.join(", "),
+            if names.len() == 1 { "applies" } else { "apply" },
+            surface_techniques()
+        ),
+    ))
+}
+
+/// [`frame_params`] for `s`, refusing the surface options (`reparam` 0, `displace`, `show`)
+/// on techniques without them.
+fn surface_frame_params(
+    s: &SurfaceState,
+    d: &TesseraFrameDesc,
+) -> Result<(FrameParams, vk::Extent2D)> {
+    let (params, extent) = frame_params(d)?;
+    refuse_surface_options(
+        s.technique.id(),
+        &[
+            ("reparam 0", !params.reparam),
+            ("displace", params.displace != 0.0),
+            ("show", params.show != SurfaceShow::Shading),
+        ],
+    )?;
+    Ok((params, extent))
 }
 
 /// Creates a standalone context: Tessera's own Vulkan instance and device, chosen as the CLI
@@ -721,6 +844,8 @@ fn choose_technique(d: &TesseraSurfaceDesc, mesh: &topology::ControlMesh) -> Res
         TESSERA_TECHNIQUE_PN => TechniqueId::Pn,
         TESSERA_TECHNIQUE_BFT => TechniqueId::Bft,
         TESSERA_TECHNIQUE_ADAPTIVE => TechniqueId::Adaptive,
+        TESSERA_TECHNIQUE_GREGORY => TechniqueId::Gregory,
+        TESSERA_TECHNIQUE_ACC => TechniqueId::Acc,
         v => return Err(invalid("technique", v, "a TESSERA_TECHNIQUE_* value")),
     };
     let info = tess::techniques::info(technique);
@@ -735,8 +860,129 @@ fn choose_technique(d: &TesseraSurfaceDesc, mesh: &topology::ControlMesh) -> Res
     Ok(technique)
 }
 
+/// One image of a surface description: `(pointer, width, height)` checked against each
+/// other and against `max_side`; `None` when absent (NULL and both sides 0).
+fn image_shape<T>(
+    what: &str,
+    ptr: *const T,
+    width: u32,
+    height: u32,
+    max_side: u32,
+    limit: &str,
+) -> Result<Option<(u32, u32)>> {
+    match (ptr.is_null(), width, height) {
+        (true, 0, 0) => Ok(None),
+        (true, w, h) => Err(Error::new(
+            TesseraStatus::NullPointer,
+            format!("{what} is NULL but its size is {w}x{h} (NULL needs both sides 0)"),
+        )),
+        (false, w, h) if w == 0 || h == 0 => Err(Error::new(
+            TesseraStatus::InvalidArgument,
+            format!("{what} size {w}x{h}: both sides must be at least 1 when {what} is given"),
+        )),
+        (false, w, h) if w > max_side || h > max_side => Err(Error::new(
+            TesseraStatus::InvalidArgument,
+            format!("{what} size {w}x{h}: each side must be at most {max_side} ({limit})"),
+        )),
+        (false, w, h) => Ok(Some((w, h))),
+    }
+}
+
+/// The texture, height map and lattice request of `d` for `technique`, copied and checked.
+///
+/// # Safety
+/// `d.texture` is NULL or addresses `texture_width * texture_height * 4` readable bytes;
+/// `d.height_map` is NULL or addresses `height_map_width * height_map_height` readable floats.
+unsafe fn read_maps(
+    d: &TesseraSurfaceDesc,
+    technique: TechniqueId,
+    device: &Device,
+    name: &str,
+) -> Result<SurfaceMaps> {
+    let device_max = device.info.caps.max_image_dimension_2d;
+    let (max_side, limit) = if device_max < TESSERA_MAX_IMAGE_SIDE {
+        (device_max, "the device's maxImageDimension2D")
+    } else {
+        (TESSERA_MAX_IMAGE_SIDE, "TESSERA_MAX_IMAGE_SIDE")
+    };
+    let texture = image_shape(
+        "texture",
+        d.texture,
+        d.texture_width,
+        d.texture_height,
+        max_side,
+        limit,
+    )?;
+    let height = image_shape(
+        "height_map",
+        d.height_map,
+        d.height_map_width,
+        d.height_map_height,
+        max_side,
+        limit,
+    )?;
+    let param_error = flag(d.param_error, "param_error")?;
+    refuse_surface_options(
+        technique,
+        &[
+            ("texture", texture.is_some()),
+            ("height_map", height.is_some()),
+            ("param_error", param_error),
+        ],
+    )?;
+    let texture = match texture {
+        None => None,
+        Some((w, h)) => {
+            let texels = w as usize * h as usize;
+            // SAFETY: the caller's contract: `w * h * 4` readable bytes.
+            let bytes = unsafe { read_slice(d.texture, texels, 4, "texture") }?;
+            Some(Arc::new(SurfaceImage {
+                name: format!("{name}: texture"),
+                width: w,
+                height: h,
+                format: vk_core::texture::TextureFormat::Rgba8Srgb,
+                texels: bytes.to_vec(),
+            }))
+        }
+    };
+    let height = match height {
+        None => None,
+        Some((w, h)) => {
+            // SAFETY: the caller's contract: `w * h` readable floats.
+            let values =
+                unsafe { read_slice(d.height_map, w as usize * h as usize, 1, "height_map") }?;
+            if let Some(i) = values.iter().position(|x| !x.is_finite()) {
+                return Err(Error::new(
+                    TesseraStatus::NonFinite,
+                    format!(
+                        "height_map texel ({}, {}) is {}: heights must be finite",
+                        i % w as usize,
+                        i / w as usize,
+                        values[i]
+                    ),
+                ));
+            }
+            Some(Arc::new(SurfaceImage {
+                name: format!("{name}: height map"),
+                width: w,
+                height: h,
+                format: vk_core::texture::TextureFormat::R32Float,
+                texels: values.iter().flat_map(|x| x.to_le_bytes()).collect(),
+            }))
+        }
+    };
+    Ok(SurfaceMaps {
+        texture,
+        height,
+        param_error,
+    })
+}
+
 /// Builds a surface on `c` (the shared tail of the two creation functions).
-fn create_surface(
+///
+/// # Safety
+/// The images `d` points to are as [`read_maps`] needs.
+unsafe fn create_surface(
     ctx_id: u64,
     c: &mut ContextState,
     mesh: topology::ControlMesh,
@@ -751,6 +997,8 @@ fn create_surface(
         TESSERA_END_CAP_BILINEAR => topology::EndCap::Bilinear,
         v => return Err(invalid("end_cap", v, "a TESSERA_END_CAP_* value")),
     };
+    // SAFETY: the caller's contract.
+    let maps = unsafe { read_maps(d, technique, &c.device, &name) }?;
     let options = tess::BuildOptions {
         name,
         table_level: d.table_level,
@@ -758,6 +1006,7 @@ fn create_surface(
         isolation: d.isolation,
         end_cap,
         sharpness_scale: d.sharpness_scale,
+        maps,
         ..tess::BuildOptions::default()
     };
     let mut t = match &c.mode {
@@ -932,7 +1181,8 @@ unsafe fn read_mesh(d: &TesseraMeshDesc) -> Result<(topology::ControlMesh, Strin
 ///
 /// # Safety
 /// `mesh` and `desc` are NULL (answered with NULL_POINTER; `desc` NULL means defaults) or
-/// readable, every array in `mesh` NULL or as long as its count says; `out` points to a
+/// readable, every array in `mesh` NULL or as long as its count says, `desc`'s `texture` and
+/// `height_map` NULL or as long as their sizes say; `out` points to a
 /// writable `TesseraSurface*` (set to NULL on failure).
 #[no_mangle]
 pub unsafe extern "C" fn tessera_surface_create(
@@ -951,7 +1201,8 @@ pub unsafe extern "C" fn tessera_surface_create(
         let d = unsafe { surface_desc(desc) }?;
         // SAFETY: the caller's contract for the arrays `mesh` points to.
         let (mesh, name) = unsafe { read_mesh(&m) }?;
-        let id = create_surface(ctx_id, c, mesh, &d, name)?;
+        // SAFETY: the caller's contract for the images `desc` points to.
+        let id = unsafe { create_surface(ctx_id, c, mesh, &d, name) }?;
         // SAFETY: the caller's contract (see this function's `# Safety`).
         unsafe { out_write(out, surface_ptr(id), "out") }
     })
@@ -987,7 +1238,8 @@ const SPOT: &str = include_str!("../../../assets/spot_control_mesh.obj");
 ///
 /// # Safety
 /// `obj_text` is NULL or points to `obj_len` readable bytes (UTF-8, no NUL needed); `name` is
-/// NULL or NUL-terminated; `desc` is NULL (defaults) or readable; `out` points to a writable
+/// NULL or NUL-terminated; `desc` is NULL (defaults) or readable, its `texture` and
+/// `height_map` NULL or as long as their sizes say; `out` points to a writable
 /// `TesseraSurface*` (set to NULL on failure).
 #[no_mangle]
 pub unsafe extern "C" fn tessera_surface_create_obj(
@@ -1026,7 +1278,8 @@ pub unsafe extern "C" fn tessera_surface_create_obj(
             (text, given.unwrap_or_else(|| "mesh".into()))
         };
         let mesh = topology::parse_obj(&text, &name)?;
-        let id = create_surface(ctx_id, c, mesh, &d, name)?;
+        // SAFETY: the caller's contract for the images `desc` points to.
+        let id = unsafe { create_surface(ctx_id, c, mesh, &d, name) }?;
         // SAFETY: the caller's contract (see this function's `# Safety`).
         unsafe { out_write(out, surface_ptr(id), "out") }
     })
@@ -1221,7 +1474,7 @@ pub unsafe extern "C" fn tessera_render(
         standalone_only(c, "tessera_render")?;
         // SAFETY: the caller's contract.
         let f = unsafe { ffi::read_required(frame, "frame") }?;
-        let (params, extent) = frame_params(&f)?;
+        let (params, extent) = surface_frame_params(s, &f)?;
         let needed = extent.width as usize * extent.height as usize * 4;
         if pixels_len != needed {
             return Err(Error::new(
@@ -1264,7 +1517,7 @@ pub unsafe extern "C" fn tessera_capture_obj(
         // SAFETY: the caller's contract (see this function's `# Safety`).
         let path = unsafe { read_str(path, "path") }?
             .ok_or_else(|| Error::new(TesseraStatus::NullPointer, "path is NULL"))?;
-        let (params, extent) = frame_params(&f)?;
+        let (params, extent) = surface_frame_params(s, &f)?;
         let capturer = tess::Capturer::new(&s.tess)?;
         let technique = s.technique.as_ref();
         let (soup, _) = capturer.capture(&mut s.tess, technique, &params, extent)?;

@@ -1,6 +1,8 @@
 //! Standalone mode from plain C: tests/c/standalone.c, compiled with `cc -std=c99 -Wall
 //! -Werror` against include/tessera.h and the cdylib, renders spot with every technique; each
-//! image must match the Rust-side render of the same view within the golden tolerance.
+//! image must match the Rust-side render of the same view within the golden tolerance. It
+//! also draws spot (gregory, acc) with a texture and a height map set through the new fields
+//! of TesseraSurfaceDesc/TesseraFrameDesc and checks that each changes the image.
 mod common;
 use std::process::Command;
 
@@ -23,6 +25,9 @@ fn c99_program_renders_every_technique_like_the_rust_side() {
             .arg("-ltessera_capi"),
     );
     let out = common::run(Command::new(&exe).arg(&dir));
-    assert!(out.contains("5 techniques rendered"), "{out}");
-    common::compare_with_rust_render(&dir);
+    assert!(
+        out.contains("7 techniques rendered, texture and height map drawn"),
+        "{out}"
+    );
+    common::compare_with_rust_render(&dir, common::ALL_TECHNIQUES);
 }

@@ -44,7 +44,7 @@ fn cpp_host_draws_every_technique_in_its_own_device_like_tessera_render() {
         out.contains("5 techniques drawn, 0 validation messages"),
         "{out}"
     );
-    common::compare_with_rust_render(&dir);
+    common::compare_with_rust_render(&dir, common::HOST_TECHNIQUES);
 }
 
 /// The same host built with `-fsanitize=address`: no invalid access, double free or

@@ -1,7 +1,9 @@
 /* Standalone mode from plain C99: Tessera makes its own device, renders the embedded spot mesh
  * with every technique into RGBA8 buffers this program reads, checks them, and writes them
  * (raw RGBA, one file per technique) for the Rust test to compare with its own render of the
- * same view. Usage: standalone OUT_DIR. Exit 0 on success; messages on stderr. */
+ * same view; then draws spot with a colour texture and a height map given as C arrays
+ * (gregory, acc) and checks that each changes the image. Usage: standalone OUT_DIR. Exit 0 on
+ * success; messages on stderr. */
 #include "tessera.h"
 
 #include <stdio.h>
@@ -23,11 +25,116 @@ static void check(TesseraStatus got, TesseraStatus want, const char *what) {
     }
 }
 
+/* Pixels of a and b (W x H RGBA8) differing by more than 24 in a channel. */
+static size_t differing(const unsigned char *a, const unsigned char *b) {
+    size_t i, c, n = 0;
+    for (i = 0; i < (size_t)W * H; i++) {
+        for (c = 0; c < 4; c++) {
+            if (abs((int)a[4 * i + c] - (int)b[4 * i + c]) > 24) {
+                n++;
+                break;
+            }
+        }
+    }
+    return n;
+}
+
+/* Spot with gregory and acc: a red/blue checker texture and a height map (0.5..1) given as C
+ * arrays must each change the image (texture: the colours; displace: the silhouette); a texture
+ * on flat and PARAM_ERROR without the lattice are refused by name. 1 when all held. */
+static int draw_maps(TesseraContext *ctx, const TesseraFrameDesc *base) {
+    static unsigned char texels[16 * 16 * 4];
+    static float heights[8 * 8];
+    static const TesseraTechnique single_pass[] = {TESSERA_TECHNIQUE_GREGORY,
+                                                   TESSERA_TECHNIQUE_ACC};
+    size_t i, t;
+    int ok = 1;
+    unsigned char *plain = malloc((size_t)W * H * 4), *other = malloc((size_t)W * H * 4);
+    if (plain == NULL || other == NULL) return 0;
+    for (i = 0; i < 16 * 16; i++) {
+        int red = ((i % 16) / 4 + (i / 16) / 4) % 2 == 0;
+        texels[4 * i] = red ? 230 : 20;
+        texels[4 * i + 1] = 20;
+        texels[4 * i + 2] = red ? 20 : 230;
+        texels[4 * i + 3] = 255;
+    }
+    for (i = 0; i < 8 * 8; i++) heights[i] = 0.5f + 0.5f * (float)(i % 8) / 7.0f;
+
+    for (t = 0; t < 2; t++) {
+        TesseraSurfaceDesc sdesc;
+        TesseraSurface *bare = NULL, *mapped = NULL;
+        TesseraFrameDesc frame = *base;
+        size_t textured, displaced;
+
+        check(tessera_surface_desc_default(&sdesc), TESSERA_STATUS_OK, "surface defaults");
+        if (sdesc.texture != NULL || sdesc.height_map != NULL || sdesc.param_error != 0) {
+            fprintf(stderr, "surface defaults hold maps\n");
+            ok = 0;
+        }
+        sdesc.technique = single_pass[t];
+        check(tessera_surface_create_obj(ctx, NULL, 0, NULL, &sdesc, &bare), TESSERA_STATUS_OK,
+              "spot without maps");
+        sdesc.texture = texels;
+        sdesc.texture_width = 16;
+        sdesc.texture_height = 16;
+        sdesc.height_map = heights;
+        sdesc.height_map_width = 8;
+        sdesc.height_map_height = 8;
+        check(tessera_surface_create_obj(ctx, NULL, 0, NULL, &sdesc, &mapped), TESSERA_STATUS_OK,
+              "spot with maps");
+        if (bare == NULL || mapped == NULL) {
+            ok = 0;
+            continue;
+        }
+        if (frame.reparam != 1 || frame.displace != 0.0f || frame.show != TESSERA_SHOW_SHADING) {
+            fprintf(stderr, "frame defaults: reparam %u, displace %g, show %u\n", frame.reparam,
+                    (double)frame.displace, frame.show);
+            ok = 0;
+        }
+        check(tessera_render(ctx, bare, &frame, plain, (size_t)W * H * 4), TESSERA_STATUS_OK,
+              "render without maps");
+        check(tessera_render(ctx, mapped, &frame, other, (size_t)W * H * 4), TESSERA_STATUS_OK,
+              "render with texture");
+        textured = differing(plain, other);
+        frame.displace = 0.3f;
+        check(tessera_render(ctx, mapped, &frame, plain, (size_t)W * H * 4), TESSERA_STATUS_OK,
+              "render displaced");
+        displaced = differing(plain, other);
+        if (textured < (size_t)W * H / 20 || displaced < (size_t)W * H / 50) {
+            fprintf(stderr, "technique %u: texture changed %lu pixels, displace %lu\n",
+                    single_pass[t], (unsigned long)textured, (unsigned long)displaced);
+            ok = 0;
+        }
+        frame.displace = 0.0f;
+        frame.show = TESSERA_SHOW_PARAM_ERROR;
+        check(tessera_render(ctx, mapped, &frame, plain, (size_t)W * H * 4),
+              TESSERA_STATUS_UNSUPPORTED, "PARAM_ERROR without the lattice");
+        check(tessera_surface_destroy(ctx, bare), TESSERA_STATUS_OK, "destroy bare");
+        check(tessera_surface_destroy(ctx, mapped), TESSERA_STATUS_OK, "destroy mapped");
+    }
+    {
+        TesseraSurfaceDesc flat;
+        TesseraSurface *s = NULL;
+        check(tessera_surface_desc_default(&flat), TESSERA_STATUS_OK, "surface defaults");
+        flat.technique = TESSERA_TECHNIQUE_FLAT;
+        flat.texture = texels;
+        flat.texture_width = 16;
+        flat.texture_height = 16;
+        check(tessera_surface_create_obj(ctx, NULL, 0, NULL, &flat, &s), TESSERA_STATUS_UNSUPPORTED,
+              "texture on flat");
+        if (s != NULL) ok = 0;
+    }
+    free(plain);
+    free(other);
+    return ok;
+}
+
 int main(int argc, char **argv) {
-    static const char *names[] = {"flat", "phong", "pn", "bft", "adaptive"};
-    static const TesseraTechnique techniques[] = {TESSERA_TECHNIQUE_FLAT, TESSERA_TECHNIQUE_PHONG,
-                                                  TESSERA_TECHNIQUE_PN, TESSERA_TECHNIQUE_BFT,
-                                                  TESSERA_TECHNIQUE_ADAPTIVE};
+    static const char *names[] = {"flat", "phong", "pn", "bft", "adaptive", "gregory", "acc"};
+    static const TesseraTechnique techniques[] = {
+        TESSERA_TECHNIQUE_FLAT,     TESSERA_TECHNIQUE_PHONG,   TESSERA_TECHNIQUE_PN,
+        TESSERA_TECHNIQUE_BFT,      TESSERA_TECHNIQUE_ADAPTIVE, TESSERA_TECHNIQUE_GREGORY,
+        TESSERA_TECHNIQUE_ACC};
     TesseraStandaloneDesc cdesc;
     TesseraContext *ctx = NULL;
     TesseraFrameDesc frame;
@@ -93,6 +200,7 @@ int main(int argc, char **argv) {
         check(tessera_surface_destroy(ctx, surface), TESSERA_STATUS_DESTROYED_HANDLE,
               "destroy surface twice");
     }
+    if (!draw_maps(ctx, &frame)) failures++;
     check(tessera_context_validation_errors(ctx, &errors), TESSERA_STATUS_OK, "validation count");
     if (errors != 0) {
         fprintf(stderr, "%u validation errors\n", errors);
@@ -101,6 +209,6 @@ int main(int argc, char **argv) {
     check(tessera_context_destroy(ctx), TESSERA_STATUS_OK, "destroy context");
     check(tessera_context_destroy(ctx), TESSERA_STATUS_DESTROYED_HANDLE, "destroy context twice");
     free(pixels);
-    if (failures == 0) printf("standalone C: 5 techniques rendered\n");
+    if (failures == 0) printf("standalone C: 7 techniques rendered, texture and height map drawn\n");
     return failures == 0 ? 0 : 1;
 }

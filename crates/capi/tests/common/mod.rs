@@ -107,16 +107,30 @@ pub fn reference(technique: tess::TechniqueId, width: u32, height: u32) -> Vec<u
     pixels
 }
 
-/// Every technique's `<name>.rgba` in `dir` (160×120, written by a C or C++ host) against the
-/// Rust-side render of the same view, within [`TOLERANCE`].
-pub fn compare_with_rust_render(dir: &Path) {
-    for (name, id) in [
-        ("flat", tess::TechniqueId::Flat),
-        ("phong", tess::TechniqueId::Phong),
-        ("pn", tess::TechniqueId::Pn),
-        ("bft", tess::TechniqueId::Bft),
-        ("adaptive", tess::TechniqueId::Adaptive),
-    ] {
+/// The techniques the C++ host draws.
+pub const HOST_TECHNIQUES: &[(&str, tess::TechniqueId)] = &[
+    ("flat", tess::TechniqueId::Flat),
+    ("phong", tess::TechniqueId::Phong),
+    ("pn", tess::TechniqueId::Pn),
+    ("bft", tess::TechniqueId::Bft),
+    ("adaptive", tess::TechniqueId::Adaptive),
+];
+
+/// Every technique of the C ABI (the C program draws them all).
+pub const ALL_TECHNIQUES: &[(&str, tess::TechniqueId)] = &[
+    ("flat", tess::TechniqueId::Flat),
+    ("phong", tess::TechniqueId::Phong),
+    ("pn", tess::TechniqueId::Pn),
+    ("bft", tess::TechniqueId::Bft),
+    ("adaptive", tess::TechniqueId::Adaptive),
+    ("gregory", tess::TechniqueId::Gregory),
+    ("acc", tess::TechniqueId::Acc),
+];
+
+/// Each of `techniques`' `<name>.rgba` in `dir` (160×120, written by a C or C++ host) against
+/// the Rust-side render of the same view, within [`TOLERANCE`].
+pub fn compare_with_rust_render(dir: &Path, techniques: &[(&str, tess::TechniqueId)]) {
+    for &(name, id) in techniques {
         let host = std::fs::read(dir.join(format!("{name}.rgba"))).unwrap();
         let d = differing_fraction(&host, &reference(id, 160, 120), 160 * 120);
         eprintln!("{name}: {d:.5} of pixels differ from the Rust-side render");
