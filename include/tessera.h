@@ -148,9 +148,10 @@ typedef struct TesseraFrameDesc {
   float base_color[3];
   // Clear colour of the standalone image (RGBA, 0..1).
   float clear_color[4];
-  // Texture coordinates at the reparameterized parameter on Gregory patches; 0 or 1
-  // (default 1; 0 only on adaptive, gregory, acc).
-  uint32_t reparam;
+  // 1: texture coordinates at the base parameter, without the reparameterization of
+  // Gregory patches (seed 003); 0 or 1 (default 0, so a zero-filled descriptor keeps it on;
+  // 1 only on adaptive, gregory, acc).
+  uint32_t no_reparam;
   // Displacement along the normal by this times the height (the surface's height map, else
   // a procedural one); finite, at most 1000 in magnitude; nonzero only on adaptive, gregory,
   // acc.

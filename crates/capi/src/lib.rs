@@ -246,9 +246,10 @@ pub struct TesseraFrameDesc {
     pub base_color: [f32; 3],
     /// Clear colour of the standalone image (RGBA, 0..1).
     pub clear_color: [f32; 4],
-    /// Texture coordinates at the reparameterized parameter on Gregory patches; 0 or 1
-    /// (default 1; 0 only on adaptive, gregory, acc).
-    pub reparam: u32,
+    /// 1: texture coordinates at the base parameter, without the reparameterization of
+    /// Gregory patches (seed 003); 0 or 1 (default 0, so a zero-filled descriptor keeps it on;
+    /// 1 only on adaptive, gregory, acc).
+    pub no_reparam: u32,
     /// Displacement along the normal by this times the height (the surface's height map, else
     /// a procedural one); finite, at most 1000 in magnitude; nonzero only on adaptive, gregory,
     /// acc.
@@ -538,7 +539,7 @@ pub unsafe extern "C" fn tessera_frame_desc_default(desc: *mut TesseraFrameDesc)
             geometric_normals: 0,
             base_color: p.base_color,
             clear_color: p.clear_color,
-            reparam: u32::from(p.reparam),
+            no_reparam: u32::from(!p.reparam),
             displace: p.displace,
             show: TESSERA_SHOW_SHADING,
         };
@@ -637,7 +638,7 @@ fn frame_params(d: &TesseraFrameDesc) -> Result<(FrameParams, vk::Extent2D)> {
         patch_colours: flag(d.patch_colours, "patch_colours")?,
         base_color: d.base_color,
         clear_color: d.clear_color,
-        reparam: flag(d.reparam, "reparam")?,
+        reparam: !flag(d.no_reparam, "no_reparam")?,
         displace: d.displace,
         show,
         ..FrameParams::default()
@@ -682,7 +683,7 @@ fn refuse_surface_options(technique: TechniqueId, given: &[(&str, bool)]) -> Res
     ))
 }
 
-/// [`frame_params`] for `s`, refusing the surface options (`reparam` 0, `displace`, `show`)
+/// [`frame_params`] for `s`, refusing the surface options (`no_reparam`, `displace`, `show`)
 /// on techniques without them.
 fn surface_frame_params(
     s: &SurfaceState,
@@ -692,7 +693,7 @@ fn surface_frame_params(
     refuse_surface_options(
         s.technique.id(),
         &[
-            ("reparam 0", !params.reparam),
+            ("no_reparam", !params.reparam),
             ("displace", params.displace != 0.0),
             ("show", params.show != SurfaceShow::Shading),
         ],

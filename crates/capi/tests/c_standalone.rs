@@ -21,6 +21,9 @@ fn c99_program_renders_every_technique_like_the_rust_side() {
             .arg("-o")
             .arg(&exe)
             .arg(format!("-L{}", lib_dir.display()))
+            // DT_RPATH, not RUNPATH: cargo's LD_LIBRARY_PATH lists target/<profile>, where a
+            // `cargo build` of an older tree may have left another libtessera_capi.so.
+            .arg("-Wl,--disable-new-dtags")
             .arg(format!("-Wl,-rpath,{}", lib_dir.display()))
             .arg("-ltessera_capi"),
     );

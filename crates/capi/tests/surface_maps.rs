@@ -1,5 +1,5 @@
 //! Issue 12's features through the C ABI: the single-pass techniques (`TESSERA_TECHNIQUE_GREGORY`,
-//! `_ACC`), a colour texture and a height map given as arrays, the frame's `reparam`,
+//! `_ACC`), a colour texture and a height map given as arrays, the frame's `no_reparam`,
 //! `displace` and `show`. Each must change what is drawn or captured (a texture changes the
 //! image, a height map moves the captured positions, a zero height map moves nothing), and
 //! every misuse gets its named status and a message naming the field. One validated
@@ -407,18 +407,18 @@ fn bad_maps_and_frame_options_get_named_statuses() {
         "displace only applies to technique adaptive, gregory or acc (this surface's technique is flat)",
     );
     let mut g = f;
-    g.reparam = 0;
+    g.no_reparam = 1;
     g.show = TESSERA_SHOW_PARAM_SHIFT;
     expect(
         render(ctx, flat, &g).0,
         TesseraStatus::Unsupported,
-        "reparam 0, show only apply",
+        "no_reparam, show only apply",
     );
     let mut g = f;
     g.show = TESSERA_SHOW_PARAM_ERROR;
     let (status, error_view) = render(ctx, gregory, &g);
     assert_eq!(status, TesseraStatus::Ok, "{}", last_error());
-    g.reparam = 0;
+    g.no_reparam = 1;
     let (status, _) = render(ctx, gregory, &g);
     assert_eq!(status, TesseraStatus::Ok, "{}", last_error());
     let (_, shaded) = render(ctx, gregory, &f);
@@ -427,11 +427,11 @@ fn bad_maps_and_frame_options_get_named_statuses() {
         "PARAM_ERROR draws the shaded image"
     );
     let mut g = f;
-    g.reparam = 2;
+    g.no_reparam = 2;
     expect(
         render(ctx, gregory, &g).0,
         TesseraStatus::InvalidArgument,
-        "reparam 2",
+        "no_reparam 2",
     );
     let mut g = f;
     g.show = 3;

@@ -86,8 +86,8 @@ static int draw_maps(TesseraContext *ctx, const TesseraFrameDesc *base) {
             ok = 0;
             continue;
         }
-        if (frame.reparam != 1 || frame.displace != 0.0f || frame.show != TESSERA_SHOW_SHADING) {
-            fprintf(stderr, "frame defaults: reparam %u, displace %g, show %u\n", frame.reparam,
+        if (frame.no_reparam != 0 || frame.displace != 0.0f || frame.show != TESSERA_SHOW_SHADING) {
+            fprintf(stderr, "frame defaults: no_reparam %u, displace %g, show %u\n", frame.no_reparam,
                     (double)frame.displace, frame.show);
             ok = 0;
         }
