@@ -412,6 +412,12 @@ fn param_error_view_follows_the_cpu_lattice() {
     let spot = shape("spot");
     for patch in [SinglePassPatch::Gregory, SinglePassPatch::Acc1] {
         let surf = gregory::build(&mut ctx, &spot, patch, 1.0, "spot", &maps).expect("build");
+        let note = surf.param_error_note().expect("a lattice summary");
+        println!("{note}");
+        assert!(
+            note.starts_with("spot: Eq. 1") && note.contains("of 420 patches"),
+            "{note}"
+        );
         let on = surface_hues(&render(&mut ctx, &surf, true));
         let off = surface_hues(&render(&mut ctx, &surf, false));
         let warm = |h: &[f64]| h.iter().filter(|&&x| x < 100.0).count();

@@ -243,30 +243,40 @@ pub fn build(
                 notes,
             });
         }
-        TechniqueId::Adaptive => Box::new(adaptive::Adaptive::new(
-            ctx,
-            mesh,
-            &adaptive::AdaptiveBuild {
-                isolation: options.isolation,
-                end_cap: options.end_cap,
-                sharpness_scale: options.sharpness_scale,
-                follow_semi_sharp: options.follow_semi_sharp,
-                name: options.name.clone(),
-                maps: options.maps.clone(),
-            },
-        )?),
-        TechniqueId::Gregory | TechniqueId::Acc => Box::new(gregory::build(
-            ctx,
-            mesh,
-            if id == TechniqueId::Acc {
-                topology::adaptive::single_pass::SinglePassPatch::Acc1
+        TechniqueId::Adaptive | TechniqueId::Gregory | TechniqueId::Acc => {
+            let surface = if id == TechniqueId::Adaptive {
+                adaptive::Adaptive::new(
+                    ctx,
+                    mesh,
+                    &adaptive::AdaptiveBuild {
+                        isolation: options.isolation,
+                        end_cap: options.end_cap,
+                        sharpness_scale: options.sharpness_scale,
+                        follow_semi_sharp: options.follow_semi_sharp,
+                        name: options.name.clone(),
+                        maps: options.maps.clone(),
+                    },
+                )?
             } else {
-                topology::adaptive::single_pass::SinglePassPatch::Gregory
-            },
-            options.sharpness_scale,
-            &options.name,
-            &options.maps,
-        )?),
+                gregory::build(
+                    ctx,
+                    mesh,
+                    if id == TechniqueId::Acc {
+                        topology::adaptive::single_pass::SinglePassPatch::Acc1
+                    } else {
+                        topology::adaptive::single_pass::SinglePassPatch::Gregory
+                    },
+                    options.sharpness_scale,
+                    &options.name,
+                    &options.maps,
+                )?
+            };
+            let notes = surface.param_error_note().into_iter().collect();
+            return Ok(Built {
+                technique: Box::new(surface),
+                notes,
+            });
+        }
     };
     Ok(Built {
         technique,
