@@ -35,7 +35,8 @@ void main() {
     }
     vec3 n = safe_normalize(cross(du, dv), vec3(0.0, 0.0, 1.0));
     // ACC-1 patches shade with their tangent patches' normal field (continuous across edges).
-    uint tangent_valences = surfaces[tc_patch].tangent_valences;
+    // (Only Gregory-kind records can be ACC-1 nets: regular and bilinear patches skip the read.)
+    uint tangent_valences = (tc_info & 15u) == uint(ADAPTIVE_KIND_GREGORY) ? surfaces[tc_patch].tangent_valences : 0u;
     if (tangent_valences != 0u) n = acc_tangent_normal(tc_patch, tangent_valences, uv);
     vec2 tex = patch_texcoord(tc_patch, uv);
     out_texcoord = tex;
