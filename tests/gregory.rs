@@ -32,14 +32,7 @@ fn shape(name: &str) -> ControlMesh {
 }
 
 fn diag(m: &ControlMesh) -> f64 {
-    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
-    for p in &m.positions {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+    m.bbox_diagonal()
 }
 
 fn semi_sharp(m: &ControlMesh) -> bool {

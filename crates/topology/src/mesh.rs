@@ -157,6 +157,28 @@ impl ControlMesh {
         self.face_offsets.len().saturating_sub(1)
     }
 
+    /// Axis-aligned bounding box `(min, max)` of the positions; the origin for a mesh without
+    /// vertices.
+    pub fn bounding_box(&self) -> ([f64; 3], [f64; 3]) {
+        if self.positions.is_empty() {
+            return ([0.0; 3], [0.0; 3]);
+        }
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for p in &self.positions {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Length of the bounding box's diagonal: the scale errors and offsets are measured in.
+    pub fn bbox_diagonal(&self) -> f64 {
+        let (lo, hi) = self.bounding_box();
+        (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+    }
+
     /// The vertex indices of face `f`.
     pub fn face(&self, f: usize) -> &[u32] {
         &self.face_vertices[self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize]
@@ -756,4 +778,20 @@ where
             f(i, &mut chunk[s..e]);
         }
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bounding_box_and_diagonal() {
+        let m = ControlMesh::from_polygons(
+            vec![[1.0, -2.0, 0.0], [4.0, 2.0, 0.0], [1.0, 2.0, 12.0]],
+            &[[0u32, 1, 2]],
+        );
+        assert_eq!(m.bounding_box(), ([1.0, -2.0, 0.0], [4.0, 2.0, 12.0]));
+        assert_eq!(m.bbox_diagonal(), 13.0);
+        assert_eq!(ControlMesh::default().bbox_diagonal(), 0.0);
+    }
 }

@@ -194,18 +194,7 @@ pub fn param_error_lattice(
     let side = side.max(2);
     let exact = LocalMesh::from_control_mesh(mesh, LimitScheme::CatmullClark)?;
     let verts = plan.apply(&mesh.positions);
-    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
-    for p in &mesh.positions {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    let diag = (0..3)
-        .map(|k| (hi[k] - lo[k]).powi(2))
-        .sum::<f64>()
-        .sqrt()
-        .max(f64::MIN_POSITIVE);
+    let diag = mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
     let step = 1.0 / (side - 1) as f64;
     let per_patch: Vec<Vec<f32>> = plan
         .patches

@@ -48,15 +48,7 @@ fn shapes() -> Vec<(String, ControlMesh)> {
 }
 
 fn diag(mesh: &ControlMesh) -> f64 {
-    let mut lo = [f64::MAX; 3];
-    let mut hi = [f64::MIN; 3];
-    for p in &mesh.positions {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+    mesh.bbox_diagonal()
 }
 
 fn dist(a: &[f64; 3], b: &[f64]) -> f64 {

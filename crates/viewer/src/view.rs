@@ -794,15 +794,7 @@ fn initial_displace_scale(displace: f32, mesh: &ControlMesh) -> f32 {
     if displace != 0.0 {
         return displace;
     }
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for p in &mesh.positions {
-        for i in 0..3 {
-            lo[i] = lo[i].min(p[i]);
-            hi[i] = hi[i].max(p[i]);
-        }
-    }
-    let diag = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt();
-    let scale = DEFAULT_DISPLACE * diag as f32;
+    let scale = DEFAULT_DISPLACE * mesh.bbox_diagonal() as f32;
     if scale.is_finite() && scale >= DISPLACE_RANGE.0 {
         scale.min(DISPLACE_RANGE.1)
     } else {

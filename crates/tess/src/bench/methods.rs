@@ -612,13 +612,7 @@ impl CpuLoopMethod {
     /// so each frame's subdivision works on new positions (its cost does not depend on them).
     fn animated_base(&self, index: u32) -> ControlMesh {
         let mut m = self.base.clone();
-        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for p in &m.positions {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
+        let (lo, hi) = m.bounding_box();
         let s = 1.0 + 0.02 * (index as f64 * 0.4).sin();
         for p in &mut m.positions {
             for k in 0..3 {
