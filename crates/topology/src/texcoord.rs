@@ -165,6 +165,16 @@ pub struct ParamErrorLattice {
     /// Per patch: the identity's lattice, then the reparameterized one, each indexed
     /// `i + side · j`.
     pub errors: Vec<f32>,
+    /// Patches with a reparameterized corner (on the others both halves are equal).
+    pub reparameterized: usize,
+}
+
+/// [`ParamErrorLattice::summary`]: over every lattice point, without (`[0]`) and with (`[1]`)
+/// the reparameterization.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParamErrorSummary {
+    pub rms: [f64; 2],
+    pub max: [f64; 2],
 }
 
 impl ParamErrorLattice {
@@ -172,6 +182,23 @@ impl ParamErrorLattice {
     pub fn at(&self, patch: usize, reparam: bool, i: usize, j: usize) -> f32 {
         let n = self.side * self.side;
         self.errors[patch * 2 * n + usize::from(reparam) * n + i + self.side * j]
+    }
+
+    /// RMS and maximum over every patch's lattice, without and with the reparameterization.
+    pub fn summary(&self) -> ParamErrorSummary {
+        let n = self.side * self.side;
+        let (mut sq, mut max) = ([0.0f64; 2], [0.0f64; 2]);
+        for (k, chunk) in self.errors.chunks(n).enumerate() {
+            for &e in chunk {
+                sq[k % 2] += f64::from(e) * f64::from(e);
+                max[k % 2] = max[k % 2].max(f64::from(e));
+            }
+        }
+        let count = (self.errors.len() / 2).max(1) as f64;
+        ParamErrorSummary {
+            rms: sq.map(|s| (s / count).sqrt()),
+            max,
+        }
     }
 
     /// The values of one patch and mode, in lattice order.
@@ -196,7 +223,7 @@ pub fn param_error_lattice(
     let verts = plan.apply(&mesh.positions);
     let diag = mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
     let step = 1.0 / (side - 1) as f64;
-    let per_patch: Vec<Vec<f32>> = plan
+    let per_patch: Vec<(Vec<f32>, bool)> = plan
         .patches
         .par_iter()
         .enumerate()
@@ -225,21 +252,26 @@ pub fn param_error_lattice(
             let face = patch.base_face as usize;
             let sub = (mesh.face(face).len() != 4).then_some(patch.sub_face as usize);
             let limit = exact.evaluate_many(face, sub, &params)?;
-            let mut out = Vec::with_capacity(2 * lattice.len());
-            for k in 0..2 * lattice.len() {
-                let at = k % lattice.len();
-                let [u, v] = lattice[at];
-                let g = plan.evaluate(&verts, index, u, v).position;
-                let p = &limit[if reparameterized { k } else { at }].position;
+            // The displayed points once; the texel's limit point per half.
+            let shown: Vec<[f64; 3]> = lattice
+                .iter()
+                .map(|&[u, v]| plan.evaluate(&verts, index, u, v).position)
+                .collect();
+            let half = lattice.len();
+            let mut out = Vec::with_capacity(2 * half);
+            for k in 0..2 * half {
+                let g = shown[k % half];
+                let p = &limit[if reparameterized { k } else { k % half }].position;
                 let d = (0..3).map(|c| (g[c] - p[c]).powi(2)).sum::<f64>().sqrt();
                 out.push((d / diag) as f32);
             }
-            Ok(out)
+            Ok((out, reparameterized))
         })
         .collect::<Result<_, EvalError>>()?;
     Ok(ParamErrorLattice {
         side,
-        errors: per_patch.concat(),
+        reparameterized: per_patch.iter().filter(|p| p.1).count(),
+        errors: per_patch.into_iter().flat_map(|p| p.0).collect(),
     })
 }
 

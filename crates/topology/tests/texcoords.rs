@@ -252,6 +252,27 @@ fn param_error_lattice_is_eq1_pointwise() {
     let plan = plan_single_pass(&mesh, &SinglePassOptions::default()).unwrap();
     let lattice = param_error_lattice(&mesh, &plan, 9).unwrap();
     assert_eq!(lattice.errors.len(), plan.patches.len() * 2 * 81);
+    // The summary: RMS and max over all points of each half, and the reparameterized count.
+    let summary = lattice.summary();
+    let half =
+        |r: usize| (0..plan.patches.len()).flat_map(move |p| (0..81).map(move |k| (p, r, k)));
+    for r in 0..2 {
+        let (mut sq, mut max) = (0.0f64, 0.0f64);
+        for (p, _, k) in half(r) {
+            let e = lattice.at(p, r == 1, k % 9, k / 9) as f64;
+            sq += e * e;
+            max = max.max(e);
+        }
+        let rms = (sq / (81 * plan.patches.len()) as f64).sqrt();
+        assert!((summary.rms[r] - rms).abs() <= 1e-12 * rms && summary.max[r] == max);
+    }
+    assert!(summary.rms[1] < summary.rms[0]);
+    let reparameterized = plan
+        .patches
+        .iter()
+        .filter(|p| p.reparam_valences.iter().any(|&v| v != 0 && v != 4))
+        .count();
+    assert_eq!(lattice.reparameterized, reparameterized);
     let exact = LocalMesh::from_control_mesh(&mesh, LimitScheme::CatmullClark).unwrap();
     let verts = plan.apply(&mesh.positions);
     let d = diag(&mesh);

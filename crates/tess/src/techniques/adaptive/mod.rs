@@ -291,9 +291,8 @@ pub struct Adaptive {
     max_level: f32,
     /// The Eq. 1 error lattice was built (`SurfaceMaps::param_error`).
     has_param_errors: bool,
-    /// Its summary, when built: RMS and max without, then with, the reparameterization, and
-    /// the patches with a reparameterized corner.
-    param_error_summary: Option<([f64; 4], usize)>,
+    /// Its summary and the patches with a reparameterized corner, when built.
+    param_error_summary: Option<(topology::texcoord::ParamErrorSummary, usize)>,
 }
 
 impl Adaptive {
@@ -367,35 +366,7 @@ impl Adaptive {
                 name: options.name.clone(),
                 source: e.into(),
             })?;
-            let n = lattice.side * lattice.side;
-            let (mut sq, mut max) = ([0.0f64; 2], [0.0f64; 2]);
-            for p in 0..plan.patches.len() {
-                for (k, reparam) in [false, true].into_iter().enumerate() {
-                    for &e in lattice.patch(p, reparam) {
-                        sq[k] += (e as f64) * (e as f64);
-                        max[k] = max[k].max(e as f64);
-                    }
-                }
-            }
-            let count = (n * plan.patches.len()).max(1) as f64;
-            let reparameterized = plan
-                .patches
-                .iter()
-                .filter(|p| {
-                    p.reparam_valences
-                        .iter()
-                        .any(|&v| topology::texcoord::reparam_block(v).is_some())
-                })
-                .count();
-            param_error_summary = Some((
-                [
-                    (sq[0] / count).sqrt(),
-                    max[0],
-                    (sq[1] / count).sqrt(),
-                    max[1],
-                ],
-                reparameterized,
-            ));
+            param_error_summary = Some((lattice.summary(), lattice.reparameterized));
             gpu.param_errors(&lattice)
         } else {
             Vec::new()
@@ -592,7 +563,8 @@ impl Adaptive {
     /// What the Eq. 1 lattice says over the whole surface, for the command line (`None` when
     /// it was not built).
     pub fn param_error_note(&self) -> Option<String> {
-        let ([rms0, max0, rms1, max1], reparameterized) = self.param_error_summary?;
+        let (summary, reparameterized) = self.param_error_summary?;
+        let ([rms0, rms1], [max0, max1]) = (summary.rms, summary.max);
         Some(format!(
             "{}: Eq. 1 texture error over the bbox diagonal ({}² lattice per patch, rest pose): \
              RMS {rms0:.2e} / max {max0:.2e} without the reparameterization, RMS {rms1:.2e} / \
