@@ -5,6 +5,7 @@
 // interior Bezier points are rational blends of Fp and Fm, so each is the right one on the
 // edge it controls the cross derivative of. Mirrors topology::gregory::gregory_weights.
 #define TECHNIQUE_PUSH_CONSTANTS
+#define PATCH_SHADING_NORMAL
 #include "frame.glsl"
 #include "adaptive.glsl"
 #include "tese_out.glsl"
@@ -72,3 +73,15 @@ void evaluate(uint id, vec2 uv, out vec3 pos, out vec3 du, out vec3 dv) {
 }
 
 #include "tese_main.glsl"
+
+// ACC-1 nets (Gregory records with tangent valences) shade with their tangent patches: the
+// net's 20 points from the control stage, the 8 limit-tangent points from the buffer.
+vec3 patch_shading_normal(uint id, vec2 uv, vec3 n) {
+    uint valences = surfaces[id].tangent_valences;
+    if (valences == 0u) return n;
+    vec3 c[28];
+    for (int k = 0; k < 20; ++k) c[k] = tc_points[k];
+    uint o = patches[id].cp_offset;
+    for (uint k = 20u; k < 28u; ++k) c[k] = vtx(control_points[o + k]);
+    return acc_tangent_normal(c, valences, uv);
+}

@@ -101,13 +101,10 @@ void bspline3(float t, out vec4 b, out vec4 d) {
 }
 
 // ACC-1 shading normal from the two tangent patches (Loop & Schaefer 2008); mirrors
-// topology::acc::tangent_normal (see there for the construction). Reads the patch's 28 points
-// from the global vertex buffer: the Gregory form of the Bezier net (20), then per corner the
-// limit-tangent points Ep, Em. `valences`: 8 bits per corner.
-vec3 acc_tangent_normal(uint id, uint valences, vec2 uv) {
-    uint o = patches[id].cp_offset;
-    vec3 c[28];
-    for (uint k = 0u; k < 28u; ++k) c[k] = vtx(control_points[o + k]);
+// topology::acc::tangent_normal (see there for the construction). `c`: the patch's 28 points,
+// the Gregory form of the Bezier net (20), then per corner the limit-tangent points Ep, Em.
+// `valences`: 8 bits per corner.
+vec3 acc_tangent_normal(vec3 c[28], uint valences, vec2 uv) {
     vec3 b[16];  // b[i + 4 j], i along u
     b[0] = c[0];  b[1] = c[1];  b[4] = c[2];  b[5] = c[3];
     b[3] = c[5];  b[7] = c[6];  b[2] = c[7];  b[6] = c[8];
@@ -159,7 +156,12 @@ vec3 acc_tangent_normal(uint id, uint valences, vec2 uv) {
 // operand order, `precise` (every TES that includes this gets the same bits).
 vec3 owner_normal(uint id, vec2 uv) {
     uint tangent_valences = surfaces[id].tangent_valences;
-    if (tangent_valences != 0u) return acc_tangent_normal(id, tangent_valences, uv);
+    if (tangent_valences != 0u) {
+        uint o = patches[id].cp_offset;
+        vec3 c[28];
+        for (uint k = 0u; k < 28u; ++k) c[k] = vtx(control_points[o + k]);
+        return acc_tangent_normal(c, tangent_valences, uv);
+    }
     AdaptivePatch p = patches[id];
     uint kind = patch_kind(p);
     precise vec3 du = vec3(0.0), dv = vec3(0.0);

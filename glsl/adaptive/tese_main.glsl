@@ -8,6 +8,11 @@ layout(location = 2) patch in uint tc_info;
 layout(location = 5) out vec3 out_albedo;
 layout(location = 6) out vec2 out_texcoord;
 #include "surface.glsl"
+#ifdef PATCH_SHADING_NORMAL
+// A patch kind whose shading normal is not cross(du, dv) defines this after including this
+// file (gregory.tese: ACC-1 nets and their tangent patches); `n` is cross(du, dv)'s.
+vec3 patch_shading_normal(uint id, vec2 uv, vec3 n);
+#endif
 
 // Regular, Gregory, bilinear.
 const vec3 KIND_COLOURS[3] = vec3[3](vec3(0.45, 0.65, 0.95), vec3(0.95, 0.45, 0.35), vec3(0.95, 0.8, 0.3));
@@ -34,10 +39,9 @@ void main() {
         pos = canonical_edge_point(p, 3u, 1.0 - uv.y, gl_TessLevelOuter[0], !fractional_factors() || edge_kind(p, 3u) != ADAPTIVE_EDGE_PLAIN, curve, s);
     }
     vec3 n = safe_normalize(cross(du, dv), vec3(0.0, 0.0, 1.0));
-    // ACC-1 patches shade with their tangent patches' normal field (continuous across edges).
-    // (Only Gregory-kind records can be ACC-1 nets: regular and bilinear patches skip the read.)
-    uint tangent_valences = (tc_info & 15u) == uint(ADAPTIVE_KIND_GREGORY) ? surfaces[tc_patch].tangent_valences : 0u;
-    if (tangent_valences != 0u) n = acc_tangent_normal(tc_patch, tangent_valences, uv);
+#ifdef PATCH_SHADING_NORMAL
+    n = patch_shading_normal(tc_patch, uv, n);
+#endif
     vec2 tex = patch_texcoord(tc_patch, uv);
     out_texcoord = tex;
     if ((adaptive.options & uint(ADAPTIVE_OPTION_DISPLACE)) != 0u) {
