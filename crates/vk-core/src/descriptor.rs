@@ -242,6 +242,25 @@ impl DescriptorSet {
         self.write_buffer_range(binding, ty, buffer, 0, buffer.size())
     }
 
+    /// The layout's slot of `binding`, which must be of type `ty`.
+    fn slot(&self, binding: u32, ty: vk::DescriptorType) -> Result<usize> {
+        let fail = |problem| VkError::Descriptor {
+            set: self.name.clone(),
+            binding,
+            problem,
+        };
+        let slot = self
+            .bindings
+            .iter()
+            .position(|b| b.binding == binding)
+            .ok_or_else(|| fail(DescriptorError::NoSuchBinding))?;
+        let layout = self.bindings[slot].ty;
+        if layout != ty {
+            return Err(fail(DescriptorError::Type { layout, given: ty }));
+        }
+        Ok(slot)
+    }
+
     /// Points `binding` at `range` bytes of `buffer` from `offset`; the set then keeps the buffer
     /// alive. Typed errors: no such binding or another type, the buffer lacks the usage, the
     /// range is empty or leaves the buffer, the offset is not a multiple of the device's
@@ -263,18 +282,7 @@ impl DescriptorSet {
             problem,
         };
         let device = &self.pool.device;
-        let slot = self
-            .bindings
-            .iter()
-            .position(|b| b.binding == binding)
-            .ok_or_else(|| fail(DescriptorError::NoSuchBinding))?;
-        let layout_ty = self.bindings[slot].ty;
-        if layout_ty != ty {
-            return Err(fail(DescriptorError::Type {
-                layout: layout_ty,
-                given: ty,
-            }));
-        }
+        let slot = self.slot(binding, ty)?;
         let caps = &device.info.caps;
         let (usage, max, alignment) = match ty {
             vk::DescriptorType::UNIFORM_BUFFER => (
@@ -343,23 +351,7 @@ impl DescriptorSet {
     /// set is bound in an unsubmitted recording; waits for submissions that used it.
     pub fn write_texture(&self, binding: u32, texture: &Texture) -> Result<()> {
         const TY: vk::DescriptorType = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
-        let fail = |problem| VkError::Descriptor {
-            set: self.name.clone(),
-            binding,
-            problem,
-        };
-        let slot = self
-            .bindings
-            .iter()
-            .position(|b| b.binding == binding)
-            .ok_or_else(|| fail(DescriptorError::NoSuchBinding))?;
-        let layout_ty = self.bindings[slot].ty;
-        if layout_ty != TY {
-            return Err(fail(DescriptorError::Type {
-                layout: layout_ty,
-                given: TY,
-            }));
-        }
+        let slot = self.slot(binding, TY)?;
         let mut written = self.lock_for_update(binding)?;
         let shared = &texture.shared;
         let info = [vk::DescriptorImageInfo::default()

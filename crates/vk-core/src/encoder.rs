@@ -264,6 +264,22 @@ impl<'a> Encoder<'a> {
         }
     }
 
+    /// `buffer` holds at least `bytes` (a copy's source or destination).
+    fn needs_size(command: &'static str, buffer: &Buffer, bytes: u64) -> Result<()> {
+        if buffer.size() >= bytes {
+            Ok(())
+        } else {
+            Err(VkError::recording(
+                command,
+                E::BufferTooSmall {
+                    buffer: buffer.name().to_owned(),
+                    needed: bytes,
+                    size: buffer.size(),
+                },
+            ))
+        }
+    }
+
     pub fn begin_label(&mut self, name: &str) {
         self.labels += 1;
         if let (Some(du), Ok(name)) = (&self.device.debug_utils, std::ffi::CString::new(name)) {
@@ -646,17 +662,7 @@ impl<'a> Encoder<'a> {
         const CMD: &str = "vkCmdCopyBufferToImage";
         self.outside_rendering(CMD)?;
         Self::needs_usage(CMD, staging, vk::BufferUsageFlags::TRANSFER_SRC)?;
-        let bytes = texture.byte_len();
-        if staging.size() < bytes {
-            return Err(VkError::recording(
-                CMD,
-                E::BufferTooSmall {
-                    buffer: staging.name().to_owned(),
-                    needed: bytes,
-                    size: staging.size(),
-                },
-            ));
-        }
+        Self::needs_size(CMD, staging, texture.byte_len())?;
         let device = &self.device.raw;
         let (cmd, image, levels) = (self.cmd, texture.raw_image(), texture.levels());
         let transfer = vk::PipelineStageFlags::TRANSFER;
@@ -803,16 +809,7 @@ impl<'a> Encoder<'a> {
         let extent = texture.level_extent(level);
         let bytes =
             extent.width as u64 * extent.height as u64 * texture.format().bytes_per_texel() as u64;
-        if buffer.size() < bytes {
-            return Err(VkError::recording(
-                CMD,
-                E::BufferTooSmall {
-                    buffer: buffer.name().to_owned(),
-                    needed: bytes,
-                    size: buffer.size(),
-                },
-            ));
-        }
+        Self::needs_size(CMD, buffer, bytes)?;
         let device = &self.device.raw;
         let (cmd, image) = (self.cmd, texture.raw_image());
         let region = vk::BufferImageCopy::default()
@@ -1360,18 +1357,11 @@ impl<'a> Encoder<'a> {
     /// Ends rendering, copies colour into `readback` (OffscreenTarget::readback_buffer), with the barriers.
     pub fn end_offscreen_and_copy(&mut self, target: &'a OffscreenTarget, readback: &'a Buffer) {
         const CMD: &str = "vkCmdCopyImageToBuffer";
+        let bytes = target.extent.width as u64 * target.extent.height as u64 * 4;
         if let Err(VkError::Recording { problem, .. }) =
             Self::needs_usage(CMD, readback, vk::BufferUsageFlags::TRANSFER_DST)
+                .and_then(|()| Self::needs_size(CMD, readback, bytes))
         {
-            return self.defer(CMD, problem);
-        }
-        let bytes = target.extent.width as u64 * target.extent.height as u64 * 4;
-        if readback.size() < bytes {
-            let problem = E::BufferTooSmall {
-                buffer: readback.name().to_owned(),
-                needed: bytes,
-                size: readback.size(),
-            };
             return self.defer(CMD, problem);
         }
         let kind = ScopeKind::Offscreen(target.color.raw);
