@@ -35,6 +35,17 @@ fn diag(m: &ControlMesh) -> f64 {
     m.bbox_diagonal()
 }
 
+/// Angle in radians between two vectors.
+fn angle(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let d: f64 = (0..3).map(|k| a[k] * b[k]).sum();
+    let c = [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ];
+    (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt().atan2(d)
+}
+
 fn semi_sharp(m: &ControlMesh) -> bool {
     let finite = |s: f32| s > 0.0 && s < 10.0;
     m.creases.iter().any(|c| finite(c.sharpness)) || m.corners.iter().any(|c| finite(c.sharpness))
@@ -450,15 +461,6 @@ fn acc_tangent_patch_normals_on_the_gpu() {
     let gpu = Gpu::new();
     let mut ctx = Context::offscreen(gpu.device()).expect("context");
     let capturer = Capturer::new(&ctx).expect("capturer");
-    let angle = |a: [f64; 3], b: [f64; 3]| {
-        let d: f64 = (0..3).map(|k| a[k] * b[k]).sum();
-        let c = [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ];
-        (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt().atan2(d)
-    };
     for name in ["spot", "catmark_pawn", "catmark_cube"] {
         let mesh = shape(name);
         let surf = gregory::build(
@@ -546,15 +548,6 @@ fn displaced_surfaces_shade_with_displaced_normals() {
     let gpu = Gpu::new();
     let mut ctx = Context::offscreen(gpu.device()).expect("context");
     let capturer = Capturer::new(&ctx).expect("capturer");
-    let angle = |a: [f64; 3], b: [f64; 3]| {
-        let d: f64 = (0..3).map(|k| a[k] * b[k]).sum();
-        let c = [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ];
-        (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt().atan2(d)
-    };
     let mesh = shape("spot");
     let height = SurfaceMaps {
         height: Some(std::sync::Arc::new(

@@ -4,6 +4,8 @@
 //! message naming what is at fault, never undefined behaviour; and animation (per-frame
 //! positions) changes what a surface draws. One validated standalone device, no validation
 //! errors at the end.
+mod common;
+use common::surface_desc;
 use std::ffi::{c_char, CStr};
 use std::ptr::{null, null_mut};
 use tessera_capi::host::*;
@@ -76,27 +78,8 @@ fn mesh_desc(c: &Cube) -> TesseraMeshDesc {
     }
 }
 
-fn surface_desc(technique: TesseraTechnique) -> TesseraSurfaceDesc {
-    let mut d = std::mem::MaybeUninit::uninit();
-    // SAFETY: `d` is writable and filled by the call.
-    let status = unsafe { tessera_surface_desc_default(d.as_mut_ptr()) };
-    assert_eq!(status, TesseraStatus::Ok);
-    // SAFETY: initialized above.
-    let mut d = unsafe { d.assume_init() };
-    d.technique = technique;
-    d
-}
-
 fn frame_desc() -> TesseraFrameDesc {
-    let mut f = std::mem::MaybeUninit::uninit();
-    // SAFETY: `f` is writable and filled by the call.
-    let status = unsafe { tessera_frame_desc_default(f.as_mut_ptr()) };
-    assert_eq!(status, TesseraStatus::Ok);
-    // SAFETY: initialized above.
-    let mut f = unsafe { f.assume_init() };
-    f.width = W;
-    f.height = H;
-    f
+    common::frame_desc(W, H)
 }
 
 fn create_surface(

@@ -154,6 +154,33 @@ fn xdotool(display: &str, args: &[&str]) -> String {
 }
 
 /// Waits for `path` to be written whole (the PNG decodes).
+/// `tessera view` with `args`, validation on (synchronization too), in `dir` (where P saves its
+/// screenshots) on `display`; returns the process and its window id, focused for xdotool.
+fn focused_view(
+    display: &str,
+    dir: &std::path::Path,
+    args: &[&std::ffi::OsStr],
+) -> (std::process::Child, String) {
+    let child = Command::new(env!("CARGO_BIN_EXE_tessera"))
+        .arg("view")
+        .args(args)
+        .args(["--validation", "--sync-validation"])
+        .current_dir(dir)
+        .env("DISPLAY", display)
+        .env("WAYLAND_DISPLAY", "")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("tessera runs");
+    let window = xdotool(
+        display,
+        &["search", "--sync", "--onlyvisible", "--name", "tessera"],
+    );
+    let window = window.lines().next().expect("a window").trim().to_owned();
+    xdotool(display, &["windowfocus", "--sync", &window]);
+    (child, window)
+}
+
 fn wait_for_png(path: &std::path::Path) -> image::RgbaImage {
     let start = std::time::Instant::now();
     loop {
@@ -196,31 +223,19 @@ fn keys_change_level_and_technique_and_p_saves_screenshots() {
     };
     let dir = std::env::temp_dir().join(format!("tessera-window-keys-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let child = Command::new(env!("CARGO_BIN_EXE_tessera"))
-        .args([
-            "view",
-            "--method",
-            "flat",
-            "--segments",
-            "2",
-            "--wireframe",
-            "--no-hud",
-        ])
-        .args(["--validation", "--sync-validation", "--size", "160x120"])
-        .current_dir(&dir)
-        .env("DISPLAY", &server.display)
-        .env("WAYLAND_DISPLAY", "")
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("tessera runs");
+    let args = [
+        "--method",
+        "flat",
+        "--segments",
+        "2",
+        "--wireframe",
+        "--no-hud",
+        "--size",
+        "160x120",
+    ]
+    .map(std::ffi::OsStr::new);
+    let (child, _) = focused_view(&server.display, &dir, &args);
     let d = server.display.clone();
-    let window = xdotool(
-        &d,
-        &["search", "--sync", "--onlyvisible", "--name", "tessera"],
-    );
-    let window = window.lines().next().expect("a window").trim().to_owned();
-    xdotool(&d, &["windowfocus", "--sync", &window]);
     let shot = |n: u32| wait_for_png(&dir.join(format!("tessera-screenshot-{n}.png")));
     xdotool(&d, &["key", "p"]);
     let level2 = shot(1);
@@ -269,27 +284,25 @@ fn surface_keys_displace_and_restore() {
     let dir = std::env::temp_dir().join(format!("tessera-window-surface-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let assets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets");
-    let child = Command::new(env!("CARGO_BIN_EXE_tessera"))
-        .arg("view")
-        .arg(assets.join("spot_control_mesh.obj"))
-        .args(["--method", "gregory", "--segments", "4", "--no-hud"])
-        .arg("--texture")
-        .arg(assets.join("spot_texture.png"))
-        .args(["--validation", "--sync-validation", "--size", "160x120"])
-        .current_dir(&dir)
-        .env("DISPLAY", &server.display)
-        .env("WAYLAND_DISPLAY", "")
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("tessera runs");
-    let d = server.display.clone();
-    let window = xdotool(
-        &d,
-        &["search", "--sync", "--onlyvisible", "--name", "tessera"],
+    let (mesh, texture) = (
+        assets.join("spot_control_mesh.obj"),
+        assets.join("spot_texture.png"),
     );
-    let window = window.lines().next().expect("a window").trim().to_owned();
-    xdotool(&d, &["windowfocus", "--sync", &window]);
+    let mut args = vec![mesh.as_os_str(), "--texture".as_ref(), texture.as_os_str()];
+    args.extend(
+        [
+            "--method",
+            "gregory",
+            "--segments",
+            "4",
+            "--no-hud",
+            "--size",
+            "160x120",
+        ]
+        .map(std::ffi::OsStr::new),
+    );
+    let (child, _) = focused_view(&server.display, &dir, &args);
+    let d = server.display.clone();
     let shot = |n: u32| wait_for_png(&dir.join(format!("tessera-screenshot-{n}.png")));
     xdotool(&d, &["key", "p"]);
     let plain = shot(1);
@@ -350,23 +363,18 @@ fn hud_is_drawn_hidden_by_h_and_its_level_control_acts() {
     };
     let dir = std::env::temp_dir().join(format!("tessera-window-hud-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let child = Command::new(env!("CARGO_BIN_EXE_tessera"))
-        .args(["view", "--method", "flat", "--segments", "2", "--wireframe"])
-        .args(["--validation", "--sync-validation", "--size", "640x480"])
-        .current_dir(&dir)
-        .env("DISPLAY", &server.display)
-        .env("WAYLAND_DISPLAY", "")
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("tessera runs");
+    let args = [
+        "--method",
+        "flat",
+        "--segments",
+        "2",
+        "--wireframe",
+        "--size",
+        "640x480",
+    ]
+    .map(std::ffi::OsStr::new);
+    let (child, window) = focused_view(&server.display, &dir, &args);
     let d = server.display.clone();
-    let window = xdotool(
-        &d,
-        &["search", "--sync", "--onlyvisible", "--name", "tessera"],
-    );
-    let window = window.lines().next().expect("a window").trim().to_owned();
-    xdotool(&d, &["windowfocus", "--sync", &window]);
     let shot = |n: u32| wait_for_png(&dir.join(format!("tessera-screenshot-{n}.png")));
     xdotool(&d, &["key", "p"]);
     let with_hud = shot(1);

@@ -137,3 +137,28 @@ pub fn compare_with_rust_render(dir: &Path, techniques: &[(&str, tess::Technique
         assert!(d <= TOLERANCE, "{name}: {d:.5} of pixels differ");
     }
 }
+
+/// `tessera_surface_desc_default` with `technique`.
+pub fn surface_desc(technique: tessera_capi::TesseraTechnique) -> tessera_capi::TesseraSurfaceDesc {
+    let mut d = std::mem::MaybeUninit::uninit();
+    // SAFETY: `d` is writable and filled by the call.
+    let status = unsafe { tessera_capi::tessera_surface_desc_default(d.as_mut_ptr()) };
+    assert_eq!(status, tessera_capi::TesseraStatus::Ok);
+    // SAFETY: initialized above.
+    let mut d = unsafe { d.assume_init() };
+    d.technique = technique;
+    d
+}
+
+/// `tessera_frame_desc_default` at `width` × `height`.
+pub fn frame_desc(width: u32, height: u32) -> tessera_capi::TesseraFrameDesc {
+    let mut f = std::mem::MaybeUninit::uninit();
+    // SAFETY: `f` is writable and filled by the call.
+    let status = unsafe { tessera_capi::tessera_frame_desc_default(f.as_mut_ptr()) };
+    assert_eq!(status, tessera_capi::TesseraStatus::Ok);
+    // SAFETY: initialized above.
+    let mut f = unsafe { f.assume_init() };
+    f.width = width;
+    f.height = height;
+    f
+}
