@@ -172,6 +172,40 @@ fn curves_interpolate_patch_corners() {
     }
 }
 
+/// Every canonical curve is its owner patch's own edge (or half of it): a curve is the
+/// surface of the patch that computed it. At a transition next to a split face the owner of
+/// each half is the fine patch; a coarse Gregory owner once gave a half curve its whole edge's
+/// inner points (spot: 6e-2 off the owner's boundary).
+#[test]
+fn curves_are_their_owners_edges() {
+    for (name, mesh) in shapes() {
+        for patch in [SinglePassPatch::Gregory, SinglePassPatch::Acc1] {
+            let plan = plan_single_pass(
+                &mesh,
+                &SinglePassOptions {
+                    patch,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            let verts = plan.apply(&mesh.positions);
+            let mut worst = 0.0f64;
+            for (c, o) in plan.curve_owners.iter().enumerate() {
+                for k in 0..=8 {
+                    let s = k as f64 / 8.0;
+                    let [u, v] = o.patch_param(s);
+                    let q = plan.evaluate(&verts, o.patch as usize, u, v).position;
+                    worst = worst.max(dist(plan.curve_point(&verts, c, s), &q));
+                }
+            }
+            assert!(
+                worst <= 1e-9 * diag(&mesh),
+                "{name} {patch:?}: a curve is {worst:e} off its owner's edge"
+            );
+        }
+    }
+}
+
 /// ACC-1's tangent patches (Loop & Schaefer 2008) give a continuous normal field: on every edge
 /// shared by two ACC-1 patches the two sides' shading normals agree, while the geometry patches'
 /// own normals disagree next to extraordinary vertices (which is why the tangent patches exist).

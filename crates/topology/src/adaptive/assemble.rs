@@ -420,6 +420,15 @@ pub(super) fn assemble(
                 }
                 EdgeKind::Coarse => {
                     patch.transition_mask |= 1 << p;
+                    // A fine patch owns each half before a coarse end cap (single-pass plans
+                    // put Gregory patches on the coarse side): its own edge is the finer
+                    // approximation. A regular coarse patch keeps its rank: its halves are
+                    // exactly the fine B-spline's.
+                    let rank = if d.kind == PatchKind::Regular {
+                        rank
+                    } else {
+                        rank + HALF_RANK
+                    };
                     let next = &levels[l + 1];
                     let maps = next.maps.as_ref().ok_or_else(unbalanced)?;
                     let m = maps.edge_child_vertex[e as usize];
@@ -544,20 +553,39 @@ pub(super) fn assemble(
                                 }
                             }
                         }
-                        PatchKind::Gregory => {
+                        PatchKind::Gregory | PatchKind::Bilinear => {
+                            // The owner's whole edge as Bézier points `[P, Ep, Em, P']`, or the
+                            // half of it (de Casteljau) when the owner is the coarse side.
                             let cp = &patch.control_points;
-                            let id = if k == 1 {
-                                cp[5 * p + 1]
-                            } else {
-                                cp[5 * ((p + 1) % 4) + 2]
-                            };
-                            locals.expand(id, 1.0, &mut scratch);
-                        }
-                        PatchKind::Bilinear => {
                             let (c0, c3) = (ids[p], ids[(p + 1) % 4]);
-                            let w = if k == 1 { 2.0 / 3.0 } else { 1.0 / 3.0 };
-                            locals.expand(c0, w, &mut scratch);
-                            locals.expand(c3, 1.0 - w, &mut scratch);
+                            let whole: [[(u32, f64); 2]; 4] = if patch.kind == PatchKind::Gregory
+                            {
+                                [
+                                    [(c0, 1.0), (c0, 0.0)],
+                                    [(cp[5 * p + 1], 1.0), (c0, 0.0)],
+                                    [(cp[5 * ((p + 1) % 4) + 2], 1.0), (c0, 0.0)],
+                                    [(c3, 1.0), (c0, 0.0)],
+                                ]
+                            } else {
+                                [
+                                    [(c0, 1.0), (c0, 0.0)],
+                                    [(c0, 2.0 / 3.0), (c3, 1.0 / 3.0)],
+                                    [(c0, 1.0 / 3.0), (c3, 2.0 / 3.0)],
+                                    [(c3, 1.0), (c0, 0.0)],
+                                ]
+                            };
+                            let row: [f64; 4] = if part == 0 {
+                                std::array::from_fn(|j| f64::from(u8::from(j == k)))
+                            } else {
+                                bezier_half(part - 1)[k]
+                            };
+                            for (j, &s) in row.iter().enumerate() {
+                                for &(id, w) in &whole[j] {
+                                    if s * w != 0.0 {
+                                        locals.expand(id, s * w, &mut scratch);
+                                    }
+                                }
+                            }
                         }
                     }
                     push_row(&mut table, &mut scratch);

@@ -417,6 +417,10 @@ pub(super) fn bezier_half(h: usize) -> [[f64; 4]; 4] {
 /// 1/2 first/second half of a coarse edge).
 pub(super) type Owner = (u8, u32, u8, u8);
 
+/// Added to a non-regular coarse patch's rank for the halves of its transition edges, so the
+/// fine patch on the other side owns them (above every kind's rank, below the placeholder's).
+pub(super) const HALF_RANK: u8 = 8;
+
 pub(super) fn kind_rank(k: PatchKind) -> u8 {
     match k {
         PatchKind::Regular => 0,
