@@ -156,6 +156,70 @@ pub enum PatchKind {
     Regular,
     Gregory,
     Bilinear,
+    /// A Gregory triangle patch ([`crate::gregory::gregory_triangle_weights`]) on a triangle
+    /// base face (single-pass plans): three corners and edges, barycentric `(u, v)`,
+    /// `u + v ≤ 1`.
+    GregoryTriangle,
+}
+
+impl PatchKind {
+    /// Corners (and edges) of the patch's domain.
+    pub fn corners(self) -> usize {
+        if self == PatchKind::GregoryTriangle {
+            3
+        } else {
+            4
+        }
+    }
+}
+
+/// Patch parameter at `t` along edge `edge` (in the patch's edge direction) of a patch with
+/// `corners` corners: the square's edges run (0,0) → (1,0) → (1,1) → (0,1); the triangle's
+/// (0,0) → (1,0) → (0,1).
+pub fn edge_param(corners: usize, edge: usize, t: f64) -> [f64; 2] {
+    if corners == 3 {
+        return match edge {
+            0 => [t, 0.0],
+            1 => [1.0 - t, t],
+            _ => [0.0, 1.0 - t],
+        };
+    }
+    match edge {
+        0 => [t, 0.0],
+        1 => [1.0, t],
+        2 => [1.0 - t, 1.0],
+        _ => [0.0, 1.0 - t],
+    }
+}
+
+/// Parameter of patch corner `corner` (see [`edge_param`]).
+pub fn corner_param(corners: usize, corner: usize) -> [f64; 2] {
+    edge_param(corners, corner, 0.0)
+}
+
+/// The sub-quad parameter of a point of a triangle's barycentric domain `(u, v)`: sub-quad
+/// `k` (of [`crate::eval::LocalMesh::evaluate_subface`]) is the third of the triangle nearest
+/// corner `k`, `[corner, edge midpoint, centroid, edge midpoint]`, mapped bilinearly from its
+/// `(s, t)`. Inverting that map: with `(a, b)` the barycentrics of the next and the previous
+/// corner, `a = s/2 − st/6`, `b = t/2 − st/6`. Face-varying data bilinear on the sub-quads is
+/// thereby linear on the triangle.
+pub fn triangle_subquad_param(u: f64, v: f64) -> (u8, f64, f64) {
+    let l = [1.0 - u - v, u, v];
+    // The nearest corner (ties to the lower index, both sides agree there anyway).
+    let k = if l[0] >= l[1] && l[0] >= l[2] {
+        0
+    } else if l[1] >= l[2] {
+        1
+    } else {
+        2
+    };
+    let (a, b) = (l[(k + 1) % 3], l[(k + 2) % 3]);
+    // s − t = 2(a − b); t² + (2(a − b) − 3) t + 6b = 0, the root in [0, 1].
+    let d = 2.0 * (a - b);
+    let p = 3.0 - d;
+    let t = (p - (p * p - 24.0 * b).max(0.0).sqrt()) * 0.5;
+    let s = t + d;
+    (k as u8, s.clamp(0.0, 1.0), t.clamp(0.0, 1.0))
 }
 
 /// Level of the neighbour across a patch edge.
@@ -189,6 +253,8 @@ pub struct CurveOwner {
     pub edge: u8,
     pub part: u8,
     pub forward: bool,
+    /// The owner is a [`PatchKind::GregoryTriangle`] (its edges run as [`edge_param`]'s).
+    pub triangle: bool,
 }
 
 impl CurveOwner {
@@ -200,12 +266,7 @@ impl CurveOwner {
             2 => 0.5 + 0.5 * e,
             _ => e,
         };
-        match self.edge {
-            0 => [t, 0.0],
-            1 => [1.0, t],
-            2 => [1.0 - t, 1.0],
-            _ => [0.0, 1.0 - t],
-        }
+        edge_param(if self.triangle { 3 } else { 4 }, self.edge as usize, t)
     }
 }
 
@@ -216,10 +277,11 @@ pub struct AdaptivePatch {
     pub level: u8,
     /// Global vertex ids. Regular: 16, row-major 4×4 as [`crate::patch`] (phantoms
     /// substituted); Gregory: 20, per corner `P, Ep, Em, Fp, Fm`; Bilinear: the 4 canonical
-    /// corners.
+    /// corners; GregoryTriangle: 15, per corner `P, Ep, Em, Fp, Fm`.
     pub control_points: Vec<u32>,
     pub base_face: u32,
-    /// Sub-quad of a non-quad base face; 0 for quads.
+    /// Sub-quad of a non-quad base face; 0 for quads and for triangle patches (which cover
+    /// their whole triangle, [`AdaptivePatch::base_param`]).
     pub sub_face: u8,
     /// Patch `(u, v)` covers `(sub)face parameter origin + size·(u, v)`.
     pub origin: [f64; 2],
@@ -229,7 +291,8 @@ pub struct AdaptivePatch {
     pub boundary_mask: u8,
     /// Bit `i`: the neighbour across edge `i` is one level finer.
     pub transition_mask: u8,
-    /// Edge 0: v0→v1 (v = 0), 1: v1→v2 (u = 1), 2: v2→v3 (v = 1), 3: v3→v0 (u = 0).
+    /// Edge 0: v0→v1 (v = 0), 1: v1→v2 (u = 1), 2: v2→v3 (v = 1), 3: v3→v0 (u = 0). A triangle
+    /// patch: 0: v0→v1 (v = 0), 1: v1→v2 (u + v = 1), 2: v2→v0 (u = 0), edge 3 unused.
     pub edges: [PatchEdge; 4],
     /// Per corner: the valence whose texture-reparameterization block applies
     /// ([`crate::reparam`]), 0 for the identity (regular and ACC-1 patches, boundary, crease and
@@ -239,6 +302,27 @@ pub struct AdaptivePatch {
     /// tangent points `Ep, Em` of [`crate::gregory`]): each corner's valence, for the tangent
     /// patches that shade them ([`crate::acc::tangent_normal`]); `[0; 4]` on every other patch.
     pub tangent_valences: [u8; 4],
+}
+
+impl AdaptivePatch {
+    /// Corners (and edges) of the patch.
+    pub fn corners(&self) -> usize {
+        self.kind.corners()
+    }
+
+    /// The base-face parameter of patch parameter `(u, v)`: `(sub-face, s, t)`, the sub-face 0
+    /// on quads. A triangle patch maps its barycentric domain onto the triangle's three
+    /// sub-quads ([`triangle_subquad_param`]).
+    pub fn base_param(&self, u: f64, v: f64) -> (u8, f64, f64) {
+        if self.kind == PatchKind::GregoryTriangle {
+            return triangle_subquad_param(u, v);
+        }
+        (
+            self.sub_face,
+            self.origin[0] + self.size * u,
+            self.origin[1] + self.size * v,
+        )
+    }
 }
 
 /// Everything a device needs to draw the feature-adaptive limit surface.
@@ -331,7 +415,7 @@ pub fn plan_adaptive_within(
         max_refined_faces,
         false,
     )?;
-    assemble::assemble(&scaled, opts, levels, opts.isolation as usize, false)
+    assemble::assemble(&scaled, opts, levels, opts.isolation as usize, false, false)
 }
 
 fn bezier(t: f64) -> ([f64; 4], [f64; 4]) {
@@ -421,9 +505,59 @@ impl AdaptivePlan {
         crate::eval::normal_of(&s.du, &s.dv)
     }
 
-    /// CPU evaluation of patch `patch` at `(u, v) ∈ [0,1]²` on the global vertex buffer
-    /// `verts` (from [`Self::apply`]): bicubic B-spline, Gregory, or the Coons patch of the
-    /// four curves of a bilinear end cap.
+    /// The boundary correction of a Gregory triangle patch on its transition edges (a finer
+    /// neighbour: the edge is two half curves of level 1, through the exact limit point of the
+    /// edge's midpoint, where the patch's own boundary is one cubic). Edge `p` (corner `p` to
+    /// `p + 1`) adds `(λp + λp+1)² · (C(t) − B(t))`, `t = λp+1 / (λp + λp+1)`, with `C` the
+    /// canonical halves and `B` the patch's own cubic: it is the whole difference on edge `p`,
+    /// and 0 on the other two edges (`C − B` vanishes at the corners, with its derivative,
+    /// since both start along the same limit tangent), so the patch's boundary is its
+    /// canonical curves exactly. Mirrored by `glsl/adaptive/gregory_tri.tese`.
+    fn triangle_transitions(
+        &self,
+        verts: &[[f64; 3]],
+        patch: usize,
+        u: f64,
+        v: f64,
+        s: &mut PatchSample,
+    ) {
+        let pa = &self.patches[patch];
+        let l = [1.0 - u - v, u, v];
+        const DL: [[f64; 2]; 3] = [[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]];
+        for p in 0..3 {
+            if pa.edges[p].kind != EdgeKind::Coarse {
+                continue;
+            }
+            let q = (p + 1) % 3;
+            let sum = l[p] + l[q];
+            if sum <= 1e-12 {
+                continue;
+            }
+            let t = l[q] / sum;
+            let (c, dc) = self.edge_sample(verts, patch, p, t);
+            let cp = |k: usize| verts[pa.control_points[k] as usize];
+            let own = [cp(5 * p), cp(5 * p + 1), cp(5 * q + 2), cp(5 * q)];
+            let (bw, bd) = bezier(t);
+            let mut d = c;
+            let mut dd = dc;
+            for k in 0..4 {
+                axpy(&mut d, -bw[k], &own[k]);
+                axpy(&mut dd, -bd[k], &own[k]);
+            }
+            let w = sum * sum;
+            axpy(&mut s.position, w, &d);
+            for (axis, out) in [&mut s.du, &mut s.dv].into_iter().enumerate() {
+                let ds = DL[p][axis] + DL[q][axis];
+                // ∂(w·d(t)) = 2·sum·∂sum·d + d'·(∂λq·sum − λq·∂sum)
+                axpy(out, 2.0 * sum * ds, &d);
+                axpy(out, DL[q][axis] * sum - l[q] * ds, &dd);
+            }
+        }
+    }
+
+    /// CPU evaluation of patch `patch` at `(u, v) ∈ [0,1]²` (`u + v ≤ 1` on a triangle patch)
+    /// on the global vertex buffer `verts` (from [`Self::apply`]): bicubic B-spline, Gregory,
+    /// Gregory triangle, or the Coons patch of the four curves of a bilinear end cap.
     pub fn evaluate(&self, verts: &[[f64; 3]], patch: usize, u: f64, v: f64) -> PatchSample {
         let pa = &self.patches[patch];
         let cp = |k: usize| &verts[pa.control_points[k] as usize];
@@ -448,6 +582,15 @@ impl AdaptivePlan {
                     axpy(&mut s.du, w.du[k], cp(k));
                     axpy(&mut s.dv, w.dv[k], cp(k));
                 }
+            }
+            PatchKind::GregoryTriangle => {
+                let w = crate::gregory::gregory_triangle_weights(u, v);
+                for k in 0..15 {
+                    axpy(&mut s.position, w.point[k], cp(k));
+                    axpy(&mut s.du, w.du[k], cp(k));
+                    axpy(&mut s.dv, w.dv[k], cp(k));
+                }
+                self.triangle_transitions(verts, patch, u, v, &mut s);
             }
             PatchKind::Bilinear => {
                 let (b, db) = self.edge_sample(verts, patch, 0, u);

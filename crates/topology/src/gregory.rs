@@ -686,6 +686,216 @@ pub fn gregory_weights(u: f64, v: f64) -> PatchWeights<20> {
     w
 }
 
+/// Gregory *triangle* patches (Loop, Schaefer, Ni, Castaño 2009, §4; OpenSubdiv's
+/// `GREGORY_TRIANGLE` layout): 15 points, per corner `i = 0..2` (corner 0 at `(u, v) = (0, 0)`,
+/// 1 at `(1, 0)`, 2 at `(0, 1)`; barycentric `λ = (1 − u − v, u, v)`) the slots `5·i + s` as for
+/// quads: `P_i`, `Ep_i` (cubic edge point toward corner `i+1`), `Em_i` (toward `i−1`), `Fp_i`,
+/// `Fm_i`.
+///
+/// The patch is a quartic triangular Bézier patch whose boundary is the cubic
+/// `[P_i, Ep_i, Em_{i+1}, P_{i+1}]` degree-elevated (so a shared edge is the same cubic curve as
+/// a neighbour's) and whose three interior points are rational blends, each the right face
+/// point on the edge it controls the cross derivative of:
+///
+/// ```text
+/// b211 = (λ1·Fp0 + λ2·Fm0) / (λ1 + λ2)    (Fp0 on edge 0: λ2 = 0; Fm0 on edge 2: λ1 = 0)
+/// b121 = (λ2·Fp1 + λ0·Fm1) / (λ2 + λ0)
+/// b112 = (λ0·Fp2 + λ1·Fm2) / (λ0 + λ1)
+/// ```
+///
+/// Derivatives are exact (quotient rule); where a blend's denominator vanishes (its corner,
+/// where its Bernstein weight vanishes quadratically) the blend is the mean and its derivative
+/// term 0.
+pub fn gregory_triangle_weights(u: f64, v: f64) -> PatchWeights<15> {
+    let l = [1.0 - u - v, u, v];
+    // ∂λ/∂u, ∂λ/∂v.
+    const DL: [[f64; 2]; 3] = [[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]];
+    let pw = |x: f64, n: i32| if n < 0 { 0.0 } else { x.powi(n) };
+    let fact = |n: usize| [1.0, 1.0, 2.0, 6.0, 24.0][n];
+    // Quartic Bernstein B_{ijk} and its derivatives.
+    let bern = |i: usize, j: usize, k: usize| -> [f64; 3] {
+        let c = 24.0 / (fact(i) * fact(j) * fact(k));
+        let (i, j, k) = (i as i32, j as i32, k as i32);
+        let b = c * pw(l[0], i) * pw(l[1], j) * pw(l[2], k);
+        let d0 = c * i as f64 * pw(l[0], i - 1) * pw(l[1], j) * pw(l[2], k);
+        let d1 = c * j as f64 * pw(l[0], i) * pw(l[1], j - 1) * pw(l[2], k);
+        let d2 = c * k as f64 * pw(l[0], i) * pw(l[1], j) * pw(l[2], k - 1);
+        [
+            b,
+            d0 * DL[0][0] + d1 * DL[1][0] + d2 * DL[2][0],
+            d0 * DL[0][1] + d1 * DL[1][1] + d2 * DL[2][1],
+        ]
+    };
+    let mut w = PatchWeights {
+        point: [0.0; 15],
+        du: [0.0; 15],
+        dv: [0.0; 15],
+    };
+    let mut add = |slot: usize, coef: f64, b: [f64; 3]| {
+        w.point[slot] += coef * b[0];
+        w.du[slot] += coef * b[1];
+        w.dv[slot] += coef * b[2];
+    };
+    // Boundary Bézier points (i, j, k) as combinations of P, Ep, Em.
+    const BOUNDARY: [((usize, usize, usize), [(usize, f64); 2]); 12] = [
+        ((4, 0, 0), [(0, 1.0), (0, 0.0)]),
+        ((0, 4, 0), [(5, 1.0), (5, 0.0)]),
+        ((0, 0, 4), [(10, 1.0), (10, 0.0)]),
+        ((3, 1, 0), [(0, 0.25), (1, 0.75)]),
+        ((2, 2, 0), [(1, 0.5), (7, 0.5)]),
+        ((1, 3, 0), [(7, 0.75), (5, 0.25)]),
+        ((0, 3, 1), [(5, 0.25), (6, 0.75)]),
+        ((0, 2, 2), [(6, 0.5), (12, 0.5)]),
+        ((0, 1, 3), [(12, 0.75), (10, 0.25)]),
+        ((1, 0, 3), [(10, 0.25), (11, 0.75)]),
+        ((2, 0, 2), [(11, 0.5), (2, 0.5)]),
+        ((3, 0, 1), [(2, 0.75), (0, 0.25)]),
+    ];
+    for &((i, j, k), terms) in &BOUNDARY {
+        let b = bern(i, j, k);
+        for (slot, c) in terms {
+            if c != 0.0 {
+                add(slot, c, b);
+            }
+        }
+    }
+    // Interior: (i, j, k), Fp slot, its weight's λ index, Fm's λ index.
+    const INTERIOR: [((usize, usize, usize), usize, usize, usize); 3] = [
+        ((2, 1, 1), 3, 1, 2),
+        ((1, 2, 1), 8, 2, 0),
+        ((1, 1, 2), 13, 0, 1),
+    ];
+    for &((i, j, k), fp, a, b) in &INTERIOR {
+        let bb = bern(i, j, k);
+        let d = l[a] + l[b];
+        let (gp, gu, gv) = if d > 1e-300 {
+            // gp = λa / (λa + λb); ∂gp = (λb ∂λa − λa ∂λb) / d².
+            let q = 1.0 / (d * d);
+            (
+                l[a] / d,
+                (l[b] * DL[a][0] - l[a] * DL[b][0]) * q,
+                (l[b] * DL[a][1] - l[a] * DL[b][1]) * q,
+            )
+        } else {
+            (0.5, 0.0, 0.0)
+        };
+        let fm = fp + 1;
+        w.point[fp] += bb[0] * gp;
+        w.point[fm] += bb[0] * (1.0 - gp);
+        w.du[fp] += bb[1] * gp + bb[0] * gu;
+        w.du[fm] += bb[1] * (1.0 - gp) - bb[0] * gu;
+        w.dv[fp] += bb[2] * gp + bb[0] * gv;
+        w.dv[fm] += bb[2] * (1.0 - gp) - bb[0] * gv;
+    }
+    w
+}
+
+/// The 15 points of the Gregory triangle patch of a triangle face, from the Gregory points of
+/// its three level-1 children (`children[i]`: the child quad at triangle corner `i`, whose
+/// corner 0 is the corner's vertex child, corner 1 on the edge toward triangle corner `i+1`;
+/// each its 20 stencils of [`gregory_basis`]).
+///
+/// Each triangle corner keeps its child's limit position and tangents (doubled: the child
+/// covers half of each edge) and its twist: with the triangle's local coordinates
+/// `(a, b) = (s, t)/2 − s·t/6` of the child's `(s, t)` (the bilinear map of the child onto the
+/// corner's third of the triangle, [`crate::AdaptivePatch::base_param`]), matching
+/// `∂²/∂a∂b` of the quartic at the corner with the child's gives
+///
+/// ```text
+/// Ep = 2·Ep' − P,  Em = 2·Em' − P,  F = 3·F' − 7/6·(Ep' + Em') + P/3   (F = Fp, Fm)
+/// ```
+///
+/// So the corner is exact to first order wherever the child's is, and the boundary is the cubic
+/// through the two corners' limit points along their limit tangents.
+pub fn gregory_triangle_from_children(children: [&[Stencil; 20]; 3]) -> [Stencil; 15] {
+    let mut out: [Stencil; 15] = Default::default();
+    for (i, basis) in children.iter().enumerate() {
+        let row = |k: usize| {
+            let mut r = Row::default();
+            for (&x, &w) in basis[k].indices.iter().zip(&basis[k].weights) {
+                r.add(x, w);
+            }
+            r
+        };
+        let (p, ep, em) = (row(0), row(1), row(2));
+        let edge = |e: &Row| {
+            let mut r = Row::default();
+            r.add_row(e, 2.0);
+            r.add_row(&p, -1.0);
+            r.into_stencil()
+        };
+        let face = |f: &Row| {
+            let mut r = Row::default();
+            r.add_row(f, 3.0);
+            r.add_row(&ep, -7.0 / 6.0);
+            r.add_row(&em, -7.0 / 6.0);
+            r.add_row(&p, 1.0 / 3.0);
+            r.into_stencil()
+        };
+        out[5 * i] = p.clone().into_stencil();
+        out[5 * i + 1] = edge(&ep);
+        out[5 * i + 2] = edge(&em);
+        out[5 * i + 3] = face(&row(3));
+        out[5 * i + 4] = face(&row(4));
+    }
+    out
+}
+
+/// Moves the six face points of a Gregory triangle patch by one common vector so the patch
+/// passes through `centre` (weights over the same vertices) at the domain's centroid, where
+/// the three interior Bézier points carry 4/9 of the weight. Corner positions, tangents and
+/// the boundary stay.
+///
+/// `mids[p]`: the limit point of edge `p`'s midpoint. The patch's boundary correction
+/// ([`crate::AdaptivePlan::evaluate`]) puts its edges through them, which moves the centroid
+/// by `4/9` of each midpoint's distance from the patch's own cubic there; that is accounted
+/// for, so the corrected patch passes through `centre`.
+pub fn gregory_triangle_through_centre(
+    points: &mut [Stencil; 15],
+    centre: &[(u32, f64)],
+    mids: [&[(u32, f64)]; 3],
+) {
+    let w = gregory_triangle_weights(1.0 / 3.0, 1.0 / 3.0);
+    let mut delta = Row::default();
+    for &(i, x) in centre {
+        delta.add(i, x * 9.0 / 4.0);
+    }
+    for (k, st) in points.iter().enumerate() {
+        for (&i, &x) in st.indices.iter().zip(&st.weights) {
+            delta.add(i, -w.point[k] * x * 9.0 / 4.0);
+        }
+    }
+    // − 9/4 · 4/9 · (M_p − B_p(1/2)), B_p(1/2) = (P_p + 3 Ep_p + 3 Em_p+1 + P_p+1) / 8.
+    for (p, mid) in mids.iter().enumerate() {
+        let q = (p + 1) % 3;
+        for &(i, x) in mid.iter() {
+            delta.add(i, -x);
+        }
+        for (k, c) in [
+            (5 * p, 1.0),
+            (5 * p + 1, 3.0),
+            (5 * q + 2, 3.0),
+            (5 * q, 1.0),
+        ] {
+            let st = &points[k];
+            for (&i, &x) in st.indices.iter().zip(&st.weights) {
+                delta.add(i, c / 8.0 * x);
+            }
+        }
+    }
+    for corner in 0..3 {
+        for slot in [3, 4] {
+            let st = &points[5 * corner + slot];
+            let mut r = Row::default();
+            for (&i, &x) in st.indices.iter().zip(&st.weights) {
+                r.add(i, x);
+            }
+            r.add_row(&delta, 1.0);
+            points[5 * corner + slot] = r.into_stencil();
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -700,6 +910,43 @@ mod tests {
                 let sv: f64 = w.dv.iter().sum();
                 assert!((s - 1.0).abs() < 1e-14 && su.abs() < 1e-13 && sv.abs() < 1e-13);
             }
+        }
+    }
+
+    #[test]
+    fn triangle_weights_are_a_partition_of_unity_with_exact_derivatives() {
+        let h = 1e-6;
+        for a in 0..=10 {
+            for b in 0..=(10 - a) {
+                let (u, v) = (a as f64 / 10.0, b as f64 / 10.0);
+                let w = gregory_triangle_weights(u, v);
+                let s: f64 = w.point.iter().sum();
+                assert!((s - 1.0).abs() < 1e-14);
+                assert!(w.du.iter().sum::<f64>().abs() < 1e-12);
+                assert!(w.dv.iter().sum::<f64>().abs() < 1e-12);
+                // Interior points: the derivatives are those of the point weights.
+                if a > 0 && b > 0 && a + b < 10 {
+                    let (pu, mu) = (
+                        gregory_triangle_weights(u + h, v),
+                        gregory_triangle_weights(u - h, v),
+                    );
+                    let (pv, mv) = (
+                        gregory_triangle_weights(u, v + h),
+                        gregory_triangle_weights(u, v - h),
+                    );
+                    for k in 0..15 {
+                        let du = (pu.point[k] - mu.point[k]) / (2.0 * h);
+                        let dv = (pv.point[k] - mv.point[k]) / (2.0 * h);
+                        assert!((du - w.du[k]).abs() < 1e-7, "du {k} at {u} {v}");
+                        assert!((dv - w.dv[k]).abs() < 1e-7, "dv {k} at {u} {v}");
+                    }
+                }
+            }
+        }
+        // On edge 0 (v = 0) only that edge's cubic counts: P0, Ep0, Em1, P1.
+        let w = gregory_triangle_weights(0.3, 0.0);
+        for (k, &x) in w.point.iter().enumerate() {
+            assert_eq!(x != 0.0, [0, 1, 5, 7].contains(&k), "slot {k}");
         }
     }
 

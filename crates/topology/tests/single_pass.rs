@@ -2,6 +2,7 @@
 //! CPU: exact on regular patches, shared edges one canonical curve (no crack), bounded
 //! deviation from the exact limit everywhere, on every Catmull-Clark shape of tests/data and
 //! spot (triangles, quads and pentagons). The GPU technique is checked in tests/gregory.rs.
+use topology::adaptive::edge_param;
 use topology::adaptive::single_pass::{plan_single_pass, SinglePassOptions, SinglePassPatch};
 use topology::eval::{LimitScheme, LocalMesh};
 use topology::{load_obj, ControlMesh, EdgeKind, PatchKind};
@@ -46,28 +47,40 @@ fn dist(a: [f64; 3], b: &[f64]) -> f64 {
 /// Deviation of the plan from the exact limit at the same base parameter over a 9×9 lattice per
 /// patch, relative to the diagonal: (regular max, max, RMS).
 fn deviation(mesh: &ControlMesh, patch: SinglePassPatch) -> (f64, f64, f64, usize, usize) {
-    let plan = plan_single_pass(
-        mesh,
-        &SinglePassOptions {
-            patch,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let opts = SinglePassOptions {
+        patch,
+        ..Default::default()
+    };
+    deviation_of(mesh, &opts, |_| true)
+}
+
+/// [`deviation`] of the plan of `opts`, over the patches whose base face passes `keep`.
+fn deviation_of(
+    mesh: &ControlMesh,
+    opts: &SinglePassOptions,
+    keep: impl Fn(usize) -> bool,
+) -> (f64, f64, f64, usize, usize) {
+    let plan = plan_single_pass(mesh, opts).unwrap();
     let exact = LocalMesh::from_control_mesh(mesh, LimitScheme::CatmullClark).unwrap();
     let verts = plan.apply(&mesh.positions);
     let d = diag(mesh);
     let (mut reg, mut max, mut sq, mut n) = (0.0f64, 0.0f64, 0.0f64, 0usize);
     for (pi, p) in plan.patches.iter().enumerate() {
+        if !keep(p.base_face as usize) {
+            continue;
+        }
         let quad = mesh.face(p.base_face as usize).len() == 4;
         for a in 0..9 {
             for b in 0..9 {
                 let (u, v) = (a as f64 / 8.0, b as f64 / 8.0);
-                let (s, t) = (p.origin[0] + p.size * u, p.origin[1] + p.size * v);
+                if p.corners() == 3 && a + b > 8 {
+                    continue;
+                }
+                let (sub, s, t) = p.base_param(u, v);
                 let e = if quad {
                     exact.evaluate(p.base_face as usize, s, t)
                 } else {
-                    exact.evaluate_subface(p.base_face as usize, p.sub_face as usize, s, t)
+                    exact.evaluate_subface(p.base_face as usize, sub as usize, s, t)
                 }
                 .unwrap()
                 .position;
@@ -138,6 +151,52 @@ fn deviation_from_the_exact_limit() {
     }
 }
 
+/// Gregory triangle patches (one per triangle) against the same triangles split into three
+/// quad patches, on the triangles of every shape that has some: within a few percent of the
+/// exact limit, as the quad patches are. Prints the table of docs/approximations.md.
+#[test]
+fn gregory_triangles_against_split_triangles() {
+    println!("| shape | triangles | triangle patches: max | RMS | split into 3 quads: max | RMS |");
+    let mut measured = 0;
+    for (name, mesh) in shapes() {
+        let triangles: Vec<bool> = (0..mesh.num_faces())
+            .map(|f| mesh.face(f).len() == 3 && !mesh.holes.contains(&(f as u32)))
+            .collect();
+        let count = triangles.iter().filter(|&&t| t).count();
+        if count == 0 {
+            continue;
+        }
+        let keep = |f: usize| triangles[f];
+        let tri = SinglePassOptions::default();
+        let split = SinglePassOptions {
+            gregory_triangles: false,
+            ..Default::default()
+        };
+        let (_, tm, trms, n, _) = deviation_of(&mesh, &tri, keep);
+        let (_, sm, srms, _, _) = deviation_of(&mesh, &split, keep);
+        println!("| {name} | {count} | {tm:.2e} | {trms:.2e} | {sm:.2e} | {srms:.2e} |");
+        let plan = plan_single_pass(&mesh, &tri).unwrap();
+        let patches = plan
+            .patches
+            .iter()
+            .filter(|p| p.kind == PatchKind::GregoryTriangle)
+            .count();
+        assert_eq!(
+            patches, count,
+            "{name}: one patch per triangle ({n} patches)"
+        );
+        // Rounded semi-sharp creases cost the same on both (catmark_pyramid_creases1: 5.3 %).
+        let finite = |s: f32| s > 0.0 && s < 10.0;
+        let semi = mesh.creases.iter().any(|c| finite(c.sharpness))
+            || mesh.corners.iter().any(|c| finite(c.sharpness));
+        assert!(tm < if semi { 0.25 } else { 0.05 }, "{name}: {tm:e}");
+        // No worse than the split where it matters most: the maximum.
+        assert!(tm <= 5.0 * sm, "{name}: {tm:e} against {sm:e} split");
+        measured += 1;
+    }
+    assert!(measured > 0, "no shape with triangles");
+}
+
 /// Shared edges are one canonical curve: two patches on either side of an edge evaluate the
 /// same points there (checked on the CPU at the curve's parameter; bits are the GPU's job).
 #[test]
@@ -146,16 +205,11 @@ fn curves_interpolate_patch_corners() {
         let plan = plan_single_pass(&mesh, &SinglePassOptions::default()).unwrap();
         let verts = plan.apply(&mesh.positions);
         for (pi, p) in plan.patches.iter().enumerate() {
-            for e in 0..4 {
+            for e in 0..p.corners() {
                 for t in [0.0, 0.3, 1.0] {
                     let (c, _) = plan.edge_sample(&verts, pi, e, t);
-                    let uv = match e {
-                        0 => (t, 0.0),
-                        1 => (1.0, t),
-                        2 => (1.0 - t, 1.0),
-                        _ => (0.0, 1.0 - t),
-                    };
-                    let q = plan.evaluate(&verts, pi, uv.0, uv.1).position;
+                    let [u, v] = edge_param(p.corners(), e, t);
+                    let q = plan.evaluate(&verts, pi, u, v).position;
                     // The patch's own edge and its canonical curve: equal at the ends, close
                     // between (a non-owner's boundary may differ from the owner's curve by
                     // the approximation only).

@@ -104,8 +104,31 @@ pub(super) fn assemble(
     mut levels: Vec<Lvl>,
     caps_from: usize,
     acc: bool,
+    triangles: bool,
 ) -> Result<AdaptivePlan, TopologyError> {
     let iso = caps_from;
+    // Single-pass plans: level-0 triangles drawn as one Gregory triangle patch each. They are
+    // selected (so level 1 holds their corners' complete all-quad rings, where their points
+    // are built) but their children make no patches.
+    let tri: Vec<bool> = {
+        let l0 = &levels[0];
+        (0..l0.t().num_faces())
+            .map(|f| {
+                triangles
+                    && levels.len() > 1
+                    && l0.t().face_vertices(f).len() == 3
+                    && l0.selected[f]
+                    && !l0.hole[f]
+            })
+            .collect()
+    };
+    let tri_child = |l: usize, f: usize| -> bool {
+        l == 1
+            && levels[1]
+                .maps
+                .as_ref()
+                .is_some_and(|m| tri[m.child_face_parent[f] as usize])
+    };
     let last = levels.last().expect("levels");
     let first_local = last.base + last.t().num_vertices() as u32;
     let mut locals = Locals {
@@ -127,13 +150,19 @@ pub(super) fn assemble(
         // End caps from the isolation level on (deeper levels follow semi-sharp features).
         let is_last = l >= iso;
         let candidates: Vec<usize> = (0..lvl.t().num_faces())
-            .filter(|&f| lvl.complete[f] && !lvl.hole[f] && !lvl.selected[f])
+            .filter(|&f| {
+                (lvl.complete[f] && !lvl.hole[f] && !lvl.selected[f] && !tri_child(l, f))
+                    || (l == 0 && tri[f])
+            })
             .collect();
         // An indexed collect writes the drafts in place (no per-face option, no list merge).
         let found: Vec<Result<Draft, TopologyError>> = candidates
             .into_par_iter()
             .with_min_len(256)
             .map(|f| {
+                if l == 0 && tri[f] {
+                    return triangle_draft(mesh, &levels, f);
+                }
                 let irregular = lvl
                     .t()
                     .face_vertices(f)
@@ -231,8 +260,9 @@ pub(super) fn assemble(
                 }
             }
         } else if let Some(g) = &d.gregory {
+            let corners = d.kind.corners();
             for (k, row) in g.iter().enumerate() {
-                if k < 20 && k % 5 == 0 {
+                if k < 5 * corners && k % 5 == 0 {
                     // P: the canonical corner, filled below.
                     cps.push(INVALID);
                 } else {
@@ -281,20 +311,50 @@ pub(super) fn assemble(
     let mut corner_owners: Vec<[u32; 2]> = Vec::new();
     for (pi, (d, patch)) in drafts.iter().zip(patches.iter_mut()).enumerate() {
         let lvl = &levels[d.level as usize];
-        let (fv, _) = rotated(lvl.t(), d.face as usize, d.shift);
-        let mut ids = [0u32; 4];
-        for (p, &v) in fv.iter().enumerate() {
+        let (fv, _, n) = draft_corners(lvl, d);
+        let mut ids = [INVALID; 4];
+        for (p, &v) in fv[..n].iter().enumerate() {
             let key = lvl.anc[v as usize] as usize;
             if canon[key] == INVALID {
                 canon[key] = first_canon + needed.len() as u32;
-                needed.push((d.level, v));
+                if d.kind == PatchKind::GregoryTriangle {
+                    // The limit mask needs an all-quad ring: the vertex's child's, at level 1.
+                    let maps = levels[1]
+                        .maps
+                        .as_ref()
+                        .expect("level 1 under a triangle patch");
+                    needed.push((1, maps.vertex_child_vertex[v as usize]));
+                } else {
+                    needed.push((d.level, v));
+                }
                 corner_owners.push([pi as u32, p as u32]);
             }
             ids[p] = canon[key];
             match patch.kind {
-                PatchKind::Gregory => patch.control_points[5 * p] = ids[p],
+                PatchKind::Gregory | PatchKind::GregoryTriangle => {
+                    patch.control_points[5 * p] = ids[p]
+                }
                 PatchKind::Bilinear => patch.control_points[p] = ids[p],
                 PatchKind::Regular => {}
+            }
+        }
+        if d.kind == PatchKind::GregoryTriangle {
+            // Its edges are level-1 halves (see `triangle_draft`): the edge midpoints are
+            // canonical corners too; a triangle owning one says so by corner index 4 + edge.
+            let (_, fe, _) = draft_corners(lvl, d);
+            let l1 = &levels[1];
+            let maps = l1.maps.as_ref().expect("level 1 under a triangle patch");
+            for (p, &e) in fe[..3].iter().enumerate() {
+                let m = maps.edge_child_vertex[e as usize];
+                if m == INVALID {
+                    continue;
+                }
+                let key = l1.anc[m as usize] as usize;
+                if canon[key] == INVALID {
+                    canon[key] = first_canon + needed.len() as u32;
+                    needed.push((1, m));
+                    corner_owners.push([pi as u32, 4 + p as u32]);
+                }
             }
         }
         corners.push(ids);
@@ -359,18 +419,23 @@ pub(super) fn assemble(
         let l = d.level as usize;
         let lvl = &levels[l];
         let t = lvl.t();
-        let (fv, fe) = rotated(t, d.face as usize, d.shift);
+        let (fv, fe, n) = draft_corners(lvl, d);
         let rank = kind_rank(d.kind);
         let unbalanced = || TopologyError::AdaptiveUnbalanced {
             level: l as u32,
             face: d.face as usize,
         };
-        for p in 0..4 {
+        for p in 0..n {
             let e = fe[p];
-            let (a, b) = (fv[p], fv[(p + 1) % 4]);
+            let (a, b) = (fv[p], fv[(p + 1) % n]);
             let [x, y] = t.edge_faces(e as usize);
             let g = if x == d.face { y } else { x };
-            let kind = if g == INVALID || lvl.hole[g as usize] {
+            let kind = if d.kind == PatchKind::GregoryTriangle {
+                // Every edge of a triangle patch is the two level-1 curves of its children's
+                // Gregory points (a finer neighbour's, or its own on a boundary or next to
+                // another triangle): through the exact limit at the edge's midpoint.
+                EdgeKind::Coarse
+            } else if g == INVALID || lvl.hole[g as usize] {
                 EdgeKind::Plain
             } else if lvl.complete[g as usize] {
                 if lvl.selected[g as usize] {
@@ -508,11 +573,12 @@ pub(super) fn assemble(
         .zip(&curves)
         .map(|(&(_, pi, p, part), c)| {
             let ids = corners[pi as usize];
+            let n = patches[pi as usize].corners();
             let p = p as usize;
             // The segment runs in the patch's edge direction from `start_id`; for a second half,
             // the midpoint: whichever end of the curve is not the patch corner.
             let start_id = if part == 2 {
-                if c[0] == ids[(p + 1) % 4] {
+                if c[0] == ids[(p + 1) % n] {
                     c[3]
                 } else {
                     c[0]
@@ -525,6 +591,7 @@ pub(super) fn assemble(
                 edge: p as u8,
                 part,
                 forward: start_id == c[0],
+                triangle: n == 3,
             }
         })
         .collect();
@@ -553,17 +620,24 @@ pub(super) fn assemble(
                                 }
                             }
                         }
-                        PatchKind::Gregory | PatchKind::Bilinear => {
+                        PatchKind::Gregory | PatchKind::GregoryTriangle | PatchKind::Bilinear => {
                             // The owner's whole edge as Bézier points `[P, Ep, Em, P']`, or the
                             // half of it (de Casteljau) when the owner is the coarse side.
                             let cp = &patch.control_points;
-                            let (c0, c3) = (ids[p], ids[(p + 1) % 4]);
-                            let whole: [[(u32, f64); 2]; 4] = if patch.kind == PatchKind::Gregory
-                            {
+                            let n = patch.corners();
+                            let (c0, c3) = (ids[p], ids[(p + 1) % n]);
+                            if patch.kind == PatchKind::GregoryTriangle && part != 0 {
+                                // The half's own inner points (`triangle_draft`).
+                                let id = cp[15 + 4 * p + 2 * (part - 1) + (k - 1)];
+                                locals.expand(id, 1.0, &mut scratch);
+                                push_row(&mut table, &mut scratch);
+                                continue;
+                            }
+                            let whole: [[(u32, f64); 2]; 4] = if patch.kind != PatchKind::Bilinear {
                                 [
                                     [(c0, 1.0), (c0, 0.0)],
                                     [(cp[5 * p + 1], 1.0), (c0, 0.0)],
-                                    [(cp[5 * ((p + 1) % 4) + 2], 1.0), (c0, 0.0)],
+                                    [(cp[5 * ((p + 1) % n) + 2], 1.0), (c0, 0.0)],
                                     [(c3, 1.0), (c0, 0.0)],
                                 ]
                             } else {
@@ -660,6 +734,105 @@ pub(super) fn assemble(
         corner_owners,
         level_stats,
         isolation: opts.isolation,
+    })
+}
+
+/// The corners and edges of a draft's face in patch order, and how many (3 for a triangle
+/// patch, whose face is never rotated).
+fn draft_corners(lvl: &Lvl, d: &Draft) -> ([u32; 4], [u32; 4], usize) {
+    if d.kind == PatchKind::GregoryTriangle {
+        let t = lvl.t();
+        let (fv, fe) = (
+            t.face_vertices(d.face as usize),
+            t.face_edge_list(d.face as usize),
+        );
+        let pad = |x: &[u32]| [x[0], x[1], x[2], INVALID];
+        return (pad(fv), pad(fe), 3);
+    }
+    let (fv, fe) = rotated(lvl.t(), d.face as usize, d.shift);
+    (fv, fe, 4)
+}
+
+/// The Gregory triangle patch of level-0 triangle `f` ([`crate::gregory::gregory_triangle_from_children`]
+/// over its three level-1 children).
+fn triangle_draft(mesh: &ControlMesh, levels: &[Lvl], f: usize) -> Result<Draft, TopologyError> {
+    let l1 = &levels[1];
+    let maps = l1
+        .maps
+        .as_ref()
+        .ok_or(TopologyError::AdaptivePatch { level: 0, face: f })?;
+    let first = maps.face_first_child[f];
+    if first == INVALID {
+        return Err(TopologyError::AdaptivePatch { level: 0, face: f });
+    }
+    let basis: Vec<[crate::gregory::Stencil; 20]> = (0..3)
+        .map(|k| crate::gregory::gregory_basis(l1.topo.view(), first as usize + k, &mesh.options))
+        .collect::<Result<_, _>>()?;
+    let mut points =
+        crate::gregory::gregory_triangle_from_children([&basis[0], &basis[1], &basis[2]]);
+    // Per edge p (corner p to p + 1), the inner points of its two level-1 halves in the edge's
+    // direction: child p's `Ep` at the corner and `Em` at the edge midpoint (its corner 1),
+    // then child p + 1's `Ep` at the midpoint (its corner 3) and `Em` at the corner.
+    let halves: Vec<&crate::gregory::Stencil> = (0..3)
+        .flat_map(|p| {
+            let (a, b) = (&basis[p], &basis[(p + 1) % 3]);
+            [&a[1], &a[5 + 2], &b[15 + 1], &b[2]]
+        })
+        .collect();
+    // Centre: the patch passes through the limit point of the triangle's face point (the
+    // centroid of the domain is that point's parameter, [`AdaptivePatch::base_param`]).
+    let fc = maps.face_child_vertex[f];
+    let edges = levels[0].t().face_edge_list(f);
+    let ec: Vec<u32> = edges
+        .iter()
+        .map(|&e| maps.edge_child_vertex[e as usize])
+        .collect();
+    if fc != INVALID && !ec.contains(&INVALID) {
+        let mut cache = Vec::new();
+        let mut limit = |v: u32| {
+            let mut out = Vec::new();
+            limit_stencil(l1, v as usize, &mut cache, &mut out);
+            out
+        };
+        let centre = limit(fc);
+        let mids = [limit(ec[0]), limit(ec[1]), limit(ec[2])];
+        crate::gregory::gregory_triangle_through_centre(
+            &mut points,
+            &centre,
+            [&mids[0], &mids[1], &mids[2]],
+        );
+    }
+    let mut boundary_mask = 0u8;
+    for (p, &e) in levels[0].t().face_edge_list(f).iter().enumerate() {
+        if levels[0].sharp_edge(e as usize) {
+            boundary_mask |= 1 << p;
+        }
+    }
+    Ok(Draft {
+        level: 0,
+        face: f as u32,
+        shift: 0,
+        kind: PatchKind::GregoryTriangle,
+        acc: false,
+        boundary_mask,
+        grid: None,
+        gregory: Some(
+            points
+                .iter()
+                .chain(halves)
+                .map(|st| {
+                    st.indices
+                        .iter()
+                        .zip(&st.weights)
+                        .map(|(&i, &w)| (i + l1.base, w))
+                        .collect()
+                })
+                .collect(),
+        ),
+        base_face: f as u32,
+        sub_face: 0,
+        origin: [0.0, 0.0],
+        size: 1.0,
     })
 }
 
@@ -774,7 +947,11 @@ mod tests {
         let first = plan.local_points.first_vertex;
         let mut terms = 0u64;
         let mut patches = 0u64;
-        for p in plan.patches.iter().filter(|p| p.kind == PatchKind::Gregory) {
+        for p in plan
+            .patches
+            .iter()
+            .filter(|p| matches!(p.kind, PatchKind::Gregory | PatchKind::GregoryTriangle))
+        {
             patches += 1;
             for &id in &p.control_points {
                 terms += if id >= first {
@@ -813,8 +990,20 @@ mod tests {
             let levels =
                 levels::build_levels(&mesh, 1, false, MAX_REFINED_FACES, true).expect("levels");
             let (patches, estimate) = project_gregory_terms(&levels, 0);
-            let plan = single_pass::plan_single_pass(&mesh, &Default::default()).expect("plan");
+            // The projection counts a triangle's three level-1 quads, as split triangles are.
+            let split = single_pass::SinglePassOptions {
+                gregory_triangles: false,
+                ..Default::default()
+            };
+            let plan = single_pass::plan_single_pass(&mesh, &split).expect("plan");
             let (built_patches, built) = built_gregory_terms(&plan);
+            // Gregory triangle patches: fewer patches and no more terms than projected.
+            let tri = single_pass::plan_single_pass(&mesh, &Default::default()).expect("plan");
+            let (tri_patches, tri_built) = built_gregory_terms(&tri);
+            assert!(
+                tri_patches < patches && tri_built <= estimate,
+                "{name}: {tri_built} terms"
+            );
             assert_eq!(patches, built_patches, "{name}");
             let ratio = estimate as f64 / built as f64;
             eprintln!(

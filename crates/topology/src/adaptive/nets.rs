@@ -424,7 +424,7 @@ pub(super) const HALF_RANK: u8 = 8;
 pub(super) fn kind_rank(k: PatchKind) -> u8 {
     match k {
         PatchKind::Regular => 0,
-        PatchKind::Gregory => 1,
+        PatchKind::Gregory | PatchKind::GregoryTriangle => 1,
         PatchKind::Bilinear => 2,
     }
 }

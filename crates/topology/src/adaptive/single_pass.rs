@@ -52,6 +52,9 @@ pub struct SinglePassOptions {
     pub patch: SinglePassPatch,
     /// Multiplies every tagged sharpness before the rounding (finite, ≥ 0).
     pub sharpness_scale: f32,
+    /// Triangles as one Gregory triangle patch each (default); off, as three quad patches of
+    /// their level-1 children.
+    pub gregory_triangles: bool,
 }
 
 impl Default for SinglePassOptions {
@@ -59,6 +62,7 @@ impl Default for SinglePassOptions {
         SinglePassOptions {
             patch: SinglePassPatch::Gregory,
             sharpness_scale: 1.0,
+            gregory_triangles: true,
         }
     }
 }
@@ -121,6 +125,7 @@ pub fn plan_single_pass(
         levels,
         0,
         opts.patch == SinglePassPatch::Acc1,
+        opts.gregory_triangles,
     )?;
     plan.isolation = u32::from(split);
     Ok(plan)
