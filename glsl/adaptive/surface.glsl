@@ -152,6 +152,70 @@ vec3 acc_tangent_normal(vec3 c[28], uint valences, vec2 uv) {
     return safe_normalize(cross(du, dv), vec3(0.0, 0.0, 1.0));
 }
 
+// (a F + b G) / (a + b) and its derivatives by a and by b (the mean, 0 where a + b vanishes).
+void tri_blend(float a, float b, vec3 f, vec3 g, out vec3 x, out vec3 dx_da, out vec3 dx_db) {
+    precise float d = a + b;
+    if (d < 1e-7) {
+        x = 0.5 * (f + g);
+        dx_da = vec3(0.0);
+        dx_db = vec3(0.0);
+        return;
+    }
+    precise vec3 r = (a * f + b * g) / d;
+    x = r;
+    dx_da = b * (f - g) / (d * d);
+    dx_db = a * (g - f) / (d * d);
+}
+
+float ipow(float x, int n) {
+    float r = 1.0;
+    for (int k = 0; k < n; ++k) r *= x;
+    return r;
+}
+
+// Quartic triangle Bezier points b_ijk (weights of corners 0, 1, 2 to the powers i, j, k) in
+// the order gregory_triangle fills them, and their multinomial coefficients.
+const ivec3 TRI_IJK[15] = ivec3[15](ivec3(4, 0, 0), ivec3(0, 4, 0), ivec3(0, 0, 4),
+    ivec3(3, 1, 0), ivec3(2, 2, 0), ivec3(1, 3, 0), ivec3(0, 3, 1), ivec3(0, 2, 2), ivec3(0, 1, 3),
+    ivec3(1, 0, 3), ivec3(2, 0, 2), ivec3(3, 0, 1), ivec3(2, 1, 1), ivec3(1, 2, 1), ivec3(1, 1, 2));
+const float TRI_COEF[15] = float[15](1.0, 1.0, 1.0, 4.0, 6.0, 4.0, 4.0, 6.0, 4.0, 4.0, 6.0, 4.0, 12.0, 12.0, 12.0);
+
+// Gregory triangle patch (topology::gregory::gregory_triangle_weights): 15 points, per corner
+// P, Ep, Em, Fp, Fm; the cubic boundary degree-elevated, interior points blended. `precise`:
+// owners are evaluated by every TES and must agree in bits.
+void gregory_triangle(vec3 c[15], vec2 uv, out vec3 pos, out vec3 du, out vec3 dv) {
+    float l0 = 1.0 - uv.x - uv.y, l1 = uv.x, l2 = uv.y;
+    vec3 b[15], bu[15], bv[15];
+    for (int k = 0; k < 15; ++k) { bu[k] = vec3(0.0); bv[k] = vec3(0.0); }
+    b[0] = c[0]; b[1] = c[5]; b[2] = c[10];
+    b[3] = 0.25 * c[0] + 0.75 * c[1];  b[4] = 0.5 * (c[1] + c[7]);   b[5] = 0.75 * c[7] + 0.25 * c[5];
+    b[6] = 0.25 * c[5] + 0.75 * c[6];  b[7] = 0.5 * (c[6] + c[12]);  b[8] = 0.75 * c[12] + 0.25 * c[10];
+    b[9] = 0.25 * c[10] + 0.75 * c[11]; b[10] = 0.5 * (c[11] + c[2]); b[11] = 0.75 * c[2] + 0.25 * c[0];
+    vec3 da, db;
+    // b211 = (l1 Fp0 + l2 Fm0) / (l1 + l2); l1 = u, l2 = v.
+    tri_blend(l1, l2, c[3], c[4], b[12], da, db);
+    bu[12] = da; bv[12] = db;
+    // b121 = (l2 Fp1 + l0 Fm1) / (l2 + l0).
+    tri_blend(l2, l0, c[8], c[9], b[13], da, db);
+    bu[13] = -db; bv[13] = da - db;
+    // b112 = (l0 Fp2 + l1 Fm2) / (l0 + l1).
+    tri_blend(l0, l1, c[13], c[14], b[14], da, db);
+    bu[14] = db - da; bv[14] = -da;
+    precise vec3 p = vec3(0.0), pu = vec3(0.0), pv = vec3(0.0);
+    for (int k = 0; k < 15; ++k) {
+        ivec3 e = TRI_IJK[k];
+        float a0 = ipow(l0, e.x), a1 = ipow(l1, e.y), a2 = ipow(l2, e.z);
+        float w = TRI_COEF[k] * a0 * a1 * a2;
+        float d0 = e.x > 0 ? TRI_COEF[k] * float(e.x) * ipow(l0, e.x - 1) * a1 * a2 : 0.0;
+        float d1 = e.y > 0 ? TRI_COEF[k] * float(e.y) * a0 * ipow(l1, e.y - 1) * a2 : 0.0;
+        float d2 = e.z > 0 ? TRI_COEF[k] * float(e.z) * a0 * a1 * ipow(l2, e.z - 1) : 0.0;
+        p += w * b[k];
+        pu += (d1 - d0) * b[k] + w * bu[k];
+        pv += (d2 - d0) * b[k] + w * bv[k];
+    }
+    pos = p; du = pu; dv = pv;
+}
+
 // The owner evaluation: the normal of patch `id` at `uv`, from the global vertex buffer, one
 // operand order, `precise` (every TES that includes this gets the same bits).
 vec3 owner_normal(uint id, vec2 uv) {
@@ -176,6 +240,14 @@ vec3 owner_normal(uint id, vec2 uv) {
                 du += (du_w[i] * bv[j]) * c;
                 dv += (bu[i] * dv_w[j]) * c;
             }
+    } else if (kind == ADAPTIVE_KIND_GREGORY_TRIANGLE) {
+        // Owners are evaluated on their edges (all of a triangle's are on level-1 halves, which
+        // it owns only where its own boundary is those halves) and corners, where the boundary
+        // correction of gregory_tri.tese vanishes with its derivatives: the quartic alone.
+        vec3 c[15];
+        for (uint k = 0u; k < 15u; ++k) c[k] = vtx(control_points[p.cp_offset + k]);
+        vec3 pos;
+        gregory_triangle(c, uv, pos, du, dv);
     } else if (kind == ADAPTIVE_KIND_GREGORY) {
         vec3 c[20];
         for (uint k = 0u; k < 20u; ++k) c[k] = vtx(control_points[p.cp_offset + k]);
@@ -218,6 +290,13 @@ vec2 owner_param(CurveOwner o, float s) {
     bool forward = ((o.info >> 4) & 1u) != 0u;
     precise float e = forward ? s : 1.0 - s;
     precise float t = part == 1u ? 0.5 * e : (part == 2u ? 0.5 + 0.5 * e : e);
+    if (((o.info >> 5) & 1u) != 0u) {
+        // Triangle: (0,0) -> (1,0) -> (0,1) -> (0,0).
+        precise float r = 1.0 - t;
+        if (edge == 0u) return vec2(t, 0.0);
+        if (edge == 1u) return vec2(r, t);
+        return vec2(0.0, r);
+    }
     if (edge == 0u) return vec2(t, 0.0);
     if (edge == 1u) return vec2(1.0, t);
     if (edge == 2u) return vec2(1.0 - t, 1.0);
@@ -225,6 +304,9 @@ vec2 owner_param(CurveOwner o, float s) {
 }
 
 const vec2 CORNER_PARAMS[4] = vec2[4](vec2(0.0, 0.0), vec2(1.0, 0.0), vec2(1.0, 1.0), vec2(0.0, 1.0));
+// A triangle owner's corners 0..2, then (4 + e) the midpoint of its edge e.
+const vec2 TRIANGLE_CORNER_PARAMS[7] = vec2[7](vec2(0.0, 0.0), vec2(1.0, 0.0), vec2(0.0, 1.0),
+    vec2(0.0, 0.0), vec2(0.5, 0.0), vec2(0.5, 0.5), vec2(0.0, 0.5));
 
 // A boundary vertex at curve `curve`, parameter `s`, displaced by its owner (see above); `pos`
 // is the canonical point.
@@ -253,7 +335,7 @@ vec3 displace_canonical(vec3 pos, uint curve, float s) {
         uint v = s == 0.0 ? curves[curve].x : curves[curve].w;
         uvec2 o = corner_owners[v - adaptive.first_corner];
         owner = o.x;
-        ouv = CORNER_PARAMS[o.y & 3u];
+        ouv = patch_kind(patches[owner]) == ADAPTIVE_KIND_GREGORY_TRIANGLE ? TRIANGLE_CORNER_PARAMS[min(o.y, 6u)] : CORNER_PARAMS[o.y & 3u];
     } else {
         CurveOwner o = curve_owners[curve];
         owner = o.patch_id;

@@ -14,14 +14,20 @@ layout(location = 6) out vec2 out_texcoord;
 vec3 patch_shading_normal(uint id, vec2 uv, vec3 n);
 #endif
 
-// Regular, Gregory, bilinear.
-const vec3 KIND_COLOURS[3] = vec3[3](vec3(0.45, 0.65, 0.95), vec3(0.95, 0.45, 0.35), vec3(0.95, 0.8, 0.3));
+// Regular, Gregory, bilinear, Gregory triangle.
+const vec3 KIND_COLOURS[4] = vec3[4](vec3(0.45, 0.65, 0.95), vec3(0.95, 0.45, 0.35), vec3(0.95, 0.8, 0.3), vec3(0.75, 0.4, 0.85));
 
 void main() {
     vec2 uv = gl_TessCoord.xy;
     vec3 pos, du, dv;
     evaluate(tc_patch, uv, pos, du, dv);
+#ifdef TRIANGLE_DOMAIN
+    // gl_TessCoord = (u, v, 1 - u - v): the weights of patch corners 1, 2, 0.
+    float w0 = gl_TessCoord.z;
+    bool canonical = uv.x == 0.0 || uv.y == 0.0 || w0 == 0.0;
+#else
     bool canonical = uv.x == 0.0 || uv.x == 1.0 || uv.y == 0.0 || uv.y == 1.0;
+#endif
     AdaptivePatch p;
     if (canonical) p = patches[tc_patch];
     // Patch edge e and the parameter along it (edges run v0 -> v1 -> v2 -> v3 -> v0);
@@ -29,6 +35,16 @@ void main() {
     // point, the same global vertex.
     uint curve = 0u;
     float s = 0.0;
+#ifdef TRIANGLE_DOMAIN
+    // Every triangle edge is a transition edge (two level-1 halves): integer levels.
+    if (uv.y == 0.0) {
+        pos = canonical_edge_point(p, 0u, uv.x, gl_TessLevelOuter[1], true, curve, s);
+    } else if (w0 == 0.0) {
+        pos = canonical_edge_point(p, 1u, uv.y, gl_TessLevelOuter[2], true, curve, s);
+    } else if (uv.x == 0.0) {
+        pos = canonical_edge_point(p, 2u, w0, gl_TessLevelOuter[0], true, curve, s);
+    }
+#else
     if (uv.y == 0.0) {
         pos = canonical_edge_point(p, 0u, uv.x, gl_TessLevelOuter[1], !fractional_factors() || edge_kind(p, 0u) != ADAPTIVE_EDGE_PLAIN, curve, s);
     } else if (uv.x == 1.0) {
@@ -38,6 +54,7 @@ void main() {
     } else if (uv.x == 0.0) {
         pos = canonical_edge_point(p, 3u, 1.0 - uv.y, gl_TessLevelOuter[0], !fractional_factors() || edge_kind(p, 3u) != ADAPTIVE_EDGE_PLAIN, curve, s);
     }
+#endif
     vec3 n = safe_normalize(cross(du, dv), vec3(0.0, 0.0, 1.0));
 #ifdef PATCH_SHADING_NORMAL
     n = patch_shading_normal(tc_patch, uv, n);
@@ -68,7 +85,7 @@ void main() {
     } else if ((adaptive.options & uint(ADAPTIVE_OPTION_PATCH_COLOURS)) != 0u) {
         // Odd levels lighter, even levels darker, a little lighter with depth: adjacent
         // levels always differ.
-        albedo = KIND_COLOURS[min(kind, 2u)] * ((level & 1u) == 1u ? 1.0 : 0.62);
+        albedo = KIND_COLOURS[min(kind, 3u)] * ((level & 1u) == 1u ? 1.0 : 0.62);
         albedo = mix(albedo, vec3(1.0), 0.05 * float(level));
         // Transition patches (a finer neighbour) darker, boundary / crease patches greener.
         if (((tc_info >> 12) & 15u) != 0u) albedo *= 0.7;

@@ -77,6 +77,8 @@ pub enum PatchType {
     Gregory,
     /// A bilinear (Coons) end cap over its four canonical boundary curves.
     Bilinear,
+    /// A Gregory triangle patch (15 control points fetched by the control stage).
+    GregoryTriangle,
 }
 
 impl PatchType {
@@ -85,7 +87,9 @@ impl PatchType {
             PatchType::Quad | PatchType::BSpline | PatchType::Gregory | PatchType::Bilinear => {
                 Domain::Quad
             }
-            PatchType::Triangle | PatchType::LoopBft => Domain::Triangle,
+            PatchType::Triangle | PatchType::LoopBft | PatchType::GregoryTriangle => {
+                Domain::Triangle
+            }
         }
     }
 }
@@ -265,6 +269,8 @@ pub struct Features {
     pub isolation: bool,
     /// Texture coordinates: colour texture, reparameterization, displacement.
     pub surface: bool,
+    /// One patch per base face (gregory, acc): triangles as Gregory triangle patches or split.
+    pub single_pass: bool,
 }
 
 impl Features {

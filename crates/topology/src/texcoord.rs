@@ -116,8 +116,24 @@ pub fn bilinear(c: &[[f64; 2]; 4], u: f64, v: f64) -> [f64; 2] {
     out
 }
 
-/// The texture coordinates at a plan patch's four corners (patch corner order).
+/// The texture coordinates at a plan patch's four corners (patch corner order). A triangle
+/// patch (corners `t0, t1, t2` at (0,0), (1,0), (0,1)) gets `[t0, t1, t1 + t2 − t0, t2]`: the
+/// bilinear blend of that parallelogram is the linear interpolation on the triangle, which is
+/// what the bilinear sub-quads give there (see [`crate::adaptive::triangle_subquad_param`]).
 pub fn patch_corners(mesh: &ControlMesh, patch: &AdaptivePatch) -> Option<[[f64; 2]; 4]> {
+    if patch.corners() == 3 {
+        if !has_texcoords(mesh) {
+            return None;
+        }
+        let f = patch.base_face as usize;
+        let uvs = mesh.uvs.as_ref()?;
+        let t = uvs.get(mesh.face_offsets[f] as usize..mesh.face_offsets[f + 1] as usize)?;
+        if t.len() != 3 {
+            return None;
+        }
+        let fourth = [t[1][0] + t[2][0] - t[0][0], t[1][1] + t[2][1] - t[0][1]];
+        return Some([t[0], t[1], fourth, t[2]]);
+    }
     let face = subface_corners(mesh, patch.base_face as usize, patch.sub_face as usize)?;
     let [u0, v0] = patch.origin;
     let h = patch.size;
@@ -231,6 +247,9 @@ pub fn param_error_lattice(
             let lattice: Vec<[f64; 2]> = (0..side * side)
                 .map(|k| [(k % side) as f64 * step, (k / side) as f64 * step])
                 .collect();
+            if patch.corners() == 3 {
+                return triangle_lattice(&exact, plan, &verts, index, &lattice, diag);
+            }
             let base = |st: [f64; 2]| {
                 [
                     (patch.origin[0] + patch.size * st[0]).clamp(0.0, 1.0),
@@ -273,6 +292,35 @@ pub fn param_error_lattice(
         reparameterized: per_patch.iter().filter(|p| p.1).count(),
         errors: per_patch.into_iter().flat_map(|p| p.0).collect(),
     })
+}
+
+/// [`param_error_lattice`] of a triangle patch (identity parameterization, so both halves are
+/// equal): lattice points past the diagonal `u + v = 1` take the value of their projection
+/// onto it (the GPU's bilinear look-up reads them next to the diagonal).
+fn triangle_lattice(
+    exact: &LocalMesh,
+    plan: &AdaptivePlan,
+    verts: &[[f64; 3]],
+    index: usize,
+    lattice: &[[f64; 2]],
+    diag: f64,
+) -> Result<(Vec<f32>, bool), EvalError> {
+    let patch = &plan.patches[index];
+    let mut half = Vec::with_capacity(lattice.len());
+    for &[u, v] in lattice {
+        let s = u + v;
+        let (u, v) = if s > 1.0 { (u / s, v / s) } else { (u, v) };
+        let (sub, a, b) = patch.base_param(u, v);
+        let p = exact
+            .evaluate_subface(patch.base_face as usize, sub as usize, a, b)?
+            .position;
+        let g = plan.evaluate(verts, index, u, v).position;
+        let d = (0..3).map(|c| (g[c] - p[c]).powi(2)).sum::<f64>().sqrt();
+        half.push((d / diag) as f32);
+    }
+    let mut out = half.clone();
+    out.extend_from_slice(&half);
+    Ok((out, false))
 }
 
 #[cfg(test)]

@@ -90,6 +90,10 @@ pub struct SurfaceArgs {
     /// Multiplies every crease and corner sharpness (adaptive), without reloading the mesh.
     #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub sharpness_scale: f32,
+    /// Split each triangle into three quad patches (gregory, acc) instead of one Gregory
+    /// triangle patch: closer to the limit, three times the patches.
+    #[arg(long)]
+    pub split_triangles: bool,
     /// Stop semi-sharp creases at the isolation level, their leftover sharpness treated as
     /// infinite there (adaptive; OpenSubdiv's behaviour). By default they are followed until
     /// they decay, so the surface beside them is exact.
@@ -250,6 +254,11 @@ impl SurfaceArgs {
                 feature: |f| f.isolation,
             },
             OptionUse {
+                name: "--split-triangles",
+                given: self.split_triangles,
+                feature: |f| f.single_pass,
+            },
+            OptionUse {
                 name: "--creases-at-isolation",
                 given: self.creases_at_isolation,
                 feature: |f| f.isolation,
@@ -399,6 +408,7 @@ impl SurfaceArgs {
                 end_cap: self.end_cap,
                 sharpness_scale: self.sharpness_scale,
                 follow_semi_sharp: !self.creases_at_isolation,
+                split_triangles: self.split_triangles,
                 maps,
             },
             params,

@@ -137,8 +137,10 @@ gpu_constants! {
     ADAPTIVE_KIND_REGULAR = 0;
     /// Gregory end cap,
     ADAPTIVE_KIND_GREGORY = 1;
-    /// bilinearly blended (Coons) end cap over its four boundary curves.
+    /// bilinearly blended (Coons) end cap over its four boundary curves,
     ADAPTIVE_KIND_BILINEAR = 2;
+    /// Gregory triangle patch (single-pass plans: one per triangle, 15 points, triangle domain).
+    ADAPTIVE_KIND_GREGORY_TRIANGLE = 3;
     /// Edge kinds (2 bits per edge in `AdaptivePatch::edge_info`): same level on both sides,
     ADAPTIVE_EDGE_PLAIN = 0;
     /// this patch is the coarse side of a transition (its factor is doubled),

@@ -378,6 +378,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         Stage::AdaptiveRegularTese,
         Stage::AdaptiveGregoryTese,
         Stage::AdaptiveBilinearTese,
+        Stage::AdaptiveGregoryTriTese,
     ];
     rows.extend([
         (Stage::AdaptiveStencilComp, PLAIN, adaptive_push()),
@@ -385,6 +386,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         (Stage::AdaptivePatchTesc, PLAIN, adaptive_push()),
         (Stage::AdaptiveRegularTesc, PLAIN, adaptive_push()),
         (Stage::AdaptiveGregoryTesc, PLAIN, adaptive_push()),
+        (Stage::AdaptiveGregoryTriTesc, PLAIN, adaptive_push()),
         (Stage::AdaptiveAdaptiveFrag, PLAIN, adaptive_push()),
         (
             Stage::AdaptiveStencilComp,

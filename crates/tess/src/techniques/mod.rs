@@ -38,6 +38,7 @@ const BASE_FACES: Features = Features {
     triangles_only: false,
     isolation: false,
     surface: false,
+    single_pass: false,
 };
 
 static REGISTRY: [TechniqueInfo; 7] = [
@@ -76,6 +77,7 @@ static REGISTRY: [TechniqueInfo; 7] = [
             triangles_only: true,
             isolation: false,
             surface: false,
+            single_pass: false,
         },
         scheme: Some(topology::Scheme::Loop),
     },
@@ -87,7 +89,7 @@ static REGISTRY: [TechniqueInfo; 7] = [
     },
     TechniqueInfo {
         id: TechniqueId::Gregory,
-        help: "Catmull-Clark approximated by one Gregory patch per base face, B-spline where regular (Loop, Schaefer, Ni, Castano); faces next to non-quads split once",
+        help: "Catmull-Clark approximated by one Gregory patch per base face, B-spline where regular (Loop, Schaefer, Ni, Castano), Gregory triangle patches on triangles; other faces next to non-quads split once",
         features: SINGLE_PASS,
         scheme: Some(topology::Scheme::CatmullClark),
     },
@@ -110,11 +112,13 @@ const ADAPTIVE: Features = Features {
     triangles_only: false,
     isolation: true,
     surface: true,
+    single_pass: false,
 };
 
 /// The single-pass approximations: the adaptive machinery without isolation.
 const SINGLE_PASS: Features = Features {
     isolation: false,
+    single_pass: true,
     ..ADAPTIVE
 };
 
@@ -172,6 +176,9 @@ pub struct BuildOptions {
     pub sharpness_scale: f32,
     /// Follow semi-sharp creases past the isolation level until they decay.
     pub follow_semi_sharp: bool,
+    /// Single-pass methods: split triangles into three quad patches instead of one Gregory
+    /// triangle patch each.
+    pub split_triangles: bool,
     /// Colour texture and height map (techniques with [`Features::surface`]).
     pub maps: crate::surface::SurfaceMaps,
 }
@@ -186,6 +193,7 @@ impl Default for BuildOptions {
             end_cap: topology::adaptive::EndCap::Gregory,
             sharpness_scale: 1.0,
             follow_semi_sharp: true,
+            split_triangles: false,
             maps: Default::default(),
         }
     }
@@ -267,6 +275,7 @@ pub fn build(
                         topology::adaptive::single_pass::SinglePassPatch::Gregory
                     },
                     options.sharpness_scale,
+                    !options.split_triangles,
                     &options.name,
                     &options.maps,
                 )?

@@ -14,7 +14,7 @@
 //!   out-of-bounds read on the device.
 use crate::gpu::bindings::{
     ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_FINE, ADAPTIVE_EDGE_PLAIN, ADAPTIVE_KIND_BILINEAR,
-    ADAPTIVE_KIND_GREGORY, ADAPTIVE_KIND_REGULAR,
+    ADAPTIVE_KIND_GREGORY, ADAPTIVE_KIND_GREGORY_TRIANGLE, ADAPTIVE_KIND_REGULAR,
 };
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
@@ -50,7 +50,9 @@ pub struct PatchRecord {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct PatchSurface {
     /// Texture coordinates at corners (0,0), (1,0), (1,1), (0,1): the OBJ's `vt`, or the
-    /// (sub)face parameter when the mesh has none.
+    /// (sub)face parameter when the mesh has none. A triangle patch (corners (0,0), (1,0),
+    /// (0,1)) stores `t1 + t2 − t0` at (1,1): the bilinear blend of that parallelogram is the
+    /// triangle's linear interpolation, so one formula serves both.
     pub uv: [[f32; 2]; 4],
     /// Per corner `i`, 8 bits at `8i`: its row of the reparameterization table (0 = identity).
     pub reparam_rows: u32,
@@ -67,7 +69,8 @@ pub struct PatchSurface {
 pub struct CurveOwner {
     /// Frame-wide patch id.
     pub patch: u32,
-    /// `edge | part << 2 | forward << 4`.
+    /// `edge | part << 2 | forward << 4 | triangle << 5` (a triangle owner's edges run
+    /// `topology::adaptive::edge_param`'s way).
     pub info: u32,
 }
 
@@ -125,6 +128,7 @@ pub fn kind_code(kind: PatchKind) -> u32 {
         PatchKind::Regular => ADAPTIVE_KIND_REGULAR,
         PatchKind::Gregory => ADAPTIVE_KIND_GREGORY,
         PatchKind::Bilinear => ADAPTIVE_KIND_BILINEAR,
+        PatchKind::GregoryTriangle => ADAPTIVE_KIND_GREGORY_TRIANGLE,
     }
 }
 
@@ -134,6 +138,9 @@ pub fn control_point_count(kind: PatchKind) -> usize {
         PatchKind::Regular => 16,
         PatchKind::Gregory => 20,
         PatchKind::Bilinear => 4,
+        // 15 Gregory points, then per edge the inner points of its two level-1 halves (which
+        // the patch owns on a boundary or next to another triangle).
+        PatchKind::GregoryTriangle => 27,
     }
 }
 
@@ -160,7 +167,7 @@ pub struct GpuAdaptive {
     /// Frame-wide patch id → index in the plan's patches.
     pub order: Vec<u32>,
     /// Patches per kind: regular, Gregory, bilinear.
-    pub counts: [u32; 3],
+    pub counts: [u32; 4],
     /// Per curve, its owner patch (frame-wide id).
     pub curve_owners: Vec<CurveOwner>,
     /// Global id of the first canonical corner.
@@ -243,7 +250,7 @@ impl GpuAdaptive {
         }
         let mut order: Vec<u32> = (0..plan.patches.len() as u32).collect();
         order.sort_by_key(|&i| kind_code(plan.patches[i as usize].kind));
-        let mut counts = [0u32; 3];
+        let mut counts = [0u32; 4];
         let mut patches = Vec::with_capacity(order.len());
         let mut control_points = Vec::new();
         let ncurves = plan.curves.len() as u64;
@@ -267,7 +274,8 @@ impl GpuAdaptive {
             }
             let mut edge_info = 0u32;
             let mut curves = [0u32; 8];
-            for (e, edge) in p.edges.iter().enumerate() {
+            // A triangle's fourth edge is unused (record zeros).
+            for (e, edge) in p.edges.iter().enumerate().take(p.corners()) {
                 let bits = edge_code(edge.kind)
                     | (edge.reversed[0] as u32) << 2
                     | (edge.reversed[1] as u32) << 3;
@@ -317,13 +325,17 @@ impl GpuAdaptive {
             check("curve owner part", o.part as u64, 3)?;
             curve_owners.push(CurveOwner {
                 patch: frame_id[o.patch as usize],
-                info: o.edge as u32 | (o.part as u32) << 2 | (o.forward as u32) << 4,
+                info: o.edge as u32
+                    | (o.part as u32) << 2
+                    | (o.forward as u32) << 4
+                    | (o.triangle as u32) << 5,
             });
         }
         let mut corner_owners = Vec::with_capacity(plan.corner_owners.len());
         for &[pi, c] in &plan.corner_owners {
             check("corner owner", pi as u64, order.len() as u64)?;
-            check("corner owner corner", c as u64, 4)?;
+            // Corner 4 + e of a triangle patch: the midpoint of its edge e.
+            check("corner owner corner", c as u64, 8)?;
             corner_owners.push([frame_id[pi as usize], c]);
         }
         // The TES reads `corner_owners[end - first_corner]` at every curve end.
@@ -367,6 +379,10 @@ impl GpuAdaptive {
             .map(|&pi| {
                 let p = &plan.patches[pi as usize];
                 let uv = topology::texcoord::patch_corners(mesh, p).unwrap_or_else(|| {
+                    if p.corners() == 3 {
+                        // Barycentric (u, v) stands in; (1, 1) completes the parallelogram.
+                        return [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+                    }
                     let [u0, v0] = p.origin;
                     let h = p.size;
                     [[u0, v0], [u0 + h, v0], [u0 + h, v0 + h], [u0, v0 + h]]

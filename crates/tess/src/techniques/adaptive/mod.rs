@@ -56,7 +56,9 @@ use crate::technique::{
     PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
 };
 use crate::techniques::bft::{base_positions, bbox};
-use crate::tessellator::{quad_triangle_count, uniform_vertex_count, Domain, Spacing};
+use crate::tessellator::{
+    quad_triangle_count, triangle_triangle_count, uniform_vertex_count, Domain, Spacing,
+};
 use layout::GpuAdaptive;
 use std::ops::Range;
 use topology::adaptive::{plan_adaptive, AdaptiveOptions, AdaptivePlan, EndCap};
@@ -518,11 +520,12 @@ impl Adaptive {
             &layouts,
             std::mem::size_of::<AdaptivePush>() as u32,
         )?;
-        let [regular, gregory, bilinear] = gpu.counts;
+        let [regular, gregory, bilinear, triangles] = gpu.counts;
         let arrays = number_arrays(&[
             (PatchType::BSpline, regular, 1),
             (PatchType::Gregory, gregory, 1),
             (PatchType::Bilinear, bilinear, 1),
+            (PatchType::GregoryTriangle, triangles, 1),
         ]);
         let edge_kinds = arrays
             .iter()
@@ -581,8 +584,8 @@ impl Adaptive {
         (self.steps.len(), self.windows.len())
     }
 
-    /// Patches of each kind: regular, Gregory, bilinear.
-    pub fn patch_counts(&self) -> [u32; 3] {
+    /// Patches of each kind: regular, Gregory, bilinear, Gregory triangle.
+    pub fn patch_counts(&self) -> [u32; 4] {
         self.gpu.counts
     }
 
@@ -674,12 +677,8 @@ impl Adaptive {
     pub fn base_param(&self, patch: u32, u: f64, v: f64) -> Option<(u32, u8, f64, f64)> {
         let pi = *self.gpu.order.get(patch as usize)?;
         let p = self.plan.patches.get(pi as usize)?;
-        Some((
-            p.base_face,
-            p.sub_face,
-            p.origin[0] + p.size * u,
-            p.origin[1] + p.size * v,
-        ))
+        let (sub, s, t) = p.base_param(u, v);
+        Some((p.base_face, sub, s, t))
     }
 }
 
@@ -737,6 +736,9 @@ impl Technique for Adaptive {
         let (control, evaluation) = match patch {
             PatchType::Gregory => (Stage::AdaptiveGregoryTesc, Stage::AdaptiveGregoryTese),
             PatchType::Bilinear => (Stage::AdaptivePatchTesc, Stage::AdaptiveBilinearTese),
+            PatchType::GregoryTriangle => {
+                (Stage::AdaptiveGregoryTriTesc, Stage::AdaptiveGregoryTriTese)
+            }
             _ => (Stage::AdaptiveRegularTesc, Stage::AdaptiveRegularTese),
         };
         PatchPipeline {
@@ -761,12 +763,16 @@ impl Technique for Adaptive {
     }
 
     /// At the largest level an edge can get (a coarse transition edge's doubled level).
-    fn max_vertices_per_patch(&self, params: &FrameParams, _array: usize) -> u64 {
+    fn max_vertices_per_patch(&self, params: &FrameParams, array: usize) -> u64 {
         let max = match params.factors {
             FactorPolicy::Uniform { segments } => 2.0 * segments,
             _ => self.factor_limit(),
         };
-        uniform_vertex_count(Domain::Quad, params.spacing, max.min(self.factor_limit()))
+        let domain = self
+            .arrays
+            .get(array)
+            .map_or(Domain::Quad, |a| a.patch.domain());
+        uniform_vertex_count(domain, params.spacing, max.min(self.factor_limit()))
     }
 
     /// Exact for uniform factors: each patch's edge levels as `patch.tesc` sets them (a
@@ -775,6 +781,7 @@ impl Technique for Adaptive {
         let FactorPolicy::Uniform { segments } = params.factors else {
             return None;
         };
+        let triangle = self.arrays.get(array)?.patch.domain() == Domain::Triangle;
         Some(
             self.edge_kinds
                 .get(array)?
@@ -784,6 +791,14 @@ impl Technique for Adaptive {
                         self.uniform_edge_level(segments, params.spacing, (kinds >> (4 * k)) & 3)
                     };
                     let (e0, e1, e2, e3) = (e(0), e(1), e(2), e(3));
+                    if triangle {
+                        // gregory_tri.tesc: outer 0 is edge 2, 1 edge 0, 2 edge 1.
+                        return n * triangle_triangle_count(
+                            params.spacing,
+                            [e2, e0, e1],
+                            e0.max(e1).max(e2),
+                        );
+                    }
                     n * quad_triangle_count(
                         params.spacing,
                         [e3, e0, e1, e2],
@@ -957,10 +972,10 @@ impl Technique for Adaptive {
     }
 
     fn report_notes(&self) -> Vec<String> {
-        let [r, g, b] = self.gpu.counts;
+        let [r, g, b, t] = self.gpu.counts;
         if self.id != TechniqueId::Adaptive {
             return vec![format!(
-                "{}: {r} B-spline and {g} Gregory/ACC-1 patches for {} base faces ({}), {} vertices, tables {} bytes",
+                "{}: {r} B-spline, {g} Gregory/ACC-1 and {t} Gregory triangle patches for {} base faces ({}), {} vertices, tables {} bytes",
                 self.id,
                 self.mesh.num_faces(),
                 if self.plan.isolation == 0 {

@@ -10,10 +10,10 @@
 //!   base), canonical corners and curves make shared edges bit-identical under every factor
 //!   policy, and the shaders are `glsl/adaptive/`'s (an ACC-1 net is a Gregory patch whose two
 //!   interior points per corner coincide).
-//! - **Non-quads**: a face with a corner next to a non-quad (the non-quad included) is split
-//!   into its level-1 children by one Catmull-Clark step folded into the stencils (no Gregory
-//!   triangle patch yet: a triangle is three quad patches). Semi-sharp tags are rounded to
-//!   smooth (< 0.5) or infinitely sharp.
+//! - **Non-quads**: a triangle is one Gregory triangle patch (`gregory_tri.tesc/.tese`, a
+//!   triangle domain), unless `split_triangles`; other non-quads, and every face with a corner
+//!   next to a non-quad, are split into their level-1 children by one Catmull-Clark step folded
+//!   into the stencils. Semi-sharp tags are rounded to smooth (< 0.5) or infinitely sharp.
 //! - **ACC-1 on triangles and outside its scope** (boundaries, creases, non-quad
 //!   neighbourhoods) falls back to Gregory patches; no tangent patches: normals come from the
 //!   geometry patch's derivatives.
@@ -30,6 +30,7 @@ pub fn build(
     mesh: &ControlMesh,
     patch: SinglePassPatch,
     sharpness_scale: f32,
+    gregory_triangles: bool,
     name: &str,
     maps: &crate::surface::SurfaceMaps,
 ) -> Result<Adaptive> {
@@ -39,6 +40,7 @@ pub fn build(
         &SinglePassOptions {
             patch,
             sharpness_scale,
+            gregory_triangles,
         },
     )
     .map_err(|e| TessError::Mesh {

@@ -1,0 +1,22 @@
+#version 450
+// Gregory triangle patches: the 15 points fetched once per patch (invocation i fetches point
+// i); the 12 half-curve points past them are read through the canonical curves.
+#define TECHNIQUE_PUSH_CONSTANTS
+#include "frame.glsl"
+#include "adaptive.glsl"
+#include "tesc_levels.glsl"
+layout(vertices = 15) out;
+layout(location = 0) flat in uint in_patch[];
+layout(location = 0) patch out uint tc_patch;
+layout(location = 2) patch out uint tc_info;
+layout(location = 1) out vec3 tc_points[];
+void main() {
+    uint id = in_patch[0];
+    AdaptivePatch p = patches[id];
+    tc_points[gl_InvocationID] = vtx(control_points[p.cp_offset + uint(gl_InvocationID)]);
+    if (gl_InvocationID == 0) {
+        tc_patch = id;
+        tc_info = p.info;
+        set_triangle_levels(p);
+    }
+}
