@@ -387,8 +387,16 @@ fn bench_equal_triangles_and_memory_per_face() {
         ("gregory", SinglePassPatch::Gregory),
         ("acc", SinglePassPatch::Acc1),
     ] {
-        let surf =
-            gregory::build(&mut tctx, &pyramid, patch, 1.0, name, &Default::default()).unwrap();
+        let surf = gregory::build(
+            &mut tctx,
+            &pyramid,
+            patch,
+            1.0,
+            true,
+            name,
+            &Default::default(),
+        )
+        .unwrap();
         let memory = surf.device_memory();
         for buffer in [
             "adaptive stencil terms",

@@ -115,8 +115,9 @@ fn captured_vertices_against_the_exact_limit() {
         ] {
             let mesh = shape(name);
             for patch in PATCHES {
-                let surf = gregory::build(&mut ctx, &mesh, patch, 1.0, name, &Default::default())
-                    .expect("build");
+                let surf =
+                    gregory::build(&mut ctx, &mesh, patch, 1.0, true, name, &Default::default())
+                        .expect("build");
                 let (soup, _) = capturer
                     .capture(&mut ctx, &surf, &FrameParams::uniform(4.0), EXTENT)
                     .expect("capture");
@@ -158,8 +159,9 @@ fn watertight_under_every_factor_policy() {
         ] {
             let mesh = shape(name);
             for patch in PATCHES {
-                let surf = gregory::build(&mut ctx, &mesh, patch, 1.0, name, &Default::default())
-                    .expect("build");
+                let surf =
+                    gregory::build(&mut ctx, &mesh, patch, 1.0, true, name, &Default::default())
+                        .expect("build");
                 let mut maps_surface = None;
                 let d = diag(&mesh) as f32;
                 let policies = [
@@ -205,7 +207,8 @@ fn watertight_under_every_factor_policy() {
                                     .expect("height map"),
                                 )),
                             };
-                            gregory::build(&mut ctx, &mesh, patch, 1.0, name, &maps).expect("build")
+                            gregory::build(&mut ctx, &mesh, patch, 1.0, true, name, &maps)
+                                .expect("build")
                         })
                     } else {
                         &surf
@@ -253,6 +256,7 @@ fn bad_input_gives_named_errors() {
                 &mesh,
                 SinglePassPatch::Gregory,
                 scale,
+                true,
                 "cube",
                 &Default::default(),
             )
@@ -278,6 +282,7 @@ fn bad_input_gives_named_errors() {
             &fan,
             SinglePassPatch::Acc1,
             1.0,
+            true,
             "fan",
             &Default::default()
         )
@@ -287,6 +292,7 @@ fn bad_input_gives_named_errors() {
             &mesh,
             SinglePassPatch::Gregory,
             1.0,
+            true,
             "cube",
             &Default::default(),
         )
@@ -312,7 +318,7 @@ fn bad_input_gives_named_errors() {
             ..Default::default()
         };
         for patch in PATCHES {
-            let e = gregory::build(&mut ctx, &bare, patch, 1.0, "bare.obj", &textured)
+            let e = gregory::build(&mut ctx, &bare, patch, 1.0, true, "bare.obj", &textured)
                 .err()
                 .expect("texture without vt");
             assert!(
@@ -325,6 +331,7 @@ fn bad_input_gives_named_errors() {
             &mesh,
             SinglePassPatch::Gregory,
             1.0,
+            true,
             "cube",
             &textured
         )
@@ -397,6 +404,7 @@ fn param_error_view_follows_the_cpu_lattice() {
         &edgecorner,
         SinglePassPatch::Gregory,
         1.0,
+        true,
         "edgecorner",
         &maps,
     )
@@ -415,11 +423,12 @@ fn param_error_view_follows_the_cpu_lattice() {
 
     let spot = shape("spot");
     for patch in [SinglePassPatch::Gregory, SinglePassPatch::Acc1] {
-        let surf = gregory::build(&mut ctx, &spot, patch, 1.0, "spot", &maps).expect("build");
+        let surf = gregory::build(&mut ctx, &spot, patch, 1.0, true, "spot", &maps).expect("build");
         let note = surf.param_error_note().expect("a lattice summary");
         println!("{note}");
+        let patches: u32 = surf.patch_counts().iter().sum();
         assert!(
-            note.starts_with("spot: Eq. 1") && note.contains("of 420 patches"),
+            note.starts_with("spot: Eq. 1") && note.contains(&format!("of {patches} patches")),
             "{note}"
         );
         let on = surface_hues(&render(&mut ctx, &surf, true));
@@ -468,6 +477,7 @@ fn acc_tangent_patch_normals_on_the_gpu() {
             &mesh,
             SinglePassPatch::Acc1,
             1.0,
+            true,
             name,
             &Default::default(),
         )
@@ -564,7 +574,8 @@ fn displaced_surfaces_shade_with_displaced_normals() {
         ("height map", height, 32.0, 0.5),
     ] {
         for patch in PATCHES {
-            let surf = gregory::build(&mut ctx, &mesh, patch, 1.0, "spot", &maps).expect("build");
+            let surf =
+                gregory::build(&mut ctx, &mesh, patch, 1.0, true, "spot", &maps).expect("build");
             let capture = |ctx: &mut Context, displace: f32| {
                 capturer
                     .capture(
@@ -629,6 +640,128 @@ fn displaced_surfaces_shade_with_displaced_normals() {
                 shaded < bound * base,
                 "{patch:?} {label}: displaced shading normals {shaded} vs undisplaced {base}"
             );
+        }
+    }
+}
+
+/// An open, bumpy grid of `n`×`n` quads each cut into two triangles, next to a strip of quads
+/// along one side: triangles next to triangles, to quads and to the boundary, valences 2 to 8.
+fn triangles_and_quads(n: u32) -> ControlMesh {
+    let mut p = Vec::new();
+    for y in 0..=n + 1 {
+        for x in 0..=n {
+            let z = ((x * 7 + y * 3) % 5) as f64 * 0.15;
+            p.push([x as f64, y as f64, z]);
+        }
+    }
+    let id = |x: u32, y: u32| y * (n + 1) + x;
+    let mut faces = Vec::new();
+    for y in 0..n {
+        for x in 0..n {
+            if (x + y) % 2 == 0 {
+                faces.push(vec![id(x, y), id(x + 1, y), id(x + 1, y + 1)]);
+                faces.push(vec![id(x, y), id(x + 1, y + 1), id(x, y + 1)]);
+            } else {
+                faces.push(vec![id(x, y), id(x + 1, y), id(x, y + 1)]);
+                faces.push(vec![id(x + 1, y), id(x + 1, y + 1), id(x, y + 1)]);
+            }
+        }
+    }
+    for x in 0..n {
+        faces.push(vec![id(x, n), id(x + 1, n), id(x + 1, n + 1), id(x, n + 1)]);
+    }
+    ControlMesh::from_polygons(p, &faces)
+}
+
+/// Gregory triangle patches (one per triangle) on the GPU: one patch per triangle; captured
+/// vertices within a few percent of the exact limit at their base parameter; 0 cracks (weld by
+/// bits) under uniform, screen, distance and fractional factors, displaced or not, where
+/// triangles meet triangles, quads (transition edges) and the boundary; and with
+/// `--split-triangles` three quad patches per triangle instead.
+#[test]
+fn gregory_triangle_patches_on_the_gpu() {
+    let gpu = Gpu::new();
+    let mut ctx = Context::offscreen(gpu.device()).expect("context");
+    let capturer = Capturer::new(&ctx).expect("capturer");
+    for (name, mesh) in [
+        ("triangles and quads", triangles_and_quads(4)),
+        ("catmark_pyramid", shape("catmark_pyramid")),
+    ] {
+        let triangles = (0..mesh.num_faces())
+            .filter(|&f| mesh.face(f).len() == 3)
+            .count() as u32;
+        let d = diag(&mesh) as f32;
+        for patch in PATCHES {
+            let surf = gregory::build(&mut ctx, &mesh, patch, 1.0, true, name, &Default::default())
+                .expect("build");
+            assert_eq!(surf.patch_counts()[3], triangles, "{name} {patch:?}");
+            let split = gregory::build(
+                &mut ctx,
+                &mesh,
+                patch,
+                1.0,
+                false,
+                name,
+                &Default::default(),
+            )
+            .expect("build");
+            assert_eq!(split.patch_counts()[3], 0, "{name} {patch:?} split");
+            let (soup, _) = capturer
+                .capture(&mut ctx, &surf, &FrameParams::uniform(4.0), EXTENT)
+                .expect("capture");
+            let (_, max, rms) = deviation(&surf, &soup, &mesh);
+            println!(
+                "{name} {patch:?}: {triangles} triangle patches, max {max:.2e}, RMS {rms:.2e}"
+            );
+            assert!(max < 0.05, "{name} {patch:?}: {max:e}");
+            for (label, factors, spacing) in [
+                (
+                    "uniform 5",
+                    FactorPolicy::Uniform { segments: 5.0 },
+                    Spacing::Equal,
+                ),
+                (
+                    "screen 6px",
+                    FactorPolicy::Screen { pixels: 6.0 },
+                    Spacing::Equal,
+                ),
+                (
+                    "distance",
+                    FactorPolicy::Distance {
+                        reference: 0.12 * d,
+                    },
+                    Spacing::Equal,
+                ),
+                (
+                    "screen fractional",
+                    FactorPolicy::Screen { pixels: 6.0 },
+                    Spacing::FractionalEven,
+                ),
+            ] {
+                for displace in [0.0, 0.03 * d] {
+                    let params = FrameParams {
+                        displace,
+                        factors,
+                        spacing,
+                        camera: Camera {
+                            zoom: 2.0,
+                            yaw: 20.0,
+                            ..Default::default()
+                        },
+                        ..FrameParams::default()
+                    };
+                    let (soup, _) = capturer
+                        .capture(&mut ctx, &surf, &params, EXTENT)
+                        .expect("capture");
+                    let (cracks, nonmanifold) = cracks(&surf, &soup, &mesh);
+                    println!(
+                        "{name} {patch:?} {label} displace {displace}: {} triangles, {cracks} cracks",
+                        soup.triangle_count()
+                    );
+                    assert_eq!(cracks, 0, "{name} {patch:?} {label} displace {displace}");
+                    assert_eq!(nonmanifold, 0, "{name} {patch:?} {label}");
+                }
+            }
         }
     }
 }

@@ -437,6 +437,10 @@ pub(super) fn assemble(
                 EdgeKind::Coarse
             } else if g == INVALID || lvl.hole[g as usize] {
                 EdgeKind::Plain
+            } else if tri_child(l, g as usize) {
+                // Half of a triangle patch's edge: its level is the two halves' (as the
+                // triangle's is), like any fine side of a transition.
+                EdgeKind::Fine
             } else if lvl.complete[g as usize] {
                 if lvl.selected[g as usize] {
                     EdgeKind::Coarse
