@@ -111,6 +111,9 @@ typedef struct TesseraSurfaceDesc {
   // Compute the texture-error lattice `TESSERA_SHOW_PARAM_ERROR` draws (CPU work at build
   // time); 0 or 1 (adaptive, gregory, acc).
   uint32_t param_error;
+  // Split each triangle into three quad patches instead of one Gregory triangle patch; 0 or
+  // 1 (gregory, acc).
+  uint32_t split_triangles;
 } TesseraSurfaceDesc;
 
 // How tessellation factors are chosen (`TESSERA_FACTORS_*`).

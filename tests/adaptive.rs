@@ -206,7 +206,7 @@ fn captured_vertices_are_the_exact_limit() {
                 .capture(&mut ctx, &surf, &FrameParams::uniform(3.0), EXTENT)
                 .expect("capture");
             let (regular, caps, geometric) = deviations(&surf, &soup, &mesh, 3000);
-            let [r, g, b] = surf.patch_counts();
+            let [r, g, b, _] = surf.patch_counts();
             println!("{name}: {r} regular, {g} Gregory, {b} bilinear: regular {regular:.2e}, end caps {caps:.2e} (parametric), {geometric:.2e} (to the surface)");
             // Known limits, measured: next to the interior infinitely sharp corner of
             // catmark_cube_corner4 the Gregory cap's tangents are a stand-in (no tangent plane

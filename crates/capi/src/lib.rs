@@ -216,6 +216,9 @@ pub struct TesseraSurfaceDesc {
     /// Compute the texture-error lattice `TESSERA_SHOW_PARAM_ERROR` draws (CPU work at build
     /// time); 0 or 1 (adaptive, gregory, acc).
     pub param_error: u32,
+    /// Split each triangle into three quad patches instead of one Gregory triangle patch; 0 or
+    /// 1 (gregory, acc).
+    pub split_triangles: u32,
 }
 
 /// What one frame shows. [`tessera_frame_desc_default`] fills the defaults.
@@ -508,6 +511,7 @@ pub unsafe extern "C" fn tessera_surface_desc_default(
             height_map_width: 0,
             height_map_height: 0,
             param_error: 0,
+            split_triangles: 0,
         };
         // SAFETY: the caller's contract.
         unsafe { out_write(desc, d, "desc") }
@@ -998,6 +1002,15 @@ unsafe fn create_surface(
         TESSERA_END_CAP_BILINEAR => topology::EndCap::Bilinear,
         v => return Err(invalid("end_cap", v, "a TESSERA_END_CAP_* value")),
     };
+    let split_triangles = flag(d.split_triangles, "split_triangles")?;
+    if split_triangles && !matches!(technique, TechniqueId::Gregory | TechniqueId::Acc) {
+        return Err(Error::new(
+            TesseraStatus::InvalidArgument,
+            format!(
+                "split_triangles: {technique} draws no Gregory triangle patches (gregory, acc do)"
+            ),
+        ));
+    }
     // SAFETY: the caller's contract.
     let maps = unsafe { read_maps(d, technique, &c.device, &name) }?;
     let options = tess::BuildOptions {
@@ -1007,6 +1020,7 @@ unsafe fn create_surface(
         isolation: d.isolation,
         end_cap,
         sharpness_scale: d.sharpness_scale,
+        split_triangles,
         maps,
         ..tess::BuildOptions::default()
     };

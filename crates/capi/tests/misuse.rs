@@ -224,6 +224,24 @@ fn misuse_gets_codes_and_messages_never_undefined_behaviour() {
             TesseraStatus::InvalidArgument,
             "tangents 2",
         );
+        let mut split = flat;
+        split.split_triangles = 1;
+        expect(
+            create_surface(ctx, &mesh_desc(&c), &split).0,
+            TesseraStatus::InvalidArgument,
+            "split_triangles: flat",
+        );
+        split.split_triangles = 3;
+        expect(
+            create_surface(ctx, &mesh_desc(&c), &split).0,
+            TesseraStatus::InvalidArgument,
+            "split_triangles 3",
+        );
+        let mut gregory_split = surface_desc(TESSERA_TECHNIQUE_GREGORY);
+        gregory_split.split_triangles = 1;
+        let (status, g) = create_surface(ctx, &mesh_desc(&c), &gregory_split);
+        assert_eq!(status, TesseraStatus::Ok, "{}", last_error(ctx));
+        expect(tessera_surface_destroy(ctx, g), TesseraStatus::Ok, "");
         let text = b"v 0 0 0\nv 1 0 0\nf 1 2 3\n";
         let mut s = null_mut();
         let status = tessera_surface_create_obj(

@@ -197,6 +197,55 @@ fn gregory_triangles_against_split_triangles() {
     assert!(measured > 0, "no shape with triangles");
 }
 
+/// Texture parameterization on triangles (Eq. 1 of seed 003 on a 9² lattice, over the
+/// diagonal): a Gregory triangle patch keeps the identity (its texture coordinates are linear
+/// on the triangle, the sub-quads' bilinear ones composed with the map of
+/// `triangle_subquad_param`; no table was fitted to triangles), against the same triangles
+/// split into three quad patches with the reparameterization on their valence-3 centres.
+/// Prints the table of docs/approximations.md.
+#[test]
+fn texture_error_on_triangles() {
+    println!("| shape | triangles | triangle patches (identity): RMS | max | split, reparameterized: RMS | max |");
+    for (name, mesh) in shapes() {
+        let triangles: Vec<bool> = (0..mesh.num_faces())
+            .map(|f| mesh.face(f).len() == 3 && !mesh.holes.contains(&(f as u32)))
+            .collect();
+        let count = triangles.iter().filter(|&&t| t).count();
+        if count == 0 || name.contains("creases") {
+            continue;
+        }
+        let stats = |split: bool| {
+            let opts = SinglePassOptions {
+                gregory_triangles: !split,
+                ..Default::default()
+            };
+            let plan = plan_single_pass(&mesh, &opts).unwrap();
+            let lattice = topology::texcoord::param_error_lattice(&mesh, &plan, 9).unwrap();
+            let (mut sq, mut max, mut n) = (0.0f64, 0.0f64, 0usize);
+            for (i, p) in plan.patches.iter().enumerate() {
+                if !triangles[p.base_face as usize] {
+                    continue;
+                }
+                for (k, &e) in lattice.patch(i, true).iter().enumerate() {
+                    let (a, b) = (k % 9, k / 9);
+                    if p.corners() == 3 && a + b > 8 {
+                        continue;
+                    }
+                    assert!(e.is_finite(), "{name}: patch {i}");
+                    sq += f64::from(e) * f64::from(e);
+                    max = max.max(f64::from(e));
+                    n += 1;
+                }
+            }
+            ((sq / n as f64).sqrt(), max)
+        };
+        let (trms, tmax) = stats(false);
+        let (srms, smax) = stats(true);
+        println!("| {name} | {count} | {trms:.2e} | {tmax:.2e} | {srms:.2e} | {smax:.2e} |");
+        assert!(tmax < 0.05, "{name}: {tmax:e}");
+    }
+}
+
 /// Shared edges are one canonical curve: two patches on either side of an edge evaluate the
 /// same points there (checked on the CPU at the curve's parameter; bits are the GPU's job).
 #[test]

@@ -123,8 +123,9 @@ pub struct SurfaceArgs {
     #[arg(long)]
     pub geometric_normals: bool,
     /// Colour patches by type (bft: regular blue, extraordinary red, boundary green, private
-    /// table violet; adaptive: regular blue, Gregory red, bilinear yellow, lighter per level,
-    /// transition patches darker, boundary and crease patches greener).
+    /// table violet; adaptive, gregory, acc: regular blue, Gregory red, bilinear yellow, Gregory
+    /// triangle purple, lighter per level, transition patches darker, boundary and crease
+    /// patches greener).
     #[arg(long, alias = "patch-colors")]
     pub patch_colours: bool,
     /// Time T of the --animate wave (base vertices moved along their normals), in seconds.
