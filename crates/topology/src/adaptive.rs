@@ -277,7 +277,9 @@ pub struct AdaptivePatch {
     pub level: u8,
     /// Global vertex ids. Regular: 16, row-major 4×4 as [`crate::patch`] (phantoms
     /// substituted); Gregory: 20, per corner `P, Ep, Em, Fp, Fm`; Bilinear: the 4 canonical
-    /// corners; GregoryTriangle: 15, per corner `P, Ep, Em, Fp, Fm`.
+    /// corners; GregoryTriangle: 27, per corner `P, Ep, Em, Fp, Fm` (15), then per edge the
+    /// inner points of its two level-1 halves in the edge's direction (12; the curves of a
+    /// triangle's edges where it owns them).
     pub control_points: Vec<u32>,
     pub base_face: u32,
     /// Sub-quad of a non-quad base face; 0 for quads and for triangle patches (which cover

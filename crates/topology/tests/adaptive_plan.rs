@@ -367,6 +367,7 @@ fn blocks_read_only_earlier_vertices() {
                 PatchKind::Regular => 16,
                 PatchKind::Gregory => 20,
                 PatchKind::Bilinear => 4,
+                PatchKind::GregoryTriangle => 27,
             };
             assert_eq!(pa.control_points.len(), n);
             assert!(pa.control_points.iter().all(|&i| i < plan.num_vertices));
