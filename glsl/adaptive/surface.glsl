@@ -243,7 +243,7 @@ vec3 owner_normal(uint id, vec2 uv) {
     } else if (kind == ADAPTIVE_KIND_GREGORY_TRIANGLE) {
         // Owners are evaluated on their edges (all of a triangle's are on level-1 halves, which
         // it owns only where its own boundary is those halves) and corners, where the boundary
-        // correction of gregory_tri.tese vanishes with its derivatives: the quartic alone.
+        // correction of triangle.tese vanishes with its derivatives: the quartic alone.
         vec3 c[15];
         for (uint k = 0u; k < 15u; ++k) c[k] = vtx(control_points[p.cp_offset + k]);
         vec3 pos;

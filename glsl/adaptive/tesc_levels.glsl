@@ -12,7 +12,7 @@ void set_patch_levels(AdaptivePatch p) {
     gl_TessLevelInner[1] = max(e1, e3);
 }
 
-// A Gregory triangle patch (gregory_tri.tese: gl_TessCoord = (u, v, 1 - u - v) at patch
+// A Gregory triangle patch (triangle.tese: gl_TessCoord = (u, v, 1 - u - v) at patch
 // corners 1, 2, 0): outer 0 is the edge u = 0 (patch edge 2), 1 is v = 0 (edge 0), 2 is
 // 1 - u - v = 0 (edge 1).
 void set_triangle_levels(AdaptivePatch p) {

@@ -62,7 +62,7 @@ mod tests {
             .iter()
             .filter(|s| vk_stage(**s) == vk::ShaderStageFlags::TESSELLATION_EVALUATION)
             .count();
-        assert_eq!(tese, 8);
+        assert_eq!(tese, 9);
     }
 
     #[test]

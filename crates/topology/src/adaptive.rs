@@ -453,6 +453,19 @@ impl AdaptivePlan {
         verts
     }
 
+    /// The parameter of canonical corner `k` in its owner patch (`corner_owners[k]`): a patch
+    /// corner, or (corner index `4 + e` of a triangle patch) the midpoint of its edge `e`.
+    pub fn corner_owner_param(&self, k: usize) -> [f64; 2] {
+        let [pi, c] = self.corner_owners[k];
+        let n = self.patches[pi as usize].corners();
+        let c = c as usize;
+        if c >= 4 {
+            edge_param(n, c - 4, 0.5)
+        } else {
+            corner_param(n, c)
+        }
+    }
+
     /// Point and derivative of curve `curve` at `t ∈ [0, 1]` (point 0 at `t = 0`).
     pub fn curve_sample(&self, verts: &[[f64; 3]], curve: usize, t: f64) -> ([f64; 3], [f64; 3]) {
         let (w, d) = bezier(t);
@@ -514,7 +527,7 @@ impl AdaptivePlan {
     /// canonical halves and `B` the patch's own cubic: it is the whole difference on edge `p`,
     /// and 0 on the other two edges (`C − B` vanishes at the corners, with its derivative,
     /// since both start along the same limit tangent), so the patch's boundary is its
-    /// canonical curves exactly. Mirrored by `glsl/adaptive/gregory_tri.tese`.
+    /// canonical curves exactly. Mirrored by `glsl/adaptive/triangle.tese`.
     fn triangle_transitions(
         &self,
         verts: &[[f64; 3]],

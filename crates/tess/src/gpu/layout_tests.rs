@@ -378,7 +378,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         Stage::AdaptiveRegularTese,
         Stage::AdaptiveGregoryTese,
         Stage::AdaptiveBilinearTese,
-        Stage::AdaptiveGregoryTriTese,
+        Stage::AdaptiveTriangleTese,
     ];
     rows.extend([
         (Stage::AdaptiveStencilComp, PLAIN, adaptive_push()),
@@ -386,7 +386,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         (Stage::AdaptivePatchTesc, PLAIN, adaptive_push()),
         (Stage::AdaptiveRegularTesc, PLAIN, adaptive_push()),
         (Stage::AdaptiveGregoryTesc, PLAIN, adaptive_push()),
-        (Stage::AdaptiveGregoryTriTesc, PLAIN, adaptive_push()),
+        (Stage::AdaptiveTriangleTesc, PLAIN, adaptive_push()),
         (Stage::AdaptiveAdaptiveFrag, PLAIN, adaptive_push()),
         (
             Stage::AdaptiveStencilComp,
@@ -672,8 +672,8 @@ fn the_table_covers_every_bft_binding_and_capture_build() {
         .iter()
         .filter(|(_, _, c)| matches!(c, Check::Xfb { .. }))
         .count();
-    // Five TESs in three spacings.
-    assert_eq!(capture_builds, 24);
+    // Nine TESs in three spacings.
+    assert_eq!(capture_builds, 27);
     assert_eq!(xfb_rows, capture_builds);
 }
 
@@ -724,7 +724,7 @@ fn capture_variants_and_only_they_have_xfb() {
             captures += v.capture as usize;
         }
     }
-    assert_eq!(captures, 24);
+    assert_eq!(captures, 27);
 }
 
 #[test]

@@ -737,7 +737,7 @@ impl Technique for Adaptive {
             PatchType::Gregory => (Stage::AdaptiveGregoryTesc, Stage::AdaptiveGregoryTese),
             PatchType::Bilinear => (Stage::AdaptivePatchTesc, Stage::AdaptiveBilinearTese),
             PatchType::GregoryTriangle => {
-                (Stage::AdaptiveGregoryTriTesc, Stage::AdaptiveGregoryTriTese)
+                (Stage::AdaptiveTriangleTesc, Stage::AdaptiveTriangleTese)
             }
             _ => (Stage::AdaptiveRegularTesc, Stage::AdaptiveRegularTese),
         };
@@ -792,7 +792,7 @@ impl Technique for Adaptive {
                     };
                     let (e0, e1, e2, e3) = (e(0), e(1), e(2), e(3));
                     if triangle {
-                        // gregory_tri.tesc: outer 0 is edge 2, 1 edge 0, 2 edge 1.
+                        // triangle.tesc: outer 0 is edge 2, 1 edge 0, 2 edge 1.
                         return n * triangle_triangle_count(
                             params.spacing,
                             [e2, e0, e1],

@@ -10,7 +10,7 @@
 //!   base), canonical corners and curves make shared edges bit-identical under every factor
 //!   policy, and the shaders are `glsl/adaptive/`'s (an ACC-1 net is a Gregory patch whose two
 //!   interior points per corner coincide).
-//! - **Non-quads**: a triangle is one Gregory triangle patch (`gregory_tri.tesc/.tese`, a
+//! - **Non-quads**: a triangle is one Gregory triangle patch (`triangle.tesc/.tese`, a
 //!   triangle domain), unless `split_triangles`; other non-quads, and every face with a corner
 //!   next to a non-quad, are split into their level-1 children by one Catmull-Clark step folded
 //!   into the stencils. Semi-sharp tags are rounded to smooth (< 0.5) or infinitely sharp.
