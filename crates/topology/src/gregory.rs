@@ -686,6 +686,9 @@ pub fn gregory_weights(u: f64, v: f64) -> PatchWeights<20> {
     w
 }
 
+/// Exponents `(i, j, k)` of a quartic Bernstein polynomial `λ0^i λ1^j λ2^k`.
+type Ijk = (usize, usize, usize);
+
 /// Gregory *triangle* patches (Loop, Schaefer, Ni, Castaño 2009, §4; OpenSubdiv's
 /// `GREGORY_TRIANGLE` layout): 15 points, per corner `i = 0..2` (corner 0 at `(u, v) = (0, 0)`,
 /// 1 at `(1, 0)`, 2 at `(0, 1)`; barycentric `λ = (1 − u − v, u, v)`) the slots `5·i + s` as for
@@ -737,7 +740,7 @@ pub fn gregory_triangle_weights(u: f64, v: f64) -> PatchWeights<15> {
         w.dv[slot] += coef * b[2];
     };
     // Boundary Bézier points (i, j, k) as combinations of P, Ep, Em.
-    const BOUNDARY: [((usize, usize, usize), [(usize, f64); 2]); 12] = [
+    const BOUNDARY: [(Ijk, [(usize, f64); 2]); 12] = [
         ((4, 0, 0), [(0, 1.0), (0, 0.0)]),
         ((0, 4, 0), [(5, 1.0), (5, 0.0)]),
         ((0, 0, 4), [(10, 1.0), (10, 0.0)]),
@@ -760,7 +763,7 @@ pub fn gregory_triangle_weights(u: f64, v: f64) -> PatchWeights<15> {
         }
     }
     // Interior: (i, j, k), Fp slot, its weight's λ index, Fm's λ index.
-    const INTERIOR: [((usize, usize, usize), usize, usize, usize); 3] = [
+    const INTERIOR: [(Ijk, usize, usize, usize); 3] = [
         ((2, 1, 1), 3, 1, 2),
         ((1, 2, 1), 8, 2, 0),
         ((1, 1, 2), 13, 0, 1),
