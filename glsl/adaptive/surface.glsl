@@ -218,14 +218,9 @@ void gregory_triangle(vec3 c[15], vec2 uv, out vec3 pos, out vec3 du, out vec3 d
 
 // The owner evaluation: the normal of patch `id` at `uv`, from the global vertex buffer, one
 // operand order, `precise` (every TES that includes this gets the same bits).
-vec3 owner_normal(uint id, vec2 uv) {
-    uint tangent_valences = surfaces[id].tangent_valences;
-    if (tangent_valences != 0u) {
-        uint o = patches[id].cp_offset;
-        vec3 c[28];
-        for (uint k = 0u; k < 28u; ++k) c[k] = vtx(control_points[o + k]);
-        return acc_tangent_normal(c, tangent_valences, uv);
-    }
+// Also its derivatives (the geometry patch's, on ACC-1 nets too, whose normal is the tangent
+// patches').
+void owner_frame(uint id, vec2 uv, out vec3 n_out, out vec3 du_out, out vec3 dv_out) {
     AdaptivePatch p = patches[id];
     uint kind = patch_kind(p);
     precise vec3 du = vec3(0.0), dv = vec3(0.0);
@@ -281,7 +276,21 @@ vec3 owner_normal(uint id, vec2 uv) {
     precise vec3 n = cross(du, dv);
     float l = length(n);
     precise vec3 r = l > 1e-30 ? n / l : vec3(0.0, 0.0, 1.0);
-    return r;
+    uint tangent_valences = surfaces[id].tangent_valences;
+    if (tangent_valences != 0u) {
+        vec3 c[28];
+        for (uint k = 0u; k < 28u; ++k) c[k] = vtx(control_points[p.cp_offset + k]);
+        r = acc_tangent_normal(c, tangent_valences, uv);
+    }
+    n_out = r;
+    du_out = du;
+    dv_out = dv;
+}
+
+vec3 owner_normal(uint id, vec2 uv) {
+    vec3 n, du, dv;
+    owner_frame(id, uv, n, du, dv);
+    return n;
 }
 
 // The owner's patch parameter at curve parameter s (CurveOwner::patch_param).
@@ -324,13 +333,16 @@ vec3 displaced_normal(uint id, vec2 uv, vec3 n, vec3 du, vec3 dv) {
     float hu = (surface_height(patch_texcoord(id, vec2(hi.x, uv.y))) - surface_height(patch_texcoord(id, vec2(lo.x, uv.y)))) / (hi.x - lo.x);
     float hv = (surface_height(patch_texcoord(id, vec2(uv.x, hi.y))) - surface_height(patch_texcoord(id, vec2(uv.x, lo.y)))) / (hi.y - lo.y);
     float k = adaptive.displace_scale;
-    vec3 m = length(cross(du, dv)) * n + (k * hv) * cross(du, n) + (k * hu) * cross(n, dv);
-    return safe_normalize(m, n);
+    // precise: canonical_normal evaluates this for an owner in every TES, to the same bits.
+    precise vec3 m = length(cross(du, dv)) * n + (k * hv) * cross(du, n) + (k * hu) * cross(n, dv);
+    precise float len = length(m);
+    precise vec3 r = len > 1e-30 ? m / len : n;
+    return r;
 }
 
-vec3 displace_canonical(vec3 pos, uint curve, float s) {
-    uint owner;
-    vec2 ouv;
+// The patch that owns the canonical point at curve `curve`, parameter s, and its parameter
+// there: the corner's owner at the curve's ends, else the curve's.
+void canonical_owner(uint curve, float s, out uint owner, out vec2 ouv) {
     if (s == 0.0 || s == 1.0) {
         uint v = s == 0.0 ? curves[curve].x : curves[curve].w;
         uvec2 o = corner_owners[v - adaptive.first_corner];
@@ -341,8 +353,26 @@ vec3 displace_canonical(vec3 pos, uint curve, float s) {
         owner = o.patch_id;
         ouv = owner_param(o, s);
     }
+}
+
+vec3 displace_canonical(vec3 pos, uint curve, float s) {
+    uint owner;
+    vec2 ouv;
+    canonical_owner(curve, s, owner, ouv);
     vec3 n = owner_normal(owner, ouv);
     float h = surface_height(patch_texcoord(owner, ouv));
     precise vec3 r = pos + n * (adaptive.displace_scale * h);
     return r;
+}
+
+// The shading normal of a canonical point (ADAPTIVE_OPTION_CANONICAL_NORMALS): its owner's,
+// displaced as the owner sees it, so every patch on the edge emits the same bits.
+vec3 canonical_normal(uint curve, float s) {
+    uint owner;
+    vec2 ouv;
+    canonical_owner(curve, s, owner, ouv);
+    vec3 n, du, dv;
+    owner_frame(owner, ouv, n, du, dv);
+    if ((adaptive.options & uint(ADAPTIVE_OPTION_DISPLACE)) != 0u) n = displaced_normal(owner, ouv, n, du, dv);
+    return n;
 }

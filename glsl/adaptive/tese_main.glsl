@@ -72,6 +72,9 @@ void main() {
         // Shade the displaced surface, not the base one (positions above are already final).
         n = displaced_normal(tc_patch, uv, n, du, dv);
     }
+    if (canonical && (adaptive.options & uint(ADAPTIVE_OPTION_CANONICAL_NORMALS)) != 0u) {
+        n = canonical_normal(curve, s);
+    }
     uint kind = tc_info & 15u, level = (tc_info >> 4) & 15u;
     vec3 albedo = frame.base_color.rgb;
     if ((adaptive.options & uint(ADAPTIVE_OPTION_SHOW_PARAM_SHIFT)) != 0u) {

@@ -165,6 +165,10 @@ gpu_constants! {
     ADAPTIVE_OPTION_SHOW_PARAM_SHIFT = 128;
     /// `options` bit: colour by the pointwise Eq. 1 texture error (seed 003, Fig. 8).
     ADAPTIVE_OPTION_SHOW_PARAM_ERROR = 256;
+    /// `options` bit: a vertex on a patch boundary is shaded with its curve owner's normal
+    /// (displaced or not), so both sides of every edge emit the same normal bits (single-pass
+    /// methods: their patches are not G1 across transitions and fallbacks).
+    ADAPTIVE_OPTION_CANONICAL_NORMALS = 512;
     /// Capture flags of the adaptive TES: patch kind in bits 0..3, level above.
     ADAPTIVE_FLAG_LEVEL_SHIFT = 4;
     /// Capture flag: the point lies on a patch boundary and came from its canonical curve.
