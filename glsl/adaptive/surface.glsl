@@ -143,7 +143,7 @@ vec3 acc_tangent_normal(vec3 c[28], uint valences, vec2 uv) {
     vec3 qu = vec3(su * su, 2.0 * u * su, u * u), qv = vec3(sv * sv, 2.0 * v * sv, v * v);
     vec4 cu = vec4(su * su * su, 3.0 * u * su * su, 3.0 * u * u * su, u * u * u);
     vec4 cv = vec4(sv * sv * sv, 3.0 * v * sv * sv, 3.0 * v * v * sv, v * v * v);
-    // precise: owner_normal returns this, and every TES must get the same bits.
+    // precise: owner_frame returns this, and every TES must get the same bits.
     precise vec3 du = vec3(0.0), dv = vec3(0.0);
     for (int j = 0; j < 4; ++j)
         for (int i = 0; i < 3; ++i) du += (qu[i] * cv[j]) * U[i + 3 * j];
@@ -217,7 +217,8 @@ void gregory_triangle(vec3 c[15], vec2 uv, out vec3 pos, out vec3 du, out vec3 d
 }
 
 // The owner evaluation: the normal of patch `id` at `uv`, from the global vertex buffer, one
-// operand order, `precise` (every TES that includes this gets the same bits).
+// operand order, `precise` (every TES that includes this gets the same bits). Call it from one
+// place only (see tese_main.glsl).
 // Also its derivatives (the geometry patch's, on ACC-1 nets too, whose normal is the tangent
 // patches').
 void owner_frame(uint id, vec2 uv, out vec3 n_out, out vec3 du_out, out vec3 dv_out) {
@@ -287,11 +288,6 @@ void owner_frame(uint id, vec2 uv, out vec3 n_out, out vec3 du_out, out vec3 dv_
     dv_out = dv;
 }
 
-vec3 owner_normal(uint id, vec2 uv) {
-    vec3 n, du, dv;
-    owner_frame(id, uv, n, du, dv);
-    return n;
-}
 
 // The owner's patch parameter at curve parameter s (CurveOwner::patch_param).
 vec2 owner_param(CurveOwner o, float s) {
@@ -333,7 +329,7 @@ vec3 displaced_normal(uint id, vec2 uv, vec3 n, vec3 du, vec3 dv) {
     float hu = (surface_height(patch_texcoord(id, vec2(hi.x, uv.y))) - surface_height(patch_texcoord(id, vec2(lo.x, uv.y)))) / (hi.x - lo.x);
     float hv = (surface_height(patch_texcoord(id, vec2(uv.x, hi.y))) - surface_height(patch_texcoord(id, vec2(uv.x, lo.y)))) / (hi.y - lo.y);
     float k = adaptive.displace_scale;
-    // precise: canonical_normal evaluates this for an owner in every TES, to the same bits.
+    // precise: with canonical normals every TES evaluates this for an owner, to the same bits.
     precise vec3 m = length(cross(du, dv)) * n + (k * hv) * cross(du, n) + (k * hu) * cross(n, dv);
     precise float len = length(m);
     precise vec3 r = len > 1e-30 ? m / len : n;
@@ -353,26 +349,4 @@ void canonical_owner(uint curve, float s, out uint owner, out vec2 ouv) {
         owner = o.patch_id;
         ouv = owner_param(o, s);
     }
-}
-
-vec3 displace_canonical(vec3 pos, uint curve, float s) {
-    uint owner;
-    vec2 ouv;
-    canonical_owner(curve, s, owner, ouv);
-    vec3 n = owner_normal(owner, ouv);
-    float h = surface_height(patch_texcoord(owner, ouv));
-    precise vec3 r = pos + n * (adaptive.displace_scale * h);
-    return r;
-}
-
-// The shading normal of a canonical point (ADAPTIVE_OPTION_CANONICAL_NORMALS): its owner's,
-// displaced as the owner sees it, so every patch on the edge emits the same bits.
-vec3 canonical_normal(uint curve, float s) {
-    uint owner;
-    vec2 ouv;
-    canonical_owner(curve, s, owner, ouv);
-    vec3 n, du, dv;
-    owner_frame(owner, ouv, n, du, dv);
-    if ((adaptive.options & uint(ADAPTIVE_OPTION_DISPLACE)) != 0u) n = displaced_normal(owner, ouv, n, du, dv);
-    return n;
 }

@@ -61,19 +61,31 @@ void main() {
 #endif
     vec2 tex = patch_texcoord(tc_patch, uv);
     out_texcoord = tex;
-    if ((adaptive.options & uint(ADAPTIVE_OPTION_DISPLACE)) != 0u) {
-        // Interior points by their own patch; boundary points by their curve's owner, so both
-        // sides of every edge move them identically.
-        if (canonical) {
-            pos = displace_canonical(pos, curve, s);
-        } else {
-            pos += n * (adaptive.displace_scale * surface_height(tex));
-        }
-        // Shade the displaced surface, not the base one (positions above are already final).
-        n = displaced_normal(tc_patch, uv, n, du, dv);
+    // A boundary point is displaced by its curve's owner (normal and height), so both sides of
+    // every edge move it identically; with ADAPTIVE_OPTION_CANONICAL_NORMALS (single-pass
+    // methods) it is shaded in the owner's frame too. Each heavy function below has one call
+    // site: lavapipe compiles every inlined copy into the TES, and a second copy of the owner
+    // evaluation made every adaptive frame 1.5x slower even where it never ran.
+    bool displace = (adaptive.options & uint(ADAPTIVE_OPTION_DISPLACE)) != 0u;
+    bool owner_shading = canonical && (adaptive.options & uint(ADAPTIVE_OPTION_CANONICAL_NORMALS)) != 0u;
+    uint oid = tc_patch;
+    vec2 ouv = uv;
+    vec3 on = n, odu = du, odv = dv;
+    if (canonical && (displace || owner_shading)) {
+        canonical_owner(curve, s, oid, ouv);
+        owner_frame(oid, ouv, on, odu, odv);
     }
-    if (canonical && (adaptive.options & uint(ADAPTIVE_OPTION_CANONICAL_NORMALS)) != 0u) {
-        n = canonical_normal(curve, s);
+    if (displace) {
+        vec2 htex = canonical ? patch_texcoord(oid, ouv) : tex;
+        precise vec3 moved = pos + (canonical ? on : n) * (adaptive.displace_scale * surface_height(htex));
+        pos = moved;
+        // Shade the displaced surface, not the base one (positions above are already final).
+        uint sid = owner_shading ? oid : tc_patch;
+        vec2 suv = owner_shading ? ouv : uv;
+        vec3 sn = owner_shading ? on : n, sdu = owner_shading ? odu : du, sdv = owner_shading ? odv : dv;
+        n = displaced_normal(sid, suv, sn, sdu, sdv);
+    } else if (owner_shading) {
+        n = on;
     }
     uint kind = tc_info & 15u, level = (tc_info >> 4) & 15u;
     vec3 albedo = frame.base_color.rgb;
