@@ -1,4 +1,5 @@
 #version 450
+#extension GL_EXT_control_flow_attributes : require
 // Bilinear end caps, made watertight: the bilinearly blended (Coons) patch of the cap's four
 // canonical boundary curves, so the cap follows its neighbours' boundaries exactly; between
 // two caps the curves are straight and it is the bilinear patch of the limit corners.

@@ -1,4 +1,5 @@
 #version 450
+#extension GL_EXT_control_flow_attributes : require
 // Gregory end caps (Loop, Schaefer, Ni, Castano 2009; OpenSubdiv's Gregory basis): 20 control
 // points, per corner i = 0..3 (v0 at (0,0), v1 (1,0), v2 (1,1), v3 (0,1)): P, Ep (towards
 // corner i+1), Em (towards corner i-1), Fp (the interior point paired with Ep), Fm. The

@@ -72,11 +72,16 @@ vec3 param_error_colour(float e) {
     return mix(ramp[k], ramp[k + 1u], t - float(k));
 }
 
+// The texture coordinate of a patch with surface record `sf` at texture parameter `st`.
+vec2 texcoord_at(PatchSurface sf, vec2 st) {
+    return mix(mix(sf.uv[0], sf.uv[1], st.x), mix(sf.uv[3], sf.uv[2], st.x), st.y);
+}
+
 // The texture coordinate patch `id` shows at its (u, v).
 vec2 patch_texcoord(uint id, vec2 uv) {
     PatchSurface sf = surfaces[id];
     vec2 st = reparam_on() ? reparameterize(sf.reparam_rows, uv) : uv;
-    return mix(mix(sf.uv[0], sf.uv[1], st.x), mix(sf.uv[3], sf.uv[2], st.x), st.y);
+    return texcoord_at(sf, st);
 }
 
 // Height at a texture coordinate: the height map's red channel (level 0, so both sides of an
@@ -326,8 +331,13 @@ const vec2 TRIANGLE_CORNER_PARAMS[7] = vec2[7](vec2(0.0, 0.0), vec2(1.0, 0.0), v
 vec3 displaced_normal(uint id, vec2 uv, vec3 n, vec3 du, vec3 dv) {
     const float h = 1.0 / 1024.0;
     vec2 lo = max(uv - vec2(h), vec2(0.0)), hi = min(uv + vec2(h), vec2(1.0));
-    float hu = (surface_height(patch_texcoord(id, vec2(hi.x, uv.y))) - surface_height(patch_texcoord(id, vec2(lo.x, uv.y)))) / (hi.x - lo.x);
-    float hv = (surface_height(patch_texcoord(id, vec2(uv.x, hi.y))) - surface_height(patch_texcoord(id, vec2(uv.x, lo.y)))) / (hi.y - lo.y);
+    // The four heights in a loop that stays a loop: unrolled, each look-up would inline its own
+    // copy of the reparameterization, and lavapipe's TES pays for code size on every vertex.
+    vec2 at[4] = vec2[4](vec2(hi.x, uv.y), vec2(lo.x, uv.y), vec2(uv.x, hi.y), vec2(uv.x, lo.y));
+    float height[4];
+    [[dont_unroll]] for (int k = 0; k < 4; ++k) height[k] = surface_height(patch_texcoord(id, at[k]));
+    float hu = (height[0] - height[1]) / (hi.x - lo.x);
+    float hv = (height[2] - height[3]) / (hi.y - lo.y);
     float k = adaptive.displace_scale;
     // precise: with canonical normals every TES evaluates this for an owner, to the same bits.
     precise vec3 m = length(cross(du, dv)) * n + (k * hv) * cross(du, n) + (k * hu) * cross(n, dv);

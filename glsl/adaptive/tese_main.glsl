@@ -35,31 +35,43 @@ void main() {
     // point, the same global vertex.
     uint curve = 0u;
     float s = 0.0;
+    // The edge and the parameter along it, then one call (one inlined copy: see below).
+    uint e = 0u;
+    float t = 0.0, tess_level = 1.0;
 #ifdef TRIANGLE_DOMAIN
     // Every triangle edge is a transition edge (two level-1 halves): integer levels.
     if (uv.y == 0.0) {
-        pos = canonical_edge_point(p, 0u, uv.x, gl_TessLevelOuter[1], true, curve, s);
+        e = 0u; t = uv.x; tess_level = gl_TessLevelOuter[1];
     } else if (w0 == 0.0) {
-        pos = canonical_edge_point(p, 1u, uv.y, gl_TessLevelOuter[2], true, curve, s);
-    } else if (uv.x == 0.0) {
-        pos = canonical_edge_point(p, 2u, w0, gl_TessLevelOuter[0], true, curve, s);
+        e = 1u; t = uv.y; tess_level = gl_TessLevelOuter[2];
+    } else {
+        e = 2u; t = w0; tess_level = gl_TessLevelOuter[0];
     }
 #else
     if (uv.y == 0.0) {
-        pos = canonical_edge_point(p, 0u, uv.x, gl_TessLevelOuter[1], !fractional_factors() || edge_kind(p, 0u) != ADAPTIVE_EDGE_PLAIN, curve, s);
+        e = 0u; t = uv.x; tess_level = gl_TessLevelOuter[1];
     } else if (uv.x == 1.0) {
-        pos = canonical_edge_point(p, 1u, uv.y, gl_TessLevelOuter[2], !fractional_factors() || edge_kind(p, 1u) != ADAPTIVE_EDGE_PLAIN, curve, s);
+        e = 1u; t = uv.y; tess_level = gl_TessLevelOuter[2];
     } else if (uv.y == 1.0) {
-        pos = canonical_edge_point(p, 2u, 1.0 - uv.x, gl_TessLevelOuter[3], !fractional_factors() || edge_kind(p, 2u) != ADAPTIVE_EDGE_PLAIN, curve, s);
-    } else if (uv.x == 0.0) {
-        pos = canonical_edge_point(p, 3u, 1.0 - uv.y, gl_TessLevelOuter[0], !fractional_factors() || edge_kind(p, 3u) != ADAPTIVE_EDGE_PLAIN, curve, s);
+        e = 2u; t = 1.0 - uv.x; tess_level = gl_TessLevelOuter[3];
+    } else {
+        e = 3u; t = 1.0 - uv.y; tess_level = gl_TessLevelOuter[0];
     }
 #endif
+    if (canonical) {
+        bool integer_level = !fractional_factors() || edge_kind(p, e) != ADAPTIVE_EDGE_PLAIN;
+        pos = canonical_edge_point(p, e, t, tess_level, integer_level, curve, s);
+    }
     vec3 n = safe_normalize(cross(du, dv), vec3(0.0, 0.0, 1.0));
 #ifdef PATCH_SHADING_NORMAL
     n = patch_shading_normal(tc_patch, uv, n);
 #endif
-    vec2 tex = patch_texcoord(tc_patch, uv);
+    // The reparameterized parameter once, for the texture coordinate and the shift view (a
+    // second call would be a second inlined copy).
+    PatchSurface own_surface = surfaces[tc_patch];
+    bool show_shift = (adaptive.options & uint(ADAPTIVE_OPTION_SHOW_PARAM_SHIFT)) != 0u;
+    vec2 st = (reparam_on() || show_shift) ? reparameterize(own_surface.reparam_rows, uv) : uv;
+    vec2 tex = texcoord_at(own_surface, reparam_on() ? st : uv);
     out_texcoord = tex;
     // A boundary point is displaced by its curve's owner (normal and height), so both sides of
     // every edge move it identically; with ADAPTIVE_OPTION_CANONICAL_NORMALS (single-pass
@@ -89,10 +101,9 @@ void main() {
     }
     uint kind = tc_info & 15u, level = (tc_info >> 4) & 15u;
     vec3 albedo = frame.base_color.rgb;
-    if ((adaptive.options & uint(ADAPTIVE_OPTION_SHOW_PARAM_SHIFT)) != 0u) {
+    if (show_shift) {
         // How far the reparameterization moves the texture parameter, in patch units: 0 blue,
         // 0.05 and beyond red.
-        vec2 st = reparameterize(surfaces[tc_patch].reparam_rows, uv);
         float shift = clamp(length(st - uv) / 0.05, 0.0, 1.0);
         albedo = mix(vec3(0.2, 0.35, 0.9), vec3(0.95, 0.25, 0.15), shift);
     } else if ((adaptive.options & uint(ADAPTIVE_OPTION_SHOW_PARAM_ERROR)) != 0u) {

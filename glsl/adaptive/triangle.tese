@@ -1,4 +1,5 @@
 #version 450
+#extension GL_EXT_control_flow_attributes : require
 // Gregory triangle patches (single-pass plans, one per triangle; topology::gregory's
 // gregory_triangle_weights): the quartic with rational interior points of surface.glsl, plus
 // the boundary correction that puts each edge on its two level-1 canonical halves
