@@ -327,17 +327,8 @@ const vec2 TRIANGLE_CORNER_PARAMS[7] = vec2[7](vec2(0.0, 0.0), vec2(1.0, 0.0), v
 //   |p_u x p_v| n + k h_v (p_u x n) + k h_u (n x p_v),
 // whose direction does not depend on the parameterization, so both sides of an edge agree
 // wherever the height is continuous. h_u, h_v: central differences of the height at the
-// patch's texture coordinates (one-sided at the patch boundary).
-vec3 displaced_normal(uint id, vec2 uv, vec3 n, vec3 du, vec3 dv) {
-    const float h = 1.0 / 1024.0;
-    vec2 lo = max(uv - vec2(h), vec2(0.0)), hi = min(uv + vec2(h), vec2(1.0));
-    // The four heights in a loop that stays a loop: unrolled, each look-up would inline its own
-    // copy of the reparameterization, and lavapipe's TES pays for code size on every vertex.
-    vec2 at[4] = vec2[4](vec2(hi.x, uv.y), vec2(lo.x, uv.y), vec2(uv.x, hi.y), vec2(uv.x, lo.y));
-    float height[4];
-    [[dont_unroll]] for (int k = 0; k < 4; ++k) height[k] = surface_height(patch_texcoord(id, at[k]));
-    float hu = (height[0] - height[1]) / (hi.x - lo.x);
-    float hv = (height[2] - height[3]) / (hi.y - lo.y);
+// patch's texture coordinates (one-sided at the patch boundary), taken by tese_main.glsl.
+vec3 displaced_normal(vec3 n, vec3 du, vec3 dv, float hu, float hv) {
     float k = adaptive.displace_scale;
     // precise: with canonical normals every TES evaluates this for an owner, to the same bits.
     precise vec3 m = length(cross(du, dv)) * n + (k * hv) * cross(du, n) + (k * hu) * cross(n, dv);

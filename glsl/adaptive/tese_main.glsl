@@ -88,14 +88,23 @@ void main() {
         owner_frame(oid, ouv, on, odu, odv);
     }
     if (displace) {
-        vec2 htex = canonical ? patch_texcoord(oid, ouv) : tex;
-        precise vec3 moved = pos + (canonical ? on : n) * (adaptive.displace_scale * surface_height(htex));
-        pos = moved;
-        // Shade the displaced surface, not the base one (positions above are already final).
+        // Shaded in this frame: the owner's with canonical normals, else the patch's own.
         uint sid = owner_shading ? oid : tc_patch;
         vec2 suv = owner_shading ? ouv : uv;
         vec3 sn = owner_shading ? on : n, sdu = owner_shading ? odu : du, sdv = owner_shading ? odv : dv;
-        n = displaced_normal(sid, suv, sn, sdu, sdv);
+        // Five heights in one loop that stays a loop (one inlined texture look-up): where the
+        // point moves (its owner's on a boundary), then around the shading point for the
+        // displaced normal's slope.
+        const float h = 1.0 / 1024.0;
+        vec2 lo = max(suv - vec2(h), vec2(0.0)), hi = min(suv + vec2(h), vec2(1.0));
+        uint ids[5] = uint[5](oid, sid, sid, sid, sid);
+        vec2 at[5] = vec2[5](ouv, vec2(hi.x, suv.y), vec2(lo.x, suv.y), vec2(suv.x, hi.y), vec2(suv.x, lo.y));
+        float height[5];
+        [[dont_unroll]] for (int k = 0; k < 5; ++k) height[k] = surface_height(patch_texcoord(ids[k], at[k]));
+        precise vec3 moved = pos + (canonical ? on : n) * (adaptive.displace_scale * height[0]);
+        pos = moved;
+        // Shade the displaced surface, not the base one (positions above are already final).
+        n = displaced_normal(sn, sdu, sdv, (height[1] - height[2]) / (hi.x - lo.x), (height[3] - height[4]) / (hi.y - lo.y));
     } else if (owner_shading) {
         n = on;
     }
