@@ -6,7 +6,10 @@
 // interior Bezier points are rational blends of Fp and Fm, so each is the right one on the
 // edge it controls the cross derivative of. Mirrors topology::gregory::gregory_weights.
 #define TECHNIQUE_PUSH_CONSTANTS
+#ifdef ADAPTIVE_SURFACE
+// ACC-1's tangent patches (acc only, which always draws the surface build).
 #define PATCH_SHADING_NORMAL
+#endif
 #include "frame.glsl"
 #include "adaptive.glsl"
 #include "tese_out.glsl"
@@ -75,6 +78,7 @@ void evaluate(uint id, vec2 uv, out vec3 pos, out vec3 du, out vec3 dv) {
 
 #include "tese_main.glsl"
 
+#ifdef PATCH_SHADING_NORMAL
 // ACC-1 nets (Gregory records with tangent valences) shade with their tangent patches: the
 // net's 20 points from the control stage, the 8 limit-tangent points from the buffer.
 vec3 patch_shading_normal(uint id, vec2 uv, vec3 n) {
@@ -86,3 +90,4 @@ vec3 patch_shading_normal(uint id, vec2 uv, vec3 n) {
     for (uint k = 20u; k < 28u; ++k) c[k] = vtx(control_points[o + k]);
     return acc_tangent_normal(c, valences, uv);
 }
+#endif

@@ -66,6 +66,9 @@ void main() {
 #ifdef PATCH_SHADING_NORMAL
     n = patch_shading_normal(tc_patch, uv, n);
 #endif
+#ifdef ADAPTIVE_SURFACE
+    // The surface build (Technique::surface_build): texture coordinates, displacement, owners'
+    // normals, the parameter views. The plain build leaves them out, a much smaller TES.
     // The reparameterized parameter once, for the texture coordinate and the shift view (a
     // second call would be a second inlined copy).
     PatchSurface own_surface = surfaces[tc_patch];
@@ -108,6 +111,11 @@ void main() {
     } else if (owner_shading) {
         n = on;
     }
+#else
+    out_texcoord = vec2(0.0);
+    const bool show_shift = false;
+    vec2 st = uv;
+#endif
     uint kind = tc_info & 15u, level = (tc_info >> 4) & 15u;
     vec3 albedo = frame.base_color.rgb;
     if (show_shift) {
@@ -115,8 +123,10 @@ void main() {
         // 0.05 and beyond red.
         float shift = clamp(length(st - uv) / 0.05, 0.0, 1.0);
         albedo = mix(vec3(0.2, 0.35, 0.9), vec3(0.95, 0.25, 0.15), shift);
+#ifdef ADAPTIVE_SURFACE
     } else if ((adaptive.options & uint(ADAPTIVE_OPTION_SHOW_PARAM_ERROR)) != 0u) {
         albedo = param_error_colour(param_error(tc_patch, uv));
+#endif
     } else if ((adaptive.options & uint(ADAPTIVE_OPTION_PATCH_COLOURS)) != 0u) {
         // Odd levels lighter, even levels darker, a little lighter with depth: adjacent
         // levels always differ.

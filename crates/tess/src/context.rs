@@ -31,6 +31,8 @@ pub struct PipelineKey {
     pub patch: PatchType,
     pub spacing: Spacing,
     pub pass: Pass,
+    /// The evaluation stage's surface build ([`crate::Technique::surface_build`]).
+    pub surface: bool,
 }
 
 /// Set 0 of every pipeline: one uniform buffer and descriptor set per frame slot.
@@ -220,6 +222,7 @@ impl Context {
                     patch: array.patch,
                     spacing: params.spacing,
                     pass,
+                    surface: technique.surface_build(params),
                 };
                 if !self.pipelines.contains_key(&key) {
                     let p = self.build_pipeline(technique, key)?;
@@ -247,6 +250,7 @@ impl Context {
         let evaluation = Variant {
             spacing: Some(key.spacing),
             capture,
+            surface: key.surface,
         };
         desc.stages = vec![
             ShaderStage::new(
@@ -365,6 +369,7 @@ impl Context {
             patch: a.patch,
             spacing: params.spacing,
             pass,
+            surface: technique.surface_build(params),
         };
         let pipeline = self
             .pipelines

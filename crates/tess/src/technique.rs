@@ -333,6 +333,13 @@ pub trait Technique: Send {
     /// Stages of one of its patch types.
     fn patch_pipeline(&self, patch: PatchType) -> PatchPipeline;
 
+    /// Whether a frame with `params` needs the evaluation stage's surface build (the manifest's
+    /// `surface` axis: texture coordinates, displacement, owners' normals, parameter views);
+    /// the plain build is smaller, and a smaller TES is a faster one on lavapipe.
+    fn surface_build(&self, _params: &FrameParams) -> bool {
+        false
+    }
+
     /// Descriptor-set layout of its set 1, if its pipelines have one (set 0 is the frame's).
     /// One layout per technique type, made by the context ([`crate::Context::set_layout`]).
     fn set_layout_bindings(&self) -> &'static [vk_core::descriptor::BindingDesc] {

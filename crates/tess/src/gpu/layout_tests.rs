@@ -65,12 +65,17 @@ enum Check {
 }
 
 fn variant(spacing: Option<Spacing>, capture: bool) -> Variant {
-    Variant { spacing, capture }
+    Variant {
+        spacing,
+        capture,
+        surface: false,
+    }
 }
 
 const PLAIN: Variant = Variant {
     spacing: None,
     capture: false,
+    surface: false,
 };
 
 /// The table. Each BFT storage buffer appears with a stage that reads or writes it.
@@ -488,7 +493,13 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
     ]);
     for stage in adaptive_tese {
         for spacing in [Spacing::Equal, Spacing::FractionalEven] {
-            rows.push((stage, variant(Some(spacing), false), adaptive_push()));
+            for surface in [false, true] {
+                let v = Variant {
+                    surface,
+                    ..variant(Some(spacing), false)
+                };
+                rows.push((stage, v, adaptive_push()));
+            }
         }
     }
     // The capture record and the push constant of every capture build (the optimizer keeps
@@ -672,8 +683,8 @@ fn the_table_covers_every_bft_binding_and_capture_build() {
         .iter()
         .filter(|(_, _, c)| matches!(c, Check::Xfb { .. }))
         .count();
-    // Nine TESs in three spacings.
-    assert_eq!(capture_builds, 27);
+    // Nine TESs in three spacings, the four adaptive ones also with their surface code.
+    assert_eq!(capture_builds, 39);
     assert_eq!(xfb_rows, capture_builds);
 }
 
@@ -724,7 +735,7 @@ fn capture_variants_and_only_they_have_xfb() {
             captures += v.capture as usize;
         }
     }
-    assert_eq!(captures, 27);
+    assert_eq!(captures, 39);
 }
 
 #[test]

@@ -759,6 +759,16 @@ impl Technique for Adaptive {
         &SET_BINDINGS
     }
 
+    /// A shown texture, displacement or parameter view, or the single-pass methods' canonical
+    /// normals (and ACC-1's tangent patches) need the surface build; adaptive's plain frames
+    /// do not.
+    fn surface_build(&self, params: &FrameParams) -> bool {
+        self.id != TechniqueId::Adaptive
+            || params.displace != 0.0
+            || params.show != SurfaceShow::Shading
+            || (self.options.maps.texture.is_some() && !params.patch_colours)
+    }
+
     fn descriptor_set(&self, slot: usize) -> Option<&DescriptorSet> {
         self.sets
             .get(slot.min(self.sets.len().saturating_sub(1)))?
