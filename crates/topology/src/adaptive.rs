@@ -439,6 +439,19 @@ fn axpy(out: &mut [f64; 3], w: f64, x: &[f64; 3]) {
     out[2] += w * x[2];
 }
 
+/// Adds the `N` control points `cp(k)` weighted by `w` to `s` (position and derivatives).
+fn add_weighted<'a, const N: usize>(
+    s: &mut PatchSample,
+    w: &crate::patch::PatchWeights<N>,
+    cp: impl Fn(usize) -> &'a [f64; 3],
+) {
+    for k in 0..N {
+        axpy(&mut s.position, w.point[k], cp(k));
+        axpy(&mut s.du, w.du[k], cp(k));
+        axpy(&mut s.dv, w.dv[k], cp(k));
+    }
+}
+
 impl AdaptivePlan {
     /// The whole global vertex buffer from the base positions (`num_base_vertices` of them).
     pub fn apply(&self, base: &[[f64; 3]]) -> Vec<[f64; 3]> {
@@ -582,29 +595,10 @@ impl AdaptivePlan {
             dv: [0.0; 3],
         };
         match pa.kind {
-            PatchKind::Regular => {
-                let w = catmark_regular_weights(u, v);
-                for k in 0..16 {
-                    axpy(&mut s.position, w.point[k], cp(k));
-                    axpy(&mut s.du, w.du[k], cp(k));
-                    axpy(&mut s.dv, w.dv[k], cp(k));
-                }
-            }
-            PatchKind::Gregory => {
-                let w = crate::gregory::gregory_weights(u, v);
-                for k in 0..20 {
-                    axpy(&mut s.position, w.point[k], cp(k));
-                    axpy(&mut s.du, w.du[k], cp(k));
-                    axpy(&mut s.dv, w.dv[k], cp(k));
-                }
-            }
+            PatchKind::Regular => add_weighted(&mut s, &catmark_regular_weights(u, v), cp),
+            PatchKind::Gregory => add_weighted(&mut s, &crate::gregory::gregory_weights(u, v), cp),
             PatchKind::GregoryTriangle => {
-                let w = crate::gregory::gregory_triangle_weights(u, v);
-                for k in 0..15 {
-                    axpy(&mut s.position, w.point[k], cp(k));
-                    axpy(&mut s.du, w.du[k], cp(k));
-                    axpy(&mut s.dv, w.dv[k], cp(k));
-                }
+                add_weighted(&mut s, &crate::gregory::gregory_triangle_weights(u, v), cp);
                 self.triangle_transitions(verts, patch, u, v, &mut s);
             }
             PatchKind::Bilinear => {

@@ -324,11 +324,10 @@ fn acc_tangent_patches_give_continuous_normals() {
         ];
         (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt().atan2(d)
     };
-    let edge_param = |e: usize, t: f64| match e {
-        0 => (t, 0.0),
-        1 => (1.0, t),
-        2 => (1.0 - t, 1.0),
-        _ => (0.0, 1.0 - t),
+    // ACC-1 patches are quads.
+    let edge_param = |e: usize, t: f64| {
+        let [u, v] = edge_param(4, e, t);
+        (u, v)
     };
     let mut worst_geometric = 0.0f64;
     println!("| shape | ACC-1 patches | shared edges | max angle, tangent patches | max angle, geometry normals | max angle to the limit normal at corners |");

@@ -319,10 +319,7 @@ pub(super) fn assemble(
                 canon[key] = first_canon + needed.len() as u32;
                 if d.kind == PatchKind::GregoryTriangle {
                     // The limit mask needs an all-quad ring: the vertex's child's, at level 1.
-                    let maps = levels[1]
-                        .maps
-                        .as_ref()
-                        .expect("level 1 under a triangle patch");
+                    let maps = level1_maps(&levels, d.face)?;
                     needed.push((1, maps.vertex_child_vertex[v as usize]));
                 } else {
                     needed.push((d.level, v));
@@ -342,8 +339,8 @@ pub(super) fn assemble(
             // Its edges are level-1 halves (see `triangle_draft`): the edge midpoints are
             // canonical corners too; a triangle owning one says so by corner index 4 + edge.
             let (_, fe, _) = draft_corners(lvl, d);
+            let maps = level1_maps(&levels, d.face)?;
             let l1 = &levels[1];
-            let maps = l1.maps.as_ref().expect("level 1 under a triangle patch");
             for (p, &e) in fe[..3].iter().enumerate() {
                 let m = maps.edge_child_vertex[e as usize];
                 if m == INVALID {
@@ -741,6 +738,18 @@ pub(super) fn assemble(
     })
 }
 
+/// The refinement maps into level 1, which a triangle patch's points and corners come from (a
+/// plan with a triangle patch always has them; a named error otherwise, not a panic).
+fn level1_maps(levels: &[Lvl], face: u32) -> Result<&ChildMaps, TopologyError> {
+    levels
+        .get(1)
+        .and_then(|l| l.maps.as_ref())
+        .ok_or(TopologyError::AdaptivePatch {
+            level: 0,
+            face: face as usize,
+        })
+}
+
 /// The corners and edges of a draft's face in patch order, and how many (3 for a triangle
 /// patch, whose face is never rotated).
 fn draft_corners(lvl: &Lvl, d: &Draft) -> ([u32; 4], [u32; 4], usize) {
@@ -760,11 +769,8 @@ fn draft_corners(lvl: &Lvl, d: &Draft) -> ([u32; 4], [u32; 4], usize) {
 /// The Gregory triangle patch of level-0 triangle `f` ([`crate::gregory::gregory_triangle_from_children`]
 /// over its three level-1 children).
 fn triangle_draft(mesh: &ControlMesh, levels: &[Lvl], f: usize) -> Result<Draft, TopologyError> {
+    let maps = level1_maps(levels, f as u32)?;
     let l1 = &levels[1];
-    let maps = l1
-        .maps
-        .as_ref()
-        .ok_or(TopologyError::AdaptivePatch { level: 0, face: f })?;
     let first = maps.face_first_child[f];
     if first == INVALID {
         return Err(TopologyError::AdaptivePatch { level: 0, face: f });
