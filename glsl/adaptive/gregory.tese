@@ -6,7 +6,7 @@
 // interior Bezier points are rational blends of Fp and Fm, so each is the right one on the
 // edge it controls the cross derivative of. Mirrors topology::gregory::gregory_weights.
 #define TECHNIQUE_PUSH_CONSTANTS
-#ifdef ADAPTIVE_SURFACE
+#ifdef SURFACE_BUILD
 // ACC-1's tangent patches (acc only, which always draws the surface build).
 #define PATCH_SHADING_NORMAL
 #endif

@@ -5,8 +5,13 @@
 #include "normals.glsl"
 layout(location = 0) patch in uint tc_patch;
 layout(location = 2) patch in uint tc_info;
+#ifdef SURFACE_BUILD
+// Only the surface build hands the fragment stage an albedo and a texture coordinate: each
+// varying costs lavapipe's rasterizer on every triangle (docs/benchmarks.md, "varyings are
+// frame time"); the plain build shades with frame.base_color.
 layout(location = 5) out vec3 out_albedo;
 layout(location = 6) out vec2 out_texcoord;
+#endif
 #include "surface.glsl"
 #ifdef PATCH_SHADING_NORMAL
 // A patch kind whose shading normal is not cross(du, dv) defines this after including this
@@ -66,9 +71,11 @@ void main() {
 #ifdef PATCH_SHADING_NORMAL
     n = patch_shading_normal(tc_patch, uv, n);
 #endif
-#ifdef ADAPTIVE_SURFACE
+    uint kind = tc_info & 15u, level = (tc_info >> 4) & 15u;
+#ifdef SURFACE_BUILD
     // The surface build (Technique::surface_build): texture coordinates, displacement, owners'
-    // normals, the parameter views. The plain build leaves them out, a much smaller TES.
+    // normals, the parameter views, patch colours. The plain build leaves them out, a much
+    // smaller TES with two varyings fewer.
     // The reparameterized parameter once, for the texture coordinate and the shift view (a
     // second call would be a second inlined copy).
     PatchSurface own_surface = surfaces[tc_patch];
@@ -111,22 +118,14 @@ void main() {
     } else if (owner_shading) {
         n = on;
     }
-#else
-    out_texcoord = vec2(0.0);
-    const bool show_shift = false;
-    vec2 st = uv;
-#endif
-    uint kind = tc_info & 15u, level = (tc_info >> 4) & 15u;
     vec3 albedo = frame.base_color.rgb;
     if (show_shift) {
         // How far the reparameterization moves the texture parameter, in patch units: 0 blue,
         // 0.05 and beyond red.
         float shift = clamp(length(st - uv) / 0.05, 0.0, 1.0);
         albedo = mix(vec3(0.2, 0.35, 0.9), vec3(0.95, 0.25, 0.15), shift);
-#ifdef ADAPTIVE_SURFACE
     } else if ((adaptive.options & uint(ADAPTIVE_OPTION_SHOW_PARAM_ERROR)) != 0u) {
         albedo = param_error_colour(param_error(tc_patch, uv));
-#endif
     } else if ((adaptive.options & uint(ADAPTIVE_OPTION_PATCH_COLOURS)) != 0u) {
         // Odd levels lighter, even levels darker, a little lighter with depth: adjacent
         // levels always differ.
@@ -137,6 +136,7 @@ void main() {
         if (((tc_info >> 8) & 15u) != 0u) albedo = mix(albedo, vec3(0.3, 0.8, 0.35), 0.5);
     }
     out_albedo = albedo;
+#endif
     emit_sample(pos, n, tc_patch,
                 kind | (level << ADAPTIVE_FLAG_LEVEL_SHIFT) | (canonical ? uint(ADAPTIVE_FLAG_CANONICAL) : 0u));
 }

@@ -6,7 +6,11 @@
 #include "shading.glsl"
 layout(location = 0) in vec3 in_world;
 layout(location = 1) in vec3 in_normal;
+#ifdef SURFACE_BUILD
 layout(location = 5) flat in vec3 in_albedo;
+#else
+#define in_albedo frame.base_color.rgb
+#endif
 layout(location = 0) out vec4 out_color;
 void main() {
     out_color = bft.mode == DRAW_MODE_WIREFRAME ? vec4(frame.wire_color.rgb, 1.0) : shade(in_world, in_normal, in_albedo);

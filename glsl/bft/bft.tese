@@ -12,7 +12,11 @@
 #include "tese_out.glsl"
 #include "normals.glsl"
 layout(triangles, SPACING, ccw) in;
+#ifdef SURFACE_BUILD
+// Only with patch colours (Technique::surface_build): a varying costs lavapipe's rasterizer on
+// every triangle (docs/benchmarks.md, "varyings are frame time").
 layout(location = 5) flat out vec3 out_albedo;
+#endif
 
 // Regular, extraordinary, boundary, private-table patches.
 const vec3 KIND_COLOURS[4] = vec3[4](vec3(0.55, 0.75, 0.95), vec3(0.95, 0.45, 0.35), vec3(0.55, 0.85, 0.45), vec3(0.75, 0.5, 0.9));
@@ -23,6 +27,8 @@ void main() {
     vec3 p, n;
     bool exact = bft_eval(face, gl_TessCoord, geometric, p, n);
     uint kind = tc_head.y >> BFT_INFO_KIND_SHIFT;
+#ifdef SURFACE_BUILD
     out_albedo = (bft.options & uint(BFT_OPTION_PATCH_COLOURS)) != 0u ? KIND_COLOURS[min(kind, 3u)] : frame.base_color.rgb;
+#endif
     emit_sample(p, safe_normalize(n, vec3(0.0)), face, (exact ? uint(CAPTURE_FLAG_EXACT) : 0u) | (kind << CAPTURE_FLAG_KIND_SHIFT));
 }

@@ -269,7 +269,14 @@ impl Context {
         if !capture {
             desc.stages.push(ShaderStage::new(
                 vk::ShaderStageFlags::FRAGMENT,
-                shaders::spirv(pp.fragment, plain)?,
+                // The fragment stage reads what the evaluation stage's build hands it.
+                shaders::spirv(
+                    pp.fragment,
+                    Variant {
+                        surface: key.surface,
+                        ..plain
+                    },
+                )?,
             ));
         }
         if pp.mesh_vertex_input {

@@ -135,7 +135,23 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         (Stage::BftBftTesc, PLAIN, frame_binding()),
         (Stage::BftBftTesc, PLAIN, bft_push()),
         (Stage::BftBftTese, variant(equal, false), bft_push()),
+        (
+            Stage::BftBftTese,
+            Variant {
+                surface: true,
+                ..variant(equal, false)
+            },
+            bft_push(),
+        ),
         (Stage::BftBftFrag, PLAIN, bft_push()),
+        (
+            Stage::BftBftFrag,
+            Variant {
+                surface: true,
+                ..PLAIN
+            },
+            bft_push(),
+        ),
         (Stage::BftSubdivideComp, PLAIN, bft_push()),
         (Stage::BftNormalsComp, PLAIN, bft_push()),
         // Vertex input.
@@ -683,8 +699,8 @@ fn the_table_covers_every_bft_binding_and_capture_build() {
         .iter()
         .filter(|(_, _, c)| matches!(c, Check::Xfb { .. }))
         .count();
-    // Nine TESs in three spacings, the four adaptive ones also with their surface code.
-    assert_eq!(capture_builds, 39);
+    // Nine TESs in three spacings, the four adaptive ones and BFT's also with their surface code.
+    assert_eq!(capture_builds, 42);
     assert_eq!(xfb_rows, capture_builds);
 }
 
@@ -735,11 +751,56 @@ fn capture_variants_and_only_they_have_xfb() {
             captures += v.capture as usize;
         }
     }
-    assert_eq!(captures, 39);
+    assert_eq!(captures, 42);
 }
 
 #[test]
 fn reflection_rejects_what_is_not_spirv() {
     assert!(Reflection::new(&[1, 2, 3]).is_err());
     assert!(Reflection::new(&[0x0723_0203, 0, 0, 0, 0, 0x0005_0000]).is_err());
+}
+
+/// The plain builds of the adaptive and BFT evaluation stages hand the rasterizer no albedo or
+/// texture-coordinate varying (each costs lavapipe on every triangle: docs/benchmarks.md,
+/// "varyings are frame time"), and each fragment build reads exactly what the evaluation build
+/// of the same `surface` value writes, at the same location and size.
+#[test]
+fn plain_builds_have_no_surface_varyings() {
+    let tese = [
+        Stage::AdaptiveRegularTese,
+        Stage::AdaptiveGregoryTese,
+        Stage::AdaptiveBilinearTese,
+        Stage::AdaptiveTriangleTese,
+        Stage::BftBftTese,
+    ];
+    let mut checked = 0;
+    for stage in tese {
+        let frag = if stage == Stage::BftBftTese {
+            Stage::BftBftFrag
+        } else {
+            Stage::AdaptiveAdaptiveFrag
+        };
+        for &(v, words) in stage.compiled() {
+            let r = Reflection::new(words).expect("SPIR-V");
+            let f = Reflection::new(spirv(frag, v).expect("fragment build")).expect("SPIR-V");
+            for (out, input) in [("out_albedo", "in_albedo"), ("out_texcoord", "in_texcoord")] {
+                let written = r.output(out);
+                if !v.surface {
+                    assert_eq!(written, None, "{} {v:?} writes {out}", stage.path());
+                }
+                assert_eq!(
+                    f.input(input),
+                    written,
+                    "{} {v:?}: {input} against {out}",
+                    stage.path()
+                );
+            }
+            if v.surface {
+                assert!(r.output("out_albedo").is_some(), "{} {v:?}", stage.path());
+            }
+            checked += 1;
+        }
+    }
+    // Four adaptive TESs and BFT's, three spacings, capture or not, plain or surface.
+    assert_eq!(checked, 60);
 }

@@ -323,8 +323,17 @@ impl Reflection {
 
     /// Location and size in bytes of the input variable named `name`.
     pub fn input(&self, name: &str) -> Option<(u32, u32)> {
+        self.interface(name, STORAGE_INPUT)
+    }
+
+    /// Location and size in bytes of the output variable named `name`.
+    pub fn output(&self, name: &str) -> Option<(u32, u32)> {
+        self.interface(name, STORAGE_OUTPUT)
+    }
+
+    fn interface(&self, name: &str, class: u32) -> Option<(u32, u32)> {
         self.variables.iter().find_map(|&(var, ty, storage)| {
-            if storage != STORAGE_INPUT || self.names.get(&var).map(String::as_str) != Some(name) {
+            if storage != class || self.names.get(&var).map(String::as_str) != Some(name) {
                 return None;
             }
             let location = self.decoration(var, DECORATION_LOCATION)?;

@@ -759,14 +759,15 @@ impl Technique for Adaptive {
         &SET_BINDINGS
     }
 
-    /// A shown texture, displacement or parameter view, or the single-pass methods' canonical
-    /// normals (and ACC-1's tangent patches) need the surface build; adaptive's plain frames
-    /// do not.
+    /// A shown texture, displacement, parameter view or patch colours, or the single-pass
+    /// methods' canonical normals (and ACC-1's tangent patches) need the surface build;
+    /// adaptive's plain frames do not (and hand the rasterizer no albedo or texture varying).
     fn surface_build(&self, params: &FrameParams) -> bool {
         self.id != TechniqueId::Adaptive
             || params.displace != 0.0
             || params.show != SurfaceShow::Shading
-            || (self.options.maps.texture.is_some() && !params.patch_colours)
+            || params.patch_colours
+            || self.options.maps.texture.is_some()
     }
 
     fn descriptor_set(&self, slot: usize) -> Option<&DescriptorSet> {

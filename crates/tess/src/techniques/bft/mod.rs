@@ -822,6 +822,11 @@ impl Technique for Bft {
         check_frame(self.summary.table.level, params)
     }
 
+    /// Only patch colours need the surface build (its albedo varying).
+    fn surface_build(&self, params: &FrameParams) -> bool {
+        params.patch_colours
+    }
+
     fn patch_pipeline(&self, _patch: PatchType) -> PatchPipeline {
         PatchPipeline {
             vertex: Stage::BftBftVert,
