@@ -19,7 +19,11 @@ pub enum WorkaroundId {
     /// emitting more than 65,536 vertices gets corrupt triangles (its vertex indices are 16-bit;
     /// the TES outputs themselves stay right) and slows down super-linearly. We split tessellated
     /// draws so that no chunk can exceed 65,536 vertices at the largest factor the draw can use.
-    /// This is likely the cause of OpenSubdiv's holes on llvmpipe.
+    /// This is likely the cause of OpenSubdiv's holes on llvmpipe. The super-linear cost starts
+    /// long before the corruption, so the split gives each draw a budget of
+    /// [`LAVAPIPE_DRAW_VERTEX_BUDGET`] vertices, not the limit: measured on the issue-11 car frame
+    /// (6.9 M triangles), 4,096 vertices a draw is 1.2x faster than 65,536 for the adaptive
+    /// surface and 1.3x for Flat (docs/benchmarks.md, "Session 14").
     LavapipeTessChunkVertexLimit,
     /// lavapipe, Mesa 22.3: a pipeline-statistics query around a draw of one-control-point
     /// patches with no vertex input (the BFT main pass) crashes a worker thread (SIGSEGV); the
@@ -34,7 +38,7 @@ pub fn known() -> Vec<Workaround> {
         Workaround {
             id: WorkaroundId::LavapipeTessChunkVertexLimit,
             driver: vk::DriverId::MESA_LLVMPIPE,
-            summary: "lavapipe: tessellated draws split so no internal chunk emits > 65,536 vertices (16-bit chunk indices)",
+            summary: "lavapipe: tessellated draws split so no internal chunk emits > 65,536 vertices (16-bit chunk indices); 4,096 a draw, where its cost is still linear",
         },
         Workaround {
             id: WorkaroundId::LavapipeStatisticsQueryPointPatches,
@@ -52,6 +56,12 @@ pub struct Workarounds {
 
 /// Vertices a lavapipe chunk may emit before its 16-bit indices overflow.
 pub const LAVAPIPE_CHUNK_VERTEX_LIMIT: u64 = 65_536;
+
+/// Vertices one tessellated draw may emit on lavapipe (at the draw's largest factors): within
+/// the chunk limit, and small enough that a chunk's super-linear cost has not set in (each
+/// draw is one chunk then). 16,384 and 8,192 measured in between, 2,048 no better.
+pub const LAVAPIPE_DRAW_VERTEX_BUDGET: u64 = 4_096;
+const _: () = assert!(LAVAPIPE_DRAW_VERTEX_BUDGET <= LAVAPIPE_CHUNK_VERTEX_LIMIT);
 
 impl Workarounds {
     pub fn for_adapter(info: &AdapterInfo) -> Self {
@@ -76,7 +86,7 @@ impl Workarounds {
     /// emit at the draw's largest factors. `u32::MAX` when no limit applies.
     pub fn max_patches_per_draw(&self, max_vertices_per_patch: u64) -> u32 {
         if self.has(WorkaroundId::LavapipeTessChunkVertexLimit) {
-            (LAVAPIPE_CHUNK_VERTEX_LIMIT / max_vertices_per_patch.max(1)).max(1) as u32
+            (LAVAPIPE_DRAW_VERTEX_BUDGET / max_vertices_per_patch.max(1)).max(1) as u32
         } else {
             u32::MAX
         }
