@@ -8,10 +8,14 @@ layout(location = 0) in vec3 in_world;
 layout(location = 1) in vec3 in_normal;
 #ifdef SURFACE_BUILD
 layout(location = 5) flat in vec3 in_albedo;
-#else
-#define in_albedo frame.base_color.rgb
 #endif
 layout(location = 0) out vec4 out_color;
 void main() {
-    out_color = bft.mode == DRAW_MODE_WIREFRAME ? vec4(frame.wire_color.rgb, 1.0) : shade(in_world, in_normal, in_albedo);
+#ifdef SURFACE_BUILD
+    vec3 albedo = in_albedo;
+#else
+    // The plain build (bft.tese): no patch colours.
+    vec3 albedo = frame.base_color.rgb;
+#endif
+    out_color = bft.mode == DRAW_MODE_WIREFRAME ? vec4(frame.wire_color.rgb, 1.0) : shade(in_world, in_normal, albedo);
 }

@@ -333,9 +333,10 @@ pub trait Technique: Send {
     /// Stages of one of its patch types.
     fn patch_pipeline(&self, patch: PatchType) -> PatchPipeline;
 
-    /// Whether a frame with `params` needs the evaluation stage's surface build (the manifest's
-    /// `surface` axis: texture coordinates, displacement, owners' normals, parameter views);
-    /// the plain build is smaller, and a smaller TES is a faster one on lavapipe.
+    /// Whether a frame with `params` needs the surface build of the evaluation and fragment
+    /// stages (the manifest's `surface` axis: texture coordinates, displacement, owners' normals,
+    /// parameter views, the patch-colour albedo varying); the plain build is smaller and hands
+    /// the rasterizer fewer varyings, and lavapipe pays for both on every vertex.
     fn surface_build(&self, _params: &FrameParams) -> bool {
         false
     }
