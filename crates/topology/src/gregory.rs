@@ -102,7 +102,10 @@
 use thiserror::Error;
 
 use crate::error::TopologyError;
-use crate::limit::{catmark_limit_masks, smooth_directional_tangent, LimitRule, LimitVertex, Mask};
+use crate::limit::{
+    catmark_directional_tangent_each, catmark_limit_masks, catmark_smooth_position_weights,
+    smooth_directional_tangent, LimitRule, LimitVertex, Mask,
+};
 use crate::mesh::{SubdivOptions, Topology};
 use crate::patch::PatchWeights;
 use crate::refine::LevelRef;
@@ -148,7 +151,7 @@ pub enum GregoryProblem {
 /// Sparse row under construction. Entries keep their first-insertion order until
 /// [`Row::into_stencil`], so equal inputs built in the same order give bit-equal sums.
 #[derive(Clone, Debug, Default)]
-struct Row(Vec<(u32, f64)>);
+struct Row(smallvec::SmallVec<[(u32, f64); 24]>);
 
 impl Row {
     fn add(&mut self, i: u32, w: f64) {
@@ -312,13 +315,24 @@ impl Corner {
         let n = self.n();
         match self.kind {
             Kind::Smooth => {
-                let (ew, fw) = smooth_directional_tangent(false, n, k);
+                // Edge weights first, then face weights, as the rows were always summed.
+                let mut fw = [0.0; 64];
                 let mut r = Row::default();
-                for (i, &w) in ew.iter().enumerate() {
-                    r.add(self.fan.ring[i], w);
-                }
-                for (i, &w) in fw.iter().enumerate() {
-                    r.add(self.diag(t, i), w);
+                catmark_directional_tangent_each(n, k, |i, e, f| {
+                    r.add(self.fan.ring[i], e);
+                    if let Some(x) = fw.get_mut(i) {
+                        *x = f;
+                    }
+                });
+                if n <= fw.len() {
+                    for (i, &w) in fw[..n].iter().enumerate() {
+                        r.add(self.diag(t, i), w);
+                    }
+                } else {
+                    let (_, fw) = smooth_directional_tangent(false, n, k);
+                    for (i, &w) in fw.iter().enumerate() {
+                        r.add(self.diag(t, i), w);
+                    }
                 }
                 r
             }
@@ -455,7 +469,20 @@ fn build_corner(
         across: Row::default(),
     };
     match kind {
-        Kind::Smooth | Kind::Crease { .. } => {
+        Kind::Smooth => {
+            // Only the position: the tangents come from `Corner::tangent`.
+            let [vw, ew, fw] = catmark_smooth_position_weights(n);
+            let p = &mut corner.p;
+            p.add(v, vw);
+            for &x in &corner.fan.ring {
+                p.add(x, ew);
+            }
+            for i in 0..corner.fan.faces.len() {
+                let d = corner.diag(t, i);
+                corner.p.add(d, fw);
+            }
+        }
+        Kind::Crease { .. } => {
             let rule = match kind {
                 Kind::Crease { a, b, .. } => LimitRule::Crease { ends: [a, b] },
                 _ => LimitRule::Smooth,

@@ -197,6 +197,15 @@ fn corner_tangents(t1: &mut Mask, t2: &mut Mask, v: &LimitVertex, scale: f64) {
 }
 
 /// Catmull-Clark limit masks. Smooth masks need the all-quad ring (`faces` = opposite vertices).
+/// Weights (vertex, each edge neighbour, each face-opposite vertex) of the smooth interior
+/// Catmull-Clark limit position of valence `n`: the position mask of [`catmark_limit_masks`]
+/// without its allocations, for callers that need only the position.
+pub fn catmark_smooth_position_weights(n: usize) -> [f64; 3] {
+    let nf = n as f64;
+    let fw = 1.0 / (nf * (nf + 5.0));
+    [1.0 - nf * 5.0 * fw, 4.0 * fw, fw]
+}
+
 pub fn catmark_limit_masks(v: &LimitVertex) -> LimitMasks {
     let n = v.valence;
     let nf_count = n_faces(v);
@@ -204,9 +213,9 @@ pub fn catmark_limit_masks(v: &LimitVertex) -> LimitMasks {
         LimitRule::Smooth => {
             let nf = n as f64;
             let mut pos = Mask::zero(n, n);
-            let fw = 1.0 / (nf * (nf + 5.0));
-            pos.vertex = 1.0 - nf * 5.0 * fw;
-            pos.edges.iter_mut().for_each(|w| *w = 4.0 * fw);
+            let [vw, ew, fw] = catmark_smooth_position_weights(n);
+            pos.vertex = vw;
+            pos.edges.iter_mut().for_each(|w| *w = ew);
             pos.faces.iter_mut().for_each(|w| *w = fw);
             let mut t1 = Mask::zero(n, n);
             let mut t2 = Mask::zero(n, n);
@@ -312,17 +321,27 @@ pub fn smooth_directional_tangent(loop_scheme: bool, n: usize, k: usize) -> (Vec
             .collect();
         (e, Vec::new())
     } else {
-        let c = (2.0 * PI / nf).cos();
-        let an = 1.0 + c + (PI / nf).cos() * (2.0 * (9.0 + c)).sqrt();
-        let s = 1.0 / (3.0 * nf);
         let mut e = Vec::with_capacity(n);
         let mut f = Vec::with_capacity(n);
-        for i in 0..n {
-            let a0 = 2.0 * PI * i as f64 / nf - tk;
-            let a1 = 2.0 * PI * (i + 1) as f64 / nf - tk;
-            e.push(s * an * a0.cos());
-            f.push(s * (a0.cos() + a1.cos()));
-        }
+        catmark_directional_tangent_each(n, k, |_, ew, fw| {
+            e.push(ew);
+            f.push(fw);
+        });
         (e, f)
+    }
+}
+
+/// The Catmull-Clark weights of [`smooth_directional_tangent`], handed to `each(i, edge i,
+/// face i)` in ring order instead of collected (same arithmetic, so the same bits).
+pub fn catmark_directional_tangent_each(n: usize, k: usize, mut each: impl FnMut(usize, f64, f64)) {
+    let nf = n as f64;
+    let tk = 2.0 * PI * k as f64 / nf;
+    let c = (2.0 * PI / nf).cos();
+    let an = 1.0 + c + (PI / nf).cos() * (2.0 * (9.0 + c)).sqrt();
+    let s = 1.0 / (3.0 * nf);
+    for i in 0..n {
+        let a0 = 2.0 * PI * i as f64 / nf - tk;
+        let a1 = 2.0 * PI * (i + 1) as f64 / nf - tk;
+        each(i, s * an * a0.cos(), s * (a0.cos() + a1.cos()));
     }
 }

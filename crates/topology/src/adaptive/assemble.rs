@@ -30,6 +30,41 @@ impl Locals {
             .extend(table.offsets[1..].iter().map(|&o| o + shift));
         id
     }
+    /// Appends the rows `build` makes for each item (in item order), built in parallel chunks
+    /// of [`CHUNK`] items. Chunks run in rounds of two per thread into tables reused from round
+    /// to round: each round is copied out of warm memory, and no chunk table is allocated and
+    /// faulted in anew (a fresh table per chunk cost more than the rows on catmark_car).
+    pub(super) fn append_par<T: Sync, S: Send>(
+        &mut self,
+        items: &[T],
+        scratch: impl Fn() -> S + Sync,
+        build: impl Fn(&Locals, &T, &mut S, &mut StencilTable) + Sync,
+    ) {
+        let per_round = 2 * rayon::current_num_threads().max(1);
+        let mut tables: Vec<(S, StencilTable)> = Vec::new();
+        for round in items.chunks(per_round * CHUNK) {
+            let chunks: Vec<&[T]> = round.chunks(CHUNK).collect();
+            while tables.len() < chunks.len() {
+                tables.push((scratch(), StencilTable::default()));
+            }
+            let me = &*self;
+            tables
+                .par_iter_mut()
+                .zip(chunks.par_iter())
+                .for_each(|((s, table), chunk)| {
+                    table.offsets.clear();
+                    table.offsets.push(0);
+                    table.indices.clear();
+                    table.weights.clear();
+                    for item in chunk.iter() {
+                        build(me, item, s, table);
+                    }
+                });
+            for (_, table) in &tables[..chunks.len()] {
+                self.append(table);
+            }
+        }
+    }
     /// Expand a global id into refined-vertex terms (local points by their rows).
     pub(super) fn expand(&self, id: u32, w: f64, out: &mut Vec<(u32, f64)>) {
         if id < self.first {
@@ -245,7 +280,13 @@ pub(super) fn assemble(
     };
     for d in &drafts {
         let mut cps = Vec::with_capacity(20);
-        if let Some(ids) = &d.grid {
+        if let Some(ids) = d
+            .grid
+            .filter(|ids| d.boundary_mask == 0 && !ids.contains(&INVALID))
+        {
+            // Interior: the 16 gathered points are the net.
+            cps.extend_from_slice(&ids);
+        } else if let Some(ids) = &d.grid {
             let grid = phantom_grid(ids, d.boundary_mask).ok_or(TopologyError::AdaptivePatch {
                 level: d.level as u32,
                 face: d.face as usize,
@@ -356,30 +397,19 @@ pub(super) fn assemble(
         }
         corners.push(ids);
     }
-    let chunks: Vec<StencilTable> = needed
-        .par_chunks(CHUNK)
-        .map(|chunk| {
-            let mut table = StencilTable {
-                offsets: vec![0],
-                ..StencilTable::default()
-            };
-            let mut cache = Vec::new();
-            let mut terms = Vec::with_capacity(32);
-            for &(l, v) in chunk {
-                let lvl = &levels[l as usize];
-                terms.clear();
-                limit_stencil(lvl, v as usize, &mut cache, &mut terms);
-                for t in terms.iter_mut() {
-                    t.0 += lvl.base;
-                }
-                push_row(&mut table, &mut terms);
+    locals.append_par(
+        &needed,
+        || (Vec::new(), Vec::with_capacity(32)),
+        |_, &(l, v), (cache, terms), table| {
+            let lvl = &levels[l as usize];
+            terms.clear();
+            limit_stencil(lvl, v as usize, cache, terms);
+            for t in terms.iter_mut() {
+                t.0 += lvl.base;
             }
-            table
-        })
-        .collect();
-    for c in &chunks {
-        locals.append(c);
-    }
+            push_row(table, terms);
+        },
+    );
     let canon_of = |l: usize, v: u32, face: u32| -> Result<u32, TopologyError> {
         let c = canon[levels[l].anc[v as usize] as usize];
         if c == INVALID {
@@ -597,81 +627,71 @@ pub(super) fn assemble(
         })
         .collect();
     let first_curve_row = first_local + locals.table.len() as u32;
-    let chunks: Vec<StencilTable> = curve_owners
-        .par_chunks(CHUNK)
-        .map(|chunk| {
-            let mut table = StencilTable {
-                offsets: vec![0],
-                ..StencilTable::default()
-            };
-            let mut scratch: Vec<(u32, f64)> = Vec::with_capacity(128);
-            for o in chunk {
-                let patch = &patches[o.patch as usize];
-                let (p, part, forward) = (o.edge as usize, o.part as usize, o.forward);
-                let ids = corners[o.patch as usize];
-                for slot in [1usize, 2] {
-                    // Curve point `slot` is the segment's Bézier point `k`.
-                    let k = if forward { slot } else { 3 - slot };
-                    scratch.clear();
-                    match patch.kind {
-                        PatchKind::Regular => {
-                            for (s, &w) in edge_rows[p][part][k].iter().enumerate() {
-                                if w != 0.0 {
-                                    locals.expand(patch.control_points[s], w, &mut scratch);
-                                }
+    locals.append_par(
+        &curve_owners,
+        || Vec::<(u32, f64)>::with_capacity(128),
+        |locals, o, scratch, table| {
+            let patch = &patches[o.patch as usize];
+            let (p, part, forward) = (o.edge as usize, o.part as usize, o.forward);
+            let ids = corners[o.patch as usize];
+            for slot in [1usize, 2] {
+                // Curve point `slot` is the segment's Bézier point `k`.
+                let k = if forward { slot } else { 3 - slot };
+                scratch.clear();
+                match patch.kind {
+                    PatchKind::Regular => {
+                        for (s, &w) in edge_rows[p][part][k].iter().enumerate() {
+                            if w != 0.0 {
+                                locals.expand(patch.control_points[s], w, scratch);
                             }
                         }
-                        PatchKind::Gregory | PatchKind::GregoryTriangle | PatchKind::Bilinear => {
-                            // The owner's whole edge as Bézier points `[P, Ep, Em, P']`, or the
-                            // half of it (de Casteljau) when the owner is the coarse side.
-                            let cp = &patch.control_points;
-                            let n = patch.corners();
-                            let (c0, c3) = (ids[p], ids[(p + 1) % n]);
-                            if patch.kind == PatchKind::GregoryTriangle && part != 0 {
-                                // The half's own inner points (`triangle_draft`).
-                                let id = cp[15 + 4 * p + 2 * (part - 1) + (k - 1)];
-                                locals.expand(id, 1.0, &mut scratch);
-                                push_row(&mut table, &mut scratch);
-                                continue;
-                            }
-                            let whole: [[(u32, f64); 2]; 4] = if patch.kind != PatchKind::Bilinear {
-                                [
-                                    [(c0, 1.0), (c0, 0.0)],
-                                    [(cp[5 * p + 1], 1.0), (c0, 0.0)],
-                                    [(cp[5 * ((p + 1) % n) + 2], 1.0), (c0, 0.0)],
-                                    [(c3, 1.0), (c0, 0.0)],
-                                ]
-                            } else {
-                                [
-                                    [(c0, 1.0), (c0, 0.0)],
-                                    [(c0, 2.0 / 3.0), (c3, 1.0 / 3.0)],
-                                    [(c0, 1.0 / 3.0), (c3, 2.0 / 3.0)],
-                                    [(c3, 1.0), (c0, 0.0)],
-                                ]
-                            };
-                            let row: [f64; 4] = if part == 0 {
-                                std::array::from_fn(|j| f64::from(u8::from(j == k)))
-                            } else {
-                                bezier_half(part - 1)[k]
-                            };
-                            for (j, &s) in row.iter().enumerate() {
-                                for &(id, w) in &whole[j] {
-                                    if s * w != 0.0 {
-                                        locals.expand(id, s * w, &mut scratch);
-                                    }
+                    }
+                    PatchKind::Gregory | PatchKind::GregoryTriangle | PatchKind::Bilinear => {
+                        // The owner's whole edge as Bézier points `[P, Ep, Em, P']`, or the
+                        // half of it (de Casteljau) when the owner is the coarse side.
+                        let cp = &patch.control_points;
+                        let n = patch.corners();
+                        let (c0, c3) = (ids[p], ids[(p + 1) % n]);
+                        if patch.kind == PatchKind::GregoryTriangle && part != 0 {
+                            // The half's own inner points (`triangle_draft`).
+                            let id = cp[15 + 4 * p + 2 * (part - 1) + (k - 1)];
+                            locals.expand(id, 1.0, scratch);
+                            push_row(table, scratch);
+                            continue;
+                        }
+                        let whole: [[(u32, f64); 2]; 4] = if patch.kind != PatchKind::Bilinear {
+                            [
+                                [(c0, 1.0), (c0, 0.0)],
+                                [(cp[5 * p + 1], 1.0), (c0, 0.0)],
+                                [(cp[5 * ((p + 1) % n) + 2], 1.0), (c0, 0.0)],
+                                [(c3, 1.0), (c0, 0.0)],
+                            ]
+                        } else {
+                            [
+                                [(c0, 1.0), (c0, 0.0)],
+                                [(c0, 2.0 / 3.0), (c3, 1.0 / 3.0)],
+                                [(c0, 1.0 / 3.0), (c3, 2.0 / 3.0)],
+                                [(c3, 1.0), (c0, 0.0)],
+                            ]
+                        };
+                        let row: [f64; 4] = if part == 0 {
+                            std::array::from_fn(|j| f64::from(u8::from(j == k)))
+                        } else {
+                            bezier_half(part - 1)[k]
+                        };
+                        for (j, &s) in row.iter().enumerate() {
+                            for &(id, w) in &whole[j] {
+                                if s * w != 0.0 {
+                                    locals.expand(id, s * w, scratch);
                                 }
                             }
                         }
                     }
-                    push_row(&mut table, &mut scratch);
                 }
+                push_row(table, scratch);
             }
-            table
-        })
-        .collect();
-    for c in &chunks {
-        locals.append(c);
-    }
+        },
+    );
     for (ci, c) in curves.iter_mut().enumerate() {
         c[1] = first_curve_row + 2 * ci as u32;
         c[2] = c[1] + 1;
