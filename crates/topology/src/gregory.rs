@@ -111,6 +111,7 @@ use crate::patch::PatchWeights;
 use crate::refine::LevelRef;
 use crate::sdc::{boundary_edge_sharpness, boundary_vertex_sharpness, is_sharp, vertex_rule, Rule};
 
+use smallvec::SmallVec;
 use std::f64::consts::PI;
 
 /// Weights over a level's vertex indices (ascending, no zero weights).
@@ -151,7 +152,7 @@ pub enum GregoryProblem {
 /// Sparse row under construction. Entries keep their first-insertion order until
 /// [`Row::into_stencil`], so equal inputs built in the same order give bit-equal sums.
 #[derive(Clone, Debug, Default)]
-struct Row(smallvec::SmallVec<[(u32, f64); 24]>);
+struct Row(SmallVec<[(u32, f64); 24]>);
 
 impl Row {
     fn add(&mut self, i: u32, w: f64) {
@@ -167,12 +168,18 @@ impl Row {
         }
     }
 
-    fn into_stencil(mut self) -> Stencil {
+    /// Zero weights dropped, indices ascending: the form of a [`Stencil`].
+    fn finished(mut self) -> Row {
         self.0.retain(|e| e.1 != 0.0);
         self.0.sort_by_key(|e| e.0);
+        self
+    }
+
+    fn into_stencil(self) -> Stencil {
+        let r = self.finished();
         Stencil {
-            indices: self.0.iter().map(|e| e.0).collect(),
-            weights: self.0.iter().map(|e| e.1).collect(),
+            indices: r.0.iter().map(|e| e.0).collect(),
+            weights: r.0.iter().map(|e| e.1).collect(),
         }
     }
 }
@@ -182,9 +189,9 @@ impl Row {
 /// `ring[i]`. Starts at the face whose leaving edge is a boundary edge, else at the first face
 /// the topology lists, so the order is a property of the vertex alone.
 struct Fan {
-    faces: Vec<(u32, usize)>,
-    ring: Vec<u32>,
-    edges: Vec<u32>,
+    faces: SmallVec<[(u32, usize); 8]>,
+    ring: SmallVec<[u32; 9]>,
+    edges: SmallVec<[u32; 9]>,
     boundary: bool,
 }
 
@@ -204,9 +211,9 @@ fn build_fan(t: &Topology, v: u32) -> Option<Fan> {
     }
     let boundary = leaving_boundary(start)?;
     let mut fan = Fan {
-        faces: Vec::with_capacity(vf.len()),
-        ring: Vec::with_capacity(vf.len() + 1),
-        edges: Vec::with_capacity(vf.len() + 1),
+        faces: SmallVec::with_capacity(vf.len()),
+        ring: SmallVec::with_capacity(vf.len() + 1),
+        edges: SmallVec::with_capacity(vf.len() + 1),
         boundary,
     };
     let mut g = start;
@@ -260,7 +267,7 @@ struct Corner {
     fan: Fan,
     /// Position of the patch face in the fan.
     j: usize,
-    sharp: Vec<bool>,
+    sharp: SmallVec<[bool; 9]>,
     kind: Kind,
     regular: bool,
     c: f64,
@@ -411,7 +418,7 @@ fn build_corner(
         .position(|&(g, _)| g as usize == face)
         .ok_or(problem(GregoryProblem::IncompleteRing { vertex: v }))?;
     let n = fan.ring.len();
-    let sharp: Vec<bool> = fan
+    let sharp: SmallVec<[bool; 9]> = fan
         .edges
         .iter()
         .map(|&e| is_sharp(edge_sharp(level, e)))
@@ -539,6 +546,24 @@ pub fn gregory_basis(
     face: usize,
     options: &SubdivOptions,
 ) -> Result<[Stencil; 20], TopologyError> {
+    let mut out: [Stencil; 20] = Default::default();
+    gregory_basis_each(level, face, options, |k, terms| {
+        out[k] = Stencil {
+            indices: terms.iter().map(|e| e.0).collect(),
+            weights: terms.iter().map(|e| e.1).collect(),
+        };
+    })?;
+    Ok(out)
+}
+
+/// [`gregory_basis`] handing each point `k` to `each(k, terms)` as sorted `(index, weight)`
+/// terms instead of allocating 20 stencils (the adaptive plan builds thousands of end caps).
+pub(crate) fn gregory_basis_each(
+    level: LevelRef<'_>,
+    face: usize,
+    options: &SubdivOptions,
+    mut each: impl FnMut(usize, &[(u32, f64)]),
+) -> Result<(), TopologyError> {
     let t = level.topology;
     if face >= t.num_faces() {
         return Err(TopologyError::FaceOutOfRange {
@@ -636,15 +661,14 @@ pub fn gregory_basis(
         }
         formula(other, other_far, !plus)
     };
-    let mut out: [Stencil; 20] = Default::default();
     for i in 0..4 {
-        out[5 * i] = corners[i].p.clone().into_stencil();
-        out[5 * i + 1] = ep[i].clone().into_stencil();
-        out[5 * i + 2] = em[i].clone().into_stencil();
-        out[5 * i + 3] = face_point(i, true).into_stencil();
-        out[5 * i + 4] = face_point(i, false).into_stencil();
+        each(5 * i, &corners[i].p.clone().finished().0);
+        each(5 * i + 1, &ep[i].clone().finished().0);
+        each(5 * i + 2, &em[i].clone().finished().0);
+        each(5 * i + 3, &face_point(i, true).finished().0);
+        each(5 * i + 4, &face_point(i, false).finished().0);
     }
-    Ok(out)
+    Ok(())
 }
 
 /// One corner's interior point in [`gregory_weights`]: Bézier indices `(j, k)`, then `dp` and

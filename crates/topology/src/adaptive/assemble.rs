@@ -230,13 +230,15 @@ pub(super) fn assemble(
                         EndCap::Bilinear => PatchKind::Bilinear,
                     };
                     if d.kind == PatchKind::Gregory {
-                        d.gregory = Some(match acc.then(|| acc_points(mesh, lvl, f, shift)) {
-                            Some(Ok(points)) => {
-                                d.acc = true;
-                                points
-                            }
-                            _ => gregory_points(mesh, lvl, f, shift)?,
-                        });
+                        d.gregory = Some(Box::new(
+                            match acc.then(|| acc_points(mesh, lvl, f, shift)) {
+                                Some(Ok(points)) => {
+                                    d.acc = true;
+                                    points
+                                }
+                                _ => gregory_points(mesh, lvl, f, shift)?,
+                            },
+                        ));
                     }
                     // The end cap handles its sharp edges itself; the mask says which.
                     let (_, fe) = rotated(lvl.t(), f, shift);
@@ -846,19 +848,10 @@ fn triangle_draft(mesh: &ControlMesh, levels: &[Lvl], f: usize) -> Result<Draft,
         acc: false,
         boundary_mask,
         grid: None,
-        gregory: Some(
-            points
-                .iter()
-                .chain(halves)
-                .map(|st| {
-                    st.indices
-                        .iter()
-                        .zip(&st.weights)
-                        .map(|(&i, &w)| (i + l1.base, w))
-                        .collect()
-                })
-                .collect(),
-        ),
+        gregory: Some(Box::new(PointRows::from_stencils(
+            l1.base,
+            points.iter().chain(halves),
+        ))),
         base_face: f as u32,
         sub_face: 0,
         origin: [0.0, 0.0],
@@ -872,11 +865,19 @@ pub(super) fn gregory_points(
     lvl: &Lvl,
     f: usize,
     shift: u8,
-) -> Result<Vec<Vec<(u32, f64)>>, TopologyError> {
-    let basis = crate::gregory::gregory_basis(lvl.topo.view(), f, &mesh.options)?;
-    Ok(rotated_points(lvl.base, shift, |corner, j| {
-        &basis[5 * corner + j]
-    }))
+) -> Result<PointRows, TopologyError> {
+    // Face corner order as built, then rotated into patch corner order.
+    let mut face_order = PointRows::with_capacity(256);
+    crate::gregory::gregory_basis_each(lvl.topo.view(), f, &mesh.options, |_, terms| {
+        face_order.push(terms.iter().copied());
+    })?;
+    let s = shift as usize;
+    let mut out = PointRows::with_capacity(face_order.terms_len());
+    for k in 0..20 {
+        let row = face_order.row(5 * ((k / 5 + s) % 4) + k % 5);
+        out.push(row.iter().map(|&(i, w)| (i + lvl.base, w)));
+    }
+    Ok(out)
 }
 
 /// The 20 Gregory points in patch corner order (patch corner p, point j = P, Ep, Em, Fp, Fm),
@@ -885,18 +886,9 @@ fn rotated_points<'a>(
     base: u32,
     shift: u8,
     point: impl Fn(usize, usize) -> &'a crate::gregory::Stencil,
-) -> Vec<Vec<(u32, f64)>> {
+) -> PointRows {
     let s = shift as usize;
-    (0..20)
-        .map(|k| {
-            let st = point((k / 5 + s) % 4, k % 5);
-            st.indices
-                .iter()
-                .zip(&st.weights)
-                .map(|(&i, &w)| (i + base, w))
-                .collect()
-        })
-        .collect()
+    PointRows::from_stencils(base, (0..20).map(|k| point((k / 5 + s) % 4, k % 5)))
 }
 
 /// Per patch corner (patch order): the valence whose corner block of the texture
@@ -927,7 +919,7 @@ pub(super) fn acc_points(
     lvl: &Lvl,
     f: usize,
     shift: u8,
-) -> Result<Vec<Vec<(u32, f64)>>, TopologyError> {
+) -> Result<PointRows, TopologyError> {
     let net = crate::acc::acc1_patch(lvl.topo.view(), f)?;
     let basis = crate::gregory::gregory_basis(lvl.topo.view(), f, &mesh.options)?;
     let tangents = rotated_points(lvl.base, shift, |corner, j| &basis[5 * corner + j]);
@@ -943,7 +935,9 @@ pub(super) fn acc_points(
         &net[bi][bj]
     });
     for corner in 0..4 {
-        points.extend_from_slice(&tangents[5 * corner + 1..5 * corner + 3]);
+        for j in 1..3 {
+            points.push(tangents.row(5 * corner + j).iter().copied());
+        }
     }
     Ok(points)
 }

@@ -46,6 +46,56 @@ impl Combo {
     }
 }
 
+/// Rows of a patch's points over global ids, flat: one allocation per end cap instead of one
+/// per point (thousands of end caps per plan).
+#[derive(Clone, Debug, Default)]
+pub(super) struct PointRows {
+    ends: smallvec::SmallVec<[u32; 28]>,
+    terms: Vec<(u32, f64)>,
+}
+
+impl PointRows {
+    pub(super) fn with_capacity(terms: usize) -> PointRows {
+        PointRows {
+            ends: smallvec::SmallVec::new(),
+            terms: Vec::with_capacity(terms),
+        }
+    }
+    pub(super) fn push(&mut self, terms: impl IntoIterator<Item = (u32, f64)>) {
+        self.terms.extend(terms);
+        self.ends.push(self.terms.len() as u32);
+    }
+    pub(super) fn len(&self) -> usize {
+        self.ends.len()
+    }
+    pub(super) fn terms_len(&self) -> usize {
+        self.terms.len()
+    }
+    pub(super) fn row(&self, k: usize) -> &[(u32, f64)] {
+        let start = if k == 0 { 0 } else { self.ends[k - 1] as usize };
+        &self.terms[start..self.ends[k] as usize]
+    }
+    pub(super) fn iter(&self) -> impl Iterator<Item = &[(u32, f64)]> {
+        (0..self.len()).map(|k| self.row(k))
+    }
+    /// Rows from stencils over a level's vertices, shifted to global ids by `base`.
+    pub(super) fn from_stencils<'a>(
+        base: u32,
+        stencils: impl IntoIterator<Item = &'a crate::gregory::Stencil>,
+    ) -> PointRows {
+        let mut out = PointRows::with_capacity(256);
+        for st in stencils {
+            out.push(
+                st.indices
+                    .iter()
+                    .zip(&st.weights)
+                    .map(|(&i, &w)| (i + base, w)),
+            );
+        }
+        out
+    }
+}
+
 /// A patch before local points are numbered.
 pub(super) struct Draft {
     pub(super) level: u8,
@@ -58,7 +108,7 @@ pub(super) struct Draft {
     /// Regular: the 16 gathered ids (`INVALID` where a phantom goes).
     pub(super) grid: Option<[u32; 16]>,
     /// Gregory: 20 stencils over global ids, patch corner order.
-    pub(super) gregory: Option<Vec<Vec<(u32, f64)>>>,
+    pub(super) gregory: Option<Box<PointRows>>,
     pub(super) base_face: u32,
     pub(super) sub_face: u8,
     pub(super) origin: [f64; 2],
