@@ -209,9 +209,10 @@ fn captured_vertices_are_the_exact_limit() {
             let [r, g, b, _] = surf.patch_counts();
             println!("{name}: {r} regular, {g} Gregory, {b} bilinear: regular {regular:.2e}, end caps {caps:.2e} (parametric), {geometric:.2e} (to the surface)");
             // Known limits, measured: next to the interior infinitely sharp corner of
-            // catmark_cube_corner4 the Gregory cap's tangents are a stand-in (no tangent plane
-            // there), and the caps where catmark_cube_creases1's sharpness-5 creases meet
-            // stop at level 5 just above the target.
+            // catmark_cube_corner4 the limit has a cusp (docs/approximations.md), which the
+            // Gregory cap's stand-in tangents cannot follow; its distance shrinks ×0.41 per
+            // level, so 5e-5 would take isolation 8. The caps where catmark_cube_creases1's
+            // sharpness-5 creases meet stop at level 5 just above the target.
             // catmark_bishop's Gregory caps at its high-valence vertices converge slowest
             // (the cap's parameterization error shrinks by the subdominant eigenvalue, about
             // 0.6 per level at valence 8).
