@@ -591,19 +591,19 @@ pub(super) fn assemble(
     });
     // The non-zero slots of each row (6 of 16 for a whole edge, 9 for a half), found once
     // instead of scanning all 16 weights for every curve point.
-    let edge_terms: [[[smallvec::SmallVec<[(usize, f64); 16]>; 4]; 3]; 4] =
-        std::array::from_fn(|p| {
-            std::array::from_fn(|part| {
-                std::array::from_fn(|k| {
-                    edge_rows[p][part][k]
-                        .iter()
-                        .enumerate()
-                        .filter(|&(_, &w)| w != 0.0)
-                        .map(|(s, &w)| (s, w))
-                        .collect()
-                })
+    type SlotTerms = smallvec::SmallVec<[(usize, f64); 16]>;
+    let edge_terms: [[[SlotTerms; 4]; 3]; 4] = std::array::from_fn(|p| {
+        std::array::from_fn(|part| {
+            std::array::from_fn(|k| {
+                edge_rows[p][part][k]
+                    .iter()
+                    .enumerate()
+                    .filter(|&(_, &w)| w != 0.0)
+                    .map(|(s, &w)| (s, w))
+                    .collect()
             })
-        });
+        })
+    });
     // Curve `c` gets rows `2c` (its point 1) and `2c + 1` (its point 2) of this run of local
     // points, computed in parallel chunks and appended in order.
     if let Some(o) = owners.iter().find(|o| o.0 == u8::MAX) {
