@@ -46,6 +46,7 @@ pub(super) struct Lvl {
     pub(super) complete: Vec<bool>,
     pub(super) hole: Vec<bool>,
     pub(super) selected: Vec<bool>,
+    /// Per vertex of a complete face: needs isolating ([`vertex_irregular`]); false elsewhere.
     pub(super) irregular: Vec<bool>,
     /// Per vertex: global id of its coarsest vertex-vertex ancestor (the canonical key).
     pub(super) anc: Vec<u32>,
@@ -155,10 +156,20 @@ pub(super) fn build_levels(
                 }
             }
         }
+        // Only the vertices of complete faces are ever asked (patches, the selection and the
+        // end-cap projection are made of complete faces); the rest of a level is its one-ring.
+        let mut asked = vec![false; lvl.t().num_vertices()];
+        for f in 0..lvl.t().num_faces() {
+            if lvl.complete[f] && !lvl.hole[f] {
+                for &v in lvl.t().face_vertices(f) {
+                    asked[v as usize] = true;
+                }
+            }
+        }
         let irregular: Vec<bool> = (0..lvl.t().num_vertices())
             .into_par_iter()
             .with_min_len(1024)
-            .map(|v| vertex_irregular(lvl, v))
+            .map(|v| asked[v] && vertex_irregular(lvl, v))
             .collect();
         lvl.irregular = irregular;
         // Past the isolation level only semi-sharp features are followed.
