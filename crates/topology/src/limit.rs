@@ -196,7 +196,6 @@ fn corner_tangents(t1: &mut Mask, t2: &mut Mask, v: &LimitVertex, scale: f64) {
     t2.edges[last] += scale;
 }
 
-/// Catmull-Clark limit masks. Smooth masks need the all-quad ring (`faces` = opposite vertices).
 /// Weights (vertex, each edge neighbour, each face-opposite vertex) of the smooth interior
 /// Catmull-Clark limit position of valence `n`: the position mask of [`catmark_limit_masks`]
 /// without its allocations, for callers that need only the position.
@@ -206,6 +205,7 @@ pub fn catmark_smooth_position_weights(n: usize) -> [f64; 3] {
     [1.0 - nf * 5.0 * fw, 4.0 * fw, fw]
 }
 
+/// Catmull-Clark limit masks. Smooth masks need the all-quad ring (`faces` = opposite vertices).
 pub fn catmark_limit_masks(v: &LimitVertex) -> LimitMasks {
     let n = v.valence;
     let nf_count = n_faces(v);
