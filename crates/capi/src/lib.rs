@@ -4,7 +4,7 @@
 //! # Handles
 //! `TesseraContext*` (a device and how Tessera uses it) and `TesseraSurface*` (one control
 //! mesh built for one technique on one context) are opaque. They are numbers in a registry
-//! ([`registry`]), never pointers into Rust memory: a null, forged, destroyed or
+//! (the `registry` module), never pointers into Rust memory: a null, forged, destroyed or
 //! twice-destroyed handle is answered with `TESSERA_STATUS_NULL_HANDLE`,
 //! `TESSERA_STATUS_INVALID_HANDLE` or `TESSERA_STATUS_DESTROYED_HANDLE`, never undefined
 //! behaviour. Destroying a context destroys the surfaces still created on it.

@@ -2,7 +2,7 @@
 //! one pipeline cache, per-technique descriptor-set layouts, and the recording of a frame —
 //! pre-pass, shaded pass, wireframe overlay, capture pass — the same for every technique.
 //!
-//! Pipelines are built on first use from a technique's [`PatchPipeline`] and keyed by
+//! Pipelines are built on first use from a technique's [`PatchPipeline`](crate::technique::PatchPipeline) and keyed by
 //! [`PipelineKey`] (technique, patch type, spacing, pass). Spacing is a layout qualifier of
 //! the evaluation stage, so it selects a SPIR-V variant, not a specialization constant.
 //!

@@ -28,12 +28,12 @@ pub enum Scheme {
 
 impl Scheme {
     /// Scheme from an OpenSubdiv shape name: the part before the first `_` (`catmark_cube`,
-    /// `loop_saddle_edgecorner`, `bilinear_nonplanar`), read by [`Scheme::from_str`].
+    /// `loop_saddle_edgecorner`, `bilinear_nonplanar`), read by its [`FromStr`](std::str::FromStr) impl.
     pub fn from_shape_name(name: &str) -> Option<Scheme> {
         name.split('_').next()?.parse().ok()
     }
 
-    /// The canonical command-line name (what [`Scheme::from_str`] reads back).
+    /// The canonical command-line name (what its [`FromStr`](std::str::FromStr) impl reads back).
     pub fn name(self) -> &'static str {
         match self {
             Scheme::Loop => "loop",

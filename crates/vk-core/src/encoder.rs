@@ -15,7 +15,7 @@
 //!    one-shot work, its whole command pool) exclusively and is neither `Send` nor `Sync`, so
 //!    Vulkan's external-synchronization rules for command buffers and pools hold. Exchanging two
 //!    encoders (`std::mem::swap` on the `&mut`) is detected at submission by identity: both are
-//!    then abandoned unsubmitted and the submission returns [`RecordingError::Exchanged`].
+//!    then abandoned unsubmitted and the submission returns [`RecordingError::Exchanged`](crate::error::RecordingError::Exchanged).
 //! 3. **Commands only where Vulkan allows them.** The encoder tracks the bound pipeline, descriptor
 //!    sets, vertex and index buffers, the open rendering scope (and its attachment formats),
 //!    active queries and transform feedback, and debug labels, and refuses what would break a

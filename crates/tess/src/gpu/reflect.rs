@@ -229,7 +229,7 @@ impl Reflection {
         }
     }
 
-    /// Size in bytes of the laid-out struct or block `name` (see [`Self::type_size`]); `None`
+    /// Size in bytes of the laid-out struct or block `name` (see `type_size`); `None`
     /// when absent, ambiguous, or ending in a runtime array.
     pub fn struct_size(&self, name: &str) -> Option<u32> {
         let sizes: Vec<u32> = self

@@ -38,7 +38,7 @@ pub struct PatchRecord {
     pub cp_offset: u32,
     /// `kind | level << 4 | boundary mask << 8 | transition mask << 12`.
     pub info: u32,
-    /// Per edge `i`, four bits at `4i`: edge kind (2 bits), reversed[0], reversed[1].
+    /// Per edge `i`, four bits at `4i`: edge kind (2 bits), `reversed[0]`, `reversed[1]`.
     pub edge_info: u32,
     pub pad: u32,
     /// Edge `i`: `curves[2i]`, `curves[2i + 1]`.

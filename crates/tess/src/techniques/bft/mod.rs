@@ -381,7 +381,7 @@ fn loop_control_mesh(
 }
 
 /// What a [`Bft`] keeps of its packed data once uploaded: counts and byte sizes (the arrays
-/// themselves live only on the GPU; tests build their CPU mirror with [`GpuBft::new`]).
+/// themselves live only on the GPU; tests build their CPU mirror with [`GpuBft::new`](layout::GpuBft::new)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct BftSummary {
     pub base_vertices: u32,
@@ -415,7 +415,7 @@ impl Bft {
     /// product is packed into its GPU form, checked, uploaded and freed before the next is
     /// built, and the level-1 mesh is dropped once the records, tables and tangent stencils
     /// are taken from it. Every array is validated before it is uploaded, as
-    /// [`GpuBft::validate`] does for the whole.
+    /// [`GpuBft::validate`](layout::GpuBft::validate) does for the whole.
     pub fn new(ctx: &mut Context, mesh: &ControlMesh, options: &BftOptions) -> Result<Self> {
         let device = ctx.device().clone();
         let table_level = options.table_level;
@@ -720,13 +720,13 @@ impl Bft {
 
     /// The base face and its domain coordinate `(U, V)` (weights of the base face's corners 1
     /// and 2) of patch coordinate `(u, v)` on level-1 face `patch`
-    /// ([`LoopBft::base_domain`]); `None` past the last patch.
+    /// ([`LoopBft::base_domain`](topology::bft::LoopBft::base_domain)); `None` past the last patch.
     pub fn base_domain(&self, patch: u32, u: f64, v: f64) -> Option<(usize, f64, f64)> {
         let rotation = *self.rotations.get(patch as usize)?;
         Some(level1_base_domain(patch as usize, rotation, u, v))
     }
 
-    /// Bytes of basis-function tables on the GPU ([`GpuBft::table_bytes`]).
+    /// Bytes of basis-function tables on the GPU ([`GpuBft::table_bytes`](layout::GpuBft::table_bytes)).
     pub fn table_bytes(&self) -> usize {
         self.summary.table_bytes as usize
     }
