@@ -74,6 +74,10 @@ pub struct Capabilities {
     pub timeline_semaphore: bool,
     /// Largest width or height of a 2D image, in texels: what textures are checked against.
     pub max_image_dimension_2d: u32,
+    /// `maintenance4` (core in Vulkan 1.3), enabled where present: among other things it lets a
+    /// stage write an output the next stage does not read (a plain build's TES leaves the
+    /// TCS's patch flags unread), which the validation layer otherwise reports every run.
+    pub maintenance4: bool,
 }
 
 /// One physical device as seen at start-up: identity, capabilities, and what it lacks.
@@ -214,6 +218,7 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
             vertex_pipeline_stores_and_atomics: feats.vertex_pipeline_stores_and_atomics
                 == vk::TRUE,
             dynamic_rendering: f13.dynamic_rendering == vk::TRUE,
+            maintenance4: f13.maintenance4 == vk::TRUE,
             timestamps,
             max_tessellation_generation_level: props.limits.max_tessellation_generation_level,
             max_tessellation_patch_size: props.limits.max_tessellation_patch_size,
@@ -496,7 +501,9 @@ impl Device {
             .pipeline_statistics_query(info.caps.pipeline_statistics_query)
             .vertex_pipeline_stores_and_atomics(info.caps.vertex_pipeline_stores_and_atomics);
         let mut f12 = vk::PhysicalDeviceVulkan12Features::default().timeline_semaphore(true);
-        let mut f13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true);
+        let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
+            .dynamic_rendering(true)
+            .maintenance4(info.caps.maintenance4);
         // Transform feedback is enabled whenever the device has it: capture is optional, and
         // enabling it costs nothing when unused.
         let xfb = info.caps.transform_feedback && !desc.without_transform_feedback;
