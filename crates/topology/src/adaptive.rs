@@ -79,7 +79,7 @@
 //!   stencil tables.
 
 use crate::error::TopologyError;
-use crate::limit::{catmark_limit_masks, LimitRule, LimitVertex};
+use crate::limit::catmark_smooth_position_weights;
 use crate::mesh::{ControlMesh, Topology, INVALID};
 use crate::patch::catmark_regular_weights;
 use crate::refine::{refine_sparse, ChildMaps, ChildOrigin, LevelTopology};

@@ -19,7 +19,8 @@
 //!
 //! `T_i(w)` is the limit tangent of the corner vertex toward its edge-neighbour `w`, scaled as a
 //! parametric derivative (exactly the B-spline derivative at a regular vertex):
-//! * smooth vertex (also a dart) of valence `n`: [`smooth_directional_tangent`] (Halstead's
+//! * smooth vertex (also a dart) of valence `n`:
+//!   [`smooth_directional_tangent`](crate::limit::smooth_directional_tangent) (Halstead's
 //!   eigenvector masks rotated onto edge `k`, `1/(3n)` of the mask);
 //! * crease (two sharp edges, boundary edges count), sector of `m` faces between the sharp
 //!   edges `a` and `b` (CCW, the face inside): `T(k) = cos θ·T_along + sin θ·T_across`,
@@ -104,7 +105,7 @@ use thiserror::Error;
 use crate::error::TopologyError;
 use crate::limit::{
     catmark_directional_tangent_each, catmark_limit_masks, catmark_smooth_position_weights,
-    smooth_directional_tangent, LimitRule, LimitVertex, Mask,
+    LimitRule, LimitVertex, Mask,
 };
 use crate::mesh::{SubdivOptions, Topology};
 use crate::patch::PatchWeights;
@@ -323,23 +324,14 @@ impl Corner {
         match self.kind {
             Kind::Smooth => {
                 // Edge weights first, then face weights, as the rows were always summed.
-                let mut fw = [0.0; 64];
+                let mut fw: SmallVec<[f64; 16]> = SmallVec::new();
                 let mut r = Row::default();
                 catmark_directional_tangent_each(n, k, |i, e, f| {
                     r.add(self.fan.ring[i], e);
-                    if let Some(x) = fw.get_mut(i) {
-                        *x = f;
-                    }
+                    fw.push(f);
                 });
-                if n <= fw.len() {
-                    for (i, &w) in fw[..n].iter().enumerate() {
-                        r.add(self.diag(t, i), w);
-                    }
-                } else {
-                    let (_, fw) = smooth_directional_tangent(false, n, k);
-                    for (i, &w) in fw.iter().enumerate() {
-                        r.add(self.diag(t, i), w);
-                    }
+                for (i, &w) in fw.iter().enumerate() {
+                    r.add(self.diag(t, i), w);
                 }
                 r
             }

@@ -401,11 +401,11 @@ pub(super) fn assemble(
     }
     locals.append_par(
         &needed,
-        || (Vec::new(), Vec::with_capacity(32)),
-        |_, &(l, v), (cache, terms), table| {
+        || Vec::with_capacity(32),
+        |_, &(l, v), terms, table| {
             let lvl = &levels[l as usize];
             terms.clear();
-            limit_stencil(lvl, v as usize, cache, terms);
+            limit_stencil(lvl, v as usize, terms);
             for t in terms.iter_mut() {
                 t.0 += lvl.base;
             }
@@ -833,10 +833,9 @@ fn triangle_draft(mesh: &ControlMesh, levels: &[Lvl], f: usize) -> Result<Draft,
         .map(|&e| maps.edge_child_vertex[e as usize])
         .collect();
     if fc != INVALID && !ec.contains(&INVALID) {
-        let mut cache = Vec::new();
-        let mut limit = |v: u32| {
+        let limit = |v: u32| {
             let mut out = Vec::new();
-            limit_stencil(l1, v as usize, &mut cache, &mut out);
+            limit_stencil(l1, v as usize, &mut out);
             out
         };
         let centre = limit(fc);

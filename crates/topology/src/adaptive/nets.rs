@@ -322,35 +322,9 @@ pub(super) fn push_row(table: &mut StencilTable, terms: &mut [(u32, f64)]) {
     table.offsets.push(table.indices.len() as u32);
 }
 
-/// Weights (vertex, each edge-neighbour, each face-opposite vertex) of the smooth
-/// Catmull-Clark limit position mask of valence `n` ([`crate::limit`]), cached per valence.
-pub(super) fn smooth_mask(cache: &mut Vec<Option<[f64; 3]>>, n: usize) -> [f64; 3] {
-    if cache.len() <= n {
-        cache.resize(n + 1, None);
-    }
-    *cache[n].get_or_insert_with(|| {
-        let m = catmark_limit_masks(&LimitVertex {
-            valence: n,
-            boundary: false,
-            rule: LimitRule::Smooth,
-        })
-        .position;
-        [
-            m.vertex,
-            m.edges.first().copied().unwrap_or(0.0),
-            m.faces.first().copied().unwrap_or(0.0),
-        ]
-    })
-}
-
 /// Limit-position stencil (level-local ids) of vertex `v` of `lvl` (its ring complete).
 /// Only positions are needed, and their masks do not depend on the ring's order.
-pub(super) fn limit_stencil(
-    lvl: &Lvl,
-    v: usize,
-    cache: &mut Vec<Option<[f64; 3]>>,
-    out: &mut Vec<(u32, f64)>,
-) {
+pub(super) fn limit_stencil(lvl: &Lvl, v: usize, out: &mut Vec<(u32, f64)>) {
     let t = lvl.t();
     let edges = t.vertex_edges(v);
     let faces = t.vertex_faces(v);
@@ -388,7 +362,7 @@ pub(super) fn limit_stencil(
             }
         }
         Rule::Smooth | Rule::Dart => {
-            let [wv, we, wf] = smooth_mask(cache, edges.len());
+            let [wv, we, wf] = catmark_smooth_position_weights(edges.len());
             out.push((v as u32, wv));
             for &e in edges {
                 out.push((other(e), we));
