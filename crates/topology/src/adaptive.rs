@@ -114,7 +114,9 @@ pub struct AdaptiveOptions {
     /// infinite tags and boundary edges stay infinitely sharp.
     pub sharpness_scale: f32,
     /// Follow semi-sharp creases and corners past the isolation level until their sharpness
-    /// has decayed (at most level 10), so the surface beside them is exact; off, leftover
+    /// has decayed, then isolate the irregular vertices that carried them `isolation` more
+    /// levels, as every other irregular vertex is (at most level 10 in all), so the surface
+    /// beside them is exact and its end caps converge with the isolation level; off, leftover
     /// sharpness at the isolation level is treated as infinite (OpenSubdiv's and the seed's
     /// behaviour).
     pub follow_semi_sharp: bool,

@@ -186,6 +186,24 @@ fn end_caps_converge_with_isolation() {
     }
 }
 
+/// An end cap beside a semi-sharp crease gets the isolation level's smooth steps after the
+/// crease decays, as every other end cap does, so its error shrinks with the isolation level.
+/// catmark_cube_creases1's sharpness-5 creases meet at valence-3 corners; capped on the level
+/// where the creases decay (the former rule), its caps were the same 8.7e-5 of the diagonal at
+/// isolation 4 and 5.
+#[test]
+fn caps_beside_decayed_creases_shrink_with_isolation() {
+    let mesh = load_obj(format!("{SHAPES}catmark_cube_creases1.obj")).expect("shape");
+    let caps: Vec<f64> = (3..=5)
+        .map(|iso| deviations(&mesh, iso, EndCap::Gregory).0)
+        .collect();
+    println!("catmark_cube_creases1 Gregory caps, isolation 3..5: {caps:?}");
+    assert!(caps[1] <= 5e-5, "isolation 4: caps {:.3e}", caps[1]);
+    for w in caps.windows(2) {
+        assert!(w[1] < 0.5 * w[0], "caps do not shrink: {caps:?}");
+    }
+}
+
 #[test]
 fn curves_are_each_patch_edge_and_corners_are_shared() {
     for (name, mesh) in shapes() {

@@ -96,7 +96,8 @@ pub struct SurfaceArgs {
     pub split_triangles: bool,
     /// Stop semi-sharp creases at the isolation level, their leftover sharpness treated as
     /// infinite there (adaptive; OpenSubdiv's behaviour). By default they are followed until
-    /// they decay, so the surface beside them is exact.
+    /// they decay, and end caps beside them get the isolation level's smooth steps after that,
+    /// so the surface beside them is exact and their caps as close as any other.
     #[arg(long)]
     pub creases_at_isolation: bool,
     /// Adaptive edge factors (bft): screen (projected edge length / --pixels) or distance

@@ -51,7 +51,8 @@ pub struct BenchConfig {
     pub cpu_max_vertices: u64,
     /// Isolation level of the feature-adaptive rows.
     pub isolation: u32,
-    /// Follow semi-sharp creases past it until they decay.
+    /// Follow semi-sharp creases past it until they decay (and `isolation` levels more at the
+    /// irregular vertices beside them).
     pub follow_semi_sharp: bool,
     /// Compare at equal output triangles: at each mesh and S, every method whose triangle
     /// count is known beforehand draws at the whole level (segments per its own edge: per

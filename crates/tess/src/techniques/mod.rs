@@ -174,7 +174,8 @@ pub struct BuildOptions {
     pub end_cap: topology::adaptive::EndCap,
     /// Scales every crease and corner sharpness.
     pub sharpness_scale: f32,
-    /// Follow semi-sharp creases past the isolation level until they decay.
+    /// Follow semi-sharp creases past the isolation level until they decay (and the irregular
+    /// vertices beside them `isolation` levels more).
     pub follow_semi_sharp: bool,
     /// Single-pass methods: split triangles into three quad patches instead of one Gregory
     /// triangle patch each.

@@ -72,6 +72,8 @@ impl Lvl {
 /// finite sharpness has decayed by then (uniform or Chaikin).
 pub(super) const SEMI_SHARP_LIMIT: usize = 10;
 
+const NEVER: u32 = u32::MAX;
+
 /// Whether vertex `v` carries a semi-sharp feature (a finite positive sharpness on an incident
 /// edge or on itself) that has not decayed yet.
 fn semi_sharp(lvl: &Lvl, v: usize) -> bool {
@@ -85,10 +87,14 @@ fn semi_sharp(lvl: &Lvl, v: usize) -> bool {
 }
 
 /// The plan's levels: irregular faces isolated to `iso`; with `follow_semi_sharp`, faces at
-/// semi-sharp features further, until the sharpness has decayed (at most
-/// [`SEMI_SHARP_LIMIT`]), so the patches beside a crease of sharpness 7.5 are exact instead of
-/// treating the leftover sharpness as infinite. Faces that stop being selected at or past
-/// `iso` while still irregular become end caps at their level.
+/// semi-sharp features further, until the sharpness has decayed, and then `iso` more levels
+/// (at most [`SEMI_SHARP_LIMIT`] in all), so the patches beside a crease of sharpness 7.5 are
+/// exact instead of treating the leftover sharpness as infinite. The `iso` levels after the
+/// decay are what every other irregular vertex gets: an end cap placed on the level where a
+/// crease just decayed sits on a net that has had no smooth step yet, and its error does not
+/// shrink with the isolation level (catmark_bishop's caps at its sharpness-6 rims were
+/// 6.3e-4 of the diagonal at isolation 4, 5 and 6 alike). Faces that stop being selected at
+/// or past `iso` while still irregular become end caps at their level.
 ///
 /// `single_pass` (the single-pass plans, [`super::single_pass`]) selects at level 0 only the
 /// faces a one-patch-per-face approximation cannot cover (the faces with a corner next to a
@@ -136,6 +142,9 @@ pub(super) fn build_levels(
     }];
     // Refined faces held so far (every level past 0); see "Size bound" in the module docs.
     let mut refined = 0u64;
+    // Per vertex of the current level: the last level at which it carried a semi-sharp feature
+    // (`NEVER` if it never did).
+    let mut last_semi_sharp = vec![NEVER; nv];
     let deepest = if follow_semi_sharp {
         SEMI_SHARP_LIMIT.max(iso)
     } else {
@@ -182,11 +191,20 @@ pub(super) fn build_levels(
                         .any(|&f| t.face_vertices(f as usize).len() != 4)
                 })
                 .collect()
-        } else if l < iso {
-            lvl.irregular.clone()
         } else {
+            for (v, last) in last_semi_sharp.iter_mut().enumerate() {
+                if follow_semi_sharp && lvl.irregular[v] && semi_sharp(lvl, v) {
+                    *last = l as u32;
+                }
+            }
             (0..lvl.t().num_vertices())
-                .map(|v| lvl.irregular[v] && semi_sharp(lvl, v))
+                .map(|v| {
+                    lvl.irregular[v]
+                        && (l < iso
+                            || (follow_semi_sharp
+                                && last_semi_sharp[v] != NEVER
+                                && l < last_semi_sharp[v] as usize + 1 + iso))
+                })
                 .collect()
         };
         let t = &lvl.topo.topology;
@@ -255,6 +273,14 @@ pub(super) fn build_levels(
             .map(|(c, o)| match *o {
                 ChildOrigin::Vertex(p) => lvl.anc[p as usize],
                 _ => base + c as u32,
+            })
+            .collect();
+        last_semi_sharp = maps
+            .child_vertex_origin
+            .iter()
+            .map(|o| match *o {
+                ChildOrigin::Vertex(p) => last_semi_sharp[p as usize],
+                _ => NEVER,
             })
             .collect();
         let kv = maps

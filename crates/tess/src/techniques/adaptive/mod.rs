@@ -240,8 +240,8 @@ pub struct AdaptiveBuild {
     pub end_cap: EndCap,
     /// Multiplies every crease and corner sharpness (the seed's run-time sharpness change).
     pub sharpness_scale: f32,
-    /// Follow semi-sharp creases past the isolation level until they decay (exact beside
-    /// them); off, leftover sharpness is treated as infinite at the isolation level
+    /// Follow semi-sharp creases past the isolation level until they decay, then isolate the
+    /// irregular vertices beside them `isolation` more levels (exact beside them); off, leftover sharpness is treated as infinite at the isolation level
     /// (OpenSubdiv's behaviour).
     pub follow_semi_sharp: bool,
     /// Name for messages (the mesh's file).
