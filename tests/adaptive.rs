@@ -5,6 +5,7 @@
 //! error fails (tests/common).
 mod common;
 use common::Gpu;
+use rayon::prelude::*;
 use tessera::tess::capture::{classify_open_edges, CapturedSoup, Capturer};
 use tessera::tess::gpu::bindings::{ADAPTIVE_FLAG_LEVEL_SHIFT, ADAPTIVE_KIND_REGULAR};
 use tessera::tess::techniques::adaptive::{Adaptive, AdaptiveBuild};
@@ -158,44 +159,74 @@ fn deviations_with(
     }
     let stride = n.div_ceil(samples).max(1);
     let d = diag(mesh);
-    let (mut regular, mut caps, mut caps_geometric) = (0.0f64, 0.0f64, 0.0f64);
-    for (i, by) in captured_by.iter().enumerate() {
-        let cap = welded.flags[i] & 15 != ADAPTIVE_KIND_REGULAR;
-        if !cap && i % stride != 0 {
-            continue;
-        }
-        let [u, v] = welded.domain[i].map(f64::from);
-        let (f, sub, bu, bv) = surf.base_param(welded.patch[i], u, v).expect("patch");
-        let quad = mesh.face(f as usize).len() == 4;
-        let e = if quad {
-            cpu.evaluate(f as usize, bu, bv)
-        } else {
-            cpu.evaluate_subface(f as usize, sub as usize, bu, bv)
-        }
-        .expect("exact limit");
-        let p = welded.positions[i].map(f64::from);
-        let err = (0..3)
-            .map(|k| (p[k] - e.position[k]).abs())
-            .fold(0.0, f64::max)
-            / d;
-        if !cap {
-            regular = regular.max(err);
-        } else {
-            caps = caps.max(err);
-            if geometric && err * d > 1e-7 {
-                let g = by
-                    .iter()
-                    .map(|&(patch, [u, v])| {
-                        let (f, sub, bu, bv) = surf
-                            .base_param(patch, f64::from(u), f64::from(v))
-                            .expect("patch");
-                        let quad = mesh.face(f as usize).len() == 4;
-                        geometric_distance(&cpu, quad, f as usize, sub as usize, (bu, bv), p)
+    // Base parameters first (the surface stays on this thread), then the exact limit and the
+    // nearest-point searches in parallel.
+    type At = (usize, usize, f64, f64, bool);
+    let at = |patch: u32, [u, v]: [f32; 2]| -> At {
+        let (f, sub, bu, bv) = surf
+            .base_param(patch, f64::from(u), f64::from(v))
+            .expect("patch");
+        (
+            f as usize,
+            sub as usize,
+            bu,
+            bv,
+            mesh.face(f as usize).len() == 4,
+        )
+    };
+    let work: Vec<(bool, [f64; 3], At, Vec<At>)> = captured_by
+        .iter()
+        .enumerate()
+        .filter_map(|(i, by)| {
+            let cap = welded.flags[i] & 15 != ADAPTIVE_KIND_REGULAR;
+            (cap || i % stride == 0).then(|| {
+                let all = if cap && geometric {
+                    by.iter().map(|&(patch, uv)| at(patch, uv)).collect()
+                } else {
+                    Vec::new()
+                };
+                (
+                    cap,
+                    welded.positions[i].map(f64::from),
+                    at(welded.patch[i], welded.domain[i]),
+                    all,
+                )
+            })
+        })
+        .collect();
+    let measured: Vec<(bool, f64, f64)> = work
+        .par_iter()
+        .map(|(cap, p, (f, sub, bu, bv, quad), all)| {
+            let e = if *quad {
+                cpu.evaluate(*f, *bu, *bv)
+            } else {
+                cpu.evaluate_subface(*f, *sub, *bu, *bv)
+            }
+            .expect("exact limit");
+            let err = (0..3)
+                .map(|k| (p[k] - e.position[k]).abs())
+                .fold(0.0, f64::max)
+                / d;
+            let g = if *cap && geometric && err * d > 1e-7 {
+                all.iter()
+                    .map(|&(f, sub, bu, bv, quad)| {
+                        geometric_distance(&cpu, quad, f, sub, (bu, bv), *p)
                     })
                     .fold(f64::MAX, f64::min)
-                    / d;
-                caps_geometric = caps_geometric.max(g);
-            }
+                    / d
+            } else {
+                0.0
+            };
+            (*cap, err, g)
+        })
+        .collect();
+    let (mut regular, mut caps, mut caps_geometric) = (0.0f64, 0.0f64, 0.0f64);
+    for (cap, err, g) in measured {
+        if cap {
+            caps = caps.max(err);
+            caps_geometric = caps_geometric.max(g);
+        } else {
+            regular = regular.max(err);
         }
     }
     (regular, caps, caps_geometric)
