@@ -192,9 +192,11 @@ pub(super) fn build_levels(
                 })
                 .collect()
         } else {
-            for (v, last) in last_semi_sharp.iter_mut().enumerate() {
-                if follow_semi_sharp && lvl.irregular[v] && semi_sharp(lvl, v) {
-                    *last = l as u32;
+            if follow_semi_sharp {
+                for (v, last) in last_semi_sharp.iter_mut().enumerate() {
+                    if lvl.irregular[v] && semi_sharp(lvl, v) {
+                        *last = l as u32;
+                    }
                 }
             }
             (0..lvl.t().num_vertices())
@@ -275,14 +277,16 @@ pub(super) fn build_levels(
                 _ => base + c as u32,
             })
             .collect();
-        last_semi_sharp = maps
-            .child_vertex_origin
-            .iter()
-            .map(|o| match *o {
-                ChildOrigin::Vertex(p) => last_semi_sharp[p as usize],
-                _ => NEVER,
-            })
-            .collect();
+        if follow_semi_sharp {
+            last_semi_sharp = maps
+                .child_vertex_origin
+                .iter()
+                .map(|o| match *o {
+                    ChildOrigin::Vertex(p) => last_semi_sharp[p as usize],
+                    _ => NEVER,
+                })
+                .collect();
+        }
         let kv = maps
             .child_vertex_origin
             .iter()
