@@ -298,8 +298,11 @@ fn captured_vertices_are_the_exact_limit() {
             // cap vertices (6.5e-5) lie on base-face edges 2 % of an edge from an
             // extraordinary vertex, where the cap's cubic edge curve cannot follow the
             // non-polynomial limit curve; a stride over the vertices had missed them (4.7e-5).
+            // catmark_cubes_infsharp (1.1e-3) has an infinitely sharp corner and creases that
+            // end inside (the same class as catmark_cube_corner4; docs/approximations.md).
             let bound = match name.as_str() {
                 "spot" => 1e-4,
+                "catmark_cubes_infsharp" => 2e-3,
                 "catmark_cube_corner4" => 2e-3,
                 "catmark_bishop" => 3e-4,
                 _ => 5e-5,

@@ -89,7 +89,7 @@ fn cracks(surf: &Bft, soup: &CapturedSoup, mesh: &ControlMesh) -> (usize, usize,
 
 /// Every captured vertex equals the exact limit within 1e-5 of the diagonal, for S = 2…64, on
 /// OpenSubdiv's Loop shapes (valences 3 to 64, boundaries, coarse meshes with overlapping
-/// rings) and the triangulated spot; all come from table points (flag bit 0).
+/// rings, darts) and the triangulated spot; all come from table points (flag bit 0).
 #[test]
 fn captured_bft_vertices_are_the_exact_limit() {
     let gpu = Gpu::new();
@@ -102,6 +102,12 @@ fn captured_bft_vertices_are_the_exact_limit() {
             ("loop_pole64", shape("loop_pole64"), &[2, 16, 64]),
             ("loop_xord_boundary", shape("loop_xord_boundary"), &[4, 32]),
             ("loop_tetrahedron", shape("loop_tetrahedron"), &[2, 64]),
+            // Darts: infinitely sharp edges ending inside (their exact limit position).
+            (
+                "loop_cubes_infsharp",
+                shape("loop_cubes_infsharp"),
+                &[8, 32],
+            ),
             (
                 "loop_saddle_edgeonly",
                 shape("loop_saddle_edgeonly"),

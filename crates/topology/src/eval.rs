@@ -933,7 +933,7 @@ impl View<'_> {
         let j = fan.faces.iter().position(|&(g, _)| g == f as u32)?;
         let dir = |k: usize| -> Vec<f64> {
             match lv.rule {
-                LimitRule::Smooth => self.directional(&fan, k % n),
+                LimitRule::Smooth | LimitRule::Dart { .. } => self.directional(&fan, k % n),
                 LimitRule::Crease { ends } => {
                     let m = ((ends[1] + n - ends[0]) % n).max(1);
                     let th = std::f64::consts::PI * ((k + n - ends[0]) % n) as f64 / m as f64;
@@ -1175,7 +1175,8 @@ fn limit_rule(
         }
     }
     let rule = match vertex_rule(vs, count) {
-        Rule::Smooth | Rule::Dart => LimitRule::Smooth,
+        Rule::Smooth => LimitRule::Smooth,
+        Rule::Dart => LimitRule::Dart { edge: sharp[0] },
         Rule::Crease => {
             let (a, b) = (sharp[0], sharp[1]);
             let ends = if boundary {

@@ -189,14 +189,14 @@ impl Row {
 /// after `v` in face `i` (plus the last neighbour of a boundary fan), `edges[i]` the edge to
 /// `ring[i]`. Starts at the face whose leaving edge is a boundary edge, else at the first face
 /// the topology lists, so the order is a property of the vertex alone.
-struct Fan {
-    faces: SmallVec<[(u32, usize); 8]>,
-    ring: SmallVec<[u32; 9]>,
-    edges: SmallVec<[u32; 9]>,
-    boundary: bool,
+pub(crate) struct Fan {
+    pub(crate) faces: SmallVec<[(u32, usize); 8]>,
+    pub(crate) ring: SmallVec<[u32; 9]>,
+    pub(crate) edges: SmallVec<[u32; 9]>,
+    pub(crate) boundary: bool,
 }
 
-fn build_fan(t: &Topology, v: u32) -> Option<Fan> {
+pub(crate) fn build_fan(t: &Topology, v: u32) -> Option<Fan> {
     let vf = t.vertex_faces(v as usize);
     let corner = |g: u32| t.face_vertices(g as usize).iter().position(|&x| x == v);
     let leaving_boundary = |g: u32| -> Option<bool> {
@@ -468,6 +468,16 @@ fn build_corner(
         across: Row::default(),
     };
     match kind {
+        Kind::Smooth if sharp_count == 1 && !corner.fan.boundary => {
+            // A dart: the smooth tangents, but its own limit position.
+            let edge = corner.sharp.iter().position(|&x| x).unwrap_or(0);
+            let masks = catmark_limit_masks(&LimitVertex {
+                valence: n,
+                boundary: false,
+                rule: LimitRule::Dart { edge },
+            });
+            corner.p = corner.mask_row(t, &masks.position);
+        }
         Kind::Smooth => {
             // Only the position: the tangents come from `Corner::tangent`.
             let [vw, ew, fw] = catmark_smooth_position_weights(n);

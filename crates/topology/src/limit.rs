@@ -1,6 +1,7 @@
 //! Limit masks: weights that push a vertex of any refinement level onto the limit surface,
 //! with two limit tangents (OpenSubdiv `Sdc` semantics for smooth, crease/boundary and corner
-//! vertices).
+//! vertices). At a dart Tessera departs from `Sdc`, whose smooth mask is not the limit there:
+//! see [`dart_position_weights`].
 //!
 //! A mask is expressed over the vertex's ordered one-ring:
 //! * `vertex`: the vertex itself;
@@ -20,8 +21,12 @@ use std::f64::consts::PI;
 /// Which limit rule applies at a vertex (the refinement rule once sharpness has decayed).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LimitRule {
-    /// Smooth interior vertex (also a dart: one sharp edge).
+    /// Smooth interior vertex.
     Smooth,
+    /// Interior vertex with one infinitely sharp edge (`edge`, its index in the ring): the
+    /// smooth vertex rule, but the sharp edge's child is its midpoint, so the limit position is
+    /// [`dart_position_weights`]'s, not the smooth mask's. Tangents are the smooth masks'.
+    Dart { edge: usize },
     /// Two infinitely sharp edges (boundary edges count): `ends` are their indices in the ring,
     /// `ends[0]` the leading edge (CCW start of the span containing the surface).
     Crease { ends: [usize; 2] },
@@ -100,7 +105,7 @@ pub fn loop_limit_masks(v: &LimitVertex) -> LimitMasks {
     let mut t1 = Mask::zero(n, 0);
     let mut t2 = Mask::zero(n, 0);
     match v.rule {
-        LimitRule::Smooth => {
+        LimitRule::Smooth | LimitRule::Dart { .. } => {
             let nf = n as f64;
             let beta = 0.25 * (2.0 * PI / nf).cos() + 0.375;
             let gamma = (0.625 - beta * beta) / nf;
@@ -109,6 +114,9 @@ pub fn loop_limit_masks(v: &LimitVertex) -> LimitMasks {
             pos.edges.iter_mut().for_each(|w| *w = e);
             for i in 0..n {
                 (t1.edges[i], t2.edges[i]) = loop_smooth_tangent_weights(n, i);
+            }
+            if let LimitRule::Dart { edge } = v.rule {
+                set_dart_position(&mut pos, true, n, edge);
             }
         }
         LimitRule::Crease { ends } => {
@@ -197,6 +205,101 @@ fn corner_tangents(t1: &mut Mask, t2: &mut Mask, v: &LimitVertex, scale: f64) {
 }
 
 /// Weights (vertex, each edge neighbour, each face-opposite vertex) of the smooth interior
+/// Exact limit-position weights of an interior dart of valence `n` (one infinitely sharp edge),
+/// over its ring `[v, e_0 … e_{n−1}]` (Loop) or `[v, e_0 … e_{n−1}, f_0 … f_{n−1}]`
+/// (Catmull-Clark; `f_i` opposite `v` in the quad between `e_i` and `e_{i+1}`), the sharp edge
+/// being `e_0`.
+///
+/// OpenSubdiv (and this crate before) used the smooth mask at a dart. But the sharp edge's child
+/// is its midpoint, so the dart's subdivision matrix `S` differs from the smooth one and so does
+/// its left eigenvector for eigenvalue 1, the limit mask: the smooth mask was off by 1.3e-2 of
+/// the diagonal on OpenSubdiv's catmark_cubes_infsharp. The ring is closed under refinement, so
+/// the mask is `e_v · S^k` as `k → ∞`: the weights of the vertex's level-`k` position over the
+/// level-0 ring, iterated until they stop changing (the error shrinks by the subdominant
+/// eigenvalue per step).
+pub fn dart_position_weights(loop_scheme: bool, n: usize) -> Vec<f64> {
+    let size = if loop_scheme { 1 + n } else { 1 + 2 * n };
+    let e = |i: usize| 1 + i % n;
+    let f = |i: usize| 1 + n + i % n;
+    let mut w = vec![0.0; size];
+    w[0] = 1.0;
+    let mut next = vec![0.0; size];
+    for _ in 0..10_000 {
+        next.iter_mut().for_each(|x| *x = 0.0);
+        // `next = w · S`: each child's weight spread over the parents its rule reads.
+        if loop_scheme {
+            let ew = (0.625 - (0.25 * (2.0 * PI / n as f64).cos() + 0.375).powi(2)) / n as f64;
+            let ew = if n == 6 { 0.0625 } else { ew };
+            next[0] += w[0] * (1.0 - ew * n as f64);
+            for i in 0..n {
+                next[e(i)] += w[0] * ew;
+            }
+            for i in 0..n {
+                let c = w[e(i)];
+                if i == 0 {
+                    next[0] += 0.5 * c;
+                    next[e(0)] += 0.5 * c;
+                } else {
+                    next[0] += 0.375 * c;
+                    next[e(i)] += 0.375 * c;
+                    next[e(i + n - 1)] += 0.125 * c;
+                    next[e(i + 1)] += 0.125 * c;
+                }
+            }
+        } else {
+            // A face point: a quarter of each corner of quad `i`.
+            let face = |next: &mut Vec<f64>, i: usize, c: f64| {
+                next[0] += 0.25 * c;
+                next[e(i)] += 0.25 * c;
+                next[f(i)] += 0.25 * c;
+                next[e(i + 1)] += 0.25 * c;
+            };
+            let nf = n as f64;
+            let ew = 1.0 / (nf * nf);
+            next[0] += w[0] * (nf - 2.0) / nf;
+            for i in 0..n {
+                next[e(i)] += w[0] * ew;
+                face(&mut next, i, w[0] * ew);
+            }
+            for i in 0..n {
+                let c = w[e(i)];
+                if i == 0 {
+                    next[0] += 0.5 * c;
+                    next[e(0)] += 0.5 * c;
+                } else {
+                    next[0] += 0.25 * c;
+                    next[e(i)] += 0.25 * c;
+                    face(&mut next, i + n - 1, 0.25 * c);
+                    face(&mut next, i, 0.25 * c);
+                }
+                face(&mut next, i, w[f(i)]);
+            }
+        }
+        let change = w
+            .iter()
+            .zip(&next)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        std::mem::swap(&mut w, &mut next);
+        if change < 1e-17 {
+            break;
+        }
+    }
+    w
+}
+
+/// Replace a smooth position mask with the dart's, its sharp edge at ring index `edge`.
+fn set_dart_position(pos: &mut Mask, loop_scheme: bool, n: usize, edge: usize) {
+    let w = dart_position_weights(loop_scheme, n);
+    pos.vertex = w[0];
+    for j in 0..n {
+        pos.edges[(edge + j) % n] = w[1 + j];
+        if !loop_scheme {
+            pos.faces[(edge + j) % n] = w[1 + n + j];
+        }
+    }
+}
+
 /// Catmull-Clark limit position of valence `n`: the position mask of [`catmark_limit_masks`]
 /// without its allocations, for callers that need only the position.
 pub fn catmark_smooth_position_weights(n: usize) -> [f64; 3] {
@@ -210,13 +313,16 @@ pub fn catmark_limit_masks(v: &LimitVertex) -> LimitMasks {
     let n = v.valence;
     let nf_count = n_faces(v);
     match v.rule {
-        LimitRule::Smooth => {
+        LimitRule::Smooth | LimitRule::Dart { .. } => {
             let nf = n as f64;
             let mut pos = Mask::zero(n, n);
             let [vw, ew, fw] = catmark_smooth_position_weights(n);
             pos.vertex = vw;
             pos.edges.iter_mut().for_each(|w| *w = ew);
             pos.faces.iter_mut().for_each(|w| *w = fw);
+            if let LimitRule::Dart { edge } = v.rule {
+                set_dart_position(&mut pos, false, n, edge);
+            }
             let mut t1 = Mask::zero(n, n);
             let mut t2 = Mask::zero(n, n);
             let c = (2.0 * PI / nf).cos();

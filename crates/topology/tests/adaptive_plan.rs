@@ -204,6 +204,34 @@ fn caps_beside_decayed_creases_shrink_with_isolation() {
     }
 }
 
+/// Every patch corner is its canonical limit point, the exact limit, darts included
+/// (catmark_cubes_infsharp's single infinitely sharp edges end in darts, whose limit is not the
+/// smooth mask's: 3e-4 of the diagonal at isolation 4 before the dart mask).
+#[test]
+fn patch_corners_are_the_exact_limit_at_darts() {
+    let mesh = load_obj(format!("{SHAPES}catmark_cubes_infsharp.obj")).expect("shape");
+    let lm = LocalMesh::from_control_mesh(&mesh, LimitScheme::CatmullClark).expect("mesh");
+    let d = diag(&mesh);
+    for iso in [2, 4] {
+        for end_cap in [EndCap::Gregory, EndCap::Bilinear] {
+            let plan = plan_adaptive(&mesh, &options(iso, end_cap)).expect("plan");
+            let verts = plan.apply(&mesh.positions);
+            let mut worst = 0.0f64;
+            for p in 0..plan.patches.len() {
+                for (u, v) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+                    let got = plan.evaluate(&verts, p, u, v).position;
+                    worst = worst.max(dist(&got, &exact(&lm, &plan, p, u, v)));
+                }
+            }
+            assert!(
+                worst <= 1e-9 * d,
+                "isolation {iso} {end_cap:?}: a patch corner is {:.3e} off the limit",
+                worst / d
+            );
+        }
+    }
+}
+
 #[test]
 fn curves_are_each_patch_edge_and_corners_are_shared() {
     for (name, mesh) in shapes() {

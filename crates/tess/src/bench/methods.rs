@@ -466,6 +466,35 @@ pub fn cpu_limit_mesh(mesh: &ControlMesh, scheme: Scheme, level: usize) -> Resul
     Ok(CpuLimitMesh { vertices, indices })
 }
 
+/// The edge-neighbours of interior vertex `v` in cyclic order (either way round) from `first`,
+/// walking its triangles; `None` if they do not close into one cycle.
+fn cyclic_ring(t: &topology::mesh::Topology, v: usize, first: u32) -> Option<Vec<u32>> {
+    let faces = t.vertex_faces(v);
+    let (vv, mut prev) = (v as u32, u32::MAX);
+    let mut ring = vec![first];
+    loop {
+        let cur = *ring.last()?;
+        let f = faces.iter().copied().find(|&f| {
+            let fv = t.face_vertices(f as usize);
+            f != prev && fv.contains(&vv) && fv.contains(&cur)
+        })?;
+        let next = t
+            .face_vertices(f as usize)
+            .iter()
+            .copied()
+            .find(|&x| x != vv && x != cur)?;
+        prev = f;
+        if next == first {
+            break;
+        }
+        ring.push(next);
+        if ring.len() > faces.len() {
+            return None;
+        }
+    }
+    (ring.len() == t.vertex_edges(v).len() && ring.len() == faces.len()).then_some(ring)
+}
+
 /// Limit positions of every vertex of a Loop level by the limit masks of
 /// [`topology::limit::loop_limit_masks`], read straight off the level's edge lists and
 /// sharpness: what a CPU application does, without building an evaluator. `None` when a
@@ -511,6 +540,20 @@ pub fn loop_limit_positions(level: &Level) -> Option<Vec<[f64; 3]>> {
                 level.positions[sharp[1] as usize],
             );
             std::array::from_fn(|k| w.vertex * p[k] + w.edges[0] * a[k] + w.edges[1] * b[k])
+        } else if sharp.len() == 1 {
+            // A dart: its own mask ([`topology::limit::dart_position_weights`]) over the ring
+            // in cyclic order from the sharp edge; a ring that cannot be walked takes the
+            // evaluator's path.
+            let ring = cyclic_ring(t, v, sharp[0])?;
+            let w = topology::limit::dart_position_weights(true, ring.len());
+            let mut q = p.map(|c| w[0] * c);
+            for (j, &x) in ring.iter().enumerate() {
+                let r = level.positions[x as usize];
+                for k in 0..3 {
+                    q[k] += w[1 + j] * r[k];
+                }
+            }
+            q
         } else {
             let (wv, we) = *smooth.entry(n).or_insert_with(|| {
                 let m = loop_limit_masks(&LimitVertex {

@@ -323,7 +323,8 @@ pub(super) fn push_row(table: &mut StencilTable, terms: &mut [(u32, f64)]) {
 }
 
 /// Limit-position stencil (level-local ids) of vertex `v` of `lvl` (its ring complete).
-/// Only positions are needed, and their masks do not depend on the ring's order.
+/// Only positions are needed, and their masks do not depend on the ring's order, except a
+/// dart's (walked as a fan from its sharp edge).
 pub(super) fn limit_stencil(lvl: &Lvl, v: usize, out: &mut Vec<(u32, f64)>) {
     let t = lvl.t();
     let edges = t.vertex_edges(v);
@@ -353,15 +354,39 @@ pub(super) fn limit_stencil(lvl: &Lvl, v: usize, out: &mut Vec<(u32, f64)>) {
     } else {
         vertex_rule(vs, count)
     };
-    match rule {
-        Rule::Corner => out.push((v as u32, 1.0)),
-        Rule::Crease => {
+    let dart_fan = (rule == Rule::Dart)
+        .then(|| crate::gregory::build_fan(t, v as u32))
+        .flatten();
+    match (rule, &dart_fan) {
+        (Rule::Corner, _) => out.push((v as u32, 1.0)),
+        (Rule::Crease, _) => {
             out.push((v as u32, 2.0 / 3.0));
             for &e in &sharp {
                 out.push((other(e), 1.0 / 6.0));
             }
         }
-        Rule::Smooth | Rule::Dart => {
+        (Rule::Dart, Some(fan)) => {
+            // Its own limit position, over the ring in fan order from the sharp edge.
+            let n = fan.ring.len();
+            let edge = fan.edges.iter().position(|&e| e == sharp[0]).unwrap_or(0);
+            let masks = crate::limit::catmark_limit_masks(&crate::limit::LimitVertex {
+                valence: n,
+                boundary: false,
+                rule: crate::limit::LimitRule::Dart { edge },
+            });
+            let m = &masks.position;
+            out.push((v as u32, m.vertex));
+            for (i, &x) in fan.ring.iter().enumerate() {
+                out.push((x, m.edges[i]));
+            }
+            for (i, &(g, c)) in fan.faces.iter().enumerate() {
+                let fv = t.face_vertices(g as usize);
+                out.push((fv[(c + 2) % fv.len()], m.faces[i]));
+            }
+        }
+        // A ring `build_fan` cannot order (none is known: the ring is complete) keeps the
+        // smooth mask rather than failing.
+        (Rule::Smooth | Rule::Dart, _) => {
             let [wv, we, wf] = catmark_smooth_position_weights(edges.len());
             out.push((v as u32, wv));
             for &e in edges {
