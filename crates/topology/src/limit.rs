@@ -204,7 +204,6 @@ fn corner_tangents(t1: &mut Mask, t2: &mut Mask, v: &LimitVertex, scale: f64) {
     t2.edges[last] += scale;
 }
 
-/// Weights (vertex, each edge neighbour, each face-opposite vertex) of the smooth interior
 /// Exact limit-position weights of an interior dart of valence `n` (one infinitely sharp edge),
 /// over its ring `[v, e_0 … e_{n−1}]` (Loop) or `[v, e_0 … e_{n−1}, f_0 … f_{n−1}]`
 /// (Catmull-Clark; `f_i` opposite `v` in the quad between `e_i` and `e_{i+1}`), the sharp edge
@@ -224,54 +223,49 @@ pub fn dart_position_weights(loop_scheme: bool, n: usize) -> Vec<f64> {
     let mut w = vec![0.0; size];
     w[0] = 1.0;
     let mut next = vec![0.0; size];
+    // A face point: a quarter of each corner of quad `i` (Catmull-Clark).
+    let face = |next: &mut [f64], i: usize, c: f64| {
+        for k in [0, e(i), f(i), e(i + 1)] {
+            next[k] += 0.25 * c;
+        }
+    };
     for _ in 0..10_000 {
-        next.iter_mut().for_each(|x| *x = 0.0);
-        // `next = w · S`: each child's weight spread over the parents its rule reads.
+        next.fill(0.0);
+        // `next = w · S`: each child's weight spread over the parents its rule reads, with the
+        // refiner's smooth rules.
+        let c = w[0];
         if loop_scheme {
-            let ew = (0.625 - (0.25 * (2.0 * PI / n as f64).cos() + 0.375).powi(2)) / n as f64;
-            let ew = if n == 6 { 0.0625 } else { ew };
-            next[0] += w[0] * (1.0 - ew * n as f64);
+            let (vw, ew) = crate::refine::loop_vertex_weights(n);
+            next[0] += c * vw;
             for i in 0..n {
-                next[e(i)] += w[0] * ew;
-            }
-            for i in 0..n {
-                let c = w[e(i)];
-                if i == 0 {
-                    next[0] += 0.5 * c;
-                    next[e(0)] += 0.5 * c;
-                } else {
-                    next[0] += 0.375 * c;
-                    next[e(i)] += 0.375 * c;
-                    next[e(i + n - 1)] += 0.125 * c;
-                    next[e(i + 1)] += 0.125 * c;
-                }
+                next[e(i)] += c * ew;
             }
         } else {
-            // A face point: a quarter of each corner of quad `i`.
-            let face = |next: &mut Vec<f64>, i: usize, c: f64| {
+            let ew = 1.0 / (n * n) as f64;
+            next[0] += c * (n as f64 - 2.0) / n as f64;
+            for i in 0..n {
+                next[e(i)] += c * ew;
+                face(&mut next, i, c * ew);
+            }
+        }
+        for i in 0..n {
+            let c = w[e(i)];
+            if i == 0 {
+                // The sharp edge's child: its midpoint.
+                next[0] += 0.5 * c;
+                next[e(0)] += 0.5 * c;
+            } else if loop_scheme {
+                next[0] += 0.375 * c;
+                next[e(i)] += 0.375 * c;
+                next[e(i + n - 1)] += 0.125 * c;
+                next[e(i + 1)] += 0.125 * c;
+            } else {
                 next[0] += 0.25 * c;
                 next[e(i)] += 0.25 * c;
-                next[f(i)] += 0.25 * c;
-                next[e(i + 1)] += 0.25 * c;
-            };
-            let nf = n as f64;
-            let ew = 1.0 / (nf * nf);
-            next[0] += w[0] * (nf - 2.0) / nf;
-            for i in 0..n {
-                next[e(i)] += w[0] * ew;
-                face(&mut next, i, w[0] * ew);
+                face(&mut next, i + n - 1, 0.25 * c);
+                face(&mut next, i, 0.25 * c);
             }
-            for i in 0..n {
-                let c = w[e(i)];
-                if i == 0 {
-                    next[0] += 0.5 * c;
-                    next[e(0)] += 0.5 * c;
-                } else {
-                    next[0] += 0.25 * c;
-                    next[e(i)] += 0.25 * c;
-                    face(&mut next, i + n - 1, 0.25 * c);
-                    face(&mut next, i, 0.25 * c);
-                }
+            if !loop_scheme {
                 face(&mut next, i, w[f(i)]);
             }
         }
@@ -300,6 +294,7 @@ fn set_dart_position(pos: &mut Mask, loop_scheme: bool, n: usize, edge: usize) {
     }
 }
 
+/// Weights (vertex, each edge neighbour, each face-opposite vertex) of the smooth interior
 /// Catmull-Clark limit position of valence `n`: the position mask of [`catmark_limit_masks`]
 /// without its allocations, for callers that need only the position.
 pub fn catmark_smooth_position_weights(n: usize) -> [f64; 3] {

@@ -1253,7 +1253,7 @@ impl MaskContext<'_> {
 }
 
 /// Loop's smooth vertex weights (vertex, each neighbour) for valence `n`.
-fn loop_vertex_weights(n: usize) -> (f64, f64) {
+pub(crate) fn loop_vertex_weights(n: usize) -> (f64, f64) {
     if n == 6 {
         return (0.625, 0.0625);
     }
