@@ -289,24 +289,11 @@ fn captured_vertices_are_the_exact_limit() {
             let (regular, caps, geometric) = deviations(&surf, &soup, &mesh, 3000);
             let [r, g, b, _] = surf.patch_counts();
             println!("{name}: {r} regular, {g} Gregory, {b} bilinear: regular {regular:.2e}, end caps {caps:.2e} (parametric), {geometric:.2e} (to the surface)");
-            // Known limits, measured: next to the interior infinitely sharp corner of
-            // catmark_cube_corner4 the limit has a cusp (docs/approximations.md), which the
-            // Gregory cap's stand-in tangents cannot follow; its distance shrinks ×0.41 per
-            // level, so 5e-5 would take isolation 8. catmark_bishop's Gregory caps at its
-            // valence-24 poles converge slowest: 2.0e-4, 1.2e-4 and 7.0e-5 at isolation 4, 5
-            // and 6 (×0.59 per level, CPU plan), so 5e-5 would take isolation 7. Spot's worst
-            // cap vertices (6.5e-5) lie on base-face edges 2 % of an edge from an
-            // extraordinary vertex, where the cap's cubic edge curve cannot follow the
-            // non-polynomial limit curve; a stride over the vertices had missed them (4.7e-5).
-            // catmark_cubes_infsharp (1.1e-3) has an infinitely sharp corner and creases that
-            // end inside (the same class as catmark_cube_corner4; docs/approximations.md).
-            let bound = match name.as_str() {
-                "spot" => 1e-4,
-                "catmark_cubes_infsharp" => 2e-3,
-                "catmark_cube_corner4" => 2e-3,
-                "catmark_bishop" => 3e-4,
-                _ => 5e-5,
-            };
+            // Every shape within 5e-5: vertices whose caps converge slowly (cones, darts,
+            // valence 6 and up) are isolated deeper by the plan. Before that, capped after four
+            // levels: catmark_cube_corner4 1.8e-3, catmark_cubes_infsharp 1.1e-3,
+            // catmark_bishop 2.0e-4, spot 6.5e-5.
+            let bound = 5e-5;
             if regular > 1e-5 || geometric > bound {
                 failures.push(format!(
                     "{name}: regular {regular:.2e}, end caps {caps:.2e} / {geometric:.2e}"

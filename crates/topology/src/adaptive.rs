@@ -115,10 +115,12 @@ pub struct AdaptiveOptions {
     pub sharpness_scale: f32,
     /// Follow semi-sharp creases and corners past the isolation level until their sharpness
     /// has decayed, then isolate the irregular vertices that carried them `isolation` more
-    /// levels, as every other irregular vertex is (at most level 10 in all), so the surface
-    /// beside them is exact and its end caps converge with the isolation level; off, leftover
-    /// sharpness at the isolation level is treated as infinite (OpenSubdiv's and the seed's
-    /// behaviour).
+    /// levels, as every other irregular vertex is, so the surface beside them is exact and its
+    /// end caps converge with the isolation level; and isolate the vertices whose end caps
+    /// converge slowly (cones, darts, valence 6 and up) a few levels deeper, so every cap is as
+    /// close to the limit as the isolation level promises elsewhere (at most level 14 in all).
+    /// Off, leftover sharpness at the isolation level is treated as infinite and every end cap
+    /// sits at the isolation level (OpenSubdiv's and the seed's behaviour).
     pub follow_semi_sharp: bool,
 }
 

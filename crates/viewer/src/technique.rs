@@ -94,10 +94,12 @@ pub struct SurfaceArgs {
     /// triangle patch: closer to the limit, three times the patches.
     #[arg(long)]
     pub split_triangles: bool,
-    /// Stop semi-sharp creases at the isolation level, their leftover sharpness treated as
-    /// infinite there (adaptive; OpenSubdiv's behaviour). By default they are followed until
-    /// they decay, and end caps beside them get the isolation level's smooth steps after that,
-    /// so the surface beside them is exact and their caps as close as any other.
+    /// Stop every feature at the isolation level: semi-sharp creases' leftover sharpness is
+    /// treated as infinite there and every end cap sits there (adaptive; OpenSubdiv's
+    /// behaviour). By default creases are followed until they decay, end caps beside them get
+    /// the isolation level's smooth steps after that, and vertices whose caps converge slowly
+    /// (cones, darts, valence 6 and up) are isolated deeper, so every cap is as close as the
+    /// isolation level promises.
     #[arg(long)]
     pub creases_at_isolation: bool,
     /// Adaptive edge factors (bft): screen (projected edge length / --pixels) or distance
