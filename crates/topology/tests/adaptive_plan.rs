@@ -281,12 +281,15 @@ fn cap_distance(mesh: &ControlMesh, iso: u32) -> f64 {
 /// plan's levels), so every cap is within 5e-5 of the diagonal of the limit surface at
 /// isolation 4. With every vertex capped after four levels they were: catmark_cube_corner4's
 /// cone (an infinitely sharp corner on smooth edges) 1.8e-3, catmark_cubes_infsharp's cone and
-/// darts 1.1e-3, spot's valence-6 vertices 6.8e-5.
+/// darts 1.1e-3, catmark_inf_crease1's corner of three sharp edges 9.1e-4, catmark_inf_crease0's
+/// 3.9e-4, spot's valence-6 vertices 6.8e-5.
 #[test]
 fn slow_caps_are_isolated_until_they_meet_the_bound() {
     for name in [
         "catmark_cube_corner4.obj",
         "catmark_cubes_infsharp.obj",
+        "catmark_inf_crease0.obj",
+        "catmark_inf_crease1.obj",
         "spot",
     ] {
         let mesh = if name == "spot" {

@@ -324,18 +324,19 @@ fn start(last: u32) -> usize {
     }
 }
 
-/// Extra levels for a cone: an interior vertex the limit surface does not pass smoothly
-/// (an infinitely sharp corner with fewer than two sharp edges, or a smooth valence-2 vertex).
-/// Its limit is not tangent-plane continuous, so no polynomial cap fits it: on catmark_cube_corner4
-/// the caps were 1.8e-3 of the diagonal at isolation 4, shrinking by 0.41 per level; five more
-/// levels bring them to 2.1e-5.
-pub(super) const CONE_EXTRA_LEVELS: usize = 5;
-
-/// Extra levels for a dart (one infinitely sharp edge ending inside the surface): its
-/// characteristic map is not the smooth one the caps' tangents assume. On
-/// catmark_cubes_infsharp the caps at its valence-3 darts were 1.4e-4 at isolation 4,
-/// shrinking by 0.42 per level; two more levels bring them to 2.6e-5.
-pub(super) const DART_EXTRA_LEVELS: usize = 2;
+/// Extra levels for an interior vertex where an infinitely sharp feature makes the limit
+/// surface something no polynomial cap follows: a cone (an infinitely sharp corner on fewer
+/// than two sharp edges, or a smooth valence-2 vertex: not tangent-plane continuous), a dart
+/// (one sharp edge ending there: its characteristic map is not the smooth one the caps'
+/// tangents assume), a corner of three or more sharp edges with a sector of several faces, or
+/// an irregular crease (two sharp edges, not straight through a valence-4 vertex). Their caps'
+/// distance to the surface shrinks by 0.41 to 0.54 per level, from up to 1.8e-3 of the diagonal
+/// at isolation 4 (catmark_cube_corner4's cone); six more levels bring the slowest measured,
+/// catmark_inf_crease1's corner (9.1e-4, ×0.54), to 3.0e-5 (nearest points to 9×9 points of
+/// each cap), and the cone to 8.5e-6. These vertices are rare, so the cost is small on most
+/// meshes (none on car, bishop, pawn or spot) and largest on meshes made of such features
+/// (catmark_cubes_infsharp 978 → 1518 patches).
+pub(super) const FEATURE_EXTRA_LEVELS: usize = 6;
 
 /// Smallest valence whose end caps are isolated by their reach (see [`cap_depth`]); up to
 /// valence 5 the caps meet 5e-5 of the diagonal at isolation 4 on every shape in tests/data.
@@ -351,10 +352,10 @@ pub(super) const REACH_MIN_VALENCE: usize = 6;
 ///   than a regular patch's after `iso` levels: `⌈iso · ln 2 / −ln λ_n⌉` (6 at valence 6 and
 ///   7 at valence 24 for isolation 4). Spot's valence-6 caps went from 6.8e-5 to 1.5e-5 and
 ///   catmark_bishop's valence-24 poles from 2.0e-4 to 4.1e-5 of the diagonal.
-/// * Cones and darts get [`CONE_EXTRA_LEVELS`] and [`DART_EXTRA_LEVELS`] more.
+/// * Interior sharp features whose caps converge slowly get [`FEATURE_EXTRA_LEVELS`] more.
 ///
-/// Only a handful of faces per level surround such a vertex, so the cost is small: +3.5 % of
-/// spot's patches, +1.6 % of catmark_bishop's.
+/// Boundary vertices keep `iso`. Only a handful of faces per level surround such a vertex, so
+/// the cost is small: +3.5 % of spot's patches, +1.4 % of catmark_bishop's.
 fn cap_depth(lvl: &Lvl, v: usize, iso: usize) -> usize {
     let t = lvl.t();
     let edges = t.vertex_edges(v);
@@ -367,22 +368,20 @@ fn cap_depth(lvl: &Lvl, v: usize, iso: usize) -> usize {
         .filter(|&&e| lvl.sharp_edge(e as usize))
         .count();
     let vs = lvl.topo.vertex_sharpness[v];
-    if sharp < 2 && (is_infinite(vs) || (vs == 0.0 && n < 3)) {
-        return iso + CONE_EXTRA_LEVELS;
+    let cone = sharp < 2 && (is_infinite(vs) || (vs == 0.0 && n < 3));
+    let dart = sharp == 1 && vs == 0.0;
+    // Reached only by irregular vertices: two sharp edges without vertex sharpness are not a
+    // straight crease through valence 4.
+    let crease = sharp == 2 && vs == 0.0;
+    let wide_corner = sharp >= 2 && sharp < n && (is_infinite(vs) || sharp >= 3);
+    if cone || dart || crease || wide_corner {
+        return iso + FEATURE_EXTRA_LEVELS;
     }
-    if vs > 0.0 || sharp >= 2 {
+    if vs > 0.0 || sharp >= 2 || n < REACH_MIN_VALENCE {
         return iso;
     }
-    let depth = if sharp == 1 {
-        iso + DART_EXTRA_LEVELS
-    } else {
-        iso
-    };
-    if n < REACH_MIN_VALENCE {
-        return depth;
-    }
     let reach = iso as f64 * std::f64::consts::LN_2 / -subdominant(n).ln();
-    depth.max(reach.ceil() as usize)
+    iso.max(reach.ceil() as usize)
 }
 
 /// Whether vertex `v` (of a complete face) needs isolating: see the module docs.
