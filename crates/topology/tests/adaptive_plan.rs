@@ -501,6 +501,17 @@ fn blocks_read_only_earlier_vertices() {
                 b.table.indices.iter().all(|&i| i < b.first_vertex),
                 "{name}: a block reads itself"
             );
+            // Every row is an affine combination, non-empty: the GPU sums it as offsets from
+            // its first term's vertex.
+            for r in 0..b.table.len() {
+                let (idx, w) = b.table.stencil(r);
+                let sum: f64 = w.iter().sum();
+                assert!(
+                    !idx.is_empty() && (sum - 1.0).abs() < 1e-9,
+                    "{name}: row {r} of the block at {} sums to {sum}",
+                    b.first_vertex
+                );
+            }
             next += b.table.len() as u32;
         }
         assert_eq!(next, plan.num_vertices);
