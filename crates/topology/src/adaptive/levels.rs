@@ -90,12 +90,13 @@ fn semi_sharp(lvl: &Lvl, v: usize) -> bool {
 /// The plan's levels: irregular faces isolated to `iso`; with `follow_semi_sharp`, faces at
 /// semi-sharp features further, until the sharpness has decayed, and then `iso` more levels
 /// ([`cap_depth`] gives slowly converging vertices more; at most [`FOLLOW_LIMIT`] in all), so
-/// the patches beside a crease of sharpness 7.5 are exact instead of treating the leftover sharpness as infinite. The `iso` levels after the
-/// decay are what every other irregular vertex gets: an end cap placed on the level where a
-/// crease just decayed sits on a net that has had no smooth step yet, and its error does not
-/// shrink with the isolation level (catmark_bishop's caps at its sharpness-6 rims were
-/// 6.3e-4 of the diagonal at isolation 4, 5 and 6 alike). Faces that stop being selected at
-/// or past `iso` while still irregular become end caps at their level.
+/// the patches beside a crease of sharpness 7.5 are exact instead of treating the leftover
+/// sharpness as infinite. The `iso` levels after the decay are what every other irregular
+/// vertex gets: an end cap placed on the level where a crease just decayed sits on a net that
+/// has had no smooth step yet, and its error does not shrink with the isolation level
+/// (catmark_bishop's caps at its sharpness-6 rims were 6.3e-4 of the diagonal at isolation 4,
+/// 5 and 6 alike). Faces that stop being selected at or past `iso` while still irregular
+/// become end caps at their level.
 ///
 /// `single_pass` (the single-pass plans, [`super::single_pass`]) selects at level 0 only the
 /// faces a one-patch-per-face approximation cannot cover (the faces with a corner next to a
