@@ -86,47 +86,6 @@ fn surface(
     .unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
-/// Distance from `p` to the exact limit surface near base point `(face, sub, s, t)`: a few
-/// Gauss-Newton steps on the (sub)face's parameters from there, clamped to the (sub)face. An
-/// end cap's parameterization differs from the limit's near extraordinary vertices (the
-/// Gregory patch is polynomial, the characteristic map is not), so this geometric distance is
-/// what tells how close the surface is, the parametric one how close its parameterization is.
-fn geometric_distance(
-    cpu: &LocalMesh,
-    quad: bool,
-    face: usize,
-    sub: usize,
-    st: (f64, f64),
-    p: [f64; 3],
-) -> f64 {
-    let eval = |s: f64, t: f64| {
-        if quad {
-            cpu.evaluate(face, s, t)
-        } else {
-            cpu.evaluate_subface(face, sub, s, t)
-        }
-        .expect("exact limit")
-    };
-    let (mut s, mut t) = st;
-    let mut best = f64::MAX;
-    for _ in 0..20 {
-        let e = eval(s, t);
-        let r: Vec<f64> = (0..3).map(|k| e.position[k] - p[k]).collect();
-        best = best.min(r.iter().map(|x| x * x).sum::<f64>().sqrt());
-        let (a, b) = (e.du, e.dv);
-        let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(x, y)| x * y).sum::<f64>();
-        let (aa, ab, bb) = (dot(&a, &a), dot(&a, &b), dot(&b, &b));
-        let (ar, br) = (dot(&a, &r), dot(&b, &r));
-        let det = aa * bb - ab * ab;
-        if det.abs() < 1e-300 {
-            break;
-        }
-        s = (s - (bb * ar - ab * br) / det).clamp(0.0, 1.0);
-        t = (t - (aa * br - ab * ar) / det).clamp(0.0, 1.0);
-    }
-    best
-}
-
 /// Worst distances over the bbox diagonal between captured vertices and the exact limit, over
 /// at most `samples` welded vertices of regular patches and every vertex of an end cap (a
 /// stride over all vertices missed catmark_bishop's worst caps once a plan change shifted it):
@@ -210,7 +169,11 @@ fn deviations_with(
             let g = if *cap && geometric && err * d > 1e-7 {
                 all.iter()
                     .map(|&(f, sub, bu, bv, quad)| {
-                        geometric_distance(&cpu, quad, f, sub, (bu, bv), *p)
+                        // An end cap's parameterization differs from the limit's near
+                        // extraordinary vertices, so the nearest limit point is what says how
+                        // close its surface is.
+                        cpu.nearest_limit_distance(f, (!quad).then_some(sub), [bu, bv], p)
+                            .expect("exact limit")
                     })
                     .fold(f64::MAX, f64::min)
                     / d

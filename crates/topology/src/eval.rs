@@ -750,6 +750,50 @@ impl LocalMesh {
         evaluate_local(&nb, r.child, points, child, u, v)
     }
 
+    /// Distance from `p` to the limit surface over one face (or sub-quad `sub` of a non-quad
+    /// Catmull-Clark face): Gauss-Newton on the face's parameters from `start`, kept inside the
+    /// domain, the least distance seen (so at most the distance at `start`). Approximations
+    /// (end caps, single-pass patches) parameterize the surface differently near extraordinary
+    /// vertices, so this geometric distance, not the one at the same parameter, says how close
+    /// their surface is. A local search: `start` should be the approximation's own parameter.
+    pub fn nearest_limit_distance(
+        &self,
+        face: usize,
+        sub: Option<usize>,
+        start: [f64; 2],
+        p: &[f64],
+    ) -> Result<f64, EvalError> {
+        let triangle = sub.is_none() && self.scheme == LimitScheme::Loop;
+        let clamp = |u: f64, v: f64| {
+            let (u, v) = (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0));
+            if triangle && u + v > 1.0 {
+                let excess = 0.5 * (u + v - 1.0);
+                ((u - excess).max(0.0), (v - excess).max(0.0))
+            } else {
+                (u, v)
+            }
+        };
+        let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(x, y)| x * y).sum::<f64>();
+        let (mut u, mut v) = clamp(start[0], start[1]);
+        let mut best = f64::MAX;
+        for _ in 0..20 {
+            let e = match sub {
+                Some(sub) => self.evaluate_subface(face, sub, u, v)?,
+                None => self.evaluate(face, u, v)?,
+            };
+            let r: Vec<f64> = e.position.iter().zip(p).map(|(a, b)| a - b).collect();
+            best = best.min(dot(&r, &r).sqrt());
+            let (aa, ab, bb) = (dot(&e.du, &e.du), dot(&e.du, &e.dv), dot(&e.dv, &e.dv));
+            let (ar, br) = (dot(&e.du, &r), dot(&e.dv, &r));
+            let det = aa * bb - ab * ab;
+            if det.abs() < 1e-300 {
+                break;
+            }
+            (u, v) = clamp(u - (bb * ar - ab * br) / det, v - (aa * br - ab * ar) / det);
+        }
+        Ok(best)
+    }
+
     /// Exact limit at many parameters of one face: [`Self::evaluate`] when `sub` is `None`,
     /// else [`Self::evaluate_subface`]. The face's neighbourhood is gathered (and for a
     /// sub-face refined once) for all of them, which is most of a single evaluation's cost.

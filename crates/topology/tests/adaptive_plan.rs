@@ -206,46 +206,6 @@ fn caps_beside_decayed_creases_shrink_with_isolation() {
     }
 }
 
-/// Distance from `p` to the exact limit near base point `(face, sub, s, t)`: Gauss-Newton on the
-/// (sub)face's parameters from there, clamped to it; the least distance seen (the parametric
-/// distance at most).
-fn geometric_distance(
-    lm: &LocalMesh,
-    plan: &AdaptivePlan,
-    patch: usize,
-    st: (f64, f64),
-    p: &[f64; 3],
-) -> f64 {
-    let pa = &plan.patches[patch];
-    let face = pa.base_face as usize;
-    let eval = |s: f64, t: f64| {
-        if lm.face(face).len() == 4 {
-            lm.evaluate(face, s, t)
-        } else {
-            lm.evaluate_subface(face, pa.sub_face as usize, s, t)
-        }
-        .expect("exact limit")
-    };
-    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(x, y)| x * y).sum::<f64>();
-    let (mut s, mut t) = st;
-    let mut best = f64::MAX;
-    for _ in 0..20 {
-        let e = eval(s, t);
-        let r: Vec<f64> = (0..3).map(|k| e.position[k] - p[k]).collect();
-        best = best.min(dot(&r, &r).sqrt());
-        let (a, b) = (&e.du, &e.dv);
-        let (aa, ab, bb) = (dot(a, a), dot(a, b), dot(b, b));
-        let (ar, br) = (dot(a, &r), dot(b, &r));
-        let det = aa * bb - ab * ab;
-        if det.abs() < 1e-300 {
-            break;
-        }
-        s = (s - (bb * ar - ab * br) / det).clamp(0.0, 1.0);
-        t = (t - (aa * br - ab * ar) / det).clamp(0.0, 1.0);
-    }
-    best
-}
-
 /// Largest distance of any Gregory end cap from the limit surface (nearest point, 9×9 points a
 /// cap), over the bbox diagonal.
 fn cap_distance(mesh: &ControlMesh, iso: u32) -> f64 {
@@ -268,8 +228,13 @@ fn cap_distance(mesh: &ControlMesh, iso: u32) -> f64 {
                         continue;
                     }
                     let pa = &plan.patches[p];
-                    let st = (pa.origin[0] + pa.size * u, pa.origin[1] + pa.size * v);
-                    worst = worst.max(geometric_distance(&lm, &plan, p, st, &got) / d);
+                    let st = [pa.origin[0] + pa.size * u, pa.origin[1] + pa.size * v];
+                    let face = pa.base_face as usize;
+                    let sub = (lm.face(face).len() != 4).then_some(pa.sub_face as usize);
+                    let g = lm
+                        .nearest_limit_distance(face, sub, st, &got)
+                        .expect("exact limit");
+                    worst = worst.max(g / d);
                 }
             }
             worst

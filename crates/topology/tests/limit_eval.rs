@@ -365,3 +365,51 @@ fn spot_quads_evaluate_on_refined_limit() {
     let p = limit_point_subface(&mesh, tri, 2, 0.25, 0.5).expect("sub-quad point");
     assert!(p.to_string().contains("subface 2"));
 }
+
+/// The nearest-point distance finds a point moved off the surface along the normal (its own
+/// offset) and a point on the surface from a wrong starting parameter (0), where the distance
+/// at the same parameter would be large.
+#[test]
+fn nearest_limit_distance_is_geometric() {
+    let cases = [
+        (
+            "catmark_cube.obj",
+            LimitScheme::CatmullClark,
+            [0.3, 0.6],
+            [0.35, 0.55],
+        ),
+        ("loop_cube.obj", LimitScheme::Loop, [0.2, 0.3], [0.25, 0.25]),
+    ];
+    for (name, scheme, at, start) in cases {
+        let mesh = load_obj(format!("{DATA}{name}")).expect("shape");
+        let lm = LocalMesh::from_control_mesh(&mesh, scheme).expect("mesh");
+        let e = lm.evaluate(0, at[0], at[1]).expect("limit");
+        let cross = [
+            e.du[1] * e.dv[2] - e.du[2] * e.dv[1],
+            e.du[2] * e.dv[0] - e.du[0] * e.dv[2],
+            e.du[0] * e.dv[1] - e.du[1] * e.dv[0],
+        ];
+        let len = cross.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let off = 1e-3;
+        let lifted: Vec<f64> = (0..3)
+            .map(|k| e.position[k] + off * cross[k] / len)
+            .collect();
+        let on = lm
+            .nearest_limit_distance(0, None, start, &e.position)
+            .expect("search");
+        let above = lm
+            .nearest_limit_distance(0, None, start, &lifted)
+            .expect("search");
+        let same_param = lm.evaluate(0, start[0], start[1]).expect("limit");
+        let param_dist = (0..3)
+            .map(|k| (same_param.position[k] - e.position[k]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        assert!(param_dist > 1e-2, "{name}: start too close ({param_dist})");
+        assert!(on < 1e-9, "{name}: on the surface, found {on}");
+        assert!(
+            (above - off).abs() < 1e-8,
+            "{name}: {off} off, found {above}"
+        );
+    }
+}
