@@ -229,13 +229,14 @@ pub fn dart_position_weights(loop_scheme: bool, n: usize) -> Vec<f64> {
             next[k] += 0.25 * c;
         }
     };
+    let (loop_vw, loop_ew) = crate::refine::loop_vertex_weights(n);
     for _ in 0..10_000 {
         next.fill(0.0);
         // `next = w · S`: each child's weight spread over the parents its rule reads, with the
         // refiner's smooth rules.
         let c = w[0];
         if loop_scheme {
-            let (vw, ew) = crate::refine::loop_vertex_weights(n);
+            let (vw, ew) = (loop_vw, loop_ew);
             next[0] += c * vw;
             for i in 0..n {
                 next[e(i)] += c * ew;

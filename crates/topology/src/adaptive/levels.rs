@@ -369,16 +369,19 @@ fn cap_depth(lvl: &Lvl, v: usize, iso: usize) -> usize {
         .filter(|&&e| lvl.sharp_edge(e as usize))
         .count();
     let vs = lvl.topo.vertex_sharpness[v];
-    let cone = sharp < 2 && (is_infinite(vs) || (vs == 0.0 && n < 3));
-    let dart = sharp == 1 && vs == 0.0;
-    // Reached only by irregular vertices: two sharp edges without vertex sharpness are not a
-    // straight crease through valence 4.
-    let crease = sharp == 2 && vs == 0.0;
-    let wide_corner = sharp >= 2 && sharp < n && (is_infinite(vs) || sharp >= 3);
-    if cone || dart || crease || wide_corner {
+    // Only irregular vertices get here, so a crease is not straight through valence 4.
+    let rule = vertex_rule(vs, sharp);
+    let slow_feature = match rule {
+        Rule::Smooth => n < 3,
+        Rule::Dart | Rule::Crease => true,
+        // Cones and wide corners; not a semi-sharp vertex (followed until it decays) nor a
+        // vertex whose every edge is sharp (each sector a single face).
+        Rule::Corner => (is_infinite(vs) || sharp >= 3) && sharp < n,
+    };
+    if slow_feature {
         return iso + FEATURE_EXTRA_LEVELS;
     }
-    if vs > 0.0 || sharp >= 2 || n < REACH_MIN_VALENCE {
+    if rule != Rule::Smooth || n < REACH_MIN_VALENCE {
         return iso;
     }
     let reach = iso as f64 * std::f64::consts::LN_2 / -subdominant(n).ln();
