@@ -33,9 +33,28 @@ fn differing_fraction(a: &Rgba8, b: &Rgba8) -> f64 {
     n as f64 / (a.width * a.height) as f64
 }
 const TOLERANCE: f64 = 0.005;
+/// Goldens are lavapipe's images. Another device rasterizes and filters textures with its own
+/// precision (NVIDIA's 8-bit filter weights move a displaced silhouette by a pixel here and
+/// there: 0.9 % of spot's pixels), so there an image matches with up to 2 % of pixels off.
+const OTHER_DEVICE_TOLERANCE: f64 = 0.02;
+static ON_LAVAPIPE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+
+fn note_device(gpu: &Gpu) {
+    let _ = ON_LAVAPIPE.set(gpu.device().info.is_lavapipe());
+}
+
+/// The most pixels an image may differ from its golden by on the device the goldens ran on.
+fn match_tolerance() -> f64 {
+    if *ON_LAVAPIPE.get().expect("a golden rendered first") {
+        TOLERANCE
+    } else {
+        OTHER_DEVICE_TOLERANCE
+    }
+}
 
 fn render_all(level: f32) -> Vec<(String, Rgba8)> {
     let gpu = Gpu::new();
+    note_device(&gpu);
     let mut ctx = Context::offscreen(gpu.device()).unwrap();
     let mut out = Vec::new();
     for path in MESHES {
@@ -82,7 +101,7 @@ fn golden_images_match_and_detect_a_level_change() {
             LEVEL + 1.0
         );
         assert!(
-            d1 <= TOLERANCE && d2 <= TOLERANCE,
+            d1 <= match_tolerance() && d2 <= match_tolerance(),
             "{name}: differs from golden ({d1:.5}, {d2:.5})"
         );
         assert!(
@@ -109,6 +128,7 @@ const BFT_MESHES: [&str; 3] = [
 fn render_bft(segments: u32, time: f32) -> Vec<(String, Rgba8)> {
     use tessera::tess::techniques::bft::{base_normals, base_positions, wave};
     let gpu = Gpu::new();
+    note_device(&gpu);
     let mut ctx = Context::offscreen(gpu.device()).unwrap();
     let mut out = Vec::new();
     for path in BFT_MESHES {
@@ -174,7 +194,7 @@ fn bft_golden_images_match_and_detect_changes() {
         };
         eprintln!("{name}: run 1 {d1:.5}, run 2 {d2:.5}, changed {changed:.5}");
         assert!(
-            d1 <= TOLERANCE && d2 <= TOLERANCE,
+            d1 <= match_tolerance() && d2 <= match_tolerance(),
             "{name}: differs from golden ({d1:.5}, {d2:.5})"
         );
         assert!(
@@ -199,6 +219,7 @@ const ADAPTIVE_EXTENT: vk::Extent2D = vk::Extent2D {
 /// (kind and level), one segment per patch edge (the patches themselves).
 fn render_adaptive(isolation: u32) -> Vec<(String, Rgba8)> {
     let gpu = Gpu::new();
+    note_device(&gpu);
     let mut ctx = Context::offscreen(gpu.device()).unwrap();
     let mut out = Vec::new();
     for path in ADAPTIVE_MESHES {
@@ -259,7 +280,7 @@ fn adaptive_golden_images_match_and_detect_an_isolation_change() {
         let changed = differing_fraction(&c.1, &golden);
         eprintln!("{name}: run 1 {d1:.5}, run 2 {d2:.5}, isolation 3 {changed:.5}");
         assert!(
-            d1 <= TOLERANCE && d2 <= TOLERANCE,
+            d1 <= match_tolerance() && d2 <= match_tolerance(),
             "{name}: differs from golden ({d1:.5}, {d2:.5})"
         );
         assert!(
@@ -318,6 +339,7 @@ fn render_surface() -> Vec<(String, Rgba8)> {
     use std::sync::Arc;
     use tessera::tess::surface::{load_height, load_texture, SurfaceMaps};
     let gpu = Gpu::new();
+    note_device(&gpu);
     let mut ctx = Context::offscreen(gpu.device()).unwrap();
     let mesh = tessera::topology::load_obj(common::data("assets/spot_control_mesh.obj")).unwrap();
     let texture = Arc::new(load_texture(common::data("assets/spot_texture.png")).unwrap());
@@ -427,7 +449,7 @@ fn surface_golden_images_match_and_show_reparameterization_and_displacement() {
         let noise = fraction_above(a, b, 4);
         eprintln!("{name}: run 1 {d1:.5}, run 2 {d2:.5}; run 1 vs run 2 (> 4/255) {noise:.5}");
         assert!(
-            d1 <= TOLERANCE && d2 <= TOLERANCE,
+            d1 <= match_tolerance() && d2 <= match_tolerance(),
             "{name}: differs from golden ({d1:.5}, {d2:.5})"
         );
         golden.push(g);

@@ -24,6 +24,7 @@ fn strip(k: u32, triangles: bool) -> ControlMesh {
 #[test]
 fn tes_invocations_equal_cpu_tessellator_counts() {
     let gpu = Gpu::new();
+    let lavapipe = gpu.device().info.is_lavapipe();
     let mut r = Context::offscreen(gpu.device()).unwrap();
     for (triangles, domain) in [(true, Domain::Triangle), (false, Domain::Quad)] {
         let k = if triangles { 10 } else { 5 };
@@ -48,10 +49,14 @@ fn tes_invocations_equal_cpu_tessellator_counts() {
                     "{domain:?} {spacing:?} {level}"
                 );
                 assert_eq!(counts.patches, k, "{domain:?} {spacing:?} {level}");
-                assert_eq!(
-                    stats.tess_evaluation_invocations, expected,
-                    "TES invocations, {domain:?} {spacing:?} level {level}"
-                );
+                // Vulkan runs the TES at least once per distinct tessellated vertex; lavapipe
+                // exactly once (NVIDIA's H100 runs 730 for lavapipe's 480 at level 7).
+                let what = format!("TES invocations, {domain:?} {spacing:?} level {level}");
+                if lavapipe {
+                    assert_eq!(stats.tess_evaluation_invocations, expected, "{what}");
+                } else {
+                    assert!(stats.tess_evaluation_invocations >= expected, "{what}");
+                }
             }
         }
     }

@@ -248,7 +248,11 @@ bool bft_eval(uint face, vec3 b, bool geometric, out vec3 p, out vec3 n) {
         u = ge == 0u ? t : (ge == 1u ? 1.0 - t : 0.0);
         v = ge == 0u ? 0.0 : (ge == 1u ? t : 1.0 - t);
     }
-    bool local = g == face && (tc_head.y & BFT_INFO_GATHERED) != 0u;
+    // Shared points (edges, corners) always take the global path, also in their owner: one code
+    // path for both faces of an edge, so their bits cannot depend on how a compiler schedules
+    // the two (on NVIDIA's, the gathered and the global sums of the same row differed in the
+    // last bits, cracking every shared point). Only interior points read the patch block.
+    bool local = g == face && corner < 0 && edge < 0 && (tc_head.y & BFT_INFO_GATHERED) != 0u;
     float grid = float(table.grid);
     float nseg = float(table.segments);
     vec2 ga = vec2(u, v) * grid;

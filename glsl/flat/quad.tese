@@ -8,7 +8,13 @@ layout(location = 0) in vec3 in_position[];
 layout(location = 1) in vec3 in_normal[];
 void main() {
     float u = gl_TessCoord.x, v = gl_TessCoord.y;
-    vec3 p = mix(mix(in_position[0], in_position[1], u), mix(in_position[3], in_position[2], u), v);
-    vec3 n = mix(mix(in_normal[0], in_normal[1], u), mix(in_normal[3], in_normal[2], u), v);
+    // Written out and `precise`, not mix(): mix's rounding is the driver's (NVIDIA's is
+    // x + a (y - x), not y at a = 1), and contraction to fused multiply-adds depends on operand
+    // order. So every edge point is a (1 - t) + b t from whichever side, the same two products
+    // summed, and both quads of an edge emit the same bits.
+    precise vec3 p = (in_position[0] * (1.0 - u) + in_position[1] * u) * (1.0 - v)
+        + (in_position[3] * (1.0 - u) + in_position[2] * u) * v;
+    precise vec3 n = (in_normal[0] * (1.0 - u) + in_normal[1] * u) * (1.0 - v)
+        + (in_normal[3] * (1.0 - u) + in_normal[2] * u) * v;
     emit_sample(p, n, draw.first_patch + uint(gl_PrimitiveID), 0u);
 }

@@ -14,9 +14,11 @@ vec3 project(vec3 q, int i) {
 }
 void main() {
     vec3 b = gl_TessCoord;
-    vec3 p = b.x * in_position[0] + b.y * in_position[1] + b.z * in_position[2];
-    vec3 phong = b.x * project(p, 0) + b.y * project(p, 1) + b.z * project(p, 2);
+    // `precise` barycentric sums (flat/tri.tese): both patches of an edge get the same bits.
+    // Each projection depends on its corner alone, so it is the same in either patch.
+    precise vec3 p = b.x * in_position[0] + b.y * in_position[1] + b.z * in_position[2];
+    precise vec3 phong = b.x * project(p, 0) + b.y * project(p, 1) + b.z * project(p, 2);
     float alpha = frame.tess.z;
-    vec3 n = b.x * in_normal[0] + b.y * in_normal[1] + b.z * in_normal[2];
+    precise vec3 n = b.x * in_normal[0] + b.y * in_normal[1] + b.z * in_normal[2];
     emit_sample(mix(p, phong, alpha), n, draw.first_patch + uint(gl_PrimitiveID), 0u);
 }
