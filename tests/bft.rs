@@ -19,6 +19,18 @@ const EXTENT: vk::Extent2D = vk::Extent2D {
 
 /// A BFT surface of `mesh` at table level `level`, with tangent tables when `tangents`.
 fn surface(ctx: &mut Context, mesh: &ControlMesh, name: &str, level: u32, tangents: bool) -> Bft {
+    surface_built(ctx, mesh, name, level, tangents, None)
+}
+
+/// [`surface`] in the patch-block build `patch_block` (`None`: the device's).
+fn surface_built(
+    ctx: &mut Context,
+    mesh: &ControlMesh,
+    name: &str,
+    level: u32,
+    tangents: bool,
+    patch_block: Option<bool>,
+) -> Bft {
     Bft::new(
         ctx,
         mesh,
@@ -26,10 +38,15 @@ fn surface(ctx: &mut Context, mesh: &ControlMesh, name: &str, level: u32, tangen
             table_level: level,
             tangents,
             name: name.into(),
+            patch_block,
         },
     )
     .expect(name)
 }
+
+/// Both builds of the BFT control and evaluation stages: with the patch block (lavapipe's
+/// default) and without (a GPU's), so each is tested on any device.
+const PATCH_BLOCK_BUILDS: [bool; 2] = [true, false];
 
 /// Uniform factors of `s` segments per base edge.
 fn uniform(s: u32) -> FrameParams {
@@ -115,9 +132,13 @@ fn captured_bft_vertices_are_the_exact_limit() {
             ),
             ("spot", spot(), &[2, 16, 64]),
         ];
-        for (name, mesh, segments) in cases {
-            let surf = surface(&mut ctx, &mesh, name, 5, false);
-            for &s in segments {
+        for ((name, mesh, segments), block) in cases
+            .iter()
+            .flat_map(|c| PATCH_BLOCK_BUILDS.map(|b| (c, b)))
+        {
+            let name = &format!("{name} (patch block {block})");
+            let surf = surface_built(&mut ctx, mesh, name, 5, false, Some(block));
+            for &s in segments.iter() {
                 let (soup, _) = capturer
                     .capture(&mut ctx, &surf, &uniform(s), EXTENT)
                     .expect("capture");
@@ -158,8 +179,12 @@ fn bft_is_watertight_under_every_factor_policy() {
             yaw: 30.0,
             ..Default::default()
         };
-        for (name, mesh) in meshes {
-            let surf = surface(&mut ctx, &mesh, name, 5, false);
+        for ((name, mesh), block) in meshes
+            .iter()
+            .flat_map(|m| PATCH_BLOCK_BUILDS.map(|b| (m, b)))
+        {
+            let name = &format!("{name} (patch block {block})");
+            let surf = surface_built(&mut ctx, mesh, name, 5, false, Some(block));
             let policies = [
                 (
                     "uniform 16",

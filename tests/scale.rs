@@ -52,6 +52,7 @@ fn bft_run(
                 table_level: 2,
                 tangents: true,
                 name: "grid".into(),
+                ..BftOptions::default()
             },
         )
         .expect("bft");
@@ -312,6 +313,7 @@ fn one_million_faces_through_every_technique() {
                         table_level: 1,
                         tangents: false,
                         name: "1M grid".into(),
+                        ..BftOptions::default()
                     },
                 )
                 .expect("bft");

@@ -150,7 +150,9 @@ void bft_accumulate_global(uint face, uint row, bool flip, bool geometric,
 // permutation (5 bits a slot), then per ring slot its level-1 position and normal (6 floats),
 // for rings of at most BFT_GATHER_SLOTS slots (valence 12 at an extraordinary vertex); larger
 // rings read the global buffers. 29 locations, 116 components: within the 120 per-patch
-// output components every Vulkan device has.
+// output components every Vulkan device has. Only in the BFT_PATCH_BLOCK build (the manifest's
+// patch_block axis, `BftOptions::patch_block`): on a GPU the block's size costs more than the
+// global reads it saves. Without it the TCS hands the TES the two header words alone.
 #define BFT_GATHER_SLOTS 18u
 #define BFT_GATHER_VEC4 27
 #define BFT_INFO_RING_MASK 0xffu
@@ -168,15 +170,17 @@ void bft_accumulate_global(uint face, uint row, bool flip, bool geometric,
 layout(location = 0) BFT_PATCH_QUALIFIER uvec4 tc_head;
 // x: dv_offset, y..w: the mirror permutation, six 5-bit slots a word.
 layout(location = 1) BFT_PATCH_QUALIFIER uvec4 tc_aux;
+#ifdef BFT_PATCH_BLOCK
 layout(location = 2) BFT_PATCH_QUALIFIER vec4 tc_ring[BFT_GATHER_VEC4];
 #endif
+#endif
 
-#ifdef BFT_PATCH_IN
+#if defined(BFT_PATCH_IN) && defined(BFT_PATCH_BLOCK)
 float bft_gathered(uint k) { return tc_ring[k >> 2u][k & 3u]; }
 
-// bft_accumulate_global over the gathered ring of this patch: the same products summed in the
-// same order, so the bits equal the global path's (a neighbour evaluating this patch's edge
-// through the global buffers gets the same point).
+// bft_accumulate_global over the gathered ring of this patch, for its interior points only
+// (bft_eval): no other patch evaluates them, so their bits need not equal the global path's,
+// and on NVIDIA's compiler they do not.
 void bft_accumulate_patch(uint row, bool flip, bool geometric,
                           out vec3 p, out vec3 q, out vec3 r) {
     uint rs = tc_head.y & BFT_INFO_RING_MASK;
@@ -203,7 +207,9 @@ void bft_accumulate_patch(uint row, bool flip, bool geometric,
     }
     if (!geometric) q = an;
 }
+#endif
 
+#ifdef BFT_PATCH_IN
 // One row of face g: from the patch block when g is this patch and its ring was gathered,
 // else from the global buffers (the same arithmetic either way).
 uint bft_row_at(uint g, bool local, uint a, uint b, out bool flip) {
@@ -216,11 +222,13 @@ uint bft_row_at(uint g, bool local, uint a, uint b, out bool flip) {
 
 void bft_accumulate(uint g, bool local, uint row, bool flip, bool geometric,
                     out vec3 p, out vec3 q, out vec3 r) {
+#ifdef BFT_PATCH_BLOCK
     if (local) {
         bft_accumulate_patch(row, flip, geometric, p, q, r);
-    } else {
-        bft_accumulate_global(g, row, flip, geometric, p, q, r);
+        return;
     }
+#endif
+    bft_accumulate_global(g, row, flip, geometric, p, q, r);
 }
 
 // The limit point (and normal source) at tess coordinate b (weights of v0, v1, v2) of `face`.

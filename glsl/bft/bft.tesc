@@ -1,6 +1,7 @@
 #version 450
-// Tessellation factors of a level-1 face, and its patch block (bft.glsl): header words and the
-// ring's level-1 positions and normals, read here once instead of once per tessellated vertex. Every edge factor is computed from the edge's two
+// Tessellation factors of a level-1 face, and its header words; in the BFT_PATCH_BLOCK build
+// its patch block too (bft.glsl): the ring's level-1 positions and normals, read here once
+// instead of once per tessellated vertex. Every edge factor is computed from the edge's two
 // endpoints only, taken in global index order, so both faces of an edge compute the same bits
 // and the tessellator makes the same points on it: no cracks by construction.
 #extension GL_EXT_control_flow_attributes : require
@@ -42,14 +43,19 @@ void main() {
     uint ring = PATCH(face).ring_offset;
     uint rs = PATCH(face).ring_size;
     uint entry = PATCH(face).entry;
+#ifdef BFT_PATCH_BLOCK
     bool gathered = rs <= BFT_GATHER_SLOTS;
+#else
+    bool gathered = false;
+#endif
     uint info = rs | (PATCH(face).mirrored != 0u ? BFT_INFO_MIRRORED : 0u)
         | (table_entries[entry].half_table != 0u ? BFT_INFO_HALF : 0u)
         | (gathered ? BFT_INFO_GATHERED : 0u)
         | (table_entries[entry].kind << BFT_INFO_KIND_SHIFT);
     tc_head = uvec4(face, info, table_entries[entry].position_offset, table_entries[entry].du_offset);
-    uint perm = table_entries[entry].perm_offset;
     uvec3 perm_words = uvec3(0u);
+#ifdef BFT_PATCH_BLOCK
+    uint perm = table_entries[entry].perm_offset;
     float slots[4 * BFT_GATHER_VEC4];
     [[unroll]] for (uint s = 0u; s < BFT_GATHER_SLOTS; ++s) {
         vec3 x = vec3(0.0), nrm = vec3(0.0);
@@ -62,10 +68,11 @@ void main() {
         slots[6u * s] = x.x; slots[6u * s + 1u] = x.y; slots[6u * s + 2u] = x.z;
         slots[6u * s + 3u] = nrm.x; slots[6u * s + 4u] = nrm.y; slots[6u * s + 5u] = nrm.z;
     }
-    tc_aux = uvec4(table_entries[entry].dv_offset, perm_words);
     [[unroll]] for (int k = 0; k < BFT_GATHER_VEC4; ++k) {
         tc_ring[k] = vec4(slots[4 * k], slots[4 * k + 1], slots[4 * k + 2], slots[4 * k + 3]);
     }
+#endif
+    tc_aux = uvec4(table_entries[entry].dv_offset, perm_words);
     uint v0 = RING(ring), v1 = RING(ring + 1u), v2 = RING(ring + 2u);
     // gl_TessLevelOuter[i] is the edge opposite corner i: v1v2, v2v0, v0v1.
     float e0 = edge_factor(v1, v2), e1 = edge_factor(v2, v0), e2 = edge_factor(v0, v1);

@@ -33,6 +33,9 @@ pub struct PipelineKey {
     pub pass: Pass,
     /// The evaluation stage's surface build ([`crate::Technique::surface_build`]).
     pub surface: bool,
+    /// The technique's own axes ([`crate::technique::PatchPipeline::axes`]): two builds of one
+    /// technique may differ in them.
+    pub axes: Variant,
 }
 
 /// Set 0 of every pipeline: one uniform buffer and descriptor set per frame slot.
@@ -223,6 +226,7 @@ impl Context {
                     spacing: params.spacing,
                     pass,
                     surface: technique.surface_build(params),
+                    axes: technique.patch_pipeline(array.patch).axes,
                 };
                 if !self.pipelines.contains_key(&key) {
                     let p = self.build_pipeline(technique, key)?;
@@ -251,6 +255,7 @@ impl Context {
             spacing: Some(key.spacing),
             capture,
             surface: key.surface,
+            ..key.axes
         };
         desc.stages = vec![
             ShaderStage::new(
@@ -259,7 +264,7 @@ impl Context {
             ),
             ShaderStage::new(
                 vk::ShaderStageFlags::TESSELLATION_CONTROL,
-                shaders::spirv(pp.control, plain)?,
+                shaders::spirv(pp.control, key.axes)?,
             ),
             ShaderStage::new(
                 vk::ShaderStageFlags::TESSELLATION_EVALUATION,
@@ -377,6 +382,7 @@ impl Context {
             spacing: params.spacing,
             pass,
             surface: technique.surface_build(params),
+            axes: technique.patch_pipeline(a.patch).axes,
         };
         let pipeline = self
             .pipelines

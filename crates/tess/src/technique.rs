@@ -23,7 +23,7 @@
 use crate::camera::Camera;
 use crate::capture::FacePoint;
 use crate::error::{Result, TessError};
-use crate::shaders::Stage;
+use crate::shaders::{Stage, Variant};
 use crate::tessellator::{Domain, Spacing};
 use vk_core::{DescriptorSet, Encoder};
 
@@ -297,6 +297,9 @@ pub struct PatchPipeline {
     pub mesh_vertex_input: bool,
     /// Bytes of the push-constant block every stage shares.
     pub push_constant_bytes: u32,
+    /// The technique's own shader axes (the `Variant` fields beyond spacing, capture and
+    /// surface, which the frame sets), for its control and evaluation stages.
+    pub axes: Variant,
 }
 
 /// How many draws and patches one recorded pass issued (for tests of the draw split).

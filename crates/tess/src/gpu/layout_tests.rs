@@ -69,6 +69,7 @@ fn variant(spacing: Option<Spacing>, capture: bool) -> Variant {
         spacing,
         capture,
         surface: false,
+        patch_block: false,
     }
 }
 
@@ -76,6 +77,13 @@ const PLAIN: Variant = Variant {
     spacing: None,
     capture: false,
     surface: false,
+    patch_block: false,
+};
+
+/// BFT's patch-block build (its control stage reads the ring and level-1 buffers too).
+const BLOCK: Variant = Variant {
+    patch_block: true,
+    ..PLAIN
 };
 
 /// The table. Each BFT storage buffer appears with a stage that reads or writes it.
@@ -282,6 +290,11 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         ),
         (
             Stage::BftBftTesc,
+            BLOCK,
+            level1("Level1Normals", BFT_LEVEL1_NORMALS_BINDING),
+        ),
+        (
+            Stage::BftBftTesc,
             PLAIN,
             words("PatchRings", BFT_PATCH_RINGS_BINDING),
         ),
@@ -293,7 +306,15 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
     ];
     for (stage, v) in [
         (Stage::BftBftTesc, PLAIN),
+        (Stage::BftBftTesc, BLOCK),
         (Stage::BftBftTese, variant(equal, false)),
+        (
+            Stage::BftBftTese,
+            Variant {
+                patch_block: true,
+                ..variant(equal, false)
+            },
+        ),
         (
             Stage::BftBftTese,
             variant(Some(Spacing::FractionalEven), true),
@@ -699,8 +720,9 @@ fn the_table_covers_every_bft_binding_and_capture_build() {
         .iter()
         .filter(|(_, _, c)| matches!(c, Check::Xfb { .. }))
         .count();
-    // Nine TESs in three spacings, the four adaptive ones and BFT's also with their surface code.
-    assert_eq!(capture_builds, 42);
+    // Nine TESs in three spacings, the four adaptive ones and BFT's also with their surface code,
+    // BFT's also with and without its patch block.
+    assert_eq!(capture_builds, 48);
     assert_eq!(xfb_rows, capture_builds);
 }
 
@@ -751,7 +773,7 @@ fn capture_variants_and_only_they_have_xfb() {
             captures += v.capture as usize;
         }
     }
-    assert_eq!(captures, 42);
+    assert_eq!(captures, 48);
 }
 
 #[test]
@@ -801,6 +823,7 @@ fn plain_builds_have_no_surface_varyings() {
             checked += 1;
         }
     }
-    // Four adaptive TESs and BFT's, three spacings, capture or not, plain or surface.
-    assert_eq!(checked, 60);
+    // Four adaptive TESs and BFT's, three spacings, capture or not, plain or surface; BFT's
+    // with and without its patch block.
+    assert_eq!(checked, 72);
 }

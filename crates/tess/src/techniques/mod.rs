@@ -244,6 +244,7 @@ pub fn build(
                     table_level: options.table_level,
                     tangents: options.tangents,
                     name: options.name.clone(),
+                    patch_block: None,
                 },
             )?;
             let notes = b.notes.clone();

@@ -752,6 +752,7 @@ impl Technique for Adaptive {
             control_points: 1,
             mesh_vertex_input: false,
             push_constant_bytes: std::mem::size_of::<AdaptivePush>() as u32,
+            axes: Variant::default(),
         }
     }
 

@@ -293,6 +293,11 @@ pub struct BftOptions {
     pub tangents: bool,
     /// Name for messages (the mesh's file).
     pub name: String,
+    /// Gather each patch's ring into a per-patch block that the TES reads instead of the
+    /// global buffers (the `patch_block` shader axis). `None`: by device, on for a CPU
+    /// implementation (lavapipe), off for a GPU (docs/benchmarks.md, "BFT on a real GPU"); there
+    /// the environment's `TESSERA_BFT_PATCH_BLOCK=1` or `=0` decides instead, for A/B runs.
+    pub patch_block: Option<bool>,
 }
 
 impl Default for BftOptions {
@@ -301,7 +306,20 @@ impl Default for BftOptions {
             table_level: DEFAULT_TABLE_LEVEL,
             tangents: false,
             name: "mesh".into(),
+            patch_block: None,
         }
+    }
+}
+
+/// [`BftOptions::patch_block`] left to the device: lavapipe runs the TES on the CPU, where a
+/// storage read indexed by the patch is a per-lane gather and a patch input one load; a GPU
+/// reads the global buffers through its caches and loses more to the block's 116 per-patch
+/// components than it saves.
+fn patch_block_for(device: &vk_core::Device) -> bool {
+    match std::env::var("TESSERA_BFT_PATCH_BLOCK").as_deref() {
+        Ok("1") => true,
+        Ok("0") => false,
+        _ => device.info.device_type == vk::PhysicalDeviceType::CPU,
     }
 }
 
@@ -338,6 +356,8 @@ pub struct Bft {
     rest_bbox: ([f32; 3], [f32; 3]),
     /// How the input was taken (fan triangulation), for the caller to show.
     pub notes: Vec<String>,
+    /// The patch-block build ([`BftOptions::patch_block`]).
+    patch_block: bool,
 }
 
 /// The base positions of `mesh` in f32.
@@ -418,6 +438,9 @@ impl Bft {
     /// [`GpuBft::validate`](layout::GpuBft::validate) does for the whole.
     pub fn new(ctx: &mut Context, mesh: &ControlMesh, options: &BftOptions) -> Result<Self> {
         let device = ctx.device().clone();
+        let patch_block = options
+            .patch_block
+            .unwrap_or_else(|| patch_block_for(&device));
         let table_level = options.table_level;
         let max_level = device.info.caps.max_tessellation_generation_level;
         if !(1..=6).contains(&table_level) || (1u32 << table_level) > max_level {
@@ -693,6 +716,7 @@ impl Bft {
             draw_chunks.len()
         );
         Ok(Self {
+            patch_block,
             subdivide,
             normals,
             pre_sets,
@@ -733,6 +757,10 @@ impl Bft {
 
     /// Chunks of the pre-pass and of the draw (one each unless a buffer exceeds the device's
     /// storage-buffer range: see the module header).
+    pub fn patch_block(&self) -> bool {
+        self.patch_block
+    }
+
     pub fn chunk_counts(&self) -> (usize, usize) {
         (self.pre_chunks.len(), self.draw_chunks.len())
     }
@@ -836,6 +864,10 @@ impl Technique for Bft {
             control_points: 1,
             mesh_vertex_input: false,
             push_constant_bytes: std::mem::size_of::<BftPush>() as u32,
+            axes: Variant {
+                patch_block: self.patch_block,
+                ..Variant::default()
+            },
         }
     }
 

@@ -1,7 +1,7 @@
 //! Flat tessellation: each base face subdivided in its own plane (quads kept as quad patches,
 //! other polygons fan-triangulated). The baseline every benchmark ratio divides by.
 use crate::gpu::DrawPush;
-use crate::shaders::Stage;
+use crate::shaders::{Stage, Variant};
 use crate::technique::{PatchPipeline, PatchType, TechniqueId};
 use crate::techniques::face_patches::{FacePatches, FaceStyle};
 
@@ -24,6 +24,7 @@ impl FaceStyle for FlatStyle {
             control_points,
             mesh_vertex_input: true,
             push_constant_bytes: std::mem::size_of::<DrawPush>() as u32,
+            axes: Variant::default(),
         }
     }
 }

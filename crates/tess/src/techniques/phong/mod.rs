@@ -1,7 +1,7 @@
 //! Phong tessellation (Boubekeur & Alexa 2008): each point of the flat triangle is projected
 //! onto the tangent planes of the corners and blended back by the shape factor α.
 use crate::gpu::DrawPush;
-use crate::shaders::Stage;
+use crate::shaders::{Stage, Variant};
 use crate::technique::{PatchPipeline, PatchType, TechniqueId};
 use crate::techniques::face_patches::{FacePatches, FaceStyle};
 
@@ -20,6 +20,7 @@ impl FaceStyle for PhongStyle {
             control_points: 3,
             mesh_vertex_input: true,
             push_constant_bytes: std::mem::size_of::<DrawPush>() as u32,
+            axes: Variant::default(),
         }
     }
 }

@@ -7,7 +7,7 @@
 //! themselves. Both patches of a shared edge thus emit the same position and normal bits
 //! (`tests/watertight.rs`), without vertex indices: repeated vertices with equal data weld too.
 use crate::gpu::DrawPush;
-use crate::shaders::Stage;
+use crate::shaders::{Stage, Variant};
 use crate::technique::{PatchPipeline, PatchType, TechniqueId};
 use crate::techniques::face_patches::{FacePatches, FaceStyle};
 
@@ -26,6 +26,7 @@ impl FaceStyle for PnStyle {
             control_points: 3,
             mesh_vertex_input: true,
             push_constant_bytes: std::mem::size_of::<DrawPush>() as u32,
+            axes: Variant::default(),
         }
     }
 }
