@@ -148,7 +148,7 @@ fn captured_bft_vertices_are_the_exact_limit() {
                     inexact, 0,
                     "{name} S={s}: {inexact} vertices not from table points"
                 );
-                let worst = exactness(&surf, &soup, &mesh, 3000);
+                let worst = exactness(&surf, &soup, mesh, 3000);
                 println!(
                     "{name} S={s}: {} triangles, worst |GPU − limit|/diag = {worst:.2e}",
                     soup.triangle_count()
@@ -167,7 +167,7 @@ fn bft_is_watertight_under_every_factor_policy() {
     {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let capturer = Capturer::new(&ctx).expect("capturer");
-        let meshes = vec![
+        let meshes = [
             ("loop_cube", shape("loop_cube")),
             ("loop_pole64", shape("loop_pole64")),
             ("loop_xord_boundary", shape("loop_xord_boundary")),
@@ -195,7 +195,7 @@ fn bft_is_watertight_under_every_factor_policy() {
                 (
                     "distance",
                     FactorPolicy::Distance {
-                        reference: 0.6 * diag(&mesh) as f32,
+                        reference: 0.6 * diag(mesh) as f32,
                     },
                     false,
                 ),
@@ -207,7 +207,7 @@ fn bft_is_watertight_under_every_factor_policy() {
                 (
                     "distance fractional",
                     FactorPolicy::Distance {
-                        reference: 0.45 * diag(&mesh) as f32,
+                        reference: 0.45 * diag(mesh) as f32,
                     },
                     true,
                 ),
@@ -226,7 +226,7 @@ fn bft_is_watertight_under_every_factor_policy() {
                 let (soup, _) = capturer
                     .capture(&mut ctx, &surf, &params, EXTENT)
                     .expect("capture");
-                let (cracks, boundary, nonmanifold) = cracks(&surf, &soup, &mesh);
+                let (cracks, boundary, nonmanifold) = cracks(&surf, &soup, mesh);
                 let interpolated = soup.records.iter().filter(|r| r.flags & 1 == 0).count();
                 println!(
                     "{name} {label}: {} triangles, {cracks} cracks, {boundary} boundary edges, \
