@@ -20,5 +20,6 @@ void main() {
     precise vec3 phong = b.x * project(p, 0) + b.y * project(p, 1) + b.z * project(p, 2);
     float alpha = frame.tess.z;
     precise vec3 n = b.x * in_normal[0] + b.y * in_normal[1] + b.z * in_normal[2];
-    emit_sample(mix(p, phong, alpha), n, draw.first_patch + uint(gl_PrimitiveID), 0u);
+    precise vec3 blended = (1.0 - alpha) * p + alpha * phong;
+    emit_sample(blended, n, draw.first_patch + uint(gl_PrimitiveID), 0u);
 }

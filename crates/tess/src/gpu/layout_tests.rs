@@ -827,3 +827,50 @@ fn plain_builds_have_no_surface_varyings() {
     // with and without its patch block.
     assert_eq!(checked, 72);
 }
+
+/// (NoContraction decorations, GLSL.std.450 FMix calls) in a SPIR-V module.
+fn contraction_and_mix(words: &[u32]) -> (usize, usize) {
+    const OP_EXT_INST_IMPORT: u32 = 11;
+    const OP_EXT_INST: u32 = 12;
+    const OP_DECORATE: u32 = 71;
+    const NO_CONTRACTION: u32 = 42;
+    const GLSL_FMIX: u32 = 46;
+    let (mut glsl_set, mut no_contraction, mut fmix) = (None, 0, 0);
+    let mut at = 5;
+    while at < words.len() {
+        let (count, op) = ((words[at] >> 16) as usize, words[at] & 0xffff);
+        assert!(count > 0 && at + count <= words.len(), "malformed SPIR-V");
+        let ins = &words[at..at + count];
+        match op {
+            OP_EXT_INST_IMPORT if super::reflect::string(&ins[2..]) == "GLSL.std.450" => {
+                glsl_set = Some(ins[1])
+            }
+            OP_EXT_INST if Some(ins[3]) == glsl_set && ins[4] == GLSL_FMIX => fmix += 1,
+            OP_DECORATE if ins[2] == NO_CONTRACTION => no_contraction += 1,
+            _ => {}
+        }
+        at += count;
+    }
+    (no_contraction, fmix)
+}
+
+/// Flat's and Phong's points on a shared edge are sums of corner products that the two patches
+/// form in different orders. Only IEEE sums without contraction to fused multiply-adds
+/// (`precise`: NoContraction) and without mix() (FMix, whose rounding is the driver's) give
+/// both sides the same bits. lavapipe neither fuses nor rewrites mix(), so only a real GPU's
+/// capture tests would see a regression (NVIDIA's cracked, docs/benchmarks.md, session 18):
+/// this check sees it anywhere.
+#[test]
+fn corner_sums_are_precise_and_mix_free() {
+    for stage in [Stage::FlatTriTese, Stage::FlatQuadTese, Stage::PhongTriTese] {
+        for (v, words) in stage.compiled() {
+            let (no_contraction, fmix) = contraction_and_mix(words);
+            assert!(
+                no_contraction >= 10,
+                "{} {v:?}: {no_contraction} NoContraction decorations",
+                stage.path()
+            );
+            assert_eq!(fmix, 0, "{} {v:?} calls mix()", stage.path());
+        }
+    }
+}

@@ -343,7 +343,7 @@ impl Reflection {
 }
 
 /// A literal string operand (UTF-8, nul-terminated, packed little-endian).
-fn string(words: &[u32]) -> String {
+pub(crate) fn string(words: &[u32]) -> String {
     let bytes: Vec<u8> = words
         .iter()
         .flat_map(|w| w.to_le_bytes())
