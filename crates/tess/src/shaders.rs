@@ -4,7 +4,7 @@
 //! ```
 //! use tess::shaders::{spirv, Stage, Variant};
 //! use tess::Spacing;
-//! let capture = Variant { spacing: Some(Spacing::FractionalOdd), capture: true, surface: false };
+//! let capture = Variant { spacing: Some(Spacing::FractionalOdd), capture: true, ..Variant::default() };
 //! let words = spirv(Stage::PnTriTese, capture).unwrap();
 //! assert_eq!(words[0], 0x0723_0203); // the SPIR-V magic number
 //! // A stage ignores the axes it does not vary along: the TCS has one build.
