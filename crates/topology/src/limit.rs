@@ -229,6 +229,7 @@ pub fn dart_position_weights(loop_scheme: bool, n: usize) -> Vec<f64> {
             next[k] += 0.25 * c;
         }
     };
+    // Loop's smooth vertex weights at valence n, read once for every step.
     let (loop_vw, loop_ew) = crate::refine::loop_vertex_weights(n);
     for _ in 0..10_000 {
         next.fill(0.0);
@@ -236,10 +237,9 @@ pub fn dart_position_weights(loop_scheme: bool, n: usize) -> Vec<f64> {
         // refiner's smooth rules.
         let c = w[0];
         if loop_scheme {
-            let (vw, ew) = (loop_vw, loop_ew);
-            next[0] += c * vw;
+            next[0] += c * loop_vw;
             for i in 0..n {
-                next[e(i)] += c * ew;
+                next[e(i)] += c * loop_ew;
             }
         } else {
             let ew = 1.0 / (n * n) as f64;

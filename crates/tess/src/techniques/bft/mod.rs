@@ -295,7 +295,7 @@ pub struct BftOptions {
     pub name: String,
     /// Gather each patch's ring into a per-patch block that the TES reads instead of the
     /// global buffers (the `patch_block` shader axis). `None`: by device, on for a CPU
-    /// implementation (lavapipe), off for a GPU (docs/benchmarks.md, "BFT on a real GPU"); there
+    /// implementation (lavapipe), off for a GPU (docs/benchmarks.md, "Session 18: the first real GPU"); there
     /// the environment's `TESSERA_BFT_PATCH_BLOCK=1` or `=0` decides instead, for A/B runs.
     pub patch_block: Option<bool>,
 }
@@ -757,10 +757,6 @@ impl Bft {
 
     /// Chunks of the pre-pass and of the draw (one each unless a buffer exceeds the device's
     /// storage-buffer range: see the module header).
-    pub fn patch_block(&self) -> bool {
-        self.patch_block
-    }
-
     pub fn chunk_counts(&self) -> (usize, usize) {
         (self.pre_chunks.len(), self.draw_chunks.len())
     }
