@@ -2,8 +2,8 @@
 //! wrong-kind handles, null pointers, wrong sizes, bad indices, out-of-range options, Loop on
 //! quads, a surface of another context, calls of the other mode. Each gets its code and a
 //! message naming what is at fault, never undefined behaviour; and animation (per-frame
-//! positions) changes what a surface draws. One validated standalone device, no validation
-//! errors at the end.
+//! positions) changes what a surface draws. Every context it creates has the validation layer
+//! on, and none may report an error.
 mod common;
 use common::surface_desc;
 use std::ffi::{c_char, CStr};
@@ -371,12 +371,12 @@ fn misuse_gets_codes_and_messages_never_undefined_behaviour() {
 
         // Another context's surface, destroyed handles.
         let mut other = null_mut();
-        let plain = TesseraStandaloneDesc {
+        let validated = TesseraStandaloneDesc {
             device: null(),
-            validation: TESSERA_VALIDATION_OFF,
+            validation: TESSERA_VALIDATION_ON,
         };
         assert_eq!(
-            tessera_context_create_standalone(&plain, &mut other),
+            tessera_context_create_standalone(&validated, &mut other),
             TesseraStatus::Ok
         );
         expect(
@@ -384,6 +384,12 @@ fn misuse_gets_codes_and_messages_never_undefined_behaviour() {
             TesseraStatus::WrongContext,
             "belongs to context",
         );
+        let mut other_errors = 1;
+        assert_eq!(
+            tessera_context_validation_errors(other, &mut other_errors),
+            TesseraStatus::Ok
+        );
+        assert_eq!(other_errors, 0, "validation errors on the other context");
         assert_eq!(tessera_context_destroy(other), TesseraStatus::Ok);
         assert_eq!(tessera_surface_destroy(ctx, flat_cube), TesseraStatus::Ok);
         expect(
