@@ -349,6 +349,35 @@ fn bad_input_gives_named_errors() {
                 "{e}"
             );
         }
+        // A height map alone too (the displacement would read it at `vt`); procedural
+        // displacement, which needs no map, is not refused.
+        let height_only = SurfaceMaps {
+            height: Some(std::sync::Arc::new(
+                tessera::tess::surface::load_height(common::data("assets/spot_height.png"))
+                    .expect("height map"),
+            )),
+            ..Default::default()
+        };
+        for patch in PATCHES {
+            let e = gregory::build(&mut ctx, &bare, patch, 1.0, true, "bare.obj", &height_only)
+                .err()
+                .expect("height map without vt");
+            let e = e.to_string();
+            assert!(
+                e.contains("bare.obj") && e.contains("a height map was given") && e.contains("vt"),
+                "{e}"
+            );
+        }
+        assert!(gregory::build(
+            &mut ctx,
+            &bare,
+            SinglePassPatch::Gregory,
+            1.0,
+            true,
+            "bare.obj",
+            &Default::default()
+        )
+        .is_ok());
         assert!(gregory::build(
             &mut ctx,
             &mesh,

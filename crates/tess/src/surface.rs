@@ -92,3 +92,69 @@ pub fn load_height(path: impl AsRef<Path>) -> Result<SurfaceImage> {
         texels,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A scratch directory of this test process.
+    fn scratch() -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("tess-surface-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// Issue 12's bad input: a colour texture or height map that is missing, or a file that is
+    /// not an image (text, with and without an image's extension), is `TessError::Image`
+    /// naming the file, whose message says it once, with the reader's reason after it.
+    #[test]
+    fn missing_and_unreadable_images_are_named_errors() {
+        let dir = scratch();
+        let missing = dir.join("no_such_texture.png");
+        let _ = std::fs::remove_file(&missing);
+        let text_png = dir.join("not_an_image.png");
+        std::fs::write(&text_png, "this is text, not a PNG\n").unwrap();
+        let text_txt = dir.join("height_notes.txt");
+        std::fs::write(&text_txt, "v 0 0 0\n").unwrap();
+        type Loader = fn(&Path) -> Result<SurfaceImage>;
+        let loaders: [(&str, Loader); 2] = [
+            ("load_texture", |p| load_texture(p)),
+            ("load_height", |p| load_height(p)),
+        ];
+        for (what, load) in loaders {
+            for path in [&missing, &text_png, &text_txt] {
+                let shown = path.display().to_string();
+                let Err(e) = load(path) else {
+                    panic!("{what} {shown}: loaded");
+                };
+                let line = e.to_string();
+                let TessError::Image { file, message } = e else {
+                    panic!("{what} {shown}: not an image error: {line}");
+                };
+                assert_eq!(file, shown, "{what}");
+                assert!(!message.trim().is_empty(), "{what} {shown}: no reason");
+                assert!(line.starts_with(&format!("{shown}: ")), "{what}: {line}");
+                assert_eq!(line.matches(&shown).count(), 1, "{what}: {line}");
+                assert!(!line.contains('\n'), "{what}: {line}");
+            }
+        }
+        // The missing file's reason is the system's, not a decoder's.
+        let e = load_texture(&missing).unwrap_err().to_string();
+        assert!(e.contains("os error"), "{e}");
+        // And the real maps load: RGBA8 texels, heights in [0, 1].
+        let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets");
+        let tex = load_texture(assets.join("spot_texture.png")).expect("spot texture");
+        assert_eq!(tex.format, TextureFormat::Rgba8Srgb);
+        assert_eq!(tex.texels.len(), (tex.width * tex.height * 4) as usize);
+        let height = load_height(assets.join("spot_height.png")).expect("spot height map");
+        assert_eq!(height.format, TextureFormat::R32Float);
+        let h: Vec<f32> = height
+            .texels
+            .chunks(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        assert_eq!(h.len(), (height.width * height.height) as usize);
+        assert!(h.iter().all(|x| (0.0..=1.0).contains(x)));
+        assert!(h.iter().any(|&x| x > 0.0) && h.iter().any(|&x| x < 1.0));
+    }
+}

@@ -122,6 +122,29 @@ fn config(a: &BenchArgs) -> Result<BenchConfig> {
     if let Some(&s) = a.segments.iter().find(|&&s| s == 0 || s > 64) {
         bail!("--segments {s} is outside 1..64");
     }
+    // The surface options, checked as render checks them; a method list none of whose
+    // techniques takes them is refused as render refuses them for such a --method.
+    crate::technique::check_displacement(a.displace, a.height.as_deref())?;
+    let given: Vec<&str> = [
+        ("--texture", a.texture.is_some()),
+        ("--displace", a.displace.is_some()),
+        ("--height", a.height.is_some()),
+        ("--no-reparam", a.no_reparam),
+    ]
+    .into_iter()
+    .filter_map(|(name, given)| given.then_some(name))
+    .collect();
+    let takers = tess::techniques::names_with(|f| f.surface);
+    if !given.is_empty() && !a.methods.iter().any(|m| takers.contains(&m.as_str())) {
+        bail!(
+            "{} only {} to the {} rows, and --methods {} has none",
+            given.join(", "),
+            if given.len() == 1 { "applies" } else { "apply" },
+            takers.join(", "),
+            a.methods.join(",")
+        );
+    }
+    let maps = crate::technique::load_maps(a.texture.as_deref(), a.height.as_deref(), false)?;
     Ok(BenchConfig {
         segments: a.segments.clone(),
         methods: a.methods.clone(),
@@ -138,6 +161,9 @@ fn config(a: &BenchArgs) -> Result<BenchConfig> {
         isolation: a.isolation,
         follow_semi_sharp: !a.creases_at_isolation,
         equal_triangles: a.equal_triangles,
+        maps,
+        displace: a.displace.unwrap_or(0.0),
+        reparam: !a.no_reparam,
     })
 }
 
@@ -166,6 +192,18 @@ pub fn run(a: BenchArgs) -> Result<()> {
     }
     let config = config(&a)?;
     let meshes = load_meshes(&a.mesh)?;
+    // A texture or height map needs `vt` on every mesh the surface techniques draw (as
+    // loaded: they take the mesh before fan triangulation); said before the device is opened.
+    let takers = tess::techniques::names_with(|f| f.surface);
+    if a.methods.iter().any(|m| takers.contains(&m.as_str())) {
+        for (i, m) in meshes.iter().enumerate() {
+            let file = a.mesh.get(i).map_or_else(
+                || format!("{}.obj (embedded)", m.name),
+                |p| p.display().to_string(),
+            );
+            tess::techniques::adaptive::check_texcoords(&m.input, &config.maps, &file)?;
+        }
+    }
     if bench::build_profile() != "release" {
         eprintln!(
             "WARNING: this is a debug build; the timings are not representative. \

@@ -137,6 +137,22 @@ pub struct BenchArgs {
     /// in --methods.
     #[arg(long)]
     pub equal_triangles: bool,
+    /// Colour texture (PNG) shown at the mesh's `vt` coordinates by the methods that take
+    /// surface maps (adaptive, gregory, acc); their rows' notes say so, the others draw as
+    /// always.
+    #[arg(long, value_name = "PNG")]
+    pub texture: Option<PathBuf>,
+    /// Displace along the normal by S times the height (the --height map's, else a procedural
+    /// bump pattern) in the same rows.
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    pub displace: Option<f32>,
+    /// Height map (PNG, luminance in [0, 1]) for --displace.
+    #[arg(long, value_name = "PNG")]
+    pub height: Option<PathBuf>,
+    /// Texture coordinates at the Gregory patches' own parameter instead of the rational
+    /// reparameterization of Schäfer et al. (seed 003, Eq. 3), in the same rows.
+    #[arg(long)]
+    pub no_reparam: bool,
     /// Write the rows as CSV.
     #[arg(long)]
     pub csv: Option<PathBuf>,

@@ -3,6 +3,8 @@
 //! no per-technique code here, so a new technique needs no change in the viewer.
 use anyhow::{bail, Result};
 use clap::Args;
+use std::path::Path;
+use std::sync::Arc;
 use tess::techniques::{self, adaptive::DEFAULT_ISOLATION, bft::DEFAULT_TABLE_LEVEL, BuildOptions};
 use tess::{FactorPolicy, Features, FrameParams, Spacing, TechniqueId};
 use topology::adaptive::EndCap;
@@ -343,14 +345,7 @@ impl SurfaceArgs {
         if f.table_level && !(1..=6).contains(&self.table_level) {
             bail!("--table-level {} is outside 1..6", self.table_level);
         }
-        if let Some(s) = self.displace {
-            if !(s.is_finite() && s.abs() <= 1e3) {
-                bail!("--displace {s}: give a finite scale (at most 1000 in magnitude)");
-            }
-        }
-        if self.height.is_some() && self.displace.is_none() {
-            bail!("--height needs --displace S (the scale of the height)");
-        }
+        check_displacement(self.displace, self.height.as_deref())?;
         params.show = match self.show.as_deref() {
             None => tess::surface::SurfaceShow::Shading,
             Some(name) => match tess::surface::SurfaceShow::parse(name) {
@@ -363,17 +358,11 @@ impl SurfaceArgs {
         };
         params.reparam = !self.no_reparam;
         params.displace = self.displace.unwrap_or(0.0);
-        let maps = tess::surface::SurfaceMaps {
-            texture: match &self.texture {
-                Some(p) => Some(std::sync::Arc::new(tess::surface::load_texture(p)?)),
-                None => None,
-            },
-            height: match &self.height {
-                Some(p) => Some(std::sync::Arc::new(tess::surface::load_height(p)?)),
-                None => None,
-            },
-            param_error: params.show == tess::surface::SurfaceShow::ParamError,
-        };
+        let maps = load_maps(
+            self.texture.as_deref(),
+            self.height.as_deref(),
+            params.show == tess::surface::SurfaceShow::ParamError,
+        )?;
         params.spacing = spacing;
         params.geometric_normals = self.geometric_normals;
         params.patch_colours = self.patch_colours;
@@ -422,6 +411,40 @@ impl SurfaceArgs {
             frame: self.frame,
         })
     }
+}
+
+/// `--displace S` and `--height PNG` as every command that takes them checks them (render,
+/// view, export, bench): a finite scale, and a height map only with a scale.
+pub fn check_displacement(displace: Option<f32>, height: Option<&Path>) -> Result<()> {
+    if let Some(s) = displace {
+        if !(s.is_finite() && s.abs() <= 1e3) {
+            bail!("--displace {s}: give a finite scale (at most 1000 in magnitude)");
+        }
+    }
+    if height.is_some() && displace.is_none() {
+        bail!("--height needs --displace S (the scale of the height)");
+    }
+    Ok(())
+}
+
+/// The images of `--texture` and `--height`, read before any device is opened: a file that
+/// is missing or not an image is `TessError::Image`, naming it.
+pub fn load_maps(
+    texture: Option<&Path>,
+    height: Option<&Path>,
+    param_error: bool,
+) -> Result<tess::surface::SurfaceMaps> {
+    Ok(tess::surface::SurfaceMaps {
+        texture: match texture {
+            Some(p) => Some(Arc::new(tess::surface::load_texture(p)?)),
+            None => None,
+        },
+        height: match height {
+            Some(p) => Some(Arc::new(tess::surface::load_height(p)?)),
+            None => None,
+        },
+        param_error,
+    })
 }
 
 fn scheme_name(s: topology::Scheme) -> &'static str {

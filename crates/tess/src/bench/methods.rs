@@ -227,6 +227,12 @@ pub struct TechniqueMethod {
     context: Context,
     /// Faces of the control mesh as loaded (the memory note's denominator).
     base_faces: usize,
+    /// Displacement scale and reparameterization of every frame: the config's for techniques
+    /// that take surface maps, else none and the default.
+    displace: f32,
+    reparam: bool,
+    /// What the row draws beyond plain shading ([`BenchConfig::surface_note`]), for its note.
+    surface_note: Option<String>,
 }
 
 impl TechniqueMethod {
@@ -239,6 +245,9 @@ impl TechniqueMethod {
         } else {
             &ctx.mesh.mesh
         };
+        // Textures, displacement and the reparameterization apply to the techniques that take
+        // them (`Features::surface`); the others draw as always.
+        let surface = info.features.surface;
         let built = techniques::build(
             &mut context,
             info.id,
@@ -247,6 +256,11 @@ impl TechniqueMethod {
                 name: ctx.mesh.name.clone(),
                 isolation: ctx.config.isolation,
                 follow_semi_sharp: ctx.config.follow_semi_sharp,
+                maps: if surface {
+                    ctx.config.maps.clone()
+                } else {
+                    Default::default()
+                },
                 ..BuildOptions::default()
             },
         )?;
@@ -266,12 +280,21 @@ impl TechniqueMethod {
             wave,
             context,
             base_faces: ctx.mesh.input.num_faces(),
+            displace: if surface { ctx.config.displace } else { 0.0 },
+            reparam: !surface || ctx.config.reparam,
+            surface_note: if surface {
+                ctx.config.surface_note()
+            } else {
+                None
+            },
         })
     }
 
-    fn params(segments: u32, camera: Camera) -> FrameParams {
+    fn params(&self, segments: u32, camera: Camera) -> FrameParams {
         FrameParams {
             camera,
+            displace: self.displace,
+            reparam: self.reparam,
             ..FrameParams::uniform(segments as f32)
         }
     }
@@ -284,13 +307,13 @@ impl BenchMethod for TechniqueMethod {
 
     fn skip_reason(&self, segments: u32) -> Option<String> {
         self.technique
-            .check(&Self::params(segments, Camera::default()))
+            .check(&self.params(segments, Camera::default()))
             .err()
             .map(|e| e.to_string())
     }
 
     fn begin_frame(&mut self, frame: &BenchFrame) -> Result<Option<f64>> {
-        let params = Self::params(frame.segments, frame.camera);
+        let params = self.params(frame.segments, frame.camera);
         self.context
             .prepare(self.technique.as_ref(), &params, &[crate::Pass::Shaded])?;
         let cpu = match (&self.wave, self.animated) {
@@ -314,13 +337,17 @@ impl BenchMethod for TechniqueMethod {
     }
 
     fn record<'a>(&'a self, enc: &mut Encoder<'a>, frame: &BenchFrame) -> Result<u64> {
-        let params = Self::params(frame.segments, frame.camera);
+        let params = self.params(frame.segments, frame.camera);
         let t = self.technique.as_ref();
         self.context
             .record_pass(enc, t, 0, &params, crate::Pass::Shaded)?;
         Ok((0..t.patch_arrays().len())
             .map(|i| t.triangles(&params, i).unwrap_or(0))
             .sum())
+    }
+
+    fn row_notes(&mut self) -> Vec<String> {
+        self.surface_note.iter().cloned().collect()
     }
 
     fn report_notes(&self) -> Vec<String> {
@@ -351,7 +378,7 @@ impl BenchMethod for TechniqueMethod {
     }
 
     fn triangles_at(&self, segments: u32) -> Option<u64> {
-        let params = Self::params(segments, Camera::default());
+        let params = self.params(segments, Camera::default());
         let t = self.technique.as_ref();
         t.check(&params).ok()?;
         (0..t.patch_arrays().len())

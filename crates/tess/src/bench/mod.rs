@@ -59,6 +59,46 @@ pub struct BenchConfig {
     /// patch edge for the patch techniques) whose CPU count is nearest Flat's at S
     /// ([`nearest_level`]); Flat keeps S. Needs `flat` among the methods.
     pub equal_triangles: bool,
+    /// Colour texture and height map of the techniques that take them
+    /// ([`crate::Features::surface`]: adaptive, gregory, acc); the other methods draw without.
+    pub maps: crate::surface::SurfaceMaps,
+    /// Displacement along the normal by this times the height (the height map's, else the
+    /// procedural pattern) for the same techniques; 0: none.
+    pub displace: f32,
+    /// Their texture coordinates at the reparameterized parameter on Gregory patches (seed 003).
+    pub reparam: bool,
+}
+
+impl BenchConfig {
+    /// What the surface techniques' rows draw beyond plain shading, for their notes and the
+    /// report: e.g. "textured (spot_texture.png), displaced by 0.05 × spot_height.png,
+    /// reparameterized texture coordinates"; `None` for a plain run.
+    pub fn surface_note(&self) -> Option<String> {
+        let file = |i: &crate::surface::SurfaceImage| {
+            std::path::Path::new(&i.name)
+                .file_name()
+                .map_or_else(|| i.name.clone(), |f| f.to_string_lossy().into_owned())
+        };
+        let mut parts = Vec::new();
+        if let Some(t) = &self.maps.texture {
+            parts.push(format!("textured ({})", file(t)));
+        }
+        match (&self.maps.height, self.displace != 0.0) {
+            (Some(h), true) => parts.push(format!("displaced by {} × {}", self.displace, file(h))),
+            (None, true) => parts.push(format!(
+                "displaced by {} × the procedural height",
+                self.displace
+            )),
+            (Some(h), false) => parts.push(format!("height map {} (displacement 0)", file(h))),
+            (None, false) => {}
+        }
+        if !self.reparam {
+            parts.push("no reparameterization".to_owned());
+        } else if !parts.is_empty() {
+            parts.push("reparameterized texture coordinates".to_owned());
+        }
+        (!parts.is_empty()).then(|| parts.join(", "))
+    }
 }
 
 impl Default for BenchConfig {
@@ -81,6 +121,9 @@ impl Default for BenchConfig {
             isolation: crate::techniques::adaptive::DEFAULT_ISOLATION,
             follow_semi_sharp: true,
             equal_triangles: false,
+            maps: Default::default(),
+            displace: 0.0,
+            reparam: true,
         }
     }
 }
@@ -626,6 +669,12 @@ fn validate(config: &BenchConfig, meshes: &[BenchMesh]) -> Result<()> {
             names.join(", ")
         ));
     }
+    if !config.displace.is_finite() {
+        return Err(TessError::BenchConfig {
+            option: format!("--displace {}", config.displace),
+            reason: "give a finite scale".into(),
+        });
+    }
     if config.equal_triangles && !config.methods.iter().any(|m| m == "flat") {
         return Err(TessError::BenchConfig {
             option: "--equal-triangles".into(),
@@ -834,6 +883,40 @@ mod tests {
         assert_eq!(nearest_level(1, (1..=4).map(quad)), Some((1, 10)));
         assert_eq!(nearest_level(10_000, (1..=4).map(quad)), Some((4, 160)));
         assert_eq!(nearest_level(5, std::iter::empty()), None);
+    }
+
+    /// The surface techniques' row note: none for a plain run, else what they drew.
+    #[test]
+    fn surface_notes_say_what_the_surface_rows_drew() {
+        let mut c = BenchConfig::default();
+        assert_eq!(c.surface_note(), None);
+        c.reparam = false;
+        assert_eq!(c.surface_note().as_deref(), Some("no reparameterization"));
+        c.reparam = true;
+        c.displace = 0.25;
+        assert_eq!(
+            c.surface_note().as_deref(),
+            Some("displaced by 0.25 × the procedural height, reparameterized texture coordinates")
+        );
+        let image = |name: &str| {
+            Some(std::sync::Arc::new(crate::surface::SurfaceImage {
+                name: name.into(),
+                width: 1,
+                height: 1,
+                format: vk_core::texture::TextureFormat::Rgba8Srgb,
+                texels: vec![0; 4],
+            }))
+        };
+        c.maps.texture = image("assets/spot_texture.png");
+        c.maps.height = image("/data/spot_height.png");
+        c.reparam = false;
+        assert_eq!(
+            c.surface_note().as_deref(),
+            Some(
+                "textured (spot_texture.png), displaced by 0.25 × spot_height.png, no \
+                 reparameterization"
+            )
+        );
     }
 
     #[test]

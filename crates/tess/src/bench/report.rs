@@ -105,9 +105,10 @@ impl BenchReport {
              vertex buffer (position + normal per render vertex) and patch index buffers; \
              adaptive, gregory, acc: base positions, vertex buffer (refined/local points), \
              stencils, patch records, control points, curves, patch surfaces, \
-             reparameterization table, curve and corner owners, 1x1 textures; bft: base \
-             positions, tables, patch records, stencils, level-1 vertices and normals; CPU \
-             baselines: the refined mesh's vertex and index buffers at the row's level"
+             reparameterization table, curve and corner owners, colour texture and height map \
+             (1x1 each unless given); bft: base positions, tables, patch records, stencils, \
+             level-1 vertices and normals; CPU baselines: the refined mesh's vertex and index \
+             buffers at the row's level"
                 .to_owned(),
         ];
         if c.equal_triangles {
@@ -119,6 +120,13 @@ impl BenchReport {
                  Flat's, and × Flat is then a cost at (nearly) equal output triangles"
                     .to_owned(),
             );
+        }
+        if let Some(surface) = c.surface_note() {
+            lines.push(format!(
+                "Surface maps on the {} rows (their notes say so; the other methods draw as \
+                 always): {surface}",
+                crate::techniques::names_with(|f| f.surface).join(", ")
+            ));
         }
         lines.extend(self.extra_notes.iter().cloned());
         lines.extend(self.mesh_notes.iter().cloned());
