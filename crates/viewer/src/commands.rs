@@ -80,6 +80,9 @@ pub fn scene_setup(s: &SceneArgs, name: &str, mesh: &topology::ControlMesh) -> R
         .setup(method, s.segments, s.spacing, s.animate, params)?;
     crate::technique::check_segments(&setup)?;
     setup.build.name = name.to_string();
+    // A texture or height map without `vt`: said before the device is opened (the build
+    // checks it too).
+    tess::techniques::adaptive::check_texcoords(mesh, &setup.build.maps, name)?;
     Ok(setup)
 }
 
@@ -275,5 +278,7 @@ fn info(g: &GpuArgs) -> Result<()> {
         }
         Err(e) => out!("chosen: none — {e}"),
     }
-    Ok(())
+    // Enumeration and capability queries go through the layer too: an error there fails the
+    // command like any other.
+    check_validation(&instance)
 }

@@ -6,7 +6,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-/// Runs `tessera`; GPU commands get `--validation` (their runs fail on any validation error).
+/// Runs `tessera`; GPU commands get `--validation --sync-validation` (their runs fail on any
+/// validation error, synchronization hazards included).
 fn tessera(args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_tessera"));
     c.args(args);
@@ -14,7 +15,7 @@ fn tessera(args: &[&str], env: &[(&str, &str)]) -> Output {
         args.first(),
         Some(&"render" | &"view" | &"info" | &"export" | &"bench")
     ) {
-        c.arg("--validation");
+        c.args(["--validation", "--sync-validation"]);
     }
     for (k, v) in env {
         c.env(k, v);
@@ -188,7 +189,8 @@ fn octahedron_faces_over(positions: &[[f64; 3]; 6]) -> String {
 /// At the accepted bound and on degenerate (but finite) meshes, every technique exports finite
 /// positions, normals and domain points, validation-clean. At the bound, the surface
 /// techniques' normals are unit vectors: `|du × dv|²` overflows f32 there, so the shaders scale
-/// before normalising (before, BFT and adaptive wrote `vn 0 0 0`). Opposite corner normals make
+/// before normalising (before, BFT and adaptive wrote `vn 0 0 0`, and later Gregory and ACC-1
+/// too, through the owners' normals of their shared points). Opposite corner normals make
 /// PN's quadratic normal field vanish at the edge midpoint (before, `normalize` wrote NaN).
 #[test]
 fn bound_and_degenerate_meshes_export_finite_through_every_technique() {
@@ -227,22 +229,42 @@ fn bound_and_degenerate_meshes_export_finite_through_every_technique() {
     let mut failures = Vec::new();
     for (name, text) in &meshes {
         let input = write(&format!("{name}.obj"), text);
-        for method in ["flat", "phong", "pn", "bft", "adaptive"] {
-            let out = tmp(&format!("{name}_{method}_out.obj"));
+        // The surface methods also displaced (procedural heights): the displaced normal is
+        // |du x dv| n + ..., whose length overflowed f32 at the bound (NaN normals, refused by
+        // export's finiteness check) until it was taken after scaling.
+        for (method, displace) in [
+            ("flat", false),
+            ("phong", false),
+            ("pn", false),
+            ("bft", false),
+            ("adaptive", false),
+            ("adaptive", true),
+            ("gregory", false),
+            ("gregory", true),
+            ("acc", false),
+            ("acc", true),
+        ] {
+            let out = tmp(&format!("{name}_{method}_{displace}_out.obj"));
             let out = out.to_str().unwrap();
-            let o = tessera(
-                &[
-                    "export",
-                    &input,
-                    "--method",
-                    method,
-                    "--segments",
-                    "4",
-                    "-o",
-                    out,
-                ],
-                &[],
-            );
+            let mut args = vec![
+                "export",
+                &input,
+                "--method",
+                method,
+                "--segments",
+                "4",
+                "-o",
+                out,
+            ];
+            if displace {
+                args.extend(["--displace", "0.05"]);
+            }
+            let method = if displace {
+                format!("{method} displaced")
+            } else {
+                method.to_string()
+            };
+            let o = tessera(&args, &[]);
             if !o.status.success() {
                 failures.push(format!("{name} {method}: {}", stderr(&o)));
                 continue;
@@ -259,7 +281,7 @@ fn bound_and_degenerate_meshes_export_finite_through_every_technique() {
                         .collect::<Vec<_>>()
                 ));
             }
-            if *name == "at_bound" && ["pn", "bft", "adaptive"].contains(&method) {
+            if *name == "at_bound" && !["flat", "phong"].contains(&method.as_str()) {
                 let not_unit = obj_normals(out)
                     .into_iter()
                     .filter(|n| {
@@ -651,7 +673,11 @@ fn every_command_path_runs_with_validation_on() {
     ]);
     assert!(stdout(&o).contains("flat"), "{}", stdout(&o));
     let o = succeeds(&["info"]);
-    assert!(stdout(&o).contains("validation layer"), "{}", stdout(&o));
+    assert!(
+        stdout(&o).contains("validation layer: on, with synchronization validation"),
+        "{}",
+        stdout(&o)
+    );
     succeeds(&[
         "subdivide",
         &cube,
@@ -745,4 +771,406 @@ fn closed_stdout_is_not_a_panic() {
             o.status
         );
     }
+}
+
+/// One error line, said once: `error: ` then the message, no panic, no repeated prefix, the
+/// file named exactly once.
+fn one_line_naming(e: &str, file: &str) {
+    assert_eq!(e.trim_end().lines().count(), 1, "one line: {e}");
+    assert!(e.starts_with("error: "), "{e}");
+    assert_eq!(e.matches("error:").count(), 1, "said once: {e}");
+    assert_eq!(e.matches(file).count(), 1, "names {file} once: {e}");
+}
+
+/// Issue 12's bad input: a colour texture or height map that is missing or not an image is a
+/// one-line error naming the file, given before any device is opened (no loader is even
+/// looked for), by render, export and bench alike.
+#[test]
+fn missing_or_unreadable_texture_and_height_map_are_named() {
+    let spot = data("assets/spot_control_mesh.obj");
+    let out = tmp("never_textured.png");
+    let out = out.to_str().unwrap();
+    let obj = tmp("never_textured.obj");
+    let obj = obj.to_str().unwrap();
+    let missing = tmp("no_such_texture.png");
+    let _ = std::fs::remove_file(&missing);
+    let missing = missing.to_str().unwrap();
+    let not_png = write("not_an_image.png", "this is text, not a PNG\n");
+    let height = data("assets/spot_height.png");
+    let texture = data("assets/spot_texture.png");
+    for method in ["gregory", "acc"] {
+        let e = fails(
+            &[
+                "render",
+                &spot,
+                "--method",
+                method,
+                "--texture",
+                missing,
+                "-o",
+                out,
+            ],
+            &[NO_LOADER],
+            1,
+            &["os error"],
+        );
+        one_line_naming(&e, missing);
+        let e = fails(
+            &[
+                "render",
+                &spot,
+                "--method",
+                method,
+                "--displace",
+                "0.1",
+                "--height",
+                &not_png,
+                "-o",
+                out,
+            ],
+            &[NO_LOADER],
+            1,
+            &[],
+        );
+        one_line_naming(&e, &not_png);
+    }
+    // The other map's slot, and the other commands.
+    let cases: [(Vec<&str>, &str); 4] = [
+        (
+            vec![
+                "render",
+                &spot,
+                "--method",
+                "gregory",
+                "--texture",
+                &not_png,
+                "--displace",
+                "0.1",
+                "--height",
+                &height,
+                "-o",
+                out,
+            ],
+            &not_png,
+        ),
+        (
+            vec![
+                "export",
+                &spot,
+                "--method",
+                "gregory",
+                "--texture",
+                &texture,
+                "--displace",
+                "0.1",
+                "--height",
+                missing,
+                "-o",
+                obj,
+            ],
+            missing,
+        ),
+        (
+            vec![
+                "bench",
+                "--mesh",
+                &spot,
+                "--methods",
+                "flat,gregory",
+                "--texture",
+                missing,
+            ],
+            missing,
+        ),
+        (
+            vec![
+                "bench",
+                "--mesh",
+                &spot,
+                "--methods",
+                "flat,gregory",
+                "--displace",
+                "0.05",
+                "--height",
+                &not_png,
+            ],
+            &not_png,
+        ),
+    ];
+    for (args, file) in cases {
+        let e = fails(&args, &[NO_LOADER], 1, &[]);
+        one_line_naming(&e, file);
+    }
+    assert!(!Path::new(out).exists() && !Path::new(obj).exists());
+}
+
+/// A colour texture or a height map alone on a mesh without `vt` is refused naming the mesh
+/// and the map, before the device; procedural displacement needs no `vt` and runs.
+#[test]
+fn maps_on_a_mesh_without_vt_are_named_before_the_device() {
+    let cube = data("tests/data/meshes/cube.obj");
+    let out = tmp("never_bare.png");
+    let out = out.to_str().unwrap();
+    let texture = data("assets/spot_texture.png");
+    let height = data("assets/spot_height.png");
+    let maps: [(&[&str], &str); 2] = [
+        (&["--texture", &texture], "a colour texture was given"),
+        (
+            &["--displace", "0.1", "--height", &height],
+            "a height map was given",
+        ),
+    ];
+    for (options, said) in maps {
+        for method in ["gregory", "acc", "adaptive"] {
+            let mut args = vec!["render", &cube, "--method", method, "-o", out];
+            args.extend_from_slice(options);
+            let e = fails(&args, &[NO_LOADER], 1, &[said, "`vt`"]);
+            one_line_naming(&e, &cube);
+        }
+        let mut args = vec!["bench", "--mesh", &cube, "--methods", "flat,gregory"];
+        args.extend_from_slice(options);
+        let e = fails(&args, &[NO_LOADER], 1, &[said, "`vt`"]);
+        one_line_naming(&e, &cube);
+    }
+    assert!(!Path::new(out).exists());
+    succeeds(&[
+        "render",
+        &cube,
+        "--method",
+        "gregory",
+        "--displace",
+        "0.1",
+        "--segments",
+        "2",
+        "--size",
+        "64x48",
+        "-o",
+        out,
+    ]);
+}
+
+/// The CSV rows of a `bench --csv` run: (method, note).
+fn bench_csv_rows(path: &str) -> Vec<(String, String)> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let method = header.iter().position(|c| *c == "method").unwrap();
+    assert_eq!(header.last(), Some(&"note"), "{header:?}");
+    lines
+        .map(|l| {
+            // The note is the last column and the only one that may be quoted.
+            let fields: Vec<&str> = l.splitn(header.len(), ',').collect();
+            let note = fields[header.len() - 1].trim_matches('"').to_owned();
+            (fields[method].to_owned(), note)
+        })
+        .collect()
+}
+
+/// `tessera bench` takes render's surface options (issue 12's interface list): the texture,
+/// height map and displacement are built into the gregory rows (their device memory holds
+/// both images) and their notes say so, Flat draws as always; `--no-reparam` is accepted and
+/// noted; bad combinations are refused as render refuses them.
+#[test]
+fn bench_applies_the_surface_options_to_the_surface_rows() {
+    let spot = data("assets/spot_control_mesh.obj");
+    let texture = data("assets/spot_texture.png");
+    let height = data("assets/spot_height.png");
+    let cheap = [
+        "--segments",
+        "2",
+        "--frames",
+        "1",
+        "--warmup",
+        "1",
+        "--size",
+        "64x48",
+    ];
+    let csv = tmp("bench_surface.csv");
+    let csv = csv.to_str().unwrap();
+    let mut args = vec![
+        "bench",
+        "--mesh",
+        &spot,
+        "--methods",
+        "flat,gregory",
+        "--texture",
+        &texture,
+        "--displace",
+        "0.05",
+        "--height",
+        &height,
+        "--csv",
+        csv,
+    ];
+    args.extend_from_slice(&cheap);
+    let text = stdout(&succeeds(&args));
+    assert!(
+        text.contains(
+            "Surface maps on the adaptive, gregory, acc rows (their notes say so; the other \
+             methods draw as always): textured (spot_texture.png), displaced by 0.05 × \
+             spot_height.png, reparameterized texture coordinates"
+        ),
+        "{text}"
+    );
+    // Both images were uploaded for gregory (its device memory lists them by file).
+    let memory = text
+        .lines()
+        .find(|l| l.contains("gregory device memory"))
+        .unwrap_or_else(|| panic!("no memory line: {text}"));
+    assert!(
+        memory.contains("spot_texture.png") && memory.contains("spot_height.png"),
+        "{memory}"
+    );
+    let rows = bench_csv_rows(csv);
+    let note = |m: &str| {
+        rows.iter()
+            .find(|(method, _)| method == m)
+            .map(|(_, n)| n.clone())
+            .unwrap_or_else(|| panic!("no {m} row: {rows:?}"))
+    };
+    for m in ["gregory", "gregory-animated"] {
+        let n = note(m);
+        assert!(
+            n.contains("textured (spot_texture.png)")
+                && n.contains("displaced by 0.05 × spot_height.png")
+                && n.contains("reparameterized"),
+            "{m}: {n}"
+        );
+    }
+    assert!(!note("flat").contains("textured"), "{}", note("flat"));
+
+    // --no-reparam alone (procedural displacement would need no vt either).
+    let mut args = vec![
+        "bench",
+        "--mesh",
+        &spot,
+        "--methods",
+        "flat,gregory",
+        "--no-reparam",
+        "--csv",
+        csv,
+    ];
+    args.extend_from_slice(&cheap);
+    succeeds(&args);
+    let rows = bench_csv_rows(csv);
+    assert!(
+        rows.iter()
+            .any(|(m, n)| m == "gregory" && n.contains("no reparameterization")),
+        "{rows:?}"
+    );
+
+    // Bad combinations, before the device, in render's words.
+    let e = fails(
+        &["bench", "--methods", "flat,bft", "--texture", &texture],
+        &[NO_LOADER],
+        1,
+        &[
+            "--texture only applies to the adaptive, gregory, acc rows",
+            "flat,bft",
+        ],
+    );
+    assert_eq!(e.trim_end().lines().count(), 1, "{e}");
+    fails(
+        &["bench", "--methods", "flat,gregory", "--height", &height],
+        &[NO_LOADER],
+        1,
+        &["--height needs --displace S"],
+    );
+    fails(
+        &["bench", "--methods", "gregory", "--displace", "inf"],
+        &[NO_LOADER],
+        1,
+        &["--displace inf: give a finite scale"],
+    );
+}
+
+/// An OBJ disk around one interior vertex of valence `n` (its `n` quads and a ring of `2n`
+/// quads around them), gently curved, `vt` the planar projection.
+fn high_valence_disk_obj(n: usize) -> String {
+    let tau = std::f64::consts::TAU;
+    let mut t = String::from("v 0 0 0\nvt 0.5 0.5\n");
+    // The first ring alternates edge neighbours (radius 1) and diagonal vertices (1.3).
+    for radii in [[1.0, 1.3], [2.2, 2.2]] {
+        for k in 0..2 * n {
+            let r = radii[k % 2];
+            let a = tau * k as f64 / (2 * n) as f64;
+            let (x, y) = (r * a.cos(), r * a.sin());
+            let z = 0.15 * r * r + 0.05 * r * (3.0 * a).cos();
+            t.push_str(&format!(
+                "v {x} {y} {z}\nvt {} {}\n",
+                0.5 + x / 4.8,
+                0.5 + y / 4.8
+            ));
+        }
+    }
+    let ring = |k: usize| 2 + k % (2 * n);
+    let outer = |k: usize| 2 + 2 * n + k % (2 * n);
+    let f = |t: &mut String, vs: [usize; 4]| {
+        t.push('f');
+        for v in vs {
+            t.push_str(&format!(" {v}/{v}"));
+        }
+        t.push('\n');
+    };
+    for i in 0..n {
+        f(&mut t, [1, ring(2 * i), ring(2 * i + 1), ring(2 * i + 2)]);
+    }
+    for k in 0..2 * n {
+        f(&mut t, [ring(k), outer(k), outer(k + 1), ring(k + 1)]);
+    }
+    t
+}
+
+/// A Gregory corner of valence 20, beyond the fitted table (3–16), renders textured and
+/// displaced with the reparameterization on (the documented fallback: the valence-16 row),
+/// validation-clean, and the reparameterization visibly moves the texture there.
+#[test]
+fn a_corner_above_the_reparameterization_table_renders() {
+    let disk = write("valence20.obj", &high_valence_disk_obj(20));
+    let texture = data("assets/spot_texture.png");
+    let height = data("assets/spot_height.png");
+    let mut images = Vec::new();
+    for (name, reparam) in [("on", true), ("off", false)] {
+        let png = tmp(&format!("valence20_{name}.png"));
+        let png = png.to_str().unwrap();
+        let mut args = vec![
+            "render",
+            &disk,
+            "--method",
+            "gregory",
+            "--texture",
+            &texture,
+            "--displace",
+            "0.02",
+            "--height",
+            &height,
+            "--segments",
+            "8",
+            // Facing the disk.
+            "--yaw",
+            "0",
+            "--pitch",
+            "0",
+            "--size",
+            "160x120",
+            "-o",
+            png,
+        ];
+        if !reparam {
+            args.push("--no-reparam");
+        }
+        let e = stderr(&succeeds(&args));
+        assert!(!e.contains("panicked"), "{e}");
+        images.push(image::open(png).unwrap().to_rgba8());
+    }
+    let differing = images[0]
+        .pixels()
+        .zip(images[1].pixels())
+        .filter(|(a, b)| a.0.iter().zip(b.0).any(|(x, y)| x.abs_diff(y) > 8))
+        .count();
+    println!("{differing} of {} pixels differ", images[0].pixels().len());
+    assert!(
+        differing > 400,
+        "the reparameterization should move the texture: {differing} pixels differ"
+    );
 }
