@@ -14,7 +14,7 @@ fn capture_writes_the_triangles_the_gpu_drew() {
     unsafe {
         let desc = TesseraStandaloneDesc {
             device: null(),
-            validation: TESSERA_VALIDATION_ON,
+            validation: TESSERA_VALIDATION_SYNCHRONIZATION,
         };
         let mut ctx = null_mut();
         assert_eq!(

@@ -145,7 +145,7 @@ fn misuse_gets_codes_and_messages_never_undefined_behaviour() {
         );
         let cdesc = TesseraStandaloneDesc {
             device: null(),
-            validation: TESSERA_VALIDATION_ON,
+            validation: TESSERA_VALIDATION_SYNCHRONIZATION,
         };
         assert_eq!(
             tessera_context_create_standalone(&cdesc, &mut ctx),
@@ -373,7 +373,7 @@ fn misuse_gets_codes_and_messages_never_undefined_behaviour() {
         let mut other = null_mut();
         let validated = TesseraStandaloneDesc {
             device: null(),
-            validation: TESSERA_VALIDATION_ON,
+            validation: TESSERA_VALIDATION_SYNCHRONIZATION,
         };
         assert_eq!(
             tessera_context_create_standalone(&validated, &mut other),

@@ -132,7 +132,7 @@ fn checker_texture() -> Vec<u8> {
 fn single_pass_techniques_draw_textures_and_displace_by_the_height_map() {
     let desc = TesseraStandaloneDesc {
         device: null(),
-        validation: TESSERA_VALIDATION_ON,
+        validation: TESSERA_VALIDATION_SYNCHRONIZATION,
     };
     let mut ctx = null_mut();
     // SAFETY: `desc` and `ctx` are live locals.
@@ -274,7 +274,7 @@ fn grid() -> (Vec<f32>, Vec<u32>, Vec<u32>, Vec<f32>) {
 fn bad_maps_and_frame_options_get_named_statuses() {
     let desc = TesseraStandaloneDesc {
         device: null(),
-        validation: TESSERA_VALIDATION_ON,
+        validation: TESSERA_VALIDATION_SYNCHRONIZATION,
     };
     let mut ctx = null_mut();
     // SAFETY: `desc` and `ctx` are live locals.

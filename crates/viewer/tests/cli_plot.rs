@@ -128,6 +128,7 @@ fn bench_plot_matches_its_csv() {
         .args(["--segments", "2,4", "--methods", "flat,pn"])
         .args(["--frames", "1", "--warmup", "0", "--size", "64x48"])
         .args(["--csv", &csv, "--plot", &svg])
+        .args(["--validation", "--sync-validation"])
         .output()
         .expect("tessera runs");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

@@ -28,6 +28,8 @@ fn bench_args(cube: &str) -> Vec<String> {
         "0",
         "--size",
         "64x48",
+        "--validation",
+        "--sync-validation",
     ]
     .map(str::to_owned)
     .to_vec()
@@ -65,7 +67,7 @@ fn no_progress_without_a_terminal() {
     let png = std::env::temp_dir().join(format!("tessera-progress-{}.png", std::process::id()));
     let o = Command::new(env!("CARGO_BIN_EXE_tessera"))
         .args(["render", &cube, "--method", "bft", "--segments", "4"])
-        .args(["--size", "64x48", "-o"])
+        .args(["--size", "64x48", "--validation", "--sync-validation", "-o"])
         .arg(&png)
         .output()
         .expect("tessera runs");

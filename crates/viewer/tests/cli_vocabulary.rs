@@ -4,11 +4,17 @@
 //! no Rust debug formatting.
 use std::process::{Command, Output};
 
+/// Runs `tessera`; GPU commands with validation and synchronization validation on.
 fn tessera(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tessera"))
-        .args(args)
-        .output()
-        .expect("tessera runs")
+    let mut c = Command::new(env!("CARGO_BIN_EXE_tessera"));
+    c.args(args);
+    if matches!(
+        args.first(),
+        Some(&"render" | &"view" | &"info" | &"export" | &"bench")
+    ) {
+        c.args(["--validation", "--sync-validation"]);
+    }
+    c.output().expect("tessera runs")
 }
 
 fn text(o: &Output) -> (String, String) {

@@ -60,6 +60,8 @@ fn window_without_screenshot_exits_validation_clean() {
         ("pn", false),
         ("bft", true),
         ("adaptive", true),
+        ("gregory", true),
+        ("acc", false),
     ] {
         for frames in ["1", "5"] {
             let mut args = vec!["--method", method, "--level", "4", "--frames", frames];

@@ -77,7 +77,7 @@ pub fn reference(technique: tess::TechniqueId, width: u32, height: u32) -> Vec<u
     use vk_core::{Device, DeviceDesc, Instance, InstanceDesc, Validation};
     let instance = Instance::new(&InstanceDesc {
         app_name: "tessera-capi reference".into(),
-        validation: Validation::On,
+        validation: Validation::Synchronization,
         surface_extensions: vec![],
     })
     .expect("Vulkan instance");
