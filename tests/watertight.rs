@@ -7,8 +7,8 @@
 //! and triangle–triangle edges), and spot (quads, 16 pentagons, 4 triangles) at sampled levels.
 //! Flat, Phong and PN: integer levels 1..=64 and a few fractional ones, every spacing, on the
 //! cube and the mixed mesh; on spot a sample up to 21 (the levels 63 and 64 are covered on the small meshes; on
-//! spot they are 2.3 M triangles per capture and cost CI minutes). BFT and adaptive: every
-//! uniform level they accept (their own tests cover screen, distance and fractional policies on
+//! spot they are 2.3 M triangles per capture and cost CI minutes). BFT, adaptive, Gregory and
+//! ACC-1: every uniform level they accept (their own tests cover screen, distance and fractional policies on
 //! more shapes, at one uniform level).
 //!
 //! Besides cracks, the same corner emitted by several patches must carry the same normal
@@ -328,7 +328,9 @@ fn base_face_techniques_are_watertight_on_spot() {
 /// (Loop, polygons fan-triangulated) at S = 2, 4, …, 64 with equal spacing and every whole S in
 /// 2..=64 with fractional-even (fractional-odd is refused: it morphs across dyadic levels);
 /// adaptive (isolation 2, Gregory and bilinear end caps) at every whole level 1..=32 (transition
-/// edges double it) with equal and fractional-even spacing (fractional-odd refused).
+/// edges double it) with equal and fractional-even spacing (fractional-odd refused); the
+/// single-pass Gregory and ACC-1 plans at the same levels (the prism's triangles are Gregory
+/// triangle patches, its quads next to them split once, so transition edges are crossed).
 #[test]
 fn bft_and_adaptive_are_watertight_at_every_uniform_level() {
     use tessera::topology::adaptive::EndCap;
@@ -366,13 +368,19 @@ fn bft_and_adaptive_are_watertight_at_every_uniform_level() {
             },
             &adaptive,
         ),
+        (TechniqueId::Gregory, BuildOptions::default(), &adaptive),
+        (TechniqueId::Acc, BuildOptions::default(), &adaptive),
     ];
     for (id, options, cases) in runs {
         let start = Instant::now();
         let triangles = assert_watertight(&mut h, &meshes, id, &options, cases);
         println!(
-            "{id:?} {:?}: {} captures, {triangles} triangles, {:.1} s",
-            options.end_cap,
+            "{id:?}{}: {} captures, {triangles} triangles, {:.1} s",
+            if id == TechniqueId::Adaptive {
+                format!(" {:?} end caps", options.end_cap)
+            } else {
+                String::new()
+            },
             meshes.len() * cases.len(),
             start.elapsed().as_secs_f64()
         );
