@@ -1,5 +1,7 @@
 //! Feature-adaptive Catmull-Clark plan (`plan_adaptive`) of structured meshes with creases,
-//! corners, holes, both end caps and any sharpness scale. For accepted input: every stencil
+//! corners, holes, both end caps and any sharpness scale, and the single-pass plans of
+//! `--method gregory|acc` (`plan_single_pass`: Gregory or ACC-1 patches, Gregory triangle
+//! patches or split triangles), which share the plan's data. For accepted input: every stencil
 //! reads only earlier vertices, every patch and curve names existing vertices, the global
 //! vertex buffer is finite, and every patch evaluates to a finite point and derivatives.
 //! Bounds: `MeshSpec` (≤ 72 faces), coordinates within `MAX_COORD`, isolation 1..=3; with
@@ -10,6 +12,7 @@
 use arbitrary::Unstructured;
 use libfuzzer_sys::fuzz_target;
 use tessera_fuzz::{all_finite, param, positions_in_range, MeshSpec};
+use topology::adaptive::single_pass::{plan_single_pass, SinglePassOptions, SinglePassPatch};
 use topology::{plan_adaptive, AdaptiveOptions, EndCap};
 
 fuzz_target!(
@@ -55,7 +58,24 @@ fuzz_target!(
         {
             return;
         }
-        let Ok(plan) = plan_adaptive(&mesh, &opts) else {
+        let plan = if knobs & 16 != 0 {
+            // Single pass: semi-sharp tags are rounded, nothing is followed.
+            plan_single_pass(
+                &mesh,
+                &SinglePassOptions {
+                    patch: if knobs & 32 == 0 {
+                        SinglePassPatch::Gregory
+                    } else {
+                        SinglePassPatch::Acc1
+                    },
+                    sharpness_scale: scale,
+                    gregory_triangles: knobs & 64 == 0,
+                },
+            )
+        } else {
+            plan_adaptive(&mesh, &opts)
+        };
+        let Ok(plan) = plan else {
             return;
         };
         assert_eq!(plan.num_base_vertices as usize, mesh.positions.len());
