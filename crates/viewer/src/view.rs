@@ -442,9 +442,10 @@ impl App {
             if let (true, Some(path)) = (final_shot, &self.args.screenshot) {
                 img.save_png(path)?;
                 out!(
-                    "wrote {} after {} frames",
+                    "wrote {} after {} frame{}",
                     path.display(),
-                    self.frames_drawn
+                    self.frames_drawn,
+                    if self.frames_drawn == 1 { "" } else { "s" }
                 );
             }
         }
