@@ -339,6 +339,13 @@ fn start(last: u32) -> usize {
 /// (catmark_cubes_infsharp 978 → 1518 patches).
 pub(super) const FEATURE_EXTRA_LEVELS: usize = 6;
 
+/// Extra levels for a boundary vertex of three or more faces (a regular boundary vertex has
+/// two). Its caps converged like an interior vertex's of twice the faces but kept `iso`:
+/// catmark_xord_boundary's fans of 3 to 6 faces were 5.9e-5 of the diagonal off the limit at
+/// isolation 4, 3.6e-5 with one more level (the GPU capture test); catmark_gregory_test1 to
+/// test6 went from at most 3.2e-5 to 1.3e-5.
+pub(super) const BOUNDARY_EXTRA_LEVELS: usize = 1;
+
 /// Smallest valence whose end caps are isolated by their reach (see [`cap_depth`]); up to
 /// valence 5 the caps meet 5e-5 of the diagonal at isolation 4 on every shape in tests/data.
 pub(super) const REACH_MIN_VALENCE: usize = 6;
@@ -350,19 +357,28 @@ pub(super) const REACH_MIN_VALENCE: usize = 6;
 /// * An end cap at an extraordinary vertex of valence `n` covers a region that shrinks by
 ///   `λ_n` ([`subdominant`]) per level, not by 1/2: 0.58 at valence 6, 0.65 at valence 24. From
 ///   valence [`REACH_MIN_VALENCE`] on, the vertex is isolated until that region is no larger
-///   than a regular patch's after `iso` levels: `⌈iso · ln 2 / −ln λ_n⌉` (6 at valence 6 and
-///   7 at valence 24 for isolation 4). Spot's valence-6 caps went from 6.8e-5 to 1.5e-5 and
-///   catmark_bishop's valence-24 poles from 2.0e-4 to 4.1e-5 of the diagonal.
+///   than a regular patch's after `iso` levels, times `6 / n`: `⌈(iso · ln 2 + ln(n / 6)) /
+///   −ln λ_n⌉` (6 at valence 6, 8 at valence 10 and 12, 10 at valence 24 for isolation 4). The
+///   `6 / n` is there because the caps' error at the same region size grows with the valence:
+///   without it catmark_xord_interior's valence-10 and 12 fans stayed at 5.8e-5 and 5.4e-5
+///   (levels 6 and 7); with it 2.8e-5. Spot's valence-6 caps went from 6.8e-5 to 1.5e-5 and
+///   catmark_bishop's valence-24 poles from 2.0e-4 to 8e-6 of the diagonal.
 /// * Interior sharp features whose caps converge slowly get [`FEATURE_EXTRA_LEVELS`] more.
+/// * Boundary vertices of three or more faces get [`BOUNDARY_EXTRA_LEVELS`] more.
 ///
-/// Boundary vertices keep `iso`. Only a handful of faces per level surround such a vertex, so
-/// the cost is small: +3.5 % of spot's patches, +1.4 % of catmark_bishop's.
+/// Only a handful of faces per level surround such a vertex, so the cost is small: +3.5 % of
+/// spot's patches, +2.2 % of catmark_bishop's.
 fn cap_depth(lvl: &Lvl, v: usize, iso: usize) -> usize {
     let t = lvl.t();
     let edges = t.vertex_edges(v);
     let n = edges.len();
-    if t.vertex_faces(v).len() != n {
-        return iso;
+    let faces = t.vertex_faces(v).len();
+    if faces != n {
+        return if faces >= 3 {
+            iso + BOUNDARY_EXTRA_LEVELS
+        } else {
+            iso
+        };
     }
     let sharp = edges
         .iter()
@@ -384,7 +400,8 @@ fn cap_depth(lvl: &Lvl, v: usize, iso: usize) -> usize {
     if rule != Rule::Smooth || n < REACH_MIN_VALENCE {
         return iso;
     }
-    let reach = iso as f64 * std::f64::consts::LN_2 / -subdominant(n).ln();
+    let margin = (n as f64 / REACH_MIN_VALENCE as f64).ln();
+    let reach = (iso as f64 * std::f64::consts::LN_2 + margin) / -subdominant(n).ln();
     iso.max(reach.ceil() as usize)
 }
 
