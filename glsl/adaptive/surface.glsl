@@ -221,29 +221,6 @@ void gregory_triangle(vec3 c[15], vec2 uv, out vec3 pos, out vec3 du, out vec3 d
     pos = p; du = pu; dv = pv;
 }
 
-// |v| and v / |v| without overflow or underflow: v is first divided by its largest component
-// (safe_normalize's way), since near topology::MAX_COORDINATE a cross product of tangents is
-// about 1e24 and its squared length overflows f32 (length() then gives inf and the normal
-// 0). precise and written out, so every TES that evaluates an owner's frame gets the same bits.
-float precise_length(vec3 v) {
-    precise float m = max(max(abs(v.x), abs(v.y)), abs(v.z));
-    if (!(m > 0.0)) return 0.0;
-    precise vec3 s = v / m;
-    precise float d = s.x * s.x + s.y * s.y + s.z * s.z;
-    precise float r = m * sqrt(d);
-    return r;
-}
-
-// The unit vector along v, or `fallback` when v is zero (see precise_length).
-vec3 precise_unit(vec3 v, vec3 fallback) {
-    precise float m = max(max(abs(v.x), abs(v.y)), abs(v.z));
-    if (!(m > 0.0)) return fallback;
-    precise vec3 s = v / m;
-    precise float d = s.x * s.x + s.y * s.y + s.z * s.z;
-    precise vec3 r = s * inversesqrt(d);
-    return r;
-}
-
 // The owner evaluation: the normal of patch `id` at `uv`, from the global vertex buffer, one
 // operand order, `precise` (every TES that includes this gets the same bits). Call it from one
 // place only (see tese_main.glsl).
@@ -302,7 +279,7 @@ void owner_frame(uint id, vec2 uv, out vec3 n_out, out vec3 du_out, out vec3 dv_
         du = (1.0 - v) * (c1 - c0) + v * (c2 - c3);
         dv = (1.0 - u) * (c3 - c0) + u * (c2 - c1);
     }
-    precise vec3 r = precise_unit(cross(du, dv), vec3(0.0, 0.0, 1.0));
+    precise vec3 r = safe_normalize(cross(du, dv), vec3(0.0, 0.0, 1.0));
     uint tangent_valences = surfaces[id].tangent_valences;
     if (tangent_valences != 0u) {
         vec3 c[28];
@@ -352,8 +329,8 @@ const vec2 TRIANGLE_CORNER_PARAMS[7] = vec2[7](vec2(0.0, 0.0), vec2(1.0, 0.0), v
 vec3 displaced_normal(vec3 n, vec3 du, vec3 dv, float hu, float hv) {
     float k = adaptive.displace_scale;
     // precise: with canonical normals every TES evaluates this for an owner, to the same bits.
-    precise vec3 m = precise_length(cross(du, dv)) * n + (k * hv) * cross(du, n) + (k * hu) * cross(n, dv);
-    return precise_unit(m, n);
+    precise vec3 m = safe_length(cross(du, dv)) * n + (k * hv) * cross(du, n) + (k * hu) * cross(n, dv);
+    return safe_normalize(m, n);
 }
 
 // The patch that owns the canonical point at curve `curve`, parameter s, and its parameter
