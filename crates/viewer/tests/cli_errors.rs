@@ -3,25 +3,10 @@
 //! view options are checked when parsed, a UTF-8 BOM is skipped, and every message says its
 //! cause once, in the OBJ's own numbers, before any device is opened. Also runs each CPU and
 //! GPU command path (render, export, bench, info, subdivide, limit) with validation on.
+mod common;
+use common::tessera;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-/// Runs `tessera`; GPU commands get `--validation --sync-validation` (their runs fail on any
-/// validation error, synchronization hazards included).
-fn tessera(args: &[&str], env: &[(&str, &str)]) -> Output {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_tessera"));
-    c.args(args);
-    if matches!(
-        args.first(),
-        Some(&"render" | &"view" | &"info" | &"export" | &"bench")
-    ) {
-        c.args(["--validation", "--sync-validation"]);
-    }
-    for (k, v) in env {
-        c.env(k, v);
-    }
-    c.output().expect("tessera runs")
-}
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

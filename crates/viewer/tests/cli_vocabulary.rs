@@ -2,19 +2,12 @@
 //! `--segments` (the old `--level` of render and view is a hidden alias), every command that
 //! takes a mesh defaults to the embedded spot, and what the commands print reads as prose, with
 //! no Rust debug formatting.
-use std::process::{Command, Output};
+mod common;
+use std::process::Output;
 
-/// Runs `tessera`; GPU commands with validation and synchronization validation on.
+/// Runs `tessera` (GPU commands with validation and synchronization validation on).
 fn tessera(args: &[&str]) -> Output {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_tessera"));
-    c.args(args);
-    if matches!(
-        args.first(),
-        Some(&"render" | &"view" | &"info" | &"export" | &"bench")
-    ) {
-        c.args(["--validation", "--sync-validation"]);
-    }
-    c.output().expect("tessera runs")
+    common::tessera(args, &[])
 }
 
 fn text(o: &Output) -> (String, String) {
