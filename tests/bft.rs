@@ -159,6 +159,87 @@ fn captured_bft_vertices_are_the_exact_limit() {
     }
 }
 
+/// Every Loop shape of tests/data, or of the folder `BFT_SHAPES_DIR` names (OpenSubdiv's whole
+/// shape set, say), with nothing chosen for BFT: the captured vertices are the exact limit
+/// within 1e-5 of the diagonal and weld without cracks at 8 and 32 segments, in the device's
+/// build. A shape BFT does not take (non-manifold) must be refused with a named error, and the
+/// refusals are listed.
+#[test]
+fn every_loop_shape_is_exact_and_watertight() {
+    let other = std::env::var_os("BFT_SHAPES_DIR").map(std::path::PathBuf::from);
+    let dir = other
+        .clone()
+        .unwrap_or_else(|| common::data("tests/data/opensubdiv/shapes"));
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .expect("shapes")
+        .filter_map(|e| {
+            let n = e.ok()?.file_name().to_string_lossy().into_owned();
+            let stem = n.strip_suffix(".obj")?.to_string();
+            stem.starts_with("loop_").then_some(stem)
+        })
+        .collect();
+    names.sort();
+    assert!(names.len() >= 10, "{} Loop shapes in {dir:?}", names.len());
+    let gpu = Gpu::new();
+    let mut failures = Vec::new();
+    let mut refused = Vec::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
+        for name in &names {
+            let path = dir.join(format!("{name}.obj"));
+            let mesh = match topology::load_obj(&path) {
+                Ok(m) => m,
+                Err(e) => {
+                    refused.push(format!("{name}: {e}"));
+                    continue;
+                }
+            };
+            let surf = match Bft::new(
+                &mut ctx,
+                &mesh,
+                &BftOptions {
+                    table_level: 5,
+                    tangents: false,
+                    name: name.clone(),
+                    patch_block: None,
+                },
+            ) {
+                Ok(s) => s,
+                Err(e) => {
+                    refused.push(format!("{name}: {e}"));
+                    continue;
+                }
+            };
+            for s in [8, 32] {
+                let (soup, _) = capturer
+                    .capture(&mut ctx, &surf, &uniform(s), EXTENT)
+                    .expect("capture");
+                let worst = exactness(&surf, &soup, &mesh, 3000);
+                let (open, boundary, nonmanifold) = cracks(&surf, &soup, &mesh);
+                let inexact = soup.records.iter().filter(|r| r.flags & 1 == 0).count();
+                println!(
+                    "{name} S={s}: {} patches, worst |GPU − limit|/diag {worst:.2e}, {open} cracks, \
+                     {boundary} base-boundary edges",
+                    surf.patch_count()
+                );
+                if worst > 1e-5 || open != 0 || nonmanifold != 0 || inexact != 0 {
+                    failures.push(format!(
+                        "{name} S={s}: {worst:.2e}, {open} cracks, {nonmanifold} non-manifold, \
+                         {inexact} inexact"
+                    ));
+                }
+            }
+        }
+    }
+    for r in &refused {
+        println!("refused: {r}");
+        // A refusal names what it refuses; nothing in tests/data is refused.
+        assert!(other.is_some(), "refused: {r}");
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
 /// No open edge beyond the base mesh's own boundary, for uniform, both adaptive policies and
 /// fractional factors, on every test mesh (positions welded only when bit-identical).
 #[test]
