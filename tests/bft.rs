@@ -218,15 +218,20 @@ fn every_loop_shape_is_exact_and_watertight() {
                 let worst = exactness(&surf, &soup, &mesh, 3000);
                 let (open, boundary, nonmanifold) = cracks(&surf, &soup, &mesh);
                 let inexact = soup.records.iter().filter(|r| r.flags & 1 == 0).count();
+                // `exactness` takes a maximum, which a NaN would not enter.
+                let finite = soup
+                    .records
+                    .iter()
+                    .all(|r| r.position.iter().chain(&r.normal).all(|x| x.is_finite()));
                 println!(
                     "{name} S={s}: {} patches, worst |GPU − limit|/diag {worst:.2e}, {open} cracks, \
                      {boundary} base-boundary edges",
                     surf.patch_count()
                 );
-                if worst > 1e-5 || open != 0 || nonmanifold != 0 || inexact != 0 {
+                if worst > 1e-5 || open != 0 || nonmanifold != 0 || inexact != 0 || !finite {
                     failures.push(format!(
                         "{name} S={s}: {worst:.2e}, {open} cracks, {nonmanifold} non-manifold, \
-                         {inexact} inexact"
+                         {inexact} inexact, finite {finite}"
                     ));
                 }
             }

@@ -78,7 +78,8 @@ pub struct ExportArgs {
     /// Viewport --adaptive screen sees, WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
-    /// Exit with status 1 when any crack (an open edge not on the base mesh's boundary) is found.
+    /// Exit with status 1 when any crack (an open edge not on the base mesh's boundary or a
+    /// hole's border) is found.
     #[arg(long)]
     pub fail_on_cracks: bool,
     #[command(flatten)]

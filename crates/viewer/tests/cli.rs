@@ -726,6 +726,33 @@ fn export_tells_base_boundary_from_cracks() {
 }
 
 #[test]
+fn export_counts_a_holes_border_as_boundary() {
+    // OpenSubdiv's catmark_hole_test1: a cube-like mesh with one face tagged `t hole`. Its
+    // border edges have two base faces, but one is not drawn: boundary, not cracks (they
+    // counted as 128 cracks for adaptive, 16 for gregory and acc before).
+    let mesh = data("tests/data/opensubdiv/shapes/catmark_hole_test1.obj");
+    let out = tmp("hole_test1_out.obj");
+    for method in ["adaptive", "gregory", "acc"] {
+        let s = export_ok(&[
+            "export",
+            &mesh,
+            "--method",
+            method,
+            "--segments",
+            "4",
+            "--fail-on-cracks",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        let open = reported(&s, "open edges:");
+        assert!(
+            open > 0 && s.contains(&format!("{open} on the base mesh's boundary, 0 cracks")),
+            "{method}: {s}"
+        );
+    }
+}
+
+#[test]
 fn export_bad_inputs_are_named_errors() {
     let out = tmp("never.obj");
     let out = out.to_str().unwrap();

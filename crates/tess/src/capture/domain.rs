@@ -110,7 +110,7 @@ impl PatchFaceTable {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct OpenEdgeClasses {
     /// Both endpoints lie on one edge of one base face, and that base edge is a boundary edge
-    /// of the base mesh (used by one face).
+    /// of the drawn surface (used by one face that is not a hole).
     pub on_base_boundary: usize,
     /// Every other open edge: a gap the GPU left inside the surface.
     pub cracks: usize,
@@ -127,8 +127,14 @@ pub fn classify_open_edges(
     map: &PatchToFace<'_>,
     base: &ControlMesh,
 ) -> OpenEdgeClasses {
+    // A hole's faces are not drawn: an edge between a hole and a drawn face is the surface's
+    // boundary, as an edge with one face is.
+    let holes: std::collections::HashSet<u32> = base.holes.iter().copied().collect();
     let mut uses: HashMap<[u32; 2], u32> = HashMap::new();
-    for face in base.faces() {
+    for (i, face) in base.faces().enumerate() {
+        if holes.contains(&(i as u32)) {
+            continue;
+        }
         for k in 0..face.len() {
             let (a, b) = (face[k], face[(k + 1) % face.len()]);
             *uses.entry([a.min(b), a.max(b)]).or_default() += 1;
