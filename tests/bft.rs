@@ -245,6 +245,41 @@ fn every_loop_shape_is_exact_and_watertight() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
+/// A face tagged as a hole is not drawn, and the rest of the surface is unchanged: the exact
+/// limit of the whole mesh (the hole still shapes its neighbours), no vertex in the hole, its
+/// border open as a boundary and no crack.
+#[test]
+fn hole_faces_are_not_drawn() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
+        let mut mesh = shape("loop_icosahedron");
+        mesh.holes = vec![0, 7];
+        let s = 8;
+        for block in PATCH_BLOCK_BUILDS {
+            let surf = surface_built(&mut ctx, &mesh, "holed icosahedron", 5, false, Some(block));
+            let (soup, _) = capturer
+                .capture(&mut ctx, &surf, &uniform(s), EXTENT)
+                .expect("capture");
+            // 18 of the 20 faces: 4 level-1 patches each at level s / 2 = 4, which the triangle
+            // tessellator splits into 3 · 4² / 2 = 24 triangles.
+            assert_eq!(soup.triangle_count(), 18 * 4 * 24);
+            for r in &soup.records {
+                let (u, v) = patch_uv(r.domain);
+                let (f, _, _) = surf.base_domain(r.patch, u, v).expect("patch");
+                assert!(f != 0 && f != 7, "a vertex of hole face {f}");
+            }
+            let worst = exactness(&surf, &soup, &mesh, 3000);
+            let (open, boundary, nonmanifold) = cracks(&surf, &soup, &mesh);
+            assert!(worst <= 1e-5, "{worst:e}");
+            assert_eq!((open, nonmanifold), (0, 0));
+            // Two holes, three edges each, s segments an edge.
+            assert_eq!(boundary, 2 * 3 * s as usize, "patch block {block}");
+        }
+    }
+}
+
 /// No open edge beyond the base mesh's own boundary, for uniform, both adaptive policies and
 /// fractional factors, on every test mesh (positions welded only when bit-identical).
 #[test]

@@ -143,7 +143,12 @@ impl RenderMesh {
                 .collect(),
             ..Default::default()
         };
+        // Faces tagged as holes are not drawn (they still shape their neighbours' normals).
+        let holes: std::collections::HashSet<u32> = mesh.holes.iter().copied().collect();
         for f in 0..mesh.num_faces() {
+            if holes.contains(&(f as u32)) {
+                continue;
+            }
             let face =
                 &corner_index[mesh.face_offsets[f] as usize..mesh.face_offsets[f + 1] as usize];
             let fan = (1..face.len() - 1).map(|i| [face[0], face[i], face[i + 1]]);
@@ -266,6 +271,30 @@ mod tests {
             .iter()
             .all(|o| o.face == 0 && o.face_size == 5 && o.domain == Domain::Triangle));
         assert!(rm.vertices.iter().all(|v| (v.normal[2] - 1.0).abs() < 1e-6));
+    }
+
+    #[test]
+    fn hole_faces_make_no_patches() {
+        let mut mesh = topology::parse_obj(
+            include_str!("../../../tests/data/meshes/cube.obj"),
+            "cube.obj",
+        )
+        .unwrap();
+        mesh.holes = vec![2];
+        let rm = RenderMesh::from_control_mesh(&mesh).unwrap();
+        assert_eq!(rm.quads.len(), 5);
+        assert_eq!(rm.triangles.len(), 10);
+        let origins = rm.quad_origins.iter().chain(&rm.triangle_origins);
+        assert!(origins.clone().all(|o| o.face != 2));
+        assert_eq!(origins.filter(|o| o.face == 3).count(), 3);
+        // The hole still shapes its corners' normals: the cube's corner diagonals, as before.
+        let whole = RenderMesh::from_control_mesh(&{
+            let mut m = mesh.clone();
+            m.holes.clear();
+            m
+        })
+        .unwrap();
+        assert_eq!(rm.vertices, whole.vertices);
     }
 
     #[test]

@@ -347,6 +347,9 @@ pub struct Bft {
     /// Per Loop triangle: its input face, the face's side count and its fan index (corners
     /// 0, j + 1, j + 2); identity for a triangle mesh.
     fans: Vec<(u32, u32, u32)>,
+    /// Runs of patches drawn: every level-1 face but the four children of a triangle tagged as
+    /// a hole (those are still evaluated: their edges and corners may own shared points).
+    drawn: Vec<Range<u32>>,
     /// The triangle mesh Loop subdivides (the input, or its fan triangulation): the positions
     /// [`Technique::update_base`] replaces.
     pub loop_mesh: ControlMesh,
@@ -366,6 +369,27 @@ pub fn base_positions(mesh: &ControlMesh) -> Vec<[f32; 3]> {
         .iter()
         .map(|p| p.map(gpu_coordinate))
         .collect()
+}
+
+/// Maximal runs of the `patches` level-1 faces whose base triangle is not among `holes` (a
+/// triangle's four children are faces `4t..4t + 4`).
+fn drawn_runs(patches: u32, holes: &[u32]) -> Vec<Range<u32>> {
+    let mut hidden = vec![false; patches as usize];
+    for &t in holes {
+        for f in 4 * t as usize..(4 * t as usize + 4).min(hidden.len()) {
+            hidden[f] = true;
+        }
+    }
+    let mut runs: Vec<Range<u32>> = Vec::new();
+    for (f, &h) in hidden.iter().enumerate() {
+        let f = f as u32;
+        match runs.last_mut() {
+            _ if h => {}
+            Some(r) if r.end == f => r.end = f + 1,
+            _ => runs.push(f..f + 1),
+        }
+    }
+    runs
 }
 
 /// The control mesh Loop subdivides: `mesh` itself when it is all triangles, else its fan
@@ -715,6 +739,7 @@ impl Bft {
             pre_chunks.len(),
             draw_chunks.len()
         );
+        let drawn = drawn_runs(summary.patch_count, &loop_mesh.holes);
         Ok(Self {
             patch_block,
             subdivide,
@@ -730,6 +755,7 @@ impl Bft {
             summary,
             rotations,
             fans,
+            drawn,
             loop_mesh,
             rest_bbox: bbox(&base_positions),
             base_positions,
@@ -889,7 +915,10 @@ impl Technique for Bft {
     fn triangles(&self, params: &FrameParams, _array: usize) -> Option<u64> {
         match params.factors {
             FactorPolicy::Uniform { segments } => Some(
-                self.summary.patch_count as u64
+                self.drawn
+                    .iter()
+                    .map(|r| (r.end - r.start) as u64)
+                    .sum::<u64>()
                     * uniform_triangle_count(Domain::Triangle, params.spacing, segments * 0.5),
             ),
             _ => None,
@@ -992,13 +1021,19 @@ impl Technique for Bft {
                 enc.bind_descriptor_sets(1, &[set])?;
             }
             w.apply(&mut push);
-            counts += for_each_draw(end - start, per_draw, |first, n| {
-                let first = start - a.first_patch + first;
-                push.first_patch = a.first_patch + first;
-                enc.push_constants(&push)?;
-                enc.draw(first..first + n)?;
-                Ok(())
-            })?;
+            for run in &self.drawn {
+                let (start, end) = (start.max(run.start), end.min(run.end));
+                if start >= end {
+                    continue;
+                }
+                counts += for_each_draw(end - start, per_draw, |first, n| {
+                    let first = start - a.first_patch + first;
+                    push.first_patch = a.first_patch + first;
+                    enc.push_constants(&push)?;
+                    enc.draw(first..first + n)?;
+                    Ok(())
+                })?;
+            }
         }
         Ok(counts)
     }
