@@ -34,10 +34,21 @@ fn display_taken(n: u32) -> bool {
     }
 }
 
-/// Starts Xvfb on the first free display of `displays` (test crates use disjoint ranges, as
-/// they run in parallel); None when Xvfb is not installed.
+/// The next display offset to try, shared by the tests of one crate: they run in parallel
+/// threads, and two of them checking the same free display at once would both start a server
+/// there; the second exits at once ("server already active"), and the first test's guard later
+/// kills the server the second test's window is drawing on (winit: "Failed to set window
+/// title: Connection(IoError)").
+static NEXT_DISPLAY: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+
+/// Starts Xvfb on a free display of `displays` (test crates use disjoint ranges, as they run in
+/// parallel; the threads of one crate take turns through [`NEXT_DISPLAY`]) and keeps it only if
+/// the server is still running once its socket is up; None when Xvfb is not installed.
 pub fn start(displays: std::ops::Range<u32>) -> Option<Xvfb> {
-    for n in displays {
+    let len = displays.end.saturating_sub(displays.start);
+    for _ in 0..len {
+        let n =
+            displays.start + NEXT_DISPLAY.fetch_add(1, std::sync::atomic::Ordering::Relaxed) % len;
         let socket = format!("/tmp/.X11-unix/X{n}");
         if display_taken(n) {
             continue;
@@ -61,13 +72,21 @@ pub fn start(displays: std::ops::Range<u32>) -> Option<Xvfb> {
             ])
             .spawn()
             .ok()?;
+        let mut server = Xvfb { child, display };
+        let mut running = true;
         for _ in 0..100 {
-            if Path::new(&socket).exists() {
+            running = matches!(server.child.try_wait(), Ok(None));
+            if !running || Path::new(&socket).exists() {
                 break;
             }
             std::thread::sleep(std::time::Duration::from_millis(50));
         }
-        return Some(Xvfb { child, display });
+        if running && matches!(server.child.try_wait(), Ok(None)) {
+            return Some(server);
+        }
+        // Another server holds the display: leave its files alone and try the next one.
+        let _ = server.child.wait();
+        std::mem::forget(server);
     }
     None
 }
