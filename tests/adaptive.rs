@@ -36,26 +36,17 @@ fn spot() -> ControlMesh {
 fn catmark_shapes() -> Vec<(String, ControlMesh)> {
     // `ADAPTIVE_SHAPES_DIR` points the accuracy test at another folder (OpenSubdiv's whole shape
     // set, say); shapes there that do not load are skipped.
-    let other = std::env::var_os("ADAPTIVE_SHAPES_DIR").map(std::path::PathBuf::from);
-    let dir = other
-        .clone()
-        .unwrap_or_else(|| common::data("tests/data/opensubdiv/shapes"));
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .expect("shapes")
-        .filter_map(|e| {
-            let n = e.ok()?.file_name().to_string_lossy().into_owned();
-            let stem = n.strip_suffix(".obj")?.to_string();
-            (stem.starts_with("catmark_") && !stem.contains("hedit")).then_some(stem)
-        })
-        .collect();
-    names.sort();
+    let (dir, other) = common::shapes_dir("ADAPTIVE_SHAPES_DIR");
+    let names = common::shape_names(&dir, "catmark_");
     let mut out: Vec<(String, ControlMesh)> = names
         .into_iter()
-        .filter_map(|n| match &other {
-            None => Some((n.clone(), shape(&n))),
-            Some(d) => topology::load_obj(d.join(format!("{n}.obj")))
+        .filter_map(|n| {
+            if !other {
+                return Some((n.clone(), shape(&n)));
+            }
+            topology::load_obj(dir.join(format!("{n}.obj")))
                 .ok()
-                .map(|m| (n, m)),
+                .map(|m| (n, m))
         })
         .collect();
     out.push(("spot".into(), spot()));
@@ -237,7 +228,7 @@ fn captured_vertices_are_the_exact_limit() {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let capturer = Capturer::new(&ctx).expect("capturer");
         let mut failures = Vec::new();
-        let other_shapes = std::env::var_os("ADAPTIVE_SHAPES_DIR").is_some();
+        let other_shapes = common::shapes_dir("ADAPTIVE_SHAPES_DIR").1;
         for (name, mesh) in catmark_shapes() {
             let surf = surface(&mut ctx, &mesh, &name, 4, EndCap::Gregory);
             let soup = match capturer.capture(&mut ctx, &surf, &FrameParams::uniform(3.0), EXTENT) {

@@ -166,19 +166,8 @@ fn captured_bft_vertices_are_the_exact_limit() {
 /// refusals are listed.
 #[test]
 fn every_loop_shape_is_exact_and_watertight() {
-    let other = std::env::var_os("BFT_SHAPES_DIR").map(std::path::PathBuf::from);
-    let dir = other
-        .clone()
-        .unwrap_or_else(|| common::data("tests/data/opensubdiv/shapes"));
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .expect("shapes")
-        .filter_map(|e| {
-            let n = e.ok()?.file_name().to_string_lossy().into_owned();
-            let stem = n.strip_suffix(".obj")?.to_string();
-            stem.starts_with("loop_").then_some(stem)
-        })
-        .collect();
-    names.sort();
+    let (dir, other) = common::shapes_dir("BFT_SHAPES_DIR");
+    let names = common::shape_names(&dir, "loop_");
     assert!(names.len() >= 10, "{} Loop shapes in {dir:?}", names.len());
     let gpu = Gpu::new();
     let mut failures = Vec::new();
@@ -240,7 +229,7 @@ fn every_loop_shape_is_exact_and_watertight() {
     for r in &refused {
         println!("refused: {r}");
         // A refusal names what it refuses; nothing in tests/data is refused.
-        assert!(other.is_some(), "refused: {r}");
+        assert!(other, "refused: {r}");
     }
     assert!(failures.is_empty(), "{failures:#?}");
 }

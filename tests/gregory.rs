@@ -187,19 +187,8 @@ fn back_to_back(m: &ControlMesh) -> bool {
 /// method refuses are listed, named; in tests/data none is.
 #[test]
 fn every_catmark_shape_welds_and_stays_near_the_limit() {
-    let other = std::env::var_os("SINGLE_PASS_SHAPES_DIR").map(std::path::PathBuf::from);
-    let dir = other
-        .clone()
-        .unwrap_or_else(|| common::data("tests/data/opensubdiv/shapes"));
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .expect("shapes")
-        .filter_map(|e| {
-            let n = e.ok()?.file_name().to_string_lossy().into_owned();
-            let stem = n.strip_suffix(".obj")?.to_string();
-            (stem.starts_with("catmark_") && !stem.contains("hedit")).then_some(stem)
-        })
-        .collect();
-    names.sort();
+    let (dir, other) = common::shapes_dir("SINGLE_PASS_SHAPES_DIR");
+    let names = common::shape_names(&dir, "catmark_");
     assert!(
         names.len() >= 10,
         "{} catmark shapes in {dir:?}",
@@ -271,7 +260,7 @@ fn every_catmark_shape_welds_and_stays_near_the_limit() {
     }
     for r in &refused {
         println!("refused: {r}");
-        assert!(other.is_some(), "refused: {r}");
+        assert!(other, "refused: {r}");
     }
     assert!(failures.is_empty(), "{failures:#?}");
 }

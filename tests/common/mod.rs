@@ -79,6 +79,31 @@ pub fn data(path: &str) -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
 }
 
+/// The OpenSubdiv shapes a whole-set test takes: those of the folder `var` names (OpenSubdiv's
+/// whole set, say), else tests/data's; and whether it is another folder (where shapes may be
+/// refused, or too large to capture).
+pub fn shapes_dir(var: &str) -> (std::path::PathBuf, bool) {
+    match std::env::var_os(var) {
+        Some(d) => (d.into(), true),
+        None => (data("tests/data/opensubdiv/shapes"), false),
+    }
+}
+
+/// Stems of the `prefix*.obj` files in `dir`, sorted, hierarchical edits aside (Tessera does
+/// not read them).
+pub fn shape_names(dir: &std::path::Path, prefix: &str) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("shapes in {dir:?}: {e}"))
+        .filter_map(|e| {
+            let n = e.ok()?.file_name().to_string_lossy().into_owned();
+            let stem = n.strip_suffix(".obj")?.to_string();
+            (stem.starts_with(prefix) && !stem.contains("hedit")).then_some(stem)
+        })
+        .collect();
+    names.sort();
+    names
+}
+
 /// Builds technique `id` for `mesh` on `ctx` with default options (tangent tables included,
 /// so geometric normals can be drawn).
 pub fn build(
