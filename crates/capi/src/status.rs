@@ -170,9 +170,10 @@ pub(crate) fn tess_status(e: &TessError) -> TesseraStatus {
         | E::TableLevel { .. }
         | E::BenchConfig { .. }
         | E::Csv { .. } => TesseraStatus::InvalidArgument,
-        E::Unsupported { .. } | E::NeedsTangentTables | E::StorageWindow { .. } => {
-            TesseraStatus::Unsupported
-        }
+        E::Unsupported { .. }
+        | E::NeedsTangentTables
+        | E::StorageWindow { .. }
+        | E::BftTablesTooLarge { .. } => TesseraStatus::Unsupported,
         E::BasePositionCount { .. } => TesseraStatus::WrongSize,
         E::FrameSlot { .. } | E::IndexOutOfRange { .. } => TesseraStatus::IndexOutOfRange,
         E::NonFiniteVertex { .. } => TesseraStatus::NonFinite,

@@ -53,6 +53,22 @@ pub enum TessError {
         level: u32,
         max_tessellation_level: u32,
     },
+    /// Basis-function tables that cannot be bound in one storage-buffer range, counted from
+    /// the patch records before any table is evaluated.
+    #[error(
+        "{name}: basis-function tables at level {level} would take {bytes} bytes \
+         ({private_faces} of {faces} level-1 faces need a private table: creases, corners or \
+         overlapping rings), more than the device's storage-buffer range of {max} bytes; {hint}"
+    )]
+    BftTablesTooLarge {
+        name: String,
+        level: u32,
+        bytes: u64,
+        private_faces: usize,
+        faces: usize,
+        max: u64,
+        hint: String,
+    },
     #[error("geometric normals need the tangent tables (this surface was built without them)")]
     NeedsTangentTables,
     /// One item's reach in a buffer exceeds the device's storage-buffer range: it cannot be

@@ -1398,6 +1398,33 @@ pub fn loop_tables(
     Ok(tables)
 }
 
+/// The number of f32 weights [`loop_tables`] will store for `records` at `level` (with the
+/// `du`/`dv` blocks when `tangents`), counted from the records alone: no table is evaluated.
+/// Private tables (one per face next to creases, corners and overlapping rings) cost a full
+/// table each, so a mesh with many of them can outgrow a device's storage-buffer range; this
+/// lets a caller refuse it in milliseconds instead of after minutes of evaluation.
+pub fn table_weight_count(records: &PatchRecords, level: u32, tangents: bool) -> u64 {
+    let pts = table_points(level);
+    let full = pts.len() as u64;
+    let half = pts.iter().filter(|&&(a, b)| a >= b).count() as u64;
+    let blocks = if tangents { 3 } else { 1 };
+    let mut shared: HashMap<BftKey, u64> = HashMap::new();
+    let mut private = 0u64;
+    for r in records.iter() {
+        if matches!(r.key.case, BftCase::Private { .. }) {
+            private += full * r.ring_size as u64;
+        } else {
+            // Mirroring permutes slots, never changes their count.
+            shared.insert(r.key.canonical().0, r.ring_size as u64);
+        }
+    }
+    let shared: u64 = shared
+        .iter()
+        .map(|(k, &ring)| if k.self_symmetric() { half } else { full } * ring)
+        .sum();
+    blocks * (shared + private)
+}
+
 /// Which corner of its level-1 face each record's `v0` is: all [`level1_base_domain`] needs
 /// of the records and the level-1 mesh (one byte per face).
 pub fn face_rotations(level1: &LocalMesh, records: &PatchRecords) -> Vec<u8> {

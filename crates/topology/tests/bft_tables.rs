@@ -356,3 +356,39 @@ fn prepare_for_the_gpu() {
         assert!((nrm[k] as f64 - c[k] / l).abs() < 1e-5, "normal {k}");
     }
 }
+
+/// `table_weight_count` (the early size check) counts exactly the weights `loop_tables`
+/// stores, with and without tangent blocks, on shapes with shared, mirrored, half and private
+/// tables (creases, corners, boundaries, the tetrahedron's overlapping rings).
+#[test]
+fn table_weight_count_is_what_the_tables_store() {
+    let mut privates = 0;
+    for name in [
+        "loop_tetrahedron",
+        "loop_cube_creases1",
+        "loop_chaikin0",
+        "loop_xord_boundary",
+        "loop_saddle_edgecorner",
+        "loop_pole8",
+        "loop_icosahedron",
+    ] {
+        let mesh = load_obj(format!("{DATA}{name}.obj")).expect("shape");
+        for (level, tangents) in [(2, true), (3, false), (5, false)] {
+            let bft = prepare_loop_bft(&mesh, level, tangents).expect("tables");
+            let counted = topology::bft::table_weight_count(&bft.records, level, tangents);
+            assert_eq!(
+                counted,
+                bft.tables.weights.len() as u64,
+                "{name} at level {level}, tangents {tangents}"
+            );
+            assert!(counted > 0, "{name}");
+        }
+        let bft = prepare_loop_bft(&mesh, 1, false).expect("tables");
+        privates += bft
+            .records
+            .iter()
+            .filter(|r| matches!(r.key.case, BftCase::Private { .. }))
+            .count();
+    }
+    assert!(privates > 0, "the set must include private tables");
+}

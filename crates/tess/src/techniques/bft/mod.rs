@@ -63,7 +63,7 @@ use layout::{BasePosition, PackedTables, PatchHeader, StencilTerm, TangentTerm, 
 use std::ops::Range;
 use topology::bft::{
     build_patch_records, face_rotations, level1_base_domain, loop_level1, loop_tables,
-    loop_tangent_stencils,
+    loop_tangent_stencils, table_weight_count,
 };
 use topology::ControlMesh;
 use vk_core::descriptor::{BindingDesc, DescriptorPool};
@@ -266,6 +266,43 @@ fn plan_draw(
             )
         })
         .collect())
+}
+
+/// Refuses tables whose weights exceed one storage-buffer range before evaluating any (the
+/// weights are one binding that every draw chunk reads whole: a shared table serves patches
+/// anywhere in the mesh). Counting takes milliseconds; evaluating the tables of a mesh with
+/// thousands of private ones takes minutes. The error names the largest level that fits.
+fn check_table_range(
+    records: &topology::bft::PatchRecords,
+    level: u32,
+    options: &BftOptions,
+    max_range: u64,
+) -> Result<()> {
+    let bytes_at = |l: u32| 4 * table_weight_count(records, l, options.tangents);
+    let bytes = bytes_at(level);
+    if bytes <= max_range {
+        return Ok(());
+    }
+    let hint = match (1..level).rev().find(|&l| bytes_at(l) <= max_range) {
+        Some(l) => format!(
+            "at level {l} they take {} bytes (--table-level {l}, up to {} segments per base edge)",
+            bytes_at(l),
+            2u32 << l
+        ),
+        None => "no table level fits".to_string(),
+    };
+    Err(TessError::BftTablesTooLarge {
+        name: options.name.clone(),
+        level,
+        bytes,
+        private_faces: records
+            .iter()
+            .filter(|r| matches!(r.key.case, topology::bft::BftCase::Private { .. }))
+            .count(),
+        faces: records.len(),
+        max: max_range,
+        hint,
+    })
 }
 
 /// `bit` when `on`.
@@ -557,6 +594,7 @@ impl Bft {
         stages.push(laps.lap("tangent stencils and upload"));
         // Records and tables; then the level-1 mesh is no longer needed.
         let records = build_patch_records(&level1).map_err(mesh_error)?;
+        check_table_range(&records, table_level, options, limits.max_range)?;
         let tables =
             loop_tables(&level1, &records, table_level, options.tangents).map_err(mesh_error)?;
         let rotations = face_rotations(&level1, &records);
@@ -1177,5 +1215,51 @@ impl Wave {
 
     pub fn at(&self, t: f32) -> Vec<[f32; 3]> {
         wave(&self.rest, &self.normals, self.bbox.0, self.bbox.1, t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The early size check refuses by the count alone, names the mesh, the level, the private
+    /// faces and the largest level that fits, and passes what fits.
+    #[test]
+    fn tables_over_the_storage_range_are_refused_before_evaluation() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../tests/data/opensubdiv/shapes/loop_cube_creases1.obj"
+        );
+        let mesh = topology::load_obj(path).expect("shape");
+        let (level1, _) = loop_level1(&mesh).expect("level 1");
+        let records = build_patch_records(&level1).expect("records");
+        let options = BftOptions {
+            name: "loop_cube_creases1.obj".into(),
+            ..Default::default()
+        };
+        let bytes = |l| 4 * table_weight_count(&records, l, false);
+        let (at5, at4, at3) = (bytes(5), bytes(4), bytes(3));
+        assert!(at5 > at4 && at4 > at3, "{at5} {at4} {at3}");
+        check_table_range(&records, 5, &options, at5).expect("exactly the range fits");
+        let err = check_table_range(&records, 5, &options, at5 - 1)
+            .expect_err("one byte short")
+            .to_string();
+        for needle in [
+            "loop_cube_creases1.obj",
+            "at level 5",
+            &format!("{at5} bytes"),
+            "need a private table",
+            &format!("at level 4 they take {at4} bytes (--table-level 4"),
+        ] {
+            assert!(err.contains(needle), "{needle:?} in {err}");
+        }
+        let err = check_table_range(&records, 5, &options, at4 - 1)
+            .expect_err("level 4 does not fit either")
+            .to_string();
+        assert!(err.contains("--table-level 3"), "{err}");
+        let err = check_table_range(&records, 5, &options, 1)
+            .expect_err("nothing fits")
+            .to_string();
+        assert!(err.contains("no table level fits"), "{err}");
     }
 }
