@@ -7,19 +7,34 @@
 //! resident: at 1M faces ~450 MB of freed BFT blocks stayed in the process
 //! (docs/benchmarks.md, Scale). A fixed threshold keeps every block of 128 KiB and more mapped
 //! on its own, returned to the system when it is freed.
+//!
+//! Smaller blocks come from the heap, and glibc trims the heap's free top back to the system
+//! once it passes 128 KiB (the trim threshold, which no longer follows the mmap threshold once
+//! that is fixed). lavapipe's draw module allocates and frees its vertex and primitive arrays
+//! on every draw, so a frame could give pages back and fault them in again, draw after draw,
+//! depending on what the heap's top held: Flat's frame on the spot control mesh took 74-80 ms
+//! when BFT's frames were interleaved in the same process and 55-63 ms alone or with trimming
+//! off, while BFT's stayed at 93 (docs/benchmarks.md, "Session 21"). The heap's top is
+//! therefore never trimmed; the large blocks above still leave the process when freed.
 
 /// glibc's default threshold, fixed so it no longer rises.
 pub const MMAP_THRESHOLD: usize = 128 * 1024;
 
-/// Fixes the mmap threshold (glibc on Linux; elsewhere nothing to do). For a program's own
-/// process, called once at start (a library linked into a host program leaves the host's heap
-/// alone). Returns whether the policy was applied.
+/// The heap's free top is kept, whatever its size.
+pub const TRIM_THRESHOLD: libc::c_int = libc::c_int::MAX;
+
+/// Fixes the mmap threshold and turns heap trimming off (glibc on Linux; elsewhere nothing to
+/// do). For a program's own process, called once at start (a library linked into a host
+/// program leaves the host's heap alone). Returns whether the policy was applied.
 pub fn return_freed_blocks() -> bool {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     {
         // SAFETY: `mallopt` sets an allocator tunable under the allocator's own lock; it is
         // valid at any time from any thread and touches no memory of ours.
-        unsafe { libc::mallopt(libc::M_MMAP_THRESHOLD, MMAP_THRESHOLD as libc::c_int) == 1 }
+        unsafe {
+            libc::mallopt(libc::M_MMAP_THRESHOLD, MMAP_THRESHOLD as libc::c_int) == 1
+                && libc::mallopt(libc::M_TRIM_THRESHOLD, TRIM_THRESHOLD) == 1
+        }
     }
     #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
     {

@@ -26,7 +26,9 @@
 //!   ([`DeviceShared::live_objects`]), next to gpu-allocator's bytes
 //!   ([`DeviceShared::allocated_bytes`]): soak runs assert both constant after warm-up.
 //! - The `tessera` binary fixes its host heap's mmap threshold ([`host_heap`]) so that freed
-//!   preparation blocks leave the process; a library linked into a host leaves its heap alone.
+//!   preparation blocks leave the process, and keeps the heap's top untrimmed so that
+//!   lavapipe's per-draw arrays keep their pages; a library linked into a host leaves its heap
+//!   alone.
 #![deny(unsafe_op_in_unsafe_fn)]
 pub mod buffer;
 pub mod command;
