@@ -236,7 +236,10 @@ pub fn run(a: BenchArgs) -> Result<()> {
     };
     let report = bench::run_bench_with_progress(&device, &meshes, &config, &mut progress);
     progress.bar.finish_and_clear();
-    let report = report?;
+    let mut report = report?;
+    if let Some(p) = vk_core::host_heap::policy() {
+        report.extra_notes.push(format!("Host heap: {p}"));
+    }
     drop(device);
     check_validation(&instance)?;
     out!("{}", report.to_text());

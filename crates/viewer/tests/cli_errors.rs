@@ -989,6 +989,12 @@ fn bench_applies_the_surface_options_to_the_surface_rows() {
     ];
     args.extend_from_slice(&cheap);
     let text = stdout(&succeeds(&args));
+    // The binary's heap policy is part of what was measured (docs/benchmarks.md, Session 21).
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    assert!(
+        text.contains("Host heap: glibc mmap threshold fixed at 128 KiB, heap top never trimmed"),
+        "{text}"
+    );
     assert!(
         text.contains(
             "Surface maps on the adaptive, gregory, acc rows (their notes say so; the other \

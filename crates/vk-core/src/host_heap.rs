@@ -17,6 +17,11 @@
 //! off, while BFT's stayed at 93 (docs/benchmarks.md, "Session 21"). The heap's top is
 //! therefore never trimmed; the large blocks above still leave the process when freed.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Whether [`return_freed_blocks`] took effect in this process.
+static APPLIED: AtomicBool = AtomicBool::new(false);
+
 /// glibc's default threshold, fixed so it no longer rises.
 pub const MMAP_THRESHOLD: usize = 128 * 1024;
 
@@ -31,15 +36,26 @@ pub fn return_freed_blocks() -> bool {
     {
         // SAFETY: `mallopt` sets an allocator tunable under the allocator's own lock; it is
         // valid at any time from any thread and touches no memory of ours.
-        unsafe {
+        let applied = unsafe {
             libc::mallopt(libc::M_MMAP_THRESHOLD, MMAP_THRESHOLD as libc::c_int) == 1
                 && libc::mallopt(libc::M_TRIM_THRESHOLD, TRIM_THRESHOLD) == 1
-        }
+        };
+        APPLIED.store(applied, Ordering::Relaxed);
+        applied
     }
     #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
     {
         false
     }
+}
+
+/// The policy in force, for a benchmark report to state (`None` where it was not applied: the
+/// heap's own defaults).
+pub fn policy() -> Option<&'static str> {
+    APPLIED.load(Ordering::Relaxed).then_some(
+        "glibc mmap threshold fixed at 128 KiB, heap top never trimmed \
+         (vk_core::host_heap: lavapipe's per-draw arrays keep their pages)",
+    )
 }
 
 #[cfg(test)]
@@ -48,5 +64,6 @@ mod tests {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     fn glibc_accepts_the_threshold() {
         assert!(super::return_freed_blocks());
+        assert!(super::policy().is_some_and(|p| p.contains("never trimmed")));
     }
 }
