@@ -258,11 +258,7 @@ fn every_catmark_shape_welds_and_stays_near_the_limit() {
             }
         }
     }
-    for r in &refused {
-        println!("refused: {r}");
-        assert!(other, "refused: {r}");
-    }
-    assert!(failures.is_empty(), "{failures:#?}");
+    common::whole_set_verdict(&refused, other, &failures);
 }
 
 /// 0 cracks beyond the base boundary (positions welded only when bit-identical) under uniform,

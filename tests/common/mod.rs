@@ -104,6 +104,17 @@ pub fn shape_names(dir: &std::path::Path, prefix: &str) -> Vec<String> {
     names
 }
 
+/// The verdict of a whole-set test: every refusal is printed, and allowed only in `other`'s
+/// folder (a refusal names what it refuses; nothing in tests/data is refused); every failure
+/// fails the test.
+pub fn whole_set_verdict(refused: &[String], other: bool, failures: &[String]) {
+    for r in refused {
+        println!("refused: {r}");
+        assert!(other, "refused: {r}");
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
 /// Builds technique `id` for `mesh` on `ctx` with default options (tangent tables included,
 /// so geometric normals can be drawn).
 pub fn build(
