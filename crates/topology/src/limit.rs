@@ -216,7 +216,22 @@ fn corner_tangents(t1: &mut Mask, t2: &mut Mask, v: &LimitVertex, scale: f64) {
 /// the mask is `e_v · S^k` as `k → ∞`: the weights of the vertex's level-`k` position over the
 /// level-0 ring, iterated until they stop changing (the error shrinks by the subdominant
 /// eigenvalue per step).
+///
+/// Memoized per scheme and valence (the iteration costs about 40,000 instructions and the
+/// adaptive plans ask once per dart corner of every end cap): the same bits as iterating anew.
 pub fn dart_position_weights(loop_scheme: bool, n: usize) -> Vec<f64> {
+    const CACHED: usize = 64;
+    static TABLES: [[std::sync::OnceLock<Vec<f64>>; CACHED]; 2] =
+        [const { [const { std::sync::OnceLock::new() }; CACHED] }; 2];
+    match TABLES[usize::from(loop_scheme)].get(n) {
+        Some(cell) => cell
+            .get_or_init(|| iterate_dart_position_weights(loop_scheme, n))
+            .clone(),
+        None => iterate_dart_position_weights(loop_scheme, n),
+    }
+}
+
+fn iterate_dart_position_weights(loop_scheme: bool, n: usize) -> Vec<f64> {
     let size = if loop_scheme { 1 + n } else { 1 + 2 * n };
     let e = |i: usize| 1 + i % n;
     let f = |i: usize| 1 + n + i % n;
@@ -436,6 +451,26 @@ pub fn smooth_directional_tangent(loop_scheme: bool, n: usize, k: usize) -> (Vec
 /// The Catmull-Clark weights of [`smooth_directional_tangent`], handed to `each(i, edge i,
 /// face i)` in ring order instead of collected (same arithmetic, so the same bits).
 pub fn catmark_directional_tangent_each(n: usize, k: usize, mut each: impl FnMut(usize, f64, f64)) {
+    // Memoized per valence and direction (two cosines per ring entry on every Gregory corner):
+    // the same bits as computing them anew.
+    const CACHED: usize = 16;
+    static TABLES: [std::sync::OnceLock<Vec<(f64, f64)>>; CACHED * CACHED] =
+        [const { std::sync::OnceLock::new() }; CACHED * CACHED];
+    if n < CACHED && k < n {
+        let table = TABLES[n * CACHED + k].get_or_init(|| {
+            let mut t = Vec::with_capacity(n);
+            directional_tangent_weights(n, k, |_, e, f| t.push((e, f)));
+            t
+        });
+        for (i, &(e, f)) in table.iter().enumerate() {
+            each(i, e, f);
+        }
+    } else {
+        directional_tangent_weights(n, k, each);
+    }
+}
+
+fn directional_tangent_weights(n: usize, k: usize, mut each: impl FnMut(usize, f64, f64)) {
     let nf = n as f64;
     let tk = 2.0 * PI * k as f64 / nf;
     let c = (2.0 * PI / nf).cos();

@@ -10,7 +10,7 @@ pub(super) const POS: [(i32, i32); 4] = [(0, 0), (1, 0), (1, 1), (0, 1)];
 pub(super) const DIR: [(i32, i32); 4] = [(1, 0), (0, 1), (-1, 0), (0, -1)];
 
 #[inline]
-pub(super) fn slot(a: i32, b: i32) -> usize {
+pub(super) const fn slot(a: i32, b: i32) -> usize {
     (4 * (b + 1) + (a + 1)) as usize
 }
 
@@ -165,6 +165,49 @@ pub(super) fn corner_in(t: &Topology, g: u32, v: u32) -> Option<usize> {
     fv.iter().position(|&x| x == v)
 }
 
+/// Slots of the three points of the face `step` faces around patch corner `p` (`step` 1 to 3
+/// in `[p][step - 1]`), walking forward (across the edge entering the corner, the first table)
+/// or backward (across the edge leaving it), in the order of that face's corners after the
+/// patch corner: the corner's local frame (x toward the next corner, y toward the previous)
+/// mapped into the 4×4 grid once, instead of per gathered point.
+const GATHER_SLOTS: [[[[u8; 3]; 3]; 4]; 2] = gather_slots();
+
+const fn gather_slots() -> [[[[u8; 3]; 3]; 4]; 2] {
+    let mut out = [[[[0u8; 3]; 3]; 4]; 2];
+    let mut p = 0;
+    while p < 4 {
+        let (ox, oy) = POS[p];
+        let (nx, ny) = POS[(p + 1) % 4];
+        let (px, py) = POS[(p + 3) % 4];
+        let (xx, xy, yx, yy) = (nx - ox, ny - oy, px - ox, py - oy);
+        let mut step = 1;
+        while step <= 3 {
+            let fwd = [
+                DIR[step % 4],
+                (
+                    DIR[step % 4].0 + DIR[(step + 1) % 4].0,
+                    DIR[step % 4].1 + DIR[(step + 1) % 4].1,
+                ),
+                DIR[(step + 1) % 4],
+            ];
+            let (ds, ds1) = (DIR[(4 - step % 4) % 4], DIR[(5 - step % 4) % 4]);
+            let bwd = [ds1, (ds1.0 + ds.0, ds1.1 + ds.1), ds];
+            let mut k = 0;
+            while k < 3 {
+                let (f, b) = (fwd[k], bwd[k]);
+                out[0][p][step - 1][k] =
+                    slot(ox + f.0 * xx + f.1 * yx, oy + f.0 * xy + f.1 * yy) as u8;
+                out[1][p][step - 1][k] =
+                    slot(ox + b.0 * xx + b.1 * yx, oy + b.0 * xy + b.1 * yy) as u8;
+                k += 1;
+            }
+            step += 1;
+        }
+        p += 1;
+    }
+    out
+}
+
 /// The 4×4 points of a regular patch (level-local ids) with phantoms for the masked edges.
 /// Returns the gathered global ids (`INVALID` where a phantom goes) and the boundary mask;
 /// [`phantom_grid`] completes them (or finds a point missing).
@@ -173,82 +216,62 @@ pub(super) fn gather_regular(lvl: &Lvl, f: usize, shift: u8) -> Option<([u32; 16
     let (fv, fe) = rotated(t, f, shift);
     let mut ids = [INVALID; 16];
     let base = lvl.base;
-    let set = |a: i32, b: i32, v: u32, grid: &mut [u32; 16]| -> bool {
-        let s = slot(a, b);
-        if grid[s] != INVALID {
-            return grid[s] == base + v;
+    // A slot written twice (the points along an edge, reached from both its corners) must get
+    // the same vertex both times; otherwise the ring is not the regular one.
+    let set = |s: u8, v: u32, grid: &mut [u32; 16]| -> bool {
+        let slot = &mut grid[s as usize];
+        if *slot != INVALID {
+            return *slot == base + v;
         }
-        grid[s] = base + v;
+        *slot = base + v;
         true
     };
     for p in 0..4 {
         let (ox, oy) = POS[p];
-        if !set(ox, oy, fv[p], &mut ids) {
+        if !set(slot(ox, oy) as u8, fv[p], &mut ids) {
             return None;
         }
     }
     for p in 0..4 {
         let v = fv[p];
-        let (ox, oy) = POS[p];
-        let (nx, ny) = POS[(p + 1) % 4];
-        let (px, py) = POS[(p + 3) % 4];
-        let (xx, xy) = (nx - ox, ny - oy);
-        let (yx, yy) = (px - ox, py - oy);
-        let at = |d: (i32, i32)| (ox + d.0 * xx + d.1 * yx, oy + d.0 * xy + d.1 * yy);
-        let add = |a: (i32, i32), b: (i32, i32)| (a.0 + b.0, a.1 + b.1);
         let start = corner_in(t, f as u32, v)?;
         let mut steps = 0;
-        // Forward: across the edge entering v.
-        let (mut g, mut k) = (f as u32, start);
-        for step in 1..=3usize {
-            let e = t.face_edge_list(g as usize)[(k + 3) % 4];
-            if lvl.sharp_edge(e as usize) {
-                break;
+        // Forward: across the edge entering v; then backward, across the edge leaving v, for
+        // what the forward walk could not reach (a boundary or sharp edge stops a walk).
+        for (dir, slots) in GATHER_SLOTS.iter().enumerate() {
+            let (mut g, mut k) = (f as u32, start);
+            let last = if dir == 0 { 3 } else { 3 - steps };
+            for step in 1..=last {
+                let fe_g = t.face_edge_list(g as usize);
+                let e = if dir == 0 { fe_g[(k + 3) % 4] } else { fe_g[k] };
+                if lvl.sharp_edge(e as usize) {
+                    break;
+                }
+                let [x, y] = t.edge_faces(e as usize);
+                let h = if x == g { y } else { x };
+                if h == INVALID || h == f as u32 {
+                    break;
+                }
+                let kh = corner_in(t, h, v)?;
+                let hv = t.face_vertices(h as usize);
+                let [s0, s1, s2] = slots[p][step - 1];
+                let (v0, v2) = if dir == 0 {
+                    (hv[(kh + 1) % 4], hv[(kh + 3) % 4])
+                } else {
+                    (hv[(kh + 3) % 4], hv[(kh + 1) % 4])
+                };
+                if !(set(s0, v0, &mut ids)
+                    && set(s1, hv[(kh + 2) % 4], &mut ids)
+                    && set(s2, v2, &mut ids))
+                {
+                    return None;
+                }
+                g = h;
+                k = kh;
+                if dir == 0 {
+                    steps = step;
+                }
             }
-            let [x, y] = t.edge_faces(e as usize);
-            let h = if x == g { y } else { x };
-            if h == INVALID || h == f as u32 {
-                break;
-            }
-            let kh = corner_in(t, h, v)?;
-            let hv = t.face_vertices(h as usize);
-            let (d0, d1) = (DIR[step % 4], DIR[(step + 1) % 4]);
-            let (a0, a1, a2) = (at(d0), at(add(d0, d1)), at(d1));
-            if !(set(a0.0, a0.1, hv[(kh + 1) % 4], &mut ids)
-                && set(a1.0, a1.1, hv[(kh + 2) % 4], &mut ids)
-                && set(a2.0, a2.1, hv[(kh + 3) % 4], &mut ids))
-            {
-                return None;
-            }
-            g = h;
-            k = kh;
-            steps = step;
-        }
-        // Backward: across the edge leaving v, for what the forward walk could not reach.
-        let (mut g, mut k) = (f as u32, start);
-        for step in 1..=(3 - steps) {
-            let e = t.face_edge_list(g as usize)[k];
-            if lvl.sharp_edge(e as usize) {
-                break;
-            }
-            let [x, y] = t.edge_faces(e as usize);
-            let h = if x == g { y } else { x };
-            if h == INVALID || h == f as u32 {
-                break;
-            }
-            let kh = corner_in(t, h, v)?;
-            let hv = t.face_vertices(h as usize);
-            let ds = DIR[(4 - step % 4) % 4];
-            let ds1 = DIR[(5 - step % 4) % 4];
-            let (a0, a1, a2) = (at(ds1), at(add(ds1, ds)), at(ds));
-            if !(set(a0.0, a0.1, hv[(kh + 3) % 4], &mut ids)
-                && set(a1.0, a1.1, hv[(kh + 2) % 4], &mut ids)
-                && set(a2.0, a2.1, hv[(kh + 1) % 4], &mut ids))
-            {
-                return None;
-            }
-            g = h;
-            k = kh;
         }
     }
     let mut mask = 0u8;
