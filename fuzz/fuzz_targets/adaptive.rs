@@ -87,9 +87,15 @@ fuzz_target!(
             }
         }
         let nv = plan.num_vertices;
+        // Control points precede the curve points, which the device computes from them.
         for p in &plan.patches {
-            assert!(p.control_points.iter().all(|&v| v < nv));
+            assert!(p.control_points.iter().all(|&v| v < plan.first_curve_point));
         }
+        for (c, curve) in plan.curves.iter().enumerate() {
+            assert_eq!(curve[1], plan.first_curve_point + 2 * c as u32);
+            assert_eq!(curve[2], curve[1] + 1);
+        }
+        assert_eq!(plan.first_curve_point + 2 * plan.curves.len() as u32, nv);
         for c in &plan.curves {
             assert!(c.iter().all(|&v| v < nv));
         }

@@ -1,7 +1,8 @@
 #version 450
 // The GPU subdivision tables, applied every frame: one dispatch per refinement level (its rows
 // read only earlier levels), then one for the local points (phantom B-spline points, Gregory
-// points, limit corners, curve Bezier points). `mode` 1 copies the base positions in first.
+// points, limit corners), then the canonical curves' inner Bezier points. `mode`
+// ADAPTIVE_STENCIL_MODE_BASE copies the base positions in first.
 // Rows are stencils over the global vertex buffer, summed in table order with `precise`, as
 // offsets from the row's first vertex (rows are affine).
 // A block larger than the storage range runs as several dispatches (chunks of rows), each
@@ -12,12 +13,80 @@
 #include "frame.glsl"
 #include "adaptive.glsl"
 layout(local_size_x = ADAPTIVE_LOCAL_SIZE) in;
+
+// Per regular patch edge: the slots of the four B-spline points along it (edge direction) and
+// the slot step across it (`topology::adaptive::nets::REGULAR_EDGE_LINES`).
+const uvec4 REGULAR_EDGE_LINE[4] = uvec4[4](uvec4(4u, 5u, 6u, 7u), uvec4(2u, 6u, 10u, 14u), uvec4(11u, 10u, 9u, 8u), uvec4(13u, 9u, 5u, 1u));
+const uint REGULAR_EDGE_STEP[4] = uint[4](4u, 1u, 4u, 1u);
+
+vec3 cp_vtx(AdaptivePatch p, uint k) { return vtx(control_points[p.cp_offset + k]); }
+
+// Curve point `i` (curve i / 2, inner point 1 + i % 2): its owner's edge as a cubic Bezier
+// curve B0..B3 in the edge's direction (a regular patch's B-spline edge, a Gregory patch's
+// P, Ep, Em, P', a bilinear end cap's straight line), or the half of it the curve is, at
+// point k of the segment in the curve's direction (`AdaptivePlan::curve_inner_point`). The
+// sums are offsets from one of the points read (as the rows are), so the f32 rounding is
+// relative to the patch's size, not to the coordinates' magnitude.
+vec3 curve_inner_point(uint i) {
+    uint c = i >> 1u;
+    uint slot = 1u + (i & 1u);
+    CurveOwner o = curve_owners[c];
+    AdaptivePatch p = patches[o.patch_id];
+    uint e = o.info & 3u;
+    uint part = (o.info >> 2u) & 3u;
+    uint k = ((o.info >> 4u) & 1u) != 0u ? slot : 3u - slot;
+    uint kind = patch_kind(p);
+    if (kind == ADAPTIVE_KIND_GREGORY_TRIANGLE && part != 0u) {
+        return cp_vtx(p, 15u + 4u * e + 2u * (part - 1u) + (k - 1u));
+    }
+    uint n = kind == ADAPTIVE_KIND_GREGORY_TRIANGLE ? 3u : 4u;
+    uint e1 = (e + 1u) % n;
+    vec3 anchor;
+    vec3 b[4];
+    if (kind == ADAPTIVE_KIND_REGULAR) {
+        uvec4 line = REGULAR_EDGE_LINE[e];
+        uint step = REGULAR_EDGE_STEP[e];
+        anchor = cp_vtx(p, line[1]);
+        vec3 q[4];
+        for (uint j = 0u; j < 4u; ++j) {
+            q[j] = ((cp_vtx(p, line[j] - step) - anchor) + 4.0 * (cp_vtx(p, line[j]) - anchor) + (cp_vtx(p, line[j] + step) - anchor)) / 6.0;
+        }
+        b[0] = (1.0 / 6.0) * q[0] + (4.0 / 6.0) * q[1] + (1.0 / 6.0) * q[2];
+        b[1] = (2.0 / 3.0) * q[1] + (1.0 / 3.0) * q[2];
+        b[2] = (1.0 / 3.0) * q[1] + (2.0 / 3.0) * q[2];
+        b[3] = (1.0 / 6.0) * q[1] + (4.0 / 6.0) * q[2] + (1.0 / 6.0) * q[3];
+    } else if (kind == ADAPTIVE_KIND_BILINEAR) {
+        anchor = cp_vtx(p, e);
+        vec3 d = cp_vtx(p, e1) - anchor;
+        b = vec3[4](vec3(0.0), d / 3.0, 2.0 * d / 3.0, d);
+    } else {
+        anchor = cp_vtx(p, 5u * e);
+        b = vec3[4](vec3(0.0), cp_vtx(p, 5u * e + 1u) - anchor, cp_vtx(p, 5u * e1 + 2u) - anchor, cp_vtx(p, 5u * e1) - anchor);
+    }
+    vec3 d;
+    if (part == 0u) {
+        d = b[k];
+    } else if (part == 1u) {
+        // de Casteljau at 1/2: the first half's points 1 and 2, or the second half's.
+        d = k == 1u ? 0.5 * b[0] + 0.5 * b[1] : 0.25 * b[0] + 0.5 * b[1] + 0.25 * b[2];
+    } else {
+        d = k == 1u ? 0.25 * b[1] + 0.5 * b[2] + 0.25 * b[3] : 0.5 * b[2] + 0.5 * b[3];
+    }
+    return anchor + d;
+}
+
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= adaptive.count) return;
-    if (adaptive.mode == 1u) {
+    if (adaptive.mode == ADAPTIVE_STENCIL_MODE_BASE) {
         uint v = adaptive.first_row + i;
         vertices[v] = vec4(base_positions[3u * v], base_positions[3u * v + 1u], base_positions[3u * v + 2u], 1.0);
+        return;
+    }
+    if (adaptive.mode == ADAPTIVE_STENCIL_MODE_CURVES) {
+        uint pi = adaptive.first_row + i;
+        uvec4 curve = curves[pi >> 1u];
+        vertices[(pi & 1u) == 0u ? curve.y : curve.z] = vec4(curve_inner_point(pi), 1.0);
         return;
     }
     uint r = adaptive.first_row + i;

@@ -60,9 +60,14 @@
 //!   B-spline's); a bilinear end cap is the Coons patch of its four curves.
 //! * **One global vertex buffer.** Base vertices first, then one [`StencilBlock`] per level (its
 //!   rows read only the previous level), then one block of local points (phantoms, Gregory
-//!   points, canonical corners, curve points) that reads only refined vertices, so each block
-//!   can run as one parallel kernel. Local points are not shared between patches except the
-//!   canonical corners and curves (two boundary patches each have their own phantoms).
+//!   points, canonical corners) that reads only refined vertices, so each block can run as one
+//!   parallel kernel; then the curves' inner points, two per curve, which no stencil computes:
+//!   each is a fixed combination of its owner patch's control points
+//!   ([`AdaptivePlan::curve_inner_point`]), which the device evaluates per curve every frame.
+//!   As stencil rows they were a third of the local rows and an eighth of catmark_car's plan
+//!   (building, sorting and copying 173,586 rows). Local points are not shared between
+//!   patches except the canonical corners and curves (two boundary patches each have their
+//!   own phantoms).
 //! * **Size bound.** Every vertex of a triangle mesh is extraordinary under Catmull-Clark (and
 //!   so is every face centre of level 1), so isolation refines nearly everything at every
 //!   level: a 1M-triangle grid at isolation 4 is tens of millions of refined faces and
@@ -340,11 +345,16 @@ pub struct AdaptivePlan {
     pub num_vertices: u32,
     /// Refinement levels 1..=isolation, in order.
     pub steps: Vec<StencilBlock>,
-    /// Phantom points, Gregory points, canonical corners and curve points (the last block).
+    /// Phantom points, Gregory points and canonical corners (the last block).
     pub local_points: StencilBlock,
     pub patches: Vec<AdaptivePatch>,
     /// Canonical boundary curves: cubic Bézier control points (global ids).
     pub curves: Vec<[u32; 4]>,
+    /// Global id of curve 0's first inner point. The inner points come after every stencil
+    /// block, two per curve in curve order (`curves[c][1] = first_curve_point + 2c`), and no
+    /// stencil rows compute them: [`AdaptivePlan::curve_inner_point`] does, from the owner's
+    /// control points, as the device does every frame.
+    pub first_curve_point: u32,
     /// Per curve: the patch that computed its inner points, whose evaluation along the curve
     /// defines the curve's normals and texture coordinates for both sides.
     pub curve_owners: Vec<CurveOwner>,
@@ -467,7 +477,52 @@ impl AdaptivePlan {
             let rows = block.table.apply(&verts);
             verts.extend_from_slice(&rows);
         }
+        verts.resize(self.first_curve_point as usize, [0.0; 3]);
+        for c in 0..self.curves.len() {
+            for slot in 1..=2 {
+                let p = self.curve_inner_point(&verts, c, slot);
+                verts.push(p);
+            }
+        }
         verts
+    }
+
+    /// Inner point `slot` (1 or 2) of canonical curve `c`, from its owner's control points in
+    /// `verts` (which must hold every vertex before [`Self::first_curve_point`]): the owner's
+    /// edge as a cubic Bézier curve `B0..B3` in the edge's direction, or the half of it that
+    /// the curve is (de Casteljau), read at point `k` of the segment in the curve's direction.
+    /// The edge's Bézier points are the regular patch's B-spline edge, a Gregory patch's
+    /// `[P, Ep, Em, P']` or a bilinear end cap's straight line between its corners; a Gregory
+    /// triangle's halves are its own points. `glsl/adaptive/stencil.comp` (mode 2) computes
+    /// the same, so both sides of an edge read one curve.
+    pub fn curve_inner_point(&self, verts: &[[f64; 3]], c: usize, slot: usize) -> [f64; 3] {
+        let o = &self.curve_owners[c];
+        let pa = &self.patches[o.patch as usize];
+        let cp = |k: usize| verts[pa.control_points[k] as usize];
+        let (e, part) = (o.edge as usize, o.part as usize);
+        let k = if o.forward { slot } else { 3 - slot };
+        let n = pa.corners();
+        let e1 = (e + 1) % n;
+        let b: [[f64; 3]; 4] = match pa.kind {
+            PatchKind::GregoryTriangle if part != 0 => {
+                return cp(15 + 4 * e + 2 * (part - 1) + (k - 1));
+            }
+            PatchKind::Regular => nets::regular_edge_bezier(e, cp),
+            PatchKind::Gregory | PatchKind::GregoryTriangle => {
+                [cp(5 * e), cp(5 * e + 1), cp(5 * e1 + 2), cp(5 * e1)]
+            }
+            PatchKind::Bilinear => {
+                let (c0, c3) = (cp(e), cp(e1));
+                let third =
+                    |a: [f64; 3], b: [f64; 3]| std::array::from_fn(|x| (2.0 * a[x] + b[x]) / 3.0);
+                [c0, third(c0, c3), third(c3, c0), c3]
+            }
+        };
+        if part == 0 {
+            return b[k];
+        }
+        let w = nets::bezier_half(part - 1)[k];
+        std::array::from_fn(|x| w[0] * b[0][x] + w[1] * b[1][x] + w[2] * b[2][x] + w[3] * b[3][x])
     }
 
     /// The parameter of canonical corner `k` in its owner patch (`corner_owners[k]`): a patch

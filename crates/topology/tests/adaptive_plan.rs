@@ -479,7 +479,13 @@ fn blocks_read_only_earlier_vertices() {
             }
             next += b.table.len() as u32;
         }
-        assert_eq!(next, plan.num_vertices);
+        // Then the curves' inner points, two per curve in curve order, which no block computes.
+        assert_eq!(next, plan.first_curve_point, "{name}");
+        for (c, curve) in plan.curves.iter().enumerate() {
+            assert_eq!(curve[1], next + 2 * c as u32, "{name}: curve {c}");
+            assert_eq!(curve[2], curve[1] + 1, "{name}: curve {c}");
+        }
+        assert_eq!(next + 2 * plan.curves.len() as u32, plan.num_vertices);
         // Semi-sharp features are followed past the isolation level until they decay, and
         // slowly converging vertices further (at most level 14).
         assert!(

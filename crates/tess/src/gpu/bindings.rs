@@ -103,11 +103,11 @@ gpu_constants! {
     ADAPTIVE_SET = 1;
     /// Base positions (three floats per base vertex), one buffer per frame slot; rewritten per frame when animated.
     ADAPTIVE_BASE_POSITIONS_BINDING = 0;
-    /// CSR offsets of every refined vertex's stencil (levels, then local points), over the global vertex buffer.
+    /// CSR offsets of the stencil of every refined vertex up to the curve points (levels, then local points), over the global vertex buffer.
     ADAPTIVE_STENCIL_OFFSETS_BINDING = 1;
     /// Stencil terms (`StencilTerm`: global vertex, weight).
     ADAPTIVE_STENCIL_TERMS_BINDING = 2;
-    /// The global vertex buffer (`vec4`): base, level 1..L, local points; written by `stencil.comp`.
+    /// The global vertex buffer (`vec4`): base, level 1..L, local points, curve points; written by `stencil.comp`.
     ADAPTIVE_VERTICES_BINDING = 3;
     /// One `AdaptivePatch` record per patch, in frame-wide patch order.
     ADAPTIVE_PATCHES_BINDING = 4;
@@ -133,6 +133,12 @@ gpu_constants! {
     ADAPTIVE_PARAM_ERROR_SIDE = 9;
     /// Work-group size of the adaptive stencil kernel.
     ADAPTIVE_LOCAL_SIZE = 64;
+    /// `mode` of the stencil kernel (`AdaptivePush`): apply stencil rows,
+    ADAPTIVE_STENCIL_MODE_ROWS = 0;
+    /// copy the base positions in,
+    ADAPTIVE_STENCIL_MODE_BASE = 1;
+    /// evaluate the canonical curves' inner points from their owner patches' control points (two per curve).
+    ADAPTIVE_STENCIL_MODE_CURVES = 2;
     /// Patch kinds (low 4 bits of `AdaptivePatch::info`): bicubic B-spline,
     ADAPTIVE_KIND_REGULAR = 0;
     /// Gregory end cap,

@@ -38,7 +38,7 @@ impl Locals {
         &mut self,
         items: &[T],
         scratch: impl Fn() -> S + Sync,
-        build: impl Fn(&Locals, &T, &mut S, &mut StencilTable) + Sync,
+        build: impl Fn(&T, &mut S, &mut StencilTable) + Sync,
     ) {
         let per_round = 2 * rayon::current_num_threads().max(1);
         let mut tables: Vec<(S, StencilTable)> = Vec::new();
@@ -47,7 +47,6 @@ impl Locals {
             while tables.len() < chunks.len() {
                 tables.push((scratch(), StencilTable::default()));
             }
-            let me = &*self;
             tables
                 .par_iter_mut()
                 .zip(chunks.par_iter())
@@ -57,21 +56,12 @@ impl Locals {
                     table.indices.clear();
                     table.weights.clear();
                     for item in chunk.iter() {
-                        build(me, item, s, table);
+                        build(item, s, table);
                     }
                 });
             for (_, table) in &tables[..chunks.len()] {
                 self.append(table);
             }
-        }
-    }
-    /// Expand a global id into refined-vertex terms (local points by their rows).
-    pub(super) fn expand(&self, id: u32, w: f64, out: &mut Vec<(u32, f64)>) {
-        if id < self.first {
-            out.push((id, w));
-        } else {
-            let (idx, ws) = self.table.stencil((id - self.first) as usize);
-            out.extend(idx.iter().zip(ws).map(|(&i, &x)| (i, w * x)));
         }
     }
 }
@@ -265,13 +255,13 @@ pub(super) fn assemble(
         }
     }
 
-    // Local points come to about 7 rows of 42 to 56 entries per patch (corners, curve points,
-    // phantoms, Gregory points; catmark_car 45.01, spot 55.6): reserve once, with room to
-    // spare, instead of regrowing (a regrowth copies tens of MB). Pages never written are
-    // never faulted in, so the spare room costs address space only.
-    locals.table.offsets.reserve(10 * drafts.len());
-    locals.table.indices.reserve(64 * drafts.len());
-    locals.table.weights.reserve(64 * drafts.len());
+    // Local points (phantoms, Gregory points, canonical corners) come to 2 to 7 rows and 15 to
+    // 29 terms per patch on every shape in tests/data (catmark_car 2.7 and 15.3, spot 2.8 and
+    // 22.8): reserve once, with room to spare, instead of regrowing (a regrowth copies MBs).
+    // Pages never written are never faulted in, so the spare room costs address space only.
+    locals.table.offsets.reserve(8 * drafts.len());
+    locals.table.indices.reserve(32 * drafts.len());
+    locals.table.weights.reserve(32 * drafts.len());
     // Control points (phantoms and Gregory points become local points).
     let mut terms: Vec<(u32, f64)> = Vec::with_capacity(64);
     let mut patches: Vec<AdaptivePatch> = Vec::with_capacity(drafts.len());
@@ -402,7 +392,7 @@ pub(super) fn assemble(
     locals.append_par(
         &needed,
         || Vec::with_capacity(32),
-        |_, &(l, v), terms, table| {
+        |&(l, v), terms, table| {
             let lvl = &levels[l as usize];
             terms.clear();
             limit_stencil(lvl, v as usize, terms);
@@ -569,43 +559,6 @@ pub(super) fn assemble(
         }
     }
 
-    // Inner Bézier points of each curve from its owner.
-    // Per patch edge and part (whole, first half, second half): Bézier weights over the slots.
-    let edge_rows: [[[[f64; 16]; 4]; 3]; 4] = std::array::from_fn(|p| {
-        let whole = regular_edge_bezier(p);
-        std::array::from_fn(|part| {
-            if part == 0 {
-                return whole;
-            }
-            let h = bezier_half(part - 1);
-            std::array::from_fn(|k| {
-                let mut w = [0.0; 16];
-                for (j, &s) in h[k].iter().enumerate() {
-                    for (o, x) in w.iter_mut().zip(&whole[j]) {
-                        *o += s * x;
-                    }
-                }
-                w
-            })
-        })
-    });
-    // The non-zero slots of each row (6 of 16 for a whole edge, 9 for a half), found once
-    // instead of scanning all 16 weights for every curve point.
-    type SlotTerms = smallvec::SmallVec<[(usize, f64); 16]>;
-    let edge_terms: [[[SlotTerms; 4]; 3]; 4] = std::array::from_fn(|p| {
-        std::array::from_fn(|part| {
-            std::array::from_fn(|k| {
-                edge_rows[p][part][k]
-                    .iter()
-                    .enumerate()
-                    .filter(|&(_, &w)| w != 0.0)
-                    .map(|(s, &w)| (s, w))
-                    .collect()
-            })
-        })
-    });
-    // Curve `c` gets rows `2c` (its point 1) and `2c + 1` (its point 2) of this run of local
-    // points, computed in parallel chunks and appended in order.
     if let Some(o) = owners.iter().find(|o| o.0 == u8::MAX) {
         // A sibling half no patch has as its own edge: a level jump next to this patch.
         let d = &drafts[o.1 as usize];
@@ -643,72 +596,11 @@ pub(super) fn assemble(
             }
         })
         .collect();
-    let first_curve_row = first_local + locals.table.len() as u32;
-    locals.append_par(
-        &curve_owners,
-        || Vec::<(u32, f64)>::with_capacity(128),
-        |locals, o, scratch, table| {
-            let patch = &patches[o.patch as usize];
-            let (p, part, forward) = (o.edge as usize, o.part as usize, o.forward);
-            let ids = corners[o.patch as usize];
-            for slot in [1usize, 2] {
-                // Curve point `slot` is the segment's Bézier point `k`.
-                let k = if forward { slot } else { 3 - slot };
-                scratch.clear();
-                match patch.kind {
-                    PatchKind::Regular => {
-                        for &(s, w) in &edge_terms[p][part][k] {
-                            locals.expand(patch.control_points[s], w, scratch);
-                        }
-                    }
-                    PatchKind::Gregory | PatchKind::GregoryTriangle | PatchKind::Bilinear => {
-                        // The owner's whole edge as Bézier points `[P, Ep, Em, P']`, or the
-                        // half of it (de Casteljau) when the owner is the coarse side.
-                        let cp = &patch.control_points;
-                        let n = patch.corners();
-                        let (c0, c3) = (ids[p], ids[(p + 1) % n]);
-                        if patch.kind == PatchKind::GregoryTriangle && part != 0 {
-                            // The half's own inner points (`triangle_draft`).
-                            let id = cp[15 + 4 * p + 2 * (part - 1) + (k - 1)];
-                            locals.expand(id, 1.0, scratch);
-                            push_row(table, scratch);
-                            continue;
-                        }
-                        let whole: [[(u32, f64); 2]; 4] = if patch.kind != PatchKind::Bilinear {
-                            [
-                                [(c0, 1.0), (c0, 0.0)],
-                                [(cp[5 * p + 1], 1.0), (c0, 0.0)],
-                                [(cp[5 * ((p + 1) % n) + 2], 1.0), (c0, 0.0)],
-                                [(c3, 1.0), (c0, 0.0)],
-                            ]
-                        } else {
-                            [
-                                [(c0, 1.0), (c0, 0.0)],
-                                [(c0, 2.0 / 3.0), (c3, 1.0 / 3.0)],
-                                [(c0, 1.0 / 3.0), (c3, 2.0 / 3.0)],
-                                [(c3, 1.0), (c0, 0.0)],
-                            ]
-                        };
-                        let row: [f64; 4] = if part == 0 {
-                            std::array::from_fn(|j| f64::from(u8::from(j == k)))
-                        } else {
-                            bezier_half(part - 1)[k]
-                        };
-                        for (j, &s) in row.iter().enumerate() {
-                            for &(id, w) in &whole[j] {
-                                if s * w != 0.0 {
-                                    locals.expand(id, s * w, scratch);
-                                }
-                            }
-                        }
-                    }
-                }
-                push_row(table, scratch);
-            }
-        },
-    );
+    // The curves' inner points follow the local points: two per curve, in curve order, which
+    // the device computes from their owners' control points every frame (no stencil rows).
+    let first_curve_point = first_local + locals.table.len() as u32;
     for (ci, c) in curves.iter_mut().enumerate() {
-        c[1] = first_curve_row + 2 * ci as u32;
+        c[1] = first_curve_point + 2 * ci as u32;
         c[2] = c[1] + 1;
     }
 
@@ -754,7 +646,13 @@ pub(super) fn assemble(
             }
         })
         .collect();
-    let num_vertices = first_local + locals.table.len() as u32;
+    let num_vertices = u32::try_from(curves.len())
+        .ok()
+        .and_then(|n| n.checked_mul(2))
+        .and_then(|n| n.checked_add(first_curve_point))
+        .ok_or(TopologyError::RefinementTooLarge {
+            faces: mesh.num_faces(),
+        })?;
     Ok(AdaptivePlan {
         num_base_vertices: levels[0].t().num_vertices() as u32,
         num_vertices,
@@ -766,6 +664,7 @@ pub(super) fn assemble(
         patches,
         curves,
         curve_owners,
+        first_curve_point,
         first_corner: first_canon,
         corner_owners,
         level_stats,

@@ -424,41 +424,33 @@ pub(super) fn limit_stencil(lvl: &Lvl, v: usize, out: &mut Vec<(u32, f64)>) {
     }
 }
 
-/// Weights over the 16 slots of the Bézier points of regular patch edge `p`, in the edge's
-/// direction.
-pub(super) fn regular_edge_bezier(p: usize) -> [[f64; 16]; 4] {
-    // The four B-spline points along the edge (limit across it), in edge direction.
-    let line: [(i32, i32); 4] = match p {
-        0 => [(-1, 0), (0, 0), (1, 0), (2, 0)],
-        1 => [(1, -1), (1, 0), (1, 1), (1, 2)],
-        2 => [(2, 1), (1, 1), (0, 1), (-1, 1)],
-        _ => [(0, 2), (0, 1), (0, 0), (0, -1)],
-    };
-    let across: (i32, i32) = if p.is_multiple_of(2) { (0, 1) } else { (1, 0) };
-    let q: Vec<[f64; 16]> = line
-        .iter()
-        .map(|&(a, b)| {
-            let mut w = [0.0; 16];
-            w[slot(a - across.0, b - across.1)] += 1.0 / 6.0;
-            w[slot(a, b)] += 4.0 / 6.0;
-            w[slot(a + across.0, b + across.1)] += 1.0 / 6.0;
-            w
-        })
-        .collect();
-    let mix = |terms: &[(f64, usize)]| {
-        let mut w = [0.0; 16];
-        for &(s, i) in terms {
-            for (o, x) in w.iter_mut().zip(&q[i]) {
-                *o += s * x;
-            }
-        }
-        w
+/// Per regular patch edge `p`: the slots of the four B-spline points along it (in the edge's
+/// direction) and the slot step across it (the row or column on either side).
+/// `glsl/adaptive/stencil.comp` holds the same table.
+pub(super) const REGULAR_EDGE_LINES: [([usize; 4], usize); 4] = [
+    ([4, 5, 6, 7], 4),
+    ([2, 6, 10, 14], 1),
+    ([11, 10, 9, 8], 4),
+    ([13, 9, 5, 1], 1),
+];
+
+/// The Bézier points of regular patch edge `p`, in the edge's direction, from the patch's
+/// control point at each slot: the uniform cubic B-spline across the edge (limit across it),
+/// then along it converted to Bézier form.
+pub(super) fn regular_edge_bezier(p: usize, cp: impl Fn(usize) -> [f64; 3]) -> [[f64; 3]; 4] {
+    let (line, step) = REGULAR_EDGE_LINES[p];
+    let q: [[f64; 3]; 4] = std::array::from_fn(|i| {
+        let (a, b, c) = (cp(line[i] - step), cp(line[i]), cp(line[i] + step));
+        std::array::from_fn(|x| (a[x] + 4.0 * b[x] + c[x]) / 6.0)
+    });
+    let mix = |w: [f64; 4]| -> [f64; 3] {
+        std::array::from_fn(|x| w[0] * q[0][x] + w[1] * q[1][x] + w[2] * q[2][x] + w[3] * q[3][x])
     };
     [
-        mix(&[(1.0 / 6.0, 0), (4.0 / 6.0, 1), (1.0 / 6.0, 2)]),
-        mix(&[(2.0 / 3.0, 1), (1.0 / 3.0, 2)]),
-        mix(&[(1.0 / 3.0, 1), (2.0 / 3.0, 2)]),
-        mix(&[(1.0 / 6.0, 1), (4.0 / 6.0, 2), (1.0 / 6.0, 3)]),
+        mix([1.0 / 6.0, 4.0 / 6.0, 1.0 / 6.0, 0.0]),
+        mix([0.0, 2.0 / 3.0, 1.0 / 3.0, 0.0]),
+        mix([0.0, 1.0 / 3.0, 2.0 / 3.0, 0.0]),
+        mix([0.0, 1.0 / 6.0, 4.0 / 6.0, 1.0 / 6.0]),
     ]
 }
 

@@ -4,9 +4,11 @@
 //!
 //! Design decisions:
 //! - **One global vertex buffer** (`vec4`): base vertices, then each level's refined vertices,
-//!   then the local points (phantom points, Gregory points, limit corners, curve Bezier
-//!   points). Every stencil row is over global vertices, so one kernel applies every block;
-//!   a block's rows read only earlier blocks, so each block is one dispatch.
+//!   then the local points (phantom points, Gregory points, limit corners), then the curves'
+//!   inner Bezier points. Every stencil row is over global vertices, so one kernel applies
+//!   every block; a block's rows read only earlier blocks, so each block is one dispatch. The
+//!   curve points have no rows: the kernel evaluates them from the owner patches' control
+//!   points (`CurveOwner`), last.
 //! - **Patches in array order** (regular, Gregory, bilinear): a patch's record index is its
 //!   frame-wide id, what the TES captures and [`crate::Technique::face_point`] maps back.
 //! - **Checked before upload**: [`GpuAdaptive::new`] proves every index a shader can form is
@@ -172,6 +174,8 @@ pub struct GpuAdaptive {
     pub curve_owners: Vec<CurveOwner>,
     /// Global id of the first canonical corner.
     pub first_corner: u32,
+    /// Global id of curve 0's first inner point (two per curve follow, after every block).
+    pub first_curve_point: u32,
     /// Per canonical corner: `[frame-wide patch id, corner]` of its owner.
     pub corner_owners: Vec<[u32; 2]>,
 }
@@ -193,6 +197,11 @@ fn edge_code(kind: EdgeKind) -> u32 {
 }
 
 impl GpuAdaptive {
+    /// The curves' inner points, which the stencil kernel's last dispatches compute.
+    pub fn curve_points(&self) -> u32 {
+        2 * self.curves.len() as u32
+    }
+
     pub fn new(plan: &AdaptivePlan) -> Result<GpuAdaptive, LayoutError> {
         let nb = plan.num_base_vertices;
         let nv = plan.num_vertices;
@@ -241,10 +250,30 @@ impl GpuAdaptive {
             }
             next = block.first_vertex + rows;
         }
-        if next != nv {
+        // The curves' inner points follow the blocks, two per curve in curve order: the kernel
+        // writes point `i` to `curves[i / 2][1 + i % 2]`, so those must be exactly that run of
+        // the buffer (no two curves write one vertex, nothing else is overwritten).
+        if next != plan.first_curve_point {
+            return Err(LayoutError::Index {
+                what: "first curve point",
+                index: plan.first_curve_point as u64,
+                len: next as u64,
+            });
+        }
+        for (c, curve) in plan.curves.iter().enumerate() {
+            let first = next as u64 + 2 * c as u64;
+            if curve[1] as u64 != first || curve[2] as u64 != first + 1 {
+                return Err(LayoutError::Index {
+                    what: "curve inner point",
+                    index: curve[1] as u64,
+                    len: first,
+                });
+            }
+        }
+        if next as u64 + 2 * plan.curves.len() as u64 != nv as u64 {
             return Err(LayoutError::Index {
                 what: "vertex count",
-                index: next as u64,
+                index: next as u64 + 2 * plan.curves.len() as u64,
                 len: nv as u64,
             });
         }
@@ -268,8 +297,10 @@ impl GpuAdaptive {
                 });
             }
             let cp_offset = control_points.len() as u32;
+            // Control points precede the curve points, which the kernel computes from them
+            // in one dispatch (a control point among them would be read while written).
             for &c in &p.control_points {
-                check("control point", c as u64, nv as u64)?;
+                check("control point", c as u64, plan.first_curve_point as u64)?;
                 control_points.push(c);
             }
             let mut edge_info = 0u32;
@@ -321,8 +352,18 @@ impl GpuAdaptive {
         let mut curve_owners = Vec::with_capacity(plan.curve_owners.len());
         for o in &plan.curve_owners {
             check("curve owner", o.patch as u64, order.len() as u64)?;
-            check("curve owner edge", o.edge as u64, 4)?;
+            // The curve kernel reads the owner's control points of that edge: an edge past
+            // the owner's corners (a triangle's fourth) would read past its points.
+            let owner = &plan.patches[o.patch as usize];
+            check("curve owner edge", o.edge as u64, owner.corners() as u64)?;
             check("curve owner part", o.part as u64, 3)?;
+            if o.triangle != (owner.kind == PatchKind::GregoryTriangle) {
+                return Err(LayoutError::Index {
+                    what: "curve owner kind",
+                    index: o.patch as u64,
+                    len: order.len() as u64,
+                });
+            }
             curve_owners.push(CurveOwner {
                 patch: frame_id[o.patch as usize],
                 info: o.edge as u32
@@ -354,6 +395,7 @@ impl GpuAdaptive {
             nv as u64 + 1,
         )?;
         Ok(GpuAdaptive {
+            first_curve_point: plan.first_curve_point,
             curve_owners,
             first_corner: plan.first_corner,
             corner_owners,

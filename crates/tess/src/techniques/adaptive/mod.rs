@@ -8,7 +8,9 @@
 //!    and canonical boundary curves.
 //! 2. **Every frame (GPU):** the stencil kernel (`glsl/adaptive/stencil.comp`) copies the base
 //!    positions and applies one block per dispatch (an animated base costs one upload of its
-//!    positions); then one draw per patch kind, one control point per patch.
+//!    positions), then evaluates each canonical curve's two inner points from its owner
+//!    patch's control points (no stencil rows: a fixed combination per patch kind and edge);
+//!    then one draw per patch kind, one control point per patch.
 //! 3. **Crack-free by construction:** every edge level comes from the edge's canonical
 //!    curve(s) only, a coarse transition edge gets twice its fine halves' level (the seed's
 //!    doubled factors: the tessellator makes the missing vertices, no T-junction), and every
@@ -46,7 +48,8 @@ use crate::gpu::bindings::{
     ADAPTIVE_OPTION_CANONICAL_NORMALS, ADAPTIVE_OPTION_DISPLACE, ADAPTIVE_OPTION_HEIGHT_MAP,
     ADAPTIVE_OPTION_REPARAM, ADAPTIVE_OPTION_SHOW_PARAM_ERROR, ADAPTIVE_OPTION_SHOW_PARAM_SHIFT,
     ADAPTIVE_OPTION_TEXTURE, ADAPTIVE_PARAM_ERROR_BINDING, ADAPTIVE_PARAM_ERROR_SIDE,
-    ADAPTIVE_REPARAM_BINDING, ADAPTIVE_SURFACES_BINDING, ADAPTIVE_TEXTURE_BINDING,
+    ADAPTIVE_REPARAM_BINDING, ADAPTIVE_STENCIL_MODE_BASE, ADAPTIVE_STENCIL_MODE_CURVES,
+    ADAPTIVE_STENCIL_MODE_ROWS, ADAPTIVE_SURFACES_BINDING, ADAPTIVE_TEXTURE_BINDING,
 };
 use crate::gpu::AdaptivePush;
 use crate::shaders::{self, Stage, Variant};
@@ -177,8 +180,8 @@ const TERMS: Space = Space {
 /// A set's windows of the stencil offsets (rows) and terms.
 type RowWindows = [Range<u32>; 2];
 
-/// One dispatch of the stencil kernel: rows (mode 0) or base vertices (mode 1) and the
-/// windows of the offsets and terms its set binds.
+/// One dispatch of the stencil kernel (`mode`: rows, the base copy or curve points; see
+/// `ADAPTIVE_STENCIL_MODE_*`), its items and the set whose windows it binds.
 #[derive(Clone, Debug, PartialEq, Eq)]
 struct Step {
     mode: u32,
@@ -218,18 +221,19 @@ fn plan_pre_pass(
             first = end;
         }
     };
-    // The base copy reads no stencils: any set serves.
-    split(1, 0..g.num_base_vertices, 0);
+    // The base copy and the curve points read no stencils: any set serves.
+    split(ADAPTIVE_STENCIL_MODE_BASE, 0..g.num_base_vertices, 0);
     for d in &g.dispatches {
         let block = d.first_row..d.first_row + d.rows;
         for (k, c) in chunks.iter().enumerate() {
             split(
-                0,
+                ADAPTIVE_STENCIL_MODE_ROWS,
                 block.start.max(c.items.start)..block.end.min(c.items.end),
                 k,
             );
         }
     }
+    split(ADAPTIVE_STENCIL_MODE_CURVES, 0..g.curve_points(), 0);
     Ok((steps, chunks.into_iter().map(|c| c.windows).collect()))
 }
 
@@ -1040,16 +1044,39 @@ mod tests {
         assert_eq!(whole.1.len(), 1, "everything fits: one set");
         let (steps, sets) = plan_pre_pass(&g, limits(4096), 100).expect("chunked");
         assert!(sets.len() > 3, "{} sets", sets.len());
-        assert_eq!(steps[0].mode, 1);
+        assert_eq!(steps[0].mode, ADAPTIVE_STENCIL_MODE_BASE);
         assert_eq!(steps[0].items.start, 0);
         let copied: u32 = steps
             .iter()
-            .filter(|s| s.mode == 1)
+            .filter(|s| s.mode == ADAPTIVE_STENCIL_MODE_BASE)
             .map(|s| s.items.len() as u32)
             .sum();
         assert_eq!(copied, g.num_base_vertices);
         let mut next = 0;
-        for s in steps.iter().filter(|s| s.mode == 0) {
+        // The curve points come last, in order, after every row.
+        let curve_steps: Vec<&Step> = steps
+            .iter()
+            .filter(|s| s.mode == ADAPTIVE_STENCIL_MODE_CURVES)
+            .collect();
+        let mut next_point = 0;
+        for s in &curve_steps {
+            assert_eq!(s.items.start, next_point);
+            assert!(s.items.len() <= 100);
+            next_point = s.items.end;
+        }
+        assert_eq!(next_point, g.curve_points());
+        assert!(next_point > 0);
+        let first_curve_step = steps
+            .iter()
+            .position(|s| s.mode == ADAPTIVE_STENCIL_MODE_CURVES)
+            .expect("curve steps");
+        assert!(steps[first_curve_step..]
+            .iter()
+            .all(|s| s.mode == ADAPTIVE_STENCIL_MODE_CURVES));
+        for s in steps
+            .iter()
+            .filter(|s| s.mode == ADAPTIVE_STENCIL_MODE_ROWS)
+        {
             assert_eq!(s.items.start, next, "in order, no gap or overlap");
             assert!(s.items.len() <= 100);
             next = s.items.end;
