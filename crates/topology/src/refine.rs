@@ -659,7 +659,19 @@ pub fn refine_sparse(
     let ec = |e: u32| edge_child_vertex[e as usize];
     let half_at =
         |e: u32, v: u32| 2 * (ec(e) - kv as u32) + u32::from(p.edge_verts[e as usize][0] != v);
-    let mut edge_verts: Vec<[u32; 2]> = Vec::with_capacity(2 * ke + 3 * faces.len());
+    // Sized up front (a quad per corner, or four triangles): growing them copied MBs per level.
+    let child_faces: usize = if quads {
+        faces
+            .iter()
+            .map(|&f| p.face_vertices(f as usize).len())
+            .sum()
+    } else {
+        4 * faces.len()
+    };
+    let corners = if quads { 4 } else { 3 } * child_faces;
+    // The halves, then one inner edge per child quad (or three per triangle).
+    let inner_edges = if quads { child_faces } else { 3 * faces.len() };
+    let mut edge_verts: Vec<[u32; 2]> = Vec::with_capacity(2 * ke + inner_edges);
     let mut edge_sharpness: Vec<f32> = Vec::with_capacity(edge_verts.capacity());
     for &e in &edges {
         let [a, b] = p.edge_verts[e as usize];
@@ -668,10 +680,11 @@ pub fn refine_sparse(
         edge_sharpness.extend_from_slice(&halves[2 * e as usize..2 * e as usize + 2]);
     }
     let mut face_first_child = vec![INVALID; nf];
-    let mut child_face_parent = Vec::new();
-    let mut face_offsets = vec![0u32];
-    let mut face_verts = Vec::new();
-    let mut face_edges = Vec::new();
+    let mut child_face_parent = Vec::with_capacity(child_faces);
+    let mut face_offsets = Vec::with_capacity(child_faces + 1);
+    face_offsets.push(0u32);
+    let mut face_verts = Vec::with_capacity(corners);
+    let mut face_edges = Vec::with_capacity(corners);
     for &f in &faces {
         let fv = p.face_vertices(f as usize);
         let fe = p.face_edge_list(f as usize);

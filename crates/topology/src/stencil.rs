@@ -195,9 +195,9 @@ const BLOCK_ROWS: usize = 8192;
 /// times parent row `j` into a dense accumulator over the parent's sources, so the result is the
 /// composition without an intermediate table, hashing or per-row allocation.
 ///
-/// Blocks run in rounds of a few per thread; each round's blocks are then copied in parallel
-/// straight into the final arrays, so block buffers and accumulators are reused (touched once
-/// per thread, not once per row) and the final arrays are touched once.
+/// Blocks run in rounds of a few per thread; each round's blocks are then appended to the
+/// final arrays, so block buffers and accumulators are reused (touched once per thread, not
+/// once per row) and the final arrays are written once.
 pub(crate) fn compose_rows<G>(
     n: usize,
     parent: Option<&StencilTable>,
@@ -226,13 +226,14 @@ where
         idx: Vec::new(),
         wts: Vec::new(),
     };
-    // Entries per row: ~10 for a composed Catmull-Clark row, fewer for masks. The arrays grow
-    // if the guess is short; untouched capacity costs no memory (zeroed pages are lazy).
+    // Entries per row: ~10 for a composed Catmull-Clark row, fewer for masks. Filled by
+    // appending (nothing is zeroed first, which on recycled heap memory wrote every page
+    // once more), and trimmed only when the guess was far off (a trim may copy).
     let guess = if parent.is_some() { 12 } else { 8 };
-    let mut offsets = vec![0u32; n + 1];
-    let mut indices = vec![0u32; n * guess];
-    let mut weights = vec![0.0f64; n * guess];
-    let mut cursor = 0usize;
+    let mut offsets: Vec<u32> = Vec::with_capacity(n + 1);
+    offsets.push(0);
+    let mut indices: Vec<u32> = Vec::with_capacity(n * guess);
+    let mut weights: Vec<f64> = Vec::with_capacity(n * guess);
     let mut b0 = 0;
     while b0 < blocks {
         let b1 = (b0 + per_round).min(blocks);
@@ -249,48 +250,28 @@ where
                 sc
             })
             .collect();
-        let total: usize = done.iter().map(|sc| sc.idx.len()).sum();
-        if cursor + total > indices.len() {
-            let cap = (cursor + total).max(indices.len() + indices.len() / 2);
-            indices.resize(cap, 0);
-            weights.resize(cap, 0.0);
+        for sc in &done {
+            let mut acc = indices.len() as u64;
+            offsets.extend(sc.sizes.iter().map(|&s| {
+                acc += s as u64;
+                acc as u32
+            }));
+            indices.extend_from_slice(&sc.idx);
+            weights.extend_from_slice(&sc.wts);
         }
-        let mut jobs = Vec::with_capacity(done.len());
-        {
-            let mut o_rest = &mut offsets[1 + done[0].rows.start..];
-            let mut i_rest = &mut indices[cursor..];
-            let mut w_rest = &mut weights[cursor..];
-            for sc in &done {
-                let (o, o_tail) = std::mem::take(&mut o_rest).split_at_mut(sc.sizes.len());
-                let (ix, i_tail) = std::mem::take(&mut i_rest).split_at_mut(sc.idx.len());
-                let (w, w_tail) = std::mem::take(&mut w_rest).split_at_mut(sc.wts.len());
-                jobs.push((sc, cursor as u32, o, ix, w));
-                cursor += sc.idx.len();
-                (o_rest, i_rest, w_rest) = (o_tail, i_tail, w_tail);
-            }
-        }
-        jobs.into_par_iter().for_each(|(sc, base, o, ix, w)| {
-            let mut acc = base;
-            for (slot, &s) in o.iter_mut().zip(&sc.sizes) {
-                acc += s;
-                *slot = acc;
-            }
-            ix.copy_from_slice(&sc.idx);
-            w.copy_from_slice(&sc.wts);
-        });
         if let Ok(mut p) = pool.lock() {
             p.extend(done);
         }
         b0 = b1;
     }
     assert!(
-        cursor < u32::MAX as usize,
+        indices.len() < u32::MAX as usize,
         "too many stencil weights for 32-bit offsets"
     );
-    indices.truncate(cursor);
-    indices.shrink_to_fit();
-    weights.truncate(cursor);
-    weights.shrink_to_fit();
+    if indices.capacity() > indices.len() + indices.len() / 3 {
+        indices.shrink_to_fit();
+        weights.shrink_to_fit();
+    }
     StencilTable {
         offsets,
         indices,
