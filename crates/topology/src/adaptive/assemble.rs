@@ -389,15 +389,44 @@ pub(super) fn assemble(
         }
         corners.push(ids);
     }
+    // A corner first met as a corner of an interior regular patch (no phantoms) is a smooth
+    // valence-4 vertex whose one-ring is the patch's 3×3 points around that corner: its limit
+    // mask reads them from the patch instead of walking the level's topology again (the same
+    // row, bit for bit: the same weights over the same vertices, sorted). Most corners are.
+    let [wv, we, wf] = catmark_smooth_position_weights(4);
+    let corner_items: Vec<((u8, u32), [u32; 2])> = needed
+        .iter()
+        .copied()
+        .zip(corner_owners.iter().copied())
+        .collect();
     locals.append_par(
-        &needed,
+        &corner_items,
         || Vec::with_capacity(32),
-        |&(l, v), terms, table| {
-            let lvl = &levels[l as usize];
+        |&((l, v), [pi, corner]), terms, table| {
             terms.clear();
-            limit_stencil(lvl, v as usize, terms);
-            for t in terms.iter_mut() {
-                t.0 += lvl.base;
+            let pa = &patches[pi as usize];
+            if pa.kind == PatchKind::Regular
+                && pa.boundary_mask == 0
+                && corner < 4
+                && pa.control_points.iter().all(|&c| c < first_local)
+            {
+                let (ox, oy) = POS[corner as usize];
+                for b in -1..=1 {
+                    for a in -1..=1 {
+                        let w = match (a != 0, b != 0) {
+                            (false, false) => wv,
+                            (true, true) => wf,
+                            _ => we,
+                        };
+                        terms.push((pa.control_points[slot(ox + a, oy + b)], w));
+                    }
+                }
+            } else {
+                let lvl = &levels[l as usize];
+                limit_stencil(lvl, v as usize, terms);
+                for t in terms.iter_mut() {
+                    t.0 += lvl.base;
+                }
             }
             push_row(table, terms);
         },
