@@ -507,7 +507,8 @@ pub(super) fn assemble(
                     return Err(unbalanced());
                 }
             };
-            let (ca, cb) = (canon_of(l, a, d.face)?, canon_of(l, b, d.face)?);
+            // The patch's own corners were numbered above: read them, not the canonical map.
+            let (ca, cb) = (corners[pi][p], corners[pi][(p + 1) % n]);
             let pe = &mut patch.edges[p];
             pe.kind = kind;
             match kind {
