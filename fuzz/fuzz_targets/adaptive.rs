@@ -13,6 +13,7 @@ use arbitrary::Unstructured;
 use libfuzzer_sys::fuzz_target;
 use tessera_fuzz::{all_finite, param, positions_in_range, MeshSpec};
 use topology::adaptive::single_pass::{plan_single_pass, SinglePassOptions, SinglePassPatch};
+use topology::adaptive::PatchKind;
 use topology::{plan_adaptive, AdaptiveOptions, EndCap};
 
 fuzz_target!(
@@ -87,9 +88,20 @@ fuzz_target!(
             }
         }
         let nv = plan.num_vertices;
-        // Control points precede the curve points, which the device computes from them.
+        // Control points precede the curve points, which the device computes from them, and
+        // the corners it computes from their owners' points follow those points.
         for p in &plan.patches {
             assert!(p.control_points.iter().all(|&v| v < plan.first_curve_point));
+        }
+        assert_eq!(
+            plan.first_corner as usize + plan.corner_owners.len(),
+            plan.first_curve_point as usize
+        );
+        let regular_from = (plan.first_regular_corner - plan.first_corner) as usize;
+        for &[pi, c] in &plan.corner_owners[regular_from..] {
+            let pa = &plan.patches[pi as usize];
+            assert!(pa.kind == PatchKind::Regular && c < 4);
+            assert!(pa.control_points.iter().all(|&v| v < plan.first_regular_corner));
         }
         for (c, curve) in plan.curves.iter().enumerate() {
             assert_eq!(curve[1], plan.first_curve_point + 2 * c as u32);

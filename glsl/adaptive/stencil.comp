@@ -1,8 +1,9 @@
 #version 450
 // The GPU subdivision tables, applied every frame: one dispatch per refinement level (its rows
 // read only earlier levels), then one for the local points (phantom B-spline points, Gregory
-// points, limit corners), then the canonical curves' inner Bezier points. `mode`
-// ADAPTIVE_STENCIL_MODE_BASE copies the base positions in first.
+// points, limit corners with rows), then the limit corners of regular patches, then
+// the canonical curves' inner Bezier points. `mode` ADAPTIVE_STENCIL_MODE_BASE copies the base
+// positions in first.
 // Rows are stencils over the global vertex buffer, summed in table order with `precise`, as
 // offsets from the row's first vertex (rows are affine).
 // A block larger than the storage range runs as several dispatches (chunks of rows), each
@@ -75,12 +76,33 @@ vec3 curve_inner_point(uint i) {
     return anchor + d;
 }
 
+// Canonical corner `k` (global vertex first_corner + k), owned by a regular patch: the
+// smooth valence-4 limit mask over the patch's 3x3 points around that corner, as offsets from
+// the corner's own point (`AdaptivePlan::regular_corner_point`).
+const ivec2 CORNER_POS[4] = ivec2[4](ivec2(0, 0), ivec2(1, 0), ivec2(1, 1), ivec2(0, 1));
+vec3 regular_corner_point(uint k) {
+    uvec2 o = corner_owners[k];
+    AdaptivePatch p = patches[o.x];
+    ivec2 c = CORNER_POS[o.y & 3u];
+    // slot(a, b) = 4 (b + 1) + (a + 1)
+    uint s = uint(4 * (c.y + 1) + (c.x + 1));
+    vec3 anchor = cp_vtx(p, s);
+    vec3 e = (cp_vtx(p, s + 1u) - anchor) + (cp_vtx(p, s + 4u) - anchor) + (cp_vtx(p, s - 1u) - anchor) + (cp_vtx(p, s - 4u) - anchor);
+    vec3 f = (cp_vtx(p, s - 3u) - anchor) + (cp_vtx(p, s + 5u) - anchor) + (cp_vtx(p, s + 3u) - anchor) + (cp_vtx(p, s - 5u) - anchor);
+    return anchor + ((1.0 / 9.0) * e + (1.0 / 36.0) * f);
+}
+
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= adaptive.count) return;
     if (adaptive.mode == ADAPTIVE_STENCIL_MODE_BASE) {
         uint v = adaptive.first_row + i;
         vertices[v] = vec4(base_positions[3u * v], base_positions[3u * v + 1u], base_positions[3u * v + 2u], 1.0);
+        return;
+    }
+    if (adaptive.mode == ADAPTIVE_STENCIL_MODE_CORNERS) {
+        uint k = adaptive.first_row + i;
+        vertices[adaptive.first_corner + k] = vec4(regular_corner_point(k), 1.0);
         return;
     }
     if (adaptive.mode == ADAPTIVE_STENCIL_MODE_CURVES) {

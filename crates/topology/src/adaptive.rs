@@ -355,6 +355,13 @@ pub struct AdaptivePlan {
     /// stencil rows compute them: [`AdaptivePlan::curve_inner_point`] does, from the owner's
     /// control points, as the device does every frame.
     pub first_curve_point: u32,
+    /// Global id of the first canonical corner that no stencil row computes. The corners
+    /// `first_regular_corner..first_curve_point` were first met on a regular patch, their
+    /// owner: each is that B-spline patch's value at its corner, a fixed combination of its
+    /// 3×3 points there, phantoms included ([`AdaptivePlan::regular_corner_point`]), which the
+    /// device evaluates every frame. The corners before it have limit-stencil rows, the
+    /// last rows of `local_points`.
+    pub first_regular_corner: u32,
     /// Per curve: the patch that computed its inner points, whose evaluation along the curve
     /// defines the curve's normals and texture coordinates for both sides.
     pub curve_owners: Vec<CurveOwner>,
@@ -477,6 +484,11 @@ impl AdaptivePlan {
             let rows = block.table.apply(&verts);
             verts.extend_from_slice(&rows);
         }
+        verts.resize(self.first_regular_corner as usize, [0.0; 3]);
+        for id in self.first_regular_corner..self.first_curve_point {
+            let p = self.regular_corner_point(&verts, id);
+            verts.push(p);
+        }
         verts.resize(self.first_curve_point as usize, [0.0; 3]);
         for c in 0..self.curves.len() {
             for slot in 1..=2 {
@@ -485,6 +497,30 @@ impl AdaptivePlan {
             }
         }
         verts
+    }
+
+    /// Canonical corner `id` (from [`Self::first_regular_corner`] on), from its owner's points
+    /// in `verts` (which must hold every vertex before `first_regular_corner`): the smooth
+    /// valence-4 limit mask over the owner's 3×3 points around that corner, summed as offsets
+    /// from the corner's own point. With phantoms across a boundary or crease it is the
+    /// crease (or corner) limit rule, exactly: the B-spline's value at the patch corner. `glsl/adaptive/stencil.comp` (mode 3) computes the same.
+    pub fn regular_corner_point(&self, verts: &[[f64; 3]], id: u32) -> [f64; 3] {
+        let [pi, corner] = self.corner_owners[(id - self.first_corner) as usize];
+        let pa = &self.patches[pi as usize];
+        let [_, we, wf] = catmark_smooth_position_weights(4);
+        let (ox, oy) = nets::POS[corner as usize];
+        let cp = |a: i32, b: i32| verts[pa.control_points[nets::slot(ox + a, oy + b)] as usize];
+        let anchor = cp(0, 0);
+        let mut e = [0.0; 3];
+        let mut f = [0.0; 3];
+        for (a, b) in [(1, 0), (0, 1), (-1, 0), (0, -1)] {
+            let (x, y) = (cp(a, b), cp(a + b, b - a));
+            for k in 0..3 {
+                e[k] += x[k] - anchor[k];
+                f[k] += y[k] - anchor[k];
+            }
+        }
+        std::array::from_fn(|k| anchor[k] + (we * e[k] + wf * f[k]))
     }
 
     /// Inner point `slot` (1 or 2) of canonical curve `c`, from its owner's control points in

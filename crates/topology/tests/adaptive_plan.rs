@@ -479,8 +479,33 @@ fn blocks_read_only_earlier_vertices() {
             }
             next += b.table.len() as u32;
         }
-        // Then the curves' inner points, two per curve in curve order, which no block computes.
-        assert_eq!(next, plan.first_curve_point, "{name}");
+        // Then the canonical corners of regular patches and the curves' inner points
+        // (two per curve in curve order), which no block computes.
+        assert_eq!(next, plan.first_regular_corner, "{name}");
+        assert_eq!(
+            plan.first_corner as usize + plan.corner_owners.len(),
+            plan.first_curve_point as usize,
+            "{name}: the canonical corners run up to the curve points"
+        );
+        let regular_from = (plan.first_regular_corner - plan.first_corner) as usize;
+        for &[pi, c] in &plan.corner_owners[regular_from..] {
+            let pa = &plan.patches[pi as usize];
+            assert!(pa.kind == PatchKind::Regular && c < 4, "{name}");
+            assert!(pa
+                .control_points
+                .iter()
+                .all(|&v| v < plan.first_regular_corner));
+        }
+        // Every corner first met on a regular patch is evaluated from it: none of the corners
+        // with rows has a regular owner.
+        for &[pi, _] in &plan.corner_owners[..regular_from] {
+            assert_ne!(
+                plan.patches[pi as usize].kind,
+                PatchKind::Regular,
+                "{name}: a corner of a regular patch has a row"
+            );
+        }
+        let next = plan.first_curve_point;
         for (c, curve) in plan.curves.iter().enumerate() {
             assert_eq!(curve[1], next + 2 * c as u32, "{name}: curve {c}");
             assert_eq!(curve[2], curve[1] + 1, "{name}: curve {c}");

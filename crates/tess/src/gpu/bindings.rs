@@ -137,8 +137,10 @@ gpu_constants! {
     ADAPTIVE_STENCIL_MODE_ROWS = 0;
     /// copy the base positions in,
     ADAPTIVE_STENCIL_MODE_BASE = 1;
-    /// evaluate the canonical curves' inner points from their owner patches' control points (two per curve).
+    /// evaluate the canonical curves' inner points from their owner patches' control points (two per curve),
     ADAPTIVE_STENCIL_MODE_CURVES = 2;
+    /// evaluate the canonical corners owned by regular patches from their 3x3 points, phantoms included (the B-spline value at the corner).
+    ADAPTIVE_STENCIL_MODE_CORNERS = 3;
     /// Patch kinds (low 4 bits of `AdaptivePatch::info`): bicubic B-spline,
     ADAPTIVE_KIND_REGULAR = 0;
     /// Gregory end cap,

@@ -335,38 +335,41 @@ pub(super) fn assemble(
     }
 
     // Canonical corners, at the coarsest level each is a patch corner (drafts are level-ordered).
-    // First the numbering (sequential, cheap), then the limit stencils (in parallel chunks,
-    // appended in order).
+    // A corner first met on a regular patch is a regular vertex, and its limit point is the
+    // B-spline patch's value at that corner: the smooth valence-4 mask over the patch's 3×3
+    // points there, phantoms included (across a boundary or crease they reproduce the crease
+    // and corner limit rules exactly). No stencil row is planned for it: the device evaluates
+    // it from the patch each frame, as it does the curves, so it is numbered after the local
+    // points. The others get limit-stencil rows at the end of the local points. First a
+    // provisional numbering in meeting order, then the rows' corners first and the regular
+    // ones after, contiguous from `first_canon`.
     let mut canon = vec![INVALID; first_local as usize];
+    // Per provisional corner: its key, whether it is a regular corner, and its owner.
+    let mut met: Vec<(u32, bool, [u32; 2])> = Vec::new();
     let mut needed: Vec<(u8, u32)> = Vec::new();
     let mut corners: Vec<[u32; 4]> = Vec::with_capacity(drafts.len());
     let first_canon = first_local + locals.table.len() as u32;
-    let mut corner_owners: Vec<[u32; 2]> = Vec::new();
     for (pi, (d, patch)) in drafts.iter().zip(patches.iter_mut()).enumerate() {
         let lvl = &levels[d.level as usize];
         let (fv, _, n) = draft_corners(lvl, d);
+        let regular = patch.kind == PatchKind::Regular;
         let mut ids = [INVALID; 4];
         for (p, &v) in fv[..n].iter().enumerate() {
             let key = lvl.anc[v as usize] as usize;
             if canon[key] == INVALID {
-                canon[key] = first_canon + needed.len() as u32;
-                if d.kind == PatchKind::GregoryTriangle {
+                canon[key] = met.len() as u32;
+                met.push((key as u32, regular, [pi as u32, p as u32]));
+                if regular {
+                    // No row: evaluated from this patch.
+                } else if d.kind == PatchKind::GregoryTriangle {
                     // The limit mask needs an all-quad ring: the vertex's child's, at level 1.
                     let maps = level1_maps(&levels, d.face)?;
                     needed.push((1, maps.vertex_child_vertex[v as usize]));
                 } else {
                     needed.push((d.level, v));
                 }
-                corner_owners.push([pi as u32, p as u32]);
             }
             ids[p] = canon[key];
-            match patch.kind {
-                PatchKind::Gregory | PatchKind::GregoryTriangle => {
-                    patch.control_points[5 * p] = ids[p]
-                }
-                PatchKind::Bilinear => patch.control_points[p] = ids[p],
-                PatchKind::Regular => {}
-            }
         }
         if d.kind == PatchKind::GregoryTriangle {
             // Its edges are level-1 halves (see `triangle_draft`): the edge midpoints are
@@ -381,56 +384,63 @@ pub(super) fn assemble(
                 }
                 let key = l1.anc[m as usize] as usize;
                 if canon[key] == INVALID {
-                    canon[key] = first_canon + needed.len() as u32;
+                    canon[key] = met.len() as u32;
+                    met.push((key as u32, false, [pi as u32, 4 + p as u32]));
                     needed.push((1, m));
-                    corner_owners.push([pi as u32, 4 + p as u32]);
                 }
             }
         }
         corners.push(ids);
     }
-    // A corner first met as a corner of an interior regular patch (no phantoms) is a smooth
-    // valence-4 vertex whose one-ring is the patch's 3×3 points around that corner: its limit
-    // mask reads them from the patch instead of walking the level's topology again (the same
-    // row, bit for bit: the same weights over the same vertices, sorted). Most corners are.
-    let [wv, we, wf] = catmark_smooth_position_weights(4);
-    let corner_items: Vec<((u8, u32), [u32; 2])> = needed
-        .iter()
-        .copied()
-        .zip(corner_owners.iter().copied())
-        .collect();
+    // Final ids: the rows' corners in meeting order, then the regular ones in meeting order.
+    let rows = needed.len() as u32;
+    let first_regular_corner = first_canon + rows;
+    let mut final_id = Vec::with_capacity(met.len());
+    let mut corner_owners: Vec<[u32; 2]> = vec![[0; 2]; met.len()];
+    let (mut next_row, mut next_regular) = (0u32, 0u32);
+    for &(key, regular, owner) in &met {
+        let id = if regular {
+            next_regular += 1;
+            first_regular_corner + next_regular - 1
+        } else {
+            next_row += 1;
+            first_canon + next_row - 1
+        };
+        final_id.push(id);
+        corner_owners[(id - first_canon) as usize] = owner;
+        canon[key as usize] = id;
+    }
+    for (ids, patch) in corners.iter_mut().zip(patches.iter_mut()) {
+        let n = patch.corners();
+        for (p, id) in ids[..n].iter_mut().enumerate() {
+            *id = final_id[*id as usize];
+            match patch.kind {
+                PatchKind::Gregory | PatchKind::GregoryTriangle => {
+                    patch.control_points[5 * p] = *id
+                }
+                PatchKind::Bilinear => patch.control_points[p] = *id,
+                PatchKind::Regular => {}
+            }
+        }
+    }
     locals.append_par(
-        &corner_items,
+        &needed,
         || Vec::with_capacity(32),
-        |&((l, v), [pi, corner]), terms, table| {
+        |&(l, v), terms, table| {
+            let lvl = &levels[l as usize];
             terms.clear();
-            let pa = &patches[pi as usize];
-            if pa.kind == PatchKind::Regular
-                && pa.boundary_mask == 0
-                && corner < 4
-                && pa.control_points.iter().all(|&c| c < first_local)
-            {
-                let (ox, oy) = POS[corner as usize];
-                for b in -1..=1 {
-                    for a in -1..=1 {
-                        let w = match (a != 0, b != 0) {
-                            (false, false) => wv,
-                            (true, true) => wf,
-                            _ => we,
-                        };
-                        terms.push((pa.control_points[slot(ox + a, oy + b)], w));
-                    }
-                }
-            } else {
-                let lvl = &levels[l as usize];
-                limit_stencil(lvl, v as usize, terms);
-                for t in terms.iter_mut() {
-                    t.0 += lvl.base;
-                }
+            limit_stencil(lvl, v as usize, terms);
+            for t in terms.iter_mut() {
+                t.0 += lvl.base;
             }
             push_row(table, terms);
         },
     );
+    debug_assert_eq!(
+        first_local + locals.table.len() as u32,
+        first_regular_corner
+    );
+    let regular_corners = next_regular;
     let canon_of = |l: usize, v: u32, face: u32| -> Result<u32, TopologyError> {
         let c = canon[levels[l].anc[v as usize] as usize];
         if c == INVALID {
@@ -628,7 +638,7 @@ pub(super) fn assemble(
         .collect();
     // The curves' inner points follow the local points: two per curve, in curve order, which
     // the device computes from their owners' control points every frame (no stencil rows).
-    let first_curve_point = first_local + locals.table.len() as u32;
+    let first_curve_point = first_regular_corner + regular_corners;
     for (ci, c) in curves.iter_mut().enumerate() {
         c[1] = first_curve_point + 2 * ci as u32;
         c[2] = c[1] + 1;
@@ -695,6 +705,7 @@ pub(super) fn assemble(
         curves,
         curve_owners,
         first_curve_point,
+        first_regular_corner,
         first_corner: first_canon,
         corner_owners,
         level_stats,

@@ -4,11 +4,12 @@
 //!
 //! Design decisions:
 //! - **One global vertex buffer** (`vec4`): base vertices, then each level's refined vertices,
-//!   then the local points (phantom points, Gregory points, limit corners), then the curves'
-//!   inner Bezier points. Every stencil row is over global vertices, so one kernel applies
-//!   every block; a block's rows read only earlier blocks, so each block is one dispatch. The
-//!   curve points have no rows: the kernel evaluates them from the owner patches' control
-//!   points (`CurveOwner`), last.
+//!   then the local points (phantom points, Gregory points, limit corners with rows), then
+//!   the limit corners of regular patches, then the curves' inner Bezier points.
+//!   Every stencil row is over global vertices, so one kernel applies every block; a block's
+//!   rows read only earlier blocks, so each block is one dispatch. The regular corners and
+//!   the curve points have no rows: the kernel evaluates them from their owner patches'
+//!   control points (corner owners, `CurveOwner`), in that order, last.
 //! - **Patches in array order** (regular, Gregory, bilinear): a patch's record index is its
 //!   frame-wide id, what the TES captures and [`crate::Technique::face_point`] maps back.
 //! - **Checked before upload**: [`GpuAdaptive::new`] proves every index a shader can form is
@@ -176,6 +177,9 @@ pub struct GpuAdaptive {
     pub first_corner: u32,
     /// Global id of curve 0's first inner point (two per curve follow, after every block).
     pub first_curve_point: u32,
+    /// Global id of the first canonical corner the kernel evaluates from its owner's points
+    /// (up to `first_curve_point`).
+    pub first_regular_corner: u32,
     /// Per canonical corner: `[frame-wide patch id, corner]` of its owner.
     pub corner_owners: Vec<[u32; 2]>,
 }
@@ -200,6 +204,11 @@ impl GpuAdaptive {
     /// The curves' inner points, which the stencil kernel's last dispatches compute.
     pub fn curve_points(&self) -> u32 {
         2 * self.curves.len() as u32
+    }
+
+    /// The canonical corners the kernel evaluates from their owners' points (after the blocks).
+    pub fn regular_corners(&self) -> u32 {
+        self.first_curve_point - self.first_regular_corner
     }
 
     pub fn new(plan: &AdaptivePlan) -> Result<GpuAdaptive, LayoutError> {
@@ -250,16 +259,26 @@ impl GpuAdaptive {
             }
             next = block.first_vertex + rows;
         }
-        // The curves' inner points follow the blocks, two per curve in curve order: the kernel
+        // Then the canonical corners of regular patches (computed from their owner's
+        // 3×3 points), then the curves' inner points, two per curve in curve order: the kernel
         // writes point `i` to `curves[i / 2][1 + i % 2]`, so those must be exactly that run of
         // the buffer (no two curves write one vertex, nothing else is overwritten).
-        if next != plan.first_curve_point {
+        if next != plan.first_regular_corner || plan.first_regular_corner < plan.first_corner {
             return Err(LayoutError::Index {
-                what: "first curve point",
-                index: plan.first_curve_point as u64,
+                what: "first regular corner",
+                index: plan.first_regular_corner as u64,
                 len: next as u64,
             });
         }
+        let regular_corners = plan
+            .first_curve_point
+            .checked_sub(plan.first_regular_corner)
+            .ok_or(LayoutError::Index {
+                what: "first curve point",
+                index: plan.first_curve_point as u64,
+                len: plan.first_regular_corner as u64,
+            })?;
+        let next = plan.first_curve_point;
         for (c, curve) in plan.curves.iter().enumerate() {
             let first = next as u64 + 2 * c as u64;
             if curve[1] as u64 != first || curve[2] as u64 != first + 1 {
@@ -379,6 +398,37 @@ impl GpuAdaptive {
             check("corner owner corner", c as u64, 8)?;
             corner_owners.push([frame_id[pi as usize], c]);
         }
+        // The kernel evaluates corner `first_regular_corner + i` from the 3×3 points around
+        // corner `c` of its owner, a regular patch whose points (phantoms included) all come earlier.
+        // The canonical corners are one run up to the curve points: rows, then regular ones.
+        if (plan.first_regular_corner - plan.first_corner) as u64 + regular_corners as u64
+            != plan.corner_owners.len() as u64
+        {
+            return Err(LayoutError::Index {
+                what: "regular corner owners",
+                index: plan.first_curve_point as u64,
+                len: plan.first_corner as u64 + plan.corner_owners.len() as u64,
+            });
+        }
+        for &[pi, c] in
+            &plan.corner_owners[(plan.first_regular_corner - plan.first_corner) as usize..]
+        {
+            let owner = &plan.patches[pi as usize];
+            if owner.kind != PatchKind::Regular || c >= 4 {
+                return Err(LayoutError::Index {
+                    what: "regular corner owner",
+                    index: pi as u64,
+                    len: plan.patches.len() as u64,
+                });
+            }
+            for &cp in &owner.control_points {
+                check(
+                    "regular corner point",
+                    cp as u64,
+                    plan.first_regular_corner as u64,
+                )?;
+            }
+        }
         // The TES reads `corner_owners[end - first_corner]` at every curve end.
         for c in &plan.curves {
             for v in [c[0], c[3]] {
@@ -396,6 +446,7 @@ impl GpuAdaptive {
         )?;
         Ok(GpuAdaptive {
             first_curve_point: plan.first_curve_point,
+            first_regular_corner: plan.first_regular_corner,
             curve_owners,
             first_corner: plan.first_corner,
             corner_owners,

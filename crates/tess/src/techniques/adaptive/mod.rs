@@ -8,8 +8,9 @@
 //!    and canonical boundary curves.
 //! 2. **Every frame (GPU):** the stencil kernel (`glsl/adaptive/stencil.comp`) copies the base
 //!    positions and applies one block per dispatch (an animated base costs one upload of its
-//!    positions), then evaluates each canonical curve's two inner points from its owner
-//!    patch's control points (no stencil rows: a fixed combination per patch kind and edge);
+//!    positions), then evaluates the canonical corners of regular patches and each
+//!    canonical curve's two inner points from their owner patches' control points (no stencil
+//!    rows: a fixed combination per patch kind and corner or edge);
 //!    then one draw per patch kind, one control point per patch.
 //! 3. **Crack-free by construction:** every edge level comes from the edge's canonical
 //!    curve(s) only, a coarse transition edge gets twice its fine halves' level (the seed's
@@ -48,8 +49,9 @@ use crate::gpu::bindings::{
     ADAPTIVE_OPTION_CANONICAL_NORMALS, ADAPTIVE_OPTION_DISPLACE, ADAPTIVE_OPTION_HEIGHT_MAP,
     ADAPTIVE_OPTION_REPARAM, ADAPTIVE_OPTION_SHOW_PARAM_ERROR, ADAPTIVE_OPTION_SHOW_PARAM_SHIFT,
     ADAPTIVE_OPTION_TEXTURE, ADAPTIVE_PARAM_ERROR_BINDING, ADAPTIVE_PARAM_ERROR_SIDE,
-    ADAPTIVE_REPARAM_BINDING, ADAPTIVE_STENCIL_MODE_BASE, ADAPTIVE_STENCIL_MODE_CURVES,
-    ADAPTIVE_STENCIL_MODE_ROWS, ADAPTIVE_SURFACES_BINDING, ADAPTIVE_TEXTURE_BINDING,
+    ADAPTIVE_REPARAM_BINDING, ADAPTIVE_STENCIL_MODE_BASE, ADAPTIVE_STENCIL_MODE_CORNERS,
+    ADAPTIVE_STENCIL_MODE_CURVES, ADAPTIVE_STENCIL_MODE_ROWS, ADAPTIVE_SURFACES_BINDING,
+    ADAPTIVE_TEXTURE_BINDING,
 };
 use crate::gpu::AdaptivePush;
 use crate::shaders::{self, Stage, Variant};
@@ -233,6 +235,12 @@ fn plan_pre_pass(
             );
         }
     }
+    let corners_from = g.first_regular_corner - g.first_corner;
+    split(
+        ADAPTIVE_STENCIL_MODE_CORNERS,
+        corners_from..corners_from + g.regular_corners(),
+        0,
+    );
     split(ADAPTIVE_STENCIL_MODE_CURVES, 0..g.curve_points(), 0);
     Ok((steps, chunks.into_iter().map(|c| c.windows).collect()))
 }
@@ -900,6 +908,7 @@ impl Technique for Adaptive {
                 base_count: self.gpu.num_base_vertices,
                 row_base: rows.start,
                 term_base: terms.start,
+                first_corner: self.gpu.first_corner,
                 ..Default::default()
             };
             enc.push_constants(&push)?;
