@@ -148,13 +148,15 @@ fn adaptive_under_a_small_storage_range_matches_the_whole_buffer_run() {
     // The smallest range that still holds every buffer bound whole, rounded up to 256 bytes.
     let cap = whole.div_ceil(256) * 256;
     println!("largest whole buffer {whole} B, stencil terms {terms} B, cap {cap} B");
+    // The rows are 1.8 times the largest buffer bound whole (the vertices) since the regular
+    // corners and the curve points have none; no shape in tests/data has over 2.2.
     assert!(
-        terms > 3 * cap,
+        2 * terms > 3 * cap,
         "the terms ({terms} B) need several windows of {cap} B"
     );
     let (image_w, capture_w, chunks_w, _) = adaptive_run(Some(cap as u32), &mesh, &params);
     println!("chunks under a {cap} B range: {chunks_w:?} (uncapped {chunks:?})");
-    assert!(chunks_w.1 > 3 && chunks_w.0 > chunks.0, "{chunks_w:?}");
+    assert!(chunks_w.1 >= 2 && chunks_w.0 > chunks.0, "{chunks_w:?}");
     assert!(image.iter().any(|&b| b != 0), "something is drawn");
     assert!(image == image_w, "images differ");
     assert_eq!(capture.len(), capture_w.len());
@@ -344,8 +346,10 @@ fn one_million_faces_through_every_technique() {
                 );
             }
         }
-        // Adaptive on the 1M-quad grid: its stencil terms exceed the range (several window
-        // sets); the vertex and patch buffers are bound whole.
+        // Adaptive on the 1M-quad grid: the vertex and patch buffers are bound whole. Its
+        // stencil terms (276 KB: the refinement around its four corners) fit the range since
+        // its regular corners and curve points have no rows (they were 264 MB, two window
+        // sets); windows are checked under a small range above and in the pre-pass's test.
         let t = std::time::Instant::now();
         let surf = Adaptive::new(
             &mut ctx,
@@ -373,9 +377,11 @@ fn one_million_faces_through_every_technique() {
         let clear = &image.pixels[..4];
         let lit = image.pixels.chunks_exact(4).filter(|p| p != &clear).count();
         assert!(lit > 64 * 48 / 8, "adaptive: the grid covers {lit} pixels");
-        assert!(
+        let terms = surf.gpu.stencil_terms.len() as u64 * 8;
+        assert_eq!(
             chunks.1 > 1,
-            "the stencil terms exceed 128 MiB: several window sets"
+            terms > 128 << 20,
+            "several window sets exactly when the stencil terms exceed 128 MiB"
         );
         drop(surf);
         // Adaptive on the 1M-triangle grid (every vertex extraordinary under Catmull-Clark):

@@ -20,7 +20,8 @@
 //!    under every factor policy, across transitions and end caps.
 //!
 //! 4. **Beyond the storage range:** a block whose stencil terms (or row offsets) exceed
-//!    `maxStorageBufferRange` (a 1M-quad grid's terms are 264 MB; lavapipe allows 128 MiB)
+//!    `maxStorageBufferRange` (lavapipe allows 128 MiB; a 1M-quad grid's terms were 264 MB
+//!    before its regular corners and curve points were evaluated from their patches)
 //!    runs as several dispatches, chunks of rows planned by `techniques::windows`: a row's
 //!    terms are one contiguous run of the term buffer, so each chunk binds only its windows of
 //!    the offsets and the terms and the kernel subtracts the window bases (push constants).
