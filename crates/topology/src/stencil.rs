@@ -215,7 +215,9 @@ where
     let threads = rayon::current_num_threads().max(1);
     let num_parent = parent.map_or(num_sources, StencilTable::len);
     let blocks = n.div_ceil(BLOCK_ROWS).max(1);
-    let per_round = threads * 2;
+    // Two blocks per thread balance the load; one thread needs one block at a time (each
+    // block in flight holds a scratch accumulator the size of the parent level).
+    let per_round = if threads == 1 { 1 } else { threads * 2 };
     let pool = std::sync::Mutex::new(Vec::<Scratch>::new());
     let new_scratch = || Scratch {
         mask: (kind == RowKind::Raw).then(|| Dense::new(num_parent)),

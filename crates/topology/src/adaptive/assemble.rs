@@ -180,78 +180,88 @@ pub(super) fn assemble(
                     || (l == 0 && tri[f])
             })
             .collect();
-        // An indexed collect writes the drafts in place (no per-face option, no list merge).
-        let found: Vec<Result<Draft, TopologyError>> = candidates
-            .into_par_iter()
-            .with_min_len(256)
-            .map(|f| {
-                if l == 0 && tri[f] {
-                    return triangle_draft(mesh, &levels, f);
+        // An indexed extend writes the drafts in place, straight into the plan's list (no
+        // per-face option, no list merge, no second list to copy: on catmark_car that copy
+        // was 5.8 MB of fresh pages). A failing face leaves a placeholder and its error; the
+        // first failing face in order is reported, whatever the thread count.
+        let first_error = std::sync::Mutex::new(None::<(usize, TopologyError)>);
+        let draft = |f: usize| -> Result<Draft, TopologyError> {
+            if l == 0 && tri[f] {
+                return triangle_draft(mesh, &levels, f);
+            }
+            let irregular = lvl
+                .t()
+                .face_vertices(f)
+                .iter()
+                .any(|&v| lvl.irregular[v as usize]);
+            if irregular && !is_last {
+                return Err(TopologyError::AdaptivePatch {
+                    level: l as u32,
+                    face: f,
+                });
+            }
+            let (base_face, sub_face, origin, size, shift) = frame(&levels, l, f);
+            let mut d = Draft {
+                level: l as u8,
+                face: f as u32,
+                shift,
+                kind: PatchKind::Regular,
+                acc: false,
+                boundary_mask: 0,
+                grid: None,
+                gregory: None,
+                base_face,
+                sub_face,
+                origin,
+                size,
+            };
+            if irregular {
+                d.kind = match opts.end_cap {
+                    EndCap::Gregory => PatchKind::Gregory,
+                    EndCap::Bilinear => PatchKind::Bilinear,
+                };
+                if d.kind == PatchKind::Gregory {
+                    d.gregory = Some(Box::new(
+                        match acc.then(|| acc_points(mesh, lvl, f, shift)) {
+                            Some(Ok(points)) => {
+                                d.acc = true;
+                                points
+                            }
+                            _ => gregory_points(mesh, lvl, f, shift)?,
+                        },
+                    ));
                 }
-                let irregular = lvl
-                    .t()
-                    .face_vertices(f)
-                    .iter()
-                    .any(|&v| lvl.irregular[v as usize]);
-                if irregular && !is_last {
-                    return Err(TopologyError::AdaptivePatch {
+                // The end cap handles its sharp edges itself; the mask says which.
+                let (_, fe) = rotated(lvl.t(), f, shift);
+                for (p, &e) in fe.iter().enumerate() {
+                    if lvl.sharp_edge(e as usize) {
+                        d.boundary_mask |= 1 << p;
+                    }
+                }
+            } else {
+                let (grid, mask) =
+                    gather_regular(lvl, f, shift).ok_or(TopologyError::AdaptivePatch {
                         level: l as u32,
                         face: f,
-                    });
-                }
-                let (base_face, sub_face, origin, size, shift) = frame(&levels, l, f);
-                let mut d = Draft {
-                    level: l as u8,
-                    face: f as u32,
-                    shift,
-                    kind: PatchKind::Regular,
-                    acc: false,
-                    boundary_mask: 0,
-                    grid: None,
-                    gregory: None,
-                    base_face,
-                    sub_face,
-                    origin,
-                    size,
-                };
-                if irregular {
-                    d.kind = match opts.end_cap {
-                        EndCap::Gregory => PatchKind::Gregory,
-                        EndCap::Bilinear => PatchKind::Bilinear,
-                    };
-                    if d.kind == PatchKind::Gregory {
-                        d.gregory = Some(Box::new(
-                            match acc.then(|| acc_points(mesh, lvl, f, shift)) {
-                                Some(Ok(points)) => {
-                                    d.acc = true;
-                                    points
-                                }
-                                _ => gregory_points(mesh, lvl, f, shift)?,
-                            },
-                        ));
+                    })?;
+                d.grid = Some(grid);
+                d.boundary_mask = mask;
+            }
+            Ok(d)
+        };
+        drafts.reserve(candidates.len());
+        drafts.par_extend(candidates.into_par_iter().with_min_len(256).map(|f| {
+            draft(f).unwrap_or_else(|e| {
+                if let Ok(mut first) = first_error.lock() {
+                    if first.as_ref().is_none_or(|(g, _)| f < *g) {
+                        *first = Some((f, e));
                     }
-                    // The end cap handles its sharp edges itself; the mask says which.
-                    let (_, fe) = rotated(lvl.t(), f, shift);
-                    for (p, &e) in fe.iter().enumerate() {
-                        if lvl.sharp_edge(e as usize) {
-                            d.boundary_mask |= 1 << p;
-                        }
-                    }
-                } else {
-                    let (grid, mask) =
-                        gather_regular(lvl, f, shift).ok_or(TopologyError::AdaptivePatch {
-                            level: l as u32,
-                            face: f,
-                        })?;
-                    d.grid = Some(grid);
-                    d.boundary_mask = mask;
                 }
-                Ok(d)
+                Draft::placeholder()
             })
-            .collect();
-        drafts.reserve(found.len());
-        for d in found {
-            drafts.push(d?);
+        }));
+        if let Some((_, e)) = first_error.into_inner().ok().flatten() {
+            return Err(e);
         }
     }
 

@@ -115,6 +115,26 @@ pub(super) struct Draft {
     pub(super) size: f64,
 }
 
+impl Draft {
+    /// What a face that failed leaves in the list until its error is returned.
+    pub(super) fn placeholder() -> Draft {
+        Draft {
+            level: 0,
+            face: INVALID,
+            shift: 0,
+            kind: PatchKind::Bilinear,
+            acc: false,
+            boundary_mask: 0,
+            grid: None,
+            gregory: None,
+            base_face: INVALID,
+            sub_face: 0,
+            origin: [0.0; 2],
+            size: 0.0,
+        }
+    }
+}
+
 /// Base face, sub-face, origin, size and corner shift of face `f` of level `l`.
 pub(super) fn frame(levels: &[Lvl], l: usize, f: usize) -> (u32, u8, [f64; 2], f64, u8) {
     let mut chain = [0u8; 16];
