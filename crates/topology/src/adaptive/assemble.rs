@@ -940,7 +940,10 @@ mod tests {
         {
             patches += 1;
             for &id in &p.control_points {
-                terms += if id >= first {
+                terms += if id >= plan.first_regular_corner {
+                    // A corner evaluated from its regular owner: the 3×3 mask.
+                    9
+                } else if id >= first {
                     plan.local_points
                         .table
                         .stencil((id - first) as usize)
