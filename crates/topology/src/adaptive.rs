@@ -60,14 +60,15 @@
 //!   B-spline's); a bilinear end cap is the Coons patch of its four curves.
 //! * **One global vertex buffer.** Base vertices first, then one [`StencilBlock`] per level (its
 //!   rows read only the previous level), then one block of local points (phantoms, Gregory
-//!   points, canonical corners) that reads only refined vertices, so each block can run as one
-//!   parallel kernel; then the curves' inner points, two per curve, which no stencil computes:
-//!   each is a fixed combination of its owner patch's control points
-//!   ([`AdaptivePlan::curve_inner_point`]), which the device evaluates per curve every frame.
-//!   As stencil rows they were a third of the local rows and an eighth of catmark_car's plan
-//!   (building, sorting and copying 173,586 rows). Local points are not shared between
-//!   patches except the canonical corners and curves (two boundary patches each have their
-//!   own phantoms).
+//!   points, the canonical corners first met on an end cap) that reads only refined vertices,
+//!   so each block can run as one parallel kernel. Then two runs of points that no stencil
+//!   computes, each a fixed combination of its owner patch's control points, which the device
+//!   evaluates every frame: the canonical corners first met on a regular patch
+//!   ([`AdaptivePlan::regular_corner_point`]), then the curves' inner points, two per curve
+//!   ([`AdaptivePlan::curve_inner_point`]). Dropping their stencil rows made most of the
+//!   drop of catmark_car's plan from 1,444 M to 1,086 M instructions (docs/benchmarks.md,
+//!   session 22). Local points are not shared between patches except the canonical corners
+//!   and curves (two boundary patches each have their own phantoms).
 //! * **Size bound.** Every vertex of a triangle mesh is extraordinary under Catmull-Clark (and
 //!   so is every face centre of level 1), so isolation refines nearly everything at every
 //!   level: a 1M-triangle grid at isolation 4 is tens of millions of refined faces and
@@ -345,13 +346,14 @@ pub struct AdaptivePlan {
     pub num_vertices: u32,
     /// Refinement levels 1..=isolation, in order.
     pub steps: Vec<StencilBlock>,
-    /// Phantom points, Gregory points and canonical corners (the last block).
+    /// Phantom points, Gregory points and the canonical corners first met on an end cap (the
+    /// last block).
     pub local_points: StencilBlock,
     pub patches: Vec<AdaptivePatch>,
     /// Canonical boundary curves: cubic Bézier control points (global ids).
     pub curves: Vec<[u32; 4]>,
-    /// Global id of curve 0's first inner point. The inner points come after every stencil
-    /// block, two per curve in curve order (`curves[c][1] = first_curve_point + 2c`), and no
+    /// Global id of curve 0's first inner point. The inner points come last, after the
+    /// regular corners, two per curve in curve order (`curves[c][1] = first_curve_point + 2c`), and no
     /// stencil rows compute them: [`AdaptivePlan::curve_inner_point`] does, from the owner's
     /// control points, as the device does every frame.
     pub first_curve_point: u32,
@@ -503,7 +505,8 @@ impl AdaptivePlan {
     /// in `verts` (which must hold every vertex before `first_regular_corner`): the smooth
     /// valence-4 limit mask over the owner's 3×3 points around that corner, summed as offsets
     /// from the corner's own point. With phantoms across a boundary or crease it is the
-    /// crease (or corner) limit rule, exactly: the B-spline's value at the patch corner. `glsl/adaptive/stencil.comp` (mode 3) computes the same.
+    /// crease (or corner) limit rule, exactly: the B-spline's value at the patch corner.
+    /// `glsl/adaptive/stencil.comp` (mode 3) computes the same.
     pub fn regular_corner_point(&self, verts: &[[f64; 3]], id: u32) -> [f64; 3] {
         let [pi, corner] = self.corner_owners[(id - self.first_corner) as usize];
         let pa = &self.patches[pi as usize];

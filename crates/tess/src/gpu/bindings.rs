@@ -103,11 +103,11 @@ gpu_constants! {
     ADAPTIVE_SET = 1;
     /// Base positions (three floats per base vertex), one buffer per frame slot; rewritten per frame when animated.
     ADAPTIVE_BASE_POSITIONS_BINDING = 0;
-    /// CSR offsets of the stencil of every refined vertex up to the curve points (levels, then local points), over the global vertex buffer.
+    /// CSR offsets of the stencil of every refined vertex up to the regular corners (levels, then local points), over the global vertex buffer.
     ADAPTIVE_STENCIL_OFFSETS_BINDING = 1;
     /// Stencil terms (`StencilTerm`: global vertex, weight).
     ADAPTIVE_STENCIL_TERMS_BINDING = 2;
-    /// The global vertex buffer (`vec4`): base, level 1..L, local points, curve points; written by `stencil.comp`.
+    /// The global vertex buffer (`vec4`): base, level 1..L, local points, regular corners, curve points; written by `stencil.comp`.
     ADAPTIVE_VERTICES_BINDING = 3;
     /// One `AdaptivePatch` record per patch, in frame-wide patch order.
     ADAPTIVE_PATCHES_BINDING = 4;

@@ -646,7 +646,7 @@ pub(super) fn assemble(
             }
         })
         .collect();
-    // The curves' inner points follow the local points: two per curve, in curve order, which
+    // The curves' inner points follow the regular corners: two per curve, in curve order, which
     // the device computes from their owners' control points every frame (no stencil rows).
     let first_curve_point = first_regular_corner + regular_corners;
     for (ci, c) in curves.iter_mut().enumerate() {

@@ -175,7 +175,8 @@ pub struct GpuAdaptive {
     pub curve_owners: Vec<CurveOwner>,
     /// Global id of the first canonical corner.
     pub first_corner: u32,
-    /// Global id of curve 0's first inner point (two per curve follow, after every block).
+    /// Global id of curve 0's first inner point (two per curve follow, after the blocks and
+    /// the regular corners).
     pub first_curve_point: u32,
     /// Global id of the first canonical corner the kernel evaluates from its owner's points
     /// (up to `first_curve_point`).
