@@ -174,13 +174,11 @@ impl Dense {
     }
 }
 
-/// Per-thread scratch of [`compose_rows`], reused across rounds: accumulators and the output
-/// of the block last computed with it.
+/// Per-thread scratch of [`compose_rows`], reused across rounds: the accumulator and the
+/// output of the block last computed with it.
 struct Scratch {
-    mask: Option<Dense>,
     out: Option<Dense>,
     row: Vec<(u32, f64)>,
-    rows: std::ops::Range<usize>,
     sizes: Vec<u32>,
     idx: Vec<u32>,
     wts: Vec<f64>,
@@ -213,17 +211,10 @@ where
         "too many stencils for 32-bit offsets"
     );
     let threads = rayon::current_num_threads().max(1);
-    let num_parent = parent.map_or(num_sources, StencilTable::len);
-    let blocks = n.div_ceil(BLOCK_ROWS).max(1);
-    // Two blocks per thread balance the load; one thread needs one block at a time (each
-    // block in flight holds a scratch accumulator the size of the parent level).
-    let per_round = if threads == 1 { 1 } else { threads * 2 };
     let pool = std::sync::Mutex::new(Vec::<Scratch>::new());
     let new_scratch = || Scratch {
-        mask: (kind == RowKind::Raw).then(|| Dense::new(num_parent)),
         out: parent.map(|_| Dense::new(num_sources)),
         row: Vec::with_capacity(64),
-        rows: 0..0,
         sizes: Vec::with_capacity(BLOCK_ROWS),
         idx: Vec::new(),
         wts: Vec::new(),
@@ -236,35 +227,77 @@ where
     offsets.push(0);
     let mut indices: Vec<u32> = Vec::with_capacity(n * guess);
     let mut weights: Vec<f64> = Vec::with_capacity(n * guess);
-    let mut b0 = 0;
-    while b0 < blocks {
-        let b1 = (b0 + per_round).min(blocks);
-        let done: Vec<Scratch> = (b0..b1)
-            .into_par_iter()
-            .map(|b| {
-                let mut sc = pool
-                    .lock()
-                    .ok()
-                    .and_then(|mut p| p.pop())
-                    .unwrap_or_else(new_scratch);
-                let rows = (b * BLOCK_ROWS).min(n)..((b + 1) * BLOCK_ROWS).min(n);
-                fill_block(&mut sc, rows, parent, &gen);
-                sc
-            })
-            .collect();
-        for sc in &done {
-            let mut acc = indices.len() as u64;
-            offsets.extend(sc.sizes.iter().map(|&s| {
-                acc += s as u64;
-                acc as u32
-            }));
-            indices.extend_from_slice(&sc.idx);
-            weights.extend_from_slice(&sc.wts);
+    if threads == 1 {
+        // One thread: rows go straight into the final arrays (no block buffers to fill and
+        // copy; on catmark_car those were 8.6 MB of pages per plan).
+        let mut sc = new_scratch();
+        // Offsets past u32 wrap here; the length check after the loop rejects them.
+        fill_rows(
+            &mut sc.out,
+            &mut sc.row,
+            0..n,
+            kind,
+            parent,
+            &gen,
+            &mut indices,
+            &mut weights,
+            |_, end| offsets.push(end as u32),
+        );
+    } else {
+        let blocks = n.div_ceil(BLOCK_ROWS).max(1);
+        // Two blocks per thread balance the load (each block in flight holds a scratch
+        // accumulator the size of the parent's sources when composing).
+        let per_round = threads * 2;
+        let mut b0 = 0;
+        while b0 < blocks {
+            let b1 = (b0 + per_round).min(blocks);
+            let done: Vec<Scratch> = (b0..b1)
+                .into_par_iter()
+                .map(|b| {
+                    let mut sc = pool
+                        .lock()
+                        .ok()
+                        .and_then(|mut p| p.pop())
+                        .unwrap_or_else(new_scratch);
+                    let rows = (b * BLOCK_ROWS).min(n)..((b + 1) * BLOCK_ROWS).min(n);
+                    let Scratch {
+                        out,
+                        row,
+                        sizes,
+                        idx,
+                        wts,
+                    } = &mut sc;
+                    sizes.clear();
+                    idx.clear();
+                    wts.clear();
+                    fill_rows(
+                        out,
+                        row,
+                        rows,
+                        kind,
+                        parent,
+                        &gen,
+                        idx,
+                        wts,
+                        |start, end| sizes.push((end - start) as u32),
+                    );
+                    sc
+                })
+                .collect();
+            for sc in &done {
+                let mut acc = indices.len() as u64;
+                offsets.extend(sc.sizes.iter().map(|&s| {
+                    acc += s as u64;
+                    acc as u32
+                }));
+                indices.extend_from_slice(&sc.idx);
+                weights.extend_from_slice(&sc.wts);
+            }
+            if let Ok(mut p) = pool.lock() {
+                p.extend(done);
+            }
+            b0 = b1;
         }
-        if let Ok(mut p) = pool.lock() {
-            p.extend(done);
-        }
-        b0 = b1;
     }
     assert!(
         indices.len() < u32::MAX as usize,
@@ -282,44 +315,77 @@ where
     }
 }
 
-/// Compute rows `rows` into the scratch's output buffers.
-fn fill_block<G>(
-    sc: &mut Scratch,
+/// Merge a raw row in place: duplicates added up in the order they were generated (as an
+/// accumulator would), sorted by index, exact zeros dropped. Rows are short (a subdivision
+/// mask's few dozen entries over about a dozen distinct vertices), so the distinct entries are
+/// found by a linear scan of those already kept, not by scattering into an accumulator the
+/// size of the parent level (which, allocated per table, cost catmark_car thousands of fresh
+/// pages per plan).
+fn merge_raw(row: &mut Vec<(u32, f64)>) {
+    if row.len() > 64 {
+        // Long rows (high valence): a stable sort keeps the generation order of duplicates.
+        row.sort_by_key(|e| e.0);
+        let n = row.len();
+        let (mut i, mut k) = (0, 0);
+        while i < n {
+            let (j, mut w) = row[i];
+            i += 1;
+            while i < n && row[i].0 == j {
+                w += row[i].1;
+                i += 1;
+            }
+            row[k] = (j, w);
+            k += 1;
+        }
+        row.truncate(k);
+    } else {
+        let mut kept = 0;
+        for i in 0..row.len() {
+            let (j, w) = row[i];
+            match row[..kept].iter().position(|e| e.0 == j) {
+                Some(k) => row[k].1 += w,
+                None => {
+                    row[kept] = (j, w);
+                    kept += 1;
+                }
+            }
+        }
+        row.truncate(kept);
+        for i in 1..row.len() {
+            let x = row[i];
+            let mut j = i;
+            while j > 0 && row[j - 1].0 > x.0 {
+                row[j] = row[j - 1];
+                j -= 1;
+            }
+            row[j] = x;
+        }
+    }
+    row.retain(|e| e.1 != 0.0);
+}
+
+/// Compute rows `rows`, appending their entries to `idx` / `wts`; `end_row(start, end)` is told
+/// each row's entry range.
+#[allow(clippy::too_many_arguments)]
+fn fill_rows<G>(
+    out: &mut Option<Dense>,
+    row: &mut Vec<(u32, f64)>,
     rows: std::ops::Range<usize>,
+    kind: RowKind,
     parent: Option<&StencilTable>,
     gen: &G,
+    idx: &mut Vec<u32>,
+    wts: &mut Vec<f64>,
+    mut end_row: impl FnMut(usize, usize),
 ) where
     G: Fn(usize, &mut Vec<(u32, f64)>) + Sync,
 {
-    let Scratch {
-        mask,
-        out,
-        row,
-        sizes,
-        idx,
-        wts,
-        ..
-    } = sc;
-    sizes.clear();
-    idx.clear();
-    wts.clear();
-    for i in rows.clone() {
+    for i in rows {
         let tag = i as u32 + 1;
         row.clear();
         gen(i, row);
-        if let Some(m) = mask.as_mut() {
-            m.touched.clear();
-            for &(j, w) in row.iter() {
-                m.add(tag, j, w);
-            }
-            m.sort_touched();
-            row.clear();
-            row.extend(
-                m.touched
-                    .iter()
-                    .map(|&j| (j, m.slots[j as usize].1))
-                    .filter(|e| e.1 != 0.0),
-            );
+        if kind == RowKind::Raw {
+            merge_raw(row);
         }
         let before = idx.len();
         match (parent, out.as_mut()) {
@@ -341,15 +407,12 @@ fn fill_block<G>(
                 }
             }
             _ => {
-                for &(j, w) in row.iter() {
-                    idx.push(j);
-                    wts.push(w);
-                }
+                idx.extend(row.iter().map(|e| e.0));
+                wts.extend(row.iter().map(|e| e.1));
             }
         }
-        sizes.push((idx.len() - before) as u32);
+        end_row(before, idx.len());
     }
-    sc.rows = rows;
 }
 
 /// Build a table row by row in parallel. `gen` writes the (index, weight) pairs of row `i`;
