@@ -169,25 +169,49 @@ pub(super) fn assemble(
         check_gregory_size(mesh, &levels, iso, MAX_LOCAL_TERMS)?;
     }
 
-    // Patches, level by level (faces in parallel).
-    let mut drafts: Vec<Draft> = Vec::new();
-    for (l, lvl) in levels.iter().enumerate() {
+    // Patches, level by level (faces in parallel), written in place into the plan's list:
+    // a regular patch with its 16 gathered ids (`INVALID` where a phantom goes), an end cap
+    // with none yet (its rows wait in `gregory_rows`), each with its face and rotation in
+    // `sites`. The candidates of every level are counted first, so the list is allocated once.
+    let candidates: Vec<Vec<u32>> = levels
+        .iter()
+        .enumerate()
+        .map(|(l, lvl)| {
+            (0..lvl.t().num_faces() as u32)
+                .filter(|&f| {
+                    let f = f as usize;
+                    (lvl.complete[f] && !lvl.hole[f] && !lvl.selected[f] && !tri_child(l, f))
+                        || (l == 0 && tri[f])
+                })
+                .collect()
+        })
+        .collect();
+    let total: usize = candidates.iter().map(Vec::len).sum();
+    let mut patches: Vec<AdaptivePatch> = Vec::with_capacity(total);
+    let mut sites: Vec<PatchSite> = Vec::with_capacity(total);
+    // Gregory rows by patch index (end caps are a few percent of the patches).
+    let gregory_rows = std::sync::Mutex::new(Vec::<(u32, Box<PointRows>)>::new());
+    for (l, (lvl, faces)) in levels.iter().zip(&candidates).enumerate() {
         // End caps from the isolation level on (deeper levels follow semi-sharp features).
         let is_last = l >= iso;
-        let candidates: Vec<usize> = (0..lvl.t().num_faces())
-            .filter(|&f| {
-                (lvl.complete[f] && !lvl.hole[f] && !lvl.selected[f] && !tri_child(l, f))
-                    || (l == 0 && tri[f])
-            })
-            .collect();
-        // An indexed extend writes the drafts in place, straight into the plan's list (no
-        // per-face option, no list merge, no second list to copy: on catmark_car that copy
-        // was 5.8 MB of fresh pages). A failing face leaves a placeholder and its error; the
-        // first failing face in order is reported, whatever the thread count.
+        let first = patches.len();
+        // A failing face leaves a placeholder and its error; the first failing face in order
+        // is reported, whatever the thread count.
         let first_error = std::sync::Mutex::new(None::<(usize, TopologyError)>);
-        let draft = |f: usize| -> Result<Draft, TopologyError> {
+        let shifts: Vec<std::sync::atomic::AtomicU8> = faces
+            .iter()
+            .map(|_| std::sync::atomic::AtomicU8::new(0))
+            .collect();
+        let keep_rows = |k: usize, rows: PointRows| {
+            if let Ok(mut g) = gregory_rows.lock() {
+                g.push(((first + k) as u32, Box::new(rows)));
+            }
+        };
+        let patch = |k: usize, f: usize| -> Result<AdaptivePatch, TopologyError> {
             if l == 0 && tri[f] {
-                return triangle_draft(mesh, &levels, f);
+                let (patch, rows) = triangle_patch(mesh, &levels, f)?;
+                keep_rows(k, rows);
+                return Ok(patch);
             }
             let irregular = lvl
                 .t()
@@ -201,41 +225,49 @@ pub(super) fn assemble(
                 });
             }
             let (base_face, sub_face, origin, size, shift) = frame(&levels, l, f);
-            let mut d = Draft {
-                level: l as u8,
-                face: f as u32,
-                shift,
+            shifts[k].store(shift, std::sync::atomic::Ordering::Relaxed);
+            let mut patch = AdaptivePatch {
                 kind: PatchKind::Regular,
-                acc: false,
-                boundary_mask: 0,
-                grid: None,
-                gregory: None,
+                level: l as u8,
+                control_points: Vec::new(),
                 base_face,
                 sub_face,
                 origin,
                 size,
+                boundary_mask: 0,
+                transition_mask: 0,
+                edges: [BLANK_EDGE; 4],
+                reparam_valences: [0; 4],
+                tangent_valences: [0; 4],
             };
             if irregular {
-                d.kind = match opts.end_cap {
+                patch.kind = match opts.end_cap {
                     EndCap::Gregory => PatchKind::Gregory,
                     EndCap::Bilinear => PatchKind::Bilinear,
                 };
-                if d.kind == PatchKind::Gregory {
-                    d.gregory = Some(Box::new(
-                        match acc.then(|| acc_points(mesh, lvl, f, shift)) {
-                            Some(Ok(points)) => {
-                                d.acc = true;
-                                points
-                            }
-                            _ => gregory_points(mesh, lvl, f, shift)?,
-                        },
-                    ));
+                if patch.kind == PatchKind::Gregory {
+                    match acc.then(|| acc_points(mesh, lvl, f, shift)) {
+                        Some(Ok(points)) => {
+                            // An ACC-1 net: its corners' valences shade it; no
+                            // reparameterization is fitted to it.
+                            patch.tangent_valences = rotated(lvl.t(), f, shift)
+                                .0
+                                .map(|v| lvl.t().vertex_edges(v as usize).len().min(255) as u8);
+                            keep_rows(k, points);
+                        }
+                        _ => {
+                            patch.reparam_valences = reparam_valences(lvl, f, shift);
+                            keep_rows(k, gregory_points(mesh, lvl, f, shift)?);
+                        }
+                    }
+                } else {
+                    patch.control_points = vec![INVALID; 4];
                 }
                 // The end cap handles its sharp edges itself; the mask says which.
                 let (_, fe) = rotated(lvl.t(), f, shift);
                 for (p, &e) in fe.iter().enumerate() {
                     if lvl.sharp_edge(e as usize) {
-                        d.boundary_mask |= 1 << p;
+                        patch.boundary_mask |= 1 << p;
                     }
                 }
             } else {
@@ -244,66 +276,55 @@ pub(super) fn assemble(
                         level: l as u32,
                         face: f,
                     })?;
-                d.grid = Some(grid);
-                d.boundary_mask = mask;
+                patch.control_points = grid.to_vec();
+                patch.boundary_mask = mask;
             }
-            Ok(d)
+            Ok(patch)
         };
-        drafts.reserve(candidates.len());
-        drafts.par_extend(candidates.into_par_iter().with_min_len(256).map(|f| {
-            draft(f).unwrap_or_else(|e| {
-                if let Ok(mut first) = first_error.lock() {
-                    if first.as_ref().is_none_or(|(g, _)| f < *g) {
-                        *first = Some((f, e));
-                    }
-                }
-                Draft::placeholder()
-            })
-        }));
+        patches.par_extend(
+            faces
+                .par_iter()
+                .enumerate()
+                .with_min_len(256)
+                .map(|(k, &f)| {
+                    patch(k, f as usize).unwrap_or_else(|e| {
+                        if let Ok(mut first) = first_error.lock() {
+                            if first.as_ref().is_none_or(|(g, _)| (f as usize) < *g) {
+                                *first = Some((f as usize, e));
+                            }
+                        }
+                        placeholder_patch()
+                    })
+                }),
+        );
         if let Some((_, e)) = first_error.into_inner().ok().flatten() {
             return Err(e);
         }
+        sites.extend(faces.iter().zip(shifts).map(|(&face, shift)| PatchSite {
+            face,
+            shift: shift.into_inner(),
+        }));
     }
+    drop(candidates);
 
     // Local points (phantoms, Gregory points, canonical corners) come to 2 to 7 rows and 15 to
     // 29 terms per patch on every shape in tests/data (catmark_car 2.7 and 15.3, spot 2.8 and
     // 22.8): reserve once, with room to spare, instead of regrowing (a regrowth copies MBs).
     // Pages never written are never faulted in, so the spare room costs address space only.
-    locals.table.offsets.reserve(8 * drafts.len());
-    locals.table.indices.reserve(32 * drafts.len());
-    locals.table.weights.reserve(32 * drafts.len());
-    // Control points (phantoms and Gregory points become local points).
+    locals.table.offsets.reserve(8 * patches.len());
+    locals.table.indices.reserve(32 * patches.len());
+    locals.table.weights.reserve(32 * patches.len());
+    // Control points: phantoms and Gregory points become local points, numbered in patch
+    // order. Each end cap's rows are dropped once numbered.
+    let mut gregory_rows = gregory_rows.into_inner().unwrap_or_default();
+    gregory_rows.sort_unstable_by_key(|g| g.0);
+    let mut gregory_rows = gregory_rows.into_iter().peekable();
     let mut terms: Vec<(u32, f64)> = Vec::with_capacity(64);
-    let mut patches: Vec<AdaptivePatch> = Vec::with_capacity(drafts.len());
-    let blank_edge = PatchEdge {
-        kind: EdgeKind::Plain,
-        curves: [INVALID; 2],
-        reversed: [false; 2],
-    };
-    for d in &drafts {
-        let mut cps = Vec::with_capacity(20);
-        if let Some(ids) = d
-            .grid
-            .filter(|ids| d.boundary_mask == 0 && !ids.contains(&INVALID))
-        {
-            // Interior: the 16 gathered points are the net.
-            cps.extend_from_slice(&ids);
-        } else if let Some(ids) = &d.grid {
-            let grid = phantom_grid(ids, d.boundary_mask).ok_or(TopologyError::AdaptivePatch {
-                level: d.level as u32,
-                face: d.face as usize,
-            })?;
-            for c in grid.iter() {
-                if c.n == 1 && c.w[0] == 1.0 {
-                    cps.push(c.idx[0]);
-                } else {
-                    terms.clear();
-                    terms.extend((0..c.n as usize).map(|k| (c.idx[k], c.w[k])));
-                    cps.push(locals.push(&mut terms));
-                }
-            }
-        } else if let Some(g) = &d.gregory {
-            let corners = d.kind.corners();
+    for (pi, (patch, site)) in patches.iter_mut().zip(&sites).enumerate() {
+        let rows = gregory_rows.next_if(|g| g.0 == pi as u32).map(|g| g.1);
+        if let Some(g) = rows {
+            let corners = patch.kind.corners();
+            let mut cps = Vec::with_capacity(g.len());
             for (k, row) in g.iter().enumerate() {
                 if k < 5 * corners && k % 5 == 0 {
                     // P: the canonical corner, filled below.
@@ -314,37 +335,30 @@ pub(super) fn assemble(
                     cps.push(locals.push(&mut terms));
                 }
             }
-        } else {
-            cps.extend_from_slice(&[INVALID; 4]);
+            patch.control_points = cps;
+        } else if patch.kind == PatchKind::Regular
+            && (patch.boundary_mask != 0 || patch.control_points.contains(&INVALID))
+        {
+            let mut ids = [INVALID; 16];
+            ids.copy_from_slice(&patch.control_points);
+            let grid =
+                phantom_grid(&ids, patch.boundary_mask).ok_or(TopologyError::AdaptivePatch {
+                    level: patch.level as u32,
+                    face: site.face as usize,
+                })?;
+            for (slot, c) in patch.control_points.iter_mut().zip(grid.iter()) {
+                *slot = if c.n == 1 && c.w[0] == 1.0 {
+                    c.idx[0]
+                } else {
+                    terms.clear();
+                    terms.extend((0..c.n as usize).map(|k| (c.idx[k], c.w[k])));
+                    locals.push(&mut terms)
+                };
+            }
         }
-        patches.push(AdaptivePatch {
-            kind: d.kind,
-            level: d.level,
-            control_points: cps,
-            base_face: d.base_face,
-            sub_face: d.sub_face,
-            origin: d.origin,
-            size: d.size,
-            boundary_mask: d.boundary_mask,
-            transition_mask: 0,
-            edges: [blank_edge; 4],
-            reparam_valences: if d.kind == PatchKind::Gregory && !d.acc {
-                reparam_valences(&levels[d.level as usize], d.face as usize, d.shift)
-            } else {
-                [0; 4]
-            },
-            tangent_valences: if d.acc {
-                let lvl = &levels[d.level as usize];
-                rotated(lvl.t(), d.face as usize, d.shift)
-                    .0
-                    .map(|v| lvl.t().vertex_edges(v as usize).len().min(255) as u8)
-            } else {
-                [0; 4]
-            },
-        });
     }
 
-    // Canonical corners, at the coarsest level each is a patch corner (drafts are level-ordered).
+    // Canonical corners, at the coarsest level each is a patch corner (patches are level-ordered).
     // A corner first met on a regular patch is a regular vertex, and its limit point is the
     // B-spline patch's value at that corner: the smooth valence-4 mask over the patch's 3×3
     // points there, phantoms included (across a boundary or crease they reproduce the crease
@@ -357,11 +371,12 @@ pub(super) fn assemble(
     // Per provisional corner: its key, whether it is a regular corner, and its owner.
     let mut met: Vec<(u32, bool, [u32; 2])> = Vec::new();
     let mut needed: Vec<(u8, u32)> = Vec::new();
-    let mut corners: Vec<[u32; 4]> = Vec::with_capacity(drafts.len());
+    let mut corners: Vec<[u32; 4]> = Vec::with_capacity(patches.len());
     let first_canon = first_local + locals.table.len() as u32;
-    for (pi, (d, patch)) in drafts.iter().zip(patches.iter_mut()).enumerate() {
-        let lvl = &levels[d.level as usize];
-        let (fv, _, n) = draft_corners(lvl, d);
+    for (pi, (site, patch)) in sites.iter().zip(patches.iter_mut()).enumerate() {
+        let (lv, pk) = (patch.level, patch.kind);
+        let lvl = &levels[lv as usize];
+        let (fv, _, n) = patch_corners(lvl, pk, *site);
         let regular = patch.kind == PatchKind::Regular;
         let mut ids = [INVALID; 4];
         for (p, &v) in fv[..n].iter().enumerate() {
@@ -371,21 +386,21 @@ pub(super) fn assemble(
                 met.push((key as u32, regular, [pi as u32, p as u32]));
                 if regular {
                     // No row: evaluated from this patch.
-                } else if d.kind == PatchKind::GregoryTriangle {
+                } else if pk == PatchKind::GregoryTriangle {
                     // The limit mask needs an all-quad ring: the vertex's child's, at level 1.
-                    let maps = level1_maps(&levels, d.face)?;
+                    let maps = level1_maps(&levels, site.face)?;
                     needed.push((1, maps.vertex_child_vertex[v as usize]));
                 } else {
-                    needed.push((d.level, v));
+                    needed.push((lv, v));
                 }
             }
             ids[p] = canon[key];
         }
-        if d.kind == PatchKind::GregoryTriangle {
+        if pk == PatchKind::GregoryTriangle {
             // Its edges are level-1 halves (see `triangle_draft`): the edge midpoints are
             // canonical corners too; a triangle owning one says so by corner index 4 + edge.
-            let (_, fe, _) = draft_corners(lvl, d);
-            let maps = level1_maps(&levels, d.face)?;
+            let (_, fe, _) = patch_corners(lvl, pk, *site);
+            let maps = level1_maps(&levels, site.face)?;
             let l1 = &levels[1];
             for (p, &e) in fe[..3].iter().enumerate() {
                 let m = maps.edge_child_vertex[e as usize];
@@ -483,22 +498,23 @@ pub(super) fn assemble(
             }
             *slot
         };
-    for (pi, (d, patch)) in drafts.iter().zip(patches.iter_mut()).enumerate() {
-        let l = d.level as usize;
+    for (pi, (site, patch)) in sites.iter().zip(patches.iter_mut()).enumerate() {
+        let (lv, pk) = (patch.level, patch.kind);
+        let l = lv as usize;
         let lvl = &levels[l];
         let t = lvl.t();
-        let (fv, fe, n) = draft_corners(lvl, d);
-        let rank = kind_rank(d.kind);
+        let (fv, fe, n) = patch_corners(lvl, pk, *site);
+        let rank = kind_rank(pk);
         let unbalanced = || TopologyError::AdaptiveUnbalanced {
             level: l as u32,
-            face: d.face as usize,
+            face: site.face as usize,
         };
         for p in 0..n {
             let e = fe[p];
             let (a, b) = (fv[p], fv[(p + 1) % n]);
             let [x, y] = t.edge_faces(e as usize);
-            let g = if x == d.face { y } else { x };
-            let kind = if d.kind == PatchKind::GregoryTriangle {
+            let g = if x == site.face { y } else { x };
+            let kind = if pk == PatchKind::GregoryTriangle {
                 // Every edge of a triangle patch is the two level-1 curves of its children's
                 // Gregory points (a finer neighbour's, or its own on a boundary or next to
                 // another triangle): through the exact limit at the edge's midpoint.
@@ -549,7 +565,7 @@ pub(super) fn assemble(
                     } else {
                         return Err(unbalanced());
                     };
-                    let (cs, ce) = (canon_of(l, start, d.face)?, canon_of(l, end, d.face)?);
+                    let (cs, ce) = (canon_of(l, start, site.face)?, canon_of(l, end, site.face)?);
                     // The sibling's owner is its own fine patch; this one only holds the place
                     // (rank u8::MAX) until that patch registers it.
                     let sc = curve_id(l, sib, [cs, ce], (u8::MAX, pi as u32, 0, 0), &mut curves);
@@ -562,7 +578,7 @@ pub(super) fn assemble(
                     // put Gregory patches on the coarse side): its own edge is the finer
                     // approximation. A regular coarse patch keeps its rank: its halves are
                     // exactly the fine B-spline's.
-                    let rank = if d.kind == PatchKind::Regular {
+                    let rank = if pk == PatchKind::Regular {
                         rank
                     } else {
                         rank + HALF_RANK
@@ -587,7 +603,7 @@ pub(super) fn assemble(
                             }
                         }
                     }
-                    let cm = canon_of(l + 1, m, d.face)?;
+                    let cm = canon_of(l + 1, m, site.face)?;
                     let c0 = curve_id(
                         l + 1,
                         h0,
@@ -611,10 +627,9 @@ pub(super) fn assemble(
 
     if let Some(o) = owners.iter().find(|o| o.0 == u8::MAX) {
         // A sibling half no patch has as its own edge: a level jump next to this patch.
-        let d = &drafts[o.1 as usize];
         return Err(TopologyError::AdaptiveUnbalanced {
-            level: d.level as u32,
-            face: d.face as usize,
+            level: patches[o.1 as usize].level as u32,
+            face: sites[o.1 as usize].face as usize,
         });
     }
     // Who defines each curve's normals and texture coordinates (seamless displacement): the
@@ -735,25 +750,29 @@ fn level1_maps(levels: &[Lvl], face: u32) -> Result<&ChildMaps, TopologyError> {
         })
 }
 
-/// The corners and edges of a draft's face in patch order, and how many (3 for a triangle
+/// The corners and edges of a patch's face in patch order, and how many (3 for a triangle
 /// patch, whose face is never rotated).
-fn draft_corners(lvl: &Lvl, d: &Draft) -> ([u32; 4], [u32; 4], usize) {
-    if d.kind == PatchKind::GregoryTriangle {
+fn patch_corners(lvl: &Lvl, kind: PatchKind, site: PatchSite) -> ([u32; 4], [u32; 4], usize) {
+    if kind == PatchKind::GregoryTriangle {
         let t = lvl.t();
         let (fv, fe) = (
-            t.face_vertices(d.face as usize),
-            t.face_edge_list(d.face as usize),
+            t.face_vertices(site.face as usize),
+            t.face_edge_list(site.face as usize),
         );
         let pad = |x: &[u32]| [x[0], x[1], x[2], INVALID];
         return (pad(fv), pad(fe), 3);
     }
-    let (fv, fe) = rotated(lvl.t(), d.face as usize, d.shift);
+    let (fv, fe) = rotated(lvl.t(), site.face as usize, site.shift);
     (fv, fe, 4)
 }
 
 /// The Gregory triangle patch of level-0 triangle `f` ([`crate::gregory::gregory_triangle_from_children`]
 /// over its three level-1 children).
-fn triangle_draft(mesh: &ControlMesh, levels: &[Lvl], f: usize) -> Result<Draft, TopologyError> {
+fn triangle_patch(
+    mesh: &ControlMesh,
+    levels: &[Lvl],
+    f: usize,
+) -> Result<(AdaptivePatch, PointRows), TopologyError> {
     let maps = level1_maps(levels, f as u32)?;
     let l1 = &levels[1];
     let first = maps.face_first_child[f];
@@ -802,23 +821,24 @@ fn triangle_draft(mesh: &ControlMesh, levels: &[Lvl], f: usize) -> Result<Draft,
             boundary_mask |= 1 << p;
         }
     }
-    Ok(Draft {
-        level: 0,
-        face: f as u32,
-        shift: 0,
+    let patch = AdaptivePatch {
         kind: PatchKind::GregoryTriangle,
-        acc: false,
-        boundary_mask,
-        grid: None,
-        gregory: Some(Box::new(PointRows::from_stencils(
-            l1.base,
-            points.iter().chain(halves),
-        ))),
+        level: 0,
+        control_points: Vec::new(),
         base_face: f as u32,
         sub_face: 0,
         origin: [0.0, 0.0],
         size: 1.0,
-    })
+        boundary_mask,
+        transition_mask: 0,
+        edges: [BLANK_EDGE; 4],
+        reparam_valences: [0; 4],
+        tangent_valences: [0; 4],
+    };
+    Ok((
+        patch,
+        PointRows::from_stencils(l1.base, points.iter().chain(halves)),
+    ))
 }
 
 /// Gregory points of face `f` (global ids, patch corner order).

@@ -96,44 +96,38 @@ impl PointRows {
     }
 }
 
-/// A patch before local points are numbered.
-pub(super) struct Draft {
-    pub(super) level: u8,
+/// Where a patch's face sits, for the passes after the patch list is made: the face of its
+/// level, and the rotation from face corners to patch corners.
+#[derive(Clone, Copy)]
+pub(super) struct PatchSite {
     pub(super) face: u32,
     pub(super) shift: u8,
-    pub(super) kind: PatchKind,
-    /// An ACC-1 net stored as a Gregory patch (no reparameterization is fitted to it).
-    pub(super) acc: bool,
-    pub(super) boundary_mask: u8,
-    /// Regular: the 16 gathered ids (`INVALID` where a phantom goes).
-    pub(super) grid: Option<[u32; 16]>,
-    /// Gregory: 20 stencils over global ids, patch corner order.
-    pub(super) gregory: Option<Box<PointRows>>,
-    pub(super) base_face: u32,
-    pub(super) sub_face: u8,
-    pub(super) origin: [f64; 2],
-    pub(super) size: f64,
 }
 
-impl Draft {
-    /// What a face that failed leaves in the list until its error is returned.
-    pub(super) fn placeholder() -> Draft {
-        Draft {
-            level: 0,
-            face: INVALID,
-            shift: 0,
-            kind: PatchKind::Bilinear,
-            acc: false,
-            boundary_mask: 0,
-            grid: None,
-            gregory: None,
-            base_face: INVALID,
-            sub_face: 0,
-            origin: [0.0; 2],
-            size: 0.0,
-        }
+/// A patch whose face failed: its place in the list until the error is returned.
+pub(super) fn placeholder_patch() -> AdaptivePatch {
+    AdaptivePatch {
+        kind: PatchKind::Bilinear,
+        level: 0,
+        control_points: Vec::new(),
+        base_face: INVALID,
+        sub_face: 0,
+        origin: [0.0; 2],
+        size: 0.0,
+        boundary_mask: 0,
+        transition_mask: 0,
+        edges: [BLANK_EDGE; 4],
+        reparam_valences: [0; 4],
+        tangent_valences: [0; 4],
     }
 }
+
+/// An edge before the edge pass sets its kind and curves.
+pub(super) const BLANK_EDGE: PatchEdge = PatchEdge {
+    kind: EdgeKind::Plain,
+    curves: [INVALID; 2],
+    reversed: [false; 2],
+};
 
 /// Base face, sub-face, origin, size and corner shift of face `f` of level `l`.
 pub(super) fn frame(levels: &[Lvl], l: usize, f: usize) -> (u32, u8, [f64; 2], f64, u8) {
