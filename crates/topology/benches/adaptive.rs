@@ -6,9 +6,9 @@
 //! figures; `TESSERA_BENCH_FACES=1` prints the face counts per level instead (the seed's
 //! Fig. 5.2: regular, end caps, faces held, uniform).
 //!
-//! `TESSERA_BENCH_TIME=row,row,... [TESSERA_BENCH_REPS=n]` times the named rows outside
-//! criterion (one untimed warm-up run, then `n` timed runs, each printed in ms, the result
-//! dropped outside the timer), so a script can interleave them with OpenSubdiv's `far_perf`,
+//! `TESSERA_BENCH_TIME=row,row,... [TESSERA_BENCH_REPS=n] [TESSERA_BENCH_WARMUP=0]` times the
+//! named rows outside criterion (one untimed warm-up run unless `TESSERA_BENCH_WARMUP=0`, then
+//! `n` timed runs, each printed in ms, the result dropped outside the timer), so a script can interleave them with OpenSubdiv's `far_perf`,
 //! which prints one time per level and process. Rows: `<shape>_adaptive4`,
 //! `<shape>_adaptive4_follow_creases`, `<shape>_uniform3_stencils`, `<shape>_base_topology`
 //! (the base level alone, which `far_perf` builds outside its timers).
@@ -96,13 +96,18 @@ fn time_rows(rows: &str) {
         .ok()
         .and_then(|r| r.parse().ok())
         .unwrap_or(1);
+    // `TESSERA_BENCH_WARMUP=0`: no warm-up run, so the first timed run is cold, as each
+    // `far_perf` run is (fresh process: every page of the plan faulted in, caches cold).
+    let warm_up = std::env::var("TESSERA_BENCH_WARMUP").map_or(true, |w| w != "0");
     let shapes = shapes();
     for row in rows.split(',') {
         let (_, m) = shapes
             .iter()
             .find(|(name, _)| row.starts_with(&format!("{name}_")))
             .unwrap_or_else(|| panic!("no shape for row {row}"));
-        drop(run_row(row, m));
+        if warm_up {
+            drop(run_row(row, m));
+        }
         let mut ms = Vec::with_capacity(reps);
         for _ in 0..reps {
             let t = Instant::now();

@@ -174,9 +174,10 @@ impl Dense {
     }
 }
 
-/// Per-thread scratch of [`compose_rows`], reused across rounds: the accumulator and the
-/// output of the block last computed with it.
+/// Per-thread scratch of [`compose_rows`], reused across rounds: the accumulators (merging a
+/// raw row; composing with the parent) and the output of the block last computed with it.
 struct Scratch {
+    mask: Option<Dense>,
     out: Option<Dense>,
     row: Vec<(u32, f64)>,
     sizes: Vec<u32>,
@@ -213,6 +214,8 @@ where
     let threads = rayon::current_num_threads().max(1);
     let pool = std::sync::Mutex::new(Vec::<Scratch>::new());
     let new_scratch = || Scratch {
+        mask: (kind == RowKind::Raw)
+            .then(|| Dense::new(parent.map_or(num_sources, StencilTable::len))),
         out: parent.map(|_| Dense::new(num_sources)),
         row: Vec::with_capacity(64),
         sizes: Vec::with_capacity(BLOCK_ROWS),
@@ -233,10 +236,10 @@ where
         let mut sc = new_scratch();
         // Offsets past u32 wrap here; the length check after the loop rejects them.
         fill_rows(
+            &mut sc.mask,
             &mut sc.out,
             &mut sc.row,
             0..n,
-            kind,
             parent,
             &gen,
             &mut indices,
@@ -261,6 +264,7 @@ where
                         .unwrap_or_else(new_scratch);
                     let rows = (b * BLOCK_ROWS).min(n)..((b + 1) * BLOCK_ROWS).min(n);
                     let Scratch {
+                        mask,
                         out,
                         row,
                         sizes,
@@ -271,10 +275,10 @@ where
                     idx.clear();
                     wts.clear();
                     fill_rows(
+                        mask,
                         out,
                         row,
                         rows,
-                        kind,
                         parent,
                         &gen,
                         idx,
@@ -315,63 +319,14 @@ where
     }
 }
 
-/// Merge a raw row in place: duplicates added up in the order they were generated (as an
-/// accumulator would), sorted by index, exact zeros dropped. Rows are short (a subdivision
-/// mask's few dozen entries over about a dozen distinct vertices), so the distinct entries are
-/// found by a linear scan of those already kept, not by scattering into an accumulator the
-/// size of the parent level (which, allocated per table, cost catmark_car thousands of fresh
-/// pages per plan).
-fn merge_raw(row: &mut Vec<(u32, f64)>) {
-    if row.len() > 64 {
-        // Long rows (high valence): a stable sort keeps the generation order of duplicates.
-        row.sort_by_key(|e| e.0);
-        let n = row.len();
-        let (mut i, mut k) = (0, 0);
-        while i < n {
-            let (j, mut w) = row[i];
-            i += 1;
-            while i < n && row[i].0 == j {
-                w += row[i].1;
-                i += 1;
-            }
-            row[k] = (j, w);
-            k += 1;
-        }
-        row.truncate(k);
-    } else {
-        let mut kept = 0;
-        for i in 0..row.len() {
-            let (j, w) = row[i];
-            match row[..kept].iter().position(|e| e.0 == j) {
-                Some(k) => row[k].1 += w,
-                None => {
-                    row[kept] = (j, w);
-                    kept += 1;
-                }
-            }
-        }
-        row.truncate(kept);
-        for i in 1..row.len() {
-            let x = row[i];
-            let mut j = i;
-            while j > 0 && row[j - 1].0 > x.0 {
-                row[j] = row[j - 1];
-                j -= 1;
-            }
-            row[j] = x;
-        }
-    }
-    row.retain(|e| e.1 != 0.0);
-}
-
 /// Compute rows `rows`, appending their entries to `idx` / `wts`; `end_row(start, end)` is told
 /// each row's entry range.
 #[allow(clippy::too_many_arguments)]
 fn fill_rows<G>(
+    mask: &mut Option<Dense>,
     out: &mut Option<Dense>,
     row: &mut Vec<(u32, f64)>,
     rows: std::ops::Range<usize>,
-    kind: RowKind,
     parent: Option<&StencilTable>,
     gen: &G,
     idx: &mut Vec<u32>,
@@ -384,8 +339,19 @@ fn fill_rows<G>(
         let tag = i as u32 + 1;
         row.clear();
         gen(i, row);
-        if kind == RowKind::Raw {
-            merge_raw(row);
+        if let Some(m) = mask.as_mut() {
+            m.touched.clear();
+            for &(j, w) in row.iter() {
+                m.add(tag, j, w);
+            }
+            m.sort_touched();
+            row.clear();
+            row.extend(
+                m.touched
+                    .iter()
+                    .map(|&j| (j, m.slots[j as usize].1))
+                    .filter(|e| e.1 != 0.0),
+            );
         }
         let before = idx.len();
         match (parent, out.as_mut()) {
