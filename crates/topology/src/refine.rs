@@ -297,7 +297,7 @@ pub fn uniform_stencils(
             table.as_ref(),
             RowKind::Raw,
             num_sources,
-            |i, out| ctx.row(i, out),
+            |i, out| ctx.row_merged(i, out),
         );
         table = Some(next);
         if k + 1 < level {
@@ -382,7 +382,7 @@ pub fn refine_level(
         child_edge_sharpness: &edge_sharpness,
         child_vertex_sharpness: &vertex_sharpness[..nv],
     };
-    let step = build_rows(vertex_sharpness.len(), nv, |i, out| ctx.row(i, out));
+    let step = build_rows(vertex_sharpness.len(), nv, |i, out| ctx.row_merged(i, out));
     let topology = split(p, scheme);
     let positions = step.apply(&parent.positions);
     Ok((
@@ -650,7 +650,7 @@ pub fn refine_sparse(
             ChildOrigin::Edge(e) => nv + e as usize,
             ChildOrigin::Face(f) => nv + ne + f as usize,
         };
-        ctx.row(uniform_index, out)
+        ctx.row_merged(uniform_index, out)
     });
 
     // Child edges: the two halves of each refined edge, then the interior edges of each
@@ -1154,27 +1154,157 @@ impl MaskContext<'_> {
                 }
             }
             _ => {
-                let tri = |f: u32| p.face_vertices(f as usize).len() == 3;
-                let smooth_tris = self.options.triangle_subdivision == TriangleSubdivision::Smooth
-                    && faces.len() == 2
-                    && (tri(faces[0]) || tri(faces[1]));
-                let (vw, fw) = if smooth_tris {
-                    const TRI_EDGE_WEIGHT: f64 = 0.470;
-                    let f0 = if tri(faces[0]) { TRI_EDGE_WEIGHT } else { 0.25 };
-                    let f1 = if tri(faces[1]) { TRI_EDGE_WEIGHT } else { 0.25 };
-                    let fw = 0.5 * (f0 + f1);
-                    (0.5 * (1.0 - 2.0 * fw), fw)
-                } else if faces.len() == 2 {
-                    (0.25, 0.25)
-                } else {
-                    (0.25, 0.5 / faces.len() as f64)
-                };
+                let (vw, fw) = self.catmark_edge_weights(faces);
                 out.extend([(a, scale * vw), (b, scale * vw)]);
                 for &f in faces {
                     self.face_center(f as usize, scale * fw, out);
                 }
             }
         }
+    }
+
+    /// Catmull-Clark's smooth edge-point weights (each end, each face's centre) for an edge
+    /// between `faces` (one or two).
+    fn catmark_edge_weights(&self, faces: &[u32]) -> (f64, f64) {
+        let p = self.p;
+        let tri = |f: u32| p.face_vertices(f as usize).len() == 3;
+        let smooth_tris = self.options.triangle_subdivision == TriangleSubdivision::Smooth
+            && faces.len() == 2
+            && (tri(faces[0]) || tri(faces[1]));
+        if smooth_tris {
+            const TRI_EDGE_WEIGHT: f64 = 0.470;
+            let f0 = if tri(faces[0]) { TRI_EDGE_WEIGHT } else { 0.25 };
+            let f1 = if tri(faces[1]) { TRI_EDGE_WEIGHT } else { 0.25 };
+            let fw = 0.5 * (f0 + f1);
+            (0.5 * (1.0 - 2.0 * fw), fw)
+        } else if faces.len() == 2 {
+            (0.25, 0.25)
+        } else {
+            (0.25, 0.5 / faces.len() as f64)
+        }
+    }
+
+    /// [`MaskContext::row`], merged (indices ascending and distinct, no zero weight) for the
+    /// common Catmull-Clark rules (face points, smooth edge points, smooth vertex points), so
+    /// the row builder skips its accumulator; `true` then. Each index's contributions are
+    /// added in the order `row` lists them, as the accumulator adds them, so the weights are
+    /// bit-identical. Where the one-ring is not what the fast rule reads (a vertex repeated in
+    /// a ring, a long ring) the raw row is written instead, and `false` returned.
+    fn row_merged(&self, i: usize, out: &mut Vec<(u32, f64)>) -> bool {
+        let p = self.p;
+        let (nv, ne) = (p.num_vertices(), p.num_edges());
+        let merged = self.scheme == Scheme::CatmullClark
+            && if i < nv {
+                self.smooth_vertex_merged(i, out)
+            } else if i < nv + ne {
+                self.smooth_edge_merged(i - nv, out)
+            } else {
+                face_centre_merged(p.face_vertices(i - nv - ne), out)
+            };
+        if !merged {
+            out.clear();
+            self.row(i, out);
+        }
+        merged
+    }
+
+    /// The smooth (or dart) vertex point of a Catmull-Clark vertex, merged: the vertex, its
+    /// ring neighbours (an edge term, then each face's share) and the other corners of its
+    /// faces (one face's share each).
+    fn smooth_vertex_merged(&self, v: usize, out: &mut Vec<(u32, f64)>) -> bool {
+        const RING: usize = 16;
+        let p = self.p;
+        let edges = p.vertex_edges(v);
+        let k = edges.len();
+        if k == 0 || k > RING {
+            return false;
+        }
+        let sharp_count = edges
+            .iter()
+            .filter(|&&e| is_sharp(self.es[e as usize]))
+            .count();
+        if !matches!(
+            vertex_rule(self.vs[v], sharp_count),
+            Rule::Smooth | Rule::Dart
+        ) {
+            return false;
+        }
+        // As `smooth_vertex(v, 1.0)` computes them.
+        let scale = 1.0f64;
+        let n = k as f64;
+        let ew = 1.0 / (n * n);
+        let mut ring = [0u32; RING];
+        let mut sums = [0.0f64; RING];
+        for (j, &e) in edges.iter().enumerate() {
+            ring[j] = other_end(p, e, v);
+            sums[j] = scale * ew;
+        }
+        let ring = &ring[..k];
+        let mut centre = scale * (n - 2.0) / n;
+        out.push((v as u32, 0.0));
+        for &f in p.vertex_faces(v) {
+            let fv = p.face_vertices(f as usize);
+            let w = (scale * ew) / fv.len() as f64;
+            let Some(c) = fv.iter().position(|&x| x as usize == v) else {
+                return false;
+            };
+            let m = fv.len();
+            for (d, &x) in fv.iter().enumerate() {
+                let d = (d + m - c) % m;
+                if d == 0 {
+                    centre += w;
+                } else if d == 1 || d == m - 1 {
+                    match ring.iter().position(|&r| r == x) {
+                        Some(j) => sums[j] += w,
+                        None => return false,
+                    }
+                } else {
+                    out.push((x, w));
+                }
+            }
+        }
+        out[0].1 = centre;
+        out.extend(ring.iter().copied().zip(sums.iter().copied()));
+        sort_distinct(out)
+    }
+
+    /// The smooth edge point of a Catmull-Clark edge, merged: its ends (the edge term, then
+    /// each face's share) and the other corners of its faces.
+    fn smooth_edge_merged(&self, e: usize, out: &mut Vec<(u32, f64)>) -> bool {
+        let p = self.p;
+        if is_sharp(self.es[e]) {
+            return false;
+        }
+        let [a, b] = p.edge_verts[e];
+        let [f0, f1] = p.edge_faces[e];
+        let face_pair = [f0, f1];
+        let faces: &[u32] = if f1 == INVALID {
+            &face_pair[..1]
+        } else {
+            &face_pair[..]
+        };
+        // As `smooth_edge(e, 1.0)` computes them.
+        let scale = 1.0f64;
+        let (vw, fw) = self.catmark_edge_weights(faces);
+        let (mut sa, mut sb) = (scale * vw, scale * vw);
+        out.push((a, 0.0));
+        out.push((b, 0.0));
+        for &f in faces {
+            let fv = p.face_vertices(f as usize);
+            let w = (scale * fw) / fv.len() as f64;
+            for &x in fv {
+                if x == a {
+                    sa += w;
+                } else if x == b {
+                    sb += w;
+                } else {
+                    out.push((x, w));
+                }
+            }
+        }
+        out[0].1 = sa;
+        out[1].1 = sb;
+        sort_distinct(out)
     }
 
     fn vertex_vertex(&self, v: usize, out: &mut Vec<(u32, f64)>) {
@@ -1274,6 +1404,34 @@ pub(crate) fn loop_vertex_weights(n: usize) -> (f64, f64) {
     let beta = 0.25 * (2.0 * std::f64::consts::PI * inv).cos() + 0.375;
     let ew = (0.625 - beta * beta) * inv;
     (1.0 - ew * n as f64, ew)
+}
+
+/// A face point, merged: each corner once at `1 / n` (as `face_center(f, 1.0)`).
+fn face_centre_merged(fv: &[u32], out: &mut Vec<(u32, f64)>) -> bool {
+    let w = 1.0 / fv.len() as f64;
+    out.extend(fv.iter().map(|&v| (v, w)));
+    sort_distinct(out)
+}
+
+/// Sort a short row by index and drop exact zeros; `false` (the row is left as it is) if an
+/// index repeats, which the merged rules do not sum.
+fn sort_distinct(row: &mut Vec<(u32, f64)>) -> bool {
+    // Distinct indices make the unstable sort's order the only order; a repeat is found next
+    // to its twin and refused below, and the caller rebuilds the row raw.
+    row.sort_unstable_by_key(|e| e.0);
+    let mut kept = 0;
+    for i in 0..row.len() {
+        let e = row[i];
+        if i > 0 && row[i - 1].0 == e.0 {
+            return false;
+        }
+        if e.1 != 0.0 {
+            row[kept] = e;
+            kept += 1;
+        }
+    }
+    row.truncate(kept);
+    true
 }
 
 #[inline]
@@ -1382,6 +1540,7 @@ fn refine_doo_sabin(parent: &Level) -> Result<(Level, StencilTable), TopologyErr
             };
             out.push((v, w));
         }
+        false
     });
     let positions = step.apply(&parent.positions);
     let mesh = ControlMesh::from_polygons(positions.clone(), &faces);

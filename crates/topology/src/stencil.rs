@@ -113,6 +113,7 @@ impl StencilTable {
             |i, out| {
                 let (idx, w) = self.stencil(i);
                 out.extend(idx.iter().copied().zip(w.iter().copied()));
+                true
             },
         )
     }
@@ -205,7 +206,7 @@ pub(crate) fn compose_rows<G>(
     gen: G,
 ) -> StencilTable
 where
-    G: Fn(usize, &mut Vec<(u32, f64)>) + Sync,
+    G: Fn(usize, &mut Vec<(u32, f64)>) -> bool + Sync,
 {
     assert!(
         n < u32::MAX as usize,
@@ -333,13 +334,13 @@ fn fill_rows<G>(
     wts: &mut Vec<f64>,
     mut end_row: impl FnMut(usize, usize),
 ) where
-    G: Fn(usize, &mut Vec<(u32, f64)>) + Sync,
+    G: Fn(usize, &mut Vec<(u32, f64)>) -> bool + Sync,
 {
     for i in rows {
         let tag = i as u32 + 1;
         row.clear();
-        gen(i, row);
-        if let Some(m) = mask.as_mut() {
+        let merged = gen(i, row);
+        if let Some(m) = mask.as_mut().filter(|_| !merged) {
             m.touched.clear();
             for &(j, w) in row.iter() {
                 m.add(tag, j, w);
@@ -381,11 +382,12 @@ fn fill_rows<G>(
     }
 }
 
-/// Build a table row by row in parallel. `gen` writes the (index, weight) pairs of row `i`;
-/// they are sorted, merged and stripped of exact zeros here.
+/// Build a table row by row in parallel. `gen` writes the (index, weight) pairs of row `i`
+/// and returns whether they are merged already (indices ascending and distinct, no zero
+/// weight); if not, they are sorted, merged and stripped of exact zeros here.
 pub(crate) fn build_rows<G>(n: usize, num_sources: usize, gen: G) -> StencilTable
 where
-    G: Fn(usize, &mut Vec<(u32, f64)>) + Sync,
+    G: Fn(usize, &mut Vec<(u32, f64)>) -> bool + Sync,
 {
     compose_rows(n, None, RowKind::Raw, num_sources, gen)
 }
@@ -400,6 +402,7 @@ mod tests {
             out.push((i as u32, 0.5));
             out.push((i as u32 + 1, 0.25));
             out.push((i as u32 + 1, 0.25));
+            false
         });
         assert_eq!(t.stencil(1), (&[1u32, 2][..], &[0.5, 0.5][..]));
         let c = t.compose(&StencilTable::identity(4));
