@@ -1565,3 +1565,103 @@ fn refine_doo_sabin(parent: &Level) -> Result<(Level, StencilTable), TopologyErr
         step,
     ))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The raw row merged as the row builder's accumulator does: each index's terms summed in
+    /// the order the row lists them, indices ascending, exact zeros dropped.
+    fn reference_merge(raw: &[(u32, f64)]) -> Vec<(u32, f64)> {
+        let mut sums: Vec<(u32, f64)> = Vec::new();
+        for &(j, w) in raw {
+            match sums.iter_mut().find(|e| e.0 == j) {
+                Some(e) => e.1 += w,
+                None => sums.push((j, w)),
+            }
+        }
+        sums.sort_by_key(|e| e.0);
+        sums.retain(|e| e.1 != 0.0);
+        sums
+    }
+
+    /// Every child row of two levels: where `row_merged` answers merged, its row is the raw
+    /// row's merge, bit for bit; where it does not, it wrote the raw row. Returns how many
+    /// rows took each path.
+    fn check_merged_rows(mesh: &ControlMesh) -> (usize, usize) {
+        let (mut fast, mut raw) = (0, 0);
+        let mut level = Level::from_mesh(mesh, Scheme::CatmullClark).unwrap();
+        for _ in 0..2 {
+            let p = &level.topology;
+            let (edge_sharpness, vertex_sharpness) = child_sharpness(
+                p,
+                &level.edge_sharpness,
+                &level.vertex_sharpness,
+                Scheme::CatmullClark,
+                &mesh.options,
+            );
+            let ctx = MaskContext {
+                p,
+                es: &level.edge_sharpness,
+                vs: &level.vertex_sharpness,
+                scheme: Scheme::CatmullClark,
+                options: &mesh.options,
+                child_edge_sharpness: &edge_sharpness,
+                child_vertex_sharpness: &vertex_sharpness[..p.num_vertices()],
+            };
+            let (mut a, mut b) = (Vec::new(), Vec::new());
+            for i in 0..vertex_sharpness.len() {
+                a.clear();
+                b.clear();
+                ctx.row(i, &mut b);
+                if ctx.row_merged(i, &mut a) {
+                    let want = reference_merge(&b);
+                    assert_eq!(a.len(), want.len(), "row {i}");
+                    for (x, y) in a.iter().zip(&want) {
+                        assert_eq!((x.0, x.1.to_bits()), (y.0, y.1.to_bits()), "row {i}");
+                    }
+                    fast += 1;
+                } else {
+                    assert_eq!(a, b, "row {i}");
+                    raw += 1;
+                }
+            }
+            level = refine_level(&level, Scheme::CatmullClark, &mesh.options)
+                .unwrap()
+                .0;
+        }
+        (fast, raw)
+    }
+
+    #[test]
+    fn merged_rows_are_the_raw_rows_merged() {
+        let dir = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../tests/data/opensubdiv/shapes/"
+        );
+        let mut fast = 0;
+        for name in [
+            "catmark_xord_interior",
+            "catmark_xord_boundary",
+            "catmark_cube_creases1",
+            "catmark_dart_edgeonly",
+            "catmark_chaikin1",
+            "catmark_hole_test2",
+            "catmark_pyramid",
+            "catmark_tent_creases1",
+            "catmark_flap2",
+        ] {
+            let mesh = crate::load_obj(format!("{dir}{name}.obj")).unwrap();
+            fast += check_merged_rows(&mesh).0;
+        }
+        assert!(fast > 1000, "the merged rules ran on {fast} rows");
+        // Two quads glued along all four edges: each vertex's two faces share its diagonal
+        // (a repeated index the merged rules refuse), so those rows take the raw path.
+        let pillow = ControlMesh::from_polygons(
+            vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]],
+            &[[0u32, 1, 2, 3], [3, 2, 1, 0]],
+        );
+        let (_, raw) = check_merged_rows(&pillow);
+        assert!(raw > 0, "the pillow's vertex rows fall back to the raw row");
+    }
+}
