@@ -271,11 +271,13 @@ pub(super) fn assemble(
                     }
                 }
             } else {
-                let (grid, mask) =
-                    gather_regular(lvl, f, shift).ok_or(TopologyError::AdaptivePatch {
+                // The error is built only on failure (it has a destructor to run otherwise).
+                let Some((grid, mask)) = gather_regular(lvl, f, shift) else {
+                    return Err(TopologyError::AdaptivePatch {
                         level: l as u32,
                         face: f,
-                    })?;
+                    });
+                };
                 patch.control_points = grid.to_vec();
                 patch.boundary_mask = mask;
             }
@@ -341,11 +343,12 @@ pub(super) fn assemble(
         {
             let mut ids = [INVALID; 16];
             ids.copy_from_slice(&patch.control_points);
-            let grid =
-                phantom_grid(&ids, patch.boundary_mask).ok_or(TopologyError::AdaptivePatch {
+            let Some(grid) = phantom_grid(&ids, patch.boundary_mask) else {
+                return Err(TopologyError::AdaptivePatch {
                     level: patch.level as u32,
                     face: site.face as usize,
-                })?;
+                });
+            };
             for (slot, c) in patch.control_points.iter_mut().zip(grid.iter()) {
                 *slot = if c.n == 1 && c.w[0] == 1.0 {
                     c.idx[0]
