@@ -246,6 +246,19 @@ pub(super) fn gather_regular(lvl: &Lvl, f: usize, shift: u8) -> Option<([u32; 16
             return None;
         }
     }
+    // A quad's corners and edges as arrays (`None` for another size, as `corner_in` refuses).
+    let quad = |g: u32| -> Option<([u32; 4], [u32; 4])> {
+        let o = t.face_offsets[g as usize] as usize;
+        if t.face_offsets[g as usize + 1] as usize != o + 4 {
+            return None;
+        }
+        Some((
+            t.face_verts[o..o + 4].try_into().ok()?,
+            t.face_edges[o..o + 4].try_into().ok()?,
+        ))
+    };
+    let sharpness = &lvl.topo.edge_sharpness;
+    let (_, f_edges) = quad(f as u32)?;
     for p in 0..4 {
         let v = fv[p];
         let start = corner_in(t, f as u32, v)?;
@@ -253,21 +266,25 @@ pub(super) fn gather_regular(lvl: &Lvl, f: usize, shift: u8) -> Option<([u32; 16
         // Forward: across the edge entering v; then backward, across the edge leaving v, for
         // what the forward walk could not reach (a boundary or sharp edge stops a walk).
         for (dir, slots) in GATHER_SLOTS.iter().enumerate() {
-            let (mut g, mut k) = (f as u32, start);
+            let (mut g, mut k, mut g_edges) = (f as u32, start, f_edges);
             let last = if dir == 0 { 3 } else { 3 - steps };
             for step in 1..=last {
-                let fe_g = t.face_edge_list(g as usize);
-                let e = if dir == 0 { fe_g[(k + 3) % 4] } else { fe_g[k] };
-                if lvl.sharp_edge(e as usize) {
+                let e = if dir == 0 {
+                    g_edges[(k + 3) % 4]
+                } else {
+                    g_edges[k]
+                } as usize;
+                // `Lvl::sharp_edge`: positive sharpness or a single face.
+                let [x, y] = t.edge_faces[e];
+                if sharpness[e] > 0.0 || y == INVALID {
                     break;
                 }
-                let [x, y] = t.edge_faces(e as usize);
                 let h = if x == g { y } else { x };
                 if h == INVALID || h == f as u32 {
                     break;
                 }
-                let kh = corner_in(t, h, v)?;
-                let hv = t.face_vertices(h as usize);
+                let (hv, h_edges) = quad(h)?;
+                let kh = hv.iter().position(|&x| x == v)?;
                 let [s0, s1, s2] = slots[p][step - 1];
                 let (v0, v2) = if dir == 0 {
                     (hv[(kh + 1) % 4], hv[(kh + 3) % 4])
@@ -282,6 +299,7 @@ pub(super) fn gather_regular(lvl: &Lvl, f: usize, shift: u8) -> Option<([u32; 16
                 }
                 g = h;
                 k = kh;
+                g_edges = h_edges;
                 if dir == 0 {
                     steps = step;
                 }
