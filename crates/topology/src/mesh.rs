@@ -683,6 +683,15 @@ impl Topology {
     pub fn edge_faces(&self, e: usize) -> [u32; 2] {
         self.edge_faces[e]
     }
+    /// The faces of edge `e`: one on a boundary, else two.
+    pub fn edge_face_list(&self, e: usize) -> &[u32] {
+        let pair = &self.edge_faces[e];
+        if pair[1] == INVALID {
+            &pair[..1]
+        } else {
+            &pair[..]
+        }
+    }
     /// Whether edge `e` has a single face.
     pub fn is_boundary_edge(&self, e: usize) -> bool {
         self.edge_faces[e][1] == INVALID

@@ -1128,13 +1128,7 @@ impl MaskContext<'_> {
     fn smooth_edge(&self, e: usize, scale: f64, out: &mut Vec<(u32, f64)>) {
         let p = self.p;
         let [a, b] = p.edge_verts[e];
-        let [f0, f1] = p.edge_faces[e];
-        let face_pair = [f0, f1];
-        let faces: &[u32] = if f1 == INVALID {
-            &face_pair[..1]
-        } else {
-            &face_pair[..]
-        };
+        let faces = p.edge_face_list(e);
         match self.scheme {
             Scheme::Loop => {
                 let (vw, fw) = if faces.len() == 2 {
@@ -1276,13 +1270,7 @@ impl MaskContext<'_> {
             return false;
         }
         let [a, b] = p.edge_verts[e];
-        let [f0, f1] = p.edge_faces[e];
-        let face_pair = [f0, f1];
-        let faces: &[u32] = if f1 == INVALID {
-            &face_pair[..1]
-        } else {
-            &face_pair[..]
-        };
+        let faces = p.edge_face_list(e);
         // As `smooth_edge(e, 1.0)` computes them.
         let scale = 1.0f64;
         let (vw, fw) = self.catmark_edge_weights(faces);

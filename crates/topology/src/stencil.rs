@@ -195,9 +195,10 @@ const BLOCK_ROWS: usize = 8192;
 /// times parent row `j` into a dense accumulator over the parent's sources, so the result is the
 /// composition without an intermediate table, hashing or per-row allocation.
 ///
-/// Blocks run in rounds of a few per thread; each round's blocks are then appended to the
-/// final arrays, so block buffers and accumulators are reused (touched once per thread, not
-/// once per row) and the final arrays are written once.
+/// On one thread the rows go straight into the final arrays. Otherwise blocks run in rounds of
+/// a few per thread; each round's blocks are then appended to the final arrays, so block
+/// buffers and accumulators are reused (touched once per thread, not once per row) and the
+/// final arrays are written once.
 pub(crate) fn compose_rows<G>(
     n: usize,
     parent: Option<&StencilTable>,
@@ -214,12 +215,14 @@ where
     );
     let threads = rayon::current_num_threads().max(1);
     let pool = std::sync::Mutex::new(Vec::<Scratch>::new());
+    // The raw-row accumulator is made on the first row that needs it: generators that write
+    // their rows merged (the common subdivision rules) seldom do.
+    let mask_len = (kind == RowKind::Raw).then(|| parent.map_or(num_sources, StencilTable::len));
     let new_scratch = || Scratch {
-        mask: (kind == RowKind::Raw)
-            .then(|| Dense::new(parent.map_or(num_sources, StencilTable::len))),
+        mask: None,
         out: parent.map(|_| Dense::new(num_sources)),
         row: Vec::with_capacity(64),
-        sizes: Vec::with_capacity(BLOCK_ROWS),
+        sizes: Vec::new(),
         idx: Vec::new(),
         wts: Vec::new(),
     };
@@ -238,6 +241,7 @@ where
         // Offsets past u32 wrap here; the length check after the loop rejects them.
         fill_rows(
             &mut sc.mask,
+            mask_len,
             &mut sc.out,
             &mut sc.row,
             0..n,
@@ -277,6 +281,7 @@ where
                     wts.clear();
                     fill_rows(
                         mask,
+                        mask_len,
                         out,
                         row,
                         rows,
@@ -321,10 +326,12 @@ where
 }
 
 /// Compute rows `rows`, appending their entries to `idx` / `wts`; `end_row(start, end)` is told
-/// each row's entry range.
+/// each row's entry range. Rows the generator did not merge are merged in `mask` (made on first
+/// use, `mask_len` slots) when `mask_len` is given.
 #[allow(clippy::too_many_arguments)]
 fn fill_rows<G>(
     mask: &mut Option<Dense>,
+    mask_len: Option<usize>,
     out: &mut Option<Dense>,
     row: &mut Vec<(u32, f64)>,
     rows: std::ops::Range<usize>,
@@ -340,7 +347,8 @@ fn fill_rows<G>(
         let tag = i as u32 + 1;
         row.clear();
         let merged = gen(i, row);
-        if let Some(m) = mask.as_mut().filter(|_| !merged) {
+        if let Some(len) = mask_len.filter(|_| !merged) {
+            let m = mask.get_or_insert_with(|| Dense::new(len));
             m.touched.clear();
             for &(j, w) in row.iter() {
                 m.add(tag, j, w);
