@@ -191,7 +191,12 @@ pub(super) fn assemble(
     let mut sites: Vec<PatchSite> = Vec::with_capacity(total);
     // Gregory rows by patch index (end caps are a few percent of the patches).
     let gregory_rows = std::sync::Mutex::new(Vec::<(u32, Box<PointRows>)>::new());
+    let mut quads: Vec<QuadRec> = Vec::new();
     for (l, (lvl, faces)) in levels.iter().zip(&candidates).enumerate() {
+        if !faces.is_empty() {
+            quad_records(lvl, &mut quads);
+        }
+        let quads = &quads;
         // End caps from the isolation level on (deeper levels follow semi-sharp features).
         let is_last = l >= iso;
         let first = patches.len();
@@ -272,7 +277,7 @@ pub(super) fn assemble(
                 }
             } else {
                 // The error is built only on failure (it has a destructor to run otherwise).
-                let Some((grid, mask)) = gather_regular(lvl, f, shift) else {
+                let Some((grid, mask)) = gather_regular(lvl, quads, f, shift) else {
                     return Err(TopologyError::AdaptivePatch {
                         level: l as u32,
                         face: f,

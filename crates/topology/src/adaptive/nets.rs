@@ -171,14 +171,6 @@ pub(super) fn rotated(t: &Topology, f: usize, shift: u8) -> ([u32; 4], [u32; 4])
     )
 }
 
-pub(super) fn corner_in(t: &Topology, g: u32, v: u32) -> Option<usize> {
-    let fv = t.face_vertices(g as usize);
-    if fv.len() != 4 {
-        return None;
-    }
-    fv.iter().position(|&x| x == v)
-}
-
 /// Slots of the three points of the face `step` faces around patch corner `p` (`step` 1 to 3
 /// in `[p][step - 1]`), walking forward (across the edge entering the corner, the first table)
 /// or backward (across the edge leaving it), in the order of that face's corners after the
@@ -222,12 +214,70 @@ const fn gather_slots() -> [[[[u8; 3]; 3]; 4]; 2] {
     out
 }
 
+/// One face of a level as the 16-point gather walks it: its corners and, per edge `i`, the
+/// face across it, `INVALID` across a boundary or sharp edge (where a walk stops), in one
+/// 32-byte record. A step of a walk around a corner then reads one cache line; read from the
+/// topology it read four scattered ones (the face's corners, its edges, the edge's faces and
+/// the edge's sharpness), and those misses were most of the gather's time on catmark_car.
+/// A face that is not a quad has `INVALID` corners, so no walk finds its vertex in it.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+pub(super) struct QuadRec {
+    pub(super) verts: [u32; 4],
+    pub(super) across: [u32; 4],
+}
+
+/// The [`QuadRec`] of every face of `lvl`, written into `out` (reused from level to level, so
+/// its pages are faulted in once per plan, not once per level).
+pub(super) fn quad_records(lvl: &Lvl, out: &mut Vec<QuadRec>) {
+    const CHUNK: usize = 4096;
+    let t = lvl.t();
+    let blank = QuadRec {
+        verts: [INVALID; 4],
+        across: [INVALID; 4],
+    };
+    out.clear();
+    out.resize(t.num_faces(), blank);
+    out.par_chunks_mut(CHUNK).enumerate().for_each(|(c, chunk)| {
+        for (k, rec) in chunk.iter_mut().enumerate() {
+            let f = c * CHUNK + k;
+            let o = t.face_offsets[f] as usize;
+            if t.face_offsets[f + 1] as usize != o + 4 {
+                continue;
+            }
+            for i in 0..4 {
+                rec.verts[i] = t.face_verts[o + i];
+                let e = t.face_edges[o + i] as usize;
+                let [x, y] = t.edge_faces[e];
+                // `Lvl::sharp_edge`: positive sharpness or a single face.
+                rec.across[i] = if lvl.topo.edge_sharpness[e] > 0.0 || y == INVALID {
+                    INVALID
+                } else if x == f as u32 {
+                    y
+                } else {
+                    x
+                };
+            }
+        }
+    });
+}
+
 /// The 4×4 points of a regular patch (level-local ids) with phantoms for the masked edges.
 /// Returns the gathered global ids (`INVALID` where a phantom goes) and the boundary mask;
-/// [`phantom_grid`] completes them (or finds a point missing).
-pub(super) fn gather_regular(lvl: &Lvl, f: usize, shift: u8) -> Option<([u32; 16], u8)> {
-    let t = lvl.t();
-    let (fv, fe) = rotated(t, f, shift);
+/// [`phantom_grid`] completes them (or finds a point missing). `quads` are the level's
+/// [`quad_records`].
+pub(super) fn gather_regular(
+    lvl: &Lvl,
+    quads: &[QuadRec],
+    f: usize,
+    shift: u8,
+) -> Option<([u32; 16], u8)> {
+    let rec = quads.get(f)?;
+    if rec.verts[0] == INVALID {
+        return None;
+    }
+    let s = shift as usize;
+    let fv: [u32; 4] = std::array::from_fn(|p| rec.verts[(p + s) % 4]);
     let mut ids = [INVALID; 16];
     let base = lvl.base;
     // A slot written twice (the points along an edge, reached from both its corners) must get
@@ -246,44 +296,22 @@ pub(super) fn gather_regular(lvl: &Lvl, f: usize, shift: u8) -> Option<([u32; 16
             return None;
         }
     }
-    // A quad's corners and edges as arrays (`None` for another size, as `corner_in` refuses).
-    let quad = |g: u32| -> Option<([u32; 4], [u32; 4])> {
-        let o = t.face_offsets[g as usize] as usize;
-        if t.face_offsets[g as usize + 1] as usize != o + 4 {
-            return None;
-        }
-        Some((
-            t.face_verts[o..o + 4].try_into().ok()?,
-            t.face_edges[o..o + 4].try_into().ok()?,
-        ))
-    };
-    let sharpness = &lvl.topo.edge_sharpness;
-    let (_, f_edges) = quad(f as u32)?;
     for p in 0..4 {
         let v = fv[p];
-        let start = corner_in(t, f as u32, v)?;
+        let start = rec.verts.iter().position(|&x| x == v)?;
         let mut steps = 0;
         // Forward: across the edge entering v; then backward, across the edge leaving v, for
         // what the forward walk could not reach (a boundary or sharp edge stops a walk).
         for (dir, slots) in GATHER_SLOTS.iter().enumerate() {
-            let (mut g, mut k, mut g_edges) = (f as u32, start, f_edges);
+            let (mut g, mut k) = (rec, start);
             let last = if dir == 0 { 3 } else { 3 - steps };
             for step in 1..=last {
-                let e = if dir == 0 {
-                    g_edges[(k + 3) % 4]
-                } else {
-                    g_edges[k]
-                } as usize;
-                // `Lvl::sharp_edge`: positive sharpness or a single face.
-                let [x, y] = t.edge_faces[e];
-                if sharpness[e] > 0.0 || y == INVALID {
-                    break;
-                }
-                let h = if x == g { y } else { x };
+                let h = g.across[if dir == 0 { (k + 3) % 4 } else { k }];
                 if h == INVALID || h == f as u32 {
                     break;
                 }
-                let (hv, h_edges) = quad(h)?;
+                let hr = quads.get(h as usize)?;
+                let hv = hr.verts;
                 let kh = hv.iter().position(|&x| x == v)?;
                 let [s0, s1, s2] = slots[p][step - 1];
                 let (v0, v2) = if dir == 0 {
@@ -297,18 +325,18 @@ pub(super) fn gather_regular(lvl: &Lvl, f: usize, shift: u8) -> Option<([u32; 16
                 {
                     return None;
                 }
-                g = h;
+                g = hr;
                 k = kh;
-                g_edges = h_edges;
                 if dir == 0 {
                     steps = step;
                 }
             }
         }
     }
+    // `across` is `INVALID` exactly across a sharp or boundary edge (`Lvl::sharp_edge`).
     let mut mask = 0u8;
-    for (p, &e) in fe.iter().enumerate() {
-        if lvl.sharp_edge(e as usize) {
+    for p in 0..4 {
+        if rec.across[(p + s) % 4] == INVALID {
             mask |= 1 << p;
         }
     }
