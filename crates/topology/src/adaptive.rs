@@ -8,9 +8,13 @@
 //! * **One refiner.** Level 0 is [`LevelTopology::from_mesh`] with every tagged crease and
 //!   corner sharpness multiplied by [`AdaptiveOptions::sharpness_scale`] (infinite tags, ≥ 10,
 //!   stay infinite, and boundary edges are infinitely sharp as always). Each step is
-//!   [`refine_sparse`] of the selected faces: level L + 1 holds their children and the children
-//!   of their one-ring. Only children of selected faces are *complete* (their own one-ring is
-//!   present with exact points), so only complete faces are selected again or become patches.
+//!   [`crate::refine::refine_sparse_region`] of the selected faces with
+//!   [`SparseRegion::SelectedCorners`]: level L + 1 holds their children and, of their
+//!   one-ring, only the children at the selected faces' corners, which is all the one-rings of
+//!   the selected faces' children need (the rest of the one-ring's children were most of a
+//!   level and were refined only to be thrown away). Only children of selected faces are
+//!   *complete* (their own one-ring is present with exact points), so only complete faces are
+//!   selected again or become patches.
 //!   Complete faces partition the surface: a complete face is either selected (its children
 //!   cover it) or a patch.
 //! * **Irregular vertices** (of a complete face): any incident non-quad face; interior valence
@@ -88,7 +92,7 @@ use crate::error::TopologyError;
 use crate::limit::catmark_smooth_position_weights;
 use crate::mesh::{ControlMesh, Topology, INVALID};
 use crate::patch::catmark_regular_weights;
-use crate::refine::{refine_sparse, ChildMaps, ChildOrigin, LevelTopology};
+use crate::refine::{refine_sparse_region, ChildMaps, ChildOrigin, LevelTopology, SparseRegion};
 use crate::sdc::{is_infinite, vertex_rule, Rule, Scheme, SHARPNESS_INFINITE};
 use crate::stencil::StencilTable;
 use rayon::prelude::*;

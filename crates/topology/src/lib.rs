@@ -28,8 +28,8 @@ pub use mesh::{
 };
 pub use obj::{load_obj, parse_obj, write_control_mesh, write_obj};
 pub use refine::{
-    refine_level, refine_sparse, refine_uniform, uniform_stencils, ChildMaps, ChildOrigin, Level,
-    LevelRef, LevelTopology, SparseRefinement, UniformRefinement,
+    refine_level, refine_sparse, refine_sparse_region, refine_uniform, uniform_stencils, ChildMaps,
+    ChildOrigin, Level, LevelRef, LevelTopology, SparseRefinement, SparseRegion, UniformRefinement,
 };
 pub use sdc::{Rule, Scheme};
 pub use stencil::{StencilTable, StencilTableF32};

@@ -475,7 +475,7 @@ impl Level {
 
 /// The parent component a child vertex comes from (OpenSubdiv: vertex-vertex, edge-vertex,
 /// face-vertex).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ChildOrigin {
     Vertex(u32),
     Edge(u32),
@@ -501,6 +501,11 @@ pub struct ChildMaps {
     pub child_vertex_origin: Vec<ChildOrigin>,
     /// Per child face: its parent face.
     pub child_face_parent: Vec<u32>,
+    /// Per edge-vertex (child vertex `kv + r` has entry `r`, `kv` the vertex-vertices): the
+    /// child edges halving its parent edge, at the parent edge's end 0 and end 1 (`INVALID`
+    /// where [`SparseRegion::SelectedCorners`] made no child at that end). With
+    /// [`SparseRegion::OneRingFaces`] they are always `2r`, `2r + 1`.
+    pub edge_child_halves: Vec<[u32; 2]>,
 }
 
 impl ChildMaps {
@@ -544,6 +549,36 @@ pub fn refine_sparse(
     options: &SubdivOptions,
     selected: &[u32],
 ) -> Result<SparseRefinement, TopologyError> {
+    refine_sparse_region(parent, scheme, options, selected, SparseRegion::OneRingFaces)
+}
+
+/// Which children of the one-ring around a selection a [`refine_sparse_region`] step makes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SparseRegion {
+    /// Every child of every face sharing a vertex with a selected face ([`refine_sparse`]).
+    #[default]
+    OneRingFaces,
+    /// Only what the children of the selected faces need for complete one-rings: the children
+    /// of one-ring faces at a corner of a selected face, the vertex-vertices of those corners
+    /// and the edge-vertices of their edges, as OpenSubdiv's sparse refinement keeps. The rest
+    /// of the one-ring's children (about half of a refined level on catmark_car) would only be
+    /// refined to be thrown away. Quad-splitting schemes; Loop takes
+    /// [`SparseRegion::OneRingFaces`].
+    SelectedCorners,
+}
+
+/// [`refine_sparse`] with a choice of [`SparseRegion`]. With
+/// [`SparseRegion::SelectedCorners`], the children of the selected faces, their one-rings and
+/// the stencils of their vertices are those of [`refine_sparse`] (the same rows, bit for bit,
+/// under other child numbers); a one-ring face's children are made only at corners of selected
+/// faces, so they come in corner order but not always all of them.
+pub fn refine_sparse_region(
+    parent: LevelRef<'_>,
+    scheme: Scheme,
+    options: &SubdivOptions,
+    selected: &[u32],
+    region: SparseRegion,
+) -> Result<SparseRefinement, TopologyError> {
     let p = parent.topology;
     let (nv, ne, nf) = (p.num_vertices(), p.num_edges(), p.num_faces());
     if scheme == Scheme::DooSabin {
@@ -584,14 +619,34 @@ pub fn refine_sparse(
             });
         }
     }
+    // Corners whose children are made: every corner of the region (the whole one-ring), or
+    // only the corners of selected faces.
+    let corners_only = quads && region == SparseRegion::SelectedCorners;
     let mut vert_mark = vec![false; nv];
     let mut edge_mark = vec![false; ne];
-    for &f in &faces {
-        for &v in p.face_vertices(f as usize) {
-            vert_mark[v as usize] = true;
+    if corners_only {
+        for &f in selected {
+            for &v in p.face_vertices(f as usize) {
+                vert_mark[v as usize] = true;
+            }
         }
-        for &e in p.face_edge_list(f as usize) {
-            edge_mark[e as usize] = true;
+        for &f in &faces {
+            let fv = p.face_vertices(f as usize);
+            let n = fv.len();
+            for (i, &e) in p.face_edge_list(f as usize).iter().enumerate() {
+                if vert_mark[fv[i] as usize] || vert_mark[fv[(i + 1) % n] as usize] {
+                    edge_mark[e as usize] = true;
+                }
+            }
+        }
+    } else {
+        for &f in &faces {
+            for &v in p.face_vertices(f as usize) {
+                vert_mark[v as usize] = true;
+            }
+            for &e in p.face_edge_list(f as usize) {
+                edge_mark[e as usize] = true;
+            }
         }
     }
     let verts = marked(&vert_mark);
@@ -657,29 +712,55 @@ pub fn refine_sparse(
     // refined face (one per corner for quads, three per triangle for Loop).
     let vc = |v: u32| vertex_child_vertex[v as usize];
     let ec = |e: u32| edge_child_vertex[e as usize];
-    let half_at =
-        |e: u32, v: u32| 2 * (ec(e) - kv as u32) + u32::from(p.edge_verts[e as usize][0] != v);
+    // Whether corner vertex `v` has children (every region vertex has, unless corners_only).
+    let made = |v: u32| vertex_child_vertex[v as usize] != INVALID;
     // Sized up front (a quad per corner, or four triangles): growing them copied MBs per level.
     let child_faces: usize = if quads {
         faces
             .iter()
-            .map(|&f| p.face_vertices(f as usize).len())
+            .map(|&f| {
+                let fv = p.face_vertices(f as usize);
+                if corners_only {
+                    fv.iter().filter(|&&v| made(v)).count()
+                } else {
+                    fv.len()
+                }
+            })
             .sum()
     } else {
         4 * faces.len()
     };
     let corners = if quads { 4 } else { 3 } * child_faces;
-    // The halves, then one inner edge per child quad (or three per triangle).
+    // The halves, then one inner edge per child quad (or three per triangle; with
+    // corners_only, one per parent edge at a made corner, at most one per child quad).
     let inner_edges = if quads { child_faces } else { 3 * faces.len() };
+    // Child edge of each refined edge's first half (end 0, or end 1 where end 0 has no
+    // child): both halves are made unless corners_only leaves an end without a child.
+    let mut edge_child_halves: Vec<[u32; 2]> = Vec::with_capacity(ke);
     let mut edge_verts: Vec<[u32; 2]> = Vec::with_capacity(2 * ke + inner_edges);
     let mut edge_sharpness: Vec<f32> = Vec::with_capacity(edge_verts.capacity());
     for &e in &edges {
         let [a, b] = p.edge_verts[e as usize];
-        edge_verts.push([vc(a), ec(e)]);
-        edge_verts.push([ec(e), vc(b)]);
-        edge_sharpness.extend_from_slice(&halves[2 * e as usize..2 * e as usize + 2]);
+        let h = &halves[2 * e as usize..2 * e as usize + 2];
+        let mut pair = [INVALID; 2];
+        if made(a) {
+            pair[0] = edge_verts.len() as u32;
+            edge_verts.push([vc(a), ec(e)]);
+            edge_sharpness.push(h[0]);
+        }
+        if made(b) {
+            pair[1] = edge_verts.len() as u32;
+            edge_verts.push([ec(e), vc(b)]);
+            edge_sharpness.push(h[1]);
+        }
+        edge_child_halves.push(pair);
     }
+    let half_at = |e: u32, v: u32| {
+        let [a, _] = p.edge_verts[e as usize];
+        edge_child_halves[(ec(e) - kv as u32) as usize][usize::from(a != v)]
+    };
     let mut face_first_child = vec![INVALID; nf];
+    let mut inner_at: Vec<u32> = Vec::new();
     let mut child_face_parent = Vec::with_capacity(child_faces);
     let mut face_offsets = Vec::with_capacity(child_faces + 1);
     face_offsets.push(0u32);
@@ -691,7 +772,34 @@ pub fn refine_sparse(
         let n = fv.len();
         let inner = edge_verts.len() as u32;
         face_first_child[f as usize] = child_face_parent.len() as u32;
-        if quads {
+        if quads && corners_only {
+            // Inner edge i (edge i's vertex to the face's) where corner i or i + 1 is made.
+            let fc = face_child_vertex[f as usize];
+            inner_at.clear();
+            inner_at.resize(n, INVALID);
+            for (i, &e) in fe.iter().enumerate() {
+                if made(fv[i]) || made(fv[(i + 1) % n]) {
+                    inner_at[i] = edge_verts.len() as u32;
+                    edge_verts.push([ec(e), fc]);
+                }
+            }
+            for i in 0..n {
+                if !made(fv[i]) {
+                    continue;
+                }
+                let prev = (i + n - 1) % n;
+                let (v, e, ep) = (fv[i], fe[i], fe[prev]);
+                face_verts.extend_from_slice(&[vc(v), ec(e), fc, ec(ep)]);
+                face_edges.extend_from_slice(&[
+                    half_at(e, v),
+                    inner_at[i],
+                    inner_at[prev],
+                    half_at(ep, v),
+                ]);
+                face_offsets.push(face_verts.len() as u32);
+                child_face_parent.push(f);
+            }
+        } else if quads {
             let fc = face_child_vertex[f as usize];
             for &e in fe {
                 edge_verts.push([ec(e), fc]);
@@ -756,6 +864,7 @@ pub fn refine_sparse(
             face_first_child,
             child_vertex_origin: origin,
             child_face_parent,
+            edge_child_halves,
         },
     })
 }

@@ -5,8 +5,8 @@
 
 use topology::mesh::INVALID;
 use topology::{
-    load_obj, refine_sparse, refine_uniform, ChildOrigin, ControlMesh, Level, Scheme,
-    SparseRefinement, Topology, TopologyError,
+    load_obj, refine_sparse, refine_sparse_region, refine_uniform, ChildOrigin, ControlMesh, Level,
+    LevelTopology, Scheme, SparseRefinement, SparseRegion, Topology, TopologyError,
 };
 
 const DATA: &str = concat!(
@@ -327,4 +327,137 @@ fn sparse_refinement_errors_name_what_is_at_fault() {
         e,
         TopologyError::LoopRequiresTriangles { size: 4, .. }
     ));
+}
+
+/// The child vertex a corner-restricted step made for each component the one-ring step made.
+fn same_origin(corners: &SparseRefinement) -> std::collections::HashMap<ChildOrigin, u32> {
+    (0..corners.maps.child_vertex_origin.len() as u32)
+        .map(|c| (corners.maps.child_vertex_origin[c as usize], c))
+        .collect()
+}
+
+/// Checks one step: the children of `selected` and the one-rings of their vertices are the
+/// one-ring step's (same faces around each vertex, same stencil rows bit for bit, same
+/// sharpness), and the step makes no more than that. Returns the corner step.
+fn corners_match_one_ring(
+    name: &str,
+    parent: &LevelTopology,
+    scheme: Scheme,
+    mesh: &ControlMesh,
+    selected: &[u32],
+) -> SparseRefinement {
+    let full = refine_sparse(parent.view(), scheme, &mesh.options, selected).expect("one ring");
+    let part = refine_sparse_region(
+        parent.view(),
+        scheme,
+        &mesh.options,
+        selected,
+        SparseRegion::SelectedCorners,
+    )
+    .expect("corners");
+    let (ft, pt) = (&full.child.topology, &part.child.topology);
+    assert!(pt.num_faces() <= ft.num_faces(), "{name}");
+    assert!(pt.num_vertices() <= ft.num_vertices(), "{name}");
+    let in_part = same_origin(&part);
+    let to_part = |c: u32| in_part[&full.maps.child_vertex_origin[c as usize]];
+    for &f in selected {
+        let (fc, pc) = (
+            full.maps.child_faces(f as usize),
+            part.maps.child_faces(f as usize),
+        );
+        assert_eq!(fc.len(), pc.len(), "{name}: children of face {f}");
+        for (a, b) in fc.zip(pc) {
+            let fv: Vec<u32> = ft.face_vertices(a).iter().map(|&v| to_part(v)).collect();
+            assert_eq!(fv, pt.face_vertices(b), "{name}: child of face {f}");
+            for (&v, &w) in ft.face_vertices(a).iter().zip(pt.face_vertices(b)) {
+                // The ring: the faces around the vertex, as corner lists, in any order.
+                let ring = |t: &Topology, x: u32, map: &dyn Fn(u32) -> u32| {
+                    let mut r: Vec<Vec<u32>> = t
+                        .vertex_faces(x as usize)
+                        .iter()
+                        .map(|&g| t.face_vertices(g as usize).iter().map(|&y| map(y)).collect())
+                        .collect();
+                    r.sort();
+                    r
+                };
+                assert_eq!(
+                    ring(ft, v, &to_part),
+                    ring(pt, w, &|y| y),
+                    "{name}: ring of child vertex {v}"
+                );
+                assert_eq!(
+                    ft.vertex_edges(v as usize).len(),
+                    pt.vertex_edges(w as usize).len(),
+                    "{name}: valence of child vertex {v}"
+                );
+                assert_eq!(
+                    full.child.vertex_sharpness[v as usize].to_bits(),
+                    part.child.vertex_sharpness[w as usize].to_bits(),
+                    "{name}: sharpness of child vertex {v}"
+                );
+                for &g in ft.vertex_faces(v as usize) {
+                    for &y in ft.face_vertices(g as usize) {
+                        assert_eq!(
+                            full.stencils.stencil(y as usize),
+                            part.stencils.stencil(to_part(y) as usize),
+                            "{name}: row of child vertex {y}"
+                        );
+                    }
+                }
+                for &e in ft.vertex_edges(v as usize) {
+                    let [x, y] = ft.edge_vertices(e as usize);
+                    let g = pt.find_edge(to_part(x), to_part(y)).expect("edge kept");
+                    assert_eq!(
+                        full.child.edge_sharpness[e as usize].to_bits(),
+                        part.child.edge_sharpness[g as usize].to_bits(),
+                        "{name}: sharpness of child edge {e}"
+                    );
+                }
+            }
+        }
+    }
+    // Every half-edge pair names child edges joining its edge-vertex to its ends' children.
+    for (r, pair) in part.maps.edge_child_halves.iter().enumerate() {
+        let m = (r + part.maps.child_vertex_origin.iter().take_while(|o| matches!(o, ChildOrigin::Vertex(_))).count()) as u32;
+        let ChildOrigin::Edge(e) = part.maps.child_vertex_origin[m as usize] else {
+            panic!("{name}: edge-vertex {m} is not an edge's");
+        };
+        let ends = parent.topology.edge_vertices(e as usize);
+        for (k, &h) in pair.iter().enumerate() {
+            let vc = part.maps.vertex_child_vertex[ends[k] as usize];
+            if h == INVALID {
+                assert_eq!(vc, INVALID, "{name}: edge {e} end {k} has a child but no half");
+            } else {
+                let mut got = pt.edge_vertices(h as usize);
+                got.sort_unstable();
+                let mut want = [vc, m];
+                want.sort_unstable();
+                assert_eq!(got, want, "{name}: half {k} of edge {e}");
+            }
+        }
+    }
+    part
+}
+
+#[test]
+fn corner_region_keeps_the_selected_childrens_rings_and_rows() {
+    let mut smaller = 0;
+    for name in SHAPES.iter().filter(|n| !n.starts_with("loop")) {
+        let (mesh, scheme) = shape(name);
+        let base = LevelTopology::from_mesh(&mesh, scheme).expect("base");
+        let nf = base.topology.num_faces();
+        let sel = selection(nf);
+        let step = corners_match_one_ring(name, &base, scheme, &mesh, &sel);
+        let full = refine_sparse(base.view(), scheme, &mesh.options, &sel).expect("one ring");
+        smaller += usize::from(step.child.topology.num_faces() < full.child.topology.num_faces());
+        // A second step from the children of the selection (complete faces).
+        let sel2: Vec<u32> = sel
+            .iter()
+            .flat_map(|&f| step.maps.child_faces(f as usize))
+            .map(|c| c as u32)
+            .step_by(2)
+            .collect();
+        corners_match_one_ring(name, &step.child, scheme, &mesh, &sel2);
+    }
+    assert!(smaller > 0, "the corner region never made fewer faces");
 }

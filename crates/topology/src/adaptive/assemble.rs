@@ -565,7 +565,18 @@ pub(super) fn assemble(
                 }
                 EdgeKind::Fine => {
                     let c = curve_id(l, e, [ca, cb], (rank, pi as u32, p as u8, 0), &mut curves);
-                    let sib = e ^ 1;
+                    // The other half of the parent edge this one halves (at the midpoint,
+                    // the end that is an edge-vertex).
+                    let maps = lvl.maps.as_ref().ok_or_else(unbalanced)?;
+                    let mid = [a, b]
+                        .into_iter()
+                        .find(|&x| matches!(maps.child_vertex_origin[x as usize], ChildOrigin::Edge(_)))
+                        .ok_or_else(unbalanced)?;
+                    let pair = maps.edge_child_halves[mid as usize - lvl.kv];
+                    let sib = if pair[0] == e { pair[1] } else { pair[0] };
+                    if sib == INVALID || (pair[0] != e && pair[1] != e) {
+                        return Err(unbalanced());
+                    }
                     let [s0, s1] = t.edge_vertices(sib as usize);
                     // The shared end is the midpoint of the coarse edge.
                     let (start, end) = if s0 == a || s1 == a {
@@ -599,9 +610,12 @@ pub(super) fn assemble(
                     if m == INVALID || (m as usize) < next.kv {
                         return Err(unbalanced());
                     }
-                    let r = m - next.kv as u32;
-                    let h0 = 2 * r + u32::from(t.edge_vertices(e as usize)[0] != a);
-                    let h1 = h0 ^ 1;
+                    let pair = maps.edge_child_halves[m as usize - next.kv];
+                    let at_a = usize::from(t.edge_vertices(e as usize)[0] != a);
+                    let (h0, h1) = (pair[at_a], pair[1 - at_a]);
+                    if h0 == INVALID || h1 == INVALID {
+                        return Err(unbalanced());
+                    }
                     // Both halves must be patches of level l + 1.
                     for h in [h0, h1] {
                         for cf in next.t().edge_faces(h as usize) {

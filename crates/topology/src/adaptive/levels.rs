@@ -241,11 +241,12 @@ pub(super) fn build_levels(
                 bound: max_refined_faces,
             });
         }
-        let r = refine_sparse(
+        let r = refine_sparse_region(
             lvl.topo.view(),
             Scheme::CatmullClark,
             &mesh.options,
             &selection,
+            SparseRegion::SelectedCorners,
         )?;
         let base = lvl
             .base
