@@ -191,7 +191,17 @@ pub(super) fn assemble(
     let mut sites: Vec<PatchSite> = Vec::with_capacity(total);
     // Gregory rows by patch index (end caps are a few percent of the patches).
     let gregory_rows = std::sync::Mutex::new(Vec::<(u32, Box<PointRows>)>::new());
-    let mut quads: Vec<QuadRec> = Vec::new();
+    // Sized once for the largest level that drafts patches: growing it level by level copied
+    // and faulted in each level's records anew.
+    let mut quads: Vec<QuadRec> = Vec::with_capacity(
+        levels
+            .iter()
+            .zip(&candidates)
+            .filter(|(_, faces)| !faces.is_empty())
+            .map(|(lvl, _)| lvl.t().num_faces())
+            .max()
+            .unwrap_or(0),
+    );
     for (l, (lvl, faces)) in levels.iter().zip(&candidates).enumerate() {
         if !faces.is_empty() {
             quad_records(lvl, &mut quads);
