@@ -378,10 +378,15 @@ fn hud_is_drawn_hidden_by_h_and_its_level_control_acts() {
     let (child, window) = focused_view(&server.display, &dir, &args);
     let d = server.display.clone();
     let shot = |n: u32| wait_for_png(&dir.join(format!("tessera-screenshot-{n}.png")));
+    // A first screenshot only to know a frame is up: egui lays a panel out unseen on its first
+    // frame (a sizing pass), and on a loaded machine the first P can come before any frame was
+    // drawn, so that shot had no HUD to compare (0 pixels; seen once in a full test run).
     xdotool(&d, &["key", "p"]);
-    let with_hud = shot(1);
+    shot(1);
+    xdotool(&d, &["key", "p"]);
+    let with_hud = shot(2);
     xdotool(&d, &["key", "h", "p"]);
-    let without_hud = shot(2);
+    let without_hud = shot(3);
     xdotool(&d, &["key", "h"]);
     let (x, y) = DOUBLE_LEVEL_BUTTON;
     let (x, y) = (x.to_string(), y.to_string());
@@ -390,7 +395,7 @@ fn hud_is_drawn_hidden_by_h_and_its_level_control_acts() {
         &["mousemove", "--window", &window, &x, &y, "click", "1"],
     );
     xdotool(&d, &["key", "h", "p"]);
-    let doubled = shot(3);
+    let doubled = shot(4);
     xdotool(&d, &["key", "Escape"]);
     let o = child.wait_with_output().expect("tessera ends");
     drop(server);
