@@ -159,7 +159,8 @@ pub struct StencilBlock {
 pub struct LevelStats {
     pub regular: u32,
     pub end_caps: u32,
-    /// Faces held at this level (the selection of the level above and its one-ring).
+    /// Faces held at this level: the children of the level above's selection and, of its
+    /// one-ring, the children at the selection's corners.
     pub faces: u32,
     /// Faces of a uniform refinement to this level.
     pub uniform_faces: u64,

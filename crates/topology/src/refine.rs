@@ -495,7 +495,8 @@ pub struct ChildMaps {
     /// Per parent face: its face-vertex (quad-splitting schemes only).
     pub face_child_vertex: Vec<u32>,
     /// Per parent face: its first child face; its children are consecutive (see the module
-    /// docs for their order).
+    /// docs for their order; with [`SparseRegion::SelectedCorners`] a one-ring face has only
+    /// the children at selected faces' corners, still in corner order).
     pub face_first_child: Vec<u32>,
     /// Per child vertex: the parent component it refines.
     pub child_vertex_origin: Vec<ChildOrigin>,
@@ -734,8 +735,8 @@ pub fn refine_sparse_region(
     // The halves, then one inner edge per child quad (or three per triangle; with
     // corners_only, one per parent edge at a made corner, at most one per child quad).
     let inner_edges = if quads { child_faces } else { 3 * faces.len() };
-    // Child edge of each refined edge's first half (end 0, or end 1 where end 0 has no
-    // child): both halves are made unless corners_only leaves an end without a child.
+    // Each refined edge's halves (`ChildMaps::edge_child_halves`): both, unless corners_only
+    // leaves an end without a vertex-vertex, and so without its half.
     let mut edge_child_halves: Vec<[u32; 2]> = Vec::with_capacity(ke);
     let mut edge_verts: Vec<[u32; 2]> = Vec::with_capacity(2 * ke + inner_edges);
     let mut edge_sharpness: Vec<f32> = Vec::with_capacity(edge_verts.capacity());
@@ -1353,7 +1354,8 @@ impl MaskContext<'_> {
             };
             let m = fv.len();
             for (d, &x) in fv.iter().enumerate() {
-                let d = (d + m - c) % m;
+                // The corner's place after `c` around the face (no division per corner).
+                let d = if d >= c { d - c } else { d + m - c };
                 if d == 0 {
                     centre += w;
                 } else if d == 1 || d == m - 1 {
