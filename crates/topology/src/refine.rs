@@ -550,7 +550,13 @@ pub fn refine_sparse(
     options: &SubdivOptions,
     selected: &[u32],
 ) -> Result<SparseRefinement, TopologyError> {
-    refine_sparse_region(parent, scheme, options, selected, SparseRegion::OneRingFaces)
+    refine_sparse_region(
+        parent,
+        scheme,
+        options,
+        selected,
+        SparseRegion::OneRingFaces,
+    )
 }
 
 /// Which children of the one-ring around a selection a [`refine_sparse_region`] step makes.

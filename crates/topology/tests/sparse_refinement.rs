@@ -375,7 +375,12 @@ fn corners_match_one_ring(
                     let mut r: Vec<Vec<u32>> = t
                         .vertex_faces(x as usize)
                         .iter()
-                        .map(|&g| t.face_vertices(g as usize).iter().map(|&y| map(y)).collect())
+                        .map(|&g| {
+                            t.face_vertices(g as usize)
+                                .iter()
+                                .map(|&y| map(y))
+                                .collect()
+                        })
                         .collect();
                     r.sort();
                     r
@@ -418,7 +423,12 @@ fn corners_match_one_ring(
     }
     // Every half-edge pair names child edges joining its edge-vertex to its ends' children.
     for (r, pair) in part.maps.edge_child_halves.iter().enumerate() {
-        let m = (r + part.maps.child_vertex_origin.iter().take_while(|o| matches!(o, ChildOrigin::Vertex(_))).count()) as u32;
+        let m = (r + part
+            .maps
+            .child_vertex_origin
+            .iter()
+            .take_while(|o| matches!(o, ChildOrigin::Vertex(_)))
+            .count()) as u32;
         let ChildOrigin::Edge(e) = part.maps.child_vertex_origin[m as usize] else {
             panic!("{name}: edge-vertex {m} is not an edge's");
         };
@@ -426,7 +436,10 @@ fn corners_match_one_ring(
         for (k, &h) in pair.iter().enumerate() {
             let vc = part.maps.vertex_child_vertex[ends[k] as usize];
             if h == INVALID {
-                assert_eq!(vc, INVALID, "{name}: edge {e} end {k} has a child but no half");
+                assert_eq!(
+                    vc, INVALID,
+                    "{name}: edge {e} end {k} has a child but no half"
+                );
             } else {
                 let mut got = pt.edge_vertices(h as usize);
                 got.sort_unstable();

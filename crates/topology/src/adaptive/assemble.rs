@@ -580,7 +580,9 @@ pub(super) fn assemble(
                     let maps = lvl.maps.as_ref().ok_or_else(unbalanced)?;
                     let mid = [a, b]
                         .into_iter()
-                        .find(|&x| matches!(maps.child_vertex_origin[x as usize], ChildOrigin::Edge(_)))
+                        .find(|&x| {
+                            matches!(maps.child_vertex_origin[x as usize], ChildOrigin::Edge(_))
+                        })
                         .ok_or_else(unbalanced)?;
                     let pair = maps.edge_child_halves[mid as usize - lvl.kv];
                     let sib = if pair[0] == e { pair[1] } else { pair[0] };

@@ -238,28 +238,30 @@ pub(super) fn quad_records(lvl: &Lvl, out: &mut Vec<QuadRec>) {
     };
     out.clear();
     out.resize(t.num_faces(), blank);
-    out.par_chunks_mut(CHUNK).enumerate().for_each(|(c, chunk)| {
-        for (k, rec) in chunk.iter_mut().enumerate() {
-            let f = c * CHUNK + k;
-            let o = t.face_offsets[f] as usize;
-            if t.face_offsets[f + 1] as usize != o + 4 {
-                continue;
+    out.par_chunks_mut(CHUNK)
+        .enumerate()
+        .for_each(|(c, chunk)| {
+            for (k, rec) in chunk.iter_mut().enumerate() {
+                let f = c * CHUNK + k;
+                let o = t.face_offsets[f] as usize;
+                if t.face_offsets[f + 1] as usize != o + 4 {
+                    continue;
+                }
+                for i in 0..4 {
+                    rec.verts[i] = t.face_verts[o + i];
+                    let e = t.face_edges[o + i] as usize;
+                    let [x, y] = t.edge_faces[e];
+                    // `Lvl::sharp_edge`: positive sharpness or a single face.
+                    rec.across[i] = if lvl.topo.edge_sharpness[e] > 0.0 || y == INVALID {
+                        INVALID
+                    } else if x == f as u32 {
+                        y
+                    } else {
+                        x
+                    };
+                }
             }
-            for i in 0..4 {
-                rec.verts[i] = t.face_verts[o + i];
-                let e = t.face_edges[o + i] as usize;
-                let [x, y] = t.edge_faces[e];
-                // `Lvl::sharp_edge`: positive sharpness or a single face.
-                rec.across[i] = if lvl.topo.edge_sharpness[e] > 0.0 || y == INVALID {
-                    INVALID
-                } else if x == f as u32 {
-                    y
-                } else {
-                    x
-                };
-            }
-        }
-    });
+        });
 }
 
 /// The 4×4 points of a regular patch (level-local ids) with phantoms for the masked edges.
