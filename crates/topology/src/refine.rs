@@ -630,28 +630,19 @@ pub fn refine_sparse_region(
     // only the corners of selected faces.
     let corners_only = quads && region == SparseRegion::SelectedCorners;
     let mut vert_mark = vec![false; nv];
+    let corner_faces: &[u32] = if corners_only { selected } else { &faces };
+    for &f in corner_faces {
+        for &v in p.face_vertices(f as usize) {
+            vert_mark[v as usize] = true;
+        }
+    }
+    // The edges at those corners (every edge of the region when every corner is made).
     let mut edge_mark = vec![false; ne];
-    if corners_only {
-        for &f in selected {
-            for &v in p.face_vertices(f as usize) {
-                vert_mark[v as usize] = true;
-            }
-        }
-        for &f in &faces {
-            let fv = p.face_vertices(f as usize);
-            let n = fv.len();
-            for (i, &e) in p.face_edge_list(f as usize).iter().enumerate() {
-                if vert_mark[fv[i] as usize] || vert_mark[fv[(i + 1) % n] as usize] {
-                    edge_mark[e as usize] = true;
-                }
-            }
-        }
-    } else {
-        for &f in &faces {
-            for &v in p.face_vertices(f as usize) {
-                vert_mark[v as usize] = true;
-            }
-            for &e in p.face_edge_list(f as usize) {
+    for &f in &faces {
+        let fv = p.face_vertices(f as usize);
+        let n = fv.len();
+        for (i, &e) in p.face_edge_list(f as usize).iter().enumerate() {
+            if vert_mark[fv[i] as usize] || vert_mark[fv[(i + 1) % n] as usize] {
                 edge_mark[e as usize] = true;
             }
         }
@@ -726,12 +717,10 @@ pub fn refine_sparse_region(
         faces
             .iter()
             .map(|&f| {
-                let fv = p.face_vertices(f as usize);
-                if corners_only {
-                    fv.iter().filter(|&&v| made(v)).count()
-                } else {
-                    fv.len()
-                }
+                p.face_vertices(f as usize)
+                    .iter()
+                    .filter(|&&v| made(v))
+                    .count()
             })
             .sum()
     } else {
@@ -779,8 +768,9 @@ pub fn refine_sparse_region(
         let n = fv.len();
         let inner = edge_verts.len() as u32;
         face_first_child[f as usize] = child_face_parent.len() as u32;
-        if quads && corners_only {
-            // Inner edge i (edge i's vertex to the face's) where corner i or i + 1 is made.
+        if quads {
+            // Inner edge i (edge i's vertex to the face's) where corner i or i + 1 is made: all
+            // of them unless corners_only, in edge order either way.
             let fc = face_child_vertex[f as usize];
             inner_at.clear();
             inner_at.resize(n, INVALID);
@@ -801,24 +791,6 @@ pub fn refine_sparse_region(
                     half_at(e, v),
                     inner_at[i],
                     inner_at[prev],
-                    half_at(ep, v),
-                ]);
-                face_offsets.push(face_verts.len() as u32);
-                child_face_parent.push(f);
-            }
-        } else if quads {
-            let fc = face_child_vertex[f as usize];
-            for &e in fe {
-                edge_verts.push([ec(e), fc]);
-            }
-            for i in 0..n {
-                let prev = (i + n - 1) % n;
-                let (v, e, ep) = (fv[i], fe[i], fe[prev]);
-                face_verts.extend_from_slice(&[vc(v), ec(e), fc, ec(ep)]);
-                face_edges.extend_from_slice(&[
-                    half_at(e, v),
-                    inner + i as u32,
-                    inner + prev as u32,
                     half_at(ep, v),
                 ]);
                 face_offsets.push(face_verts.len() as u32);

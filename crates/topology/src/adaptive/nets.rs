@@ -251,8 +251,7 @@ pub(super) fn quad_records(lvl: &Lvl, out: &mut Vec<QuadRec>) {
                     rec.verts[i] = t.face_verts[o + i];
                     let e = t.face_edges[o + i] as usize;
                     let [x, y] = t.edge_faces[e];
-                    // `Lvl::sharp_edge`: positive sharpness or a single face.
-                    rec.across[i] = if lvl.topo.edge_sharpness[e] > 0.0 || y == INVALID {
+                    rec.across[i] = if lvl.sharp_edge(e) {
                         INVALID
                     } else if x == f as u32 {
                         y
