@@ -6,10 +6,12 @@
 //! figures; `TESSERA_BENCH_FACES=1` prints the face counts per level instead (the seed's
 //! Fig. 5.2: regular, end caps, faces held, uniform).
 //!
-//! `TESSERA_BENCH_TIME=row,row,... [TESSERA_BENCH_REPS=n] [TESSERA_BENCH_WARMUP=0]` times the
-//! named rows outside criterion (one untimed warm-up run unless `TESSERA_BENCH_WARMUP=0`, then
-//! `n` timed runs, each printed in ms, the result dropped outside the timer), so a script can interleave them with OpenSubdiv's `far_perf`,
-//! which prints one time per level and process. Rows: `<shape>_adaptive4`,
+//! `TESSERA_BENCH_TIME=row,row,... [TESSERA_BENCH_REPS=n] [TESSERA_BENCH_WARMUP=0|levels]` times
+//! the named rows outside criterion (one untimed warm-up run of the row; none with `0`; with
+//! `levels` the row's lower levels 1..N-1, as `far_perf -l N` runs them in one process before
+//! the level-N figure it is compared at), then `n` timed runs, each printed in ms, the result
+//! dropped outside the timer, so a script can interleave them with OpenSubdiv's `far_perf`.
+//! `TESSERA_BENCH_FAULTS=1` also prints each timed run's minor page faults. Rows: `<shape>_adaptive4`,
 //! `<shape>_adaptive4_follow_creases`, `<shape>_uniform3_stencils`, `<shape>_base_topology`
 //! (the base level alone, which `far_perf` builds outside its timers).
 use criterion::Criterion;
@@ -78,12 +80,18 @@ fn print_face_counts() {
 
 /// One run of a named row; the result is returned so that its drop is not timed.
 fn run_row(row: &str, m: &ControlMesh) -> Box<dyn std::any::Any> {
+    run_row_at(row, m, None)
+}
+
+/// `level` replaces the row's isolation (or uniform) level: the warm-up that mirrors
+/// `far_perf`, which plans levels 1, 2, .. N in one process and reports each.
+fn run_row_at(row: &str, m: &ControlMesh, level: Option<u32>) -> Box<dyn std::any::Any> {
     if row.ends_with("_adaptive4_follow_creases") {
-        Box::new(plan_adaptive(m, &options(4, true)).unwrap())
+        Box::new(plan_adaptive(m, &options(level.unwrap_or(4), true)).unwrap())
     } else if row.ends_with("_adaptive4") {
-        Box::new(plan_adaptive(m, &options(4, false)).unwrap())
+        Box::new(plan_adaptive(m, &options(level.unwrap_or(4), false)).unwrap())
     } else if row.ends_with("_uniform3_stencils") {
-        Box::new(uniform_stencils(m, Scheme::CatmullClark, 3).unwrap())
+        Box::new(uniform_stencils(m, Scheme::CatmullClark, level.unwrap_or(3) as usize).unwrap())
     } else if row.ends_with("_base_topology") {
         Box::new(LevelTopology::from_mesh(m, Scheme::CatmullClark).unwrap())
     } else {
@@ -91,14 +99,26 @@ fn run_row(row: &str, m: &ControlMesh) -> Box<dyn std::any::Any> {
     }
 }
 
+/// The process's minor page faults so far (Linux `/proc`), `None` elsewhere: each is a fresh
+/// page zeroed and mapped, the part of a cold run that a warm one does not pay.
+fn minor_faults() -> Option<u64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which may hold spaces) start at the state, field 3.
+    let rest = &stat[stat.rfind(')')? + 2..];
+    rest.split(' ').nth(7)?.parse().ok()
+}
+
 fn time_rows(rows: &str) {
     let reps: usize = std::env::var("TESSERA_BENCH_REPS")
         .ok()
         .and_then(|r| r.parse().ok())
         .unwrap_or(1);
-    // `TESSERA_BENCH_WARMUP=0`: no warm-up run, so the first timed run is cold, as each
-    // `far_perf` run is (fresh process: every page of the plan faulted in, caches cold).
-    let warm_up = std::env::var("TESSERA_BENCH_WARMUP").map_or(true, |w| w != "0");
+    // `TESSERA_BENCH_WARMUP=0`: no warm-up run, so the first timed run is cold (fresh
+    // process: every page of the plan faulted in, caches cold). `=levels`: the lower levels
+    // first, as `far_perf -l N` runs them in one process before level N (its reported figure).
+    let warm_up = std::env::var("TESSERA_BENCH_WARMUP").unwrap_or_default();
+    let lower_levels = warm_up == "levels";
+    let warm_up = warm_up != "0" && !lower_levels;
     let shapes = shapes();
     for row in rows.split(',') {
         let (_, m) = shapes
@@ -108,15 +128,31 @@ fn time_rows(rows: &str) {
         if warm_up {
             drop(run_row(row, m));
         }
+        if lower_levels {
+            let top = if row.contains("_uniform3") { 3 } else { 4 };
+            for level in 1..top {
+                drop(run_row_at(row, m, Some(level)));
+            }
+        }
         let mut ms = Vec::with_capacity(reps);
+        let mut faults = Vec::with_capacity(reps);
         for _ in 0..reps {
+            let f = minor_faults();
             let t = Instant::now();
             let out = run_row(row, m);
             ms.push(t.elapsed().as_secs_f64() * 1e3);
+            faults.push(minor_faults().zip(f).map(|(b, a)| b - a));
             drop(out);
         }
         let list: Vec<String> = ms.iter().map(|t| format!("{t:.3}")).collect();
         println!("{row} ms {}", list.join(" "));
+        if std::env::var_os("TESSERA_BENCH_FAULTS").is_some() {
+            let list: Vec<String> = faults
+                .iter()
+                .map(|f| f.map_or("?".into(), |f| f.to_string()))
+                .collect();
+            println!("{row} minor_faults {}", list.join(" "));
+        }
     }
 }
 

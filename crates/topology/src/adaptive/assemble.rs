@@ -244,7 +244,7 @@ pub(super) fn assemble(
             let mut patch = AdaptivePatch {
                 kind: PatchKind::Regular,
                 level: l as u8,
-                control_points: Vec::new(),
+                control_points: ControlPoints::new(),
                 base_face,
                 sub_face,
                 origin,
@@ -276,7 +276,7 @@ pub(super) fn assemble(
                         }
                     }
                 } else {
-                    patch.control_points = vec![INVALID; 4];
+                    patch.control_points = ControlPoints::from_elem(INVALID, 4);
                 }
                 // The end cap handles its sharp edges itself; the mask says which.
                 let (_, fe) = rotated(lvl.t(), f, shift);
@@ -293,7 +293,7 @@ pub(super) fn assemble(
                         face: f,
                     });
                 };
-                patch.control_points = grid.to_vec();
+                patch.control_points = ControlPoints::from_buf(grid);
                 patch.boundary_mask = mask;
             }
             Ok(patch)
@@ -341,7 +341,7 @@ pub(super) fn assemble(
         let rows = gregory_rows.next_if(|g| g.0 == pi as u32).map(|g| g.1);
         if let Some(g) = rows {
             let corners = patch.kind.corners();
-            let mut cps = Vec::with_capacity(g.len());
+            let mut cps = ControlPoints::with_capacity(g.len());
             for (k, row) in g.iter().enumerate() {
                 if k < 5 * corners && k % 5 == 0 {
                     // P: the canonical corner, filled below.
@@ -860,7 +860,7 @@ fn triangle_patch(
     let patch = AdaptivePatch {
         kind: PatchKind::GregoryTriangle,
         level: 0,
-        control_points: Vec::new(),
+        control_points: ControlPoints::new(),
         base_face: f as u32,
         sub_face: 0,
         origin: [0.0, 0.0],

@@ -109,7 +109,7 @@ pub(super) fn placeholder_patch() -> AdaptivePatch {
     AdaptivePatch {
         kind: PatchKind::Bilinear,
         level: 0,
-        control_points: Vec::new(),
+        control_points: ControlPoints::new(),
         base_face: INVALID,
         sub_face: 0,
         origin: [0.0; 2],
