@@ -14,11 +14,6 @@ pub(super) struct Locals {
 }
 
 impl Locals {
-    pub(super) fn push(&mut self, terms: &mut [(u32, f64)]) -> u32 {
-        let id = self.first + self.table.len() as u32;
-        push_row(&mut self.table, terms);
-        id
-    }
     /// Append the rows of `table` (built by [`push_row`]); returns the id of its first row.
     pub(super) fn append(&mut self, table: &StencilTable) -> u32 {
         let id = self.first + self.table.len() as u32;
@@ -64,6 +59,48 @@ impl Locals {
             }
         }
     }
+}
+
+/// Faces per chunk of the patch pass.
+const PATCH_CHUNK: usize = 1024;
+
+/// One chunk of the patch pass: its local points' rows, which of each patch's control points
+/// are ids of those rows (bit per slot), the first failure, and scratch terms.
+#[derive(Default)]
+struct PatchChunk {
+    table: StencilTable,
+    table_len0: usize,
+    masks: Vec<u32>,
+    error: Option<TopologyError>,
+    terms: Vec<(u32, f64)>,
+}
+
+/// Appends an end cap's point rows to `table` as local points and sets its control points to
+/// their ids relative to `rel0`, except each corner's `P` (the canonical corner, numbered
+/// later). Returns the slots that hold such ids.
+fn number_rows(
+    patch: &mut AdaptivePatch,
+    rows: &PointRows,
+    table: &mut StencilTable,
+    rel0: usize,
+    terms: &mut Vec<(u32, f64)>,
+) -> u32 {
+    let corners = patch.kind.corners();
+    let mut cps = ControlPoints::with_capacity(rows.len());
+    let mut mask = 0u32;
+    for (k, row) in rows.iter().enumerate() {
+        if k < 5 * corners && k % 5 == 0 {
+            cps.push(INVALID);
+        } else {
+            terms.clear();
+            terms.extend_from_slice(row);
+            cps.push((table.len() - rel0) as u32);
+            push_row(table, terms);
+            mask |= 1 << k;
+        }
+    }
+    patch.control_points = cps;
+    mask
 }
 
 /// `caps_from`: the first level whose irregular faces become end caps (the isolation level;
@@ -189,8 +226,13 @@ pub(super) fn assemble(
     let total: usize = candidates.iter().map(Vec::len).sum();
     let mut patches: Vec<AdaptivePatch> = Vec::with_capacity(total);
     let mut sites: Vec<PatchSite> = Vec::with_capacity(total);
-    // Gregory rows by patch index (end caps are a few percent of the patches).
-    let gregory_rows = std::sync::Mutex::new(Vec::<(u32, Box<PointRows>)>::new());
+    // Local points (phantoms, Gregory points, canonical corners) come to 2 to 7 rows and 15 to
+    // 29 terms per patch on every shape in tests/data (catmark_car 2.7 and 15.3, spot 2.8 and
+    // 22.8): reserve once, with room to spare, instead of regrowing (a regrowth copies MBs).
+    // Pages never written are never faulted in, so the spare room costs address space only.
+    locals.table.offsets.reserve(8 * total);
+    locals.table.indices.reserve(32 * total);
+    locals.table.weights.reserve(32 * total);
     // Sized once for the largest level that drafts patches: growing it level by level copied
     // and faulted in each level's records anew.
     let mut quads: Vec<QuadRec> = Vec::with_capacity(
@@ -202,6 +244,9 @@ pub(super) fn assemble(
             .max()
             .unwrap_or(0),
     );
+    // Chunk tables of local rows, reused from round to round (see `PatchChunk`).
+    let threads = rayon::current_num_threads().max(1);
+    let mut chunks: Vec<PatchChunk> = Vec::new();
     for (l, (lvl, faces)) in levels.iter().zip(&candidates).enumerate() {
         if !faces.is_empty() {
             quad_records(lvl, &mut quads);
@@ -209,24 +254,18 @@ pub(super) fn assemble(
         let quads = &quads;
         // End caps from the isolation level on (deeper levels follow semi-sharp features).
         let is_last = l >= iso;
-        let first = patches.len();
-        // A failing face leaves a placeholder and its error; the first failing face in order
-        // is reported, whatever the thread count.
-        let first_error = std::sync::Mutex::new(None::<(usize, TopologyError)>);
-        let shifts: Vec<std::sync::atomic::AtomicU8> = faces
-            .iter()
-            .map(|_| std::sync::atomic::AtomicU8::new(0))
-            .collect();
-        let keep_rows = |k: usize, rows: PointRows| {
-            if let Ok(mut g) = gregory_rows.lock() {
-                g.push(((first + k) as u32, Box::new(rows)));
-            }
-        };
-        let patch = |k: usize, f: usize| -> Result<AdaptivePatch, TopologyError> {
+        // One patch: its control points, with its local points' rows appended to `table`
+        // (their ids relative to `rel0`, marked in the returned mask for the caller to
+        // number), and its rotation.
+        let patch = |f: usize,
+                     table: &mut StencilTable,
+                     rel0: usize,
+                     terms: &mut Vec<(u32, f64)>|
+         -> Result<(AdaptivePatch, u32, u8), TopologyError> {
             if l == 0 && tri[f] {
-                let (patch, rows) = triangle_patch(mesh, &levels, f)?;
-                keep_rows(k, rows);
-                return Ok(patch);
+                let (mut patch, rows) = triangle_patch(mesh, &levels, f)?;
+                let mask = number_rows(&mut patch, &rows, table, rel0, terms);
+                return Ok((patch, mask, 0));
             }
             let irregular = lvl
                 .t()
@@ -240,7 +279,6 @@ pub(super) fn assemble(
                 });
             }
             let (base_face, sub_face, origin, size, shift) = frame(&levels, l, f);
-            shifts[k].store(shift, std::sync::atomic::Ordering::Relaxed);
             let mut patch = AdaptivePatch {
                 kind: PatchKind::Regular,
                 level: l as u8,
@@ -255,26 +293,28 @@ pub(super) fn assemble(
                 reparam_valences: [0; 4],
                 tangent_valences: [0; 4],
             };
+            let mut mask = 0;
             if irregular {
                 patch.kind = match opts.end_cap {
                     EndCap::Gregory => PatchKind::Gregory,
                     EndCap::Bilinear => PatchKind::Bilinear,
                 };
                 if patch.kind == PatchKind::Gregory {
-                    match acc.then(|| acc_points(mesh, lvl, f, shift)) {
+                    let rows = match acc.then(|| acc_points(mesh, lvl, f, shift)) {
                         Some(Ok(points)) => {
                             // An ACC-1 net: its corners' valences shade it; no
                             // reparameterization is fitted to it.
                             patch.tangent_valences = rotated(lvl.t(), f, shift)
                                 .0
                                 .map(|v| lvl.t().vertex_edges(v as usize).len().min(255) as u8);
-                            keep_rows(k, points);
+                            points
                         }
                         _ => {
                             patch.reparam_valences = reparam_valences(lvl, f, shift);
-                            keep_rows(k, gregory_points(mesh, lvl, f, shift)?);
+                            gregory_points(mesh, lvl, f, shift)?
                         }
-                    }
+                    };
+                    mask = number_rows(&mut patch, &rows, table, rel0, terms);
                 } else {
                     patch.control_points = ControlPoints::from_elem(INVALID, 4);
                 }
@@ -287,94 +327,124 @@ pub(super) fn assemble(
                 }
             } else {
                 // The error is built only on failure (it has a destructor to run otherwise).
-                let Some((grid, mask)) = gather_regular(lvl, quads, f, shift) else {
+                let Some((ids, boundary)) = gather_regular(lvl, quads, f, shift) else {
                     return Err(TopologyError::AdaptivePatch {
                         level: l as u32,
                         face: f,
                     });
                 };
-                patch.control_points = ControlPoints::from_buf(grid);
-                patch.boundary_mask = mask;
-            }
-            Ok(patch)
-        };
-        patches.par_extend(
-            faces
-                .par_iter()
-                .enumerate()
-                .with_min_len(256)
-                .map(|(k, &f)| {
-                    patch(k, f as usize).unwrap_or_else(|e| {
-                        if let Ok(mut first) = first_error.lock() {
-                            if first.as_ref().is_none_or(|(g, _)| (f as usize) < *g) {
-                                *first = Some((f as usize, e));
-                            }
+                patch.control_points = ControlPoints::from_buf(ids);
+                patch.boundary_mask = boundary;
+                if boundary != 0 || ids.contains(&INVALID) {
+                    // Phantom points past the boundary: extrapolated local points.
+                    let Some(grid) = phantom_grid(&ids, boundary) else {
+                        return Err(TopologyError::AdaptivePatch {
+                            level: l as u32,
+                            face: f,
+                        });
+                    };
+                    for (slot, (cp, c)) in patch.control_points.iter_mut().zip(&grid).enumerate() {
+                        if !(c.n == 1 && c.w[0] == 1.0) {
+                            terms.clear();
+                            terms.extend((0..c.n as usize).map(|k| (c.idx[k], c.w[k])));
+                            *cp = (table.len() - rel0) as u32;
+                            push_row(table, terms);
+                            mask |= 1 << slot;
+                        } else {
+                            *cp = c.idx[0];
                         }
-                        placeholder_patch()
-                    })
-                }),
-        );
-        if let Some((_, e)) = first_error.into_inner().ok().flatten() {
-            return Err(e);
-        }
-        sites.extend(faces.iter().zip(shifts).map(|(&face, shift)| PatchSite {
-            face,
-            shift: shift.into_inner(),
-        }));
-    }
-    drop(candidates);
-
-    // Local points (phantoms, Gregory points, canonical corners) come to 2 to 7 rows and 15 to
-    // 29 terms per patch on every shape in tests/data (catmark_car 2.7 and 15.3, spot 2.8 and
-    // 22.8): reserve once, with room to spare, instead of regrowing (a regrowth copies MBs).
-    // Pages never written are never faulted in, so the spare room costs address space only.
-    locals.table.offsets.reserve(8 * patches.len());
-    locals.table.indices.reserve(32 * patches.len());
-    locals.table.weights.reserve(32 * patches.len());
-    // Control points: phantoms and Gregory points become local points, numbered in patch
-    // order. Each end cap's rows are dropped once numbered.
-    let mut gregory_rows = gregory_rows.into_inner().unwrap_or_default();
-    gregory_rows.sort_unstable_by_key(|g| g.0);
-    let mut gregory_rows = gregory_rows.into_iter().peekable();
-    let mut terms: Vec<(u32, f64)> = Vec::with_capacity(64);
-    for (pi, (patch, site)) in patches.iter_mut().zip(&sites).enumerate() {
-        let rows = gregory_rows.next_if(|g| g.0 == pi as u32).map(|g| g.1);
-        if let Some(g) = rows {
-            let corners = patch.kind.corners();
-            let mut cps = ControlPoints::with_capacity(g.len());
-            for (k, row) in g.iter().enumerate() {
-                if k < 5 * corners && k % 5 == 0 {
-                    // P: the canonical corner, filled below.
-                    cps.push(INVALID);
-                } else {
-                    terms.clear();
-                    terms.extend_from_slice(row);
-                    cps.push(locals.push(&mut terms));
+                    }
                 }
             }
-            patch.control_points = cps;
-        } else if patch.kind == PatchKind::Regular
-            && (patch.boundary_mask != 0 || patch.control_points.contains(&INVALID))
-        {
-            let mut ids = [INVALID; 16];
-            ids.copy_from_slice(&patch.control_points);
-            let Some(grid) = phantom_grid(&ids, patch.boundary_mask) else {
-                return Err(TopologyError::AdaptivePatch {
-                    level: patch.level as u32,
-                    face: site.face as usize,
-                });
+            Ok((patch, mask, shift))
+        };
+        // Rounds of chunks of faces, two per thread, each writing its patches in place and its
+        // local points' rows into a chunk table; then, in face order, each chunk's rows are
+        // appended to the local points and its patches' local ids numbered. The rows are
+        // numbered in patch order, as one pass over the patches would, and each end cap's rows
+        // die with its chunk's round instead of waiting for the whole list (catmark_car: 3 MB).
+        // On one thread the rows go straight into the local points.
+        let direct = threads == 1;
+        let per_round = if direct { 1 } else { 2 * threads };
+        for round in faces.chunks(per_round * PATCH_CHUNK) {
+            let first = patches.len();
+            patches.extend((0..round.len()).map(|_| placeholder_patch()));
+            sites.extend(round.iter().map(|&face| PatchSite { face, shift: 0 }));
+            let parts: Vec<&[u32]> = round.chunks(PATCH_CHUNK).collect();
+            while chunks.len() < parts.len() {
+                chunks.push(PatchChunk::default());
+            }
+            let mut taken = direct.then(|| std::mem::take(&mut locals.table));
+            let run = |c: &mut PatchChunk,
+                       table: &mut StencilTable,
+                       out: &mut [AdaptivePatch],
+                       out_sites: &mut [PatchSite],
+                       part: &[u32]| {
+                c.masks.clear();
+                c.error = None;
+                let rel0 = table.len();
+                for ((slot, site), &f) in out.iter_mut().zip(out_sites.iter_mut()).zip(part) {
+                    match patch(f as usize, table, rel0, &mut c.terms) {
+                        Ok((p, mask, shift)) => {
+                            *slot = p;
+                            site.shift = shift;
+                            c.masks.push(mask);
+                        }
+                        Err(e) => {
+                            // The first failing face of the chunk; chunks are checked in order.
+                            c.error = Some(e);
+                            return;
+                        }
+                    }
+                }
             };
-            for (slot, c) in patch.control_points.iter_mut().zip(grid.iter()) {
-                *slot = if c.n == 1 && c.w[0] == 1.0 {
-                    c.idx[0]
+            let (out, out_sites) = (&mut patches[first..], &mut sites[first..]);
+            if let Some(table) = taken.as_mut() {
+                let c = &mut chunks[0];
+                c.table_len0 = table.len();
+                run(c, table, out, out_sites, parts[0]);
+            } else {
+                chunks[..parts.len()]
+                    .par_iter_mut()
+                    .zip(out.par_chunks_mut(PATCH_CHUNK))
+                    .zip(out_sites.par_chunks_mut(PATCH_CHUNK))
+                    .zip(parts.par_iter())
+                    .for_each(|(((c, out), out_sites), part)| {
+                        let mut table = std::mem::take(&mut c.table);
+                        table.offsets.clear();
+                        table.offsets.push(0);
+                        table.indices.clear();
+                        table.weights.clear();
+                        c.table_len0 = 0;
+                        run(c, &mut table, out, out_sites, part);
+                        c.table = table;
+                    });
+            }
+            if let Some(table) = taken {
+                locals.table = table;
+            }
+            for (k, c) in chunks[..parts.len()].iter_mut().enumerate() {
+                if let Some(e) = c.error.take() {
+                    return Err(e);
+                }
+                let offset = if direct {
+                    first_local + c.table_len0 as u32
                 } else {
-                    terms.clear();
-                    terms.extend((0..c.n as usize).map(|k| (c.idx[k], c.w[k])));
-                    locals.push(&mut terms)
+                    locals.append(&c.table)
                 };
+                let at = first + k * PATCH_CHUNK;
+                for (p, &mask) in patches[at..at + c.masks.len()].iter_mut().zip(&c.masks) {
+                    let mut m = mask;
+                    while m != 0 {
+                        let slot = m.trailing_zeros() as usize;
+                        p.control_points[slot] += offset;
+                        m &= m - 1;
+                    }
+                }
             }
         }
     }
+    drop(candidates);
 
     // Canonical corners, at the coarsest level each is a patch corner (patches are level-ordered).
     // A corner first met on a regular patch is a regular vertex, and its limit point is the
@@ -530,8 +600,10 @@ pub(super) fn assemble(
             face: site.face as usize,
         };
         for p in 0..n {
+            // The next corner without a division (`n` is 3 or 4, known only at run time).
+            let q = if p + 1 == n { 0 } else { p + 1 };
             let e = fe[p];
-            let (a, b) = (fv[p], fv[(p + 1) % n]);
+            let (a, b) = (fv[p], fv[q]);
             let [x, y] = t.edge_faces(e as usize);
             let g = if x == site.face { y } else { x };
             let kind = if pk == PatchKind::GregoryTriangle {
@@ -564,7 +636,7 @@ pub(super) fn assemble(
                 }
             };
             // The patch's own corners were numbered above: read them, not the canonical map.
-            let (ca, cb) = (corners[pi][p], corners[pi][(p + 1) % n]);
+            let (ca, cb) = (corners[pi][p], corners[pi][q]);
             let pe = &mut patch.edges[p];
             pe.kind = kind;
             match kind {
