@@ -679,8 +679,11 @@ pub fn refine_sparse_region(
     for &v in &verts {
         for &e in p.vertex_edges(v as usize) {
             let e = e as usize;
-            let pair = half_edge_sharpness(p, parent.edge_sharpness, options, e, &mut scratch);
-            halves[2 * e..2 * e + 2].copy_from_slice(&pair);
+            // Smooth edges have smooth halves (as the zeroed `halves` has them).
+            if is_sharp(parent.edge_sharpness[e]) {
+                let pair = half_edge_sharpness(p, parent.edge_sharpness, options, e, &mut scratch);
+                halves[2 * e..2 * e + 2].copy_from_slice(&pair);
+            }
         }
     }
     let decayed: Vec<f32> = parent
@@ -768,7 +771,36 @@ pub fn refine_sparse_region(
         let n = fv.len();
         let inner = edge_verts.len() as u32;
         face_first_child[f as usize] = child_face_parent.len() as u32;
-        if quads {
+        if let (true, Ok(fv), Ok(fe)) =
+            (quads, <&[u32; 4]>::try_from(fv), <&[u32; 4]>::try_from(fe))
+        {
+            // A quad: as the general case below, unrolled.
+            let fc = face_child_vertex[f as usize];
+            let corner_made = fv.map(made);
+            let mut inner4 = [INVALID; 4];
+            for i in 0..4 {
+                if corner_made[i] || corner_made[(i + 1) & 3] {
+                    inner4[i] = edge_verts.len() as u32;
+                    edge_verts.push([ec(fe[i]), fc]);
+                }
+            }
+            for i in 0..4 {
+                if !corner_made[i] {
+                    continue;
+                }
+                let prev = (i + 3) & 3;
+                let (v, e, ep) = (fv[i], fe[i], fe[prev]);
+                face_verts.extend_from_slice(&[vc(v), ec(e), fc, ec(ep)]);
+                face_edges.extend_from_slice(&[
+                    half_at(e, v),
+                    inner4[i],
+                    inner4[prev],
+                    half_at(ep, v),
+                ]);
+                face_offsets.push(face_verts.len() as u32);
+                child_face_parent.push(f);
+            }
+        } else if quads {
             // Inner edge i (edge i's vertex to the face's) where corner i or i + 1 is made: all
             // of them unless corners_only, in edge order either way.
             let fc = face_child_vertex[f as usize];
@@ -1523,8 +1555,8 @@ fn face_centre_merged(fv: &[u32], out: &mut RowOut) -> bool {
         if q[0] == q[1] || q[1] == q[2] || q[2] == q[3] {
             return false;
         }
-        out.idx.extend(q.map(|j| j as u32));
-        out.wts.extend([w; 4]);
+        out.idx.extend_from_slice(&q.map(|j| j as u32));
+        out.wts.extend_from_slice(&[w; 4]);
         return true;
     }
     let mut keys = [0u64; 16];
