@@ -462,10 +462,9 @@ impl Topology {
         edge_verts: Vec<[u32; 2]>,
     ) -> Topology {
         let mut edge_faces = vec![[INVALID, INVALID]; edge_verts.len()];
-        let nf = face_offsets.len() - 1;
-        for f in 0..nf {
-            for c in face_offsets[f]..face_offsets[f + 1] {
-                let slot = &mut edge_faces[face_edges[c as usize] as usize];
+        for (f, ends) in face_offsets.windows(2).enumerate() {
+            for &e in &face_edges[ends[0] as usize..ends[1] as usize] {
+                let slot = &mut edge_faces[e as usize];
                 if slot[0] == INVALID {
                     slot[0] = f as u32;
                 } else {
@@ -532,40 +531,44 @@ impl Topology {
         }
     }
 
-    /// Counting-sort the vertex→edge and vertex→face incidence lists.
+    /// Counting-sort the vertex→edge and vertex→face incidence lists. The counts go to slot
+    /// `v + 2`, so that after the prefix sum slot `v + 1` is vertex `v`'s fill cursor and ends
+    /// as its end offset: the offsets come out without a second array.
     fn build_vertex_incidence(&mut self) {
         let nv = self.num_vertices;
-        let mut counts = vec![0u32; nv + 1];
-        for e in &self.edge_verts {
-            counts[e[0] as usize + 1] += 1;
-            counts[e[1] as usize + 1] += 1;
+        let mut offsets = vec![0u32; nv + 2];
+        for ev in &self.edge_verts {
+            offsets[ev[0] as usize + 2] += 1;
+            offsets[ev[1] as usize + 2] += 1;
         }
-        prefix_sum(&mut counts);
-        let mut fill = counts.clone();
-        let mut vert_edges = vec![0u32; *counts.last().unwrap_or(&0) as usize];
+        prefix_sum(&mut offsets);
+        let mut vert_edges = vec![0u32; 2 * self.edge_verts.len()];
         for (e, ev) in self.edge_verts.iter().enumerate() {
             for &v in ev {
-                vert_edges[fill[v as usize] as usize] = e as u32;
-                fill[v as usize] += 1;
+                let cursor = &mut offsets[v as usize + 1];
+                vert_edges[*cursor as usize] = e as u32;
+                *cursor += 1;
             }
         }
-        self.vert_edge_offsets = counts;
+        offsets.pop();
+        self.vert_edge_offsets = offsets;
         self.vert_edges = vert_edges;
 
-        let mut counts = vec![0u32; nv + 1];
+        let mut offsets = vec![0u32; nv + 2];
         for &v in &self.face_verts {
-            counts[v as usize + 1] += 1;
+            offsets[v as usize + 2] += 1;
         }
-        prefix_sum(&mut counts);
-        let mut fill = counts.clone();
+        prefix_sum(&mut offsets);
         let mut vert_faces = vec![0u32; self.face_verts.len()];
-        for f in 0..self.num_faces() {
-            for &v in self.face_vertices(f) {
-                vert_faces[fill[v as usize] as usize] = f as u32;
-                fill[v as usize] += 1;
+        for (f, ends) in self.face_offsets.windows(2).enumerate() {
+            for &v in &self.face_verts[ends[0] as usize..ends[1] as usize] {
+                let cursor = &mut offsets[v as usize + 1];
+                vert_faces[*cursor as usize] = f as u32;
+                *cursor += 1;
             }
         }
-        self.vert_face_offsets = counts;
+        offsets.pop();
+        self.vert_face_offsets = offsets;
         self.vert_faces = vert_faces;
     }
 

@@ -58,7 +58,7 @@ use crate::sdc::{
     boundary_edge_sharpness, boundary_vertex_sharpness, decrement_sharpness, fractional_weight,
     is_sharp, subdivide_edge_sharpness_at_vertex, vertex_rule, Rule, Scheme,
 };
-use crate::stencil::{build_rows, compose_rows, RowKind, StencilTable};
+use crate::stencil::{build_rows, compose_rows, RowKind, RowOut, StencilTable};
 use rayon::prelude::*;
 
 /// One level of a refinement: topology, positions and (propagated) sharpness.
@@ -679,8 +679,11 @@ pub fn refine_sparse_region(
     for &v in &verts {
         for &e in p.vertex_edges(v as usize) {
             let e = e as usize;
-            let pair = half_edge_sharpness(p, parent.edge_sharpness, options, e, &mut scratch);
-            halves[2 * e..2 * e + 2].copy_from_slice(&pair);
+            // Smooth edges have smooth halves (as the zeroed `halves` has them).
+            if is_sharp(parent.edge_sharpness[e]) {
+                let pair = half_edge_sharpness(p, parent.edge_sharpness, options, e, &mut scratch);
+                halves[2 * e..2 * e + 2].copy_from_slice(&pair);
+            }
         }
     }
     let decayed: Vec<f32> = parent
@@ -768,7 +771,36 @@ pub fn refine_sparse_region(
         let n = fv.len();
         let inner = edge_verts.len() as u32;
         face_first_child[f as usize] = child_face_parent.len() as u32;
-        if quads {
+        if let (true, Ok(fv), Ok(fe)) =
+            (quads, <&[u32; 4]>::try_from(fv), <&[u32; 4]>::try_from(fe))
+        {
+            // A quad: as the general case below, unrolled.
+            let fc = face_child_vertex[f as usize];
+            let corner_made = fv.map(made);
+            let mut inner4 = [INVALID; 4];
+            for i in 0..4 {
+                if corner_made[i] || corner_made[(i + 1) & 3] {
+                    inner4[i] = edge_verts.len() as u32;
+                    edge_verts.push([ec(fe[i]), fc]);
+                }
+            }
+            for i in 0..4 {
+                if !corner_made[i] {
+                    continue;
+                }
+                let prev = (i + 3) & 3;
+                let (v, e, ep) = (fv[i], fe[i], fe[prev]);
+                face_verts.extend_from_slice(&[vc(v), ec(e), fc, ec(ep)]);
+                face_edges.extend_from_slice(&[
+                    half_at(e, v),
+                    inner4[i],
+                    inner4[prev],
+                    half_at(ep, v),
+                ]);
+                face_offsets.push(face_verts.len() as u32);
+                child_face_parent.push(f);
+            }
+        } else if quads {
             // Inner edge i (edge i's vertex to the face's) where corner i or i + 1 is made: all
             // of them unless corners_only, in edge order either way.
             let fc = face_child_vertex[f as usize];
@@ -1272,7 +1304,7 @@ impl MaskContext<'_> {
     /// added in the order `row` lists them, as the accumulator adds them, so the weights are
     /// bit-identical. Where the one-ring is not what the fast rule reads (a vertex repeated in
     /// a ring, a long ring) the raw row is written instead, and `false` returned.
-    fn row_merged(&self, i: usize, out: &mut Vec<(u32, f64)>) -> bool {
+    fn row_merged(&self, i: usize, out: &mut RowOut) -> bool {
         let p = self.p;
         let (nv, ne) = (p.num_vertices(), p.num_edges());
         let merged = self.scheme == Scheme::CatmullClark
@@ -1284,8 +1316,7 @@ impl MaskContext<'_> {
                 face_centre_merged(p.face_vertices(i - nv - ne), out)
             };
         if !merged {
-            out.clear();
-            self.row(i, out);
+            self.row(i, out.raw);
         }
         merged
     }
@@ -1293,12 +1324,15 @@ impl MaskContext<'_> {
     /// The smooth (or dart) vertex point of a Catmull-Clark vertex, merged: the vertex, its
     /// ring neighbours (an edge term, then each face's share) and the other corners of its
     /// faces (one face's share each).
-    fn smooth_vertex_merged(&self, v: usize, out: &mut Vec<(u32, f64)>) -> bool {
-        const RING: usize = 16;
+    fn smooth_vertex_merged(&self, v: usize, out: &mut RowOut) -> bool {
+        // Longest ring and row taken here (kept short: the arrays are zeroed per row).
+        const RING: usize = 11;
+        const ROW: usize = 24;
         let p = self.p;
         let edges = p.vertex_edges(v);
+        let faces = p.vertex_faces(v);
         let k = edges.len();
-        if k == 0 || k > RING {
+        if k == 0 || k > RING || faces.len() > RING {
             return false;
         }
         let sharp_count = edges
@@ -1311,77 +1345,106 @@ impl MaskContext<'_> {
         ) {
             return false;
         }
-        // As `smooth_vertex(v, 1.0)` computes them.
+        // As `smooth_vertex(v, 1.0)` computes them. Weight slots: the vertex, each ring
+        // neighbour, then each face's share at its far corners.
         let scale = 1.0f64;
         let n = k as f64;
         let ew = 1.0 / (n * n);
         let mut ring = [0u32; RING];
-        let mut sums = [0.0f64; RING];
+        let mut w = [0.0f64; 1 + 2 * RING];
+        let mut keys = [0u64; ROW];
+        keys[0] = key(v as u32, 0);
         for (j, &e) in edges.iter().enumerate() {
             ring[j] = other_end(p, e, v);
-            sums[j] = scale * ew;
+            w[1 + j] = scale * ew;
+            keys[1 + j] = key(ring[j], 1 + j);
         }
+        let mut len = 1 + k;
         let ring = &ring[..k];
         let mut centre = scale * (n - 2.0) / n;
-        out.push((v as u32, 0.0));
-        for &f in p.vertex_faces(v) {
+        for (s, &f) in (1 + k..).zip(faces) {
             let fv = p.face_vertices(f as usize);
-            let w = (scale * ew) / fv.len() as f64;
+            let m = fv.len();
+            if len + m > ROW {
+                return false;
+            }
+            let wf = (scale * ew) / m as f64;
+            w[s] = wf;
             let Some(c) = fv.iter().position(|&x| x as usize == v) else {
                 return false;
             };
-            let m = fv.len();
+            if let Ok(q) = <&[u32; 4]>::try_from(fv) {
+                // A quad: the corner, the ring neighbours either side, the far corner. Each
+                // sum takes its terms in face order, as the loop below adds them.
+                centre += wf;
+                for x in [q[(c + 1) & 3], q[(c + 3) & 3]] {
+                    match ring.iter().position(|&r| r == x) {
+                        Some(j) => w[1 + j] += wf,
+                        None => return false,
+                    }
+                }
+                keys[len] = key(q[(c + 2) & 3], s);
+                len += 1;
+                continue;
+            }
             for (d, &x) in fv.iter().enumerate() {
                 // The corner's place after `c` around the face (no division per corner).
                 let d = if d >= c { d - c } else { d + m - c };
                 if d == 0 {
-                    centre += w;
+                    centre += wf;
                 } else if d == 1 || d == m - 1 {
                     match ring.iter().position(|&r| r == x) {
-                        Some(j) => sums[j] += w,
+                        Some(j) => w[1 + j] += wf,
                         None => return false,
                     }
                 } else {
-                    out.push((x, w));
+                    keys[len] = key(x, s);
+                    len += 1;
                 }
             }
         }
-        out[0].1 = centre;
-        out.extend(ring.iter().copied().zip(sums.iter().copied()));
-        sort_distinct(out)
+        w[0] = centre;
+        emit_merged(&mut keys[..len], &w[..1 + k + faces.len()], out)
     }
 
     /// The smooth edge point of a Catmull-Clark edge, merged: its ends (the edge term, then
     /// each face's share) and the other corners of its faces.
-    fn smooth_edge_merged(&self, e: usize, out: &mut Vec<(u32, f64)>) -> bool {
+    fn smooth_edge_merged(&self, e: usize, out: &mut RowOut) -> bool {
         let p = self.p;
         if is_sharp(self.es[e]) {
             return false;
         }
         let [a, b] = p.edge_verts[e];
         let faces = p.edge_face_list(e);
-        // As `smooth_edge(e, 1.0)` computes them.
+        // As `smooth_edge(e, 1.0)` computes them. Weight slots: the two ends, then each face's
+        // share at its other corners.
         let scale = 1.0f64;
         let (vw, fw) = self.catmark_edge_weights(faces);
-        let (mut sa, mut sb) = (scale * vw, scale * vw);
-        out.push((a, 0.0));
-        out.push((b, 0.0));
-        for &f in faces {
+        let mut w = [scale * vw, scale * vw, 0.0, 0.0];
+        // Long enough for two octagons.
+        let mut keys = [0u64; 16];
+        keys[0] = key(a, 0);
+        keys[1] = key(b, 1);
+        let mut len = 2;
+        for (s, &f) in (2..).zip(faces) {
             let fv = p.face_vertices(f as usize);
-            let w = (scale * fw) / fv.len() as f64;
+            if len + fv.len() > keys.len() {
+                return false;
+            }
+            let wf = (scale * fw) / fv.len() as f64;
+            w[s] = wf;
             for &x in fv {
                 if x == a {
-                    sa += w;
+                    w[0] += wf;
                 } else if x == b {
-                    sb += w;
+                    w[1] += wf;
                 } else {
-                    out.push((x, w));
+                    keys[len] = key(x, s);
+                    len += 1;
                 }
             }
         }
-        out[0].1 = sa;
-        out[1].1 = sb;
-        sort_distinct(out)
+        emit_merged(&mut keys[..len], &w[..2 + faces.len()], out)
     }
 
     fn vertex_vertex(&self, v: usize, out: &mut Vec<(u32, f64)>) {
@@ -1484,30 +1547,109 @@ pub(crate) fn loop_vertex_weights(n: usize) -> (f64, f64) {
 }
 
 /// A face point, merged: each corner once at `1 / n` (as `face_center(f, 1.0)`).
-fn face_centre_merged(fv: &[u32], out: &mut Vec<(u32, f64)>) -> bool {
+fn face_centre_merged(fv: &[u32], out: &mut RowOut) -> bool {
     let w = 1.0 / fv.len() as f64;
-    out.extend(fv.iter().map(|&v| (v, w)));
-    sort_distinct(out)
-}
-
-/// Sort a short row by index and drop exact zeros; `false` (the row is left as it is) if an
-/// index repeats, which the merged rules do not sum.
-fn sort_distinct(row: &mut Vec<(u32, f64)>) -> bool {
-    // Distinct indices make the unstable sort's order the only order; a repeat is found next
-    // to its twin and refused below, and the caller rebuilds the row raw.
-    row.sort_unstable_by_key(|e| e.0);
-    let mut kept = 0;
-    for i in 0..row.len() {
-        let e = row[i];
-        if i > 0 && row[i - 1].0 == e.0 {
+    if let Ok(&q) = <&[u32; 4]>::try_from(fv) {
+        let mut q = q.map(u64::from);
+        sort4(&mut q);
+        if q[0] == q[1] || q[1] == q[2] || q[2] == q[3] {
             return false;
         }
-        if e.1 != 0.0 {
-            row[kept] = e;
-            kept += 1;
+        out.idx.extend_from_slice(&q.map(|j| j as u32));
+        out.wts.extend_from_slice(&[w; 4]);
+        return true;
+    }
+    let mut keys = [0u64; 16];
+    if fv.len() > keys.len() {
+        return false;
+    }
+    for (slot, &x) in keys.iter_mut().zip(fv) {
+        *slot = key(x, 0);
+    }
+    emit_merged(&mut keys[..fv.len()], &[w], out)
+}
+
+/// A merged rule's entry as one word: its index above its weight's slot, so sorting the words
+/// sorts the entries by index and moves a word, not an (index, weight) pair.
+#[inline]
+fn key(j: u32, slot: usize) -> u64 {
+    (u64::from(j) << 32) | slot as u64
+}
+
+/// Sort `$k` with a comparator network (branch-free compare-exchanges, unrolled).
+macro_rules! sort_net {
+    ($k:expr; $(($i:literal, $j:literal)),* $(,)?) => {
+        $(
+            let (a, b) = ($k[$i], $k[$j]);
+            $k[$i] = a.min(b);
+            $k[$j] = a.max(b);
+        )*
+    };
+}
+
+/// Optimal sorting networks for the common row lengths: a face point of a quad (4), a smooth
+/// edge point between quads (6), a smooth valence-4 vertex point among quads (9).
+#[inline(always)]
+fn sort4(k: &mut [u64; 4]) {
+    sort_net!(k; (0, 1), (2, 3), (0, 2), (1, 3), (1, 2));
+}
+
+#[inline(always)]
+fn sort6(k: &mut [u64; 6]) {
+    sort_net!(k;
+        (0, 5), (1, 3), (2, 4), (1, 2), (3, 4), (0, 3),
+        (2, 5), (0, 1), (2, 3), (4, 5), (1, 2), (3, 4),
+    );
+}
+
+#[inline(always)]
+fn sort9(k: &mut [u64; 9]) {
+    sort_net!(k;
+        (0, 3), (1, 7), (2, 5), (4, 8), (0, 7), (2, 4), (3, 8), (5, 6), (0, 2),
+        (1, 3), (4, 5), (7, 8), (1, 4), (3, 6), (5, 7), (0, 1), (2, 4), (3, 5),
+        (6, 8), (2, 3), (4, 5), (6, 7), (1, 2), (3, 4), (5, 6),
+    );
+}
+
+/// Sort a short row's keys ([`key`]).
+#[inline]
+fn sort_keys(keys: &mut [u64]) {
+    if let Ok(k) = <&mut [u64; 6]>::try_from(&mut *keys) {
+        sort6(k);
+    } else if let Ok(k) = <&mut [u64; 9]>::try_from(&mut *keys) {
+        sort9(k);
+    } else {
+        for i in 1..keys.len() {
+            let x = keys[i];
+            let mut j = i;
+            while j > 0 && keys[j - 1] > x {
+                keys[j] = keys[j - 1];
+                j -= 1;
+            }
+            keys[j] = x;
         }
     }
-    row.truncate(kept);
+}
+
+/// Append a merged rule's entries ([`key`]) to `out`: by ascending index, with their slot's
+/// weight in `w` (every slot used), exact zeros dropped. `false` (nothing written) if an index
+/// repeats: the merged rules do not sum repeats, the caller writes the row raw.
+#[inline]
+fn emit_merged(keys: &mut [u64], w: &[f64], out: &mut RowOut) -> bool {
+    sort_keys(keys);
+    if keys.windows(2).any(|pair| pair[0] >> 32 == pair[1] >> 32) {
+        return false;
+    }
+    let weight = |key: u64| w[key as u32 as usize];
+    if w.contains(&0.0) {
+        for &key in keys.iter().filter(|&&key| weight(key) != 0.0) {
+            out.idx.push((key >> 32) as u32);
+            out.wts.push(weight(key));
+        }
+    } else {
+        out.idx.extend(keys.iter().map(|&key| (key >> 32) as u32));
+        out.wts.extend(keys.iter().map(|&key| weight(key)));
+    }
     true
 }
 
@@ -1615,7 +1757,7 @@ fn refine_doo_sabin(parent: &Level) -> Result<(Level, StencilTable), TopologyErr
                 let d = (i + n - j) % n;
                 (3.0 + 2.0 * (2.0 * std::f64::consts::PI * d as f64 / nf).cos()) / (4.0 * nf)
             };
-            out.push((v, w));
+            out.raw.push((v, w));
         }
         false
     });
@@ -1687,11 +1829,21 @@ mod tests {
                 child_vertex_sharpness: &vertex_sharpness[..p.num_vertices()],
             };
             let (mut a, mut b) = (Vec::new(), Vec::new());
+            let (mut idx, mut wts) = (Vec::new(), Vec::new());
             for i in 0..vertex_sharpness.len() {
                 a.clear();
                 b.clear();
+                idx.clear();
+                wts.clear();
                 ctx.row(i, &mut b);
-                if ctx.row_merged(i, &mut a) {
+                let mut out = RowOut {
+                    raw: &mut a,
+                    idx: &mut idx,
+                    wts: &mut wts,
+                };
+                if ctx.row_merged(i, &mut out) {
+                    assert!(a.is_empty(), "row {i}");
+                    let a: Vec<(u32, f64)> = idx.iter().copied().zip(wts.iter().copied()).collect();
                     let want = reference_merge(&b);
                     assert_eq!(a.len(), want.len(), "row {i}");
                     for (x, y) in a.iter().zip(&want) {
@@ -1699,6 +1851,7 @@ mod tests {
                     }
                     fast += 1;
                 } else {
+                    assert!(idx.is_empty() && wts.is_empty(), "row {i}");
                     assert_eq!(a, b, "row {i}");
                     raw += 1;
                 }
@@ -1708,6 +1861,21 @@ mod tests {
                 .0;
         }
         (fast, raw)
+    }
+
+    /// The networks sort every sequence of zeros and ones, and so every sequence.
+    #[test]
+    fn sorting_networks_sort() {
+        fn check<const N: usize>(sort: fn(&mut [u64; N])) {
+            for bits in 0..1u32 << N {
+                let mut k: [u64; N] = std::array::from_fn(|i| u64::from(bits >> i & 1));
+                sort(&mut k);
+                assert!(k.windows(2).all(|p| p[0] <= p[1]), "{N} {bits:b}");
+            }
+        }
+        check(sort4);
+        check(sort6);
+        check(sort9);
     }
 
     #[test]

@@ -112,19 +112,31 @@ impl StencilTable {
             parent.num_sources,
             |i, out| {
                 let (idx, w) = self.stencil(i);
-                out.extend(idx.iter().copied().zip(w.iter().copied()));
+                out.idx.extend_from_slice(idx);
+                out.wts.extend_from_slice(w);
                 true
             },
         )
     }
 }
 
+/// Where a row generator writes its row: raw, or merged straight after the rows before it.
+pub(crate) struct RowOut<'a> {
+    /// The row as written (answer `false`): see [`RowKind`].
+    pub(crate) raw: &'a mut Vec<(u32, f64)>,
+    /// The row merged (answer `true`): indices ascending and distinct, no zero weight, appended
+    /// to the table's arrays (or to the scratch the composition reads), so a merged row is
+    /// written once.
+    pub(crate) idx: &'a mut Vec<u32>,
+    pub(crate) wts: &'a mut Vec<f64>,
+}
+
 /// What a row generator writes.
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub(crate) enum RowKind {
-    /// Indices may repeat and come in any order (subdivision masks).
+    /// Raw rows' indices may repeat and come in any order (subdivision masks).
     Raw,
-    /// Indices are sorted and unique, weights non-zero (rows of an existing table).
+    /// Raw rows are merged already (rows of an existing table).
     Merged,
 }
 
@@ -181,6 +193,8 @@ struct Scratch {
     mask: Option<Dense>,
     out: Option<Dense>,
     row: Vec<(u32, f64)>,
+    /// A merged row before composing (with a parent).
+    merged: (Vec<u32>, Vec<f64>),
     sizes: Vec<u32>,
     idx: Vec<u32>,
     wts: Vec<f64>,
@@ -189,9 +203,9 @@ struct Scratch {
 /// Rows per block of [`compose_rows`].
 const BLOCK_ROWS: usize = 8192;
 
-/// Build a table of `n` rows in parallel blocks. `gen` writes the (index, weight) pairs of row
-/// `i` over the "parent" vertices. Without `parent` those are the sources: rows are merged
-/// (duplicates added, sorted, exact zeros dropped). With `parent`, each entry `(j, w)` adds `w`
+/// Build a table of `n` rows in parallel blocks. `gen` writes row `i` over the "parent"
+/// vertices ([`RowOut`]) and answers whether it wrote it merged. Without `parent` those are the
+/// sources: raw rows are merged (duplicates added, sorted, exact zeros dropped). With `parent`, each entry `(j, w)` adds `w`
 /// times parent row `j` into a dense accumulator over the parent's sources, so the result is the
 /// composition without an intermediate table, hashing or per-row allocation.
 ///
@@ -207,7 +221,7 @@ pub(crate) fn compose_rows<G>(
     gen: G,
 ) -> StencilTable
 where
-    G: Fn(usize, &mut Vec<(u32, f64)>) -> bool + Sync,
+    G: Fn(usize, &mut RowOut) -> bool + Sync,
 {
     assert!(
         n < u32::MAX as usize,
@@ -222,6 +236,7 @@ where
         mask: None,
         out: parent.map(|_| Dense::new(num_sources)),
         row: Vec::with_capacity(64),
+        merged: (Vec::with_capacity(64), Vec::with_capacity(64)),
         sizes: Vec::new(),
         idx: Vec::new(),
         wts: Vec::new(),
@@ -244,6 +259,7 @@ where
             mask_len,
             &mut sc.out,
             &mut sc.row,
+            &mut sc.merged,
             0..n,
             parent,
             &gen,
@@ -272,6 +288,7 @@ where
                         mask,
                         out,
                         row,
+                        merged,
                         sizes,
                         idx,
                         wts,
@@ -284,6 +301,7 @@ where
                         mask_len,
                         out,
                         row,
+                        merged,
                         rows,
                         parent,
                         &gen,
@@ -326,14 +344,15 @@ where
 }
 
 /// Compute rows `rows`, appending their entries to `idx` / `wts`; `end_row(start, end)` is told
-/// each row's entry range. Rows the generator did not merge are merged in `mask` (made on first
-/// use, `mask_len` slots) when `mask_len` is given.
+/// each row's entry range. Raw rows are merged in `mask` (made on first use, `mask_len` slots)
+/// when `mask_len` is given.
 #[allow(clippy::too_many_arguments)]
 fn fill_rows<G>(
     mask: &mut Option<Dense>,
     mask_len: Option<usize>,
     out: &mut Option<Dense>,
     row: &mut Vec<(u32, f64)>,
+    merged: &mut (Vec<u32>, Vec<f64>),
     rows: std::ops::Range<usize>,
     parent: Option<&StencilTable>,
     gen: &G,
@@ -341,32 +360,30 @@ fn fill_rows<G>(
     wts: &mut Vec<f64>,
     mut end_row: impl FnMut(usize, usize),
 ) where
-    G: Fn(usize, &mut Vec<(u32, f64)>) -> bool + Sync,
+    G: Fn(usize, &mut RowOut) -> bool + Sync,
 {
     for i in rows {
         let tag = i as u32 + 1;
-        row.clear();
-        let merged = gen(i, row);
-        if let Some(len) = mask_len.filter(|_| !merged) {
-            let m = mask.get_or_insert_with(|| Dense::new(len));
-            m.touched.clear();
-            for &(j, w) in row.iter() {
-                m.add(tag, j, w);
-            }
-            m.sort_touched();
-            row.clear();
-            row.extend(
-                m.touched
-                    .iter()
-                    .map(|&j| (j, m.slots[j as usize].1))
-                    .filter(|e| e.1 != 0.0),
-            );
-        }
         let before = idx.len();
+        row.clear();
         match (parent, out.as_mut()) {
             (Some(p), Some(o)) => {
+                // The row over the parent's vertices, merged, then composed.
+                let (midx, mwts) = merged;
+                midx.clear();
+                mwts.clear();
+                let mut sink = RowOut {
+                    raw: row,
+                    idx: midx,
+                    wts: mwts,
+                };
+                if !gen(i, &mut sink) {
+                    midx.clear();
+                    mwts.clear();
+                    merge_raw(mask, mask_len, tag, row, midx, mwts);
+                }
                 o.touched.clear();
-                for &(j, wj) in row.iter() {
+                for (&j, &wj) in midx.iter().zip(mwts.iter()) {
                     let (pidx, pw) = p.stencil(j as usize);
                     for (&s, &ws) in pidx.iter().zip(pw) {
                         o.add(tag, s, wj * ws);
@@ -382,20 +399,53 @@ fn fill_rows<G>(
                 }
             }
             _ => {
-                idx.extend(row.iter().map(|e| e.0));
-                wts.extend(row.iter().map(|e| e.1));
+                let mut sink = RowOut { raw: row, idx, wts };
+                if !gen(i, &mut sink) {
+                    idx.truncate(before);
+                    wts.truncate(before);
+                    merge_raw(mask, mask_len, tag, row, idx, wts);
+                }
             }
         }
         end_row(before, idx.len());
     }
 }
 
-/// Build a table row by row in parallel. `gen` writes the (index, weight) pairs of row `i`
-/// and returns whether they are merged already (indices ascending and distinct, no zero
-/// weight); if not, they are sorted, merged and stripped of exact zeros here.
+/// Append raw row `row` to `idx` / `wts`: merged in `mask` (made on first use, `mask_len`
+/// slots) when `mask_len` is given, else as it is.
+fn merge_raw(
+    mask: &mut Option<Dense>,
+    mask_len: Option<usize>,
+    tag: u32,
+    row: &[(u32, f64)],
+    idx: &mut Vec<u32>,
+    wts: &mut Vec<f64>,
+) {
+    let Some(len) = mask_len else {
+        idx.extend(row.iter().map(|e| e.0));
+        wts.extend(row.iter().map(|e| e.1));
+        return;
+    };
+    let m = mask.get_or_insert_with(|| Dense::new(len));
+    m.touched.clear();
+    for &(j, w) in row {
+        m.add(tag, j, w);
+    }
+    m.sort_touched();
+    for &j in &m.touched {
+        let w = m.slots[j as usize].1;
+        if w != 0.0 {
+            idx.push(j);
+            wts.push(w);
+        }
+    }
+}
+
+/// Build a table row by row in parallel. `gen` writes row `i` ([`RowOut`]) and answers whether
+/// it wrote it merged; raw rows are sorted, merged and stripped of exact zeros here.
 pub(crate) fn build_rows<G>(n: usize, num_sources: usize, gen: G) -> StencilTable
 where
-    G: Fn(usize, &mut Vec<(u32, f64)>) -> bool + Sync,
+    G: Fn(usize, &mut RowOut) -> bool + Sync,
 {
     compose_rows(n, None, RowKind::Raw, num_sources, gen)
 }
@@ -407,9 +457,9 @@ mod tests {
     #[test]
     fn compose_with_identity_is_unchanged() {
         let t = build_rows(3, 4, |i, out| {
-            out.push((i as u32, 0.5));
-            out.push((i as u32 + 1, 0.25));
-            out.push((i as u32 + 1, 0.25));
+            out.raw.push((i as u32, 0.5));
+            out.raw.push((i as u32 + 1, 0.25));
+            out.raw.push((i as u32 + 1, 0.25));
             false
         });
         assert_eq!(t.stencil(1), (&[1u32, 2][..], &[0.5, 0.5][..]));
