@@ -262,106 +262,221 @@ enum Kind {
     Cone,
 }
 
-/// One corner of the patch: its vertex, ring, rule and limit data.
+/// One corner of the patch: its vertex's rule and limit constants, with the vertex, its ring
+/// and the diagonal of each fan face as slots of the cap's [`CapRows`].
 struct Corner {
-    v: u32,
-    fan: Fan,
     /// Position of the patch face in the fan.
     j: usize,
+    boundary: bool,
     sharp: SmallVec<[bool; 9]>,
     kind: Kind,
     regular: bool,
     c: f64,
-    p: Row,
-    /// Cross tangent of a crease sector (rows over the level's vertices).
-    across: Row,
+    v: usize,
+    ring: SmallVec<[usize; 9]>,
+    diag: SmallVec<[usize; 8]>,
+}
+
+/// The level vertices an end cap touches (its corners' one-rings), each a slot of the cap's
+/// dense rows.
+#[derive(Default)]
+struct Slots(SmallVec<[u32; 32]>);
+
+impl Slots {
+    fn slot(&mut self, v: u32) -> usize {
+        match self.0.iter().position(|&x| x == v) {
+            Some(s) => s,
+            None => {
+                self.0.push(v);
+                self.0.len() - 1
+            }
+        }
+    }
+}
+
+/// The cap's rows, dense over its [`Slots`]: row `r` is `w[r·l..(r+1)·l]`.
+///
+/// Each row receives the same additions in the same order as a sparse [`Row`] would, one per
+/// slot per `add_row` (a slot a source lacks adds `s·0`, which changes no nonzero sum), so
+/// after dropping zeros the sums are bit-equal; no lookups, no copies of sparse rows.
+struct CapRows {
+    l: usize,
+    w: Vec<f64>,
+}
+
+/// Rows 0..20 are the points (`5·corner + {P, Ep, Em, Fp, Fm}`), then each corner's cross
+/// tangent (crease sectors) and two scratch rows.
+const ACROSS: usize = 20;
+const TANGENT: usize = 24;
+const SCRATCH: usize = 25;
+const CAP_ROWS: usize = 26;
+
+impl CapRows {
+    fn new(l: usize) -> CapRows {
+        CapRows {
+            l,
+            w: vec![0.0; l * CAP_ROWS],
+        }
+    }
+
+    fn row(&self, r: usize) -> &[f64] {
+        &self.w[r * self.l..(r + 1) * self.l]
+    }
+
+    fn clear(&mut self, r: usize) {
+        let l = self.l;
+        self.w[r * l..(r + 1) * l].fill(0.0);
+    }
+
+    fn add(&mut self, r: usize, slot: usize, w: f64) {
+        self.w[r * self.l + slot] += w;
+    }
+
+    /// Rows `dst` and `src` (distinct) as one mutable and one shared slice.
+    fn pair(&mut self, dst: usize, src: usize) -> (&mut [f64], &[f64]) {
+        let l = self.l;
+        if dst < src {
+            let (a, b) = self.w.split_at_mut(src * l);
+            (&mut a[dst * l..(dst + 1) * l], &b[..l])
+        } else {
+            let (a, b) = self.w.split_at_mut(dst * l);
+            (&mut b[..l], &a[src * l..(src + 1) * l])
+        }
+    }
+
+    fn copy(&mut self, dst: usize, src: usize) {
+        let (d, s) = self.pair(dst, src);
+        d.copy_from_slice(s);
+    }
+
+    fn add_row(&mut self, dst: usize, src: usize, s: f64) {
+        let (d, r) = self.pair(dst, src);
+        for (d, &r) in d.iter_mut().zip(r) {
+            *d += s * r;
+        }
+    }
 }
 
 impl Corner {
     fn n(&self) -> usize {
-        self.fan.ring.len()
+        self.ring.len()
     }
 
-    /// Diagonal vertex of fan face `i` (quads only, checked when the corner is built).
-    fn diag(&self, t: &Topology, i: usize) -> u32 {
-        let (g, c) = self.fan.faces[i % self.fan.faces.len()];
-        t.face_vertices(g as usize)[(c + 2) % 4]
+    /// Diagonal vertex of fan face `i` (wrapping, as a boundary ring has one more entry).
+    fn diag(&self, i: usize) -> usize {
+        self.diag[i % self.diag.len()]
     }
 
-    fn mask_row(&self, t: &Topology, m: &Mask) -> Row {
-        let mut r = Row::default();
-        r.add(self.v, m.vertex);
+    fn mask_row(&self, rows: &mut CapRows, r: usize, m: &Mask) {
+        rows.add(r, self.v, m.vertex);
         for (i, &w) in m.edges.iter().enumerate() {
-            r.add(self.fan.ring[i], w);
+            rows.add(r, self.ring[i], w);
         }
-        for (i, &w) in m.faces.iter().enumerate().take(self.fan.faces.len()) {
-            r.add(self.diag(t, i), w);
+        for (i, &w) in m.faces.iter().enumerate().take(self.diag.len()) {
+            rows.add(r, self.diag(i), w);
         }
-        r
     }
 
-    /// `e_k − v`.
-    fn edge_vector(&self, k: usize) -> Row {
-        let mut r = Row::default();
-        r.add(self.fan.ring[k], 1.0);
-        r.add(self.v, -1.0);
-        r
+    /// `e_k − v` into the cleared row `r`.
+    fn edge_vector(&self, rows: &mut CapRows, r: usize, k: usize) {
+        rows.add(r, self.ring[k], 1.0);
+        rows.add(r, self.v, -1.0);
     }
 
     /// Crease tangent along the sharp edges, toward `toward` (one of the two ends), built in
-    /// ascending ring order so both sectors produce the same row.
-    fn along(&self, a: usize, b: usize, toward: usize) -> Row {
+    /// ascending ring order so both sectors produce the same row; into the cleared row `r`.
+    fn along(&self, rows: &mut CapRows, r: usize, a: usize, b: usize, toward: usize) {
         let (lo, hi) = (a.min(b), a.max(b));
-        let mut r = Row::default();
-        r.add(self.fan.ring[lo], if toward == lo { 0.5 } else { -0.5 });
-        r.add(self.fan.ring[hi], if toward == hi { 0.5 } else { -0.5 });
-        r
+        rows.add(r, self.ring[lo], if toward == lo { 0.5 } else { -0.5 });
+        rows.add(r, self.ring[hi], if toward == hi { 0.5 } else { -0.5 });
     }
 
-    /// Parametric limit tangent toward ring neighbour `k` (see the module docs).
-    fn tangent(&self, t: &Topology, k: usize) -> Row {
+    /// The limit position into row `5·i` and, for a crease, the cross tangent into
+    /// `ACROSS + i` (rows cleared).
+    fn limit_rows(&self, rows: &mut CapRows, i: usize) {
+        let p = 5 * i;
         let n = self.n();
+        match self.kind {
+            Kind::Smooth if self.sharp.iter().filter(|&&x| x).count() == 1 && !self.boundary => {
+                // A dart: the smooth tangents, but its own limit position.
+                let edge = self.sharp.iter().position(|&x| x).unwrap_or(0);
+                let masks = catmark_limit_masks(&LimitVertex {
+                    valence: n,
+                    boundary: false,
+                    rule: LimitRule::Dart { edge },
+                });
+                self.mask_row(rows, p, &masks.position);
+            }
+            Kind::Smooth => {
+                // Only the position: the tangents come from `Corner::tangent`.
+                let [vw, ew, fw] = catmark_smooth_position_weights(n);
+                rows.add(p, self.v, vw);
+                for &x in &self.ring {
+                    rows.add(p, x, ew);
+                }
+                for &d in &self.diag {
+                    rows.add(p, d, fw);
+                }
+            }
+            Kind::Crease { a, b, .. } => {
+                let masks = catmark_limit_masks(&LimitVertex {
+                    valence: n,
+                    boundary: self.boundary,
+                    rule: LimitRule::Crease { ends: [a, b] },
+                });
+                self.mask_row(rows, p, &masks.position);
+                self.mask_row(rows, ACROSS + i, &masks.tangent2);
+            }
+            Kind::Corner { .. } | Kind::Cone => rows.add(p, self.v, 1.0),
+        }
+    }
+
+    /// Parametric limit tangent toward ring neighbour `k` (see the module docs) of corner `i`,
+    /// into row [`TANGENT`] (cleared here; [`SCRATCH`] is used too).
+    fn tangent(&self, rows: &mut CapRows, i: usize, k: usize) {
+        let n = self.n();
+        let r = TANGENT;
+        rows.clear(r);
         match self.kind {
             Kind::Smooth => {
                 // Edge weights first, then face weights, as the rows were always summed.
                 let mut fw: SmallVec<[f64; 16]> = SmallVec::new();
-                let mut r = Row::default();
                 catmark_directional_tangent_each(n, k, |i, e, f| {
-                    r.add(self.fan.ring[i], e);
+                    rows.add(r, self.ring[i], e);
                     fw.push(f);
                 });
                 for (i, &w) in fw.iter().enumerate() {
-                    r.add(self.diag(t, i), w);
+                    rows.add(r, self.diag(i), w);
                 }
-                r
             }
             Kind::Crease { a, b, m } => {
                 if k == a || k == b {
-                    return self.along(a, b, k);
+                    return self.along(rows, r, a, b, k);
                 }
                 let s = (k + n - a) % n;
-                let t1 = self.along(a, b, a);
                 if 2 * s == m {
-                    return self.across.clone();
+                    return rows.copy(r, ACROSS + i);
                 }
+                rows.clear(SCRATCH);
+                self.along(rows, SCRATCH, a, b, a);
                 let th = PI * s as f64 / m as f64;
-                let mut r = Row::default();
-                r.add_row(&t1, th.cos());
-                r.add_row(&self.across, th.sin());
-                r
+                rows.add_row(r, SCRATCH, th.cos());
+                rows.add_row(r, ACROSS + i, th.sin());
             }
             Kind::Corner { a, b, m } => {
                 if k == a || k == b {
-                    return self.edge_vector(k);
+                    return self.edge_vector(rows, r, k);
                 }
                 let s = (k + n - a) % n;
                 let phi = PI / (2.0 * m as f64);
-                let mut r = Row::default();
-                r.add_row(&self.edge_vector(a), ((m - s) as f64 * phi).sin());
-                r.add_row(&self.edge_vector(b), (s as f64 * phi).sin());
-                r
+                rows.clear(SCRATCH);
+                self.edge_vector(rows, SCRATCH, a);
+                rows.add_row(r, SCRATCH, ((m - s) as f64 * phi).sin());
+                rows.clear(SCRATCH);
+                self.edge_vector(rows, SCRATCH, b);
+                rows.add_row(r, SCRATCH, (s as f64 * phi).sin());
             }
-            Kind::Cone => self.edge_vector(k),
+            Kind::Cone => self.edge_vector(rows, r, k),
         }
     }
 }
@@ -393,6 +508,7 @@ fn build_corner(
     options: &SubdivOptions,
     face: usize,
     v: u32,
+    slots: &mut Slots,
 ) -> Result<Corner, TopologyError> {
     let t = level.topology;
     let problem = |problem| TopologyError::GregoryPatch { face, problem };
@@ -456,69 +572,87 @@ fn build_corner(
         ),
         Kind::Cone => (false, 0.0),
     };
-    let mut corner = Corner {
-        v,
-        fan,
+    Ok(Corner {
         j,
+        boundary: fan.boundary,
         sharp,
         kind,
         regular,
         c,
-        p: Row::default(),
-        across: Row::default(),
-    };
-    match kind {
-        Kind::Smooth if sharp_count == 1 && !corner.fan.boundary => {
-            // A dart: the smooth tangents, but its own limit position.
-            let edge = corner.sharp.iter().position(|&x| x).unwrap_or(0);
-            let masks = catmark_limit_masks(&LimitVertex {
-                valence: n,
-                boundary: false,
-                rule: LimitRule::Dart { edge },
-            });
-            corner.p = corner.mask_row(t, &masks.position);
-        }
-        Kind::Smooth => {
-            // Only the position: the tangents come from `Corner::tangent`.
-            let [vw, ew, fw] = catmark_smooth_position_weights(n);
-            let p = &mut corner.p;
-            p.add(v, vw);
-            for &x in &corner.fan.ring {
-                p.add(x, ew);
-            }
-            for i in 0..corner.fan.faces.len() {
-                let d = corner.diag(t, i);
-                corner.p.add(d, fw);
-            }
-        }
-        Kind::Crease { .. } => {
-            let rule = match kind {
-                Kind::Crease { a, b, .. } => LimitRule::Crease { ends: [a, b] },
-                _ => LimitRule::Smooth,
-            };
-            let masks = catmark_limit_masks(&LimitVertex {
-                valence: n,
-                boundary: corner.fan.boundary,
-                rule,
-            });
-            corner.p = corner.mask_row(t, &masks.position);
-            if matches!(kind, Kind::Crease { .. }) {
-                corner.across = corner.mask_row(t, &masks.tangent2);
-            }
-        }
-        Kind::Corner { .. } | Kind::Cone => corner.p.add(v, 1.0),
-    }
-    Ok(corner)
+        v: slots.slot(v),
+        ring: fan.ring.iter().map(|&x| slots.slot(x)).collect(),
+        diag: fan
+            .faces
+            .iter()
+            .map(|&(g, c)| slots.slot(t.face_vertices(g as usize)[(c + 2) % 4]))
+            .collect(),
+    })
 }
 
-/// The Bézier interior point of a regular patch: `(4v_i + 2v_{i+1} + 2v_{i−1} + v_{i+2})/9`.
-fn face_mask(fv: &[u32], i: usize) -> Row {
-    let mut r = Row::default();
-    r.add(fv[i], 4.0 / 9.0);
-    r.add(fv[(i + 1) % 4], 2.0 / 9.0);
-    r.add(fv[(i + 3) % 4], 2.0 / 9.0);
-    r.add(fv[(i + 2) % 4], 1.0 / 9.0);
-    r
+/// The Bézier interior point of a regular patch, `(4v_i + 2v_{i+1} + 2v_{i−1} + v_{i+2})/9`,
+/// into row `r` (`fv`: the corners' slots).
+fn face_mask(rows: &mut CapRows, r: usize, fv: [usize; 4], i: usize) {
+    rows.add(r, fv[i], 4.0 / 9.0);
+    rows.add(r, fv[(i + 1) % 4], 2.0 / 9.0);
+    rows.add(r, fv[(i + 3) % 4], 2.0 / 9.0);
+    rows.add(r, fv[(i + 2) % 4], 1.0 / 9.0);
+}
+
+/// Face point `Fp_i` (`plus`) or `Fm_i` into its (cleared) row, from the finished `P`, `Ep`
+/// and `Em` rows.
+fn face_point(rows: &mut CapRows, corners: &[Corner], i: usize, plus: bool) {
+    let dst = 5 * i + if plus { 3 } else { 4 };
+    let fv = [corners[0].v, corners[1].v, corners[2].v, corners[3].v];
+    let near = &corners[i];
+    let n = near.n();
+    let j = near.j;
+    let (k, other, far_i) = if plus {
+        (j, (j + 1) % n, (i + 1) % 4)
+    } else {
+        ((j + 1) % n, j, (i + 3) % 4)
+    };
+    let far = &corners[far_i];
+    if near.regular && far.regular {
+        return face_mask(rows, dst, fv, i);
+    }
+    let formula = |rows: &mut CapRows, k: usize, far_i: usize, plus: bool| {
+        let far = &corners[far_i];
+        let (e_near, e_far) = if plus {
+            (5 * i + 1, 5 * far_i + 2)
+        } else {
+            (5 * i + 2, 5 * far_i + 1)
+        };
+        let (cn, cf) = (near.c, far.c);
+        rows.add_row(dst, 5 * i, cf / 3.0);
+        rows.add_row(dst, e_near, (3.0 - 2.0 * cn - cf) / 3.0);
+        rows.add_row(dst, e_far, 2.0 * cn / 3.0);
+        // Ring neighbours and diagonals on either side of edge k (inside: our face j).
+        let (x_in, x_out, d_out) = if plus {
+            (
+                near.ring[(k + 1) % n],
+                near.ring[(k + n - 1) % n],
+                (k + n - 1) % n,
+            )
+        } else {
+            (near.ring[(k + n - 1) % n], near.ring[(k + 1) % n], k)
+        };
+        rows.add(dst, x_in, 1.0 / 9.0);
+        rows.add(dst, x_out, -1.0 / 9.0);
+        rows.add(dst, near.diag(j), 1.0 / 18.0);
+        rows.add(dst, near.diag(d_out), -1.0 / 18.0);
+    };
+    if !near.sharp[k] {
+        return formula(rows, k, far_i, plus);
+    }
+    // Sharp edge: nothing to match across it; take the corner's other face point.
+    if near.sharp[other] {
+        return face_mask(rows, dst, fv, i);
+    }
+    let other_far = if plus { (i + 3) % 4 } else { (i + 1) % 4 };
+    if near.regular && corners[other_far].regular {
+        return face_mask(rows, dst, fv, i);
+    }
+    formula(rows, other, other_far, !plus)
 }
 
 /// The 20 Gregory control points of quad `face` of `level` as stencils over the level's vertex
@@ -588,87 +722,45 @@ pub(crate) fn gregory_basis_each(
             problem: GregoryProblem::NotQuad { size: fv.len() },
         });
     }
-    let mut corners = Vec::with_capacity(4);
+    let mut slots = Slots::default();
+    let mut corners: SmallVec<[Corner; 4]> = SmallVec::new();
     for &v in fv {
-        corners.push(build_corner(&level, options, face, v)?);
+        corners.push(build_corner(&level, options, face, v, &mut slots)?);
+    }
+    let mut rows = CapRows::new(slots.0.len());
+    for (i, c) in corners.iter().enumerate() {
+        c.limit_rows(&mut rows, i);
     }
     // Edge points: index k of the ring is the edge toward the face's next (j) or previous
     // (j + 1) corner.
-    let mut ep = Vec::with_capacity(4);
-    let mut em = Vec::with_capacity(4);
-    for c in &corners {
+    for (i, c) in corners.iter().enumerate() {
         let n = c.n();
-        let mut p = c.p.clone();
-        p.add_row(&c.tangent(t, c.j), 1.0 / 3.0);
-        ep.push(p);
-        let mut m = c.p.clone();
-        m.add_row(&c.tangent(t, (c.j + 1) % n), 1.0 / 3.0);
-        em.push(m);
+        rows.copy(5 * i + 1, 5 * i);
+        c.tangent(&mut rows, i, c.j);
+        rows.add_row(5 * i + 1, TANGENT, 1.0 / 3.0);
+        rows.copy(5 * i + 2, 5 * i);
+        c.tangent(&mut rows, i, (c.j + 1) % n);
+        rows.add_row(5 * i + 2, TANGENT, 1.0 / 3.0);
     }
-    let face_point = |i: usize, plus: bool| -> Row {
-        let near = &corners[i];
-        let n = near.n();
-        let j = near.j;
-        let (k, other, far_i) = if plus {
-            (j, (j + 1) % n, (i + 1) % 4)
-        } else {
-            ((j + 1) % n, j, (i + 3) % 4)
-        };
-        let far = &corners[far_i];
-        if near.regular && far.regular {
-            return face_mask(fv, i);
-        }
-        let formula = |k: usize, far_i: usize, plus: bool| -> Row {
-            let far = &corners[far_i];
-            let (e_near, e_far) = if plus {
-                (&ep[i], &em[far_i])
-            } else {
-                (&em[i], &ep[far_i])
-            };
-            let (cn, cf) = (near.c, far.c);
-            let mut r = Row::default();
-            r.add_row(&near.p, cf / 3.0);
-            r.add_row(e_near, (3.0 - 2.0 * cn - cf) / 3.0);
-            r.add_row(e_far, 2.0 * cn / 3.0);
-            // Ring neighbours and diagonals on either side of edge k (inside: our face j).
-            let (x_in, x_out, d_out) = if plus {
-                (
-                    near.fan.ring[(k + 1) % n],
-                    near.fan.ring[(k + n - 1) % n],
-                    (k + n - 1) % n,
-                )
-            } else {
-                (
-                    near.fan.ring[(k + n - 1) % n],
-                    near.fan.ring[(k + 1) % n],
-                    k,
-                )
-            };
-            r.add(x_in, 1.0 / 9.0);
-            r.add(x_out, -1.0 / 9.0);
-            r.add(near.diag(t, j), 1.0 / 18.0);
-            r.add(near.diag(t, d_out), -1.0 / 18.0);
-            r
-        };
-        if !near.sharp[k] {
-            return formula(k, far_i, plus);
-        }
-        // Sharp edge: nothing to match across it; take the corner's other face point.
-        if near.sharp[other] {
-            return face_mask(fv, i);
-        }
-        let other_far = if plus { (i + 3) % 4 } else { (i + 1) % 4 };
-        if near.regular && corners[other_far].regular {
-            return face_mask(fv, i);
-        }
-        formula(other, other_far, !plus)
-    };
     for i in 0..4 {
-        each(5 * i, &corners[i].p.clone().finished().0);
-        each(5 * i + 1, &ep[i].clone().finished().0);
-        each(5 * i + 2, &em[i].clone().finished().0);
-        each(5 * i + 3, &face_point(i, true).finished().0);
-        each(5 * i + 4, &face_point(i, false).finished().0);
+        face_point(&mut rows, &corners, i, true);
+        face_point(&mut rows, &corners, i, false);
+    }
+    // Zero weights dropped, indices ascending: the form of a [`Stencil`].
+    let mut order: SmallVec<[(u32, usize); 32]> =
+        slots.0.iter().enumerate().map(|(s, &x)| (x, s)).collect();
+    order.sort_unstable();
+    let mut terms: SmallVec<[(u32, f64); 32]> = SmallVec::new();
+    for k in 0..20 {
+        terms.clear();
+        let row = rows.row(k);
+        terms.extend(
+            order
+                .iter()
+                .map(|&(x, s)| (x, row[s]))
+                .filter(|e| e.1 != 0.0),
+        );
+        each(k, &terms);
     }
     Ok(())
 }
