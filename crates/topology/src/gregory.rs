@@ -107,7 +107,7 @@ use crate::limit::{
     catmark_directional_tangent_each, catmark_limit_masks, catmark_smooth_position_weights,
     LimitRule, LimitVertex, Mask,
 };
-use crate::mesh::{SubdivOptions, Topology};
+use crate::mesh::{SubdivOptions, Topology, INVALID};
 use crate::patch::PatchWeights;
 use crate::refine::LevelRef;
 use crate::sdc::{boundary_edge_sharpness, boundary_vertex_sharpness, is_sharp, vertex_rule, Rule};
@@ -197,11 +197,15 @@ pub(crate) struct Fan {
 }
 
 pub(crate) fn build_fan(t: &Topology, v: u32) -> Option<Fan> {
+    // The face and edge tables read directly: this runs for every corner of every end cap.
+    let (offsets, face_verts, face_edges) = (&t.face_offsets, &t.face_verts, &t.face_edges);
+    let span = |g: u32| offsets[g as usize] as usize..offsets[g as usize + 1] as usize;
+    let boundary_edge = |e: u32| t.edge_faces[e as usize][1] == INVALID;
     let vf = t.vertex_faces(v as usize);
-    let corner = |g: u32| t.face_vertices(g as usize).iter().position(|&x| x == v);
+    let corner = |g: u32| face_verts[span(g)].iter().position(|&x| x == v);
     let leaving_boundary = |g: u32| -> Option<bool> {
         let c = corner(g)?;
-        Some(t.is_boundary_edge(*t.face_edge_list(g as usize).get(c)? as usize))
+        Some(boundary_edge(*face_edges[span(g)].get(c)?))
     };
     let mut start = *vf.first()?;
     for &g in vf {
@@ -219,17 +223,17 @@ pub(crate) fn build_fan(t: &Topology, v: u32) -> Option<Fan> {
     };
     let mut g = start;
     loop {
-        let c = corner(g)?;
-        let fv = t.face_vertices(g as usize);
-        let fe = t.face_edge_list(g as usize);
+        let fv = &face_verts[span(g)];
+        let fe = &face_edges[span(g)];
+        let c = fv.iter().position(|&x| x == v)?;
         let n = fv.len();
         fan.faces.push((g, c));
         fan.ring.push(fv[(c + 1) % n]);
         fan.edges.push(fe[c]);
         let entering = fe[(c + n - 1) % n];
-        let [a, b] = t.edge_faces(entering as usize);
+        let [a, b] = t.edge_faces[entering as usize];
         let h = if a == g { b } else { a };
-        if t.is_boundary_edge(entering as usize) {
+        if boundary_edge(entering) {
             fan.ring.push(fv[(c + n - 1) % n]);
             fan.edges.push(entering);
             break;
@@ -263,7 +267,8 @@ enum Kind {
 }
 
 /// One corner of the patch: its vertex's rule and limit constants, with the vertex, its ring
-/// and the diagonal of each fan face as slots of the cap's [`CapRows`].
+/// and the diagonal of each fan face (level vertex ids from [`build_corner`], then slots of the
+/// cap's [`CapRows`]).
 struct Corner {
     /// Position of the patch face in the fan.
     j: usize,
@@ -272,36 +277,20 @@ struct Corner {
     kind: Kind,
     regular: bool,
     c: f64,
-    v: usize,
-    ring: SmallVec<[usize; 9]>,
-    diag: SmallVec<[usize; 8]>,
+    /// The vertex, its `n` ring neighbours, the diagonals of its `nf` fan faces.
+    verts: SmallVec<[usize; 20]>,
+    n: usize,
+    nf: usize,
 }
 
-/// The level vertices an end cap touches (its corners' one-rings), each a slot of the cap's
-/// dense rows.
-#[derive(Default)]
-struct Slots(SmallVec<[u32; 32]>);
-
-impl Slots {
-    fn slot(&mut self, v: u32) -> usize {
-        match self.0.iter().position(|&x| x == v) {
-            Some(s) => s,
-            None => {
-                self.0.push(v);
-                self.0.len() - 1
-            }
-        }
-    }
-}
-
-/// The cap's rows, dense over its [`Slots`]: row `r` is `w[r·l..(r+1)·l]`.
+/// The cap's rows, dense over its vertices (ascending): row `r` is `w[r·l..(r+1)·l]`.
 ///
 /// Each row receives the same additions in the same order as a sparse [`Row`] would, one per
 /// slot per `add_row` (a slot a source lacks adds `s·0`, which changes no nonzero sum), so
 /// after dropping zeros the sums are bit-equal; no lookups, no copies of sparse rows.
-struct CapRows {
+struct CapRows<'a> {
     l: usize,
-    w: Vec<f64>,
+    w: &'a mut [f64],
 }
 
 /// Rows 0..20 are the points (`5·corner + {P, Ep, Em, Fp, Fm}`), then each corner's cross
@@ -311,14 +300,10 @@ const TANGENT: usize = 24;
 const SCRATCH: usize = 25;
 const CAP_ROWS: usize = 26;
 
-impl CapRows {
-    fn new(l: usize) -> CapRows {
-        CapRows {
-            l,
-            w: vec![0.0; l * CAP_ROWS],
-        }
-    }
+/// Rows up to this many slots live on the stack.
+const CAP_SLOTS: usize = 32;
 
+impl CapRows<'_> {
     fn row(&self, r: usize) -> &[f64] {
         &self.w[r * self.l..(r + 1) * self.l]
     }
@@ -359,41 +344,49 @@ impl CapRows {
 
 impl Corner {
     fn n(&self) -> usize {
-        self.ring.len()
+        self.n
+    }
+
+    fn v(&self) -> usize {
+        self.verts[0]
+    }
+
+    fn ring(&self, k: usize) -> usize {
+        self.verts[1 + k]
     }
 
     /// Diagonal vertex of fan face `i` (wrapping, as a boundary ring has one more entry).
     fn diag(&self, i: usize) -> usize {
-        self.diag[i % self.diag.len()]
+        self.verts[1 + self.n + i % self.nf]
     }
 
-    fn mask_row(&self, rows: &mut CapRows, r: usize, m: &Mask) {
-        rows.add(r, self.v, m.vertex);
+    fn mask_row(&self, rows: &mut CapRows<'_>, r: usize, m: &Mask) {
+        rows.add(r, self.v(), m.vertex);
         for (i, &w) in m.edges.iter().enumerate() {
-            rows.add(r, self.ring[i], w);
+            rows.add(r, self.ring(i), w);
         }
-        for (i, &w) in m.faces.iter().enumerate().take(self.diag.len()) {
+        for (i, &w) in m.faces.iter().enumerate().take(self.nf) {
             rows.add(r, self.diag(i), w);
         }
     }
 
     /// `e_k − v` into the cleared row `r`.
-    fn edge_vector(&self, rows: &mut CapRows, r: usize, k: usize) {
-        rows.add(r, self.ring[k], 1.0);
-        rows.add(r, self.v, -1.0);
+    fn edge_vector(&self, rows: &mut CapRows<'_>, r: usize, k: usize) {
+        rows.add(r, self.ring(k), 1.0);
+        rows.add(r, self.v(), -1.0);
     }
 
     /// Crease tangent along the sharp edges, toward `toward` (one of the two ends), built in
     /// ascending ring order so both sectors produce the same row; into the cleared row `r`.
-    fn along(&self, rows: &mut CapRows, r: usize, a: usize, b: usize, toward: usize) {
+    fn along(&self, rows: &mut CapRows<'_>, r: usize, a: usize, b: usize, toward: usize) {
         let (lo, hi) = (a.min(b), a.max(b));
-        rows.add(r, self.ring[lo], if toward == lo { 0.5 } else { -0.5 });
-        rows.add(r, self.ring[hi], if toward == hi { 0.5 } else { -0.5 });
+        rows.add(r, self.ring(lo), if toward == lo { 0.5 } else { -0.5 });
+        rows.add(r, self.ring(hi), if toward == hi { 0.5 } else { -0.5 });
     }
 
     /// The limit position into row `5·i` and, for a crease, the cross tangent into
     /// `ACROSS + i` (rows cleared).
-    fn limit_rows(&self, rows: &mut CapRows, i: usize) {
+    fn limit_rows(&self, rows: &mut CapRows<'_>, i: usize) {
         let p = 5 * i;
         let n = self.n();
         match self.kind {
@@ -410,11 +403,11 @@ impl Corner {
             Kind::Smooth => {
                 // Only the position: the tangents come from `Corner::tangent`.
                 let [vw, ew, fw] = catmark_smooth_position_weights(n);
-                rows.add(p, self.v, vw);
-                for &x in &self.ring {
+                rows.add(p, self.v(), vw);
+                for &x in &self.verts[1..1 + n] {
                     rows.add(p, x, ew);
                 }
-                for &d in &self.diag {
+                for &d in &self.verts[1 + n..] {
                     rows.add(p, d, fw);
                 }
             }
@@ -427,13 +420,13 @@ impl Corner {
                 self.mask_row(rows, p, &masks.position);
                 self.mask_row(rows, ACROSS + i, &masks.tangent2);
             }
-            Kind::Corner { .. } | Kind::Cone => rows.add(p, self.v, 1.0),
+            Kind::Corner { .. } | Kind::Cone => rows.add(p, self.v(), 1.0),
         }
     }
 
     /// Parametric limit tangent toward ring neighbour `k` (see the module docs) of corner `i`,
     /// into row [`TANGENT`] (cleared here; [`SCRATCH`] is used too).
-    fn tangent(&self, rows: &mut CapRows, i: usize, k: usize) {
+    fn tangent(&self, rows: &mut CapRows<'_>, i: usize, k: usize) {
         let n = self.n();
         let r = TANGENT;
         rows.clear(r);
@@ -442,7 +435,7 @@ impl Corner {
                 // Edge weights first, then face weights, as the rows were always summed.
                 let mut fw: SmallVec<[f64; 16]> = SmallVec::new();
                 catmark_directional_tangent_each(n, k, |i, e, f| {
-                    rows.add(r, self.ring[i], e);
+                    rows.add(r, self.ring(i), e);
                     fw.push(f);
                 });
                 for (i, &w) in fw.iter().enumerate() {
@@ -508,7 +501,6 @@ fn build_corner(
     options: &SubdivOptions,
     face: usize,
     v: u32,
-    slots: &mut Slots,
 ) -> Result<Corner, TopologyError> {
     let t = level.topology;
     let problem = |problem| TopologyError::GregoryPatch { face, problem };
@@ -579,19 +571,23 @@ fn build_corner(
         kind,
         regular,
         c,
-        v: slots.slot(v),
-        ring: fan.ring.iter().map(|&x| slots.slot(x)).collect(),
-        diag: fan
-            .faces
-            .iter()
-            .map(|&(g, c)| slots.slot(t.face_vertices(g as usize)[(c + 2) % 4]))
+        verts: std::iter::once(v)
+            .chain(fan.ring.iter().copied())
+            .chain(
+                fan.faces
+                    .iter()
+                    .map(|&(g, c)| t.face_vertices(g as usize)[(c + 2) % 4]),
+            )
+            .map(|x| x as usize)
             .collect(),
+        n,
+        nf: fan.faces.len(),
     })
 }
 
 /// The Bézier interior point of a regular patch, `(4v_i + 2v_{i+1} + 2v_{i−1} + v_{i+2})/9`,
 /// into row `r` (`fv`: the corners' slots).
-fn face_mask(rows: &mut CapRows, r: usize, fv: [usize; 4], i: usize) {
+fn face_mask(rows: &mut CapRows<'_>, r: usize, fv: [usize; 4], i: usize) {
     rows.add(r, fv[i], 4.0 / 9.0);
     rows.add(r, fv[(i + 1) % 4], 2.0 / 9.0);
     rows.add(r, fv[(i + 3) % 4], 2.0 / 9.0);
@@ -600,9 +596,14 @@ fn face_mask(rows: &mut CapRows, r: usize, fv: [usize; 4], i: usize) {
 
 /// Face point `Fp_i` (`plus`) or `Fm_i` into its (cleared) row, from the finished `P`, `Ep`
 /// and `Em` rows.
-fn face_point(rows: &mut CapRows, corners: &[Corner], i: usize, plus: bool) {
+fn face_point(rows: &mut CapRows<'_>, corners: &[Corner], i: usize, plus: bool) {
     let dst = 5 * i + if plus { 3 } else { 4 };
-    let fv = [corners[0].v, corners[1].v, corners[2].v, corners[3].v];
+    let fv = [
+        corners[0].v(),
+        corners[1].v(),
+        corners[2].v(),
+        corners[3].v(),
+    ];
     let near = &corners[i];
     let n = near.n();
     let j = near.j;
@@ -615,7 +616,7 @@ fn face_point(rows: &mut CapRows, corners: &[Corner], i: usize, plus: bool) {
     if near.regular && far.regular {
         return face_mask(rows, dst, fv, i);
     }
-    let formula = |rows: &mut CapRows, k: usize, far_i: usize, plus: bool| {
+    let formula = |rows: &mut CapRows<'_>, k: usize, far_i: usize, plus: bool| {
         let far = &corners[far_i];
         let (e_near, e_far) = if plus {
             (5 * i + 1, 5 * far_i + 2)
@@ -629,12 +630,12 @@ fn face_point(rows: &mut CapRows, corners: &[Corner], i: usize, plus: bool) {
         // Ring neighbours and diagonals on either side of edge k (inside: our face j).
         let (x_in, x_out, d_out) = if plus {
             (
-                near.ring[(k + 1) % n],
-                near.ring[(k + n - 1) % n],
+                near.ring((k + 1) % n),
+                near.ring((k + n - 1) % n),
                 (k + n - 1) % n,
             )
         } else {
-            (near.ring[(k + n - 1) % n], near.ring[(k + 1) % n], k)
+            (near.ring((k + n - 1) % n), near.ring((k + 1) % n), k)
         };
         rows.add(dst, x_in, 1.0 / 9.0);
         rows.add(dst, x_out, -1.0 / 9.0);
@@ -722,12 +723,64 @@ pub(crate) fn gregory_basis_each(
             problem: GregoryProblem::NotQuad { size: fv.len() },
         });
     }
-    let mut slots = Slots::default();
     let mut corners: SmallVec<[Corner; 4]> = SmallVec::new();
     for &v in fv {
-        corners.push(build_corner(&level, options, face, v, &mut slots)?);
+        corners.push(build_corner(&level, options, face, v)?);
     }
-    let mut rows = CapRows::new(slots.0.len());
+    // The cap's vertices become slots of its dense rows, numbered as first seen through a
+    // small open-addressing table.
+    let refs: usize = corners.iter().map(|c| c.verts.len()).sum();
+    let bits = (2 * refs).next_power_of_two().max(64).trailing_zeros();
+    let mask = (1usize << bits) - 1;
+    let mut table_inline = [(u32::MAX, 0u32); 128];
+    let mut table_heap = Vec::new();
+    let table: &mut [(u32, u32)] = if mask < 128 {
+        &mut table_inline[..mask + 1]
+    } else {
+        table_heap.resize(mask + 1, (u32::MAX, 0));
+        &mut table_heap
+    };
+    let mut ids: SmallVec<[u32; 32]> = SmallVec::new();
+    for x in corners.iter_mut().flat_map(|c| &mut c.verts) {
+        let id = *x as u32;
+        let mut h = (id.wrapping_mul(0x9E37_79B9) >> (32 - bits)) as usize;
+        loop {
+            let e = &mut table[h];
+            if e.0 == id {
+                *x = e.1 as usize;
+                break;
+            }
+            if e.0 == u32::MAX {
+                *e = (id, ids.len() as u32);
+                *x = ids.len();
+                ids.push(id);
+                break;
+            }
+            h = (h + 1) & mask;
+        }
+    }
+    // Renumbered in ascending id order, so each row comes out as a stencil's sorted indices.
+    let l = ids.len();
+    let mut order: SmallVec<[u64; 32]> = ids
+        .iter()
+        .enumerate()
+        .map(|(s, &x)| (x as u64) << 32 | s as u64)
+        .collect();
+    order.sort_unstable();
+    let mut rank: SmallVec<[usize; 32]> = SmallVec::from_elem(0, l);
+    for (new, &key) in order.iter().enumerate() {
+        rank[key as u32 as usize] = new;
+        ids[new] = (key >> 32) as u32;
+    }
+    for x in corners.iter_mut().flat_map(|c| &mut c.verts) {
+        *x = rank[*x];
+    }
+    // Zeroed a row at a time: one large memset costs more than the rows' small ones.
+    let mut w = Vec::with_capacity(l * CAP_ROWS);
+    for _ in 0..CAP_ROWS {
+        w.resize(w.len() + l, 0.0);
+    }
+    let mut rows = CapRows { l, w: &mut w };
     for (i, c) in corners.iter().enumerate() {
         c.limit_rows(&mut rows, i);
     }
@@ -746,21 +799,23 @@ pub(crate) fn gregory_basis_each(
         face_point(&mut rows, &corners, i, true);
         face_point(&mut rows, &corners, i, false);
     }
-    // Zero weights dropped, indices ascending: the form of a [`Stencil`].
-    let mut order: SmallVec<[(u32, usize); 32]> =
-        slots.0.iter().enumerate().map(|(s, &x)| (x, s)).collect();
-    order.sort_unstable();
-    let mut terms: SmallVec<[(u32, f64); 32]> = SmallVec::new();
+    // Zero weights dropped (indices already ascending): the form of a [`Stencil`].
+    let mut terms_inline = [(0u32, 0.0f64); CAP_SLOTS];
+    let mut terms_heap = Vec::new();
+    let terms: &mut [(u32, f64)] = if l <= CAP_SLOTS {
+        &mut terms_inline[..l]
+    } else {
+        terms_heap.resize(l, (0, 0.0));
+        &mut terms_heap
+    };
     for k in 0..20 {
-        terms.clear();
         let row = rows.row(k);
-        terms.extend(
-            order
-                .iter()
-                .map(|&(x, s)| (x, row[s]))
-                .filter(|e| e.1 != 0.0),
-        );
-        each(k, &terms);
+        let mut m = 0;
+        for (&x, &w) in ids.iter().zip(row) {
+            terms[m] = (x, w);
+            m += (w != 0.0) as usize;
+        }
+        each(k, &terms[..m]);
     }
     Ok(())
 }
