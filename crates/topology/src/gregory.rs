@@ -208,13 +208,13 @@ pub(crate) fn build_fan(t: &Topology, v: u32) -> Option<Fan> {
         Some(boundary_edge(*face_edges[span(g)].get(c)?))
     };
     let mut start = *vf.first()?;
+    let mut boundary = false;
     for &g in vf {
         if leaving_boundary(g)? {
-            start = g;
+            (start, boundary) = (g, true);
             break;
         }
     }
-    let boundary = leaving_boundary(start)?;
     let mut fan = Fan {
         faces: SmallVec::with_capacity(vf.len()),
         ring: SmallVec::with_capacity(vf.len() + 1),
@@ -504,7 +504,8 @@ fn build_corner(
 ) -> Result<Corner, TopologyError> {
     let t = level.topology;
     let problem = |problem| TopologyError::GregoryPatch { face, problem };
-    let fan = build_fan(t, v).ok_or(problem(GregoryProblem::IncompleteRing { vertex: v }))?;
+    let fan =
+        build_fan(t, v).ok_or_else(|| problem(GregoryProblem::IncompleteRing { vertex: v }))?;
     if fan
         .faces
         .iter()
@@ -516,7 +517,7 @@ fn build_corner(
         .faces
         .iter()
         .position(|&(g, _)| g as usize == face)
-        .ok_or(problem(GregoryProblem::IncompleteRing { vertex: v }))?;
+        .ok_or_else(|| problem(GregoryProblem::IncompleteRing { vertex: v }))?;
     let n = fan.ring.len();
     let sharp: SmallVec<[bool; 9]> = fan
         .edges
@@ -564,6 +565,12 @@ fn build_corner(
         ),
         Kind::Cone => (false, 0.0),
     };
+    let mut verts = SmallVec::with_capacity(1 + n + fan.faces.len());
+    verts.push(v as usize);
+    verts.extend(fan.ring.iter().map(|&x| x as usize));
+    for &(g, c) in &fan.faces {
+        verts.push(t.face_vertices(g as usize)[(c + 2) % 4] as usize);
+    }
     Ok(Corner {
         j,
         boundary: fan.boundary,
@@ -571,15 +578,7 @@ fn build_corner(
         kind,
         regular,
         c,
-        verts: std::iter::once(v)
-            .chain(fan.ring.iter().copied())
-            .chain(
-                fan.faces
-                    .iter()
-                    .map(|&(g, c)| t.face_vertices(g as usize)[(c + 2) % 4]),
-            )
-            .map(|x| x as usize)
-            .collect(),
+        verts,
         n,
         nf: fan.faces.len(),
     })
