@@ -811,8 +811,10 @@ pub(crate) fn gregory_basis_each(
         let row = rows.row(k);
         let mut m = 0;
         for (&x, &w) in ids.iter().zip(row) {
-            terms[m] = (x, w);
-            m += (w != 0.0) as usize;
+            if w != 0.0 {
+                terms[m] = (x, w);
+                m += 1;
+            }
         }
         each(k, &terms[..m]);
     }
