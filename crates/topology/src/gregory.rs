@@ -355,9 +355,11 @@ impl Corner {
         self.verts[1 + k]
     }
 
-    /// Diagonal vertex of fan face `i` (wrapping, as a boundary ring has one more entry).
+    /// Diagonal vertex of fan face `i` (wrapping, as a boundary ring has one more entry:
+    /// `i ≤ nf`, so one subtraction instead of a division).
     fn diag(&self, i: usize) -> usize {
-        self.verts[1 + self.n + i % self.nf]
+        let i = if i >= self.nf { i - self.nf } else { i };
+        self.verts[1 + self.n + i]
     }
 
     fn mask_row(&self, rows: &mut CapRows<'_>, r: usize, m: &Mask) {
