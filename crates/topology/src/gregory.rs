@@ -107,7 +107,7 @@ use crate::limit::{
     catmark_directional_tangent_each, catmark_limit_masks, catmark_smooth_position_weights,
     LimitRule, LimitVertex, Mask,
 };
-use crate::mesh::{SubdivOptions, Topology};
+use crate::mesh::{SubdivOptions, Topology, INVALID};
 use crate::patch::PatchWeights;
 use crate::refine::LevelRef;
 use crate::sdc::{boundary_edge_sharpness, boundary_vertex_sharpness, is_sharp, vertex_rule, Rule};
@@ -197,20 +197,24 @@ pub(crate) struct Fan {
 }
 
 pub(crate) fn build_fan(t: &Topology, v: u32) -> Option<Fan> {
+    // The face and edge tables read directly: this runs for every corner of every end cap.
+    let (offsets, face_verts, face_edges) = (&t.face_offsets, &t.face_verts, &t.face_edges);
+    let span = |g: u32| offsets[g as usize] as usize..offsets[g as usize + 1] as usize;
+    let boundary_edge = |e: u32| t.edge_faces[e as usize][1] == INVALID;
     let vf = t.vertex_faces(v as usize);
-    let corner = |g: u32| t.face_vertices(g as usize).iter().position(|&x| x == v);
+    let corner = |g: u32| face_verts[span(g)].iter().position(|&x| x == v);
     let leaving_boundary = |g: u32| -> Option<bool> {
         let c = corner(g)?;
-        Some(t.is_boundary_edge(*t.face_edge_list(g as usize).get(c)? as usize))
+        Some(boundary_edge(*face_edges[span(g)].get(c)?))
     };
     let mut start = *vf.first()?;
+    let mut boundary = false;
     for &g in vf {
         if leaving_boundary(g)? {
-            start = g;
+            (start, boundary) = (g, true);
             break;
         }
     }
-    let boundary = leaving_boundary(start)?;
     let mut fan = Fan {
         faces: SmallVec::with_capacity(vf.len()),
         ring: SmallVec::with_capacity(vf.len() + 1),
@@ -219,17 +223,17 @@ pub(crate) fn build_fan(t: &Topology, v: u32) -> Option<Fan> {
     };
     let mut g = start;
     loop {
-        let c = corner(g)?;
-        let fv = t.face_vertices(g as usize);
-        let fe = t.face_edge_list(g as usize);
+        let fv = &face_verts[span(g)];
+        let fe = &face_edges[span(g)];
+        let c = fv.iter().position(|&x| x == v)?;
         let n = fv.len();
         fan.faces.push((g, c));
         fan.ring.push(fv[(c + 1) % n]);
         fan.edges.push(fe[c]);
         let entering = fe[(c + n - 1) % n];
-        let [a, b] = t.edge_faces(entering as usize);
+        let [a, b] = t.edge_faces[entering as usize];
         let h = if a == g { b } else { a };
-        if t.is_boundary_edge(entering as usize) {
+        if boundary_edge(entering) {
             fan.ring.push(fv[(c + n - 1) % n]);
             fan.edges.push(entering);
             break;
@@ -262,106 +266,212 @@ enum Kind {
     Cone,
 }
 
-/// One corner of the patch: its vertex, ring, rule and limit data.
+/// One corner of the patch: its vertex's rule and limit constants, with the vertex, its ring
+/// and the diagonal of each fan face (level vertex ids from [`build_corner`], then slots of the
+/// cap's [`CapRows`]).
 struct Corner {
-    v: u32,
-    fan: Fan,
     /// Position of the patch face in the fan.
     j: usize,
+    boundary: bool,
     sharp: SmallVec<[bool; 9]>,
     kind: Kind,
     regular: bool,
     c: f64,
-    p: Row,
-    /// Cross tangent of a crease sector (rows over the level's vertices).
-    across: Row,
+    /// The vertex, its `n` ring neighbours, the diagonals of its `nf` fan faces.
+    verts: SmallVec<[usize; 20]>,
+    n: usize,
+    nf: usize,
+}
+
+/// The cap's rows, dense over its vertices (ascending): row `r` is `w[r·l..(r+1)·l]`.
+///
+/// Each row receives the same additions in the same order as a sparse [`Row`] would, one per
+/// slot per `add_row` (a slot a source lacks adds `s·0`, which changes no nonzero sum), so
+/// after dropping zeros the sums are bit-equal; no lookups, no copies of sparse rows.
+struct CapRows<'a> {
+    l: usize,
+    w: &'a mut [f64],
+}
+
+/// Rows 0..20 are the points (`5·corner + {P, Ep, Em, Fp, Fm}`), then each corner's cross
+/// tangent (crease sectors) and two scratch rows.
+const ACROSS: usize = 20;
+const TANGENT: usize = 24;
+const SCRATCH: usize = 25;
+const CAP_ROWS: usize = 26;
+
+/// Rows up to this many slots live on the stack.
+const CAP_SLOTS: usize = 32;
+
+impl CapRows<'_> {
+    fn row(&self, r: usize) -> &[f64] {
+        &self.w[r * self.l..(r + 1) * self.l]
+    }
+
+    fn clear(&mut self, r: usize) {
+        let l = self.l;
+        self.w[r * l..(r + 1) * l].fill(0.0);
+    }
+
+    fn add(&mut self, r: usize, slot: usize, w: f64) {
+        self.w[r * self.l + slot] += w;
+    }
+
+    /// Rows `dst` and `src` (distinct) as one mutable and one shared slice.
+    fn pair(&mut self, dst: usize, src: usize) -> (&mut [f64], &[f64]) {
+        let l = self.l;
+        if dst < src {
+            let (a, b) = self.w.split_at_mut(src * l);
+            (&mut a[dst * l..(dst + 1) * l], &b[..l])
+        } else {
+            let (a, b) = self.w.split_at_mut(dst * l);
+            (&mut b[..l], &a[src * l..(src + 1) * l])
+        }
+    }
+
+    fn copy(&mut self, dst: usize, src: usize) {
+        let (d, s) = self.pair(dst, src);
+        d.copy_from_slice(s);
+    }
+
+    fn add_row(&mut self, dst: usize, src: usize, s: f64) {
+        let (d, r) = self.pair(dst, src);
+        for (d, &r) in d.iter_mut().zip(r) {
+            *d += s * r;
+        }
+    }
 }
 
 impl Corner {
     fn n(&self) -> usize {
-        self.fan.ring.len()
+        self.n
     }
 
-    /// Diagonal vertex of fan face `i` (quads only, checked when the corner is built).
-    fn diag(&self, t: &Topology, i: usize) -> u32 {
-        let (g, c) = self.fan.faces[i % self.fan.faces.len()];
-        t.face_vertices(g as usize)[(c + 2) % 4]
+    fn v(&self) -> usize {
+        self.verts[0]
     }
 
-    fn mask_row(&self, t: &Topology, m: &Mask) -> Row {
-        let mut r = Row::default();
-        r.add(self.v, m.vertex);
+    fn ring(&self, k: usize) -> usize {
+        self.verts[1 + k]
+    }
+
+    /// Diagonal vertex of fan face `i` (wrapping, as a boundary ring has one more entry:
+    /// `i ≤ nf`, so one subtraction instead of a division).
+    fn diag(&self, i: usize) -> usize {
+        let i = if i >= self.nf { i - self.nf } else { i };
+        self.verts[1 + self.n + i]
+    }
+
+    fn mask_row(&self, rows: &mut CapRows<'_>, r: usize, m: &Mask) {
+        rows.add(r, self.v(), m.vertex);
         for (i, &w) in m.edges.iter().enumerate() {
-            r.add(self.fan.ring[i], w);
+            rows.add(r, self.ring(i), w);
         }
-        for (i, &w) in m.faces.iter().enumerate().take(self.fan.faces.len()) {
-            r.add(self.diag(t, i), w);
+        for (i, &w) in m.faces.iter().enumerate().take(self.nf) {
+            rows.add(r, self.diag(i), w);
         }
-        r
     }
 
-    /// `e_k − v`.
-    fn edge_vector(&self, k: usize) -> Row {
-        let mut r = Row::default();
-        r.add(self.fan.ring[k], 1.0);
-        r.add(self.v, -1.0);
-        r
+    /// `e_k − v` into the cleared row `r`.
+    fn edge_vector(&self, rows: &mut CapRows<'_>, r: usize, k: usize) {
+        rows.add(r, self.ring(k), 1.0);
+        rows.add(r, self.v(), -1.0);
     }
 
     /// Crease tangent along the sharp edges, toward `toward` (one of the two ends), built in
-    /// ascending ring order so both sectors produce the same row.
-    fn along(&self, a: usize, b: usize, toward: usize) -> Row {
+    /// ascending ring order so both sectors produce the same row; into the cleared row `r`.
+    fn along(&self, rows: &mut CapRows<'_>, r: usize, a: usize, b: usize, toward: usize) {
         let (lo, hi) = (a.min(b), a.max(b));
-        let mut r = Row::default();
-        r.add(self.fan.ring[lo], if toward == lo { 0.5 } else { -0.5 });
-        r.add(self.fan.ring[hi], if toward == hi { 0.5 } else { -0.5 });
-        r
+        rows.add(r, self.ring(lo), if toward == lo { 0.5 } else { -0.5 });
+        rows.add(r, self.ring(hi), if toward == hi { 0.5 } else { -0.5 });
     }
 
-    /// Parametric limit tangent toward ring neighbour `k` (see the module docs).
-    fn tangent(&self, t: &Topology, k: usize) -> Row {
+    /// The limit position into row `5·i` and, for a crease, the cross tangent into
+    /// `ACROSS + i` (rows cleared).
+    fn limit_rows(&self, rows: &mut CapRows<'_>, i: usize) {
+        let p = 5 * i;
         let n = self.n();
+        match self.kind {
+            Kind::Smooth if self.sharp.iter().filter(|&&x| x).count() == 1 && !self.boundary => {
+                // A dart: the smooth tangents, but its own limit position.
+                let edge = self.sharp.iter().position(|&x| x).unwrap_or(0);
+                let masks = catmark_limit_masks(&LimitVertex {
+                    valence: n,
+                    boundary: false,
+                    rule: LimitRule::Dart { edge },
+                });
+                self.mask_row(rows, p, &masks.position);
+            }
+            Kind::Smooth => {
+                // Only the position: the tangents come from `Corner::tangent`.
+                let [vw, ew, fw] = catmark_smooth_position_weights(n);
+                rows.add(p, self.v(), vw);
+                for &x in &self.verts[1..1 + n] {
+                    rows.add(p, x, ew);
+                }
+                for &d in &self.verts[1 + n..] {
+                    rows.add(p, d, fw);
+                }
+            }
+            Kind::Crease { a, b, .. } => {
+                let masks = catmark_limit_masks(&LimitVertex {
+                    valence: n,
+                    boundary: self.boundary,
+                    rule: LimitRule::Crease { ends: [a, b] },
+                });
+                self.mask_row(rows, p, &masks.position);
+                self.mask_row(rows, ACROSS + i, &masks.tangent2);
+            }
+            Kind::Corner { .. } | Kind::Cone => rows.add(p, self.v(), 1.0),
+        }
+    }
+
+    /// Parametric limit tangent toward ring neighbour `k` (see the module docs) of corner `i`,
+    /// into row [`TANGENT`] (cleared here; [`SCRATCH`] is used too).
+    fn tangent(&self, rows: &mut CapRows<'_>, i: usize, k: usize) {
+        let n = self.n();
+        let r = TANGENT;
+        rows.clear(r);
         match self.kind {
             Kind::Smooth => {
                 // Edge weights first, then face weights, as the rows were always summed.
                 let mut fw: SmallVec<[f64; 16]> = SmallVec::new();
-                let mut r = Row::default();
                 catmark_directional_tangent_each(n, k, |i, e, f| {
-                    r.add(self.fan.ring[i], e);
+                    rows.add(r, self.ring(i), e);
                     fw.push(f);
                 });
                 for (i, &w) in fw.iter().enumerate() {
-                    r.add(self.diag(t, i), w);
+                    rows.add(r, self.diag(i), w);
                 }
-                r
             }
             Kind::Crease { a, b, m } => {
                 if k == a || k == b {
-                    return self.along(a, b, k);
+                    return self.along(rows, r, a, b, k);
                 }
                 let s = (k + n - a) % n;
-                let t1 = self.along(a, b, a);
                 if 2 * s == m {
-                    return self.across.clone();
+                    return rows.copy(r, ACROSS + i);
                 }
+                rows.clear(SCRATCH);
+                self.along(rows, SCRATCH, a, b, a);
                 let th = PI * s as f64 / m as f64;
-                let mut r = Row::default();
-                r.add_row(&t1, th.cos());
-                r.add_row(&self.across, th.sin());
-                r
+                rows.add_row(r, SCRATCH, th.cos());
+                rows.add_row(r, ACROSS + i, th.sin());
             }
             Kind::Corner { a, b, m } => {
                 if k == a || k == b {
-                    return self.edge_vector(k);
+                    return self.edge_vector(rows, r, k);
                 }
                 let s = (k + n - a) % n;
                 let phi = PI / (2.0 * m as f64);
-                let mut r = Row::default();
-                r.add_row(&self.edge_vector(a), ((m - s) as f64 * phi).sin());
-                r.add_row(&self.edge_vector(b), (s as f64 * phi).sin());
-                r
+                rows.clear(SCRATCH);
+                self.edge_vector(rows, SCRATCH, a);
+                rows.add_row(r, SCRATCH, ((m - s) as f64 * phi).sin());
+                rows.clear(SCRATCH);
+                self.edge_vector(rows, SCRATCH, b);
+                rows.add_row(r, SCRATCH, (s as f64 * phi).sin());
             }
-            Kind::Cone => self.edge_vector(k),
+            Kind::Cone => self.edge_vector(rows, r, k),
         }
     }
 }
@@ -396,7 +506,8 @@ fn build_corner(
 ) -> Result<Corner, TopologyError> {
     let t = level.topology;
     let problem = |problem| TopologyError::GregoryPatch { face, problem };
-    let fan = build_fan(t, v).ok_or(problem(GregoryProblem::IncompleteRing { vertex: v }))?;
+    let fan =
+        build_fan(t, v).ok_or_else(|| problem(GregoryProblem::IncompleteRing { vertex: v }))?;
     if fan
         .faces
         .iter()
@@ -408,7 +519,7 @@ fn build_corner(
         .faces
         .iter()
         .position(|&(g, _)| g as usize == face)
-        .ok_or(problem(GregoryProblem::IncompleteRing { vertex: v }))?;
+        .ok_or_else(|| problem(GregoryProblem::IncompleteRing { vertex: v }))?;
     let n = fan.ring.len();
     let sharp: SmallVec<[bool; 9]> = fan
         .edges
@@ -456,69 +567,94 @@ fn build_corner(
         ),
         Kind::Cone => (false, 0.0),
     };
-    let mut corner = Corner {
-        v,
-        fan,
+    let mut verts = SmallVec::with_capacity(1 + n + fan.faces.len());
+    verts.push(v as usize);
+    verts.extend(fan.ring.iter().map(|&x| x as usize));
+    for &(g, c) in &fan.faces {
+        verts.push(t.face_vertices(g as usize)[(c + 2) % 4] as usize);
+    }
+    Ok(Corner {
         j,
+        boundary: fan.boundary,
         sharp,
         kind,
         regular,
         c,
-        p: Row::default(),
-        across: Row::default(),
-    };
-    match kind {
-        Kind::Smooth if sharp_count == 1 && !corner.fan.boundary => {
-            // A dart: the smooth tangents, but its own limit position.
-            let edge = corner.sharp.iter().position(|&x| x).unwrap_or(0);
-            let masks = catmark_limit_masks(&LimitVertex {
-                valence: n,
-                boundary: false,
-                rule: LimitRule::Dart { edge },
-            });
-            corner.p = corner.mask_row(t, &masks.position);
-        }
-        Kind::Smooth => {
-            // Only the position: the tangents come from `Corner::tangent`.
-            let [vw, ew, fw] = catmark_smooth_position_weights(n);
-            let p = &mut corner.p;
-            p.add(v, vw);
-            for &x in &corner.fan.ring {
-                p.add(x, ew);
-            }
-            for i in 0..corner.fan.faces.len() {
-                let d = corner.diag(t, i);
-                corner.p.add(d, fw);
-            }
-        }
-        Kind::Crease { .. } => {
-            let rule = match kind {
-                Kind::Crease { a, b, .. } => LimitRule::Crease { ends: [a, b] },
-                _ => LimitRule::Smooth,
-            };
-            let masks = catmark_limit_masks(&LimitVertex {
-                valence: n,
-                boundary: corner.fan.boundary,
-                rule,
-            });
-            corner.p = corner.mask_row(t, &masks.position);
-            if matches!(kind, Kind::Crease { .. }) {
-                corner.across = corner.mask_row(t, &masks.tangent2);
-            }
-        }
-        Kind::Corner { .. } | Kind::Cone => corner.p.add(v, 1.0),
-    }
-    Ok(corner)
+        verts,
+        n,
+        nf: fan.faces.len(),
+    })
 }
 
-/// The Bézier interior point of a regular patch: `(4v_i + 2v_{i+1} + 2v_{i−1} + v_{i+2})/9`.
-fn face_mask(fv: &[u32], i: usize) -> Row {
-    let mut r = Row::default();
-    r.add(fv[i], 4.0 / 9.0);
-    r.add(fv[(i + 1) % 4], 2.0 / 9.0);
-    r.add(fv[(i + 3) % 4], 2.0 / 9.0);
-    r.add(fv[(i + 2) % 4], 1.0 / 9.0);
-    r
+/// The Bézier interior point of a regular patch, `(4v_i + 2v_{i+1} + 2v_{i−1} + v_{i+2})/9`,
+/// into row `r` (`fv`: the corners' slots).
+fn face_mask(rows: &mut CapRows<'_>, r: usize, fv: [usize; 4], i: usize) {
+    rows.add(r, fv[i], 4.0 / 9.0);
+    rows.add(r, fv[(i + 1) % 4], 2.0 / 9.0);
+    rows.add(r, fv[(i + 3) % 4], 2.0 / 9.0);
+    rows.add(r, fv[(i + 2) % 4], 1.0 / 9.0);
+}
+
+/// Face point `Fp_i` (`plus`) or `Fm_i` into its (cleared) row, from the finished `P`, `Ep`
+/// and `Em` rows.
+fn face_point(rows: &mut CapRows<'_>, corners: &[Corner], i: usize, plus: bool) {
+    let dst = 5 * i + if plus { 3 } else { 4 };
+    let fv = [
+        corners[0].v(),
+        corners[1].v(),
+        corners[2].v(),
+        corners[3].v(),
+    ];
+    let near = &corners[i];
+    let n = near.n();
+    let j = near.j;
+    let (k, other, far_i) = if plus {
+        (j, (j + 1) % n, (i + 1) % 4)
+    } else {
+        ((j + 1) % n, j, (i + 3) % 4)
+    };
+    let far = &corners[far_i];
+    if near.regular && far.regular {
+        return face_mask(rows, dst, fv, i);
+    }
+    let formula = |rows: &mut CapRows<'_>, k: usize, far_i: usize, plus: bool| {
+        let far = &corners[far_i];
+        let (e_near, e_far) = if plus {
+            (5 * i + 1, 5 * far_i + 2)
+        } else {
+            (5 * i + 2, 5 * far_i + 1)
+        };
+        let (cn, cf) = (near.c, far.c);
+        rows.add_row(dst, 5 * i, cf / 3.0);
+        rows.add_row(dst, e_near, (3.0 - 2.0 * cn - cf) / 3.0);
+        rows.add_row(dst, e_far, 2.0 * cn / 3.0);
+        // Ring neighbours and diagonals on either side of edge k (inside: our face j).
+        let (x_in, x_out, d_out) = if plus {
+            (
+                near.ring((k + 1) % n),
+                near.ring((k + n - 1) % n),
+                (k + n - 1) % n,
+            )
+        } else {
+            (near.ring((k + n - 1) % n), near.ring((k + 1) % n), k)
+        };
+        rows.add(dst, x_in, 1.0 / 9.0);
+        rows.add(dst, x_out, -1.0 / 9.0);
+        rows.add(dst, near.diag(j), 1.0 / 18.0);
+        rows.add(dst, near.diag(d_out), -1.0 / 18.0);
+    };
+    if !near.sharp[k] {
+        return formula(rows, k, far_i, plus);
+    }
+    // Sharp edge: nothing to match across it; take the corner's other face point.
+    if near.sharp[other] {
+        return face_mask(rows, dst, fv, i);
+    }
+    let other_far = if plus { (i + 3) % 4 } else { (i + 1) % 4 };
+    if near.regular && corners[other_far].regular {
+        return face_mask(rows, dst, fv, i);
+    }
+    formula(rows, other, other_far, !plus)
 }
 
 /// The 20 Gregory control points of quad `face` of `level` as stencils over the level's vertex
@@ -588,87 +724,101 @@ pub(crate) fn gregory_basis_each(
             problem: GregoryProblem::NotQuad { size: fv.len() },
         });
     }
-    let mut corners = Vec::with_capacity(4);
+    let mut corners: SmallVec<[Corner; 4]> = SmallVec::new();
     for &v in fv {
         corners.push(build_corner(&level, options, face, v)?);
     }
+    // The cap's vertices become slots of its dense rows, numbered as first seen through a
+    // small open-addressing table.
+    let refs: usize = corners.iter().map(|c| c.verts.len()).sum();
+    let bits = (2 * refs).next_power_of_two().max(64).trailing_zeros();
+    let mask = (1usize << bits) - 1;
+    let mut table_inline = [(u32::MAX, 0u32); 128];
+    let mut table_heap = Vec::new();
+    let table: &mut [(u32, u32)] = if mask < 128 {
+        &mut table_inline[..mask + 1]
+    } else {
+        table_heap.resize(mask + 1, (u32::MAX, 0));
+        &mut table_heap
+    };
+    let mut ids: SmallVec<[u32; 32]> = SmallVec::new();
+    for x in corners.iter_mut().flat_map(|c| &mut c.verts) {
+        let id = *x as u32;
+        let mut h = (id.wrapping_mul(0x9E37_79B9) >> (32 - bits)) as usize;
+        loop {
+            let e = &mut table[h];
+            if e.0 == id {
+                *x = e.1 as usize;
+                break;
+            }
+            if e.0 == u32::MAX {
+                *e = (id, ids.len() as u32);
+                *x = ids.len();
+                ids.push(id);
+                break;
+            }
+            h = (h + 1) & mask;
+        }
+    }
+    // Renumbered in ascending id order, so each row comes out as a stencil's sorted indices.
+    let l = ids.len();
+    let mut order: SmallVec<[u64; 32]> = ids
+        .iter()
+        .enumerate()
+        .map(|(s, &x)| (x as u64) << 32 | s as u64)
+        .collect();
+    order.sort_unstable();
+    let mut rank: SmallVec<[usize; 32]> = SmallVec::from_elem(0, l);
+    for (new, &key) in order.iter().enumerate() {
+        rank[key as u32 as usize] = new;
+        ids[new] = (key >> 32) as u32;
+    }
+    for x in corners.iter_mut().flat_map(|c| &mut c.verts) {
+        *x = rank[*x];
+    }
+    // Zeroed a row at a time: one large memset costs more than the rows' small ones.
+    let mut w = Vec::with_capacity(l * CAP_ROWS);
+    for _ in 0..CAP_ROWS {
+        w.resize(w.len() + l, 0.0);
+    }
+    let mut rows = CapRows { l, w: &mut w };
+    for (i, c) in corners.iter().enumerate() {
+        c.limit_rows(&mut rows, i);
+    }
     // Edge points: index k of the ring is the edge toward the face's next (j) or previous
     // (j + 1) corner.
-    let mut ep = Vec::with_capacity(4);
-    let mut em = Vec::with_capacity(4);
-    for c in &corners {
+    for (i, c) in corners.iter().enumerate() {
         let n = c.n();
-        let mut p = c.p.clone();
-        p.add_row(&c.tangent(t, c.j), 1.0 / 3.0);
-        ep.push(p);
-        let mut m = c.p.clone();
-        m.add_row(&c.tangent(t, (c.j + 1) % n), 1.0 / 3.0);
-        em.push(m);
+        rows.copy(5 * i + 1, 5 * i);
+        c.tangent(&mut rows, i, c.j);
+        rows.add_row(5 * i + 1, TANGENT, 1.0 / 3.0);
+        rows.copy(5 * i + 2, 5 * i);
+        c.tangent(&mut rows, i, (c.j + 1) % n);
+        rows.add_row(5 * i + 2, TANGENT, 1.0 / 3.0);
     }
-    let face_point = |i: usize, plus: bool| -> Row {
-        let near = &corners[i];
-        let n = near.n();
-        let j = near.j;
-        let (k, other, far_i) = if plus {
-            (j, (j + 1) % n, (i + 1) % 4)
-        } else {
-            ((j + 1) % n, j, (i + 3) % 4)
-        };
-        let far = &corners[far_i];
-        if near.regular && far.regular {
-            return face_mask(fv, i);
-        }
-        let formula = |k: usize, far_i: usize, plus: bool| -> Row {
-            let far = &corners[far_i];
-            let (e_near, e_far) = if plus {
-                (&ep[i], &em[far_i])
-            } else {
-                (&em[i], &ep[far_i])
-            };
-            let (cn, cf) = (near.c, far.c);
-            let mut r = Row::default();
-            r.add_row(&near.p, cf / 3.0);
-            r.add_row(e_near, (3.0 - 2.0 * cn - cf) / 3.0);
-            r.add_row(e_far, 2.0 * cn / 3.0);
-            // Ring neighbours and diagonals on either side of edge k (inside: our face j).
-            let (x_in, x_out, d_out) = if plus {
-                (
-                    near.fan.ring[(k + 1) % n],
-                    near.fan.ring[(k + n - 1) % n],
-                    (k + n - 1) % n,
-                )
-            } else {
-                (
-                    near.fan.ring[(k + n - 1) % n],
-                    near.fan.ring[(k + 1) % n],
-                    k,
-                )
-            };
-            r.add(x_in, 1.0 / 9.0);
-            r.add(x_out, -1.0 / 9.0);
-            r.add(near.diag(t, j), 1.0 / 18.0);
-            r.add(near.diag(t, d_out), -1.0 / 18.0);
-            r
-        };
-        if !near.sharp[k] {
-            return formula(k, far_i, plus);
-        }
-        // Sharp edge: nothing to match across it; take the corner's other face point.
-        if near.sharp[other] {
-            return face_mask(fv, i);
-        }
-        let other_far = if plus { (i + 3) % 4 } else { (i + 1) % 4 };
-        if near.regular && corners[other_far].regular {
-            return face_mask(fv, i);
-        }
-        formula(other, other_far, !plus)
-    };
     for i in 0..4 {
-        each(5 * i, &corners[i].p.clone().finished().0);
-        each(5 * i + 1, &ep[i].clone().finished().0);
-        each(5 * i + 2, &em[i].clone().finished().0);
-        each(5 * i + 3, &face_point(i, true).finished().0);
-        each(5 * i + 4, &face_point(i, false).finished().0);
+        face_point(&mut rows, &corners, i, true);
+        face_point(&mut rows, &corners, i, false);
+    }
+    // Zero weights dropped (indices already ascending): the form of a [`Stencil`].
+    let mut terms_inline = [(0u32, 0.0f64); CAP_SLOTS];
+    let mut terms_heap = Vec::new();
+    let terms: &mut [(u32, f64)] = if l <= CAP_SLOTS {
+        &mut terms_inline[..l]
+    } else {
+        terms_heap.resize(l, (0, 0.0));
+        &mut terms_heap
+    };
+    for k in 0..20 {
+        let row = rows.row(k);
+        let mut m = 0;
+        for (&x, &w) in ids.iter().zip(row) {
+            if w != 0.0 {
+                terms[m] = (x, w);
+                m += 1;
+            }
+        }
+        each(k, &terms[..m]);
     }
     Ok(())
 }
