@@ -73,14 +73,20 @@ struct PatchChunk {
     masks: Vec<u32>,
     error: Option<TopologyError>,
     terms: Vec<(u32, f64)>,
+    /// An end cap's point rows, reused from cap to cap.
+    rows: PointRows,
 }
 
 /// Appends an end cap's point rows to `table` as local points and sets its control points to
 /// their ids relative to `rel0`, except each corner's `P` (the canonical corner, numbered
-/// later). Returns the slots that hold such ids.
+/// later). Point `k` is row `order(k)` of `rows`, its ids shifted by `base` (Gregory points are
+/// built in face corner order over the level's vertices: rotated and made global here, without
+/// a copy of the rows in patch order). Returns the slots that hold such ids.
 fn number_rows(
     patch: &mut AdaptivePatch,
     rows: &PointRows,
+    order: impl Fn(usize) -> usize,
+    base: u32,
     table: &mut StencilTable,
     rel0: usize,
     terms: &mut Vec<(u32, f64)>,
@@ -88,12 +94,12 @@ fn number_rows(
     let corners = patch.kind.corners();
     let mut cps = ControlPoints::with_capacity(rows.len());
     let mut mask = 0u32;
-    for (k, row) in rows.iter().enumerate() {
+    for k in 0..rows.len() {
         if k < 5 * corners && k % 5 == 0 {
             cps.push(INVALID);
         } else {
             terms.clear();
-            terms.extend_from_slice(row);
+            terms.extend(rows.row(order(k)).iter().map(|&(i, w)| (i + base, w)));
             cps.push((table.len() - rel0) as u32);
             push_row(table, terms);
             mask |= 1 << k;
@@ -260,11 +266,12 @@ pub(super) fn assemble(
         let patch = |f: usize,
                      table: &mut StencilTable,
                      rel0: usize,
-                     terms: &mut Vec<(u32, f64)>|
+                     terms: &mut Vec<(u32, f64)>,
+                     rows: &mut PointRows|
          -> Result<(AdaptivePatch, u32, u8), TopologyError> {
             if l == 0 && tri[f] {
                 let (mut patch, rows) = triangle_patch(mesh, &levels, f)?;
-                let mask = number_rows(&mut patch, &rows, table, rel0, terms);
+                let mask = number_rows(&mut patch, &rows, |k| k, 0, table, rel0, terms);
                 return Ok((patch, mask, 0));
             }
             let irregular = lvl
@@ -300,21 +307,25 @@ pub(super) fn assemble(
                     EndCap::Bilinear => PatchKind::Bilinear,
                 };
                 if patch.kind == PatchKind::Gregory {
-                    let rows = match acc.then(|| acc_points(mesh, lvl, f, shift)) {
+                    match acc.then(|| acc_points(mesh, lvl, f, shift)) {
                         Some(Ok(points)) => {
                             // An ACC-1 net: its corners' valences shade it; no
                             // reparameterization is fitted to it.
                             patch.tangent_valences = rotated(lvl.t(), f, shift)
                                 .0
                                 .map(|v| lvl.t().vertex_edges(v as usize).len().min(255) as u8);
-                            points
+                            mask = number_rows(&mut patch, &points, |k| k, 0, table, rel0, terms);
                         }
                         _ => {
                             patch.reparam_valences = reparam_valences(lvl, f, shift);
-                            gregory_points(mesh, lvl, f, shift)?
+                            gregory_face_rows(mesh, lvl, f, rows)?;
+                            // Patch corner p is face corner p + shift.
+                            let s = shift as usize;
+                            let order = |k: usize| 5 * ((k / 5 + s) % 4) + k % 5;
+                            mask =
+                                number_rows(&mut patch, rows, order, lvl.base, table, rel0, terms);
                         }
-                    };
-                    mask = number_rows(&mut patch, &rows, table, rel0, terms);
+                    }
                 } else {
                     patch.control_points = ControlPoints::from_elem(INVALID, 4);
                 }
@@ -384,7 +395,7 @@ pub(super) fn assemble(
                 c.error = None;
                 let rel0 = table.len();
                 for ((slot, site), &f) in out.iter_mut().zip(out_sites.iter_mut()).zip(part) {
-                    match patch(f as usize, table, rel0, &mut c.terms) {
+                    match patch(f as usize, table, rel0, &mut c.terms, &mut c.rows) {
                         Ok((p, mask, shift)) => {
                             *slot = p;
                             site.shift = shift;
@@ -949,25 +960,17 @@ fn triangle_patch(
     ))
 }
 
-/// Gregory points of face `f` (global ids, patch corner order).
-pub(super) fn gregory_points(
+/// Gregory points of face `f` into `rows` (level-local ids, face corner order).
+fn gregory_face_rows(
     mesh: &ControlMesh,
     lvl: &Lvl,
     f: usize,
-    shift: u8,
-) -> Result<PointRows, TopologyError> {
-    // Face corner order as built, then rotated into patch corner order.
-    let mut face_order = PointRows::with_capacity(256);
+    rows: &mut PointRows,
+) -> Result<(), TopologyError> {
+    rows.clear();
     crate::gregory::gregory_basis_each(lvl.topo.view(), f, &mesh.options, |_, terms| {
-        face_order.push(terms.iter().copied());
-    })?;
-    let s = shift as usize;
-    let mut out = PointRows::with_capacity(face_order.terms_len());
-    for k in 0..20 {
-        let row = face_order.row(5 * ((k / 5 + s) % 4) + k % 5);
-        out.push(row.iter().map(|&(i, w)| (i + lvl.base, w)));
-    }
-    Ok(out)
+        rows.push(terms.iter().copied());
+    })
 }
 
 /// The 20 Gregory points in patch corner order (patch corner p, point j = P, Ep, Em, Fp, Fm),

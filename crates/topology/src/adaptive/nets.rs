@@ -68,15 +68,13 @@ impl PointRows {
     pub(super) fn len(&self) -> usize {
         self.ends.len()
     }
-    pub(super) fn terms_len(&self) -> usize {
-        self.terms.len()
+    pub(super) fn clear(&mut self) {
+        self.ends.clear();
+        self.terms.clear();
     }
     pub(super) fn row(&self, k: usize) -> &[(u32, f64)] {
         let start = if k == 0 { 0 } else { self.ends[k - 1] as usize };
         &self.terms[start..self.ends[k] as usize]
-    }
-    pub(super) fn iter(&self) -> impl Iterator<Item = &[(u32, f64)]> {
-        (0..self.len()).map(|k| self.row(k))
     }
     /// Rows from stencils over a level's vertices, shifted to global ids by `base`.
     pub(super) fn from_stencils<'a>(
