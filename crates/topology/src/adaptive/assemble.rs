@@ -549,6 +549,8 @@ pub(super) fn assemble(
             }
         }
     }
+    // Done with: freed before the rows and curves allocate, so their pages can be reused.
+    drop((met, final_id));
     locals.append_par(
         &needed,
         || Vec::with_capacity(32),
@@ -753,10 +755,12 @@ pub(super) fn assemble(
     }
     // Who defines each curve's normals and texture coordinates (seamless displacement): the
     // owner patch, its edge, the part of the edge, and whether the curve runs with the edge.
+    drop(curve_of);
+    // Collected into the owners' own allocation (same size): no second array faulted in.
     let curve_owners: Vec<CurveOwner> = owners
-        .iter()
+        .into_iter()
         .zip(&curves)
-        .map(|(&(_, pi, p, part), c)| {
+        .map(|((_, pi, p, part), c)| {
             let ids = corners[pi as usize];
             let n = patches[pi as usize].corners();
             let p = p as usize;
