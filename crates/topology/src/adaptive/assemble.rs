@@ -467,10 +467,14 @@ pub(super) fn assemble(
     // provisional numbering in meeting order, then the rows' corners first and the regular
     // ones after, contiguous from `first_canon`.
     let mut canon = vec![INVALID; first_local as usize];
-    // Per provisional corner: its key, whether it is a regular corner, and its owner.
-    // About 1.2 corners and 2.2 curves per patch on catmark_car: reserved so they are not
-    // regrown (a regrowth copies and faults in both).
-    let mut met: Vec<(u32, bool, [u32; 2])> = Vec::with_capacity(patches.len() * 5 / 4);
+    // Provisional ids: the rows' corners and the regular ones each numbered in meeting order,
+    // the regular ones marked by `REGULAR`, each with its owner (patch, corner) in the order of
+    // its class. About 1.2 corners per patch on catmark_car: reserved so they are not regrown
+    // (a regrowth copies and faults in both); the rows' owners get room for all, as the plan's
+    // corner owners are they followed by the regular ones.
+    const REGULAR: u32 = 1 << 31;
+    let mut row_owners: Vec<[u32; 2]> = Vec::with_capacity(patches.len() * 5 / 4);
+    let mut regular_owners: Vec<[u32; 2]> = Vec::with_capacity(patches.len() * 5 / 4);
     let mut needed: Vec<(u8, u32)> = Vec::new();
     let mut corners: Vec<[u32; 4]> = Vec::with_capacity(patches.len());
     let first_canon = first_local + locals.table.len() as u32;
@@ -483,17 +487,23 @@ pub(super) fn assemble(
         for (p, &v) in fv[..n].iter().enumerate() {
             let key = lvl.anc[v as usize] as usize;
             if canon[key] == INVALID {
-                canon[key] = met.len() as u32;
-                met.push((key as u32, regular, [pi as u32, p as u32]));
-                if regular {
+                let owner = [pi as u32, p as u32];
+                canon[key] = if regular {
                     // No row: evaluated from this patch.
-                } else if pk == PatchKind::GregoryTriangle {
-                    // The limit mask needs an all-quad ring: the vertex's child's, at level 1.
-                    let maps = level1_maps(&levels, site.face)?;
-                    needed.push((1, maps.vertex_child_vertex[v as usize]));
+                    regular_owners.push(owner);
+                    REGULAR | (regular_owners.len() as u32 - 1)
                 } else {
-                    needed.push((lv, v));
-                }
+                    row_owners.push(owner);
+                    if pk == PatchKind::GregoryTriangle {
+                        // The limit mask needs an all-quad ring: the vertex's child's, at
+                        // level 1.
+                        let maps = level1_maps(&levels, site.face)?;
+                        needed.push((1, maps.vertex_child_vertex[v as usize]));
+                    } else {
+                        needed.push((lv, v));
+                    }
+                    row_owners.len() as u32 - 1
+                };
             }
             ids[p] = canon[key];
         }
@@ -510,8 +520,8 @@ pub(super) fn assemble(
                 }
                 let key = l1.anc[m as usize] as usize;
                 if canon[key] == INVALID {
-                    canon[key] = met.len() as u32;
-                    met.push((key as u32, false, [pi as u32, 4 + p as u32]));
+                    row_owners.push([pi as u32, 4 + p as u32]);
+                    canon[key] = row_owners.len() as u32 - 1;
                     needed.push((1, m));
                 }
             }
@@ -519,27 +529,28 @@ pub(super) fn assemble(
         corners.push(ids);
     }
     // Final ids: the rows' corners in meeting order, then the regular ones in meeting order.
-    let rows = needed.len() as u32;
+    let rows = row_owners.len() as u32;
+    let regular_corners = regular_owners.len() as u32;
+    if rows >= REGULAR || regular_corners >= REGULAR - 1 {
+        return Err(TopologyError::RefinementTooLarge {
+            faces: mesh.num_faces(),
+        });
+    }
     let first_regular_corner = first_canon + rows;
-    let mut final_id = Vec::with_capacity(met.len());
-    let mut corner_owners: Vec<[u32; 2]> = vec![[0; 2]; met.len()];
-    let (mut next_row, mut next_regular) = (0u32, 0u32);
-    for &(key, regular, owner) in &met {
-        let id = if regular {
-            next_regular += 1;
-            first_regular_corner + next_regular - 1
+    let final_id = |c: u32| {
+        if c & REGULAR != 0 {
+            first_regular_corner + (c & !REGULAR)
         } else {
-            next_row += 1;
-            first_canon + next_row - 1
-        };
-        final_id.push(id);
-        corner_owners[(id - first_canon) as usize] = owner;
-        canon[key as usize] = id;
+            first_canon + c
+        }
+    };
+    for c in canon.iter_mut().filter(|c| **c != INVALID) {
+        *c = final_id(*c);
     }
     for (ids, patch) in corners.iter_mut().zip(patches.iter_mut()) {
         let n = patch.corners();
         for (p, id) in ids[..n].iter_mut().enumerate() {
-            *id = final_id[*id as usize];
+            *id = final_id(*id);
             match patch.kind {
                 PatchKind::Gregory | PatchKind::GregoryTriangle => {
                     patch.control_points[5 * p] = *id
@@ -549,8 +560,9 @@ pub(super) fn assemble(
             }
         }
     }
-    // Done with: freed before the rows and curves allocate, so their pages can be reused.
-    drop((met, final_id));
+    let mut corner_owners = row_owners;
+    corner_owners.extend_from_slice(&regular_owners);
+    drop(regular_owners);
     locals.append_par(
         &needed,
         || Vec::with_capacity(32),
@@ -568,7 +580,6 @@ pub(super) fn assemble(
         first_local + locals.table.len() as u32,
         first_regular_corner
     );
-    let regular_corners = next_regular;
     let canon_of = |l: usize, v: u32, face: u32| -> Result<u32, TopologyError> {
         let c = canon[levels[l].anc[v as usize] as usize];
         if c == INVALID {
