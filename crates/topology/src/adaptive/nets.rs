@@ -32,6 +32,7 @@ impl Combo {
     }
     /// `2·a − b`. Phantoms extrapolate gathered points (one term each) or, at a corner,
     /// extrapolated ones (two terms each), so four terms always suffice.
+    #[inline]
     pub(super) fn extrapolate(a: &Combo, b: &Combo) -> Combo {
         let mut c = Combo::default();
         let terms = (0..a.n as usize)
@@ -278,6 +279,19 @@ pub(super) fn gather_regular(
         return None;
     }
     let s = shift as usize;
+    if let Some(out) = gather_ring(lvl.base, quads, rec, f as u32, s) {
+        return Some(out);
+    }
+    gather_walk(lvl, quads, f, shift)
+}
+
+/// [`gather_regular`] by walks around the corners, for any ring.
+fn gather_walk(lvl: &Lvl, quads: &[QuadRec], f: usize, shift: u8) -> Option<([u32; 16], u8)> {
+    let rec = quads.get(f)?;
+    if rec.verts[0] == INVALID {
+        return None;
+    }
+    let s = shift as usize;
     let fv: [u32; 4] = std::array::from_fn(|p| rec.verts[(p + s) % 4]);
     let mut ids = [INVALID; 16];
     let base = lvl.base;
@@ -342,6 +356,138 @@ pub(super) fn gather_regular(
         }
     }
     // Whether the phantoms can be completed is checked where they are built (the same error).
+    Some((ids, mask))
+}
+
+/// Position of `v` among a face's corners (its first), 4 if absent.
+#[inline]
+fn corner_of(verts: &[u32; 4], v: u32) -> usize {
+    let hits = (verts[0] == v) as u32
+        | ((verts[1] == v) as u32) << 1
+        | ((verts[2] == v) as u32) << 2
+        | ((verts[3] == v) as u32) << 3;
+    (hits | 16).trailing_zeros() as usize
+}
+
+/// Slot of patch corner `p`.
+const CORNER_SLOTS: [usize; 4] = [slot(0, 0), slot(1, 0), slot(1, 1), slot(0, 1)];
+
+/// The walks of [`gather_regular`] around the four corners visit each edge neighbour twice
+/// (last face around one corner, first around the next) and set the points shared by
+/// consecutive faces twice. These are the slot identities that let [`gather_ring`] visit each
+/// ring face once and compare once instead.
+const fn ring_slots_agree() -> bool {
+    let [w, back] = &GATHER_SLOTS;
+    let mut p = 0;
+    while p < 4 {
+        let q = (p + 1) % 4;
+        if w[p][2][2] as usize != CORNER_SLOTS[q]
+            || w[q][0][0] as usize != CORNER_SLOTS[p]
+            || w[q][0][1] != w[p][2][0]
+            || w[q][0][2] != w[p][2][1]
+            || w[p][1][0] != w[p][0][2]
+            || w[p][1][2] != w[p][2][0]
+            // A backward walk's first face is the forward walk's last, read the other way.
+            || back[p][0][0] != w[p][2][2]
+            || back[p][0][1] != w[p][2][1]
+            || back[p][0][2] != w[p][2][0]
+        {
+            return false;
+        }
+        p += 1;
+    }
+    // The corners, two points per edge neighbour and one per diagonal face fill the grid.
+    let mut seen = 0u32;
+    let mut p = 0;
+    while p < 4 {
+        seen |= 1 << CORNER_SLOTS[p] | 1 << w[p][2][0] | 1 << w[p][2][1] | 1 << w[p][1][1];
+        p += 1;
+    }
+    seen == 0xffff
+}
+const _: () = assert!(ring_slots_agree());
+
+/// [`gather_regular`] with each ring face visited once: per edge `e` not masked, the neighbour
+/// `N_e` across it, and per corner `p` between two such edges the diagonal face `D_p` (across
+/// `N_{p-1}`'s edge leaving the corner). `Some` only where the corner walks would visit the
+/// same faces, stop at the same masked edges and set every slot consistently, with the same
+/// ids; otherwise `None`, and the walks decide (the same outcome, or the error).
+#[inline]
+fn gather_ring(
+    base: u32,
+    quads: &[QuadRec],
+    rec: &QuadRec,
+    f: u32,
+    s: usize,
+) -> Option<([u32; 16], u8)> {
+    let w = &GATHER_SLOTS[0];
+    let v: [u32; 4] = std::array::from_fn(|p| rec.verts[(p + s) & 3]);
+    // Distinct corners: a walk starts at the corner's own position in the face.
+    if v[0] == v[1] || v[0] == v[2] || v[0] == v[3] || v[1] == v[2] || v[1] == v[3] || v[2] == v[3]
+    {
+        return None;
+    }
+    let across: [u32; 4] = std::array::from_fn(|e| rec.across[(e + s) & 3]);
+    let mut ids = [INVALID; 16];
+    let mut mask = 0u8;
+    let mut nb = [rec; 4];
+    let mut at = [0usize; 4];
+    for e in 0..4 {
+        ids[CORNER_SLOTS[e]] = base + v[e];
+        if across[e] == INVALID {
+            mask |= 1 << e;
+            continue;
+        }
+        let r = quads.get(across[e] as usize)?;
+        // Edge `e` runs `v[e] → v[e+1]` here and backward in `N_e`: `v[e]` follows `v[e+1]`
+        // (which also tells `N_e` from this face, where it leads).
+        let a = corner_of(&r.verts, v[e]);
+        let b = corner_of(&r.verts, v[(e + 1) & 3]);
+        if a > 3 || b != (a + 3) & 3 {
+            return None;
+        }
+        ids[w[e][2][0] as usize] = base + r.verts[(a + 1) & 3];
+        ids[w[e][2][1] as usize] = base + r.verts[(a + 2) & 3];
+        nb[e] = r;
+        at[e] = a;
+    }
+    for p in 0..4 {
+        let q = (p + 3) & 3;
+        match (mask >> q & 1 == 0, mask >> p & 1 == 0) {
+            (true, true) => {
+                let (m, am) = (nb[q], at[q]);
+                let d = m.across[(am + 2) & 3];
+                if d == f {
+                    return None;
+                }
+                // `INVALID` (a sharp edge past the corner) is past the end.
+                let dr = quads.get(d as usize)?;
+                let k = corner_of(&dr.verts, v[p]);
+                // The walk closes: `D_p`'s next face around the corner is `N_p`.
+                if k > 3
+                    || dr.across[(k + 3) & 3] != across[p]
+                    || dr.verts[(k + 1) & 3] != m.verts[(am + 2) & 3]
+                    || dr.verts[(k + 3) & 3] != nb[p].verts[(at[p] + 1) & 3]
+                {
+                    return None;
+                }
+                ids[w[p][1][1] as usize] = base + dr.verts[(k + 2) & 3];
+            }
+            // One masked edge at the corner: the walk from the other one stops at its
+            // neighbour (a boundary or crease runs on through the corner).
+            (true, false) => {
+                if nb[q].across[(at[q] + 2) & 3] != INVALID {
+                    return None;
+                }
+            }
+            (false, true) => {
+                if nb[p].across[at[p]] != INVALID {
+                    return None;
+                }
+            }
+            (false, false) => {}
+        }
+    }
     Some((ids, mask))
 }
 
