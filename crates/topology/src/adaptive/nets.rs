@@ -282,11 +282,11 @@ pub(super) fn gather_regular(
     if let Some(out) = gather_ring(lvl.base, quads, rec, f as u32, s) {
         return Some(out);
     }
-    gather_walk(lvl, quads, f, shift)
+    gather_walk(lvl.base, quads, f, shift)
 }
 
 /// [`gather_regular`] by walks around the corners, for any ring.
-fn gather_walk(lvl: &Lvl, quads: &[QuadRec], f: usize, shift: u8) -> Option<([u32; 16], u8)> {
+fn gather_walk(base: u32, quads: &[QuadRec], f: usize, shift: u8) -> Option<([u32; 16], u8)> {
     let rec = quads.get(f)?;
     if rec.verts[0] == INVALID {
         return None;
@@ -294,7 +294,6 @@ fn gather_walk(lvl: &Lvl, quads: &[QuadRec], f: usize, shift: u8) -> Option<([u3
     let s = shift as usize;
     let fv: [u32; 4] = std::array::from_fn(|p| rec.verts[(p + s) % 4]);
     let mut ids = [INVALID; 16];
-    let base = lvl.base;
     // A slot written twice (the points along an edge, reached from both its corners) must get
     // the same vertex both times; otherwise the ring is not the regular one.
     let set = |s: u8, v: u32, grid: &mut [u32; 16]| -> bool {
@@ -697,5 +696,84 @@ pub(super) fn kind_rank(k: PatchKind) -> u8 {
         PatchKind::Regular => 0,
         PatchKind::Gregory | PatchKind::GregoryTriangle => 1,
         PatchKind::Bilinear => 2,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 3×3 grid of quads (vertex `4y + x`, face `3j + i`), counter-clockwise.
+    fn grid() -> Vec<QuadRec> {
+        let face = |i: i32, j: i32| {
+            if (0..3).contains(&i) && (0..3).contains(&j) {
+                (3 * j + i) as u32
+            } else {
+                INVALID
+            }
+        };
+        let mut out = Vec::new();
+        for j in 0..3 {
+            for i in 0..3 {
+                let v = |x: i32, y: i32| (4 * (j + y) + i + x) as u32;
+                out.push(QuadRec {
+                    verts: [v(0, 0), v(1, 0), v(1, 1), v(0, 1)],
+                    across: [
+                        face(i, j - 1),
+                        face(i + 1, j),
+                        face(i, j + 1),
+                        face(i - 1, j),
+                    ],
+                });
+            }
+        }
+        out
+    }
+
+    /// The one-visit gather agrees with the corner walks wherever it answers, and answers on
+    /// every face of a plain grid, boundary faces included.
+    #[test]
+    fn ring_gather_matches_walks() {
+        let quads = grid();
+        for f in 0..9 {
+            for shift in 0..4u8 {
+                let ring = gather_ring(7, &quads, &quads[f], f as u32, shift as usize);
+                assert!(ring.is_some(), "face {f} shift {shift}");
+                assert_eq!(ring, gather_walk(7, &quads, f, shift));
+            }
+        }
+    }
+
+    /// Broken rings around the middle face: the one-visit gather either agrees with the walks
+    /// or leaves the answer to them, and a broken ring is never gathered.
+    #[test]
+    fn broken_rings_left_to_walks() {
+        let mut rejected = 0;
+        for g in (0..9).filter(|&g| g != 4) {
+            for field in 0..8 {
+                for value in [99, 4, (g as u32 + 1) % 9, INVALID] {
+                    let mut quads = grid();
+                    let rec = &mut quads[g];
+                    if field < 4 {
+                        rec.verts[field] = value;
+                    } else {
+                        rec.across[field - 4] = value;
+                    }
+                    for shift in 0..4u8 {
+                        let walk = gather_walk(0, &quads, 4, shift);
+                        match gather_ring(0, &quads, &quads[4], 4, shift as usize) {
+                            Some(ring) => assert_eq!(Some(ring), walk),
+                            None => rejected += 1,
+                        }
+                    }
+                }
+            }
+        }
+        assert!(rejected > 0);
+        // A diagonal face that does not meet its edge neighbours is an error, not a patch.
+        let mut quads = grid();
+        quads[0].verts[1] = 99;
+        assert_eq!(gather_ring(0, &quads, &quads[4], 4, 0), None);
+        assert_eq!(gather_walk(0, &quads, 4, 0), None);
     }
 }
