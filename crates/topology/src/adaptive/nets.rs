@@ -32,6 +32,7 @@ impl Combo {
     }
     /// `2·a − b`. Phantoms extrapolate gathered points (one term each) or, at a corner,
     /// extrapolated ones (two terms each), so four terms always suffice.
+    #[inline]
     pub(super) fn extrapolate(a: &Combo, b: &Combo) -> Combo {
         let mut c = Combo::default();
         let terms = (0..a.n as usize)
@@ -276,9 +277,21 @@ pub(super) fn gather_regular(
         return None;
     }
     let s = shift as usize;
+    if let Some(out) = gather_ring(lvl.base, quads, rec, f as u32, s) {
+        return Some(out);
+    }
+    gather_walk(lvl.base, quads, f, shift)
+}
+
+/// [`gather_regular`] by walks around the corners, for any ring.
+fn gather_walk(base: u32, quads: &[QuadRec], f: usize, shift: u8) -> Option<([u32; 16], u8)> {
+    let rec = quads.get(f)?;
+    if rec.verts[0] == INVALID {
+        return None;
+    }
+    let s = shift as usize;
     let fv: [u32; 4] = std::array::from_fn(|p| rec.verts[(p + s) % 4]);
     let mut ids = [INVALID; 16];
-    let base = lvl.base;
     // A slot written twice (the points along an edge, reached from both its corners) must get
     // the same vertex both times; otherwise the ring is not the regular one.
     let set = |s: u8, v: u32, grid: &mut [u32; 16]| -> bool {
@@ -340,6 +353,138 @@ pub(super) fn gather_regular(
         }
     }
     // Whether the phantoms can be completed is checked where they are built (the same error).
+    Some((ids, mask))
+}
+
+/// Position of `v` among a face's corners (its first), 4 if absent.
+#[inline]
+fn corner_of(verts: &[u32; 4], v: u32) -> usize {
+    let hits = (verts[0] == v) as u32
+        | ((verts[1] == v) as u32) << 1
+        | ((verts[2] == v) as u32) << 2
+        | ((verts[3] == v) as u32) << 3;
+    (hits | 16).trailing_zeros() as usize
+}
+
+/// Slot of patch corner `p`.
+const CORNER_SLOTS: [usize; 4] = [slot(0, 0), slot(1, 0), slot(1, 1), slot(0, 1)];
+
+/// The walks of [`gather_regular`] around the four corners visit each edge neighbour twice
+/// (last face around one corner, first around the next) and set the points shared by
+/// consecutive faces twice. These are the slot identities that let [`gather_ring`] visit each
+/// ring face once and compare once instead.
+const fn ring_slots_agree() -> bool {
+    let [w, back] = &GATHER_SLOTS;
+    let mut p = 0;
+    while p < 4 {
+        let q = (p + 1) % 4;
+        if w[p][2][2] as usize != CORNER_SLOTS[q]
+            || w[q][0][0] as usize != CORNER_SLOTS[p]
+            || w[q][0][1] != w[p][2][0]
+            || w[q][0][2] != w[p][2][1]
+            || w[p][1][0] != w[p][0][2]
+            || w[p][1][2] != w[p][2][0]
+            // A backward walk's first face is the forward walk's last, read the other way.
+            || back[p][0][0] != w[p][2][2]
+            || back[p][0][1] != w[p][2][1]
+            || back[p][0][2] != w[p][2][0]
+        {
+            return false;
+        }
+        p += 1;
+    }
+    // The corners, two points per edge neighbour and one per diagonal face fill the grid.
+    let mut seen = 0u32;
+    let mut p = 0;
+    while p < 4 {
+        seen |= 1 << CORNER_SLOTS[p] | 1 << w[p][2][0] | 1 << w[p][2][1] | 1 << w[p][1][1];
+        p += 1;
+    }
+    seen == 0xffff
+}
+const _: () = assert!(ring_slots_agree());
+
+/// [`gather_regular`] with each ring face visited once: per edge `e` not masked, the neighbour
+/// `N_e` across it, and per corner `p` between two such edges the diagonal face `D_p` (across
+/// `N_{p-1}`'s edge leaving the corner). `Some` only where the corner walks would visit the
+/// same faces, stop at the same masked edges and set every slot consistently, with the same
+/// ids; otherwise `None`, and the walks decide (the same outcome, or the error).
+#[inline]
+fn gather_ring(
+    base: u32,
+    quads: &[QuadRec],
+    rec: &QuadRec,
+    f: u32,
+    s: usize,
+) -> Option<([u32; 16], u8)> {
+    let w = &GATHER_SLOTS[0];
+    let v: [u32; 4] = std::array::from_fn(|p| rec.verts[(p + s) & 3]);
+    // Distinct corners: a walk starts at the corner's own position in the face.
+    if v[0] == v[1] || v[0] == v[2] || v[0] == v[3] || v[1] == v[2] || v[1] == v[3] || v[2] == v[3]
+    {
+        return None;
+    }
+    let across: [u32; 4] = std::array::from_fn(|e| rec.across[(e + s) & 3]);
+    let mut ids = [INVALID; 16];
+    let mut mask = 0u8;
+    let mut nb = [rec; 4];
+    let mut at = [0usize; 4];
+    for e in 0..4 {
+        ids[CORNER_SLOTS[e]] = base + v[e];
+        if across[e] == INVALID {
+            mask |= 1 << e;
+            continue;
+        }
+        let r = quads.get(across[e] as usize)?;
+        // Edge `e` runs `v[e] → v[e+1]` here and backward in `N_e`: `v[e]` follows `v[e+1]`
+        // (which also tells `N_e` from this face, where it leads).
+        let a = corner_of(&r.verts, v[e]);
+        let b = corner_of(&r.verts, v[(e + 1) & 3]);
+        if a > 3 || b != (a + 3) & 3 {
+            return None;
+        }
+        ids[w[e][2][0] as usize] = base + r.verts[(a + 1) & 3];
+        ids[w[e][2][1] as usize] = base + r.verts[(a + 2) & 3];
+        nb[e] = r;
+        at[e] = a;
+    }
+    for p in 0..4 {
+        let q = (p + 3) & 3;
+        match (mask >> q & 1 == 0, mask >> p & 1 == 0) {
+            (true, true) => {
+                let (m, am) = (nb[q], at[q]);
+                let d = m.across[(am + 2) & 3];
+                if d == f {
+                    return None;
+                }
+                // `INVALID` (a sharp edge past the corner) is past the end.
+                let dr = quads.get(d as usize)?;
+                let k = corner_of(&dr.verts, v[p]);
+                // The walk closes: `D_p`'s next face around the corner is `N_p`.
+                if k > 3
+                    || dr.across[(k + 3) & 3] != across[p]
+                    || dr.verts[(k + 1) & 3] != m.verts[(am + 2) & 3]
+                    || dr.verts[(k + 3) & 3] != nb[p].verts[(at[p] + 1) & 3]
+                {
+                    return None;
+                }
+                ids[w[p][1][1] as usize] = base + dr.verts[(k + 2) & 3];
+            }
+            // One masked edge at the corner: the walk from the other one stops at its
+            // neighbour (a boundary or crease runs on through the corner).
+            (true, false) => {
+                if nb[q].across[(at[q] + 2) & 3] != INVALID {
+                    return None;
+                }
+            }
+            (false, true) => {
+                if nb[p].across[at[p]] != INVALID {
+                    return None;
+                }
+            }
+            (false, false) => {}
+        }
+    }
     Some((ids, mask))
 }
 
@@ -549,5 +694,84 @@ pub(super) fn kind_rank(k: PatchKind) -> u8 {
         PatchKind::Regular => 0,
         PatchKind::Gregory | PatchKind::GregoryTriangle => 1,
         PatchKind::Bilinear => 2,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 3×3 grid of quads (vertex `4y + x`, face `3j + i`), counter-clockwise.
+    fn grid() -> Vec<QuadRec> {
+        let face = |i: i32, j: i32| {
+            if (0..3).contains(&i) && (0..3).contains(&j) {
+                (3 * j + i) as u32
+            } else {
+                INVALID
+            }
+        };
+        let mut out = Vec::new();
+        for j in 0..3 {
+            for i in 0..3 {
+                let v = |x: i32, y: i32| (4 * (j + y) + i + x) as u32;
+                out.push(QuadRec {
+                    verts: [v(0, 0), v(1, 0), v(1, 1), v(0, 1)],
+                    across: [
+                        face(i, j - 1),
+                        face(i + 1, j),
+                        face(i, j + 1),
+                        face(i - 1, j),
+                    ],
+                });
+            }
+        }
+        out
+    }
+
+    /// The one-visit gather agrees with the corner walks wherever it answers, and answers on
+    /// every face of a plain grid, boundary faces included.
+    #[test]
+    fn ring_gather_matches_walks() {
+        let quads = grid();
+        for f in 0..9 {
+            for shift in 0..4u8 {
+                let ring = gather_ring(7, &quads, &quads[f], f as u32, shift as usize);
+                assert!(ring.is_some(), "face {f} shift {shift}");
+                assert_eq!(ring, gather_walk(7, &quads, f, shift));
+            }
+        }
+    }
+
+    /// Broken rings around the middle face: the one-visit gather either agrees with the walks
+    /// or leaves the answer to them, and a broken ring is never gathered.
+    #[test]
+    fn broken_rings_left_to_walks() {
+        let mut rejected = 0;
+        for g in (0..9).filter(|&g| g != 4) {
+            for field in 0..8 {
+                for value in [99, 4, (g as u32 + 1) % 9, INVALID] {
+                    let mut quads = grid();
+                    let rec = &mut quads[g];
+                    if field < 4 {
+                        rec.verts[field] = value;
+                    } else {
+                        rec.across[field - 4] = value;
+                    }
+                    for shift in 0..4u8 {
+                        let walk = gather_walk(0, &quads, 4, shift);
+                        match gather_ring(0, &quads, &quads[4], 4, shift as usize) {
+                            Some(ring) => assert_eq!(Some(ring), walk),
+                            None => rejected += 1,
+                        }
+                    }
+                }
+            }
+        }
+        assert!(rejected > 0);
+        // A diagonal face that does not meet its edge neighbours is an error, not a patch.
+        let mut quads = grid();
+        quads[0].verts[1] = 99;
+        assert_eq!(gather_ring(0, &quads, &quads[4], 4, 0), None);
+        assert_eq!(gather_walk(0, &quads, 4, 0), None);
     }
 }
