@@ -263,16 +263,19 @@ pub(super) fn assemble(
         // One patch: its control points, with its local points' rows appended to `table`
         // (their ids relative to `rel0`, marked in the returned mask for the caller to
         // number), and its rotation.
+        // Written in place into its slot of the plan's list (no copy of the patch per face).
         let patch = |f: usize,
+                     patch: &mut AdaptivePatch,
                      table: &mut StencilTable,
                      rel0: usize,
                      terms: &mut Vec<(u32, f64)>,
                      rows: &mut PointRows|
-         -> Result<(AdaptivePatch, u32, u8), TopologyError> {
+         -> Result<(u32, u8), TopologyError> {
             if l == 0 && tri[f] {
-                let (mut patch, rows) = triangle_patch(mesh, &levels, f)?;
-                let mask = number_rows(&mut patch, &rows, |k| k, 0, table, rel0, terms);
-                return Ok((patch, mask, 0));
+                let rows;
+                (*patch, rows) = triangle_patch(mesh, &levels, f)?;
+                let mask = number_rows(patch, &rows, |k| k, 0, table, rel0, terms);
+                return Ok((mask, 0));
             }
             let irregular = lvl
                 .t()
@@ -286,7 +289,7 @@ pub(super) fn assemble(
                 });
             }
             let (base_face, sub_face, origin, size, shift) = frame(&levels, l, f);
-            let mut patch = AdaptivePatch {
+            *patch = AdaptivePatch {
                 kind: PatchKind::Regular,
                 level: l as u8,
                 control_points: ControlPoints::new(),
@@ -314,7 +317,7 @@ pub(super) fn assemble(
                             patch.tangent_valences = rotated(lvl.t(), f, shift)
                                 .0
                                 .map(|v| lvl.t().vertex_edges(v as usize).len().min(255) as u8);
-                            mask = number_rows(&mut patch, &points, |k| k, 0, table, rel0, terms);
+                            mask = number_rows(patch, &points, |k| k, 0, table, rel0, terms);
                         }
                         _ => {
                             patch.reparam_valences = reparam_valences(lvl, f, shift);
@@ -322,8 +325,7 @@ pub(super) fn assemble(
                             // Patch corner p is face corner p + shift.
                             let s = shift as usize;
                             let order = |k: usize| 5 * ((k / 5 + s) % 4) + k % 5;
-                            mask =
-                                number_rows(&mut patch, rows, order, lvl.base, table, rel0, terms);
+                            mask = number_rows(patch, rows, order, lvl.base, table, rel0, terms);
                         }
                     }
                 } else {
@@ -367,7 +369,7 @@ pub(super) fn assemble(
                     }
                 }
             }
-            Ok((patch, mask, shift))
+            Ok((mask, shift))
         };
         // Rounds of chunks of faces, two per thread, each writing its patches in place and its
         // local points' rows into a chunk table; then, in face order, each chunk's rows are
@@ -395,9 +397,8 @@ pub(super) fn assemble(
                 c.error = None;
                 let rel0 = table.len();
                 for ((slot, site), &f) in out.iter_mut().zip(out_sites.iter_mut()).zip(part) {
-                    match patch(f as usize, table, rel0, &mut c.terms, &mut c.rows) {
-                        Ok((p, mask, shift)) => {
-                            *slot = p;
+                    match patch(f as usize, slot, table, rel0, &mut c.terms, &mut c.rows) {
+                        Ok((mask, shift)) => {
                             site.shift = shift;
                             c.masks.push(mask);
                         }
