@@ -58,7 +58,9 @@ use crate::sdc::{
     boundary_edge_sharpness, boundary_vertex_sharpness, decrement_sharpness, fractional_weight,
     is_sharp, subdivide_edge_sharpness_at_vertex, vertex_rule, Rule, Scheme,
 };
-use crate::stencil::{build_rows, compose_rows, RowKind, RowOut, StencilTable};
+use crate::stencil::{
+    build_rows, compose_rows, entry_key, insertion_sort, RowKind, RowOut, StencilTable,
+};
 use rayon::prelude::*;
 
 /// One level of a refinement: topology, positions and (propagated) sharpness.
@@ -1353,11 +1355,11 @@ impl MaskContext<'_> {
         let mut ring = [0u32; RING];
         let mut w = [0.0f64; 1 + 2 * RING];
         let mut keys = [0u64; ROW];
-        keys[0] = key(v as u32, 0);
+        keys[0] = entry_key(v as u32, 0);
         for (j, &e) in edges.iter().enumerate() {
             ring[j] = other_end(p, e, v);
             w[1 + j] = scale * ew;
-            keys[1 + j] = key(ring[j], 1 + j);
+            keys[1 + j] = entry_key(ring[j], 1 + j);
         }
         let mut len = 1 + k;
         let ring = &ring[..k];
@@ -1383,7 +1385,7 @@ impl MaskContext<'_> {
                         None => return false,
                     }
                 }
-                keys[len] = key(q[(c + 2) & 3], s);
+                keys[len] = entry_key(q[(c + 2) & 3], s);
                 len += 1;
                 continue;
             }
@@ -1398,7 +1400,7 @@ impl MaskContext<'_> {
                         None => return false,
                     }
                 } else {
-                    keys[len] = key(x, s);
+                    keys[len] = entry_key(x, s);
                     len += 1;
                 }
             }
@@ -1423,8 +1425,8 @@ impl MaskContext<'_> {
         let mut w = [scale * vw, scale * vw, 0.0, 0.0];
         // Long enough for two octagons.
         let mut keys = [0u64; 16];
-        keys[0] = key(a, 0);
-        keys[1] = key(b, 1);
+        keys[0] = entry_key(a, 0);
+        keys[1] = entry_key(b, 1);
         let mut len = 2;
         for (s, &f) in (2..).zip(faces) {
             let fv = p.face_vertices(f as usize);
@@ -1439,7 +1441,7 @@ impl MaskContext<'_> {
                 } else if x == b {
                     w[1] += wf;
                 } else {
-                    keys[len] = key(x, s);
+                    keys[len] = entry_key(x, s);
                     len += 1;
                 }
             }
@@ -1564,16 +1566,9 @@ fn face_centre_merged(fv: &[u32], out: &mut RowOut) -> bool {
         return false;
     }
     for (slot, &x) in keys.iter_mut().zip(fv) {
-        *slot = key(x, 0);
+        *slot = entry_key(x, 0);
     }
     emit_merged(&mut keys[..fv.len()], &[w], out)
-}
-
-/// A merged rule's entry as one word: its index above its weight's slot, so sorting the words
-/// sorts the entries by index and moves a word, not an (index, weight) pair.
-#[inline]
-fn key(j: u32, slot: usize) -> u64 {
-    (u64::from(j) << 32) | slot as u64
 }
 
 /// Sort `$k` with a comparator network (branch-free compare-exchanges, unrolled).
@@ -1611,7 +1606,7 @@ fn sort9(k: &mut [u64; 9]) {
     );
 }
 
-/// Sort a short row's keys ([`key`]).
+/// Sort a short row's keys ([`entry_key`]).
 #[inline]
 fn sort_keys(keys: &mut [u64]) {
     if let Ok(k) = <&mut [u64; 6]>::try_from(&mut *keys) {
@@ -1619,19 +1614,11 @@ fn sort_keys(keys: &mut [u64]) {
     } else if let Ok(k) = <&mut [u64; 9]>::try_from(&mut *keys) {
         sort9(k);
     } else {
-        for i in 1..keys.len() {
-            let x = keys[i];
-            let mut j = i;
-            while j > 0 && keys[j - 1] > x {
-                keys[j] = keys[j - 1];
-                j -= 1;
-            }
-            keys[j] = x;
-        }
+        insertion_sort(keys);
     }
 }
 
-/// Append a merged rule's entries ([`key`]) to `out`: by ascending index, with their slot's
+/// Append a merged rule's entries ([`entry_key`]) to `out`: by ascending index, with their slot's
 /// weight in `w` (every slot used), exact zeros dropped. `false` (nothing written) if an index
 /// repeats: the merged rules do not sum repeats, the caller writes the row raw.
 #[inline]

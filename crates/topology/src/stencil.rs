@@ -173,18 +173,33 @@ impl Dense {
         let t = &mut self.touched;
         if t.len() > 32 {
             t.sort_unstable();
-            return;
-        }
-        for i in 1..t.len() {
-            let x = t[i];
-            let mut j = i;
-            while j > 0 && t[j - 1] > x {
-                t[j] = t[j - 1];
-                j -= 1;
-            }
-            t[j] = x;
+        } else {
+            insertion_sort(t);
         }
     }
+}
+
+/// Insertion sort: for the short rows and lists of the stencil builders, cheaper than the
+/// library sort's dispatch.
+#[inline]
+pub(crate) fn insertion_sort<T: Copy + PartialOrd>(s: &mut [T]) {
+    for i in 1..s.len() {
+        let x = s[i];
+        let mut j = i;
+        while j > 0 && s[j - 1] > x {
+            s[j] = s[j - 1];
+            j -= 1;
+        }
+        s[j] = x;
+    }
+}
+
+/// A row entry as one sortable word: its index above `slot` (where its weight is, or its place
+/// in the row), so sorting the words sorts the entries by index, ties by slot, and moves a
+/// word rather than an (index, weight) pair.
+#[inline]
+pub(crate) fn entry_key(index: u32, slot: usize) -> u64 {
+    (u64::from(index) << 32) | slot as u64
 }
 
 /// Per-thread scratch of [`compose_rows`], reused across rounds: the accumulators (merging a
@@ -427,11 +442,7 @@ fn merge_raw(
         return;
     }
     keys.clear();
-    keys.extend(
-        row.iter()
-            .enumerate()
-            .map(|(k, e)| (u64::from(e.0) << 32) | k as u64),
-    );
+    keys.extend(row.iter().enumerate().map(|(k, e)| entry_key(e.0, k)));
     keys.sort_unstable();
     let mut k = 0;
     while k < keys.len() {
