@@ -35,6 +35,14 @@ impl StencilTable {
         }
     }
 
+    /// No rows, the storage kept: a table reused as a scratch from chunk to chunk.
+    pub fn clear(&mut self) {
+        self.offsets.clear();
+        self.offsets.push(0);
+        self.indices.clear();
+        self.weights.clear();
+    }
+
     /// Number of stencils (refined vertices).
     pub fn len(&self) -> usize {
         self.offsets.len().saturating_sub(1)

@@ -46,10 +46,7 @@ impl Locals {
                 .par_iter_mut()
                 .zip(chunks.par_iter())
                 .for_each(|((s, table), chunk)| {
-                    table.offsets.clear();
-                    table.offsets.push(0);
-                    table.indices.clear();
-                    table.weights.clear();
+                    table.clear();
                     for item in chunk.iter() {
                         build(item, s, table);
                     }
@@ -423,10 +420,7 @@ pub(super) fn assemble(
                     .zip(parts.par_iter())
                     .for_each(|(((c, out), out_sites), part)| {
                         let mut table = std::mem::take(&mut c.table);
-                        table.offsets.clear();
-                        table.offsets.push(0);
-                        table.indices.clear();
-                        table.weights.clear();
+                        table.clear();
                         c.table_len0 = 0;
                         run(c, &mut table, out, out_sites, part);
                         c.table = table;
