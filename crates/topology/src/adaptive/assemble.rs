@@ -28,14 +28,24 @@ impl Locals {
     /// Appends the rows `build` makes for each item (in item order), built in parallel chunks
     /// of [`CHUNK`] items. Chunks run in rounds of two per thread into tables reused from round
     /// to round: each round is copied out of warm memory, and no chunk table is allocated and
-    /// faulted in anew (a fresh table per chunk: catmark_car's plan 108 → 116 ms).
+    /// faulted in anew (a fresh table per chunk: catmark_car's plan 108 → 116 ms). On one
+    /// thread the rows go straight into the table.
     pub(super) fn append_par<T: Sync, S: Send>(
         &mut self,
         items: &[T],
         scratch: impl Fn() -> S + Sync,
         build: impl Fn(&T, &mut S, &mut StencilTable) + Sync,
     ) {
-        let per_round = 2 * rayon::current_num_threads().max(1);
+        let threads = rayon::current_num_threads().max(1);
+        if threads == 1 {
+            // Straight into the local points: no chunk table to fill and copy out.
+            let mut s = scratch();
+            for item in items {
+                build(item, &mut s, &mut self.table);
+            }
+            return;
+        }
+        let per_round = 2 * threads;
         let mut tables: Vec<(S, StencilTable)> = Vec::new();
         for round in items.chunks(per_round * CHUNK) {
             let chunks: Vec<&[T]> = round.chunks(CHUNK).collect();
@@ -451,6 +461,8 @@ pub(super) fn assemble(
         }
     }
     drop(candidates);
+    drop(quads);
+    drop(chunks);
 
     // Canonical corners, at the coarsest level each is a patch corner (patches are level-ordered).
     // A corner first met on a regular patch is a regular vertex, and its limit point is the
@@ -461,6 +473,12 @@ pub(super) fn assemble(
     // points. The others get limit-stencil rows at the end of the local points. First a
     // provisional numbering in meeting order, then the rows' corners first and the regular
     // ones after, contiguous from `first_canon`.
+    //
+    // The same walk over the patches does their edges (neighbour levels, balance, curves) on
+    // the provisional ids: they map to the final ones monotonically (rows' corners, then
+    // `REGULAR` ones), so the ends' order, `reversed` and the owners' directions are the same;
+    // the curves' ends are made final at the end. A coarse edge's midpoint is a corner of a
+    // finer patch, met later: its lookups wait in `pending` until the walk is done.
     let mut canon = vec![INVALID; first_local as usize];
     // Provisional ids: the rows' corners and the regular ones each numbered in meeting order,
     // the regular ones marked by `REGULAR`, each with its owner (patch, corner) in the order of
@@ -471,58 +489,231 @@ pub(super) fn assemble(
     let mut row_owners: Vec<[u32; 2]> = Vec::with_capacity(patches.len() * 5 / 4);
     let mut regular_owners: Vec<[u32; 2]> = Vec::with_capacity(patches.len() * 5 / 4);
     let mut needed: Vec<(u8, u32)> = Vec::new();
-    let mut corners: Vec<[u32; 4]> = Vec::with_capacity(patches.len());
+    // End caps' corners (provisional): their control points get the final ids at the end.
+    let mut cap_corners: Vec<(u32, [u32; 4])> = Vec::new();
+    let mut pending: Vec<Pending> = Vec::new();
     let first_canon = first_local + locals.table.len() as u32;
-    for (pi, (site, patch)) in sites.iter().zip(patches.iter_mut()).enumerate() {
-        let (lv, pk) = (patch.level, patch.kind);
-        let lvl = &levels[lv as usize];
-        let (fv, _, n) = patch_corners(lvl, pk, *site);
-        let regular = patch.kind == PatchKind::Regular;
-        let mut ids = [INVALID; 4];
-        for (p, &v) in fv[..n].iter().enumerate() {
-            let key = lvl.anc[v as usize] as usize;
-            if canon[key] == INVALID {
-                let owner = [pi as u32, p as u32];
-                canon[key] = if regular {
-                    // No row: evaluated from this patch.
-                    regular_owners.push(owner);
-                    REGULAR | (regular_owners.len() as u32 - 1)
-                } else {
-                    row_owners.push(owner);
-                    if pk == PatchKind::GregoryTriangle {
-                        // The limit mask needs an all-quad ring: the vertex's child's, at
-                        // level 1.
-                        let maps = level1_maps(&levels, site.face)?;
-                        needed.push((1, maps.vertex_child_vertex[v as usize]));
-                    } else {
-                        needed.push((lv, v));
-                    }
-                    row_owners.len() as u32 - 1
-                };
+    let mut curve_of: Vec<Vec<u32>> = levels
+        .iter()
+        .map(|l| vec![INVALID; l.t().num_edges()])
+        .collect();
+    let mut curves: Vec<[u32; 4]> = Vec::with_capacity(patches.len() * 5 / 2);
+    let mut owners: Vec<Owner> = Vec::with_capacity(curves.capacity());
+    // The curve of edge `e` of level `l`, made with `ends` (`INVALID` ones wait in `pending`).
+    let mut curve_id =
+        |l: usize, e: u32, ends: [u32; 2], owner: Owner, curves: &mut Vec<[u32; 4]>| -> u32 {
+            let slot = &mut curve_of[l][e as usize];
+            if *slot == INVALID {
+                *slot = curves.len() as u32;
+                let (a, b) = (ends[0].min(ends[1]), ends[0].max(ends[1]));
+                curves.push([a, INVALID, INVALID, b]);
+                owners.push(owner);
+            } else if owner < owners[*slot as usize] {
+                owners[*slot as usize] = owner;
             }
-            ids[p] = canon[key];
-        }
-        if pk == PatchKind::GregoryTriangle {
-            // Its edges are level-1 halves (see `triangle_draft`): the edge midpoints are
-            // canonical corners too; a triangle owning one says so by corner index 4 + edge.
-            let (_, fe, _) = patch_corners(lvl, pk, *site);
-            let maps = level1_maps(&levels, site.face)?;
-            let l1 = &levels[1];
-            for (p, &e) in fe[..3].iter().enumerate() {
-                let m = maps.edge_child_vertex[e as usize];
-                if m == INVALID {
-                    continue;
-                }
-                let key = l1.anc[m as usize] as usize;
+            *slot
+        };
+    let canon_at = |canon: &[u32], l: usize, v: u32| canon[levels[l].anc[v as usize] as usize];
+    let walk = (|| -> Result<(), TopologyError> {
+        for (pi, (site, patch)) in sites.iter().zip(patches.iter_mut()).enumerate() {
+            let (lv, pk) = (patch.level, patch.kind);
+            let l = lv as usize;
+            let lvl = &levels[l];
+            let t = lvl.t();
+            let (fv, fe, n) = patch_corners(lvl, pk, *site);
+            let regular = pk == PatchKind::Regular;
+            let mut ids = [INVALID; 4];
+            for (p, &v) in fv[..n].iter().enumerate() {
+                let key = lvl.anc[v as usize] as usize;
                 if canon[key] == INVALID {
-                    row_owners.push([pi as u32, 4 + p as u32]);
-                    canon[key] = row_owners.len() as u32 - 1;
-                    needed.push((1, m));
+                    let owner = [pi as u32, p as u32];
+                    canon[key] = if regular {
+                        // No row: evaluated from this patch.
+                        regular_owners.push(owner);
+                        REGULAR | (regular_owners.len() as u32 - 1)
+                    } else {
+                        row_owners.push(owner);
+                        if pk == PatchKind::GregoryTriangle {
+                            // The limit mask needs an all-quad ring: the vertex's child's, at
+                            // level 1.
+                            let maps = level1_maps(&levels, site.face)?;
+                            needed.push((1, maps.vertex_child_vertex[v as usize]));
+                        } else {
+                            needed.push((lv, v));
+                        }
+                        row_owners.len() as u32 - 1
+                    };
+                }
+                ids[p] = canon[key];
+            }
+            if pk == PatchKind::GregoryTriangle {
+                // Its edges are level-1 halves (see `triangle_draft`): the edge midpoints are
+                // canonical corners too; a triangle owning one says so by corner index 4 + edge.
+                let maps = level1_maps(&levels, site.face)?;
+                let l1 = &levels[1];
+                for (p, &e) in fe[..3].iter().enumerate() {
+                    let m = maps.edge_child_vertex[e as usize];
+                    if m == INVALID {
+                        continue;
+                    }
+                    let key = l1.anc[m as usize] as usize;
+                    if canon[key] == INVALID {
+                        row_owners.push([pi as u32, 4 + p as u32]);
+                        canon[key] = row_owners.len() as u32 - 1;
+                        needed.push((1, m));
+                    }
+                }
+            }
+            if !regular {
+                cap_corners.push((pi as u32, ids));
+            }
+
+            // Edges: neighbour levels, balance, curves.
+            let rank = kind_rank(pk);
+            let unbalanced = || TopologyError::AdaptiveUnbalanced {
+                level: l as u32,
+                face: site.face as usize,
+            };
+            for p in 0..n {
+                // The next corner without a division (`n` is 3 or 4, known only at run time).
+                let q = if p + 1 == n { 0 } else { p + 1 };
+                let e = fe[p];
+                let (a, b) = (fv[p], fv[q]);
+                let [x, y] = t.edge_faces(e as usize);
+                let g = if x == site.face { y } else { x };
+                let kind = if pk == PatchKind::GregoryTriangle {
+                    // Every edge of a triangle patch is the two level-1 curves of its children's
+                    // Gregory points (a finer neighbour's, or its own on a boundary or next to
+                    // another triangle): through the exact limit at the edge's midpoint.
+                    EdgeKind::Coarse
+                } else if g == INVALID || lvl.hole[g as usize] {
+                    EdgeKind::Plain
+                } else if tri_child(l, g as usize) {
+                    // Half of a triangle patch's edge: its level is the two halves' (as the
+                    // triangle's is), like any fine side of a transition.
+                    EdgeKind::Fine
+                } else if lvl.complete[g as usize] {
+                    if lvl.selected[g as usize] {
+                        EdgeKind::Coarse
+                    } else {
+                        EdgeKind::Plain
+                    }
+                } else {
+                    let maps = lvl.maps.as_ref().ok_or_else(unbalanced)?;
+                    let gp = maps.child_face_parent[g as usize] as usize;
+                    let parent = &levels[l - 1];
+                    if parent.hole[gp] {
+                        EdgeKind::Plain
+                    } else if parent.complete[gp] && !parent.selected[gp] {
+                        EdgeKind::Fine
+                    } else {
+                        return Err(unbalanced());
+                    }
+                };
+                let (ca, cb) = (ids[p], ids[q]);
+                let pe = &mut patch.edges[p];
+                pe.kind = kind;
+                match kind {
+                    EdgeKind::Plain => {
+                        let owner = Owner::new(rank, pi as u32, p as u8, 0);
+                        let c = curve_id(l, e, [ca, cb], owner, &mut curves);
+                        pe.curves = [c, c];
+                        pe.reversed = [ca > cb; 2];
+                    }
+                    EdgeKind::Fine => {
+                        let owner = Owner::new(rank, pi as u32, p as u8, 0);
+                        let c = curve_id(l, e, [ca, cb], owner, &mut curves);
+                        // The other half of the parent edge this one halves (at the midpoint,
+                        // the end that is an edge-vertex).
+                        let maps = lvl.maps.as_ref().ok_or_else(unbalanced)?;
+                        let mid = [a, b]
+                            .into_iter()
+                            .find(|&x| {
+                                matches!(maps.child_vertex_origin[x as usize], ChildOrigin::Edge(_))
+                            })
+                            .ok_or_else(unbalanced)?;
+                        let pair = maps.edge_child_halves[mid as usize - lvl.kv];
+                        let sib = if pair[0] == e { pair[1] } else { pair[0] };
+                        if sib == INVALID || (pair[0] != e && pair[1] != e) {
+                            return Err(unbalanced());
+                        }
+                        let [s0, s1] = t.edge_vertices(sib as usize);
+                        // The shared end is the midpoint of the coarse edge.
+                        let (start, end) = if s0 == a || s1 == a {
+                            (if s0 == a { s1 } else { s0 }, a)
+                        } else if s0 == b || s1 == b {
+                            (b, if s0 == b { s1 } else { s0 })
+                        } else {
+                            return Err(unbalanced());
+                        };
+                        // The far end is a corner of the coarse patch, met already; otherwise
+                        // the lookup waits for the walk's end.
+                        let (cs, ce) = (canon_at(&canon, l, start), canon_at(&canon, l, end));
+                        // The sibling's owner is its own fine patch; this one only holds the
+                        // place (rank u8::MAX) until that patch registers it.
+                        let owner = Owner::new(u8::MAX, pi as u32, 0, 0);
+                        let wait = cs == INVALID || ce == INVALID;
+                        let ends = if wait { [INVALID; 2] } else { [cs, ce] };
+                        let sc = curve_id(l, sib, ends, owner, &mut curves);
+                        pe.curves = [c, sc];
+                        pe.reversed = [ca > cb, cs > ce];
+                        if wait {
+                            pending.push(Pending {
+                                patch: pi as u32,
+                                edge: p as u8,
+                                verts: [start, end],
+                                ids: [INVALID; 2],
+                            });
+                        }
+                    }
+                    EdgeKind::Coarse => {
+                        patch.transition_mask |= 1 << p;
+                        // A fine patch owns each half before a coarse end cap (single-pass plans
+                        // put Gregory patches on the coarse side): its own edge is the finer
+                        // approximation. A regular coarse patch keeps its rank: its halves are
+                        // exactly the fine B-spline's.
+                        let rank = if regular { rank } else { rank + HALF_RANK };
+                        let next = &levels[l + 1];
+                        let maps = next.maps.as_ref().ok_or_else(unbalanced)?;
+                        let m = maps.edge_child_vertex[e as usize];
+                        if m == INVALID || (m as usize) < next.kv {
+                            return Err(unbalanced());
+                        }
+                        let pair = maps.edge_child_halves[m as usize - next.kv];
+                        let at_a = usize::from(t.edge_vertices(e as usize)[0] != a);
+                        let (h0, h1) = (pair[at_a], pair[1 - at_a]);
+                        if h0 == INVALID || h1 == INVALID {
+                            return Err(unbalanced());
+                        }
+                        // Both halves must be patches of level l + 1.
+                        for h in [h0, h1] {
+                            for cf in next.t().edge_faces(h as usize) {
+                                if cf != INVALID
+                                    && next.complete[cf as usize]
+                                    && next.selected.get(cf as usize).copied().unwrap_or(false)
+                                {
+                                    return Err(unbalanced());
+                                }
+                            }
+                        }
+                        // The midpoint's id (a finer patch's corner) waits for the walk's end.
+                        let owner = Owner::new(rank, pi as u32, p as u8, 1);
+                        let c0 = curve_id(l + 1, h0, [INVALID; 2], owner, &mut curves);
+                        let owner = Owner::new(rank, pi as u32, p as u8, 2);
+                        let c1 = curve_id(l + 1, h1, [INVALID; 2], owner, &mut curves);
+                        pe.curves = [c0, c1];
+                        pending.push(Pending {
+                            patch: pi as u32,
+                            edge: p as u8,
+                            verts: [m, INVALID],
+                            ids: [ca, cb],
+                        });
+                    }
                 }
             }
         }
-        corners.push(ids);
-    }
+        Ok(())
+    })();
     // Final ids: the rows' corners in meeting order, then the regular ones in meeting order.
     let rows = row_owners.len() as u32;
     let regular_corners = regular_owners.len() as u32;
@@ -531,6 +722,39 @@ pub(super) fn assemble(
             faces: mesh.num_faces(),
         });
     }
+    // The waiting lookups, in walk order: all come before the walk's failure, if any. A curve
+    // whose ends are `INVALID` was made by the waiting edge (or its twin: the same ends).
+    for w in &pending {
+        let pi = w.patch as usize;
+        let patch = &mut patches[pi];
+        let pe = &mut patch.edges[w.edge as usize];
+        let coarse = pe.kind == EdgeKind::Coarse;
+        let l = patch.level as usize + usize::from(coarse);
+        let look = |v: u32| match canon_at(&canon, l, v) {
+            INVALID => Err(TopologyError::AdaptiveUnbalanced {
+                level: l as u32,
+                face: sites[pi].face as usize,
+            }),
+            c => Ok(c),
+        };
+        let (ends, curves_of) = if coarse {
+            let cm = look(w.verts[0])?;
+            let [ca, cb] = w.ids;
+            pe.reversed = [ca > cm, cm > cb];
+            ([[ca, cm], [cm, cb]], pe.curves)
+        } else {
+            let (cs, ce) = (look(w.verts[0])?, look(w.verts[1])?);
+            pe.reversed[1] = cs > ce;
+            ([[cs, ce]; 2], [pe.curves[1]; 2])
+        };
+        for ([a, b], c) in ends.into_iter().zip(curves_of) {
+            let c = &mut curves[c as usize];
+            if c[0] == INVALID {
+                *c = [a.min(b), INVALID, INVALID, a.max(b)];
+            }
+        }
+    }
+    walk?;
     let first_regular_corner = first_canon + rows;
     let final_id = |c: u32| {
         if c & REGULAR != 0 {
@@ -539,25 +763,29 @@ pub(super) fn assemble(
             first_canon + c
         }
     };
-    for c in canon.iter_mut().filter(|c| **c != INVALID) {
-        *c = final_id(*c);
-    }
-    for (ids, patch) in corners.iter_mut().zip(patches.iter_mut()) {
+    for &(pi, ids) in &cap_corners {
+        let patch = &mut patches[pi as usize];
         let n = patch.corners();
-        for (p, id) in ids[..n].iter_mut().enumerate() {
-            *id = final_id(*id);
+        for (p, &id) in ids[..n].iter().enumerate() {
             match patch.kind {
                 PatchKind::Gregory | PatchKind::GregoryTriangle => {
-                    patch.control_points[5 * p] = *id
+                    patch.control_points[5 * p] = final_id(id)
                 }
-                PatchKind::Bilinear => patch.control_points[p] = *id,
+                PatchKind::Bilinear => patch.control_points[p] = final_id(id),
                 PatchKind::Regular => {}
             }
         }
     }
-    let mut corner_owners = row_owners;
-    corner_owners.extend_from_slice(&regular_owners);
-    drop(regular_owners);
+    drop(cap_corners);
+    // The larger class's allocation takes the other's (the regular ones after the rows):
+    // no third array faulted in.
+    let corner_owners = if regular_owners.len() > row_owners.len() {
+        regular_owners.splice(0..0, row_owners);
+        regular_owners
+    } else {
+        row_owners.extend_from_slice(&regular_owners);
+        row_owners
+    };
     locals.append_par(
         &needed,
         || Vec::with_capacity(32),
@@ -575,227 +803,43 @@ pub(super) fn assemble(
         first_local + locals.table.len() as u32,
         first_regular_corner
     );
-    let canon_of = |l: usize, v: u32, face: u32| -> Result<u32, TopologyError> {
-        let c = canon[levels[l].anc[v as usize] as usize];
-        if c == INVALID {
-            Err(TopologyError::AdaptiveUnbalanced {
-                level: l as u32,
-                face: face as usize,
-            })
-        } else {
-            Ok(c)
-        }
-    };
 
-    // Edges: neighbour levels, balance, curves.
-    let mut curve_of: Vec<Vec<u32>> = levels
-        .iter()
-        .map(|l| vec![INVALID; l.t().num_edges()])
-        .collect();
-    let mut curves: Vec<[u32; 4]> = Vec::with_capacity(patches.len() * 5 / 2);
-    let mut owners: Vec<Owner> = Vec::with_capacity(curves.capacity());
-    let mut curve_id =
-        |l: usize, e: u32, ends: [u32; 2], owner: Owner, curves: &mut Vec<[u32; 4]>| -> u32 {
-            let slot = &mut curve_of[l][e as usize];
-            if *slot == INVALID {
-                *slot = curves.len() as u32;
-                let (a, b) = (ends[0].min(ends[1]), ends[0].max(ends[1]));
-                curves.push([a, INVALID, INVALID, b]);
-                owners.push(owner);
-            } else if owner < owners[*slot as usize] {
-                owners[*slot as usize] = owner;
-            }
-            *slot
-        };
-    for (pi, (site, patch)) in sites.iter().zip(patches.iter_mut()).enumerate() {
-        let (lv, pk) = (patch.level, patch.kind);
-        let l = lv as usize;
-        let lvl = &levels[l];
-        let t = lvl.t();
-        let (fv, fe, n) = patch_corners(lvl, pk, *site);
-        let rank = kind_rank(pk);
-        let unbalanced = || TopologyError::AdaptiveUnbalanced {
-            level: l as u32,
-            face: site.face as usize,
-        };
-        for p in 0..n {
-            // The next corner without a division (`n` is 3 or 4, known only at run time).
-            let q = if p + 1 == n { 0 } else { p + 1 };
-            let e = fe[p];
-            let (a, b) = (fv[p], fv[q]);
-            let [x, y] = t.edge_faces(e as usize);
-            let g = if x == site.face { y } else { x };
-            let kind = if pk == PatchKind::GregoryTriangle {
-                // Every edge of a triangle patch is the two level-1 curves of its children's
-                // Gregory points (a finer neighbour's, or its own on a boundary or next to
-                // another triangle): through the exact limit at the edge's midpoint.
-                EdgeKind::Coarse
-            } else if g == INVALID || lvl.hole[g as usize] {
-                EdgeKind::Plain
-            } else if tri_child(l, g as usize) {
-                // Half of a triangle patch's edge: its level is the two halves' (as the
-                // triangle's is), like any fine side of a transition.
-                EdgeKind::Fine
-            } else if lvl.complete[g as usize] {
-                if lvl.selected[g as usize] {
-                    EdgeKind::Coarse
-                } else {
-                    EdgeKind::Plain
-                }
-            } else {
-                let maps = lvl.maps.as_ref().ok_or_else(unbalanced)?;
-                let gp = maps.child_face_parent[g as usize] as usize;
-                let parent = &levels[l - 1];
-                if parent.hole[gp] {
-                    EdgeKind::Plain
-                } else if parent.complete[gp] && !parent.selected[gp] {
-                    EdgeKind::Fine
-                } else {
-                    return Err(unbalanced());
-                }
-            };
-            // The patch's own corners were numbered above: read them, not the canonical map.
-            let (ca, cb) = (corners[pi][p], corners[pi][q]);
-            let pe = &mut patch.edges[p];
-            pe.kind = kind;
-            match kind {
-                EdgeKind::Plain => {
-                    let c = curve_id(l, e, [ca, cb], (rank, pi as u32, p as u8, 0), &mut curves);
-                    pe.curves = [c, c];
-                    pe.reversed = [ca > cb; 2];
-                }
-                EdgeKind::Fine => {
-                    let c = curve_id(l, e, [ca, cb], (rank, pi as u32, p as u8, 0), &mut curves);
-                    // The other half of the parent edge this one halves (at the midpoint,
-                    // the end that is an edge-vertex).
-                    let maps = lvl.maps.as_ref().ok_or_else(unbalanced)?;
-                    let mid = [a, b]
-                        .into_iter()
-                        .find(|&x| {
-                            matches!(maps.child_vertex_origin[x as usize], ChildOrigin::Edge(_))
-                        })
-                        .ok_or_else(unbalanced)?;
-                    let pair = maps.edge_child_halves[mid as usize - lvl.kv];
-                    let sib = if pair[0] == e { pair[1] } else { pair[0] };
-                    if sib == INVALID || (pair[0] != e && pair[1] != e) {
-                        return Err(unbalanced());
-                    }
-                    let [s0, s1] = t.edge_vertices(sib as usize);
-                    // The shared end is the midpoint of the coarse edge.
-                    let (start, end) = if s0 == a || s1 == a {
-                        (if s0 == a { s1 } else { s0 }, a)
-                    } else if s0 == b || s1 == b {
-                        (b, if s0 == b { s1 } else { s0 })
-                    } else {
-                        return Err(unbalanced());
-                    };
-                    let (cs, ce) = (canon_of(l, start, site.face)?, canon_of(l, end, site.face)?);
-                    // The sibling's owner is its own fine patch; this one only holds the place
-                    // (rank u8::MAX) until that patch registers it.
-                    let sc = curve_id(l, sib, [cs, ce], (u8::MAX, pi as u32, 0, 0), &mut curves);
-                    pe.curves = [c, sc];
-                    pe.reversed = [ca > cb, cs > ce];
-                }
-                EdgeKind::Coarse => {
-                    patch.transition_mask |= 1 << p;
-                    // A fine patch owns each half before a coarse end cap (single-pass plans
-                    // put Gregory patches on the coarse side): its own edge is the finer
-                    // approximation. A regular coarse patch keeps its rank: its halves are
-                    // exactly the fine B-spline's.
-                    let rank = if pk == PatchKind::Regular {
-                        rank
-                    } else {
-                        rank + HALF_RANK
-                    };
-                    let next = &levels[l + 1];
-                    let maps = next.maps.as_ref().ok_or_else(unbalanced)?;
-                    let m = maps.edge_child_vertex[e as usize];
-                    if m == INVALID || (m as usize) < next.kv {
-                        return Err(unbalanced());
-                    }
-                    let pair = maps.edge_child_halves[m as usize - next.kv];
-                    let at_a = usize::from(t.edge_vertices(e as usize)[0] != a);
-                    let (h0, h1) = (pair[at_a], pair[1 - at_a]);
-                    if h0 == INVALID || h1 == INVALID {
-                        return Err(unbalanced());
-                    }
-                    // Both halves must be patches of level l + 1.
-                    for h in [h0, h1] {
-                        for cf in next.t().edge_faces(h as usize) {
-                            if cf != INVALID
-                                && next.complete[cf as usize]
-                                && next.selected.get(cf as usize).copied().unwrap_or(false)
-                            {
-                                return Err(unbalanced());
-                            }
-                        }
-                    }
-                    let cm = canon_of(l + 1, m, site.face)?;
-                    let c0 = curve_id(
-                        l + 1,
-                        h0,
-                        [ca, cm],
-                        (rank, pi as u32, p as u8, 1),
-                        &mut curves,
-                    );
-                    let c1 = curve_id(
-                        l + 1,
-                        h1,
-                        [cm, cb],
-                        (rank, pi as u32, p as u8, 2),
-                        &mut curves,
-                    );
-                    pe.curves = [c0, c1];
-                    pe.reversed = [ca > cm, cm > cb];
-                }
-            }
-        }
-    }
-
-    if let Some(o) = owners.iter().find(|o| o.0 == u8::MAX) {
+    if let Some(o) = owners.iter().find(|o| o.rank() == u8::MAX) {
         // A sibling half no patch has as its own edge: a level jump next to this patch.
         return Err(TopologyError::AdaptiveUnbalanced {
-            level: patches[o.1 as usize].level as u32,
-            face: sites[o.1 as usize].face as usize,
+            level: patches[o.patch() as usize].level as u32,
+            face: sites[o.patch() as usize].face as usize,
         });
     }
     // Who defines each curve's normals and texture coordinates (seamless displacement): the
-    // owner patch, its edge, the part of the edge, and whether the curve runs with the edge.
+    // owner patch, its edge, the part of the edge, and whether the curve runs with the edge:
+    // from its point 0 (the smaller end id), so not `reversed`.
     drop(curve_of);
+    drop(canon);
     // Collected into the owners' own allocation (same size): no second array faulted in.
     let curve_owners: Vec<CurveOwner> = owners
         .into_iter()
-        .zip(&curves)
-        .map(|((_, pi, p, part), c)| {
-            let ids = corners[pi as usize];
-            let n = patches[pi as usize].corners();
-            let p = p as usize;
-            // The segment runs in the patch's edge direction from `start_id`; for a second half,
-            // the midpoint: whichever end of the curve is not the patch corner.
-            let start_id = if part == 2 {
-                if c[0] == ids[(p + 1) % n] {
-                    c[3]
-                } else {
-                    c[0]
-                }
-            } else {
-                ids[p]
-            };
+        .map(|o| {
+            let (pi, p, part) = (o.patch(), o.edge(), o.part());
+            let patch = &patches[pi as usize];
             CurveOwner {
                 patch: pi,
-                edge: p as u8,
+                edge: p,
                 part,
-                forward: start_id == c[0],
-                triangle: n == 3,
+                forward: !patch.edges[p as usize].reversed[usize::from(part == 2)],
+                triangle: patch.kind == PatchKind::GregoryTriangle,
             }
         })
         .collect();
-    // The curves' inner points follow the regular corners: two per curve, in curve order, which
-    // the device computes from their owners' control points every frame (no stencil rows).
+    // The curves' ends get their final ids; their inner points follow the regular corners: two
+    // per curve, in curve order, which the device computes from their owners' control points
+    // every frame (no stencil rows).
     let first_curve_point = first_regular_corner + regular_corners;
     for (ci, c) in curves.iter_mut().enumerate() {
+        c[0] = final_id(c[0]);
         c[1] = first_curve_point + 2 * ci as u32;
         c[2] = c[1] + 1;
+        c[3] = final_id(c[3]);
     }
 
     // Statistics.
@@ -865,6 +909,16 @@ pub(super) fn assemble(
         level_stats,
         isolation: opts.isolation,
     })
+}
+
+/// A lookup of the edge walk that waits for the walk's end, for its curves' ends and `reversed`:
+/// a fine edge's sibling ends (`verts`, at the patch's level) or a coarse edge's midpoint
+/// (`verts[0]`, a level finer, between the patch's corners `ids`).
+struct Pending {
+    patch: u32,
+    edge: u8,
+    verts: [u32; 2],
+    ids: [u32; 2],
 }
 
 /// The refinement maps into level 1, which a triangle patch's points and corners come from (a

@@ -682,8 +682,36 @@ pub(super) fn bezier_half(h: usize) -> [[f64; 4]; 4] {
 }
 
 /// Who computes a curve's inner points: (kind rank, patch, patch edge, part: 0 whole edge,
-/// 1/2 first/second half of a coarse edge).
-pub(super) type Owner = (u8, u32, u8, u8);
+/// 1/2 first/second half of a coarse edge), packed into two words that compare in that order
+/// (8 bytes a curve, not 12, aligned as [`crate::CurveOwner`], collected in place).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub(super) struct Owner {
+    /// Rank, then the patch's high half.
+    hi: u32,
+    /// The patch's low half, edge, part.
+    lo: u32,
+}
+
+impl Owner {
+    pub(super) fn new(rank: u8, patch: u32, edge: u8, part: u8) -> Owner {
+        Owner {
+            hi: (rank as u32) << 16 | patch >> 16,
+            lo: patch << 16 | (edge as u32) << 8 | part as u32,
+        }
+    }
+    pub(super) fn rank(self) -> u8 {
+        (self.hi >> 16) as u8
+    }
+    pub(super) fn patch(self) -> u32 {
+        self.hi << 16 | self.lo >> 16
+    }
+    pub(super) fn edge(self) -> u8 {
+        (self.lo >> 8) as u8
+    }
+    pub(super) fn part(self) -> u8 {
+        self.lo as u8
+    }
+}
 
 /// Added to a non-regular coarse patch's rank for the halves of its transition edges, so the
 /// fine patch on the other side owns them (above every kind's rank, below the placeholder's).
