@@ -734,7 +734,7 @@ pub struct SubTopology {
     pub edges: Vec<u32>,
 }
 
-fn prefix_sum(v: &mut [u32]) {
+pub(crate) fn prefix_sum(v: &mut [u32]) {
     for i in 1..v.len() {
         v[i] += v[i - 1];
     }

@@ -51,8 +51,8 @@
 
 use crate::error::{TagKind, TopologyError};
 use crate::mesh::{
-    corner_faces, par_fill_ragged, BoundaryInterpolation, ControlMesh, SubdivOptions, Topology,
-    TriangleSubdivision, INVALID,
+    corner_faces, par_fill_ragged, prefix_sum, BoundaryInterpolation, ControlMesh, SubdivOptions,
+    Topology, TriangleSubdivision, INVALID,
 };
 use crate::sdc::{
     boundary_edge_sharpness, boundary_vertex_sharpness, decrement_sharpness, fractional_weight,
@@ -717,19 +717,84 @@ pub fn refine_sparse_region(
     let ec = |e: u32| edge_child_vertex[e as usize];
     // Whether corner vertex `v` has children (every region vertex has, unless corners_only).
     let made = |v: u32| vertex_child_vertex[v as usize] != INVALID;
-    // Sized up front (a quad per corner, or four triangles): growing them copied MBs per level.
-    let child_faces: usize = if quads {
-        faces
-            .iter()
-            .map(|&f| {
-                p.face_vertices(f as usize)
-                    .iter()
-                    .filter(|&&v| made(v))
-                    .count()
-            })
-            .sum()
+    // Quads: the child's vertex → edge and vertex → face lists are filled as the child edges
+    // and faces are made (both in ascending order, so the lists come out as the counting sort
+    // of `Topology::from_parts` makes them), into rows counted from the parent: a
+    // vertex-vertex has a half of each refined edge and a child of each refined face at its
+    // vertex, an edge-vertex its halves and an inner edge per refined face of its edge and a
+    // child per made end and face, a face-vertex an inner edge per edge at a made corner and
+    // its children. Counts go to slot `c + 2`, so that after the prefix sum slot `c + 1` is
+    // the fill cursor of child vertex `c` and ends as its end offset.
+    let nc = origin.len();
+    let (mut edge_rows, mut face_rows) = if quads {
+        (vec![0u32; nc + 2], vec![0u32; nc + 2])
     } else {
-        4 * faces.len()
+        (Vec::new(), Vec::new())
+    };
+    // Whether face `g` is refined.
+    let refined = |g: u32| g != INVALID && face_mark[g as usize];
+    if quads {
+        for (i, &v) in verts.iter().enumerate() {
+            let (ne_v, nf_v) = if corners_only {
+                // Every face at a selected face's corner is in the region, and so every edge.
+                (
+                    p.vertex_edges(v as usize).len(),
+                    p.vertex_faces(v as usize).len(),
+                )
+            } else {
+                (
+                    p.vertex_edges(v as usize)
+                        .iter()
+                        .filter(|&&e| edge_mark[e as usize])
+                        .count(),
+                    p.vertex_faces(v as usize)
+                        .iter()
+                        .filter(|&&g| face_mark[g as usize])
+                        .count(),
+                )
+            };
+            edge_rows[i + 2] = ne_v as u32;
+            face_rows[i + 2] = nf_v as u32;
+        }
+        for (r, &e) in edges.iter().enumerate() {
+            let ends = p.edge_verts[e as usize]
+                .iter()
+                .filter(|&&v| made(v))
+                .count() as u32;
+            let faces_e = p.edge_faces[e as usize]
+                .iter()
+                .filter(|&&g| refined(g))
+                .count() as u32;
+            edge_rows[kv + r + 2] = ends + faces_e;
+            face_rows[kv + r + 2] = ends * faces_e;
+        }
+    }
+    // Sized up front (a quad per corner, or four triangles): growing them copied MBs per level.
+    let mut child_faces = 0usize;
+    for (r, &f) in faces.iter().enumerate() {
+        if quads {
+            let fv = p.face_vertices(f as usize);
+            let n = fv.len();
+            let (mut corners_made, mut inner) = (0u32, 0u32);
+            for i in 0..n {
+                corners_made += u32::from(made(fv[i]));
+                inner += u32::from(made(fv[i]) || made(fv[(i + 1) % n]));
+            }
+            edge_rows[kv + ke + r + 2] = inner;
+            face_rows[kv + ke + r + 2] = corners_made;
+            child_faces += corners_made as usize;
+        } else {
+            child_faces += 4;
+        }
+    }
+    prefix_sum(&mut edge_rows);
+    prefix_sum(&mut face_rows);
+    let mut vert_edges = vec![0u32; edge_rows.last().map_or(0, |&x| x as usize)];
+    let mut vert_faces = vec![0u32; face_rows.last().map_or(0, |&x| x as usize)];
+    let mut edge_to = |c: u32, e: u32| {
+        let cursor = &mut edge_rows[c as usize + 1];
+        vert_edges[*cursor as usize] = e;
+        *cursor += 1;
     };
     let corners = if quads { 4 } else { 3 } * child_faces;
     // The halves, then one inner edge per child quad (or three per triangle; with
@@ -754,11 +819,26 @@ pub fn refine_sparse_region(
             edge_verts.push([ec(e), vc(b)]);
             edge_sharpness.push(h[1]);
         }
+        if quads {
+            for x in pair {
+                if x != INVALID {
+                    let [u, w] = edge_verts[x as usize];
+                    edge_to(u, x);
+                    edge_to(w, x);
+                }
+            }
+        }
         edge_child_halves.push(pair);
     }
     let half_at = |e: u32, v: u32| {
         let [a, _] = p.edge_verts[e as usize];
         edge_child_halves[(ec(e) - kv as u32) as usize][usize::from(a != v)]
+    };
+    // Quads: each child edge's faces, filled as the faces are made (as `from_parts` does).
+    let mut edge_faces: Vec<[u32; 2]> = if quads {
+        vec![[INVALID; 2]; 2 * ke + inner_edges]
+    } else {
+        Vec::new()
     };
     let mut face_first_child = vec![INVALID; nf];
     let mut inner_at: Vec<u32> = Vec::new();
@@ -778,12 +858,15 @@ pub fn refine_sparse_region(
         {
             // A quad: as the general case below, unrolled.
             let fc = face_child_vertex[f as usize];
-            let corner_made = fv.map(made);
+            let corner_made = [made(fv[0]), made(fv[1]), made(fv[2]), made(fv[3])];
             let mut inner4 = [INVALID; 4];
             for i in 0..4 {
                 if corner_made[i] || corner_made[(i + 1) & 3] {
-                    inner4[i] = edge_verts.len() as u32;
+                    let x = edge_verts.len() as u32;
+                    inner4[i] = x;
                     edge_verts.push([ec(fe[i]), fc]);
+                    edge_to(ec(fe[i]), x);
+                    edge_to(fc, x);
                 }
             }
             for i in 0..4 {
@@ -792,13 +875,16 @@ pub fn refine_sparse_region(
                 }
                 let prev = (i + 3) & 3;
                 let (v, e, ep) = (fv[i], fe[i], fe[prev]);
-                face_verts.extend_from_slice(&[vc(v), ec(e), fc, ec(ep)]);
-                face_edges.extend_from_slice(&[
-                    half_at(e, v),
-                    inner4[i],
-                    inner4[prev],
-                    half_at(ep, v),
-                ]);
+                let qv = [vc(v), ec(e), fc, ec(ep)];
+                let qe = [half_at(e, v), inner4[i], inner4[prev], half_at(ep, v)];
+                quad_made(
+                    (&mut face_rows, &mut vert_faces, &mut edge_faces),
+                    child_face_parent.len() as u32,
+                    qv,
+                    qe,
+                );
+                face_verts.extend_from_slice(&qv);
+                face_edges.extend_from_slice(&qe);
                 face_offsets.push(face_verts.len() as u32);
                 child_face_parent.push(f);
             }
@@ -810,8 +896,11 @@ pub fn refine_sparse_region(
             inner_at.resize(n, INVALID);
             for (i, &e) in fe.iter().enumerate() {
                 if made(fv[i]) || made(fv[(i + 1) % n]) {
-                    inner_at[i] = edge_verts.len() as u32;
+                    let x = edge_verts.len() as u32;
+                    inner_at[i] = x;
                     edge_verts.push([ec(e), fc]);
+                    edge_to(ec(e), x);
+                    edge_to(fc, x);
                 }
             }
             for i in 0..n {
@@ -820,13 +909,16 @@ pub fn refine_sparse_region(
                 }
                 let prev = (i + n - 1) % n;
                 let (v, e, ep) = (fv[i], fe[i], fe[prev]);
-                face_verts.extend_from_slice(&[vc(v), ec(e), fc, ec(ep)]);
-                face_edges.extend_from_slice(&[
-                    half_at(e, v),
-                    inner_at[i],
-                    inner_at[prev],
-                    half_at(ep, v),
-                ]);
+                let qv = [vc(v), ec(e), fc, ec(ep)];
+                let qe = [half_at(e, v), inner_at[i], inner_at[prev], half_at(ep, v)];
+                quad_made(
+                    (&mut face_rows, &mut vert_faces, &mut edge_faces),
+                    child_face_parent.len() as u32,
+                    qv,
+                    qe,
+                );
+                face_verts.extend_from_slice(&qv);
+                face_edges.extend_from_slice(&qe);
                 face_offsets.push(face_verts.len() as u32);
                 child_face_parent.push(f);
             }
@@ -855,13 +947,25 @@ pub fn refine_sparse_region(
     for (slot, &v) in vertex_sharpness.iter_mut().zip(&verts) {
         *slot = decayed[v as usize];
     }
-    let topology = Topology::from_parts(
-        origin.len(),
-        face_offsets,
-        face_verts,
-        face_edges,
-        edge_verts,
-    );
+    let topology = if quads {
+        edge_faces.truncate(edge_verts.len());
+        edge_rows.pop();
+        face_rows.pop();
+        Topology {
+            num_vertices: nc,
+            face_offsets,
+            face_verts,
+            face_edges,
+            edge_verts,
+            edge_faces,
+            vert_edge_offsets: edge_rows,
+            vert_edges,
+            vert_face_offsets: face_rows,
+            vert_faces,
+        }
+    } else {
+        Topology::from_parts(nc, face_offsets, face_verts, face_edges, edge_verts)
+    };
     Ok(SparseRefinement {
         child: LevelTopology {
             topology,
@@ -880,6 +984,25 @@ pub fn refine_sparse_region(
             edge_child_halves,
         },
     })
+}
+
+/// A child quad `cf` of a sparse step made, with corners `qv` and edges `qe`: its corners'
+/// face lists (`rows` are their fill cursors) and its edges' face pairs.
+#[inline(always)]
+fn quad_made(
+    (rows, vert_faces, edge_faces): (&mut [u32], &mut [u32], &mut [[u32; 2]]),
+    cf: u32,
+    qv: [u32; 4],
+    qe: [u32; 4],
+) {
+    for x in qv {
+        let cursor = &mut rows[x as usize + 1];
+        vert_faces[*cursor as usize] = cf;
+        *cursor += 1;
+    }
+    for x in qe {
+        push_pair(&mut edge_faces[x as usize], cf);
+    }
 }
 
 /// The indices of the set marks, in order.
@@ -1895,5 +2018,77 @@ mod tests {
         );
         let (_, raw) = check_merged_rows(&pillow);
         assert!(raw > 0, "the pillow's vertex rows fall back to the raw row");
+    }
+
+    /// The quad steps' directly written child adjacency (edge faces, vertex incidence) is
+    /// what [`Topology::from_parts`] derives from the child's faces, list order included:
+    /// sparse steps of both regions over three levels, from base and uniformly refined
+    /// parents, on meshes with n-gons, boundaries, holes and triangles.
+    #[test]
+    fn sparse_child_adjacency_is_from_parts() {
+        let dir = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../tests/data/opensubdiv/shapes/"
+        );
+        let same = |t: &Topology| {
+            let g = Topology::from_parts(
+                t.num_vertices,
+                t.face_offsets.clone(),
+                t.face_verts.clone(),
+                t.face_edges.clone(),
+                t.edge_verts.clone(),
+            );
+            assert_eq!(t.edge_faces, g.edge_faces);
+            assert_eq!(t.vert_edge_offsets, g.vert_edge_offsets);
+            assert_eq!(t.vert_edges, g.vert_edges);
+            assert_eq!(t.vert_face_offsets, g.vert_face_offsets);
+            assert_eq!(t.vert_faces, g.vert_faces);
+        };
+        for name in [
+            "catmark_xord_interior",
+            "catmark_xord_boundary",
+            "catmark_hole_test2",
+            "catmark_pyramid",
+            "catmark_flap2",
+            "catmark_car",
+            "catmark_bishop",
+            "catmark_hole_test3",
+        ] {
+            let mesh = crate::load_obj(format!("{dir}{name}.obj")).unwrap();
+            let base = LevelTopology::from_mesh(&mesh, Scheme::CatmullClark).unwrap();
+            let uniform = refine_level(
+                &Level::from_mesh(&mesh, Scheme::CatmullClark).unwrap(),
+                Scheme::CatmullClark,
+                &mesh.options,
+            )
+            .unwrap()
+            .0;
+            for region in [SparseRegion::OneRingFaces, SparseRegion::SelectedCorners] {
+                for (start, stride) in [(0usize, 7usize), (3, 2), (1, 29)] {
+                    let mut level = base.clone();
+                    for step in 0..3 {
+                        let parent = if step == 0 && start == 3 {
+                            uniform.view()
+                        } else {
+                            level.view()
+                        };
+                        let selected: Vec<u32> = (start..parent.topology.num_faces())
+                            .step_by(stride)
+                            .map(|f| f as u32)
+                            .collect();
+                        let r = refine_sparse_region(
+                            parent,
+                            Scheme::CatmullClark,
+                            &mesh.options,
+                            &selected,
+                            region,
+                        )
+                        .unwrap();
+                        same(&r.child.topology);
+                        level = r.child;
+                    }
+                }
+            }
+        }
     }
 }
