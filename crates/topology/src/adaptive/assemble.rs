@@ -28,24 +28,14 @@ impl Locals {
     /// Appends the rows `build` makes for each item (in item order), built in parallel chunks
     /// of [`CHUNK`] items. Chunks run in rounds of two per thread into tables reused from round
     /// to round: each round is copied out of warm memory, and no chunk table is allocated and
-    /// faulted in anew (a fresh table per chunk: catmark_car's plan 108 → 116 ms). On one
-    /// thread the rows go straight into the table.
+    /// faulted in anew (a fresh table per chunk: catmark_car's plan 108 → 116 ms).
     pub(super) fn append_par<T: Sync, S: Send>(
         &mut self,
         items: &[T],
         scratch: impl Fn() -> S + Sync,
         build: impl Fn(&T, &mut S, &mut StencilTable) + Sync,
     ) {
-        let threads = rayon::current_num_threads().max(1);
-        if threads == 1 {
-            // Straight into the local points: no chunk table to fill and copy out.
-            let mut s = scratch();
-            for item in items {
-                build(item, &mut s, &mut self.table);
-            }
-            return;
-        }
-        let per_round = 2 * threads;
+        let per_round = 2 * rayon::current_num_threads().max(1);
         let mut tables: Vec<(S, StencilTable)> = Vec::new();
         for round in items.chunks(per_round * CHUNK) {
             let chunks: Vec<&[T]> = round.chunks(CHUNK).collect();
