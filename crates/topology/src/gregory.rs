@@ -104,7 +104,8 @@ use thiserror::Error;
 
 use crate::error::TopologyError;
 use crate::limit::{
-    catmark_directional_tangent_each, catmark_limit_masks, catmark_smooth_position_weights,
+    catmark_cross_tangent_into, catmark_directional_tangent_each,
+    catmark_directional_tangent_table, catmark_limit_masks, catmark_smooth_position_weights,
     LimitRule, LimitVertex, Mask,
 };
 use crate::mesh::{SubdivOptions, Topology, INVALID};
@@ -248,8 +249,9 @@ pub(crate) fn build_fan(t: &Topology, v: u32) -> Option<Fan> {
 
 /// The limit rule of a corner vertex as seen from the face (sector of the face for creases
 /// and corners).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 enum Kind {
+    #[default]
     Smooth,
     /// Sharp edges `a`, `b` (ring indices) bound the face's sector of `m` faces, CCW a → b.
     Crease {
@@ -269,6 +271,7 @@ enum Kind {
 /// One corner of the patch: its vertex's rule and limit constants, with the vertex, its ring
 /// and the diagonal of each fan face (level vertex ids from [`build_corner`], then slots of the
 /// cap's [`CapRows`]).
+#[derive(Default)]
 struct Corner {
     /// Position of the patch face in the fan.
     j: usize,
@@ -340,6 +343,51 @@ impl CapRows<'_> {
             *d += s * r;
         }
     }
+
+    /// Row `dst` (distinct from the sources) as one mutable slice and the rows before and
+    /// after it.
+    fn split(&mut self, dst: usize) -> (&[f64], &mut [f64], &[f64]) {
+        let l = self.l;
+        let (before, rest) = self.w.split_at_mut(dst * l);
+        let (d, after) = rest.split_at_mut(l);
+        (before, d, after)
+    }
+
+    /// `dst = src + s·add` in one pass: what copying `src` and then adding `s·add` gives.
+    fn copy_add(&mut self, dst: usize, src: usize, add: usize, s: f64) {
+        let l = self.l;
+        let (before, d, after) = self.split(dst);
+        let (p, t) = (
+            other_row(before, after, dst, src, l),
+            other_row(before, after, dst, add, l),
+        );
+        let (p, t) = (&p[..d.len()], &t[..d.len()]);
+        for k in 0..d.len() {
+            d[k] = p[k] + s * t[k];
+        }
+    }
+
+    /// `dst = a·ra + b·rb + c·rc` in one pass: what adding the three scaled rows to a cleared
+    /// `dst` in that order gives (`0 + x` is `x`; a zero's sign is dropped with it).
+    fn combine3(&mut self, dst: usize, [(ra, a), (rb, b), (rc, c)]: [(usize, f64); 3]) {
+        let l = self.l;
+        let (before, d, after) = self.split(dst);
+        let x = &other_row(before, after, dst, ra, l)[..d.len()];
+        let y = &other_row(before, after, dst, rb, l)[..d.len()];
+        let z = &other_row(before, after, dst, rc, l)[..d.len()];
+        for k in 0..d.len() {
+            d[k] = a * x[k] + b * y[k] + c * z[k];
+        }
+    }
+}
+
+/// Row `r` (not `dst`) of the rows split around `dst` by [`CapRows::split`].
+fn other_row<'a>(before: &'a [f64], after: &'a [f64], dst: usize, r: usize, l: usize) -> &'a [f64] {
+    if r < dst {
+        &before[r * l..(r + 1) * l]
+    } else {
+        &after[(r - dst - 1) * l..(r - dst) * l]
+    }
 }
 
 impl Corner {
@@ -391,6 +439,7 @@ impl Corner {
     fn limit_rows(&self, rows: &mut CapRows<'_>, i: usize) {
         let p = 5 * i;
         let n = self.n();
+        rows.clear(p);
         match self.kind {
             Kind::Smooth if self.sharp.iter().filter(|&&x| x).count() == 1 && !self.boundary => {
                 // A dart: the smooth tangents, but its own limit position.
@@ -414,13 +463,32 @@ impl Corner {
                 }
             }
             Kind::Crease { a, b, .. } => {
-                let masks = catmark_limit_masks(&LimitVertex {
-                    valence: n,
-                    boundary: self.boundary,
-                    rule: LimitRule::Crease { ends: [a, b] },
-                });
-                self.mask_row(rows, p, &masks.position);
-                self.mask_row(rows, ACROSS + i, &masks.tangent2);
+                // `catmark_limit_masks`' crease position and cross tangent, added as
+                // `mask_row` would (vertex, edges, faces; zero weights change no sum).
+                rows.add(p, self.v(), 2.0 / 3.0);
+                rows.add(p, self.ring(a.min(b)), 1.0 / 6.0);
+                rows.add(p, self.ring(a.max(b)), 1.0 / 6.0);
+                let nf = if self.boundary {
+                    n.saturating_sub(1)
+                } else {
+                    n
+                };
+                let mut edges: SmallVec<[f64; 16]> = SmallVec::from_elem(0.0, n);
+                let mut faces: SmallVec<[f64; 16]> = SmallVec::from_elem(0.0, nf);
+                let vertex = catmark_cross_tangent_into(&mut edges, &mut faces, [a, b], n);
+                let r = ACROSS + i;
+                rows.clear(r);
+                rows.add(r, self.v(), vertex);
+                for (k, &w) in edges.iter().enumerate() {
+                    if w != 0.0 {
+                        rows.add(r, self.ring(k), w);
+                    }
+                }
+                for (k, &w) in faces.iter().enumerate().take(self.nf) {
+                    if w != 0.0 {
+                        rows.add(r, self.diag(k), w);
+                    }
+                }
             }
             Kind::Corner { .. } | Kind::Cone => rows.add(p, self.v(), 1.0),
         }
@@ -435,13 +503,24 @@ impl Corner {
         match self.kind {
             Kind::Smooth => {
                 // Edge weights first, then face weights, as the rows were always summed.
+                let l = rows.l;
+                let t = &mut rows.w[r * l..(r + 1) * l];
+                if let Some(table) = catmark_directional_tangent_table(n, k) {
+                    for (&x, &(e, _)) in self.verts[1..].iter().zip(table) {
+                        t[x] += e;
+                    }
+                    for (i, &(_, f)) in table.iter().enumerate() {
+                        t[self.diag(i)] += f;
+                    }
+                    return;
+                }
                 let mut fw: SmallVec<[f64; 16]> = SmallVec::new();
                 catmark_directional_tangent_each(n, k, |i, e, f| {
-                    rows.add(r, self.ring(i), e);
+                    t[self.ring(i)] += e;
                     fw.push(f);
                 });
                 for (i, &w) in fw.iter().enumerate() {
-                    rows.add(r, self.diag(i), w);
+                    t[self.diag(i)] += w;
                 }
             }
             Kind::Crease { a, b, m } => {
@@ -498,34 +577,87 @@ fn sector(sharp: &[bool], j: usize, boundary: bool) -> Option<(usize, usize, usi
     (m > 0).then_some((a, b, m))
 }
 
+/// The fan of `v` as [`build_fan`] orders it, straight into `out` (`verts`: the vertex, its
+/// ring, the diagonals; `sharp`: the edges' sharpness), its position `j` of `face` and whether
+/// it is a boundary fan. `None` where the ring is not one complete fan of quads containing
+/// `face` (then [`build_corner`] takes [`build_fan`]'s way, which says why).
+fn walk_fan(level: &LevelRef<'_>, face: usize, v: u32, out: &mut Corner) -> Option<(usize, bool)> {
+    let t = level.topology;
+    let (offsets, face_verts, face_edges) = (&t.face_offsets, &t.face_verts, &t.face_edges);
+    let quad = |g: u32| -> Option<(&[u32], &[u32], usize)> {
+        let (s, e) = (
+            offsets[g as usize] as usize,
+            offsets[g as usize + 1] as usize,
+        );
+        let fv: &[u32; 4] = face_verts.get(s..e)?.try_into().ok()?;
+        let fe: &[u32; 4] = face_edges.get(s..e)?.try_into().ok()?;
+        let c = fv.iter().position(|&x| x == v)?;
+        Some((fv, fe, c))
+    };
+    let boundary_edge = |e: u32| t.edge_faces[e as usize][1] == INVALID;
+    let vf = t.vertex_faces(v as usize);
+    let nf = vf.len();
+    let mut start = *vf.first()?;
+    let mut boundary = false;
+    for &g in vf {
+        let (_, fe, c) = quad(g)?;
+        if boundary_edge(fe[c]) {
+            (start, boundary) = (g, true);
+            break;
+        }
+    }
+    let n = nf + boundary as usize;
+    out.verts.clear();
+    out.verts.resize(1 + n + nf, 0);
+    out.verts[0] = v as usize;
+    out.sharp.clear();
+    out.sharp.resize(n, false);
+    let (ring, diag) = out.verts[1..].split_at_mut(n);
+    let mut j = None;
+    let mut g = start;
+    for i in 0..nf {
+        let (fv, fe, c) = quad(g)?;
+        if j.is_none() && g as usize == face {
+            j = Some(i);
+        }
+        ring[i] = fv[(c + 1) % 4] as usize;
+        diag[i] = fv[(c + 2) % 4] as usize;
+        out.sharp[i] = is_sharp(edge_sharp(level, fe[c]));
+        let entering = fe[(c + 3) % 4];
+        if boundary_edge(entering) {
+            // Only the last face of a boundary fan may end it.
+            if !boundary || i + 1 != nf {
+                return None;
+            }
+            ring[nf] = fv[(c + 3) % 4] as usize;
+            out.sharp[nf] = is_sharp(edge_sharp(level, entering));
+            return Some((j?, true));
+        }
+        let [x, y] = t.edge_faces[entering as usize];
+        let h = if x == g { y } else { x };
+        if h == start {
+            return (!boundary && i + 1 == nf).then_some((j?, false));
+        }
+        g = h;
+    }
+    None
+}
+
+/// Corner `v` of `face` into `out` (its vectors reused).
 fn build_corner(
     level: &LevelRef<'_>,
     options: &SubdivOptions,
     face: usize,
     v: u32,
-) -> Result<Corner, TopologyError> {
+    out: &mut Corner,
+) -> Result<(), TopologyError> {
     let t = level.topology;
-    let problem = |problem| TopologyError::GregoryPatch { face, problem };
-    let fan =
-        build_fan(t, v).ok_or_else(|| problem(GregoryProblem::IncompleteRing { vertex: v }))?;
-    if fan
-        .faces
-        .iter()
-        .any(|&(g, _)| t.face_vertices(g as usize).len() != 4)
-    {
-        return Err(problem(GregoryProblem::NonQuadRing { vertex: v }));
-    }
-    let j = fan
-        .faces
-        .iter()
-        .position(|&(g, _)| g as usize == face)
-        .ok_or_else(|| problem(GregoryProblem::IncompleteRing { vertex: v }))?;
-    let n = fan.ring.len();
-    let sharp: SmallVec<[bool; 9]> = fan
-        .edges
-        .iter()
-        .map(|&e| is_sharp(edge_sharp(level, e)))
-        .collect();
+    let (j, boundary) = match walk_fan(level, face, v, out) {
+        Some(fan) => fan,
+        None => build_corner_fan(level, face, v, out)?,
+    };
+    let n = out.verts.len() - 1 - t.vertex_faces(v as usize).len();
+    let sharp = &out.sharp;
     let mut vs = level.vertex_sharpness[v as usize];
     if let Some(s) = boundary_vertex_sharpness(
         options.boundary,
@@ -538,11 +670,11 @@ fn build_corner(
     let kind = match vertex_rule(vs, sharp_count) {
         Rule::Smooth | Rule::Dart if n >= 3 => Kind::Smooth,
         Rule::Smooth | Rule::Dart => Kind::Cone,
-        Rule::Crease => match sector(&sharp, j, fan.boundary) {
+        Rule::Crease => match sector(sharp, j, boundary) {
             Some((a, b, m)) => Kind::Crease { a, b, m },
             None => Kind::Cone,
         },
-        Rule::Corner => match sector(&sharp, j, fan.boundary) {
+        Rule::Corner => match sector(sharp, j, boundary) {
             Some((a, b, m)) => Kind::Corner { a, b, m },
             None => Kind::Cone,
         },
@@ -567,36 +699,64 @@ fn build_corner(
         ),
         Kind::Cone => (false, 0.0),
     };
-    let mut verts = SmallVec::with_capacity(1 + n + fan.faces.len());
-    verts.push(v as usize);
-    verts.extend(fan.ring.iter().map(|&x| x as usize));
-    for &(g, c) in &fan.faces {
-        verts.push(t.face_vertices(g as usize)[(c + 2) % 4] as usize);
+    out.j = j;
+    out.boundary = boundary;
+    out.kind = kind;
+    out.regular = regular;
+    out.c = c;
+    out.n = n;
+    out.nf = out.verts.len() - 1 - n;
+    Ok(())
+}
+
+/// [`walk_fan`] through [`build_fan`], for the rings it leaves (the errors come from here).
+fn build_corner_fan(
+    level: &LevelRef<'_>,
+    face: usize,
+    v: u32,
+    out: &mut Corner,
+) -> Result<(usize, bool), TopologyError> {
+    let t = level.topology;
+    let problem = |problem| TopologyError::GregoryPatch { face, problem };
+    let fan =
+        build_fan(t, v).ok_or_else(|| problem(GregoryProblem::IncompleteRing { vertex: v }))?;
+    if fan
+        .faces
+        .iter()
+        .any(|&(g, _)| t.face_vertices(g as usize).len() != 4)
+    {
+        return Err(problem(GregoryProblem::NonQuadRing { vertex: v }));
     }
-    Ok(Corner {
-        j,
-        boundary: fan.boundary,
-        sharp,
-        kind,
-        regular,
-        c,
-        verts,
-        n,
-        nf: fan.faces.len(),
-    })
+    let j = fan
+        .faces
+        .iter()
+        .position(|&(g, _)| g as usize == face)
+        .ok_or_else(|| problem(GregoryProblem::IncompleteRing { vertex: v }))?;
+    out.sharp.clear();
+    out.sharp
+        .extend(fan.edges.iter().map(|&e| is_sharp(edge_sharp(level, e))));
+    out.verts.clear();
+    out.verts.push(v as usize);
+    out.verts.extend(fan.ring.iter().map(|&x| x as usize));
+    for &(g, c) in &fan.faces {
+        out.verts
+            .push(t.face_vertices(g as usize)[(c + 2) % 4] as usize);
+    }
+    Ok((j, fan.boundary))
 }
 
 /// The Bézier interior point of a regular patch, `(4v_i + 2v_{i+1} + 2v_{i−1} + v_{i+2})/9`,
 /// into row `r` (`fv`: the corners' slots).
 fn face_mask(rows: &mut CapRows<'_>, r: usize, fv: [usize; 4], i: usize) {
+    rows.clear(r);
     rows.add(r, fv[i], 4.0 / 9.0);
     rows.add(r, fv[(i + 1) % 4], 2.0 / 9.0);
     rows.add(r, fv[(i + 3) % 4], 2.0 / 9.0);
     rows.add(r, fv[(i + 2) % 4], 1.0 / 9.0);
 }
 
-/// Face point `Fp_i` (`plus`) or `Fm_i` into its (cleared) row, from the finished `P`, `Ep`
-/// and `Em` rows.
+/// Face point `Fp_i` (`plus`) or `Fm_i` into its row, from the finished `P`, `Ep` and `Em`
+/// rows.
 fn face_point(rows: &mut CapRows<'_>, corners: &[Corner], i: usize, plus: bool) {
     let dst = 5 * i + if plus { 3 } else { 4 };
     let fv = [
@@ -625,9 +785,14 @@ fn face_point(rows: &mut CapRows<'_>, corners: &[Corner], i: usize, plus: bool) 
             (5 * i + 2, 5 * far_i + 1)
         };
         let (cn, cf) = (near.c, far.c);
-        rows.add_row(dst, 5 * i, cf / 3.0);
-        rows.add_row(dst, e_near, (3.0 - 2.0 * cn - cf) / 3.0);
-        rows.add_row(dst, e_far, 2.0 * cn / 3.0);
+        rows.combine3(
+            dst,
+            [
+                (5 * i, cf / 3.0),
+                (e_near, (3.0 - 2.0 * cn - cf) / 3.0),
+                (e_far, 2.0 * cn / 3.0),
+            ],
+        );
         // Ring neighbours and diagonals on either side of edge k (inside: our face j).
         let (x_in, x_out, d_out) = if plus {
             (
@@ -724,9 +889,9 @@ pub(crate) fn gregory_basis_each(
             problem: GregoryProblem::NotQuad { size: fv.len() },
         });
     }
-    let mut corners: SmallVec<[Corner; 4]> = SmallVec::new();
-    for &v in fv {
-        corners.push(build_corner(&level, options, face, v)?);
+    let mut corners: [Corner; 4] = Default::default();
+    for (c, &v) in corners.iter_mut().zip(fv) {
+        build_corner(&level, options, face, v, c)?;
     }
     // The cap's vertices become slots of its dense rows, numbered as first seen through a
     // small open-addressing table.
@@ -776,29 +941,49 @@ pub(crate) fn gregory_basis_each(
     for x in corners.iter_mut().flat_map(|c| &mut c.verts) {
         *x = rank[*x];
     }
-    // Zeroed a row at a time: one large memset costs more than the rows' small ones.
-    let mut w = Vec::with_capacity(l * CAP_ROWS);
-    for _ in 0..CAP_ROWS {
-        w.resize(w.len() + l, 0.0);
+    // The rows live in a per-thread buffer (no allocation per cap); every row is written
+    // before it is read, so what an earlier cap left there never counts.
+    thread_local! {
+        static ROWS: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
     }
-    let mut rows = CapRows { l, w: &mut w };
+    ROWS.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut w) => cap_rows(&corners, &ids, &mut w, &mut each),
+        Err(_) => cap_rows(&corners, &ids, &mut Vec::new(), &mut each),
+    });
+    Ok(())
+}
+
+/// The 20 points of the cap with `corners` (slots into `ids`, the cap's vertices ascending)
+/// to `each`, `w` the rows' storage.
+fn cap_rows(
+    corners: &[Corner; 4],
+    ids: &[u32],
+    w: &mut Vec<f64>,
+    each: &mut impl FnMut(usize, &[(u32, f64)]),
+) {
+    let l = ids.len();
+    if w.len() < l * CAP_ROWS {
+        w.resize(l * CAP_ROWS, 0.0);
+    }
+    let mut rows = CapRows {
+        l,
+        w: &mut w[..l * CAP_ROWS],
+    };
     for (i, c) in corners.iter().enumerate() {
         c.limit_rows(&mut rows, i);
     }
     // Edge points: index k of the ring is the edge toward the face's next (j) or previous
-    // (j + 1) corner.
+    // (j + 1) corner; `P + T/3` in one pass.
     for (i, c) in corners.iter().enumerate() {
         let n = c.n();
-        rows.copy(5 * i + 1, 5 * i);
         c.tangent(&mut rows, i, c.j);
-        rows.add_row(5 * i + 1, TANGENT, 1.0 / 3.0);
-        rows.copy(5 * i + 2, 5 * i);
+        rows.copy_add(5 * i + 1, 5 * i, TANGENT, 1.0 / 3.0);
         c.tangent(&mut rows, i, (c.j + 1) % n);
-        rows.add_row(5 * i + 2, TANGENT, 1.0 / 3.0);
+        rows.copy_add(5 * i + 2, 5 * i, TANGENT, 1.0 / 3.0);
     }
     for i in 0..4 {
-        face_point(&mut rows, &corners, i, true);
-        face_point(&mut rows, &corners, i, false);
+        face_point(&mut rows, corners, i, true);
+        face_point(&mut rows, corners, i, false);
     }
     // Zero weights dropped (indices already ascending): the form of a [`Stencil`].
     let mut terms_inline = [(0u32, 0.0f64); CAP_SLOTS];
@@ -820,7 +1005,6 @@ pub(crate) fn gregory_basis_each(
         }
         each(k, &terms[..m]);
     }
-    Ok(())
 }
 
 /// One corner's interior point in [`gregory_weights`]: Bézier indices `(j, k)`, then `dp` and

@@ -388,23 +388,34 @@ pub fn catmark_limit_masks(v: &LimitVertex) -> LimitMasks {
 /// formula for more, and the average of the two crease edges for a single face. Face `i` is
 /// the quad between edges `i` and `i + 1`.
 fn catmark_cross_tangent(t2: &mut Mask, ends: [usize; 2], n: usize) {
+    t2.vertex = catmark_cross_tangent_into(&mut t2.edges, &mut t2.faces, ends, n);
+}
+
+/// [`catmark_cross_tangent`] into zeroed edge and face weights (`edges.len() == n`, one face
+/// per ring gap), returning the vertex weight: no [`Mask`] allocated (Gregory end caps).
+pub(crate) fn catmark_cross_tangent_into(
+    edges: &mut [f64],
+    faces: &mut [f64],
+    ends: [usize; 2],
+    n: usize,
+) -> f64 {
     let interior = (ends[1] + n - ends[0]) % n - 1;
     let e = |i: usize| (ends[0] + i) % n;
-    let nf = t2.faces.len().max(1);
+    let nf = faces.len().max(1);
     let f = |i: usize| (ends[0] + i) % nf;
     match interior {
         0 => {
-            t2.vertex = -6.0;
-            t2.edges[ends[0]] = 3.0;
-            t2.edges[ends[1]] = 3.0;
+            edges[ends[0]] = 3.0;
+            edges[ends[1]] = 3.0;
+            -6.0
         }
         1 => {
-            t2.vertex = -4.0 / 6.0;
-            t2.edges[ends[0]] = -1.0 / 6.0;
-            t2.edges[e(1)] = 4.0 / 6.0;
-            t2.edges[ends[1]] = -1.0 / 6.0;
-            t2.faces[f(0)] = 1.0 / 6.0;
-            t2.faces[f(1)] = 1.0 / 6.0;
+            edges[ends[0]] = -1.0 / 6.0;
+            edges[e(1)] = 4.0 / 6.0;
+            edges[ends[1]] = -1.0 / 6.0;
+            faces[f(0)] = 1.0 / 6.0;
+            faces[f(1)] = 1.0 / 6.0;
+            -4.0 / 6.0
         }
         _ => {
             let k = (interior + 1) as f64;
@@ -412,15 +423,15 @@ fn catmark_cross_tangent(t2: &mut Mask, ends: [usize; 2], n: usize) {
             let (c, s) = (th.cos(), th.sin());
             let d = 1.0 / (k * (3.0 + c));
             let r = (c + 1.0) / s;
-            t2.vertex = 4.0 * r * (c - 1.0) * d;
-            t2.edges[ends[0]] = -r * (1.0 + 2.0 * c) * d;
-            t2.edges[ends[1]] = -r * (1.0 + 2.0 * c) * d;
-            t2.faces[f(0)] = s * d;
+            edges[ends[0]] = -r * (1.0 + 2.0 * c) * d;
+            edges[ends[1]] = -r * (1.0 + 2.0 * c) * d;
+            faces[f(0)] = s * d;
             for i in 1..=interior {
                 let (si, si1) = ((i as f64 * th).sin(), ((i + 1) as f64 * th).sin());
-                t2.edges[e(i)] = 4.0 * si * d;
-                t2.faces[f(i)] = (si + si1) * d;
+                edges[e(i)] = 4.0 * si * d;
+                faces[f(i)] = (si + si1) * d;
             }
+            4.0 * r * (c - 1.0) * d
         }
     }
 }
@@ -453,21 +464,33 @@ pub fn smooth_directional_tangent(loop_scheme: bool, n: usize, k: usize) -> (Vec
 pub fn catmark_directional_tangent_each(n: usize, k: usize, mut each: impl FnMut(usize, f64, f64)) {
     // Memoized per valence and direction (two cosines per ring entry on every Gregory corner):
     // the same bits as computing them anew.
-    const CACHED: usize = 16;
-    static TABLES: [std::sync::OnceLock<Vec<(f64, f64)>>; CACHED * CACHED] =
-        [const { std::sync::OnceLock::new() }; CACHED * CACHED];
-    if n < CACHED && k < n {
-        let table = TABLES[n * CACHED + k].get_or_init(|| {
-            let mut t = Vec::with_capacity(n);
-            directional_tangent_weights(n, k, |_, e, f| t.push((e, f)));
-            t
-        });
+    if let Some(table) = catmark_directional_tangent_table(n, k) {
         for (i, &(e, f)) in table.iter().enumerate() {
             each(i, e, f);
         }
     } else {
         directional_tangent_weights(n, k, each);
     }
+}
+
+/// The memoized `(edge, face)` weights of [`catmark_directional_tangent_each`] for valences
+/// below 16 (`None` above, or for `k ≥ n`).
+pub(crate) fn catmark_directional_tangent_table(
+    n: usize,
+    k: usize,
+) -> Option<&'static [(f64, f64)]> {
+    const CACHED: usize = 16;
+    static TABLES: [std::sync::OnceLock<Vec<(f64, f64)>>; CACHED * CACHED] =
+        [const { std::sync::OnceLock::new() }; CACHED * CACHED];
+    (n < CACHED && k < n).then(|| {
+        TABLES[n * CACHED + k]
+            .get_or_init(|| {
+                let mut t = Vec::with_capacity(n);
+                directional_tangent_weights(n, k, |_, e, f| t.push((e, f)));
+                t
+            })
+            .as_slice()
+    })
 }
 
 fn directional_tangent_weights(n: usize, k: usize, mut each: impl FnMut(usize, f64, f64)) {
