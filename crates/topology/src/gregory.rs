@@ -105,8 +105,7 @@ use thiserror::Error;
 use crate::error::TopologyError;
 use crate::limit::{
     catmark_cross_tangent_into, catmark_directional_tangent_each,
-    catmark_directional_tangent_table, catmark_limit_masks, catmark_smooth_position_weights,
-    LimitRule, LimitVertex, Mask,
+    catmark_directional_tangent_table, catmark_smooth_position_weights, dart_position_weights,
 };
 use crate::mesh::{SubdivOptions, Topology, INVALID};
 use crate::patch::PatchWeights;
@@ -410,16 +409,6 @@ impl Corner {
         self.verts[1 + self.n + i]
     }
 
-    fn mask_row(&self, rows: &mut CapRows<'_>, r: usize, m: &Mask) {
-        rows.add(r, self.v(), m.vertex);
-        for (i, &w) in m.edges.iter().enumerate() {
-            rows.add(r, self.ring(i), w);
-        }
-        for (i, &w) in m.faces.iter().enumerate().take(self.nf) {
-            rows.add(r, self.diag(i), w);
-        }
-    }
-
     /// `e_k − v` into the cleared row `r`.
     fn edge_vector(&self, rows: &mut CapRows<'_>, r: usize, k: usize) {
         rows.add(r, self.ring(k), 1.0);
@@ -443,13 +432,17 @@ impl Corner {
         match self.kind {
             Kind::Smooth if self.sharp.iter().filter(|&&x| x).count() == 1 && !self.boundary => {
                 // A dart: the smooth tangents, but its own limit position.
+                // `catmark_limit_masks`' dart position, added as `mask_row` would (vertex,
+                // edges, faces in ring order), without its tangent masks.
                 let edge = self.sharp.iter().position(|&x| x).unwrap_or(0);
-                let masks = catmark_limit_masks(&LimitVertex {
-                    valence: n,
-                    boundary: false,
-                    rule: LimitRule::Dart { edge },
-                });
-                self.mask_row(rows, p, &masks.position);
+                let w = dart_position_weights(false, n);
+                rows.add(p, self.v(), w[0]);
+                for k in 0..n {
+                    rows.add(p, self.ring(k), w[1 + (k + n - edge) % n]);
+                }
+                for k in 0..n.min(self.nf) {
+                    rows.add(p, self.diag(k), w[1 + n + (k + n - edge) % n]);
+                }
             }
             Kind::Smooth => {
                 // Only the position: the tangents come from `Corner::tangent`.
@@ -607,11 +600,21 @@ fn walk_fan(level: &LevelRef<'_>, face: usize, v: u32, out: &mut Corner) -> Opti
         }
     }
     let n = nf + boundary as usize;
-    out.verts.clear();
-    out.verts.resize(1 + n + nf, 0);
+    // Sized from zeroed inline buffers where they fit (`resize` costs more).
+    let len = 1 + n + nf;
+    if len <= 20 {
+        out.verts = SmallVec::from_buf_and_len([0; 20], len);
+    } else {
+        out.verts.clear();
+        out.verts.resize(len, 0);
+    }
     out.verts[0] = v as usize;
-    out.sharp.clear();
-    out.sharp.resize(n, false);
+    if n <= 9 {
+        out.sharp = SmallVec::from_buf_and_len([false; 9], n);
+    } else {
+        out.sharp.clear();
+        out.sharp.resize(n, false);
+    }
     let (ring, diag) = out.verts[1..].split_at_mut(n);
     let mut j = None;
     let mut g = start;
