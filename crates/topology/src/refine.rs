@@ -1726,8 +1726,13 @@ fn quad_edge_row(p: &Topology, a: u32, b: u32, faces: [u32; 2], out: &mut RowOut
         return false;
     }
     out.idx.extend_from_slice(&s);
-    out.wts
-        .extend_from_slice(&s.map(|x| if x == a || x == b { 0.375 } else { 0.0625 }));
+    let mut w = [0.0625f64; 6];
+    for j in 0..6 {
+        if s[j] == a || s[j] == b {
+            w[j] = 0.375;
+        }
+    }
+    out.wts.extend_from_slice(&w);
     true
 }
 
@@ -1749,16 +1754,17 @@ fn quad_vertex_row<const K: usize, const N: usize>(
     else {
         return false;
     };
-    let ring: [u32; K] = edges.map(|e| other_end(p, e, v));
+    let mut ring = [0u32; K];
     let mut keys = [0u64; N];
     keys[0] = u64::from(v as u32) << 32;
     for j in 0..K {
+        ring[j] = other_end(p, edges[j], v);
         keys[1 + j] = (u64::from(ring[j]) << 32) | 1;
     }
     // Ring neighbours beside one face so far, and beside two.
     let (mut once, mut twice) = (0u32, 0u32);
-    for (j, &f) in faces.iter().enumerate() {
-        let Some(q) = quad_of(p, f) else {
+    for j in 0..K {
+        let Some(q) = quad_of(p, faces[j]) else {
             return false;
         };
         let Some(c) = q.iter().position(|&x| x as usize == v) else {
@@ -1768,20 +1774,24 @@ fn quad_vertex_row<const K: usize, const N: usize>(
             let Some(r) = ring.iter().position(|&y| y == x) else {
                 return false;
             };
-            let bit = 1u32 << r;
-            if twice & bit != 0 {
+            let bits = 1u32 << r;
+            if twice & bits != 0 {
                 return false;
             }
-            twice |= once & bit;
-            once |= bit;
+            twice |= once & bits;
+            once |= bits;
         }
         keys[1 + K + j] = (u64::from(q[(c + 2) & 3]) << 32) | 2;
     }
     if twice != (1u32 << K) - 1 {
         return false;
     }
-    sort_keys(&mut keys);
-    if keys.windows(2).any(|pair| pair[0] >> 32 == pair[1] >> 32) {
+    if let Ok(k) = <&mut [u64; 9]>::try_from(&mut keys[..]) {
+        sort9(k);
+    } else {
+        insertion_sort(&mut keys);
+    }
+    if (1..N).any(|j| keys[j - 1] >> 32 == keys[j] >> 32) {
         return false;
     }
     // As `smooth_vertex(v, 1.0)` and the general rule compute them.
@@ -1796,9 +1806,15 @@ fn quad_vertex_row<const K: usize, const N: usize>(
     let mut side = scale * ew;
     side += wf;
     side += wf;
-    let w = [centre, side, wf];
-    out.idx.extend(keys.iter().map(|&key| (key >> 32) as u32));
-    out.wts.extend(keys.iter().map(|&key| w[key as usize & 3]));
+    let w = [centre, side, wf, wf];
+    let mut idx = [0u32; N];
+    let mut wts = [0.0f64; N];
+    for j in 0..N {
+        idx[j] = (keys[j] >> 32) as u32;
+        wts[j] = w[keys[j] as usize & 3];
+    }
+    out.idx.extend_from_slice(&idx);
+    out.wts.extend_from_slice(&wts);
     true
 }
 
