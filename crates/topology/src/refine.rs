@@ -1687,11 +1687,15 @@ pub(crate) fn loop_vertex_weights(n: usize) -> (f64, f64) {
 /// Corners of face `f` when it is a quad (inlined: the row fast paths read two to four).
 #[inline(always)]
 fn quad_of(p: &Topology, f: u32) -> Option<[u32; 4]> {
-    let (s, t) = (
-        p.face_offsets[f as usize] as usize,
-        p.face_offsets[f as usize + 1] as usize,
-    );
-    <[u32; 4]>::try_from(p.face_verts.get(s..t)?).ok()
+    let f = f as usize;
+    let &[s, t] = p.face_offsets.get(f..f + 2)? else {
+        return None;
+    };
+    if t.wrapping_sub(s) != 4 {
+        return None;
+    }
+    let s = s as usize;
+    <[u32; 4]>::try_from(p.face_verts.get(s..s + 4)?).ok()
 }
 
 /// The corners of quad `q` other than its edge `a`-`b` (`a` found first), if `b` is beside `a`.
@@ -1720,18 +1724,16 @@ fn quad_edge_row(p: &Topology, a: u32, b: u32, faces: [u32; 2], out: &mut RowOut
     else {
         return false;
     };
-    let mut s = [a, b, c0, d0, c1, d1];
-    sort6(&mut s);
-    if s[0] == s[1] || s[1] == s[2] || s[2] == s[3] || s[3] == s[4] || s[4] == s[5] {
+    // Words (index, end or not), so the weight of a sorted entry is read off its low bit.
+    let key = |x: u32| u64::from(x) << 32;
+    let mut k = [key(a) | 1, key(b) | 1, key(c0), key(d0), key(c1), key(d1)];
+    sort6(&mut k);
+    if (1..6).any(|j| k[j - 1] >> 32 == k[j] >> 32) {
         return false;
     }
-    out.idx.extend_from_slice(&s);
-    let mut w = [0.0625f64; 6];
-    for j in 0..6 {
-        if s[j] == a || s[j] == b {
-            w[j] = 0.375;
-        }
-    }
+    let idx: [u32; 6] = std::array::from_fn(|j| (k[j] >> 32) as u32);
+    let w: [f64; 6] = std::array::from_fn(|j| if k[j] & 1 != 0 { 0.375 } else { 0.0625 });
+    out.idx.extend_from_slice(&idx);
     out.wts.extend_from_slice(&w);
     true
 }
