@@ -1470,6 +1470,15 @@ impl MaskContext<'_> {
         ) {
             return false;
         }
+        let done = match k {
+            3 => quad_vertex_row::<3, 7>(p, v, edges, faces, out),
+            4 => quad_vertex_row::<4, 9>(p, v, edges, faces, out),
+            5 => quad_vertex_row::<5, 11>(p, v, edges, faces, out),
+            _ => false,
+        };
+        if done {
+            return true;
+        }
         // As `smooth_vertex(v, 1.0)` computes them. Weight slots: the vertex, each ring
         // neighbour, then each face's share at its far corners.
         let scale = 1.0f64;
@@ -1540,6 +1549,10 @@ impl MaskContext<'_> {
             return false;
         }
         let [a, b] = p.edge_verts[e];
+        let pair = p.edge_faces[e];
+        if pair[1] != INVALID && quad_edge_row(p, a, b, pair, out) {
+            return true;
+        }
         let faces = p.edge_face_list(e);
         // As `smooth_edge(e, 1.0)` computes them. Weight slots: the two ends, then each face's
         // share at its other corners.
@@ -1671,16 +1684,152 @@ pub(crate) fn loop_vertex_weights(n: usize) -> (f64, f64) {
     (1.0 - ew * n as f64, ew)
 }
 
+/// Corners of face `f` when it is a quad (inlined: the row fast paths read two to four).
+#[inline(always)]
+fn quad_of(p: &Topology, f: u32) -> Option<[u32; 4]> {
+    let f = f as usize;
+    let &[s, t] = p.face_offsets.get(f..f + 2)? else {
+        return None;
+    };
+    if t.wrapping_sub(s) != 4 {
+        return None;
+    }
+    let s = s as usize;
+    <[u32; 4]>::try_from(p.face_verts.get(s..s + 4)?).ok()
+}
+
+/// The corners of quad `q` other than its edge `a`-`b` (`a` found first), if `b` is beside `a`.
+#[inline(always)]
+fn quad_far_side(q: [u32; 4], a: u32, b: u32) -> Option<[u32; 2]> {
+    let c = q.iter().position(|&x| x == a)?;
+    if q[(c + 1) & 3] == b {
+        Some([q[(c + 2) & 3], q[(c + 3) & 3]])
+    } else if q[(c + 3) & 3] == b {
+        Some([q[(c + 1) & 3], q[(c + 2) & 3]])
+    } else {
+        None
+    }
+}
+
+/// The smooth edge point of an edge between two quads, merged, sorted in registers: the ends
+/// at 1/4 plus one share of 1/16 per face (3/8, exact in any order), the far corners at 1/16,
+/// as [`MaskContext::smooth_edge_merged`]'s general rule sums them. `false` (nothing written)
+/// when a face is no quad with the edge as a side or an index repeats.
+#[inline(always)]
+fn quad_edge_row(p: &Topology, a: u32, b: u32, faces: [u32; 2], out: &mut RowOut) -> bool {
+    let (Some(q0), Some(q1)) = (quad_of(p, faces[0]), quad_of(p, faces[1])) else {
+        return false;
+    };
+    let (Some([c0, d0]), Some([c1, d1])) = (quad_far_side(q0, a, b), quad_far_side(q1, a, b))
+    else {
+        return false;
+    };
+    // Words (index, end or not), so the weight of a sorted entry is read off its low bit.
+    let key = |x: u32| u64::from(x) << 32;
+    let mut k = [key(a) | 1, key(b) | 1, key(c0), key(d0), key(c1), key(d1)];
+    sort6(&mut k);
+    if (1..6).any(|j| k[j - 1] >> 32 == k[j] >> 32) {
+        return false;
+    }
+    let idx: [u32; 6] = std::array::from_fn(|j| (k[j] >> 32) as u32);
+    let w: [f64; 6] = std::array::from_fn(|j| if k[j] & 1 != 0 { 0.375 } else { 0.0625 });
+    out.idx.extend_from_slice(&idx);
+    out.wts.extend_from_slice(&w);
+    true
+}
+
+/// The smooth vertex point of an interior vertex of valence `K` among `K` quads, merged, with
+/// its `N = 2K + 1` entries sorted as words (index, class): the weights are
+/// [`MaskContext::smooth_vertex_merged`]'s, computed the same way once per row (the centre,
+/// each ring neighbour with its two faces' shares, each far corner with one). `false` (nothing
+/// written) when a face is no quad, a ring neighbour is not beside exactly two of the faces,
+/// or an index repeats.
+#[inline(always)]
+fn quad_vertex_row<const K: usize, const N: usize>(
+    p: &Topology,
+    v: usize,
+    edges: &[u32],
+    faces: &[u32],
+    out: &mut RowOut,
+) -> bool {
+    let (Ok(edges), Ok(faces)) = (<&[u32; K]>::try_from(edges), <&[u32; K]>::try_from(faces))
+    else {
+        return false;
+    };
+    let mut ring = [0u32; K];
+    let mut keys = [0u64; N];
+    keys[0] = u64::from(v as u32) << 32;
+    for j in 0..K {
+        ring[j] = other_end(p, edges[j], v);
+        keys[1 + j] = (u64::from(ring[j]) << 32) | 1;
+    }
+    // Ring neighbours beside one face so far, and beside two.
+    let (mut once, mut twice) = (0u32, 0u32);
+    for j in 0..K {
+        let Some(q) = quad_of(p, faces[j]) else {
+            return false;
+        };
+        let Some(c) = q.iter().position(|&x| x as usize == v) else {
+            return false;
+        };
+        for x in [q[(c + 1) & 3], q[(c + 3) & 3]] {
+            let Some(r) = ring.iter().position(|&y| y == x) else {
+                return false;
+            };
+            let bits = 1u32 << r;
+            if twice & bits != 0 {
+                return false;
+            }
+            twice |= once & bits;
+            once |= bits;
+        }
+        keys[1 + K + j] = (u64::from(q[(c + 2) & 3]) << 32) | 2;
+    }
+    if twice != (1u32 << K) - 1 {
+        return false;
+    }
+    if let Ok(k) = <&mut [u64; 9]>::try_from(&mut keys[..]) {
+        sort9(k);
+    } else {
+        insertion_sort(&mut keys);
+    }
+    if (1..N).any(|j| keys[j - 1] >> 32 == keys[j] >> 32) {
+        return false;
+    }
+    // As `smooth_vertex(v, 1.0)` and the general rule compute them.
+    let scale = 1.0f64;
+    let n = K as f64;
+    let ew = 1.0 / (n * n);
+    let wf = (scale * ew) / 4.0;
+    let mut centre = scale * (n - 2.0) / n;
+    for _ in 0..K {
+        centre += wf;
+    }
+    let mut side = scale * ew;
+    side += wf;
+    side += wf;
+    let w = [centre, side, wf, wf];
+    let mut idx = [0u32; N];
+    let mut wts = [0.0f64; N];
+    for j in 0..N {
+        idx[j] = (keys[j] >> 32) as u32;
+        wts[j] = w[keys[j] as usize & 3];
+    }
+    out.idx.extend_from_slice(&idx);
+    out.wts.extend_from_slice(&wts);
+    true
+}
+
 /// A face point, merged: each corner once at `1 / n` (as `face_center(f, 1.0)`).
 fn face_centre_merged(fv: &[u32], out: &mut RowOut) -> bool {
     let w = 1.0 / fv.len() as f64;
     if let Ok(&q) = <&[u32; 4]>::try_from(fv) {
-        let mut q = q.map(u64::from);
+        let mut q = q;
         sort4(&mut q);
         if q[0] == q[1] || q[1] == q[2] || q[2] == q[3] {
             return false;
         }
-        out.idx.extend_from_slice(&q.map(|j| j as u32));
+        out.idx.extend_from_slice(&q);
         out.wts.extend_from_slice(&[w; 4]);
         return true;
     }
@@ -1708,12 +1857,12 @@ macro_rules! sort_net {
 /// Optimal sorting networks for the common row lengths: a face point of a quad (4), a smooth
 /// edge point between quads (6), a smooth valence-4 vertex point among quads (9).
 #[inline(always)]
-fn sort4(k: &mut [u64; 4]) {
+fn sort4<T: Copy + Ord>(k: &mut [T; 4]) {
     sort_net!(k; (0, 1), (2, 3), (0, 2), (1, 3), (1, 2));
 }
 
 #[inline(always)]
-fn sort6(k: &mut [u64; 6]) {
+fn sort6<T: Copy + Ord>(k: &mut [T; 6]) {
     sort_net!(k;
         (0, 5), (1, 3), (2, 4), (1, 2), (3, 4), (0, 3),
         (2, 5), (0, 1), (2, 3), (4, 5), (1, 2), (3, 4),
@@ -1721,7 +1870,7 @@ fn sort6(k: &mut [u64; 6]) {
 }
 
 #[inline(always)]
-fn sort9(k: &mut [u64; 9]) {
+fn sort9<T: Copy + Ord>(k: &mut [T; 9]) {
     sort_net!(k;
         (0, 3), (1, 7), (2, 5), (4, 8), (0, 7), (2, 4), (3, 8), (5, 6), (0, 2),
         (1, 3), (4, 5), (7, 8), (1, 4), (3, 6), (5, 7), (0, 1), (2, 4), (3, 5),
