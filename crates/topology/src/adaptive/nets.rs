@@ -128,7 +128,9 @@ pub(super) const BLANK_EDGE: PatchEdge = PatchEdge {
     reversed: [false; 2],
 };
 
-/// Base face, sub-face, origin, size and corner shift of face `f` of level `l`.
+/// Base face, sub-face, origin, size and corner shift of face `f` of level `l`, by its whole
+/// chain of parents (the reference for [`FrameMemo`]).
+#[cfg(test)]
 pub(super) fn frame(levels: &[Lvl], l: usize, f: usize) -> (u32, u8, [f64; 2], f64, u8) {
     let mut chain = [0u8; 16];
     let mut n = 0;
@@ -157,6 +159,78 @@ pub(super) fn frame(levels: &[Lvl], l: usize, f: usize) -> (u32, u8, [f64; 2], f
         shift = (shift + 4 - c) % 4;
     }
     (g as u32, sub, origin, size, shift)
+}
+
+/// A face's frame: base face, sub-face, origin, size and corner shift (and whether the base
+/// face is a quad).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Frame {
+    pub(super) base: u32,
+    pub(super) sub: u8,
+    pub(super) shift: u8,
+    quad: bool,
+    pub(super) origin: [f64; 2],
+    pub(super) size: f64,
+}
+
+/// Per level, the last face whose frame was asked for as a parent, and that frame. A face's
+/// frame is its parent's extended by one step (the same arithmetic as a walk down its chain
+/// from the base face, so the same bits): the patch pass meets faces in order, siblings
+/// together, and finds their parent here instead of walking up to the base face
+/// (catmark_car: ~200 → ~50 instructions per patch).
+pub(super) struct FrameMemo {
+    at: Vec<(u32, Frame)>,
+}
+
+impl FrameMemo {
+    pub(super) fn new(levels: usize) -> FrameMemo {
+        let blank = Frame {
+            base: INVALID,
+            sub: 0,
+            shift: 0,
+            quad: true,
+            origin: [0.0; 2],
+            size: 0.0,
+        };
+        FrameMemo {
+            at: vec![(INVALID, blank); levels],
+        }
+    }
+
+    /// The frame of face `f` of level `l`.
+    pub(super) fn frame(&mut self, levels: &[Lvl], l: usize, f: usize) -> Frame {
+        if l == 0 {
+            return Frame {
+                base: f as u32,
+                sub: 0,
+                shift: 0,
+                quad: levels[0].t().face_vertices(f).len() == 4,
+                origin: [0.0, 0.0],
+                size: 1.0,
+            };
+        }
+        let maps = levels[l].maps.as_ref().expect("refined level has maps");
+        let p = maps.child_face_parent[f];
+        let c = (f - maps.face_first_child[p as usize] as usize) as u8;
+        let (h, mut fr) = self.at[l - 1];
+        if h != p {
+            fr = self.frame(levels, l - 1, p as usize);
+            self.at[l - 1] = (p, fr);
+        }
+        if l == 1 && !fr.quad {
+            fr.sub = c;
+        } else {
+            let pc = (c + 4 - fr.shift) % 4;
+            let (a, b) = POS[pc as usize];
+            fr.origin = [
+                fr.origin[0] + 0.5 * fr.size * a as f64,
+                fr.origin[1] + 0.5 * fr.size * b as f64,
+            ];
+            fr.size *= 0.5;
+            fr.shift = (fr.shift + 4 - c) % 4;
+        }
+        fr
+    }
 }
 
 /// The face corners and edges of `f` rotated into patch order.
