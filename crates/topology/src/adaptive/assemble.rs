@@ -356,23 +356,19 @@ pub(super) fn assemble(
                 patch.boundary_mask = boundary;
                 if boundary != 0 || ids.contains(&INVALID) {
                     // Phantom points past the boundary: extrapolated local points.
-                    let Some(grid) = phantom_grid(&ids, boundary) else {
+                    let row = |terms: &mut [(u32, f64)]| {
+                        let id = (table.len() - rel0) as u32;
+                        push_short_row(table, terms);
+                        id
+                    };
+                    let Some(m) = phantom_points(&ids, boundary, &mut patch.control_points, row)
+                    else {
                         return Err(TopologyError::AdaptivePatch {
                             level: l as u32,
                             face: f,
                         });
                     };
-                    for (slot, (cp, c)) in patch.control_points.iter_mut().zip(&grid).enumerate() {
-                        if !(c.n == 1 && c.w[0] == 1.0) {
-                            terms.clear();
-                            terms.extend((0..c.n as usize).map(|k| (c.idx[k], c.w[k])));
-                            *cp = (table.len() - rel0) as u32;
-                            push_row(table, terms);
-                            mask |= 1 << slot;
-                        } else {
-                            *cp = c.idx[0];
-                        }
-                    }
+                    mask = m;
                 }
             }
             Ok((mask, shift))
