@@ -63,7 +63,6 @@ const PATCH_CHUNK: usize = 1024;
 
 /// One chunk of the patch pass: its local points' rows, which of each patch's control points
 /// are ids of those rows (bit per slot), the first failure, and scratch terms.
-#[derive(Default)]
 struct PatchChunk {
     table: StencilTable,
     table_len0: usize,
@@ -72,6 +71,8 @@ struct PatchChunk {
     terms: Vec<(u32, f64)>,
     /// An end cap's point rows, reused from cap to cap.
     rows: PointRows,
+    /// The frames of the faces last met, per level.
+    frames: FrameMemo,
 }
 
 /// Appends an end cap's point rows to `table` as local points and sets its control points to
@@ -266,7 +267,8 @@ pub(super) fn assemble(
                      table: &mut StencilTable,
                      rel0: usize,
                      terms: &mut Vec<(u32, f64)>,
-                     rows: &mut PointRows|
+                     rows: &mut PointRows,
+                     frames: &mut FrameMemo|
          -> Result<(u32, u8), TopologyError> {
             if l == 0 && tri[f] {
                 let rows;
@@ -285,7 +287,14 @@ pub(super) fn assemble(
                     face: f,
                 });
             }
-            let (base_face, sub_face, origin, size, shift) = frame(&levels, l, f);
+            let Frame {
+                base: base_face,
+                sub: sub_face,
+                origin,
+                size,
+                shift,
+                ..
+            } = frames.frame(&levels, l, f);
             *patch = AdaptivePatch {
                 kind: PatchKind::Regular,
                 level: l as u8,
@@ -347,23 +356,19 @@ pub(super) fn assemble(
                 patch.boundary_mask = boundary;
                 if boundary != 0 || ids.contains(&INVALID) {
                     // Phantom points past the boundary: extrapolated local points.
-                    let Some(grid) = phantom_grid(&ids, boundary) else {
+                    let row = |terms: &mut [(u32, f64)]| {
+                        let id = (table.len() - rel0) as u32;
+                        push_short_row(table, terms);
+                        id
+                    };
+                    let Some(m) = phantom_points(&ids, boundary, &mut patch.control_points, row)
+                    else {
                         return Err(TopologyError::AdaptivePatch {
                             level: l as u32,
                             face: f,
                         });
                     };
-                    for (slot, (cp, c)) in patch.control_points.iter_mut().zip(&grid).enumerate() {
-                        if !(c.n == 1 && c.w[0] == 1.0) {
-                            terms.clear();
-                            terms.extend((0..c.n as usize).map(|k| (c.idx[k], c.w[k])));
-                            *cp = (table.len() - rel0) as u32;
-                            push_row(table, terms);
-                            mask |= 1 << slot;
-                        } else {
-                            *cp = c.idx[0];
-                        }
-                    }
+                    mask = m;
                 }
             }
             Ok((mask, shift))
@@ -382,7 +387,15 @@ pub(super) fn assemble(
             sites.extend(round.iter().map(|&face| PatchSite { face, shift: 0 }));
             let parts: Vec<&[u32]> = round.chunks(PATCH_CHUNK).collect();
             while chunks.len() < parts.len() {
-                chunks.push(PatchChunk::default());
+                chunks.push(PatchChunk {
+                    table: StencilTable::default(),
+                    table_len0: 0,
+                    masks: Vec::new(),
+                    error: None,
+                    terms: Vec::new(),
+                    rows: PointRows::default(),
+                    frames: FrameMemo::new(levels.len()),
+                });
             }
             let mut taken = direct.then(|| std::mem::take(&mut locals.table));
             let run = |c: &mut PatchChunk,
@@ -394,7 +407,8 @@ pub(super) fn assemble(
                 c.error = None;
                 let rel0 = table.len();
                 for ((slot, site), &f) in out.iter_mut().zip(out_sites.iter_mut()).zip(part) {
-                    match patch(f as usize, slot, table, rel0, &mut c.terms, &mut c.rows) {
+                    let (terms, rows, frames) = (&mut c.terms, &mut c.rows, &mut c.frames);
+                    match patch(f as usize, slot, table, rel0, terms, rows, frames) {
                         Ok((mask, shift)) => {
                             site.shift = shift;
                             c.masks.push(mask);
@@ -1187,6 +1201,30 @@ mod tests {
                 (0.5..=2.0).contains(&ratio),
                 "{name}: {estimate} vs {built}"
             );
+        }
+    }
+
+    /// The remembered frames are the chain walk's, bit for bit, in any order of faces.
+    #[test]
+    fn frame_memo_matches_the_chain_walk() {
+        let mesh = triangle_grid(3);
+        let levels =
+            levels::build_levels(&mesh, 3, false, MAX_REFINED_FACES, false).expect("levels");
+        let mut memo = FrameMemo::new(levels.len());
+        for (l, lvl) in levels.iter().enumerate() {
+            let n = lvl.t().num_faces();
+            // Forward, then scattered (every 7th face, from the back).
+            for f in (0..n).chain((0..n).rev().step_by(7)) {
+                let (base, sub, origin, size, shift) = frame(&levels, l, f);
+                let fr = memo.frame(&levels, l, f);
+                assert_eq!(
+                    (fr.base, fr.sub, fr.shift),
+                    (base, sub, shift),
+                    "level {l} face {f}"
+                );
+                assert_eq!(fr.origin.map(f64::to_bits), origin.map(f64::to_bits));
+                assert_eq!(fr.size.to_bits(), size.to_bits());
+            }
         }
     }
 

@@ -14,6 +14,7 @@ pub(super) const fn slot(a: i32, b: i32) -> usize {
     (4 * (b + 1) + (a + 1)) as usize
 }
 
+#[cfg(test)]
 /// A linear combination of at most four global vertices (a gathered or phantom point).
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Combo {
@@ -22,6 +23,7 @@ pub(super) struct Combo {
     pub(super) w: [f64; 4],
 }
 
+#[cfg(test)]
 impl Combo {
     pub(super) fn one(i: u32) -> Combo {
         Combo {
@@ -128,7 +130,9 @@ pub(super) const BLANK_EDGE: PatchEdge = PatchEdge {
     reversed: [false; 2],
 };
 
-/// Base face, sub-face, origin, size and corner shift of face `f` of level `l`.
+/// Base face, sub-face, origin, size and corner shift of face `f` of level `l`, by its whole
+/// chain of parents (the reference for [`FrameMemo`]).
+#[cfg(test)]
 pub(super) fn frame(levels: &[Lvl], l: usize, f: usize) -> (u32, u8, [f64; 2], f64, u8) {
     let mut chain = [0u8; 16];
     let mut n = 0;
@@ -157,6 +161,78 @@ pub(super) fn frame(levels: &[Lvl], l: usize, f: usize) -> (u32, u8, [f64; 2], f
         shift = (shift + 4 - c) % 4;
     }
     (g as u32, sub, origin, size, shift)
+}
+
+/// A face's frame: base face, sub-face, origin, size and corner shift (and whether the base
+/// face is a quad).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Frame {
+    pub(super) base: u32,
+    pub(super) sub: u8,
+    pub(super) shift: u8,
+    quad: bool,
+    pub(super) origin: [f64; 2],
+    pub(super) size: f64,
+}
+
+/// Per level, the last face whose frame was asked for as a parent, and that frame. A face's
+/// frame is its parent's extended by one step (the same arithmetic as a walk down its chain
+/// from the base face, so the same bits): the patch pass meets faces in order, siblings
+/// together, and finds their parent here instead of walking up to the base face
+/// (catmark_car: ~200 → ~50 instructions per patch).
+pub(super) struct FrameMemo {
+    at: Vec<(u32, Frame)>,
+}
+
+impl FrameMemo {
+    pub(super) fn new(levels: usize) -> FrameMemo {
+        let blank = Frame {
+            base: INVALID,
+            sub: 0,
+            shift: 0,
+            quad: true,
+            origin: [0.0; 2],
+            size: 0.0,
+        };
+        FrameMemo {
+            at: vec![(INVALID, blank); levels],
+        }
+    }
+
+    /// The frame of face `f` of level `l`.
+    pub(super) fn frame(&mut self, levels: &[Lvl], l: usize, f: usize) -> Frame {
+        if l == 0 {
+            return Frame {
+                base: f as u32,
+                sub: 0,
+                shift: 0,
+                quad: levels[0].t().face_vertices(f).len() == 4,
+                origin: [0.0, 0.0],
+                size: 1.0,
+            };
+        }
+        let maps = levels[l].maps.as_ref().expect("refined level has maps");
+        let p = maps.child_face_parent[f];
+        let c = (f - maps.face_first_child[p as usize] as usize) as u8;
+        let (h, mut fr) = self.at[l - 1];
+        if h != p {
+            fr = self.frame(levels, l - 1, p as usize);
+            self.at[l - 1] = (p, fr);
+        }
+        if l == 1 && !fr.quad {
+            fr.sub = c;
+        } else {
+            let pc = (c + 4 - fr.shift) % 4;
+            let (a, b) = POS[pc as usize];
+            fr.origin = [
+                fr.origin[0] + 0.5 * fr.size * a as f64,
+                fr.origin[1] + 0.5 * fr.size * b as f64,
+            ];
+            fr.size *= 0.5;
+            fr.shift = (fr.shift + 4 - c) % 4;
+        }
+        fr
+    }
 }
 
 /// The face corners and edges of `f` rotated into patch order.
@@ -488,10 +564,12 @@ fn gather_ring(
     Some((ids, mask))
 }
 
-/// The 16 points of a regular patch from its gathered ids: rows and columns across the
+/// The 16 points of a regular patch from its gathered ids (the reference for
+/// [`phantom_points`]): rows and columns across the
 /// masked edges extrapolated (`2·P_edge − P_inner`), columns (edges 3 and 1) first where
 /// their rows exist, then rows (edges 0 and 2), which gives the corner rule where two masked
 /// edges meet. `None` if a point is missing.
+#[cfg(test)]
 pub(super) fn phantom_grid(ids: &[u32; 16], mask: u8) -> Option<[Combo; 16]> {
     let mut grid = [Combo::default(); 16];
     let mut known = [false; 16];
@@ -531,9 +609,100 @@ pub(super) fn phantom_grid(ids: &[u32; 16], mask: u8) -> Option<[Combo; 16]> {
     known.iter().all(|&k| k).then_some(grid)
 }
 
+/// The points of a regular patch from its gathered ids (`INVALID` where none was gathered),
+/// as `phantom_grid` makes them, without the grid: rows and columns across the masked edges
+/// extrapolated (`2·P_edge − P_inner`), columns (edges 3 and 1) first where their rows
+/// exist, then rows (edges 0 and 2). `cps` holds the gathered ids: each phantom's is
+/// replaced, in slot order, by the id `row` gives its terms (2, or 4 at a corner where two
+/// masked edges meet, in `Combo::extrapolate`'s order). Returns the phantoms' slots, or
+/// `None` (and no row made) if a point is missing.
+pub(super) fn phantom_points(
+    ids: &[u32; 16],
+    mask: u8,
+    cps: &mut [u32],
+    mut row: impl FnMut(&mut [(u32, f64)]) -> u32,
+) -> Option<u32> {
+    // Grid `(x, y)`, slot `4y + x`: columns 0 and 3 (edges 3 and 1), rows 0 and 3 (edges 0
+    // and 2). The column phantoms are in the rows that are not phantoms.
+    let col = [mask & 8 != 0, false, false, mask & 2 != 0];
+    let rows = if mask & 1 != 0 { 0xf } else { 0 } | if mask & 4 != 0 { 0xf000 } else { 0 };
+    let cols = (if col[0] { 0x1111 } else { 0 } | if col[3] { 0x8888 } else { 0 }) & !rows;
+    let mut gathered = 0u32;
+    for (s, &id) in ids.iter().enumerate() {
+        gathered |= ((id != INVALID) as u32) << s;
+    }
+    // A column phantom extrapolates gathered points of its row; a row phantom, gathered points
+    // or column phantoms of its column (rows 1 and 2); every other point is gathered.
+    let col_src =
+        (cols & 0x1111) << 1 | (cols & 0x1111) << 2 | (cols & 0x8888) >> 1 | (cols & 0x8888) >> 2;
+    let row_src = if rows != 0 { 0x0ff0 } else { 0 };
+    if col_src & !gathered != 0
+        || row_src & !(gathered | cols) != 0
+        || gathered | cols | rows != 0xffff
+    {
+        return None;
+    }
+    // Column phantom `(x, y)`: `(edge, inner)` ids of its row.
+    let column = |x: usize, y: usize| -> [(u32, f64); 2] {
+        let (e, i) = if x == 0 { (1, 2) } else { (2, 1) };
+        [(ids[4 * y + e], 2.0), (ids[4 * y + i], -1.0)]
+    };
+    let phantoms = cols | rows;
+    let mut m = phantoms;
+    while m != 0 {
+        let s = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let (x, y) = (s % 4, s / 4);
+        cps[s] = if cols & 1 << s != 0 {
+            row(&mut column(x, y))
+        } else {
+            let (e, i) = if y == 0 { (1, 2) } else { (2, 1) };
+            if col[x] {
+                let [(e0, a0), (e1, a1)] = column(x, e);
+                let [(i0, b0), (i1, b1)] = column(x, i);
+                row(&mut [(e0, 2.0 * a0), (e1, 2.0 * a1), (i0, -b0), (i1, -b1)])
+            } else {
+                row(&mut [(ids[4 * e + x], 2.0), (ids[4 * i + x], -1.0)])
+            }
+        };
+    }
+    Some(phantoms)
+}
+
 /// Append a stencil row: indices sorted, duplicates merged.
 pub(super) fn push_row(table: &mut StencilTable, terms: &mut [(u32, f64)]) {
+    if terms.len() <= 4 {
+        push_short_row(table, terms);
+        return;
+    }
     terms.sort_unstable_by_key(|t| t.0);
+    let mut last = INVALID;
+    for &(i, w) in terms.iter() {
+        if i == last {
+            if let Some(x) = table.weights.last_mut() {
+                *x += w;
+            }
+        } else {
+            table.indices.push(i);
+            table.weights.push(w);
+            last = i;
+        }
+    }
+    table.offsets.push(table.indices.len() as u32);
+}
+
+/// [`push_row`] of at most four terms (phantoms' rows: 40k on catmark_car), inlined where the
+/// count is known. Insertion sort is stable as the standard sort is on short slices, so
+/// duplicates merge in the same order, into the same sums.
+#[inline]
+pub(super) fn push_short_row(table: &mut StencilTable, terms: &mut [(u32, f64)]) {
+    for k in 1..terms.len() {
+        let mut j = k;
+        while j > 0 && terms[j].0 < terms[j - 1].0 {
+            terms.swap(j, j - 1);
+            j -= 1;
+        }
+    }
     let mut last = INVALID;
     for &(i, w) in terms.iter() {
         if i == last {
@@ -754,6 +923,101 @@ mod tests {
             }
         }
         out
+    }
+
+    /// The phantoms made without the grid are the grid's, term for term, for every mask and
+    /// missing points (rows pushed in slot order; `None` where the grid finds a point missing).
+    #[test]
+    fn phantom_points_match_the_grid() {
+        let mut checked = 0;
+        for mask in 0..16u8 {
+            for holes in 0..(1u32 << 16) {
+                // Points missing: any subset of the border slots, and one inner slot.
+                let border = holes & 0xf99f;
+                if border != holes && holes != 1 << 5 {
+                    continue;
+                }
+                let ids: [u32; 16] = std::array::from_fn(|s| {
+                    if holes >> s & 1 != 0 {
+                        INVALID
+                    } else {
+                        100 + (s as u32 * 7) % 16
+                    }
+                });
+                let grid = phantom_grid(&ids, mask);
+                let mut cps = ids;
+                let mut rows: Vec<Vec<(u32, f64)>> = Vec::new();
+                let got = phantom_points(&ids, mask, &mut cps, |t| {
+                    rows.push(t.to_vec());
+                    1000 + rows.len() as u32 - 1
+                });
+                let Some(grid) = grid else {
+                    assert_eq!(got, None, "mask {mask} holes {holes:x}");
+                    assert!(rows.is_empty());
+                    continue;
+                };
+                let mut want = Vec::new();
+                let mut slots = 0u32;
+                for (s, c) in grid.iter().enumerate() {
+                    if c.n == 1 && c.w[0] == 1.0 {
+                        assert_eq!(cps[s], c.idx[0]);
+                    } else {
+                        assert_eq!(cps[s], 1000 + want.len() as u32);
+                        want.push((0..c.n as usize).map(|k| (c.idx[k], c.w[k])).collect());
+                        slots |= 1 << s;
+                    }
+                }
+                let bits = |r: &Vec<Vec<(u32, f64)>>| -> Vec<Vec<(u32, u64)>> {
+                    r.iter()
+                        .map(|t| t.iter().map(|&(i, w)| (i, w.to_bits())).collect())
+                        .collect()
+                };
+                assert_eq!(bits(&rows), bits(&want), "mask {mask} holes {holes:x}");
+                assert_eq!(got, Some(slots));
+                checked += 1;
+            }
+        }
+        assert!(checked > 16);
+    }
+
+    /// Short rows merge as the standard sort would: sorted, duplicates summed in order.
+    #[test]
+    fn short_rows_match_push_row() {
+        let cases: [&[(u32, f64)]; 5] = [
+            &[(5, 2.0), (3, -1.0)],
+            &[(3, 2.0), (5, -1.0)],
+            &[(4, 4.0), (4, -2.0), (2, -2.0), (4, 1.0)],
+            &[(9, 0.1), (1, 0.2), (9, 0.3), (1, 0.4)],
+            &[(7, 1.0)],
+        ];
+        for terms in cases {
+            let mut a = StencilTable {
+                offsets: vec![0],
+                ..StencilTable::default()
+            };
+            let mut b = a.clone();
+            let mut t = terms.to_vec();
+            push_short_row(&mut a, &mut t);
+            let mut t = terms.to_vec();
+            t.sort_by_key(|x| x.0);
+            let mut last = INVALID;
+            for &(i, w) in &t {
+                if i == last {
+                    *b.weights.last_mut().unwrap() += w;
+                } else {
+                    b.indices.push(i);
+                    b.weights.push(w);
+                    last = i;
+                }
+            }
+            b.offsets.push(b.indices.len() as u32);
+            assert_eq!(a.indices, b.indices);
+            assert_eq!(
+                a.weights.iter().map(|w| w.to_bits()).collect::<Vec<_>>(),
+                b.weights.iter().map(|w| w.to_bits()).collect::<Vec<_>>()
+            );
+            assert_eq!(a.offsets, b.offsets);
+        }
     }
 
     /// The one-visit gather agrees with the corner walks wherever it answers, and answers on
