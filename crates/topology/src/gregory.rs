@@ -25,7 +25,8 @@
 //! * crease (two sharp edges, boundary edges count), sector of `m` faces between the sharp
 //!   edges `a` and `b` (CCW, the face inside): `T(k) = cos θ·T_along + sin θ·T_across`,
 //!   `θ = π·(k−a)/m`, with `T_along = (e_a − e_b)/2` and the cross tangent of
-//!   [`catmark_limit_masks`]; along the sharp edges themselves `T = ±T_along` exactly;
+//!   [`catmark_limit_masks`](crate::limit::catmark_limit_masks); along the sharp edges
+//!   themselves `T = ±T_along` exactly;
 //! * corner (sharp vertex or more than two sharp edges), sector of `m` faces between sharp
 //!   edges `a` and `b`: the vertex stays, `T(a) = e_a − v`, `T(b) = e_b − v`, interior edges
 //!   `T(k) = sin((m−t)φ)·T(a) + sin(tφ)·T(b)`, `t = k−a`, `φ = π/(2m)`.
