@@ -676,19 +676,7 @@ pub(super) fn push_row(table: &mut StencilTable, terms: &mut [(u32, f64)]) {
         return;
     }
     terms.sort_unstable_by_key(|t| t.0);
-    let mut last = INVALID;
-    for &(i, w) in terms.iter() {
-        if i == last {
-            if let Some(x) = table.weights.last_mut() {
-                *x += w;
-            }
-        } else {
-            table.indices.push(i);
-            table.weights.push(w);
-            last = i;
-        }
-    }
-    table.offsets.push(table.indices.len() as u32);
+    push_sorted_row(table, terms);
 }
 
 /// [`push_row`] of at most four terms (phantoms' rows: 40k on catmark_car), inlined where the
@@ -703,8 +691,14 @@ pub(super) fn push_short_row(table: &mut StencilTable, terms: &mut [(u32, f64)])
             j -= 1;
         }
     }
+    push_sorted_row(table, terms);
+}
+
+/// Appends terms sorted by index as one row, duplicates summed in order.
+#[inline]
+fn push_sorted_row(table: &mut StencilTable, terms: &[(u32, f64)]) {
     let mut last = INVALID;
-    for &(i, w) in terms.iter() {
+    for &(i, w) in terms {
         if i == last {
             if let Some(x) = table.weights.last_mut() {
                 *x += w;
