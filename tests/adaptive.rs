@@ -11,8 +11,8 @@ use tessera::tess::gpu::bindings::{ADAPTIVE_FLAG_LEVEL_SHIFT, ADAPTIVE_KIND_REGU
 use tessera::tess::techniques::adaptive::{Adaptive, AdaptiveBuild};
 use tessera::tess::techniques::bft::{base_normals, base_positions, wave};
 use tessera::tess::{Camera, Context, FactorPolicy, FrameParams, Spacing, Technique};
-use tessera::topology::adaptive::EndCap;
-use tessera::topology::eval::{LimitScheme, LocalMesh};
+use tessera::topology::limit::eval::{LimitScheme, LocalMesh};
+use tessera::topology::patches::adaptive::EndCap;
 use tessera::topology::{self, ControlMesh};
 use tessera::vk_core::vk;
 

@@ -382,7 +382,7 @@ fn bench_equal_triangles_and_memory_per_face() {
     .unwrap();
     use tessera::tess::techniques::gregory;
     use tessera::tess::Technique;
-    use tessera::topology::adaptive::single_pass::SinglePassPatch;
+    use tessera::topology::patches::adaptive::single_pass::SinglePassPatch;
     for (name, patch) in [
         ("gregory", SinglePassPatch::Gregory),
         ("acc", SinglePassPatch::Acc1),

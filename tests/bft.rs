@@ -7,8 +7,8 @@ use tessera::tess::capture::{classify_open_edges, CapturedSoup, Capturer};
 use tessera::tess::techniques::bft::layout::GpuBft;
 use tessera::tess::techniques::bft::{base_normals, patch_uv, wave, Bft, BftOptions};
 use tessera::tess::{Context, FactorPolicy, FrameParams, Spacing, Technique};
-use tessera::topology::bft::prepare_loop_bft;
-use tessera::topology::eval::{LimitScheme, LocalMesh};
+use tessera::topology::limit::eval::{LimitScheme, LocalMesh};
+use tessera::topology::patches::bft::prepare_loop_bft;
 use tessera::topology::{self, ControlMesh};
 use tessera::vk_core::vk;
 

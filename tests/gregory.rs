@@ -11,8 +11,8 @@ use tessera::tess::surface::{SurfaceMaps, SurfaceShow};
 use tessera::tess::techniques::adaptive::Adaptive;
 use tessera::tess::techniques::gregory;
 use tessera::tess::{Camera, Context, FactorPolicy, FrameParams, Spacing, Technique};
-use tessera::topology::adaptive::single_pass::SinglePassPatch;
-use tessera::topology::eval::{LimitScheme, LocalMesh};
+use tessera::topology::limit::eval::{LimitScheme, LocalMesh};
+use tessera::topology::patches::adaptive::single_pass::SinglePassPatch;
 use tessera::topology::{self, ControlMesh};
 use tessera::vk_core::vk;
 
@@ -688,7 +688,7 @@ fn acc_tangent_patch_normals_on_the_gpu() {
                 let g = |rec: &tessera::tess::CaptureRecord| {
                     let [u, v] = rec.domain.map(f64::from);
                     let s = surf.plan.evaluate(&verts, plan_patch(rec.patch), u, v);
-                    topology::eval::normal_of(&s.du, &s.dv)
+                    topology::limit::eval::normal_of(&s.du, &s.dv)
                 };
                 geometric_max = geometric_max.max(angle(g(r), g(first)));
             }

@@ -205,7 +205,7 @@ fn assert_watertight(
 /// the GPU's coordinates were made `+0.0` (`techniques::shared::gpu_coordinate`).
 #[test]
 fn negative_zero_coordinates_do_not_crack() {
-    use tessera::topology::adaptive::EndCap;
+    use tessera::topology::patches::adaptive::EndCap;
     let c = |x: u32| if x == 0 { -0.0 } else { 1.0 };
     let positions = (0..8)
         .map(|i| [c(i & 1), c((i >> 1) & 1), c((i >> 2) & 1)])
@@ -333,7 +333,7 @@ fn base_face_techniques_are_watertight_on_spot() {
 /// triangle patches, its quads next to them split once, so transition edges are crossed).
 #[test]
 fn bft_and_adaptive_are_watertight_at_every_uniform_level() {
-    use tessera::topology::adaptive::EndCap;
+    use tessera::topology::patches::adaptive::EndCap;
     let gpu = Gpu::new();
     let mut h = Harness::new(&gpu);
     let meshes = [

@@ -12,8 +12,10 @@
 use arbitrary::Unstructured;
 use libfuzzer_sys::fuzz_target;
 use tessera_fuzz::{all_finite, param, positions_in_range, MeshSpec};
-use topology::adaptive::single_pass::{plan_single_pass, SinglePassOptions, SinglePassPatch};
-use topology::adaptive::PatchKind;
+use topology::patches::adaptive::single_pass::{
+    plan_single_pass, SinglePassOptions, SinglePassPatch,
+};
+use topology::patches::adaptive::PatchKind;
 use topology::{plan_adaptive, AdaptiveOptions, EndCap};
 
 fuzz_target!(

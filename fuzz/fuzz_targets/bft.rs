@@ -9,7 +9,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use tessera_fuzz::{all_finite, positions_in_range, MeshSpec};
-use topology::bft::{prepare_loop_bft, shader_eval_full};
+use topology::patches::bft::{prepare_loop_bft, shader_eval_full};
 
 fuzz_target!(
     init: tessera_fuzz::single_thread_rayon(),

@@ -9,7 +9,7 @@
 use arbitrary::Unstructured;
 use libfuzzer_sys::fuzz_target;
 use tessera_fuzz::{all_finite, param, positions_in_range, MeshSpec};
-use topology::eval::{limit_point, normal_of, LimitSample, LimitScheme, LocalMesh};
+use topology::limit::eval::{limit_point, normal_of, LimitSample, LimitScheme, LocalMesh};
 
 fn finite(s: &LimitSample) -> bool {
     all_finite(&s.position) && all_finite(&s.du) && all_finite(&s.dv)

@@ -21,7 +21,7 @@ pub struct SurfaceImage {
 pub struct SurfaceMaps {
     pub texture: Option<Arc<SurfaceImage>>,
     pub height: Option<Arc<SurfaceImage>>,
-    /// Also compute the pointwise Eq. 1 error lattice (`topology::texcoord::ParamErrorLattice`)
+    /// Also compute the pointwise Eq. 1 error lattice (`topology::patches::texcoord::ParamErrorLattice`)
     /// that [`SurfaceShow::ParamError`] draws: exact limit evaluations on the CPU at build
     /// time (seconds on meshes of thousands of patches), so only on request.
     pub param_error: bool,

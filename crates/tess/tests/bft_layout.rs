@@ -6,8 +6,8 @@
 
 use std::collections::HashMap;
 use tess::techniques::bft::layout::{owner_face, pack_owner, GpuBft};
-use topology::bft::{prepare_loop_bft, tessellator_interior_points, LoopBft};
 use topology::load_obj;
+use topology::patches::bft::{prepare_loop_bft, tessellator_interior_points, LoopBft};
 
 #[path = "../../../tests/support/loop_grid.rs"]
 mod loop_grid;

@@ -17,7 +17,7 @@
 use criterion::Criterion;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
-use topology::adaptive::{plan_adaptive, AdaptiveOptions, EndCap};
+use topology::patches::adaptive::{plan_adaptive, AdaptiveOptions, EndCap};
 use topology::{load_obj, uniform_stencils, ControlMesh, LevelTopology, Scheme};
 
 fn mesh(rel: &str) -> ControlMesh {

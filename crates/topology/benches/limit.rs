@@ -5,9 +5,9 @@
 use criterion::Criterion;
 use std::path::PathBuf;
 use std::time::Duration;
-use topology::bft::{BasisTables, BftCase, BftKey};
-use topology::eval::{LimitScheme, LocalMesh};
+use topology::limit::eval::{LimitScheme, LocalMesh};
 use topology::load_obj;
+use topology::patches::bft::{BasisTables, BftCase, BftKey};
 
 fn shape(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -20,7 +20,9 @@
 use std::collections::hash_map::DefaultHasher;
 use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
-use topology::adaptive::single_pass::{plan_single_pass, SinglePassOptions, SinglePassPatch};
+use topology::patches::adaptive::single_pass::{
+    plan_single_pass, SinglePassOptions, SinglePassPatch,
+};
 use topology::{
     load_obj, plan_adaptive, uniform_stencils, AdaptiveOptions, AdaptivePlan, EndCap, Scheme,
 };

@@ -5,7 +5,7 @@
 //!
 //! `tools/reparam_fit.sh [--write] [--max-valence N]`, which runs
 //! `cargo run --release -p topology --example reparam_fit -- [--write] [--max-valence N]`.
-use topology::reparam::{
+use topology::patches::reparam::{
     fit_corner_block, min_jacobian, CharacteristicMap, FIT_GRID, IDENTITY_BLOCK, PAPER_TABLE_1,
     TABLE_VALENCES,
 };

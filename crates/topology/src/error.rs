@@ -102,23 +102,23 @@ pub enum TopologyError {
     /// An operation the scheme does not support (Doo-Sabin has no sparse refinement).
     #[error("{scheme} does not support {operation}")]
     UnsupportedScheme {
-        scheme: crate::sdc::Scheme,
+        scheme: crate::rules::Scheme,
         operation: &'static str,
     },
     /// A face index (e.g. in a refinement selection) beyond the level's faces.
     #[error("face {face} out of range (the level has {count} faces)")]
     FaceOutOfRange { face: usize, count: usize },
-    /// A Gregory end cap cannot be built on this face ([`crate::gregory::gregory_basis`]).
+    /// A Gregory end cap cannot be built on this face ([`crate::patches::gregory::gregory_basis`]).
     #[error("Gregory patch of face {face}: {problem}")]
     GregoryPatch {
         face: usize,
-        problem: crate::gregory::GregoryProblem,
+        problem: crate::patches::gregory::GregoryProblem,
     },
-    /// An ACC-1 patch cannot be built on this face ([`crate::acc::acc1_patch`]).
+    /// An ACC-1 patch cannot be built on this face ([`crate::patches::acc::acc1_patch`]).
     #[error("ACC-1 patch of face {face}: {problem}")]
     AccPatch {
         face: usize,
-        problem: crate::acc::AccProblem,
+        problem: crate::patches::acc::AccProblem,
     },
     /// An adaptive isolation level outside `1..=8`.
     #[error("isolation level {isolation} is outside 1..=8")]

@@ -1,9 +1,9 @@
 //! ACC-1 geometry patches against the exact Catmull-Clark limit: exact on regular faces,
 //! interpolating limit positions at extraordinary corners, watertight along shared edges, and
 //! their deviation (with single-pass Gregory patches beside them) on OpenSubdiv's shapes.
-use topology::acc::{acc1_patch, evaluate};
-use topology::eval::{LimitScheme, LocalMesh};
-use topology::gregory::{gregory_basis, gregory_weights};
+use topology::limit::eval::{LimitScheme, LocalMesh};
+use topology::patches::acc::{acc1_patch, evaluate};
+use topology::patches::gregory::{gregory_basis, gregory_weights};
 use topology::refine::Level;
 use topology::{load_obj, ControlMesh, Scheme};
 

@@ -1,4 +1,4 @@
-//! The feature-adaptive plan against the exact limit ([`topology::eval`]) on every OpenSubdiv
+//! The feature-adaptive plan against the exact limit ([`topology::limit::eval`]) on every OpenSubdiv
 //! `catmark_*` shape in tests/data and on spot: regular patches exact, end caps converging with
 //! the isolation level, canonical curves equal to each patch's own edges (transitions
 //! included), balance, uniform counts and errors.
@@ -7,7 +7,7 @@ use std::collections::HashMap;
 
 use rayon::prelude::*;
 
-use topology::eval::{LimitScheme, LocalMesh};
+use topology::limit::eval::{LimitScheme, LocalMesh};
 use topology::{
     load_obj, plan_adaptive, AdaptiveOptions, AdaptivePlan, ControlMesh, EdgeCrease, EdgeKind,
     EndCap, PatchKind, TopologyError, VertexCorner,
@@ -798,7 +798,7 @@ fn bad_options_and_meshes_are_named_errors() {
 /// mesh size and the isolation, and the default bound plans it.
 #[test]
 fn a_plan_projected_past_its_bound_is_refused_before_refining() {
-    use topology::adaptive::plan_adaptive_within;
+    use topology::patches::adaptive::plan_adaptive_within;
     let mesh = load_obj(format!("{SHAPES}catmark_cube.obj")).expect("cube");
     let opts = options(3, EndCap::Gregory);
     for (bound, level, estimate) in [(71, 0, 72), (72, 1, 216)] {

@@ -3,7 +3,7 @@
 //! characteristic kept), quads from level 1 on, and their sharpness-6 creases decaying by one
 //! per level along twice as many edges.
 
-use topology::sdc::is_semi_sharp;
+use topology::rules::is_semi_sharp;
 use topology::{load_obj, refine_uniform, Level, Scheme};
 
 const DATA: &str = concat!(

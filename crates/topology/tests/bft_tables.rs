@@ -3,11 +3,11 @@
 
 use std::collections::HashMap;
 
-use topology::bft::{
+use topology::limit::eval::{LimitScheme, LocalMesh};
+use topology::patches::bft::{
     bft_face_ring, build_patch_records, classify_face, configuration_mesh, face_control_ring,
     memory_for, prepare_loop_bft, shader_eval, shader_eval_full, BasisTables, BftCase, BftKey,
 };
-use topology::eval::{LimitScheme, LocalMesh};
 use topology::refine::refine_uniform;
 use topology::{load_obj, ControlMesh, Scheme};
 
@@ -375,7 +375,7 @@ fn table_weight_count_is_what_the_tables_store() {
         let mesh = load_obj(format!("{DATA}{name}.obj")).expect("shape");
         for (level, tangents) in [(2, true), (3, false), (5, false)] {
             let bft = prepare_loop_bft(&mesh, level, tangents).expect("tables");
-            let counted = topology::bft::table_weight_count(&bft.records, level, tangents);
+            let counted = topology::patches::bft::table_weight_count(&bft.records, level, tangents);
             assert_eq!(
                 counted,
                 bft.tables.weights.len() as u64,

@@ -36,7 +36,7 @@ fn tag_counts_that_overflow_are_a_count_mismatch() {
 /// NaN]"). They have no limit point: the mask is `None` and the exact limit an error.
 #[test]
 fn isolated_vertex_has_no_limit_point() {
-    use topology::eval::{EvalError, LimitScheme, LocalMesh};
+    use topology::limit::eval::{EvalError, LimitScheme, LocalMesh};
     use topology::ControlMesh;
     let positions = vec![
         [0.0, 1.0, 0.0],

@@ -3,9 +3,9 @@
 //! to the exact limit surface, shared edges have bit-identical boundary curves, and the basis
 //! has no NaN on the closed square.
 
-use topology::eval::{LimitScheme, LocalMesh};
-use topology::gregory::{gregory_basis, gregory_weights, GregoryProblem, Stencil};
-use topology::patch::catmark_regular_weights;
+use topology::limit::basis::catmark_regular_weights;
+use topology::limit::eval::{LimitScheme, LocalMesh};
+use topology::patches::gregory::{gregory_basis, gregory_weights, GregoryProblem, Stencil};
 use topology::refine::{refine_uniform, Level};
 use topology::{
     load_obj, BoundaryInterpolation, ControlMesh, EdgeCrease, Scheme, TopologyError, VertexCorner,

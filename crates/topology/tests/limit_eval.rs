@@ -1,10 +1,10 @@
 //! Limit masks, regular patch bases and exact limit evaluation, checked against direct spline
 //! algebra and against uniform refinement pushed to the limit by masks.
 
-use topology::eval::{limit_point, limit_point_subface, LimitScheme, LocalMesh};
-use topology::patch::{
+use topology::limit::basis::{
     catmark_regular_weights, loop_regular_weights, CATMARK_CORNER_SLOTS, LOOP_REGULAR_LATTICE,
 };
+use topology::limit::eval::{limit_point, limit_point_subface, LimitScheme, LocalMesh};
 use topology::refine::{refine_uniform, Level};
 use topology::{load_obj, ControlMesh, Scheme};
 
@@ -209,7 +209,7 @@ fn catmark_shapes_match_refined_limit() {
 /// Darts (an interior vertex with one infinitely sharp edge): the smooth limit mask that
 /// OpenSubdiv applies there is not the limit of the refinement (the sharp edge's child is its
 /// midpoint), so the limit at level 0 and at level 3 disagreed by 1.3e-2 of the diagonal on
-/// catmark_cubes_infsharp; [`topology::limit::dart_position_weights`] is.
+/// catmark_cubes_infsharp; [`topology::limit::masks::dart_position_weights`] is.
 #[test]
 fn dart_shapes_match_refined_limit() {
     check_shape("catmark_cubes_infsharp", 2);

@@ -1,8 +1,8 @@
 //! Limit masks against deep refinement: positions converge to the mask value and the
 //! refined neighbours approach the tangent plane spanned by the tangent masks.
 
-use topology::eval::{LimitScheme, LocalMesh};
-use topology::limit::{catmark_limit_masks, loop_limit_masks, LimitRule, LimitVertex};
+use topology::limit::eval::{LimitScheme, LocalMesh};
+use topology::limit::masks::{catmark_limit_masks, loop_limit_masks, LimitRule, LimitVertex};
 use topology::refine::refine_uniform;
 use topology::{load_obj, ControlMesh, Scheme};
 

@@ -1,11 +1,11 @@
 //! The texture reparameterization of seed 003 (Eq. 2–3, Table 1) on the characteristic maps:
 //! the maps are Catmull-Clark's subdominant eigenfunctions, the committed table is what the fit
 //! gives, and it lowers Eq. 1's texture error at every valence it covers.
-use topology::refine::refine_uniform;
-use topology::reparam::{
+use topology::patches::reparam::{
     admissible, control_net, corner_block, fit_corner_block, reparameterize, CharacteristicMap,
     FIT_GRID, IDENTITY_BLOCK, REPARAM_TABLE, TABLE_VALENCES,
 };
+use topology::refine::refine_uniform;
 use topology::Scheme;
 
 /// Catmull-Clark's subdominant eigenvalue at valence `n` (Doo & Sabin's analysis, with
@@ -40,7 +40,7 @@ fn characteristic_maps_are_eigenvectors_of_the_refiner() {
         // n-fold symmetry: spoke k is spoke 0 rotated by 2πk/n, same distance.
         let r1 = p[1][0].hypot(p[1][1]);
         for k in 0..n as usize {
-            let q = p[1 + k * topology::reparam::STAR_RINGS];
+            let q = p[1 + k * topology::patches::reparam::STAR_RINGS];
             assert!(
                 (q[0].hypot(q[1]) - r1).abs() < 1e-9,
                 "valence {n} spoke {k}"

@@ -2,9 +2,11 @@
 //! CPU: exact on regular patches, shared edges one canonical curve (no crack), bounded
 //! deviation from the exact limit everywhere, on every Catmull-Clark shape of tests/data and
 //! spot (triangles, quads and pentagons). The GPU technique is checked in tests/gregory.rs.
-use topology::adaptive::edge_param;
-use topology::adaptive::single_pass::{plan_single_pass, SinglePassOptions, SinglePassPatch};
-use topology::eval::{LimitScheme, LocalMesh};
+use topology::limit::eval::{LimitScheme, LocalMesh};
+use topology::patches::adaptive::edge_param;
+use topology::patches::adaptive::single_pass::{
+    plan_single_pass, SinglePassOptions, SinglePassPatch,
+};
 use topology::{load_obj, ControlMesh, EdgeKind, PatchKind};
 
 fn data(rel: &str) -> String {
@@ -220,7 +222,8 @@ fn texture_error_on_triangles() {
                 ..Default::default()
             };
             let plan = plan_single_pass(&mesh, &opts).unwrap();
-            let lattice = topology::texcoord::param_error_lattice(&mesh, &plan, 9).unwrap();
+            let lattice =
+                topology::patches::texcoord::param_error_lattice(&mesh, &plan, 9).unwrap();
             let (mut sq, mut max, mut n) = (0.0f64, 0.0f64, 0usize);
             for (i, p) in plan.patches.iter().enumerate() {
                 if !triangles[p.base_face as usize] {
@@ -389,7 +392,7 @@ fn acc_tangent_patches_give_continuous_normals() {
                 ));
                 let g = |p: usize, u: f64, v: f64| {
                     let s = plan.evaluate(&verts, p, u, v);
-                    topology::eval::normal_of(&s.du, &s.dv)
+                    topology::limit::eval::normal_of(&s.du, &s.dv)
                 };
                 geometric_max = geometric_max.max(angle(g(a, ua, va), g(b, ub, vb)));
             }
@@ -408,7 +411,7 @@ fn acc_tangent_patches_give_continuous_normals() {
                     exact.evaluate_subface(face, p.sub_face as usize, bu, bv)
                 }
                 .unwrap();
-                let n = topology::eval::normal_of(
+                let n = topology::limit::eval::normal_of(
                     &[s.du[0], s.du[1], s.du[2]],
                     &[s.dv[0], s.dv[1], s.dv[2]],
                 );

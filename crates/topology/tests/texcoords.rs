@@ -2,9 +2,11 @@
 //! owner evaluates to the curve (what seamless displacement relies on), texture coordinates are
 //! continuous inside a base face, and the texture reparameterization of seed 003 lowers the
 //! pointwise texture error of Eq. 1 on real meshes (spot and OpenSubdiv's shapes).
-use topology::adaptive::single_pass::{plan_single_pass, SinglePassOptions, SinglePassPatch};
-use topology::eval::{LimitScheme, LocalMesh};
-use topology::texcoord::{has_texcoords, patch_parameter, patch_texcoord};
+use topology::limit::eval::{LimitScheme, LocalMesh};
+use topology::patches::adaptive::single_pass::{
+    plan_single_pass, SinglePassOptions, SinglePassPatch,
+};
+use topology::patches::texcoord::{has_texcoords, patch_parameter, patch_texcoord};
 use topology::{load_obj, plan_adaptive, AdaptiveOptions, AdaptivePlan, ControlMesh, PatchKind};
 
 fn data(rel: &str) -> String {
@@ -247,7 +249,7 @@ fn reparameterization_lowers_the_texture_error_on_meshes() {
 /// docs/approximations.md; spot has valences 3, 5 and 6, and each must gain).
 #[test]
 fn param_error_lattice_is_eq1_pointwise() {
-    use topology::texcoord::param_error_lattice;
+    use topology::patches::texcoord::param_error_lattice;
     let mesh = load_obj(data("assets/spot_control_mesh.obj")).unwrap();
     let plan = plan_single_pass(&mesh, &SinglePassOptions::default()).unwrap();
     let lattice = param_error_lattice(&mesh, &plan, 9).unwrap();
@@ -401,8 +403,10 @@ fn high_valence_disk(n: usize) -> ControlMesh {
 /// valence 20 says it should (docs/approximations.md: RMS 0.10× there).
 #[test]
 fn corners_above_the_table_reuse_its_last_row() {
-    use topology::reparam::{corner_block, TABLE_VALENCES};
-    use topology::texcoord::{param_error_lattice, reparam_block, reparam_row, subface_corners};
+    use topology::patches::reparam::{corner_block, TABLE_VALENCES};
+    use topology::patches::texcoord::{
+        param_error_lattice, reparam_block, reparam_row, subface_corners,
+    };
     let n = 20;
     assert!(!TABLE_VALENCES.contains(&(n as u32)) && corner_block(n as u32).is_none());
     assert_eq!(reparam_block(n as u8), corner_block(16));

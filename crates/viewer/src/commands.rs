@@ -35,7 +35,7 @@ pub fn validation(g: &GpuArgs) -> Validation {
 }
 
 /// Loads and validates the mesh (the embedded spot without a path); errors say the file, the
-/// line and the OBJ's 1-based numbers (`topology::obj`).
+/// line and the OBJ's 1-based numbers (`topology::mesh::obj`).
 pub fn load_mesh(path: Option<&std::path::Path>) -> Result<topology::ControlMesh> {
     let mesh = match path {
         Some(p) => topology::load_obj(p)?,

@@ -7,7 +7,7 @@ use std::path::Path;
 use std::sync::Arc;
 use tess::techniques::{self, adaptive::DEFAULT_ISOLATION, bft::DEFAULT_TABLE_LEVEL, BuildOptions};
 use tess::{FactorPolicy, Features, FrameParams, Spacing, TechniqueId};
-use topology::adaptive::EndCap;
+use topology::patches::adaptive::EndCap;
 
 pub fn parse_technique(s: &str) -> Result<TechniqueId, String> {
     s.parse::<TechniqueId>().map_err(|e| e.to_string())

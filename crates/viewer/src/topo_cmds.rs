@@ -4,7 +4,7 @@
 //! numbers ([`topology::TopologyError::in_file`]); nothing non-finite is written or printed.
 use crate::cli::{LimitArgs, SubdivideArgs};
 use anyhow::{bail, Context, Result};
-use topology::eval::{limit_point, EvalError, LimitScheme, LocalMesh};
+use topology::limit::eval::{limit_point, EvalError, LimitScheme, LocalMesh};
 use topology::{refine_uniform, ControlMesh, Level, Scheme};
 
 /// Clap's value parser for `--scheme`: topology's one scheme parser.

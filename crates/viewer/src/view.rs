@@ -593,8 +593,12 @@ impl App {
             Action::EndCaps if features.isolation => {
                 let b = &mut self.setup.build;
                 b.end_cap = match b.end_cap {
-                    topology::adaptive::EndCap::Gregory => topology::adaptive::EndCap::Bilinear,
-                    topology::adaptive::EndCap::Bilinear => topology::adaptive::EndCap::Gregory,
+                    topology::patches::adaptive::EndCap::Gregory => {
+                        topology::patches::adaptive::EndCap::Bilinear
+                    }
+                    topology::patches::adaptive::EndCap::Bilinear => {
+                        topology::patches::adaptive::EndCap::Gregory
+                    }
                 };
                 self.rebuild = true;
             }
@@ -852,10 +856,10 @@ fn stamp<'a>(
 }
 
 /// `--end-cap`'s spelling of an end cap.
-pub(crate) fn end_cap_name(e: topology::adaptive::EndCap) -> &'static str {
+pub(crate) fn end_cap_name(e: topology::patches::adaptive::EndCap) -> &'static str {
     match e {
-        topology::adaptive::EndCap::Gregory => "gregory",
-        topology::adaptive::EndCap::Bilinear => "bilinear",
+        topology::patches::adaptive::EndCap::Gregory => "gregory",
+        topology::patches::adaptive::EndCap::Bilinear => "bilinear",
     }
 }
 

@@ -373,7 +373,7 @@ const SEMI_SHARP_SHAPES: &[&str] = &[
 /// `level`, each vertex evaluated from the base mesh at its dyadic `(face, u, v)` (every face
 /// corner is checked, so each vertex once per incident face).
 fn limit_output_error(shape: &str, level: usize) -> f64 {
-    use topology::eval::{LimitScheme, LocalMesh};
+    use topology::limit::eval::{LimitScheme, LocalMesh};
     let input = data(&format!("tests/data/opensubdiv/shapes/{shape}.obj"));
     let quad = shape.starts_with("catmark");
     let (scheme, name) = if quad {
@@ -468,8 +468,8 @@ fn subdivide_limit_is_exact_next_to_semi_sharp_features() {
 /// sharpness-2.5 creases of `catmark_pyramid_creases1` (0.5 left at level 2).
 #[test]
 fn limit_masks_at_the_output_level_miss_semi_sharp_creases() {
-    use topology::eval::{LimitScheme, LocalMesh};
-    use topology::sdc::{is_semi_sharp, SHARPNESS_INFINITE};
+    use topology::limit::eval::{LimitScheme, LocalMesh};
+    use topology::rules::{is_semi_sharp, SHARPNESS_INFINITE};
     let shape = "catmark_pyramid_creases1";
     let input = data(&format!("tests/data/opensubdiv/shapes/{shape}.obj"));
     let mesh = topology::load_obj(&input).unwrap();
@@ -886,7 +886,7 @@ fn exported_points(path: &Path) -> Vec<([f64; 3], usize, f64, f64)> {
 /// in the export's domain convention (triangles: weights of corners 0 and 1; quads: the unit
 /// square, fan triangles (0, 1, 2) below the diagonal and (0, 2, 3) above it).
 fn loop_limit_at(
-    cpu: &topology::eval::LocalMesh,
+    cpu: &topology::limit::eval::LocalMesh,
     mesh: &topology::ControlMesh,
     face: usize,
     u: f64,
@@ -921,7 +921,7 @@ fn bbox_diag(points: &[[f64; 3]]) -> f64 {
 /// is the CPU's exact Loop limit there; no cracks.
 #[test]
 fn export_bft_writes_the_exact_limit_at_each_vertex() {
-    use topology::eval::{LimitScheme, LocalMesh};
+    use topology::limit::eval::{LimitScheme, LocalMesh};
     let cube = data("tests/data/meshes/cube.obj");
     let ico = data("tests/data/opensubdiv/shapes/loop_icosahedron.obj");
     for (input, frame, segments) in [(&cube, None, "8"), (&ico, Some("0.7"), "16")] {

@@ -11,7 +11,7 @@ use crate::technique::{FrameParams, Technique};
 use crate::techniques::bft::Wave;
 use crate::techniques::{self, BuildOptions, TechniqueInfo};
 use std::time::Instant;
-use topology::eval::{LimitScheme, LocalMesh};
+use topology::limit::eval::{LimitScheme, LocalMesh};
 use topology::{refine_level, ControlMesh, Level, Scheme};
 use vk_core::{vk, Device, Encoder};
 
@@ -523,12 +523,12 @@ fn cyclic_ring(t: &topology::mesh::Topology, v: usize, first: u32) -> Option<Vec
 }
 
 /// Limit positions of every vertex of a Loop level by the limit masks of
-/// [`topology::limit::loop_limit_masks`], read straight off the level's edge lists and
+/// [`topology::limit::masks::loop_limit_masks`], read straight off the level's edge lists and
 /// sharpness: what a CPU application does, without building an evaluator. `None` when a
 /// semi-sharp feature is left (its vertices need more refinement first).
 pub fn loop_limit_positions(level: &Level) -> Option<Vec<[f64; 3]>> {
-    use topology::limit::{loop_limit_masks, LimitRule, LimitVertex};
-    use topology::sdc::{is_infinite, is_semi_sharp as semi};
+    use topology::limit::masks::{loop_limit_masks, LimitRule, LimitVertex};
+    use topology::rules::{is_infinite, is_semi_sharp as semi};
     let t = &level.topology;
     // Smooth weights (vertex, each neighbour) depend on the valence only.
     let mut smooth: std::collections::HashMap<usize, (f64, f64)> = Default::default();
@@ -568,11 +568,11 @@ pub fn loop_limit_positions(level: &Level) -> Option<Vec<[f64; 3]>> {
             );
             std::array::from_fn(|k| w.vertex * p[k] + w.edges[0] * a[k] + w.edges[1] * b[k])
         } else if sharp.len() == 1 {
-            // A dart: its own mask ([`topology::limit::dart_position_weights`]) over the ring
+            // A dart: its own mask ([`topology::limit::masks::dart_position_weights`]) over the ring
             // in cyclic order from the sharp edge; a ring that cannot be walked takes the
             // evaluator's path.
             let ring = cyclic_ring(t, v, sharp[0])?;
-            let w = topology::limit::dart_position_weights(true, ring.len());
+            let w = topology::limit::masks::dart_position_weights(true, ring.len());
             let mut q = p.map(|c| w[0] * c);
             for (j, &x) in ring.iter().enumerate() {
                 let r = level.positions[x as usize];
@@ -895,7 +895,7 @@ mod tests {
         let cpu = cpu_loop_limit_mesh(&mesh, 1).expect("exact beside the crease");
         let corner = mesh.face(0).iter().position(|&v| v == 0).unwrap();
         let (u, v) = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)][corner];
-        let want = topology::eval::limit_point(&mesh, LimitScheme::Loop, 0, u, v)
+        let want = topology::limit::eval::limit_point(&mesh, LimitScheme::Loop, 0, u, v)
             .unwrap()
             .position;
         for (got, want) in cpu.vertices[0].position.iter().zip(&want) {

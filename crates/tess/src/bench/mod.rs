@@ -1013,9 +1013,9 @@ mod tests {
             let triangles = if level == 0 { 6 } else { 2 * f };
             assert_eq!(cpu.indices.len() as u64, 3 * triangles, "level {level}");
             // Base vertex 4 keeps its index; its limit is face 0's corner 2.
-            let want = topology::eval::limit_point(
+            let want = topology::limit::eval::limit_point(
                 &mesh,
-                topology::eval::LimitScheme::CatmullClark,
+                topology::limit::eval::LimitScheme::CatmullClark,
                 0,
                 1.0,
                 1.0,

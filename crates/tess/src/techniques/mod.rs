@@ -171,7 +171,7 @@ pub struct BuildOptions {
     /// Isolation level (techniques with [`Features::isolation`]).
     pub isolation: u32,
     /// End caps of faces still irregular at the isolation level.
-    pub end_cap: topology::adaptive::EndCap,
+    pub end_cap: topology::patches::adaptive::EndCap,
     /// Scales every crease and corner sharpness.
     pub sharpness_scale: f32,
     /// Follow semi-sharp creases past the isolation level until they decay (and the irregular
@@ -191,7 +191,7 @@ impl Default for BuildOptions {
             table_level: bft::DEFAULT_TABLE_LEVEL,
             tangents: false,
             isolation: adaptive::DEFAULT_ISOLATION,
-            end_cap: topology::adaptive::EndCap::Gregory,
+            end_cap: topology::patches::adaptive::EndCap::Gregory,
             sharpness_scale: 1.0,
             follow_semi_sharp: true,
             split_triangles: false,
@@ -272,9 +272,9 @@ pub fn build(
                     ctx,
                     mesh,
                     if id == TechniqueId::Acc {
-                        topology::adaptive::single_pass::SinglePassPatch::Acc1
+                        topology::patches::adaptive::single_pass::SinglePassPatch::Acc1
                     } else {
-                        topology::adaptive::single_pass::SinglePassPatch::Gregory
+                        topology::patches::adaptive::single_pass::SinglePassPatch::Gregory
                     },
                     options.sharpness_scale,
                     !options.split_triangles,

@@ -21,7 +21,7 @@ use crate::gpu::bindings::{
 };
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
-use topology::adaptive::{AdaptivePlan, EdgeKind, PatchKind};
+use topology::patches::adaptive::{AdaptivePlan, EdgeKind, PatchKind};
 use topology::ControlMesh;
 
 /// `StencilTerm` of `adaptive.glsl`: one term of a stencil row.
@@ -60,20 +60,20 @@ pub struct PatchSurface {
     /// Per corner `i`, 8 bits at `8i`: its row of the reparameterization table (0 = identity).
     pub reparam_rows: u32,
     /// ACC-1 patches: per corner `i`, 8 bits at `8i`, its valence for the tangent patches
-    /// (`topology::acc::tangent_normal`); 0 on every other patch.
+    /// (`topology::patches::acc::tangent_normal`); 0 on every other patch.
     pub tangent_valences: u32,
     pub pad: [u32; 2],
 }
 
 /// `CurveOwner` of `adaptive.glsl`: the patch whose evaluation along a canonical curve gives
-/// both sides its normals and texture coordinates (`topology::adaptive::CurveOwner`).
+/// both sides its normals and texture coordinates (`topology::patches::adaptive::CurveOwner`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct CurveOwner {
     /// Frame-wide patch id.
     pub patch: u32,
     /// `edge | part << 2 | forward << 4 | triangle << 5` (a triangle owner's edges run
-    /// `topology::adaptive::edge_param`'s way).
+    /// `topology::patches::adaptive::edge_param`'s way).
     pub info: u32,
 }
 
@@ -92,9 +92,9 @@ const _: () = {
     assert!(size_of::<ReparamRow>() == 32);
 };
 
-/// The GPU's reparameterization table (`topology::texcoord::reparam_rows`).
+/// The GPU's reparameterization table (`topology::patches::texcoord::reparam_rows`).
 pub fn reparam_rows() -> Vec<ReparamRow> {
-    topology::texcoord::reparam_rows()
+    topology::patches::texcoord::reparam_rows()
         .iter()
         .map(|r| {
             let mut c = [0.0f32; 8];
@@ -465,14 +465,14 @@ impl GpuAdaptive {
     }
 
     /// Per frame-wide patch: texture coordinates at its corners and its reparameterization
-    /// rows (`topology::texcoord`).
+    /// rows (`topology::patches::texcoord`).
     pub fn surfaces(&self, plan: &AdaptivePlan, mesh: &ControlMesh) -> Vec<PatchSurface> {
         let f32x2 = |p: [f64; 2]| [p[0] as f32, p[1] as f32];
         self.order
             .iter()
             .map(|&pi| {
                 let p = &plan.patches[pi as usize];
-                let uv = topology::texcoord::patch_corners(mesh, p).unwrap_or_else(|| {
+                let uv = topology::patches::texcoord::patch_corners(mesh, p).unwrap_or_else(|| {
                     if p.corners() == 3 {
                         // Barycentric (u, v) stands in; (1, 1) completes the parallelogram.
                         return [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
@@ -483,7 +483,7 @@ impl GpuAdaptive {
                 });
                 let mut rows = 0u32;
                 for (i, &v) in p.reparam_valences.iter().enumerate() {
-                    rows |= topology::texcoord::reparam_row(v) << (8 * i);
+                    rows |= topology::patches::texcoord::reparam_row(v) << (8 * i);
                 }
                 // Tangent patches read 8 points past the 20 (checked in `new`).
                 let mut tangent_valences = 0u32;
@@ -504,7 +504,10 @@ impl GpuAdaptive {
 
     /// The Eq. 1 error lattice (`--show param-error`) in array order: per record, the
     /// identity's lattice then the reparameterized one.
-    pub fn param_errors(&self, lattice: &topology::texcoord::ParamErrorLattice) -> Vec<f32> {
+    pub fn param_errors(
+        &self,
+        lattice: &topology::patches::texcoord::ParamErrorLattice,
+    ) -> Vec<f32> {
         let mut out = Vec::with_capacity(lattice.errors.len());
         for &pi in &self.order {
             out.extend_from_slice(lattice.patch(pi as usize, false));

@@ -1,7 +1,7 @@
 //! Feature-adaptive Catmull-Clark on the tessellation stage (Nießner et al. 2012; the seed's
 //! §3–4), exact where patches are regular and watertight everywhere:
 //!
-//! 1. **Plan (CPU, once; again when the sharpness scale changes):** `topology::adaptive`
+//! 1. **Plan (CPU, once; again when the sharpness scale changes):** `topology::patches::adaptive`
 //!    isolates extraordinary vertices, non-quads and semi-sharp creases level by level with
 //!    the crate's one sparse refiner, and flattens the result into stencil blocks (one per
 //!    level, then the local points), patches (regular B-spline, Gregory or bilinear end caps)
@@ -67,7 +67,7 @@ use crate::tessellator::{
 };
 use layout::GpuAdaptive;
 use std::ops::Range;
-use topology::adaptive::{plan_adaptive, AdaptiveOptions, AdaptivePlan, EndCap};
+use topology::patches::adaptive::{plan_adaptive, AdaptiveOptions, AdaptivePlan, EndCap};
 use topology::ControlMesh;
 use vk_core::descriptor::{BindingDesc, DescriptorPool};
 use vk_core::pipeline::{Pipeline, ShaderStage};
@@ -151,7 +151,7 @@ pub fn check_texcoords(mesh: &ControlMesh, maps: &SurfaceMaps, name: &str) -> Re
         (None, Some(_)) => "a height map",
         (None, None) => return Ok(()),
     };
-    if topology::texcoord::has_texcoords(mesh) {
+    if topology::patches::texcoord::has_texcoords(mesh) {
         return Ok(());
     }
     Err(TessError::Mesh {
@@ -307,7 +307,7 @@ pub struct Adaptive {
     /// The Eq. 1 error lattice was built (`SurfaceMaps::param_error`).
     has_param_errors: bool,
     /// Its summary and the patches with a reparameterized corner, when built.
-    param_error_summary: Option<(topology::texcoord::ParamErrorSummary, usize)>,
+    param_error_summary: Option<(topology::patches::texcoord::ParamErrorSummary, usize)>,
 }
 
 impl Adaptive {
@@ -372,7 +372,7 @@ impl Adaptive {
         // One 0 stands in when the lattice is not asked for (the view is then refused).
         let mut param_error_summary = None;
         let param_errors = if options.maps.param_error {
-            let lattice = topology::texcoord::param_error_lattice(
+            let lattice = topology::patches::texcoord::param_error_lattice(
                 mesh,
                 &plan,
                 ADAPTIVE_PARAM_ERROR_SIDE as usize,
@@ -688,7 +688,7 @@ impl Adaptive {
     }
 
     /// Where patch `patch` (frame-wide id) at patch coordinate `(u, v)` lies in its base face:
-    /// `(base face, sub-face, u, v)` in `topology::eval`'s convention (sub-quads of
+    /// `(base face, sub-face, u, v)` in `topology::limit::eval`'s convention (sub-quads of
     /// non-quads as `LocalMesh::evaluate_subface` numbers them).
     pub fn base_param(&self, patch: u32, u: f64, v: f64) -> Option<(u32, u8, f64, f64)> {
         let pi = *self.gpu.order.get(patch as usize)?;

@@ -29,8 +29,10 @@ use crate::gpu::bindings::{
 };
 use bytemuck::{Pod, Zeroable};
 use std::mem::{offset_of, size_of};
-use topology::bft::{BasisTables, BftCase, BftKey, LoopBft, Owner, PatchRecords, TangentStencils};
-use topology::stencil::StencilTable;
+use topology::patches::bft::{
+    BasisTables, BftCase, BftKey, LoopBft, Owner, PatchRecords, TangentStencils,
+};
+use topology::refine::stencil::StencilTable;
 
 /// `BasePosition` of `bft.glsl`: one base vertex (binding [`BFT_BASE_POSITIONS_BINDING`]),
 /// rewritten every frame of an animation.

@@ -61,7 +61,7 @@ use crate::technique::{
 use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, Domain, Spacing};
 use layout::{BasePosition, PackedTables, PatchHeader, StencilTerm, TangentTerm, STORAGE_BINDINGS};
 use std::ops::Range;
-use topology::bft::{
+use topology::patches::bft::{
     build_patch_records, face_rotations, level1_base_domain, loop_level1, loop_tables,
     loop_tangent_stencils, table_weight_count,
 };
@@ -273,7 +273,7 @@ fn plan_draw(
 /// anywhere in the mesh). Counting takes milliseconds; evaluating the tables of a mesh with
 /// thousands of private ones takes minutes. The error names the largest level that fits.
 fn check_table_range(
-    records: &topology::bft::PatchRecords,
+    records: &topology::patches::bft::PatchRecords,
     level: u32,
     options: &BftOptions,
     max_range: u64,
@@ -297,7 +297,7 @@ fn check_table_range(
         bytes,
         private_faces: records
             .iter()
-            .filter(|r| matches!(r.key.case, topology::bft::BftCase::Private { .. }))
+            .filter(|r| matches!(r.key.case, topology::patches::bft::BftCase::Private { .. }))
             .count(),
         faces: records.len(),
         max: max_range,
@@ -512,7 +512,7 @@ impl Bft {
         }
         let mut laps = Laps::new();
         let mut stages = Vec::new();
-        let mesh_error = |e: topology::eval::EvalError| TessError::Mesh {
+        let mesh_error = |e: topology::limit::eval::EvalError| TessError::Mesh {
             name: options.name.clone(),
             source: e.into(),
         };
@@ -808,7 +808,7 @@ impl Bft {
 
     /// The base face and its domain coordinate `(U, V)` (weights of the base face's corners 1
     /// and 2) of patch coordinate `(u, v)` on level-1 face `patch`
-    /// ([`LoopBft::base_domain`](topology::bft::LoopBft::base_domain)); `None` past the last patch.
+    /// ([`LoopBft::base_domain`](topology::patches::bft::LoopBft::base_domain)); `None` past the last patch.
     pub fn base_domain(&self, patch: u32, u: f64, v: f64) -> Option<(usize, f64, f64)> {
         let rotation = *self.rotations.get(patch as usize)?;
         Some(level1_base_domain(patch as usize, rotation, u, v))

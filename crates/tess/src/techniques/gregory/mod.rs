@@ -4,7 +4,7 @@
 //! patch per base face, bicubic B-spline where the face is regular.
 //!
 //! Design decisions:
-//! - **The plan is `topology::adaptive::single_pass`'s**, an `AdaptivePlan`, so the adaptive
+//! - **The plan is `topology::patches::adaptive::single_pass`'s**, an `AdaptivePlan`, so the adaptive
 //!   technique's GPU machinery draws it unchanged ([`Adaptive::from_plan`]): one stencil kernel
 //!   turns the base positions into every control point each frame (animation uploads only the
 //!   base), canonical corners and curves make shared edges bit-identical under every factor
@@ -21,7 +21,9 @@ use super::adaptive::{Adaptive, AdaptiveBuild};
 use crate::context::Context;
 use crate::error::{Result, TessError};
 use crate::technique::TechniqueId;
-use topology::adaptive::single_pass::{plan_single_pass, SinglePassOptions, SinglePassPatch};
+use topology::patches::adaptive::single_pass::{
+    plan_single_pass, SinglePassOptions, SinglePassPatch,
+};
 use topology::ControlMesh;
 
 /// Builds `--method gregory` (`patch` Gregory) or `--method acc` (`patch` ACC-1) for `mesh`.

@@ -82,7 +82,7 @@ impl PointRows {
     /// Rows from stencils over a level's vertices, shifted to global ids by `base`.
     pub(super) fn from_stencils<'a>(
         base: u32,
-        stencils: impl IntoIterator<Item = &'a crate::gregory::Stencil>,
+        stencils: impl IntoIterator<Item = &'a crate::patches::gregory::Stencil>,
     ) -> PointRows {
         let mut out = PointRows::with_capacity(256);
         for st in stencils {
@@ -745,7 +745,7 @@ pub(super) fn limit_stencil(lvl: &Lvl, v: usize, out: &mut Vec<(u32, f64)>) {
         vertex_rule(vs, count)
     };
     let dart_fan = (rule == Rule::Dart)
-        .then(|| crate::gregory::build_fan(t, v as u32))
+        .then(|| crate::patches::gregory::build_fan(t, v as u32))
         .flatten();
     match (rule, &dart_fan) {
         (Rule::Corner, _) => out.push((v as u32, 1.0)),
@@ -759,11 +759,12 @@ pub(super) fn limit_stencil(lvl: &Lvl, v: usize, out: &mut Vec<(u32, f64)>) {
             // Its own limit position, over the ring in fan order from the sharp edge.
             let n = fan.ring.len();
             let edge = fan.edges.iter().position(|&e| e == sharp[0]).unwrap_or(0);
-            let masks = crate::limit::catmark_limit_masks(&crate::limit::LimitVertex {
-                valence: n,
-                boundary: false,
-                rule: crate::limit::LimitRule::Dart { edge },
-            });
+            let masks =
+                crate::limit::masks::catmark_limit_masks(&crate::limit::masks::LimitVertex {
+                    valence: n,
+                    boundary: false,
+                    rule: crate::limit::masks::LimitRule::Dart { edge },
+                });
             let m = &masks.position;
             out.push((v as u32, m.vertex));
             for (i, &x) in fan.ring.iter().enumerate() {

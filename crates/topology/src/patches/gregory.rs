@@ -6,7 +6,7 @@
 //! # Control points and their order
 //!
 //! Face corners `i = 0..3` follow the face's vertex order: corner 0 at `(u,v) = (0,0)`, 1 at
-//! `(1,0)`, 2 at `(1,1)`, 3 at `(0,1)` (the domain of [`crate::patch`]). Each corner owns five
+//! `(1,0)`, 2 at `(1,1)`, 3 at `(0,1)` (the domain of [`crate::limit::basis`]). Each corner owns five
 //! points, slot `5·i + s`:
 //!
 //! | s | name   | meaning                                                               |
@@ -20,12 +20,12 @@
 //! `T_i(w)` is the limit tangent of the corner vertex toward its edge-neighbour `w`, scaled as a
 //! parametric derivative (exactly the B-spline derivative at a regular vertex):
 //! * smooth vertex (also a dart) of valence `n`:
-//!   [`smooth_directional_tangent`](crate::limit::smooth_directional_tangent) (Halstead's
+//!   [`smooth_directional_tangent`](crate::limit::masks::smooth_directional_tangent) (Halstead's
 //!   eigenvector masks rotated onto edge `k`, `1/(3n)` of the mask);
 //! * crease (two sharp edges, boundary edges count), sector of `m` faces between the sharp
 //!   edges `a` and `b` (CCW, the face inside): `T(k) = cos θ·T_along + sin θ·T_across`,
 //!   `θ = π·(k−a)/m`, with `T_along = (e_a − e_b)/2` and the cross tangent of
-//!   [`catmark_limit_masks`](crate::limit::catmark_limit_masks); along the sharp edges
+//!   [`catmark_limit_masks`](crate::limit::masks::catmark_limit_masks); along the sharp edges
 //!   themselves `T = ±T_along` exactly;
 //! * corner (sharp vertex or more than two sharp edges), sector of `m` faces between sharp
 //!   edges `a` and `b`: the vertex stays, `T(a) = e_a − v`, `T(b) = e_b − v`, interior edges
@@ -104,14 +104,16 @@
 use thiserror::Error;
 
 use crate::error::TopologyError;
-use crate::limit::{
+use crate::limit::basis::PatchWeights;
+use crate::limit::masks::{
     catmark_cross_tangent_into, catmark_directional_tangent_each,
     catmark_directional_tangent_table, catmark_smooth_position_weights, dart_position_weights,
 };
 use crate::mesh::{SubdivOptions, Topology, INVALID};
-use crate::patch::PatchWeights;
 use crate::refine::LevelRef;
-use crate::sdc::{boundary_edge_sharpness, boundary_vertex_sharpness, is_sharp, vertex_rule, Rule};
+use crate::rules::{
+    boundary_edge_sharpness, boundary_vertex_sharpness, is_sharp, vertex_rule, Rule,
+};
 
 use smallvec::SmallVec;
 use std::f64::consts::PI;
@@ -834,7 +836,7 @@ fn face_point(rows: &mut CapRows<'_>, corners: &[Corner], i: usize, plus: bool) 
 /// Semi-sharp creases are treated as infinitely sharp: this is meant for the last level.
 ///
 /// ```
-/// use topology::gregory::{gregory_basis, gregory_weights};
+/// use topology::patches::gregory::{gregory_basis, gregory_weights};
 /// use topology::refine::refine_uniform;
 /// use topology::{ControlMesh, Scheme};
 /// let mesh = ControlMesh::from_polygons(
@@ -1018,8 +1020,8 @@ type InteriorBlend = (usize, usize, [f64; 3], [f64; 3], f64);
 /// Value and parametric derivative weights of the 20 Gregory points at `(u, v) ∈ [0,1]²`
 /// (formulas in the module docs; finite everywhere on the square, corners included).
 pub fn gregory_weights(u: f64, v: f64) -> PatchWeights<20> {
-    let (bu, dbu) = crate::patch::bezier_curve_weights(u);
-    let (bv, dbv) = crate::patch::bezier_curve_weights(v);
+    let (bu, dbu) = crate::limit::basis::bezier_curve_weights(u);
+    let (bv, dbv) = crate::limit::basis::bezier_curve_weights(v);
     let mut w = PatchWeights {
         point: [0.0; 20],
         du: [0.0; 20],

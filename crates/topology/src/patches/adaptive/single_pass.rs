@@ -11,9 +11,9 @@
 //! * **Quads away from non-quads: one patch per base face.** Regular faces (the adaptive
 //!   plan's regularity, sharp-but-regular boundaries and creases included) are bicubic
 //!   B-spline patches; the others Gregory patches built on the base mesh
-//!   ([`crate::gregory::gregory_basis`]), or with [`SinglePassPatch::Acc1`] ACC-1 nets where
+//!   ([`crate::patches::gregory::gregory_basis`]), or with [`SinglePassPatch::Acc1`] ACC-1 nets where
 //!   ACC-1 applies (interior quads with smooth corners and all-quad neighbourhoods,
-//!   [`crate::acc`]) and Gregory patches elsewhere. An ACC-1 net is stored as a Gregory patch
+//!   [`crate::patches::acc`]) and Gregory patches elsewhere. An ACC-1 net is stored as a Gregory patch
 //!   whose two interior points per corner coincide (then the Gregory patch is that bicubic
 //!   Bézier patch), so the device needs no third patch kind.
 //! * **Non-quads and their neighbours: one Catmull-Clark step, on the CPU.** Gregory and ACC-1
@@ -95,7 +95,7 @@ pub fn rounded_sharpness(mesh: &ControlMesh, scale: f32) -> Result<ControlMesh, 
 /// split, else 1.
 ///
 /// ```
-/// use topology::adaptive::single_pass::{plan_single_pass, SinglePassOptions};
+/// use topology::patches::adaptive::single_pass::{plan_single_pass, SinglePassOptions};
 /// use topology::{ControlMesh, PatchKind};
 /// let p = [[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.],
 ///          [0., 0., 1.], [1., 0., 1.], [1., 1., 1.], [0., 1., 1.]];

@@ -10,7 +10,7 @@
 //!   *corner point* is the centroid of the `n` interior points around the vertex, which is the
 //!   vertex's Catmull-Clark limit position. Where every corner has valence 4 the 16 points are
 //!   the B-spline patch's Bézier points, so the patch is exact there.
-//! - **Stencils, not points.** Like [`crate::gregory`], each point is a stencil over the level's
+//! - **Stencils, not points.** Like [`crate::patches::gregory`], each point is a stencil over the level's
 //!   vertices, so it serves any vertex data (animated positions, texture coordinates) and the
 //!   GPU builds the points from the same weights.
 //! - **Scope.** Interior quads whose corners are smooth (no boundary, crease or corner tag) and
@@ -18,8 +18,8 @@
 //!   Others are refused with [`AccProblem`] naming the vertex; the technique that draws ACC-1
 //!   treats those faces another way (the issue that adds it decides which).
 use crate::error::TopologyError;
-use crate::gregory::Stencil;
 use crate::mesh::INVALID;
+use crate::patches::gregory::Stencil;
 use crate::refine::LevelRef;
 use std::collections::BTreeMap;
 
@@ -82,7 +82,7 @@ fn check_corner(level: &LevelRef<'_>, v: u32) -> Result<(), AccProblem> {
 
 /// The 16 Bézier points of quad `face`'s ACC-1 geometry patch, `[i][j]` = Bernstein index `i` in
 /// `u`, `j` in `v` (corner 0 of the face at `(0,0)`, 1 at `(1,0)`, 2 at `(1,1)`, 3 at `(0,1)`,
-/// the domain of [`crate::patch`]), each a stencil over the level's vertices.
+/// the domain of [`crate::limit::basis`]), each a stencil over the level's vertices.
 pub fn acc1_patch(level: LevelRef<'_>, face: usize) -> Result<[[Stencil; 4]; 4], TopologyError> {
     let t = level.topology;
     if face >= t.num_faces() {
@@ -136,7 +136,7 @@ pub fn acc1_patch(level: LevelRef<'_>, face: usize) -> Result<[[Stencil; 4]; 4],
 
 /// Value and derivative weights of the 16 Bézier points at `(u, v)`, in `[i][j]` order.
 pub fn bezier_weights(u: f64, v: f64) -> [[[f64; 3]; 4]; 4] {
-    let b = crate::patch::bezier_curve_weights;
+    let b = crate::limit::basis::bezier_curve_weights;
     let ((bu, du), (bv, dv)) = (b(u), b(v));
     let mut w = [[[0.0; 3]; 4]; 4];
     for i in 0..4 {
@@ -180,7 +180,7 @@ fn bernstein23(t: f64) -> ([f64; 3], [f64; 4]) {
 ///
 /// `points` is the patch in the plan's layout (`AdaptivePatch::tangent_valences`): the 20
 /// points of the Gregory form of the Bézier net (per corner `P, Ep, Em, Fp, Fm`), then per
-/// corner the limit-tangent points `Ep, Em` of [`crate::gregory`]; `valences` the corners'.
+/// corner the limit-tangent points `Ep, Em` of [`crate::patches::gregory`]; `valences` the corners'.
 ///
 /// Construction: start from the geometry patch's derivative. On the patch's own boundary the
 /// tangent along the edge becomes the quadratic [corner limit tangent, middle derivative,
@@ -274,5 +274,5 @@ pub fn tangent_normal(points: &[[f64; 3]; 28], valences: [u8; 4], u: f64, v: f64
             dv = add(dv, scale(tv[j][i], cu[j] * qv[i]));
         }
     }
-    crate::eval::normal_of(&du, &dv)
+    crate::limit::eval::normal_of(&du, &dv)
 }

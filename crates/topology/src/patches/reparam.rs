@@ -25,13 +25,13 @@
 //!   We measure what a texture shows: the Gregory point `g(u, v)` displays the texel of the
 //!   exact point `p(s(u, v))`, so its error is `|p(s(u, v)) − g(u, v)|` (without
 //!   reparameterization `|p(u, v) − g(u, v)|`), relative to the patch's diameter.
-use crate::eval::EvalError;
-use crate::eval::{LimitScheme, LocalMesh};
-use crate::gregory::{gregory_basis, gregory_weights, Stencil};
+use crate::limit::basis::bezier_curve_weights;
+use crate::limit::eval::EvalError;
+use crate::limit::eval::{LimitScheme, LocalMesh};
 use crate::mesh::ControlMesh;
-use crate::patch::bezier_curve_weights;
+use crate::patches::gregory::{gregory_basis, gregory_weights, Stencil};
 use crate::refine::{refine_uniform, Level};
-use crate::sdc::Scheme;
+use crate::rules::Scheme;
 
 /// Rings of quads per sector in the characteristic-map control mesh: the patch at the
 /// extraordinary vertex and the one-rings of its corners reach ring 2; one more ring keeps the
@@ -74,7 +74,7 @@ pub fn corner_block(valence: u32) -> Option<[f64; 5]> {
 
 /// The 4×4 rational control net of Eq. 3 (`(u, v, w)` per point, `[i][j]` = Bernstein index `i`
 /// in `u`, `j` in `v`) of a face whose corners (0 at `(0,0)`, 1 at `(1,0)`, 2 at `(1,1)`, 3 at
-/// `(0,1)`, the domain of [`crate::patch`]) carry `blocks`.
+/// `(0,1)`, the domain of [`crate::limit::basis`]) carry `blocks`.
 pub fn control_net(blocks: &[[f64; 5]; 4]) -> [[[f64; 3]; 4]; 4] {
     let mut net = [[[0.0; 3]; 4]; 4];
     for (i, row) in net.iter_mut().enumerate() {

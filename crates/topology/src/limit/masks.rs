@@ -13,8 +13,8 @@
 //!   after one refinement.
 //!
 //! Tangent magnitudes follow OpenSubdiv (cos/sin masks for smooth vertices, Biermann et al.'s
-//! cross-crease masks for Catmull-Clark); they give exact tangent *directions*. Parametric derivatives of a patch are produced by [`crate::patch`]
-//! and [`crate::eval`] instead.
+//! cross-crease masks for Catmull-Clark); they give exact tangent *directions*. Parametric derivatives of a patch are produced by [`crate::limit::basis`]
+//! and [`crate::limit::eval`] instead.
 
 use std::f64::consts::PI;
 
@@ -141,7 +141,7 @@ pub fn loop_limit_masks(v: &LimitVertex) -> LimitMasks {
 
 /// Weights of edge-neighbour `i` of a smooth Loop vertex of valence `n` in its two tangent
 /// masks (`cos`, `sin` of its angle): one place, so the masks and the allocation-free rows of
-/// [`crate::eval::LocalMesh::loop_tangent_row`] agree to the bit.
+/// [`crate::limit::eval::LocalMesh::loop_tangent_row`] agree to the bit.
 pub fn loop_smooth_tangent_weights(n: usize, i: usize) -> (f64, f64) {
     let a = 2.0 * PI * i as f64 / n as f64;
     (a.cos(), a.sin())

@@ -3,6 +3,8 @@
 use crate::error::TopologyError;
 use rayon::prelude::*;
 
+pub mod obj;
+
 /// Sentinel for "no face" / "no edge" in adjacency tables.
 pub const INVALID: u32 = u32::MAX;
 

@@ -1,10 +1,10 @@
 //! Texture coordinates of the limit surface: the OBJ's face-varying `vt` data, interpolated
 //! bilinearly on each face (OpenSubdiv's `FVAR_LINEAR_ALL`), at a patch's parameter or — on
-//! Gregory patches — at the reparameterized parameter `s(u, v)` of seed 003 ([`crate::reparam`]).
+//! Gregory patches — at the reparameterized parameter `s(u, v)` of seed 003 ([`crate::patches::reparam`]).
 //!
 //! Design decisions:
 //! - **Linear face-varying data.** A quad's coordinate is the bilinear blend of its four
-//!   corners; sub-quad `k` of an `n`-gon (the parameterization of [`crate::eval`]:
+//!   corners; sub-quad `k` of an `n`-gon (the parameterization of [`crate::limit::eval`]:
 //!   `[v_k, e_{k,k+1}, face point, e_{k−1,k}]`) blends the corner's coordinate, the two edge
 //!   midpoints and the face's centroid. Texture seams (a vertex with several `vt`) stay seams,
 //!   and a patch's coordinates are the bilinear blend of its own four corners' (a patch covers
@@ -14,10 +14,12 @@
 //!   in docs/approximations.md: still 8–10× below no reparameterization up to valence 64), the
 //!   identity where the valence is 0 (boundary, crease and corner vertices; regular and ACC-1
 //!   patches).
-use crate::adaptive::{AdaptivePatch, AdaptivePlan};
-use crate::eval::{EvalError, LimitScheme, LocalMesh};
+use crate::limit::eval::{EvalError, LimitScheme, LocalMesh};
 use crate::mesh::ControlMesh;
-use crate::reparam::{control_net, corner_block, reparameterize, IDENTITY_BLOCK, TABLE_VALENCES};
+use crate::patches::adaptive::{AdaptivePatch, AdaptivePlan};
+use crate::patches::reparam::{
+    control_net, corner_block, reparameterize, IDENTITY_BLOCK, TABLE_VALENCES,
+};
 use rayon::prelude::*;
 
 /// The corner block of Eq. 3 that a patch corner of reparameterization valence `valence`
@@ -119,7 +121,7 @@ pub fn bilinear(c: &[[f64; 2]; 4], u: f64, v: f64) -> [f64; 2] {
 /// The texture coordinates at a plan patch's four corners (patch corner order). A triangle
 /// patch (corners `t0, t1, t2` at (0,0), (1,0), (0,1)) gets `[t0, t1, t1 + t2 − t0, t2]`: the
 /// bilinear blend of that parallelogram is the linear interpolation on the triangle, which is
-/// what the bilinear sub-quads give there (see [`crate::adaptive::triangle_subquad_param`]).
+/// what the bilinear sub-quads give there (see [`crate::patches::adaptive::triangle_subquad_param`]).
 pub fn patch_corners(mesh: &ControlMesh, patch: &AdaptivePatch) -> Option<[[f64; 2]; 4]> {
     if patch.corners() == 3 {
         if !has_texcoords(mesh) {

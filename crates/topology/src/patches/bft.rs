@@ -72,7 +72,7 @@
 use rayon::prelude::*;
 use std::collections::HashMap;
 
-use crate::eval::{EvalError, LimitScheme, LocalMesh};
+use crate::limit::eval::{EvalError, LimitScheme, LocalMesh};
 use crate::mesh::SubdivOptions;
 
 /// Configuration of a face around its (possibly) extraordinary vertex `v0`.
@@ -1327,7 +1327,7 @@ pub fn loop_tangent_stencils(level1: &LocalMesh) -> TangentStencils {
 #[derive(Clone, Debug)]
 pub struct LoopBft {
     pub level1: LocalMesh,
-    pub stencils: crate::stencil::StencilTable,
+    pub stencils: crate::refine::stencil::StencilTable,
     /// Per level-1 vertex: control indices and the two tangent weight rows.
     pub tangent_stencils: TangentStencils,
     pub records: PatchRecords,
@@ -1344,10 +1344,10 @@ pub struct LoopBft {
 /// applies).
 pub fn loop_level1(
     mesh: &crate::mesh::ControlMesh,
-) -> Result<(LocalMesh, crate::stencil::StencilTable), EvalError> {
+) -> Result<(LocalMesh, crate::refine::stencil::StencilTable), EvalError> {
     let (level1, stencils) = {
-        let base = crate::refine::Level::from_mesh(mesh, crate::sdc::Scheme::Loop)?;
-        crate::refine::refine_level(&base, crate::sdc::Scheme::Loop, &mesh.options)?
+        let base = crate::refine::Level::from_mesh(mesh, crate::rules::Scheme::Loop)?;
+        crate::refine::refine_level(&base, crate::rules::Scheme::Loop, &mesh.options)?
     };
     let crate::refine::Level {
         topology,

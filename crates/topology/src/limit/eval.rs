@@ -1,6 +1,6 @@
 //! Exact limit evaluation at any `(face, u, v)` of a Loop or Catmull-Clark control mesh.
 //!
-//! Parametric domains are those of [`crate::patch`] (Loop: `P = v0·(1−u−v) + v1·u + v2·v`;
+//! Parametric domains are those of [`crate::limit::basis`] (Loop: `P = v0·(1−u−v) + v1·u + v2·v`;
 //! Catmull-Clark: unit square, `v0=(0,0)`, `v1=(1,0)`, `v2=(1,1)`, `v3=(0,1)`).
 //!
 //! Method (Stam-free, recursion on local neighbourhoods):
@@ -9,14 +9,14 @@
 //! 2. if the face is a regular patch (all corners regular smooth, or regular boundary/crease
 //!    corners whose missing half is replaced by phantom points, or a Catmull-Clark regular
 //!    corner), evaluate the box spline / bicubic B-spline in closed form;
-//! 3. if `(u, v)` is exactly a corner, apply the vertex's limit masks ([`crate::limit`]) as soon
+//! 3. if `(u, v)` is exactly a corner, apply the vertex's limit masks ([`crate::limit::masks`]) as soon
 //!    as no semi-sharp feature remains there;
 //! 4. otherwise refine the face and its one-ring once with the crate's one refiner
 //!    ([`crate::refine::refine_sparse`]: OpenSubdiv rules, semi-sharp creases included), pick
 //!    the child face containing the point, and repeat on it.
 //!
 //! This module has no subdivision rule of its own: sharpness tests and rules come from
-//! [`crate::sdc`], refinement and its masks from [`crate::refine`], and the level type is the
+//! [`crate::rules`], refinement and its masks from [`crate::refine`], and the level type is the
 //! refiner's [`LevelTopology`]; [`LocalMesh`] only adds per-vertex data of any dimension (3
 //! for geometry, one per basis function for tables) and the ordered vertex fans the limit
 //! masks and regular patches read.
@@ -36,14 +36,14 @@
 use std::fmt;
 
 use crate::error::TopologyError;
-use crate::limit::{
+use crate::limit::basis::{catmark_regular_weights, loop_regular_weights};
+use crate::limit::masks::{
     catmark_limit_masks, loop_limit_masks, loop_smooth_tangent_weights, smooth_directional_tangent,
     LimitRule, LimitVertex,
 };
 use crate::mesh::{ControlMesh, SubdivOptions, Topology, INVALID};
-use crate::patch::{catmark_regular_weights, loop_regular_weights};
 use crate::refine::{refine_sparse, Level, LevelTopology};
-use crate::sdc::{is_infinite, is_semi_sharp, is_sharp, vertex_rule, Rule, Scheme};
+use crate::rules::{is_infinite, is_semi_sharp, is_sharp, vertex_rule, Rule, Scheme};
 
 /// The schemes with a limit surface here: a restricted view of [`Scheme`], parsed by
 /// [`Scheme`]'s one parser.
@@ -124,13 +124,13 @@ pub enum EvalError {
     #[error("evaluation of face {face} at ({u}, {v}) did not converge")]
     NotConverged { face: usize, u: f64, v: f64 },
     #[error("no basis-function table case {key:?}")]
-    NoBftCase { key: crate::bft::BftKey },
+    NoBftCase { key: crate::patches::bft::BftKey },
     #[error("BFT level {level} not in 1..=6")]
     BftLevel { level: u32 },
-    /// A characteristic map ([`crate::reparam`]) of a valence below 3.
+    /// A characteristic map ([`crate::patches::reparam`]) of a valence below 3.
     #[error("a characteristic map needs valence 3 or more, not {valence}")]
     Valence { valence: u32 },
-    /// Patch records name a face and a local index in one word ([`crate::bft::Owner`]).
+    /// Patch records name a face and a local index in one word ([`crate::patches::bft::Owner`]).
     #[error("{faces} faces after one refinement step; patch records address at most {max}")]
     TooManyPatches { faces: usize, max: usize },
     /// The mesh or a refinement step failed (names the face, edge or vertex at fault).
@@ -674,7 +674,7 @@ impl LocalMesh {
         true
     }
 
-    /// Control points of face `f` as a regular patch (ordering of [`crate::patch`]), or `None`.
+    /// Control points of face `f` as a regular patch (ordering of [`crate::limit::basis`]), or `None`.
     pub fn regular_patch(&self, f: usize) -> Option<Vec<Vec<f64>>> {
         self.view().regular_patch(f)
     }
@@ -871,7 +871,7 @@ impl View<'_> {
     /// Sharpness of edge `e`; an edge with one face is infinitely sharp.
     fn edge_sharp(&self, e: u32) -> f32 {
         if self.level.topology.is_boundary_edge(e as usize) {
-            crate::sdc::boundary_edge_sharpness()
+            crate::rules::boundary_edge_sharpness()
         } else {
             self.level.edge_sharpness[e as usize]
         }
@@ -899,7 +899,7 @@ impl View<'_> {
         )
     }
 
-    /// Limit position and the two mask tangents (see [`crate::limit`]) of vertex `v`.
+    /// Limit position and the two mask tangents (see [`crate::limit::masks`]) of vertex `v`.
     fn vertex_limit(
         &self,
         v: u32,
@@ -1143,7 +1143,7 @@ impl View<'_> {
         Some(seq)
     }
 
-    /// Control points of face `f` as a regular patch (ordering of [`crate::patch`]), or `None`.
+    /// Control points of face `f` as a regular patch (ordering of [`crate::limit::basis`]), or `None`.
     fn regular_patch(&self, f: usize) -> Option<Vec<Vec<f64>>> {
         let quad = self.scheme == LimitScheme::CatmullClark;
         let fv = self.face(f);

@@ -35,7 +35,7 @@
 //!   around its corners, rows across a boundary or infinitely sharp edge replaced by phantom
 //!   points `2·P_edge − P_inner`, the corner by `4·P − 2·E₀ − 2·E₁ + F`, as OpenSubdiv does).
 //!   At the isolation level an irregular complete face is an end cap: Gregory (the 20 points
-//!   of [`crate::gregory::gregory_basis`] on that level, its four `P` replaced by the
+//!   of [`crate::patches::gregory::gregory_basis`] on that level, its four `P` replaced by the
 //!   canonical corners below, which are the same limit points) or bilinear. Semi-sharp
 //!   sharpness still positive at the isolation level is treated as infinite there, for the
 //!   classification, the phantoms, the Gregory points and the corner masks alike (as the seed
@@ -43,7 +43,7 @@
 //!   approximation besides the end caps; it vanishes once the isolation level reaches the
 //!   sharpness. Holes make no patches and are never selected.
 //! * **Parameterisation.** Each patch knows its base face (and sub-quad of a non-quad base
-//!   face, numbered as [`crate::eval::LocalMesh::evaluate_subface`] does) and the square
+//!   face, numbered as [`crate::limit::eval::LocalMesh::evaluate_subface`] does) and the square
 //!   `origin + size·[0,1]²` of that (sub-)face's domain it covers. Its corners are rotated so
 //!   that patch corner 0 is the corner at the square's `(0, 0)` and the corners run in the
 //!   base face's orientation.
@@ -53,7 +53,7 @@
 //! * **Canonical corners and curves** (what makes shared edges bit-identical on a GPU): every
 //!   distinct limit point used as a patch corner is one local point, keyed by the coarsest
 //!   vertex-vertex ancestor of the vertex, so a vertex at level L and its child at L + 1 share
-//!   it. Its limit stencil is the Catmull-Clark limit mask ([`crate::limit`]) at the first
+//!   it. Its limit stencil is the Catmull-Clark limit mask ([`crate::limit::masks`]) at the first
 //!   (coarsest) level where it is a patch corner (where its whole ring is present). Every
 //!   distinct patch edge at the finest level where it exists (a transition edge is the union of
 //!   its two fine halves) is one cubic Bézier curve `[c0, b1, b2, c3]`, `c0 < c3` the canonical
@@ -89,12 +89,12 @@
 //!   stencil tables.
 
 use crate::error::TopologyError;
-use crate::limit::catmark_smooth_position_weights;
+use crate::limit::basis::catmark_regular_weights;
+use crate::limit::masks::catmark_smooth_position_weights;
 use crate::mesh::{ControlMesh, Topology, INVALID};
-use crate::patch::catmark_regular_weights;
+use crate::refine::stencil::StencilTable;
 use crate::refine::{refine_sparse_region, ChildMaps, ChildOrigin, LevelTopology, SparseRegion};
-use crate::sdc::{is_infinite, vertex_rule, Rule, Scheme, SHARPNESS_INFINITE};
-use crate::stencil::StencilTable;
+use crate::rules::{is_infinite, vertex_rule, Rule, Scheme, SHARPNESS_INFINITE};
 use rayon::prelude::*;
 
 /// Default bound on the refined faces of an adaptive plan (summed over its levels), 2²³: a
@@ -171,7 +171,7 @@ pub enum PatchKind {
     Regular,
     Gregory,
     Bilinear,
-    /// A Gregory triangle patch ([`crate::gregory::gregory_triangle_weights`]) on a triangle
+    /// A Gregory triangle patch ([`crate::patches::gregory::gregory_triangle_weights`]) on a triangle
     /// base face (single-pass plans): three corners and edges, barycentric `(u, v)`,
     /// `u + v ≤ 1`.
     GregoryTriangle,
@@ -213,7 +213,7 @@ pub fn corner_param(corners: usize, corner: usize) -> [f64; 2] {
 }
 
 /// The sub-quad parameter of a point of a triangle's barycentric domain `(u, v)`: sub-quad
-/// `k` (of [`crate::eval::LocalMesh::evaluate_subface`]) is the third of the triangle nearest
+/// `k` (of [`crate::limit::eval::LocalMesh::evaluate_subface`]) is the third of the triangle nearest
 /// corner `k`, `[corner, edge midpoint, centroid, edge midpoint]`, mapped bilinearly from its
 /// `(s, t)`. Inverting that map: with `(a, b)` the barycentrics of the next and the previous
 /// corner, `a = s/2 − st/6`, `b = t/2 − st/6`. Face-varying data bilinear on the sub-quads is
@@ -295,7 +295,7 @@ pub type ControlPoints = smallvec::SmallVec<[u32; 16]>;
 pub struct AdaptivePatch {
     pub kind: PatchKind,
     pub level: u8,
-    /// Global vertex ids. Regular: 16, row-major 4×4 as [`crate::patch`] (phantoms
+    /// Global vertex ids. Regular: 16, row-major 4×4 as [`crate::limit::basis`] (phantoms
     /// substituted); Gregory: 20, per corner `P, Ep, Em, Fp, Fm`; Bilinear: the 4 canonical
     /// corners; GregoryTriangle: 27, per corner `P, Ep, Em, Fp, Fm` (15), then per edge the
     /// inner points of its two level-1 halves in the edge's direction (12; the curves of a
@@ -317,12 +317,12 @@ pub struct AdaptivePatch {
     /// patch: 0: v0→v1 (v = 0), 1: v1→v2 (u + v = 1), 2: v2→v0 (u = 0), edge 3 unused.
     pub edges: [PatchEdge; 4],
     /// Per corner: the valence whose texture-reparameterization block applies
-    /// ([`crate::reparam`]), 0 for the identity (regular and ACC-1 patches, boundary, crease and
+    /// ([`crate::patches::reparam`]), 0 for the identity (regular and ACC-1 patches, boundary, crease and
     /// corner vertices). Gregory patches only: the table is fitted to them.
     pub reparam_valences: [u8; 4],
     /// ACC-1 patches (Gregory kind, 28 control points: the net's 20, then per corner the limit
-    /// tangent points `Ep, Em` of [`crate::gregory`]): each corner's valence, for the tangent
-    /// patches that shade them ([`crate::acc::tangent_normal`]); `[0; 4]` on every other patch.
+    /// tangent points `Ep, Em` of [`crate::patches::gregory`]): each corner's valence, for the tangent
+    /// patches that shade them ([`crate::patches::acc::tangent_normal`]); `[0; 4]` on every other patch.
     pub tangent_valences: [u8; 4],
 }
 
@@ -475,7 +475,7 @@ fn axpy(out: &mut [f64; 3], w: f64, x: &[f64; 3]) {
 /// Adds the `N` control points `cp(k)` weighted by `w` to `s` (position and derivatives).
 fn add_weighted<'a, const N: usize>(
     s: &mut PatchSample,
-    w: &crate::patch::PatchWeights<N>,
+    w: &crate::limit::basis::PatchWeights<N>,
     cp: impl Fn(usize) -> &'a [f64; 3],
 ) {
     for k in 0..N {
@@ -629,16 +629,16 @@ impl AdaptivePlan {
     }
 
     /// The shading normal of patch `patch` at `(u, v)`: from the tangent patches on ACC-1
-    /// patches ([`crate::acc::tangent_normal`]), else the unit cross product of the
+    /// patches ([`crate::patches::acc::tangent_normal`]), else the unit cross product of the
     /// derivatives of [`Self::evaluate`].
     pub fn shading_normal(&self, verts: &[[f64; 3]], patch: usize, u: f64, v: f64) -> [f64; 3] {
         let pa = &self.patches[patch];
         if pa.tangent_valences != [0; 4] && pa.control_points.len() == 28 {
             let points = std::array::from_fn(|k| verts[pa.control_points[k] as usize]);
-            return crate::acc::tangent_normal(&points, pa.tangent_valences, u, v);
+            return crate::patches::acc::tangent_normal(&points, pa.tangent_valences, u, v);
         }
         let s = self.evaluate(verts, patch, u, v);
-        crate::eval::normal_of(&s.du, &s.dv)
+        crate::limit::eval::normal_of(&s.du, &s.dv)
     }
 
     /// The boundary correction of a Gregory triangle patch on its transition edges (a finer
@@ -704,9 +704,15 @@ impl AdaptivePlan {
         };
         match pa.kind {
             PatchKind::Regular => add_weighted(&mut s, &catmark_regular_weights(u, v), cp),
-            PatchKind::Gregory => add_weighted(&mut s, &crate::gregory::gregory_weights(u, v), cp),
+            PatchKind::Gregory => {
+                add_weighted(&mut s, &crate::patches::gregory::gregory_weights(u, v), cp)
+            }
             PatchKind::GregoryTriangle => {
-                add_weighted(&mut s, &crate::gregory::gregory_triangle_weights(u, v), cp);
+                add_weighted(
+                    &mut s,
+                    &crate::patches::gregory::gregory_triangle_weights(u, v),
+                    cp,
+                );
                 self.triangle_transitions(verts, patch, u, v, &mut s);
             }
             PatchKind::Bilinear => {

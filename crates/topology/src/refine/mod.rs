@@ -1,5 +1,5 @@
 //! The crate's one refiner: Catmull-Clark, Loop, bilinear and Doo-Sabin with OpenSubdiv's
-//! semi-sharp crease, corner and boundary rules (all taken from [`crate::sdc`]), in the spirit of
+//! semi-sharp crease, corner and boundary rules (all taken from [`crate::rules`]), in the spirit of
 //! OpenSubdiv's `Vtr::Refinement` (sdc rules → one topology representation → stencil tables).
 //!
 //! # Levels and steps
@@ -22,7 +22,7 @@
 //!   children. So if the parent holds the complete one-ring of each selected face, every child
 //!   of a selected face has its complete one-ring in the child level, with exactly the uniform
 //!   refiner's stencils, and the next step can select those children again (isolating a
-//!   feature level by level, or following a point as [`crate::eval`] does). Child vertices on
+//!   feature level by level, or following a point as [`crate::limit::eval`] does). Child vertices on
 //!   the border of the refined region are still computed (from what the parent has), but their
 //!   masks see only part of their neighbourhood and are not those of a uniform refinement.
 //!   The step returns [`ChildMaps`]: parent → child (vertex-, edge-, face-vertex and first child
@@ -54,14 +54,16 @@ use crate::mesh::{
     corner_faces, par_fill_ragged, prefix_sum, BoundaryInterpolation, ControlMesh, SubdivOptions,
     Topology, TriangleSubdivision, INVALID,
 };
-use crate::sdc::{
+use crate::refine::stencil::{
+    build_rows, compose_rows, entry_key, insertion_sort, RowKind, RowOut, StencilTable,
+};
+use crate::rules::{
     boundary_edge_sharpness, boundary_vertex_sharpness, decrement_sharpness, fractional_weight,
     is_sharp, subdivide_edge_sharpness_at_vertex, vertex_rule, Rule, Scheme,
 };
-use crate::stencil::{
-    build_rows, compose_rows, entry_key, insertion_sort, RowKind, RowOut, StencilTable,
-};
 use rayon::prelude::*;
+
+pub mod stencil;
 
 /// One level of a refinement: topology, positions and (propagated) sharpness.
 #[derive(Clone, Debug)]
@@ -161,8 +163,8 @@ fn base_sharpness(
 }
 
 /// Boundary edges become infinitely sharp and, with "edges and corners", boundary corners too
-/// (the rules are [`crate::sdc::boundary_edge_sharpness`] and
-/// [`crate::sdc::boundary_vertex_sharpness`]). Applied to a base level only: refinement
+/// (the rules are [`crate::rules::boundary_edge_sharpness`] and
+/// [`crate::rules::boundary_vertex_sharpness`]). Applied to a base level only: refinement
 /// propagates infinite sharpness unchanged.
 pub(crate) fn apply_boundary_rules(
     topology: &Topology,
@@ -410,7 +412,7 @@ pub struct LevelRef<'a> {
 }
 
 /// Topology and sharpness of one level without vertex data: what [`refine_sparse`] consumes and
-/// produces, and the level type of [`crate::eval`] and [`crate::bft`].
+/// produces, and the level type of [`crate::limit::eval`] and [`crate::patches::bft`].
 #[derive(Clone, Debug, Default)]
 pub struct LevelTopology {
     pub topology: Topology,

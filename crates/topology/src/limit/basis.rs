@@ -249,7 +249,7 @@ pub fn loop_regular_weights(u: f64, v: f64) -> PatchWeights<12> {
 }
 
 /// Cubic Bernstein basis and its derivative at `t`: the Bézier patches' curve weights (Gregory
-/// end caps, ACC-1, the reparameterization of [`crate::reparam`]).
+/// end caps, ACC-1, the reparameterization of [`crate::patches::reparam`]).
 pub fn bezier_curve_weights(t: f64) -> ([f64; 4], [f64; 4]) {
     let s = 1.0 - t;
     (

@@ -953,7 +953,7 @@ fn patch_corners(lvl: &Lvl, kind: PatchKind, site: PatchSite) -> ([u32; 4], [u32
     (fv, fe, 4)
 }
 
-/// The Gregory triangle patch of level-0 triangle `f` ([`crate::gregory::gregory_triangle_from_children`]
+/// The Gregory triangle patch of level-0 triangle `f` ([`crate::patches::gregory::gregory_triangle_from_children`]
 /// over its three level-1 children).
 fn triangle_patch(
     mesh: &ControlMesh,
@@ -966,15 +966,21 @@ fn triangle_patch(
     if first == INVALID {
         return Err(TopologyError::AdaptivePatch { level: 0, face: f });
     }
-    let basis: Vec<[crate::gregory::Stencil; 20]> = (0..3)
-        .map(|k| crate::gregory::gregory_basis(l1.topo.view(), first as usize + k, &mesh.options))
+    let basis: Vec<[crate::patches::gregory::Stencil; 20]> = (0..3)
+        .map(|k| {
+            crate::patches::gregory::gregory_basis(
+                l1.topo.view(),
+                first as usize + k,
+                &mesh.options,
+            )
+        })
         .collect::<Result<_, _>>()?;
     let mut points =
-        crate::gregory::gregory_triangle_from_children([&basis[0], &basis[1], &basis[2]]);
+        crate::patches::gregory::gregory_triangle_from_children([&basis[0], &basis[1], &basis[2]]);
     // Per edge p (corner p to p + 1), the inner points of its two level-1 halves in the edge's
     // direction: child p's `Ep` at the corner and `Em` at the edge midpoint (its corner 1),
     // then child p + 1's `Ep` at the midpoint (its corner 3) and `Em` at the corner.
-    let halves: Vec<&crate::gregory::Stencil> = (0..3)
+    let halves: Vec<&crate::patches::gregory::Stencil> = (0..3)
         .flat_map(|p| {
             let (a, b) = (&basis[p], &basis[(p + 1) % 3]);
             [&a[1], &a[5 + 2], &b[15 + 1], &b[2]]
@@ -996,7 +1002,7 @@ fn triangle_patch(
         };
         let centre = limit(fc);
         let mids = [limit(ec[0]), limit(ec[1]), limit(ec[2])];
-        crate::gregory::gregory_triangle_through_centre(
+        crate::patches::gregory::gregory_triangle_through_centre(
             &mut points,
             &centre,
             [&mids[0], &mids[1], &mids[2]],
@@ -1036,7 +1042,7 @@ fn gregory_face_rows(
     rows: &mut PointRows,
 ) -> Result<(), TopologyError> {
     rows.clear();
-    crate::gregory::gregory_basis_each(lvl.topo.view(), f, &mesh.options, |_, terms| {
+    crate::patches::gregory::gregory_basis_each(lvl.topo.view(), f, &mesh.options, |_, terms| {
         rows.push(terms.iter().copied());
     })
 }
@@ -1046,14 +1052,14 @@ fn gregory_face_rows(
 fn rotated_points<'a>(
     base: u32,
     shift: u8,
-    point: impl Fn(usize, usize) -> &'a crate::gregory::Stencil,
+    point: impl Fn(usize, usize) -> &'a crate::patches::gregory::Stencil,
 ) -> PointRows {
     let s = shift as usize;
     PointRows::from_stencils(base, (0..20).map(|k| point((k / 5 + s) % 4, k % 5)))
 }
 
 /// Per patch corner (patch order): the valence whose corner block of the texture
-/// reparameterization ([`crate::reparam`]) applies — that of a smooth interior vertex — or 0
+/// reparameterization ([`crate::patches::reparam`]) applies — that of a smooth interior vertex — or 0
 /// (identity) at boundary, crease and corner vertices, where no characteristic map was fitted.
 fn reparam_valences(lvl: &Lvl, f: usize, shift: u8) -> [u8; 4] {
     let (fv, _) = rotated(lvl.t(), f, shift);
@@ -1074,17 +1080,17 @@ fn reparam_valences(lvl: &Lvl, f: usize, shift: u8) -> [u8; 4] {
 /// order): each corner's `Fp` and `Fm` are both its inner Bézier point, which makes the
 /// Gregory patch that bicubic Bézier patch. Then 8 more: per patch corner the Gregory edge
 /// points `Ep, Em`, which lie on the limit tangents, for the tangent patches
-/// ([`crate::acc::tangent_normal`]). Fails outside ACC-1's scope ([`crate::acc`]).
+/// ([`crate::patches::acc::tangent_normal`]). Fails outside ACC-1's scope ([`crate::patches::acc`]).
 pub(super) fn acc_points(
     mesh: &ControlMesh,
     lvl: &Lvl,
     f: usize,
     shift: u8,
 ) -> Result<PointRows, TopologyError> {
-    let net = crate::acc::acc1_patch(lvl.topo.view(), f)?;
-    let basis = crate::gregory::gregory_basis(lvl.topo.view(), f, &mesh.options)?;
+    let net = crate::patches::acc::acc1_patch(lvl.topo.view(), f)?;
+    let basis = crate::patches::gregory::gregory_basis(lvl.topo.view(), f, &mesh.options)?;
     let tangents = rotated_points(lvl.base, shift, |corner, j| &basis[5 * corner + j]);
-    // Per face corner: the Bézier (i, j) of P, Ep, Em, F (module docs of crate::gregory).
+    // Per face corner: the Bézier (i, j) of P, Ep, Em, F (module docs of crate::patches::gregory).
     const SLOTS: [[(usize, usize); 4]; 4] = [
         [(0, 0), (1, 0), (0, 1), (1, 1)],
         [(3, 0), (3, 1), (2, 0), (2, 1)],

@@ -6,7 +6,7 @@
 //! Sharpness is kept in `f32` like OpenSubdiv, so decay and rule transitions happen at the same
 //! levels as in the reference implementation. Nothing here knows a mesh representation: the
 //! refiner ([`crate::refine`]) gathers the incident sharpness values and calls these functions,
-//! and the evaluator ([`crate::eval`]) refines through the refiner, so a crease fix is made once.
+//! and the evaluator ([`crate::limit::eval`]) refines through the refiner, so a crease fix is made once.
 
 use crate::error::TopologyError;
 use crate::mesh::{BoundaryInterpolation, CreaseMethod};

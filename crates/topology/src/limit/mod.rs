@@ -1,0 +1,5 @@
+//! The limit surface.
+
+pub mod basis;
+pub mod eval;
+pub mod masks;
