@@ -16,7 +16,7 @@ use topology::patches::adaptive::single_pass::{
     plan_single_pass, SinglePassOptions, SinglePassPatch,
 };
 use topology::patches::adaptive::PatchKind;
-use topology::{plan_adaptive, AdaptiveOptions, EndCap};
+use topology::patches::adaptive::{plan_adaptive, AdaptiveOptions, EndCap};
 
 fuzz_target!(
     init: tessera_fuzz::single_thread_rayon(),

@@ -6,7 +6,9 @@
 
 use libfuzzer_sys::fuzz_target;
 use tessera_fuzz::MeshSpec;
-use topology::{Level, LevelTopology, Scheme, Topology};
+use topology::Scheme;
+use topology::refine::{Level, LevelTopology};
+use topology::mesh::Topology;
 
 fuzz_target!(
     init: tessera_fuzz::single_thread_rayon(),

@@ -5,7 +5,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use topology::{parse_obj, write_control_mesh};
+use topology::mesh::obj::{parse_obj, write_control_mesh};
 
 fuzz_target!(
     init: tessera_fuzz::single_thread_rayon(),

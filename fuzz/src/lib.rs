@@ -18,13 +18,13 @@
 //!   the targets bound refinement levels themselves.
 
 use arbitrary::{Arbitrary, Unstructured};
-use topology::{
-    BoundaryInterpolation, ControlMesh, CreaseMethod, EdgeCrease, TriangleSubdivision, VertexCorner,
-};
+use topology::ControlMesh;
+use topology::rules::options::{BoundaryInterpolation, CreaseMethod, TriangleSubdivision};
+use topology::mesh::{EdgeCrease, VertexCorner};
 
 /// Largest coordinate magnitude the topology targets feed in: the library's own bound, within
 /// which it promises finite output (`ControlMesh::validate` refuses the rest).
-pub const MAX_COORD: f64 = topology::MAX_COORDINATE;
+pub const MAX_COORD: f64 = topology::mesh::MAX_COORDINATE;
 pub const MAX_VERTICES: usize = 64;
 pub const MAX_FACES: usize = 72;
 

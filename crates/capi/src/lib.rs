@@ -994,12 +994,12 @@ unsafe fn create_surface(
     d: &TesseraSurfaceDesc,
     name: String,
 ) -> Result<u64> {
-    topology::check_positions(&mesh.positions)?;
+    topology::mesh::check_positions(&mesh.positions)?;
     mesh.validate()?;
     let technique = choose_technique(d, &mesh)?;
     let end_cap = match d.end_cap {
-        TESSERA_END_CAP_GREGORY => topology::EndCap::Gregory,
-        TESSERA_END_CAP_BILINEAR => topology::EndCap::Bilinear,
+        TESSERA_END_CAP_GREGORY => topology::patches::adaptive::EndCap::Gregory,
+        TESSERA_END_CAP_BILINEAR => topology::patches::adaptive::EndCap::Bilinear,
         v => return Err(invalid("end_cap", v, "a TESSERA_END_CAP_* value")),
     };
     let split_triangles = flag(d.split_triangles, "split_triangles")?;
@@ -1165,7 +1165,7 @@ unsafe fn read_mesh(d: &TesseraMeshDesc) -> Result<(topology::ControlMesh, Strin
     let creases = crease_vertices
         .chunks_exact(2)
         .zip(crease_sharpness)
-        .map(|(v, &sharpness)| topology::EdgeCrease {
+        .map(|(v, &sharpness)| topology::mesh::EdgeCrease {
             vertices: [v[0], v[1]],
             sharpness,
         })
@@ -1173,7 +1173,7 @@ unsafe fn read_mesh(d: &TesseraMeshDesc) -> Result<(topology::ControlMesh, Strin
     let corners = corner_vertices
         .iter()
         .zip(corner_sharpness)
-        .map(|(&vertex, &sharpness)| topology::VertexCorner { vertex, sharpness })
+        .map(|(&vertex, &sharpness)| topology::mesh::VertexCorner { vertex, sharpness })
         .collect();
     let mesh = topology::ControlMesh {
         positions: positions
@@ -1292,7 +1292,7 @@ pub unsafe extern "C" fn tessera_surface_create_obj(
             })?;
             (text, given.unwrap_or_else(|| "mesh".into()))
         };
-        let mesh = topology::parse_obj(&text, &name)?;
+        let mesh = topology::mesh::obj::parse_obj(&text, &name)?;
         // SAFETY: the caller's contract for the images `desc` points to.
         let id = unsafe { create_surface(ctx_id, c, mesh, &d, name) }?;
         // SAFETY: the caller's contract (see this function's `# Safety`).

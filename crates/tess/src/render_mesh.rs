@@ -230,7 +230,7 @@ mod tests {
 
     #[test]
     fn cube_normals_point_along_diagonals() {
-        let mesh = topology::parse_obj(
+        let mesh = topology::mesh::obj::parse_obj(
             include_str!("../../../tests/data/meshes/cube.obj"),
             "cube.obj",
         )
@@ -275,7 +275,7 @@ mod tests {
 
     #[test]
     fn hole_faces_make_no_patches() {
-        let mut mesh = topology::parse_obj(
+        let mut mesh = topology::mesh::obj::parse_obj(
             include_str!("../../../tests/data/meshes/cube.obj"),
             "cube.obj",
         )

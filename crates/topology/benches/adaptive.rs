@@ -18,7 +18,8 @@ use criterion::Criterion;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use topology::patches::adaptive::{plan_adaptive, AdaptiveOptions, EndCap};
-use topology::{load_obj, uniform_stencils, ControlMesh, LevelTopology, Scheme};
+use topology::refine::{uniform_stencils, LevelTopology};
+use topology::{load_obj, ControlMesh, Scheme};
 
 fn mesh(rel: &str) -> ControlMesh {
     load_obj(

@@ -6,7 +6,9 @@
 use criterion::Criterion;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
-use topology::{load_obj, refine_uniform, uniform_stencils, ControlMesh, Scheme, Topology};
+use topology::mesh::Topology;
+use topology::refine::{refine_uniform, uniform_stencils};
+use topology::{load_obj, ControlMesh, Scheme};
 
 fn asset(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -23,9 +23,9 @@ use std::path::{Path, PathBuf};
 use topology::patches::adaptive::single_pass::{
     plan_single_pass, SinglePassOptions, SinglePassPatch,
 };
-use topology::{
-    load_obj, plan_adaptive, uniform_stencils, AdaptiveOptions, AdaptivePlan, EndCap, Scheme,
-};
+use topology::patches::adaptive::{plan_adaptive, AdaptiveOptions, AdaptivePlan, EndCap};
+use topology::refine::uniform_stencils;
+use topology::{load_obj, Scheme};
 
 fn hash_debug<T: std::fmt::Debug>(value: &T) -> u64 {
     let mut h = DefaultHasher::new();

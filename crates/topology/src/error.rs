@@ -1,4 +1,8 @@
-//! The crate's single error type: every failure names the face, edge, vertex or file involved.
+//! The crate's error types: every failure names the face, edge, vertex or file involved.
+//!
+//! This module is below every layer (see the crate documentation): each layer reports
+//! through it, and it names what went wrong in plain data (numbers, names, the problem
+//! kinds of the end caps), importing nothing from the layers themselves.
 
 /// Everything that can go wrong while loading, validating or refining a control mesh.
 #[derive(Debug, thiserror::Error)]
@@ -16,7 +20,7 @@ pub enum TopologyError {
     },
     /// A validation error found in an OBJ file: shown in the file's own terms (1-based vertex
     /// and face numbers, the line that made the element at fault when there is one), while
-    /// `error` keeps the 0-based numbers of the loaded [`crate::ControlMesh`] for code that
+    /// `error` keeps the 0-based numbers of the loaded [`crate::mesh::ControlMesh`] for code that
     /// matches on it ([`TopologyError::root`]). Said in the message, not chained.
     #[error("{file}{}: {}", at_line(*.line), ObjTerms(.error))]
     InFile {
@@ -59,15 +63,19 @@ pub enum TopologyError {
     /// A vertex position with NaN or infinite coordinates.
     #[error("vertex {vertex} has a non-finite position ({})", xyz(position))]
     NonFinitePosition { vertex: usize, position: [f64; 3] },
-    /// A finite vertex position with a coordinate beyond [`crate::MAX_COORDINATE`], where
-    /// intermediates of the f32 GPU path would overflow (see there).
+    /// A finite vertex position with a coordinate beyond `bound` (the mesh's
+    /// [`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE)), where intermediates of the f32 GPU
+    /// path would overflow (see there).
     #[error(
-        "vertex {vertex} at ({}) has a coordinate beyond ±{:e}, the largest the GPU's f32 \
+        "vertex {vertex} at ({}) has a coordinate beyond ±{bound:e}, the largest the GPU's f32 \
          arithmetic keeps finite (scale the mesh down)",
-        xyz(position),
-        crate::MAX_COORDINATE
+        xyz(position)
     )]
-    CoordinateOutOfRange { vertex: usize, position: [f64; 3] },
+    CoordinateOutOfRange {
+        vertex: usize,
+        position: [f64; 3],
+        bound: f64,
+    },
     /// Loop subdivision was asked for a mesh with non-triangular faces.
     #[error("Loop subdivision needs triangles, but face {face} has {size} vertices")]
     LoopRequiresTriangles { face: usize, size: usize },
@@ -99,10 +107,11 @@ pub enum TopologyError {
     /// A scheme name no parser knows.
     #[error("unknown scheme '{name}' (loop, catmull-clark, doo-sabin, bilinear)")]
     UnknownScheme { name: String },
-    /// An operation the scheme does not support (Doo-Sabin has no sparse refinement).
+    /// An operation the scheme does not support (Doo-Sabin has no sparse refinement); the
+    /// scheme by its command-line name (`Scheme::name`).
     #[error("{scheme} does not support {operation}")]
     UnsupportedScheme {
-        scheme: crate::rules::Scheme,
+        scheme: &'static str,
         operation: &'static str,
     },
     /// A face index (e.g. in a refinement selection) beyond the level's faces.
@@ -112,14 +121,11 @@ pub enum TopologyError {
     #[error("Gregory patch of face {face}: {problem}")]
     GregoryPatch {
         face: usize,
-        problem: crate::patches::gregory::GregoryProblem,
+        problem: GregoryProblem,
     },
     /// An ACC-1 patch cannot be built on this face ([`crate::patches::acc::acc1_patch`]).
     #[error("ACC-1 patch of face {face}: {problem}")]
-    AccPatch {
-        face: usize,
-        problem: crate::patches::acc::AccProblem,
-    },
+    AccPatch { face: usize, problem: AccProblem },
     /// An adaptive isolation level outside `1..=8`.
     #[error("isolation level {isolation} is outside 1..=8")]
     IsolationOutOfRange { isolation: u32 },
@@ -164,6 +170,32 @@ pub enum TopologyError {
     /// would leave a crack).
     #[error("adaptive plan: face {face} of level {level} borders a face more than one level away")]
     AdaptiveUnbalanced { level: u32, face: usize },
+}
+
+/// Why a Gregory patch cannot be built on a face ([`TopologyError::GregoryPatch`]).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum GregoryProblem {
+    #[error("the face has {size} corners, a Gregory patch needs a quad")]
+    NotQuad { size: usize },
+    #[error("the faces around vertex {vertex} do not form one complete fan in this level")]
+    IncompleteRing { vertex: u32 },
+    #[error("a face around vertex {vertex} is not a quad (refine once first)")]
+    NonQuadRing { vertex: u32 },
+    #[error("the level's sharpness tables do not match its topology")]
+    SharpnessLength,
+}
+
+/// Why an ACC-1 patch cannot be built on a face ([`TopologyError::AccPatch`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum AccProblem {
+    #[error("the face has {size} corners; ACC-1 patches are quads")]
+    NotQuad { size: usize },
+    #[error("vertex {vertex} is on a boundary")]
+    Boundary { vertex: u32 },
+    #[error("vertex {vertex} has a sharp edge or is a tagged corner")]
+    Sharp { vertex: u32 },
+    #[error("vertex {vertex} has a face that is not a quad")]
+    NonQuadNeighbour { vertex: u32 },
 }
 
 /// Which OBJ tag a [`TopologyError::TagOutOfRange`] comes from.
@@ -303,13 +335,16 @@ impl std::fmt::Display for ObjTerms<'_> {
                 vertex + 1,
                 xyz(position)
             ),
-            E::CoordinateOutOfRange { vertex, position } => write!(
+            E::CoordinateOutOfRange {
+                vertex,
+                position,
+                bound,
+            } => write!(
                 f,
-                "vertex {} at ({}) has a coordinate beyond ±{:e}, the largest the GPU's f32 \
+                "vertex {} at ({}) has a coordinate beyond ±{bound:e}, the largest the GPU's f32 \
                  arithmetic keeps finite (scale the mesh down)",
                 vertex + 1,
-                xyz(position),
-                crate::MAX_COORDINATE
+                xyz(position)
             ),
             E::LoopRequiresTriangles { face, size } => write!(
                 f,

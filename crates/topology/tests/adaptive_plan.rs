@@ -8,10 +8,11 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 
 use topology::limit::eval::{LimitScheme, LocalMesh};
-use topology::{
-    load_obj, plan_adaptive, AdaptiveOptions, AdaptivePlan, ControlMesh, EdgeCrease, EdgeKind,
-    EndCap, PatchKind, TopologyError, VertexCorner,
+use topology::mesh::{EdgeCrease, VertexCorner};
+use topology::patches::adaptive::{
+    plan_adaptive, AdaptiveOptions, AdaptivePlan, EdgeKind, EndCap, PatchKind,
 };
+use topology::{load_obj, ControlMesh, TopologyError};
 
 const SHAPES: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -416,7 +417,7 @@ fn check_curves(name: &str, plan: &AdaptivePlan, mesh: &ControlMesh, d: f64) {
     }
     // Every curve is used by one side (boundary) or two sides, within one level.
     let closed = mesh.holes.is_empty()
-        && topology::Topology::from_mesh(mesh)
+        && topology::mesh::Topology::from_mesh(mesh)
             .map(|t| (0..t.num_edges()).all(|e| !t.is_boundary_edge(e)))
             .unwrap_or(false);
     for (c, &n) in refs.iter().enumerate() {

@@ -3,8 +3,9 @@
 //! characteristic kept), quads from level 1 on, and their sharpness-6 creases decaying by one
 //! per level along twice as many edges.
 
+use topology::refine::{refine_uniform, Level};
 use topology::rules::is_semi_sharp;
-use topology::{load_obj, refine_uniform, Level, Scheme};
+use topology::{load_obj, Scheme};
 
 const DATA: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),

@@ -1,7 +1,9 @@
 //! Inputs the fuzz targets (fuzz/, tools/fuzz.sh) found crashing, kept as ordinary tests so
 //! `cargo test` guards the fixes without a nightly toolchain.
 
-use topology::{parse_obj, ObjSyntax, TopologyError};
+use topology::error::ObjSyntax;
+use topology::mesh::obj::parse_obj;
+use topology::TopologyError;
 
 const TRIANGLE: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
 

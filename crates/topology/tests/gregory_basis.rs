@@ -3,13 +3,15 @@
 //! to the exact limit surface, shared edges have bit-identical boundary curves, and the basis
 //! has no NaN on the closed square.
 
+use topology::error::GregoryProblem;
 use topology::limit::basis::catmark_regular_weights;
 use topology::limit::eval::{LimitScheme, LocalMesh};
-use topology::patches::gregory::{gregory_basis, gregory_weights, GregoryProblem, Stencil};
+use topology::mesh::{EdgeCrease, VertexCorner};
+use topology::patches::gregory::{gregory_basis, gregory_weights};
+use topology::refine::stencil::Stencil;
 use topology::refine::{refine_uniform, Level};
-use topology::{
-    load_obj, BoundaryInterpolation, ControlMesh, EdgeCrease, Scheme, TopologyError, VertexCorner,
-};
+use topology::rules::options::BoundaryInterpolation;
+use topology::{load_obj, ControlMesh, Scheme, TopologyError};
 
 const DATA: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),

@@ -3,7 +3,8 @@
 
 use std::collections::HashMap;
 use std::path::PathBuf;
-use topology::{load_obj, refine_uniform, Scheme};
+use topology::refine::refine_uniform;
+use topology::{load_obj, Scheme};
 
 fn data_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/opensubdiv")

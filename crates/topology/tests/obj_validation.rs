@@ -1,8 +1,9 @@
 //! OBJ parsing, OpenSubdiv tags and every validation error on small inline meshes.
 
-use topology::{
-    parse_obj, BoundaryInterpolation, CreaseMethod, TagKind, TopologyError, TriangleSubdivision,
-};
+use topology::error::TagKind;
+use topology::mesh::obj::parse_obj;
+use topology::rules::options::{BoundaryInterpolation, CreaseMethod, TriangleSubdivision};
+use topology::TopologyError;
 
 const QUAD_PAIR: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\n";
 
@@ -211,7 +212,8 @@ fn tags_naming_missing_vertices() {
 fn write_obj_round_trips() {
     let m = parse_obj(&format!("{QUAD_PAIR}f 1 2 3 4\nf 2 5 6 3\n"), "rt.obj").unwrap();
     let mut buf = Vec::new();
-    topology::write_obj(&mut buf, &m.positions, &m.face_offsets, &m.face_vertices).unwrap();
+    topology::mesh::obj::write_obj(&mut buf, &m.positions, &m.face_offsets, &m.face_vertices)
+        .unwrap();
     let back = parse_obj(std::str::from_utf8(&buf).unwrap(), "back.obj").unwrap();
     assert_eq!(back.positions, m.positions);
     assert_eq!(back.face_vertices, m.face_vertices);
@@ -219,7 +221,9 @@ fn write_obj_round_trips() {
 
 mod never_panics {
     use proptest::prelude::*;
-    use topology::{parse_obj, refine_uniform, ControlMesh, Scheme};
+    use topology::mesh::obj::parse_obj;
+    use topology::refine::refine_uniform;
+    use topology::{ControlMesh, Scheme};
 
     fn line() -> impl Strategy<Value = String> {
         prop_oneof![
@@ -272,7 +276,7 @@ mod never_panics {
 /// numbers once wrapped by `in_file`, like the parser's own.
 #[test]
 fn later_errors_use_the_files_face_numbers() {
-    use topology::{plan_adaptive, AdaptiveOptions};
+    use topology::patches::adaptive::{plan_adaptive, AdaptiveOptions};
     let n = 300;
     let mut text = String::from("v 5 5 0\nv 6 5 0\nv 5 6 0\nf 1 2 3\n");
     for i in 0..n {

@@ -7,7 +7,8 @@ use topology::patches::adaptive::edge_param;
 use topology::patches::adaptive::single_pass::{
     plan_single_pass, SinglePassOptions, SinglePassPatch,
 };
-use topology::{load_obj, ControlMesh, EdgeKind, PatchKind};
+use topology::patches::adaptive::{EdgeKind, PatchKind};
+use topology::{load_obj, ControlMesh};
 
 fn data(rel: &str) -> String {
     format!("{}/../../{rel}", env!("CARGO_MANIFEST_DIR"))

@@ -3,11 +3,13 @@
 //! one-rings, and their positions equal the uniform refiner's (bitwise after one step, to
 //! 1e-12 after two).
 
+use topology::mesh::Topology;
 use topology::mesh::INVALID;
-use topology::{
-    load_obj, refine_sparse, refine_sparse_region, refine_uniform, ChildOrigin, ControlMesh, Level,
-    LevelTopology, Scheme, SparseRefinement, SparseRegion, Topology, TopologyError,
+use topology::refine::{
+    refine_sparse, refine_sparse_region, refine_uniform, ChildOrigin, Level, LevelTopology,
+    SparseRefinement, SparseRegion,
 };
+use topology::{load_obj, ControlMesh, Scheme, TopologyError};
 
 const DATA: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -318,7 +320,7 @@ fn sparse_refinement_errors_name_what_is_at_fault() {
     assert!(matches!(
         e,
         TopologyError::UnsupportedScheme {
-            scheme: Scheme::DooSabin,
+            scheme: "doo-sabin",
             ..
         }
     ));

@@ -3,10 +3,11 @@
 
 use proptest::prelude::*;
 use std::path::PathBuf;
-use topology::{
-    load_obj, parse_obj, refine_uniform, uniform_stencils, ControlMesh, CreaseMethod, EdgeCrease,
-    Scheme, TopologyError, VertexCorner,
-};
+use topology::mesh::obj::parse_obj;
+use topology::mesh::{EdgeCrease, VertexCorner};
+use topology::refine::{refine_uniform, uniform_stencils};
+use topology::rules::options::CreaseMethod;
+use topology::{load_obj, ControlMesh, Scheme, TopologyError};
 
 fn shape(name: &str) -> ControlMesh {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -6,8 +6,9 @@ use topology::limit::eval::{LimitScheme, LocalMesh};
 use topology::patches::adaptive::single_pass::{
     plan_single_pass, SinglePassOptions, SinglePassPatch,
 };
+use topology::patches::adaptive::{plan_adaptive, AdaptiveOptions, AdaptivePlan, PatchKind};
 use topology::patches::texcoord::{has_texcoords, patch_parameter, patch_texcoord};
-use topology::{load_obj, plan_adaptive, AdaptiveOptions, AdaptivePlan, ControlMesh, PatchKind};
+use topology::{load_obj, ControlMesh};
 
 fn data(rel: &str) -> String {
     format!("{}/../../{rel}", env!("CARGO_MANIFEST_DIR"))

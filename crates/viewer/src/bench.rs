@@ -31,7 +31,7 @@ fn load_meshes(paths: &[std::path::PathBuf]) -> Result<Vec<BenchMesh>> {
     let mut out = Vec::new();
     if paths.is_empty() {
         for (name, text) in DEFAULT_MESHES {
-            let mesh = topology::parse_obj(text, &format!("{name}.obj (embedded)"))?;
+            let mesh = topology::mesh::obj::parse_obj(text, &format!("{name}.obj (embedded)"))?;
             let prepared = crate::progress::during(format!("preparing {name}"), || {
                 BenchMesh::new(name, &mesh)
             });

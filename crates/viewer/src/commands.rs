@@ -39,7 +39,7 @@ pub fn validation(g: &GpuArgs) -> Validation {
 pub fn load_mesh(path: Option<&std::path::Path>) -> Result<topology::ControlMesh> {
     let mesh = match path {
         Some(p) => topology::load_obj(p)?,
-        None => topology::parse_obj(DEFAULT_MESH, "spot_control_mesh.obj (embedded)")?,
+        None => topology::mesh::obj::parse_obj(DEFAULT_MESH, "spot_control_mesh.obj (embedded)")?,
     };
     if mesh.num_faces() == 0 {
         bail!(

@@ -29,7 +29,7 @@ pub struct ExportReport {
 }
 
 /// Refuses to write a capture with a NaN or infinite position or normal: validated input
-/// (coordinates within `topology::MAX_COORDINATE`) never makes one, so one is a bug to report,
+/// (coordinates within `topology::mesh::MAX_COORDINATE`) never makes one, so one is a bug to report,
 /// not a file to write.
 fn check_finite(welded: &tess::WeldedMesh) -> Result<()> {
     for (what, values) in [("position", &welded.positions), ("normal", &welded.normals)] {

@@ -5,7 +5,8 @@
 use crate::cli::{LimitArgs, SubdivideArgs};
 use anyhow::{bail, Context, Result};
 use topology::limit::eval::{limit_point, EvalError, LimitScheme, LocalMesh};
-use topology::{refine_uniform, ControlMesh, Level, Scheme};
+use topology::refine::{refine_uniform, Level};
+use topology::{ControlMesh, Scheme};
 
 /// Clap's value parser for `--scheme`: topology's one scheme parser.
 pub fn parse_scheme(s: &str) -> Result<Scheme, String> {
@@ -73,7 +74,7 @@ pub fn subdivide(a: SubdivideArgs) -> Result<()> {
     let (offsets, verts) = level.topology.face_tables();
     let file = std::fs::File::create(&a.output)
         .with_context(|| format!("creating {}", a.output.display()))?;
-    topology::write_obj(file, &positions, offsets, verts)
+    topology::mesh::obj::write_obj(file, &positions, offsets, verts)
         .with_context(|| format!("writing {}", a.output.display()))?;
     out!(
         "wrote {}: {} vertices, {} faces (level {}, {}{})",

@@ -475,7 +475,7 @@ fn limit_masks_at_the_output_level_miss_semi_sharp_creases() {
     let mesh = topology::load_obj(&input).unwrap();
     assert!(mesh.creases.iter().any(|c| c.sharpness == 2.5));
     let level = 2;
-    let r = topology::refine_uniform(&mesh, topology::Scheme::CatmullClark, level).unwrap();
+    let r = topology::refine::refine_uniform(&mesh, topology::Scheme::CatmullClark, level).unwrap();
     let mut lm =
         LocalMesh::from_refined_level(r.level(level), LimitScheme::CatmullClark, &mesh.options)
             .unwrap();

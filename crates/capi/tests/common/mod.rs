@@ -83,7 +83,7 @@ pub fn reference(technique: tess::TechniqueId, width: u32, height: u32) -> Vec<u
     .expect("Vulkan instance");
     let device = Device::new(&instance, &DeviceDesc::default(), &[]).expect("device");
     let text = std::fs::read_to_string(repo().join("assets/spot_control_mesh.obj")).unwrap();
-    let mesh = topology::parse_obj(&text, "spot").unwrap();
+    let mesh = topology::mesh::obj::parse_obj(&text, "spot").unwrap();
     let pixels = {
         let mut ctx = tess::Context::offscreen(&device).unwrap();
         let built = tess::build(&mut ctx, technique, &mesh, &tess::BuildOptions::default())

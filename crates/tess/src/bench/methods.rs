@@ -12,7 +12,8 @@ use crate::techniques::bft::Wave;
 use crate::techniques::{self, BuildOptions, TechniqueInfo};
 use std::time::Instant;
 use topology::limit::eval::{LimitScheme, LocalMesh};
-use topology::{refine_level, ControlMesh, Level, Scheme};
+use topology::refine::{refine_level, Level};
+use topology::{ControlMesh, Scheme};
 use vk_core::{vk, Device, Encoder};
 
 /// What one frame of a row asks for.
@@ -614,7 +615,7 @@ pub fn loop_limit_positions(level: &Level) -> Option<Vec<[f64; 3]>> {
 fn evaluator_limit_positions(
     current: &Level,
     level: usize,
-    options: &topology::SubdivOptions,
+    options: &topology::rules::options::SubdivOptions,
     scheme: LimitScheme,
 ) -> Result<Vec<[f64; 3]>> {
     let scheme_name = match scheme {
@@ -848,13 +849,13 @@ mod tests {
     #[test]
     fn mask_limit_positions_equal_the_evaluator() {
         let mut corners = open_grid();
-        corners.options.boundary = topology::BoundaryInterpolation::EdgesAndCorners;
+        corners.options.boundary = topology::rules::options::BoundaryInterpolation::EdgesAndCorners;
         let mut creased = tetrahedron();
-        creased.creases.push(topology::EdgeCrease {
+        creased.creases.push(topology::mesh::EdgeCrease {
             vertices: [0, 1],
             sharpness: 10.0,
         });
-        creased.creases.push(topology::EdgeCrease {
+        creased.creases.push(topology::mesh::EdgeCrease {
             vertices: [1, 2],
             sharpness: 10.0,
         });
@@ -883,7 +884,7 @@ mod tests {
     #[test]
     fn semi_sharp_creases_are_evaluated_exactly_until_decayed() {
         let mut mesh = tetrahedron();
-        mesh.creases.push(topology::EdgeCrease {
+        mesh.creases.push(topology::mesh::EdgeCrease {
             vertices: [0, 1],
             sharpness: 1.5,
         });

@@ -41,8 +41,9 @@ use crate::limit::masks::{
     catmark_limit_masks, loop_limit_masks, loop_smooth_tangent_weights, smooth_directional_tangent,
     LimitRule, LimitVertex,
 };
-use crate::mesh::{ControlMesh, SubdivOptions, Topology, INVALID};
+use crate::mesh::{ControlMesh, Topology, INVALID};
 use crate::refine::{refine_sparse, Level, LevelTopology};
+use crate::rules::options::SubdivOptions;
 use crate::rules::{is_infinite, is_semi_sharp, is_sharp, vertex_rule, Rule, Scheme};
 
 /// The schemes with a limit surface here: a restricted view of [`Scheme`], parsed by
@@ -123,8 +124,10 @@ pub enum EvalError {
     IsolatedVertex { vertex: u32 },
     #[error("evaluation of face {face} at ({u}, {v}) did not converge")]
     NotConverged { face: usize, u: f64, v: f64 },
-    #[error("no basis-function table case {key:?}")]
-    NoBftCase { key: crate::patches::bft::BftKey },
+    /// A basis-function table key (`patches::bft::BftKey`, in its `Debug` form) that names
+    /// no table.
+    #[error("no basis-function table case {key}")]
+    NoBftCase { key: String },
     #[error("BFT level {level} not in 1..=6")]
     BftLevel { level: u32 },
     /// A characteristic map ([`crate::patches::reparam`]) of a valence below 3.

@@ -1,4 +1,15 @@
-//! The limit surface.
+//! The limit surface: where a refinement converges, computed without refining forever.
+//!
+//! - [`masks`]: limit masks, weights that put a vertex of any level on the limit surface with
+//!   two limit tangents (OpenSubdiv's `Sdc` limit masks);
+//! - [`basis`]: the basis functions of the regular patches (Loop's quartic box spline,
+//!   Catmull-Clark's bicubic B-spline) and the cubic Bézier and B-spline curves, the surface in
+//!   closed form where the mesh is regular;
+//! - [`eval`]: exact limit evaluation at any `(face, u, v)` (OpenSubdiv's `Bfr`), refining
+//!   locally with the [`refine`](crate::refine) layer until a regular patch or a limit mask
+//!   applies.
+//!
+//! Builds on `rules/`, `mesh/` and `refine/`; the `patches/` layer builds on it.
 
 pub mod basis;
 pub mod eval;

@@ -1,6 +1,7 @@
 //! Control meshes (plain data as loaded) and their validated edge/vertex adjacency ([`Topology`]).
 
 use crate::error::TopologyError;
+use crate::rules::options::SubdivOptions;
 use rayon::prelude::*;
 
 pub mod obj;
@@ -53,6 +54,7 @@ pub fn check_positions(positions: &[[f64; 3]]) -> Result<(), TopologyError> {
             Err(TopologyError::CoordinateOutOfRange {
                 vertex,
                 position: *p,
+                bound: MAX_COORDINATE,
             })
         }
         Some((vertex, p)) => Err(TopologyError::NonFinitePosition {
@@ -60,48 +62,6 @@ pub fn check_positions(positions: &[[f64; 3]]) -> Result<(), TopologyError> {
             position: *p,
         }),
     }
-}
-
-/// How boundary vertices are treated (OpenSubdiv `VtxBoundaryInterpolation`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum BoundaryInterpolation {
-    /// OBJ tag value 0. OpenSubdiv turns the boundary faces into holes; this crate still
-    /// refines them like [`BoundaryInterpolation::EdgesOnly`] (boundary edges stay sharp).
-    None,
-    /// OBJ tag value 2 (the default): boundary edges are infinitely sharp creases.
-    #[default]
-    EdgesOnly,
-    /// OBJ tag value 1: boundary edges are sharp and corners (vertices with a single face)
-    /// are infinitely sharp too, so they stay put.
-    EdgesAndCorners,
-}
-
-/// How semi-sharp edge sharpness decays per level (OpenSubdiv `CreasingMethod`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum CreaseMethod {
-    /// Subtract one per level.
-    #[default]
-    Uniform,
-    /// Chaikin: blend with the average sharpness of the other semi-sharp edges at the end vertex.
-    Chaikin,
-}
-
-/// Catmull-Clark rule for edges next to triangles (OpenSubdiv `TriangleSubdivision`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum TriangleSubdivision {
-    /// The plain Catmull-Clark edge rule.
-    #[default]
-    Catmark,
-    /// OpenSubdiv's "smooth triangle" weights for edges next to triangles.
-    Smooth,
-}
-
-/// Subdivision options carried by a control mesh (set from OBJ `t` tags).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct SubdivOptions {
-    pub boundary: BoundaryInterpolation,
-    pub crease_method: CreaseMethod,
-    pub triangle_subdivision: TriangleSubdivision,
 }
 
 /// A semi-sharp or infinitely sharp (≥ 10) edge, named by its two vertices.

@@ -7,14 +7,13 @@
 //!
 //! Errors speak the file's language: a parse error names its line; a validation error found
 //! after parsing (an index out of range, a non-manifold edge, a coordinate beyond
-//! [`crate::MAX_COORDINATE`]) is located on the line that made the vertex, face or tag at fault
+//! [`crate::mesh::MAX_COORDINATE`]) is located on the line that made the vertex, face or tag at fault
 //! and worded with the file's 1-based numbers ([`TopologyError::InFile`]). The parser keeps the
 //! line of every vertex, face and tag for that (a few bytes each).
 
 use crate::error::{ObjSyntax, TagKind, TopologyError};
-use crate::mesh::{
-    BoundaryInterpolation, ControlMesh, CreaseMethod, EdgeCrease, TriangleSubdivision, VertexCorner,
-};
+use crate::mesh::{ControlMesh, EdgeCrease, VertexCorner};
+use crate::rules::options::{BoundaryInterpolation, CreaseMethod, TriangleSubdivision};
 use std::io::Write;
 use std::path::Path;
 
@@ -536,7 +535,7 @@ pub fn write_control_mesh<W: Write>(mut out: W, mesh: &ControlMesh) -> std::io::
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::MAX_COORDINATE;
+    use crate::mesh::MAX_COORDINATE;
     use std::error::Error as _;
 
     fn err(text: &str) -> TopologyError {
@@ -633,7 +632,7 @@ mod tests {
     /// Each cause is said once: file errors embed their cause and do not chain it too.
     #[test]
     fn causes_are_said_once() {
-        let e = crate::load_obj("/nonexistent/dir/m.obj").unwrap_err();
+        let e = super::load_obj("/nonexistent/dir/m.obj").unwrap_err();
         assert!(e.source().is_none());
         let m = e.to_string();
         assert_eq!(m.matches("os error").count(), 1, "{m}");

@@ -17,24 +17,11 @@
 //!   whose corners' faces are all quads: ACC-1's masks are defined for quad neighbourhoods only.
 //!   Others are refused with [`AccProblem`] naming the vertex; the technique that draws ACC-1
 //!   treats those faces another way (the issue that adds it decides which).
-use crate::error::TopologyError;
+use crate::error::{AccProblem, TopologyError};
 use crate::mesh::INVALID;
-use crate::patches::gregory::Stencil;
+use crate::refine::stencil::Stencil;
 use crate::refine::LevelRef;
 use std::collections::BTreeMap;
-
-/// Why an ACC-1 patch cannot be built on a face ([`TopologyError::AccPatch`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
-pub enum AccProblem {
-    #[error("the face has {size} corners; ACC-1 patches are quads")]
-    NotQuad { size: usize },
-    #[error("vertex {vertex} is on a boundary")]
-    Boundary { vertex: u32 },
-    #[error("vertex {vertex} has a sharp edge or is a tagged corner")]
-    Sharp { vertex: u32 },
-    #[error("vertex {vertex} has a face that is not a quad")]
-    NonQuadNeighbour { vertex: u32 },
-}
 
 fn add(acc: &mut BTreeMap<u32, f64>, v: u32, w: f64) {
     *acc.entry(v).or_insert(0.0) += w;

@@ -405,7 +405,8 @@ pub use assemble::MAX_LOCAL_TERMS;
 /// Plan the feature-adaptive refinement and patches of `mesh` (Catmull-Clark).
 ///
 /// ```
-/// use topology::{plan_adaptive, AdaptiveOptions, ControlMesh, EndCap};
+/// use topology::patches::adaptive::{plan_adaptive, AdaptiveOptions, EndCap};
+/// use topology::ControlMesh;
 /// // A cube: eight valence-3 vertices, isolated to level 2.
 /// let p = [[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.],
 ///          [0., 0., 1.], [1., 0., 1.], [1., 1., 1.], [0., 1., 1.]];

@@ -73,7 +73,7 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 
 use crate::limit::eval::{EvalError, LimitScheme, LocalMesh};
-use crate::mesh::SubdivOptions;
+use crate::rules::options::SubdivOptions;
 
 /// Configuration of a face around its (possibly) extraordinary vertex `v0`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -147,7 +147,9 @@ const RADIUS: u32 = 2;
 /// and the face index.
 pub fn configuration_mesh(key: BftKey, identity: bool) -> Result<(LocalMesh, usize), EvalError> {
     if !key.valid() {
-        return Err(EvalError::NoBftCase { key });
+        return Err(EvalError::NoBftCase {
+            key: format!("{key:?}"),
+        });
     }
     let n = key.valence;
     let boundary = matches!(key.case, BftCase::Boundary { .. });

@@ -101,57 +101,22 @@
 //! * Semi-sharp edges and vertices are treated as infinitely sharp (this is the last level).
 //! * Every face around each of the four corners must be a quad (true from level 1 on).
 
-use thiserror::Error;
-
-use crate::error::TopologyError;
+use crate::error::{GregoryProblem, TopologyError};
 use crate::limit::basis::PatchWeights;
 use crate::limit::masks::{
     catmark_cross_tangent_into, catmark_directional_tangent_each,
     catmark_directional_tangent_table, catmark_smooth_position_weights, dart_position_weights,
 };
-use crate::mesh::{SubdivOptions, Topology, INVALID};
+use crate::mesh::{Topology, INVALID};
+use crate::refine::stencil::Stencil;
 use crate::refine::LevelRef;
+use crate::rules::options::SubdivOptions;
 use crate::rules::{
     boundary_edge_sharpness, boundary_vertex_sharpness, is_sharp, vertex_rule, Rule,
 };
 
 use smallvec::SmallVec;
 use std::f64::consts::PI;
-
-/// Weights over a level's vertex indices (ascending, no zero weights).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Stencil {
-    pub indices: Vec<u32>,
-    pub weights: Vec<f64>,
-}
-
-impl Stencil {
-    /// Apply to 3D points indexed like the level's vertices.
-    pub fn apply(&self, points: &[[f64; 3]]) -> [f64; 3] {
-        let mut out = [0.0; 3];
-        for (&i, &w) in self.indices.iter().zip(&self.weights) {
-            if let Some(p) = points.get(i as usize) {
-                for k in 0..3 {
-                    out[k] += w * p[k];
-                }
-            }
-        }
-        out
-    }
-}
-
-/// Why a Gregory patch cannot be built on a face ([`TopologyError::GregoryPatch`]).
-#[derive(Clone, Debug, PartialEq, Eq, Error)]
-pub enum GregoryProblem {
-    #[error("the face has {size} corners, a Gregory patch needs a quad")]
-    NotQuad { size: usize },
-    #[error("the faces around vertex {vertex} do not form one complete fan in this level")]
-    IncompleteRing { vertex: u32 },
-    #[error("a face around vertex {vertex} is not a quad (refine once first)")]
-    NonQuadRing { vertex: u32 },
-    #[error("the level's sharpness tables do not match its topology")]
-    SharpnessLength,
-}
 
 /// Sparse row under construction. Entries keep their first-insertion order until
 /// [`Row::into_stencil`], so equal inputs built in the same order give bit-equal sums.
@@ -1194,7 +1159,7 @@ pub fn gregory_triangle_weights(u: f64, v: f64) -> PatchWeights<15> {
 /// Each triangle corner keeps its child's limit position and tangents (doubled: the child
 /// covers half of each edge) and its twist: with the triangle's local coordinates
 /// `(a, b) = (s, t)/2 − s·t/6` of the child's `(s, t)` (the bilinear map of the child onto the
-/// corner's third of the triangle, [`crate::AdaptivePatch::base_param`]), matching
+/// corner's third of the triangle, [`crate::patches::adaptive::AdaptivePatch::base_param`]), matching
 /// `∂²/∂a∂b` of the quartic at the corner with the child's gives
 ///
 /// ```text
@@ -1243,7 +1208,7 @@ pub fn gregory_triangle_from_children(children: [&[Stencil; 20]; 3]) -> [Stencil
 /// the boundary stay.
 ///
 /// `mids[p]`: the limit point of edge `p`'s midpoint. The patch's boundary correction
-/// ([`crate::AdaptivePlan::evaluate`]) puts its edges through them, which moves the centroid
+/// ([`crate::patches::adaptive::AdaptivePlan::evaluate`]) puts its edges through them, which moves the centroid
 /// by `4/9` of each midpoint's distance from the patch's own cubic there; that is accounted
 /// for, so the corrected patch passes through `centre`.
 pub fn gregory_triangle_through_centre(

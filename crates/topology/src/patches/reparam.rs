@@ -29,7 +29,8 @@ use crate::limit::basis::bezier_curve_weights;
 use crate::limit::eval::EvalError;
 use crate::limit::eval::{LimitScheme, LocalMesh};
 use crate::mesh::ControlMesh;
-use crate::patches::gregory::{gregory_basis, gregory_weights, Stencil};
+use crate::patches::gregory::{gregory_basis, gregory_weights};
+use crate::refine::stencil::Stencil;
 use crate::refine::{refine_uniform, Level};
 use crate::rules::Scheme;
 

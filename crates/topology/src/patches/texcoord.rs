@@ -9,7 +9,7 @@
 //!   midpoints and the face's centroid. Texture seams (a vertex with several `vt`) stay seams,
 //!   and a patch's coordinates are the bilinear blend of its own four corners' (a patch covers
 //!   an axis-aligned square of its (sub)face's parameter), so the GPU needs four pairs per patch.
-//! - **Reparameterization per corner valence** ([`crate::AdaptivePatch::reparam_valences`]):
+//! - **Reparameterization per corner valence** ([`crate::patches::adaptive::AdaptivePatch::reparam_valences`]):
 //!   the table's row at valences 3–16 (4 is the identity), the valence-16 row above it (measured
 //!   in docs/approximations.md: still 8–10× below no reparameterization up to valence 64), the
 //!   identity where the valence is 0 (boundary, crease and corner vertices; regular and ACC-1

@@ -50,13 +50,11 @@
 //! Doo-Sabin makes one child vertex per parent face corner and is uniform only.
 
 use crate::error::{TagKind, TopologyError};
-use crate::mesh::{
-    corner_faces, par_fill_ragged, prefix_sum, BoundaryInterpolation, ControlMesh, SubdivOptions,
-    Topology, TriangleSubdivision, INVALID,
-};
+use crate::mesh::{corner_faces, par_fill_ragged, prefix_sum, ControlMesh, Topology, INVALID};
 use crate::refine::stencil::{
     build_rows, compose_rows, entry_key, insertion_sort, RowKind, RowOut, StencilTable,
 };
+use crate::rules::options::{BoundaryInterpolation, SubdivOptions, TriangleSubdivision};
 use crate::rules::{
     boundary_edge_sharpness, boundary_vertex_sharpness, decrement_sharpness, fractional_weight,
     is_sharp, subdivide_edge_sharpness_at_vertex, vertex_rule, Rule, Scheme,
@@ -594,7 +592,7 @@ pub fn refine_sparse_region(
     let (nv, ne, nf) = (p.num_vertices(), p.num_edges(), p.num_faces());
     if scheme == Scheme::DooSabin {
         return Err(TopologyError::UnsupportedScheme {
-            scheme,
+            scheme: scheme.name(),
             operation: "sparse refinement",
         });
     }
@@ -2157,7 +2155,7 @@ mod tests {
             "catmark_tent_creases1",
             "catmark_flap2",
         ] {
-            let mesh = crate::load_obj(format!("{dir}{name}.obj")).unwrap();
+            let mesh = crate::mesh::obj::load_obj(format!("{dir}{name}.obj")).unwrap();
             fast += check_merged_rows(&mesh).0;
         }
         assert!(fast > 1000, "the merged rules ran on {fast} rows");
@@ -2205,7 +2203,7 @@ mod tests {
             "catmark_bishop",
             "catmark_hole_test3",
         ] {
-            let mesh = crate::load_obj(format!("{dir}{name}.obj")).unwrap();
+            let mesh = crate::mesh::obj::load_obj(format!("{dir}{name}.obj")).unwrap();
             let base = LevelTopology::from_mesh(&mesh, Scheme::CatmullClark).unwrap();
             let uniform = refine_level(
                 &Level::from_mesh(&mesh, Scheme::CatmullClark).unwrap(),

@@ -3,6 +3,28 @@
 
 use rayon::prelude::*;
 
+/// Weights over a level's vertex indices (ascending, no zero weights).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Stencil {
+    pub indices: Vec<u32>,
+    pub weights: Vec<f64>,
+}
+
+impl Stencil {
+    /// Apply to 3D points indexed like the level's vertices.
+    pub fn apply(&self, points: &[[f64; 3]]) -> [f64; 3] {
+        let mut out = [0.0; 3];
+        for (&i, &w) in self.indices.iter().zip(&self.weights) {
+            if let Some(p) = points.get(i as usize) {
+                for k in 0..3 {
+                    out[k] += w * p[k];
+                }
+            }
+        }
+        out
+    }
+}
+
 /// Row-compressed stencils: stencil `i` uses `indices[offsets[i]..offsets[i + 1]]` with the
 /// matching `weights`. Indices within a stencil are sorted and unique.
 #[derive(Clone, Debug, Default, PartialEq)]

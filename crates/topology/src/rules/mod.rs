@@ -8,8 +8,10 @@
 //! refiner ([`crate::refine`]) gathers the incident sharpness values and calls these functions,
 //! and the evaluator ([`crate::limit::eval`]) refines through the refiner, so a crease fix is made once.
 
+pub mod options;
+
 use crate::error::TopologyError;
-use crate::mesh::{BoundaryInterpolation, CreaseMethod};
+use options::{BoundaryInterpolation, CreaseMethod};
 
 /// The subdivision schemes this crate refines.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -966,7 +966,7 @@ fn triangle_patch(
     if first == INVALID {
         return Err(TopologyError::AdaptivePatch { level: 0, face: f });
     }
-    let basis: Vec<[crate::patches::gregory::Stencil; 20]> = (0..3)
+    let basis: Vec<[crate::refine::stencil::Stencil; 20]> = (0..3)
         .map(|k| {
             crate::patches::gregory::gregory_basis(
                 l1.topo.view(),
@@ -980,7 +980,7 @@ fn triangle_patch(
     // Per edge p (corner p to p + 1), the inner points of its two level-1 halves in the edge's
     // direction: child p's `Ep` at the corner and `Em` at the edge midpoint (its corner 1),
     // then child p + 1's `Ep` at the midpoint (its corner 3) and `Em` at the corner.
-    let halves: Vec<&crate::patches::gregory::Stencil> = (0..3)
+    let halves: Vec<&crate::refine::stencil::Stencil> = (0..3)
         .flat_map(|p| {
             let (a, b) = (&basis[p], &basis[(p + 1) % 3]);
             [&a[1], &a[5 + 2], &b[15 + 1], &b[2]]
@@ -1052,7 +1052,7 @@ fn gregory_face_rows(
 fn rotated_points<'a>(
     base: u32,
     shift: u8,
-    point: impl Fn(usize, usize) -> &'a crate::patches::gregory::Stencil,
+    point: impl Fn(usize, usize) -> &'a crate::refine::stencil::Stencil,
 ) -> PointRows {
     let s = shift as usize;
     PointRows::from_stencils(base, (0..20).map(|k| point((k / 5 + s) % 4, k % 5)))

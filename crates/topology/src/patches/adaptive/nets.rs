@@ -82,7 +82,7 @@ impl PointRows {
     /// Rows from stencils over a level's vertices, shifted to global ids by `base`.
     pub(super) fn from_stencils<'a>(
         base: u32,
-        stencils: impl IntoIterator<Item = &'a crate::patches::gregory::Stencil>,
+        stencils: impl IntoIterator<Item = &'a crate::refine::stencil::Stencil>,
     ) -> PointRows {
         let mut out = PointRows::with_capacity(256);
         for st in stencils {
@@ -847,7 +847,7 @@ pub(super) fn bezier_half(h: usize) -> [[f64; 4]; 4] {
 
 /// Who computes a curve's inner points: (kind rank, patch, patch edge, part: 0 whole edge,
 /// 1/2 first/second half of a coarse edge), packed into two words that compare in that order
-/// (8 bytes a curve, not 12, aligned as [`crate::CurveOwner`], collected in place).
+/// (8 bytes a curve, not 12, aligned as [`crate::patches::adaptive::CurveOwner`], collected in place).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub(super) struct Owner {
     /// Rank, then the patch's high half.

@@ -96,7 +96,8 @@ pub fn rounded_sharpness(mesh: &ControlMesh, scale: f32) -> Result<ControlMesh, 
 ///
 /// ```
 /// use topology::patches::adaptive::single_pass::{plan_single_pass, SinglePassOptions};
-/// use topology::{ControlMesh, PatchKind};
+/// use topology::patches::adaptive::PatchKind;
+/// use topology::ControlMesh;
 /// let p = [[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.],
 ///          [0., 0., 1.], [1., 0., 1.], [1., 1., 1.], [0., 1., 1.]];
 /// let faces = [[0u32, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]];
