@@ -2,6 +2,7 @@
 //! vertices and the selection (see the parent module for the design).
 
 use super::*;
+use crate::refine::SparseRefinement;
 
 /// A copy of `mesh` with tag sharpness scaled (infinite tags stay infinite); rejects NaN or
 /// negative sharpness.
@@ -108,45 +109,13 @@ pub(super) fn build_levels(
     max_refined_faces: u64,
     single_pass: bool,
 ) -> Result<Vec<Lvl>, TopologyError> {
-    let topo = LevelTopology::from_mesh(mesh, Scheme::CatmullClark)?;
-    if let Some((face, size)) = (0..topo.topology.num_faces())
-        .map(|f| (f, topo.topology.face_vertices(f).len()))
-        .find(|&(_, n)| n > 256)
-    {
-        return Err(TopologyError::AdaptiveFaceTooLarge { face, size });
-    }
-    let nf = topo.topology.num_faces();
-    let nv = topo.topology.num_vertices();
-    let mut hole = vec![false; nf];
-    for &h in &mesh.holes {
-        match hole.get_mut(h as usize) {
-            Some(x) => *x = true,
-            None => {
-                return Err(TopologyError::TagOutOfRange {
-                    tag: crate::error::TagKind::Hole,
-                    index: h,
-                    count: nf,
-                })
-            }
-        }
-    }
-    let mut levels = vec![Lvl {
-        topo,
-        base: 0,
-        complete: vec![true; nf],
-        hole,
-        selected: Vec::new(),
-        irregular: Vec::new(),
-        anc: (0..nv as u32).collect(),
-        maps: None,
-        stencils: None,
-        kv: 0,
-    }];
+    let mut levels = vec![base_level(mesh)?];
+    let nf = levels[0].t().num_faces();
     // Refined faces held so far (every level past 0); see "Size bound" in the module docs.
     let mut refined = 0u64;
     // Per vertex of the current level: the last level at which it carried a semi-sharp feature
     // (`NEVER` if it never did).
-    let mut last_semi_sharp = vec![NEVER; nv];
+    let mut last_semi_sharp = vec![NEVER; levels[0].t().num_vertices()];
     let deepest = if follow_semi_sharp {
         FOLLOW_LIMIT.max(iso)
     } else {
@@ -156,59 +125,14 @@ pub(super) fn build_levels(
         let last = l == deepest;
         let lvl = levels.last_mut().expect("level present");
         if last {
-            for s in lvl
-                .topo
-                .edge_sharpness
-                .iter_mut()
-                .chain(lvl.topo.vertex_sharpness.iter_mut())
-            {
-                if *s > 0.0 {
-                    *s = SHARPNESS_INFINITE;
-                }
-            }
+            make_sharpness_effective(lvl);
         }
-        // Only the vertices of complete faces are ever asked (patches, the selection and the
-        // end-cap projection are made of complete faces); the rest of a level is its one-ring.
-        let mut asked = vec![false; lvl.t().num_vertices()];
-        for f in 0..lvl.t().num_faces() {
-            if lvl.complete[f] && !lvl.hole[f] {
-                for &v in lvl.t().face_vertices(f) {
-                    asked[v as usize] = true;
-                }
-            }
-        }
-        let irregular: Vec<bool> = (0..lvl.t().num_vertices())
-            .into_par_iter()
-            .with_min_len(1024)
-            .map(|v| asked[v] && vertex_irregular(lvl, v))
-            .collect();
-        lvl.irregular = irregular;
-        // Past the isolation level only semi-sharp features are followed.
-        let follow: Vec<bool> = if single_pass {
-            let t = lvl.t();
-            (0..t.num_vertices())
-                .map(|v| {
-                    t.vertex_faces(v)
-                        .iter()
-                        .any(|&f| t.face_vertices(f as usize).len() != 4)
-                })
-                .collect()
+        lvl.irregular = irregular_vertices(lvl);
+        let follow = if single_pass {
+            next_to_non_quads(lvl.t())
         } else {
-            if follow_semi_sharp {
-                for (v, last) in last_semi_sharp.iter_mut().enumerate() {
-                    if lvl.irregular[v] && semi_sharp(lvl, v) {
-                        *last = l as u32;
-                    }
-                }
-            }
-            (0..lvl.t().num_vertices())
-                .map(|v| {
-                    lvl.irregular[v]
-                        && (l < iso
-                            || (follow_semi_sharp
-                                && l < start(last_semi_sharp[v]) + cap_depth(lvl, v, iso)))
-                })
-                .collect()
+            let semi_sharp = follow_semi_sharp.then_some(&mut last_semi_sharp[..]);
+            followed(lvl, l, iso, semi_sharp)
         };
         let t = &lvl.topo.topology;
         lvl.selected = (0..t.num_faces())
@@ -248,66 +172,194 @@ pub(super) fn build_levels(
             &selection,
             SparseRegion::SelectedCorners,
         )?;
-        let base = lvl
-            .base
-            .checked_add(t.num_vertices() as u32)
-            .filter(|b| {
-                b.checked_add(r.child.topology.num_vertices() as u32)
-                    .is_some()
-            })
-            .ok_or(TopologyError::RefinementTooLarge {
-                faces: t.num_faces(),
-            })?;
-        refined = refined.saturating_add(r.child.topology.num_faces() as u64);
-        let maps = r.maps;
-        let complete = maps
-            .child_face_parent
-            .iter()
-            .map(|&p| lvl.selected[p as usize])
-            .collect();
-        let hole = maps
-            .child_face_parent
-            .iter()
-            .map(|&p| lvl.hole[p as usize])
-            .collect();
-        let anc = maps
-            .child_vertex_origin
-            .iter()
-            .enumerate()
-            .map(|(c, o)| match *o {
-                ChildOrigin::Vertex(p) => lvl.anc[p as usize],
-                _ => base + c as u32,
-            })
-            .collect();
-        if follow_semi_sharp {
-            last_semi_sharp = maps
-                .child_vertex_origin
-                .iter()
-                .map(|o| match *o {
-                    ChildOrigin::Vertex(p) => last_semi_sharp[p as usize],
-                    _ => NEVER,
-                })
-                .collect();
-        }
-        let kv = maps
-            .child_vertex_origin
-            .iter()
-            .take_while(|o| matches!(o, ChildOrigin::Vertex(_)))
-            .count();
-        levels.push(Lvl {
-            topo: r.child,
-            base,
-            complete,
-            hole,
-            selected: Vec::new(),
-            irregular: Vec::new(),
-            anc,
-            maps: Some(maps),
-            stencils: Some(r.stencils),
-            kv,
-        });
+        let child = child_level(
+            lvl,
+            r,
+            &mut refined,
+            follow_semi_sharp,
+            &mut last_semi_sharp,
+        )?;
+        levels.push(child);
     }
     Ok(levels)
+}
+
+/// Level 0: the mesh's topology, every face complete, its holes; faces past the 256 corners
+/// a patch can number and holes that name no face are errors.
+fn base_level(mesh: &ControlMesh) -> Result<Lvl, TopologyError> {
+    let topo = LevelTopology::from_mesh(mesh, Scheme::CatmullClark)?;
+    if let Some((face, size)) = (0..topo.topology.num_faces())
+        .map(|f| (f, topo.topology.face_vertices(f).len()))
+        .find(|&(_, n)| n > 256)
+    {
+        return Err(TopologyError::AdaptiveFaceTooLarge { face, size });
+    }
+    let nf = topo.topology.num_faces();
+    let nv = topo.topology.num_vertices();
+    let mut hole = vec![false; nf];
+    for &h in &mesh.holes {
+        match hole.get_mut(h as usize) {
+            Some(x) => *x = true,
+            None => {
+                return Err(TopologyError::TagOutOfRange {
+                    tag: crate::error::TagKind::Hole,
+                    index: h,
+                    count: nf,
+                })
+            }
+        }
+    }
+    Ok(Lvl {
+        topo,
+        base: 0,
+        complete: vec![true; nf],
+        hole,
+        selected: Vec::new(),
+        irregular: Vec::new(),
+        anc: (0..nv as u32).collect(),
+        maps: None,
+        stencils: None,
+        kv: 0,
+    })
+}
+
+/// At the deepest level, every positive sharpness becomes infinite (the effective sharpness
+/// of the module documentation's "Patches").
+fn make_sharpness_effective(lvl: &mut Lvl) {
+    for s in lvl
+        .topo
+        .edge_sharpness
+        .iter_mut()
+        .chain(lvl.topo.vertex_sharpness.iter_mut())
+    {
+        if *s > 0.0 {
+            *s = SHARPNESS_INFINITE;
+        }
+    }
+}
+
+/// Per vertex: whether it needs isolating ([`vertex_irregular`]). Only the vertices of
+/// complete faces are ever asked (patches, the selection and the end-cap projection are made
+/// of complete faces); the rest of a level is its one-ring, false here.
+fn irregular_vertices(lvl: &Lvl) -> Vec<bool> {
+    let mut asked = vec![false; lvl.t().num_vertices()];
+    for f in 0..lvl.t().num_faces() {
+        if lvl.complete[f] && !lvl.hole[f] {
+            for &v in lvl.t().face_vertices(f) {
+                asked[v as usize] = true;
+            }
+        }
+    }
+    (0..lvl.t().num_vertices())
+        .into_par_iter()
+        .with_min_len(1024)
+        .map(|v| asked[v] && vertex_irregular(lvl, v))
+        .collect()
+}
+
+/// Per vertex of level `l`: whether the faces at it are selected. Irregular vertices are
+/// isolated to `iso`; past it only semi-sharp features are followed, when `last_semi_sharp`
+/// is given (updated here with the vertices that carry one at `l`), until [`cap_depth`]
+/// levels after their sharpness decayed.
+fn followed(lvl: &Lvl, l: usize, iso: usize, last_semi_sharp: Option<&mut [u32]>) -> Vec<bool> {
+    let Some(last_semi_sharp) = last_semi_sharp else {
+        return (0..lvl.t().num_vertices())
+            .map(|v| lvl.irregular[v] && l < iso)
+            .collect();
+    };
+    for (v, last) in last_semi_sharp.iter_mut().enumerate() {
+        if lvl.irregular[v] && semi_sharp(lvl, v) {
+            *last = l as u32;
+        }
+    }
+    (0..lvl.t().num_vertices())
+        .map(|v| {
+            lvl.irregular[v] && (l < iso || l < start(last_semi_sharp[v]) + cap_depth(lvl, v, iso))
+        })
+        .collect()
+}
+
+/// Per vertex: whether a face at it is not a quad (what single-pass plans select around).
+fn next_to_non_quads(t: &Topology) -> Vec<bool> {
+    (0..t.num_vertices())
+        .map(|v| {
+            t.vertex_faces(v)
+                .iter()
+                .any(|&f| t.face_vertices(f as usize).len() != 4)
+        })
+        .collect()
+}
+
+/// The level a sparse step `r` of `lvl` made: its global ids after the parent's, which of its
+/// faces are complete (children of selected faces) and holes, each vertex's canonical
+/// ancestor. Counts its faces into `refined`; with `follow_semi_sharp`, carries
+/// `last_semi_sharp` over to its vertex-vertices.
+fn child_level(
+    lvl: &Lvl,
+    r: SparseRefinement,
+    refined: &mut u64,
+    follow_semi_sharp: bool,
+    last_semi_sharp: &mut Vec<u32>,
+) -> Result<Lvl, TopologyError> {
+    let t = lvl.t();
+    let base = lvl
+        .base
+        .checked_add(t.num_vertices() as u32)
+        .filter(|b| {
+            b.checked_add(r.child.topology.num_vertices() as u32)
+                .is_some()
+        })
+        .ok_or(TopologyError::RefinementTooLarge {
+            faces: t.num_faces(),
+        })?;
+    *refined = refined.saturating_add(r.child.topology.num_faces() as u64);
+    let maps = r.maps;
+    let complete = maps
+        .child_face_parent
+        .iter()
+        .map(|&p| lvl.selected[p as usize])
+        .collect();
+    let hole = maps
+        .child_face_parent
+        .iter()
+        .map(|&p| lvl.hole[p as usize])
+        .collect();
+    let anc = maps
+        .child_vertex_origin
+        .iter()
+        .enumerate()
+        .map(|(c, o)| match *o {
+            ChildOrigin::Vertex(p) => lvl.anc[p as usize],
+            _ => base + c as u32,
+        })
+        .collect();
+    if follow_semi_sharp {
+        *last_semi_sharp = maps
+            .child_vertex_origin
+            .iter()
+            .map(|o| match *o {
+                ChildOrigin::Vertex(p) => last_semi_sharp[p as usize],
+                _ => NEVER,
+            })
+            .collect();
+    }
+    let kv = maps
+        .child_vertex_origin
+        .iter()
+        .take_while(|o| matches!(o, ChildOrigin::Vertex(_)))
+        .count();
+    Ok(Lvl {
+        topo: r.child,
+        base,
+        complete,
+        hole,
+        selected: Vec::new(),
+        irregular: Vec::new(),
+        anc,
+        maps: Some(maps),
+        stencils: Some(r.stencils),
+        kv,
+    })
 }
 
 /// Subdominant eigenvalue of Catmull-Clark's smooth subdivision matrix at valence `n`: the
