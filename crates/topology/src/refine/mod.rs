@@ -581,6 +581,10 @@ pub enum SparseRegion {
 /// the stencils of their vertices are those of [`refine_sparse`] (the same rows, bit for bit,
 /// under other child numbers); a one-ring face's children are made only at corners of selected
 /// faces, so they come in corner order but not always all of them.
+///
+/// The step: the region (`Region`: the selected faces' one-ring, the vertices and edges
+/// whose children are made), the child numbering (`ChildNumbering`), the edge halves'
+/// sharpness and the stencil rows, then the child topology (`SparseChild`).
 pub fn refine_sparse_region(
     parent: LevelRef<'_>,
     scheme: Scheme,
@@ -589,7 +593,7 @@ pub fn refine_sparse_region(
     region: SparseRegion,
 ) -> Result<SparseRefinement, TopologyError> {
     let p = parent.topology;
-    let (nv, ne, nf) = (p.num_vertices(), p.num_edges(), p.num_faces());
+    let nf = p.num_faces();
     if scheme == Scheme::DooSabin {
         return Err(TopologyError::UnsupportedScheme {
             scheme: scheme.name(),
@@ -604,90 +608,10 @@ pub fn refine_sparse_region(
     }
     check_size(p, scheme)?;
     let quads = scheme.splits_into_quads();
+    let region = Region::of(p, selected, quads, region)?;
+    let numbering = ChildNumbering::of(p, &region, quads);
 
-    // The region: the selected faces and their one-ring, then its vertices and edges.
-    // Marks, not sort and dedup: each face is reached once per corner of every selected face
-    // around it (about 16 times), and the marks give parent order directly.
-    let mut face_mark = vec![false; nf];
-    for &f in selected {
-        for &v in p.face_vertices(f as usize) {
-            for &g in p.vertex_faces(v as usize) {
-                face_mark[g as usize] = true;
-            }
-        }
-    }
-    let faces = marked(&face_mark);
-    if !quads {
-        if let Some(&f) = faces
-            .iter()
-            .find(|&&f| p.face_vertices(f as usize).len() != 3)
-        {
-            return Err(TopologyError::LoopRequiresTriangles {
-                face: f as usize,
-                size: p.face_vertices(f as usize).len(),
-            });
-        }
-    }
-    // Corners whose children are made: every corner of the region (the whole one-ring), or
-    // only the corners of selected faces.
-    let corners_only = quads && region == SparseRegion::SelectedCorners;
-    let mut vert_mark = vec![false; nv];
-    let corner_faces: &[u32] = if corners_only { selected } else { &faces };
-    for &f in corner_faces {
-        for &v in p.face_vertices(f as usize) {
-            vert_mark[v as usize] = true;
-        }
-    }
-    // The edges at those corners (every edge of the region when every corner is made).
-    let mut edge_mark = vec![false; ne];
-    for &f in &faces {
-        let fv = p.face_vertices(f as usize);
-        let n = fv.len();
-        for (i, &e) in p.face_edge_list(f as usize).iter().enumerate() {
-            if vert_mark[fv[i] as usize] || vert_mark[fv[(i + 1) % n] as usize] {
-                edge_mark[e as usize] = true;
-            }
-        }
-    }
-    let verts = marked(&vert_mark);
-    let edges = marked(&edge_mark);
-
-    // Child numbering: vertex-vertices, edge-vertices, face-vertices, each in parent order.
-    let (kv, ke) = (verts.len(), edges.len());
-    let mut vertex_child_vertex = vec![INVALID; nv];
-    let mut edge_child_vertex = vec![INVALID; ne];
-    let mut face_child_vertex = vec![INVALID; nf];
-    let mut origin = Vec::with_capacity(kv + ke + faces.len());
-    for (i, &v) in verts.iter().enumerate() {
-        vertex_child_vertex[v as usize] = i as u32;
-        origin.push(ChildOrigin::Vertex(v));
-    }
-    for (i, &e) in edges.iter().enumerate() {
-        edge_child_vertex[e as usize] = (kv + i) as u32;
-        origin.push(ChildOrigin::Edge(e));
-    }
-    if quads {
-        for (i, &f) in faces.iter().enumerate() {
-            face_child_vertex[f as usize] = (kv + ke + i) as u32;
-            origin.push(ChildOrigin::Face(f));
-        }
-    }
-
-    // Sharpness of the edge halves in the parent's numbering (2e, 2e + 1), as the masks read
-    // it: a vertex-vertex's rule reads the halves of all its edges, also those leaving the
-    // region, so every edge at a refined vertex gets its halves.
-    let mut halves = vec![0.0f32; 2 * ne];
-    let mut scratch = Vec::new();
-    for &v in &verts {
-        for &e in p.vertex_edges(v as usize) {
-            let e = e as usize;
-            // Smooth edges have smooth halves (as the zeroed `halves` has them).
-            if is_sharp(parent.edge_sharpness[e]) {
-                let pair = half_edge_sharpness(p, parent.edge_sharpness, options, e, &mut scratch);
-                halves[2 * e..2 * e + 2].copy_from_slice(&pair);
-            }
-        }
-    }
+    let halves = region_half_sharpness(parent, options, &region.verts);
     let decayed: Vec<f32> = parent
         .vertex_sharpness
         .iter()
@@ -702,279 +626,28 @@ pub fn refine_sparse_region(
         child_edge_sharpness: &halves,
         child_vertex_sharpness: &decayed,
     };
-    let stencils = build_rows(origin.len(), nv, |i, out| {
-        let uniform_index = match origin[i] {
-            ChildOrigin::Vertex(v) => v as usize,
-            ChildOrigin::Edge(e) => nv + e as usize,
-            ChildOrigin::Face(f) => nv + ne + f as usize,
-        };
-        ctx.row_merged(uniform_index, out)
-    });
+    let stencils = numbering.stencils(&ctx);
 
-    // Child edges: the two halves of each refined edge, then the interior edges of each
-    // refined face (one per corner for quads, three per triangle for Loop).
-    let vc = |v: u32| vertex_child_vertex[v as usize];
-    let ec = |e: u32| edge_child_vertex[e as usize];
-    // Whether corner vertex `v` has children (every region vertex has, unless corners_only).
-    let made = |v: u32| vertex_child_vertex[v as usize] != INVALID;
-    // Quads: the child's vertex → edge and vertex → face lists are filled as the child edges
-    // and faces are made (both in ascending order, so the lists come out as the counting sort
-    // of `Topology::from_parts` makes them), into rows counted from the parent: a
-    // vertex-vertex has a half of each refined edge and a child of each refined face at its
-    // vertex, an edge-vertex its halves and an inner edge per refined face of its edge and a
-    // child per made end and face, a face-vertex an inner edge per edge at a made corner and
-    // its children. Counts go to slot `c + 2`, so that after the prefix sum slot `c + 1` is
-    // the fill cursor of child vertex `c` and ends as its end offset.
-    let nc = origin.len();
-    let (mut edge_rows, mut face_rows) = if quads {
-        (vec![0u32; nc + 2], vec![0u32; nc + 2])
-    } else {
-        (Vec::new(), Vec::new())
-    };
-    // Whether face `g` is refined.
-    let refined = |g: u32| g != INVALID && face_mark[g as usize];
-    if quads {
-        for (i, &v) in verts.iter().enumerate() {
-            let (ne_v, nf_v) = if corners_only {
-                // Every face at a selected face's corner is in the region, and so every edge.
-                (
-                    p.vertex_edges(v as usize).len(),
-                    p.vertex_faces(v as usize).len(),
-                )
-            } else {
-                (
-                    p.vertex_edges(v as usize)
-                        .iter()
-                        .filter(|&&e| edge_mark[e as usize])
-                        .count(),
-                    p.vertex_faces(v as usize)
-                        .iter()
-                        .filter(|&&g| face_mark[g as usize])
-                        .count(),
-                )
-            };
-            edge_rows[i + 2] = ne_v as u32;
-            face_rows[i + 2] = nf_v as u32;
-        }
-        for (r, &e) in edges.iter().enumerate() {
-            let ends = p.edge_verts[e as usize]
-                .iter()
-                .filter(|&&v| made(v))
-                .count() as u32;
-            let faces_e = p.edge_faces[e as usize]
-                .iter()
-                .filter(|&&g| refined(g))
-                .count() as u32;
-            edge_rows[kv + r + 2] = ends + faces_e;
-            face_rows[kv + r + 2] = ends * faces_e;
-        }
+    let mut child = SparseChild::new(p, &region, &numbering, quads);
+    child.halves(&region.edges, &halves);
+    for &f in &region.faces {
+        child.children_of(f);
     }
-    // Sized up front (a quad per corner, or four triangles): growing them copied MBs per level.
-    let mut child_faces = 0usize;
-    for (r, &f) in faces.iter().enumerate() {
-        if quads {
-            let fv = p.face_vertices(f as usize);
-            let n = fv.len();
-            let (mut corners_made, mut inner) = (0u32, 0u32);
-            for i in 0..n {
-                corners_made += u32::from(made(fv[i]));
-                inner += u32::from(made(fv[i]) || made(fv[(i + 1) % n]));
-            }
-            edge_rows[kv + ke + r + 2] = inner;
-            face_rows[kv + ke + r + 2] = corners_made;
-            child_faces += corners_made as usize;
-        } else {
-            child_faces += 4;
-        }
-    }
-    prefix_sum(&mut edge_rows);
-    prefix_sum(&mut face_rows);
-    let mut vert_edges = vec![0u32; edge_rows.last().map_or(0, |&x| x as usize)];
-    let mut vert_faces = vec![0u32; face_rows.last().map_or(0, |&x| x as usize)];
-    let mut edge_to = |c: u32, e: u32| {
-        let cursor = &mut edge_rows[c as usize + 1];
-        vert_edges[*cursor as usize] = e;
-        *cursor += 1;
-    };
-    let corners = if quads { 4 } else { 3 } * child_faces;
-    // The halves, then one inner edge per child quad (or three per triangle; with
-    // corners_only, one per parent edge at a made corner, at most one per child quad).
-    let inner_edges = if quads { child_faces } else { 3 * faces.len() };
-    // Each refined edge's halves (`ChildMaps::edge_child_halves`): both, unless corners_only
-    // leaves an end without a vertex-vertex, and so without its half.
-    let mut edge_child_halves: Vec<[u32; 2]> = Vec::with_capacity(ke);
-    let mut edge_verts: Vec<[u32; 2]> = Vec::with_capacity(2 * ke + inner_edges);
-    let mut edge_sharpness: Vec<f32> = Vec::with_capacity(edge_verts.capacity());
-    for &e in &edges {
-        let [a, b] = p.edge_verts[e as usize];
-        let h = &halves[2 * e as usize..2 * e as usize + 2];
-        let mut pair = [INVALID; 2];
-        if made(a) {
-            pair[0] = edge_verts.len() as u32;
-            edge_verts.push([vc(a), ec(e)]);
-            edge_sharpness.push(h[0]);
-        }
-        if made(b) {
-            pair[1] = edge_verts.len() as u32;
-            edge_verts.push([ec(e), vc(b)]);
-            edge_sharpness.push(h[1]);
-        }
-        if quads {
-            for x in pair {
-                if x != INVALID {
-                    let [u, w] = edge_verts[x as usize];
-                    edge_to(u, x);
-                    edge_to(w, x);
-                }
-            }
-        }
-        edge_child_halves.push(pair);
-    }
-    let half_at = |e: u32, v: u32| {
-        let [a, _] = p.edge_verts[e as usize];
-        edge_child_halves[(ec(e) - kv as u32) as usize][usize::from(a != v)]
-    };
-    // Quads: each child edge's faces, filled as the faces are made (as `from_parts` does).
-    let mut edge_faces: Vec<[u32; 2]> = if quads {
-        vec![[INVALID; 2]; 2 * ke + inner_edges]
-    } else {
-        Vec::new()
-    };
-    let mut face_first_child = vec![INVALID; nf];
-    let mut inner_at: Vec<u32> = Vec::new();
-    let mut child_face_parent = Vec::with_capacity(child_faces);
-    let mut face_offsets = Vec::with_capacity(child_faces + 1);
-    face_offsets.push(0u32);
-    let mut face_verts = Vec::with_capacity(corners);
-    let mut face_edges = Vec::with_capacity(corners);
-    for &f in &faces {
-        let fv = p.face_vertices(f as usize);
-        let fe = p.face_edge_list(f as usize);
-        let n = fv.len();
-        let inner = edge_verts.len() as u32;
-        face_first_child[f as usize] = child_face_parent.len() as u32;
-        if let (true, Ok(fv), Ok(fe)) =
-            (quads, <&[u32; 4]>::try_from(fv), <&[u32; 4]>::try_from(fe))
-        {
-            // A quad: as the general case below, unrolled.
-            let fc = face_child_vertex[f as usize];
-            let corner_made = [made(fv[0]), made(fv[1]), made(fv[2]), made(fv[3])];
-            let mut inner4 = [INVALID; 4];
-            for i in 0..4 {
-                if corner_made[i] || corner_made[(i + 1) & 3] {
-                    let x = edge_verts.len() as u32;
-                    inner4[i] = x;
-                    edge_verts.push([ec(fe[i]), fc]);
-                    edge_to(ec(fe[i]), x);
-                    edge_to(fc, x);
-                }
-            }
-            for i in 0..4 {
-                if !corner_made[i] {
-                    continue;
-                }
-                let prev = (i + 3) & 3;
-                let (v, e, ep) = (fv[i], fe[i], fe[prev]);
-                let qv = [vc(v), ec(e), fc, ec(ep)];
-                let qe = [half_at(e, v), inner4[i], inner4[prev], half_at(ep, v)];
-                quad_made(
-                    (&mut face_rows, &mut vert_faces, &mut edge_faces),
-                    child_face_parent.len() as u32,
-                    qv,
-                    qe,
-                );
-                face_verts.extend_from_slice(&qv);
-                face_edges.extend_from_slice(&qe);
-                face_offsets.push(face_verts.len() as u32);
-                child_face_parent.push(f);
-            }
-        } else if quads {
-            // Inner edge i (edge i's vertex to the face's) where corner i or i + 1 is made: all
-            // of them unless corners_only, in edge order either way.
-            let fc = face_child_vertex[f as usize];
-            inner_at.clear();
-            inner_at.resize(n, INVALID);
-            for (i, &e) in fe.iter().enumerate() {
-                if made(fv[i]) || made(fv[(i + 1) % n]) {
-                    let x = edge_verts.len() as u32;
-                    inner_at[i] = x;
-                    edge_verts.push([ec(e), fc]);
-                    edge_to(ec(e), x);
-                    edge_to(fc, x);
-                }
-            }
-            for i in 0..n {
-                if !made(fv[i]) {
-                    continue;
-                }
-                let prev = (i + n - 1) % n;
-                let (v, e, ep) = (fv[i], fe[i], fe[prev]);
-                let qv = [vc(v), ec(e), fc, ec(ep)];
-                let qe = [half_at(e, v), inner_at[i], inner_at[prev], half_at(ep, v)];
-                quad_made(
-                    (&mut face_rows, &mut vert_faces, &mut edge_faces),
-                    child_face_parent.len() as u32,
-                    qv,
-                    qe,
-                );
-                face_verts.extend_from_slice(&qv);
-                face_edges.extend_from_slice(&qe);
-                face_offsets.push(face_verts.len() as u32);
-                child_face_parent.push(f);
-            }
-        } else {
-            for j in 0..3 {
-                let prev = (j + 2) % 3;
-                // Inner edge j joins the midpoints of the two edges at corner j.
-                edge_verts.push([ec(fe[j]), ec(fe[prev])]);
-                face_verts.extend_from_slice(&[vc(fv[j]), ec(fe[j]), ec(fe[prev])]);
-                face_edges.extend_from_slice(&[
-                    half_at(fe[j], fv[j]),
-                    inner + j as u32,
-                    half_at(fe[prev], fv[j]),
-                ]);
-                face_offsets.push(face_verts.len() as u32);
-                child_face_parent.push(f);
-            }
-            face_verts.extend_from_slice(&[ec(fe[0]), ec(fe[1]), ec(fe[2])]);
-            face_edges.extend_from_slice(&[inner + 1, inner + 2, inner]);
-            face_offsets.push(face_verts.len() as u32);
-            child_face_parent.push(f);
-        }
-    }
-    edge_sharpness.resize(edge_verts.len(), 0.0);
-    let mut vertex_sharpness = vec![0.0f32; origin.len()];
-    for (slot, &v) in vertex_sharpness.iter_mut().zip(&verts) {
-        *slot = decayed[v as usize];
-    }
-    let topology = if quads {
-        edge_faces.truncate(edge_verts.len());
-        edge_rows.pop();
-        face_rows.pop();
-        Topology {
-            num_vertices: nc,
-            face_offsets,
-            face_verts,
-            face_edges,
-            edge_verts,
-            edge_faces,
-            vert_edge_offsets: edge_rows,
-            vert_edges,
-            vert_face_offsets: face_rows,
-            vert_faces,
-        }
-    } else {
-        Topology::from_parts(nc, face_offsets, face_verts, face_edges, edge_verts)
-    };
+    let face_first_child = std::mem::take(&mut child.face_first_child);
+    let child_face_parent = std::mem::take(&mut child.child_face_parent);
+    let edge_child_halves = std::mem::take(&mut child.edge_child_halves);
+    let child = child.level(&region, &decayed);
+    let ChildNumbering {
+        vertex_child_vertex,
+        edge_child_vertex,
+        face_child_vertex,
+        origin,
+    } = numbering;
     Ok(SparseRefinement {
-        child: LevelTopology {
-            topology,
-            edge_sharpness,
-            vertex_sharpness,
-        },
+        child,
         stencils,
         maps: ChildMaps {
-            refined_faces: faces,
+            refined_faces: region.faces,
             vertex_child_vertex,
             edge_child_vertex,
             face_child_vertex,
@@ -984,6 +657,570 @@ pub fn refine_sparse_region(
             edge_child_halves,
         },
     })
+}
+
+/// Sharpness of the edge halves in the parent's numbering (2e, 2e + 1), as the masks read
+/// it: a vertex-vertex's rule reads the halves of all its edges, also those leaving the
+/// region, so every edge at a refined vertex (`verts`) gets its halves.
+fn region_half_sharpness(parent: LevelRef<'_>, options: &SubdivOptions, verts: &[u32]) -> Vec<f32> {
+    let p = parent.topology;
+    let mut halves = vec![0.0f32; 2 * p.num_edges()];
+    let mut scratch = Vec::new();
+    for &v in verts {
+        for &e in p.vertex_edges(v as usize) {
+            let e = e as usize;
+            // Smooth edges have smooth halves (as the zeroed `halves` has them).
+            if is_sharp(parent.edge_sharpness[e]) {
+                let pair = half_edge_sharpness(p, parent.edge_sharpness, options, e, &mut scratch);
+                halves[2 * e..2 * e + 2].copy_from_slice(&pair);
+            }
+        }
+    }
+    halves
+}
+
+/// The part of a parent level a sparse step refines: the selected faces and their one-ring,
+/// then the vertices and edges whose children are made.
+struct Region {
+    /// Per parent face, whether it is refined.
+    face_mark: Vec<bool>,
+    /// Per parent edge, whether it is refined.
+    edge_mark: Vec<bool>,
+    /// The refined faces, vertices and edges, in parent order.
+    faces: Vec<u32>,
+    verts: Vec<u32>,
+    edges: Vec<u32>,
+    /// Only the corners of selected faces get children ([`SparseRegion::SelectedCorners`]).
+    corners_only: bool,
+}
+
+impl Region {
+    fn of(
+        p: &Topology,
+        selected: &[u32],
+        quads: bool,
+        region: SparseRegion,
+    ) -> Result<Region, TopologyError> {
+        // Marks, not sort and dedup: each face is reached once per corner of every selected
+        // face around it (about 16 times), and the marks give parent order directly.
+        let mut face_mark = vec![false; p.num_faces()];
+        for &f in selected {
+            for &v in p.face_vertices(f as usize) {
+                for &g in p.vertex_faces(v as usize) {
+                    face_mark[g as usize] = true;
+                }
+            }
+        }
+        let faces = marked(&face_mark);
+        if !quads {
+            if let Some(&f) = faces
+                .iter()
+                .find(|&&f| p.face_vertices(f as usize).len() != 3)
+            {
+                return Err(TopologyError::LoopRequiresTriangles {
+                    face: f as usize,
+                    size: p.face_vertices(f as usize).len(),
+                });
+            }
+        }
+        // Corners whose children are made: every corner of the region (the whole one-ring),
+        // or only the corners of selected faces.
+        let corners_only = quads && region == SparseRegion::SelectedCorners;
+        let mut vert_mark = vec![false; p.num_vertices()];
+        let corner_faces: &[u32] = if corners_only { selected } else { &faces };
+        for &f in corner_faces {
+            for &v in p.face_vertices(f as usize) {
+                vert_mark[v as usize] = true;
+            }
+        }
+        // The edges at those corners (every edge of the region when every corner is made).
+        let mut edge_mark = vec![false; p.num_edges()];
+        for &f in &faces {
+            let fv = p.face_vertices(f as usize);
+            let n = fv.len();
+            for (i, &e) in p.face_edge_list(f as usize).iter().enumerate() {
+                if vert_mark[fv[i] as usize] || vert_mark[fv[(i + 1) % n] as usize] {
+                    edge_mark[e as usize] = true;
+                }
+            }
+        }
+        let verts = marked(&vert_mark);
+        let edges = marked(&edge_mark);
+        Ok(Region {
+            face_mark,
+            edge_mark,
+            faces,
+            verts,
+            edges,
+            corners_only,
+        })
+    }
+}
+
+/// The child vertices of a sparse step: vertex-vertices, edge-vertices, face-vertices, each
+/// in parent order, with the parent → child maps.
+struct ChildNumbering {
+    vertex_child_vertex: Vec<u32>,
+    edge_child_vertex: Vec<u32>,
+    face_child_vertex: Vec<u32>,
+    origin: Vec<ChildOrigin>,
+}
+
+impl ChildNumbering {
+    fn of(p: &Topology, region: &Region, quads: bool) -> ChildNumbering {
+        let (kv, ke) = (region.verts.len(), region.edges.len());
+        let mut vertex_child_vertex = vec![INVALID; p.num_vertices()];
+        let mut edge_child_vertex = vec![INVALID; p.num_edges()];
+        let mut face_child_vertex = vec![INVALID; p.num_faces()];
+        let mut origin = Vec::with_capacity(kv + ke + region.faces.len());
+        for (i, &v) in region.verts.iter().enumerate() {
+            vertex_child_vertex[v as usize] = i as u32;
+            origin.push(ChildOrigin::Vertex(v));
+        }
+        for (i, &e) in region.edges.iter().enumerate() {
+            edge_child_vertex[e as usize] = (kv + i) as u32;
+            origin.push(ChildOrigin::Edge(e));
+        }
+        if quads {
+            for (i, &f) in region.faces.iter().enumerate() {
+                face_child_vertex[f as usize] = (kv + ke + i) as u32;
+                origin.push(ChildOrigin::Face(f));
+            }
+        }
+        ChildNumbering {
+            vertex_child_vertex,
+            edge_child_vertex,
+            face_child_vertex,
+            origin,
+        }
+    }
+
+    /// One stencil row per child vertex, in child order: the uniform refiner's row of the
+    /// same parent component.
+    fn stencils(&self, ctx: &MaskContext<'_>) -> StencilTable {
+        let (nv, ne) = (ctx.p.num_vertices(), ctx.p.num_edges());
+        build_rows(self.origin.len(), nv, |i, out| {
+            let uniform_index = match self.origin[i] {
+                ChildOrigin::Vertex(v) => v as usize,
+                ChildOrigin::Edge(e) => nv + e as usize,
+                ChildOrigin::Face(f) => nv + ne + f as usize,
+            };
+            ctx.row_merged(uniform_index, out)
+        })
+    }
+}
+
+/// The child topology of a sparse step as it is made: the two halves of each refined edge,
+/// then the children of each refined face with their interior edges (one per corner for
+/// quads, three per triangle for Loop).
+///
+/// Quads: the child's vertex → edge and vertex → face lists are filled as the child edges and
+/// faces are made (both in ascending order, so the lists come out as the counting sort of
+/// `Topology::from_parts` makes them), into rows counted from the parent: a vertex-vertex has
+/// a half of each refined edge and a child of each refined face at its vertex, an
+/// edge-vertex its halves and an inner edge per refined face of its edge and a child per made
+/// end and face, a face-vertex an inner edge per edge at a made corner and its children.
+/// Counts go to slot `c + 2`, so that after the prefix sum slot `c + 1` is the fill cursor of
+/// child vertex `c` and ends as its end offset.
+struct SparseChild<'a> {
+    p: &'a Topology,
+    quads: bool,
+    /// Child vertices, and the first edge-vertex.
+    nc: usize,
+    kv: usize,
+    vertex_child_vertex: &'a [u32],
+    edge_child_vertex: &'a [u32],
+    face_child_vertex: &'a [u32],
+    /// Quads: the vertex → edge and vertex → face rows (fill cursors until made) and lists.
+    edge_rows: Vec<u32>,
+    face_rows: Vec<u32>,
+    vert_edges: Vec<u32>,
+    vert_faces: Vec<u32>,
+    /// Each refined edge's halves (`ChildMaps::edge_child_halves`).
+    edge_child_halves: Vec<[u32; 2]>,
+    edge_verts: Vec<[u32; 2]>,
+    edge_sharpness: Vec<f32>,
+    /// Quads: each child edge's faces, filled as the faces are made (as `from_parts` does).
+    edge_faces: Vec<[u32; 2]>,
+    face_first_child: Vec<u32>,
+    /// An n-gon's inner edges, reused from face to face.
+    inner_at: Vec<u32>,
+    child_face_parent: Vec<u32>,
+    face_offsets: Vec<u32>,
+    face_verts: Vec<u32>,
+    face_edges: Vec<u32>,
+}
+
+impl<'a> SparseChild<'a> {
+    /// Counts the rows and sizes the child's arrays up front (a quad per corner, or four
+    /// triangles): growing them copied MBs per level.
+    fn new(
+        p: &'a Topology,
+        region: &Region,
+        numbering: &'a ChildNumbering,
+        quads: bool,
+    ) -> SparseChild<'a> {
+        let (kv, ke) = (region.verts.len(), region.edges.len());
+        let nc = numbering.origin.len();
+        let mut child = SparseChild {
+            p,
+            quads,
+            nc,
+            kv,
+            vertex_child_vertex: &numbering.vertex_child_vertex,
+            edge_child_vertex: &numbering.edge_child_vertex,
+            face_child_vertex: &numbering.face_child_vertex,
+            edge_rows: Vec::new(),
+            face_rows: Vec::new(),
+            vert_edges: Vec::new(),
+            vert_faces: Vec::new(),
+            edge_child_halves: Vec::new(),
+            edge_verts: Vec::new(),
+            edge_sharpness: Vec::new(),
+            edge_faces: Vec::new(),
+            face_first_child: Vec::new(),
+            inner_at: Vec::new(),
+            child_face_parent: Vec::new(),
+            face_offsets: Vec::new(),
+            face_verts: Vec::new(),
+            face_edges: Vec::new(),
+        };
+        if quads {
+            (child.edge_rows, child.face_rows) = (vec![0u32; nc + 2], vec![0u32; nc + 2]);
+            child.count_vertex_rows(region);
+        }
+        let child_faces = child.count_face_rows(region);
+        prefix_sum(&mut child.edge_rows);
+        prefix_sum(&mut child.face_rows);
+        child.vert_edges = vec![0u32; child.edge_rows.last().map_or(0, |&x| x as usize)];
+        child.vert_faces = vec![0u32; child.face_rows.last().map_or(0, |&x| x as usize)];
+        let corners = if quads { 4 } else { 3 } * child_faces;
+        // The halves, then one inner edge per child quad (or three per triangle; with
+        // corners_only, one per parent edge at a made corner, at most one per child quad).
+        let inner_edges = if quads {
+            child_faces
+        } else {
+            3 * region.faces.len()
+        };
+        child.edge_child_halves = Vec::with_capacity(ke);
+        child.edge_verts = Vec::with_capacity(2 * ke + inner_edges);
+        child.edge_sharpness = Vec::with_capacity(child.edge_verts.capacity());
+        if quads {
+            child.edge_faces = vec![[INVALID; 2]; 2 * ke + inner_edges];
+        }
+        child.face_first_child = vec![INVALID; p.num_faces()];
+        child.child_face_parent = Vec::with_capacity(child_faces);
+        child.face_offsets = Vec::with_capacity(child_faces + 1);
+        child.face_offsets.push(0u32);
+        child.face_verts = Vec::with_capacity(corners);
+        child.face_edges = Vec::with_capacity(corners);
+        child
+    }
+
+    /// The child vertex of parent vertex `v`.
+    #[inline(always)]
+    fn vc(&self, v: u32) -> u32 {
+        self.vertex_child_vertex[v as usize]
+    }
+
+    /// The child vertex of parent edge `e`.
+    #[inline(always)]
+    fn ec(&self, e: u32) -> u32 {
+        self.edge_child_vertex[e as usize]
+    }
+
+    /// Whether corner vertex `v` has children (every region vertex has, unless corners_only).
+    #[inline(always)]
+    fn made(&self, v: u32) -> bool {
+        self.vertex_child_vertex[v as usize] != INVALID
+    }
+
+    /// Child edge `e` into the edge list of child vertex `c`.
+    #[inline(always)]
+    fn edge_to(&mut self, c: u32, e: u32) {
+        let cursor = &mut self.edge_rows[c as usize + 1];
+        self.vert_edges[*cursor as usize] = e;
+        *cursor += 1;
+    }
+
+    /// The half of refined edge `e` at its end `v`.
+    #[inline(always)]
+    fn half_at(&self, e: u32, v: u32) -> u32 {
+        let [a, _] = self.p.edge_verts[e as usize];
+        self.edge_child_halves[(self.ec(e) - self.kv as u32) as usize][usize::from(a != v)]
+    }
+
+    /// The vertex → edge and vertex → face counts of the vertex- and edge-vertices (quads).
+    fn count_vertex_rows(&mut self, region: &Region) {
+        let p = self.p;
+        let kv = self.kv;
+        for (i, &v) in region.verts.iter().enumerate() {
+            let (ne_v, nf_v) = if region.corners_only {
+                // Every face at a selected face's corner is in the region, and so every edge.
+                (
+                    p.vertex_edges(v as usize).len(),
+                    p.vertex_faces(v as usize).len(),
+                )
+            } else {
+                (
+                    p.vertex_edges(v as usize)
+                        .iter()
+                        .filter(|&&e| region.edge_mark[e as usize])
+                        .count(),
+                    p.vertex_faces(v as usize)
+                        .iter()
+                        .filter(|&&g| region.face_mark[g as usize])
+                        .count(),
+                )
+            };
+            self.edge_rows[i + 2] = ne_v as u32;
+            self.face_rows[i + 2] = nf_v as u32;
+        }
+        // Whether face `g` is refined.
+        let refined = |g: u32| g != INVALID && region.face_mark[g as usize];
+        for (r, &e) in region.edges.iter().enumerate() {
+            let ends = p.edge_verts[e as usize]
+                .iter()
+                .filter(|&&v| self.made(v))
+                .count() as u32;
+            let faces_e = p.edge_faces[e as usize]
+                .iter()
+                .filter(|&&g| refined(g))
+                .count() as u32;
+            self.edge_rows[kv + r + 2] = ends + faces_e;
+            self.face_rows[kv + r + 2] = ends * faces_e;
+        }
+    }
+
+    /// The face-vertices' counts (quads) and the number of child faces.
+    fn count_face_rows(&mut self, region: &Region) -> usize {
+        let base = self.kv + region.edges.len() + 2;
+        let mut child_faces = 0usize;
+        for (r, &f) in region.faces.iter().enumerate() {
+            if self.quads {
+                let fv = self.p.face_vertices(f as usize);
+                let n = fv.len();
+                let (mut corners_made, mut inner) = (0u32, 0u32);
+                for i in 0..n {
+                    corners_made += u32::from(self.made(fv[i]));
+                    inner += u32::from(self.made(fv[i]) || self.made(fv[(i + 1) % n]));
+                }
+                self.edge_rows[base + r] = inner;
+                self.face_rows[base + r] = corners_made;
+                child_faces += corners_made as usize;
+            } else {
+                child_faces += 4;
+            }
+        }
+        child_faces
+    }
+
+    /// The halves of each refined edge `edges`: both, unless corners_only leaves an end
+    /// without a vertex-vertex, and so without its half; `halves` their sharpness in the
+    /// parent's numbering.
+    fn halves(&mut self, edges: &[u32], halves: &[f32]) {
+        for &e in edges {
+            let [a, b] = self.p.edge_verts[e as usize];
+            let h = &halves[2 * e as usize..2 * e as usize + 2];
+            let mut pair = [INVALID; 2];
+            if self.made(a) {
+                pair[0] = self.edge_verts.len() as u32;
+                self.edge_verts.push([self.vc(a), self.ec(e)]);
+                self.edge_sharpness.push(h[0]);
+            }
+            if self.made(b) {
+                pair[1] = self.edge_verts.len() as u32;
+                self.edge_verts.push([self.ec(e), self.vc(b)]);
+                self.edge_sharpness.push(h[1]);
+            }
+            if self.quads {
+                for x in pair {
+                    if x != INVALID {
+                        let [u, w] = self.edge_verts[x as usize];
+                        self.edge_to(u, x);
+                        self.edge_to(w, x);
+                    }
+                }
+            }
+            self.edge_child_halves.push(pair);
+        }
+    }
+
+    /// The children of refined face `f` and their inner edges.
+    fn children_of(&mut self, f: u32) {
+        let p = self.p;
+        let fv = p.face_vertices(f as usize);
+        let fe = p.face_edge_list(f as usize);
+        self.face_first_child[f as usize] = self.child_face_parent.len() as u32;
+        if let (true, Ok(fv), Ok(fe)) = (
+            self.quads,
+            <&[u32; 4]>::try_from(fv),
+            <&[u32; 4]>::try_from(fe),
+        ) {
+            self.quad_children(f, fv, fe);
+        } else if self.quads {
+            self.polygon_children(f, fv, fe);
+        } else {
+            self.triangle_children(f, fv, fe);
+        }
+    }
+
+    /// A child quad `[v, e, fc, ep]` with edges `qe` of parent face `f`.
+    #[inline(always)]
+    fn push_quad(&mut self, f: u32, qv: [u32; 4], qe: [u32; 4]) {
+        quad_made(
+            (
+                &mut self.face_rows,
+                &mut self.vert_faces,
+                &mut self.edge_faces,
+            ),
+            self.child_face_parent.len() as u32,
+            qv,
+            qe,
+        );
+        self.face_verts.extend_from_slice(&qv);
+        self.face_edges.extend_from_slice(&qe);
+        self.face_offsets.push(self.face_verts.len() as u32);
+        self.child_face_parent.push(f);
+    }
+
+    /// A quad's children: as [`SparseChild::polygon_children`], unrolled.
+    fn quad_children(&mut self, f: u32, fv: &[u32; 4], fe: &[u32; 4]) {
+        let fc = self.face_child_vertex[f as usize];
+        let corner_made = [
+            self.made(fv[0]),
+            self.made(fv[1]),
+            self.made(fv[2]),
+            self.made(fv[3]),
+        ];
+        let mut inner4 = [INVALID; 4];
+        for i in 0..4 {
+            if corner_made[i] || corner_made[(i + 1) & 3] {
+                let x = self.edge_verts.len() as u32;
+                inner4[i] = x;
+                self.edge_verts.push([self.ec(fe[i]), fc]);
+                self.edge_to(self.ec(fe[i]), x);
+                self.edge_to(fc, x);
+            }
+        }
+        for i in 0..4 {
+            if !corner_made[i] {
+                continue;
+            }
+            let prev = (i + 3) & 3;
+            let (v, e, ep) = (fv[i], fe[i], fe[prev]);
+            let qv = [self.vc(v), self.ec(e), fc, self.ec(ep)];
+            let qe = [
+                self.half_at(e, v),
+                inner4[i],
+                inner4[prev],
+                self.half_at(ep, v),
+            ];
+            self.push_quad(f, qv, qe);
+        }
+    }
+
+    /// The children of an n-gon (Catmull-Clark, bilinear): inner edge i (edge i's vertex to
+    /// the face's) where corner i or i + 1 is made (all of them unless corners_only, in edge
+    /// order either way), then a quad per made corner.
+    fn polygon_children(&mut self, f: u32, fv: &[u32], fe: &[u32]) {
+        let n = fv.len();
+        let fc = self.face_child_vertex[f as usize];
+        self.inner_at.clear();
+        self.inner_at.resize(n, INVALID);
+        for (i, &e) in fe.iter().enumerate() {
+            if self.made(fv[i]) || self.made(fv[(i + 1) % n]) {
+                let x = self.edge_verts.len() as u32;
+                self.inner_at[i] = x;
+                self.edge_verts.push([self.ec(e), fc]);
+                self.edge_to(self.ec(e), x);
+                self.edge_to(fc, x);
+            }
+        }
+        for i in 0..n {
+            if !self.made(fv[i]) {
+                continue;
+            }
+            let prev = (i + n - 1) % n;
+            let (v, e, ep) = (fv[i], fe[i], fe[prev]);
+            let qv = [self.vc(v), self.ec(e), fc, self.ec(ep)];
+            let qe = [
+                self.half_at(e, v),
+                self.inner_at[i],
+                self.inner_at[prev],
+                self.half_at(ep, v),
+            ];
+            self.push_quad(f, qv, qe);
+        }
+    }
+
+    /// A Loop triangle's four children and its three inner edges.
+    fn triangle_children(&mut self, f: u32, fv: &[u32], fe: &[u32]) {
+        let inner = self.edge_verts.len() as u32;
+        for j in 0..3 {
+            let prev = (j + 2) % 3;
+            // Inner edge j joins the midpoints of the two edges at corner j.
+            self.edge_verts.push([self.ec(fe[j]), self.ec(fe[prev])]);
+            let corner = [self.vc(fv[j]), self.ec(fe[j]), self.ec(fe[prev])];
+            self.face_verts.extend_from_slice(&corner);
+            let edges = [
+                self.half_at(fe[j], fv[j]),
+                inner + j as u32,
+                self.half_at(fe[prev], fv[j]),
+            ];
+            self.face_edges.extend_from_slice(&edges);
+            self.face_offsets.push(self.face_verts.len() as u32);
+            self.child_face_parent.push(f);
+        }
+        let centre = [self.ec(fe[0]), self.ec(fe[1]), self.ec(fe[2])];
+        self.face_verts.extend_from_slice(&centre);
+        self.face_edges
+            .extend_from_slice(&[inner + 1, inner + 2, inner]);
+        self.face_offsets.push(self.face_verts.len() as u32);
+        self.child_face_parent.push(f);
+    }
+
+    /// The child level: its topology (quads: the lists filled as it was made; Loop: built
+    /// from the faces and edges), the inner edges smooth, and the vertex-vertices' decayed
+    /// sharpness.
+    fn level(mut self, region: &Region, decayed: &[f32]) -> LevelTopology {
+        let nc = self.nc;
+        self.edge_sharpness.resize(self.edge_verts.len(), 0.0);
+        let mut vertex_sharpness = vec![0.0f32; nc];
+        for (slot, &v) in vertex_sharpness.iter_mut().zip(&region.verts) {
+            *slot = decayed[v as usize];
+        }
+        let topology = if self.quads {
+            self.edge_faces.truncate(self.edge_verts.len());
+            self.edge_rows.pop();
+            self.face_rows.pop();
+            Topology {
+                num_vertices: nc,
+                face_offsets: self.face_offsets,
+                face_verts: self.face_verts,
+                face_edges: self.face_edges,
+                edge_verts: self.edge_verts,
+                edge_faces: self.edge_faces,
+                vert_edge_offsets: self.edge_rows,
+                vert_edges: self.vert_edges,
+                vert_face_offsets: self.face_rows,
+                vert_faces: self.vert_faces,
+            }
+        } else {
+            Topology::from_parts(
+                nc,
+                self.face_offsets,
+                self.face_verts,
+                self.face_edges,
+                self.edge_verts,
+            )
+        };
+        LevelTopology {
+            topology,
+            edge_sharpness: self.edge_sharpness,
+            vertex_sharpness,
+        }
+    }
 }
 
 /// A child quad `cf` of a sparse step made, with corners `qv` and edges `qe`: its corners'
