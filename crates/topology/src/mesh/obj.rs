@@ -78,117 +78,146 @@ impl Lines {
 /// A UTF-8 byte-order mark at the start is skipped.
 pub fn parse_obj(text: &str, name: &str) -> Result<ControlMesh, TopologyError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut mesh = ControlMesh::default();
-    let mut lines = Lines::default();
-    let mut uvs: Vec<[f64; 2]> = Vec::new();
-    let mut normals: Vec<[f64; 3]> = Vec::new();
-    let mut corners: Vec<RawCorner> = Vec::new();
-    mesh.face_offsets.push(0);
-
     let perr = |line: usize, kind: ObjSyntax| TopologyError::Parse {
         file: name.to_string(),
         line,
         kind,
     };
-
+    let mut obj = RawObj::default();
+    obj.mesh.face_offsets.push(0);
     for (lineno, raw) in text.lines().enumerate() {
-        let line = lineno + 1;
         let content = raw.split('#').next().unwrap_or("").trim();
-        if content.is_empty() {
-            continue;
-        }
-        let mut words = content.split_whitespace();
-        let keyword = words.next().unwrap_or("");
-        let rest: Vec<&str> = words.collect();
-        match keyword {
-            "v" => {
-                // Range and finiteness are checked by validation (it names the vertex).
-                let p = parse_floats(&rest, 3, line, "v", &perr)?;
-                mesh.positions.push([p[0], p[1], p[2]]);
-                lines.vertices.push(line);
-            }
-            "vt" => {
-                let p = parse_finite(&rest, 1, line, "vt", &perr)?;
-                uvs.push([p[0], p.get(1).copied().unwrap_or(0.0)]);
-            }
-            "vn" => {
-                let p = parse_finite(&rest, 3, line, "vn", &perr)?;
-                normals.push([p[0], p[1], p[2]]);
-            }
-            "f" => {
-                if rest.is_empty() {
-                    return Err(perr(line, ObjSyntax::FaceWithoutVertices));
-                }
-                for word in &rest {
-                    corners.push(parse_corner(
-                        word,
-                        [mesh.positions.len(), uvs.len(), normals.len()],
-                        line,
-                        &perr,
-                    )?);
-                }
-                mesh.face_offsets.push(corners.len() as u32);
-                lines.faces.push(line);
-            }
-            "t" => parse_tag(&rest, line, name, &mut mesh, &mut lines, &perr)?,
-            "o" | "g" | "s" | "usemtl" | "mtllib" | "l" | "p" | "vp" => {}
-            other => log::warn!("{name}:{line}: ignoring unknown OBJ statement '{other}'"),
+        if !content.is_empty() {
+            obj.statement(content, lineno + 1, name, &perr)?;
         }
     }
-
-    // Resolve corners: vertex indices are checked by validation (it names the face);
-    // attribute indices are checked here (they name the line).
-    let nv = mesh.positions.len();
-    let all_uv = !corners.is_empty() && corners.iter().all(|c| c.1.is_some());
-    let all_n = !corners.is_empty() && corners.iter().all(|c| c.2.is_some());
-    let mut corner_uvs = Vec::with_capacity(if all_uv { corners.len() } else { 0 });
-    let mut corner_normals = Vec::with_capacity(if all_n { corners.len() } else { 0 });
-    for (f, &face_line) in lines.faces.iter().enumerate() {
-        let (s, e) = (
-            mesh.face_offsets[f] as usize,
-            mesh.face_offsets[f + 1] as usize,
-        );
-        for &(v, t, n) in &corners[s..e] {
-            if v < 0 || v as usize >= nv {
-                return Err(TopologyError::IndexOutOfRange {
-                    face: f,
-                    index: v,
-                    count: nv,
-                }
-                .in_file(name, Some(face_line)));
-            }
-            mesh.face_vertices.push(v as u32);
-            if all_uv {
-                let t = t.unwrap_or(-1);
-                let uv = usize::try_from(t).ok().and_then(|t| uvs.get(t));
-                corner_uvs.push(*uv.ok_or_else(|| {
-                    perr(
-                        face_line,
-                        ObjSyntax::TextureIndexOutOfRange { index: t + 1 },
-                    )
-                })?);
-            }
-            if all_n {
-                let n = n.unwrap_or(-1);
-                let nn = usize::try_from(n).ok().and_then(|n| normals.get(n));
-                corner_normals.push(*nn.ok_or_else(|| {
-                    perr(face_line, ObjSyntax::NormalIndexOutOfRange { index: n + 1 })
-                })?);
-            }
-        }
-    }
-    if all_uv {
-        mesh.uvs = Some(corner_uvs);
-    }
-    if all_n {
-        mesh.normals = Some(corner_normals);
-    }
+    let mesh = obj.resolve_corners(name, &perr)?;
+    let lines = obj.lines;
     check_tags(&mesh, &lines).map_err(|(e, line)| e.in_file(name, Some(line)))?;
     mesh.validate().map_err(|e| {
         let line = lines.locate(&e, &mesh);
         e.in_file(name, line)
     })?;
     Ok(mesh)
+}
+
+/// An OBJ file as its statements are read: the mesh so far, the line of each element, the
+/// texture coordinates and normals and the face corners as written.
+#[derive(Default)]
+struct RawObj {
+    mesh: ControlMesh,
+    lines: Lines,
+    uvs: Vec<[f64; 2]>,
+    normals: Vec<[f64; 3]>,
+    corners: Vec<RawCorner>,
+}
+
+impl RawObj {
+    /// One statement (`content`, comment stripped) on line `line`.
+    fn statement<E: Fn(usize, ObjSyntax) -> TopologyError>(
+        &mut self,
+        content: &str,
+        line: usize,
+        name: &str,
+        perr: &E,
+    ) -> Result<(), TopologyError> {
+        let mut words = content.split_whitespace();
+        let keyword = words.next().unwrap_or("");
+        let rest: Vec<&str> = words.collect();
+        match keyword {
+            "v" => {
+                // Range and finiteness are checked by validation (it names the vertex).
+                let p = parse_floats(&rest, 3, line, "v", perr)?;
+                self.mesh.positions.push([p[0], p[1], p[2]]);
+                self.lines.vertices.push(line);
+            }
+            "vt" => {
+                let p = parse_finite(&rest, 1, line, "vt", perr)?;
+                self.uvs.push([p[0], p.get(1).copied().unwrap_or(0.0)]);
+            }
+            "vn" => {
+                let p = parse_finite(&rest, 3, line, "vn", perr)?;
+                self.normals.push([p[0], p[1], p[2]]);
+            }
+            "f" => {
+                if rest.is_empty() {
+                    return Err(perr(line, ObjSyntax::FaceWithoutVertices));
+                }
+                let counts = [
+                    self.mesh.positions.len(),
+                    self.uvs.len(),
+                    self.normals.len(),
+                ];
+                for word in &rest {
+                    self.corners.push(parse_corner(word, counts, line, perr)?);
+                }
+                self.mesh.face_offsets.push(self.corners.len() as u32);
+                self.lines.faces.push(line);
+            }
+            "t" => parse_tag(&rest, line, name, &mut self.mesh, &mut self.lines, perr)?,
+            "o" | "g" | "s" | "usemtl" | "mtllib" | "l" | "p" | "vp" => {}
+            other => log::warn!("{name}:{line}: ignoring unknown OBJ statement '{other}'"),
+        }
+        Ok(())
+    }
+
+    /// The mesh with its corners resolved: vertex indices are checked by validation (it names
+    /// the face); attribute indices are checked here (they name the line). Texture
+    /// coordinates and normals are kept when every corner has one.
+    fn resolve_corners<E: Fn(usize, ObjSyntax) -> TopologyError>(
+        &mut self,
+        name: &str,
+        perr: &E,
+    ) -> Result<ControlMesh, TopologyError> {
+        let mut mesh = std::mem::take(&mut self.mesh);
+        let corners = &self.corners;
+        let nv = mesh.positions.len();
+        let all_uv = !corners.is_empty() && corners.iter().all(|c| c.1.is_some());
+        let all_n = !corners.is_empty() && corners.iter().all(|c| c.2.is_some());
+        let mut corner_uvs = Vec::with_capacity(if all_uv { corners.len() } else { 0 });
+        let mut corner_normals = Vec::with_capacity(if all_n { corners.len() } else { 0 });
+        for (f, &face_line) in self.lines.faces.iter().enumerate() {
+            let (s, e) = (
+                mesh.face_offsets[f] as usize,
+                mesh.face_offsets[f + 1] as usize,
+            );
+            for &(v, t, n) in &corners[s..e] {
+                if v < 0 || v as usize >= nv {
+                    return Err(TopologyError::IndexOutOfRange {
+                        face: f,
+                        index: v,
+                        count: nv,
+                    }
+                    .in_file(name, Some(face_line)));
+                }
+                mesh.face_vertices.push(v as u32);
+                if all_uv {
+                    let t = t.unwrap_or(-1);
+                    let uv = usize::try_from(t).ok().and_then(|t| self.uvs.get(t));
+                    corner_uvs.push(*uv.ok_or_else(|| {
+                        perr(
+                            face_line,
+                            ObjSyntax::TextureIndexOutOfRange { index: t + 1 },
+                        )
+                    })?);
+                }
+                if all_n {
+                    let n = n.unwrap_or(-1);
+                    let nn = usize::try_from(n).ok().and_then(|n| self.normals.get(n));
+                    corner_normals.push(*nn.ok_or_else(|| {
+                        perr(face_line, ObjSyntax::NormalIndexOutOfRange { index: n + 1 })
+                    })?);
+                }
+            }
+        }
+        if all_uv {
+            mesh.uvs = Some(corner_uvs);
+        }
+        if all_n {
+            mesh.normals = Some(corner_normals);
+        }
+        Ok(mesh)
+    }
 }
 
 fn parse_floats<E: Fn(usize, ObjSyntax) -> TopologyError>(
@@ -291,179 +320,210 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
     lines: &mut Lines,
     perr: &E,
 ) -> Result<(), TopologyError> {
-    let (Some(&tag), Some(&counts)) = (words.first(), words.get(1)) else {
-        return Err(perr(line, ObjSyntax::TagWithoutCounts));
-    };
-    let nums: Vec<usize> = counts
-        .split('/')
-        .map(|c| c.parse::<usize>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| {
-            perr(
-                line,
-                ObjSyntax::BadTagCounts {
-                    counts: counts.into(),
-                },
-            )
-        })?;
-    // Checked: counts near usize::MAX would wrap the sum and pass the length test.
-    let needed = nums.iter().try_fold(2usize, |sum, &n| sum.checked_add(n));
-    if nums.len() != 3 || needed.is_none_or(|needed| words.len() < needed) {
-        return Err(perr(
-            line,
-            ObjSyntax::TagCountMismatch {
-                tag: tag.into(),
-                counts: counts.into(),
-            },
-        ));
-    }
-    let vals = &words[2..];
-    let ints: Vec<i64> = vals[..nums[0]]
-        .iter()
-        .map(|w| w.parse::<i64>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| perr(line, ObjSyntax::BadTagInteger { tag: tag.into() }))?;
-    let floats: Vec<f32> = vals[nums[0]..nums[0] + nums[1]]
-        .iter()
-        .map(|w| w.parse::<f32>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| perr(line, ObjSyntax::BadTagFloat { tag: tag.into() }))?;
-    let strings = &vals[nums[0] + nums[1]..nums[0] + nums[1] + nums[2]];
-    let to_u32 = |i: i64| -> Result<u32, TopologyError> {
-        u32::try_from(i).map_err(|_| {
-            perr(
-                line,
-                ObjSyntax::NegativeTagIndex {
-                    tag: tag.into(),
-                    index: i,
-                },
-            )
-        })
-    };
-    // One float for all elements, or one per element.
-    let sharp_for = |k: usize, n: usize| -> Result<f32, TopologyError> {
-        let s = match floats.len() {
-            0 => return Err(perr(line, ObjSyntax::MissingSharpness { tag: tag.into() })),
-            1 => floats[0],
-            m if m == n => floats[k],
-            _ => {
-                return Err(perr(
-                    line,
-                    ObjSyntax::SharpnessCount {
-                        tag: tag.into(),
-                        values: floats.len(),
-                        elements: n,
-                    },
-                ))
-            }
-        };
-        if !s.is_finite() {
-            return Err(perr(
-                line,
-                ObjSyntax::NonFiniteSharpness {
-                    tag: tag.into(),
-                    value: s,
-                },
-            ));
-        }
-        if s < 0.0 {
-            // OpenSubdiv treats sharpness ≤ 0 as smooth; say so rather than drop it silently.
-            log::warn!(
-                "{file}:{line}: tag '{tag}': negative sharpness {s} is treated as 0 (smooth), \
-                 as OpenSubdiv does"
-            );
-        }
-        Ok(s.max(0.0))
-    };
-    match tag {
-        "crease" => {
-            if ints.len() < 2 || ints.len() & 1 != 0 {
-                return Err(perr(line, ObjSyntax::CreaseNeedsPairs));
-            }
-            let pairs = ints.len() / 2;
-            for k in 0..pairs {
-                mesh.creases.push(EdgeCrease {
-                    vertices: [to_u32(ints[2 * k])?, to_u32(ints[2 * k + 1])?],
-                    sharpness: sharp_for(k, pairs)?,
-                });
-                lines.creases.push(line);
-            }
-        }
-        "corner" => {
-            if ints.is_empty() {
-                return Err(perr(line, ObjSyntax::CornerNeedsVertices));
-            }
-            for (k, &v) in ints.iter().enumerate() {
-                mesh.corners.push(VertexCorner {
-                    vertex: to_u32(v)?,
-                    sharpness: sharp_for(k, ints.len())?,
-                });
-                lines.corners.push(line);
-            }
-        }
-        "interpolateboundary" => {
-            mesh.options.boundary = match ints.first() {
-                Some(0) => BoundaryInterpolation::None,
-                Some(1) => BoundaryInterpolation::EdgesAndCorners,
-                Some(2) => BoundaryInterpolation::EdgesOnly,
-                other => {
-                    return Err(perr(
-                        line,
-                        ObjSyntax::BadOptionValue {
-                            option: "interpolateboundary",
-                            value: other.map_or_else(|| "(none)".into(), |v| v.to_string()),
-                        },
-                    ))
-                }
-            }
-        }
-        "creasemethod" => {
-            mesh.options.crease_method = match strings.first().copied() {
-                Some("chaikin") => CreaseMethod::Chaikin,
-                Some("normal") | Some("uniform") => CreaseMethod::Uniform,
-                other => {
-                    return Err(perr(
-                        line,
-                        ObjSyntax::BadOptionValue {
-                            option: "creasemethod",
-                            value: other.unwrap_or("(none)").to_string(),
-                        },
-                    ))
-                }
-            }
-        }
-        "smoothtriangles" => {
-            let smooth = match (strings.first().copied(), ints.first()) {
-                (Some("smooth"), _) | (None, Some(1)) => true,
-                (Some("catmark"), _) | (None, Some(0)) => false,
-                (s, i) => {
-                    return Err(perr(
-                        line,
-                        ObjSyntax::BadOptionValue {
-                            option: "smoothtriangles",
-                            value: s
-                                .map(str::to_string)
-                                .or(i.map(|i| i.to_string()))
-                                .unwrap_or_else(|| "(none)".into()),
-                        },
-                    ))
-                }
-            };
-            mesh.options.triangle_subdivision = if smooth {
-                TriangleSubdivision::Smooth
-            } else {
-                TriangleSubdivision::Catmark
-            };
-        }
+    let tag = Tag::parse(words, line, file, perr)?;
+    match tag.name {
+        "crease" => tag.creases(mesh, lines)?,
+        "corner" => tag.corners(mesh, lines)?,
+        "interpolateboundary" => mesh.options.boundary = tag.boundary_interpolation()?,
+        "creasemethod" => mesh.options.crease_method = tag.crease_method()?,
+        "smoothtriangles" => mesh.options.triangle_subdivision = tag.triangle_subdivision()?,
         "hole" => {
-            for &f in &ints {
-                mesh.holes.push(to_u32(f)?);
+            for &f in &tag.ints {
+                mesh.holes.push(tag.index(f)?);
                 lines.holes.push(line);
             }
         }
         other => log::warn!("{file}:{line}: ignoring unsupported tag '{other}'"),
     }
     Ok(())
+}
+
+/// One `t` line, its values read: the tag's name, integers, floats and strings, where it is
+/// (for errors and warnings) and how a syntax error is made.
+struct Tag<'a, E> {
+    name: &'a str,
+    ints: Vec<i64>,
+    floats: Vec<f32>,
+    strings: &'a [&'a str],
+    line: usize,
+    file: &'a str,
+    perr: &'a E,
+}
+
+impl<'a, E: Fn(usize, ObjSyntax) -> TopologyError> Tag<'a, E> {
+    /// The name, the counts `<nints>/<nfloats>/<nstrings>` and as many values of each.
+    fn parse(
+        words: &'a [&'a str],
+        line: usize,
+        file: &'a str,
+        perr: &'a E,
+    ) -> Result<Tag<'a, E>, TopologyError> {
+        let (Some(&tag), Some(&counts)) = (words.first(), words.get(1)) else {
+            return Err(perr(line, ObjSyntax::TagWithoutCounts));
+        };
+        let nums: Vec<usize> = counts
+            .split('/')
+            .map(|c| c.parse::<usize>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| {
+                perr(
+                    line,
+                    ObjSyntax::BadTagCounts {
+                        counts: counts.into(),
+                    },
+                )
+            })?;
+        // Checked: counts near usize::MAX would wrap the sum and pass the length test.
+        let needed = nums.iter().try_fold(2usize, |sum, &n| sum.checked_add(n));
+        if nums.len() != 3 || needed.is_none_or(|needed| words.len() < needed) {
+            return Err(perr(
+                line,
+                ObjSyntax::TagCountMismatch {
+                    tag: tag.into(),
+                    counts: counts.into(),
+                },
+            ));
+        }
+        let vals = &words[2..];
+        let ints: Vec<i64> = vals[..nums[0]]
+            .iter()
+            .map(|w| w.parse::<i64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| perr(line, ObjSyntax::BadTagInteger { tag: tag.into() }))?;
+        let floats: Vec<f32> = vals[nums[0]..nums[0] + nums[1]]
+            .iter()
+            .map(|w| w.parse::<f32>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| perr(line, ObjSyntax::BadTagFloat { tag: tag.into() }))?;
+        let strings = &vals[nums[0] + nums[1]..nums[0] + nums[1] + nums[2]];
+        Ok(Tag {
+            name: tag,
+            ints,
+            floats,
+            strings,
+            line,
+            file,
+            perr,
+        })
+    }
+
+    fn err(&self, kind: ObjSyntax) -> TopologyError {
+        (self.perr)(self.line, kind)
+    }
+
+    /// An integer value as a vertex or face index.
+    fn index(&self, i: i64) -> Result<u32, TopologyError> {
+        u32::try_from(i).map_err(|_| {
+            self.err(ObjSyntax::NegativeTagIndex {
+                tag: self.name.into(),
+                index: i,
+            })
+        })
+    }
+
+    /// The sharpness of element `k` of `n`: one float for all elements, or one per element.
+    fn sharpness(&self, k: usize, n: usize) -> Result<f32, TopologyError> {
+        let (tag, floats) = (self.name, &self.floats);
+        let s = match floats.len() {
+            0 => return Err(self.err(ObjSyntax::MissingSharpness { tag: tag.into() })),
+            1 => floats[0],
+            m if m == n => floats[k],
+            _ => {
+                return Err(self.err(ObjSyntax::SharpnessCount {
+                    tag: tag.into(),
+                    values: floats.len(),
+                    elements: n,
+                }))
+            }
+        };
+        if !s.is_finite() {
+            return Err(self.err(ObjSyntax::NonFiniteSharpness {
+                tag: tag.into(),
+                value: s,
+            }));
+        }
+        if s < 0.0 {
+            // OpenSubdiv treats sharpness ≤ 0 as smooth; say so rather than drop it silently.
+            let (file, line) = (self.file, self.line);
+            log::warn!(
+                "{file}:{line}: tag '{tag}': negative sharpness {s} is treated as 0 (smooth), \
+                 as OpenSubdiv does"
+            );
+        }
+        Ok(s.max(0.0))
+    }
+
+    /// `crease`: vertex pairs, their sharpness.
+    fn creases(&self, mesh: &mut ControlMesh, lines: &mut Lines) -> Result<(), TopologyError> {
+        let ints = &self.ints;
+        if ints.len() < 2 || ints.len() & 1 != 0 {
+            return Err(self.err(ObjSyntax::CreaseNeedsPairs));
+        }
+        let pairs = ints.len() / 2;
+        for k in 0..pairs {
+            mesh.creases.push(EdgeCrease {
+                vertices: [self.index(ints[2 * k])?, self.index(ints[2 * k + 1])?],
+                sharpness: self.sharpness(k, pairs)?,
+            });
+            lines.creases.push(self.line);
+        }
+        Ok(())
+    }
+
+    /// `corner`: vertices, their sharpness.
+    fn corners(&self, mesh: &mut ControlMesh, lines: &mut Lines) -> Result<(), TopologyError> {
+        if self.ints.is_empty() {
+            return Err(self.err(ObjSyntax::CornerNeedsVertices));
+        }
+        for (k, &v) in self.ints.iter().enumerate() {
+            mesh.corners.push(VertexCorner {
+                vertex: self.index(v)?,
+                sharpness: self.sharpness(k, self.ints.len())?,
+            });
+            lines.corners.push(self.line);
+        }
+        Ok(())
+    }
+
+    /// `interpolateboundary`: OpenSubdiv's integer (0 none, 1 edges and corners, 2 edges).
+    fn boundary_interpolation(&self) -> Result<BoundaryInterpolation, TopologyError> {
+        match self.ints.first() {
+            Some(0) => Ok(BoundaryInterpolation::None),
+            Some(1) => Ok(BoundaryInterpolation::EdgesAndCorners),
+            Some(2) => Ok(BoundaryInterpolation::EdgesOnly),
+            other => Err(self.err(ObjSyntax::BadOptionValue {
+                option: "interpolateboundary",
+                value: other.map_or_else(|| "(none)".into(), |v| v.to_string()),
+            })),
+        }
+    }
+
+    /// `creasemethod`: `chaikin`, or `normal` / `uniform`.
+    fn crease_method(&self) -> Result<CreaseMethod, TopologyError> {
+        match self.strings.first().copied() {
+            Some("chaikin") => Ok(CreaseMethod::Chaikin),
+            Some("normal") | Some("uniform") => Ok(CreaseMethod::Uniform),
+            other => Err(self.err(ObjSyntax::BadOptionValue {
+                option: "creasemethod",
+                value: other.unwrap_or("(none)").to_string(),
+            })),
+        }
+    }
+
+    /// `smoothtriangles`: `smooth` or 1, `catmark` or 0.
+    fn triangle_subdivision(&self) -> Result<TriangleSubdivision, TopologyError> {
+        match (self.strings.first().copied(), self.ints.first()) {
+            (Some("smooth"), _) | (None, Some(1)) => Ok(TriangleSubdivision::Smooth),
+            (Some("catmark"), _) | (None, Some(0)) => Ok(TriangleSubdivision::Catmark),
+            (s, i) => Err(self.err(ObjSyntax::BadOptionValue {
+                option: "smoothtriangles",
+                value: s
+                    .map(str::to_string)
+                    .or(i.map(|i| i.to_string()))
+                    .unwrap_or_else(|| "(none)".into()),
+            })),
+        }
+    }
 }
 
 /// Tags must name existing vertices/faces; the error comes with the tag's line.
