@@ -316,91 +316,9 @@ impl Topology {
         face_offsets: Vec<u32>,
         face_verts: Vec<u32>,
     ) -> Result<Topology, TopologyError> {
-        // Half-edges as (min, max, corner) keys, ordered by a counting sort on `min` and a short
-        // sort of each bucket (a vertex's valence) — the same order as sorting the keys, in
-        // linear time. The corner index identifies face + direction.
-        let corners = face_verts.len();
-        let corner_face = corner_faces(&face_offsets, corners);
-        let next = |c: usize| {
-            let f = corner_face[c] as usize;
-            if c + 1 == face_offsets[f + 1] as usize {
-                face_offsets[f] as usize
-            } else {
-                c + 1
-            }
-        };
-        let mut bucket_offsets = vec![0u32; num_vertices + 1];
-        for c in 0..corners {
-            let (a, b) = (face_verts[c], face_verts[next(c)]);
-            bucket_offsets[a.min(b) as usize + 1] += 1;
-        }
-        prefix_sum(&mut bucket_offsets);
-        let mut fill = bucket_offsets.clone();
-        // (max, corner), packed so a plain integer sort orders by max then corner.
-        let mut buckets = vec![0u64; corners];
-        for c in 0..corners {
-            let (a, b) = (face_verts[c], face_verts[next(c)]);
-            let slot = &mut fill[a.min(b) as usize];
-            buckets[*slot as usize] = ((a.max(b) as u64) << 32) | c as u64;
-            *slot += 1;
-        }
-        drop(fill);
-        par_fill_ragged(&bucket_offsets, &mut buckets, |_, row| row.sort_unstable());
-        let half: Vec<(u64, u32)> = (0..num_vertices)
-            .flat_map(|v| {
-                let r = bucket_offsets[v] as usize..bucket_offsets[v + 1] as usize;
-                buckets[r]
-                    .iter()
-                    .map(move |&k| (((v as u64) << 32) | (k >> 32), k as u32))
-            })
-            .collect();
-        drop(buckets);
-
-        let mut face_edges = vec![INVALID; face_verts.len()];
-        let mut edge_verts = Vec::with_capacity(half.len() / 2 + 1);
-        let mut edge_faces = Vec::with_capacity(half.len() / 2 + 1);
-        let mut i = 0;
-        while i < half.len() {
-            let key = half[i].0;
-            let mut j = i + 1;
-            while j < half.len() && half[j].0 == key {
-                j += 1;
-            }
-            let v0 = (key >> 32) as u32;
-            let v1 = key as u32;
-            if j - i > 2 {
-                return Err(TopologyError::NonManifoldEdge {
-                    v0,
-                    v1,
-                    faces: j - i,
-                });
-            }
-            let e = edge_verts.len() as u32;
-            let c0 = half[i].1 as usize;
-            let f0 = corner_face[c0];
-            // Orient the edge as the first face traverses it.
-            let a0 = face_verts[c0];
-            edge_verts.push(if a0 == v0 { [v0, v1] } else { [v1, v0] });
-            face_edges[c0] = e;
-            let mut faces = [f0, INVALID];
-            if j - i == 2 {
-                let c1 = half[i + 1].1 as usize;
-                let f1 = corner_face[c1];
-                if face_verts[c1] == a0 {
-                    let (b0, b1) = if a0 == v0 { (v0, v1) } else { (v1, v0) };
-                    return Err(TopologyError::InconsistentOrientation {
-                        face0: f0.min(f1) as usize,
-                        face1: f0.max(f1) as usize,
-                        v0: b0,
-                        v1: b1,
-                    });
-                }
-                face_edges[c1] = e;
-                faces[1] = f1;
-            }
-            edge_faces.push(faces);
-            i = j;
-        }
+        let corner_face = corner_faces(&face_offsets, face_verts.len());
+        let half = sorted_half_edges(num_vertices, &face_offsets, &face_verts, &corner_face);
+        let (face_edges, edge_verts, edge_faces) = edges_of(&half, &face_verts, &corner_face)?;
         let mut topo = Topology {
             num_vertices,
             face_offsets,
@@ -683,6 +601,111 @@ impl Topology {
             (x == a && y == b) || (x == b && y == a)
         })
     }
+}
+
+/// The half-edges of the faces as (min, max, corner) keys, `(min << 32 | max, corner)`,
+/// ordered by a counting sort on `min` and a short sort of each bucket (a vertex's valence):
+/// the same order as sorting the keys, in linear time. The corner index identifies face +
+/// direction.
+fn sorted_half_edges(
+    num_vertices: usize,
+    face_offsets: &[u32],
+    face_verts: &[u32],
+    corner_face: &[u32],
+) -> Vec<(u64, u32)> {
+    let corners = face_verts.len();
+    let next = |c: usize| {
+        let f = corner_face[c] as usize;
+        if c + 1 == face_offsets[f + 1] as usize {
+            face_offsets[f] as usize
+        } else {
+            c + 1
+        }
+    };
+    let mut bucket_offsets = vec![0u32; num_vertices + 1];
+    for c in 0..corners {
+        let (a, b) = (face_verts[c], face_verts[next(c)]);
+        bucket_offsets[a.min(b) as usize + 1] += 1;
+    }
+    prefix_sum(&mut bucket_offsets);
+    let mut fill = bucket_offsets.clone();
+    // (max, corner), packed so a plain integer sort orders by max then corner.
+    let mut buckets = vec![0u64; corners];
+    for c in 0..corners {
+        let (a, b) = (face_verts[c], face_verts[next(c)]);
+        let slot = &mut fill[a.min(b) as usize];
+        buckets[*slot as usize] = ((a.max(b) as u64) << 32) | c as u64;
+        *slot += 1;
+    }
+    drop(fill);
+    par_fill_ragged(&bucket_offsets, &mut buckets, |_, row| row.sort_unstable());
+    (0..num_vertices)
+        .flat_map(|v| {
+            let r = bucket_offsets[v] as usize..bucket_offsets[v + 1] as usize;
+            buckets[r]
+                .iter()
+                .map(move |&k| (((v as u64) << 32) | (k >> 32), k as u32))
+        })
+        .collect()
+}
+
+/// Per face corner its edge; per edge its vertices and its faces.
+type EdgeTables = (Vec<u32>, Vec<[u32; 2]>, Vec<[u32; 2]>);
+
+/// The edges of sorted half-edges `half` (runs of one key): each face corner's edge, each
+/// edge's vertices (oriented as its first face traverses it) and faces. An edge of more than
+/// two faces, or of two faces that traverse it the same way, is an error.
+fn edges_of(
+    half: &[(u64, u32)],
+    face_verts: &[u32],
+    corner_face: &[u32],
+) -> Result<EdgeTables, TopologyError> {
+    let mut face_edges = vec![INVALID; face_verts.len()];
+    let mut edge_verts = Vec::with_capacity(half.len() / 2 + 1);
+    let mut edge_faces = Vec::with_capacity(half.len() / 2 + 1);
+    let mut i = 0;
+    while i < half.len() {
+        let key = half[i].0;
+        let mut j = i + 1;
+        while j < half.len() && half[j].0 == key {
+            j += 1;
+        }
+        let v0 = (key >> 32) as u32;
+        let v1 = key as u32;
+        if j - i > 2 {
+            return Err(TopologyError::NonManifoldEdge {
+                v0,
+                v1,
+                faces: j - i,
+            });
+        }
+        let e = edge_verts.len() as u32;
+        let c0 = half[i].1 as usize;
+        let f0 = corner_face[c0];
+        // Orient the edge as the first face traverses it.
+        let a0 = face_verts[c0];
+        edge_verts.push(if a0 == v0 { [v0, v1] } else { [v1, v0] });
+        face_edges[c0] = e;
+        let mut faces = [f0, INVALID];
+        if j - i == 2 {
+            let c1 = half[i + 1].1 as usize;
+            let f1 = corner_face[c1];
+            if face_verts[c1] == a0 {
+                let (b0, b1) = if a0 == v0 { (v0, v1) } else { (v1, v0) };
+                return Err(TopologyError::InconsistentOrientation {
+                    face0: f0.min(f1) as usize,
+                    face1: f0.max(f1) as usize,
+                    v0: b0,
+                    v1: b1,
+                });
+            }
+            face_edges[c1] = e;
+            faces[1] = f1;
+        }
+        edge_faces.push(faces);
+        i = j;
+    }
+    Ok((face_edges, edge_verts, edge_faces))
 }
 
 /// A sub-mesh cut out of a [`Topology`] ([`Topology::sub_topology`]) and where its parts come
