@@ -1333,37 +1333,90 @@ fn push_pair(pair: &mut [u32; 2], x: u32) {
 /// child is written directly from the parent's, in parallel and in the order (ascending
 /// indices) a generic counting sort would produce.
 fn split_quads(p: &Topology) -> Topology {
-    let (nv, ne, nf) = (p.num_vertices(), p.num_edges(), p.num_faces());
-    let corners = p.face_verts.len();
-    let vert_e = |e: u32| (nv as u32) + e;
-    let vert_f = |f: u32| (nv + ne) as u32 + f;
-    let face_edge = |c: usize| (2 * ne + c) as u32;
-    let corner_face = corner_faces(&p.face_offsets, corners);
-    let min_len = 4096;
+    let split = QuadSplit {
+        p,
+        nv: p.num_vertices(),
+        ne: p.num_edges(),
+        corner_face: corner_faces(&p.face_offsets, p.face_verts.len()),
+    };
+    let (edge_verts, edge_faces) = split.edges();
+    let (face_verts, face_edges) = split.faces();
+    let face_offsets: Vec<u32> = (0..=p.face_verts.len() as u32).map(|i| 4 * i).collect();
+    let (vert_edge_offsets, vert_face_offsets) = split.vertex_offsets();
+    let vert_edges = split.vertex_edges(&vert_edge_offsets);
+    let vert_faces = split.vertex_faces(&vert_face_offsets);
+    Topology {
+        num_vertices: split.nv + split.ne + p.num_faces(),
+        face_offsets,
+        face_verts,
+        face_edges,
+        edge_verts,
+        edge_faces,
+        vert_edge_offsets,
+        vert_edges,
+        vert_face_offsets,
+        vert_faces,
+    }
+}
 
-    let mut edge_verts = vec![[0u32; 2]; 2 * ne + corners];
-    let mut edge_faces = vec![[INVALID; 2]; 2 * ne + corners];
-    {
+/// A uniform Catmull-Clark / bilinear split of `p` ([`split_quads`]), table by table.
+struct QuadSplit<'a> {
+    p: &'a Topology,
+    nv: usize,
+    ne: usize,
+    /// The face of each parent corner.
+    corner_face: Vec<u32>,
+}
+
+/// Parallel chunks of the split's tables.
+const SPLIT_MIN_LEN: usize = 4096;
+
+impl QuadSplit<'_> {
+    /// The child vertex of parent edge `e`.
+    fn vert_e(&self, e: u32) -> u32 {
+        (self.nv as u32) + e
+    }
+
+    /// The child vertex of parent face `f`.
+    fn vert_f(&self, f: u32) -> u32 {
+        (self.nv + self.ne) as u32 + f
+    }
+
+    /// The interior child edge at parent corner `c`.
+    fn face_edge(&self, c: usize) -> u32 {
+        (2 * self.ne + c) as u32
+    }
+
+    /// The child edges' vertices and faces: the halves of each parent edge, then one interior
+    /// edge per parent corner.
+    fn edges(&self) -> (Vec<[u32; 2]>, Vec<[u32; 2]>) {
+        let (p, ne) = (self.p, self.ne);
+        let corners = p.face_verts.len();
+        let corner_face = &self.corner_face;
+        let mut edge_verts = vec![[0u32; 2]; 2 * ne + corners];
+        let mut edge_faces = vec![[INVALID; 2]; 2 * ne + corners];
         let (halves, inner) = edge_verts.split_at_mut(2 * ne);
         halves
             .par_chunks_mut(2)
             .enumerate()
-            .with_min_len(min_len)
+            .with_min_len(SPLIT_MIN_LEN)
             .for_each(|(e, pair)| {
                 let [a, b] = p.edge_verts[e];
-                pair[0] = [a, vert_e(e as u32)];
-                pair[1] = [vert_e(e as u32), b];
+                pair[0] = [a, self.vert_e(e as u32)];
+                pair[1] = [self.vert_e(e as u32), b];
             });
         inner
             .par_iter_mut()
             .enumerate()
-            .with_min_len(min_len)
-            .for_each(|(c, slot)| *slot = [vert_e(p.face_edges[c]), vert_f(corner_face[c])]);
+            .with_min_len(SPLIT_MIN_LEN)
+            .for_each(|(c, slot)| {
+                *slot = [self.vert_e(p.face_edges[c]), self.vert_f(corner_face[c])]
+            });
         let (halves, inner) = edge_faces.split_at_mut(2 * ne);
         halves
             .par_chunks_mut(2)
             .enumerate()
-            .with_min_len(min_len)
+            .with_min_len(SPLIT_MIN_LEN)
             .for_each(|(e, pair)| {
                 for f in p.edge_faces[e] {
                     if f == INVALID {
@@ -1386,7 +1439,7 @@ fn split_quads(p: &Topology) -> Topology {
         inner
             .par_iter_mut()
             .enumerate()
-            .with_min_len(min_len)
+            .with_min_len(SPLIT_MIN_LEN)
             .for_each(|(c, slot)| {
                 let f = corner_face[c] as usize;
                 let s = p.face_offsets[f] as usize;
@@ -1394,124 +1447,136 @@ fn split_quads(p: &Topology) -> Topology {
                 let next = (s + (c - s + 1) % n) as u32;
                 *slot = [(c as u32).min(next), (c as u32).max(next)];
             });
+        (edge_verts, edge_faces)
     }
-    let mut face_verts = vec![0u32; 4 * corners];
-    let mut face_edges = vec![0u32; 4 * corners];
-    face_verts
-        .par_chunks_mut(4)
-        .zip(face_edges.par_chunks_mut(4))
-        .enumerate()
-        .with_min_len(min_len)
-        .for_each(|(c, (qv, qe))| {
-            let f = corner_face[c] as usize;
-            let s = p.face_offsets[f] as usize;
-            let n = p.face_offsets[f + 1] as usize - s;
-            let i = c - s;
-            let prev = s + (i + n - 1) % n;
-            let v = p.face_verts[c];
-            let (e, ep) = (p.face_edges[c], p.face_edges[prev]);
-            qv.copy_from_slice(&[v, vert_e(e), vert_f(f as u32), vert_e(ep)]);
-            qe.copy_from_slice(&[
-                child_edge_at(p, e, v),
-                face_edge(c),
-                face_edge(prev),
-                child_edge_at(p, ep, v),
-            ]);
-        });
-    let face_offsets: Vec<u32> = (0..=corners as u32).map(|i| 4 * i).collect();
 
-    // Vertex incidence: vertex-vertices inherit their parent's counts, edge-vertices have the
-    // two halves plus one interior edge per face, face-vertices one edge and face per corner.
-    let nc = nv + ne + nf;
-    let mut vert_edge_offsets = Vec::with_capacity(nc + 1);
-    let mut vert_face_offsets = Vec::with_capacity(nc + 1);
-    vert_edge_offsets.extend_from_slice(&p.vert_edge_offsets);
-    vert_face_offsets.extend_from_slice(&p.vert_face_offsets);
-    let (mut oe, mut of) = (p.vert_edges.len() as u32, p.vert_faces.len() as u32);
-    for ef in &p.edge_faces {
-        let k = 1 + u32::from(ef[1] != INVALID);
-        oe += 2 + k;
-        of += 2 * k;
-        vert_edge_offsets.push(oe);
-        vert_face_offsets.push(of);
+    /// The child quads' vertices and edges: quad `c` at parent corner `c`.
+    fn faces(&self) -> (Vec<u32>, Vec<u32>) {
+        let p = self.p;
+        let corners = p.face_verts.len();
+        let mut face_verts = vec![0u32; 4 * corners];
+        let mut face_edges = vec![0u32; 4 * corners];
+        face_verts
+            .par_chunks_mut(4)
+            .zip(face_edges.par_chunks_mut(4))
+            .enumerate()
+            .with_min_len(SPLIT_MIN_LEN)
+            .for_each(|(c, (qv, qe))| {
+                let f = self.corner_face[c] as usize;
+                let s = p.face_offsets[f] as usize;
+                let n = p.face_offsets[f + 1] as usize - s;
+                let i = c - s;
+                let prev = s + (i + n - 1) % n;
+                let v = p.face_verts[c];
+                let (e, ep) = (p.face_edges[c], p.face_edges[prev]);
+                qv.copy_from_slice(&[v, self.vert_e(e), self.vert_f(f as u32), self.vert_e(ep)]);
+                qe.copy_from_slice(&[
+                    child_edge_at(p, e, v),
+                    self.face_edge(c),
+                    self.face_edge(prev),
+                    child_edge_at(p, ep, v),
+                ]);
+            });
+        (face_verts, face_edges)
     }
-    for w in p.face_offsets.windows(2) {
-        let n = w[1] - w[0];
-        oe += n;
-        of += n;
-        vert_edge_offsets.push(oe);
-        vert_face_offsets.push(of);
+
+    /// Vertex incidence offsets (edges, faces): vertex-vertices inherit their parent's counts,
+    /// edge-vertices have the two halves plus one interior edge per face, face-vertices one
+    /// edge and face per corner.
+    fn vertex_offsets(&self) -> (Vec<u32>, Vec<u32>) {
+        let p = self.p;
+        let nc = self.nv + self.ne + p.num_faces();
+        let mut vert_edge_offsets = Vec::with_capacity(nc + 1);
+        let mut vert_face_offsets = Vec::with_capacity(nc + 1);
+        vert_edge_offsets.extend_from_slice(&p.vert_edge_offsets);
+        vert_face_offsets.extend_from_slice(&p.vert_face_offsets);
+        let (mut oe, mut of) = (p.vert_edges.len() as u32, p.vert_faces.len() as u32);
+        for ef in &p.edge_faces {
+            let k = 1 + u32::from(ef[1] != INVALID);
+            oe += 2 + k;
+            of += 2 * k;
+            vert_edge_offsets.push(oe);
+            vert_face_offsets.push(of);
+        }
+        for w in p.face_offsets.windows(2) {
+            let n = w[1] - w[0];
+            oe += n;
+            of += n;
+            vert_edge_offsets.push(oe);
+            vert_face_offsets.push(of);
+        }
+        (vert_edge_offsets, vert_face_offsets)
     }
-    let mut vert_edges = vec![0u32; oe as usize];
-    let mut vert_faces = vec![0u32; of as usize];
-    par_fill_ragged(&vert_edge_offsets, &mut vert_edges, |i, out| {
-        if i < nv {
-            for (slot, &e) in out.iter_mut().zip(p.vertex_edges(i)) {
-                *slot = child_edge_at(p, e, i as u32);
-            }
-        } else if i < nv + ne {
-            let e = (i - nv) as u32;
-            out[0] = 2 * e;
-            out[1] = 2 * e + 1;
-            let mut k = 2;
-            for f in p.edge_faces[e as usize] {
-                if f != INVALID {
-                    let c = p.face_offsets[f as usize] as usize + edge_slot(p, f, e);
-                    out[k] = face_edge(c);
-                    k += 1;
+
+    /// Each child vertex's edges, ascending.
+    fn vertex_edges(&self, offsets: &[u32]) -> Vec<u32> {
+        let (p, nv, ne) = (self.p, self.nv, self.ne);
+        let mut vert_edges = vec![0u32; *offsets.last().expect("offsets") as usize];
+        par_fill_ragged(offsets, &mut vert_edges, |i, out| {
+            if i < nv {
+                for (slot, &e) in out.iter_mut().zip(p.vertex_edges(i)) {
+                    *slot = child_edge_at(p, e, i as u32);
+                }
+            } else if i < nv + ne {
+                let e = (i - nv) as u32;
+                out[0] = 2 * e;
+                out[1] = 2 * e + 1;
+                let mut k = 2;
+                for f in p.edge_faces[e as usize] {
+                    if f != INVALID {
+                        let c = p.face_offsets[f as usize] as usize + edge_slot(p, f, e);
+                        out[k] = self.face_edge(c);
+                        k += 1;
+                    }
+                }
+                out[2..].sort_unstable();
+            } else {
+                let s = p.face_offsets[i - nv - ne] as usize;
+                for (k, slot) in out.iter_mut().enumerate() {
+                    *slot = self.face_edge(s + k);
                 }
             }
-            out[2..].sort_unstable();
-        } else {
-            let s = p.face_offsets[i - nv - ne] as usize;
-            for (k, slot) in out.iter_mut().enumerate() {
-                *slot = face_edge(s + k);
-            }
-        }
-    });
-    par_fill_ragged(&vert_face_offsets, &mut vert_faces, |i, out| {
-        if i < nv {
-            for (slot, &f) in out.iter_mut().zip(p.vertex_faces(i)) {
-                let s = p.face_offsets[f as usize] as usize;
-                let k = p
-                    .face_vertices(f as usize)
-                    .iter()
-                    .position(|&x| x as usize == i)
-                    .expect("face lists its vertices");
-                *slot = (s + k) as u32;
-            }
-        } else if i < nv + ne {
-            let e = (i - nv) as u32;
-            let mut k = 0;
-            for f in p.edge_faces[e as usize] {
-                if f != INVALID {
+        });
+        vert_edges
+    }
+
+    /// Each child vertex's faces, ascending.
+    fn vertex_faces(&self, offsets: &[u32]) -> Vec<u32> {
+        let (p, nv, ne) = (self.p, self.nv, self.ne);
+        let mut vert_faces = vec![0u32; *offsets.last().expect("offsets") as usize];
+        par_fill_ragged(offsets, &mut vert_faces, |i, out| {
+            if i < nv {
+                for (slot, &f) in out.iter_mut().zip(p.vertex_faces(i)) {
                     let s = p.face_offsets[f as usize] as usize;
-                    let n = p.face_offsets[f as usize + 1] as usize - s;
-                    let j = edge_slot(p, f, e);
-                    out[k] = (s + j) as u32;
-                    out[k + 1] = (s + (j + 1) % n) as u32;
-                    k += 2;
+                    let k = p
+                        .face_vertices(f as usize)
+                        .iter()
+                        .position(|&x| x as usize == i)
+                        .expect("face lists its vertices");
+                    *slot = (s + k) as u32;
+                }
+            } else if i < nv + ne {
+                let e = (i - nv) as u32;
+                let mut k = 0;
+                for f in p.edge_faces[e as usize] {
+                    if f != INVALID {
+                        let s = p.face_offsets[f as usize] as usize;
+                        let n = p.face_offsets[f as usize + 1] as usize - s;
+                        let j = edge_slot(p, f, e);
+                        out[k] = (s + j) as u32;
+                        out[k + 1] = (s + (j + 1) % n) as u32;
+                        k += 2;
+                    }
+                }
+                out.sort_unstable();
+            } else {
+                let s = p.face_offsets[i - nv - ne];
+                for (k, slot) in out.iter_mut().enumerate() {
+                    *slot = s + k as u32;
                 }
             }
-            out.sort_unstable();
-        } else {
-            let s = p.face_offsets[i - nv - ne];
-            for (k, slot) in out.iter_mut().enumerate() {
-                *slot = s + k as u32;
-            }
-        }
-    });
-    Topology {
-        num_vertices: nc,
-        face_offsets,
-        face_verts,
-        face_edges,
-        edge_verts,
-        edge_faces,
-        vert_edge_offsets,
-        vert_edges,
-        vert_face_offsets,
-        vert_faces,
+        });
+        vert_faces
     }
 }
 
@@ -2164,25 +2229,47 @@ fn other_end(p: &Topology, e: u32, v: usize) -> u32 {
 /// so the refined mesh pulls away from the control boundary (sharpness is ignored).
 fn refine_doo_sabin(parent: &Level) -> Result<(Level, StencilTable), TopologyError> {
     let p = &parent.topology;
-    let corners = p.face_verts.len();
-    let corner_face = {
-        let mut cf = vec![0u32; corners];
-        for f in 0..p.num_faces() {
-            for c in p.face_offsets[f]..p.face_offsets[f + 1] {
-                cf[c as usize] = f as u32;
+    let faces = doo_sabin_faces(p);
+    let step = doo_sabin_rows(p);
+    let positions = step.apply(&parent.positions);
+    let mesh = ControlMesh::from_polygons(positions.clone(), &faces);
+    let topology = Topology::from_mesh(&mesh)?;
+    let edge_sharpness = (0..topology.num_edges())
+        .map(|e| {
+            if topology.is_boundary_edge(e) {
+                boundary_edge_sharpness()
+            } else {
+                0.0
             }
-        }
-        cf
-    };
-    let corner_of = |f: u32, v: u32| -> u32 {
-        let s = p.face_offsets[f as usize];
-        let i = p
-            .face_vertices(f as usize)
-            .iter()
-            .position(|&x| x == v)
-            .unwrap_or(0);
-        s + i as u32
-    };
+        })
+        .collect();
+    let vertex_sharpness = vec![0.0; topology.num_vertices()];
+    Ok((
+        Level {
+            topology,
+            positions,
+            edge_sharpness,
+            vertex_sharpness,
+        },
+        step,
+    ))
+}
+
+/// The corner of face `f` at vertex `v` (a Doo-Sabin child vertex).
+fn doo_sabin_corner(p: &Topology, f: u32, v: u32) -> u32 {
+    let s = p.face_offsets[f as usize];
+    let i = p
+        .face_vertices(f as usize)
+        .iter()
+        .position(|&x| x == v)
+        .unwrap_or(0);
+    s + i as u32
+}
+
+/// The Doo-Sabin child faces over the child vertices (the parent's corners): one per parent
+/// face, one per interior edge, one per interior vertex.
+fn doo_sabin_faces(p: &Topology) -> Vec<Vec<u32>> {
+    let corner_of = |f: u32, v: u32| doo_sabin_corner(p, f, v);
     let mut faces: Vec<Vec<u32>> = Vec::new();
     for f in 0..p.num_faces() {
         faces.push((p.face_offsets[f]..p.face_offsets[f + 1]).collect());
@@ -2223,24 +2310,47 @@ fn refine_doo_sabin(parent: &Level) -> Result<(Level, StencilTable), TopologyErr
         {
             continue;
         }
-        // Walk around v through each face's incoming edge.
-        let mut ring = Vec::with_capacity(vf.len());
-        let mut f = vf[0];
-        for _ in 0..vf.len() {
-            ring.push(corner_of(f, v as u32));
-            let fv = p.face_vertices(f as usize);
-            let fe = p.face_edge_list(f as usize);
-            let i = fv.iter().position(|&x| x == v as u32).unwrap_or(0);
-            let e_in = fe[(i + fv.len() - 1) % fv.len()];
-            let [x, y] = p.edge_faces[e_in as usize];
-            f = if x == f { y } else { x };
-            if f == vf[0] || f == INVALID {
-                break;
+        faces.push(doo_sabin_vertex_face(p, v));
+    }
+    faces
+}
+
+/// The child face of interior vertex `v`: the corners at `v`, walking around it through each
+/// face's incoming edge.
+fn doo_sabin_vertex_face(p: &Topology, v: usize) -> Vec<u32> {
+    let vf = p.vertex_faces(v);
+    let mut ring = Vec::with_capacity(vf.len());
+    let mut f = vf[0];
+    for _ in 0..vf.len() {
+        ring.push(doo_sabin_corner(p, f, v as u32));
+        let fv = p.face_vertices(f as usize);
+        let fe = p.face_edge_list(f as usize);
+        let i = fv.iter().position(|&x| x == v as u32).unwrap_or(0);
+        let e_in = fe[(i + fv.len() - 1) % fv.len()];
+        let [x, y] = p.edge_faces[e_in as usize];
+        f = if x == f { y } else { x };
+        if f == vf[0] || f == INVALID {
+            break;
+        }
+    }
+    ring
+}
+
+/// The Doo-Sabin stencils: child vertex `c` (corner `i` of an `n`-gon) over the face's
+/// vertices, `(n + 5) / 4n` at its own corner and `(3 + 2 cos(2π d / n)) / 4n` at distance
+/// `d`.
+fn doo_sabin_rows(p: &Topology) -> StencilTable {
+    let corners = p.face_verts.len();
+    let corner_face = {
+        let mut cf = vec![0u32; corners];
+        for f in 0..p.num_faces() {
+            for c in p.face_offsets[f]..p.face_offsets[f + 1] {
+                cf[c as usize] = f as u32;
             }
         }
-        faces.push(ring);
-    }
-    let step = build_rows(corners, p.num_vertices(), |c, out| {
+        cf
+    };
+    build_rows(corners, p.num_vertices(), |c, out| {
         let f = corner_face[c] as usize;
         let fv = p.face_vertices(f);
         let n = fv.len();
@@ -2256,29 +2366,7 @@ fn refine_doo_sabin(parent: &Level) -> Result<(Level, StencilTable), TopologyErr
             out.raw.push((v, w));
         }
         false
-    });
-    let positions = step.apply(&parent.positions);
-    let mesh = ControlMesh::from_polygons(positions.clone(), &faces);
-    let topology = Topology::from_mesh(&mesh)?;
-    let edge_sharpness = (0..topology.num_edges())
-        .map(|e| {
-            if topology.is_boundary_edge(e) {
-                boundary_edge_sharpness()
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    let vertex_sharpness = vec![0.0; topology.num_vertices()];
-    Ok((
-        Level {
-            topology,
-            positions,
-            edge_sharpness,
-            vertex_sharpness,
-        },
-        step,
-    ))
+    })
 }
 
 #[cfg(test)]
