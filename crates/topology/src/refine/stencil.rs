@@ -246,6 +246,21 @@ struct Scratch {
     wts: Vec<f64>,
 }
 
+impl Scratch {
+    /// Empty buffers, and an accumulator over `num_sources` when composing with a parent.
+    fn new(composing: bool, num_sources: usize) -> Scratch {
+        Scratch {
+            keys: Vec::with_capacity(64),
+            out: composing.then(|| Dense::new(num_sources)),
+            row: Vec::with_capacity(64),
+            merged: (Vec::with_capacity(64), Vec::with_capacity(64)),
+            sizes: Vec::new(),
+            idx: Vec::new(),
+            wts: Vec::new(),
+        }
+    }
+}
+
 /// Rows per block of [`compose_rows`].
 const BLOCK_ROWS: usize = 8192;
 
@@ -274,17 +289,7 @@ where
         "too many stencils for 32-bit offsets"
     );
     let threads = rayon::current_num_threads().max(1);
-    let pool = std::sync::Mutex::new(Vec::<Scratch>::new());
     let merge = kind == RowKind::Raw;
-    let new_scratch = || Scratch {
-        keys: Vec::with_capacity(64),
-        out: parent.map(|_| Dense::new(num_sources)),
-        row: Vec::with_capacity(64),
-        merged: (Vec::with_capacity(64), Vec::with_capacity(64)),
-        sizes: Vec::new(),
-        idx: Vec::new(),
-        wts: Vec::new(),
-    };
     // Entries per row: ~10 for a composed Catmull-Clark row, fewer for masks. Filled by
     // appending (nothing is zeroed first, which on recycled heap memory wrote every page
     // once more), and trimmed only when the guess was far off (a trim may copy).
@@ -296,7 +301,7 @@ where
     if threads == 1 {
         // One thread: rows go straight into the final arrays (no block buffers to fill and
         // copy; on catmark_car those were 8.6 MB of pages per plan).
-        let mut sc = new_scratch();
+        let mut sc = Scratch::new(parent.is_some(), num_sources);
         // Offsets past u32 wrap here; the length check after the loop rejects them.
         fill_rows(
             &mut sc.keys,
@@ -312,64 +317,8 @@ where
             |_, end| offsets.push(end as u32),
         );
     } else {
-        let blocks = n.div_ceil(BLOCK_ROWS).max(1);
-        // Two blocks per thread balance the load (each block in flight holds a scratch
-        // accumulator the size of the parent's sources when composing).
-        let per_round = threads * 2;
-        let mut b0 = 0;
-        while b0 < blocks {
-            let b1 = (b0 + per_round).min(blocks);
-            let done: Vec<Scratch> = (b0..b1)
-                .into_par_iter()
-                .map(|b| {
-                    let mut sc = pool
-                        .lock()
-                        .ok()
-                        .and_then(|mut p| p.pop())
-                        .unwrap_or_else(new_scratch);
-                    let rows = (b * BLOCK_ROWS).min(n)..((b + 1) * BLOCK_ROWS).min(n);
-                    let Scratch {
-                        keys,
-                        out,
-                        row,
-                        merged,
-                        sizes,
-                        idx,
-                        wts,
-                    } = &mut sc;
-                    sizes.clear();
-                    idx.clear();
-                    wts.clear();
-                    fill_rows(
-                        keys,
-                        merge,
-                        out,
-                        row,
-                        merged,
-                        rows,
-                        parent,
-                        &gen,
-                        idx,
-                        wts,
-                        |start, end| sizes.push((end - start) as u32),
-                    );
-                    sc
-                })
-                .collect();
-            for sc in &done {
-                let mut acc = indices.len() as u64;
-                offsets.extend(sc.sizes.iter().map(|&s| {
-                    acc += s as u64;
-                    acc as u32
-                }));
-                indices.extend_from_slice(&sc.idx);
-                weights.extend_from_slice(&sc.wts);
-            }
-            if let Ok(mut p) = pool.lock() {
-                p.extend(done);
-            }
-            b0 = b1;
-        }
+        let table = (&mut offsets, &mut indices, &mut weights);
+        compose_in_rounds(n, parent, merge, num_sources, &gen, table);
     }
     assert!(
         indices.len() < u32::MAX as usize,
@@ -384,6 +333,82 @@ where
         indices,
         weights,
         num_sources,
+    }
+}
+
+/// [`compose_rows`] on more than one thread: blocks of [`BLOCK_ROWS`] rows in rounds of two
+/// per thread, each round's blocks appended in order to the table (`offsets`, `indices`,
+/// `weights`); the scratch of each block (buffers and accumulator) goes back to a pool for the
+/// next round.
+fn compose_in_rounds<G>(
+    n: usize,
+    parent: Option<&StencilTable>,
+    merge: bool,
+    num_sources: usize,
+    gen: &G,
+    (offsets, indices, weights): (&mut Vec<u32>, &mut Vec<u32>, &mut Vec<f64>),
+) where
+    G: Fn(usize, &mut RowOut) -> bool + Sync,
+{
+    let threads = rayon::current_num_threads().max(1);
+    let pool = std::sync::Mutex::new(Vec::<Scratch>::new());
+    let blocks = n.div_ceil(BLOCK_ROWS).max(1);
+    // Two blocks per thread balance the load (each block in flight holds a scratch
+    // accumulator the size of the parent's sources when composing).
+    let per_round = threads * 2;
+    let mut b0 = 0;
+    while b0 < blocks {
+        let b1 = (b0 + per_round).min(blocks);
+        let done: Vec<Scratch> = (b0..b1)
+            .into_par_iter()
+            .map(|b| {
+                let mut sc = pool
+                    .lock()
+                    .ok()
+                    .and_then(|mut p| p.pop())
+                    .unwrap_or_else(|| Scratch::new(parent.is_some(), num_sources));
+                let rows = (b * BLOCK_ROWS).min(n)..((b + 1) * BLOCK_ROWS).min(n);
+                let Scratch {
+                    keys,
+                    out,
+                    row,
+                    merged,
+                    sizes,
+                    idx,
+                    wts,
+                } = &mut sc;
+                sizes.clear();
+                idx.clear();
+                wts.clear();
+                fill_rows(
+                    keys,
+                    merge,
+                    out,
+                    row,
+                    merged,
+                    rows,
+                    parent,
+                    gen,
+                    idx,
+                    wts,
+                    |start, end| sizes.push((end - start) as u32),
+                );
+                sc
+            })
+            .collect();
+        for sc in &done {
+            let mut acc = indices.len() as u64;
+            offsets.extend(sc.sizes.iter().map(|&s| {
+                acc += s as u64;
+                acc as u32
+            }));
+            indices.extend_from_slice(&sc.idx);
+            weights.extend_from_slice(&sc.wts);
+        }
+        if let Ok(mut p) = pool.lock() {
+            p.extend(done);
+        }
+        b0 = b1;
     }
 }
 
