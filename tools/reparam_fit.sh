@@ -3,7 +3,7 @@
 # Gregory patches): fit the corner block c0..c4 of Eq. 3 per valence by Levenberg–Marquardt on
 # Eq. 2 over Catmull-Clark's characteristic map, check the fitted map does not fold, and print
 # Eq. 1's texture error with and without it (and with the paper's rows) as Markdown tables.
-# With --write it regenerates crates/topology/src/reparam_table.rs, the committed table the
+# With --write it regenerates crates/topology/src/patches/reparam_table.rs, the committed table the
 # GPU reads (valences 3..16); the test `committed_table_is_the_fit` in
 # crates/topology/tests/reparam.rs fails when that file and a fresh fit disagree.
 #
