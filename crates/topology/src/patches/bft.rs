@@ -151,35 +151,10 @@ pub fn configuration_mesh(key: BftKey, identity: bool) -> Result<(LocalMesh, usi
             key: format!("{key:?}"),
         });
     }
-    let n = key.valence;
     let boundary = matches!(key.case, BftCase::Boundary { .. });
-    let sectors = if boundary { n - 1 } else { n };
-    let r = RADIUS;
-    // Vertex ids: centre 0; per sector the points (i ≥ 1, j ≥ 0, i + j ≤ R); a boundary fan has
-    // one more closing ray (the last sector's (0, j)).
-    let per: Vec<(u32, u32)> = (1..=r)
-        .flat_map(|i| (0..=r - i).map(move |j| (i, j)))
-        .collect();
-    let index: HashMap<(u32, u32), u32> = per
-        .iter()
-        .enumerate()
-        .map(|(k, &p)| (p, k as u32))
-        .collect();
-    let closing = sectors * per.len() as u32 + 1;
-    let id = |s: u32, i: u32, j: u32| -> u32 {
-        if i == 0 && j == 0 {
-            0
-        } else if i == 0 {
-            if s + 1 == sectors && boundary {
-                closing + j - 1
-            } else {
-                1 + ((s + 1) % sectors) * per.len() as u32 + index[&(j, 0)]
-            }
-        } else {
-            1 + s * per.len() as u32 + index[&(i, j)]
-        }
-    };
-    let nv = (closing + if boundary { r } else { 0 }) as usize;
+    let lattice = FanLattice::new(key.valence, boundary);
+    let (sectors, r) = (lattice.sectors, RADIUS);
+    let id = |s: u32, i: u32, j: u32| lattice.id(s, i, j);
     let mut fo = vec![0u32];
     let mut fv = Vec::new();
     let mut face = 0;
@@ -204,30 +179,14 @@ pub fn configuration_mesh(key: BftKey, identity: bool) -> Result<(LocalMesh, usi
         }
     }
     let (dim, points) = if identity {
+        let nv = lattice.num_vertices();
         let mut p = vec![0.0; nv * nv];
         for v in 0..nv {
             p[v * nv + v] = 1.0;
         }
         (nv, p)
     } else {
-        // A planar fan: sector s spans angles [s, s+1]·span (boundary fans cover a half-plane).
-        let span = if boundary {
-            std::f64::consts::PI / sectors as f64
-        } else {
-            2.0 * std::f64::consts::PI / sectors as f64
-        };
-        let mut p = vec![0.0; nv * 3];
-        for s in 0..sectors {
-            let (a0, a1) = (s as f64 * span, (s + 1) as f64 * span);
-            for i in 0..=r {
-                for j in 0..=r - i {
-                    let v = id(s, i, j) as usize;
-                    p[v * 3] = i as f64 * a0.cos() + j as f64 * a1.cos();
-                    p[v * 3 + 1] = i as f64 * a0.sin() + j as f64 * a1.sin();
-                }
-            }
-        }
-        (3, p)
+        (3, lattice.planar_points())
     };
     let mesh = LocalMesh::from_faces(
         LimitScheme::Loop,
@@ -238,6 +197,87 @@ pub fn configuration_mesh(key: BftKey, identity: bool) -> Result<(LocalMesh, usi
         fv,
     )?;
     Ok((mesh, face))
+}
+
+/// The vertices of a configuration mesh: `v0` at the centre of `sectors` regular lattice
+/// sectors of radius [`RADIUS`].
+struct FanLattice {
+    sectors: u32,
+    boundary: bool,
+    /// A sector's points (i ≥ 1, j ≥ 0, i + j ≤ R), and each one's place among them.
+    per: Vec<(u32, u32)>,
+    index: HashMap<(u32, u32), u32>,
+    /// The first vertex of a boundary fan's closing ray.
+    closing: u32,
+}
+
+impl FanLattice {
+    /// `n` edges at `v0`: `n` sectors, or `n − 1` at a boundary.
+    fn new(n: u32, boundary: bool) -> FanLattice {
+        let sectors = if boundary { n - 1 } else { n };
+        let r = RADIUS;
+        // Vertex ids: centre 0; per sector the points (i ≥ 1, j ≥ 0, i + j ≤ R); a boundary fan
+        // has one more closing ray (the last sector's (0, j)).
+        let per: Vec<(u32, u32)> = (1..=r)
+            .flat_map(|i| (0..=r - i).map(move |j| (i, j)))
+            .collect();
+        let index: HashMap<(u32, u32), u32> = per
+            .iter()
+            .enumerate()
+            .map(|(k, &p)| (p, k as u32))
+            .collect();
+        let closing = sectors * per.len() as u32 + 1;
+        FanLattice {
+            sectors,
+            boundary,
+            per,
+            index,
+            closing,
+        }
+    }
+
+    fn num_vertices(&self) -> usize {
+        (self.closing + if self.boundary { RADIUS } else { 0 }) as usize
+    }
+
+    /// The vertex at lattice point `(i, j)` of sector `s`.
+    fn id(&self, s: u32, i: u32, j: u32) -> u32 {
+        let per = self.per.len() as u32;
+        if i == 0 && j == 0 {
+            0
+        } else if i == 0 {
+            if s + 1 == self.sectors && self.boundary {
+                self.closing + j - 1
+            } else {
+                1 + ((s + 1) % self.sectors) * per + self.index[&(j, 0)]
+            }
+        } else {
+            1 + s * per + self.index[&(i, j)]
+        }
+    }
+
+    /// A planar fan, `z = 0`: sector s spans angles [s, s+1]·span (boundary fans cover a
+    /// half-plane).
+    fn planar_points(&self) -> Vec<f64> {
+        let (sectors, r) = (self.sectors, RADIUS);
+        let span = if self.boundary {
+            std::f64::consts::PI / sectors as f64
+        } else {
+            2.0 * std::f64::consts::PI / sectors as f64
+        };
+        let mut p = vec![0.0; self.num_vertices() * 3];
+        for s in 0..sectors {
+            let (a0, a1) = (s as f64 * span, (s + 1) as f64 * span);
+            for i in 0..=r {
+                for j in 0..=r - i {
+                    let v = self.id(s, i, j) as usize;
+                    p[v * 3] = i as f64 * a0.cos() + j as f64 * a1.cos();
+                    p[v * 3 + 1] = i as f64 * a0.sin() + j as f64 * a1.sin();
+                }
+            }
+        }
+        p
+    }
 }
 
 /// The one-ring of `v` rotated to begin at `start` (no allocation: this runs per face).
@@ -947,11 +987,21 @@ pub fn build_patch_records(mesh: &LocalMesh) -> Result<PatchRecords, EvalError> 
             max: Owner::MAX_FACES,
         });
     }
-    let creases = has_interior_creases(mesh);
+    let blocks = classify_blocks(mesh, has_interior_creases(mesh));
+    let mut recs = join_blocks(blocks, nf);
+    set_owners(mesh, &mut recs);
+    Ok(recs)
+}
+
+/// The records of a Loop mesh's faces (triangles), classified in parallel blocks: each
+/// block's records with its rings in one array, offsets local to the block. `creases`: the
+/// mesh has interior creases ([`has_interior_creases`]).
+fn classify_blocks(mesh: &LocalMesh, creases: bool) -> Vec<PatchRecords> {
     // Faces are independent: classified in parallel blocks, a shape cache per rayon job, each
     // block's rings in one array (offsets made global when the blocks are joined).
     const BLOCK: usize = 1 << 14;
-    let blocks: Vec<PatchRecords> = (0..nf.div_ceil(BLOCK))
+    let nf = mesh.num_faces();
+    (0..nf.div_ceil(BLOCK))
         .into_par_iter()
         .map_init(ConfigShapes::new, |shapes, b| {
             let faces = b * BLOCK..((b + 1) * BLOCK).min(nf);
@@ -987,7 +1037,11 @@ pub fn build_patch_records(mesh: &LocalMesh) -> Result<PatchRecords, EvalError> 
             }
             out
         })
-        .collect();
+        .collect()
+}
+
+/// The blocks' records in one table, the ring offsets made global.
+fn join_blocks(blocks: Vec<PatchRecords>, nf: usize) -> PatchRecords {
     // Joined block by block, each block freed once copied: the peak is the whole plus one
     // block, not twice the whole.
     let mut recs = PatchRecords {
@@ -1002,6 +1056,11 @@ pub fn build_patch_records(mesh: &LocalMesh) -> Result<PatchRecords, EvalError> 
         }));
         recs.rings.extend_from_slice(&b.rings);
     }
+    recs
+}
+
+/// Each record's edge and corner owners.
+fn set_owners(mesh: &LocalMesh, recs: &mut PatchRecords) {
     // Owners: the smallest (face, local index) among the faces around the corner (sharing the
     // edge), found from the mesh's vertex-face adjacency instead of global edge maps. A face's
     // rotation (its `v0` among its corners) is all a neighbour needs from its record.
@@ -1038,7 +1097,6 @@ pub fn build_patch_records(mesh: &LocalMesh) -> Result<PatchRecords, EvalError> 
             r.corner_owner[e] = corner;
         }
     });
-    Ok(recs)
 }
 
 /// The vertices of `face` and of every face touching one of its corners, in the order
