@@ -134,15 +134,12 @@ pub(super) fn build_levels(
             let semi_sharp = follow_semi_sharp.then_some(&mut last_semi_sharp[..]);
             followed(lvl, l, iso, semi_sharp)
         };
+        lvl.selected = if last {
+            vec![false; lvl.t().num_faces()]
+        } else {
+            selected_faces(lvl, &follow)
+        };
         let t = &lvl.topo.topology;
-        lvl.selected = (0..t.num_faces())
-            .map(|f| {
-                !last
-                    && lvl.complete[f]
-                    && !lvl.hole[f]
-                    && t.face_vertices(f).iter().any(|&v| follow[v as usize])
-            })
-            .collect();
         let none = !lvl.selected.iter().any(|&x| x);
         if last || (none && (l >= iso || single_pass)) {
             break;
@@ -275,6 +272,19 @@ fn followed(lvl: &Lvl, l: usize, iso: usize, last_semi_sharp: Option<&mut [u32]>
     (0..lvl.t().num_vertices())
         .map(|v| {
             lvl.irregular[v] && (l < iso || l < start(last_semi_sharp[v]) + cap_depth(lvl, v, iso))
+        })
+        .collect()
+}
+
+/// Per face: whether it is selected for the next step, a complete face (not a hole) at a
+/// followed vertex.
+fn selected_faces(lvl: &Lvl, follow: &[bool]) -> Vec<bool> {
+    let t = lvl.t();
+    (0..t.num_faces())
+        .map(|f| {
+            lvl.complete[f]
+                && !lvl.hole[f]
+                && t.face_vertices(f).iter().any(|&v| follow[v as usize])
         })
         .collect()
 }
