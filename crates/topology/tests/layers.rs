@@ -68,10 +68,12 @@ fn code_only(text: &str) -> String {
             i += end;
         } else if rest[0] == b'\'' && rest.len() > 2 && (rest[1] == b'\\' || rest[2] == b'\'') {
             // A character literal (`'a'`, `'\n'`, `'\''`); a lifetime has no closing quote.
-            let end = rest[2..]
+            // After a backslash the escaped character is skipped, then the closing quote.
+            let from = if rest[1] == b'\\' { 3 } else { 2 };
+            let end = rest[from.min(rest.len())..]
                 .iter()
                 .position(|&c| c == b'\'')
-                .map_or(1, |e| e + 3);
+                .map_or(1, |e| e + from + 1);
             blank(&mut out, &rest[..end]);
             i += end;
         } else {
@@ -347,6 +349,7 @@ fn layers_import_only_layers_below_them_without_cycles() {
 fn the_path_reader_sees_groups_and_skips_comments_and_strings() {
     let code = code_only(
         "use crate::{a::{B, C}, d::E};\n// crate::x::Y\nlet s = \"crate::z\"; let c = '\"';\n\
+         let q = '\\''; /* crate::w::V */ let r = r#\"crate::u\"#;\n\
          fn f<'a>(x: &'a crate::g::H) {}\npub(crate) fn k() {}\n",
     );
     let paths: Vec<Vec<String>> = paths_after(&code, "crate")
