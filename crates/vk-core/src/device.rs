@@ -41,6 +41,12 @@ pub struct Capabilities {
     pub fill_mode_non_solid: bool,
     pub pipeline_statistics_query: bool,
     pub vertex_pipeline_stores_and_atomics: bool,
+    /// `multiDrawIndirect`: one indirect draw command may hold more than one draw.
+    pub multi_draw_indirect: bool,
+    /// `drawIndirectFirstInstance`: indirect draws may start at an instance other than 0.
+    pub draw_indirect_first_instance: bool,
+    /// `maxDrawIndirectCount`: the most draws one indirect command may hold.
+    pub max_draw_indirect_count: u32,
     pub dynamic_rendering: bool,
     pub timestamps: bool,
     pub max_tessellation_generation_level: u32,
@@ -217,6 +223,9 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
             pipeline_statistics_query: feats.pipeline_statistics_query == vk::TRUE,
             vertex_pipeline_stores_and_atomics: feats.vertex_pipeline_stores_and_atomics
                 == vk::TRUE,
+            multi_draw_indirect: feats.multi_draw_indirect == vk::TRUE,
+            draw_indirect_first_instance: feats.draw_indirect_first_instance == vk::TRUE,
+            max_draw_indirect_count: props.limits.max_draw_indirect_count,
             dynamic_rendering: f13.dynamic_rendering == vk::TRUE,
             maintenance4: f13.maintenance4 == vk::TRUE,
             timestamps,
@@ -499,7 +508,9 @@ impl Device {
             .tessellation_shader(true)
             .fill_mode_non_solid(true)
             .pipeline_statistics_query(info.caps.pipeline_statistics_query)
-            .vertex_pipeline_stores_and_atomics(info.caps.vertex_pipeline_stores_and_atomics);
+            .vertex_pipeline_stores_and_atomics(info.caps.vertex_pipeline_stores_and_atomics)
+            .multi_draw_indirect(info.caps.multi_draw_indirect)
+            .draw_indirect_first_instance(info.caps.draw_indirect_first_instance);
         let mut f12 = vk::PhysicalDeviceVulkan12Features::default().timeline_semaphore(true);
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
             .dynamic_rendering(true)
@@ -593,6 +604,10 @@ impl Device {
         info.queue_family = Some(host.queue_family);
         info.caps.pipeline_statistics_query &= host.pipeline_statistics_query;
         info.caps.vertex_pipeline_stores_and_atomics &= host.vertex_pipeline_stores_and_atomics;
+        // The host does not say whether it enabled these: indirect draws hold one draw each
+        // and start at instance 0 on its device.
+        info.caps.multi_draw_indirect = false;
+        info.caps.draw_indirect_first_instance = false;
         let xfb = info.caps.transform_feedback && host.transform_feedback;
         info.caps.transform_feedback = xfb;
         // SAFETY: the caller's contract: a live device of this instance.

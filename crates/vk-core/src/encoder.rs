@@ -41,6 +41,7 @@ use crate::descriptor::DescriptorSet;
 use crate::device::Device;
 use crate::error::{RecordingError as E, Result, VkContext, VkError};
 use crate::image::transition;
+use crate::indirect::{IndirectDraws, IndirectKind};
 use crate::pipeline::Pipeline;
 use crate::query::QueryPool;
 use crate::retire::Retired;
@@ -503,12 +504,14 @@ impl<'a> Encoder<'a> {
     }
 
     /// Every vertex binding of the pipeline has a buffer; `vertices_end` (when the vertex range
-    /// is known) fits in each per-vertex binding.
+    /// is known) fits in each per-vertex binding, `instances_end` (when known) in each
+    /// per-instance binding.
     fn check_vertex_buffers(
         &self,
         command: &'static str,
         pipeline: &Pipeline,
         vertices_end: Option<u32>,
+        instances_end: Option<u32>,
     ) -> Result<()> {
         for binding in &pipeline.vertex_bindings {
             let buffer = self
@@ -525,18 +528,33 @@ impl<'a> Encoder<'a> {
                         },
                     )
                 })?;
-            let Some(end) = vertices_end.filter(|&e| e > 0 && binding.per_vertex) else {
+            let end = if binding.per_vertex {
+                vertices_end
+            } else {
+                instances_end
+            };
+            let Some(end) = end.filter(|&e| e > 0) else {
                 continue;
             };
             let needed = (end as u64 - 1) * binding.stride as u64 + binding.element_bytes as u64;
             if needed > buffer.size() {
+                let (buffer, size) = (buffer.name().to_owned(), buffer.size());
                 return Err(VkError::recording(
                     command,
-                    E::VertexRange {
-                        buffer: buffer.name().to_owned(),
-                        end,
-                        needed,
-                        size: buffer.size(),
+                    if binding.per_vertex {
+                        E::VertexRange {
+                            buffer,
+                            end,
+                            needed,
+                            size,
+                        }
+                    } else {
+                        E::InstanceRange {
+                            buffer,
+                            end,
+                            needed,
+                            size,
+                        }
                     },
                 ));
             }
@@ -544,53 +562,116 @@ impl<'a> Encoder<'a> {
         Ok(())
     }
 
+    /// The bound index buffer, when `indices_end` indices fit in it.
+    fn check_indices(&self, command: &'static str, first: u32, end: u32) -> Result<&'a Buffer> {
+        let index_buffer = self
+            .index_buffer
+            .ok_or_else(|| VkError::recording(command, E::NoIndexBuffer))?;
+        let available = index_buffer.size() / 4;
+        if first > end || end as u64 > available {
+            return Err(VkError::recording(
+                command,
+                E::IndexRange {
+                    buffer: index_buffer.name().to_owned(),
+                    first,
+                    end,
+                    count: available,
+                },
+            ));
+        }
+        Ok(index_buffer)
+    }
+
     /// Error unless a graphics pipeline is bound.
     pub fn draw(&mut self, vertices: Range<u32>) -> Result<()> {
+        self.draw_instanced(vertices, 0..1)
+    }
+
+    /// `vertices` of each of `instances`; per-instance vertex bindings are checked against the
+    /// instance range as per-vertex ones are against the vertex range.
+    pub fn draw_instanced(&mut self, vertices: Range<u32>, instances: Range<u32>) -> Result<()> {
         const CMD: &str = "vkCmdDraw";
         let pipeline = self.check_pipeline_state(CMD, vk::PipelineBindPoint::GRAPHICS)?;
-        self.check_vertex_buffers(CMD, pipeline, Some(vertices.end))?;
+        self.check_vertex_buffers(CMD, pipeline, Some(vertices.end), Some(instances.end))?;
         let count = vertices.end.saturating_sub(vertices.start);
+        let instance_count = instances.end.saturating_sub(instances.start);
         // SAFETY: a graphics pipeline is bound inside a rendering scope of its formats, with
         // every set and vertex buffer it declares bound and large enough (invariant 3).
         unsafe {
-            self.device
-                .raw
-                .cmd_draw(self.cmd, count, 1, vertices.start, 0)
+            self.device.raw.cmd_draw(
+                self.cmd,
+                count,
+                instance_count,
+                vertices.start,
+                instances.start,
+            )
         };
         Ok(())
     }
 
     /// Error unless a graphics pipeline and an index buffer are bound and the range lies inside the index buffer.
     pub fn draw_indexed(&mut self, indices: Range<u32>) -> Result<()> {
+        self.draw_indexed_instanced(indices, 0..1)
+    }
+
+    /// `indices` of each of `instances`, checked as [`Self::draw_indexed`] and
+    /// [`Self::draw_instanced`] check theirs.
+    pub fn draw_indexed_instanced(
+        &mut self,
+        indices: Range<u32>,
+        instances: Range<u32>,
+    ) -> Result<()> {
         const CMD: &str = "vkCmdDrawIndexed";
         let pipeline = self.check_pipeline_state(CMD, vk::PipelineBindPoint::GRAPHICS)?;
-        self.check_vertex_buffers(CMD, pipeline, None)?;
-        let index_buffer = self
-            .index_buffer
-            .ok_or_else(|| VkError::recording(CMD, E::NoIndexBuffer))?;
-        let available = index_buffer.size() / 4;
-        if indices.start > indices.end || indices.end as u64 > available {
-            return Err(VkError::recording(
-                CMD,
-                E::IndexRange {
-                    buffer: index_buffer.name().to_owned(),
-                    first: indices.start,
-                    end: indices.end,
-                    count: available,
-                },
-            ));
-        }
+        self.check_vertex_buffers(CMD, pipeline, None, Some(instances.end))?;
+        self.check_indices(CMD, indices.start, indices.end)?;
         // SAFETY: as for draw, and the index range lies inside the bound index buffer.
         unsafe {
             self.device.raw.cmd_draw_indexed(
                 self.cmd,
                 indices.end - indices.start,
-                1,
+                instances.end.saturating_sub(instances.start),
                 indices.start,
                 0,
-                0,
+                instances.start,
             )
         };
+        Ok(())
+    }
+
+    /// Every draw of `draws` (indexed through the bound index buffer when they are indexed
+    /// commands), checked against the extent they promise ([`crate::indirect`]).
+    pub fn draw_indirect(&mut self, draws: &'a IndirectDraws) -> Result<()> {
+        let indexed = draws.kind() == IndirectKind::DrawIndexed;
+        let cmd: &'static str = if indexed {
+            "vkCmdDrawIndexedIndirect"
+        } else {
+            "vkCmdDrawIndirect"
+        };
+        let pipeline = self.check_pipeline_state(cmd, vk::PipelineBindPoint::GRAPHICS)?;
+        Self::needs_usage(cmd, draws.buffer(), vk::BufferUsageFlags::INDIRECT_BUFFER)?;
+        let extent = draws.extent();
+        let vertices = (!indexed).then_some(extent.vertices);
+        self.check_vertex_buffers(cmd, pipeline, vertices, Some(extent.instances))?;
+        let (buffer, count, stride) = (draws.buffer().raw, draws.draws(), draws.kind().stride());
+        if indexed {
+            self.check_indices(cmd, 0, extent.indices)?;
+            // SAFETY: as for draw_indexed; every command's indices and instances lie inside
+            // the promised extent, checked against the bound buffers above, and the command
+            // count was checked against the device's limit when the buffer was made.
+            unsafe {
+                self.device
+                    .raw
+                    .cmd_draw_indexed_indirect(self.cmd, buffer, 0, count, stride)
+            };
+        } else {
+            // SAFETY: as for draw, with the extent as the ranges.
+            unsafe {
+                self.device
+                    .raw
+                    .cmd_draw_indirect(self.cmd, buffer, 0, count, stride)
+            };
+        }
         Ok(())
     }
 

@@ -77,6 +77,9 @@ pub enum VkError {
         index: u32,
         count: u32,
     },
+    /// An indirect draw command vk-core refused to write (see [`crate::indirect`]).
+    #[error("indirect draw {draw}: {problem}")]
+    IndirectCommand { draw: usize, problem: String },
     /// A command recorded where Vulkan forbids it, or with arguments vk-core can tell are wrong.
     #[error("{command}: {problem}")]
     Recording {
@@ -172,6 +175,13 @@ pub enum RecordingError {
     VertexBufferMissing { pipeline: String, binding: u32 },
     #[error("vertices up to {end} need {needed} bytes of vertex buffer {buffer} ({size} bytes)")]
     VertexRange {
+        buffer: String,
+        end: u32,
+        needed: u64,
+        size: u64,
+    },
+    #[error("instances up to {end} need {needed} bytes of vertex buffer {buffer} ({size} bytes)")]
+    InstanceRange {
         buffer: String,
         end: u32,
         needed: u64,

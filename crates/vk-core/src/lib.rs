@@ -13,6 +13,9 @@
 //!   present; what needs them returns [`VkError::Unsupported`] where they are absent.
 //! - Textures ([`texture`]) are sampled 2D images with their own sampler, uploaded and
 //!   mip-mapped when made, and resting in SHADER_READ_ONLY_OPTIMAL between recordings.
+//! - Draws are direct, instanced or indirect; an indirect draw's buffer knows how far its
+//!   commands reach ([`indirect`]), and the encoder checks that against the bound buffers as it
+//!   checks a direct draw's ranges.
 //! - Driver bugs are worked around through [`workarounds`], a documented list keyed by driver.
 //! - Commands are recorded through [`Encoder`], whose module states the `unsafe` contracts once
 //!   and why its safe methods uphold them; crates above vk-core need no `unsafe`.
@@ -38,6 +41,7 @@ pub mod encoder;
 pub mod error;
 pub mod host_heap;
 pub mod image;
+pub mod indirect;
 pub mod instance;
 pub mod overlay;
 pub mod pipeline;
@@ -59,6 +63,7 @@ pub use encoder::{Encoder, Submission};
 pub use error::{DescriptorError, RecordingError, Result, VkError};
 pub use gpu_allocator::MemoryLocation;
 pub use image::{Image, ImageDesc};
+pub use indirect::{DrawCommand, DrawIndexedCommand, IndirectDraws, IndirectExtent, IndirectKind};
 pub use instance::{Instance, InstanceDesc, MessageCounts, Validation};
 pub use overlay::{Overlay, OverlayDesc};
 pub use pipeline::Pipeline;

@@ -2,6 +2,7 @@
 //! loader offers (lavapipe in CI) with the validation layer on, synchronization validation
 //! included. Every test fails on any
 //! error-severity validation message and on memory still allocated at its end.
+mod draws;
 mod overlay;
 mod spirv;
 mod texture;
