@@ -322,9 +322,12 @@ pub unsafe extern "C" fn tessera_record_draw(
         let slot = c.slot();
         s.sync_positions(slot)?;
         let (params, extent) = s.frame;
+        s.tess.prepare(
+            s.technique.as_mut(),
+            &params,
+            tess::Context::frame_passes(&params),
+        )?;
         let technique = s.technique.as_ref();
-        s.tess
-            .prepare(technique, &params, tess::Context::frame_passes(&params))?;
         let eye = view.inverse().w_axis.truncate();
         let m = tess::camera::CameraMatrices { view, proj, eye };
         let uniforms = tess::context::frame_uniforms_with(m, technique.bbox(), &params, extent);

@@ -94,6 +94,11 @@ pub const TESSERA_TECHNIQUE_GREGORY: TesseraTechnique = 6;
 /// Catmull-Clark approximated in one pass by ACC-1 patches, Gregory where ACC-1 does not apply
 /// (`--method acc`).
 pub const TESSERA_TECHNIQUE_ACC: TesseraTechnique = 7;
+/// Loop subdivision on the CPU to level log2 S at the limit, drawn as a static mesh
+/// (`--method cpu`; levels are powers of two up to 64 segments).
+pub const TESSERA_TECHNIQUE_CPU: TesseraTechnique = 8;
+/// Catmull-Clark subdivision on the CPU, drawn as a static mesh (`--method cpu-catmark`).
+pub const TESSERA_TECHNIQUE_CPU_CATMARK: TesseraTechnique = 9;
 
 /// The subdivision scheme (`TESSERA_SCHEME_*`).
 pub type TesseraScheme = u32;
@@ -833,9 +838,7 @@ fn choose_technique(d: &TesseraSurfaceDesc, mesh: &topology::ControlMesh) -> Res
             } else {
                 Scheme::CatmullClark
             });
-            tess::registry()
-                .iter()
-                .find(|i| i.scheme == Some(scheme))
+            tess::techniques::default_for(scheme)
                 .map(|i| i.id)
                 .ok_or_else(|| {
                     Error::new(
@@ -844,14 +847,11 @@ fn choose_technique(d: &TesseraSurfaceDesc, mesh: &topology::ControlMesh) -> Res
                     )
                 })?
         }
-        TESSERA_TECHNIQUE_FLAT => TechniqueId::Flat,
-        TESSERA_TECHNIQUE_PHONG => TechniqueId::Phong,
-        TESSERA_TECHNIQUE_PN => TechniqueId::Pn,
-        TESSERA_TECHNIQUE_BFT => TechniqueId::Bft,
-        TESSERA_TECHNIQUE_ADAPTIVE => TechniqueId::Adaptive,
-        TESSERA_TECHNIQUE_GREGORY => TechniqueId::Gregory,
-        TESSERA_TECHNIQUE_ACC => TechniqueId::Acc,
-        v => return Err(invalid("technique", v, "a TESSERA_TECHNIQUE_* value")),
+        // Every other value is a registry entry's stable C ABI value.
+        v => match tess::techniques::by_abi_code(v) {
+            Some(info) => info.id,
+            None => return Err(invalid("technique", v, "a TESSERA_TECHNIQUE_* value")),
+        },
     };
     let info = tess::techniques::info(technique);
     if let (Some(want), Some(draws)) = (scheme, info.scheme) {
@@ -1003,7 +1003,7 @@ unsafe fn create_surface(
         v => return Err(invalid("end_cap", v, "a TESSERA_END_CAP_* value")),
     };
     let split_triangles = flag(d.split_triangles, "split_triangles")?;
-    if split_triangles && !matches!(technique, TechniqueId::Gregory | TechniqueId::Acc) {
+    if split_triangles && !tess::techniques::info(technique).features.single_pass {
         return Err(Error::new(
             TesseraStatus::InvalidArgument,
             format!(
@@ -1504,7 +1504,7 @@ pub unsafe extern "C" fn tessera_render(
         let out = unsafe { ffi::write_slice(pixels, pixels_len, "pixels") }?;
         let image = s
             .tess
-            .render_offscreen(s.technique.as_ref(), &params, extent)?;
+            .render_offscreen(s.technique.as_mut(), &params, extent)?;
         out.copy_from_slice(&image.pixels);
         Ok(())
     })
@@ -1534,8 +1534,8 @@ pub unsafe extern "C" fn tessera_capture_obj(
             .ok_or_else(|| Error::new(TesseraStatus::NullPointer, "path is NULL"))?;
         let (params, extent) = surface_frame_params(s, &f)?;
         let capturer = tess::Capturer::new(&s.tess)?;
+        let (soup, _) = capturer.capture(&mut s.tess, s.technique.as_mut(), &params, extent)?;
         let technique = s.technique.as_ref();
-        let (soup, _) = capturer.capture(&mut s.tess, technique, &params, extent)?;
         let welded = soup.weld()?;
         if let Some(i) = welded
             .positions

@@ -1438,6 +1438,126 @@ fn to3(x: &[f64]) -> [f64; 3] {
     [x[0], x[1], x[2]]
 }
 
+/// Where corner `k` of an `n`-sided face sits in the face's (u, v) domain, the convention of
+/// every point Tessera reports on a base mesh (captures, `# p` lines of exports):
+/// - triangles: corner 0 (1, 0), corner 1 (0, 1), corner 2 (0, 0), so (u, v) are the
+///   barycentric weights of corners 0 and 1 (= `gl_TessCoord.xy` of a triangle patch);
+/// - quads: (0, 0), (1, 0), (1, 1), (0, 1), the bilinear domain of the quad TES;
+/// - n-gons, n ≥ 5: the regular n-gon inscribed in the unit square's circle,
+///   (½ + ½ cos 2πk/n, ½ + ½ sin 2πk/n).
+///
+/// A Catmull-Clark non-quad is evaluated on its sub-quads ([`LocalMesh::evaluate_subface`]);
+/// sub-quad `k` maps bilinearly onto (corner k, midpoint of edge k, centre, midpoint of edge
+/// k − 1) of this domain ([`subface_domain`]).
+pub fn face_corner_uv(n: u32, k: u32) -> [f64; 2] {
+    match (n, k % n.max(1)) {
+        (3, 0) => [1.0, 0.0],
+        (3, 1) => [0.0, 1.0],
+        (3, _) => [0.0, 0.0],
+        (4, 0) => [0.0, 0.0],
+        (4, 1) => [1.0, 0.0],
+        (4, 2) => [1.0, 1.0],
+        (4, _) => [0.0, 1.0],
+        (n, k) => {
+            let a = std::f64::consts::TAU * k as f64 / n as f64;
+            [0.5 + 0.5 * a.cos(), 0.5 + 0.5 * a.sin()]
+        }
+    }
+}
+
+/// The corners of sub-quad `k` of an `n`-gon in the face's domain ([`face_corner_uv`]):
+/// corner k, midpoint of edge k, centre, midpoint of edge k − 1.
+pub fn subface_domain(n: u32, k: u32) -> [[f64; 2]; 4] {
+    let c = |i: u32| face_corner_uv(n, i % n);
+    let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) * 0.5, (a[1] + b[1]) * 0.5];
+    let centre = (0..n).fold([0.0, 0.0], |s, i| {
+        let p = c(i);
+        [s[0] + p[0] / n as f64, s[1] + p[1] / n as f64]
+    });
+    let (corner, next, prev) = (c(k), c(k + 1), c(k + n - 1));
+    [corner, mid(corner, next), centre, mid(prev, corner)]
+}
+
+/// The bilinear map of `quad` at (s, t): weights (1−s)(1−t), s(1−t), st, (1−s)t.
+pub fn bilinear(quad: &[[f64; 2]; 4], s: f64, t: f64) -> [f64; 2] {
+    let w = [(1.0 - s) * (1.0 - t), s * (1.0 - t), s * t, (1.0 - s) * t];
+    let mut out = [0.0; 2];
+    for (p, w) in quad.iter().zip(w) {
+        out[0] += w * p[0];
+        out[1] += w * p[1];
+    }
+    out
+}
+
+/// (s, t) with `bilinear(quad, s, t) = p` (Newton from the centre), or `None` when `p` lies
+/// outside `quad` by more than `slack` in parameter.
+fn invert_bilinear(quad: &[[f64; 2]; 4], p: [f64; 2], slack: f64) -> Option<[f64; 2]> {
+    let [a, b, c, d] = *quad;
+    let (mut s, mut t) = (0.5, 0.5);
+    for _ in 0..50 {
+        let q = bilinear(quad, s, t);
+        let r = [q[0] - p[0], q[1] - p[1]];
+        let ds = [
+            (1.0 - t) * (b[0] - a[0]) + t * (c[0] - d[0]),
+            (1.0 - t) * (b[1] - a[1]) + t * (c[1] - d[1]),
+        ];
+        let dt = [
+            (1.0 - s) * (d[0] - a[0]) + s * (c[0] - b[0]),
+            (1.0 - s) * (d[1] - a[1]) + s * (c[1] - b[1]),
+        ];
+        let det = ds[0] * dt[1] - ds[1] * dt[0];
+        if det.abs() < 1e-300 {
+            return None;
+        }
+        let step = [
+            (r[0] * dt[1] - r[1] * dt[0]) / det,
+            (ds[0] * r[1] - ds[1] * r[0]) / det,
+        ];
+        s -= step[0];
+        t -= step[1];
+        if step[0].abs() + step[1].abs() < 1e-15 {
+            break;
+        }
+    }
+    let q = bilinear(quad, s, t);
+    let solved = (q[0] - p[0]).abs() + (q[1] - p[1]).abs() <= 1e-12;
+    let inside = |x: f64| (-slack..=1.0 + slack).contains(&x);
+    (solved && inside(s) && inside(t)).then(|| [s.clamp(0.0, 1.0), t.clamp(0.0, 1.0)])
+}
+
+/// Sub-quad and its (s, t) of a point `uv` of an `n`-gon's domain (n ≠ 4): the sub-quad whose
+/// bilinear map reaches `uv` with parameters closest to its inside.
+pub fn subface_param(n: u32, uv: [f64; 2]) -> Option<(u32, [f64; 2])> {
+    (0..n)
+        .filter_map(|k| invert_bilinear(&subface_domain(n, k), uv, 1e-6).map(|st| (k, st)))
+        .next()
+}
+
+impl LocalMesh {
+    /// The exact limit at a point of base face `face` in the domain of [`face_corner_uv`]:
+    /// Loop triangles by their barycentric weights, Catmull-Clark quads directly and other
+    /// Catmull-Clark faces on the sub-quad that holds the point.
+    pub fn evaluate_face_point(&self, face: usize, uv: [f64; 2]) -> Result<LimitSample, EvalError> {
+        if face >= self.num_faces() {
+            return Err(EvalError::FaceOutOfRange {
+                face,
+                count: self.num_faces(),
+            });
+        }
+        let n = self.face(face).len() as u32;
+        match (self.scheme, n) {
+            // (u, v) weigh corners 0 and 1; the evaluator's (u, v) weigh corners 1 and 2.
+            (LimitScheme::Loop, _) => self.evaluate(face, uv[1], (1.0 - uv[0] - uv[1]).max(0.0)),
+            (LimitScheme::CatmullClark, 4) => self.evaluate(face, uv[0], uv[1]),
+            (LimitScheme::CatmullClark, _) => {
+                let (k, st) = subface_param(n, uv)
+                    .ok_or(EvalError::ParamOutOfRange { u: uv[0], v: uv[1] })?;
+                self.evaluate_subface(face, k as usize, st[0], st[1])
+            }
+        }
+    }
+}
+
 /// `tessera limit`: exact limit position, tangents and normal of a control mesh at
 /// `(face, u, v)` (face indices of the control mesh itself). Non-quad Catmull-Clark faces need
 /// a sub-quad: see [`limit_point_subface`].

@@ -8,6 +8,7 @@ pub mod error;
 pub mod eval;
 pub mod gregory;
 pub mod limit;
+pub mod limit_mesh;
 pub mod mesh;
 pub mod obj;
 pub mod patch;

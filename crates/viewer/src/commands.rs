@@ -198,9 +198,9 @@ fn render_offscreen(
     output: &std::path::Path,
 ) -> Result<String> {
     let mut ctx = Context::offscreen(device)?;
-    let technique = build_technique(&mut ctx, mesh, setup)?;
+    let mut technique = build_technique(&mut ctx, mesh, setup)?;
     let params = setup.world_params(technique.bbox());
-    let frame = ctx.render_offscreen_stats(technique.as_ref(), &params, extent, false)?;
+    let frame = ctx.render_offscreen_stats(technique.as_mut(), &params, extent, false)?;
     frame.image.save_png(output)?;
     let patches: u32 = technique.patch_arrays().iter().map(|a| a.patches).sum();
     Ok(format!(

@@ -73,10 +73,10 @@ pub fn run(a: ExportArgs) -> Result<()> {
         let mut ctx = Context::offscreen(&device)?;
         let capturer = Capturer::new(&ctx)
             .context("tessera export captures through VK_EXT_transform_feedback")?;
-        let technique = build_technique(&mut ctx, &base, &setup)?;
+        let mut technique = build_technique(&mut ctx, &base, &setup)?;
         let params = setup.world_params(technique.bbox());
         let (soup, stats) = crate::progress::during("capturing the tessellated triangles", || {
-            capturer.capture(&mut ctx, technique.as_ref(), &params, extent)
+            capturer.capture(&mut ctx, technique.as_mut(), &params, extent)
         })?;
         let summary = format!(
             "{}; {} draws over {} patches, {} pass(es)",

@@ -403,6 +403,7 @@ impl SurfaceArgs {
                 follow_semi_sharp: !self.creases_at_isolation,
                 split_triangles: self.split_triangles,
                 maps,
+                ..BuildOptions::default()
             },
             params,
             distance_diagonals: (self.adaptive == Some(Adaptive::Distance))

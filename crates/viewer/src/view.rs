@@ -363,8 +363,12 @@ impl App {
         if let (true, Some(wave)) = (self.moved, &surface.wave) {
             surface.technique.update_base(slot, &wave.at(self.time))?;
         }
+        context.prepare(
+            surface.technique.as_mut(),
+            &params,
+            Context::frame_passes(&params),
+        )?;
         let technique = surface.technique.as_ref();
-        context.prepare(technique, &params, Context::frame_passes(&params))?;
         context.write_frame(slot, technique.bbox(), &params, extent)?;
         let last = self.args.frames.is_some_and(|n| self.frames_drawn + 1 >= n);
         let context = &*context;
@@ -897,9 +901,15 @@ mod tests {
         for (i, id) in order.iter().enumerate() {
             assert_eq!(key(&(i + 1).to_string()), Some(Action::Technique(*id)));
         }
-        assert_eq!(key("6"), Some(Action::Technique(TechniqueId::Gregory)));
-        assert_eq!(key("7"), Some(Action::Technique(TechniqueId::Acc)));
-        assert_eq!(key("5"), Some(Action::Technique(TechniqueId::Adaptive)));
+        assert_eq!(
+            key("6"),
+            Some(Action::Technique("gregory".parse().unwrap()))
+        );
+        assert_eq!(key("7"), Some(Action::Technique("acc".parse().unwrap())));
+        assert_eq!(
+            key("5"),
+            Some(Action::Technique("adaptive".parse().unwrap()))
+        );
         assert_eq!(key("8"), None);
         assert_eq!(key("0"), None);
         for (c, action) in [

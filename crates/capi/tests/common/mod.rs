@@ -86,11 +86,11 @@ pub fn reference(technique: tess::TechniqueId, width: u32, height: u32) -> Vec<u
     let mesh = topology::parse_obj(&text, "spot").unwrap();
     let pixels = {
         let mut ctx = tess::Context::offscreen(&device).unwrap();
-        let built = tess::build(&mut ctx, technique, &mesh, &tess::BuildOptions::default())
+        let mut built = tess::build(&mut ctx, technique, &mesh, &tess::BuildOptions::default())
             .unwrap_or_else(|e| panic!("{technique}: {e}"));
         let params = tess::FrameParams::uniform(4.0);
         ctx.render_offscreen(
-            built.technique.as_ref(),
+            built.technique.as_mut(),
             &params,
             vk_core::vk::Extent2D { width, height },
         )
@@ -109,22 +109,22 @@ pub fn reference(technique: tess::TechniqueId, width: u32, height: u32) -> Vec<u
 
 /// The techniques the C++ host draws.
 pub const HOST_TECHNIQUES: &[(&str, tess::TechniqueId)] = &[
-    ("flat", tess::TechniqueId::Flat),
-    ("phong", tess::TechniqueId::Phong),
-    ("pn", tess::TechniqueId::Pn),
-    ("bft", tess::TechniqueId::Bft),
-    ("adaptive", tess::TechniqueId::Adaptive),
+    ("flat", tess::TechniqueId::FLAT),
+    ("phong", tess::TechniqueId::PHONG),
+    ("pn", tess::TechniqueId::PN),
+    ("bft", tess::TechniqueId::BFT),
+    ("adaptive", tess::TechniqueId::ADAPTIVE),
 ];
 
 /// Every technique of the C ABI (the C program draws them all).
 pub const ALL_TECHNIQUES: &[(&str, tess::TechniqueId)] = &[
-    ("flat", tess::TechniqueId::Flat),
-    ("phong", tess::TechniqueId::Phong),
-    ("pn", tess::TechniqueId::Pn),
-    ("bft", tess::TechniqueId::Bft),
-    ("adaptive", tess::TechniqueId::Adaptive),
-    ("gregory", tess::TechniqueId::Gregory),
-    ("acc", tess::TechniqueId::Acc),
+    ("flat", tess::TechniqueId::FLAT),
+    ("phong", tess::TechniqueId::PHONG),
+    ("pn", tess::TechniqueId::PN),
+    ("bft", tess::TechniqueId::BFT),
+    ("adaptive", tess::TechniqueId::ADAPTIVE),
+    ("gregory", tess::TechniqueId::GREGORY),
+    ("acc", tess::TechniqueId::ACC),
 ];
 
 /// Each of `techniques`' `<name>.rgba` in `dir` (160×120, written by a C or C++ host) against

@@ -17,27 +17,7 @@ pub struct FacePoint {
 /// Maps a captured patch id and domain coordinate to the base mesh; `None` for an unknown patch.
 pub type PatchToFace<'a> = dyn Fn(u32, [f32; 2]) -> Option<FacePoint> + 'a;
 
-/// Where corner `k` of an `n`-sided face sits in the face's (u, v) domain:
-/// - triangles: corner 0 (1, 0), corner 1 (0, 1), corner 2 (0, 0), so (u, v) are the
-///   barycentric weights of corners 0 and 1 (= `gl_TessCoord.xy` of a triangle patch);
-/// - quads: (0, 0), (1, 0), (1, 1), (0, 1), the bilinear domain of the quad TES;
-/// - n-gons, n ≥ 5: the regular n-gon inscribed in the unit square's circle,
-///   (½ + ½ cos 2πk/n, ½ + ½ sin 2πk/n); a fan triangle's barycentrics map linearly into it.
-pub fn face_corner_uv(n: u32, k: u32) -> [f64; 2] {
-    match (n, k % n.max(1)) {
-        (3, 0) => [1.0, 0.0],
-        (3, 1) => [0.0, 1.0],
-        (3, _) => [0.0, 0.0],
-        (4, 0) => [0.0, 0.0],
-        (4, 1) => [1.0, 0.0],
-        (4, 2) => [1.0, 1.0],
-        (4, _) => [0.0, 1.0],
-        (n, k) => {
-            let a = std::f64::consts::TAU * k as f64 / n as f64;
-            [0.5 + 0.5 * a.cos(), 0.5 + 0.5 * a.sin()]
-        }
-    }
-}
+pub use topology::eval::face_corner_uv;
 
 /// How far (in domain units) a captured coordinate may sit from a face edge and still count as
 /// on it: the tessellator's edge coordinates are exact 0 or 1 or i/n with 1 − x − y rounding.

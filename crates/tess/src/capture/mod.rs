@@ -95,7 +95,7 @@ pub enum CaptureSizing {
 /// [`Capturer::max_bytes`] deliberately.
 pub const DEFAULT_MAX_CAPTURE_BYTES: u64 = 1 << 30;
 
-/// Captures what any technique's TES emits. Holds only its settings: pipelines and frame
+/// Captures what any technique emits from its last stage before rasterization. Holds only its settings: pipelines and frame
 /// uniforms are the [`Context`]'s.
 #[derive(Clone, Copy, Debug)]
 pub struct Capturer {
@@ -128,11 +128,12 @@ impl Capturer {
     pub fn capture(
         &self,
         ctx: &mut Context,
-        technique: &dyn Technique,
+        technique: &mut dyn Technique,
         params: &FrameParams,
         extent: vk::Extent2D,
     ) -> Result<(CapturedSoup, CaptureStats)> {
         ctx.prepare(technique, params, &[Pass::Capture])?;
+        let technique = &*technique;
         ctx.write_frame(0, technique.bbox(), params, extent)?;
         let arrays = technique.patch_arrays();
         let known: Vec<Option<u64>> = (0..arrays.len())
@@ -236,7 +237,7 @@ impl Capturer {
                 ctx.bind_array(enc, technique, 0, params, Pass::Capture, i)?;
                 enc.begin_transform_feedback(&[buffer], &[])?;
                 enc.begin_query_stream(&query, i as u32, 0)?;
-                counts += ctx.draw_array(enc, technique, params, Pass::Capture, i)?;
+                counts += ctx.draw_array(enc, technique, 0, params, Pass::Capture, i)?;
                 enc.end_query_stream(&query, i as u32, 0)?;
                 enc.end_transform_feedback(&[])?;
                 enc.end_rendering();
