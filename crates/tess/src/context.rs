@@ -233,7 +233,8 @@ impl Context {
         Ok(())
     }
 
-    /// Checks `params`, lets `technique` do the host work of the frame
+    /// Checks `params` (what the technique's registry entry says it does not take, then its
+    /// own [`Technique::check`]), lets `technique` do the host work of the frame
     /// ([`Technique::prepare_frame`]) and builds the pipelines `passes` need. Must precede
     /// recording (which borrows the context and the technique immutably for the encoder's
     /// lifetime).
@@ -243,6 +244,9 @@ impl Context {
         params: &FrameParams,
         passes: &[Pass],
     ) -> Result<()> {
+        crate::techniques::info(technique.id())
+            .features
+            .refuse(technique.id(), params)?;
         technique.check(params)?;
         technique.prepare_frame(params)?;
         let technique = &*technique;

@@ -297,6 +297,43 @@ impl DrawPath {
 }
 
 impl Features {
+    /// The first option of `params` a technique with these features does not take, as the
+    /// [`TessError::Unsupported`] naming `technique` and the option; what every technique
+    /// refuses alike, before its own [`Technique::check`].
+    pub fn refuse(&self, technique: TechniqueId, params: &FrameParams) -> Result<()> {
+        let refused = [
+            (
+                !self.adaptive_factors && params.uniform_segments().is_none(),
+                "screen-space and distance factors (--adaptive)",
+            ),
+            (!self.spacing(params.spacing), "this --spacing"),
+            (
+                !self.patch_colours && params.patch_colours,
+                "patch colours (--patch-colours)",
+            ),
+            (
+                !self.geometric_normals && params.geometric_normals,
+                "geometric normals (--geometric-normals)",
+            ),
+            (
+                !self.surface && params.displace != 0.0,
+                "displacement (--displace)",
+            ),
+            (
+                !self.surface && params.show != crate::surface::SurfaceShow::Shading,
+                "parameter views (--show)",
+            ),
+            (
+                !self.surface && !params.reparam,
+                "texture reparameterization (--no-reparam)",
+            ),
+        ];
+        match refused.iter().find(|(refuse, _)| *refuse) {
+            Some(&(_, what)) => Err(TessError::Unsupported { technique, what }),
+            None => Ok(()),
+        }
+    }
+
     pub fn spacing(&self, s: Spacing) -> bool {
         self.spacings[match s {
             Spacing::Equal => 0,

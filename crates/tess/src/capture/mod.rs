@@ -406,7 +406,11 @@ mod tests {
         let r = w.open_edges();
         assert_eq!(r.open.len(), 3);
         let c = classify_open_edges(&soup, &w, &r, &map, &base);
-        assert_eq!((c.on_base_boundary, c.cracks, c.unmapped), (1, 2, 0), "{r:?}");
+        assert_eq!(
+            (c.on_base_boundary, c.cracks, c.unmapped),
+            (1, 2, 0),
+            "{r:?}"
+        );
     }
 
     #[test]
