@@ -250,6 +250,13 @@ typedef struct TesseraHostDesc {
 // (`--method acc`).
 #define TESSERA_TECHNIQUE_ACC 7
 
+// Loop subdivision on the CPU to level log2 S at the limit, drawn as a static mesh
+// (`--method cpu`; levels are powers of two up to 64 segments).
+#define TESSERA_TECHNIQUE_CPU 8
+
+// Catmull-Clark subdivision on the CPU, drawn as a static mesh (`--method cpu-catmark`).
+#define TESSERA_TECHNIQUE_CPU_CATMARK 9
+
 // Catmull-Clark unless every face is a triangle (then Loop); a Loop technique fan-triangulates.
 #define TESSERA_SCHEME_AUTO 0
 

@@ -71,7 +71,7 @@ fn render_all(level: f32) -> Vec<(String, Rgba8)> {
                 .to_string_lossy()
                 .into_owned();
             out.push((
-                format!("{stem}_{m:?}").to_lowercase(),
+                format!("{stem}_{m}"),
                 ctx.render_offscreen(t.as_mut(), &p, EXTENT).unwrap(),
             ));
         }

@@ -308,8 +308,8 @@ fn bad_maps_and_frame_options_get_named_statuses() {
     nan_heights[8 * 3 + 5] = f32::NAN;
 
     // An unknown technique value.
-    let (status, s) = create(&surface_desc(8));
-    expect(status, TesseraStatus::InvalidArgument, "technique 8");
+    let (status, s) = create(&surface_desc(99));
+    expect(status, TesseraStatus::InvalidArgument, "technique 99");
     assert!(s.is_null());
 
     // NULL with a size, a size of 0 with a pointer, a side over the limit.

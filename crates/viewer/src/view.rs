@@ -910,7 +910,10 @@ mod tests {
             key("5"),
             Some(Action::Technique("adaptive".parse().unwrap()))
         );
-        assert_eq!(key("8"), None);
+        let past = techniques::registry().len() + 1;
+        if past <= 9 {
+            assert_eq!(key(&past.to_string()), None);
+        }
         assert_eq!(key("0"), None);
         for (c, action) in [
             ("r", Action::Reparam),
