@@ -56,9 +56,9 @@ pub struct PlotArgs {
 pub struct ExportArgs {
     /// OBJ control mesh; the embedded spot control mesh when absent.
     pub input: Option<PathBuf>,
-    /// flat, phong, pn, bft (Loop limit) or adaptive (Catmull-Clark limit); by default the
-    /// limit surface of --scheme (Catmull-Clark unless every face is a triangle).
-    #[arg(long, value_parser = crate::technique::parse_technique)]
+    /// The technique (the list: --help); by default the limit surface of --scheme.
+    #[arg(long, value_parser = crate::technique::parse_technique,
+          long_help = crate::technique::method_long_help())]
     pub method: Option<TechniqueId>,
     /// Segments per base edge, the tessellation level (outer and inner): 1 to 64; bft takes
     /// powers of two from 2 to 2^(table level + 1) unless --fractional; adaptive: segments per
@@ -100,9 +100,9 @@ pub struct BenchArgs {
         default_value = "4,16,32"
     )]
     pub segments: Vec<u32>,
-    /// Techniques: flat, phong, pn, bft (Loop basis-function tables: bft and bft-animated rows),
-    /// cpu (CPU Loop subdivision: cpu-static and cpu-animated rows).
-    #[arg(long, value_delimiter = ',', default_value = "flat,phong,pn,bft,cpu")]
+    /// Techniques to measure, comma-separated (the list: --help).
+    #[arg(long, value_delimiter = ',', default_value = "flat,phong,pn,bft,cpu",
+          long_help = crate::technique::methods_long_help())]
     pub methods: Vec<String>,
     /// Timed frames per row (at least 1).
     #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..))]
@@ -280,11 +280,9 @@ pub fn parse_alpha(s: &str) -> Result<f32, String> {
 pub struct SceneArgs {
     /// OBJ control mesh; the embedded spot control mesh when absent.
     pub mesh: Option<PathBuf>,
-    /// flat, phong, pn (the base faces as patches), bft (the Loop limit surface from
-    /// basis-function tables) or adaptive (the Catmull-Clark limit surface by feature-adaptive
-    /// refinement). By default the limit surface of --scheme, which defaults to Catmull-Clark
-    /// unless every face is a triangle (then Loop).
-    #[arg(long, value_parser = crate::technique::parse_technique)]
+    /// The technique (the list: --help); by default the limit surface of --scheme.
+    #[arg(long, value_parser = crate::technique::parse_technique,
+          long_help = crate::technique::method_long_help())]
     pub method: Option<TechniqueId>,
     /// Segments per base edge, the tessellation level (outer and inner): 1 to 64; bft takes
     /// powers of two from 2 to 2^(table level + 1) unless --fractional; adaptive: segments per

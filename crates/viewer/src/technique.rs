@@ -13,6 +13,37 @@ pub fn parse_technique(s: &str) -> Result<TechniqueId, String> {
     s.parse::<TechniqueId>().map_err(|e| e.to_string())
 }
 
+/// `--method`'s long help: every technique of the registry with its one line, so the list is
+/// never out of date.
+pub fn method_long_help() -> String {
+    let mut out = String::from(
+        "The technique that draws the mesh; by default the limit surface of --scheme \
+         (Catmull-Clark unless every face is a triangle, then Loop). One of:",
+    );
+    for info in techniques::registry() {
+        out.push_str(&format!("\n  {:<12} {}", info.id.name(), info.help));
+    }
+    out
+}
+
+/// `bench --methods`'s long help: the registry's techniques, each with an `-animated` row when
+/// it animates.
+pub fn methods_long_help() -> String {
+    let mut out = String::from(
+        "Techniques to measure, comma-separated (each draws a row; those that animate also an \
+         -animated row that moves the base every frame). Any of:",
+    );
+    for info in techniques::registry() {
+        let animated = if info.features.animation {
+            " (+ -animated row)"
+        } else {
+            ""
+        };
+        out.push_str(&format!("\n  {}{animated}", info.id.name()));
+    }
+    out
+}
+
 pub fn parse_end_cap(s: &str) -> Result<EndCap, String> {
     match s {
         "gregory" => Ok(EndCap::Gregory),
