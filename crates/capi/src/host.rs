@@ -160,7 +160,7 @@ pub unsafe extern "C" fn tessera_context_create_host(
             )?,
         };
         // SAFETY: as above.
-        let device = unsafe { Device::from_host(&instance, &host) }?;
+        let device = unsafe { Device::from_host(&instance, &host, None) }?;
         let id = lock(registry())?.add_context(ContextState {
             graveyard: Vec::new(),
             device,
@@ -332,7 +332,7 @@ pub unsafe extern "C" fn tessera_record_draw(
         // SAFETY: the caller's contract: a recording command buffer of this device inside the
         // host's scope of these formats, whose execution the host waits for before destroying
         // the surface.
-        let mut enc = unsafe { Encoder::record_into(&c.device, cmd, Some(formats)) };
+        let mut enc = unsafe { Encoder::record_into(&c.device, cmd, Some(vk_core::HostScope::Rendering(formats))) };
         s.tess.record_frame(&mut enc, technique, slot, &params)?;
         enc.finish()?;
         Ok(())

@@ -150,7 +150,9 @@ pub(crate) fn vk_status(e: &VkError) -> TesseraStatus {
         | V::OutOfBounds { .. } => TesseraStatus::Internal,
         V::Extent { .. } => TesseraStatus::InvalidArgument,
         V::PictureSize { .. } => TesseraStatus::WrongSize,
-        V::Recording { .. } | V::Descriptor { .. } => TesseraStatus::Recording,
+        V::Recording { .. } | V::Descriptor { .. } | V::IndirectCommand { .. } => {
+            TesseraStatus::Recording
+        }
         V::Io { .. } | V::Image { .. } => TesseraStatus::Io,
     }
 }

@@ -229,6 +229,11 @@ pub struct GpuArgs {
     /// Also run synchronization validation.
     #[arg(long)]
     pub sync_validation: bool,
+    /// Compile every pipeline afresh: neither read nor write the pipeline cache kept in the
+    /// user's cache directory ($XDG_CACHE_HOME/tessera/pipelines or ~/.cache/tessera/pipelines;
+    /// TESSERA_PIPELINE_CACHE=off does the same for every run).
+    #[arg(long)]
+    pub no_pipeline_cache: bool,
 }
 
 #[derive(Args, Debug, Clone)]
