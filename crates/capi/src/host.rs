@@ -332,7 +332,9 @@ pub unsafe extern "C" fn tessera_record_draw(
         // SAFETY: the caller's contract: a recording command buffer of this device inside the
         // host's scope of these formats, whose execution the host waits for before destroying
         // the surface.
-        let mut enc = unsafe { Encoder::record_into(&c.device, cmd, Some(vk_core::HostScope::Rendering(formats))) };
+        let mut enc = unsafe {
+            Encoder::record_into(&c.device, cmd, Some(vk_core::HostScope::Rendering(formats)))
+        };
         s.tess.record_frame(&mut enc, technique, slot, &params)?;
         enc.finish()?;
         Ok(())

@@ -11,6 +11,7 @@ pub mod capture;
 pub mod context;
 pub mod error;
 pub mod gpu;
+pub mod limit;
 pub mod plain;
 pub mod render_mesh;
 pub mod shaders;
