@@ -468,7 +468,7 @@ mod tests {
             let e = LimitEvaluator::new(&mesh, scheme).unwrap();
             let points: Vec<(u32, [f64; 2])> = (0..40)
                 .map(|i| {
-                    let face = (i * 7 % 4) as u32;
+                    let face = i * 7 % 4;
                     let n = mesh.face(face as usize).len() as u32;
                     let a = face_corner_uv(n, i % n);
                     let b = face_corner_uv(n, (i + 1) % n);
