@@ -206,7 +206,7 @@ pub(crate) unsafe fn pipeline_cache_dir(
                 TesseraStatus::InvalidArgument,
                 "pipeline_cache_dir is empty (NULL means the user's cache directory)",
             )),
-            Some(d) if vk_core::pipeline_cache::user_dir().is_some() => Ok(Some(d.into())),
+            Some(d) if vk_core::pipeline_cache::allowed_by_env() => Ok(Some(d.into())),
             Some(_) => Ok(None),
             None => Ok(vk_core::pipeline_cache::user_dir()),
         },

@@ -105,15 +105,26 @@ pub fn check_header(data: &[u8], id: &CacheIdentity) -> Result<(), HeaderMismatc
     Ok(())
 }
 
+/// False when [`ENV`] turns the on-disk cache off (`off`, `0`, `no`, `false`).
+pub fn allowed_by_env() -> bool {
+    let Some(v) = std::env::var_os(ENV) else {
+        return true;
+    };
+    match v.to_str().map(str::to_ascii_lowercase).as_deref() {
+        Some("off" | "0" | "no" | "false") => false,
+        Some("on" | "1" | "yes" | "true" | "") => true,
+        _ => {
+            log::warn!("{ENV}={v:?}: expected off or on; keeping the cache on");
+            true
+        }
+    }
+}
+
 /// The user's cache directory for pipelines, or `None` when [`ENV`] turns the cache off or
 /// neither `$XDG_CACHE_HOME` nor `$HOME` is set.
 pub fn user_dir() -> Option<PathBuf> {
-    if let Some(v) = std::env::var_os(ENV) {
-        match v.to_str().map(str::to_ascii_lowercase).as_deref() {
-            Some("off" | "0" | "no" | "false") => return None,
-            Some("on" | "1" | "yes" | "true" | "") => {}
-            _ => log::warn!("{ENV}={v:?}: expected off or on; keeping the cache on"),
-        }
+    if !allowed_by_env() {
+        return None;
     }
     let base = std::env::var_os("XDG_CACHE_HOME")
         .filter(|d| !d.is_empty())
