@@ -114,10 +114,8 @@ impl Evaluator {
 impl Drop for Evaluator {
     fn drop(&mut self) {
         // SAFETY: the handle is looked up, never dereferenced.
-        assert_eq!(
-            unsafe { tessera_limit_evaluator_destroy(self.0) },
-            TesseraStatus::Ok
-        );
+        let status = unsafe { tessera_limit_evaluator_destroy(self.0) };
+        assert_eq!(status, TesseraStatus::Ok);
     }
 }
 
@@ -127,8 +125,11 @@ fn spot_mesh() -> topology::ControlMesh {
     topology::parse_obj(&text, "spot").unwrap()
 }
 
+/// A face and its (u, v), as on a `# p` line.
+type Point = (u32, [f64; 2]);
+
 /// `v` positions and `# p` points of a captured OBJ, in vertex order.
-fn captured(path: &std::path::Path) -> Vec<([f64; 3], (u32, [f64; 2]))> {
+fn captured(path: &std::path::Path) -> Vec<([f64; 3], Point)> {
     let text = std::fs::read_to_string(path).unwrap();
     let nums = |l: &str, skip: usize| -> Vec<f64> {
         l.split_whitespace()
@@ -183,8 +184,8 @@ fn limit_evaluation_is_what_tessera_limit_prints() {
         // weighs its corners as (0.5, 0.25, 0.25).
         let [pos, ..] = bft.evaluate(&[(f, [v, u])]).unwrap();
         let want = limit_point(&tri, LimitScheme::Loop, first(f as usize), v - u, u).unwrap();
-        for k in 0..3 {
-            assert!((pos[0][k] - want.position[k]).abs() < 1e-14, "face {f}");
+        for (got, want) in pos[0].iter().zip(want.position) {
+            assert!((got - want).abs() < 1e-14, "face {f}");
         }
     }
 }
