@@ -2,8 +2,9 @@
 //! `include/tessera.hpp` sits on top of it).
 //!
 //! # Handles
-//! `TesseraContext*` (a device and how Tessera uses it) and `TesseraSurface*` (one control
-//! mesh built for one technique on one context) are opaque. They are numbers in a registry
+//! `TesseraContext*` (a device and how Tessera uses it), `TesseraSurface*` (one control mesh
+//! built for one technique on one context) and `TesseraLimitEvaluator*` (a surface's or mesh's
+//! exact limit surface on the CPU, [`limit`]) are opaque. They are numbers in a registry
 //! (the `registry` module), never pointers into Rust memory: a null, forged, destroyed or
 //! twice-destroyed handle is answered with `TESSERA_STATUS_NULL_HANDLE`,
 //! `TESSERA_STATUS_INVALID_HANDLE` or `TESSERA_STATUS_DESTROYED_HANDLE`, never undefined
@@ -31,9 +32,13 @@
 //! # Modes
 //! - **Standalone** ([`tessera_context_create_standalone`]): Tessera loads Vulkan, chooses the
 //!   device by the CLI's rules (`vk_core::device::choose_adapter`: best-scored, or by index or
-//!   name substring) and renders into an RGBA8 buffer the host reads ([`tessera_render`]), or
-//!   captures what the GPU drew into an OBJ file ([`tessera_capture_obj`]).
-//! - **Host-owned** (see `host` below): the host's Vulkan objects, never destroyed by Tessera.
+//!   name substring) and renders into an RGBA8 buffer the host reads ([`tessera_render`]).
+//! - **Host-owned** (see [`host`]): the host's Vulkan objects, never destroyed by Tessera;
+//!   Tessera records into the host's dynamic-rendering scopes or a subpass of its render pass.
+//!
+//! Both capture what the GPU drew, with `tessera export`'s weld, crack report and OBJ
+//! ([`capture`]), and both make limit evaluators ([`limit`]), which need no device at all when
+//! made from a mesh.
 //!
 //! # Thread safety
 //! Every function may be called from any thread. Calls on one context (and on its surfaces)

@@ -571,9 +571,12 @@ impl Device {
     ///
     /// # Safety
     /// - `host.device` is a live device created from `host.physical` of `instance`, with
-    ///   `tessellationShader`, `fillModeNonSolid`, `dynamicRendering` and `timelineSemaphore`
-    ///   enabled, and each optional feature `host` claims enabled (transform feedback with its
-    ///   extension, pipeline statistics queries, vertex-pipeline stores) enabled.
+    ///   `tessellationShader`, `fillModeNonSolid` and `timelineSemaphore` enabled,
+    ///   `dynamicRendering` too unless nothing vk-core records on it begins a rendering scope
+    ///   of its own or is recorded into a dynamic-rendering scope (a host that draws only into
+    ///   render pass subpasses and never captures), and each optional feature `host` claims
+    ///   enabled (transform feedback with its extension, pipeline statistics queries,
+    ///   vertex-pipeline stores) enabled.
     /// - `host.queue` is queue 0 of `host.queue_family`, a family with graphics and compute.
     /// - The device outlives every object made from the result; the host does not use the
     ///   queue on another thread while a vk-core call that submits runs (Vulkan's external

@@ -1,9 +1,11 @@
 //! Graphics pipelines with tessellation stages, and compute pipelines. All go through the
-//! device's pipeline cache (kept on disk when the device was given a path).
+//! device's pipeline cache (kept on disk when the device was given a directory:
+//! [`crate::pipeline_cache`]).
 //!
 //! A pipeline remembers what an [`crate::Encoder`] needs to check commands against it: its bind
-//! point, layout, set layouts, push-constant range, attachment formats, vertex bindings, and
-//! whether its shaders write transform feedback (the SPIR-V's Xfb execution mode).
+//! point, layout, set layouts, push-constant range, attachment formats and the render pass
+//! subpass it was made for (if any), vertex bindings, and whether its shaders write transform
+//! feedback (the SPIR-V's Xfb execution mode).
 use crate::device::{Device, DeviceShared};
 use crate::error::{Result, VkContext, VkError};
 use crate::retire::Retired;
