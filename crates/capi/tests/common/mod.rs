@@ -177,9 +177,21 @@ impl Host {
         let build = profile_dir()
             .join("capi-tests")
             .join(format!("{name}-build"));
+        let source = repo().join("examples").join(self.example);
+        // A build directory configured from another checkout (a copied target directory)
+        // cannot be reconfigured from this one: start it afresh.
+        let home = source.canonicalize().unwrap();
+        let cache = std::fs::read_to_string(build.join("CMakeCache.txt")).unwrap_or_default();
+        let configured_here = cache
+            .lines()
+            .filter_map(|l| l.strip_prefix("CMAKE_HOME_DIRECTORY:INTERNAL="))
+            .any(|d| Path::new(d).canonicalize().ok().as_deref() == Some(home.as_path()));
+        if !cache.is_empty() && !configured_here {
+            std::fs::remove_dir_all(&build).unwrap();
+        }
         run(Command::new("cmake")
             .arg("-S")
-            .arg(repo().join("examples").join(self.example))
+            .arg(&source)
             .arg("-B")
             .arg(&build)
             .arg(format!("-DTessera_DIR={}", repo().join("cmake").display()))
