@@ -233,7 +233,7 @@ public:
     };
 
     // The limit surface of `surface` (its scheme, creases and current positions).
-    static LimitEvaluator of_surface(const Surface &surface, const Context &ctx) {
+    static LimitEvaluator of_surface(const Context &ctx, const Surface &surface) {
         TesseraLimitEvaluator *raw = nullptr;
         check(tessera_limit_evaluator_create(ctx.get(), surface.get(), &raw), ctx.get());
         return LimitEvaluator(raw);

@@ -92,7 +92,7 @@ int check_misuse(tessera::Context &ctx) {
         }
     }
     // Limit evaluation of a face the surface does not have, and of a NaN parameter.
-    tessera::LimitEvaluator ev = tessera::LimitEvaluator::of_surface(s, ctx);
+    tessera::LimitEvaluator ev = tessera::LimitEvaluator::of_surface(ctx, s);
     uint32_t face = uint32_t(ev.face_count());
     double uv[2] = {0.5, 0.5};
     double out[3];
@@ -286,7 +286,7 @@ int run(const std::string &out_dir, bool misuse) {
                                  (unsigned long long)report.cracks);
                     failures++;
                 }
-                tessera::LimitEvaluator ev = tessera::LimitEvaluator::of_surface(surface, ctx);
+                tessera::LimitEvaluator ev = tessera::LimitEvaluator::of_surface(ctx, surface);
                 failures += check_limit(ev, obj, t.name);
             }
             // Animation, for the techniques that take it: the base moves once, in frame 2
