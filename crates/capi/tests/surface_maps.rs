@@ -133,6 +133,7 @@ fn single_pass_techniques_draw_textures_and_displace_by_the_height_map() {
     let desc = TesseraStandaloneDesc {
         device: null(),
         validation: TESSERA_VALIDATION_SYNCHRONIZATION,
+        ..Default::default()
     };
     let mut ctx = null_mut();
     // SAFETY: `desc` and `ctx` are live locals.
@@ -275,6 +276,7 @@ fn bad_maps_and_frame_options_get_named_statuses() {
     let desc = TesseraStandaloneDesc {
         device: null(),
         validation: TESSERA_VALIDATION_SYNCHRONIZATION,
+        ..Default::default()
     };
     let mut ctx = null_mut();
     // SAFETY: `desc` and `ctx` are live locals.

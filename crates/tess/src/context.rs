@@ -21,7 +21,7 @@ use crate::tessellator::{Spacing, MAX_LEVEL};
 use std::collections::HashMap;
 use std::mem::size_of;
 use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
-use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage, TessellationDesc};
+use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage, Subpass, TessellationDesc};
 use vk_core::query::{PipelineStatistics, QueryPool};
 use vk_core::target::{OffscreenTarget, Rgba8, COLOR_FORMAT, DEPTH_FORMAT};
 use vk_core::workarounds::WorkaroundId;
@@ -120,6 +120,9 @@ pub struct Context {
     frames: FrameSets,
     color_format: vk::Format,
     depth_format: vk::Format,
+    /// The host's render pass subpass the draw pipelines are made for; `None`: dynamic
+    /// rendering ([`Self::for_subpass`]).
+    subpass: Option<Subpass>,
     device: Device,
 }
 
@@ -141,8 +144,24 @@ impl Context {
             frames: FrameSets::new(device, frames_in_flight)?,
             color_format,
             depth_format,
+            subpass: None,
             device: device.clone(),
         })
+    }
+
+    /// A context whose draw pipelines render in `subpass` of a host's render pass (whose
+    /// colour and depth attachments have these formats; `UNDEFINED` for none) instead of a
+    /// dynamic-rendering scope. Capture pipelines still use a scope of their own.
+    pub fn for_subpass(
+        device: &Device,
+        subpass: Subpass,
+        color_format: vk::Format,
+        depth_format: vk::Format,
+        frames_in_flight: usize,
+    ) -> Result<Self> {
+        let mut ctx = Self::new(device, color_format, depth_format, frames_in_flight)?;
+        ctx.subpass = Some(subpass);
+        Ok(ctx)
     }
 
     /// A context for offscreen targets (RGBA8 + D32) and captures, one frame slot.
@@ -279,6 +298,7 @@ impl Context {
             (self.color_format, self.depth_format)
         };
         let mut desc = GraphicsPipelineDesc::new(&name, color, depth);
+        desc.subpass = if capture { None } else { self.subpass };
         desc.stages = pipeline_stages(&pp, key)?;
         desc.vertex_bindings = pp.vertex_input.bindings.to_vec();
         desc.vertex_attributes = pp.vertex_input.attributes.to_vec();

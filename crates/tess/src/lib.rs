@@ -13,6 +13,7 @@ pub mod capture;
 pub mod context;
 pub mod error;
 pub mod gpu;
+pub mod limit;
 pub mod render_mesh;
 pub mod shaders;
 pub mod surface;

@@ -191,11 +191,31 @@ pub struct LimitArgs {
     #[arg(long)]
     pub scheme: String,
     /// Face number, 1-based as in the OBJ (the N-th `f` line), like every message.
+    #[arg(long, required_unless_present = "points", conflicts_with = "points")]
+    pub face: Option<usize>,
+    /// Domain coordinate U,V (the evaluator's patch domain: Loop triangles weigh corners 1
+    /// and 2; Catmull-Clark quads the unit square).
+    #[arg(
+        long,
+        value_parser = parse_uv,
+        allow_hyphen_values = true,
+        required_unless_present = "points",
+        conflicts_with = "points"
+    )]
+    pub uv: Option<(f64, f64)>,
+    /// Many points at once: a file of `F U V` lines in the domain of `tessera export`'s
+    /// `# p F U V` lines (F 0-based; triangles weigh corners 0 and 1, quads the unit square,
+    /// n-gons the regular n-gon); `# p` lines count as points too and other OBJ lines are
+    /// skipped, so an exported OBJ can be given as it is. Writes one `X Y Z` line per point.
     #[arg(long)]
-    pub face: usize,
-    /// Domain coordinate U,V.
-    #[arg(long, value_parser = parse_uv, allow_hyphen_values = true)]
-    pub uv: (f64, f64),
+    pub points: Option<PathBuf>,
+    /// Where --points writes its positions (default: standard output).
+    #[arg(short, long, requires = "points")]
+    pub output: Option<PathBuf>,
+    /// With --points: also the derivatives along U and V and the unit normal on each line
+    /// (X Y Z DUX DUY DUZ DVX DVY DVZ NX NY NZ).
+    #[arg(long, requires = "points")]
+    pub derivatives: bool,
 }
 
 fn parse_uv(s: &str) -> Result<(f64, f64), String> {
@@ -229,6 +249,11 @@ pub struct GpuArgs {
     /// Also run synchronization validation.
     #[arg(long)]
     pub sync_validation: bool,
+    /// Compile every pipeline afresh: neither read nor write the pipeline cache kept in the
+    /// user's cache directory ($XDG_CACHE_HOME/tessera/pipelines or ~/.cache/tessera/pipelines;
+    /// TESSERA_PIPELINE_CACHE=off does the same for every run).
+    #[arg(long)]
+    pub no_pipeline_cache: bool,
 }
 
 #[derive(Args, Debug, Clone)]

@@ -140,15 +140,16 @@ pub fn open_device(
         surface_extensions,
     })?;
     let selector = choose_device(g, &instance)?;
-    let cache = std::env::var_os("XDG_CACHE_HOME")
-        .map(std::path::PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| std::path::PathBuf::from(h).join(".cache")))
-        .map(|d| d.join("tessera").join("pipeline-cache.bin"));
+    let cache = if g.no_pipeline_cache {
+        None
+    } else {
+        vk_core::pipeline_cache::user_dir()
+    };
     let device = Device::new(
         &instance,
         &DeviceDesc {
             selector,
-            pipeline_cache_path: cache,
+            pipeline_cache_dir: cache,
             ..DeviceDesc::default()
         },
         device_extensions,

@@ -111,24 +111,141 @@ pub fn limit(a: LimitArgs) -> Result<()> {
         .parse()
         .map_err(|e| anyhow::anyhow!("--scheme {}: {e}", a.scheme))?;
     let name = crate::commands::mesh_name(a.input.as_deref());
+    let points = match &a.points {
+        Some(path) => Some(read_points(path)?),
+        None => None,
+    };
     let mesh = read_mesh(a.input.as_deref())?;
-    let faces = mesh.num_faces();
-    if a.face == 0 || a.face > faces {
-        bail!(
-            "--face {}: {name} has faces 1 to {faces} (numbered as its `f` lines, from 1)",
-            a.face
-        );
+    if let Some((points, lines)) = points {
+        let path = a.points.as_deref().unwrap_or(std::path::Path::new(""));
+        return limit_points(&a, &mesh, scheme, &name, path, &points, &lines);
     }
-    let p = limit_point(&mesh, scheme, a.face - 1, a.uv.0, a.uv.1)
-        .map_err(|e| eval_in_file(e, &name))?;
+    let (Some(face), Some(uv)) = (a.face, a.uv) else {
+        bail!("--face and --uv, or --points, say where to evaluate");
+    };
+    let faces = mesh.num_faces();
+    if face == 0 || face > faces {
+        bail!("--face {face}: {name} has faces 1 to {faces} (numbered as its `f` lines, from 1)");
+    }
+    let p = limit_point(&mesh, scheme, face - 1, uv.0, uv.1).map_err(|e| eval_in_file(e, &name))?;
     if non_finite(&[p.position, p.du, p.dv, p.normal]).is_some() {
         bail!(
-            "{name}: the limit at face {} ({}, {}) is not finite",
-            a.face,
-            a.uv.0,
-            a.uv.1
+            "{name}: the limit at face {face} ({}, {}) is not finite",
+            uv.0,
+            uv.1
         );
     }
     out!("{p}");
+    Ok(())
+}
+
+/// Statements of an OBJ that a points file skips (so an exported OBJ is a points file).
+const OBJ_STATEMENTS: [&str; 10] = ["v", "vn", "vt", "f", "l", "o", "g", "s", "usemtl", "mtllib"];
+
+/// A face (from 0) and its domain coordinates, as on a `# p` line.
+type FacePoint = (u32, [f64; 2]);
+
+/// The points of a `--points` file and the 1-based line of each.
+fn read_points(path: &std::path::Path) -> Result<(Vec<FacePoint>, Vec<usize>)> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("--points {}: cannot read it", path.display()))?;
+    let (mut points, mut lines) = (Vec::new(), Vec::new());
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        let words = match line.strip_prefix("# p ") {
+            Some(rest) => rest,
+            None if line.is_empty() || line.starts_with('#') => continue,
+            None if line
+                .split_whitespace()
+                .next()
+                .is_some_and(|w| OBJ_STATEMENTS.contains(&w)) =>
+            {
+                continue
+            }
+            None => line,
+        };
+        let at = || format!("{}:{}", path.display(), i + 1);
+        let w: Vec<&str> = words.split_whitespace().collect();
+        let [f, u, v] = w[..] else {
+            bail!(
+                "{}: expected `F U V` (a face from 0 and its domain coordinates), found {line:?}",
+                at()
+            );
+        };
+        let face: u32 = f
+            .parse()
+            .map_err(|_| anyhow::anyhow!("{}: face {f:?} is not a number from 0", at()))?;
+        let coord = |x: &str| -> Result<f64> {
+            x.parse()
+                .map_err(|_| anyhow::anyhow!("{}: {x:?} is not a number", at()))
+        };
+        points.push((face, [coord(u)?, coord(v)?]));
+        lines.push(i + 1);
+    }
+    if points.is_empty() {
+        bail!(
+            "--points {}: no `F U V` or `# p F U V` lines in it",
+            path.display()
+        );
+    }
+    Ok((points, lines))
+}
+
+/// `limit --points`: every point of the file, evaluated as one batch, written one per line.
+fn limit_points(
+    a: &LimitArgs,
+    mesh: &ControlMesh,
+    scheme: LimitScheme,
+    name: &str,
+    path: &std::path::Path,
+    points: &[FacePoint],
+    lines: &[usize],
+) -> Result<()> {
+    let evaluator =
+        tess::limit::LimitEvaluator::new(mesh, scheme).map_err(|e| eval_in_file(e, name))?;
+    let samples = evaluator.evaluate_many(points).map_err(|e| {
+        let at = format!("{}:{}", path.display(), lines[e.point]);
+        match e.source {
+            EvalError::FaceOutOfRange { face, count } => anyhow::anyhow!(
+                "{at}: face {face} out of range: {name} has faces 0 to {} (counted from 0, as on \
+                 `# p` lines)",
+                count.saturating_sub(1)
+            ),
+            EvalError::ParamOutOfRange { u, v } => anyhow::anyhow!(
+                "{at}: ({u}, {v}) is not in face {}'s domain (the `# p` convention; NaN and \
+                 infinity never are)",
+                e.face
+            ),
+            other => anyhow::Error::new(other).context(at),
+        }
+    })?;
+    let mut text = String::with_capacity(samples.len() * 64);
+    for (s, &line) in samples.iter().zip(lines) {
+        let mut values = vec![s.position];
+        if a.derivatives {
+            values.extend([s.du, s.dv, s.normal]);
+        }
+        if non_finite(&values).is_some() {
+            bail!(
+                "{}:{line}: the limit there is not finite; nothing written",
+                path.display()
+            );
+        }
+        let words: Vec<String> = values.iter().flatten().map(|x| x.to_string()).collect();
+        text.push_str(&words.join(" "));
+        text.push('\n');
+    }
+    match &a.output {
+        Some(out) => {
+            std::fs::write(out, &text).with_context(|| format!("writing {}", out.display()))?;
+            out!(
+                "wrote {}: {} limit points of {name} ({})",
+                out.display(),
+                samples.len(),
+                scheme.scheme()
+            );
+        }
+        None => out!("{}", text.trim_end()),
+    }
     Ok(())
 }

@@ -42,7 +42,7 @@ use crate::device::Device;
 use crate::error::{RecordingError as E, Result, VkContext, VkError};
 use crate::image::transition;
 use crate::indirect::{IndirectDraws, IndirectKind};
-use crate::pipeline::Pipeline;
+use crate::pipeline::{Pipeline, Subpass};
 use crate::query::QueryPool;
 use crate::retire::Retired;
 use crate::target::{OffscreenTarget, COLOR_FORMAT, DEPTH_FORMAT};
@@ -82,7 +82,24 @@ struct Scope {
     kind: ScopeKind,
     /// (colour, depth); `UNDEFINED` where the scope has no such attachment.
     formats: [vk::Format; 2],
+    /// The render pass subpass the scope is; `None` for dynamic rendering.
+    subpass: Option<Subpass>,
     id: u32,
+}
+
+/// The rendering scope a host application has open when it hands its command buffer to
+/// [`Encoder::record_into`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HostScope {
+    /// Dynamic rendering with these (colour, depth) attachment formats (`UNDEFINED`: none).
+    Rendering([vk::Format; 2]),
+    /// A subpass of a render pass instance (of `subpass.render_pass` or one compatible with
+    /// it), whose colour and depth attachments `formats` describe as for pipelines
+    /// ([`crate::pipeline::GraphicsPipelineDesc::subpass`]).
+    Subpass {
+        subpass: Subpass,
+        formats: [vk::Format; 2],
+    },
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -152,27 +169,41 @@ impl<'a> Encoder<'a> {
 
     /// Records into `cmd`, a command buffer a host application owns and submits itself (the
     /// C ABI's host-owned mode): the encoder neither begins, ends, submits nor resets it, and
-    /// is closed with [`Encoder::finish`]. With `scope`, the host has begun a dynamic-rendering
-    /// scope with those (colour, depth) formats, which draws are checked against; the host
-    /// also set the viewport and scissor (every vk-core pipeline takes them as dynamic state).
+    /// is closed with [`Encoder::finish`]. With `scope`, the host has begun a rendering scope
+    /// (dynamic rendering of those formats, or a render pass instance in that subpass), which
+    /// draws are checked against; the host also set the viewport and scissor (every vk-core
+    /// pipeline takes them as dynamic state).
     ///
     /// # Safety
     /// - `cmd` is a primary command buffer of `device`, in the recording state, that nothing
     ///   else records into, resets or frees until the encoder is finished or dropped.
-    /// - With `scope`, `cmd` is inside a rendering scope begun with dynamic rendering, with
-    ///   exactly those attachment formats (`UNDEFINED` where there is no attachment), viewport
-    ///   and scissor set; without, it is outside any rendering scope.
+    /// - With `scope`, `cmd` is inside the rendering scope it describes, viewport and scissor
+    ///   set: [`HostScope::Rendering`], a scope begun with dynamic rendering with exactly those
+    ///   attachment formats (`UNDEFINED` where there is no attachment);
+    ///   [`HostScope::Subpass`], a render pass instance, begun with contents
+    ///   `VK_SUBPASS_CONTENTS_INLINE`, of a render pass compatible with `subpass.render_pass`,
+    ///   in subpass `subpass.index`, whose attachments `formats` and `subpass.samples`
+    ///   describe. Without `scope`, `cmd` is outside any rendering scope.
     /// - Everything the recording references stays alive until the GPU finished executing
     ///   `cmd`. vk-core cannot see the host's submissions, so its retire queue does not cover
     ///   them: the caller destroys what it recorded only after the host waited for them.
     pub unsafe fn record_into(
         device: &Device,
         cmd: vk::CommandBuffer,
-        scope: Option<[vk::Format; 2]>,
+        scope: Option<HostScope>,
     ) -> Self {
         let mut e = Self::recording(device, cmd, Origin::Host);
-        if let Some(formats) = scope {
-            e.open_scope("host rendering scope", ScopeKind::Host, formats);
+        let (what, formats, subpass) = match scope {
+            Some(HostScope::Rendering(formats)) => ("host rendering scope", formats, None),
+            Some(HostScope::Subpass { subpass, formats }) => {
+                ("host render pass instance", formats, Some(subpass))
+            }
+            None => return e,
+        };
+        if e.open_scope(what, ScopeKind::Host, formats) {
+            if let Some(s) = e.scope.as_mut() {
+                s.subpass = subpass;
+            }
         }
         e
     }
@@ -475,6 +506,16 @@ impl<'a> Encoder<'a> {
             let scope = self
                 .scope
                 .ok_or_else(|| VkError::recording(command, E::OutsideRendering))?;
+            if scope.subpass != pipeline.subpass {
+                return Err(VkError::recording(
+                    command,
+                    E::Subpass {
+                        pipeline: pipeline.name.clone(),
+                        pipeline_subpass: Subpass::describe(pipeline.subpass),
+                        scope_subpass: Subpass::describe(scope.subpass),
+                    },
+                ));
+            }
             if scope.formats != pipeline.attachment_formats {
                 return Err(VkError::recording(
                     command,
@@ -1325,6 +1366,7 @@ impl<'a> Encoder<'a> {
         self.scope = Some(Scope {
             kind,
             formats,
+            subpass: None,
             id: self.scopes_opened,
         });
         true
@@ -1524,6 +1566,17 @@ impl<'a> Encoder<'a> {
         let Some(scope) = self.scope else {
             return Err(VkError::recording(command, E::OutsideRendering));
         };
+        if scope.subpass.is_some() {
+            // vk-core's own raw draws (the overlay) are made for dynamic rendering.
+            return Err(VkError::recording(
+                command,
+                E::Subpass {
+                    pipeline: "HUD overlay".into(),
+                    pipeline_subpass: Subpass::describe(None),
+                    scope_subpass: Subpass::describe(scope.subpass),
+                },
+            ));
+        }
         self.pipeline = None;
         self.sets.clear();
         self.vertex_buffers.clear();

@@ -203,6 +203,15 @@ pub enum RecordingError {
         pipeline_formats: [vk::Format; 2],
         scope_formats: [vk::Format; 2],
     },
+    #[error(
+        "pipeline {pipeline} was made for {pipeline_subpass}, the open scope is {scope_subpass}"
+    )]
+    Subpass {
+        pipeline: String,
+        /// "dynamic rendering" or "subpass I of render pass R".
+        pipeline_subpass: String,
+        scope_subpass: String,
+    },
     #[error("query {index} of pool {pool} was not reset earlier in this command buffer")]
     QueryNotReset { pool: String, index: u32 },
     #[error("query {index} of pool {pool} is active")]

@@ -6,7 +6,10 @@
 //! - Every resource holds an `Arc<DeviceShared>` and frees itself in `Drop`; the device outlives
 //!   all of them and the instance outlives the device. Field order states the drop order.
 //! - The validation layer's messages are counted by severity; tests assert no error-severity one.
-//! - Rendering uses Vulkan 1.3 dynamic rendering (no render-pass objects).
+//! - Rendering uses Vulkan 1.3 dynamic rendering; vk-core makes no render-pass objects, but
+//!   pipelines can be made for a host application's render pass subpass
+//!   ([`pipeline::Subpass`]) and recorded into its render pass instance
+//!   ([`HostScope::Subpass`]).
 //! - A UI overlay ([`overlay`], egui through egui-ash-renderer) draws into a frame's scope behind
 //!   safe calls, so the window's HUD needs no `unsafe` above vk-core.
 //! - Optional features (VK_EXT_transform_feedback, for captures) are detected and enabled when
@@ -45,6 +48,7 @@ pub mod indirect;
 pub mod instance;
 pub mod overlay;
 pub mod pipeline;
+pub mod pipeline_cache;
 pub mod query;
 pub mod retire;
 pub mod swapchain;
@@ -59,7 +63,7 @@ pub use ash::vk;
 pub use buffer::{Buffer, BufferDesc};
 pub use descriptor::{BindingDesc, DescriptorPool, DescriptorSet, DescriptorSetLayout};
 pub use device::{AdapterInfo, Device, DeviceDesc, DeviceSelector, DeviceShared, HostDevice};
-pub use encoder::{Encoder, Submission};
+pub use encoder::{Encoder, HostScope, Submission};
 pub use error::{DescriptorError, RecordingError, Result, VkError};
 pub use gpu_allocator::MemoryLocation;
 pub use image::{Image, ImageDesc};

@@ -4,7 +4,9 @@
 //! error-severity validation message and on memory still allocated at its end.
 mod draws;
 mod overlay;
+mod pipeline_cache;
 mod spirv;
+mod subpass;
 mod texture;
 
 use crate::descriptor::{BindingDesc, DescriptorPool, DescriptorSet, DescriptorSetLayout};
