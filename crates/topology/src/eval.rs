@@ -1260,10 +1260,39 @@ fn evaluate_local(
     let (start_face, u0, v0) = (face, u, v);
     let (mut u, mut v) = (u, v);
     let mut jac = [[1.0, 0.0], [0.0, 1.0]];
-    const MAX_DEPTH: usize = 56;
+    // What `points` are relative to (see `recentre`).
+    let mut origin = vec![0.0; dim];
+    let corners: &[(f64, f64)] = if quad {
+        &[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+    } else {
+        &[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]
+    };
+    // Each level doubles the distance to the corner the point is nearest. From level 56 on, a
+    // point within 2^-50 of a corner of its face (2^-106 of the base face's domain) is snapped
+    // to it and takes the corner's limit masks; a point further from every corner is followed
+    // down until a regular patch holds it (a few levels more). No f64 parameter needs more
+    // than MAX_DEPTH levels (2^-1074 is the smallest).
+    const SNAP_FROM: usize = 56;
+    const SNAP: f64 = 1.0 / (1u64 << 50) as f64;
+    const MAX_DEPTH: usize = 1100;
     for depth in 0..=MAX_DEPTH {
+        if depth >= RECENTRE_FROM {
+            recentre(
+                &mut points,
+                dim,
+                level.topology.face_vertices(face)[0],
+                &mut origin,
+            );
+        }
+        if depth >= SNAP_FROM {
+            let near = corners
+                .iter()
+                .find(|&&(a, b)| (u - a).abs() <= SNAP && (v - b).abs() <= SNAP);
+            if let Some(&(a, b)) = near {
+                (u, v) = (a, b);
+            }
+        }
         if depth == MAX_DEPTH {
-            // 2^-56 from a corner: snap (far below f64 resolution of the surface).
             u = u.round();
             v = v.round();
             if !quad && u + v > 1.0 {
@@ -1293,16 +1322,11 @@ fn evaluate_local(
                 axpy(&mut du, wu[i], x);
                 axpy(&mut dv, wv[i], x);
             }
-            return Ok(chain(p, du, dv, &jac));
+            return Ok(chain(shifted(p, &origin), du, dv, &jac));
         }
-        let corners: &[(f64, f64)] = if quad {
-            &[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
-        } else {
-            &[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]
-        };
         if let Some(c) = corners.iter().position(|&(a, b)| a == u && b == v) {
             if let Some(s) = view.corner_limit(face, c) {
-                return Ok(chain(s.position, s.du, s.dv, &jac));
+                return Ok(chain(shifted(s.position, &origin), s.du, s.dv, &jac));
             }
         }
         let step = refine_sparse(level.view(), scheme.scheme(), &mesh.options, &[face as u32])?;
@@ -1328,6 +1352,44 @@ fn evaluate_local(
         u: u0,
         v: v0,
     })
+}
+
+/// The recursion depth from which [`evaluate_local`] keeps its points relative to the face it
+/// descends into. Near an extraordinary vertex the points of level `k` lie within about `λ^k`
+/// of each other (`λ` the subdominant eigenvalue, 0.4 to 0.9), while their coordinates keep
+/// the mesh's magnitude: by level 40 or so their differences, which the tangent masks and the
+/// patches' derivative weights take, are below the coordinates' f64 resolution, and the
+/// derivatives came out as rounding noise (a normal 45° off at `u = v = 1e-20`, a zero normal
+/// further in). Subtracting one point of the face from all of them at each level keeps the
+/// differences at full relative precision (every stencil, mask and patch weight sums to 1,
+/// their derivative weights to 0, so the shift changes nothing but the rounding). Shallower
+/// levels are left alone, so dyadic parameters of the tables' levels evaluate bit for bit as
+/// they always did.
+const RECENTRE_FROM: usize = 8;
+
+/// Makes `points` (`dim` values each) relative to vertex `v`'s point, adding that point to
+/// `origin`, the offset the returned positions get back ([`shifted`]).
+fn recentre(points: &mut [f64], dim: usize, v: u32, origin: &mut [f64]) {
+    let start = v as usize * dim;
+    let Some(centre) = points.get(start..start + dim).map(<[f64]>::to_vec) else {
+        return;
+    };
+    for p in points.chunks_exact_mut(dim) {
+        for (x, c) in p.iter_mut().zip(&centre) {
+            *x -= c;
+        }
+    }
+    for (o, c) in origin.iter_mut().zip(&centre) {
+        *o += c;
+    }
+}
+
+/// A position of the recentred points, back in the mesh's coordinates.
+fn shifted(mut p: Vec<f64>, origin: &[f64]) -> Vec<f64> {
+    for (x, o) in p.iter_mut().zip(origin) {
+        *x += o;
+    }
+    p
 }
 
 /// Derivatives with respect to the original parameters.
