@@ -38,9 +38,12 @@ impl Camera {
         let center = (lo + hi) * 0.5;
         // A box that is a point (or thinner than f32 resolves at its distance from the origin)
         // would put the eye on the centre after rounding: NaN view. The radius is kept to a
-        // few hundred ulps of the centre's largest coordinate.
+        // few hundred ulps of the centre's largest coordinate, and to half the smallest extent
+        // f32 draws (`crate::framing::MIN_DRAWN_EXTENT`: below it the view direction's square
+        // underflows). A mesh of size 1e-9 fills the view like one of size 1.
         let resolution = center.abs().max_element() * 1e-4;
-        let radius = ((hi - lo).length() * 0.5).max(resolution).max(1e-6);
+        let floor = 0.5 * crate::framing::MIN_DRAWN_EXTENT as f32;
+        let radius = ((hi - lo).length() * 0.5).max(resolution).max(floor);
         let fov = self.fov_y_degrees.to_radians();
         let half = (fov * 0.5).tan().min((fov * 0.5).tan() * aspect.max(1e-3));
         let distance = radius / half.atan().sin() / self.zoom.max(1e-3);
@@ -84,6 +87,24 @@ mod tests {
             let m = cam.matrices(lo, hi, 4.0 / 3.0);
             assert!(finite(&m), "{lo:?}..{hi:?}: {m:?}");
             assert_ne!(m.eye, Vec3::from(lo), "{lo:?}: eye on the centre");
+        }
+    }
+
+    /// A small box fills the view as a large one does: its corners project to the same
+    /// normalized device coordinates (the eye's distance follows the box, with no absolute
+    /// floor; one of 1e-6 kept a 1e-9 cube a thousandth of the picture).
+    #[test]
+    fn small_boxes_fill_the_view_like_large_ones() {
+        let cam = Camera::default();
+        let project = |s: f32| {
+            let m = cam.matrices([-s; 3], [s; 3], 4.0 / 3.0);
+            let p = m.proj * m.view * glam::Vec4::new(s, s, s, 1.0);
+            glam::Vec2::new(p.x / p.w, p.y / p.w)
+        };
+        let unit = project(1.0);
+        for s in [1e-3, 1e-6, 1e-9, 1e-12] {
+            let q = project(s);
+            assert!((q - unit).length() < 1e-3, "{s}: {q} against {unit}");
         }
     }
 }

@@ -233,17 +233,19 @@ fn at_line(line: Option<usize>) -> String {
     line.map(|l| format!(":{l}")).unwrap_or_default()
 }
 
-/// `x, y, z` as a user would write them: shortest round-trip digits, in exponent form when
-/// very large or small (3e38, not 39 digits).
+/// A number as a user would write it: shortest round-trip digits, in exponent form when very
+/// large or small (3e38 and -1e-300, not 39 or 300 digits).
+pub fn number(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-6..1e16).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
+/// `x, y, z` as [`number`] writes each.
 pub(crate) fn xyz(p: &[f64; 3]) -> String {
-    let num = |x: f64| {
-        if x != 0.0 && x.is_finite() && !(1e-6..1e16).contains(&x.abs()) {
-            format!("{x:e}")
-        } else {
-            format!("{x}")
-        }
-    };
-    format!("{}, {}, {}", num(p[0]), num(p[1]), num(p[2]))
+    format!("{}, {}, {}", number(p[0]), number(p[1]), number(p[2]))
 }
 
 /// A [`TopologyError`] about a mesh read from OBJ, worded with the file's 1-based vertex and

@@ -35,7 +35,7 @@
 
 use std::fmt;
 
-use crate::error::TopologyError;
+use crate::error::{number, TopologyError};
 use crate::limit::{
     catmark_limit_masks, loop_limit_masks, loop_smooth_tangent_weights, smooth_directional_tangent,
     LimitRule, LimitVertex,
@@ -94,7 +94,7 @@ impl std::str::FromStr for LimitScheme {
 pub enum EvalError {
     #[error("face {face} out of range (the mesh has {count} faces)")]
     FaceOutOfRange { face: usize, count: usize },
-    #[error("parameter ({u}, {v}) outside the face domain")]
+    #[error("parameter ({}, {}) outside the face domain", number(*.u), number(*.v))]
     ParamOutOfRange { u: f64, v: f64 },
     #[error("face {face} has {size} corners; {} evaluation needs {need}", scheme.scheme())]
     FaceSize {
@@ -121,7 +121,7 @@ pub enum EvalError {
     },
     #[error("vertex {vertex} belongs to no face: it has no limit position")]
     IsolatedVertex { vertex: u32 },
-    #[error("evaluation of face {face} at ({u}, {v}) did not converge")]
+    #[error("evaluation of face {face} at ({}, {}) did not converge", number(*.u), number(*.v))]
     NotConverged { face: usize, u: f64, v: f64 },
     #[error("no basis-function table case {key:?}")]
     NoBftCase { key: crate::bft::BftKey },
@@ -1488,7 +1488,7 @@ impl fmt::Display for LimitPoint {
         if let Some(s) = self.subface {
             write!(f, " subface {s}")?;
         }
-        writeln!(f, " uv {} {}", self.u, self.v)?;
+        writeln!(f, " uv {} {}", number(self.u), number(self.v))?;
         writeln!(f, "position {}", v3(&self.position))?;
         writeln!(f, "du {}", v3(&self.du))?;
         writeln!(f, "dv {}", v3(&self.dv))?;

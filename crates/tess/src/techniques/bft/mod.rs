@@ -795,7 +795,7 @@ impl Bft {
             fans,
             drawn,
             loop_mesh,
-            rest_bbox: bbox(&base_positions),
+            rest_bbox: crate::framing::drawn_bbox(mesh),
             base_positions,
             notes: note.into_iter().collect(),
         })
@@ -1205,7 +1205,8 @@ pub struct Wave {
 impl Wave {
     pub fn new(mesh: &ControlMesh) -> Self {
         let rest = base_positions(mesh);
-        let bbox = bbox(&rest);
+        // The amplitude follows the drawn size, not a far vertex no face uses.
+        let bbox = crate::framing::drawn_bbox(mesh);
         Self {
             normals: base_normals(mesh),
             rest,
