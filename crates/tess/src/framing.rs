@@ -6,14 +6,17 @@
 //!
 //! [`check_drawable`] refuses, before anything is built, what f32 positions cannot draw: a face
 //! edge whose two ends are distinct in the file but the same f32 point (a mesh far from the
-//! origin for its size: at x ≈ 1e12, f32 steps by 65,536), and a drawn box smaller than
-//! [`MIN_DRAWN_EXTENT`], whose products (normals, the camera's depth range) underflow f32.
+//! origin for its size: at x ≈ 1e12, f32 steps by 65,536; or coordinates below f32's smallest
+//! numbers). [`check_shaded`] also refuses a mesh too small to shade: the surface techniques'
+//! normals are cross products of tangents of the mesh's size, which underflow f32 below
+//! [`MIN_SHADED_EXTENT`] (a cube of 1e-30 is framed, but its limit surface comes out as a
+//! flat silhouette). Captures (`tessera export`) need no shading and take such meshes.
 use crate::techniques::shared::gpu_coordinate;
 use topology::ControlMesh;
 
-/// The smallest diagonal of the drawn box: squares of coordinate differences (cross products,
-/// the projection's near·far) stay far above f32's smallest normal number (1.2e-38).
-pub const MIN_DRAWN_EXTENT: f64 = 1e-15;
+/// The smallest diagonal of the drawn faces that is shaded: squares of lengths of the mesh's
+/// size (cross products of tangents) stay far above f32's smallest normal number (1.2e-38).
+pub const MIN_SHADED_EXTENT: f64 = 1e-15;
 
 /// The vertices of `mesh`'s faces that are not holes, or of every face when all are holes.
 fn drawn_vertices(mesh: &ControlMesh) -> Vec<bool> {
@@ -69,9 +72,9 @@ pub enum Undrawable {
         positions: [[f64; 3]; 2],
         f32_point: [f32; 3],
     },
-    /// The drawn box's diagonal is below [`MIN_DRAWN_EXTENT`] (and not 0: a mesh all of
+    /// The drawn faces' diagonal is below [`MIN_SHADED_EXTENT`] (and not 0: a mesh all of
     /// whose vertices coincide in the file is the file's own degenerate mesh).
-    TooSmall { extent: f64 },
+    TooSmallToShade { extent: f64 },
 }
 
 impl std::fmt::Display for Undrawable {
@@ -96,19 +99,33 @@ impl std::fmt::Display for Undrawable {
                 xyz(&positions[1]),
                 xyz(&f32_point.map(f64::from))
             ),
-            Undrawable::TooSmall { extent } => write!(
+            Undrawable::TooSmallToShade { extent } => write!(
                 f,
-                "the drawn faces span {}, below the {} the GPU's f32 arithmetic draws (its \
-                 products underflow; scale the mesh up)",
+                "the drawn faces span {}, below the {} the GPU's f32 arithmetic shades (normals \
+                 underflow; scale the mesh up)",
                 n(*extent),
-                n(MIN_DRAWN_EXTENT)
+                n(MIN_SHADED_EXTENT)
             ),
         }
     }
 }
 
+/// [`check_drawable`], and a drawn box below [`MIN_SHADED_EXTENT`]: what a picture needs.
+pub fn check_shaded(mesh: &ControlMesh) -> Result<(), Undrawable> {
+    check_drawable(mesh)?;
+    let (lo, hi) = drawn_bbox(mesh);
+    let extent = (0..3)
+        .map(|k| (f64::from(hi[k]) - f64::from(lo[k])).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    if extent > 0.0 && extent < MIN_SHADED_EXTENT {
+        return Err(Undrawable::TooSmallToShade { extent });
+    }
+    Ok(())
+}
+
 /// Refuses what the GPU's f32 cannot draw (see the module docs): the first collapsed face
-/// edge, or a drawn box below [`MIN_DRAWN_EXTENT`].
+/// edge.
 pub fn check_drawable(mesh: &ControlMesh) -> Result<(), Undrawable> {
     for f in 0..mesh.num_faces() {
         let fv = mesh.face(f);
@@ -130,14 +147,6 @@ pub fn check_drawable(mesh: &ControlMesh) -> Result<(), Undrawable> {
                 });
             }
         }
-    }
-    let (lo, hi) = drawn_bbox(mesh);
-    let extent = (0..3)
-        .map(|k| (f64::from(hi[k]) - f64::from(lo[k])).powi(2))
-        .sum::<f64>()
-        .sqrt();
-    if extent > 0.0 && extent < MIN_DRAWN_EXTENT {
-        return Err(Undrawable::TooSmall { extent });
     }
     Ok(())
 }
@@ -171,15 +180,16 @@ mod tests {
         assert_eq!(drawn_bbox(&m), ([0.0; 3], [1.0; 3]));
     }
 
-    /// Accepted: ordinary, tiny but above the bound, far but resolved, all coincident (the
-    /// file's own degenerate mesh). Refused: corners that collapse in f32, and boxes below the
-    /// bound, each naming what it is.
+    /// Accepted: ordinary, tiny, far but resolved, all coincident (the file's own degenerate
+    /// mesh). Refused: corners that collapse in f32 (far from the origin for their size, or
+    /// below f32's smallest numbers), naming what they are.
     #[test]
     fn what_f32_cannot_draw_is_refused() {
         for ok in [
             cube(1.0, [0.0; 3]),
             cube(1e-9, [0.0; 3]),
             cube(1e-9, [1e-6; 3]),
+            cube(1e-30, [0.0; 3]),
             cube(1e6, [1e12; 3]),
             cube(0.0, [5.0; 3]),
         ] {
@@ -204,8 +214,13 @@ mod tests {
             ),
             "{e}"
         );
-        let e = check_drawable(&cube(1e-30, [0.0; 3])).unwrap_err();
-        assert!(matches!(e, Undrawable::TooSmall { .. }), "{e:?}");
-        assert!(e.to_string().contains("1.7320508"), "{e}");
+        let e = check_drawable(&cube(1e-50, [0.0; 3])).unwrap_err();
+        assert!(matches!(e, Undrawable::Collapsed { .. }), "{e:?}");
+        // Shaded pictures need more.
+        check_shaded(&cube(1e-9, [0.0; 3])).unwrap();
+        check_shaded(&cube(0.0, [5.0; 3])).unwrap();
+        let e = check_shaded(&cube(1e-30, [0.0; 3])).unwrap_err();
+        assert!(matches!(e, Undrawable::TooSmallToShade { .. }), "{e:?}");
+        assert!(e.to_string().contains("span 1.7320508"), "{e}");
     }
 }

@@ -75,10 +75,14 @@ fn open(path: &Path) -> Result<image::DynamicImage> {
     };
     let bytes = topology::read_regular_file(path, MAX_IMAGE_BYTES, "an image")
         .map_err(|e| err(format!("cannot read file: {e}")))?;
+    // The size is bounded here, not by the decoder's default allocation limit (512 MiB,
+    // less than a 16384² RGBA map takes).
     let reader = || {
-        image::ImageReader::new(std::io::Cursor::new(&bytes))
+        let mut r = image::ImageReader::new(std::io::Cursor::new(&bytes))
             .with_guessed_format()
-            .map_err(|e| err(e.to_string()))
+            .map_err(|e| err(e.to_string()))?;
+        r.no_limits();
+        Ok::<_, TessError>(r)
     };
     let (width, height) = reader()?
         .into_dimensions()

@@ -655,16 +655,11 @@ fn validate(config: &BenchConfig, meshes: &[BenchMesh]) -> Result<()> {
     if config.frames == 0 {
         return bad("at least one timed frame is needed".into());
     }
-    // Frame numbers are u32 and run one past the last frame.
-    if config
-        .frames
-        .checked_add(config.warmup)
-        .and_then(|n| n.checked_add(1))
-        .is_none()
-    {
+    // Frame numbers are u32.
+    if config.frames.checked_add(config.warmup).is_none() {
         return Err(TessError::BenchConfig {
             option: format!("--frames {} --warmup {}", config.frames, config.warmup),
-            reason: format!("a row has at most {} frames in all", u32::MAX - 1),
+            reason: format!("a row has at most {} frames in all", u32::MAX),
         });
     }
     if config.methods.is_empty() {
@@ -792,6 +787,11 @@ fn run_group(
                 st.times.wall_ms.push(wall);
             }
         }
+        // Every row has its frames (checked before the increment: the last frame number may
+        // be u32::MAX - 1).
+        if !any && index >= warmup {
+            break;
+        }
         index += 1;
         // After the warm-up, fit each technique's timed frames into the row budget.
         if index == fit_at {
@@ -809,9 +809,6 @@ fn run_group(
                     }
                 }
             }
-        }
-        if !any && index > warmup {
-            break;
         }
     }
     methods
