@@ -1267,31 +1267,15 @@ fn evaluate_local(
     } else {
         &[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]
     };
-    // Each level doubles the distance to the corner the point is nearest. From level 56 on, a
-    // point within 2^-50 of a corner of its face (2^-106 of the base face's domain) is snapped
-    // to it and takes the corner's limit masks; a point further from every corner is followed
-    // down until a regular patch holds it (a few levels more). No f64 parameter needs more
-    // than MAX_DEPTH levels (2^-1074 is the smallest).
-    const SNAP_FROM: usize = 56;
-    const SNAP: f64 = 1.0 / (1u64 << 50) as f64;
+    // No f64 parameter needs more than MAX_DEPTH levels (2^-1074 is the smallest; see
+    // `snapped`).
     const MAX_DEPTH: usize = 1100;
     for depth in 0..=MAX_DEPTH {
         if depth >= RECENTRE_FROM {
-            recentre(
-                &mut points,
-                dim,
-                level.topology.face_vertices(face)[0],
-                &mut origin,
-            );
+            let v0 = level.topology.face_vertices(face)[0];
+            recentre(&mut points, dim, v0, &mut origin);
         }
-        if depth >= SNAP_FROM {
-            let near = corners
-                .iter()
-                .find(|&&(a, b)| (u - a).abs() <= SNAP && (v - b).abs() <= SNAP);
-            if let Some(&(a, b)) = near {
-                (u, v) = (a, b);
-            }
-        }
+        (u, v) = snapped(depth, u, v, corners);
         if depth == MAX_DEPTH {
             u = u.round();
             v = v.round();
@@ -1366,6 +1350,24 @@ fn evaluate_local(
 /// levels are left alone, so dyadic parameters of the tables' levels evaluate bit for bit as
 /// they always did.
 const RECENTRE_FROM: usize = 8;
+
+/// `(u, v)` at recursion depth `depth`, snapped to a corner of `corners` when it is there to
+/// within what is left of f64's precision. Each level doubles the distance to the corner the
+/// point is nearest: from level 56 on, a point within 2^-50 of a corner of its face (2^-106 of
+/// the base face's domain) is snapped to it and takes the corner's limit masks; a point further
+/// from every corner is followed down until a regular patch holds it (a few levels more).
+fn snapped(depth: usize, u: f64, v: f64, corners: &[(f64, f64)]) -> (f64, f64) {
+    const SNAP_FROM: usize = 56;
+    const SNAP: f64 = 1.0 / (1u64 << 50) as f64;
+    if depth < SNAP_FROM {
+        return (u, v);
+    }
+    corners
+        .iter()
+        .copied()
+        .find(|&(a, b)| (u - a).abs() <= SNAP && (v - b).abs() <= SNAP)
+        .unwrap_or((u, v))
+}
 
 /// Makes `points` (`dim` values each) relative to vertex `v`'s point, adding that point to
 /// `origin`, the offset the returned positions get back ([`shifted`]).

@@ -14,7 +14,8 @@
 use crate::error::{ObjSyntax, TagKind, TopologyError};
 use crate::input::{read_regular_file, MAX_OBJ_BYTES};
 use crate::mesh::{
-    BoundaryInterpolation, ControlMesh, CreaseMethod, EdgeCrease, TriangleSubdivision, VertexCorner,
+    BoundaryInterpolation, ControlMesh, CreaseMethod, EdgeCrease, SubdivOptions,
+    TriangleSubdivision, VertexCorner,
 };
 use std::borrow::Cow;
 use std::io::Write;
@@ -619,16 +620,6 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
         })
     };
     let sharp_for = |k: usize, n: usize| tag_sharpness(&t, k, n, line, file, perr);
-    let bad_option = |expected: &'static str| {
-        perr(
-            line,
-            ObjSyntax::BadOptionValue {
-                option: tag.into(),
-                value: t.shown(),
-                expected,
-            },
-        )
-    };
     match tag {
         "crease" => {
             if t.ints.len() < 2 || t.ints.len() % 2 != 0 {
@@ -660,40 +651,8 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
                 lines.corners.push(line);
             }
         }
-        "interpolateboundary" => {
-            mesh.options.boundary =
-                match (&t.ints[..], t.strings.len()) {
-                    ([0], 0) => BoundaryInterpolation::None,
-                    ([1], 0) => BoundaryInterpolation::EdgesAndCorners,
-                    ([2], 0) => BoundaryInterpolation::EdgesOnly,
-                    _ => return Err(bad_option(
-                        "one integer: 0 (none), 1 (edges and corners) or 2 (edges only), as in \
-                         't interpolateboundary 1/0/0 1'",
-                    )),
-                }
-        }
-        "creasemethod" => {
-            mesh.options.crease_method = match (t.strings, t.ints.len()) {
-                (["chaikin"], 0) => CreaseMethod::Chaikin,
-                (["normal" | "uniform"], 0) => CreaseMethod::Uniform,
-                _ => {
-                    return Err(bad_option(
-                        "one string: chaikin, normal or uniform, as in 't creasemethod 0/0/1 \
-                         chaikin'",
-                    ))
-                }
-            }
-        }
-        "smoothtriangles" => {
-            mesh.options.triangle_subdivision = match (t.strings, &t.ints[..]) {
-                (["smooth"], []) | ([], [1]) => TriangleSubdivision::Smooth,
-                (["catmark"], []) | ([], [0]) => TriangleSubdivision::Catmark,
-                _ => {
-                    return Err(bad_option(
-                        "one string, smooth or catmark (or one integer, 1 or 0)",
-                    ))
-                }
-            }
+        "interpolateboundary" | "creasemethod" | "smoothtriangles" => {
+            option_tag(&t, &mut mesh.options, line, perr)?
         }
         "hole" => {
             if t.ints.is_empty() {
@@ -705,6 +664,65 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
             }
         }
         other => log::warn!("{file}:{line}: ignoring unsupported tag '{other}'"),
+    }
+    Ok(())
+}
+
+/// The option tags: `interpolateboundary` (one integer), `creasemethod` and `smoothtriangles`
+/// (one string; `smoothtriangles` also one integer). Anything else is refused with the value as
+/// written and what the tag takes.
+fn option_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
+    t: &TagValues<'_>,
+    options: &mut SubdivOptions,
+    line: usize,
+    perr: &E,
+) -> Result<(), TopologyError> {
+    let bad = |expected: &'static str| {
+        perr(
+            line,
+            ObjSyntax::BadOptionValue {
+                option: t.tag.into(),
+                value: t.shown(),
+                expected,
+            },
+        )
+    };
+    match t.tag {
+        "interpolateboundary" => {
+            options.boundary =
+                match (&t.ints[..], t.strings.len()) {
+                    ([0], 0) => BoundaryInterpolation::None,
+                    ([1], 0) => BoundaryInterpolation::EdgesAndCorners,
+                    ([2], 0) => BoundaryInterpolation::EdgesOnly,
+                    _ => return Err(bad(
+                        "one integer: 0 (none), 1 (edges and corners) or 2 (edges only), as in \
+                         't interpolateboundary 1/0/0 1'",
+                    )),
+                }
+        }
+        "creasemethod" => {
+            options.crease_method = match (t.strings, t.ints.len()) {
+                (["chaikin"], 0) => CreaseMethod::Chaikin,
+                (["normal" | "uniform"], 0) => CreaseMethod::Uniform,
+                _ => {
+                    return Err(bad(
+                        "one string: chaikin, normal or uniform, as in 't creasemethod 0/0/1 \
+                         chaikin'",
+                    ))
+                }
+            }
+        }
+        _ => {
+            options.triangle_subdivision = match (t.strings, &t.ints[..]) {
+                (["smooth"], []) | ([], [1]) => TriangleSubdivision::Smooth,
+                (["catmark"], []) | ([], [0]) => TriangleSubdivision::Catmark,
+                _ => {
+                    return Err(bad(
+                        "one string, smooth or catmark (or one integer, 1 or 0)",
+                    ))
+                }
+            }
+        }
     }
     Ok(())
 }
