@@ -189,7 +189,7 @@ pub(crate) fn tess_status(e: &TessError) -> TesseraStatus {
         E::CaptureTooLarge { .. } | E::CaptureOverflow { .. } | E::PartialTriangle { .. } => {
             TesseraStatus::Capture
         }
-        E::Io { .. } | E::Image { .. } => TesseraStatus::Io,
+        E::Io { .. } | E::Write { .. } | E::Image { .. } => TesseraStatus::Io,
     }
 }
 

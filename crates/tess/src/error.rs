@@ -155,4 +155,8 @@ pub enum TessError {
         path: String,
         source: std::io::Error,
     },
+    /// A file Tessera writes could not be written whole ([`crate::output::write_file`]): the
+    /// operating system's reason is said in the message, not chained.
+    #[error("cannot write {path}: {error}")]
+    Write { path: String, error: std::io::Error },
 }

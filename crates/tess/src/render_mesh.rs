@@ -170,16 +170,8 @@ impl RenderMesh {
                 out.quad_mode_triangle_origins.extend(fan_origins);
             }
         }
-        let mut lo = [f32::INFINITY; 3];
-        let mut hi = [f32::NEG_INFINITY; 3];
-        for v in &out.vertices {
-            for k in 0..3 {
-                lo[k] = lo[k].min(v.position[k]);
-                hi[k] = hi[k].max(v.position[k]);
-            }
-        }
-        out.bbox_min = lo;
-        out.bbox_max = hi;
+        // The vertices the faces use, not every vertex the file has.
+        (out.bbox_min, out.bbox_max) = crate::framing::drawn_bbox(mesh);
         Ok(out)
     }
 }

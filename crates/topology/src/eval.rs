@@ -35,7 +35,7 @@
 
 use std::fmt;
 
-use crate::error::TopologyError;
+use crate::error::{number, TopologyError};
 use crate::limit::{
     catmark_limit_masks, loop_limit_masks, loop_smooth_tangent_weights, smooth_directional_tangent,
     LimitRule, LimitVertex,
@@ -94,7 +94,7 @@ impl std::str::FromStr for LimitScheme {
 pub enum EvalError {
     #[error("face {face} out of range (the mesh has {count} faces)")]
     FaceOutOfRange { face: usize, count: usize },
-    #[error("parameter ({u}, {v}) outside the face domain")]
+    #[error("parameter ({}, {}) outside the face domain", number(*.u), number(*.v))]
     ParamOutOfRange { u: f64, v: f64 },
     #[error("face {face} has {size} corners; {} evaluation needs {need}", scheme.scheme())]
     FaceSize {
@@ -121,7 +121,7 @@ pub enum EvalError {
     },
     #[error("vertex {vertex} belongs to no face: it has no limit position")]
     IsolatedVertex { vertex: u32 },
-    #[error("evaluation of face {face} at ({u}, {v}) did not converge")]
+    #[error("evaluation of face {face} at ({}, {}) did not converge", number(*.u), number(*.v))]
     NotConverged { face: usize, u: f64, v: f64 },
     #[error("no basis-function table case {key:?}")]
     NoBftCase { key: crate::bft::BftKey },
@@ -1260,10 +1260,23 @@ fn evaluate_local(
     let (start_face, u0, v0) = (face, u, v);
     let (mut u, mut v) = (u, v);
     let mut jac = [[1.0, 0.0], [0.0, 1.0]];
-    const MAX_DEPTH: usize = 56;
+    // What `points` are relative to (see `recentre`).
+    let mut origin = vec![0.0; dim];
+    let corners: &[(f64, f64)] = if quad {
+        &[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+    } else {
+        &[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]
+    };
+    // No f64 parameter needs more than MAX_DEPTH levels (2^-1074 is the smallest; see
+    // `snapped`).
+    const MAX_DEPTH: usize = 1100;
     for depth in 0..=MAX_DEPTH {
+        if depth >= RECENTRE_FROM {
+            let v0 = level.topology.face_vertices(face)[0];
+            recentre(&mut points, dim, v0, &mut origin);
+        }
+        (u, v) = snapped(depth, u, v, corners);
         if depth == MAX_DEPTH {
-            // 2^-56 from a corner: snap (far below f64 resolution of the surface).
             u = u.round();
             v = v.round();
             if !quad && u + v > 1.0 {
@@ -1293,16 +1306,11 @@ fn evaluate_local(
                 axpy(&mut du, wu[i], x);
                 axpy(&mut dv, wv[i], x);
             }
-            return Ok(chain(p, du, dv, &jac));
+            return Ok(chain(shifted(p, &origin), du, dv, &jac));
         }
-        let corners: &[(f64, f64)] = if quad {
-            &[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
-        } else {
-            &[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]
-        };
         if let Some(c) = corners.iter().position(|&(a, b)| a == u && b == v) {
             if let Some(s) = view.corner_limit(face, c) {
-                return Ok(chain(s.position, s.du, s.dv, &jac));
+                return Ok(chain(shifted(s.position, &origin), s.du, s.dv, &jac));
             }
         }
         let step = refine_sparse(level.view(), scheme.scheme(), &mesh.options, &[face as u32])?;
@@ -1328,6 +1336,62 @@ fn evaluate_local(
         u: u0,
         v: v0,
     })
+}
+
+/// The recursion depth from which [`evaluate_local`] keeps its points relative to the face it
+/// descends into. Near an extraordinary vertex the points of level `k` lie within about `λ^k`
+/// of each other (`λ` the subdominant eigenvalue, 0.4 to 0.9), while their coordinates keep
+/// the mesh's magnitude: by level 40 or so their differences, which the tangent masks and the
+/// patches' derivative weights take, are below the coordinates' f64 resolution, and the
+/// derivatives came out as rounding noise (a normal 45° off at `u = v = 1e-20`, a zero normal
+/// further in). Subtracting one point of the face from all of them at each level keeps the
+/// differences at full relative precision (every stencil, mask and patch weight sums to 1,
+/// their derivative weights to 0, so the shift changes nothing but the rounding). Shallower
+/// levels are left alone, so dyadic parameters of the tables' levels evaluate bit for bit as
+/// they always did.
+const RECENTRE_FROM: usize = 8;
+
+/// `(u, v)` at recursion depth `depth`, snapped to a corner of `corners` when it is there to
+/// within what is left of f64's precision. Each level doubles the distance to the corner the
+/// point is nearest: from level 56 on, a point within 2^-50 of a corner of its face (2^-106 of
+/// the base face's domain) is snapped to it and takes the corner's limit masks; a point further
+/// from every corner is followed down until a regular patch holds it (a few levels more).
+fn snapped(depth: usize, u: f64, v: f64, corners: &[(f64, f64)]) -> (f64, f64) {
+    const SNAP_FROM: usize = 56;
+    const SNAP: f64 = 1.0 / (1u64 << 50) as f64;
+    if depth < SNAP_FROM {
+        return (u, v);
+    }
+    corners
+        .iter()
+        .copied()
+        .find(|&(a, b)| (u - a).abs() <= SNAP && (v - b).abs() <= SNAP)
+        .unwrap_or((u, v))
+}
+
+/// Makes `points` (`dim` values each) relative to vertex `v`'s point, adding that point to
+/// `origin`, the offset the returned positions get back ([`shifted`]).
+fn recentre(points: &mut [f64], dim: usize, v: u32, origin: &mut [f64]) {
+    let start = v as usize * dim;
+    let Some(centre) = points.get(start..start + dim).map(<[f64]>::to_vec) else {
+        return;
+    };
+    for p in points.chunks_exact_mut(dim) {
+        for (x, c) in p.iter_mut().zip(&centre) {
+            *x -= c;
+        }
+    }
+    for (o, c) in origin.iter_mut().zip(&centre) {
+        *o += c;
+    }
+}
+
+/// A position of the recentred points, back in the mesh's coordinates.
+fn shifted(mut p: Vec<f64>, origin: &[f64]) -> Vec<f64> {
+    for (x, o) in p.iter_mut().zip(origin) {
+        *x += o;
+    }
+    p
 }
 
 /// Derivatives with respect to the original parameters.
@@ -1426,7 +1490,7 @@ impl fmt::Display for LimitPoint {
         if let Some(s) = self.subface {
             write!(f, " subface {s}")?;
         }
-        writeln!(f, " uv {} {}", self.u, self.v)?;
+        writeln!(f, " uv {} {}", number(self.u), number(self.v))?;
         writeln!(f, "position {}", v3(&self.position))?;
         writeln!(f, "du {}", v3(&self.du))?;
         writeln!(f, "dv {}", v3(&self.dv))?;

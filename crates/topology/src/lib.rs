@@ -7,6 +7,7 @@ pub mod bft;
 pub mod error;
 pub mod eval;
 pub mod gregory;
+pub mod input;
 pub mod limit;
 pub mod limit_mesh;
 pub mod mesh;
@@ -23,11 +24,15 @@ pub use adaptive::{
     PatchEdge, PatchKind, PatchSample, StencilBlock,
 };
 pub use error::{ObjSyntax, TagKind, TopologyError};
+pub use input::{read_regular_file, MAX_OBJ_BYTES};
 pub use mesh::{
     check_positions, BoundaryInterpolation, ControlMesh, CreaseMethod, EdgeCrease, SubdivOptions,
     Topology, TriangleSubdivision, VertexCorner, MAX_COORDINATE,
 };
-pub use obj::{load_obj, parse_obj, write_control_mesh, write_obj};
+pub use obj::{
+    load_obj, load_obj_with_lines, parse_obj, parse_obj_bytes, parse_obj_with_lines,
+    write_control_mesh, write_obj, ObjLines,
+};
 pub use refine::{
     refine_level, refine_sparse, refine_sparse_region, refine_uniform, uniform_stencils, ChildMaps,
     ChildOrigin, Level, LevelRef, LevelTopology, SparseRefinement, SparseRegion, UniformRefinement,

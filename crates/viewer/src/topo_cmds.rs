@@ -5,7 +5,7 @@
 use crate::cli::{LimitArgs, SubdivideArgs};
 use anyhow::{bail, Context, Result};
 use topology::eval::{limit_point, EvalError, LimitScheme, LocalMesh};
-use topology::{refine_uniform, ControlMesh, Level, Scheme};
+use topology::{refine_uniform, ControlMesh, Level, ObjLines, Scheme};
 
 /// Clap's value parser for `--scheme`: topology's one scheme parser.
 pub fn parse_scheme(s: &str) -> Result<Scheme, String> {
@@ -43,21 +43,24 @@ fn non_finite(positions: &[[f64; 3]]) -> Option<usize> {
 }
 
 /// The OBJ at `path` as read (an empty mesh included: refining it is not an error here), or the
-/// embedded spot control mesh.
-fn read_mesh(path: Option<&std::path::Path>) -> Result<ControlMesh> {
+/// embedded spot control mesh, with the lines of its elements.
+fn read_mesh(path: Option<&std::path::Path>) -> Result<(ControlMesh, ObjLines)> {
     match path {
-        Some(p) => Ok(topology::load_obj(p)?),
-        None => crate::commands::load_mesh(None),
+        Some(p) => Ok(topology::load_obj_with_lines(p)?),
+        None => crate::commands::load_mesh_with_lines(None),
     }
 }
 
 pub fn subdivide(a: SubdivideArgs) -> Result<()> {
     if a.level > 6 {
-        bail!("--level {} is above 6 (meshes grow 4× per level)", a.level);
+        bail!(
+            "--level {}: give a level from 0 to 6 (meshes grow 4× per level)",
+            a.level
+        );
     }
     let name = crate::commands::mesh_name(a.input.as_deref());
-    let mesh = read_mesh(a.input.as_deref())?;
-    let r = refine_uniform(&mesh, a.scheme, a.level).map_err(|e| e.in_file(&name, None))?;
+    let (mesh, lines) = read_mesh(a.input.as_deref())?;
+    let r = refine_uniform(&mesh, a.scheme, a.level).map_err(|e| lines.locate(e, &mesh, &name))?;
     let level = r.level(a.level);
     let positions = if a.limit {
         limit_positions(level, &mesh, a.scheme)?
@@ -71,10 +74,9 @@ pub fn subdivide(a: SubdivideArgs) -> Result<()> {
         );
     }
     let (offsets, verts) = level.topology.face_tables();
-    let file = std::fs::File::create(&a.output)
-        .with_context(|| format!("creating {}", a.output.display()))?;
-    topology::write_obj(file, &positions, offsets, verts)
-        .with_context(|| format!("writing {}", a.output.display()))?;
+    tess::output::write_file(&a.output, |w| {
+        topology::write_obj(w, &positions, offsets, verts)
+    })?;
     out!(
         "wrote {}: {} vertices, {} faces (level {}, {}{})",
         a.output.display(),
@@ -87,10 +89,17 @@ pub fn subdivide(a: SubdivideArgs) -> Result<()> {
     Ok(())
 }
 
-/// An evaluation error about a mesh read from `name`, in the OBJ's 1-based face numbers.
-fn eval_in_file(e: EvalError, name: &str) -> anyhow::Error {
+/// An evaluation error about a mesh read from `name`, in the OBJ's 1-based face numbers (and
+/// the line at fault, from `lines`).
+fn eval_in_file(e: EvalError, name: &str, mesh: &ControlMesh, lines: &ObjLines) -> anyhow::Error {
     match e {
-        EvalError::Topology(t) => t.in_file(name, None).into(),
+        EvalError::Topology(t) => lines.locate(t, mesh, name).into(),
+        EvalError::ParamOutOfRange { u, v } => anyhow::anyhow!(
+            "--uv {},{}: outside the face's domain (a quad's is 0 to 1 in u and v; a \
+             triangle's u, v ≥ 0 with u + v ≤ 1)",
+            topology::error::number(u),
+            topology::error::number(v)
+        ),
         EvalError::FaceSize {
             face,
             size,
@@ -115,10 +124,17 @@ pub fn limit(a: LimitArgs) -> Result<()> {
         Some(path) => Some(read_points(path)?),
         None => None,
     };
-    let mesh = read_mesh(a.input.as_deref())?;
-    if let Some((points, lines)) = points {
+    let (mesh, lines) = read_mesh(a.input.as_deref())?;
+    if let Some((points, point_lines)) = points {
         let path = a.points.as_deref().unwrap_or(std::path::Path::new(""));
-        return limit_points(&a, &mesh, scheme, &name, path, &points, &lines);
+        return limit_points(
+            &a,
+            (&mesh, &lines),
+            scheme,
+            &name,
+            path,
+            (&points, &point_lines),
+        );
     }
     let (Some(face), Some(uv)) = (a.face, a.uv) else {
         bail!("--face and --uv, or --points, say where to evaluate");
@@ -127,12 +143,13 @@ pub fn limit(a: LimitArgs) -> Result<()> {
     if face == 0 || face > faces {
         bail!("--face {face}: {name} has faces 1 to {faces} (numbered as its `f` lines, from 1)");
     }
-    let p = limit_point(&mesh, scheme, face - 1, uv.0, uv.1).map_err(|e| eval_in_file(e, &name))?;
+    let p = limit_point(&mesh, scheme, face - 1, uv.0, uv.1)
+        .map_err(|e| eval_in_file(e, &name, &mesh, &lines))?;
     if non_finite(&[p.position, p.du, p.dv, p.normal]).is_some() {
         bail!(
             "{name}: the limit at face {face} ({}, {}) is not finite",
-            uv.0,
-            uv.1
+            topology::error::number(uv.0),
+            topology::error::number(uv.1)
         );
     }
     out!("{p}");
@@ -194,15 +211,14 @@ fn read_points(path: &std::path::Path) -> Result<(Vec<FacePoint>, Vec<usize>)> {
 /// `limit --points`: every point of the file, evaluated as one batch, written one per line.
 fn limit_points(
     a: &LimitArgs,
-    mesh: &ControlMesh,
+    (mesh, obj_lines): (&ControlMesh, &ObjLines),
     scheme: LimitScheme,
     name: &str,
     path: &std::path::Path,
-    points: &[FacePoint],
-    lines: &[usize],
+    (points, lines): (&[FacePoint], &[usize]),
 ) -> Result<()> {
-    let evaluator =
-        tess::limit::LimitEvaluator::new(mesh, scheme).map_err(|e| eval_in_file(e, name))?;
+    let evaluator = tess::limit::LimitEvaluator::new(mesh, scheme)
+        .map_err(|e| eval_in_file(e, name, mesh, obj_lines))?;
     let samples = evaluator.evaluate_many(points).map_err(|e| {
         let at = format!("{}:{}", path.display(), lines[e.point]);
         match e.source {
@@ -237,7 +253,7 @@ fn limit_points(
     }
     match &a.output {
         Some(out) => {
-            std::fs::write(out, &text).with_context(|| format!("writing {}", out.display()))?;
+            tess::output::write_file(out, |w| w.write_all(text.as_bytes()))?;
             out!(
                 "wrote {}: {} limit points of {name} ({})",
                 out.display(),

@@ -834,6 +834,25 @@ impl DeviceShared {
         self.collect_retired();
     }
 
+    /// Destroys the one-shot command pools kept for reuse ([`Device::submit_once`] takes one
+    /// and gives it back when its submission completes). Idle pools are the device's cache,
+    /// not anything a caller holds: after this, [`DeviceShared::live_objects`] counts only
+    /// what callers hold (or leaked). Used before a final count; a later one-shot submission
+    /// makes a new pool.
+    pub fn release_idle_command_pools(&self) {
+        let pools = match self.once_pools.lock() {
+            Ok(mut p) => std::mem::take(&mut *p),
+            Err(_) => return,
+        };
+        for (pool, _) in pools {
+            // SAFETY: a pool is in `once_pools` only once its command buffer is no longer
+            // pending (recycled after its submission completed, or never submitted); it was
+            // taken out under the lock, so no other thread uses it.
+            unsafe { self.raw.destroy_command_pool(pool, None) };
+            self.destroyed(1);
+        }
+    }
+
     pub fn pipeline_cache(&self) -> vk::PipelineCache {
         self.pipeline_cache
     }

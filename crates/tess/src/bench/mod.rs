@@ -38,9 +38,10 @@ pub struct BenchConfig {
     pub warmup: u32,
     pub extent: vk::Extent2D,
     pub camera: Camera,
-    /// When set, a row whose timed frames would take longer than this (judged from the last
-    /// warm-up frame's wall time) gets fewer frames, never fewer than `min_frames`; the row
-    /// says so in its note.
+    /// When set, a row whose timed frames would take longer than this gets fewer frames
+    /// ([`fit_frames`], judged from the last warm-up frame's wall time, or the first timed
+    /// frame's without warm-up), never fewer than `min_frames` (nor more than `frames`); the
+    /// row says so in its note.
     pub row_budget_s: Option<f64>,
     pub min_frames: u32,
     /// The CPU baseline skips levels with more vertices than this (3 M vertices peak at about
@@ -649,6 +650,13 @@ fn validate(config: &BenchConfig, meshes: &[BenchMesh]) -> Result<()> {
     if config.frames == 0 {
         return bad("at least one timed frame is needed".into());
     }
+    // Frame numbers are u32.
+    if config.frames.checked_add(config.warmup).is_none() {
+        return Err(TessError::BenchConfig {
+            option: format!("--frames {} --warmup {}", config.frames, config.warmup),
+            reason: format!("a row has at most {} frames in all", u32::MAX),
+        });
+    }
     if config.methods.is_empty() {
         return bad("no methods to benchmark".into());
     }
@@ -679,13 +687,24 @@ fn validate(config: &BenchConfig, meshes: &[BenchMesh]) -> Result<()> {
     Ok(())
 }
 
+/// The timed frames a row keeps under `--row-budget`: as many frames of `per_frame_s` as fit
+/// in `budget_s`, at least `min_frames` (and at least 1) and at most `frames` (a `min_frames`
+/// above `frames` is `frames`).
+pub fn fit_frames(budget_s: f64, per_frame_s: f64, frames: u32, min_frames: u32) -> u32 {
+    let fit = (budget_s / per_frame_s).floor();
+    // `as` saturates: NaN gives 0, a huge quotient u32::MAX.
+    let fit = if fit.is_nan() { 0 } else { fit as u32 };
+    fit.clamp(min_frames.clamp(1, frames.max(1)), frames.max(1))
+}
+
 /// One technique's frames within a group.
 struct RowState {
     frames: u32,
     times: FrameTimes,
     expected: Option<u64>,
     counted: Option<u64>,
-    last_warmup_cost_s: f64,
+    /// Wall time of the row's last frame (warm-up or timed), seconds.
+    last_cost_s: f64,
     notes: Vec<String>,
 }
 
@@ -715,10 +734,13 @@ fn run_group(
             },
             expected: None,
             counted: None,
-            last_warmup_cost_s: 0.0,
+            last_cost_s: 0.0,
             notes: Vec::new(),
         })
         .collect();
+    // The budget is fitted once a frame of each row was measured: after the warm-up, or after
+    // the first timed frame without one.
+    let fit_at = warmup.max(1);
     let mut index = 0;
     loop {
         let is_warmup = index < warmup;
@@ -753,22 +775,25 @@ fn run_group(
                 }
                 Some(_) => {}
             }
-            if is_warmup {
-                st.last_warmup_cost_s = frame_start.elapsed().as_secs_f64();
-            } else {
+            st.last_cost_s = frame_start.elapsed().as_secs_f64();
+            if !is_warmup {
                 st.times.gpu_ms.push(gpu);
                 st.times.cpu_ms.push(cpu);
                 st.times.wall_ms.push(wall);
             }
         }
+        // Every row has its frames (checked before the increment: the last frame number may
+        // be u32::MAX - 1).
+        if !any && index >= warmup {
+            break;
+        }
         index += 1;
         // After the warm-up, fit each technique's timed frames into the row budget.
-        if index == warmup {
+        if index == fit_at {
             if let Some(budget) = config.row_budget_s {
                 for st in &mut states {
-                    let per_frame = st.last_warmup_cost_s.max(1e-9);
-                    let fit = (budget / per_frame).floor() as u32;
-                    let reduced = fit.clamp(config.min_frames.max(1), st.frames);
+                    let per_frame = st.last_cost_s.max(1e-9);
+                    let reduced = fit_frames(budget, per_frame, st.frames, config.min_frames);
                     if reduced < st.frames {
                         st.notes.push(format!(
                             "frames reduced from {} to {reduced} (row budget {budget} s, \
@@ -779,9 +804,6 @@ fn run_group(
                     }
                 }
             }
-        }
-        if !any && index > warmup {
-            break;
         }
     }
     methods
@@ -865,6 +887,32 @@ fn finish_row(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every combination of the budget's inputs gives a frame count in `1..=frames`: a
+    /// `min_frames` above `frames` panicked in `clamp` (`--frames 2` with the default
+    /// `--min-frames 5`, or `--min-frames 3`).
+    #[test]
+    fn fit_frames_stays_within_one_and_frames() {
+        let cases: [(f64, f64, u32, u32, u32); 10] = [
+            (1.5, 0.1, 2, 5, 2),
+            (1.5, 0.1, 2, 3, 2),
+            (1.0, 0.1, 3000, 5, 10),
+            (1.0, 0.5, 3000, 5, 5),
+            (1.0, 0.5, 3000, 0, 2),
+            (1.0, 1e-9, u32::MAX, 5, 999_999_999),
+            (1e12, 1e-9, u32::MAX, 5, u32::MAX),
+            (1e-300, 1.0, 30, 0, 1),
+            (1.0, 1e-300, 30, 5, 30),
+            (f64::MAX, 1e-300, 7, 1, 7),
+        ];
+        for (budget, per_frame, frames, min_frames, want) in cases {
+            assert_eq!(
+                fit_frames(budget, per_frame, frames, min_frames),
+                want,
+                "budget {budget}, {per_frame} s a frame, frames {frames}, min {min_frames}"
+            );
+        }
+    }
 
     #[test]
     fn nearest_level_picks_the_closest_count_and_the_lower_level_on_ties() {

@@ -179,6 +179,25 @@ fn problem(e: VkError) -> RecordingError {
     }
 }
 
+/// A one-shot submission leaves its command pool cached for the next (counted live); releasing
+/// the idle pools brings the count back to what callers hold, and a later submission works.
+#[test]
+fn idle_one_shot_pools_are_released_on_request() {
+    let gpu = Gpu::new();
+    let device = gpu.device();
+    let start = device.live_objects();
+    device.submit_once(|_| ()).unwrap();
+    device.wait_idle();
+    assert_eq!(device.live_objects(), start + 1, "the idle pool is cached");
+    device.release_idle_command_pools();
+    assert_eq!(device.live_objects(), start);
+    device.submit_once(|_| ()).unwrap();
+    device.wait_idle();
+    device.release_idle_command_pools();
+    assert_eq!(device.live_objects(), start);
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+}
+
 #[test]
 fn encoder_renders_and_dispatches() {
     let gpu = Gpu::new();

@@ -61,7 +61,7 @@ use crate::technique::{
     for_each_draw, number_arrays, DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features,
     FrameParams, Pass, PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
 };
-use crate::techniques::bft::{base_positions, bbox};
+use crate::techniques::bft::base_positions;
 use crate::techniques::{BuildOptions, Built, LegendEntry, TechniqueInfo};
 use crate::tessellator::{
     quad_triangle_count, triangle_triangle_count, uniform_vertex_count, Domain, Spacing,
@@ -635,7 +635,7 @@ impl Adaptive {
             gpu,
             plan,
             mesh: mesh.clone(),
-            rest_bbox: bbox(&base_positions),
+            rest_bbox: crate::framing::drawn_bbox(mesh),
             base_positions,
             options: options.clone(),
             max_level,

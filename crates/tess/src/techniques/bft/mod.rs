@@ -855,7 +855,7 @@ impl Bft {
             fans,
             drawn,
             loop_mesh,
-            rest_bbox: bbox(&base_positions),
+            rest_bbox: crate::framing::drawn_bbox(mesh),
             base_positions,
             notes: note.into_iter().collect(),
         })
@@ -1267,7 +1267,8 @@ pub struct Wave {
 impl Wave {
     pub fn new(mesh: &ControlMesh) -> Self {
         let rest = base_positions(mesh);
-        let bbox = bbox(&rest);
+        // The amplitude follows the drawn size, not a far vertex no face uses.
+        let bbox = crate::framing::drawn_bbox(mesh);
         Self {
             normals: base_normals(mesh),
             rest,
