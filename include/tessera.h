@@ -69,6 +69,9 @@ typedef enum TesseraStatus {
 // An opaque context: a Vulkan device and how Tessera uses it.
 typedef struct TesseraContext TesseraContext;
 
+// An opaque limit evaluator: one surface's (or mesh's) exact limit surface on the CPU.
+typedef struct TesseraLimitEvaluator TesseraLimitEvaluator;
+
 // An opaque surface: one control mesh built for one technique on one context.
 typedef struct TesseraSurface TesseraSurface;
 
@@ -166,13 +169,23 @@ typedef struct TesseraFrameDesc {
 // The Khronos validation layer in standalone mode (`TESSERA_VALIDATION_*`).
 typedef uint32_t TesseraValidation;
 
-// How a standalone context is made.
+// Whether Tessera keeps its Vulkan pipeline cache on disk between runs
+// (`TESSERA_PIPELINE_CACHE_*`).
+typedef uint32_t TesseraPipelineCache;
+
+// How a standalone context is made. A zero-filled descriptor is valid (best device, no
+// validation, the default pipeline cache).
 typedef struct TesseraStandaloneDesc {
   // NUL-terminated device selector as the CLI's `--device`: NULL, "" or "auto" for the
   // best-scored device, a number for an index, other text for a name substring.
   const char *device;
   // `TESSERA_VALIDATION_*`; the layer must be installed when not OFF.
   TesseraValidation validation;
+  // `TESSERA_PIPELINE_CACHE_*`.
+  TesseraPipelineCache pipeline_cache;
+  // NULL (the user's cache directory) or a NUL-terminated directory for the pipeline cache
+  // (created when missing).
+  const char *pipeline_cache_dir;
 } TesseraStandaloneDesc;
 
 // A control mesh. Arrays are read during the call only. Counts are of elements (vertices,
@@ -203,19 +216,42 @@ typedef struct TesseraMeshDesc {
   const float *uvs;
 } TesseraMeshDesc;
 
+// What a capture found (as `tessera export` reports it).
+typedef struct TesseraCaptureReport {
+  // Triangles the GPU emitted (zero-area ones included).
+  uint64_t triangles;
+  // Welded vertices: corners merged only when the bits of their positions are identical.
+  uint64_t vertices;
+  // Edges used by exactly one triangle: `on_base_boundary + cracks`.
+  uint64_t open_edges;
+  // Open edges on the control mesh's own boundary.
+  uint64_t on_base_boundary;
+  // Open edges inside the surface: cracks in what the GPU drew.
+  uint64_t cracks;
+  // Of the cracks, those on patches with no base face (a technique bug).
+  uint64_t unmapped;
+  // Edges used by three or more triangles.
+  uint64_t non_manifold_edges;
+  // Triangles with two welded corners alike.
+  uint64_t zero_area_triangles;
+} TesseraCaptureReport;
+
 // The host's Vulkan objects, none of which Tessera ever destroys.
 typedef struct TesseraHostDesc {
   PFN_vkGetInstanceProcAddr get_instance_proc_addr;
   // Created for Vulkan 1.3 or later.
   VkInstance instance;
   VkPhysicalDevice physical_device;
-  // Created from `physical_device` with `tessellationShader`, `fillModeNonSolid`,
-  // `dynamicRendering` and `timelineSemaphore` enabled.
+  // Created from `physical_device` with `tessellationShader`, `fillModeNonSolid` and
+  // `timelineSemaphore` enabled, and `dynamicRendering` for dynamic-rendering scopes and
+  // captures.
   VkDevice device;
   // A family with graphics and compute; `queue` is its queue 0.
   uint32_t queue_family;
   VkQueue queue;
-  // Formats of the host's rendering scopes Tessera's draws are recorded into.
+  // Formats of the host's attachments Tessera's draws write: of its dynamic-rendering
+  // scopes, or of the colour attachment (the subpass's one) and the depth attachment
+  // (`VK_FORMAT_UNDEFINED`: none) of `subpass` of `render_pass`.
   VkFormat color_format;
   VkFormat depth_format;
   // 1 or more.
@@ -228,6 +264,25 @@ typedef struct TesseraHostDesc {
   uint32_t pipeline_statistics_query;
   // 0 or 1: `vertexPipelineStoresAndAtomics` is enabled.
   uint32_t vertex_pipeline_stores_and_atomics;
+  // VK_NULL_HANDLE: Tessera's draws go into the host's dynamic-rendering scopes. Otherwise
+  // they go into subpass `subpass` of instances of this render pass (or of one compatible
+  // with it): its pipelines are made for that subpass, which must have exactly one colour
+  // attachment (`color_format`) and at most a depth attachment (`depth_format`), all with
+  // `samples` samples. The render pass must outlive the context.
+  VkRenderPass render_pass;
+  uint32_t subpass;
+  // `VkSampleCountFlagBits` of the subpass's attachments (1, 2, 4, ... 64; 0 means 1).
+  // Render passes only: dynamic rendering takes 0 or 1.
+  uint32_t samples;
+  // 0 or 1: `dynamicRendering` is enabled. Dynamic rendering needs it (so it is taken as 1
+  // there); with a render pass only captures do (they render into a scope of their own),
+  // and are UNSUPPORTED without it.
+  uint32_t dynamic_rendering;
+  // `TESSERA_PIPELINE_CACHE_*`: Tessera's own pipeline cache (never one of the host's), kept
+  // as [`crate::TesseraStandaloneDesc`] says.
+  TesseraPipelineCache pipeline_cache;
+  // NULL (the user's cache directory) or a NUL-terminated directory for it.
+  const char *pipeline_cache_dir;
 } TesseraHostDesc;
 
 // The technique of the scheme: `adaptive` for Catmull-Clark, `bft` for Loop.
@@ -249,6 +304,13 @@ typedef struct TesseraHostDesc {
 // Catmull-Clark approximated in one pass by ACC-1 patches, Gregory where ACC-1 does not apply
 // (`--method acc`).
 #define TESSERA_TECHNIQUE_ACC 7
+
+// Loop subdivision on the CPU to level log2 S at the limit, drawn as a static mesh
+// (`--method cpu`; levels are powers of two up to 64 segments).
+#define TESSERA_TECHNIQUE_CPU 8
+
+// Catmull-Clark subdivision on the CPU, drawn as a static mesh (`--method cpu-catmark`).
+#define TESSERA_TECHNIQUE_CPU_CATMARK 9
 
 // Catmull-Clark unless every face is a triangle (then Loop); a Loop technique fan-triangulates.
 #define TESSERA_SCHEME_AUTO 0
@@ -293,6 +355,16 @@ typedef struct TesseraHostDesc {
 // Also synchronization validation (slower).
 #define TESSERA_VALIDATION_SYNCHRONIZATION 2
 
+// On disk, in the descriptor's `pipeline_cache_dir`, or when that is NULL in the user's cache
+// directory (`$XDG_CACHE_HOME/tessera/pipelines`, else `~/.cache/tessera/pipelines`), one
+// file per device and driver build (its header is checked against the device before use);
+// the environment variable `TESSERA_PIPELINE_CACHE=off` turns it off for the process. The
+// value of a zero-filled descriptor.
+#define TESSERA_PIPELINE_CACHE_DEFAULT 0
+
+// In memory only: every context compiles its pipelines afresh.
+#define TESSERA_PIPELINE_CACHE_OFF 1
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -331,9 +403,10 @@ enum TesseraStatus tessera_frame_desc_default(struct TesseraFrameDesc *desc);
 // chooses. Thread-safe.
 //
 // # Safety
-// `desc` is NULL (defaults: best device, validation off) or points to a readable
-// `TesseraStandaloneDesc` whose `device` is NULL or a NUL-terminated string; `out` points to
-// a writable `TesseraContext*` (set to NULL on failure).
+// `desc` is NULL (defaults: best device, validation off, the default pipeline cache) or
+// points to a readable `TesseraStandaloneDesc` whose `device` and `pipeline_cache_dir` are
+// NULL or NUL-terminated strings; `out` points to a writable `TesseraContext*` (set to NULL
+// on failure).
 enum TesseraStatus tessera_context_create_standalone(const struct TesseraStandaloneDesc *desc,
                                                      struct TesseraContext **out);
 
@@ -449,10 +522,23 @@ enum TesseraStatus tessera_render(struct TesseraContext *ctx,
                                   uint8_t *pixels,
                                   size_t pixels_len);
 
-// Standalone: captures the triangles the GPU's tessellation emitted for one frame (transform
-// feedback) and writes them as OBJ to `path`, welded by position bits as `tessera export`
-// writes them; `triangles` (may be NULL) receives the count. UNSUPPORTED on a device without
-// VK_EXT_transform_feedback. Thread-safe (serialized per context).
+// Captures the triangles the GPU's tessellation emitted for one frame of the surface,
+// welds them, reports open edges and cracks into `report` (may be NULL) and, when `path` is
+// not NULL, writes them as OBJ there (as `tessera export` writes it: `v`, `vn`, a `# p F U V`
+// base-face point per vertex, `f`). Standalone and host-owned contexts alike (see the module
+// documentation in crates/capi/src/capture.rs for what a host must ensure). UNSUPPORTED on a
+// device without VK_EXT_transform_feedback. Thread-safe (serialized per context).
+//
+// # Safety
+// `frame` is readable; `path` is NULL or NUL-terminated; `report` is NULL or writable.
+enum TesseraStatus tessera_capture(struct TesseraContext *ctx,
+                                   struct TesseraSurface *surface,
+                                   const struct TesseraFrameDesc *frame,
+                                   const char *path,
+                                   struct TesseraCaptureReport *report);
+
+// [`tessera_capture`] writing the OBJ to `path` (required) and the triangle count to
+// `triangles` (may be NULL).
 //
 // # Safety
 // `frame` is readable; `path` is NUL-terminated; `triangles` is NULL or writable.
@@ -515,9 +601,10 @@ enum TesseraStatus tessera_record_pre_pass(struct TesseraContext *ctx,
 // thread during the call.
 //
 // # Safety
-// `cmd` is a primary command buffer of the context's device in the recording state, inside
-// a rendering scope begun with dynamic rendering and the context's formats, viewport and
-// scissor set; `view` and `proj` point to 16 readable floats each; `cmd` is submitted in the
+// `cmd` is a primary command buffer of the context's device in the recording state, viewport
+// and scissor set, inside a rendering scope begun with dynamic rendering and the context's
+// formats, or (a context made with a render pass) inside its `subpass` of an instance of that
+// render pass or of one compatible with it, begun with `VK_SUBPASS_CONTENTS_INLINE`; `view` and `proj` point to 16 readable floats each; `cmd` is submitted in the
 // frame named by [`tessera_begin_frame`], and the context is destroyed only after the GPU
 // finished it.
 enum TesseraStatus tessera_record_draw(struct TesseraContext *ctx,
@@ -525,6 +612,65 @@ enum TesseraStatus tessera_record_draw(struct TesseraContext *ctx,
                                        VkCommandBuffer cmd,
                                        const float *view,
                                        const float *proj);
+
+// Makes an evaluator of the surface's limit surface (its scheme, control mesh, creases and
+// current positions; see the module documentation in crates/capi/src/limit.rs). Thread-safe.
+//
+// # Safety
+// `out` points to a writable `TesseraLimitEvaluator*` (set to NULL on failure).
+enum TesseraStatus tessera_limit_evaluator_create(const struct TesseraContext *ctx,
+                                                  const struct TesseraSurface *surface,
+                                                  struct TesseraLimitEvaluator **out);
+
+// Makes an evaluator of a control mesh given as arrays, with no context or device:
+// `scheme` is `TESSERA_SCHEME_*` (AUTO: Loop when every face is a triangle, else
+// Catmull-Clark). The mesh is checked as [`crate::tessera_surface_create`] checks it.
+// Thread-safe.
+//
+// # Safety
+// `mesh` is readable and its arrays as long as its counts say; `out` points to a writable
+// `TesseraLimitEvaluator*` (set to NULL on failure).
+enum TesseraStatus tessera_limit_evaluator_create_mesh(const struct TesseraMeshDesc *mesh,
+                                                       TesseraScheme scheme,
+                                                       struct TesseraLimitEvaluator **out);
+
+// Destroys an evaluator (an evaluation running on another thread finishes first). Thread-safe;
+// a second destroy returns DESTROYED_HANDLE.
+//
+// # Safety
+// None: the handle is looked up, never dereferenced.
+enum TesseraStatus tessera_limit_evaluator_destroy(struct TesseraLimitEvaluator *ev);
+
+// The evaluator's face count (points name faces `0..face_count`) and scheme
+// (`TESSERA_SCHEME_CATMULL_CLARK` or `TESSERA_SCHEME_LOOP`). Either output may be NULL.
+// Thread-safe.
+//
+// # Safety
+// Each output is NULL or writable.
+enum TesseraStatus tessera_limit_evaluator_info(const struct TesseraLimitEvaluator *ev,
+                                                size_t *face_count,
+                                                TesseraScheme *scheme);
+
+// Evaluates `count` points of the limit surface exactly (see the module documentation in
+// crates/capi/src/limit.rs for the domain): point `i` is face `faces[i]` at
+// `(uvs[2i], uvs[2i+1])`. Writes `3 * count` doubles to each output that is not NULL:
+// `positions`, `du`, `dv` (derivatives along u and v) and `normals` (unit, or zero where the
+// derivatives are parallel). Every point is checked before any output is written: a face out
+// of range is INDEX_OUT_OF_RANGE, a NaN or infinite parameter NON_FINITE, a parameter outside
+// the face's domain INVALID_ARGUMENT, each naming the point. Thread-safe and lock-free per
+// evaluator: call it from as many threads as you like.
+//
+// # Safety
+// `faces` points to `count` readable `uint32_t`, `uvs` to `2 * count` readable doubles, each
+// output is NULL or points to `3 * count` writable doubles.
+enum TesseraStatus tessera_limit_evaluate(const struct TesseraLimitEvaluator *ev,
+                                          const uint32_t *faces,
+                                          const double *uvs,
+                                          size_t count,
+                                          double *positions,
+                                          double *du,
+                                          double *dv,
+                                          double *normals);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -70,10 +70,14 @@ inline TesseraFrameDesc default_frame_desc() {
 
 class Context {
 public:
-    // A context with Tessera's own device (`device`: as the CLI's --device).
+    // A context with Tessera's own device (`device`: as the CLI's --device). The pipeline
+    // cache is kept in `pipeline_cache_dir` (nullptr: the user's cache directory) unless
+    // `pipeline_cache` is TESSERA_PIPELINE_CACHE_OFF.
     static Context standalone(const char *device = nullptr,
-                              TesseraValidation validation = TESSERA_VALIDATION_OFF) {
-        TesseraStandaloneDesc d{device, validation};
+                              TesseraValidation validation = TESSERA_VALIDATION_OFF,
+                              TesseraPipelineCache pipeline_cache = TESSERA_PIPELINE_CACHE_DEFAULT,
+                              const char *pipeline_cache_dir = nullptr) {
+        TesseraStandaloneDesc d{device, validation, pipeline_cache, pipeline_cache_dir};
         TesseraContext *raw = nullptr;
         check(tessera_context_create_standalone(&d, &raw));
         return Context(raw);
@@ -203,10 +207,92 @@ public:
         check(tessera_record_draw(ctx_, raw_, cmd, view, proj), ctx_);
     }
 
+    // Both modes: captures one frame (see tessera_capture for what a host ensures first),
+    // writes the OBJ to `obj_path` unless it is nullptr, and returns the weld and crack
+    // report.
+    TesseraCaptureReport capture(const TesseraFrameDesc &frame, const char *obj_path = nullptr) {
+        TesseraCaptureReport report{};
+        check(tessera_capture(ctx_, raw_, &frame, obj_path, &report), ctx_);
+        return report;
+    }
+
 private:
     Surface(TesseraContext *ctx, TesseraSurface *raw) : ctx_(ctx), raw_(raw) {}
     TesseraContext *ctx_ = nullptr;
     TesseraSurface *raw_ = nullptr;
+};
+
+// Exact limit positions, derivatives and normals on the CPU (see tessera_limit_evaluate for
+// the (face, u, v) domain, the # p lines of a capture). Immutable: one evaluator may be used
+// by any number of threads at once.
+class LimitEvaluator {
+public:
+    // Three doubles per point in each.
+    struct Samples {
+        std::vector<double> positions, du, dv, normals;
+    };
+
+    // The limit surface of `surface` (its scheme, creases and current positions).
+    static LimitEvaluator of_surface(const Context &ctx, const Surface &surface) {
+        TesseraLimitEvaluator *raw = nullptr;
+        check(tessera_limit_evaluator_create(ctx.get(), surface.get(), &raw), ctx.get());
+        return LimitEvaluator(raw);
+    }
+
+    // The limit surface of a mesh under `scheme` (TESSERA_SCHEME_*), with no device.
+    static LimitEvaluator of_mesh(const TesseraMeshDesc &mesh,
+                                  TesseraScheme scheme = TESSERA_SCHEME_AUTO) {
+        TesseraLimitEvaluator *raw = nullptr;
+        check(tessera_limit_evaluator_create_mesh(&mesh, scheme, &raw));
+        return LimitEvaluator(raw);
+    }
+
+    LimitEvaluator(LimitEvaluator &&o) noexcept : raw_(std::exchange(o.raw_, nullptr)) {}
+    LimitEvaluator &operator=(LimitEvaluator &&o) noexcept {
+        if (this != &o) {
+            reset();
+            raw_ = std::exchange(o.raw_, nullptr);
+        }
+        return *this;
+    }
+    LimitEvaluator(const LimitEvaluator &) = delete;
+    LimitEvaluator &operator=(const LimitEvaluator &) = delete;
+    ~LimitEvaluator() { reset(); }
+
+    void reset() noexcept {
+        if (raw_ != nullptr) {
+            tessera_limit_evaluator_destroy(raw_);
+            raw_ = nullptr;
+        }
+    }
+
+    TesseraLimitEvaluator *get() const noexcept { return raw_; }
+
+    size_t face_count() const {
+        size_t n = 0;
+        check(tessera_limit_evaluator_info(raw_, &n, nullptr));
+        return n;
+    }
+
+    // Point i is faces[i] at (uvs[2i], uvs[2i+1]). Throws Error naming the first bad point.
+    Samples evaluate(const std::vector<uint32_t> &faces, const std::vector<double> &uvs) const {
+        if (uvs.size() != 2 * faces.size()) {
+            throw Error(TESSERA_STATUS_WRONG_SIZE, "uvs must hold two values per face index");
+        }
+        Samples s;
+        const size_t n = faces.size();
+        s.positions.resize(3 * n);
+        s.du.resize(3 * n);
+        s.dv.resize(3 * n);
+        s.normals.resize(3 * n);
+        check(tessera_limit_evaluate(raw_, faces.data(), uvs.data(), n, s.positions.data(),
+                                     s.du.data(), s.dv.data(), s.normals.data()));
+        return s;
+    }
+
+private:
+    explicit LimitEvaluator(TesseraLimitEvaluator *raw) : raw_(raw) {}
+    TesseraLimitEvaluator *raw_ = nullptr;
 };
 
 } // namespace tessera

@@ -230,16 +230,17 @@ fn captured_vertices_are_the_exact_limit() {
         let mut failures = Vec::new();
         let other_shapes = common::shapes_dir("ADAPTIVE_SHAPES_DIR").1;
         for (name, mesh) in catmark_shapes() {
-            let surf = surface(&mut ctx, &mesh, &name, 4, EndCap::Gregory);
-            let soup = match capturer.capture(&mut ctx, &surf, &FrameParams::uniform(3.0), EXTENT) {
-                Ok((soup, _)) => soup,
-                // Another folder's shapes may be too large to capture whole.
-                Err(e) if other_shapes => {
-                    println!("{name}: skipped: {e}");
-                    continue;
-                }
-                Err(e) => panic!("{name}: capture: {e}"),
-            };
+            let mut surf = surface(&mut ctx, &mesh, &name, 4, EndCap::Gregory);
+            let soup =
+                match capturer.capture(&mut ctx, &mut surf, &FrameParams::uniform(3.0), EXTENT) {
+                    Ok((soup, _)) => soup,
+                    // Another folder's shapes may be too large to capture whole.
+                    Err(e) if other_shapes => {
+                        println!("{name}: skipped: {e}");
+                        continue;
+                    }
+                    Err(e) => panic!("{name}: capture: {e}"),
+                };
             let (regular, caps, geometric) = deviations(&surf, &soup, &mesh, 3000);
             let [r, g, b, _] = surf.patch_counts();
             println!("{name}: {r} regular, {g} Gregory, {b} bilinear: regular {regular:.2e}, end caps {caps:.2e} (parametric), {geometric:.2e} (to the surface)");
@@ -272,9 +273,9 @@ fn end_cap_deviation_shrinks_with_isolation() {
             for end_cap in [EndCap::Gregory, EndCap::Bilinear] {
                 let mut devs = Vec::new();
                 for isolation in 1..=6 {
-                    let surf = surface(&mut ctx, &mesh, &name, isolation, end_cap);
+                    let mut surf = surface(&mut ctx, &mesh, &name, isolation, end_cap);
                     let (soup, _) = capturer
-                        .capture(&mut ctx, &surf, &FrameParams::uniform(2.0), EXTENT)
+                        .capture(&mut ctx, &mut surf, &FrameParams::uniform(2.0), EXTENT)
                         .expect("capture");
                     let (regular, caps) = deviation(&surf, &soup, &mesh, 4000);
                     assert!(
@@ -331,7 +332,7 @@ fn watertight_under_every_factor_policy() {
                 &[EndCap::Gregory]
             };
             for &end_cap in caps {
-                let surf = surface(&mut ctx, &mesh, name, 3, end_cap);
+                let mut surf = surface(&mut ctx, &mesh, name, 3, end_cap);
                 let policies = [
                     ("uniform 3", FactorPolicy::Uniform { segments: 3.0 }, false),
                     ("screen 6px", FactorPolicy::Screen { pixels: 6.0 }, false),
@@ -367,7 +368,7 @@ fn watertight_under_every_factor_policy() {
                         ..FrameParams::default()
                     };
                     let (soup, _) = capturer
-                        .capture(&mut ctx, &surf, &params, EXTENT)
+                        .capture(&mut ctx, &mut surf, &params, EXTENT)
                         .expect("capture");
                     let (cracks, boundary, nonmanifold) = cracks(&surf, &soup, &mesh);
                     println!(
@@ -402,7 +403,7 @@ fn animated_base_mesh_gives_the_deformed_limit() {
         let mut deformed = mesh.clone();
         deformed.positions = posed.iter().map(|p| p.map(f64::from)).collect();
         let (soup, _) = capturer
-            .capture(&mut ctx, &surf, &FrameParams::uniform(4.0), EXTENT)
+            .capture(&mut ctx, &mut surf, &FrameParams::uniform(4.0), EXTENT)
             .expect("capture");
         let (regular, caps, geometric) = deviations(&surf, &soup, &deformed, 3000);
         let (rest_regular, _) = deviation(&surf, &soup, &mesh, 3000);
@@ -425,9 +426,9 @@ fn isolation_level_shows_in_the_captured_levels() {
         let capturer = Capturer::new(&ctx).expect("capturer");
         let mesh = spot();
         for isolation in [1, 2, 5] {
-            let surf = surface(&mut ctx, &mesh, "spot", isolation, EndCap::Gregory);
+            let mut surf = surface(&mut ctx, &mesh, "spot", isolation, EndCap::Gregory);
             let (soup, _) = capturer
-                .capture(&mut ctx, &surf, &FrameParams::uniform(1.0), EXTENT)
+                .capture(&mut ctx, &mut surf, &FrameParams::uniform(1.0), EXTENT)
                 .expect("capture");
             let deepest = soup
                 .records
@@ -530,9 +531,9 @@ fn gpu_matches_the_cpu_plan() {
             ("catmark_pyramid", EndCap::Bilinear),
         ] {
             let mesh = shape(name);
-            let surf = surface(&mut ctx, &mesh, name, 3, end_cap);
+            let mut surf = surface(&mut ctx, &mesh, name, 3, end_cap);
             let (soup, _) = capturer
-                .capture(&mut ctx, &surf, &FrameParams::uniform(3.0), EXTENT)
+                .capture(&mut ctx, &mut surf, &FrameParams::uniform(3.0), EXTENT)
                 .expect("capture");
             let welded = soup.weld().unwrap();
             let verts = surf.plan.apply(&mesh.positions);
@@ -561,7 +562,7 @@ fn uniform_triangle_count_matches_the_capture() {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let capturer = Capturer::new(&ctx).expect("capturer");
         let mesh = spot();
-        let surf = surface(&mut ctx, &mesh, "spot", 3, EndCap::Gregory);
+        let mut surf = surface(&mut ctx, &mesh, "spot", 3, EndCap::Gregory);
         for (s, spacing) in [
             (1.0, Spacing::Equal),
             (3.0, Spacing::Equal),
@@ -575,7 +576,7 @@ fn uniform_triangle_count_matches_the_capture() {
                 .map(|a| surf.triangles(&params, a).expect("uniform count"))
                 .sum();
             let (soup, _) = capturer
-                .capture(&mut ctx, &surf, &params, EXTENT)
+                .capture(&mut ctx, &mut surf, &params, EXTENT)
                 .expect("capture");
             assert_eq!(
                 soup.triangle_count() as u64,
@@ -600,7 +601,7 @@ fn sharpness_scale_reshapes_the_surface() {
         smooth.corners.clear();
         let mut results = Vec::new();
         for scale in [0.0f32, 1.0] {
-            let surf = Adaptive::new(
+            let mut surf = Adaptive::new(
                 &mut ctx,
                 &mesh,
                 &AdaptiveBuild {
@@ -612,7 +613,7 @@ fn sharpness_scale_reshapes_the_surface() {
             )
             .expect("surface");
             let (soup, _) = capturer
-                .capture(&mut ctx, &surf, &FrameParams::uniform(2.0), EXTENT)
+                .capture(&mut ctx, &mut surf, &FrameParams::uniform(2.0), EXTENT)
                 .expect("capture");
             let (vs_smooth, _) = deviation(&surf, &soup, &smooth, 2000);
             let (vs_creased, _) = deviation(&surf, &soup, &mesh, 2000);

@@ -37,7 +37,7 @@ fn bench_rows_counts_and_csv_round_trip() {
     assert_eq!(seen, report.rows.len());
 
     let tess_methods = ["flat", "phong", "pn"];
-    let cpu_methods = ["cpu-static", "cpu-animated"];
+    let cpu_methods = ["cpu", "cpu-animated"];
     let mut expected_rows = Vec::new();
     for s in [1u32, 3, 4] {
         for m in tess_methods {
@@ -64,9 +64,9 @@ fn bench_rows_counts_and_csv_round_trip() {
     assert_eq!(
         skipped,
         vec![
-            (3, "cpu-static"),
+            (3, "cpu"),
             (3, "cpu-animated"),
-            (4, "cpu-static"),
+            (4, "cpu"),
             (4, "cpu-animated")
         ]
     );
@@ -257,41 +257,41 @@ fn bench_equal_triangles_and_memory_per_face() {
     // The techniques again, captured at each row's level: the GPU's own triangle count.
     let mut cap_ctx = tessera::tess::Context::offscreen(gpu.device()).unwrap();
     let capturer = tessera::tess::Capturer::new(&cap_ctx).unwrap();
-    let surfaces: Vec<(&str, Box<dyn tessera::tess::Technique>)> = ["adaptive", "gregory", "acc"]
-        .into_iter()
-        .map(|name| {
-            let built = tessera::tess::build(
-                &mut cap_ctx,
-                name.parse().unwrap(),
-                &pyramid,
-                &tessera::tess::BuildOptions {
-                    isolation: config.isolation,
-                    ..Default::default()
-                },
-            )
-            .unwrap();
-            (name, built.technique)
-        })
-        .collect();
+    let mut surfaces: Vec<(&str, Box<dyn tessera::tess::Technique>)> =
+        ["adaptive", "gregory", "acc"]
+            .into_iter()
+            .map(|name| {
+                let built = tessera::tess::build(
+                    &mut cap_ctx,
+                    name.parse().unwrap(),
+                    &pyramid,
+                    &tessera::tess::BuildOptions {
+                        isolation: config.isolation,
+                        ..Default::default()
+                    },
+                )
+                .unwrap();
+                (name, built.technique)
+            })
+            .collect();
     let mut gpu_count = |name: &str, level: u32| {
-        let surf = &surfaces.iter().find(|(n, _)| *n == name).unwrap().1;
+        let surf = &mut surfaces.iter_mut().find(|(n, _)| *n == name).unwrap().1;
         let params = tessera::tess::FrameParams::uniform(level as f32);
         let (_, stats) = capturer
-            .capture(&mut cap_ctx, surf.as_ref(), &params, config.extent)
+            .capture(&mut cap_ctx, surf.as_mut(), &params, config.extent)
             .unwrap();
         stats.primitives_needed
     };
 
     // The same methods again, to count neighbouring levels independently of the run.
-    let ctx = bench::MethodContext {
+    let ctx = bench::RowContext {
         device: gpu.device(),
-        technique: None,
         mesh: &mesh,
         config: &config,
         color_format: tessera::vk_core::target::COLOR_FORMAT,
         depth_format: tessera::vk_core::target::DEPTH_FORMAT,
     };
-    let methods = bench::build_methods(&config.methods, &ctx).unwrap();
+    let methods = bench::build_rows(&config.methods, &ctx).unwrap();
     let count = |label: &str, level: u32| {
         methods
             .iter()

@@ -137,10 +137,10 @@ fn captured_bft_vertices_are_the_exact_limit() {
             .flat_map(|c| PATCH_BLOCK_BUILDS.map(|b| (c, b)))
         {
             let name = &format!("{name} (patch block {block})");
-            let surf = surface_built(&mut ctx, mesh, name, 5, false, Some(block));
+            let mut surf = surface_built(&mut ctx, mesh, name, 5, false, Some(block));
             for &s in segments.iter() {
                 let (soup, _) = capturer
-                    .capture(&mut ctx, &surf, &uniform(s), EXTENT)
+                    .capture(&mut ctx, &mut surf, &uniform(s), EXTENT)
                     .expect("capture");
                 assert!(!soup.records.is_empty());
                 let inexact = soup.records.iter().filter(|r| r.flags & 1 == 0).count();
@@ -184,7 +184,7 @@ fn every_loop_shape_is_exact_and_watertight() {
                     continue;
                 }
             };
-            let surf = match Bft::new(
+            let mut surf = match Bft::new(
                 &mut ctx,
                 &mesh,
                 &BftOptions {
@@ -202,7 +202,7 @@ fn every_loop_shape_is_exact_and_watertight() {
             };
             for s in [8, 32] {
                 let (soup, _) = capturer
-                    .capture(&mut ctx, &surf, &uniform(s), EXTENT)
+                    .capture(&mut ctx, &mut surf, &uniform(s), EXTENT)
                     .expect("capture");
                 let worst = exactness(&surf, &soup, &mesh, 3000);
                 let (open, boundary, nonmanifold) = cracks(&surf, &soup, &mesh);
@@ -242,9 +242,10 @@ fn hole_faces_are_not_drawn() {
         mesh.holes = vec![0, 7];
         let s = 8;
         for block in PATCH_BLOCK_BUILDS {
-            let surf = surface_built(&mut ctx, &mesh, "holed icosahedron", 5, false, Some(block));
+            let mut surf =
+                surface_built(&mut ctx, &mesh, "holed icosahedron", 5, false, Some(block));
             let (soup, _) = capturer
-                .capture(&mut ctx, &surf, &uniform(s), EXTENT)
+                .capture(&mut ctx, &mut surf, &uniform(s), EXTENT)
                 .expect("capture");
             // 18 of the 20 faces: 4 level-1 patches each at level s / 2 = 4, which the triangle
             // tessellator splits into 3 · 4² / 2 = 24 triangles.
@@ -289,7 +290,7 @@ fn bft_is_watertight_under_every_factor_policy() {
             .flat_map(|m| PATCH_BLOCK_BUILDS.map(|b| (m, b)))
         {
             let name = &format!("{name} (patch block {block})");
-            let surf = surface_built(&mut ctx, mesh, name, 5, false, Some(block));
+            let mut surf = surface_built(&mut ctx, mesh, name, 5, false, Some(block));
             let policies = [
                 (
                     "uniform 16",
@@ -329,7 +330,7 @@ fn bft_is_watertight_under_every_factor_policy() {
                     ..FrameParams::default()
                 };
                 let (soup, _) = capturer
-                    .capture(&mut ctx, &surf, &params, EXTENT)
+                    .capture(&mut ctx, &mut surf, &params, EXTENT)
                     .expect("capture");
                 let (cracks, boundary, nonmanifold) = cracks(&surf, &soup, mesh);
                 let interpolated = soup.records.iter().filter(|r| r.flags & 1 == 0).count();
@@ -372,10 +373,11 @@ fn animated_base_mesh_gives_the_deformed_limit() {
         for frame in 0..5 {
             deformed = wave(&base, &normals, lo, hi, frame as f32 * 0.1);
             surf.update_base(0, &deformed).expect("upload");
-            ctx.render_offscreen(&surf, &params, EXTENT).expect("frame");
+            ctx.render_offscreen(&mut surf, &params, EXTENT)
+                .expect("frame");
         }
         let (soup, _) = capturer
-            .capture(&mut ctx, &surf, &params, EXTENT)
+            .capture(&mut ctx, &mut surf, &params, EXTENT)
             .expect("capture");
         let mut moved = mesh.clone();
         moved.positions = deformed
@@ -401,14 +403,14 @@ fn bft_renders_spot_with_patch_colours_and_wireframe() {
     {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let mesh = spot();
-        let surf = surface(&mut ctx, &mesh, "spot", 5, false);
+        let mut surf = surface(&mut ctx, &mesh, "spot", 5, false);
         let params = FrameParams {
             wireframe: true,
             patch_colours: true,
             ..uniform(4)
         };
         let frame = ctx
-            .render_offscreen_stats(&surf, &params, EXTENT, false)
+            .render_offscreen_stats(&mut surf, &params, EXTENT, false)
             .expect("render");
         let (img, counts) = (frame.image, frame.counts);
         assert_eq!(
@@ -436,10 +438,10 @@ fn bad_segments_are_rejected_with_a_clear_error() {
     {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let mesh = shape("loop_cube");
-        let surf = surface(&mut ctx, &mesh, "cube", 3, false);
+        let mut surf = surface(&mut ctx, &mesh, "cube", 3, false);
         for s in [3, 0, 32] {
             let e = ctx
-                .render_offscreen(&surf, &uniform(s), EXTENT)
+                .render_offscreen(&mut surf, &uniform(s), EXTENT)
                 .map(|_| ())
                 .expect_err("rejected");
             assert!(e.to_string().contains("--segments"), "{e}");
@@ -454,9 +456,9 @@ fn statistics_request_is_safe_on_every_driver() {
     {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let mesh = shape("loop_cube");
-        let surf = surface(&mut ctx, &mesh, "cube", 3, false);
+        let mut surf = surface(&mut ctx, &mesh, "cube", 3, false);
         let frame = ctx
-            .render_offscreen_stats(&surf, &uniform(16), EXTENT, true)
+            .render_offscreen_stats(&mut surf, &uniform(16), EXTENT, true)
             .expect("render");
         let (stats, counts) = (frame.statistics, frame.counts);
         assert_eq!(counts.patches, surf.patch_count());
@@ -520,7 +522,7 @@ fn geometric_normals_are_the_exact_limit_normals() {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let capturer = Capturer::new(&ctx).expect("capturer");
         let mesh = spot();
-        let surf = surface(&mut ctx, &mesh, "spot", 5, true);
+        let mut surf = surface(&mut ctx, &mesh, "spot", 5, true);
         let mut angles = Vec::new();
         for geometric_normals in [true, false] {
             let params = FrameParams {
@@ -528,7 +530,7 @@ fn geometric_normals_are_the_exact_limit_normals() {
                 ..uniform(8)
             };
             let (soup, _) = capturer
-                .capture(&mut ctx, &surf, &params, EXTENT)
+                .capture(&mut ctx, &mut surf, &params, EXTENT)
                 .expect("capture");
             angles.push(normal_angles(&surf, &soup, &mesh, 3000));
         }
@@ -547,7 +549,7 @@ fn geometric_normals_are_the_exact_limit_normals() {
             "subdivision shading: mean {sub_mean:.3}°"
         );
         let (soup, _) = capturer
-            .capture(&mut ctx, &surf, &uniform(8), EXTENT)
+            .capture(&mut ctx, &mut surf, &uniform(8), EXTENT)
             .expect("capture");
         let base = tessera::tess::techniques::bft::base_positions(&mesh);
         // The CPU mirror, packed from its own preparation (the surface keeps its arrays only on
@@ -580,13 +582,13 @@ fn geometric_normals_are_the_exact_limit_normals() {
             "subdivision shading vs mirror: {mirror_worst:.4}°"
         );
 
-        let plain = surface(&mut ctx, &mesh, "spot", 5, false);
+        let mut plain = surface(&mut ctx, &mesh, "spot", 5, false);
         let params = FrameParams {
             geometric_normals: true,
             ..uniform(16)
         };
         let e = ctx
-            .render_offscreen(&plain, &params, EXTENT)
+            .render_offscreen(&mut plain, &params, EXTENT)
             .map(|_| ())
             .expect_err("geometric normals without tangent tables");
         assert!(e.to_string().contains("tangent tables"), "{e}");

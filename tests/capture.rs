@@ -60,10 +60,10 @@ const EXTENT: vk::Extent2D = vk::Extent2D {
 
 /// Builds technique `id` for `base` and captures one frame of `p`.
 fn capture(h: &mut Harness, base: &ControlMesh, id: TechniqueId, p: &FrameParams) -> Captured {
-    let technique = common::build(&mut h.ctx, id, base);
+    let mut technique = common::build(&mut h.ctx, id, base);
     let (soup, stats) = h
         .capturer
-        .capture(&mut h.ctx, technique.as_ref(), p, EXTENT)
+        .capture(&mut h.ctx, technique.as_mut(), p, EXTENT)
         .unwrap();
     Captured {
         soup,
@@ -116,8 +116,8 @@ fn corner_count_is_three_per_tessellated_triangle() {
                 let Captured {
                     soup,
                     stats,
-                    technique,
-                } = capture(&mut h, &base, TechniqueId::Flat, &p);
+                    mut technique,
+                } = capture(&mut h, &base, TechniqueId::FLAT, &p);
                 let per_patch = uniform_triangle_count(domain, spacing, level);
                 let cpu = patches as u64 * per_patch;
                 let what = format!("{domain:?} {spacing:?} level {level}");
@@ -137,7 +137,7 @@ fn corner_count_is_three_per_tessellated_triangle() {
                 let s = h
                     .ctx
                     .render_offscreen_stats(
-                        technique.as_ref(),
+                        technique.as_mut(),
                         &p,
                         vk::Extent2D {
                             width: 32,
@@ -170,7 +170,7 @@ fn flat_positions_equal_cpu_interpolation() {
             .fold(0.0f64, |m, c| m.max((c as f64).abs()));
         for spacing in SPACINGS {
             for level in [1.0f32, 3.0, 5.5, 16.0] {
-                let c = capture(&mut h, &base, TechniqueId::Flat, &flat(level, spacing));
+                let c = capture(&mut h, &base, TechniqueId::FLAT, &flat(level, spacing));
                 assert!(!c.soup.records.is_empty());
                 let mut worst = 0.0f64;
                 for r in &c.soup.records {
@@ -209,7 +209,7 @@ fn cpu_interpolation_check_detects_a_swapped_domain() {
     let mut h = Harness::new(&gpu);
     let base = strip(2, true);
     let rm = RenderMesh::from_control_mesh(&base).unwrap();
-    let c = capture(&mut h, &base, TechniqueId::Flat, &FrameParams::uniform(4.0));
+    let c = capture(&mut h, &base, TechniqueId::FLAT, &FrameParams::uniform(4.0));
     let off = c
         .soup
         .records
@@ -244,7 +244,7 @@ fn open_strip_edges_are_base_boundary() {
             let c = capture(
                 &mut h,
                 &base,
-                TechniqueId::Flat,
+                TechniqueId::FLAT,
                 &FrameParams::uniform(level),
             );
             let (classes, ..) = watertightness(&c, &base);
@@ -267,7 +267,7 @@ fn capture_across_draw_split_numbers_patches_frame_wide() {
     // 24 quads at level 64: 101,400 TES vertices, more than one lavapipe chunk may hold.
     let base = strip(24, false);
     let base_params = FrameParams::uniform(64.0);
-    let split = capture(&mut h, &base, TechniqueId::Flat, &base_params);
+    let split = capture(&mut h, &base, TechniqueId::FLAT, &base_params);
     let per_patch = uniform_triangle_count(Domain::Quad, Spacing::Equal, 64.0);
     assert_eq!(split.stats.patches, 24);
     if gpu.device().info.is_lavapipe() {
@@ -282,7 +282,7 @@ fn capture_across_draw_split_numbers_patches_frame_wide() {
     let reference = capture(
         &mut h,
         &base,
-        TechniqueId::Flat,
+        TechniqueId::FLAT,
         &FrameParams {
             split: DrawSplit::PerPatch,
             ..base_params
@@ -299,7 +299,7 @@ fn capture_across_draw_split_numbers_patches_frame_wide() {
         let unsplit = capture(
             &mut h,
             &base,
-            TechniqueId::Flat,
+            TechniqueId::FLAT,
             &FrameParams {
                 split: DrawSplit::Off,
                 ..base_params
@@ -343,9 +343,9 @@ fn capture_without_transform_feedback_is_a_typed_error() {
         "{e}"
     );
     assert!(e.to_string().contains("VK_EXT_transform_feedback"), "{e}");
-    let t = common::build(&mut ctx, TechniqueId::Flat, &strip(2, true));
+    let mut t = common::build(&mut ctx, TechniqueId::FLAT, &strip(2, true));
     ctx.render_offscreen(
-        t.as_ref(),
+        t.as_mut(),
         &FrameParams::default(),
         vk::Extent2D {
             width: 16,
@@ -363,7 +363,7 @@ fn measured_sizing_reruns_and_agrees_with_cpu_bound() {
     let gpu = Gpu::new();
     let mut h = Harness::new(&gpu);
     let base = load("assets/spot_control_mesh.obj");
-    for method in [TechniqueId::Flat, TechniqueId::Pn] {
+    for method in [TechniqueId::FLAT, TechniqueId::PN] {
         let p = flat(5.5, Spacing::FractionalOdd);
         h.capturer.sizing = CaptureSizing::CpuBound;
         let cpu = capture(&mut h, &base, method, &p);
@@ -384,10 +384,10 @@ fn oversized_capture_is_a_typed_error() {
     let gpu = Gpu::new();
     let mut h = Harness::new(&gpu);
     h.capturer.max_bytes = 1000;
-    let t = common::build(&mut h.ctx, TechniqueId::Flat, &strip(2, true));
+    let mut t = common::build(&mut h.ctx, TechniqueId::FLAT, &strip(2, true));
     let e = h
         .capturer
-        .capture(&mut h.ctx, t.as_ref(), &FrameParams::uniform(8.0), EXTENT)
+        .capture(&mut h.ctx, t.as_mut(), &FrameParams::uniform(8.0), EXTENT)
         .unwrap_err();
     assert!(
         matches!(

@@ -17,7 +17,7 @@ const MESHES: [&str; 3] = [
     "tests/data/meshes/cube.obj",
     "tests/data/opensubdiv/shapes/loop_icosahedron.obj",
 ];
-const METHODS: [TechniqueId; 3] = [TechniqueId::Flat, TechniqueId::Phong, TechniqueId::Pn];
+const METHODS: [TechniqueId; 3] = [TechniqueId::FLAT, TechniqueId::PHONG, TechniqueId::PN];
 
 /// A pixel differs when any channel moves by more than 24/255; an image matches when at most
 /// 0.5% of its pixels differ. Rasterisation noise (an edge pixel flipping) stays far below; a
@@ -60,7 +60,7 @@ fn render_all(level: f32) -> Vec<(String, Rgba8)> {
     for path in MESHES {
         let mesh = tessera::topology::load_obj(common::data(path)).unwrap();
         for m in METHODS {
-            let t = common::build(&mut ctx, m, &mesh);
+            let mut t = common::build(&mut ctx, m, &mesh);
             let p = FrameParams {
                 wireframe: true,
                 ..FrameParams::uniform(level)
@@ -71,8 +71,8 @@ fn render_all(level: f32) -> Vec<(String, Rgba8)> {
                 .to_string_lossy()
                 .into_owned();
             out.push((
-                format!("{stem}_{m:?}").to_lowercase(),
-                ctx.render_offscreen(t.as_ref(), &p, EXTENT).unwrap(),
+                format!("{stem}_{m}"),
+                ctx.render_offscreen(t.as_mut(), &p, EXTENT).unwrap(),
             ));
         }
     }
@@ -141,7 +141,7 @@ fn render_bft(segments: u32, time: f32) -> Vec<(String, Rgba8)> {
             .unwrap()
             .to_string_lossy()
             .into_owned();
-        let mut surf = common::build_with(&mut ctx, TechniqueId::Bft, &mesh, 5, false);
+        let mut surf = common::build_with(&mut ctx, TechniqueId::BFT, &mesh, 5, false);
         let rest = base_positions(&mesh);
         let (lo, hi) = surf.bbox();
         surf.update_base(0, &wave(&rest, &base_normals(&mesh), lo, hi, time))
@@ -158,7 +158,7 @@ fn render_bft(segments: u32, time: f32) -> Vec<(String, Rgba8)> {
                 ..FrameParams::uniform(segments as f32)
             };
             let img = ctx
-                .render_offscreen(surf.as_ref(), &params, BFT_EXTENT)
+                .render_offscreen(surf.as_mut(), &params, BFT_EXTENT)
                 .unwrap();
             out.push((format!("{stem}_bft_{kind}"), img));
         }
@@ -229,9 +229,9 @@ fn render_adaptive(isolation: u32) -> Vec<(String, Rgba8)> {
             .unwrap()
             .to_string_lossy()
             .into_owned();
-        let surf = tessera::tess::build(
+        let mut surf = tessera::tess::build(
             &mut ctx,
-            TechniqueId::Adaptive,
+            TechniqueId::ADAPTIVE,
             &mesh,
             &tessera::tess::BuildOptions {
                 isolation,
@@ -252,7 +252,7 @@ fn render_adaptive(isolation: u32) -> Vec<(String, Rgba8)> {
             ..FrameParams::uniform(1.0)
         };
         let img = ctx
-            .render_offscreen(surf.as_ref(), &params, ADAPTIVE_EXTENT)
+            .render_offscreen(surf.as_mut(), &params, ADAPTIVE_EXTENT)
             .unwrap();
         out.push((format!("{stem}_adaptive"), img));
     }
@@ -350,7 +350,7 @@ fn render_surface() -> Vec<(String, Rgba8)> {
             maps,
             ..Default::default()
         };
-        tessera::tess::build(&mut ctx, TechniqueId::Gregory, &mesh, &options)
+        tessera::tess::build(&mut ctx, TechniqueId::GREGORY, &mesh, &options)
             .unwrap()
             .technique
     };
@@ -367,17 +367,13 @@ fn render_surface() -> Vec<(String, Rgba8)> {
     let (lo, hi) = textured.bbox();
     let diag = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f32>().sqrt();
     let mut out = Vec::new();
+    let mut surfaces = [textured, checkered];
     for (name, surf, reparam, displace) in [
-        ("spot_gregory_textured", &textured, true, 0.0),
-        ("spot_gregory_textured_no_reparam", &textured, false, 0.0),
-        (
-            "spot_gregory_displaced",
-            &textured,
-            true,
-            SURFACE_DISPLACE * diag,
-        ),
-        ("spot_gregory_checker", &checkered, true, 0.0),
-        ("spot_gregory_checker_no_reparam", &checkered, false, 0.0),
+        ("spot_gregory_textured", 0, true, 0.0),
+        ("spot_gregory_textured_no_reparam", 0, false, 0.0),
+        ("spot_gregory_displaced", 0, true, SURFACE_DISPLACE * diag),
+        ("spot_gregory_checker", 1, true, 0.0),
+        ("spot_gregory_checker_no_reparam", 1, false, 0.0),
     ] {
         let params = FrameParams {
             reparam,
@@ -386,7 +382,7 @@ fn render_surface() -> Vec<(String, Rgba8)> {
             ..FrameParams::uniform(SURFACE_SEGMENTS)
         };
         let img = ctx
-            .render_offscreen(surf.as_ref(), &params, SURFACE_EXTENT)
+            .render_offscreen(surfaces[surf].as_mut(), &params, SURFACE_EXTENT)
             .unwrap();
         out.push((name.to_owned(), img));
     }

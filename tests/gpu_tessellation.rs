@@ -28,7 +28,7 @@ fn tes_invocations_equal_cpu_tessellator_counts() {
     let mut r = Context::offscreen(gpu.device()).unwrap();
     for (triangles, domain) in [(true, Domain::Triangle), (false, Domain::Quad)] {
         let k = if triangles { 10 } else { 5 };
-        let mesh = common::build(&mut r, TechniqueId::Flat, &strip(5, triangles));
+        let mut mesh = common::build(&mut r, TechniqueId::FLAT, &strip(5, triangles));
         for spacing in [
             Spacing::Equal,
             Spacing::FractionalEven,
@@ -40,7 +40,7 @@ fn tes_invocations_equal_cpu_tessellator_counts() {
                     ..FrameParams::uniform(level)
                 };
                 let frame = r
-                    .render_offscreen_stats(mesh.as_ref(), &p, SMALL, true)
+                    .render_offscreen_stats(mesh.as_mut(), &p, SMALL, true)
                     .unwrap();
                 let (stats, counts) = (frame.statistics.unwrap(), frame.counts);
                 let expected = k as u64 * uniform_vertex_count(domain, spacing, level);
@@ -90,8 +90,7 @@ fn grid(w: u32, h: u32) -> ControlMesh {
 fn draw_split_matches_per_patch_reference() {
     let gpu = Gpu::new();
     let mut r = Context::offscreen(gpu.device()).unwrap();
-    let mesh = common::build(&mut r, TechniqueId::Flat, &grid(6, 4));
-    let mesh = mesh.as_ref();
+    let mut mesh = common::build(&mut r, TechniqueId::FLAT, &grid(6, 4));
     let extent = vk::Extent2D {
         width: 192,
         height: 192,
@@ -100,9 +99,9 @@ fn draw_split_matches_per_patch_reference() {
         wireframe: true,
         ..FrameParams::uniform(64.0)
     };
-    let render = |r: &mut Context, split: DrawSplit| {
+    let mut render = |r: &mut Context, split: DrawSplit| {
         let f = r
-            .render_offscreen_stats(mesh, &FrameParams { split, ..base }, extent, false)
+            .render_offscreen_stats(mesh.as_mut(), &FrameParams { split, ..base }, extent, false)
             .unwrap();
         (f.image, f.counts)
     };
@@ -140,13 +139,13 @@ fn timestamp_queries_measure_a_draw() {
     let gpu = Gpu::new();
     let device = gpu.device();
     let mut r = Context::offscreen(device).unwrap();
-    let mesh = common::build(&mut r, TechniqueId::Flat, &grid(6, 4));
-    let mesh = mesh.as_ref();
+    let mut mesh = common::build(&mut r, TechniqueId::FLAT, &grid(6, 4));
     let target = OffscreenTarget::new(device, SMALL).unwrap();
     let readback = target.readback_buffer(device).unwrap();
     let pool = QueryPool::timestamps(device, "test timestamps", 2).unwrap();
     let params = FrameParams::uniform(32.0);
-    r.prepare(mesh, &params, &[Pass::Shaded]).unwrap();
+    r.prepare(mesh.as_mut(), &params, &[Pass::Shaded]).unwrap();
+    let mesh = mesh.as_ref();
     r.write_frame(0, mesh.bbox(), &params, SMALL).unwrap();
     let r = &r;
     device

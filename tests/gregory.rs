@@ -149,11 +149,11 @@ fn captured_vertices_against_the_exact_limit() {
         ] {
             let mesh = shape(name);
             for patch in PATCHES {
-                let surf =
+                let mut surf =
                     gregory::build(&mut ctx, &mesh, patch, 1.0, true, name, &Default::default())
                         .expect("build");
                 let (soup, _) = capturer
-                    .capture(&mut ctx, &surf, &FrameParams::uniform(4.0), EXTENT)
+                    .capture(&mut ctx, &mut surf, &FrameParams::uniform(4.0), EXTENT)
                     .expect("capture");
                 let (regular, max, rms) = deviation(&surf, &soup, &mesh);
                 println!(
@@ -208,7 +208,7 @@ fn every_catmark_shape_welds_and_stays_near_the_limit() {
                 }
             };
             for patch in PATCHES {
-                let surf = match gregory::build(
+                let mut surf = match gregory::build(
                     &mut ctx,
                     &mesh,
                     patch,
@@ -224,7 +224,8 @@ fn every_catmark_shape_welds_and_stays_near_the_limit() {
                     }
                 };
                 let soup =
-                    match capturer.capture(&mut ctx, &surf, &FrameParams::uniform(4.0), EXTENT) {
+                    match capturer.capture(&mut ctx, &mut surf, &FrameParams::uniform(4.0), EXTENT)
+                    {
                         Ok((soup, _)) => soup,
                         Err(e) => {
                             refused.push(format!("{name} {patch:?}: capture: {e}"));
@@ -285,7 +286,7 @@ fn watertight_under_every_factor_policy() {
         ] {
             let mesh = shape(name);
             for patch in PATCHES {
-                let surf =
+                let mut surf =
                     gregory::build(&mut ctx, &mesh, patch, 1.0, true, name, &Default::default())
                         .expect("build");
                 let mut maps_surface = None;
@@ -337,7 +338,7 @@ fn watertight_under_every_factor_policy() {
                                 .expect("build")
                         })
                     } else {
-                        &surf
+                        &mut surf
                     };
                     let params = FrameParams {
                         displace,
@@ -351,7 +352,7 @@ fn watertight_under_every_factor_policy() {
                         ..FrameParams::default()
                     };
                     let (soup, _) = capturer
-                        .capture(&mut ctx, surf, &params, EXTENT)
+                        .capture(&mut ctx, &mut *surf, &params, EXTENT)
                         .expect("capture");
                     let (cracks, nonmanifold) = cracks(surf, &soup, &mesh);
                     let (shared, differing) = normal_seams(&soup);
@@ -543,7 +544,7 @@ fn param_error_view_follows_the_cpu_lattice() {
         width: 320,
         height: 240,
     };
-    let render = |ctx: &mut Context, surf: &Adaptive, reparam: bool| {
+    let render = |ctx: &mut Context, surf: &mut Adaptive, reparam: bool| {
         let params = FrameParams {
             show: SurfaceShow::ParamError,
             reparam,
@@ -556,7 +557,7 @@ fn param_error_view_follows_the_cpu_lattice() {
     let mean = |h: &[f64]| h.iter().sum::<f64>() / h.len().max(1) as f64;
     // Exact everywhere: every patch is a B-spline patch of a mesh without semi-sharp tags.
     let edgecorner = shape("catmark_edgecorner");
-    let surf = gregory::build(
+    let mut surf = gregory::build(
         &mut ctx,
         &edgecorner,
         SinglePassPatch::Gregory,
@@ -566,7 +567,7 @@ fn param_error_view_follows_the_cpu_lattice() {
         &maps,
     )
     .expect("build");
-    let hues = surface_hues(&render(&mut ctx, &surf, true));
+    let hues = surface_hues(&render(&mut ctx, &mut surf, true));
     let blue = hues.iter().filter(|&&h| h > 200.0).count();
     println!(
         "catmark_edgecorner: {} surface pixels, {blue} blue",
@@ -580,7 +581,8 @@ fn param_error_view_follows_the_cpu_lattice() {
 
     let spot = shape("spot");
     for patch in [SinglePassPatch::Gregory, SinglePassPatch::Acc1] {
-        let surf = gregory::build(&mut ctx, &spot, patch, 1.0, true, "spot", &maps).expect("build");
+        let mut surf =
+            gregory::build(&mut ctx, &spot, patch, 1.0, true, "spot", &maps).expect("build");
         let note = surf.param_error_note().expect("a lattice summary");
         println!("{note}");
         let patches: u32 = surf.patch_counts().iter().sum();
@@ -588,8 +590,8 @@ fn param_error_view_follows_the_cpu_lattice() {
             note.starts_with("spot: Eq. 1") && note.contains(&format!("of {patches} patches")),
             "{note}"
         );
-        let on = surface_hues(&render(&mut ctx, &surf, true));
-        let off = surface_hues(&render(&mut ctx, &surf, false));
+        let on = surface_hues(&render(&mut ctx, &mut surf, true));
+        let off = surface_hues(&render(&mut ctx, &mut surf, false));
         let warm = |h: &[f64]| h.iter().filter(|&&x| x < 100.0).count();
         println!(
             "spot {patch:?}: mean hue reparameterized {:.1} (warm {}), identity {:.1} (warm {}), {} pixels",
@@ -629,7 +631,7 @@ fn acc_tangent_patch_normals_on_the_gpu() {
     let capturer = Capturer::new(&ctx).expect("capturer");
     for name in ["spot", "catmark_pawn", "catmark_cube"] {
         let mesh = shape(name);
-        let surf = gregory::build(
+        let mut surf = gregory::build(
             &mut ctx,
             &mesh,
             SinglePassPatch::Acc1,
@@ -640,7 +642,7 @@ fn acc_tangent_patch_normals_on_the_gpu() {
         )
         .expect("build");
         let (soup, _) = capturer
-            .capture(&mut ctx, &surf, &FrameParams::uniform(6.0), EXTENT)
+            .capture(&mut ctx, &mut surf, &FrameParams::uniform(6.0), EXTENT)
             .expect("capture");
         let verts = surf.plan.apply(&mesh.positions);
         let plan_patch = |id: u32| surf.gpu.order[id as usize] as usize;
@@ -733,13 +735,13 @@ fn displaced_surfaces_shade_with_displaced_normals() {
         ("height map", height, 32.0, 0.5),
     ] {
         for patch in PATCHES {
-            let surf =
+            let mut surf =
                 gregory::build(&mut ctx, &mesh, patch, 1.0, true, "spot", &maps).expect("build");
-            let capture = |ctx: &mut Context, displace: f32| {
+            let mut capture = |ctx: &mut Context, displace: f32| {
                 capturer
                     .capture(
                         ctx,
-                        &surf,
+                        &mut surf,
                         &FrameParams {
                             displace,
                             ..FrameParams::uniform(segments)
@@ -851,8 +853,9 @@ fn gregory_triangle_patches_on_the_gpu() {
             .count() as u32;
         let d = diag(&mesh) as f32;
         for patch in PATCHES {
-            let surf = gregory::build(&mut ctx, &mesh, patch, 1.0, true, name, &Default::default())
-                .expect("build");
+            let mut surf =
+                gregory::build(&mut ctx, &mesh, patch, 1.0, true, name, &Default::default())
+                    .expect("build");
             assert_eq!(surf.patch_counts()[3], triangles, "{name} {patch:?}");
             let split = gregory::build(
                 &mut ctx,
@@ -866,7 +869,7 @@ fn gregory_triangle_patches_on_the_gpu() {
             .expect("build");
             assert_eq!(split.patch_counts()[3], 0, "{name} {patch:?} split");
             let (soup, _) = capturer
-                .capture(&mut ctx, &surf, &FrameParams::uniform(4.0), EXTENT)
+                .capture(&mut ctx, &mut surf, &FrameParams::uniform(4.0), EXTENT)
                 .expect("capture");
             let (_, max, rms) = deviation(&surf, &soup, &mesh);
             println!(
@@ -910,7 +913,7 @@ fn gregory_triangle_patches_on_the_gpu() {
                         ..FrameParams::default()
                     };
                     let (soup, _) = capturer
-                        .capture(&mut ctx, &surf, &params, EXTENT)
+                        .capture(&mut ctx, &mut surf, &params, EXTENT)
                         .expect("capture");
                     let (cracks, nonmanifold) = cracks(&surf, &soup, &mesh);
                     let (shared, differing) = normal_seams(&soup);

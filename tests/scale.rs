@@ -45,7 +45,7 @@ fn bft_run(
     let out = {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let capturer = Capturer::new(&ctx).expect("capturer");
-        let surf = Bft::new(
+        let mut surf = Bft::new(
             &mut ctx,
             mesh,
             &BftOptions {
@@ -56,9 +56,11 @@ fn bft_run(
             },
         )
         .expect("bft");
-        let image = ctx.render_offscreen(&surf, params, SMALL).expect("render");
+        let image = ctx
+            .render_offscreen(&mut surf, params, SMALL)
+            .expect("render");
         let (soup, _) = capturer
-            .capture(&mut ctx, &surf, params, SMALL)
+            .capture(&mut ctx, &mut surf, params, SMALL)
             .expect("capture");
         (image.pixels, soup.records, surf.chunk_counts())
     };
@@ -101,7 +103,7 @@ fn adaptive_run(cap: Option<u32>, mesh: &ControlMesh, params: &FrameParams) -> A
     let out = {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let capturer = Capturer::new(&ctx).expect("capturer");
-        let surf = Adaptive::new(
+        let mut surf = Adaptive::new(
             &mut ctx,
             mesh,
             &AdaptiveBuild {
@@ -111,9 +113,11 @@ fn adaptive_run(cap: Option<u32>, mesh: &ControlMesh, params: &FrameParams) -> A
             },
         )
         .expect("adaptive");
-        let image = ctx.render_offscreen(&surf, params, SMALL).expect("render");
+        let image = ctx
+            .render_offscreen(&mut surf, params, SMALL)
+            .expect("render");
         let (soup, _) = capturer
-            .capture(&mut ctx, &surf, params, SMALL)
+            .capture(&mut ctx, &mut surf, params, SMALL)
             .expect("capture");
         let g = &surf.gpu;
         let whole = [
@@ -300,14 +304,14 @@ fn one_million_faces_through_every_technique() {
     {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
         for (id, mesh, segments) in [
-            (TechniqueId::Flat, &tri, 1.0),
-            (TechniqueId::Phong, &tri, 1.0),
-            (TechniqueId::Pn, &tri, 1.0),
-            (TechniqueId::Bft, &tri, 2.0),
+            (TechniqueId::FLAT, &tri, 1.0),
+            (TechniqueId::PHONG, &tri, 1.0),
+            (TechniqueId::PN, &tri, 1.0),
+            (TechniqueId::BFT, &tri, 2.0),
         ] {
             let t = std::time::Instant::now();
             // BFT built directly, to see its chunking (table level 1 either way).
-            let (technique, chunks): (Box<dyn Technique>, _) = if id == TechniqueId::Bft {
+            let (mut technique, chunks): (Box<dyn Technique>, _) = if id == TechniqueId::BFT {
                 let b = Bft::new(
                     &mut ctx,
                     mesh,
@@ -327,7 +331,7 @@ fn one_million_faces_through_every_technique() {
             let built = t.elapsed().as_secs_f64();
             let t = std::time::Instant::now();
             let image = ctx
-                .render_offscreen(technique.as_ref(), &FrameParams::uniform(segments), tiny)
+                .render_offscreen(technique.as_mut(), &FrameParams::uniform(segments), tiny)
                 .unwrap_or_else(|e| panic!("{id}: {e}"));
             let frame = t.elapsed().as_secs_f64();
             println!(
@@ -351,7 +355,7 @@ fn one_million_faces_through_every_technique() {
         // its regular corners and curve points have no rows (they were 264 MB, two window
         // sets); windows are checked under a small range above and in the pre-pass's test.
         let t = std::time::Instant::now();
-        let surf = Adaptive::new(
+        let mut surf = Adaptive::new(
             &mut ctx,
             &quad,
             &AdaptiveBuild {
@@ -363,7 +367,7 @@ fn one_million_faces_through_every_technique() {
         let built = t.elapsed().as_secs_f64();
         let t = std::time::Instant::now();
         let image = ctx
-            .render_offscreen(&surf, &FrameParams::uniform(1.0), tiny)
+            .render_offscreen(&mut surf, &FrameParams::uniform(1.0), tiny)
             .expect("adaptive render");
         let frame = t.elapsed().as_secs_f64();
         let chunks = surf.chunk_counts();
@@ -415,12 +419,12 @@ fn one_million_faces_through_every_technique() {
         // The single-pass approximations: one patch per quad of the 1M-quad grid; on the
         // triangle grid (3M Gregory patches after the split, ~5.7e8 point-stencil terms, which
         // took 24 GB before the OOM killer) refused by the Gregory bound before building any.
-        for id in [TechniqueId::Gregory, TechniqueId::Acc] {
+        for id in [TechniqueId::GREGORY, TechniqueId::ACC] {
             let t = std::time::Instant::now();
-            let surf = common::build_with(&mut ctx, id, &quad, 1, false);
+            let mut surf = common::build_with(&mut ctx, id, &quad, 1, false);
             let built = t.elapsed().as_secs_f64();
             let image = ctx
-                .render_offscreen(surf.as_ref(), &FrameParams::uniform(1.0), tiny)
+                .render_offscreen(surf.as_mut(), &FrameParams::uniform(1.0), tiny)
                 .unwrap_or_else(|e| panic!("{id}: {e}"));
             println!("{id}: {} faces, build {built:.1} s", quad.num_faces());
             let clear = &image.pixels[..4];

@@ -96,13 +96,13 @@ impl Harness {
 
     fn openings(
         &mut self,
-        technique: &dyn Technique,
+        technique: &mut dyn Technique,
         base: &ControlMesh,
         p: &FrameParams,
     ) -> Openings {
         let (soup, stats) = self
             .capturer
-            .capture(&mut self.ctx, technique, p, EXTENT)
+            .capture(&mut self.ctx, &mut *technique, p, EXTENT)
             .unwrap();
         let welded = soup.weld().unwrap();
         let report = welded.open_edges();
@@ -173,11 +173,11 @@ fn assert_watertight(
 ) -> usize {
     let mut triangles = 0;
     for (name, base) in meshes {
-        let technique = tessera::tess::build(&mut h.ctx, id, base, options)
+        let mut technique = tessera::tess::build(&mut h.ctx, id, base, options)
             .unwrap_or_else(|e| panic!("building {id} on {name}: {e}"))
             .technique;
         for &(spacing, level) in cases {
-            let o = h.openings(technique.as_ref(), base, &uniform(level, spacing));
+            let o = h.openings(technique.as_mut(), base, &uniform(level, spacing));
             let what = format!("{name} {id:?} {spacing:?} level {level}");
             if o.cracks > 0 || level == 8.0 || level == 64.0 {
                 println!("{what}: {o:?}");
@@ -189,7 +189,7 @@ fn assert_watertight(
             assert_eq!(o.non_manifold, 0, "{what}");
             assert_eq!(o.zero_area, 0, "{what}");
             assert_eq!(o.stats.passes, 1, "{what}: the CPU bound is exact");
-            if id != TechniqueId::Adaptive {
+            if id != TechniqueId::ADAPTIVE {
                 assert_eq!(o.split_normals, 0, "{what}: one normal per welded vertex");
             }
             // Consistent winding, opposite to the base faces' (the export reverses it).
@@ -227,7 +227,7 @@ fn negative_zero_coordinates_do_not_crack() {
     let equal = |levels: &[f32]| -> Vec<(Spacing, f32)> {
         levels.iter().map(|&l| (Spacing::Equal, l)).collect()
     };
-    for id in [TechniqueId::Flat, TechniqueId::Phong, TechniqueId::Pn] {
+    for id in [TechniqueId::FLAT, TechniqueId::PHONG, TechniqueId::PN] {
         assert_watertight(
             &mut h,
             &meshes,
@@ -239,7 +239,7 @@ fn negative_zero_coordinates_do_not_crack() {
     assert_watertight(
         &mut h,
         &meshes,
-        TechniqueId::Bft,
+        TechniqueId::BFT,
         &BuildOptions::default(),
         &equal(&[4.0, 8.0]),
     );
@@ -251,7 +251,7 @@ fn negative_zero_coordinates_do_not_crack() {
     assert_watertight(
         &mut h,
         &meshes,
-        TechniqueId::Adaptive,
+        TechniqueId::ADAPTIVE,
         &adaptive,
         &equal(&[3.0, 7.0]),
     );
@@ -281,7 +281,7 @@ fn base_face_techniques_are_watertight_at_every_level_and_spacing() {
         ("mixed prism", mixed_prism()),
     ];
     let cases = all_levels();
-    for id in [TechniqueId::Pn, TechniqueId::Flat, TechniqueId::Phong] {
+    for id in [TechniqueId::PN, TechniqueId::FLAT, TechniqueId::PHONG] {
         let start = Instant::now();
         let triangles = assert_watertight(&mut h, &meshes, id, &BuildOptions::default(), &cases);
         println!(
@@ -306,9 +306,9 @@ fn base_face_techniques_are_watertight_on_spot() {
     let mut h = Harness::new(&gpu);
     let meshes = [("spot", load("assets/spot_control_mesh.obj"))];
     for (id, levels) in [
-        (TechniqueId::Pn, &[1.0f32, 2.0, 5.0, 5.5, 8.0, 21.0][..]),
-        (TechniqueId::Flat, &[1.0, 5.0, 8.0][..]),
-        (TechniqueId::Phong, &[1.0, 5.0, 8.0][..]),
+        (TechniqueId::PN, &[1.0f32, 2.0, 5.0, 5.5, 8.0, 21.0][..]),
+        (TechniqueId::FLAT, &[1.0, 5.0, 8.0][..]),
+        (TechniqueId::PHONG, &[1.0, 5.0, 8.0][..]),
     ] {
         let cases: Vec<(Spacing, f32)> = SPACINGS
             .iter()
@@ -349,9 +349,9 @@ fn bft_and_adaptive_are_watertight_at_every_uniform_level() {
         .flat_map(|&s| (1..=32).map(move |l| (s, l as f32)))
         .collect();
     let runs = [
-        (TechniqueId::Bft, BuildOptions::default(), &bft),
+        (TechniqueId::BFT, BuildOptions::default(), &bft),
         (
-            TechniqueId::Adaptive,
+            TechniqueId::ADAPTIVE,
             BuildOptions {
                 isolation: 2,
                 end_cap: EndCap::Gregory,
@@ -360,7 +360,7 @@ fn bft_and_adaptive_are_watertight_at_every_uniform_level() {
             &adaptive,
         ),
         (
-            TechniqueId::Adaptive,
+            TechniqueId::ADAPTIVE,
             BuildOptions {
                 isolation: 2,
                 end_cap: EndCap::Bilinear,
@@ -368,15 +368,15 @@ fn bft_and_adaptive_are_watertight_at_every_uniform_level() {
             },
             &adaptive,
         ),
-        (TechniqueId::Gregory, BuildOptions::default(), &adaptive),
-        (TechniqueId::Acc, BuildOptions::default(), &adaptive),
+        (TechniqueId::GREGORY, BuildOptions::default(), &adaptive),
+        (TechniqueId::ACC, BuildOptions::default(), &adaptive),
     ];
     for (id, options, cases) in runs {
         let start = Instant::now();
         let triangles = assert_watertight(&mut h, &meshes, id, &options, cases);
         println!(
             "{id:?}{}: {} captures, {triangles} triangles, {:.1} s",
-            if id == TechniqueId::Adaptive {
+            if id == TechniqueId::ADAPTIVE {
                 format!(" {:?} end caps", options.end_cap)
             } else {
                 String::new()

@@ -51,9 +51,10 @@ fuzz_target!(
             sharpness_scale: scale,
             follow_semi_sharp: knobs & 8 != 0,
         };
+        // Scaled as the plan scales it: an infinite tag (≥ 10) counts as 10.
         let deep = |s: f32| {
-            let t = s * scale;
-            s < 10.0 && t > 4.0 && t < 10.0
+            let t = if scale == 1.0 { s } else { s.min(10.0) * scale };
+            t > 4.0 && t < 10.0
         };
         if opts.follow_semi_sharp
             && (mesh.creases.iter().any(|c| deep(c.sharpness))

@@ -6,9 +6,9 @@
 
 use libfuzzer_sys::fuzz_target;
 use tessera_fuzz::MeshSpec;
-use topology::Scheme;
-use topology::refine::{Level, LevelTopology};
 use topology::mesh::Topology;
+use topology::refine::{Level, LevelTopology};
+use topology::Scheme;
 
 fuzz_target!(
     init: tessera_fuzz::single_thread_rayon(),

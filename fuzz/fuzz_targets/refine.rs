@@ -8,8 +8,8 @@
 
 use libfuzzer_sys::fuzz_target;
 use tessera_fuzz::{positions_in_range, MeshSpec};
-use topology::Scheme;
 use topology::refine::{refine_uniform, uniform_stencils};
+use topology::Scheme;
 
 const MAX_REFINED_FACES: usize = 4608;
 

@@ -18,9 +18,9 @@
 //!   the targets bound refinement levels themselves.
 
 use arbitrary::{Arbitrary, Unstructured};
-use topology::ControlMesh;
-use topology::rules::options::{BoundaryInterpolation, CreaseMethod, TriangleSubdivision};
 use topology::mesh::{EdgeCrease, VertexCorner};
+use topology::rules::options::{BoundaryInterpolation, CreaseMethod, TriangleSubdivision};
+use topology::ControlMesh;
 
 /// Largest coordinate magnitude the topology targets feed in: the library's own bound, within
 /// which it promises finite output (`ControlMesh::validate` refuses the rest).

@@ -1,32 +1,8 @@
-// What every TES hands to the fragment stage, and the clip-space write.
-//
-// Capture contract (`tess::gpu::CaptureRecord`): a TES compiled with `-DCAPTURE` (the manifest's
-// capture axis) also records, through transform feedback, one record per emitted triangle
-// corner, in the order the primitive assembler sees them: world position, normal (as shaded),
-// patch id, flags (technique-defined, 0 = none) and the domain coordinate (gl_TessCoord.xy, as
-// the tessellator produced it). Buffer, stride and offsets come from bindings.glsl; a test reads
-// them back from the SPIR-V against the Rust struct.
-// The patch id is the index of the patch in the frame's patch numbering, draw splits included:
-// the triangle/quad techniques pass `draw.first_patch + uint(gl_PrimitiveID)`.
-#include "bindings.glsl"
-#ifdef CAPTURE
-#define XFB_AT(off) , xfb_buffer = CAPTURE_XFB_BUFFER, xfb_stride = CAPTURE_XFB_STRIDE, xfb_offset = off
-#else
-#define XFB_AT(off)
-#endif
-layout(location = 0 XFB_AT(CAPTURE_OFFSET_POSITION)) out vec3 out_world;
-layout(location = 1 XFB_AT(CAPTURE_OFFSET_NORMAL)) out vec3 out_normal;
-#ifdef CAPTURE
-layout(location = 2 XFB_AT(CAPTURE_OFFSET_PATCH)) flat out uvec2 out_patch_flags;
-layout(location = 3 XFB_AT(CAPTURE_OFFSET_DOMAIN)) out vec2 out_domain;
-#endif
+// The evaluation stages' output: `common/stage_out.glsl` (the capture contract is there) at the
+// tessellator's domain coordinate. The triangle/quad techniques pass
+// `draw.first_patch + uint(gl_PrimitiveID)` as the patch id.
+#include "stage_out.glsl"
 
 void emit_sample(vec3 p, vec3 n, uint patch_id, uint flags) {
-    out_world = p;
-    out_normal = n;
-#ifdef CAPTURE
-    out_patch_flags = uvec2(patch_id, flags);
-    out_domain = gl_TessCoord.xy;
-#endif
-    gl_Position = frame.view_proj * vec4(p, 1.0);
+    emit_vertex_at(p, n, patch_id, flags, gl_TessCoord.xy);
 }

@@ -148,3 +148,23 @@ pub(crate) unsafe fn write_c_string(s: &str, buffer: *mut c_char, capacity: usiz
         buffer.add(n).write(0);
     }
 }
+
+/// Copies `values` to `ptr`; NULL or a misaligned pointer is an error.
+///
+/// # Safety
+/// `ptr` is NULL or addresses `values.len()` writable `f64` nothing else accesses during the
+/// call.
+pub(crate) unsafe fn write_f64s(ptr: *mut f64, values: &[f64], what: &str) -> Result<()> {
+    if ptr.is_null() {
+        return Err(null(what));
+    }
+    if !ptr.is_aligned() {
+        return Err(Error::new(
+            TesseraStatus::InvalidArgument,
+            format!("{what} is not aligned for double"),
+        ));
+    }
+    // SAFETY: non-null and aligned; the caller vouches for the length.
+    unsafe { std::ptr::copy_nonoverlapping(values.as_ptr(), ptr, values.len()) };
+    Ok(())
+}

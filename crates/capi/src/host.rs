@@ -2,8 +2,11 @@
 //!
 //! # What the host gives and keeps
 //! The host passes its `VkInstance`, `VkPhysicalDevice`, `VkDevice`, a queue family and queue,
-//! its `vkGetInstanceProcAddr` and the colour/depth formats of the dynamic-rendering scopes
-//! Tessera's draws will be recorded into. Tessera wraps them (`vk_core::Instance::from_host`,
+//! its `vkGetInstanceProcAddr` and where Tessera's draws will be recorded: dynamic-rendering
+//! scopes of given colour/depth formats, or a subpass of its `VkRenderPass` (index, sample
+//! count and the formats of its colour and depth attachments), for which Tessera builds
+//! compatible pipelines (render pass compatibility: the host may begin any render pass
+//! compatible with the one it gave). Tessera wraps them (`vk_core::Instance::from_host`,
 //! `vk_core::Device::from_host`) and never destroys any of them; it creates and destroys only
 //! its own objects (buffers, pipelines, layouts, descriptor pools, its pipeline cache, a
 //! timeline semaphore and one-shot command pools).
@@ -17,17 +20,24 @@
 //!   control and evaluation stages' reads (shader read) of this frame. The host needs no
 //!   barrier for Tessera's resources.
 //! - [`tessera_record_draw`] records the draws inside the host's rendering scope (begun by the
-//!   host with dynamic rendering and the formats given at creation, viewport and scissor set
-//!   by the host: Tessera's pipelines take both as dynamic state). It binds its own pipelines
+//!   host with dynamic rendering and the formats given at creation, or the given subpass of
+//!   a render pass instance; viewport and scissor set by the host: Tessera's pipelines take
+//!   both as dynamic state). It binds its own pipelines
 //!   and sets; after it returns the host must re-bind its own. It writes the colour and depth
 //!   attachments the host's scope holds, with depth test and write on (LESS; the wireframe
 //!   overlay LESS_OR_EQUAL without writes); ordering those writes against later reads of the
 //!   attachments is the host's, as for its own draws.
 //! - Tessera never begins, ends, resets or submits a host command buffer, and never waits on
 //!   the device or a host queue. The only submissions it makes are its own uploads when a
-//!   surface is created (device-local tables), on the host's queue, each waited for on
-//!   Tessera's own timeline semaphore: the host must not use that queue on another thread
-//!   during `tessera_surface_create*` (Vulkan's external synchronization of queues).
+//!   surface is created (device-local tables) and captures ([`crate::tessera_capture`]), on
+//!   the host's queue, each in a command buffer of its own waited for on Tessera's own
+//!   timeline semaphore: the host must not use that queue on another thread during
+//!   `tessera_surface_create*` and `tessera_capture*` (Vulkan's external synchronization of
+//!   queues).
+//!
+//! # Device features
+//! Dynamic rendering needs `dynamicRendering` enabled; a render pass does not, except for
+//! captures, which render into an attachment-less dynamic-rendering scope of Tessera's own.
 //!
 //! # Frames in flight
 //! The host says how many frames it keeps in flight (`frames_in_flight`); every surface keeps
@@ -52,7 +62,7 @@ use crate::{
     context_ptr, flag, guard, registry, surface_frame_params, with_context, with_surface,
     ContextState, Mode, TesseraContext, TesseraFrameDesc, TesseraSurface,
 };
-use vk_core::{vk, Device, Encoder, HostDevice, Instance};
+use vk_core::{vk, Device, Encoder, HostDevice, HostScope, Instance};
 
 /// `vkGetInstanceProcAddr` as vulkan.h declares it (the header uses vulkan.h's own type).
 #[allow(non_camel_case_types)]
@@ -64,6 +74,7 @@ pub type VkDevice = vk::Device;
 pub type VkQueue = vk::Queue;
 pub type VkCommandBuffer = vk::CommandBuffer;
 pub type VkFormat = vk::Format;
+pub type VkRenderPass = vk::RenderPass;
 
 /// The host's Vulkan objects, none of which Tessera ever destroys.
 #[repr(C)]
@@ -73,13 +84,16 @@ pub struct TesseraHostDesc {
     /// Created for Vulkan 1.3 or later.
     pub instance: VkInstance,
     pub physical_device: VkPhysicalDevice,
-    /// Created from `physical_device` with `tessellationShader`, `fillModeNonSolid`,
-    /// `dynamicRendering` and `timelineSemaphore` enabled.
+    /// Created from `physical_device` with `tessellationShader`, `fillModeNonSolid` and
+    /// `timelineSemaphore` enabled, and `dynamicRendering` for dynamic-rendering scopes and
+    /// captures.
     pub device: VkDevice,
     /// A family with graphics and compute; `queue` is its queue 0.
     pub queue_family: u32,
     pub queue: VkQueue,
-    /// Formats of the host's rendering scopes Tessera's draws are recorded into.
+    /// Formats of the host's attachments Tessera's draws write: of its dynamic-rendering
+    /// scopes, or of the colour attachment (the subpass's one) and the depth attachment
+    /// (`VK_FORMAT_UNDEFINED`: none) of `subpass` of `render_pass`.
     pub color_format: VkFormat,
     pub depth_format: VkFormat,
     /// 1 or more.
@@ -92,6 +106,60 @@ pub struct TesseraHostDesc {
     pub pipeline_statistics_query: u32,
     /// 0 or 1: `vertexPipelineStoresAndAtomics` is enabled.
     pub vertex_pipeline_stores_and_atomics: u32,
+    /// VK_NULL_HANDLE: Tessera's draws go into the host's dynamic-rendering scopes. Otherwise
+    /// they go into subpass `subpass` of instances of this render pass (or of one compatible
+    /// with it): its pipelines are made for that subpass, which must have exactly one colour
+    /// attachment (`color_format`) and at most a depth attachment (`depth_format`), all with
+    /// `samples` samples. The render pass must outlive the context.
+    pub render_pass: VkRenderPass,
+    pub subpass: u32,
+    /// `VkSampleCountFlagBits` of the subpass's attachments (1, 2, 4, ... 64; 0 means 1).
+    /// Render passes only: dynamic rendering takes 0 or 1.
+    pub samples: u32,
+    /// 0 or 1: `dynamicRendering` is enabled. Dynamic rendering needs it (so it is taken as 1
+    /// there); with a render pass only captures do (they render into a scope of their own),
+    /// and are UNSUPPORTED without it.
+    pub dynamic_rendering: u32,
+    /// `TESSERA_PIPELINE_CACHE_*`: Tessera's own pipeline cache (never one of the host's), kept
+    /// as [`crate::TesseraStandaloneDesc`] says.
+    pub pipeline_cache: crate::TesseraPipelineCache,
+    /// NULL (the user's cache directory) or a NUL-terminated directory for it.
+    pub pipeline_cache_dir: *const std::ffi::c_char,
+}
+
+/// The subpass `d` names, checked; `None` for dynamic rendering.
+fn host_subpass(d: &TesseraHostDesc) -> Result<Option<vk_core::pipeline::Subpass>> {
+    let samples = match d.samples {
+        0 => 1,
+        s => s,
+    };
+    if !samples.is_power_of_two() || samples > 64 {
+        return Err(Error::new(
+            TesseraStatus::InvalidArgument,
+            format!(
+                "samples {}: expected a VkSampleCountFlagBits (1, 2, 4, ... 64)",
+                d.samples
+            ),
+        ));
+    }
+    if d.render_pass == vk::RenderPass::null() {
+        if d.subpass != 0 || samples != 1 {
+            return Err(Error::new(
+                TesseraStatus::InvalidArgument,
+                format!(
+                    "subpass {} and samples {} apply to a render pass, and render_pass is \
+                     VK_NULL_HANDLE (dynamic rendering takes subpass 0 and samples 0 or 1)",
+                    d.subpass, d.samples
+                ),
+            ));
+        }
+        return Ok(None);
+    }
+    Ok(Some(vk_core::pipeline::Subpass {
+        render_pass: d.render_pass,
+        index: d.subpass,
+        samples: vk::SampleCountFlags::from_raw(samples),
+    }))
 }
 
 /// Creates a host-owned context on the host's device (see the module documentation in
@@ -141,6 +209,11 @@ pub unsafe extern "C" fn tessera_context_create_host(
                 "color_format is VK_FORMAT_UNDEFINED: Tessera's draws need a colour attachment",
             ));
         }
+        let subpass = host_subpass(&d)?;
+        let dynamic_rendering =
+            flag(d.dynamic_rendering, "dynamic_rendering")? || subpass.is_none();
+        // SAFETY: the caller's contract for `pipeline_cache_dir`.
+        let cache = unsafe { crate::pipeline_cache_dir(d.pipeline_cache, d.pipeline_cache_dir) }?;
         // SAFETY: the caller's contract (TesseraHostDesc's documented requirements).
         let instance =
             unsafe { Instance::from_host(gipa, d.instance, flag(d.debug_utils, "debug_utils")?) }?;
@@ -160,7 +233,7 @@ pub unsafe extern "C" fn tessera_context_create_host(
             )?,
         };
         // SAFETY: as above.
-        let device = unsafe { Device::from_host(&instance, &host) }?;
+        let device = unsafe { Device::from_host(&instance, &host, cache.as_deref()) }?;
         let id = lock(registry())?.add_context(ContextState {
             graveyard: Vec::new(),
             device,
@@ -169,6 +242,8 @@ pub unsafe extern "C" fn tessera_context_create_host(
                 frames_in_flight: d.frames_in_flight as usize,
                 frame: 0,
                 formats: [d.color_format, d.depth_format],
+                subpass,
+                dynamic_rendering,
             },
             last_error: String::new(),
         });
@@ -282,9 +357,10 @@ pub unsafe extern "C" fn tessera_record_pre_pass(
 /// thread during the call.
 ///
 /// # Safety
-/// `cmd` is a primary command buffer of the context's device in the recording state, inside
-/// a rendering scope begun with dynamic rendering and the context's formats, viewport and
-/// scissor set; `view` and `proj` point to 16 readable floats each; `cmd` is submitted in the
+/// `cmd` is a primary command buffer of the context's device in the recording state, viewport
+/// and scissor set, inside a rendering scope begun with dynamic rendering and the context's
+/// formats, or (a context made with a render pass) inside its `subpass` of an instance of that
+/// render pass or of one compatible with it, begun with `VK_SUBPASS_CONTENTS_INLINE`; `view` and `proj` point to 16 readable floats each; `cmd` is submitted in the
 /// frame named by [`tessera_begin_frame`], and the context is destroyed only after the GPU
 /// finished it.
 #[no_mangle]
@@ -316,23 +392,34 @@ pub unsafe extern "C" fn tessera_record_draw(
                 "view is not invertible",
             ));
         }
-        let Mode::Host { formats, .. } = c.mode else {
+        let Mode::Host {
+            formats, subpass, ..
+        } = c.mode
+        else {
             return Err(Error::new(TesseraStatus::WrongMode, "not host-owned"));
+        };
+        let scope = match subpass {
+            None => HostScope::Rendering(formats),
+            Some(subpass) => HostScope::Subpass { subpass, formats },
         };
         let slot = c.slot();
         s.sync_positions(slot)?;
         let (params, extent) = s.frame;
+        s.tess.prepare(
+            s.technique.as_mut(),
+            &params,
+            tess::Context::frame_passes(&params),
+        )?;
         let technique = s.technique.as_ref();
-        s.tess
-            .prepare(technique, &params, tess::Context::frame_passes(&params))?;
         let eye = view.inverse().w_axis.truncate();
         let m = tess::camera::CameraMatrices { view, proj, eye };
         let uniforms = tess::context::frame_uniforms_with(m, technique.bbox(), &params, extent);
         s.tess.write_frame_uniforms(slot, &uniforms)?;
         // SAFETY: the caller's contract: a recording command buffer of this device inside the
-        // host's scope of these formats, whose execution the host waits for before destroying
+        // host's scope as the context describes it (dynamic rendering of these formats, or
+        // the render pass's subpass), whose execution the host waits for before destroying
         // the surface.
-        let mut enc = unsafe { Encoder::record_into(&c.device, cmd, Some(formats)) };
+        let mut enc = unsafe { Encoder::record_into(&c.device, cmd, Some(scope)) };
         s.tess.record_frame(&mut enc, technique, slot, &params)?;
         enc.finish()?;
         Ok(())

@@ -2,8 +2,9 @@
 //! `include/tessera.hpp` sits on top of it).
 //!
 //! # Handles
-//! `TesseraContext*` (a device and how Tessera uses it) and `TesseraSurface*` (one control
-//! mesh built for one technique on one context) are opaque. They are numbers in a registry
+//! `TesseraContext*` (a device and how Tessera uses it), `TesseraSurface*` (one control mesh
+//! built for one technique on one context) and `TesseraLimitEvaluator*` (a surface's or mesh's
+//! exact limit surface on the CPU, [`limit`]) are opaque. They are numbers in a registry
 //! (the `registry` module), never pointers into Rust memory: a null, forged, destroyed or
 //! twice-destroyed handle is answered with `TESSERA_STATUS_NULL_HANDLE`,
 //! `TESSERA_STATUS_INVALID_HANDLE` or `TESSERA_STATUS_DESTROYED_HANDLE`, never undefined
@@ -31,9 +32,13 @@
 //! # Modes
 //! - **Standalone** ([`tessera_context_create_standalone`]): Tessera loads Vulkan, chooses the
 //!   device by the CLI's rules (`vk_core::device::choose_adapter`: best-scored, or by index or
-//!   name substring) and renders into an RGBA8 buffer the host reads ([`tessera_render`]), or
-//!   captures what the GPU drew into an OBJ file ([`tessera_capture_obj`]).
-//! - **Host-owned** (see `host` below): the host's Vulkan objects, never destroyed by Tessera.
+//!   name substring) and renders into an RGBA8 buffer the host reads ([`tessera_render`]).
+//! - **Host-owned** (see [`host`]): the host's Vulkan objects, never destroyed by Tessera;
+//!   Tessera records into the host's dynamic-rendering scopes or a subpass of its render pass.
+//!
+//! Both capture what the GPU drew, with `tessera export`'s weld, crack report and OBJ
+//! ([`capture`]), and both make limit evaluators ([`limit`]), which need no device at all when
+//! made from a mesh.
 //!
 //! # Thread safety
 //! Every function may be called from any thread. Calls on one context (and on its surfaces)
@@ -55,6 +60,11 @@ pub mod ffi;
 mod registry;
 pub mod status;
 
+pub use capture::{tessera_capture, tessera_capture_obj, TesseraCaptureReport};
+pub use limit::{
+    tessera_limit_evaluate, tessera_limit_evaluator_create, tessera_limit_evaluator_create_mesh,
+    tessera_limit_evaluator_destroy, tessera_limit_evaluator_info, TesseraLimitEvaluator,
+};
 pub use status::TesseraStatus;
 
 use ffi::{out_write, read_slice, read_str};
@@ -94,6 +104,11 @@ pub const TESSERA_TECHNIQUE_GREGORY: TesseraTechnique = 6;
 /// Catmull-Clark approximated in one pass by ACC-1 patches, Gregory where ACC-1 does not apply
 /// (`--method acc`).
 pub const TESSERA_TECHNIQUE_ACC: TesseraTechnique = 7;
+/// Loop subdivision on the CPU to level log2 S at the limit, drawn as a static mesh
+/// (`--method cpu`; levels are powers of two up to 64 segments).
+pub const TESSERA_TECHNIQUE_CPU: TesseraTechnique = 8;
+/// Catmull-Clark subdivision on the CPU, drawn as a static mesh (`--method cpu-catmark`).
+pub const TESSERA_TECHNIQUE_CPU_CATMARK: TesseraTechnique = 9;
 
 /// The subdivision scheme (`TESSERA_SCHEME_*`).
 pub type TesseraScheme = u32;
@@ -143,7 +158,20 @@ pub const TESSERA_VALIDATION_ON: TesseraValidation = 1;
 /// Also synchronization validation (slower).
 pub const TESSERA_VALIDATION_SYNCHRONIZATION: TesseraValidation = 2;
 
-/// How a standalone context is made.
+/// Whether Tessera keeps its Vulkan pipeline cache on disk between runs
+/// (`TESSERA_PIPELINE_CACHE_*`).
+pub type TesseraPipelineCache = u32;
+/// On disk, in the descriptor's `pipeline_cache_dir`, or when that is NULL in the user's cache
+/// directory (`$XDG_CACHE_HOME/tessera/pipelines`, else `~/.cache/tessera/pipelines`), one
+/// file per device and driver build (its header is checked against the device before use);
+/// the environment variable `TESSERA_PIPELINE_CACHE=off` turns it off for the process. The
+/// value of a zero-filled descriptor.
+pub const TESSERA_PIPELINE_CACHE_DEFAULT: TesseraPipelineCache = 0;
+/// In memory only: every context compiles its pipelines afresh.
+pub const TESSERA_PIPELINE_CACHE_OFF: TesseraPipelineCache = 1;
+
+/// How a standalone context is made. A zero-filled descriptor is valid (best device, no
+/// validation, the default pipeline cache).
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct TesseraStandaloneDesc {
@@ -152,6 +180,52 @@ pub struct TesseraStandaloneDesc {
     pub device: *const c_char,
     /// `TESSERA_VALIDATION_*`; the layer must be installed when not OFF.
     pub validation: TesseraValidation,
+    /// `TESSERA_PIPELINE_CACHE_*`.
+    pub pipeline_cache: TesseraPipelineCache,
+    /// NULL (the user's cache directory) or a NUL-terminated directory for the pipeline cache
+    /// (created when missing).
+    pub pipeline_cache_dir: *const c_char,
+}
+
+impl Default for TesseraStandaloneDesc {
+    /// What a zero-filled descriptor holds.
+    fn default() -> Self {
+        Self {
+            device: std::ptr::null(),
+            validation: TESSERA_VALIDATION_OFF,
+            pipeline_cache: TESSERA_PIPELINE_CACHE_DEFAULT,
+            pipeline_cache_dir: std::ptr::null(),
+        }
+    }
+}
+
+/// The directory of the pipeline cache a descriptor asks for; `None`: in memory only.
+///
+/// # Safety
+/// `dir` is NULL or NUL-terminated.
+pub(crate) unsafe fn pipeline_cache_dir(
+    setting: TesseraPipelineCache,
+    dir: *const c_char,
+) -> Result<Option<std::path::PathBuf>> {
+    // SAFETY: the caller's contract.
+    let dir = unsafe { read_str(dir, "pipeline_cache_dir") }?;
+    match setting {
+        TESSERA_PIPELINE_CACHE_OFF => Ok(None),
+        TESSERA_PIPELINE_CACHE_DEFAULT => match dir {
+            Some(d) if d.is_empty() => Err(Error::new(
+                TesseraStatus::InvalidArgument,
+                "pipeline_cache_dir is empty (NULL means the user's cache directory)",
+            )),
+            Some(d) if vk_core::pipeline_cache::allowed_by_env() => Ok(Some(d.into())),
+            Some(_) => Ok(None),
+            None => Ok(vk_core::pipeline_cache::user_dir()),
+        },
+        v => Err(invalid(
+            "pipeline_cache",
+            v,
+            "a TESSERA_PIPELINE_CACHE_* value",
+        )),
+    }
 }
 
 /// A control mesh. Arrays are read during the call only. Counts are of elements (vertices,
@@ -261,7 +335,7 @@ pub struct TesseraFrameDesc {
     pub show: TesseraShow,
 }
 
-type Contexts = Registry<ContextState, SurfaceState>;
+type Contexts = Registry<ContextState, SurfaceState, tess::limit::LimitEvaluator>;
 
 fn registry() -> &'static Mutex<Contexts> {
     static REGISTRY: OnceLock<Mutex<Contexts>> = OnceLock::new();
@@ -292,6 +366,10 @@ pub(crate) enum Mode {
         frames_in_flight: usize,
         frame: u64,
         formats: [vk::Format; 2],
+        /// The host's render pass subpass; `None`: dynamic rendering.
+        subpass: Option<vk_core::pipeline::Subpass>,
+        /// `dynamicRendering` is enabled on the host's device (captures need it).
+        dynamic_rendering: bool,
     },
 }
 
@@ -317,6 +395,13 @@ pub(crate) struct SurfaceState {
     vertex_count: usize,
     /// Base positions at creation ([`tessera_surface_positions`] before any update).
     rest: Vec<[f32; 3]>,
+    /// The control mesh as built (positions at creation): what captures classify open edges
+    /// against and limit evaluators evaluate.
+    mesh: topology::ControlMesh,
+    /// The subdivision scheme of its limit surface ([`limit`]).
+    scheme: topology::Scheme,
+    /// The sharpness scale its technique applied (1 where the technique does not scale).
+    sharpness_scale: f32,
     /// What host-owned frames draw ([`tessera_surface_set_frame`]).
     frame: (FrameParams, vk::Extent2D),
     /// The newest animated positions and their version; each slot records the version it
@@ -326,6 +411,27 @@ pub(crate) struct SurfaceState {
 }
 
 impl SurfaceState {
+    /// The control mesh whose limit surface the surface stands for: its newest positions,
+    /// its creases and corners scaled as its technique scaled them.
+    fn limit_mesh(&self) -> topology::ControlMesh {
+        let mut mesh = self.mesh.clone();
+        if let Some((_, p)) = &self.positions {
+            mesh.positions = p.iter().map(|q| q.map(f64::from)).collect();
+        }
+        let scale = |s: &mut f32| {
+            if !topology::rules::is_infinite(*s) {
+                *s *= self.sharpness_scale;
+            }
+        };
+        mesh.creases
+            .iter_mut()
+            .for_each(|c| scale(&mut c.sharpness));
+        mesh.corners
+            .iter_mut()
+            .for_each(|c| scale(&mut c.sharpness));
+        mesh
+    }
+
     /// Brings frame slot `slot`'s animated positions up to the newest ones.
     fn sync_positions(&mut self, slot: usize) -> Result<()> {
         if let Some((version, p)) = &self.positions {
@@ -709,9 +815,10 @@ fn surface_frame_params(
 /// chooses. Thread-safe.
 ///
 /// # Safety
-/// `desc` is NULL (defaults: best device, validation off) or points to a readable
-/// `TesseraStandaloneDesc` whose `device` is NULL or a NUL-terminated string; `out` points to
-/// a writable `TesseraContext*` (set to NULL on failure).
+/// `desc` is NULL (defaults: best device, validation off, the default pipeline cache) or
+/// points to a readable `TesseraStandaloneDesc` whose `device` and `pipeline_cache_dir` are
+/// NULL or NUL-terminated strings; `out` points to a writable `TesseraContext*` (set to NULL
+/// on failure).
 #[no_mangle]
 pub unsafe extern "C" fn tessera_context_create_standalone(
     desc: *const TesseraStandaloneDesc,
@@ -721,10 +828,9 @@ pub unsafe extern "C" fn tessera_context_create_standalone(
         // SAFETY: the caller's contract for `out`.
         unsafe { out_write(out, std::ptr::null_mut(), "out") }?;
         // SAFETY: the caller's contract for `desc`.
-        let desc = unsafe { ffi::read_opt(desc) }.unwrap_or(TesseraStandaloneDesc {
-            device: std::ptr::null(),
-            validation: TESSERA_VALIDATION_OFF,
-        });
+        let desc = unsafe { ffi::read_opt(desc) }.unwrap_or_default();
+        // SAFETY: the caller's contract for `desc.pipeline_cache_dir`.
+        let cache = unsafe { pipeline_cache_dir(desc.pipeline_cache, desc.pipeline_cache_dir) }?;
         // SAFETY: the caller's contract for `desc.device`.
         let selector: DeviceSelector = unsafe { read_str(desc.device, "device") }?
             .unwrap_or_default()
@@ -752,6 +858,7 @@ pub unsafe extern "C" fn tessera_context_create_standalone(
             &instance,
             &DeviceDesc {
                 selector,
+                pipeline_cache_dir: cache,
                 ..DeviceDesc::default()
             },
             &[],
@@ -807,16 +914,40 @@ pub unsafe extern "C" fn tessera_context_validation_errors(
     })
 }
 
+/// `TESSERA_SCHEME_*` as a scheme, `None` for AUTO.
+fn given_scheme(scheme: TesseraScheme) -> Result<Option<topology::Scheme>> {
+    use topology::Scheme;
+    match scheme {
+        TESSERA_SCHEME_AUTO => Ok(None),
+        TESSERA_SCHEME_CATMULL_CLARK => Ok(Some(Scheme::CatmullClark)),
+        TESSERA_SCHEME_LOOP => Ok(Some(Scheme::Loop)),
+        v => Err(invalid("scheme", v, "a TESSERA_SCHEME_* value")),
+    }
+}
+
+/// The scheme of a surface's limit surface: the one given, else its technique's, else Loop
+/// when every face is a triangle and Catmull-Clark otherwise.
+fn surface_scheme(
+    scheme: TesseraScheme,
+    technique: Option<TechniqueId>,
+    mesh: &topology::ControlMesh,
+) -> Result<topology::Scheme> {
+    use topology::Scheme;
+    let drawn = technique.and_then(|t| tess::techniques::info(t).scheme);
+    Ok(given_scheme(scheme)?.or(drawn).unwrap_or_else(|| {
+        if mesh.faces().all(|f| f.len() == 3) {
+            Scheme::Loop
+        } else {
+            Scheme::CatmullClark
+        }
+    }))
+}
+
 /// The technique `d` asks for on `mesh`, and the mesh it is built from (a strict Loop scheme
 /// refuses non-triangles, naming the face).
 fn choose_technique(d: &TesseraSurfaceDesc, mesh: &topology::ControlMesh) -> Result<TechniqueId> {
     use topology::Scheme;
-    let scheme = match d.scheme {
-        TESSERA_SCHEME_AUTO => None,
-        TESSERA_SCHEME_CATMULL_CLARK => Some(Scheme::CatmullClark),
-        TESSERA_SCHEME_LOOP => Some(Scheme::Loop),
-        v => return Err(invalid("scheme", v, "a TESSERA_SCHEME_* value")),
-    };
+    let scheme = given_scheme(d.scheme)?;
     if scheme == Some(Scheme::Loop) {
         if let Some((face, f)) = mesh.faces().enumerate().find(|(_, f)| f.len() != 3) {
             return Err(topology::TopologyError::LoopRequiresTriangles {
@@ -833,9 +964,7 @@ fn choose_technique(d: &TesseraSurfaceDesc, mesh: &topology::ControlMesh) -> Res
             } else {
                 Scheme::CatmullClark
             });
-            tess::registry()
-                .iter()
-                .find(|i| i.scheme == Some(scheme))
+            tess::techniques::default_for(scheme)
                 .map(|i| i.id)
                 .ok_or_else(|| {
                     Error::new(
@@ -844,14 +973,11 @@ fn choose_technique(d: &TesseraSurfaceDesc, mesh: &topology::ControlMesh) -> Res
                     )
                 })?
         }
-        TESSERA_TECHNIQUE_FLAT => TechniqueId::Flat,
-        TESSERA_TECHNIQUE_PHONG => TechniqueId::Phong,
-        TESSERA_TECHNIQUE_PN => TechniqueId::Pn,
-        TESSERA_TECHNIQUE_BFT => TechniqueId::Bft,
-        TESSERA_TECHNIQUE_ADAPTIVE => TechniqueId::Adaptive,
-        TESSERA_TECHNIQUE_GREGORY => TechniqueId::Gregory,
-        TESSERA_TECHNIQUE_ACC => TechniqueId::Acc,
-        v => return Err(invalid("technique", v, "a TESSERA_TECHNIQUE_* value")),
+        // Every other value is a registry entry's stable C ABI value.
+        v => match tess::techniques::by_abi_code(v) {
+            Some(info) => info.id,
+            None => return Err(invalid("technique", v, "a TESSERA_TECHNIQUE_* value")),
+        },
     };
     let info = tess::techniques::info(technique);
     if let (Some(want), Some(draws)) = (scheme, info.scheme) {
@@ -1003,7 +1129,7 @@ unsafe fn create_surface(
         v => return Err(invalid("end_cap", v, "a TESSERA_END_CAP_* value")),
     };
     let split_triangles = flag(d.split_triangles, "split_triangles")?;
-    if split_triangles && !matches!(technique, TechniqueId::Gregory | TechniqueId::Acc) {
+    if split_triangles && !tess::techniques::info(technique).features.single_pass {
         return Err(Error::new(
             TesseraStatus::InvalidArgument,
             format!(
@@ -1029,12 +1155,32 @@ unsafe fn create_surface(
         Mode::Host {
             frames_in_flight,
             formats,
+            subpass: None,
             ..
         } => tess::Context::new(&c.device, formats[0], formats[1], *frames_in_flight)?,
+        Mode::Host {
+            frames_in_flight,
+            formats,
+            subpass: Some(subpass),
+            ..
+        } => tess::Context::for_subpass(
+            &c.device,
+            *subpass,
+            formats[0],
+            formats[1],
+            *frames_in_flight,
+        )?,
     };
     let built = tess::build(&mut t, technique, &mesh, &options)?;
     let slots = t.frames_in_flight();
+    let info = tess::techniques::info(technique);
     let state = SurfaceState {
+        scheme: surface_scheme(d.scheme, Some(technique), &mesh)?,
+        sharpness_scale: if info.scheme == Some(topology::Scheme::CatmullClark) {
+            d.sharpness_scale
+        } else {
+            1.0
+        },
         technique: built.technique,
         tess: t,
         vertex_count: mesh.positions.len(),
@@ -1052,6 +1198,7 @@ unsafe fn create_surface(
         ),
         positions: None,
         slot_versions: vec![0; slots],
+        mesh,
     };
     Ok(lock(registry())?.add_surface(ctx_id, state))
 }
@@ -1504,58 +1651,8 @@ pub unsafe extern "C" fn tessera_render(
         let out = unsafe { ffi::write_slice(pixels, pixels_len, "pixels") }?;
         let image = s
             .tess
-            .render_offscreen(s.technique.as_ref(), &params, extent)?;
+            .render_offscreen(s.technique.as_mut(), &params, extent)?;
         out.copy_from_slice(&image.pixels);
-        Ok(())
-    })
-}
-
-/// Standalone: captures the triangles the GPU's tessellation emitted for one frame (transform
-/// feedback) and writes them as OBJ to `path`, welded by position bits as `tessera export`
-/// writes them; `triangles` (may be NULL) receives the count. UNSUPPORTED on a device without
-/// VK_EXT_transform_feedback. Thread-safe (serialized per context).
-///
-/// # Safety
-/// `frame` is readable; `path` is NUL-terminated; `triangles` is NULL or writable.
-#[no_mangle]
-pub unsafe extern "C" fn tessera_capture_obj(
-    ctx: *mut TesseraContext,
-    surface: *mut TesseraSurface,
-    frame: *const TesseraFrameDesc,
-    path: *const c_char,
-    triangles: *mut u64,
-) -> TesseraStatus {
-    with_surface(ctx, surface, |c, s| {
-        standalone_only(c, "tessera_capture_obj")?;
-        // SAFETY: the caller's contract.
-        let f = unsafe { ffi::read_required(frame, "frame") }?;
-        // SAFETY: the caller's contract (see this function's `# Safety`).
-        let path = unsafe { read_str(path, "path") }?
-            .ok_or_else(|| Error::new(TesseraStatus::NullPointer, "path is NULL"))?;
-        let (params, extent) = surface_frame_params(s, &f)?;
-        let capturer = tess::Capturer::new(&s.tess)?;
-        let technique = s.technique.as_ref();
-        let (soup, _) = capturer.capture(&mut s.tess, technique, &params, extent)?;
-        let welded = soup.weld()?;
-        if let Some(i) = welded
-            .positions
-            .iter()
-            .chain(&welded.normals)
-            .position(|p| !p.iter().all(|x| x.is_finite()))
-        {
-            return Err(Error::new(
-                TesseraStatus::NonFinite,
-                format!("the GPU emitted a non-finite position or normal (captured value {i}); nothing written"),
-            ));
-        }
-        let map = |patch: u32, domain: [f32; 2]| technique.face_point(patch, domain);
-        welded.write_obj(
-            std::path::Path::new(&path),
-            &map,
-            tess::capture::Winding::Reversed,
-        )?;
-        // SAFETY: the caller's contract; NULL is skipped.
-        unsafe { ffi::out_write_opt(triangles, soup.triangle_count() as u64) };
         Ok(())
     })
 }
@@ -1570,7 +1667,9 @@ fn standalone_only(c: &ContextState, call: &str) -> Result<()> {
     }
 }
 
+pub mod capture;
 pub mod host;
+pub mod limit;
 
 #[cfg(test)]
 mod tests {

@@ -3,9 +3,9 @@
 //! dereferenced. So a null, forged, destroyed or twice-destroyed handle is looked up, found
 //! missing and answered with a code; it can never reach freed memory.
 //!
-//! Numbers come from one 64-bit counter shared by both kinds and are never reused, so a
-//! destroyed handle stays distinguishable from one never issued, and a surface passed where a
-//! context is expected is not mistaken for one.
+//! Numbers come from one 64-bit counter shared by every kind (contexts, surfaces, limit
+//! evaluators) and are never reused, so a destroyed handle stays distinguishable from one never
+//! issued, and a surface passed where a context is expected is not mistaken for one.
 use crate::status::{Error, Result, TesseraStatus};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -14,6 +14,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 pub(crate) enum Kind {
     Context,
     Surface,
+    Evaluator,
 }
 
 impl Kind {
@@ -21,21 +22,24 @@ impl Kind {
         match self {
             Kind::Context => "context",
             Kind::Surface => "surface",
+            Kind::Evaluator => "limit evaluator",
         }
     }
 }
 
 /// Every handle issued: its kind and whether it is live. Destroyed entries stay (a few bytes
 /// each) so double destroy and use after destroy are told apart from a forged handle.
-pub(crate) struct Registry<C, S> {
+pub(crate) struct Registry<C, S, E> {
     next: u64,
     issued: HashMap<u64, Kind>,
     contexts: HashMap<u64, Arc<Mutex<C>>>,
     /// Each live surface with the context it was created on.
     surfaces: HashMap<u64, (u64, Arc<Mutex<S>>)>,
+    /// Limit evaluators: immutable, so shared without a lock (any number of threads at once).
+    evaluators: HashMap<u64, Arc<E>>,
 }
 
-impl<C, S> Default for Registry<C, S> {
+impl<C, S, E> Default for Registry<C, S, E> {
     fn default() -> Self {
         Self {
             // 0 is the null handle; start high enough that small forged integers are unissued.
@@ -43,11 +47,12 @@ impl<C, S> Default for Registry<C, S> {
             issued: HashMap::new(),
             contexts: HashMap::new(),
             surfaces: HashMap::new(),
+            evaluators: HashMap::new(),
         }
     }
 }
 
-impl<C, S> Registry<C, S> {
+impl<C, S, E> Registry<C, S, E> {
     fn issue(&mut self, kind: Kind) -> u64 {
         // Ids step by 16 so that the pointer a host sees is aligned like a real one.
         let id = self.next;
@@ -66,6 +71,26 @@ impl<C, S> Registry<C, S> {
         let id = self.issue(Kind::Surface);
         self.surfaces.insert(id, (context, Arc::new(Mutex::new(s))));
         id
+    }
+
+    pub fn add_evaluator(&mut self, e: E) -> u64 {
+        let id = self.issue(Kind::Evaluator);
+        self.evaluators.insert(id, Arc::new(e));
+        id
+    }
+
+    pub fn evaluator(&self, id: u64) -> Result<Arc<E>> {
+        self.evaluators
+            .get(&id)
+            .cloned()
+            .ok_or_else(|| self.missing(id, Kind::Evaluator))
+    }
+
+    pub fn remove_evaluator(&mut self, id: u64) -> Result<Arc<E>> {
+        match self.evaluators.remove(&id) {
+            Some(e) => Ok(e),
+            None => Err(self.missing(id, Kind::Evaluator)),
+        }
     }
 
     fn missing(&self, id: u64, want: Kind) -> Error {

@@ -150,7 +150,9 @@ pub(crate) fn vk_status(e: &VkError) -> TesseraStatus {
         | V::OutOfBounds { .. } => TesseraStatus::Internal,
         V::Extent { .. } => TesseraStatus::InvalidArgument,
         V::PictureSize { .. } => TesseraStatus::WrongSize,
-        V::Recording { .. } | V::Descriptor { .. } => TesseraStatus::Recording,
+        V::Recording { .. } | V::Descriptor { .. } | V::IndirectCommand { .. } => {
+            TesseraStatus::Recording
+        }
         V::Io { .. } | V::Image { .. } => TesseraStatus::Io,
     }
 }
@@ -167,13 +169,15 @@ pub(crate) fn tess_status(e: &TessError) -> TesseraStatus {
         E::OutOfRange { .. }
         | E::UnknownTechnique { .. }
         | E::BftSegments { .. }
+        | E::RefinedSegments { .. }
         | E::TableLevel { .. }
         | E::BenchConfig { .. }
         | E::Csv { .. } => TesseraStatus::InvalidArgument,
         E::Unsupported { .. }
         | E::NeedsTangentTables
         | E::StorageWindow { .. }
-        | E::BftTablesTooLarge { .. } => TesseraStatus::Unsupported,
+        | E::BftTablesTooLarge { .. }
+        | E::RefinedTooLarge { .. } => TesseraStatus::Unsupported,
         E::BasePositionCount { .. } => TesseraStatus::WrongSize,
         E::FrameSlot { .. } | E::IndexOutOfRange { .. } => TesseraStatus::IndexOutOfRange,
         E::NonFiniteVertex { .. } => TesseraStatus::NonFinite,
@@ -185,7 +189,7 @@ pub(crate) fn tess_status(e: &TessError) -> TesseraStatus {
         E::CaptureTooLarge { .. } | E::CaptureOverflow { .. } | E::PartialTriangle { .. } => {
             TesseraStatus::Capture
         }
-        E::Io { .. } | E::Image { .. } => TesseraStatus::Io,
+        E::Io { .. } | E::Write { .. } | E::Image { .. } => TesseraStatus::Io,
     }
 }
 

@@ -15,6 +15,7 @@ fn capture_writes_the_triangles_the_gpu_drew() {
         let desc = TesseraStandaloneDesc {
             device: null(),
             validation: TESSERA_VALIDATION_SYNCHRONIZATION,
+            ..Default::default()
         };
         let mut ctx = null_mut();
         assert_eq!(

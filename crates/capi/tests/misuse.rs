@@ -126,6 +126,7 @@ fn misuse_gets_codes_and_messages_never_undefined_behaviour() {
         let bad_validation = TesseraStandaloneDesc {
             device: null(),
             validation: 7,
+            ..Default::default()
         };
         let mut ctx = null_mut();
         expect(
@@ -137,6 +138,7 @@ fn misuse_gets_codes_and_messages_never_undefined_behaviour() {
         let no_device = TesseraStandaloneDesc {
             device: c"no such device name".as_ptr(),
             validation: TESSERA_VALIDATION_OFF,
+            ..Default::default()
         };
         expect(
             tessera_context_create_standalone(&no_device, &mut ctx),
@@ -146,6 +148,7 @@ fn misuse_gets_codes_and_messages_never_undefined_behaviour() {
         let cdesc = TesseraStandaloneDesc {
             device: null(),
             validation: TESSERA_VALIDATION_SYNCHRONIZATION,
+            ..Default::default()
         };
         assert_eq!(
             tessera_context_create_standalone(&cdesc, &mut ctx),
@@ -374,6 +377,7 @@ fn misuse_gets_codes_and_messages_never_undefined_behaviour() {
         let validated = TesseraStandaloneDesc {
             device: null(),
             validation: TESSERA_VALIDATION_SYNCHRONIZATION,
+            ..Default::default()
         };
         assert_eq!(
             tessera_context_create_standalone(&validated, &mut other),

@@ -133,6 +133,7 @@ fn single_pass_techniques_draw_textures_and_displace_by_the_height_map() {
     let desc = TesseraStandaloneDesc {
         device: null(),
         validation: TESSERA_VALIDATION_SYNCHRONIZATION,
+        ..Default::default()
     };
     let mut ctx = null_mut();
     // SAFETY: `desc` and `ctx` are live locals.
@@ -275,6 +276,7 @@ fn bad_maps_and_frame_options_get_named_statuses() {
     let desc = TesseraStandaloneDesc {
         device: null(),
         validation: TESSERA_VALIDATION_SYNCHRONIZATION,
+        ..Default::default()
     };
     let mut ctx = null_mut();
     // SAFETY: `desc` and `ctx` are live locals.
@@ -308,8 +310,8 @@ fn bad_maps_and_frame_options_get_named_statuses() {
     nan_heights[8 * 3 + 5] = f32::NAN;
 
     // An unknown technique value.
-    let (status, s) = create(&surface_desc(8));
-    expect(status, TesseraStatus::InvalidArgument, "technique 8");
+    let (status, s) = create(&surface_desc(99));
+    expect(status, TesseraStatus::InvalidArgument, "technique 99");
     assert!(s.is_null());
 
     // NULL with a size, a size of 0 with a pointer, a side over the limit.

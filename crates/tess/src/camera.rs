@@ -21,6 +21,10 @@ impl Default for Camera {
     }
 }
 
+/// The smallest radius framed: far above f32's smallest normal number (1.2e-38), so the eye's
+/// distance and the near plane (a hundredth of it) stay normal numbers.
+const MIN_RADIUS: f32 = 1e-33;
+
 /// View, projection and eye position for one frame.
 #[derive(Clone, Copy, Debug)]
 pub struct CameraMatrices {
@@ -38,9 +42,20 @@ impl Camera {
         let center = (lo + hi) * 0.5;
         // A box that is a point (or thinner than f32 resolves at its distance from the origin)
         // would put the eye on the centre after rounding: NaN view. The radius is kept to a
-        // few hundred ulps of the centre's largest coordinate.
+        // few hundred ulps of the centre's largest coordinate, and above f32's smallest normal
+        // numbers (a point at the origin). No other floor: a mesh of size 1e-9 or 1e-30 fills
+        // the view like one of size 1. Nothing below squares a length of the mesh's size (the
+        // box's diagonal is taken scaled, the view direction is the unit `dir`), so nothing
+        // underflows.
         let resolution = center.abs().max_element() * 1e-4;
-        let radius = ((hi - lo).length() * 0.5).max(resolution).max(1e-6);
+        let half = hi - lo;
+        let scale = half.abs().max_element();
+        let diagonal = if scale > 0.0 {
+            (half / scale).length() * scale
+        } else {
+            0.0
+        };
+        let radius = (diagonal * 0.5).max(resolution).max(MIN_RADIUS);
         let fov = self.fov_y_degrees.to_radians();
         let half = (fov * 0.5).tan().min((fov * 0.5).tan() * aspect.max(1e-3));
         let distance = radius / half.atan().sin() / self.zoom.max(1e-3);
@@ -54,7 +69,7 @@ impl Camera {
             yaw.cos() * pitch.cos(),
         );
         let eye = center + dir * distance;
-        let view = Mat4::look_at_rh(eye, center, Vec3::Y);
+        let view = Mat4::look_to_rh(eye, -dir, Vec3::Y);
         let near = (distance - radius * 1.5).max(distance * 0.01);
         let far = distance + radius * 1.5;
         let proj = Mat4::perspective_rh(fov, aspect.max(1e-3), near, far);
@@ -84,6 +99,24 @@ mod tests {
             let m = cam.matrices(lo, hi, 4.0 / 3.0);
             assert!(finite(&m), "{lo:?}..{hi:?}: {m:?}");
             assert_ne!(m.eye, Vec3::from(lo), "{lo:?}: eye on the centre");
+        }
+    }
+
+    /// A small box fills the view as a large one does: its corners project to the same
+    /// normalized device coordinates (the eye's distance follows the box, with no absolute
+    /// floor; one of 1e-6 kept a 1e-9 cube a thousandth of the picture).
+    #[test]
+    fn small_boxes_fill_the_view_like_large_ones() {
+        let cam = Camera::default();
+        let project = |s: f32| {
+            let m = cam.matrices([-s; 3], [s; 3], 4.0 / 3.0);
+            let p = m.proj * m.view * glam::Vec4::new(s, s, s, 1.0);
+            glam::Vec2::new(p.x / p.w, p.y / p.w)
+        };
+        let unit = project(1.0);
+        for s in [1e-3, 1e-6, 1e-9, 1e-12, 1e-20, 1e-30] {
+            let q = project(s);
+            assert!((q - unit).length() < 1e-3, "{s}: {q} against {unit}");
         }
     }
 }

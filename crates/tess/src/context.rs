@@ -2,23 +2,26 @@
 //! one pipeline cache, per-technique descriptor-set layouts, and the recording of a frame —
 //! pre-pass, shaded pass, wireframe overlay, capture pass — the same for every technique.
 //!
-//! Pipelines are built on first use from a technique's [`PatchPipeline`](crate::technique::PatchPipeline) and keyed by
-//! [`PipelineKey`] (technique, patch type, spacing, pass). Spacing is a layout qualifier of
-//! the evaluation stage, so it selects a SPIR-V variant, not a specialization constant.
+//! Pipelines are built on first use from a technique's [`PatchPipeline`] and keyed by
+//! [`PipelineKey`] (technique, patch type, spacing, pass, builds). Both draw paths go through
+//! the same cache and the same pass styles: tessellated patches (`PATCH_LIST`, the evaluation
+//! stage built per spacing, since spacing is a layout qualifier and selects a SPIR-V variant)
+//! and vertex-stage triangles (`TRIANGLE_LIST`, the vertex stage last before rasterization).
 //!
 //! Drop order (field order): pipelines, set layouts, frame sets, device handle.
 use crate::error::{Result, TessError};
 use crate::gpu::bindings::FRAME_UNIFORMS_BINDING;
-use crate::gpu::{FrameUniforms, Vertex};
+use crate::gpu::FrameUniforms;
 use crate::shaders::{self, Variant};
 use crate::technique::{
-    DrawCounts, DrawSplit, FactorPolicy, FrameParams, Pass, PatchType, Technique, TechniqueId,
+    DrawCounts, DrawSplit, FactorPolicy, FrameParams, Geometry, Pass, PatchPipeline, PatchType,
+    Technique, TechniqueId,
 };
 use crate::tessellator::{Spacing, MAX_LEVEL};
 use std::collections::HashMap;
 use std::mem::size_of;
 use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
-use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage, TessellationDesc};
+use vk_core::pipeline::{GraphicsPipelineDesc, Pipeline, ShaderStage, Subpass, TessellationDesc};
 use vk_core::query::{PipelineStatistics, QueryPool};
 use vk_core::target::{OffscreenTarget, Rgba8, COLOR_FORMAT, DEPTH_FORMAT};
 use vk_core::workarounds::WorkaroundId;
@@ -36,6 +39,31 @@ pub struct PipelineKey {
     /// The technique's own axes ([`crate::technique::PatchPipeline::axes`]): two builds of one
     /// technique may differ in them.
     pub axes: Variant,
+}
+
+impl PipelineKey {
+    /// The pipeline `technique` draws `patch` with in `pass` of a frame of `params`. Spacing
+    /// keys only tessellated pipelines (the vertex-stage path has no tessellator).
+    pub fn of(
+        technique: &dyn Technique,
+        patch: PatchType,
+        params: &FrameParams,
+        pass: Pass,
+    ) -> Self {
+        let pp = technique.patch_pipeline(patch);
+        Self {
+            technique: technique.id(),
+            patch,
+            spacing: if pp.geometry.is_tessellated() {
+                params.spacing
+            } else {
+                Spacing::Equal
+            },
+            pass,
+            surface: technique.surface_build(params),
+            axes: pp.axes,
+        }
+    }
 }
 
 /// Set 0 of every pipeline: one uniform buffer and descriptor set per frame slot.
@@ -92,6 +120,9 @@ pub struct Context {
     frames: FrameSets,
     color_format: vk::Format,
     depth_format: vk::Format,
+    /// The host's render pass subpass the draw pipelines are made for; `None`: dynamic
+    /// rendering ([`Self::for_subpass`]).
+    subpass: Option<Subpass>,
     device: Device,
 }
 
@@ -113,8 +144,24 @@ impl Context {
             frames: FrameSets::new(device, frames_in_flight)?,
             color_format,
             depth_format,
+            subpass: None,
             device: device.clone(),
         })
+    }
+
+    /// A context whose draw pipelines render in `subpass` of a host's render pass (whose
+    /// colour and depth attachments have these formats; `UNDEFINED` for none) instead of a
+    /// dynamic-rendering scope. Capture pipelines still use a scope of their own.
+    pub fn for_subpass(
+        device: &Device,
+        subpass: Subpass,
+        color_format: vk::Format,
+        depth_format: vk::Format,
+        frames_in_flight: usize,
+    ) -> Result<Self> {
+        let mut ctx = Self::new(device, color_format, depth_format, frames_in_flight)?;
+        ctx.subpass = Some(subpass);
+        Ok(ctx)
     }
 
     /// A context for offscreen targets (RGBA8 + D32) and captures, one frame slot.
@@ -205,29 +252,30 @@ impl Context {
         Ok(())
     }
 
-    /// Checks `params` and builds the pipelines `passes` need for `technique`. Must precede
-    /// recording (which borrows the context immutably for the encoder's lifetime).
+    /// Checks `params` (what the technique's registry entry says it does not take, then its
+    /// own [`Technique::check`]), lets `technique` do the host work of the frame
+    /// ([`Technique::prepare_frame`]) and builds the pipelines `passes` need. Must precede
+    /// recording (which borrows the context and the technique immutably for the encoder's
+    /// lifetime).
     pub fn prepare(
         &mut self,
-        technique: &dyn Technique,
+        technique: &mut dyn Technique,
         params: &FrameParams,
         passes: &[Pass],
     ) -> Result<()> {
+        crate::techniques::info(technique.id())
+            .features
+            .refuse(technique.id(), params)?;
         technique.check(params)?;
+        technique.prepare_frame(params)?;
+        let technique = &*technique;
         let bindings = technique.set_layout_bindings();
         if !bindings.is_empty() {
             self.ensure_set_layout(technique.id(), bindings)?;
         }
         for array in technique.patch_arrays() {
             for &pass in passes {
-                let key = PipelineKey {
-                    technique: technique.id(),
-                    patch: array.patch,
-                    spacing: params.spacing,
-                    pass,
-                    surface: technique.surface_build(params),
-                    axes: technique.patch_pipeline(array.patch).axes,
-                };
+                let key = PipelineKey::of(technique, array.patch, params, pass);
                 if !self.pipelines.contains_key(&key) {
                     let p = self.build_pipeline(technique, key)?;
                     self.pipelines.insert(key, p);
@@ -250,48 +298,20 @@ impl Context {
             (self.color_format, self.depth_format)
         };
         let mut desc = GraphicsPipelineDesc::new(&name, color, depth);
-        let plain = Variant::default();
-        let evaluation = Variant {
-            spacing: Some(key.spacing),
-            capture,
-            surface: key.surface,
-            ..key.axes
-        };
-        desc.stages = vec![
-            ShaderStage::new(
-                vk::ShaderStageFlags::VERTEX,
-                shaders::spirv(pp.vertex, plain)?,
-            ),
-            ShaderStage::new(
-                vk::ShaderStageFlags::TESSELLATION_CONTROL,
-                shaders::spirv(pp.control, key.axes)?,
-            ),
-            ShaderStage::new(
-                vk::ShaderStageFlags::TESSELLATION_EVALUATION,
-                shaders::spirv(pp.evaluation, evaluation)?,
-            ),
-        ];
-        if !capture {
-            desc.stages.push(ShaderStage::new(
-                vk::ShaderStageFlags::FRAGMENT,
-                // The fragment stage reads what the evaluation stage's build hands it.
-                shaders::spirv(
-                    pp.fragment,
-                    Variant {
-                        surface: key.surface,
-                        ..plain
-                    },
-                )?,
-            ));
+        desc.subpass = if capture { None } else { self.subpass };
+        desc.stages = pipeline_stages(&pp, key)?;
+        desc.vertex_bindings = pp.vertex_input.bindings.to_vec();
+        desc.vertex_attributes = pp.vertex_input.attributes.to_vec();
+        match pp.geometry {
+            Geometry::Tessellated { control_points, .. } => {
+                desc.topology = vk::PrimitiveTopology::PATCH_LIST;
+                desc.tessellation = Some(TessellationDesc {
+                    patch_control_points: control_points,
+                    domain_origin: vk::TessellationDomainOrigin::UPPER_LEFT,
+                });
+            }
+            Geometry::Triangles => desc.topology = vk::PrimitiveTopology::TRIANGLE_LIST,
         }
-        if pp.mesh_vertex_input {
-            set_vertex_input(&mut desc);
-        }
-        desc.topology = vk::PrimitiveTopology::PATCH_LIST;
-        desc.tessellation = Some(TessellationDesc {
-            patch_control_points: pp.control_points,
-            domain_origin: vk::TessellationDomainOrigin::UPPER_LEFT,
-        });
         desc.set_layouts = vec![self.frames.layout.raw];
         if let Some(l) = self.set_layouts.get(&key.technique) {
             desc.set_layouts.push(l.raw);
@@ -314,6 +334,15 @@ impl Context {
             DrawSplit::Off => u32::MAX,
             DrawSplit::PerPatch => 1,
             DrawSplit::Auto => {
+                let tessellated = technique
+                    .patch_arrays()
+                    .get(array)
+                    .is_some_and(|a| technique.patch_pipeline(a.patch).geometry.is_tessellated());
+                if !tessellated {
+                    // The split works around the tessellator's chunking; a vertex-stage draw
+                    // is one draw.
+                    return u32::MAX;
+                }
                 let max = technique.max_vertices_per_patch(params, array);
                 self.device.workarounds.max_patches_per_draw(max)
             }
@@ -358,7 +387,7 @@ impl Context {
         array: usize,
     ) -> Result<DrawCounts> {
         self.bind_array(enc, technique, slot, params, pass, array)?;
-        self.draw_array(enc, technique, params, pass, array)
+        self.draw_array(enc, technique, slot, params, pass, array)
     }
 
     /// Binds the pipeline and sets of one pass of one patch array (a capture begins transform
@@ -376,14 +405,7 @@ impl Context {
             .patch_arrays()
             .get(array)
             .ok_or(TessError::NoPatchArray { array })?;
-        let key = PipelineKey {
-            technique: technique.id(),
-            patch: a.patch,
-            spacing: params.spacing,
-            pass,
-            surface: technique.surface_build(params),
-            axes: technique.patch_pipeline(a.patch).axes,
-        };
+        let key = PipelineKey::of(technique, a.patch, params, pass);
         let pipeline = self
             .pipelines
             .get(&key)
@@ -400,11 +422,13 @@ impl Context {
         Ok(())
     }
 
-    /// The draws of one pass of one patch array, after [`Self::bind_array`].
+    /// The draws of one pass of one patch array for frame slot `slot`, after
+    /// [`Self::bind_array`].
     pub fn draw_array<'a>(
         &'a self,
         enc: &mut Encoder<'a>,
         technique: &'a dyn Technique,
+        slot: usize,
         params: &FrameParams,
         pass: Pass,
         array: usize,
@@ -415,7 +439,7 @@ impl Context {
             .ok_or(TessError::NoPatchArray { array })?;
         enc.begin_label(&format!("{} {:?} {:?}", technique.id(), a.patch, pass));
         let per_draw = self.patches_per_draw(technique, params, array);
-        let counts = technique.record_array(enc, array, params, pass, per_draw)?;
+        let counts = technique.record_array(enc, array, slot, params, pass, per_draw)?;
         enc.end_label();
         Ok(counts)
     }
@@ -449,7 +473,7 @@ impl Context {
     /// overlay) and reads it back.
     pub fn render_offscreen(
         &mut self,
-        technique: &dyn Technique,
+        technique: &mut dyn Technique,
         params: &FrameParams,
         extent: vk::Extent2D,
     ) -> Result<Rgba8> {
@@ -462,12 +486,13 @@ impl Context {
     /// shaded pass (None where a driver workaround forbids the query for these patches).
     pub fn render_offscreen_stats(
         &mut self,
-        technique: &dyn Technique,
+        technique: &mut dyn Technique,
         params: &FrameParams,
         extent: vk::Extent2D,
         statistics: bool,
     ) -> Result<OffscreenFrame> {
         self.prepare(technique, params, Self::frame_passes(params))?;
+        let technique = &*technique;
         self.write_frame(0, technique.bbox(), params, extent)?;
         let device = self.device.clone();
         let target = OffscreenTarget::new(&device, extent)?;
@@ -515,6 +540,60 @@ pub struct OffscreenFrame {
     pub image: Rgba8,
     pub statistics: Option<PipelineStatistics>,
     pub counts: DrawCounts,
+}
+
+/// The shader stages of `pp` for `key`. The last stage before rasterization (the evaluation
+/// stage, or the vertex stage on the vertex-stage path) takes the frame's spacing, capture and
+/// surface builds; the fragment stage the surface build (it reads what that stage hands it);
+/// captures have no fragment stage.
+fn pipeline_stages(pp: &PatchPipeline, key: PipelineKey) -> Result<Vec<ShaderStage<'static>>> {
+    let capture = key.pass == Pass::Capture;
+    let last = Variant {
+        spacing: pp.geometry.is_tessellated().then_some(key.spacing),
+        capture,
+        surface: key.surface,
+        ..key.axes
+    };
+    let stage = |flags, stage, variant| -> Result<ShaderStage<'static>> {
+        Ok(ShaderStage::new(flags, shaders::spirv(stage, variant)?))
+    };
+    let mut stages = Vec::with_capacity(4);
+    match pp.geometry {
+        Geometry::Tessellated {
+            control,
+            evaluation,
+            ..
+        } => {
+            stages.push(stage(
+                vk::ShaderStageFlags::VERTEX,
+                pp.vertex,
+                Variant::default(),
+            )?);
+            stages.push(stage(
+                vk::ShaderStageFlags::TESSELLATION_CONTROL,
+                control,
+                key.axes,
+            )?);
+            stages.push(stage(
+                vk::ShaderStageFlags::TESSELLATION_EVALUATION,
+                evaluation,
+                last,
+            )?);
+        }
+        Geometry::Triangles => stages.push(stage(vk::ShaderStageFlags::VERTEX, pp.vertex, last)?),
+    }
+    if !capture {
+        let fragment = Variant {
+            surface: key.surface,
+            ..Variant::default()
+        };
+        stages.push(stage(
+            vk::ShaderStageFlags::FRAGMENT,
+            pp.fragment,
+            fragment,
+        )?);
+    }
+    Ok(stages)
 }
 
 /// Whether a pipeline-statistics query may wrap `technique`'s draws on `device`: lavapipe
@@ -593,11 +672,4 @@ pub(crate) fn set_pass_style(desc: &mut GraphicsPipelineDesc<'_>, pass: Pass) {
             desc.depth_write = false;
         }
     }
-}
-
-/// Vertex input of the interleaved [`Vertex`] (position at location 0, normal at 1): what
-/// `mesh.vert` and `plain.vert` read.
-pub(crate) fn set_vertex_input(desc: &mut GraphicsPipelineDesc<'_>) {
-    desc.vertex_bindings = vec![Vertex::BINDING];
-    desc.vertex_attributes = Vertex::ATTRIBUTES.to_vec();
 }

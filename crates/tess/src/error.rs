@@ -69,6 +69,23 @@ pub enum TessError {
         max: u64,
         hint: String,
     },
+    /// A mesh refined on the CPU halves every edge per level.
+    #[error(
+        "--segments {segments}: a mesh refined on the CPU takes a power of two in 1..={max} \
+         segments per base edge (each level halves every edge)"
+    )]
+    RefinedSegments { segments: f32, max: u32 },
+    /// A CPU refinement too large to hold.
+    #[error(
+        "{scheme} level {level} would have {vertices} vertices, more than the limit of {max} \
+         for a mesh refined on the CPU"
+    )]
+    RefinedTooLarge {
+        scheme: topology::Scheme,
+        level: usize,
+        vertices: u64,
+        max: u64,
+    },
     #[error("geometric normals need the tangent tables (this surface was built without them)")]
     NeedsTangentTables,
     /// One item's reach in a buffer exceeds the device's storage-buffer range: it cannot be
@@ -138,4 +155,8 @@ pub enum TessError {
         path: String,
         source: std::io::Error,
     },
+    /// A file Tessera writes could not be written whole ([`crate::output::write_file`]): the
+    /// operating system's reason is said in the message, not chained.
+    #[error("cannot write {path}: {error}")]
+    Write { path: String, error: std::io::Error },
 }

@@ -1,17 +1,21 @@
 //! The tessellation techniques: what joins `topology` (CPU truth) to `vk-core` (Vulkan).
 //!
-//! Every technique implements [`Technique`], the one seam its callers see; a [`Context`] owns
-//! the pipelines (one cache for all techniques), the frame uniforms and the recording of a
-//! frame; [`capture`] reads back exactly what any technique's TES emitted (transform feedback)
-//! and checks it for cracks. Techniques are built by name from [`techniques::registry`].
+//! Every technique implements [`Technique`], the one seam its callers see, on either draw path
+//! (patches through the tessellation stage, or triangles from the vertex stage); a [`Context`]
+//! owns the pipelines (one cache for all techniques and both paths), the frame uniforms and the
+//! recording of a frame; [`capture`] reads back exactly what any technique's last stage before
+//! rasterization emitted (transform feedback) and checks it for cracks. Techniques are built by
+//! name from [`techniques::registry`], where each declares itself once.
 #![forbid(unsafe_code)]
 pub mod bench;
 pub mod camera;
 pub mod capture;
 pub mod context;
 pub mod error;
+pub mod framing;
 pub mod gpu;
-pub mod plain;
+pub mod limit;
+pub mod output;
 pub mod render_mesh;
 pub mod shaders;
 pub mod surface;
@@ -25,8 +29,8 @@ pub use context::Context;
 pub use error::{Result, TessError};
 pub use render_mesh::RenderMesh;
 pub use technique::{
-    DeviceAllocation, DrawCounts, DrawSplit, FactorPolicy, Features, FrameParams, Pass, PatchArray,
-    PatchType, Technique, TechniqueId,
+    DeviceAllocation, DrawCounts, DrawPath, DrawSplit, FactorPolicy, Features, FrameParams,
+    Geometry, Pass, PatchArray, PatchPipeline, PatchType, Technique, TechniqueId, VertexInput,
 };
 pub use techniques::{build, registry, BuildOptions};
 pub use tessellator::{Domain, Spacing};

@@ -46,9 +46,6 @@ impl PatchOrigin {
     }
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
@@ -129,7 +126,11 @@ impl RenderMesh {
                 }
                 n
             }
-            None => angle_weighted_normals(&positions, &mesh.face_offsets, &corner_index),
+            None => topology::limit::limit_mesh::angle_weighted_normals(
+                &positions,
+                &mesh.face_offsets,
+                &corner_index,
+            ),
         };
 
         let mut out = RenderMesh {
@@ -169,59 +170,10 @@ impl RenderMesh {
                 out.quad_mode_triangle_origins.extend(fan_origins);
             }
         }
-        let mut lo = [f32::INFINITY; 3];
-        let mut hi = [f32::NEG_INFINITY; 3];
-        for v in &out.vertices {
-            for k in 0..3 {
-                lo[k] = lo[k].min(v.position[k]);
-                hi[k] = hi[k].max(v.position[k]);
-            }
-        }
-        out.bbox_min = lo;
-        out.bbox_max = hi;
+        // The vertices the faces use, not every vertex the file has.
+        (out.bbox_min, out.bbox_max) = crate::framing::drawn_bbox(mesh);
         Ok(out)
     }
-}
-
-/// Vertex normals as the sum of face normals weighted by each corner's angle (Thürmer & Wüthrich),
-/// independent of how faces are split into triangles.
-pub fn angle_weighted_normals(
-    positions: &[[f64; 3]],
-    face_offsets: &[u32],
-    corners: &[u32],
-) -> Vec<[f64; 3]> {
-    let mut acc = vec![[0.0f64; 3]; positions.len()];
-    for f in 0..face_offsets.len().saturating_sub(1) {
-        let face = &corners[face_offsets[f] as usize..face_offsets[f + 1] as usize];
-        // Newell's method: robust for non-planar polygons.
-        let mut n = [0.0; 3];
-        for i in 0..face.len() {
-            let a = positions[face[i] as usize];
-            let b = positions[face[(i + 1) % face.len()] as usize];
-            n[0] += (a[1] - b[1]) * (a[2] + b[2]);
-            n[1] += (a[2] - b[2]) * (a[0] + b[0]);
-            n[2] += (a[0] - b[0]) * (a[1] + b[1]);
-        }
-        let Some(n) = normalize(n) else { continue };
-        for i in 0..face.len() {
-            let v = face[i] as usize;
-            let prev = positions[face[(i + face.len() - 1) % face.len()] as usize];
-            let next = positions[face[(i + 1) % face.len()] as usize];
-            let (Some(e0), Some(e1)) = (
-                normalize(sub(prev, positions[v])),
-                normalize(sub(next, positions[v])),
-            ) else {
-                continue;
-            };
-            let angle = dot(e0, e1).clamp(-1.0, 1.0).acos();
-            for k in 0..3 {
-                acc[v][k] += angle * n[k];
-            }
-        }
-    }
-    acc.into_iter()
-        .map(|n| normalize(n).unwrap_or([0.0, 0.0, 1.0]))
-        .collect()
 }
 
 #[cfg(test)]

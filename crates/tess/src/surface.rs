@@ -56,11 +56,43 @@ impl SurfaceShow {
     }
 }
 
+/// The largest image file read as a colour texture or height map: 512 MiB.
+pub const MAX_IMAGE_BYTES: u64 = 512 << 20;
+
+/// The largest side, in pixels, of a colour texture or height map: what Vulkan devices commonly
+/// take (`maxImageDimension2D`, 16384 on lavapipe and most desktop GPUs; a device with less
+/// refuses the upload by its own limit).
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+/// The image at `path`, decoded only after its header says a size within
+/// [`MAX_IMAGE_SIDE`] (so a 20000×20000 map is refused before 2 GB are decoded); the file is
+/// read as every input is ([`topology::mesh::input::read_regular_file`]: regular files within
+/// [`MAX_IMAGE_BYTES`]).
 fn open(path: &Path) -> Result<image::DynamicImage> {
-    image::open(path).map_err(|e| TessError::Image {
+    let err = |message: String| TessError::Image {
         file: path.display().to_string(),
-        message: e.to_string(),
-    })
+        message,
+    };
+    let bytes = topology::mesh::input::read_regular_file(path, MAX_IMAGE_BYTES, "an image")
+        .map_err(|e| err(format!("cannot read file: {e}")))?;
+    // The size is bounded here, not by the decoder's default allocation limit (512 MiB,
+    // less than a 16384² RGBA map takes).
+    let reader = || {
+        let mut r = image::ImageReader::new(std::io::Cursor::new(&bytes))
+            .with_guessed_format()
+            .map_err(|e| err(e.to_string()))?;
+        r.no_limits();
+        Ok::<_, TessError>(r)
+    };
+    let (width, height) = reader()?
+        .into_dimensions()
+        .map_err(|e| err(e.to_string()))?;
+    if width == 0 || height == 0 || width > MAX_IMAGE_SIDE || height > MAX_IMAGE_SIDE {
+        return Err(err(format!(
+            "{width}x{height} pixels, outside 1..{MAX_IMAGE_SIDE} per side"
+        )));
+    }
+    reader()?.decode().map_err(|e| err(e.to_string()))
 }
 
 /// A colour texture (sRGB, mipmapped on upload).
@@ -156,5 +188,32 @@ mod tests {
         assert_eq!(h.len(), (height.width * height.height) as usize);
         assert!(h.iter().all(|x| (0.0..=1.0).contains(x)));
         assert!(h.iter().any(|&x| x > 0.0) && h.iter().any(|&x| x < 1.0));
+    }
+
+    /// A map wider or taller than [`MAX_IMAGE_SIDE`] is refused by its header, naming the file
+    /// and the size; what is not a regular file is refused unopened.
+    #[test]
+    fn oversized_and_irregular_images_are_refused_before_decoding() {
+        let dir = scratch();
+        let wide = dir.join("wide.png");
+        image::GrayImage::new(MAX_IMAGE_SIDE + 1, 1)
+            .save(&wide)
+            .unwrap();
+        let e = load_height(&wide).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            format!(
+                "{}: 16385x1 pixels, outside 1..16384 per side",
+                wide.display()
+            )
+        );
+        #[cfg(unix)]
+        {
+            let e = load_texture("/dev/zero").unwrap_err().to_string();
+            assert!(
+                e.contains("/dev/zero: cannot read file: is a character device"),
+                "{e}"
+            );
+        }
     }
 }

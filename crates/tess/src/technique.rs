@@ -27,30 +27,22 @@ use crate::shaders::{Stage, Variant};
 use crate::tessellator::{Domain, Spacing};
 use vk_core::{DescriptorSet, Encoder};
 
-/// The techniques Tessera has; keys pipelines and names techniques in messages.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum TechniqueId {
-    Flat,
-    Phong,
-    Pn,
-    Bft,
-    Adaptive,
-    Gregory,
-    Acc,
-}
+/// A technique's name: keys pipelines and names techniques in messages. Each technique
+/// declares its own constant in its folder (`TechniqueId::FLAT` in `techniques/flat/`), and
+/// the registry ([`crate::techniques::registry`]) lists them; nothing else enumerates them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct TechniqueId(&'static str);
 
 impl TechniqueId {
+    /// The id named `name` (the command line's `--method NAME`): made only next to a
+    /// registry entry (outside this crate, ids come from the registry or by name).
+    pub(crate) const fn new(name: &'static str) -> Self {
+        Self(name)
+    }
+
     /// The command-line name (`--method NAME`).
     pub fn name(self) -> &'static str {
-        match self {
-            TechniqueId::Flat => "flat",
-            TechniqueId::Phong => "phong",
-            TechniqueId::Pn => "pn",
-            TechniqueId::Bft => "bft",
-            TechniqueId::Adaptive => "adaptive",
-            TechniqueId::Gregory => "gregory",
-            TechniqueId::Acc => "acc",
-        }
+        self.0
     }
 }
 
@@ -60,8 +52,9 @@ impl std::fmt::Display for TechniqueId {
     }
 }
 
-/// The type of the patches of one array: decides the domain, the shader stages and the
-/// pipeline. Future techniques add theirs (regular B-spline, Gregory, ...).
+/// The type of the patches of one array: decides the domain, the geometry path and the
+/// pipeline (OpenSubdiv's `PatchDescriptor::Type`, whose non-patch types are drawn without
+/// tessellation too).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum PatchType {
     /// A base triangle (or fan triangle of a polygon), three control points.
@@ -79,6 +72,9 @@ pub enum PatchType {
     Bilinear,
     /// A Gregory triangle patch (15 control points fetched by the control stage).
     GregoryTriangle,
+    /// Triangles of a mesh refined before the draw (no tessellation stage): the vertex stage
+    /// reads each vertex as it is. A captured id names a vertex of the mesh.
+    MeshTriangles,
 }
 
 impl PatchType {
@@ -87,18 +83,23 @@ impl PatchType {
             PatchType::Quad | PatchType::BSpline | PatchType::Gregory | PatchType::Bilinear => {
                 Domain::Quad
             }
-            PatchType::Triangle | PatchType::LoopBft | PatchType::GregoryTriangle => {
-                Domain::Triangle
-            }
+            PatchType::Triangle
+            | PatchType::LoopBft
+            | PatchType::GregoryTriangle
+            | PatchType::MeshTriangles => Domain::Triangle,
         }
     }
 }
 
 /// One array of patches of one type.
+///
+/// A *patch* is the unit a captured id names: a tessellated patch, or on the vertex-stage
+/// path whatever the technique numbers (a vertex of a refined mesh, a pattern instance).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PatchArray {
     pub patch: PatchType,
     pub patches: u32,
+    /// Control points per tessellated patch; 0 on the vertex-stage path.
     pub control_points: u32,
     /// Frame-wide id of the array's first patch.
     pub first_patch: u32,
@@ -129,8 +130,9 @@ pub enum Pass {
     Shaded,
     /// Wireframe overlay (lines, no depth writes).
     Wireframe,
-    /// No attachments, rasterizer discard; the TES's `-DCAPTURE` build writes transform
-    /// feedback records.
+    /// No attachments, rasterizer discard; the `-DCAPTURE` build of the last stage before
+    /// rasterization (the evaluation stage, or the vertex stage on the vertex-stage path)
+    /// writes transform feedback records.
     Capture,
 }
 
@@ -271,9 +273,67 @@ pub struct Features {
     pub surface: bool,
     /// One patch per base face (gregory, acc): triangles as Gregory triangle patches or split.
     pub single_pass: bool,
+    /// The draw paths it has (the conformance suite runs each).
+    pub paths: &'static [DrawPath],
+}
+
+/// A draw path of the seam: what geometry reaches the rasterizer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum DrawPath {
+    /// Patches through the tessellation stage ([`Geometry::Tessellated`]).
+    Tessellation,
+    /// Triangles from the vertex stage ([`Geometry::Triangles`]).
+    VertexStage,
+}
+
+impl DrawPath {
+    /// The path `geometry` belongs to.
+    pub fn of(geometry: Geometry) -> Self {
+        match geometry {
+            Geometry::Tessellated { .. } => DrawPath::Tessellation,
+            Geometry::Triangles => DrawPath::VertexStage,
+        }
+    }
 }
 
 impl Features {
+    /// The first option of `params` a technique with these features does not take, as the
+    /// [`TessError::Unsupported`] naming `technique` and the option; what every technique
+    /// refuses alike, before its own [`Technique::check`].
+    pub fn refuse(&self, technique: TechniqueId, params: &FrameParams) -> Result<()> {
+        let refused = [
+            (
+                !self.adaptive_factors && params.uniform_segments().is_none(),
+                "screen-space and distance factors (--adaptive)",
+            ),
+            (!self.spacing(params.spacing), "this --spacing"),
+            (
+                !self.patch_colours && params.patch_colours,
+                "patch colours (--patch-colours)",
+            ),
+            (
+                !self.geometric_normals && params.geometric_normals,
+                "geometric normals (--geometric-normals)",
+            ),
+            (
+                !self.surface && params.displace != 0.0,
+                "displacement (--displace)",
+            ),
+            (
+                !self.surface && params.show != crate::surface::SurfaceShow::Shading,
+                "parameter views (--show)",
+            ),
+            (
+                !self.surface && !params.reparam,
+                "texture reparameterization (--no-reparam)",
+            ),
+        ];
+        match refused.iter().find(|(refuse, _)| *refuse) {
+            Some(&(_, what)) => Err(TessError::Unsupported { technique, what }),
+            None => Ok(()),
+        }
+    }
+
     pub fn spacing(&self, s: Spacing) -> bool {
         self.spacings[match s {
             Spacing::Equal => 0,
@@ -283,23 +343,112 @@ impl Features {
     }
 }
 
-/// The stages and fixed state of one patch type's pipelines. The evaluation stage is picked
-/// per spacing and (for capture) its `-DCAPTURE` build; capture pipelines drop the fragment
-/// stage.
+/// How an array's geometry reaches the rasterizer: the two draw paths behind the seam.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Geometry {
+    /// Patches of `control_points` points through the tessellation stage; the evaluation stage
+    /// is built per spacing (and as its `-DCAPTURE` build for captures).
+    Tessellated {
+        control: Stage,
+        evaluation: Stage,
+        control_points: u32,
+    },
+    /// Triangle lists from the vertex stage, which is then the last stage before rasterization
+    /// (built as its `-DCAPTURE` build for captures). Indexed, instanced or indirect: the
+    /// technique's [`Technique::record_array`] chooses the draw.
+    Triangles,
+}
+
+impl Geometry {
+    /// Whether the tessellation stage draws it (lavapipe's draw split applies only then).
+    pub fn is_tessellated(self) -> bool {
+        matches!(self, Geometry::Tessellated { .. })
+    }
+}
+
+/// Vertex buffers a pipeline reads (`vk` descriptions, binding 0 upwards); per-instance
+/// bindings carry per-instance data.
+#[derive(Clone, Copy, Debug)]
+pub struct VertexInput {
+    pub bindings: &'static [vk_core::vk::VertexInputBindingDescription],
+    pub attributes: &'static [vk_core::vk::VertexInputAttributeDescription],
+}
+
+impl VertexInput {
+    /// No vertex buffers: the shaders fetch what they need from storage buffers.
+    pub const NONE: VertexInput = VertexInput {
+        bindings: &[],
+        attributes: &[],
+    };
+    /// The interleaved [`crate::gpu::Vertex`] buffer at binding 0 (position, normal).
+    pub const MESH: VertexInput = VertexInput {
+        bindings: &[crate::gpu::Vertex::BINDING],
+        attributes: &crate::gpu::Vertex::ATTRIBUTES,
+    };
+
+    pub fn is_empty(&self) -> bool {
+        self.bindings.is_empty()
+    }
+}
+
+/// The stages and fixed state of one patch type's pipelines. On the tessellated path the
+/// evaluation stage is picked per spacing; the last stage before rasterization comes as its
+/// `-DCAPTURE` build for captures, which drop the fragment stage.
+#[derive(Clone, Copy, Debug)]
 pub struct PatchPipeline {
     pub vertex: Stage,
-    pub control: Stage,
-    pub evaluation: Stage,
+    pub geometry: Geometry,
     pub fragment: Stage,
-    pub control_points: u32,
-    /// Reads the interleaved [`crate::gpu::Vertex`] buffer at binding 0.
-    pub mesh_vertex_input: bool,
+    pub vertex_input: VertexInput,
     /// Bytes of the push-constant block every stage shares.
     pub push_constant_bytes: u32,
     /// The technique's own shader axes (the `Variant` fields beyond spacing, capture and
     /// surface, which the frame sets), for its control and evaluation stages.
     pub axes: Variant,
+}
+
+impl PatchPipeline {
+    /// A tessellated pipeline of `control_points`-point patches.
+    pub fn tessellated(
+        vertex: Stage,
+        control: Stage,
+        evaluation: Stage,
+        fragment: Stage,
+        control_points: u32,
+    ) -> Self {
+        Self {
+            vertex,
+            geometry: Geometry::Tessellated {
+                control,
+                evaluation,
+                control_points,
+            },
+            fragment,
+            vertex_input: VertexInput::NONE,
+            push_constant_bytes: std::mem::size_of::<crate::gpu::DrawPush>() as u32,
+            axes: Variant::default(),
+        }
+    }
+
+    /// A vertex-stage pipeline drawing triangle lists.
+    pub fn triangles(vertex: Stage, fragment: Stage) -> Self {
+        Self {
+            vertex,
+            geometry: Geometry::Triangles,
+            fragment,
+            vertex_input: VertexInput::NONE,
+            push_constant_bytes: std::mem::size_of::<crate::gpu::DrawPush>() as u32,
+            axes: Variant::default(),
+        }
+    }
+
+    /// Control points per patch (0 on the vertex-stage path).
+    pub fn control_points(&self) -> u32 {
+        match self.geometry {
+            Geometry::Tessellated { control_points, .. } => control_points,
+            Geometry::Triangles => 0,
+        }
+    }
 }
 
 /// How many draws and patches one recorded pass issued (for tests of the draw split).
@@ -369,6 +518,13 @@ pub trait Technique: Send {
         None
     }
 
+    /// Host work a frame of `params` needs before it is recorded, such as refining a mesh to the
+    /// level the frame asks for. Called by [`crate::Context::prepare`] after [`Self::check`].
+    fn prepare_frame(&mut self, params: &FrameParams) -> Result<()> {
+        let _ = params;
+        Ok(())
+    }
+
     /// Uploads new base positions for frame slot `slot` (animation). Techniques without
     /// [`Features::animation`] refuse.
     fn update_base(&mut self, slot: usize, positions: &[[f32; 3]]) -> Result<()> {
@@ -392,18 +548,22 @@ pub trait Technique: Send {
         Ok(())
     }
 
-    /// Records the draws of `array` with its pipeline and sets already bound by the context,
-    /// `per_draw` patches at most per draw, each draw's first patch id in its push constants.
+    /// Records the draws of `array` for frame slot `slot` with its pipeline and sets already
+    /// bound by the context,
+    /// `per_draw` patches at most per draw (tessellated arrays), each draw's first patch id in
+    /// its push constants.
     fn record_array<'a>(
         &'a self,
         enc: &mut Encoder<'a>,
         array: usize,
+        slot: usize,
         params: &FrameParams,
         pass: Pass,
         per_draw: u32,
     ) -> Result<DrawCounts>;
 
-    /// Maps a captured (patch id, `gl_TessCoord.xy`) to a point of a base face, in
+    /// Maps a captured (patch id, domain coordinate) — the tessellator's `gl_TessCoord.xy`, or
+    /// what a vertex-stage capture records — to a point of a base face, in
     /// [`crate::capture::face_corner_uv`]'s convention; `None` for an id it never drew.
     fn face_point(&self, patch: u32, domain: [f32; 2]) -> Option<FacePoint>;
 

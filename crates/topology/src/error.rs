@@ -265,17 +265,19 @@ fn at_line(line: Option<usize>) -> String {
     line.map(|l| format!(":{l}")).unwrap_or_default()
 }
 
-/// `x, y, z` as a user would write them: shortest round-trip digits, in exponent form when
-/// very large or small (3e38, not 39 digits).
+/// A number as a user would write it: shortest round-trip digits, in exponent form when very
+/// large or small (3e38 and -1e-300, not 39 or 300 digits).
+pub fn number(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-6..1e16).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
+/// `x, y, z` as [`number`] writes each.
 pub(crate) fn xyz(p: &[f64; 3]) -> String {
-    let num = |x: f64| {
-        if x != 0.0 && x.is_finite() && !(1e-6..1e16).contains(&x.abs()) {
-            format!("{x:e}")
-        } else {
-            format!("{x}")
-        }
-    };
-    format!("{}, {}, {}", num(p[0]), num(p[1]), num(p[2]))
+    format!("{}, {}, {}", number(p[0]), number(p[1]), number(p[2]))
 }
 
 /// A [`TopologyError`] about a mesh read from OBJ, worded with the file's 1-based vertex and
@@ -412,20 +414,29 @@ pub enum ObjSyntax {
     IndexBeforeStart { word: String },
     #[error("face corner '{word}' has no vertex")]
     CornerWithoutVertex { word: String },
-    #[error("texture index {index} out of range")]
-    TextureIndexOutOfRange { index: i64 },
-    #[error("normal index {index} out of range")]
-    NormalIndexOutOfRange { index: i64 },
-    #[error("tag line needs a name and counts")]
+    #[error("face corner '{word}' has more than three indices (v, v/vt, v//vn or v/vt/vn)")]
+    CornerTooManyIndices { word: String },
+    #[error("texture coordinate {index} is named, but the file has {count} 'vt' lines")]
+    TextureIndexOutOfRange { index: i64, count: usize },
+    #[error("normal {index} is named, but the file has {count} 'vn' lines")]
+    NormalIndexOutOfRange { index: i64, count: usize },
+    #[error("'t' needs a tag name and its counts (t NAME INTS/FLOATS/STRINGS VALUES...)")]
     TagWithoutCounts,
-    #[error("bad tag counts '{counts}'")]
-    BadTagCounts { counts: String },
-    #[error("tag '{tag}': counts '{counts}' do not match the values")]
-    TagCountMismatch { tag: String, counts: String },
-    #[error("tag '{tag}': bad integer")]
-    BadTagInteger { tag: String },
-    #[error("tag '{tag}': bad float")]
-    BadTagFloat { tag: String },
+    #[error(
+        "tag '{tag}': counts '{counts}' are not three whole numbers INTS/FLOATS/STRINGS \
+         (such as 2/1/0)"
+    )]
+    BadTagCounts { tag: String, counts: String },
+    #[error("tag '{tag}': counts '{counts}' do not match the {found} values on the line")]
+    TagCountMismatch {
+        tag: String,
+        counts: String,
+        found: usize,
+    },
+    #[error("tag '{tag}': '{word}' is not an integer")]
+    BadTagInteger { tag: String, word: String },
+    #[error("tag '{tag}': '{word}' is not a number")]
+    BadTagFloat { tag: String, word: String },
     #[error("tag '{tag}': negative index {index}")]
     NegativeTagIndex { tag: String, index: i64 },
     #[error("tag '{tag}' needs a sharpness value")]
@@ -443,10 +454,20 @@ pub enum ObjSyntax {
     },
     #[error("tag '{tag}': sharpness {value} is not finite")]
     NonFiniteSharpness { tag: String, value: f32 },
-    #[error("crease tag needs vertex pairs")]
-    CreaseNeedsPairs,
-    #[error("corner tag needs vertices")]
+    #[error(
+        "tag 'crease' needs vertex pairs (an even number of integers), found {found} integers"
+    )]
+    CreaseNeedsPairs { found: usize },
+    #[error("tag 'corner' needs at least one vertex")]
     CornerNeedsVertices,
-    #[error("{option}: bad value {value}")]
-    BadOptionValue { option: &'static str, value: String },
+    #[error("tag 'hole' needs at least one face")]
+    HoleNeedsFaces,
+    #[error("tag '{option}': {value}; expected {expected}")]
+    BadOptionValue {
+        option: String,
+        value: String,
+        expected: &'static str,
+    },
+    #[error("NUL byte: not UTF-8 text (UTF-16 without a byte-order mark? save the file as UTF-8)")]
+    NulByte,
 }

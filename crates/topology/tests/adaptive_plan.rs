@@ -713,6 +713,50 @@ fn sharpness_scale_changes_the_plan() {
     assert_ne!(a.level_stats, c.level_stats);
 }
 
+/// Infinite tags (≥ 10) are scaled too, as 10: at scale 0 a crease of 10.5 is smooth (it
+/// stayed sharp), at 0.5 it is a crease of 5, and any scale ≥ 1 keeps it infinite.
+#[test]
+fn sharpness_scale_scales_infinite_tags_as_ten() {
+    let mesh = load_obj(format!("{SHAPES}catmark_cube_creases1.obj")).expect("shape");
+    let with = |s: f32| {
+        let mut m = mesh.clone();
+        for c in &mut m.creases {
+            c.sharpness = s;
+        }
+        m.corners.clear();
+        m
+    };
+    let plan = |m: &ControlMesh, scale: f32| {
+        let o = AdaptiveOptions {
+            sharpness_scale: scale,
+            ..options(3, EndCap::Bilinear)
+        };
+        plan_adaptive(m, &o).expect("plan").level_stats
+    };
+    let infinite = with(10.5);
+    assert_eq!(
+        plan(&infinite, 0.0),
+        plan(&with(0.0), 1.0),
+        "scale 0: smooth"
+    );
+    assert_eq!(
+        plan(&infinite, 0.5),
+        plan(&with(5.0), 1.0),
+        "scale 0.5: sharpness 5"
+    );
+    assert_eq!(
+        plan(&infinite, 2.0),
+        plan(&with(10.0), 1.0),
+        "scale 2: infinite"
+    );
+    assert_eq!(
+        plan(&with(1e30), 0.25),
+        plan(&with(2.5), 1.0),
+        "every infinite tag as 10"
+    );
+    assert_ne!(plan(&infinite, 0.5), plan(&infinite, 1.0));
+}
+
 #[test]
 fn bad_options_and_meshes_are_named_errors() {
     let mesh = load_obj(format!("{SHAPES}catmark_cube.obj")).expect("cube");

@@ -39,7 +39,8 @@ fn load_meshes(paths: &[std::path::PathBuf]) -> Result<Vec<BenchMesh>> {
         }
     } else {
         for p in paths {
-            let mesh = crate::commands::load_mesh(Some(p))?;
+            let (mesh, lines) = crate::commands::load_mesh_with_lines(Some(p))?;
+            crate::commands::check_drawable(&mesh, &lines, &p.display().to_string(), true)?;
             let name = p
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
@@ -116,6 +117,15 @@ fn config(a: &BenchArgs) -> Result<BenchConfig> {
     if a.frames == 0 {
         bail!("--frames must be at least 1");
     }
+    // Frame numbers are u32 (tess::bench refuses this too, after the device is open).
+    if a.frames.checked_add(a.warmup).is_none() {
+        bail!(
+            "--frames {} --warmup {}: a row has at most {} frames in all",
+            a.frames,
+            a.warmup,
+            u32::MAX
+        );
+    }
     if a.equal_triangles && !a.methods.iter().any(|m| m == "flat") {
         bail!("--equal-triangles matches Flat's triangle counts: add flat to --methods");
     }
@@ -167,28 +177,39 @@ fn config(a: &BenchArgs) -> Result<BenchConfig> {
     })
 }
 
-fn write(path: &std::path::Path, text: &str) -> Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
-}
+/// The largest CSV `tessera plot` reads: 64 MiB (a run writes a few hundred bytes a row).
+const MAX_CSV_BYTES: u64 = 64 << 20;
 
-/// `tessera plot`: a saved run's CSV as a picture.
+/// `tessera plot`: a saved run's CSV as a picture. The CSV is read as every input is (a
+/// regular file within [`MAX_CSV_BYTES`]), as UTF-8 with or without a byte-order mark; errors
+/// name it.
 pub fn plot(a: PlotArgs) -> Result<()> {
-    crate::plot::format_of(&a.output)?;
-    let text =
-        std::fs::read_to_string(&a.csv).with_context(|| format!("reading {}", a.csv.display()))?;
-    let rows = bench::parse_csv(&text).with_context(|| a.csv.display().to_string())?;
-    crate::plot::write(&a.output, &rows)?;
-    out!("wrote {} ({} rows)", a.output.display(), rows.len());
+    crate::plot::format_of(&a.output, "-o")?;
+    let csv = a.csv.display().to_string();
+    let bytes = topology::mesh::input::read_regular_file(&a.csv, MAX_CSV_BYTES, "a benchmark CSV")
+        .with_context(|| format!("{csv}: cannot read file"))?;
+    let text = std::str::from_utf8(&bytes).with_context(|| format!("{csv}: not UTF-8 text"))?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let rows = bench::parse_csv(text).with_context(|| csv.clone())?;
+    if !rows.iter().any(crate::plot::drawable) {
+        bail!(
+            "{csv}: no measured rows to plot ({} rows in all)",
+            rows.len()
+        );
+    }
+    crate::plot::write(&a.output, &rows, "-o")?;
+    out!(
+        "wrote {} ({} rows of {csv})",
+        a.output.display(),
+        rows.len()
+    );
     Ok(())
 }
 
 pub fn run(a: BenchArgs) -> Result<()> {
     if let Some(p) = &a.plot {
         // Before minutes of measuring, not after.
-        crate::plot::format_of(p)?;
+        crate::plot::format_of(p, "--plot")?;
     }
     let config = config(&a)?;
     let meshes = load_meshes(&a.mesh)?;
@@ -244,16 +265,16 @@ pub fn run(a: BenchArgs) -> Result<()> {
     check_validation(&instance)?;
     out!("{}", report.to_text());
     if let Some(p) = &a.csv {
-        write(p, &report.to_csv())?;
+        crate::output::write_text(p, &report.to_csv())?;
         out!("wrote {}", p.display());
     }
     if let Some(p) = &a.markdown {
-        write(p, &report.to_markdown())?;
+        crate::output::write_text(p, &report.to_markdown())?;
         out!("wrote {}", p.display());
     }
     if let Some(p) = &a.plot {
         crate::progress::during(format!("plotting {}", p.display()), || {
-            crate::plot::write(p, &report.rows)
+            crate::plot::write(p, &report.rows, "--plot")
         })?;
         out!("wrote {}", p.display());
     }

@@ -56,27 +56,27 @@ pub struct PlotArgs {
 pub struct ExportArgs {
     /// OBJ control mesh; the embedded spot control mesh when absent.
     pub input: Option<PathBuf>,
-    /// flat, phong, pn, bft (Loop limit) or adaptive (Catmull-Clark limit); by default the
-    /// limit surface of --scheme (Catmull-Clark unless every face is a triangle).
-    #[arg(long, value_parser = crate::technique::parse_technique)]
+    /// The technique (the list: --help); by default the limit surface of --scheme.
+    #[arg(long, value_parser = crate::technique::parse_technique,
+          long_help = crate::technique::method_long_help())]
     pub method: Option<TechniqueId>,
     /// Segments per base edge, the tessellation level (outer and inner): 1 to 64; bft takes
     /// powers of two from 2 to 2^(table level + 1) unless --fractional; adaptive: segments per
     /// patch edge, 1 to 32. Ignored with --adaptive.
-    #[arg(long, alias = "level", default_value_t = 8.0)]
+    #[arg(long, alias = "level", default_value_t = 8.0, allow_hyphen_values = true, value_parser = parse_segments)]
     pub segments: f32,
     #[arg(long, default_value = "equal", value_parser = parse_spacing)]
     pub spacing: Spacing,
     #[command(flatten)]
     pub surface: SurfaceArgs,
     /// Phong tessellation shape factor α, 0 to 1.
-    #[arg(long, default_value_t = 0.75, value_parser = parse_alpha)]
+    #[arg(long, default_value_t = 0.75, allow_hyphen_values = true, value_parser = parse_alpha)]
     pub alpha: f32,
     /// The view --adaptive screen and distance see.
     #[command(flatten)]
     pub camera: CameraArgs,
     /// Viewport --adaptive screen sees, WIDTHxHEIGHT.
-    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    #[arg(long, default_value = "1280x720", allow_hyphen_values = true, value_parser = parse_size)]
     pub size: (u32, u32),
     /// Exit with status 1 when any crack (an open edge not on the base mesh's boundary or a
     /// hole's border) is found.
@@ -97,37 +97,41 @@ pub struct BenchArgs {
         long,
         alias = "level",
         value_delimiter = ',',
-        default_value = "4,16,32"
+        default_value = "4,16,32",
+        allow_hyphen_values = true,
+        value_parser = parse_bench_segments
     )]
     pub segments: Vec<u32>,
-    /// Techniques: flat, phong, pn, bft (Loop basis-function tables: bft and bft-animated rows),
-    /// cpu (CPU Loop subdivision: cpu-static and cpu-animated rows).
-    #[arg(long, value_delimiter = ',', default_value = "flat,phong,pn,bft,cpu")]
+    /// Techniques to measure, comma-separated (the list: --help).
+    #[arg(long, value_delimiter = ',', default_value = "flat,phong,pn,bft,cpu",
+          long_help = crate::technique::methods_long_help())]
     pub methods: Vec<String>,
     /// Timed frames per row (at least 1).
-    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = 30, allow_hyphen_values = true, value_parser = parse_frames)]
     pub frames: u32,
     /// Untimed frames before them.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, allow_hyphen_values = true, value_parser = parse_warmup)]
     pub warmup: u32,
     /// OBJ control mesh (repeatable); replaces the default set.
     #[arg(long)]
     pub mesh: Vec<PathBuf>,
     /// Offscreen size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    #[arg(long, default_value = "1280x720", allow_hyphen_values = true, value_parser = parse_size)]
     pub size: (u32, u32),
     /// Seconds a row's timed frames may take; slower rows get fewer frames (noted in the row).
-    #[arg(long, value_parser = parse_row_budget)]
+    /// The first measured frame of each row (the last warm-up frame, or the first timed one
+    /// with --warmup 0) sets how many fit.
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_row_budget)]
     pub row_budget: Option<f64>,
-    /// The fewest timed frames --row-budget may leave.
-    #[arg(long, default_value_t = 5)]
+    /// The fewest timed frames --row-budget may leave (at most --frames).
+    #[arg(long, default_value_t = 5, allow_hyphen_values = true, value_parser = parse_min_frames)]
     pub min_frames: u32,
     /// The CPU baseline skips subdivision levels with more vertices than this (Loop level 5
     /// of the quadrangulated spot, 3.0 M vertices, peaks at about 1.6 GB of memory).
-    #[arg(long, default_value_t = 4_000_000)]
+    #[arg(long, default_value_t = 4_000_000, allow_hyphen_values = true, value_parser = parse_cpu_max_vertices)]
     pub cpu_max_vertices: u64,
-    /// Isolation level of the adaptive rows (segments are then per patch edge).
-    #[arg(long, default_value_t = tess::techniques::adaptive::DEFAULT_ISOLATION)]
+    /// Isolation level of the adaptive rows (segments are then per patch edge): 1 to 8.
+    #[arg(long, default_value_t = tess::techniques::adaptive::DEFAULT_ISOLATION, allow_hyphen_values = true, value_parser = crate::technique::parse_isolation)]
     pub isolation: u32,
     /// Adaptive rows stop semi-sharp creases at the isolation level (OpenSubdiv's behaviour).
     #[arg(long)]
@@ -144,8 +148,8 @@ pub struct BenchArgs {
     #[arg(long, value_name = "PNG")]
     pub texture: Option<PathBuf>,
     /// Displace along the normal by S times the height (the --height map's, else a procedural
-    /// bump pattern) in the same rows.
-    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    /// bump pattern) in the same rows: -1000 to 1000.
+    #[arg(long, value_name = "S", allow_hyphen_values = true, value_parser = crate::technique::parse_displace)]
     pub displace: Option<f32>,
     /// Height map (PNG, luminance in [0, 1]) for --displace.
     #[arg(long, value_name = "PNG")]
@@ -174,7 +178,8 @@ pub struct SubdivideArgs {
     pub input: Option<PathBuf>,
     #[arg(long, value_parser = crate::topo_cmds::parse_scheme)]
     pub scheme: topology::Scheme,
-    #[arg(long)]
+    /// Refinement level, 0 to 6 (meshes grow 4× per level).
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_subdivide_level)]
     pub level: usize,
     /// Move every vertex to its limit position.
     #[arg(long)]
@@ -191,37 +196,112 @@ pub struct LimitArgs {
     #[arg(long)]
     pub scheme: String,
     /// Face number, 1-based as in the OBJ (the N-th `f` line), like every message.
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        value_parser = parse_face,
+        required_unless_present = "points",
+        conflicts_with = "points"
+    )]
+    pub face: Option<usize>,
+    /// Domain coordinate U,V (the evaluator's patch domain: Loop triangles weigh corners 1
+    /// and 2; Catmull-Clark quads the unit square).
+    #[arg(
+        long,
+        value_parser = parse_uv,
+        allow_hyphen_values = true,
+        required_unless_present = "points",
+        conflicts_with = "points"
+    )]
+    pub uv: Option<(f64, f64)>,
+    /// Many points at once: a file of `F U V` lines in the domain of `tessera export`'s
+    /// `# p F U V` lines (F 0-based; triangles weigh corners 0 and 1, quads the unit square,
+    /// n-gons the regular n-gon); `# p` lines count as points too and other OBJ lines are
+    /// skipped, so an exported OBJ can be given as it is. Writes one `X Y Z` line per point.
     #[arg(long)]
-    pub face: usize,
-    /// Domain coordinate U,V.
-    #[arg(long, value_parser = parse_uv, allow_hyphen_values = true)]
-    pub uv: (f64, f64),
+    pub points: Option<PathBuf>,
+    /// Where --points writes its positions (default: standard output).
+    #[arg(short, long, requires = "points")]
+    pub output: Option<PathBuf>,
+    /// With --points: also the derivatives along U and V and the unit normal on each line
+    /// (X Y Z DUX DUY DUZ DVX DVY DVZ NX NY NZ).
+    #[arg(long, requires = "points")]
+    pub derivatives: bool,
 }
 
 fn parse_uv(s: &str) -> Result<(f64, f64), String> {
-    let (u, v) = s
-        .split_once(',')
-        .ok_or_else(|| format!("'{s}' is not U,V"))?;
-    let u: f64 = u.trim().parse().map_err(|_| format!("bad U in '{s}'"))?;
-    let v: f64 = v.trim().parse().map_err(|_| format!("bad V in '{s}'"))?;
-    Ok((u, v))
+    let bad = || {
+        "--uv takes U,V: two finite numbers (0 to 1 on a quad; u, v ≥ 0 and u + v ≤ 1 on a triangle)".to_string()
+    };
+    let (u, v) = s.split_once(',').ok_or_else(bad)?;
+    let coordinate = |t: &str| {
+        t.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(bad)
+    };
+    Ok((coordinate(u)?, coordinate(v)?))
 }
 
 fn parse_row_budget(s: &str) -> Result<f64, String> {
-    let x: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| "--row-budget takes seconds".to_string())?;
-    if !(x.is_finite() && x > 0.0) {
-        return Err("--row-budget must be a positive, finite number of seconds".into());
+    let x = numbers::float64_in(s, "--row-budget", 0.0, 1e6)?;
+    if x <= 0.0 {
+        return Err("--row-budget takes a number of seconds above 0, at most 1000000".into());
     }
     Ok(x)
 }
 
+fn parse_frames(s: &str) -> Result<u32, String> {
+    numbers::whole_in(s, "--frames", 1, u32::MAX)
+}
+
+fn parse_warmup(s: &str) -> Result<u32, String> {
+    numbers::whole_in(s, "--warmup", 0, u32::MAX)
+}
+
+fn parse_min_frames(s: &str) -> Result<u32, String> {
+    numbers::whole_in(s, "--min-frames", 1, u32::MAX)
+}
+
+fn parse_cpu_max_vertices(s: &str) -> Result<u64, String> {
+    numbers::whole_in(s, "--cpu-max-vertices", 0, u64::MAX)
+}
+
+// The range of these is checked after parsing, by the command (its message names the value).
+fn parse_bench_segments(s: &str) -> Result<u32, String> {
+    numbers::whole(s, "--segments", 1, 64)
+}
+
+fn parse_subdivide_level(s: &str) -> Result<usize, String> {
+    numbers::whole(s, "--level", 0, 6)
+}
+
+fn parse_face(s: &str) -> Result<usize, String> {
+    numbers::whole(s, "--face", 1, u32::MAX as usize)
+}
+
+/// `--segments` of render, view and export: a number (from 1 to
+/// [`crate::technique::MAX_SEGMENTS`], and what the technique takes, checked with the
+/// technique: `crate::technique::check_segments`).
+fn parse_segments(s: &str) -> Result<f32, String> {
+    numbers::float(s, "--segments", 1.0, 64.0)
+}
+
+/// `--device`: `auto`, an index from `tessera info`, or part of a device's name; never empty.
+fn parse_device(s: &str) -> Result<String, String> {
+    if s.trim().is_empty() {
+        return Err(
+            "--device takes auto, an index from `tessera info` or part of a device's name".into(),
+        );
+    }
+    Ok(s.to_string())
+}
+
 #[derive(Args, Debug, Clone)]
 pub struct GpuArgs {
-    /// Device to use: an index from `tessera info` or a name substring.
-    #[arg(long, default_value = "auto")]
+    /// Device to use: auto, an index from `tessera info` or a name substring.
+    #[arg(long, default_value = "auto", value_parser = parse_device)]
     pub device: String,
     /// Enable the Vulkan validation layer (always on in debug builds).
     #[arg(long)]
@@ -229,6 +309,11 @@ pub struct GpuArgs {
     /// Also run synchronization validation.
     #[arg(long)]
     pub sync_validation: bool,
+    /// Compile every pipeline afresh: neither read nor write the pipeline cache kept in the
+    /// user's cache directory ($XDG_CACHE_HOME/tessera/pipelines or ~/.cache/tessera/pipelines;
+    /// TESSERA_PIPELINE_CACHE=off does the same for every run).
+    #[arg(long)]
+    pub no_pipeline_cache: bool,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -244,20 +329,7 @@ pub struct CameraArgs {
     pub zoom: f32,
 }
 
-/// A finite `f32` in `lo..=hi`; the message names the option (clap prefixes it with the value
-/// and the option too, so the range is what it adds).
-fn float_in(s: &str, option: &str, lo: f32, hi: f32) -> Result<f32, String> {
-    let x: f32 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("{option} takes a number"))?;
-    if !(x.is_finite() && (lo..=hi).contains(&x)) {
-        return Err(format!(
-            "{option} must be a finite number from {lo} to {hi}"
-        ));
-    }
-    Ok(x)
-}
+use crate::numbers::{self, float_in};
 
 fn parse_yaw(s: &str) -> Result<f32, String> {
     float_in(s, "--yaw", -360.0, 360.0)
@@ -280,16 +352,14 @@ pub fn parse_alpha(s: &str) -> Result<f32, String> {
 pub struct SceneArgs {
     /// OBJ control mesh; the embedded spot control mesh when absent.
     pub mesh: Option<PathBuf>,
-    /// flat, phong, pn (the base faces as patches), bft (the Loop limit surface from
-    /// basis-function tables) or adaptive (the Catmull-Clark limit surface by feature-adaptive
-    /// refinement). By default the limit surface of --scheme, which defaults to Catmull-Clark
-    /// unless every face is a triangle (then Loop).
-    #[arg(long, value_parser = crate::technique::parse_technique)]
+    /// The technique (the list: --help); by default the limit surface of --scheme.
+    #[arg(long, value_parser = crate::technique::parse_technique,
+          long_help = crate::technique::method_long_help())]
     pub method: Option<TechniqueId>,
     /// Segments per base edge, the tessellation level (outer and inner): 1 to 64; bft takes
     /// powers of two from 2 to 2^(table level + 1) unless --fractional; adaptive: segments per
     /// patch edge, 1 to 32 (a coarse transition edge gets twice as many).
-    #[arg(long, alias = "level", default_value_t = 8.0)]
+    #[arg(long, alias = "level", default_value_t = 8.0, allow_hyphen_values = true, value_parser = parse_segments)]
     pub segments: f32,
     #[arg(long, default_value = "equal", value_parser = parse_spacing)]
     pub spacing: Spacing,
@@ -299,7 +369,7 @@ pub struct SceneArgs {
     #[command(flatten)]
     pub camera: CameraArgs,
     /// Phong tessellation shape factor α, 0 to 1.
-    #[arg(long, default_value_t = 0.75, value_parser = parse_alpha)]
+    #[arg(long, default_value_t = 0.75, allow_hyphen_values = true, value_parser = parse_alpha)]
     pub alpha: f32,
     #[command(flatten)]
     pub surface: SurfaceArgs,
@@ -316,7 +386,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     /// Image size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "800x600", value_parser = parse_size)]
+    #[arg(long, default_value = "800x600", allow_hyphen_values = true, value_parser = parse_size)]
     pub size: (u32, u32),
     /// Output PNG.
     #[arg(short, long, default_value = "tessera.png")]
@@ -327,10 +397,11 @@ pub struct RenderArgs {
 pub struct ViewArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
-    #[arg(long, default_value = "1024x768", value_parser = parse_size)]
+    /// Window size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768", allow_hyphen_values = true, value_parser = parse_size)]
     pub size: (u32, u32),
     /// Render this many frames (at least 1), then exit (with --screenshot: save the last one).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_frames)]
     pub frames: Option<u32>,
     /// PNG to save the last frame to (needs --frames).
     #[arg(long)]
@@ -350,19 +421,5 @@ fn parse_spacing(s: &str) -> Result<Spacing, String> {
 }
 
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("size '{s}' is not WIDTHxHEIGHT"))?;
-    let w: u32 = w
-        .trim()
-        .parse()
-        .map_err(|_| format!("bad width in '{s}'"))?;
-    let h: u32 = h
-        .trim()
-        .parse()
-        .map_err(|_| format!("bad height in '{s}'"))?;
-    if w == 0 || h == 0 || w > 16384 || h > 16384 {
-        return Err(format!("size '{s}' must be between 1x1 and 16384x16384"));
-    }
-    Ok((w, h))
+    numbers::size(s)
 }

@@ -1,10 +1,11 @@
 //! The subcommands' bodies.
 use crate::cli::{CameraArgs, Cli, Command, GpuArgs, RenderArgs, SceneArgs};
 use crate::technique::{describe, Setup};
-use anyhow::{bail, Result};
+use anyhow::{bail, Context as _, Result};
 use std::sync::Arc;
 use tess::techniques::bft::Wave;
-use tess::{Camera, Context, FrameParams, Technique};
+use tess::{Camera, Context, FrameParams, Technique, TechniqueId};
+use topology::mesh::obj::ObjLines;
 use vk_core::{vk, Device, DeviceDesc, Instance, InstanceDesc, Validation};
 
 /// The spot control mesh by Keenan Crane (public domain), embedded so `tessera render` works
@@ -35,11 +36,17 @@ pub fn validation(g: &GpuArgs) -> Validation {
 }
 
 /// Loads and validates the mesh (the embedded spot without a path); errors say the file, the
-/// line and the OBJ's 1-based numbers (`topology::mesh::obj`).
-pub fn load_mesh(path: Option<&std::path::Path>) -> Result<topology::ControlMesh> {
-    let mesh = match path {
-        Some(p) => topology::load_obj(p)?,
-        None => topology::mesh::obj::parse_obj(DEFAULT_MESH, "spot_control_mesh.obj (embedded)")?,
+/// line and the OBJ's 1-based numbers (`topology::mesh::obj`). With the line of every element, for
+/// errors found later ([`in_mesh_file`]).
+pub fn load_mesh_with_lines(
+    path: Option<&std::path::Path>,
+) -> Result<(topology::ControlMesh, ObjLines)> {
+    let (mesh, lines) = match path {
+        Some(p) => topology::mesh::obj::load_obj_with_lines(p)?,
+        None => topology::mesh::obj::parse_obj_with_lines(
+            DEFAULT_MESH,
+            "spot_control_mesh.obj (embedded)",
+        )?,
     };
     if mesh.num_faces() == 0 {
         bail!(
@@ -47,7 +54,54 @@ pub fn load_mesh(path: Option<&std::path::Path>) -> Result<topology::ControlMesh
             path.map(|p| p.display().to_string()).unwrap_or_default()
         );
     }
-    Ok(mesh)
+    Ok((mesh, lines))
+}
+
+/// Refuses, before any device is opened, a mesh the GPU's f32 cannot draw
+/// ([`tess::framing::check_drawable`]) or, for a picture (`shaded`), cannot shade
+/// ([`tess::framing::check_shaded`]), naming the file and the face's line.
+pub fn check_drawable(
+    mesh: &topology::ControlMesh,
+    lines: &ObjLines,
+    name: &str,
+    shaded: bool,
+) -> Result<()> {
+    let checked = if shaded {
+        tess::framing::check_shaded(mesh)
+    } else {
+        tess::framing::check_drawable(mesh)
+    };
+    checked.map_err(|e| {
+        let line = match &e {
+            tess::framing::Undrawable::Collapsed { face, .. } => lines.face(*face),
+            tess::framing::Undrawable::TooSmallToShade { .. } => None,
+        };
+        let at = line.map(|l| format!(":{l}")).unwrap_or_default();
+        anyhow::anyhow!("{name}{at}: {e}")
+    })
+}
+
+/// A technique's build error about the mesh read from `name`, in the file's terms: a topology
+/// error (an adaptive plan's face too large, a patch that cannot be built) gets the 1-based
+/// numbers and the line of the face or vertex at fault. A technique that fan-triangulates
+/// polygons (its faces are not the file's) keeps its own words.
+pub fn in_mesh_file(
+    e: tess::TessError,
+    technique: TechniqueId,
+    mesh: &topology::ControlMesh,
+    lines: &ObjLines,
+) -> anyhow::Error {
+    let own_faces = !tess::techniques::info(technique).features.triangles_only
+        || mesh.faces().all(|f| f.len() == 3);
+    match e {
+        tess::TessError::Mesh { name, source } if own_faces => {
+            match source.downcast::<topology::TopologyError>() {
+                Ok(t) => lines.locate(*t, mesh, &name).into(),
+                Err(source) => tess::TessError::Mesh { name, source }.into(),
+            }
+        }
+        other => other.into(),
+    }
 }
 
 /// The name a mesh goes by in messages: its path, or the embedded default's.
@@ -87,25 +141,35 @@ pub fn scene_setup(s: &SceneArgs, name: &str, mesh: &topology::ControlMesh) -> R
 }
 
 /// Builds `setup`'s technique for `mesh` on `ctx`, says how it took the mesh (stderr), and
-/// poses an animated base at `--frame` (0 by default) in every frame slot.
+/// poses an animated base at `--frame` (0 by default) in every frame slot. Errors about the
+/// mesh name its file and line ([`in_mesh_file`]).
 pub fn build_technique(
     ctx: &mut Context,
     mesh: &topology::ControlMesh,
+    lines: &ObjLines,
     setup: &Setup,
 ) -> Result<Box<dyn Technique>> {
     let built = crate::progress::during(
         format!("building {} for {}", setup.technique, setup.build.name),
         || tess::build(ctx, setup.technique, mesh, &setup.build),
-    )?;
+    )
+    .map_err(|e| in_mesh_file(e, setup.technique, mesh, lines))?;
     for n in &built.notes {
         eprintln!("{n}");
     }
     let mut technique = built.technique;
     if setup.moved() {
         if let Some(base) = technique.base_mesh() {
-            let posed = Wave::new(base).at(setup.frame.unwrap_or(0.0));
+            let t = setup.frame.unwrap_or(0.0);
+            let posed = Wave::new(base).at(t);
             for slot in 0..ctx.frames_in_flight() {
-                technique.update_base(slot, &posed)?;
+                technique.update_base(slot, &posed).with_context(|| {
+                    format!(
+                        "{}: the wave at --frame {}",
+                        setup.build.name,
+                        crate::numbers::number32(t)
+                    )
+                })?;
             }
         }
     }
@@ -115,7 +179,7 @@ pub fn build_technique(
 /// `--device` resolved against the adapters the instance sees: the adapter's index, or an
 /// error naming the option as given (with the devices seen).
 fn choose_device(g: &GpuArgs, instance: &Instance) -> Result<vk_core::DeviceSelector> {
-    let selector: vk_core::DeviceSelector = g.device.parse().unwrap_or_default();
+    let selector = device_selector(g)?;
     let adapters = vk_core::device::enumerate_adapters(instance)?;
     match vk_core::device::choose_adapter(&adapters, &selector) {
         Ok(i) => Ok(vk_core::DeviceSelector::Index(adapters[i].index)),
@@ -126,6 +190,14 @@ fn choose_device(g: &GpuArgs, instance: &Instance) -> Result<vk_core::DeviceSele
         ),
         Err(e) => Err(e.into()),
     }
+}
+
+/// `--device` as a selector (never empty: `crate::cli` refuses that, which vk-core would take
+/// for `auto`).
+fn device_selector(g: &GpuArgs) -> Result<vk_core::DeviceSelector> {
+    let selector: std::result::Result<vk_core::DeviceSelector, std::convert::Infallible> =
+        g.device.parse();
+    Ok(selector.unwrap_or_else(|never| match never {}))
 }
 
 /// Instance + device as the command line asks; errors list the devices seen.
@@ -140,15 +212,16 @@ pub fn open_device(
         surface_extensions,
     })?;
     let selector = choose_device(g, &instance)?;
-    let cache = std::env::var_os("XDG_CACHE_HOME")
-        .map(std::path::PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| std::path::PathBuf::from(h).join(".cache")))
-        .map(|d| d.join("tessera").join("pipeline-cache.bin"));
+    let cache = if g.no_pipeline_cache {
+        None
+    } else {
+        vk_core::pipeline_cache::user_dir()
+    };
     let device = Device::new(
         &instance,
         &DeviceDesc {
             selector,
-            pipeline_cache_path: cache,
+            pipeline_cache_dir: cache,
             ..DeviceDesc::default()
         },
         device_extensions,
@@ -170,44 +243,57 @@ pub fn check_validation(instance: &Instance) -> Result<()> {
 }
 
 fn render(a: RenderArgs) -> Result<()> {
-    let mesh = load_mesh(a.scene.mesh.as_deref())?;
-    let setup = scene_setup(&a.scene, &mesh_name(a.scene.mesh.as_deref()), &mesh)?;
+    let name = mesh_name(a.scene.mesh.as_deref());
+    let (mesh, lines) = load_mesh_with_lines(a.scene.mesh.as_deref())?;
+    check_drawable(&mesh, &lines, &name, true)?;
+    let setup = scene_setup(&a.scene, &name, &mesh)?;
+    // Before the device and any work.
+    crate::output::check_png_name(&a.output, "-o")?;
     let extent = vk::Extent2D {
         width: a.size.0,
         height: a.size.1,
     };
     let (instance, device) = open_device(&a.scene.gpu, vec![], &[])?;
-    let what = render_offscreen(&device, &mesh, &setup, extent, &a.output);
+    let what = render_offscreen(&device, (&mesh, &lines), &setup, extent);
     drop(device);
     check_validation(&instance)?;
+    let (image, what) = what?;
+    crate::output::write_png(&a.output, &image)?;
     out!(
         "wrote {} ({}x{}, {})",
         a.output.display(),
         a.size.0,
         a.size.1,
-        what?
+        what
     );
     Ok(())
 }
 
+/// One frame of `setup` offscreen, and what it drew; a picture with nothing drawn in it (every
+/// pixel the background) is an error, not a file.
 fn render_offscreen(
     device: &Device,
-    mesh: &topology::ControlMesh,
+    (mesh, lines): (&topology::ControlMesh, &ObjLines),
     setup: &Setup,
     extent: vk::Extent2D,
-    output: &std::path::Path,
-) -> Result<String> {
+) -> Result<(vk_core::target::Rgba8, String)> {
     let mut ctx = Context::offscreen(device)?;
-    let technique = build_technique(&mut ctx, mesh, setup)?;
+    let mut technique = build_technique(&mut ctx, mesh, lines, setup)?;
     let params = setup.world_params(technique.bbox());
-    let frame = ctx.render_offscreen_stats(technique.as_ref(), &params, extent, false)?;
-    frame.image.save_png(output)?;
+    let frame = ctx.render_offscreen_stats(technique.as_mut(), &params, extent, false)?;
     let patches: u32 = technique.patch_arrays().iter().map(|a| a.patches).sum();
-    Ok(format!(
+    let what = format!(
         "{}, {patches} patches in {} draws",
         describe(setup.technique, &params),
         frame.counts.draws
-    ))
+    );
+    if crate::output::is_blank(&frame.image, params.clear_color) {
+        bail!(
+            "{}: nothing was drawn ({what}; every pixel is the background); nothing written",
+            setup.build.name
+        );
+    }
+    Ok((frame.image, what))
 }
 
 fn info(g: &GpuArgs) -> Result<()> {
@@ -251,7 +337,7 @@ fn info(g: &GpuArgs) -> Result<()> {
             c.transform_feedback, c.transform_feedback_queries, c.max_transform_feedback_buffer_size, c.max_transform_feedback_stride
         );
     }
-    let selector = g.device.parse().unwrap_or_default();
+    let selector = device_selector(g)?;
     match vk_core::device::choose_adapter(&adapters, &selector) {
         Ok(i) => {
             let a = &adapters[i];

@@ -6,7 +6,8 @@
 //! shared, so a new technique needs nothing here.
 use crate::cli::ExportArgs;
 use crate::commands::{
-    build_technique, camera, check_validation, load_mesh, mesh_name, open_device,
+    build_technique, camera, check_drawable, check_validation, load_mesh_with_lines, mesh_name,
+    open_device,
 };
 use crate::technique::describe;
 use anyhow::{bail, Context as _, Result};
@@ -54,7 +55,8 @@ pub fn run(a: ExportArgs) -> Result<()> {
         phong_alpha: a.alpha,
         ..FrameParams::default()
     };
-    let base = load_mesh(a.input.as_deref())?;
+    let (base, lines) = load_mesh_with_lines(a.input.as_deref())?;
+    check_drawable(&base, &lines, &mesh_name(a.input.as_deref()), false)?;
     let method = crate::technique::resolve_method(a.method, a.surface.scheme.as_deref(), &base)?;
     let mut setup = a
         .surface
@@ -73,10 +75,10 @@ pub fn run(a: ExportArgs) -> Result<()> {
         let mut ctx = Context::offscreen(&device)?;
         let capturer = Capturer::new(&ctx)
             .context("tessera export captures through VK_EXT_transform_feedback")?;
-        let technique = build_technique(&mut ctx, &base, &setup)?;
+        let mut technique = build_technique(&mut ctx, &base, &lines, &setup)?;
         let params = setup.world_params(technique.bbox());
         let (soup, stats) = crate::progress::during("capturing the tessellated triangles", || {
-            capturer.capture(&mut ctx, technique.as_ref(), &params, extent)
+            capturer.capture(&mut ctx, technique.as_mut(), &params, extent)
         })?;
         let summary = format!(
             "{}; {} draws over {} patches, {} pass(es)",

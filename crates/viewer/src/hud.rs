@@ -85,23 +85,9 @@ pub struct Hud {
 }
 
 /// The colours and names of the patch-colour legend of `technique` (empty when it
-/// has no patch colours).
+/// has no patch colours): its registry entry's.
 fn legend(technique: TechniqueId) -> &'static [([f32; 3], &'static str)] {
-    match technique {
-        TechniqueId::Bft => &[
-            ([0.55, 0.75, 0.95], "regular"),
-            ([0.95, 0.45, 0.35], "extraordinary"),
-            ([0.55, 0.85, 0.45], "boundary"),
-            ([0.75, 0.5, 0.9], "private table"),
-        ],
-        TechniqueId::Adaptive | TechniqueId::Gregory | TechniqueId::Acc => &[
-            ([0.45, 0.65, 0.95], "B-spline (odd levels lighter)"),
-            ([0.95, 0.45, 0.35], "Gregory end cap"),
-            ([0.95, 0.8, 0.3], "bilinear end cap"),
-            ([0.3, 0.8, 0.35], "boundary / crease (greener)"),
-        ],
-        _ => &[],
-    }
+    techniques::info(technique).legend
 }
 
 fn colour([r, g, b]: [f32; 3]) -> Color32 {

@@ -15,6 +15,8 @@ mod cli;
 mod commands;
 mod export;
 mod hud;
+mod numbers;
+mod output;
 mod plot;
 mod progress;
 mod technique;

@@ -65,8 +65,9 @@ pub enum Format {
     Png,
 }
 
-/// `--plot`'s format from the file name: `.svg` or `.png`.
-pub fn format_of(path: &Path) -> Result<Format> {
+/// The format a plot's file name asks for: `.svg` or `.png`; `option` is how the command line
+/// gave the name (`--plot` for bench, `-o` for plot).
+pub fn format_of(path: &Path, option: &str) -> Result<Format> {
     match path
         .extension()
         .and_then(|e| e.to_str())
@@ -76,7 +77,7 @@ pub fn format_of(path: &Path) -> Result<Format> {
         Some("svg") => Ok(Format::Svg),
         Some("png") => Ok(Format::Png),
         _ => bail!(
-            "--plot {}: give a file name ending in .svg or .png",
+            "{option} {}: give a file name ending in .svg or .png",
             path.display()
         ),
     }
@@ -185,7 +186,7 @@ fn ms_label(ms: f64) -> String {
 }
 
 /// Whether a row's frame time can be drawn on the log axis.
-fn drawable(r: &BenchRow) -> bool {
+pub fn drawable(r: &BenchRow) -> bool {
     r.total_median_ms.is_finite() && r.total_median_ms > 0.0 && r.segments > 0
 }
 
@@ -370,18 +371,16 @@ where
     Ok(maps)
 }
 
-/// Writes the plot of `rows` to `path` (SVG or PNG by its extension).
-pub fn write(path: &Path, rows: &[BenchRow]) -> Result<()> {
-    let format = format_of(path)?;
+/// Writes the plot of `rows` to `path` (SVG or PNG by its extension; `option` names how the
+/// command line gave it), whole or not at all.
+pub fn write(path: &Path, rows: &[BenchRow], option: &str) -> Result<()> {
+    let format = format_of(path, option)?;
     if !rows.iter().any(drawable) {
-        bail!("--plot {}: no measured rows to plot", path.display());
+        bail!("{option} {}: no measured rows to plot", path.display());
     }
     register_font()?;
     let (meshes, _) = order(rows);
     let size = (2 * CHART.0, CHART.1 * meshes.len() as u32);
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
     match format {
         Format::Svg => {
             let mut svg = String::new();
@@ -394,7 +393,7 @@ pub fn write(path: &Path, rows: &[BenchRow]) -> Result<()> {
                 Some(end) => svg.insert_str(end, &comments),
                 None => bail!("the SVG backend wrote no closing tag"),
             }
-            std::fs::write(path, svg).with_context(|| format!("writing {}", path.display()))
+            crate::output::write_text(path, &svg)
         }
         Format::Png => {
             let mut pixels = vec![0u8; size.0 as usize * size.1 as usize * 3];
@@ -404,11 +403,16 @@ pub fn write(path: &Path, rows: &[BenchRow]) -> Result<()> {
                     .into_drawing_area();
                 draw(&root, rows)?;
             }
-            let image = image::RgbImage::from_raw(size.0, size.1, pixels)
-                .context("the plot's pixel buffer has the wrong size")?;
-            image
-                .save(path)
-                .with_context(|| format!("writing {}", path.display()))
+            let mut png = Vec::new();
+            image::ImageEncoder::write_image(
+                image::codecs::png::PngEncoder::new(&mut png),
+                &pixels,
+                size.0,
+                size.1,
+                image::ExtendedColorType::Rgb8,
+            )
+            .context("encoding the plot as PNG")?;
+            Ok(tess::output::write_bytes(path, &png)?)
         }
     }
 }

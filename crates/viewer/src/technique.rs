@@ -1,6 +1,7 @@
 //! The technique options shared by `render`, `view` and `export`, checked against what the
 //! chosen technique declares it takes ([`tess::Features`] in [`tess::techniques::registry`]):
 //! no per-technique code here, so a new technique needs no change in the viewer.
+use crate::numbers::{float, number32, whole};
 use anyhow::{bail, Result};
 use clap::Args;
 use std::path::Path;
@@ -9,8 +10,75 @@ use tess::techniques::{self, adaptive::DEFAULT_ISOLATION, bft::DEFAULT_TABLE_LEV
 use tess::{FactorPolicy, Features, FrameParams, Spacing, TechniqueId};
 use topology::patches::adaptive::EndCap;
 
+/// The largest `--frame`: the wave's phase keeps f32 precision well past it (its period is 2).
+const MAX_FRAME: f32 = 1e6;
+
+// The range of these is checked with the technique after parsing (the message names the
+// value); here a value that is no number is refused with the range.
+pub fn parse_isolation(s: &str) -> Result<u32, String> {
+    whole(s, "--isolation", 1, 8)
+}
+
+fn parse_sharpness_scale(s: &str) -> Result<f32, String> {
+    float(s, "--sharpness-scale", 0.0, MAX_SHARPNESS_SCALE)
+}
+
+fn parse_pixels(s: &str) -> Result<f32, String> {
+    float(s, "--pixels", 0.5, 16384.0)
+}
+
+fn parse_distance(s: &str) -> Result<f32, String> {
+    float(s, "--distance", 0.0, 1e6)
+}
+
+fn parse_table_level(s: &str) -> Result<u32, String> {
+    whole(s, "--table-level", 1, 6)
+}
+
+fn parse_frame(s: &str) -> Result<f32, String> {
+    float(s, "--frame", -MAX_FRAME, MAX_FRAME)
+}
+
+pub fn parse_displace(s: &str) -> Result<f32, String> {
+    float(s, "--displace", -1000.0, 1000.0)
+}
+
+/// The largest `--sharpness-scale`.
+const MAX_SHARPNESS_SCALE: f32 = 1000.0;
+
 pub fn parse_technique(s: &str) -> Result<TechniqueId, String> {
     s.parse::<TechniqueId>().map_err(|e| e.to_string())
+}
+
+/// `--method`'s long help: every technique of the registry with its one line, so the list is
+/// never out of date.
+pub fn method_long_help() -> String {
+    let mut out = String::from(
+        "The technique that draws the mesh; by default the limit surface of --scheme \
+         (Catmull-Clark unless every face is a triangle, then Loop). One of:",
+    );
+    for info in techniques::registry() {
+        out.push_str(&format!("\n  {:<12} {}", info.id.name(), info.help));
+    }
+    out
+}
+
+/// `bench --methods`'s long help: the registry's techniques, each with an `-animated` row when
+/// it animates.
+pub fn methods_long_help() -> String {
+    let mut out = String::from(
+        "Techniques to measure, comma-separated (each draws a row; those that animate also an \
+         -animated row that moves the base every frame). Any of:",
+    );
+    for info in techniques::registry() {
+        let animated = if info.features.animation {
+            " (+ -animated row)"
+        } else {
+            ""
+        };
+        out.push_str(&format!("\n  {}{animated}", info.id.name()));
+    }
+    out
 }
 
 pub fn parse_end_cap(s: &str) -> Result<EndCap, String> {
@@ -83,14 +151,17 @@ pub struct SurfaceArgs {
     #[arg(long)]
     pub scheme: Option<String>,
     /// Isolation level of feature-adaptive refinement (adaptive): 1 to 8.
-    #[arg(long, default_value_t = DEFAULT_ISOLATION)]
+    #[arg(long, default_value_t = DEFAULT_ISOLATION, allow_hyphen_values = true, value_parser = parse_isolation)]
     pub isolation: u32,
     /// End caps of faces still irregular at the isolation level (adaptive): gregory or
     /// bilinear.
     #[arg(long, default_value = "gregory", value_parser = parse_end_cap)]
     pub end_cap: EndCap,
-    /// Multiplies every crease and corner sharpness (adaptive), without reloading the mesh.
-    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    /// Multiplies every crease and corner sharpness (adaptive), without reloading the mesh: 0
+    /// to 1000. An infinitely sharp tag (sharpness 10 or more) counts as 10: it stays
+    /// infinitely sharp at 1 and above, becomes semi-sharp below 1 (10 × the scale) and smooth
+    /// at 0. Boundary edges stay infinitely sharp.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true, value_parser = parse_sharpness_scale)]
     pub sharpness_scale: f32,
     /// Split each triangle into three quad patches (gregory, acc) instead of one Gregory
     /// triangle patch: closer to the limit, three times the patches.
@@ -109,19 +180,19 @@ pub struct SurfaceArgs {
     /// value with --fractional; computed from an edge's two endpoints only, so no cracks.
     #[arg(long, value_parser = parse_adaptive)]
     pub adaptive: Option<Adaptive>,
-    /// --adaptive screen: target pixels per segment.
-    #[arg(long, default_value_t = 8.0)]
+    /// --adaptive screen: target pixels per segment, 0.5 to 16384.
+    #[arg(long, default_value_t = 8.0, allow_hyphen_values = true, value_parser = parse_pixels)]
     pub pixels: f32,
     /// --adaptive distance: eye distance, in bounding-box diagonals, at which an edge gets the
-    /// tables' maximum level.
-    #[arg(long, default_value_t = 1.0)]
+    /// tables' maximum level (above 0, at most 1000000).
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true, value_parser = parse_distance)]
     pub distance: f32,
     /// Fractional factors (bft: linear geomorph between the two dyadic levels); the same as
     /// `--spacing fractional-even`.
     #[arg(long)]
     pub fractional: bool,
-    /// Maximum table level L (bft): segments per base edge up to 2^(L+1).
-    #[arg(long, default_value_t = DEFAULT_TABLE_LEVEL)]
+    /// Maximum table level L (bft): segments per base edge up to 2^(L+1); 1 to 6.
+    #[arg(long, default_value_t = DEFAULT_TABLE_LEVEL, allow_hyphen_values = true, value_parser = parse_table_level)]
     pub table_level: u32,
     /// Normals from the surface's derivatives (bft: du × dv from the tangent tables) instead of
     /// its shading normals.
@@ -133,15 +204,16 @@ pub struct SurfaceArgs {
     /// patches greener).
     #[arg(long, alias = "patch-colors")]
     pub patch_colours: bool,
-    /// Time T of the --animate wave (base vertices moved along their normals), in seconds.
-    #[arg(long, allow_hyphen_values = true)]
+    /// Time T of the --animate wave (base vertices moved along their normals), in seconds:
+    /// -1000000 to 1000000.
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_frame)]
     pub frame: Option<f32>,
     /// Colour texture (PNG) shown at the mesh's `vt` coordinates (adaptive, gregory, acc).
     #[arg(long, value_name = "PNG")]
     pub texture: Option<std::path::PathBuf>,
     /// Displace along the normal by S times the height (the --height map's, else a procedural
-    /// bump pattern), seamlessly: shared edges stay bit-identical.
-    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    /// bump pattern), seamlessly: shared edges stay bit-identical. -1000 to 1000.
+    #[arg(long, value_name = "S", allow_hyphen_values = true, value_parser = parse_displace)]
     pub displace: Option<f32>,
     /// Height map (PNG, luminance in [0, 1]) for --displace.
     #[arg(long, value_name = "PNG")]
@@ -336,10 +408,13 @@ impl SurfaceArgs {
         if f.isolation && !(1..=8).contains(&self.isolation) {
             bail!("--isolation {} is outside 1..8", self.isolation);
         }
-        if f.isolation && !(self.sharpness_scale.is_finite() && self.sharpness_scale >= 0.0) {
+        if f.isolation
+            && !(self.sharpness_scale.is_finite()
+                && (0.0..=MAX_SHARPNESS_SCALE).contains(&self.sharpness_scale))
+        {
             bail!(
-                "--sharpness-scale {}: give a finite, non-negative factor",
-                self.sharpness_scale
+                "--sharpness-scale {}: give a factor from 0 to {MAX_SHARPNESS_SCALE}",
+                number32(self.sharpness_scale)
             );
         }
         if f.table_level && !(1..=6).contains(&self.table_level) {
@@ -377,18 +452,27 @@ impl SurfaceArgs {
             },
         };
         if let FactorPolicy::Screen { pixels } = params.factors {
-            if !(pixels.is_finite() && pixels >= 0.5) {
-                bail!("--pixels {pixels}: give at least 0.5 pixels per segment");
+            if !(pixels.is_finite() && (0.5..=16384.0).contains(&pixels)) {
+                bail!(
+                    "--pixels {}: give 0.5 to 16384 pixels per segment",
+                    number32(pixels)
+                );
             }
         }
         if let FactorPolicy::Distance { reference } = params.factors {
-            if !(reference.is_finite() && reference > 0.0) {
-                bail!("--distance {reference}: give a positive number of diagonals");
+            if !(reference.is_finite() && reference > 0.0 && reference <= 1e6) {
+                bail!(
+                    "--distance {}: give a number of diagonals above 0, at most 1000000",
+                    number32(reference)
+                );
             }
         }
         if let Some(t) = self.frame {
-            if !t.is_finite() {
-                bail!("--frame {t}: give a finite time");
+            if !(t.is_finite() && t.abs() <= MAX_FRAME) {
+                bail!(
+                    "--frame {}: give a finite time from -{MAX_FRAME} to {MAX_FRAME} seconds",
+                    number32(t)
+                );
             }
         }
         Ok(Setup {
@@ -403,6 +487,7 @@ impl SurfaceArgs {
                 follow_semi_sharp: !self.creases_at_isolation,
                 split_triangles: self.split_triangles,
                 maps,
+                ..BuildOptions::default()
             },
             params,
             distance_diagonals: (self.adaptive == Some(Adaptive::Distance))
@@ -418,7 +503,10 @@ impl SurfaceArgs {
 pub fn check_displacement(displace: Option<f32>, height: Option<&Path>) -> Result<()> {
     if let Some(s) = displace {
         if !(s.is_finite() && s.abs() <= 1e3) {
-            bail!("--displace {s}: give a finite scale (at most 1000 in magnitude)");
+            bail!(
+                "--displace {}: give a finite scale from -1000 to 1000",
+                number32(s)
+            );
         }
     }
     if height.is_some() && displace.is_none() {
@@ -428,19 +516,25 @@ pub fn check_displacement(displace: Option<f32>, height: Option<&Path>) -> Resul
 }
 
 /// The images of `--texture` and `--height`, read before any device is opened: a file that
-/// is missing or not an image is `TessError::Image`, naming it.
+/// is missing, not a regular file, too large or not an image is an error naming the option
+/// and the file (`--height FILE: 20000x20000 pixels, outside 1..16384 per side`).
 pub fn load_maps(
     texture: Option<&Path>,
     height: Option<&Path>,
     param_error: bool,
 ) -> Result<tess::surface::SurfaceMaps> {
+    let load = |option: &str, p: &Path, load: fn(&Path) -> tess::Result<_>| {
+        load(p)
+            .map(Arc::new)
+            .map_err(|e| anyhow::anyhow!("{option} {e}"))
+    };
     Ok(tess::surface::SurfaceMaps {
         texture: match texture {
-            Some(p) => Some(Arc::new(tess::surface::load_texture(p)?)),
+            Some(p) => Some(load("--texture", p, |p| tess::surface::load_texture(p))?),
             None => None,
         },
         height: match height {
-            Some(p) => Some(Arc::new(tess::surface::load_height(p)?)),
+            Some(p) => Some(load("--height", p, |p| tess::surface::load_height(p))?),
             None => None,
         },
         param_error,
@@ -485,7 +579,7 @@ impl Setup {
 
 /// The most uniform segments per base edge any technique takes: BFT at table level 6 draws
 /// level-1 faces at tessellation level 64, i.e. 2^(6+1) per base edge.
-const MAX_SEGMENTS: f32 = 128.0;
+pub const MAX_SEGMENTS: f32 = 128.0;
 
 /// `--segments` (every command's name for the uniform segments per edge; `--level` is a hidden
 /// alias), checked before any device is opened: a finite number of segments from 1 to
@@ -497,8 +591,9 @@ pub fn check_segments(setup: &Setup) -> Result<()> {
     if let FactorPolicy::Uniform { segments } = setup.params.factors {
         if !(segments.is_finite() && (1.0..=MAX_SEGMENTS).contains(&segments)) {
             bail!(
-                "--segments {segments}: give a number of segments per edge (the tessellation \
-                 level) from 1 to 64 (--method bft: up to 2^(--table-level + 1))"
+                "--segments {}: give a number of segments per edge (the tessellation \
+                 level) from 1 to 64 (--method bft: up to 2^(--table-level + 1))",
+                number32(segments)
             );
         }
     }

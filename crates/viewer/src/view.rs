@@ -35,7 +35,10 @@
 //! drop; vk-core's retire queue destroys each object only after the submissions that could use
 //! it completed (the swapchain's own objects after an idle wait in its drop).
 use crate::cli::ViewArgs;
-use crate::commands::{check_validation, load_mesh, mesh_name, open_device, scene_setup};
+use crate::commands::{
+    check_drawable, check_validation, in_mesh_file, load_mesh_with_lines, mesh_name, open_device,
+    scene_setup,
+};
 use crate::hud::{Action, Hud, PassTimes, Shown};
 use crate::technique::{describe, Setup};
 use anyhow::{Context as _, Result};
@@ -45,6 +48,7 @@ use std::sync::Arc;
 use std::time::Instant;
 use tess::techniques::{self, bft::Wave};
 use tess::{Context, FactorPolicy, Spacing, Technique, TechniqueId};
+use topology::mesh::obj::ObjLines;
 use topology::ControlMesh;
 use vk_core::swapchain::{required_surface_extensions, Swapchain, FRAMES_IN_FLIGHT};
 use vk_core::target::DEPTH_FORMAT;
@@ -92,6 +96,8 @@ struct Gpu {
 struct App {
     args: ViewArgs,
     mesh: ControlMesh,
+    /// The line of every element of `mesh` in its file, for errors about it.
+    lines: ObjLines,
     setup: Setup,
     /// The setup of the last frame drawn, to go back to when a key asks for a surface that
     /// cannot be built.
@@ -198,13 +204,18 @@ impl App {
 
     /// `setup`'s technique built for `mesh` (with what every key may need, e.g. tangent tables
     /// for geometric normals).
-    fn build_surface(gpu: &mut Gpu, mesh: &ControlMesh, setup: &Setup) -> Result<Surface> {
+    fn build_surface(
+        gpu: &mut Gpu,
+        (mesh, lines): (&ControlMesh, &ObjLines),
+        setup: &Setup,
+    ) -> Result<Surface> {
         let mut build = setup.build.clone();
         build.tangents = techniques::info(setup.technique).features.geometric_normals;
         let built = crate::progress::during(
             format!("building {} for {}", setup.technique, build.name),
             || tess::build(&mut gpu.context, setup.technique, mesh, &build),
-        )?;
+        )
+        .map_err(|e| in_mesh_file(e, setup.technique, mesh, lines))?;
         for n in &built.notes {
             eprintln!("{n}");
         }
@@ -216,7 +227,7 @@ impl App {
     }
 
     /// The current technique's surface, built on first use.
-    fn surface(gpu: &mut Gpu, mesh: &ControlMesh, setup: &Setup) -> Result<()> {
+    fn surface(gpu: &mut Gpu, mesh: (&ControlMesh, &ObjLines), setup: &Setup) -> Result<()> {
         if !gpu.surfaces.contains_key(&setup.technique) {
             let surface = Self::build_surface(gpu, mesh, setup)?;
             gpu.surfaces.insert(setup.technique, surface);
@@ -234,7 +245,9 @@ impl App {
     /// place of the mesh; on any error the window keeps the mesh it had.
     fn open_dropped(&mut self, path: &std::path::Path) {
         let name = path.display().to_string();
-        let mesh = match load_mesh(Some(path)) {
+        let loaded = load_mesh_with_lines(Some(path))
+            .and_then(|(m, l)| check_drawable(&m, &l, &name, true).map(|()| (m, l)));
+        let (mesh, lines) = match loaded {
             Ok(m) => m,
             Err(e) => return self.report(format!("cannot open {name}: {}", crate::message(&e))),
         };
@@ -243,13 +256,14 @@ impl App {
         };
         let mut setup = self.setup.clone();
         setup.build.name = name.clone();
-        match Self::build_surface(gpu, &mesh, &setup) {
+        match Self::build_surface(gpu, (&mesh, &lines), &setup) {
             Ok(surface) => {
                 // Frames in flight keep the old surfaces' buffers alive (vk-core defers
                 // destruction).
                 gpu.surfaces.clear();
                 gpu.surfaces.insert(setup.technique, surface);
                 self.mesh = mesh;
+                self.lines = lines;
                 self.setup = setup;
                 self.moved = self.setup.moved();
                 self.status = None;
@@ -271,7 +285,7 @@ impl App {
             // Frames in flight keep their buffers alive (vk-core defers destruction).
             gpu.surfaces.remove(&self.setup.technique);
         }
-        if let Err(e) = Self::surface(gpu, &self.mesh, &self.setup) {
+        if let Err(e) = Self::surface(gpu, (&self.mesh, &self.lines), &self.setup) {
             // A key asked for it: go back to what was drawn. The first build is the command
             // line's: it fails the command.
             let Some(good) = self.last_good.clone() else {
@@ -363,8 +377,12 @@ impl App {
         if let (true, Some(wave)) = (self.moved, &surface.wave) {
             surface.technique.update_base(slot, &wave.at(self.time))?;
         }
+        context.prepare(
+            surface.technique.as_mut(),
+            &params,
+            Context::frame_passes(&params),
+        )?;
         let technique = surface.technique.as_ref();
-        context.prepare(technique, &params, Context::frame_passes(&params))?;
         context.write_frame(slot, technique.bbox(), &params, extent)?;
         let last = self.args.frames.is_some_and(|n| self.frames_drawn + 1 >= n);
         let context = &*context;
@@ -434,13 +452,22 @@ impl App {
                 self.shots += 1;
                 let path =
                     std::path::PathBuf::from(format!("tessera-screenshot-{}.png", self.shots));
-                match img.save_png(&path) {
+                match crate::output::write_png(&path, &img) {
                     Ok(()) => out!("wrote {} (P)", path.display()),
-                    Err(e) => self.report(format!("cannot save {}: {e}", path.display())),
+                    Err(e) => self.report(crate::message(&e)),
                 }
             }
             if let (true, Some(path)) = (final_shot, &self.args.screenshot) {
-                img.save_png(path)?;
+                if crate::output::is_blank(&img, params.clear_color) {
+                    anyhow::bail!(
+                        "{}: nothing was drawn in frame {} (every pixel is the background); \
+                         {} not written",
+                        self.setup.build.name,
+                        self.frames_drawn,
+                        path.display()
+                    );
+                }
+                crate::output::write_png(path, &img)?;
                 out!(
                     "wrote {} after {} frame{}",
                     path.display(),
@@ -714,8 +741,13 @@ pub fn run(args: ViewArgs) -> Result<()> {
     if args.screenshot.is_some() && args.frames.is_none() {
         anyhow::bail!("--screenshot needs --frames N");
     }
-    let mesh = load_mesh(args.scene.mesh.as_deref())?;
-    let setup = scene_setup(&args.scene, &mesh_name(args.scene.mesh.as_deref()), &mesh)?;
+    if let Some(p) = &args.screenshot {
+        crate::output::check_png_name(p, "--screenshot")?;
+    }
+    let name = mesh_name(args.scene.mesh.as_deref());
+    let (mesh, lines) = load_mesh_with_lines(args.scene.mesh.as_deref())?;
+    check_drawable(&mesh, &lines, &name, true)?;
+    let setup = scene_setup(&args.scene, &name, &mesh)?;
     // winit's OS errors name a source file of winit itself: not for users.
     let event_loop = EventLoop::new().map_err(|e| match e {
         winit::error::EventLoopError::Os(_) => anyhow::anyhow!(
@@ -732,6 +764,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         setup,
         args,
         mesh,
+        lines,
         last_good: None,
         status: None,
         shot_requested: false,
@@ -765,8 +798,10 @@ pub fn run(args: ViewArgs) -> Result<()> {
         }) => {
             drop((surfaces, overlay, timer, context, swapchain));
             if app.args.stats {
-                // What outlives every frame resource: idle one-shot command pools only.
+                // Every frame resource is gone; the one-shot command pools the device keeps
+                // for reuse go too, so what is counted is what leaked.
                 device.wait_idle();
+                device.release_idle_command_pools();
                 print_stats("exit", &device, app.started.unwrap_or_else(Instant::now));
             }
             drop(device);
@@ -901,10 +936,19 @@ mod tests {
         for (i, id) in order.iter().enumerate() {
             assert_eq!(key(&(i + 1).to_string()), Some(Action::Technique(*id)));
         }
-        assert_eq!(key("6"), Some(Action::Technique(TechniqueId::Gregory)));
-        assert_eq!(key("7"), Some(Action::Technique(TechniqueId::Acc)));
-        assert_eq!(key("5"), Some(Action::Technique(TechniqueId::Adaptive)));
-        assert_eq!(key("8"), None);
+        assert_eq!(
+            key("6"),
+            Some(Action::Technique("gregory".parse().unwrap()))
+        );
+        assert_eq!(key("7"), Some(Action::Technique("acc".parse().unwrap())));
+        assert_eq!(
+            key("5"),
+            Some(Action::Technique("adaptive".parse().unwrap()))
+        );
+        let past = techniques::registry().len() + 1;
+        if past <= 9 {
+            assert_eq!(key(&past.to_string()), None);
+        }
         assert_eq!(key("0"), None);
         for (c, action) in [
             ("r", Action::Reparam),

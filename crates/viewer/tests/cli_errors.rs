@@ -446,7 +446,8 @@ fn messages_say_each_cause_once_in_obj_terms() {
         &["render", &p, "--method", "adaptive", "-o", out],
         &[],
         1,
-        &["ngon.obj: adaptive plan: "],
+        // The face's line too, since errors found after loading are located.
+        &["ngon.obj:301: adaptive plan: "],
     );
     assert_eq!(e.matches("300 corners").count(), 1, "{e}");
     // Refinement errors after loading speak the same language (Loop on a quad).
@@ -467,7 +468,7 @@ fn messages_say_each_cause_once_in_obj_terms() {
         ],
         &[],
         1,
-        &["quad.obj: Loop subdivision needs triangles, but face 1 has 4 vertices"],
+        &["quad.obj:5: Loop subdivision needs triangles, but face 1 has 4 vertices"],
     );
 }
 

@@ -1,6 +1,7 @@
 //! Physical-device choice (deterministic, overridable) and the logical device with its allocator.
 use crate::error::{Result, VkContext, VkError};
 use crate::instance::Instance;
+use crate::pipeline_cache;
 use crate::retire::RetireQueue;
 use crate::workarounds::Workarounds;
 use ash::vk;
@@ -41,6 +42,12 @@ pub struct Capabilities {
     pub fill_mode_non_solid: bool,
     pub pipeline_statistics_query: bool,
     pub vertex_pipeline_stores_and_atomics: bool,
+    /// `multiDrawIndirect`: one indirect draw command may hold more than one draw.
+    pub multi_draw_indirect: bool,
+    /// `drawIndirectFirstInstance`: indirect draws may start at an instance other than 0.
+    pub draw_indirect_first_instance: bool,
+    /// `maxDrawIndirectCount`: the most draws one indirect command may hold.
+    pub max_draw_indirect_count: u32,
     pub dynamic_rendering: bool,
     pub timestamps: bool,
     pub max_tessellation_generation_level: u32,
@@ -92,6 +99,9 @@ pub struct AdapterInfo {
     pub driver_version: u32,
     pub api_version: u32,
     pub vendor_id: u32,
+    pub device_id: u32,
+    /// The driver's `pipelineCacheUUID`: pipeline cache data is only valid for the same one.
+    pub pipeline_cache_uuid: [u8; 16],
     pub caps: Capabilities,
     pub queue_family: Option<u32>,
     /// Empty when the device can run Tessera.
@@ -217,6 +227,9 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
             pipeline_statistics_query: feats.pipeline_statistics_query == vk::TRUE,
             vertex_pipeline_stores_and_atomics: feats.vertex_pipeline_stores_and_atomics
                 == vk::TRUE,
+            multi_draw_indirect: feats.multi_draw_indirect == vk::TRUE,
+            draw_indirect_first_instance: feats.draw_indirect_first_instance == vk::TRUE,
+            max_draw_indirect_count: props.limits.max_draw_indirect_count,
             dynamic_rendering: f13.dynamic_rendering == vk::TRUE,
             maintenance4: f13.maintenance4 == vk::TRUE,
             timestamps,
@@ -301,6 +314,8 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
             driver_version: props.driver_version,
             api_version: props.api_version,
             vendor_id: props.vendor_id,
+            device_id: props.device_id,
+            pipeline_cache_uuid: props.pipeline_cache_uuid,
             caps,
             queue_family,
             missing,
@@ -357,8 +372,10 @@ pub fn choose_adapter(adapters: &[AdapterInfo], selector: &DeviceSelector) -> Re
 #[derive(Clone, Debug, Default)]
 pub struct DeviceDesc {
     pub selector: DeviceSelector,
-    /// Where the pipeline cache is kept between runs; `None` keeps it in memory only.
-    pub pipeline_cache_path: Option<std::path::PathBuf>,
+    /// The directory the pipeline cache is kept in between runs, one file per device
+    /// ([`crate::pipeline_cache`]; [`crate::pipeline_cache::user_dir`] is the user's);
+    /// `None` keeps it in memory only.
+    pub pipeline_cache_dir: Option<std::path::PathBuf>,
     /// Leaves VK_EXT_transform_feedback off even where the device has it, so the path of devices
     /// without it (typed errors from captures) can be tested on any device.
     pub without_transform_feedback: bool,
@@ -394,7 +411,9 @@ pub struct DeviceShared {
     /// [`DeviceShared::live_objects`]).
     pub(crate) live: AtomicU64,
     pub(crate) pipeline_cache: vk::PipelineCache,
-    pub(crate) pipeline_cache_path: Option<std::path::PathBuf>,
+    /// This device's cache file, and a hash of the data read from it (nothing is written
+    /// back when the cache still holds exactly that).
+    pub(crate) pipeline_cache_file: Option<(std::path::PathBuf, u64)>,
     /// False for a host application's device ([`Device::from_host`]): never waited idle or
     /// destroyed here.
     pub(crate) owns_device: bool,
@@ -499,7 +518,9 @@ impl Device {
             .tessellation_shader(true)
             .fill_mode_non_solid(true)
             .pipeline_statistics_query(info.caps.pipeline_statistics_query)
-            .vertex_pipeline_stores_and_atomics(info.caps.vertex_pipeline_stores_and_atomics);
+            .vertex_pipeline_stores_and_atomics(info.caps.vertex_pipeline_stores_and_atomics)
+            .multi_draw_indirect(info.caps.multi_draw_indirect)
+            .draw_indirect_first_instance(info.caps.draw_indirect_first_instance);
         let mut f12 = vk::PhysicalDeviceVulkan12Features::default().timeline_semaphore(true);
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
             .dynamic_rendering(true)
@@ -535,7 +556,7 @@ impl Device {
             owned,
             queue,
             xfb,
-            desc.pipeline_cache_path.clone(),
+            desc.pipeline_cache_dir.as_deref(),
         )
     }
 
@@ -550,14 +571,24 @@ impl Device {
     ///
     /// # Safety
     /// - `host.device` is a live device created from `host.physical` of `instance`, with
-    ///   `tessellationShader`, `fillModeNonSolid`, `dynamicRendering` and `timelineSemaphore`
-    ///   enabled, and each optional feature `host` claims enabled (transform feedback with its
-    ///   extension, pipeline statistics queries, vertex-pipeline stores) enabled.
+    ///   `tessellationShader`, `fillModeNonSolid` and `timelineSemaphore` enabled,
+    ///   `dynamicRendering` too unless nothing vk-core records on it begins a rendering scope
+    ///   of its own or is recorded into a dynamic-rendering scope (a host that draws only into
+    ///   render pass subpasses and never captures), and each optional feature `host` claims
+    ///   enabled (transform feedback with its extension, pipeline statistics queries,
+    ///   vertex-pipeline stores) enabled.
     /// - `host.queue` is queue 0 of `host.queue_family`, a family with graphics and compute.
     /// - The device outlives every object made from the result; the host does not use the
     ///   queue on another thread while a vk-core call that submits runs (Vulkan's external
     ///   synchronization of queues).
-    pub unsafe fn from_host(instance: &Arc<Instance>, host: &HostDevice) -> Result<Self> {
+    ///
+    /// `pipeline_cache_dir` is as [`DeviceDesc::pipeline_cache_dir`]: vk-core's own pipeline
+    /// cache (never the host's) is read from and saved to this device's file there.
+    pub unsafe fn from_host(
+        instance: &Arc<Instance>,
+        host: &HostDevice,
+        pipeline_cache_dir: Option<&std::path::Path>,
+    ) -> Result<Self> {
         let adapters = enumerate_adapters(instance)?;
         let Some(mut info) = adapters.into_iter().find(|a| a.physical == host.physical) else {
             return Err(VkError::NoSuchDevice {
@@ -593,6 +624,10 @@ impl Device {
         info.queue_family = Some(host.queue_family);
         info.caps.pipeline_statistics_query &= host.pipeline_statistics_query;
         info.caps.vertex_pipeline_stores_and_atomics &= host.vertex_pipeline_stores_and_atomics;
+        // The host does not say whether it enabled these: indirect draws hold one draw each
+        // and start at instance 0 on its device.
+        info.caps.multi_draw_indirect = false;
+        info.caps.draw_indirect_first_instance = false;
         let xfb = info.caps.transform_feedback && host.transform_feedback;
         info.caps.transform_feedback = xfb;
         // SAFETY: the caller's contract: a live device of this instance.
@@ -601,7 +636,7 @@ impl Device {
             raw,
             destroy: false,
         };
-        Self::wrap(instance, info, owned, host.queue, xfb, None)
+        Self::wrap(instance, info, owned, host.queue, xfb, pipeline_cache_dir)
     }
 
     /// Everything after the device and its queue exist, for both owners.
@@ -611,7 +646,7 @@ impl Device {
         owned: Owned,
         queue: vk::Queue,
         xfb: bool,
-        pipeline_cache_path: Option<std::path::PathBuf>,
+        pipeline_cache_dir: Option<&std::path::Path>,
     ) -> Result<Self> {
         let Owned { raw, destroy: owns } = owned;
         let physical = info.physical;
@@ -655,12 +690,21 @@ impl Device {
                 });
             }
         };
-        let initial = pipeline_cache_path
-            .as_ref()
-            .and_then(|p| std::fs::read(p).ok())
+        let identity = pipeline_cache::CacheIdentity {
+            vendor_id: info.vendor_id,
+            device_id: info.device_id,
+            pipeline_cache_uuid: info.pipeline_cache_uuid,
+        };
+        let file = pipeline_cache_dir.map(|d| identity.file_in(d));
+        // Only data whose header names this device and driver build (checked in `load`).
+        let initial = file
+            .as_deref()
+            .map(|p| pipeline_cache::load(p, &identity))
             .unwrap_or_default();
+        let pipeline_cache_file = file.map(|p| (p, data_hash(&initial)));
         let cache_info = vk::PipelineCacheCreateInfo::default().initial_data(&initial);
-        // SAFETY: the driver validates the header of `initial` and ignores incompatible data.
+        // SAFETY: `initial` is empty or data whose header matches this device; the driver
+        // still validates it and ignores what it cannot use.
         let pipeline_cache = match unsafe { raw.create_pipeline_cache(&cache_info, None) } {
             Ok(c) => c,
             Err(_) => {
@@ -694,7 +738,7 @@ impl Device {
             retired: Mutex::new(RetireQueue::default()),
             live: AtomicU64::new(0),
             pipeline_cache,
-            pipeline_cache_path,
+            pipeline_cache_file,
             owns_device: owns,
             instance: instance.clone(),
         };
@@ -790,28 +834,59 @@ impl DeviceShared {
         self.collect_retired();
     }
 
+    /// Destroys the one-shot command pools kept for reuse ([`Device::submit_once`] takes one
+    /// and gives it back when its submission completes). Idle pools are the device's cache,
+    /// not anything a caller holds: after this, [`DeviceShared::live_objects`] counts only
+    /// what callers hold (or leaked). Used before a final count; a later one-shot submission
+    /// makes a new pool.
+    pub fn release_idle_command_pools(&self) {
+        let pools = match self.once_pools.lock() {
+            Ok(mut p) => std::mem::take(&mut *p),
+            Err(_) => return,
+        };
+        for (pool, _) in pools {
+            // SAFETY: a pool is in `once_pools` only once its command buffer is no longer
+            // pending (recycled after its submission completed, or never submitted); it was
+            // taken out under the lock, so no other thread uses it.
+            unsafe { self.raw.destroy_command_pool(pool, None) };
+            self.destroyed(1);
+        }
+    }
+
     pub fn pipeline_cache(&self) -> vk::PipelineCache {
         self.pipeline_cache
     }
 
-    /// Writes the pipeline cache to its file (if one was given); failures only warn.
+    /// Writes the pipeline cache to this device's file (when a directory was given and the
+    /// cache changed since it was read), atomically; failures only warn.
     pub fn save_pipeline_cache(&self) {
-        let Some(path) = &self.pipeline_cache_path else {
+        let Some((path, read_hash)) = &self.pipeline_cache_file else {
             return;
         };
         // SAFETY: the cache belongs to this device.
         match unsafe { self.raw.get_pipeline_cache_data(self.pipeline_cache) } {
+            Ok(data) if data_hash(&data) == *read_hash => {}
             Ok(data) => {
-                if let Some(dir) = path.parent() {
-                    let _ = std::fs::create_dir_all(dir);
-                }
-                if let Err(e) = std::fs::write(path, data) {
+                if let Err(e) = pipeline_cache::save(path, &data) {
                     log::warn!("pipeline cache not saved to {}: {e}", path.display());
                 }
             }
             Err(e) => log::warn!("pipeline cache data unavailable: {e}"),
         }
     }
+
+    /// This device's pipeline cache file, when it keeps one.
+    pub fn pipeline_cache_file(&self) -> Option<&std::path::Path> {
+        self.pipeline_cache_file.as_ref().map(|(p, _)| p.as_path())
+    }
+}
+
+/// A hash of cache data, to tell whether it changed since it was read.
+fn data_hash(data: &[u8]) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    data.hash(&mut h);
+    h.finish()
 }
 
 impl Drop for DeviceShared {
@@ -882,6 +957,8 @@ mod tests {
             driver_version: 0,
             api_version: vk::API_VERSION_1_3,
             vendor_id: 0,
+            device_id: 0,
+            pipeline_cache_uuid: [0; 16],
             caps: Capabilities {
                 tessellation_shader: tess,
                 fill_mode_non_solid: true,

@@ -41,7 +41,8 @@ use crate::descriptor::DescriptorSet;
 use crate::device::Device;
 use crate::error::{RecordingError as E, Result, VkContext, VkError};
 use crate::image::transition;
-use crate::pipeline::Pipeline;
+use crate::indirect::{IndirectDraws, IndirectKind};
+use crate::pipeline::{Pipeline, Subpass};
 use crate::query::QueryPool;
 use crate::retire::Retired;
 use crate::target::{OffscreenTarget, COLOR_FORMAT, DEPTH_FORMAT};
@@ -81,7 +82,24 @@ struct Scope {
     kind: ScopeKind,
     /// (colour, depth); `UNDEFINED` where the scope has no such attachment.
     formats: [vk::Format; 2],
+    /// The render pass subpass the scope is; `None` for dynamic rendering.
+    subpass: Option<Subpass>,
     id: u32,
+}
+
+/// The rendering scope a host application has open when it hands its command buffer to
+/// [`Encoder::record_into`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HostScope {
+    /// Dynamic rendering with these (colour, depth) attachment formats (`UNDEFINED`: none).
+    Rendering([vk::Format; 2]),
+    /// A subpass of a render pass instance (of `subpass.render_pass` or one compatible with
+    /// it), whose colour and depth attachments `formats` describe as for pipelines
+    /// ([`crate::pipeline::GraphicsPipelineDesc::subpass`]).
+    Subpass {
+        subpass: Subpass,
+        formats: [vk::Format; 2],
+    },
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -151,27 +169,41 @@ impl<'a> Encoder<'a> {
 
     /// Records into `cmd`, a command buffer a host application owns and submits itself (the
     /// C ABI's host-owned mode): the encoder neither begins, ends, submits nor resets it, and
-    /// is closed with [`Encoder::finish`]. With `scope`, the host has begun a dynamic-rendering
-    /// scope with those (colour, depth) formats, which draws are checked against; the host
-    /// also set the viewport and scissor (every vk-core pipeline takes them as dynamic state).
+    /// is closed with [`Encoder::finish`]. With `scope`, the host has begun a rendering scope
+    /// (dynamic rendering of those formats, or a render pass instance in that subpass), which
+    /// draws are checked against; the host also set the viewport and scissor (every vk-core
+    /// pipeline takes them as dynamic state).
     ///
     /// # Safety
     /// - `cmd` is a primary command buffer of `device`, in the recording state, that nothing
     ///   else records into, resets or frees until the encoder is finished or dropped.
-    /// - With `scope`, `cmd` is inside a rendering scope begun with dynamic rendering, with
-    ///   exactly those attachment formats (`UNDEFINED` where there is no attachment), viewport
-    ///   and scissor set; without, it is outside any rendering scope.
+    /// - With `scope`, `cmd` is inside the rendering scope it describes, viewport and scissor
+    ///   set: [`HostScope::Rendering`], a scope begun with dynamic rendering with exactly those
+    ///   attachment formats (`UNDEFINED` where there is no attachment);
+    ///   [`HostScope::Subpass`], a render pass instance, begun with contents
+    ///   `VK_SUBPASS_CONTENTS_INLINE`, of a render pass compatible with `subpass.render_pass`,
+    ///   in subpass `subpass.index`, whose attachments `formats` and `subpass.samples`
+    ///   describe. Without `scope`, `cmd` is outside any rendering scope.
     /// - Everything the recording references stays alive until the GPU finished executing
     ///   `cmd`. vk-core cannot see the host's submissions, so its retire queue does not cover
     ///   them: the caller destroys what it recorded only after the host waited for them.
     pub unsafe fn record_into(
         device: &Device,
         cmd: vk::CommandBuffer,
-        scope: Option<[vk::Format; 2]>,
+        scope: Option<HostScope>,
     ) -> Self {
         let mut e = Self::recording(device, cmd, Origin::Host);
-        if let Some(formats) = scope {
-            e.open_scope("host rendering scope", ScopeKind::Host, formats);
+        let (what, formats, subpass) = match scope {
+            Some(HostScope::Rendering(formats)) => ("host rendering scope", formats, None),
+            Some(HostScope::Subpass { subpass, formats }) => {
+                ("host render pass instance", formats, Some(subpass))
+            }
+            None => return e,
+        };
+        if e.open_scope(what, ScopeKind::Host, formats) {
+            if let Some(s) = e.scope.as_mut() {
+                s.subpass = subpass;
+            }
         }
         e
     }
@@ -474,6 +506,16 @@ impl<'a> Encoder<'a> {
             let scope = self
                 .scope
                 .ok_or_else(|| VkError::recording(command, E::OutsideRendering))?;
+            if scope.subpass != pipeline.subpass {
+                return Err(VkError::recording(
+                    command,
+                    E::Subpass {
+                        pipeline: pipeline.name.clone(),
+                        pipeline_subpass: Subpass::describe(pipeline.subpass),
+                        scope_subpass: Subpass::describe(scope.subpass),
+                    },
+                ));
+            }
             if scope.formats != pipeline.attachment_formats {
                 return Err(VkError::recording(
                     command,
@@ -503,12 +545,14 @@ impl<'a> Encoder<'a> {
     }
 
     /// Every vertex binding of the pipeline has a buffer; `vertices_end` (when the vertex range
-    /// is known) fits in each per-vertex binding.
+    /// is known) fits in each per-vertex binding, `instances_end` (when known) in each
+    /// per-instance binding.
     fn check_vertex_buffers(
         &self,
         command: &'static str,
         pipeline: &Pipeline,
         vertices_end: Option<u32>,
+        instances_end: Option<u32>,
     ) -> Result<()> {
         for binding in &pipeline.vertex_bindings {
             let buffer = self
@@ -525,18 +569,33 @@ impl<'a> Encoder<'a> {
                         },
                     )
                 })?;
-            let Some(end) = vertices_end.filter(|&e| e > 0 && binding.per_vertex) else {
+            let end = if binding.per_vertex {
+                vertices_end
+            } else {
+                instances_end
+            };
+            let Some(end) = end.filter(|&e| e > 0) else {
                 continue;
             };
             let needed = (end as u64 - 1) * binding.stride as u64 + binding.element_bytes as u64;
             if needed > buffer.size() {
+                let (buffer, size) = (buffer.name().to_owned(), buffer.size());
                 return Err(VkError::recording(
                     command,
-                    E::VertexRange {
-                        buffer: buffer.name().to_owned(),
-                        end,
-                        needed,
-                        size: buffer.size(),
+                    if binding.per_vertex {
+                        E::VertexRange {
+                            buffer,
+                            end,
+                            needed,
+                            size,
+                        }
+                    } else {
+                        E::InstanceRange {
+                            buffer,
+                            end,
+                            needed,
+                            size,
+                        }
                     },
                 ));
             }
@@ -544,53 +603,116 @@ impl<'a> Encoder<'a> {
         Ok(())
     }
 
+    /// The bound index buffer, when `indices_end` indices fit in it.
+    fn check_indices(&self, command: &'static str, first: u32, end: u32) -> Result<&'a Buffer> {
+        let index_buffer = self
+            .index_buffer
+            .ok_or_else(|| VkError::recording(command, E::NoIndexBuffer))?;
+        let available = index_buffer.size() / 4;
+        if first > end || end as u64 > available {
+            return Err(VkError::recording(
+                command,
+                E::IndexRange {
+                    buffer: index_buffer.name().to_owned(),
+                    first,
+                    end,
+                    count: available,
+                },
+            ));
+        }
+        Ok(index_buffer)
+    }
+
     /// Error unless a graphics pipeline is bound.
     pub fn draw(&mut self, vertices: Range<u32>) -> Result<()> {
+        self.draw_instanced(vertices, 0..1)
+    }
+
+    /// `vertices` of each of `instances`; per-instance vertex bindings are checked against the
+    /// instance range as per-vertex ones are against the vertex range.
+    pub fn draw_instanced(&mut self, vertices: Range<u32>, instances: Range<u32>) -> Result<()> {
         const CMD: &str = "vkCmdDraw";
         let pipeline = self.check_pipeline_state(CMD, vk::PipelineBindPoint::GRAPHICS)?;
-        self.check_vertex_buffers(CMD, pipeline, Some(vertices.end))?;
+        self.check_vertex_buffers(CMD, pipeline, Some(vertices.end), Some(instances.end))?;
         let count = vertices.end.saturating_sub(vertices.start);
+        let instance_count = instances.end.saturating_sub(instances.start);
         // SAFETY: a graphics pipeline is bound inside a rendering scope of its formats, with
         // every set and vertex buffer it declares bound and large enough (invariant 3).
         unsafe {
-            self.device
-                .raw
-                .cmd_draw(self.cmd, count, 1, vertices.start, 0)
+            self.device.raw.cmd_draw(
+                self.cmd,
+                count,
+                instance_count,
+                vertices.start,
+                instances.start,
+            )
         };
         Ok(())
     }
 
     /// Error unless a graphics pipeline and an index buffer are bound and the range lies inside the index buffer.
     pub fn draw_indexed(&mut self, indices: Range<u32>) -> Result<()> {
+        self.draw_indexed_instanced(indices, 0..1)
+    }
+
+    /// `indices` of each of `instances`, checked as [`Self::draw_indexed`] and
+    /// [`Self::draw_instanced`] check theirs.
+    pub fn draw_indexed_instanced(
+        &mut self,
+        indices: Range<u32>,
+        instances: Range<u32>,
+    ) -> Result<()> {
         const CMD: &str = "vkCmdDrawIndexed";
         let pipeline = self.check_pipeline_state(CMD, vk::PipelineBindPoint::GRAPHICS)?;
-        self.check_vertex_buffers(CMD, pipeline, None)?;
-        let index_buffer = self
-            .index_buffer
-            .ok_or_else(|| VkError::recording(CMD, E::NoIndexBuffer))?;
-        let available = index_buffer.size() / 4;
-        if indices.start > indices.end || indices.end as u64 > available {
-            return Err(VkError::recording(
-                CMD,
-                E::IndexRange {
-                    buffer: index_buffer.name().to_owned(),
-                    first: indices.start,
-                    end: indices.end,
-                    count: available,
-                },
-            ));
-        }
+        self.check_vertex_buffers(CMD, pipeline, None, Some(instances.end))?;
+        self.check_indices(CMD, indices.start, indices.end)?;
         // SAFETY: as for draw, and the index range lies inside the bound index buffer.
         unsafe {
             self.device.raw.cmd_draw_indexed(
                 self.cmd,
                 indices.end - indices.start,
-                1,
+                instances.end.saturating_sub(instances.start),
                 indices.start,
                 0,
-                0,
+                instances.start,
             )
         };
+        Ok(())
+    }
+
+    /// Every draw of `draws` (indexed through the bound index buffer when they are indexed
+    /// commands), checked against the extent they promise ([`crate::indirect`]).
+    pub fn draw_indirect(&mut self, draws: &'a IndirectDraws) -> Result<()> {
+        let indexed = draws.kind() == IndirectKind::DrawIndexed;
+        let cmd: &'static str = if indexed {
+            "vkCmdDrawIndexedIndirect"
+        } else {
+            "vkCmdDrawIndirect"
+        };
+        let pipeline = self.check_pipeline_state(cmd, vk::PipelineBindPoint::GRAPHICS)?;
+        Self::needs_usage(cmd, draws.buffer(), vk::BufferUsageFlags::INDIRECT_BUFFER)?;
+        let extent = draws.extent();
+        let vertices = (!indexed).then_some(extent.vertices);
+        self.check_vertex_buffers(cmd, pipeline, vertices, Some(extent.instances))?;
+        let (buffer, count, stride) = (draws.buffer().raw, draws.draws(), draws.kind().stride());
+        if indexed {
+            self.check_indices(cmd, 0, extent.indices)?;
+            // SAFETY: as for draw_indexed; every command's indices and instances lie inside
+            // the promised extent, checked against the bound buffers above, and the command
+            // count was checked against the device's limit when the buffer was made.
+            unsafe {
+                self.device
+                    .raw
+                    .cmd_draw_indexed_indirect(self.cmd, buffer, 0, count, stride)
+            };
+        } else {
+            // SAFETY: as for draw, with the extent as the ranges.
+            unsafe {
+                self.device
+                    .raw
+                    .cmd_draw_indirect(self.cmd, buffer, 0, count, stride)
+            };
+        }
         Ok(())
     }
 
@@ -1244,6 +1366,7 @@ impl<'a> Encoder<'a> {
         self.scope = Some(Scope {
             kind,
             formats,
+            subpass: None,
             id: self.scopes_opened,
         });
         true
@@ -1443,6 +1566,17 @@ impl<'a> Encoder<'a> {
         let Some(scope) = self.scope else {
             return Err(VkError::recording(command, E::OutsideRendering));
         };
+        if scope.subpass.is_some() {
+            // vk-core's own raw draws (the overlay) are made for dynamic rendering.
+            return Err(VkError::recording(
+                command,
+                E::Subpass {
+                    pipeline: "HUD overlay".into(),
+                    pipeline_subpass: Subpass::describe(None),
+                    scope_subpass: Subpass::describe(scope.subpass),
+                },
+            ));
+        }
         self.pipeline = None;
         self.sets.clear();
         self.vertex_buffers.clear();

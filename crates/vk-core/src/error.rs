@@ -77,6 +77,9 @@ pub enum VkError {
         index: u32,
         count: u32,
     },
+    /// An indirect draw command vk-core refused to write (see [`crate::indirect`]).
+    #[error("indirect draw {draw}: {problem}")]
+    IndirectCommand { draw: usize, problem: String },
     /// A command recorded where Vulkan forbids it, or with arguments vk-core can tell are wrong.
     #[error("{command}: {problem}")]
     Recording {
@@ -177,6 +180,13 @@ pub enum RecordingError {
         needed: u64,
         size: u64,
     },
+    #[error("instances up to {end} need {needed} bytes of vertex buffer {buffer} ({size} bytes)")]
+    InstanceRange {
+        buffer: String,
+        end: u32,
+        needed: u64,
+        size: u64,
+    },
     #[error("{groups:?} workgroups exceed the device's maximum {max:?}")]
     WorkgroupCount { groups: [u32; 3], max: [u32; 3] },
     #[error("must be recorded inside a rendering scope")]
@@ -192,6 +202,15 @@ pub enum RecordingError {
         pipeline: String,
         pipeline_formats: [vk::Format; 2],
         scope_formats: [vk::Format; 2],
+    },
+    #[error(
+        "pipeline {pipeline} was made for {pipeline_subpass}, the open scope is {scope_subpass}"
+    )]
+    Subpass {
+        pipeline: String,
+        /// "dynamic rendering" or "subpass I of render pass R".
+        pipeline_subpass: String,
+        scope_subpass: String,
     },
     #[error("query {index} of pool {pool} was not reset earlier in this command buffer")]
     QueryNotReset { pool: String, index: u32 },

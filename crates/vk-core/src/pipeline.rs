@@ -1,9 +1,11 @@
 //! Graphics pipelines with tessellation stages, and compute pipelines. All go through the
-//! device's pipeline cache (kept on disk when the device was given a path).
+//! device's pipeline cache (kept on disk when the device was given a directory:
+//! [`crate::pipeline_cache`]).
 //!
 //! A pipeline remembers what an [`crate::Encoder`] needs to check commands against it: its bind
-//! point, layout, set layouts, push-constant range, attachment formats, vertex bindings, and
-//! whether its shaders write transform feedback (the SPIR-V's Xfb execution mode).
+//! point, layout, set layouts, push-constant range, attachment formats and the render pass
+//! subpass it was made for (if any), vertex bindings, and whether its shaders write transform
+//! feedback (the SPIR-V's Xfb execution mode).
 use crate::device::{Device, DeviceShared};
 use crate::error::{Result, VkContext, VkError};
 use crate::retire::Retired;
@@ -35,6 +37,30 @@ pub struct TessellationDesc {
     pub domain_origin: vk::TessellationDomainOrigin,
 }
 
+/// A subpass of a render pass (render-pass rendering, the alternative to dynamic rendering a
+/// host application may use): a pipeline made for it draws only inside that subpass of that
+/// render pass, or of one compatible with it (Vulkan's render pass compatibility).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Subpass {
+    pub render_pass: vk::RenderPass,
+    pub index: u32,
+    /// The subpass's sample count (its attachments'): pipelines rasterize with it.
+    pub samples: vk::SampleCountFlags,
+}
+
+impl Subpass {
+    /// "dynamic rendering" for `None`, else the subpass and its render pass, for messages.
+    pub fn describe(subpass: Option<Subpass>) -> String {
+        match subpass {
+            None => "dynamic rendering".into(),
+            Some(s) => format!(
+                "subpass {} of render pass {:?} ({:?})",
+                s.index, s.render_pass, s.samples
+            ),
+        }
+    }
+}
+
 #[derive(Clone)]
 pub struct GraphicsPipelineDesc<'a> {
     pub name: &'a str,
@@ -53,6 +79,10 @@ pub struct GraphicsPipelineDesc<'a> {
     pub depth_bias: Option<(f32, f32)>,
     pub color_format: vk::Format,
     pub depth_format: vk::Format,
+    /// `None`: dynamic rendering with the formats above. `Some`: that subpass of a render
+    /// pass, whose colour attachment (one, or none when `color_format` is `UNDEFINED`) and
+    /// depth attachment (none when `depth_format` is `UNDEFINED`) the formats describe.
+    pub subpass: Option<Subpass>,
     /// No rasterization: for passes that only capture TES output (transform feedback or storage
     /// buffers). Such a pipeline needs no fragment stage; give `vk::Format::UNDEFINED` as both
     /// formats to render into a scope without attachments.
@@ -80,6 +110,7 @@ impl<'a> GraphicsPipelineDesc<'a> {
             depth_bias: None,
             color_format,
             depth_format,
+            subpass: None,
             rasterizer_discard: false,
             set_layouts: Vec::new(),
             push_constant_bytes: 0,
@@ -106,6 +137,8 @@ pub struct Pipeline {
     pub(crate) push_constant_bytes: u32,
     /// (colour, depth) formats; `UNDEFINED` for none (and for compute pipelines).
     pub(crate) attachment_formats: [vk::Format; 2],
+    /// The subpass it was made for; `None` for dynamic rendering (and compute).
+    pub(crate) subpass: Option<Subpass>,
     pub(crate) vertex_bindings: Vec<VertexBinding>,
     pub(crate) transform_feedback_output: bool,
     device: Arc<DeviceShared>,
@@ -300,8 +333,10 @@ impl Pipeline {
             .depth_bias_enable(desc.depth_bias.is_some())
             .depth_bias_constant_factor(desc.depth_bias.map(|b| b.0).unwrap_or(0.0))
             .depth_bias_slope_factor(desc.depth_bias.map(|b| b.1).unwrap_or(0.0));
-        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(
+            desc.subpass
+                .map_or(vk::SampleCountFlags::TYPE_1, |s| s.samples),
+        );
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(desc.depth_test)
             .depth_write_enable(desc.depth_write)
@@ -329,8 +364,11 @@ impl Pipeline {
             .depth_stencil_state(&depth)
             .color_blend_state(&blend)
             .dynamic_state(&dynamic)
-            .layout(layout)
-            .push_next(&mut rendering);
+            .layout(layout);
+        info = match desc.subpass {
+            Some(s) => info.render_pass(s.render_pass).subpass(s.index),
+            None => info.push_next(&mut rendering),
+        };
         if desc.tessellation.is_some() {
             info = info.tessellation_state(&tess_state);
         }
@@ -353,6 +391,7 @@ impl Pipeline {
                     set_layouts: desc.set_layouts.clone(),
                     push_constant_bytes: desc.push_constant_bytes,
                     attachment_formats: [desc.color_format, desc.depth_format],
+                    subpass: desc.subpass,
                     vertex_bindings: vertex_bindings(desc),
                     transform_feedback_output: desc
                         .stages
@@ -424,6 +463,7 @@ impl Pipeline {
                     set_layouts: set_layouts.to_vec(),
                     push_constant_bytes,
                     attachment_formats: [vk::Format::UNDEFINED; 2],
+                    subpass: None,
                     vertex_bindings: Vec::new(),
                     transform_feedback_output: false,
                     device: device.shared.clone(),

@@ -146,8 +146,9 @@ int main(int argc, char **argv) {
         fprintf(stderr, "usage: %s OUT_DIR\n", argv[0]);
         return 2;
     }
-    cdesc.device = NULL;
+    memset(&cdesc, 0, sizeof cdesc);
     cdesc.validation = TESSERA_VALIDATION_SYNCHRONIZATION;
+    cdesc.pipeline_cache = TESSERA_PIPELINE_CACHE_OFF;
     check(tessera_context_create_standalone(&cdesc, &ctx), TESSERA_STATUS_OK, "create context");
     if (ctx == NULL) return 1;
 

@@ -86,11 +86,11 @@ pub fn reference(technique: tess::TechniqueId, width: u32, height: u32) -> Vec<u
     let mesh = topology::mesh::obj::parse_obj(&text, "spot").unwrap();
     let pixels = {
         let mut ctx = tess::Context::offscreen(&device).unwrap();
-        let built = tess::build(&mut ctx, technique, &mesh, &tess::BuildOptions::default())
+        let mut built = tess::build(&mut ctx, technique, &mesh, &tess::BuildOptions::default())
             .unwrap_or_else(|e| panic!("{technique}: {e}"));
         let params = tess::FrameParams::uniform(4.0);
         ctx.render_offscreen(
-            built.technique.as_ref(),
+            built.technique.as_mut(),
             &params,
             vk_core::vk::Extent2D { width, height },
         )
@@ -109,22 +109,22 @@ pub fn reference(technique: tess::TechniqueId, width: u32, height: u32) -> Vec<u
 
 /// The techniques the C++ host draws.
 pub const HOST_TECHNIQUES: &[(&str, tess::TechniqueId)] = &[
-    ("flat", tess::TechniqueId::Flat),
-    ("phong", tess::TechniqueId::Phong),
-    ("pn", tess::TechniqueId::Pn),
-    ("bft", tess::TechniqueId::Bft),
-    ("adaptive", tess::TechniqueId::Adaptive),
+    ("flat", tess::TechniqueId::FLAT),
+    ("phong", tess::TechniqueId::PHONG),
+    ("pn", tess::TechniqueId::PN),
+    ("bft", tess::TechniqueId::BFT),
+    ("adaptive", tess::TechniqueId::ADAPTIVE),
 ];
 
 /// Every technique of the C ABI (the C program draws them all).
 pub const ALL_TECHNIQUES: &[(&str, tess::TechniqueId)] = &[
-    ("flat", tess::TechniqueId::Flat),
-    ("phong", tess::TechniqueId::Phong),
-    ("pn", tess::TechniqueId::Pn),
-    ("bft", tess::TechniqueId::Bft),
-    ("adaptive", tess::TechniqueId::Adaptive),
-    ("gregory", tess::TechniqueId::Gregory),
-    ("acc", tess::TechniqueId::Acc),
+    ("flat", tess::TechniqueId::FLAT),
+    ("phong", tess::TechniqueId::PHONG),
+    ("pn", tess::TechniqueId::PN),
+    ("bft", tess::TechniqueId::BFT),
+    ("adaptive", tess::TechniqueId::ADAPTIVE),
+    ("gregory", tess::TechniqueId::GREGORY),
+    ("acc", tess::TechniqueId::ACC),
 ];
 
 /// Each of `techniques`' `<name>.rgba` in `dir` (160×120, written by a C or C++ host) against
@@ -161,4 +161,114 @@ pub fn frame_desc(width: u32, height: u32) -> tessera_capi::TesseraFrameDesc {
     f.width = width;
     f.height = height;
     f
+}
+
+/// One of the example C++ hosts under examples/ and the line it prints when all went well.
+#[derive(Clone, Copy)]
+pub struct Host {
+    pub example: &'static str,
+    pub done: &'static str,
+}
+
+impl Host {
+    /// Configures and builds the host against the in-tree CMake package (`Tessera_DIR` and
+    /// `TESSERA_LIBRARY`: this test's library) into `target/<profile>/capi-tests/<name>-build`.
+    pub fn build_in_tree(&self, name: &str, asan: bool) -> PathBuf {
+        let build = profile_dir()
+            .join("capi-tests")
+            .join(format!("{name}-build"));
+        let source = repo().join("examples").join(self.example);
+        // A build directory configured from another checkout (a copied target directory)
+        // cannot be reconfigured from this one: start it afresh.
+        let home = source.canonicalize().unwrap();
+        let cache = std::fs::read_to_string(build.join("CMakeCache.txt")).unwrap_or_default();
+        let configured_here = cache
+            .lines()
+            .filter_map(|l| l.strip_prefix("CMAKE_HOME_DIRECTORY:INTERNAL="))
+            .any(|d| Path::new(d).canonicalize().ok().as_deref() == Some(home.as_path()));
+        if !cache.is_empty() && !configured_here {
+            std::fs::remove_dir_all(&build).unwrap();
+        }
+        run(Command::new("cmake")
+            .arg("-S")
+            .arg(&source)
+            .arg("-B")
+            .arg(&build)
+            .arg(format!("-DTessera_DIR={}", repo().join("cmake").display()))
+            .arg(format!("-DTESSERA_LIBRARY={}", library().display()))
+            .arg(format!(
+                "-DTESSERA_HOST_ASAN={}",
+                if asan { "ON" } else { "OFF" }
+            )));
+        run(Command::new("cmake").arg("--build").arg(&build));
+        build.join(self.example)
+    }
+
+    /// Builds the host (as [`Self::build_in_tree`]) and runs it with its misuse checks into a
+    /// fresh `capi-tests/<out>` directory, which it returns.
+    pub fn run_in_tree(&self, out: &str, asan: bool) -> PathBuf {
+        let exe = self.build_in_tree(&format!("{}-{out}", self.example), asan);
+        let dir = scratch(out);
+        let text = run(Command::new(&exe).arg(&dir).arg("misuse"));
+        assert!(text.contains(self.done), "{text}");
+        dir
+    }
+}
+
+/// Captures spot drawn by technique `name` on a standalone context through the C ABI, with
+/// the surface and frame descriptions the example hosts use (defaults, 160×120, 4 uniform
+/// segments), into `dir/<name>.standalone.obj`; returns the file and the report.
+pub fn standalone_capture(name: &str, dir: &Path) -> (Vec<u8>, tessera_capi::TesseraCaptureReport) {
+    use tessera_capi::*;
+    let technique = match name {
+        "flat" => TESSERA_TECHNIQUE_FLAT,
+        "phong" => TESSERA_TECHNIQUE_PHONG,
+        "pn" => TESSERA_TECHNIQUE_PN,
+        "bft" => TESSERA_TECHNIQUE_BFT,
+        "adaptive" => TESSERA_TECHNIQUE_ADAPTIVE,
+        "gregory" => TESSERA_TECHNIQUE_GREGORY,
+        "acc" => TESSERA_TECHNIQUE_ACC,
+        other => panic!("no technique {other}"),
+    };
+    let path = dir.join(format!("{name}.standalone.obj"));
+    let c_path = std::ffi::CString::new(path.to_str().unwrap()).unwrap();
+    let desc = TesseraStandaloneDesc {
+        validation: TESSERA_VALIDATION_SYNCHRONIZATION,
+        pipeline_cache: TESSERA_PIPELINE_CACHE_OFF,
+        ..Default::default()
+    };
+    let mut frame = frame_desc(160, 120);
+    frame.factor = 4.0;
+    let sdesc = surface_desc(technique);
+    let mut report = tessera_capi::TesseraCaptureReport::default();
+    // SAFETY: every pointer addresses a live local of the type the call reads or writes.
+    unsafe {
+        let mut ctx = std::ptr::null_mut();
+        assert_eq!(
+            tessera_context_create_standalone(&desc, &mut ctx),
+            TesseraStatus::Ok
+        );
+        let mut surface = std::ptr::null_mut();
+        assert_eq!(
+            tessera_surface_create_obj(
+                ctx,
+                std::ptr::null(),
+                0,
+                std::ptr::null(),
+                &sdesc,
+                &mut surface
+            ),
+            TesseraStatus::Ok
+        );
+        let status = tessera_capture(ctx, surface, &frame, c_path.as_ptr(), &mut report);
+        assert_eq!(status, TesseraStatus::Ok, "{name}");
+        let mut errors = 1;
+        assert_eq!(
+            tessera_context_validation_errors(ctx, &mut errors),
+            TesseraStatus::Ok
+        );
+        assert_eq!(errors, 0, "{name}: validation errors");
+        assert_eq!(tessera_context_destroy(ctx), TesseraStatus::Ok);
+    }
+    (std::fs::read(&path).unwrap(), report)
 }

@@ -3,7 +3,8 @@
 //! base edge S and each technique, the output triangles and the GPU frame time (median and p90
 //! over timed frames after warm-up), offscreen, with the ratio to Flat at the same S.
 //!
-//! Techniques are [`BenchMethod`]s built by name from [`registry`]; the runner owns the frame
+//! Rows are [`TechniqueRow`]s, one per technique of [`crate::techniques::registry`] named in
+//! the configuration (the CPU baselines are techniques too); the runner owns the frame
 //! structure (timestamps, pipeline statistics, rendering scope) so every technique is timed the
 //! same way, and interleaves the techniques' frames at each mesh and S so that a machine's
 //! drift does not bias one of them. Speed is measured here, never asserted by tests.
@@ -12,11 +13,7 @@ mod report;
 pub mod stats;
 pub mod usage;
 
-pub use methods::{
-    build_methods, catmark_level_size, cpu_limit_mesh, cpu_loop_limit_mesh, loop_level_for,
-    loop_level_size, method_names, one, registry, BenchFrame, BenchMethod, CpuLimitMesh,
-    CpuLoopMethod, MethodContext, MethodEntry, MethodFactory, TechniqueMethod,
-};
+pub use methods::{build_rows, method_names, BenchFrame, RowContext, TechniqueRow};
 pub use report::{parse_csv, CSV_HEADER, CSV_HEADER_V1};
 
 use crate::camera::Camera;
@@ -41,9 +38,10 @@ pub struct BenchConfig {
     pub warmup: u32,
     pub extent: vk::Extent2D,
     pub camera: Camera,
-    /// When set, a row whose timed frames would take longer than this (judged from the last
-    /// warm-up frame's wall time) gets fewer frames, never fewer than `min_frames`; the row
-    /// says so in its note.
+    /// When set, a row whose timed frames would take longer than this gets fewer frames
+    /// ([`fit_frames`], judged from the last warm-up frame's wall time, or the first timed
+    /// frame's without warm-up), never fewer than `min_frames` (nor more than `frames`); the
+    /// row says so in its note.
     pub row_budget_s: Option<f64>,
     pub min_frames: u32,
     /// The CPU baseline skips levels with more vertices than this (3 M vertices peak at about
@@ -405,7 +403,7 @@ impl Harness<'_> {
     /// statistics triangles when queried).
     fn frame(
         &self,
-        method: &dyn BenchMethod,
+        method: &TechniqueRow,
         frame: &BenchFrame,
         query_statistics: bool,
         clear: [f32; 4],
@@ -534,16 +532,15 @@ pub fn run_bench_with_progress(
     };
     for mesh in meshes {
         report.mesh_notes.extend(mesh.notes.iter().cloned());
-        let ctx = MethodContext {
+        let ctx = RowContext {
             device,
-            technique: None,
             mesh,
             config,
             color_format: COLOR_FORMAT,
             depth_format: DEPTH_FORMAT,
         };
         progress.building(&mesh.name);
-        let mut methods = build_methods(&config.methods, &ctx)?;
+        let mut methods = build_rows(&config.methods, &ctx)?;
         for &segments in &config.segments {
             progress.measuring(&mesh.name, segments);
             let levels = group_levels(&methods, segments, config, &mesh.name)?;
@@ -590,17 +587,17 @@ pub fn run_bench_with_progress(
 /// method that knows its triangles beforehand, the whole level in
 /// 1..=[`MAX_EQUAL_TRIANGLE_LEVEL`] it accepts whose count is nearest Flat's at S.
 fn group_levels(
-    methods: &[Box<dyn BenchMethod>],
+    methods: &[TechniqueRow],
     segments: u32,
     config: &BenchConfig,
     mesh: &str,
 ) -> Result<Vec<std::result::Result<u32, String>>> {
-    let at_s = |m: &dyn BenchMethod| match m.skip_reason(segments) {
+    let at_s = |m: &TechniqueRow| match m.skip_reason(segments) {
         Some(reason) => Err(reason),
         None => Ok(segments),
     };
     if !config.equal_triangles {
-        return Ok(methods.iter().map(|m| at_s(m.as_ref())).collect());
+        return Ok(methods.iter().map(at_s).collect());
     }
     let flat = methods.iter().find(|m| m.label() == "flat");
     let target = flat
@@ -613,7 +610,6 @@ fn group_levels(
     Ok(methods
         .iter()
         .map(|m| {
-            let m = m.as_ref();
             if m.label() == "flat" {
                 return at_s(m);
             }
@@ -622,8 +618,8 @@ fn group_levels(
                 .filter_map(|l| m.triangles_at(l).map(|t| (l, t)));
             match nearest_level(target, candidates) {
                 Some((level, _)) => Ok(level),
-                // No count known beforehand (the CPU baselines: they keep S) or no level
-                // accepted (skipped at S with the method's own reason).
+                // No count known beforehand, or no level accepted (skipped at S with the
+                // method's own reason).
                 None => at_s(m),
             }
         })
@@ -653,6 +649,13 @@ fn validate(config: &BenchConfig, meshes: &[BenchMesh]) -> Result<()> {
     }
     if config.frames == 0 {
         return bad("at least one timed frame is needed".into());
+    }
+    // Frame numbers are u32.
+    if config.frames.checked_add(config.warmup).is_none() {
+        return Err(TessError::BenchConfig {
+            option: format!("--frames {} --warmup {}", config.frames, config.warmup),
+            reason: format!("a row has at most {} frames in all", u32::MAX),
+        });
     }
     if config.methods.is_empty() {
         return bad("no methods to benchmark".into());
@@ -684,13 +687,24 @@ fn validate(config: &BenchConfig, meshes: &[BenchMesh]) -> Result<()> {
     Ok(())
 }
 
+/// The timed frames a row keeps under `--row-budget`: as many frames of `per_frame_s` as fit
+/// in `budget_s`, at least `min_frames` (and at least 1) and at most `frames` (a `min_frames`
+/// above `frames` is `frames`).
+pub fn fit_frames(budget_s: f64, per_frame_s: f64, frames: u32, min_frames: u32) -> u32 {
+    let fit = (budget_s / per_frame_s).floor();
+    // `as` saturates: NaN gives 0, a huge quotient u32::MAX.
+    let fit = if fit.is_nan() { 0 } else { fit as u32 };
+    fit.clamp(min_frames.clamp(1, frames.max(1)), frames.max(1))
+}
+
 /// One technique's frames within a group.
 struct RowState {
     frames: u32,
     times: FrameTimes,
     expected: Option<u64>,
     counted: Option<u64>,
-    last_warmup_cost_s: f64,
+    /// Wall time of the row's last frame (warm-up or timed), seconds.
+    last_cost_s: f64,
     notes: Vec<String>,
 }
 
@@ -699,7 +713,7 @@ struct RowState {
 /// changes) spreads over all techniques instead of biasing whichever ran during it.
 fn run_group(
     harness: &Harness<'_>,
-    methods: &mut [(&mut Box<dyn BenchMethod>, u32)],
+    methods: &mut [(&mut TechniqueRow, u32)],
     mesh: &BenchMesh,
     segments: u32,
     config: &BenchConfig,
@@ -720,10 +734,13 @@ fn run_group(
             },
             expected: None,
             counted: None,
-            last_warmup_cost_s: 0.0,
+            last_cost_s: 0.0,
             notes: Vec::new(),
         })
         .collect();
+    // The budget is fitted once a frame of each row was measured: after the warm-up, or after
+    // the first timed frame without one.
+    let fit_at = warmup.max(1);
     let mut index = 0;
     loop {
         let is_warmup = index < warmup;
@@ -744,7 +761,7 @@ fn run_group(
             let cpu = method.begin_frame(&frame)?;
             let query = index == 0 && method.statistics_query_safe();
             let (gpu, wall, cpu_count, stats_count) =
-                harness.frame(method.as_ref(), &frame, query, clear)?;
+                harness.frame(method, &frame, query, clear)?;
             if index == 0 {
                 st.counted = stats_count;
             }
@@ -758,22 +775,25 @@ fn run_group(
                 }
                 Some(_) => {}
             }
-            if is_warmup {
-                st.last_warmup_cost_s = frame_start.elapsed().as_secs_f64();
-            } else {
+            st.last_cost_s = frame_start.elapsed().as_secs_f64();
+            if !is_warmup {
                 st.times.gpu_ms.push(gpu);
                 st.times.cpu_ms.push(cpu);
                 st.times.wall_ms.push(wall);
             }
         }
+        // Every row has its frames (checked before the increment: the last frame number may
+        // be u32::MAX - 1).
+        if !any && index >= warmup {
+            break;
+        }
         index += 1;
         // After the warm-up, fit each technique's timed frames into the row budget.
-        if index == warmup {
+        if index == fit_at {
             if let Some(budget) = config.row_budget_s {
                 for st in &mut states {
-                    let per_frame = st.last_warmup_cost_s.max(1e-9);
-                    let fit = (budget / per_frame).floor() as u32;
-                    let reduced = fit.clamp(config.min_frames.max(1), st.frames);
+                    let per_frame = st.last_cost_s.max(1e-9);
+                    let reduced = fit_frames(budget, per_frame, st.frames, config.min_frames);
                     if reduced < st.frames {
                         st.notes.push(format!(
                             "frames reduced from {} to {reduced} (row budget {budget} s, \
@@ -785,22 +805,17 @@ fn run_group(
                 }
             }
         }
-        if !any && index > warmup {
-            break;
-        }
     }
     methods
         .iter_mut()
         .zip(states)
-        .map(|((method, level), st)| {
-            finish_row(method.as_mut(), st, mesh, (segments, *level), warmup)
-        })
+        .map(|((method, level), st)| finish_row(method, st, mesh, (segments, *level), warmup))
         .collect()
 }
 
 /// The row of one method; `(segments, level)`: the group's S and the level it drew at.
 fn finish_row(
-    method: &mut dyn BenchMethod,
+    method: &mut TechniqueRow,
     st: RowState,
     mesh: &BenchMesh,
     (segments, level): (u32, u32),
@@ -872,6 +887,32 @@ fn finish_row(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every combination of the budget's inputs gives a frame count in `1..=frames`: a
+    /// `min_frames` above `frames` panicked in `clamp` (`--frames 2` with the default
+    /// `--min-frames 5`, or `--min-frames 3`).
+    #[test]
+    fn fit_frames_stays_within_one_and_frames() {
+        let cases: [(f64, f64, u32, u32, u32); 10] = [
+            (1.5, 0.1, 2, 5, 2),
+            (1.5, 0.1, 2, 3, 2),
+            (1.0, 0.1, 3000, 5, 10),
+            (1.0, 0.5, 3000, 5, 5),
+            (1.0, 0.5, 3000, 0, 2),
+            (1.0, 1e-9, u32::MAX, 5, 999_999_999),
+            (1e12, 1e-9, u32::MAX, 5, u32::MAX),
+            (1e-300, 1.0, 30, 0, 1),
+            (1.0, 1e-300, 30, 5, 30),
+            (f64::MAX, 1e-300, 7, 1, 7),
+        ];
+        for (budget, per_frame, frames, min_frames, want) in cases {
+            assert_eq!(
+                fit_frames(budget, per_frame, frames, min_frames),
+                want,
+                "budget {budget}, {per_frame} s a frame, frames {frames}, min {min_frames}"
+            );
+        }
+    }
 
     #[test]
     fn nearest_level_picks_the_closest_count_and_the_lower_level_on_ties() {
@@ -947,88 +988,5 @@ mod tests {
         let n: Vec<f64> = tri.normals.unwrap().iter().map(|n| n[0]).collect();
         assert_eq!(n, vec![0.0, 1.0, 2.0, 0.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
         assert_eq!(tri.holes, vec![0, 1]);
-    }
-
-    #[test]
-    fn loop_sizes_follow_the_recurrence() {
-        // Octahedron: V 6, E 12, F 8; one step: V 18, E 48, F 32.
-        let mesh = ControlMesh::from_polygons(
-            vec![
-                [1.0, 0.0, 0.0],
-                [-1.0, 0.0, 0.0],
-                [0.0, 1.0, 0.0],
-                [0.0, -1.0, 0.0],
-                [0.0, 0.0, 1.0],
-                [0.0, 0.0, -1.0],
-            ],
-            &[
-                [0u32, 2, 4],
-                [2, 1, 4],
-                [1, 3, 4],
-                [3, 0, 4],
-                [2, 0, 5],
-                [1, 2, 5],
-                [3, 1, 5],
-                [0, 3, 5],
-            ],
-        );
-        assert_eq!(loop_level_size(&mesh, 0), (6, 12, 8));
-        assert_eq!(loop_level_size(&mesh, 1), (18, 48, 32));
-        let cpu = cpu_loop_limit_mesh(&mesh, 2).unwrap();
-        let (v, _, f) = loop_level_size(&mesh, 2);
-        assert_eq!(cpu.vertices.len() as u64, v);
-        assert_eq!(cpu.indices.len() as u64, 3 * f);
-        assert_eq!(loop_level_for(32), Ok(5));
-        assert!(loop_level_for(12).is_err());
-    }
-
-    /// The Catmull-Clark baseline: sizes known before refining, every vertex on the limit
-    /// surface (the exact evaluator at the base vertices' corners), quads drawn as 2 triangles.
-    #[test]
-    fn catmark_baseline_sizes_and_limit() {
-        // Two quads and two triangles sharing edges: an open mixed mesh.
-        let mesh = ControlMesh::from_polygons(
-            vec![
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.1],
-                [2.0, 0.0, 0.0],
-                [0.0, 1.0, 0.2],
-                [1.0, 1.0, 0.0],
-                [2.0, 1.0, 0.3],
-                [1.5, 1.8, 0.1],
-            ],
-            &[
-                vec![0u32, 1, 4, 3],
-                vec![1, 2, 5, 4],
-                vec![4, 5, 6],
-                vec![3, 4, 6],
-            ],
-        );
-        assert_eq!(catmark_level_size(&mesh, 0), (7, 10, 4));
-        for level in 0..=3 {
-            let cpu = cpu_limit_mesh(&mesh, topology::Scheme::CatmullClark, level).unwrap();
-            let (v, _, f) = catmark_level_size(&mesh, level);
-            assert_eq!(cpu.vertices.len() as u64, v, "level {level}");
-            // Level 0 draws its polygons as fans (2 + 2 + 1 + 1 triangles), then quads.
-            let triangles = if level == 0 { 6 } else { 2 * f };
-            assert_eq!(cpu.indices.len() as u64, 3 * triangles, "level {level}");
-            // Base vertex 4 keeps its index; its limit is face 0's corner 2.
-            let want = topology::limit::eval::limit_point(
-                &mesh,
-                topology::limit::eval::LimitScheme::CatmullClark,
-                0,
-                1.0,
-                1.0,
-            )
-            .unwrap()
-            .position;
-            let got = cpu.vertices[4].position;
-            for k in 0..3 {
-                assert!(
-                    (got[k] as f64 - want[k]).abs() < 1e-6,
-                    "level {level}: {got:?} {want:?}"
-                );
-            }
-        }
     }
 }

@@ -17,27 +17,7 @@ pub struct FacePoint {
 /// Maps a captured patch id and domain coordinate to the base mesh; `None` for an unknown patch.
 pub type PatchToFace<'a> = dyn Fn(u32, [f32; 2]) -> Option<FacePoint> + 'a;
 
-/// Where corner `k` of an `n`-sided face sits in the face's (u, v) domain:
-/// - triangles: corner 0 (1, 0), corner 1 (0, 1), corner 2 (0, 0), so (u, v) are the
-///   barycentric weights of corners 0 and 1 (= `gl_TessCoord.xy` of a triangle patch);
-/// - quads: (0, 0), (1, 0), (1, 1), (0, 1), the bilinear domain of the quad TES;
-/// - n-gons, n ≥ 5: the regular n-gon inscribed in the unit square's circle,
-///   (½ + ½ cos 2πk/n, ½ + ½ sin 2πk/n); a fan triangle's barycentrics map linearly into it.
-pub fn face_corner_uv(n: u32, k: u32) -> [f64; 2] {
-    match (n, k % n.max(1)) {
-        (3, 0) => [1.0, 0.0],
-        (3, 1) => [0.0, 1.0],
-        (3, _) => [0.0, 0.0],
-        (4, 0) => [0.0, 0.0],
-        (4, 1) => [1.0, 0.0],
-        (4, 2) => [1.0, 1.0],
-        (4, _) => [0.0, 1.0],
-        (n, k) => {
-            let a = std::f64::consts::TAU * k as f64 / n as f64;
-            [0.5 + 0.5 * a.cos(), 0.5 + 0.5 * a.sin()]
-        }
-    }
-}
+pub use topology::limit::eval::face_corner_uv;
 
 /// How far (in domain units) a captured coordinate may sit from a face edge and still count as
 /// on it: the tessellator's edge coordinates are exact 0 or 1 or i/n with 1 − x − y rounding.
@@ -120,6 +100,14 @@ pub struct OpenEdgeClasses {
 
 /// Classifies `report.open` from the base mesh's topology and the captured patch ids and domain
 /// coordinates of each open edge's own triangle (never from positions).
+///
+/// An open edge lies on the base mesh's boundary when both its ends lie on one base edge that
+/// is a boundary of the drawn surface. Each end names its base edges through its own face
+/// point: the edges of its face it lies on, and at a face corner every base edge of that
+/// corner's vertex. So the two ends may name different faces (a technique whose domains are
+/// not base faces, or whose vertices are shared by several faces, maps each vertex into one of
+/// them), and an edge between two faces' points on one boundary edge is still told apart from
+/// a crack.
 pub fn classify_open_edges(
     soup: &CapturedSoup,
     welded: &WeldedMesh,
@@ -127,28 +115,7 @@ pub fn classify_open_edges(
     map: &PatchToFace<'_>,
     base: &ControlMesh,
 ) -> OpenEdgeClasses {
-    // A hole's faces are not drawn: an edge between a hole and a drawn face is the surface's
-    // boundary, as an edge with one face is.
-    let holes: std::collections::HashSet<u32> = base.holes.iter().copied().collect();
-    let mut uses: HashMap<[u32; 2], u32> = HashMap::new();
-    for (i, face) in base.faces().enumerate() {
-        if holes.contains(&(i as u32)) {
-            continue;
-        }
-        for k in 0..face.len() {
-            let (a, b) = (face[k], face[(k + 1) % face.len()]);
-            *uses.entry([a.min(b), a.max(b)]).or_default() += 1;
-        }
-    }
-    let base_boundary = |face: u32, k: u32| -> bool {
-        if face as usize >= base.num_faces() {
-            return false;
-        }
-        let f = base.face(face as usize);
-        let n = f.len();
-        let (a, b) = (f[k as usize % n], f[(k as usize + 1) % n]);
-        uses.get(&[a.min(b), a.max(b)]) == Some(&1)
-    };
+    let edges = BaseEdges::new(base);
     let mut out = OpenEdgeClasses::default();
     for e in &report.open {
         let t = e.triangle as usize;
@@ -166,21 +133,66 @@ pub fn classify_open_edges(
             out.unmapped += 1;
             continue;
         };
-        let on_boundary = fa.face == fb.face && {
-            let n = base
-                .faces()
-                .nth(fa.face as usize)
-                .map_or(0, |f| f.len() as u32);
-            let ea = face_edges_at(n, [fa.u, fa.v]);
-            let eb = face_edges_at(n, [fb.u, fb.v]);
-            ea.iter()
-                .any(|k| eb.contains(k) && base_boundary(fa.face, *k))
-        };
-        if on_boundary {
+        let (ea, eb) = (edges.at(base, &fa), edges.at(base, &fb));
+        if ea.iter().any(|k| eb.contains(k) && edges.is_boundary(*k)) {
             out.on_base_boundary += 1;
         } else {
             out.cracks += 1;
         }
     }
     out
+}
+
+/// The base mesh's edges as sorted vertex pairs: how many drawn faces use each (a hole's faces
+/// are not drawn: an edge between a hole and a drawn face is the surface's boundary, as an
+/// edge with one face is), and the edges at each vertex.
+struct BaseEdges {
+    uses: HashMap<[u32; 2], u32>,
+    at_vertex: HashMap<u32, Vec<[u32; 2]>>,
+}
+
+impl BaseEdges {
+    fn new(base: &ControlMesh) -> Self {
+        let holes: std::collections::HashSet<u32> = base.holes.iter().copied().collect();
+        let mut uses: HashMap<[u32; 2], u32> = HashMap::new();
+        let mut at_vertex: HashMap<u32, Vec<[u32; 2]>> = HashMap::new();
+        for (i, face) in base.faces().enumerate() {
+            for k in 0..face.len() {
+                let (a, b) = (face[k], face[(k + 1) % face.len()]);
+                let key = [a.min(b), a.max(b)];
+                if !uses.contains_key(&key) {
+                    at_vertex.entry(a).or_default().push(key);
+                    at_vertex.entry(b).or_default().push(key);
+                }
+                let u = uses.entry(key).or_default();
+                *u += u32::from(!holes.contains(&(i as u32)));
+            }
+        }
+        Self { uses, at_vertex }
+    }
+
+    fn is_boundary(&self, edge: [u32; 2]) -> bool {
+        self.uses.get(&edge) == Some(&1)
+    }
+
+    /// The base edges `p` lies on: those of its face it lies on, and at a corner of its face
+    /// every edge of that corner's vertex.
+    fn at(&self, base: &ControlMesh, p: &FacePoint) -> Vec<[u32; 2]> {
+        if p.face as usize >= base.num_faces() {
+            return Vec::new();
+        }
+        let f = base.face(p.face as usize);
+        let n = f.len();
+        let on = face_edges_at(n as u32, [p.u, p.v]);
+        let mut out = Vec::new();
+        for &k in &on {
+            let k = k as usize;
+            let (a, b) = (f[k], f[(k + 1) % n]);
+            out.push([a.min(b), a.max(b)]);
+            if on.contains(&(((k + n - 1) % n) as u32)) {
+                out.extend(self.at_vertex.get(&a).into_iter().flatten().copied());
+            }
+        }
+        out
+    }
 }

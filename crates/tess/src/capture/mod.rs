@@ -95,7 +95,7 @@ pub enum CaptureSizing {
 /// [`Capturer::max_bytes`] deliberately.
 pub const DEFAULT_MAX_CAPTURE_BYTES: u64 = 1 << 30;
 
-/// Captures what any technique's TES emits. Holds only its settings: pipelines and frame
+/// Captures what any technique emits from its last stage before rasterization. Holds only its settings: pipelines and frame
 /// uniforms are the [`Context`]'s.
 #[derive(Clone, Copy, Debug)]
 pub struct Capturer {
@@ -128,11 +128,12 @@ impl Capturer {
     pub fn capture(
         &self,
         ctx: &mut Context,
-        technique: &dyn Technique,
+        technique: &mut dyn Technique,
         params: &FrameParams,
         extent: vk::Extent2D,
     ) -> Result<(CapturedSoup, CaptureStats)> {
         ctx.prepare(technique, params, &[Pass::Capture])?;
+        let technique = &*technique;
         ctx.write_frame(0, technique.bbox(), params, extent)?;
         let arrays = technique.patch_arrays();
         let known: Vec<Option<u64>> = (0..arrays.len())
@@ -236,7 +237,7 @@ impl Capturer {
                 ctx.bind_array(enc, technique, 0, params, Pass::Capture, i)?;
                 enc.begin_transform_feedback(&[buffer], &[])?;
                 enc.begin_query_stream(&query, i as u32, 0)?;
-                counts += ctx.draw_array(enc, technique, params, Pass::Capture, i)?;
+                counts += ctx.draw_array(enc, technique, 0, params, Pass::Capture, i)?;
                 enc.end_query_stream(&query, i as u32, 0)?;
                 enc.end_transform_feedback(&[])?;
                 enc.end_rendering();
@@ -357,6 +358,59 @@ mod tests {
         let none = |_: u32, _: [f32; 2]| None;
         let c = classify_open_edges(&soup, &w, &r, &none, &base);
         assert_eq!((c.on_base_boundary, c.cracks, c.unmapped), (0, 6, 6));
+    }
+
+    /// Ends mapped into different faces: a vertex-stage technique maps each vertex into one of
+    /// its faces. Ends on one boundary edge (a corner of the other face, a point inside the
+    /// edge) are the boundary; ends only on inner edges are a crack.
+    #[test]
+    fn ends_in_different_faces_are_classified_by_their_base_edges() {
+        // Base: the square as two triangles (0 1 2), (0 2 3).
+        let base = ControlMesh::from_polygons(
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+            ],
+            &[[0u32, 1, 2], [0, 2, 3]],
+        );
+        // One triangle: base vertex 0 named by face 1 (its corner 0), the midpoint of the
+        // boundary edge 0-1 named by face 0, and a point inside face 1.
+        let soup = CapturedSoup {
+            records: vec![
+                rec([0.0, 0.0, 0.0], 0, [0.0, 0.0]),
+                rec([0.5, 0.0, 0.0], 1, [0.0, 0.0]),
+                rec([0.3, 0.6, 0.0], 2, [0.0, 0.0]),
+            ],
+        };
+        let points = [
+            FacePoint {
+                face: 1,
+                u: 1.0,
+                v: 0.0,
+            },
+            FacePoint {
+                face: 0,
+                u: 0.5,
+                v: 0.5,
+            },
+            FacePoint {
+                face: 1,
+                u: 0.2,
+                v: 0.3,
+            },
+        ];
+        let map = |patch: u32, _: [f32; 2]| points.get(patch as usize).copied();
+        let w = soup.weld().unwrap();
+        let r = w.open_edges();
+        assert_eq!(r.open.len(), 3);
+        let c = classify_open_edges(&soup, &w, &r, &map, &base);
+        assert_eq!(
+            (c.on_base_boundary, c.cracks, c.unmapped),
+            (1, 2, 0),
+            "{r:?}"
+        );
     }
 
     #[test]

@@ -4,7 +4,6 @@ use super::domain::PatchToFace;
 use crate::error::{Result, TessError};
 pub use crate::gpu::{CaptureRecord, CAPTURE_STRIDE};
 use std::collections::HashMap;
-use std::io::Write as _;
 use std::path::Path;
 
 /// Every corner the TES emitted, three per triangle, in the order the GPU wrote them.
@@ -118,28 +117,31 @@ impl WeldedMesh {
     }
 
     /// Writes the mesh as OBJ (format in the module doc); `map` names each vertex's base face.
+    /// Every vertex is mapped before the file is touched; the file is written whole or not at
+    /// all ([`crate::output::write_file`]).
     pub fn write_obj(&self, path: &Path, map: &PatchToFace<'_>, winding: Winding) -> Result<()> {
-        let io = |source| TessError::Io {
-            path: path.display().to_string(),
-            source,
-        };
-        let file = std::fs::File::create(path).map_err(io)?;
-        let mut w = std::io::BufWriter::new(file);
-        self.write_obj_to(&mut w, map, winding)
-            .map_err(|e| match e {
-                ObjWriteError::Io(source) => io(source),
-                ObjWriteError::Unmapped { vertex, patch } => TessError::UnmappedPatch {
+        for (vertex, (&patch, &domain)) in self.patch.iter().zip(&self.domain).enumerate() {
+            if map(patch, domain).is_none() {
+                return Err(TessError::UnmappedPatch {
                     path: path.display().to_string(),
                     vertex,
                     patch,
-                },
-            })?;
-        w.flush().map_err(io)
+                });
+            }
+        }
+        crate::output::write_file(path, |w| {
+            self.write_obj_to(w, map, winding).map_err(|e| match e {
+                ObjWriteError::Io(e) => e,
+                ObjWriteError::Unmapped { vertex, patch } => std::io::Error::other(format!(
+                    "vertex {vertex} has patch id {patch}, which maps to no base face"
+                )),
+            })
+        })
     }
 
     fn write_obj_to(
         &self,
-        w: &mut impl std::io::Write,
+        w: &mut dyn std::io::Write,
         map: &PatchToFace<'_>,
         winding: Winding,
     ) -> std::result::Result<(), ObjWriteError> {

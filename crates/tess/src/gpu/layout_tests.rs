@@ -138,7 +138,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         (Stage::CommonShadeFrag, PLAIN, draw()),
         (Stage::CommonTriTesc, PLAIN, frame()),
         (Stage::CommonQuadTesc, PLAIN, frame_binding()),
-        (Stage::PlainPlainVert, PLAIN, frame()),
+        (Stage::CpuMeshVert, PLAIN, frame()),
         (Stage::BftBftTesc, PLAIN, frame()),
         (Stage::BftBftTesc, PLAIN, frame_binding()),
         (Stage::BftBftTesc, PLAIN, bft_push()),
@@ -182,7 +182,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
             },
         ),
         (
-            Stage::PlainPlainVert,
+            Stage::CpuMeshVert,
             PLAIN,
             Input {
                 name: "in_position",
@@ -191,7 +191,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
             },
         ),
         (
-            Stage::PlainPlainVert,
+            Stage::CpuMeshVert,
             PLAIN,
             Input {
                 name: "in_normal",
@@ -721,8 +721,8 @@ fn the_table_covers_every_bft_binding_and_capture_build() {
         .filter(|(_, _, c)| matches!(c, Check::Xfb { .. }))
         .count();
     // Nine TESs in three spacings, the four adaptive ones and BFT's also with their surface code,
-    // BFT's also with and without its patch block.
-    assert_eq!(capture_builds, 48);
+    // BFT's also with and without its patch block; the CPU mesh's vertex stage.
+    assert_eq!(capture_builds, 49);
     assert_eq!(xfb_rows, capture_builds);
 }
 
@@ -773,7 +773,7 @@ fn capture_variants_and_only_they_have_xfb() {
             captures += v.capture as usize;
         }
     }
-    assert_eq!(captures, 48);
+    assert_eq!(captures, 49);
 }
 
 #[test]

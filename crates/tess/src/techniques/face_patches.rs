@@ -7,12 +7,28 @@ use crate::error::{Result, TessError};
 use crate::gpu::DrawPush;
 use crate::render_mesh::{PatchOrigin, RenderMesh};
 use crate::technique::{
-    for_each_draw, number_arrays, DeviceAllocation, DrawCounts, FactorPolicy, FrameParams, Pass,
-    PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
+    for_each_draw, number_arrays, DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features,
+    FrameParams, Pass, PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
 };
 use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, MAX_LEVEL};
 use topology::ControlMesh;
 use vk_core::{vk, Buffer, Device, Encoder};
+
+/// What flat, Phong and PN take: uniform factors in every spacing, on the tessellation path.
+pub const BASE_FACES: Features = Features {
+    adaptive_factors: false,
+    spacings: [true, true, true],
+    animation: false,
+    patch_colours: false,
+    geometric_normals: false,
+    phong_alpha: false,
+    table_level: false,
+    triangles_only: false,
+    isolation: false,
+    surface: false,
+    single_pass: false,
+    paths: &[DrawPath::Tessellation],
+};
 
 /// What distinguishes flat, Phong and PN.
 pub trait FaceStyle: Send + 'static {
@@ -169,6 +185,7 @@ impl<S: FaceStyle> Technique for FacePatches<S> {
         &'a self,
         enc: &mut Encoder<'a>,
         array: usize,
+        _slot: usize,
         _params: &FrameParams,
         pass: Pass,
         per_draw: u32,

@@ -1,8 +1,13 @@
-//! Every technique, and the registry that builds one by name: the only place that knows
-//! which techniques exist. Callers (viewer, bench, export, C ABI) build through [`build`] and
-//! check options against [`TechniqueInfo::features`].
+//! Every technique, and the registry that builds one by name: the only place that lists
+//! which techniques exist. Each technique declares itself in its own folder — its
+//! [`TechniqueId`] constant and a [`TechniqueInfo`] (name, help, options it takes, the scheme
+//! whose limit it draws, shader folder, C ABI value, patch-colour legend, constructor) — and
+//! [`REGISTRY`] holds one line per technique. Callers (viewer, HUD, bench, export, C ABI,
+//! tests) build through [`build`], check options against [`TechniqueInfo::features`] and
+//! iterate [`registry`]; none of them matches on techniques.
 pub mod adaptive;
 pub mod bft;
+pub mod cpu;
 pub mod face_patches;
 pub mod flat;
 pub mod gregory;
@@ -13,10 +18,21 @@ pub mod windows;
 
 use crate::context::Context;
 use crate::error::{Result, TessError};
-use crate::technique::{Features, Technique, TechniqueId};
+use crate::technique::{Features, FrameParams, Technique, TechniqueId};
 use topology::ControlMesh;
 
-/// What the registry says of one technique.
+/// Builds a technique for a mesh on a context's device.
+pub type BuildFn = fn(&mut Context, &ControlMesh, &BuildOptions) -> Result<Built>;
+
+/// Checks a frame's options against what a technique refuses before any device or mesh
+/// exists (see [`check_options`]).
+pub type CheckFn = fn(&BuildOptions, &FrameParams) -> Result<()>;
+
+/// A patch-colour legend entry: colour and what it marks.
+pub type LegendEntry = ([f32; 3], &'static str);
+
+/// What the registry says of one technique: everything callers need, declared in the
+/// technique's own folder.
 #[derive(Clone, Copy, Debug)]
 pub struct TechniqueInfo {
     pub id: TechniqueId,
@@ -25,111 +41,79 @@ pub struct TechniqueInfo {
     pub features: Features,
     /// The subdivision scheme whose limit surface it draws (None: not a subdivision surface).
     pub scheme: Option<topology::Scheme>,
+    /// Drawn for its scheme when no technique is named (one per scheme).
+    pub default_for_scheme: bool,
+    /// Its shaders' folder under `glsl/` (a test checks every stage it names lies there or in
+    /// `glsl/common/`).
+    pub shader_folder: &'static str,
+    /// Its `TESSERA_TECHNIQUE_*` value in the C ABI: stable, never reused.
+    pub abi_code: u32,
+    /// The patch-colour legend (empty without patch colours).
+    pub legend: &'static [LegendEntry],
+    pub build: BuildFn,
+    pub check_options: CheckFn,
 }
 
-const BASE_FACES: Features = Features {
-    adaptive_factors: false,
-    spacings: [true, true, true],
-    animation: false,
-    patch_colours: false,
-    geometric_normals: false,
-    phong_alpha: false,
-    table_level: false,
-    triangles_only: false,
-    isolation: false,
-    surface: false,
-    single_pass: false,
-};
-
-static REGISTRY: [TechniqueInfo; 7] = [
-    TechniqueInfo {
-        id: TechniqueId::Flat,
-        help: "flat tessellation of each base face (quads as quad patches)",
-        features: BASE_FACES,
-        scheme: None,
-    },
-    TechniqueInfo {
-        id: TechniqueId::Phong,
-        help: "Phong tessellation (Boubekeur & Alexa 2008) of the fan triangles",
-        features: Features {
-            phong_alpha: true,
-            ..BASE_FACES
-        },
-        scheme: None,
-    },
-    TechniqueInfo {
-        id: TechniqueId::Pn,
-        help: "curved PN triangles with the corrected normal field",
-        features: BASE_FACES,
-        scheme: None,
-    },
-    TechniqueInfo {
-        id: TechniqueId::Bft,
-        help: "exact Loop limit surface from basis-function tables (Holländer & Boubekeur)",
-        features: Features {
-            adaptive_factors: true,
-            spacings: [true, true, false],
-            animation: true,
-            patch_colours: true,
-            geometric_normals: true,
-            phong_alpha: false,
-            table_level: true,
-            triangles_only: true,
-            isolation: false,
-            surface: false,
-            single_pass: false,
-        },
-        scheme: Some(topology::Scheme::Loop),
-    },
-    TechniqueInfo {
-        id: TechniqueId::Adaptive,
-        help: "exact Catmull-Clark limit surface by feature-adaptive refinement (Niessner et al.), Gregory or bilinear end caps",
-        features: ADAPTIVE,
-        scheme: Some(topology::Scheme::CatmullClark),
-    },
-    TechniqueInfo {
-        id: TechniqueId::Gregory,
-        help: "Catmull-Clark approximated by one Gregory patch per base face, B-spline where regular (Loop, Schaefer, Ni, Castano), Gregory triangle patches on triangles; other faces next to non-quads split once",
-        features: SINGLE_PASS,
-        scheme: Some(topology::Scheme::CatmullClark),
-    },
-    TechniqueInfo {
-        id: TechniqueId::Acc,
-        help: "Catmull-Clark approximated by ACC-1 bicubic patches (Loop & Schaefer), Gregory patches where ACC-1 does not apply",
-        features: SINGLE_PASS,
-        scheme: Some(topology::Scheme::CatmullClark),
-    },
+/// Every technique, one line each, in the order reports and the window's number keys list
+/// them (flat first: ratios divide by it).
+pub static REGISTRY: [&TechniqueInfo; 9] = [
+    &flat::INFO,
+    &phong::INFO,
+    &pn::INFO,
+    &bft::INFO,
+    &adaptive::INFO,
+    &gregory::INFO,
+    &gregory::ACC_INFO,
+    &cpu::INFO,
+    &cpu::CATMARK_INFO,
 ];
 
-const ADAPTIVE: Features = Features {
-    adaptive_factors: true,
-    spacings: [true, true, false],
-    animation: true,
-    patch_colours: true,
-    geometric_normals: false,
-    phong_alpha: false,
-    table_level: false,
-    triangles_only: false,
-    isolation: true,
-    surface: true,
-    single_pass: false,
-};
-
-/// The single-pass approximations: the adaptive machinery without isolation.
-const SINGLE_PASS: Features = Features {
-    isolation: false,
-    single_pass: true,
-    ..ADAPTIVE
-};
-
 /// Every technique, in the order reports list them (flat first: ratios divide by it).
-pub fn registry() -> &'static [TechniqueInfo] {
+pub fn registry() -> &'static [&'static TechniqueInfo] {
     &REGISTRY
 }
 
-/// The registry entry of `id`.
+/// The registry entry of `id`. Ids are made only inside this crate, each next to its
+/// technique's registry entry (a test checks every entry's id finds it), so every id has one.
 pub fn info(id: TechniqueId) -> &'static TechniqueInfo {
-    REGISTRY.iter().find(|i| i.id == id).unwrap_or(&REGISTRY[0])
+    REGISTRY
+        .iter()
+        .copied()
+        .find(|i| i.id == id)
+        .unwrap_or(REGISTRY[0])
+}
+
+/// The registry entry named `name` (`--method NAME`).
+pub fn named(name: &str) -> Result<&'static TechniqueInfo> {
+    REGISTRY
+        .iter()
+        .copied()
+        .find(|i| i.id.name() == name)
+        .ok_or_else(|| unknown(name))
+}
+
+/// The registry entry with C ABI value `code`.
+pub fn by_abi_code(code: u32) -> Option<&'static TechniqueInfo> {
+    REGISTRY.iter().copied().find(|i| i.abi_code == code)
+}
+
+/// The technique drawn for `scheme` when none is named.
+pub fn default_for(scheme: topology::Scheme) -> Option<&'static TechniqueInfo> {
+    REGISTRY
+        .iter()
+        .copied()
+        .find(|i| i.default_for_scheme && i.scheme == Some(scheme))
+}
+
+fn unknown(name: &str) -> TessError {
+    TessError::UnknownTechnique {
+        name: name.to_string(),
+        known: REGISTRY
+            .iter()
+            .map(|i| i.id.name())
+            .collect::<Vec<_>>()
+            .join(", "),
+    }
 }
 
 /// The techniques that have a feature, by name, for messages ("needs --method bft").
@@ -144,19 +128,13 @@ pub fn names_with(feature: impl Fn(&Features) -> bool) -> Vec<&'static str> {
 impl std::str::FromStr for TechniqueId {
     type Err = TessError;
     fn from_str(s: &str) -> Result<Self> {
-        REGISTRY
-            .iter()
-            .find(|i| i.id.name() == s)
-            .map(|i| i.id)
-            .ok_or_else(|| TessError::UnknownTechnique {
-                name: s.to_string(),
-                known: REGISTRY
-                    .iter()
-                    .map(|i| i.id.name())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            })
+        named(s).map(|i| i.id)
     }
+}
+
+/// A [`CheckFn`] for techniques with nothing to refuse before they are built.
+pub fn no_early_checks(_build: &BuildOptions, _params: &FrameParams) -> Result<()> {
+    Ok(())
 }
 
 /// How a surface is built (per-frame choices are [`crate::FrameParams`]).
@@ -182,6 +160,9 @@ pub struct BuildOptions {
     pub split_triangles: bool,
     /// Colour texture and height map (techniques with [`Features::surface`]).
     pub maps: crate::surface::SurfaceMaps,
+    /// Meshes refined on the CPU refuse levels with more vertices than this (3 M vertices
+    /// peak at about 1.6 GB of host memory).
+    pub max_refined_vertices: u64,
 }
 
 impl Default for BuildOptions {
@@ -196,6 +177,7 @@ impl Default for BuildOptions {
             follow_semi_sharp: true,
             split_triangles: false,
             maps: Default::default(),
+            max_refined_vertices: 4_000_000,
         }
     }
 }
@@ -210,18 +192,8 @@ pub struct Built {
 /// (spacings, BFT's dyadic segments, adaptive's whole segments), so a bad option is reported
 /// before the device is opened and the surface built. [`Technique::check`] repeats these checks
 /// with what only the built surface and device know (tangent tables, the device's level).
-pub fn check_options(
-    id: TechniqueId,
-    build: &BuildOptions,
-    params: &crate::technique::FrameParams,
-) -> Result<()> {
-    match id {
-        TechniqueId::Bft => bft::check_frame(build.table_level, params),
-        TechniqueId::Adaptive | TechniqueId::Gregory | TechniqueId::Acc => {
-            adaptive::check_frame(None, params)
-        }
-        TechniqueId::Flat | TechniqueId::Phong | TechniqueId::Pn => Ok(()),
-    }
+pub fn check_options(id: TechniqueId, build: &BuildOptions, params: &FrameParams) -> Result<()> {
+    (info(id).check_options)(build, params)
 }
 
 /// Builds technique `id` for `mesh` on `ctx`'s device, with one frame slot per slot of `ctx`.
@@ -231,66 +203,13 @@ pub fn build(
     mesh: &ControlMesh,
     options: &BuildOptions,
 ) -> Result<Built> {
-    let device = ctx.device().clone();
-    let technique: Box<dyn Technique> = match id {
-        TechniqueId::Flat => Box::new(flat::Flat::new(&device, mesh)?),
-        TechniqueId::Phong => Box::new(phong::Phong::new(&device, mesh)?),
-        TechniqueId::Pn => Box::new(pn::Pn::new(&device, mesh)?),
-        TechniqueId::Bft => {
-            let b = bft::Bft::new(
-                ctx,
-                mesh,
-                &bft::BftOptions {
-                    table_level: options.table_level,
-                    tangents: options.tangents,
-                    name: options.name.clone(),
-                    patch_block: None,
-                },
-            )?;
-            let notes = b.notes.clone();
-            return Ok(Built {
-                technique: Box::new(b),
-                notes,
-            });
-        }
-        TechniqueId::Adaptive | TechniqueId::Gregory | TechniqueId::Acc => {
-            let surface = if id == TechniqueId::Adaptive {
-                adaptive::Adaptive::new(
-                    ctx,
-                    mesh,
-                    &adaptive::AdaptiveBuild {
-                        isolation: options.isolation,
-                        end_cap: options.end_cap,
-                        sharpness_scale: options.sharpness_scale,
-                        follow_semi_sharp: options.follow_semi_sharp,
-                        name: options.name.clone(),
-                        maps: options.maps.clone(),
-                    },
-                )?
-            } else {
-                gregory::build(
-                    ctx,
-                    mesh,
-                    if id == TechniqueId::Acc {
-                        topology::patches::adaptive::single_pass::SinglePassPatch::Acc1
-                    } else {
-                        topology::patches::adaptive::single_pass::SinglePassPatch::Gregory
-                    },
-                    options.sharpness_scale,
-                    !options.split_triangles,
-                    &options.name,
-                    &options.maps,
-                )?
-            };
-            let notes = surface.param_error_note().into_iter().collect();
-            return Ok(Built {
-                technique: Box::new(surface),
-                notes,
-            });
-        }
-    };
+    (info(id).build)(ctx, mesh, options)
+}
+
+/// A [`Built`] with no notes.
+pub fn built(technique: impl Technique + 'static) -> Result<Built> {
     Ok(Built {
-        technique,
+        technique: Box::new(technique),
         notes: Vec::new(),
     })
 }
@@ -300,19 +219,47 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_technique_has_its_own_registry_entry() {
-        for id in [
-            TechniqueId::Flat,
-            TechniqueId::Phong,
-            TechniqueId::Pn,
-            TechniqueId::Bft,
-            TechniqueId::Adaptive,
-            TechniqueId::Gregory,
-            TechniqueId::Acc,
-        ] {
-            assert_eq!(info(id).id, id);
-            assert_eq!(id.name().parse::<TechniqueId>().unwrap(), id);
+    fn every_registry_entry_is_found_by_name_id_and_abi_code() {
+        for info in registry() {
+            assert_eq!(named(info.id.name()).unwrap().id, info.id);
+            assert_eq!(super::info(info.id).id, info.id);
+            assert_eq!(by_abi_code(info.abi_code).unwrap().id, info.id);
+            assert_eq!(info.id.name().parse::<TechniqueId>().unwrap(), info.id);
         }
         assert!("acc2".parse::<TechniqueId>().is_err());
+        assert!(by_abi_code(0).is_none(), "0 is the C ABI's 'auto'");
+    }
+
+    #[test]
+    fn names_and_abi_codes_are_unique_and_each_scheme_has_one_default() {
+        let mut names: Vec<_> = registry().iter().map(|i| i.id.name()).collect();
+        let mut codes: Vec<_> = registry().iter().map(|i| i.abi_code).collect();
+        names.sort();
+        names.dedup();
+        codes.sort();
+        codes.dedup();
+        assert_eq!(names.len(), registry().len());
+        assert_eq!(codes.len(), registry().len());
+        for scheme in [topology::Scheme::Loop, topology::Scheme::CatmullClark] {
+            let defaults = registry()
+                .iter()
+                .filter(|i| i.default_for_scheme && i.scheme == Some(scheme))
+                .count();
+            assert_eq!(defaults, 1, "{scheme}");
+        }
+    }
+
+    #[test]
+    fn every_shader_folder_holds_stages() {
+        use crate::shaders::Stage;
+        for info in registry() {
+            let own = format!("{}/", info.shader_folder);
+            let stages: Vec<Stage> = Stage::ALL
+                .iter()
+                .copied()
+                .filter(|s| s.path().starts_with(&own))
+                .collect();
+            assert!(!stages.is_empty(), "{}: no stage in glsl/{own}", info.id);
+        }
     }
 }

@@ -35,7 +35,7 @@
 
 use std::fmt;
 
-use crate::error::TopologyError;
+use crate::error::{number, TopologyError};
 use crate::limit::basis::{catmark_regular_weights, loop_regular_weights};
 use crate::limit::masks::{
     catmark_limit_masks, loop_limit_masks, loop_smooth_tangent_weights, smooth_directional_tangent,
@@ -95,7 +95,7 @@ impl std::str::FromStr for LimitScheme {
 pub enum EvalError {
     #[error("face {face} out of range (the mesh has {count} faces)")]
     FaceOutOfRange { face: usize, count: usize },
-    #[error("parameter ({u}, {v}) outside the face domain")]
+    #[error("parameter ({}, {}) outside the face domain", number(*.u), number(*.v))]
     ParamOutOfRange { u: f64, v: f64 },
     #[error("face {face} has {size} corners; {} evaluation needs {need}", scheme.scheme())]
     FaceSize {
@@ -122,7 +122,7 @@ pub enum EvalError {
     },
     #[error("vertex {vertex} belongs to no face: it has no limit position")]
     IsolatedVertex { vertex: u32 },
-    #[error("evaluation of face {face} at ({u}, {v}) did not converge")]
+    #[error("evaluation of face {face} at ({}, {}) did not converge", number(*.u), number(*.v))]
     NotConverged { face: usize, u: f64, v: f64 },
     /// A basis-function table key (`patches::bft::BftKey`, in its `Debug` form) that names
     /// no table.
@@ -1263,10 +1263,23 @@ fn evaluate_local(
     let (start_face, u0, v0) = (face, u, v);
     let (mut u, mut v) = (u, v);
     let mut jac = [[1.0, 0.0], [0.0, 1.0]];
-    const MAX_DEPTH: usize = 56;
+    // What `points` are relative to (see `recentre`).
+    let mut origin = vec![0.0; dim];
+    let corners: &[(f64, f64)] = if quad {
+        &[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+    } else {
+        &[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]
+    };
+    // No f64 parameter needs more than MAX_DEPTH levels (2^-1074 is the smallest; see
+    // `snapped`).
+    const MAX_DEPTH: usize = 1100;
     for depth in 0..=MAX_DEPTH {
+        if depth >= RECENTRE_FROM {
+            let v0 = level.topology.face_vertices(face)[0];
+            recentre(&mut points, dim, v0, &mut origin);
+        }
+        (u, v) = snapped(depth, u, v, corners);
         if depth == MAX_DEPTH {
-            // 2^-56 from a corner: snap (far below f64 resolution of the surface).
             u = u.round();
             v = v.round();
             if !quad && u + v > 1.0 {
@@ -1296,16 +1309,11 @@ fn evaluate_local(
                 axpy(&mut du, wu[i], x);
                 axpy(&mut dv, wv[i], x);
             }
-            return Ok(chain(p, du, dv, &jac));
+            return Ok(chain(shifted(p, &origin), du, dv, &jac));
         }
-        let corners: &[(f64, f64)] = if quad {
-            &[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
-        } else {
-            &[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]
-        };
         if let Some(c) = corners.iter().position(|&(a, b)| a == u && b == v) {
             if let Some(s) = view.corner_limit(face, c) {
-                return Ok(chain(s.position, s.du, s.dv, &jac));
+                return Ok(chain(shifted(s.position, &origin), s.du, s.dv, &jac));
             }
         }
         let step = refine_sparse(level.view(), scheme.scheme(), &mesh.options, &[face as u32])?;
@@ -1331,6 +1339,62 @@ fn evaluate_local(
         u: u0,
         v: v0,
     })
+}
+
+/// The recursion depth from which [`evaluate_local`] keeps its points relative to the face it
+/// descends into. Near an extraordinary vertex the points of level `k` lie within about `λ^k`
+/// of each other (`λ` the subdominant eigenvalue, 0.4 to 0.9), while their coordinates keep
+/// the mesh's magnitude: by level 40 or so their differences, which the tangent masks and the
+/// patches' derivative weights take, are below the coordinates' f64 resolution, and the
+/// derivatives came out as rounding noise (a normal 45° off at `u = v = 1e-20`, a zero normal
+/// further in). Subtracting one point of the face from all of them at each level keeps the
+/// differences at full relative precision (every stencil, mask and patch weight sums to 1,
+/// their derivative weights to 0, so the shift changes nothing but the rounding). Shallower
+/// levels are left alone, so dyadic parameters of the tables' levels evaluate bit for bit as
+/// they always did.
+const RECENTRE_FROM: usize = 8;
+
+/// `(u, v)` at recursion depth `depth`, snapped to a corner of `corners` when it is there to
+/// within what is left of f64's precision. Each level doubles the distance to the corner the
+/// point is nearest: from level 56 on, a point within 2^-50 of a corner of its face (2^-106 of
+/// the base face's domain) is snapped to it and takes the corner's limit masks; a point further
+/// from every corner is followed down until a regular patch holds it (a few levels more).
+fn snapped(depth: usize, u: f64, v: f64, corners: &[(f64, f64)]) -> (f64, f64) {
+    const SNAP_FROM: usize = 56;
+    const SNAP: f64 = 1.0 / (1u64 << 50) as f64;
+    if depth < SNAP_FROM {
+        return (u, v);
+    }
+    corners
+        .iter()
+        .copied()
+        .find(|&(a, b)| (u - a).abs() <= SNAP && (v - b).abs() <= SNAP)
+        .unwrap_or((u, v))
+}
+
+/// Makes `points` (`dim` values each) relative to vertex `v`'s point, adding that point to
+/// `origin`, the offset the returned positions get back ([`shifted`]).
+fn recentre(points: &mut [f64], dim: usize, v: u32, origin: &mut [f64]) {
+    let start = v as usize * dim;
+    let Some(centre) = points.get(start..start + dim).map(<[f64]>::to_vec) else {
+        return;
+    };
+    for p in points.chunks_exact_mut(dim) {
+        for (x, c) in p.iter_mut().zip(&centre) {
+            *x -= c;
+        }
+    }
+    for (o, c) in origin.iter_mut().zip(&centre) {
+        *o += c;
+    }
+}
+
+/// A position of the recentred points, back in the mesh's coordinates.
+fn shifted(mut p: Vec<f64>, origin: &[f64]) -> Vec<f64> {
+    for (x, o) in p.iter_mut().zip(origin) {
+        *x += o;
+    }
+    p
 }
 
 /// Derivatives with respect to the original parameters.
@@ -1429,7 +1493,7 @@ impl fmt::Display for LimitPoint {
         if let Some(s) = self.subface {
             write!(f, " subface {s}")?;
         }
-        writeln!(f, " uv {} {}", self.u, self.v)?;
+        writeln!(f, " uv {} {}", number(self.u), number(self.v))?;
         writeln!(f, "position {}", v3(&self.position))?;
         writeln!(f, "du {}", v3(&self.du))?;
         writeln!(f, "dv {}", v3(&self.dv))?;
@@ -1439,6 +1503,126 @@ impl fmt::Display for LimitPoint {
 
 fn to3(x: &[f64]) -> [f64; 3] {
     [x[0], x[1], x[2]]
+}
+
+/// Where corner `k` of an `n`-sided face sits in the face's (u, v) domain, the convention of
+/// every point Tessera reports on a base mesh (captures, `# p` lines of exports):
+/// - triangles: corner 0 (1, 0), corner 1 (0, 1), corner 2 (0, 0), so (u, v) are the
+///   barycentric weights of corners 0 and 1 (= `gl_TessCoord.xy` of a triangle patch);
+/// - quads: (0, 0), (1, 0), (1, 1), (0, 1), the bilinear domain of the quad TES;
+/// - n-gons, n ≥ 5: the regular n-gon inscribed in the unit square's circle,
+///   (½ + ½ cos 2πk/n, ½ + ½ sin 2πk/n).
+///
+/// A Catmull-Clark non-quad is evaluated on its sub-quads ([`LocalMesh::evaluate_subface`]);
+/// sub-quad `k` maps bilinearly onto (corner k, midpoint of edge k, centre, midpoint of edge
+/// k − 1) of this domain ([`subface_domain`]).
+pub fn face_corner_uv(n: u32, k: u32) -> [f64; 2] {
+    match (n, k % n.max(1)) {
+        (3, 0) => [1.0, 0.0],
+        (3, 1) => [0.0, 1.0],
+        (3, _) => [0.0, 0.0],
+        (4, 0) => [0.0, 0.0],
+        (4, 1) => [1.0, 0.0],
+        (4, 2) => [1.0, 1.0],
+        (4, _) => [0.0, 1.0],
+        (n, k) => {
+            let a = std::f64::consts::TAU * k as f64 / n as f64;
+            [0.5 + 0.5 * a.cos(), 0.5 + 0.5 * a.sin()]
+        }
+    }
+}
+
+/// The corners of sub-quad `k` of an `n`-gon in the face's domain ([`face_corner_uv`]):
+/// corner k, midpoint of edge k, centre, midpoint of edge k − 1.
+pub fn subface_domain(n: u32, k: u32) -> [[f64; 2]; 4] {
+    let c = |i: u32| face_corner_uv(n, i % n);
+    let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) * 0.5, (a[1] + b[1]) * 0.5];
+    let centre = (0..n).fold([0.0, 0.0], |s, i| {
+        let p = c(i);
+        [s[0] + p[0] / n as f64, s[1] + p[1] / n as f64]
+    });
+    let (corner, next, prev) = (c(k), c(k + 1), c(k + n - 1));
+    [corner, mid(corner, next), centre, mid(prev, corner)]
+}
+
+/// The bilinear map of `quad` at (s, t): weights (1−s)(1−t), s(1−t), st, (1−s)t.
+pub fn bilinear(quad: &[[f64; 2]; 4], s: f64, t: f64) -> [f64; 2] {
+    let w = [(1.0 - s) * (1.0 - t), s * (1.0 - t), s * t, (1.0 - s) * t];
+    let mut out = [0.0; 2];
+    for (p, w) in quad.iter().zip(w) {
+        out[0] += w * p[0];
+        out[1] += w * p[1];
+    }
+    out
+}
+
+/// (s, t) with `bilinear(quad, s, t) = p` (Newton from the centre), or `None` when `p` lies
+/// outside `quad` by more than `slack` in parameter.
+fn invert_bilinear(quad: &[[f64; 2]; 4], p: [f64; 2], slack: f64) -> Option<[f64; 2]> {
+    let [a, b, c, d] = *quad;
+    let (mut s, mut t) = (0.5, 0.5);
+    for _ in 0..50 {
+        let q = bilinear(quad, s, t);
+        let r = [q[0] - p[0], q[1] - p[1]];
+        let ds = [
+            (1.0 - t) * (b[0] - a[0]) + t * (c[0] - d[0]),
+            (1.0 - t) * (b[1] - a[1]) + t * (c[1] - d[1]),
+        ];
+        let dt = [
+            (1.0 - s) * (d[0] - a[0]) + s * (c[0] - b[0]),
+            (1.0 - s) * (d[1] - a[1]) + s * (c[1] - b[1]),
+        ];
+        let det = ds[0] * dt[1] - ds[1] * dt[0];
+        if det.abs() < 1e-300 {
+            return None;
+        }
+        let step = [
+            (r[0] * dt[1] - r[1] * dt[0]) / det,
+            (ds[0] * r[1] - ds[1] * r[0]) / det,
+        ];
+        s -= step[0];
+        t -= step[1];
+        if step[0].abs() + step[1].abs() < 1e-15 {
+            break;
+        }
+    }
+    let q = bilinear(quad, s, t);
+    let solved = (q[0] - p[0]).abs() + (q[1] - p[1]).abs() <= 1e-12;
+    let inside = |x: f64| (-slack..=1.0 + slack).contains(&x);
+    (solved && inside(s) && inside(t)).then(|| [s.clamp(0.0, 1.0), t.clamp(0.0, 1.0)])
+}
+
+/// Sub-quad and its (s, t) of a point `uv` of an `n`-gon's domain (n ≠ 4): the sub-quad whose
+/// bilinear map reaches `uv` with parameters closest to its inside.
+pub fn subface_param(n: u32, uv: [f64; 2]) -> Option<(u32, [f64; 2])> {
+    (0..n)
+        .filter_map(|k| invert_bilinear(&subface_domain(n, k), uv, 1e-6).map(|st| (k, st)))
+        .next()
+}
+
+impl LocalMesh {
+    /// The exact limit at a point of base face `face` in the domain of [`face_corner_uv`]:
+    /// Loop triangles by their barycentric weights, Catmull-Clark quads directly and other
+    /// Catmull-Clark faces on the sub-quad that holds the point.
+    pub fn evaluate_face_point(&self, face: usize, uv: [f64; 2]) -> Result<LimitSample, EvalError> {
+        if face >= self.num_faces() {
+            return Err(EvalError::FaceOutOfRange {
+                face,
+                count: self.num_faces(),
+            });
+        }
+        let n = self.face(face).len() as u32;
+        match (self.scheme, n) {
+            // (u, v) weigh corners 0 and 1; the evaluator's (u, v) weigh corners 1 and 2.
+            (LimitScheme::Loop, _) => self.evaluate(face, uv[1], (1.0 - uv[0] - uv[1]).max(0.0)),
+            (LimitScheme::CatmullClark, 4) => self.evaluate(face, uv[0], uv[1]),
+            (LimitScheme::CatmullClark, _) => {
+                let (k, st) = subface_param(n, uv)
+                    .ok_or(EvalError::ParamOutOfRange { u: uv[0], v: uv[1] })?;
+                self.evaluate_subface(face, k as usize, st[0], st[1])
+            }
+        }
+    }
 }
 
 /// `tessera limit`: exact limit position, tangents and normal of a control mesh at

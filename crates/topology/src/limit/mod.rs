@@ -7,10 +7,13 @@
 //!   closed form where the mesh is regular;
 //! - [`eval`]: exact limit evaluation at any `(face, u, v)` (OpenSubdiv's `Bfr`), refining
 //!   locally with the [`refine`](crate::refine) layer until a regular patch or a limit mask
-//!   applies.
+//!   applies;
+//! - [`limit_mesh`]: a control mesh refined uniformly and placed on its limit surface, the
+//!   mesh a CPU application would draw, with each vertex's point of the base mesh.
 //!
 //! Builds on `rules/`, `mesh/` and `refine/`; the `patches/` layer builds on it.
 
 pub mod basis;
 pub mod eval;
+pub mod limit_mesh;
 pub mod masks;

@@ -4,6 +4,7 @@ use crate::error::TopologyError;
 use crate::rules::options::SubdivOptions;
 use rayon::prelude::*;
 
+pub mod input;
 pub mod obj;
 
 /// Sentinel for "no face" / "no edge" in adjacency tables.

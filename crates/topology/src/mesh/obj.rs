@@ -12,28 +12,115 @@
 //! line of every vertex, face and tag for that (a few bytes each).
 
 use crate::error::{ObjSyntax, TagKind, TopologyError};
+use crate::mesh::input::{read_regular_file, MAX_OBJ_BYTES};
 use crate::mesh::{ControlMesh, EdgeCrease, VertexCorner};
-use crate::rules::options::{BoundaryInterpolation, CreaseMethod, TriangleSubdivision};
+use crate::rules::options::{
+    BoundaryInterpolation, CreaseMethod, SubdivOptions, TriangleSubdivision,
+};
+use std::borrow::Cow;
 use std::io::Write;
 use std::path::Path;
 
-/// Read and validate an OBJ file. Errors name the file.
+/// Read and validate an OBJ file. Errors name the file. Only a regular file of at most
+/// [`MAX_OBJ_BYTES`] is read ([`crate::mesh::input::read_regular_file`]: a FIFO, a device or a
+/// directory is refused unopened); its text is decoded by [`parse_obj_bytes`].
 pub fn load_obj(path: impl AsRef<Path>) -> Result<ControlMesh, TopologyError> {
+    load_obj_with_lines(path).map(|(mesh, _)| mesh)
+}
+
+/// [`load_obj`], with the line of every vertex, face and tag ([`ObjLines`]), so errors found
+/// later (refinement, adaptive plans) can name the line at fault too.
+pub fn load_obj_with_lines(
+    path: impl AsRef<Path>,
+) -> Result<(ControlMesh, ObjLines), TopologyError> {
     let path = path.as_ref();
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|error| TopologyError::Io {
-        file: name.clone(),
-        error,
+    let bytes = read_regular_file(path, MAX_OBJ_BYTES, "an OBJ file").map_err(|error| {
+        TopologyError::Io {
+            file: name.clone(),
+            error,
+        }
     })?;
-    parse_obj(&text, &name)
+    parse_obj_bytes_with_lines(&bytes, &name)
+}
+
+/// OBJ bytes as text: UTF-8, a byte-order mark skipped; UTF-16 (little- or big-endian) when it
+/// starts with its byte-order mark. A NUL byte is refused, naming its line: text with NULs is
+/// UTF-16 without a byte-order mark (every ASCII character then has one) or not text at all.
+/// A line with bytes that are not UTF-8 is read with U+FFFD in their place: in a comment or a
+/// name nothing changes; in a number, an index or a tag the parser refuses the word, naming
+/// the line; a warning names the first such line outside a comment.
+fn decode<'a>(bytes: &'a [u8], name: &str) -> Result<Cow<'a, str>, TopologyError> {
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let utf16 = |rest: &[u8], unit: fn([u8; 2]) -> u16| -> String {
+        let units = rest.chunks_exact(2).map(|c| unit([c[0], c[1]]));
+        char::decode_utf16(units)
+            .map(|c| c.unwrap_or(char::REPLACEMENT_CHARACTER))
+            .collect()
+    };
+    if let Some(rest) = bytes.strip_prefix(b"\xFF\xFE") {
+        return Ok(Cow::Owned(utf16(rest, u16::from_le_bytes)));
+    }
+    if let Some(rest) = bytes.strip_prefix(b"\xFE\xFF") {
+        return Ok(Cow::Owned(utf16(rest, u16::from_be_bytes)));
+    }
+    if let Some(at) = bytes.iter().position(|&b| b == 0) {
+        let line = 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();
+        return Err(TopologyError::Parse {
+            file: name.to_string(),
+            line,
+            kind: ObjSyntax::NulByte,
+        });
+    }
+    if let Ok(text) = std::str::from_utf8(bytes) {
+        return Ok(Cow::Borrowed(text));
+    }
+    let mut text = String::with_capacity(bytes.len());
+    let mut warned = false;
+    for (i, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        if i > 0 {
+            text.push('\n');
+        }
+        match std::str::from_utf8(line) {
+            Ok(l) => text.push_str(l),
+            Err(e) => {
+                let comment = line.iter().position(|&b| b == b'#');
+                if !warned && comment.is_none_or(|c| e.valid_up_to() < c) {
+                    log::warn!(
+                        "{name}:{}: bytes that are not UTF-8 are read as U+FFFD (save the file \
+                         as UTF-8)",
+                        i + 1
+                    );
+                    warned = true;
+                }
+                text.push_str(&String::from_utf8_lossy(line));
+            }
+        }
+    }
+    Ok(Cow::Owned(text))
+}
+
+/// Parse and validate OBJ bytes ([`parse_obj`] after decoding them as [`load_obj`] does).
+pub fn parse_obj_bytes(bytes: &[u8], name: &str) -> Result<ControlMesh, TopologyError> {
+    parse_obj_bytes_with_lines(bytes, name).map(|(mesh, _)| mesh)
+}
+
+/// [`parse_obj_bytes`] with the lines of its elements.
+pub fn parse_obj_bytes_with_lines(
+    bytes: &[u8],
+    name: &str,
+) -> Result<(ControlMesh, ObjLines), TopologyError> {
+    parse_obj_with_lines(&decode(bytes, name)?, name)
 }
 
 /// One face corner as written in the file: (vertex, uv, normal), already 0-based.
 type RawCorner = (i64, Option<i64>, Option<i64>);
 
-/// The line that made each element, for locating validation errors.
-#[derive(Default)]
-struct Lines {
+/// The line that made each element of a mesh read from OBJ, for locating errors about it:
+/// validation's while parsing, and later ones (refinement, plans) through
+/// [`ObjLines::locate`].
+#[derive(Clone, Debug, Default)]
+pub struct ObjLines {
     vertices: Vec<usize>,
     faces: Vec<usize>,
     creases: Vec<usize>,
@@ -41,20 +128,42 @@ struct Lines {
     holes: Vec<usize>,
 }
 
-impl Lines {
-    /// The line a validation error of `mesh` is about: the vertex's `v` line, the face's `f`
-    /// line (for an edge, the face that made it non-manifold or flipped it), the tag's `t` line.
-    fn locate(&self, e: &TopologyError, mesh: &ControlMesh) -> Option<usize> {
+impl ObjLines {
+    /// The line of face `f` (0-based, as the mesh counts it).
+    pub fn face(&self, f: usize) -> Option<usize> {
+        self.faces.get(f).copied()
+    }
+
+    /// The line of vertex `v` (0-based).
+    pub fn vertex(&self, v: usize) -> Option<usize> {
+        self.vertices.get(v).copied()
+    }
+
+    /// `e`, an error about the mesh read from `file` with these lines, in the file's terms
+    /// ([`TopologyError::in_file`] with the line at fault when there is one).
+    pub fn locate(&self, e: TopologyError, mesh: &ControlMesh, file: &str) -> TopologyError {
+        let line = self.line_of(&e, mesh);
+        e.in_file(file, line)
+    }
+
+    /// The line an error about `mesh` is about: the vertex's `v` line, the face's `f` line
+    /// (for an edge, the face that made it non-manifold or flipped it), the tag's `t` line.
+    /// Faces of refined levels have no line.
+    fn line_of(&self, e: &TopologyError, mesh: &ControlMesh) -> Option<usize> {
         use TopologyError as E;
-        let face = |f: usize| self.faces.get(f).copied();
+        let face = |f: usize| self.face(f);
         match *e {
             E::NonFinitePosition { vertex, .. } | E::CoordinateOutOfRange { vertex, .. } => {
-                self.vertices.get(vertex).copied()
+                self.vertex(vertex)
             }
-            E::NonManifoldVertex { vertex, .. } => self.vertices.get(vertex as usize).copied(),
+            E::NonManifoldVertex { vertex, .. } => self.vertex(vertex as usize),
             E::IndexOutOfRange { face: f, .. }
             | E::DegenerateFace { face: f, .. }
-            | E::RepeatedVertex { face: f, .. } => face(f),
+            | E::RepeatedVertex { face: f, .. }
+            | E::LoopRequiresTriangles { face: f, .. }
+            | E::AdaptiveFaceTooLarge { face: f, .. }
+            | E::AdaptivePatch { level: 0, face: f }
+            | E::AdaptiveUnbalanced { level: 0, face: f } => face(f),
             E::InconsistentOrientation { face1, .. } => face(face1),
             E::NonManifoldEdge { v0, v1, .. } => {
                 // The third face on the edge (the first two are a manifold edge).
@@ -69,6 +178,30 @@ impl Lines {
                     .nth(2)?;
                 face(f)
             }
+            E::BadEdgeSharpness { v0, v1, .. } => {
+                let k = mesh.creases.iter().position(|c| c.vertices == [v0, v1])?;
+                self.creases.get(k).copied()
+            }
+            E::BadVertexSharpness { vertex, .. } => {
+                let k = mesh.corners.iter().position(|c| c.vertex == vertex)?;
+                self.corners.get(k).copied()
+            }
+            E::TagOutOfRange { tag, index, .. } => {
+                let k = match tag {
+                    TagKind::Crease => mesh
+                        .creases
+                        .iter()
+                        .position(|c| c.vertices.contains(&index)),
+                    TagKind::Corner => mesh.corners.iter().position(|c| c.vertex == index),
+                    TagKind::Hole => mesh.holes.iter().position(|&h| h == index),
+                }?;
+                match tag {
+                    TagKind::Crease => self.creases.get(k),
+                    TagKind::Corner => self.corners.get(k),
+                    TagKind::Hole => self.holes.get(k),
+                }
+                .copied()
+            }
             _ => None,
         }
     }
@@ -77,147 +210,189 @@ impl Lines {
 /// Parse and validate OBJ text; `name` is used in error messages (usually the file name).
 /// A UTF-8 byte-order mark at the start is skipped.
 pub fn parse_obj(text: &str, name: &str) -> Result<ControlMesh, TopologyError> {
+    parse_obj_with_lines(text, name).map(|(mesh, _)| mesh)
+}
+
+/// [`parse_obj`], with the line of every vertex, face and tag.
+pub fn parse_obj_with_lines(
+    text: &str,
+    name: &str,
+) -> Result<(ControlMesh, ObjLines), TopologyError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut mesh = ControlMesh::default();
+    let mut lines = ObjLines::default();
+    let mut uvs: Vec<[f64; 2]> = Vec::new();
+    let mut normals: Vec<[f64; 3]> = Vec::new();
+    let mut corners: Vec<RawCorner> = Vec::new();
+    mesh.face_offsets.push(0);
+
     let perr = |line: usize, kind: ObjSyntax| TopologyError::Parse {
         file: name.to_string(),
         line,
         kind,
     };
-    let mut obj = RawObj::default();
-    obj.mesh.face_offsets.push(0);
+
     for (lineno, raw) in text.lines().enumerate() {
+        let line = lineno + 1;
         let content = raw.split('#').next().unwrap_or("").trim();
-        if !content.is_empty() {
-            obj.statement(content, lineno + 1, name, &perr)?;
+        if content.is_empty() {
+            continue;
         }
-    }
-    let mesh = obj.resolve_corners(name, &perr)?;
-    let lines = obj.lines;
-    check_tags(&mesh, &lines).map_err(|(e, line)| e.in_file(name, Some(line)))?;
-    mesh.validate().map_err(|e| {
-        let line = lines.locate(&e, &mesh);
-        e.in_file(name, line)
-    })?;
-    Ok(mesh)
-}
-
-/// An OBJ file as its statements are read: the mesh so far, the line of each element, the
-/// texture coordinates and normals and the face corners as written.
-#[derive(Default)]
-struct RawObj {
-    mesh: ControlMesh,
-    lines: Lines,
-    uvs: Vec<[f64; 2]>,
-    normals: Vec<[f64; 3]>,
-    corners: Vec<RawCorner>,
-}
-
-impl RawObj {
-    /// One statement (`content`, comment stripped) on line `line`.
-    fn statement<E: Fn(usize, ObjSyntax) -> TopologyError>(
-        &mut self,
-        content: &str,
-        line: usize,
-        name: &str,
-        perr: &E,
-    ) -> Result<(), TopologyError> {
         let mut words = content.split_whitespace();
         let keyword = words.next().unwrap_or("");
         let rest: Vec<&str> = words.collect();
         match keyword {
             "v" => {
                 // Range and finiteness are checked by validation (it names the vertex).
-                let p = parse_floats(&rest, 3, line, "v", perr)?;
-                self.mesh.positions.push([p[0], p[1], p[2]]);
-                self.lines.vertices.push(line);
+                let p = parse_floats(&rest, 3, line, "v", &perr)?;
+                mesh.positions.push([p[0], p[1], p[2]]);
+                lines.vertices.push(line);
             }
             "vt" => {
-                let p = parse_finite(&rest, 1, line, "vt", perr)?;
-                self.uvs.push([p[0], p.get(1).copied().unwrap_or(0.0)]);
+                let p = parse_finite(&rest, 1, line, "vt", &perr)?;
+                uvs.push([p[0], p.get(1).copied().unwrap_or(0.0)]);
             }
             "vn" => {
-                let p = parse_finite(&rest, 3, line, "vn", perr)?;
-                self.normals.push([p[0], p[1], p[2]]);
+                let p = parse_finite(&rest, 3, line, "vn", &perr)?;
+                normals.push([p[0], p[1], p[2]]);
             }
             "f" => {
                 if rest.is_empty() {
                     return Err(perr(line, ObjSyntax::FaceWithoutVertices));
                 }
-                let counts = [
-                    self.mesh.positions.len(),
-                    self.uvs.len(),
-                    self.normals.len(),
-                ];
                 for word in &rest {
-                    self.corners.push(parse_corner(word, counts, line, perr)?);
+                    corners.push(parse_corner(
+                        word,
+                        [mesh.positions.len(), uvs.len(), normals.len()],
+                        line,
+                        &perr,
+                    )?);
                 }
-                self.mesh.face_offsets.push(self.corners.len() as u32);
-                self.lines.faces.push(line);
+                mesh.face_offsets.push(corners.len() as u32);
+                lines.faces.push(line);
             }
-            "t" => parse_tag(&rest, line, name, &mut self.mesh, &mut self.lines, perr)?,
+            "t" => parse_tag(&rest, line, name, &mut mesh, &mut lines, &perr)?,
             "o" | "g" | "s" | "usemtl" | "mtllib" | "l" | "p" | "vp" => {}
             other => log::warn!("{name}:{line}: ignoring unknown OBJ statement '{other}'"),
         }
-        Ok(())
     }
 
-    /// The mesh with its corners resolved: vertex indices are checked by validation (it names
-    /// the face); attribute indices are checked here (they name the line). Texture
-    /// coordinates and normals are kept when every corner has one.
-    fn resolve_corners<E: Fn(usize, ObjSyntax) -> TopologyError>(
-        &mut self,
-        name: &str,
-        perr: &E,
-    ) -> Result<ControlMesh, TopologyError> {
-        let mut mesh = std::mem::take(&mut self.mesh);
-        let corners = &self.corners;
-        let nv = mesh.positions.len();
-        let all_uv = !corners.is_empty() && corners.iter().all(|c| c.1.is_some());
-        let all_n = !corners.is_empty() && corners.iter().all(|c| c.2.is_some());
-        let mut corner_uvs = Vec::with_capacity(if all_uv { corners.len() } else { 0 });
-        let mut corner_normals = Vec::with_capacity(if all_n { corners.len() } else { 0 });
-        for (f, &face_line) in self.lines.faces.iter().enumerate() {
-            let (s, e) = (
-                mesh.face_offsets[f] as usize,
-                mesh.face_offsets[f + 1] as usize,
-            );
-            for &(v, t, n) in &corners[s..e] {
-                if v < 0 || v as usize >= nv {
-                    return Err(TopologyError::IndexOutOfRange {
-                        face: f,
-                        index: v,
-                        count: nv,
-                    }
-                    .in_file(name, Some(face_line)));
+    resolve_corners(&mut mesh, &lines, &corners, &uvs, &normals, name)?;
+    check_tags(&mesh, &lines).map_err(|(e, line)| e.in_file(name, Some(line)))?;
+    mesh.validate().map_err(|e| lines.locate(e, &mesh, name))?;
+    drop_creases_off_edges(&mut mesh, &mut lines, name);
+    Ok((mesh, lines))
+}
+
+/// Fills the mesh's face vertices and per-corner attributes from the corners as written.
+/// Vertex indices are checked here and by validation (both name the face and its line);
+/// every texture and normal index given is checked here, naming the line, also where the
+/// mesh keeps no attribute because some corner has none.
+fn resolve_corners(
+    mesh: &mut ControlMesh,
+    lines: &ObjLines,
+    corners: &[RawCorner],
+    uvs: &[[f64; 2]],
+    normals: &[[f64; 3]],
+    name: &str,
+) -> Result<(), TopologyError> {
+    let nv = mesh.positions.len();
+    let all_uv = !corners.is_empty() && corners.iter().all(|c| c.1.is_some());
+    let all_n = !corners.is_empty() && corners.iter().all(|c| c.2.is_some());
+    let mut corner_uvs = Vec::with_capacity(if all_uv { corners.len() } else { 0 });
+    let mut corner_normals = Vec::with_capacity(if all_n { corners.len() } else { 0 });
+    let perr = |line: usize, kind: ObjSyntax| TopologyError::Parse {
+        file: name.to_string(),
+        line,
+        kind,
+    };
+    for (f, &face_line) in lines.faces.iter().enumerate() {
+        let (s, e) = (
+            mesh.face_offsets[f] as usize,
+            mesh.face_offsets[f + 1] as usize,
+        );
+        for &(v, t, n) in &corners[s..e] {
+            if v < 0 || v as usize >= nv {
+                return Err(TopologyError::IndexOutOfRange {
+                    face: f,
+                    index: v,
+                    count: nv,
                 }
-                mesh.face_vertices.push(v as u32);
+                .in_file(name, Some(face_line)));
+            }
+            mesh.face_vertices.push(v as u32);
+            if let Some(t) = t {
+                let uv = usize::try_from(t).ok().and_then(|t| uvs.get(t));
+                let uv = *uv.ok_or_else(|| {
+                    perr(
+                        face_line,
+                        ObjSyntax::TextureIndexOutOfRange {
+                            index: t + 1,
+                            count: uvs.len(),
+                        },
+                    )
+                })?;
                 if all_uv {
-                    let t = t.unwrap_or(-1);
-                    let uv = usize::try_from(t).ok().and_then(|t| self.uvs.get(t));
-                    corner_uvs.push(*uv.ok_or_else(|| {
-                        perr(
-                            face_line,
-                            ObjSyntax::TextureIndexOutOfRange { index: t + 1 },
-                        )
-                    })?);
+                    corner_uvs.push(uv);
                 }
+            }
+            if let Some(n) = n {
+                let nn = usize::try_from(n).ok().and_then(|n| normals.get(n));
+                let nn = *nn.ok_or_else(|| {
+                    perr(
+                        face_line,
+                        ObjSyntax::NormalIndexOutOfRange {
+                            index: n + 1,
+                            count: normals.len(),
+                        },
+                    )
+                })?;
                 if all_n {
-                    let n = n.unwrap_or(-1);
-                    let nn = usize::try_from(n).ok().and_then(|n| self.normals.get(n));
-                    corner_normals.push(*nn.ok_or_else(|| {
-                        perr(face_line, ObjSyntax::NormalIndexOutOfRange { index: n + 1 })
-                    })?);
+                    corner_normals.push(nn);
                 }
             }
         }
-        if all_uv {
-            mesh.uvs = Some(corner_uvs);
-        }
-        if all_n {
-            mesh.normals = Some(corner_normals);
-        }
-        Ok(mesh)
     }
+    if all_uv {
+        mesh.uvs = Some(corner_uvs);
+    }
+    if all_n {
+        mesh.normals = Some(corner_normals);
+    }
+    Ok(())
+}
+
+/// Removes crease tags between vertices no face edge joins, warning with the tag's line:
+/// OpenSubdiv ignores them, and so would every refinement (each warning without a line).
+fn drop_creases_off_edges(mesh: &mut ControlMesh, lines: &mut ObjLines, name: &str) {
+    if mesh.creases.is_empty() {
+        return;
+    }
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    let edges: std::collections::HashSet<(u32, u32)> = (0..mesh.num_faces())
+        .flat_map(|f| {
+            let fv = mesh.face(f);
+            (0..fv.len()).map(move |i| key(fv[i], fv[(i + 1) % fv.len()]))
+        })
+        .collect();
+    let mut kept_lines = Vec::with_capacity(lines.creases.len());
+    let mut k = 0;
+    mesh.creases.retain(|c| {
+        let line = lines.creases[k];
+        k += 1;
+        let [a, b] = c.vertices;
+        let on_edge = edges.contains(&key(a, b));
+        if on_edge {
+            kept_lines.push(line);
+        } else {
+            log::warn!(
+                "{name}:{line}: crease tag on vertices {a} and {b} (tags count from 0), which \
+                 no face edge joins: ignored"
+            );
+        }
+        on_edge
+    });
+    lines.creases = kept_lines;
 }
 
 fn parse_floats<E: Fn(usize, ObjSyntax) -> TopologyError>(
@@ -308,7 +483,118 @@ fn parse_corner<E: Fn(usize, ObjSyntax) -> TopologyError>(
         idx(0)?.ok_or_else(|| perr(line, ObjSyntax::CornerWithoutVertex { word: word.into() }))?;
     let t = idx(1)?;
     let n = idx(2)?;
+    if parts.next().is_some() {
+        return Err(perr(
+            line,
+            ObjSyntax::CornerTooManyIndices { word: word.into() },
+        ));
+    }
     Ok((v, t, n))
+}
+
+/// The values of one `t` line as its counts announce them.
+struct TagValues<'a> {
+    tag: &'a str,
+    ints: Vec<i64>,
+    floats: Vec<f32>,
+    strings: &'a [&'a str],
+}
+
+impl<'a> TagValues<'a> {
+    /// `<name> <nints>/<nfloats>/<nstrings> ints... floats... strings...`: exactly as many
+    /// values as the counts announce.
+    fn parse<E: Fn(usize, ObjSyntax) -> TopologyError>(
+        words: &'a [&'a str],
+        line: usize,
+        perr: &E,
+    ) -> Result<Self, TopologyError> {
+        let (Some(&tag), Some(&counts)) = (words.first(), words.get(1)) else {
+            return Err(perr(line, ObjSyntax::TagWithoutCounts));
+        };
+        let bad_counts = || {
+            perr(
+                line,
+                ObjSyntax::BadTagCounts {
+                    tag: tag.into(),
+                    counts: counts.into(),
+                },
+            )
+        };
+        let nums: Vec<usize> = counts
+            .split('/')
+            .map(|c| c.parse::<usize>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| bad_counts())?;
+        let [n_int, n_float, n_string] = nums[..] else {
+            return Err(bad_counts());
+        };
+        let vals = &words[2..];
+        // Checked: counts near usize::MAX would wrap the sum and pass the length test.
+        let needed = n_int
+            .checked_add(n_float)
+            .and_then(|n| n.checked_add(n_string));
+        if needed != Some(vals.len()) {
+            return Err(perr(
+                line,
+                ObjSyntax::TagCountMismatch {
+                    tag: tag.into(),
+                    counts: counts.into(),
+                    found: vals.len(),
+                },
+            ));
+        }
+        let ints = vals[..n_int]
+            .iter()
+            .map(|w| {
+                w.parse::<i64>().map_err(|_| {
+                    perr(
+                        line,
+                        ObjSyntax::BadTagInteger {
+                            tag: tag.into(),
+                            word: w.to_string(),
+                        },
+                    )
+                })
+            })
+            .collect::<Result<_, _>>()?;
+        let floats = vals[n_int..n_int + n_float]
+            .iter()
+            .map(|w| {
+                w.parse::<f32>().map_err(|_| {
+                    perr(
+                        line,
+                        ObjSyntax::BadTagFloat {
+                            tag: tag.into(),
+                            word: w.to_string(),
+                        },
+                    )
+                })
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(TagValues {
+            tag,
+            ints,
+            floats,
+            strings: &vals[n_int + n_float..],
+        })
+    }
+
+    /// The values as written, for a message about an option tag: its integers, else its
+    /// strings, quoted.
+    fn shown(&self) -> String {
+        if !self.ints.is_empty() {
+            let ints: Vec<String> = self.ints.iter().map(i64::to_string).collect();
+            ints.join(" ")
+        } else if !self.strings.is_empty() {
+            let strings: Vec<String> = self.strings.iter().map(|s| format!("'{s}'")).collect();
+            strings.join(" ")
+        } else if !self.floats.is_empty() {
+            let floats: Vec<String> = self.floats.iter().map(f32::to_string).collect();
+            floats.join(" ")
+        } else {
+            "no value".into()
+        }
+    }
 }
 
 /// `t <name> <nints>/<nfloats>/<nstrings> ints... floats... strings...`
@@ -317,19 +603,63 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
     line: usize,
     file: &str,
     mesh: &mut ControlMesh,
-    lines: &mut Lines,
+    lines: &mut ObjLines,
     perr: &E,
 ) -> Result<(), TopologyError> {
-    let tag = Tag::parse(words, line, file, perr)?;
-    match tag.name {
-        "crease" => tag.creases(mesh, lines)?,
-        "corner" => tag.corners(mesh, lines)?,
-        "interpolateboundary" => mesh.options.boundary = tag.boundary_interpolation()?,
-        "creasemethod" => mesh.options.crease_method = tag.crease_method()?,
-        "smoothtriangles" => mesh.options.triangle_subdivision = tag.triangle_subdivision()?,
+    let t = TagValues::parse(words, line, perr)?;
+    let tag = t.tag;
+    let to_u32 = |i: i64| -> Result<u32, TopologyError> {
+        u32::try_from(i).map_err(|_| {
+            perr(
+                line,
+                ObjSyntax::NegativeTagIndex {
+                    tag: tag.into(),
+                    index: i,
+                },
+            )
+        })
+    };
+    let sharp_for = |k: usize, n: usize| tag_sharpness(&t, k, n, line, file, perr);
+    match tag {
+        "crease" => {
+            if t.ints.len() < 2 || t.ints.len() % 2 != 0 {
+                return Err(perr(
+                    line,
+                    ObjSyntax::CreaseNeedsPairs {
+                        found: t.ints.len(),
+                    },
+                ));
+            }
+            let pairs = t.ints.len() / 2;
+            for k in 0..pairs {
+                mesh.creases.push(EdgeCrease {
+                    vertices: [to_u32(t.ints[2 * k])?, to_u32(t.ints[2 * k + 1])?],
+                    sharpness: sharp_for(k, pairs)?,
+                });
+                lines.creases.push(line);
+            }
+        }
+        "corner" => {
+            if t.ints.is_empty() {
+                return Err(perr(line, ObjSyntax::CornerNeedsVertices));
+            }
+            for (k, &v) in t.ints.iter().enumerate() {
+                mesh.corners.push(VertexCorner {
+                    vertex: to_u32(v)?,
+                    sharpness: sharp_for(k, t.ints.len())?,
+                });
+                lines.corners.push(line);
+            }
+        }
+        "interpolateboundary" | "creasemethod" | "smoothtriangles" => {
+            option_tag(&t, &mut mesh.options, line, perr)?
+        }
         "hole" => {
-            for &f in &tag.ints {
-                mesh.holes.push(tag.index(f)?);
+            if t.ints.is_empty() {
+                return Err(perr(line, ObjSyntax::HoleNeedsFaces));
+            }
+            for &f in &t.ints {
+                mesh.holes.push(to_u32(f)?);
                 lines.holes.push(line);
             }
         }
@@ -338,196 +668,112 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
     Ok(())
 }
 
-/// One `t` line, its values read: the tag's name, integers, floats and strings, where it is
-/// (for errors and warnings) and how a syntax error is made.
-struct Tag<'a, E> {
-    name: &'a str,
-    ints: Vec<i64>,
-    floats: Vec<f32>,
-    strings: &'a [&'a str],
+/// The option tags: `interpolateboundary` (one integer), `creasemethod` and `smoothtriangles`
+/// (one string; `smoothtriangles` also one integer). Anything else is refused with the value as
+/// written and what the tag takes.
+fn option_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
+    t: &TagValues<'_>,
+    options: &mut SubdivOptions,
     line: usize,
-    file: &'a str,
-    perr: &'a E,
+    perr: &E,
+) -> Result<(), TopologyError> {
+    let bad = |expected: &'static str| {
+        perr(
+            line,
+            ObjSyntax::BadOptionValue {
+                option: t.tag.into(),
+                value: t.shown(),
+                expected,
+            },
+        )
+    };
+    match t.tag {
+        "interpolateboundary" => {
+            options.boundary =
+                match (&t.ints[..], t.strings.len()) {
+                    ([0], 0) => BoundaryInterpolation::None,
+                    ([1], 0) => BoundaryInterpolation::EdgesAndCorners,
+                    ([2], 0) => BoundaryInterpolation::EdgesOnly,
+                    _ => return Err(bad(
+                        "one integer: 0 (none), 1 (edges and corners) or 2 (edges only), as in \
+                         't interpolateboundary 1/0/0 1'",
+                    )),
+                }
+        }
+        "creasemethod" => {
+            options.crease_method = match (t.strings, t.ints.len()) {
+                (["chaikin"], 0) => CreaseMethod::Chaikin,
+                (["normal" | "uniform"], 0) => CreaseMethod::Uniform,
+                _ => {
+                    return Err(bad(
+                        "one string: chaikin, normal or uniform, as in 't creasemethod 0/0/1 \
+                         chaikin'",
+                    ))
+                }
+            }
+        }
+        _ => {
+            options.triangle_subdivision = match (t.strings, &t.ints[..]) {
+                (["smooth"], []) | ([], [1]) => TriangleSubdivision::Smooth,
+                (["catmark"], []) | ([], [0]) => TriangleSubdivision::Catmark,
+                _ => {
+                    return Err(bad(
+                        "one string, smooth or catmark (or one integer, 1 or 0)",
+                    ))
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
-impl<'a, E: Fn(usize, ObjSyntax) -> TopologyError> Tag<'a, E> {
-    /// The name, the counts `<nints>/<nfloats>/<nstrings>` and as many values of each.
-    fn parse(
-        words: &'a [&'a str],
-        line: usize,
-        file: &'a str,
-        perr: &'a E,
-    ) -> Result<Tag<'a, E>, TopologyError> {
-        let (Some(&tag), Some(&counts)) = (words.first(), words.get(1)) else {
-            return Err(perr(line, ObjSyntax::TagWithoutCounts));
-        };
-        let nums: Vec<usize> = counts
-            .split('/')
-            .map(|c| c.parse::<usize>())
-            .collect::<Result<_, _>>()
-            .map_err(|_| {
-                perr(
-                    line,
-                    ObjSyntax::BadTagCounts {
-                        counts: counts.into(),
-                    },
-                )
-            })?;
-        // Checked: counts near usize::MAX would wrap the sum and pass the length test.
-        let needed = nums.iter().try_fold(2usize, |sum, &n| sum.checked_add(n));
-        if nums.len() != 3 || needed.is_none_or(|needed| words.len() < needed) {
+/// The sharpness of element `k` of `n` a crease or corner tag names: one float for all
+/// elements, or one per element; finite; a negative value is smooth (warned, as OpenSubdiv
+/// treats sharpness ≤ 0).
+fn tag_sharpness<E: Fn(usize, ObjSyntax) -> TopologyError>(
+    t: &TagValues<'_>,
+    k: usize,
+    n: usize,
+    line: usize,
+    file: &str,
+    perr: &E,
+) -> Result<f32, TopologyError> {
+    let tag = t.tag;
+    let s = match t.floats.len() {
+        0 => return Err(perr(line, ObjSyntax::MissingSharpness { tag: tag.into() })),
+        1 => t.floats[0],
+        m if m == n => t.floats[k],
+        _ => {
             return Err(perr(
                 line,
-                ObjSyntax::TagCountMismatch {
+                ObjSyntax::SharpnessCount {
                     tag: tag.into(),
-                    counts: counts.into(),
-                },
-            ));
-        }
-        let vals = &words[2..];
-        let ints: Vec<i64> = vals[..nums[0]]
-            .iter()
-            .map(|w| w.parse::<i64>())
-            .collect::<Result<_, _>>()
-            .map_err(|_| perr(line, ObjSyntax::BadTagInteger { tag: tag.into() }))?;
-        let floats: Vec<f32> = vals[nums[0]..nums[0] + nums[1]]
-            .iter()
-            .map(|w| w.parse::<f32>())
-            .collect::<Result<_, _>>()
-            .map_err(|_| perr(line, ObjSyntax::BadTagFloat { tag: tag.into() }))?;
-        let strings = &vals[nums[0] + nums[1]..nums[0] + nums[1] + nums[2]];
-        Ok(Tag {
-            name: tag,
-            ints,
-            floats,
-            strings,
-            line,
-            file,
-            perr,
-        })
-    }
-
-    fn err(&self, kind: ObjSyntax) -> TopologyError {
-        (self.perr)(self.line, kind)
-    }
-
-    /// An integer value as a vertex or face index.
-    fn index(&self, i: i64) -> Result<u32, TopologyError> {
-        u32::try_from(i).map_err(|_| {
-            self.err(ObjSyntax::NegativeTagIndex {
-                tag: self.name.into(),
-                index: i,
-            })
-        })
-    }
-
-    /// The sharpness of element `k` of `n`: one float for all elements, or one per element.
-    fn sharpness(&self, k: usize, n: usize) -> Result<f32, TopologyError> {
-        let (tag, floats) = (self.name, &self.floats);
-        let s = match floats.len() {
-            0 => return Err(self.err(ObjSyntax::MissingSharpness { tag: tag.into() })),
-            1 => floats[0],
-            m if m == n => floats[k],
-            _ => {
-                return Err(self.err(ObjSyntax::SharpnessCount {
-                    tag: tag.into(),
-                    values: floats.len(),
+                    values: t.floats.len(),
                     elements: n,
-                }))
-            }
-        };
-        if !s.is_finite() {
-            return Err(self.err(ObjSyntax::NonFiniteSharpness {
+                },
+            ))
+        }
+    };
+    if !s.is_finite() {
+        return Err(perr(
+            line,
+            ObjSyntax::NonFiniteSharpness {
                 tag: tag.into(),
                 value: s,
-            }));
-        }
-        if s < 0.0 {
-            // OpenSubdiv treats sharpness ≤ 0 as smooth; say so rather than drop it silently.
-            let (file, line) = (self.file, self.line);
-            log::warn!(
-                "{file}:{line}: tag '{tag}': negative sharpness {s} is treated as 0 (smooth), \
-                 as OpenSubdiv does"
-            );
-        }
-        Ok(s.max(0.0))
+            },
+        ));
     }
-
-    /// `crease`: vertex pairs, their sharpness.
-    fn creases(&self, mesh: &mut ControlMesh, lines: &mut Lines) -> Result<(), TopologyError> {
-        let ints = &self.ints;
-        if ints.len() < 2 || ints.len() & 1 != 0 {
-            return Err(self.err(ObjSyntax::CreaseNeedsPairs));
-        }
-        let pairs = ints.len() / 2;
-        for k in 0..pairs {
-            mesh.creases.push(EdgeCrease {
-                vertices: [self.index(ints[2 * k])?, self.index(ints[2 * k + 1])?],
-                sharpness: self.sharpness(k, pairs)?,
-            });
-            lines.creases.push(self.line);
-        }
-        Ok(())
+    if s < 0.0 {
+        log::warn!(
+            "{file}:{line}: tag '{tag}': negative sharpness {s} is treated as 0 (smooth), \
+             as OpenSubdiv does"
+        );
     }
-
-    /// `corner`: vertices, their sharpness.
-    fn corners(&self, mesh: &mut ControlMesh, lines: &mut Lines) -> Result<(), TopologyError> {
-        if self.ints.is_empty() {
-            return Err(self.err(ObjSyntax::CornerNeedsVertices));
-        }
-        for (k, &v) in self.ints.iter().enumerate() {
-            mesh.corners.push(VertexCorner {
-                vertex: self.index(v)?,
-                sharpness: self.sharpness(k, self.ints.len())?,
-            });
-            lines.corners.push(self.line);
-        }
-        Ok(())
-    }
-
-    /// `interpolateboundary`: OpenSubdiv's integer (0 none, 1 edges and corners, 2 edges).
-    fn boundary_interpolation(&self) -> Result<BoundaryInterpolation, TopologyError> {
-        match self.ints.first() {
-            Some(0) => Ok(BoundaryInterpolation::None),
-            Some(1) => Ok(BoundaryInterpolation::EdgesAndCorners),
-            Some(2) => Ok(BoundaryInterpolation::EdgesOnly),
-            other => Err(self.err(ObjSyntax::BadOptionValue {
-                option: "interpolateboundary",
-                value: other.map_or_else(|| "(none)".into(), |v| v.to_string()),
-            })),
-        }
-    }
-
-    /// `creasemethod`: `chaikin`, or `normal` / `uniform`.
-    fn crease_method(&self) -> Result<CreaseMethod, TopologyError> {
-        match self.strings.first().copied() {
-            Some("chaikin") => Ok(CreaseMethod::Chaikin),
-            Some("normal") | Some("uniform") => Ok(CreaseMethod::Uniform),
-            other => Err(self.err(ObjSyntax::BadOptionValue {
-                option: "creasemethod",
-                value: other.unwrap_or("(none)").to_string(),
-            })),
-        }
-    }
-
-    /// `smoothtriangles`: `smooth` or 1, `catmark` or 0.
-    fn triangle_subdivision(&self) -> Result<TriangleSubdivision, TopologyError> {
-        match (self.strings.first().copied(), self.ints.first()) {
-            (Some("smooth"), _) | (None, Some(1)) => Ok(TriangleSubdivision::Smooth),
-            (Some("catmark"), _) | (None, Some(0)) => Ok(TriangleSubdivision::Catmark),
-            (s, i) => Err(self.err(ObjSyntax::BadOptionValue {
-                option: "smoothtriangles",
-                value: s
-                    .map(str::to_string)
-                    .or(i.map(|i| i.to_string()))
-                    .unwrap_or_else(|| "(none)".into()),
-            })),
-        }
-    }
+    Ok(s.max(0.0))
 }
 
 /// Tags must name existing vertices/faces; the error comes with the tag's line.
-fn check_tags(mesh: &ControlMesh, lines: &Lines) -> Result<(), (TopologyError, usize)> {
+fn check_tags(mesh: &ControlMesh, lines: &ObjLines) -> Result<(), (TopologyError, usize)> {
     let nv = mesh.positions.len() as u32;
     let out_of_range =
         |tag, index, count, line| (TopologyError::TagOutOfRange { tag, index, count }, line);
@@ -700,14 +946,36 @@ mod tests {
         assert!(e.source().is_none(), "{e}");
     }
 
+    /// An option tag's value is shown as written (integers plain, strings quoted, "no value"),
+    /// with the values the tag takes.
     #[test]
     fn bad_option_values_are_shown_as_written() {
         let e = err(&format!("{TRI}f 1 2 3\nt interpolateboundary 1/0/0 7\n"));
-        assert_eq!(e.to_string(), "t.obj:5: interpolateboundary: bad value 7");
+        assert_eq!(
+            e.to_string(),
+            "t.obj:5: tag 'interpolateboundary': 7; expected one integer: 0 (none), 1 (edges \
+             and corners) or 2 (edges only), as in 't interpolateboundary 1/0/0 1'"
+        );
         let e = err(&format!("{TRI}f 1 2 3\nt creasemethod 0/0/1 sharp\n"));
-        assert_eq!(e.to_string(), "t.obj:5: creasemethod: bad value sharp");
+        assert!(
+            e.to_string()
+                .starts_with("t.obj:5: tag 'creasemethod': 'sharp'; expected one string: chaikin"),
+            "{e}"
+        );
         let e = err(&format!("{TRI}f 1 2 3\nt smoothtriangles 0/0/0\n"));
-        assert_eq!(e.to_string(), "t.obj:5: smoothtriangles: bad value (none)");
+        assert!(
+            e.to_string()
+                .starts_with("t.obj:5: tag 'smoothtriangles': no value; expected one string"),
+            "{e}"
+        );
+        let e = err(&format!(
+            "{TRI}f 1 2 3\nt interpolateboundary 0/0/1 edges\n"
+        ));
+        assert!(
+            e.to_string()
+                .starts_with("t.obj:5: tag 'interpolateboundary': 'edges'; expected one integer"),
+            "{e}"
+        );
     }
 
     #[test]

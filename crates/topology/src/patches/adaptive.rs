@@ -6,8 +6,9 @@
 //!
 //! # Design decisions
 //! * **One refiner.** Level 0 is [`LevelTopology::from_mesh`] with every tagged crease and
-//!   corner sharpness multiplied by [`AdaptiveOptions::sharpness_scale`] (infinite tags, ≥ 10,
-//!   stay infinite, and boundary edges are infinitely sharp as always). Each step is
+//!   corner sharpness multiplied by [`AdaptiveOptions::sharpness_scale`] (an infinite tag,
+//!   ≥ 10, counts as 10, so it stays infinite at scales ≥ 1 and softens below; boundary edges
+//!   are infinitely sharp as always). Each step is
 //!   [`crate::refine::refine_sparse_region`] of the selected faces with
 //!   [`SparseRegion::SelectedCorners`]: level L + 1 holds their children and, of their
 //!   one-ring, only the children at the selected faces' corners, which is all the one-rings of
@@ -120,8 +121,9 @@ pub struct AdaptiveOptions {
     /// Deepest refinement level, `1..=8`.
     pub isolation: u32,
     pub end_cap: EndCap,
-    /// Multiplies every tagged edge and vertex sharpness before planning (finite, ≥ 0);
-    /// infinite tags and boundary edges stay infinitely sharp.
+    /// Multiplies every tagged edge and vertex sharpness before planning (finite, ≥ 0); an
+    /// infinite tag (≥ 10) counts as 10, so 0 makes every tag smooth and 0.5 makes an infinite
+    /// one 5; boundary edges stay infinitely sharp.
     pub sharpness_scale: f32,
     /// Follow semi-sharp creases and corners past the isolation level until their sharpness
     /// has decayed, then isolate the irregular vertices that carried them `isolation` more

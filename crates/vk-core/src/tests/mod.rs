@@ -2,8 +2,11 @@
 //! loader offers (lavapipe in CI) with the validation layer on, synchronization validation
 //! included. Every test fails on any
 //! error-severity validation message and on memory still allocated at its end.
+mod draws;
 mod overlay;
+mod pipeline_cache;
 mod spirv;
+mod subpass;
 mod texture;
 
 use crate::descriptor::{BindingDesc, DescriptorPool, DescriptorSet, DescriptorSetLayout};
@@ -174,6 +177,25 @@ fn problem(e: VkError) -> RecordingError {
         VkError::Recording { problem, .. } => problem,
         other => panic!("expected a recording error, got {other}"),
     }
+}
+
+/// A one-shot submission leaves its command pool cached for the next (counted live); releasing
+/// the idle pools brings the count back to what callers hold, and a later submission works.
+#[test]
+fn idle_one_shot_pools_are_released_on_request() {
+    let gpu = Gpu::new();
+    let device = gpu.device();
+    let start = device.live_objects();
+    device.submit_once(|_| ()).unwrap();
+    device.wait_idle();
+    assert_eq!(device.live_objects(), start + 1, "the idle pool is cached");
+    device.release_idle_command_pools();
+    assert_eq!(device.live_objects(), start);
+    device.submit_once(|_| ()).unwrap();
+    device.wait_idle();
+    device.release_idle_command_pools();
+    assert_eq!(device.live_objects(), start);
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
 }
 
 #[test]

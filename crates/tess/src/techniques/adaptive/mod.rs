@@ -36,7 +36,7 @@ use super::shared::{
     canonical_zero, check_adaptive_policy, factor_fields, storage, storage_binding,
 };
 use super::windows::{self, Limits, Member, Space};
-use crate::capture::{face_corner_uv, FacePoint};
+use crate::capture::FacePoint;
 use crate::context::Context;
 use crate::error::{Result, TessError};
 use crate::gpu::bindings::{
@@ -58,10 +58,11 @@ use crate::gpu::AdaptivePush;
 use crate::shaders::{self, Stage, Variant};
 use crate::surface::{SurfaceImage, SurfaceMaps, SurfaceShow};
 use crate::technique::{
-    for_each_draw, number_arrays, DeviceAllocation, DrawCounts, FactorPolicy, FrameParams, Pass,
-    PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
+    for_each_draw, number_arrays, DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features,
+    FrameParams, Pass, PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
 };
-use crate::techniques::bft::{base_positions, bbox};
+use crate::techniques::bft::base_positions;
+use crate::techniques::{BuildOptions, Built, LegendEntry, TechniqueInfo};
 use crate::tessellator::{
     quad_triangle_count, triangle_triangle_count, uniform_vertex_count, Domain, Spacing,
 };
@@ -246,6 +247,73 @@ fn plan_pre_pass(
     Ok((steps, chunks.into_iter().map(|c| c.windows).collect()))
 }
 
+impl TechniqueId {
+    pub const ADAPTIVE: TechniqueId = TechniqueId::new("adaptive");
+}
+
+/// What feature-adaptive Catmull-Clark takes (the single-pass techniques take it without
+/// isolation).
+pub const ADAPTIVE_FEATURES: Features = Features {
+    adaptive_factors: true,
+    spacings: [true, true, false],
+    animation: true,
+    patch_colours: true,
+    geometric_normals: false,
+    phong_alpha: false,
+    table_level: false,
+    triangles_only: false,
+    isolation: true,
+    surface: true,
+    single_pass: false,
+    paths: &[DrawPath::Tessellation],
+};
+
+/// The patch-colour legend of the planned Catmull-Clark techniques.
+pub const PATCH_LEGEND: &[LegendEntry] = &[
+    ([0.45, 0.65, 0.95], "B-spline (odd levels lighter)"),
+    ([0.95, 0.45, 0.35], "Gregory end cap"),
+    ([0.95, 0.8, 0.3], "bilinear end cap"),
+    ([0.3, 0.8, 0.35], "boundary / crease (greener)"),
+];
+
+/// The registry entry.
+pub static INFO: TechniqueInfo = TechniqueInfo {
+    id: TechniqueId::ADAPTIVE,
+    help: "exact Catmull-Clark limit surface by feature-adaptive refinement (Niessner et al.), Gregory or bilinear end caps",
+    features: ADAPTIVE_FEATURES,
+    scheme: Some(topology::Scheme::CatmullClark),
+    default_for_scheme: true,
+    shader_folder: "adaptive",
+    abi_code: 5,
+    legend: PATCH_LEGEND,
+    build: build_registered,
+    check_options: |_, params| check_frame(None, params),
+};
+
+/// The registry's constructor: [`Adaptive::new`] with the build options adaptive takes.
+fn build_registered(
+    ctx: &mut Context,
+    mesh: &ControlMesh,
+    options: &BuildOptions,
+) -> Result<Built> {
+    let surface = Adaptive::new(
+        ctx,
+        mesh,
+        &AdaptiveBuild {
+            isolation: options.isolation,
+            end_cap: options.end_cap,
+            sharpness_scale: options.sharpness_scale,
+            follow_semi_sharp: options.follow_semi_sharp,
+            name: options.name.clone(),
+            maps: options.maps.clone(),
+        },
+    )?;
+    Ok(Built {
+        notes: surface.param_error_note().into_iter().collect(),
+        technique: Box::new(surface),
+    })
+}
+
 /// How an adaptive surface is built (the per-frame choices are in [`FrameParams`]).
 #[derive(Clone, Debug)]
 pub struct AdaptiveBuild {
@@ -328,7 +396,7 @@ impl Adaptive {
             name: options.name.clone(),
             source: e.into(),
         })?;
-        Self::from_plan(ctx, mesh, plan, options, TechniqueId::Adaptive)
+        Self::from_plan(ctx, mesh, plan, options, TechniqueId::ADAPTIVE)
     }
 
     /// Uploads an already made plan (the single-pass techniques' too,
@@ -567,7 +635,7 @@ impl Adaptive {
             gpu,
             plan,
             mesh: mesh.clone(),
-            rest_bbox: bbox(&base_positions),
+            rest_bbox: crate::framing::drawn_bbox(mesh),
             base_positions,
             options: options.clone(),
             max_level,
@@ -636,7 +704,7 @@ impl Adaptive {
             SurfaceShow::ParamShift => options |= ADAPTIVE_OPTION_SHOW_PARAM_SHIFT,
             SurfaceShow::ParamError => options |= ADAPTIVE_OPTION_SHOW_PARAM_ERROR,
         }
-        if self.id != TechniqueId::Adaptive {
+        if self.id != TechniqueId::ADAPTIVE {
             options |= ADAPTIVE_OPTION_CANONICAL_NORMALS;
         }
         if fractional {
@@ -705,7 +773,7 @@ impl Adaptive {
 pub fn check_frame(factor_limit: Option<f32>, params: &FrameParams) -> Result<()> {
     if params.spacing == Spacing::FractionalOdd {
         return Err(TessError::Unsupported {
-            technique: TechniqueId::Adaptive,
+            technique: TechniqueId::ADAPTIVE,
             what: "--spacing fractional-odd (transition edges need even levels: use --fractional, i.e. fractional-even)",
         });
     }
@@ -758,14 +826,14 @@ impl Technique for Adaptive {
             _ => (Stage::AdaptiveRegularTesc, Stage::AdaptiveRegularTese),
         };
         PatchPipeline {
-            vertex: Stage::AdaptivePatchVert,
-            control,
-            evaluation,
-            fragment: Stage::AdaptiveAdaptiveFrag,
-            control_points: 1,
-            mesh_vertex_input: false,
             push_constant_bytes: std::mem::size_of::<AdaptivePush>() as u32,
-            axes: Variant::default(),
+            ..PatchPipeline::tessellated(
+                Stage::AdaptivePatchVert,
+                control,
+                evaluation,
+                Stage::AdaptiveAdaptiveFrag,
+                1,
+            )
         }
     }
 
@@ -777,7 +845,7 @@ impl Technique for Adaptive {
     /// methods' canonical normals (and ACC-1's tangent patches) need the surface build;
     /// adaptive's plain frames do not (and hand the rasterizer no albedo or texture varying).
     fn surface_build(&self, params: &FrameParams) -> bool {
-        self.id != TechniqueId::Adaptive
+        self.id != TechniqueId::ADAPTIVE
             || params.displace != 0.0
             || params.show != SurfaceShow::Shading
             || params.patch_colours
@@ -935,6 +1003,7 @@ impl Technique for Adaptive {
         &'a self,
         enc: &mut Encoder<'a>,
         array: usize,
+        _slot: usize,
         params: &FrameParams,
         pass: Pass,
         per_draw: u32,
@@ -964,23 +1033,8 @@ impl Technique for Adaptive {
                 v: v as f32,
             });
         }
-        let k = sub as u32;
-        let c = |i: u32| face_corner_uv(n, i % n);
-        let corner = c(k);
-        let next = c(k + 1);
-        let prev = c(k + n - 1);
-        let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) * 0.5, (a[1] + b[1]) * 0.5];
-        let centre = (0..n).fold([0.0, 0.0], |s, i| {
-            let p = c(i);
-            [s[0] + p[0] / n as f64, s[1] + p[1] / n as f64]
-        });
-        let q = [corner, mid(corner, next), centre, mid(prev, corner)];
-        let w = [(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v];
-        let mut uv = [0.0; 2];
-        for (p, w) in q.iter().zip(w) {
-            uv[0] += w * p[0];
-            uv[1] += w * p[1];
-        }
+        let quad = topology::limit::eval::subface_domain(n, sub as u32);
+        let uv = topology::limit::eval::bilinear(&quad, u, v);
         Some(FacePoint {
             face,
             u: uv[0] as f32,
@@ -1002,7 +1056,7 @@ impl Technique for Adaptive {
 
     fn report_notes(&self) -> Vec<String> {
         let [r, g, b, t] = self.gpu.counts;
-        if self.id != TechniqueId::Adaptive {
+        if self.id != TechniqueId::ADAPTIVE {
             return vec![format!(
                 "{}: {r} B-spline, {g} Gregory/ACC-1 and {t} Gregory triangle patches for {} base faces ({}), {} vertices, tables {} bytes",
                 self.id,

@@ -55,9 +55,10 @@ use crate::gpu::bindings::{
 use crate::gpu::BftPush;
 use crate::shaders::{self, Stage, Variant};
 use crate::technique::{
-    for_each_draw, number_arrays, DeviceAllocation, DrawCounts, FactorPolicy, FrameParams, Pass,
-    PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
+    for_each_draw, number_arrays, DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features,
+    FrameParams, Pass, PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
 };
+use crate::techniques::{BuildOptions, Built, TechniqueInfo};
 use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, Domain, Spacing};
 use layout::{BasePosition, PackedTables, PatchHeader, StencilTerm, TangentTerm, STORAGE_BINDINGS};
 use std::ops::Range;
@@ -69,6 +70,65 @@ use topology::ControlMesh;
 use vk_core::descriptor::{BindingDesc, DescriptorPool};
 use vk_core::pipeline::{Pipeline, ShaderStage};
 use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Encoder, MemoryLocation};
+
+impl TechniqueId {
+    pub const BFT: TechniqueId = TechniqueId::new("bft");
+}
+
+/// The registry entry.
+pub static INFO: TechniqueInfo = TechniqueInfo {
+    id: TechniqueId::BFT,
+    help: "exact Loop limit surface from basis-function tables (Holländer & Boubekeur)",
+    features: Features {
+        adaptive_factors: true,
+        spacings: [true, true, false],
+        animation: true,
+        patch_colours: true,
+        geometric_normals: true,
+        phong_alpha: false,
+        table_level: true,
+        triangles_only: true,
+        isolation: false,
+        surface: false,
+        single_pass: false,
+        paths: &[DrawPath::Tessellation],
+    },
+    scheme: Some(topology::Scheme::Loop),
+    default_for_scheme: true,
+    shader_folder: "bft",
+    abi_code: 4,
+    legend: &[
+        ([0.55, 0.75, 0.95], "regular"),
+        ([0.95, 0.45, 0.35], "extraordinary"),
+        ([0.55, 0.85, 0.45], "boundary"),
+        ([0.75, 0.5, 0.9], "private table"),
+    ],
+    build: build_registered,
+    check_options: |build, params| check_frame(build.table_level, params),
+};
+
+/// The registry's constructor: [`Bft::new`] with the build options BFT takes.
+fn build_registered(
+    ctx: &mut Context,
+    mesh: &ControlMesh,
+    options: &BuildOptions,
+) -> Result<Built> {
+    let b = Bft::new(
+        ctx,
+        mesh,
+        &BftOptions {
+            table_level: options.table_level,
+            tangents: options.tangents,
+            name: options.name.clone(),
+            patch_block: None,
+        },
+    )?;
+    let notes = b.notes.clone();
+    Ok(Built {
+        technique: Box::new(b),
+        notes,
+    })
+}
 
 /// Default maximum table level: 32 segments per level-1 edge, 64 per base edge.
 pub const DEFAULT_TABLE_LEVEL: u32 = 5;
@@ -667,8 +727,8 @@ impl Bft {
         drop(packed_tables);
         stages.push(laps.lap("patches and upload"));
         let frames = ctx.frames_in_flight();
-        ctx.ensure_set_layout(TechniqueId::Bft, &SET_BINDINGS)?;
-        let set_layout = ctx.set_layout(TechniqueId::Bft)?;
+        ctx.ensure_set_layout(TechniqueId::BFT, &SET_BINDINGS)?;
+        let set_layout = ctx.set_layout(TechniqueId::BFT)?;
         let max_sets = frames * pre_chunks.len() + draw_chunks.len();
         let pool =
             DescriptorPool::new(&device, "bft descriptor pool", set_layout, max_sets as u32)?;
@@ -795,7 +855,7 @@ impl Bft {
             fans,
             drawn,
             loop_mesh,
-            rest_bbox: bbox(&base_positions),
+            rest_bbox: crate::framing::drawn_bbox(mesh),
             base_positions,
             notes: note.into_iter().collect(),
         })
@@ -867,7 +927,7 @@ impl Bft {
 pub fn check_frame(table_level: u32, params: &FrameParams) -> Result<()> {
     if params.spacing == Spacing::FractionalOdd {
         return Err(TessError::Unsupported {
-            technique: TechniqueId::Bft,
+            technique: TechniqueId::BFT,
             what: "--spacing fractional-odd (it morphs between dyadic levels: use --fractional, i.e. fractional-even)",
         });
     }
@@ -890,7 +950,7 @@ pub fn check_frame(table_level: u32, params: &FrameParams) -> Result<()> {
 
 impl Technique for Bft {
     fn id(&self) -> TechniqueId {
-        TechniqueId::Bft
+        TechniqueId::BFT
     }
 
     fn bbox(&self) -> ([f32; 3], [f32; 3]) {
@@ -917,17 +977,18 @@ impl Technique for Bft {
 
     fn patch_pipeline(&self, _patch: PatchType) -> PatchPipeline {
         PatchPipeline {
-            vertex: Stage::BftBftVert,
-            control: Stage::BftBftTesc,
-            evaluation: Stage::BftBftTese,
-            fragment: Stage::BftBftFrag,
-            control_points: 1,
-            mesh_vertex_input: false,
             push_constant_bytes: std::mem::size_of::<BftPush>() as u32,
             axes: Variant {
                 patch_block: self.patch_block,
                 ..Variant::default()
             },
+            ..PatchPipeline::tessellated(
+                Stage::BftBftVert,
+                Stage::BftBftTesc,
+                Stage::BftBftTese,
+                Stage::BftBftFrag,
+                1,
+            )
         }
     }
 
@@ -1037,6 +1098,7 @@ impl Technique for Bft {
         &'a self,
         enc: &mut Encoder<'a>,
         array: usize,
+        _slot: usize,
         params: &FrameParams,
         pass: Pass,
         per_draw: u32,
@@ -1205,7 +1267,8 @@ pub struct Wave {
 impl Wave {
     pub fn new(mesh: &ControlMesh) -> Self {
         let rest = base_positions(mesh);
-        let bbox = bbox(&rest);
+        // The amplitude follows the drawn size, not a far vertex no face uses.
+        let bbox = crate::framing::drawn_bbox(mesh);
         Self {
             normals: base_normals(mesh),
             rest,

@@ -1,15 +1,33 @@
 //! Flat tessellation: each base face subdivided in its own plane (quads kept as quad patches,
 //! other polygons fan-triangulated). The baseline every benchmark ratio divides by.
-use crate::gpu::DrawPush;
-use crate::shaders::{Stage, Variant};
-use crate::technique::{PatchPipeline, PatchType, TechniqueId};
-use crate::techniques::face_patches::{FacePatches, FaceStyle};
+use crate::shaders::Stage;
+use crate::technique::{PatchPipeline, PatchType, TechniqueId, VertexInput};
+use crate::techniques::face_patches::{FacePatches, FaceStyle, BASE_FACES};
+use crate::techniques::{built, no_early_checks, TechniqueInfo};
+
+impl TechniqueId {
+    pub const FLAT: TechniqueId = TechniqueId::new("flat");
+}
+
+/// The registry entry.
+pub static INFO: TechniqueInfo = TechniqueInfo {
+    id: TechniqueId::FLAT,
+    help: "flat tessellation of each base face (quads as quad patches)",
+    features: BASE_FACES,
+    scheme: None,
+    default_for_scheme: false,
+    shader_folder: "flat",
+    abi_code: 1,
+    legend: &[],
+    build: |ctx, mesh, _| built(Flat::new(ctx.device(), mesh)?),
+    check_options: no_early_checks,
+};
 
 /// See the module docs.
 pub struct FlatStyle;
 
 impl FaceStyle for FlatStyle {
-    const ID: TechniqueId = TechniqueId::Flat;
+    const ID: TechniqueId = TechniqueId::FLAT;
     const QUADS: bool = true;
     fn pipeline(patch: PatchType) -> PatchPipeline {
         let (control, evaluation, control_points) = match patch {
@@ -17,14 +35,14 @@ impl FaceStyle for FlatStyle {
             _ => (Stage::CommonTriTesc, Stage::FlatTriTese, 3),
         };
         PatchPipeline {
-            vertex: Stage::CommonMeshVert,
-            control,
-            evaluation,
-            fragment: Stage::CommonShadeFrag,
-            control_points,
-            mesh_vertex_input: true,
-            push_constant_bytes: std::mem::size_of::<DrawPush>() as u32,
-            axes: Variant::default(),
+            vertex_input: VertexInput::MESH,
+            ..PatchPipeline::tessellated(
+                Stage::CommonMeshVert,
+                control,
+                evaluation,
+                Stage::CommonShadeFrag,
+                control_points,
+            )
         }
     }
 }

@@ -17,10 +17,68 @@
 //! - **ACC-1 on triangles and outside its scope** (boundaries, creases, non-quad
 //!   neighbourhoods) falls back to Gregory patches; no tangent patches: normals come from the
 //!   geometry patch's derivatives.
-use super::adaptive::{Adaptive, AdaptiveBuild};
+use super::adaptive::{check_frame, Adaptive, AdaptiveBuild, ADAPTIVE_FEATURES, PATCH_LEGEND};
 use crate::context::Context;
 use crate::error::{Result, TessError};
-use crate::technique::TechniqueId;
+use crate::technique::{Features, TechniqueId};
+use crate::techniques::{BuildOptions, Built, TechniqueInfo};
+
+impl TechniqueId {
+    pub const GREGORY: TechniqueId = TechniqueId::new("gregory");
+    pub const ACC: TechniqueId = TechniqueId::new("acc");
+}
+
+/// The single-pass approximations: the adaptive machinery without isolation.
+pub const SINGLE_PASS: Features = Features {
+    isolation: false,
+    single_pass: true,
+    ..ADAPTIVE_FEATURES
+};
+
+/// The registry entry of `--method gregory`.
+pub static INFO: TechniqueInfo = TechniqueInfo {
+    id: TechniqueId::GREGORY,
+    help: "Catmull-Clark approximated by one Gregory patch per base face, B-spline where regular (Loop, Schaefer, Ni, Castano), Gregory triangle patches on triangles; other faces next to non-quads split once",
+    features: SINGLE_PASS,
+    scheme: Some(topology::Scheme::CatmullClark),
+    default_for_scheme: false,
+    shader_folder: "adaptive",
+    abi_code: 6,
+    legend: PATCH_LEGEND,
+    build: |ctx, mesh, options| build_registered(ctx, mesh, options, SinglePassPatch::Gregory),
+    check_options: |_, params| check_frame(None, params),
+};
+
+/// The registry entry of `--method acc`.
+pub static ACC_INFO: TechniqueInfo = TechniqueInfo {
+    id: TechniqueId::ACC,
+    help: "Catmull-Clark approximated by ACC-1 bicubic patches (Loop & Schaefer), Gregory patches where ACC-1 does not apply",
+    abi_code: 7,
+    build: |ctx, mesh, options| build_registered(ctx, mesh, options, SinglePassPatch::Acc1),
+    ..INFO
+};
+
+/// The registry's constructor of both single-pass techniques.
+fn build_registered(
+    ctx: &mut Context,
+    mesh: &ControlMesh,
+    options: &BuildOptions,
+    patch: SinglePassPatch,
+) -> Result<Built> {
+    let surface = build(
+        ctx,
+        mesh,
+        patch,
+        options.sharpness_scale,
+        !options.split_triangles,
+        &options.name,
+        &options.maps,
+    )?;
+    Ok(Built {
+        notes: surface.param_error_note().into_iter().collect(),
+        technique: Box::new(surface),
+    })
+}
 use topology::patches::adaptive::single_pass::{
     plan_single_pass, SinglePassOptions, SinglePassPatch,
 };
@@ -50,8 +108,8 @@ pub fn build(
         source: e.into(),
     })?;
     let id = match patch {
-        SinglePassPatch::Gregory => TechniqueId::Gregory,
-        SinglePassPatch::Acc1 => TechniqueId::Acc,
+        SinglePassPatch::Gregory => TechniqueId::GREGORY,
+        SinglePassPatch::Acc1 => TechniqueId::ACC,
     };
     Adaptive::from_plan(
         ctx,

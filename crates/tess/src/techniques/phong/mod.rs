@@ -1,26 +1,48 @@
 //! Phong tessellation (Boubekeur & Alexa 2008): each point of the flat triangle is projected
 //! onto the tangent planes of the corners and blended back by the shape factor α.
-use crate::gpu::DrawPush;
-use crate::shaders::{Stage, Variant};
-use crate::technique::{PatchPipeline, PatchType, TechniqueId};
-use crate::techniques::face_patches::{FacePatches, FaceStyle};
+use crate::shaders::Stage;
+use crate::technique::Features;
+use crate::technique::{PatchPipeline, PatchType, TechniqueId, VertexInput};
+use crate::techniques::face_patches::{FacePatches, FaceStyle, BASE_FACES};
+use crate::techniques::{built, no_early_checks, TechniqueInfo};
+
+impl TechniqueId {
+    pub const PHONG: TechniqueId = TechniqueId::new("phong");
+}
+
+/// The registry entry.
+pub static INFO: TechniqueInfo = TechniqueInfo {
+    id: TechniqueId::PHONG,
+    help: "Phong tessellation (Boubekeur & Alexa 2008) of the fan triangles",
+    features: Features {
+        phong_alpha: true,
+        ..BASE_FACES
+    },
+    scheme: None,
+    default_for_scheme: false,
+    shader_folder: "phong",
+    abi_code: 2,
+    legend: &[],
+    build: |ctx, mesh, _| built(Phong::new(ctx.device(), mesh)?),
+    check_options: no_early_checks,
+};
 
 /// See the module docs.
 pub struct PhongStyle;
 
 impl FaceStyle for PhongStyle {
-    const ID: TechniqueId = TechniqueId::Phong;
+    const ID: TechniqueId = TechniqueId::PHONG;
     const QUADS: bool = false;
     fn pipeline(_patch: PatchType) -> PatchPipeline {
         PatchPipeline {
-            vertex: Stage::CommonMeshVert,
-            control: Stage::CommonTriTesc,
-            evaluation: Stage::PhongTriTese,
-            fragment: Stage::CommonShadeFrag,
-            control_points: 3,
-            mesh_vertex_input: true,
-            push_constant_bytes: std::mem::size_of::<DrawPush>() as u32,
-            axes: Variant::default(),
+            vertex_input: VertexInput::MESH,
+            ..PatchPipeline::tessellated(
+                Stage::CommonMeshVert,
+                Stage::CommonTriTesc,
+                Stage::PhongTriTese,
+                Stage::CommonShadeFrag,
+                3,
+            )
         }
     }
 }

@@ -6,27 +6,45 @@
 //! lower position (then normal) bits, with `precise` arithmetic; corners are the control points
 //! themselves. Both patches of a shared edge thus emit the same position and normal bits
 //! (`tests/watertight.rs`), without vertex indices: repeated vertices with equal data weld too.
-use crate::gpu::DrawPush;
-use crate::shaders::{Stage, Variant};
-use crate::technique::{PatchPipeline, PatchType, TechniqueId};
-use crate::techniques::face_patches::{FacePatches, FaceStyle};
+use crate::shaders::Stage;
+use crate::technique::{PatchPipeline, PatchType, TechniqueId, VertexInput};
+use crate::techniques::face_patches::{FacePatches, FaceStyle, BASE_FACES};
+use crate::techniques::{built, no_early_checks, TechniqueInfo};
+
+impl TechniqueId {
+    pub const PN: TechniqueId = TechniqueId::new("pn");
+}
+
+/// The registry entry.
+pub static INFO: TechniqueInfo = TechniqueInfo {
+    id: TechniqueId::PN,
+    help: "curved PN triangles with the corrected normal field",
+    features: BASE_FACES,
+    scheme: None,
+    default_for_scheme: false,
+    shader_folder: "pn",
+    abi_code: 3,
+    legend: &[],
+    build: |ctx, mesh, _| built(Pn::new(ctx.device(), mesh)?),
+    check_options: no_early_checks,
+};
 
 /// See the module docs.
 pub struct PnStyle;
 
 impl FaceStyle for PnStyle {
-    const ID: TechniqueId = TechniqueId::Pn;
+    const ID: TechniqueId = TechniqueId::PN;
     const QUADS: bool = false;
     fn pipeline(_patch: PatchType) -> PatchPipeline {
         PatchPipeline {
-            vertex: Stage::CommonMeshVert,
-            control: Stage::PnTriTesc,
-            evaluation: Stage::PnTriTese,
-            fragment: Stage::CommonShadeFrag,
-            control_points: 3,
-            mesh_vertex_input: true,
-            push_constant_bytes: std::mem::size_of::<DrawPush>() as u32,
-            axes: Variant::default(),
+            vertex_input: VertexInput::MESH,
+            ..PatchPipeline::tessellated(
+                Stage::CommonMeshVert,
+                Stage::PnTriTesc,
+                Stage::PnTriTese,
+                Stage::CommonShadeFrag,
+                3,
+            )
         }
     }
 }

@@ -4,14 +4,17 @@
 use super::*;
 use crate::refine::SparseRefinement;
 
-/// A copy of `mesh` with tag sharpness scaled (infinite tags stay infinite); rejects NaN or
-/// negative sharpness.
+/// A copy of `mesh` with every tag's sharpness multiplied by `scale`; rejects NaN or negative
+/// sharpness. A tag at or above [`crate::rules::SHARPNESS_INFINITE`] (10, infinitely sharp)
+/// counts as exactly 10, so all infinite tags scale alike: kept infinite by any scale ≥ 1,
+/// semi-sharp below it, smooth at 0. Boundary edges are infinitely sharp by the boundary rule,
+/// not by a tag, and stay so.
 pub(super) fn scaled_mesh(mesh: &ControlMesh, scale: f32) -> Result<ControlMesh, TopologyError> {
     let scale_one = |s: f32| {
-        if is_infinite(s) {
+        if scale == 1.0 {
             s
         } else {
-            s * scale
+            s.min(crate::rules::SHARPNESS_INFINITE) * scale
         }
     };
     let mut out = mesh.clone();

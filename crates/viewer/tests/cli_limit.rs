@@ -1,0 +1,214 @@
+//! `tessera limit --points`: many limit points at once, in the domain of `tessera export`'s
+//! `# p` lines. An exported OBJ given as the points file comes back as its own vertices (the
+//! GPU drew the limit surface); `F U V` lines give what `limit --face --uv` prints; bad lines,
+//! faces and parameters are named by file and line.
+mod common;
+use common::tessera;
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tessera-cli-limit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn data(p: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(p)
+        .to_str()
+        .unwrap()
+        .to_owned()
+}
+
+fn ok(args: &[&str]) -> String {
+    let o: Output = tessera(args, &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn numbers(line: &str) -> Vec<f64> {
+    line.split_whitespace()
+        .map(|w| w.parse().unwrap())
+        .collect()
+}
+
+/// The `v` lines of an OBJ.
+fn vertices(path: &Path) -> Vec<[f64; 3]> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let n = numbers(l);
+            [n[0], n[1], n[2]]
+        })
+        .collect()
+}
+
+/// The cube exported by bft (the Loop limit of its fan triangulation) and by adaptive (the
+/// Catmull-Clark limit, Gregory end caps at its eight valence-3 corners), fed back as points:
+/// bft's vertices are the limit to float rounding, adaptive's on its regular patches.
+#[test]
+fn exported_points_evaluate_to_the_exported_vertices() {
+    let cube = data("tests/data/meshes/cube.obj");
+    for (method, scheme) in [("bft", "loop"), ("adaptive", "catmull-clark")] {
+        let obj = tmp(&format!("cube_{method}.obj"));
+        let positions = tmp(&format!("cube_{method}.xyz"));
+        ok(&[
+            "export",
+            &cube,
+            "--method",
+            method,
+            "--scheme",
+            scheme,
+            "--segments",
+            "4",
+            "-o",
+            obj.to_str().unwrap(),
+        ]);
+        let said = ok(&[
+            "limit",
+            &cube,
+            "--scheme",
+            scheme,
+            "--points",
+            obj.to_str().unwrap(),
+            "-o",
+            positions.to_str().unwrap(),
+        ]);
+        let want = vertices(&obj);
+        assert!(
+            said.contains(&format!("{} limit points", want.len())),
+            "{said}"
+        );
+        let got: Vec<Vec<f64>> = std::fs::read_to_string(&positions)
+            .unwrap()
+            .lines()
+            .map(numbers)
+            .collect();
+        assert_eq!(got.len(), want.len());
+        let mut errors: Vec<f64> = got
+            .iter()
+            .zip(&want)
+            .map(|(g, w)| (0..3).map(|k| (g[k] - w[k]).abs()).fold(0.0, f64::max))
+            .collect();
+        errors.sort_by(f64::total_cmp);
+        let (median, worst) = (errors[errors.len() / 2], errors[errors.len() - 1]);
+        eprintln!("{method}: |GPU − limit| median {median:.2e}, worst {worst:.2e} (cube side 2)");
+        if method == "bft" {
+            assert!(worst < 2e-5, "{method}: {worst:.2e}");
+        } else {
+            assert!(
+                median < 2e-6 && worst < 1e-2,
+                "{method}: {median:.2e} {worst:.2e}"
+            );
+        }
+    }
+}
+
+/// On quads the two conventions agree: `F U V` (F from 0) is `--face F+1 --uv U,V`; on Loop
+/// triangles the `# p` (U, V) weigh corners 0 and 1, the patch domain's corners 1 and 2.
+#[test]
+fn points_are_what_limit_face_uv_prints() {
+    let cube = data("tests/data/meshes/cube.obj");
+    let ico = data("tests/data/opensubdiv/shapes/loop_icosahedron.obj");
+    let file = tmp("points.txt");
+    std::fs::write(&file, "# comment\n0 0.25 0.75\n\n3 0.5 0.125\n").unwrap();
+    let single = |input: &str, scheme: &str, face: &str, uv: &str| -> Vec<f64> {
+        let s = ok(&[
+            "limit", input, "--scheme", scheme, "--face", face, "--uv", uv,
+        ]);
+        let line = s.lines().find_map(|l| l.strip_prefix("position ")).unwrap();
+        numbers(line)
+    };
+    let many = ok(&[
+        "limit",
+        &cube,
+        "--scheme",
+        "catmull-clark",
+        "--points",
+        file.to_str().unwrap(),
+        "--derivatives",
+    ]);
+    let rows: Vec<Vec<f64>> = many.lines().map(numbers).collect();
+    assert_eq!(rows.len(), 2);
+    assert!(rows.iter().all(|r| r.len() == 12), "{many}");
+    for (row, (face, uv)) in rows.iter().zip([("1", "0.25,0.75"), ("4", "0.5,0.125")]) {
+        let want = single(&cube, "catmull-clark", face, uv);
+        for k in 0..3 {
+            assert!(
+                (row[k] - want[k]).abs() < 1e-11,
+                "face {face}: {row:?} {want:?}"
+            );
+        }
+        let n = &row[9..12];
+        assert!(((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() - 1.0).abs() < 1e-12);
+    }
+    std::fs::write(&file, "2 0.2 0.3\n").unwrap();
+    let many = ok(&[
+        "limit",
+        &ico,
+        "--scheme",
+        "loop",
+        "--points",
+        file.to_str().unwrap(),
+    ]);
+    let got = numbers(many.lines().next().unwrap());
+    let want = single(&ico, "loop", "3", "0.3,0.5");
+    for k in 0..3 {
+        assert!((got[k] - want[k]).abs() < 1e-11, "{got:?} {want:?}");
+    }
+}
+
+#[test]
+fn bad_points_are_named_by_file_and_line() {
+    let cube = data("tests/data/meshes/cube.obj");
+    let file = tmp("bad_points.txt");
+    let path = file.to_str().unwrap();
+    for (text, needles) in [
+        ("0 0.5 0.5\n0 0.5\n", vec![":2:", "expected `F U V`"]),
+        (
+            "0 0.5 0.5\nx 0.5 0.5\n",
+            vec![":2:", "\"x\" is not a number from 0"],
+        ),
+        (
+            "0 0.5 0.5\n\n6 0.5 0.5\n",
+            vec![":3:", "face 6 out of range", "0 to 5"],
+        ),
+        ("0 nan 0.5\n", vec![":1:", "NaN", "domain"]),
+        ("0 1.5 0.5\n", vec![":1:", "(1.5, 0.5)", "domain"]),
+        ("# nothing\n", vec!["no `F U V`"]),
+    ] {
+        std::fs::write(&file, text).unwrap();
+        let o = tessera(
+            &[
+                "limit",
+                &cube,
+                "--scheme",
+                "catmull-clark",
+                "--points",
+                path,
+            ],
+            &[],
+        );
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{text:?}: {e}");
+        for n in needles {
+            assert!(e.contains(n), "{text:?}: {e} should mention {n:?}");
+        }
+    }
+    // --face with --points is a usage error.
+    let o = tessera(
+        &[
+            "limit", &cube, "--scheme", "loop", "--points", path, "--face", "1",
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    let o = tessera(&["limit", &cube, "--scheme", "loop"], &[]);
+    assert_eq!(o.status.code(), Some(2));
+}

@@ -1,0 +1,254 @@
+//! The conformance suite: every technique of the registry, on every draw path it declares, is
+//! held to what the seam promises — a technique is tested by being registered. For each, on
+//! spot's control mesh (triangles, quads, pentagons) and a cube:
+//! - it builds, and its arrays use the geometry of the declared path with stages from its own
+//!   shader folder or `glsl/common/`;
+//! - a frame renders validation-clean and draws something;
+//! - a capture of what the GPU emitted welds by position bits with 0 cracks and 0 unmapped
+//!   vertices on these closed meshes;
+//! - if it declares animation, a moved base captures with 0 cracks too, and the surface moved;
+//! - each option it declares it does not take is refused by name, and animation is refused
+//!   where it is not declared.
+mod common;
+
+use common::Gpu;
+use tessera::tess::capture::classify_open_edges;
+use tessera::tess::techniques::bft::Wave;
+use tessera::tess::techniques::{self, TechniqueInfo};
+use tessera::tess::{
+    BuildOptions, Capturer, Context, DrawPath, FactorPolicy, FrameParams, Spacing, Technique,
+    TessError,
+};
+use tessera::topology::{load_obj, ControlMesh};
+use tessera::vk_core::vk;
+
+const EXTENT: vk::Extent2D = vk::Extent2D {
+    width: 96,
+    height: 96,
+};
+
+/// Every technique takes four uniform segments (BFT and the CPU meshes: a power of two;
+/// adaptive: whole segments).
+const SEGMENTS: f32 = 4.0;
+
+fn meshes() -> Vec<(&'static str, ControlMesh)> {
+    vec![
+        (
+            "spot",
+            load_obj(common::data("assets/spot_control_mesh.obj")).unwrap(),
+        ),
+        (
+            "cube",
+            load_obj(common::data("tests/data/meshes/cube.obj")).unwrap(),
+        ),
+    ]
+}
+
+fn build(ctx: &mut Context, info: &TechniqueInfo, mesh: &ControlMesh) -> Box<dyn Technique> {
+    techniques::build(
+        ctx,
+        info.id,
+        mesh,
+        &BuildOptions {
+            name: "conformance".into(),
+            tangents: info.features.geometric_normals,
+            ..BuildOptions::default()
+        },
+    )
+    .unwrap_or_else(|e| panic!("building {}: {e}", info.id))
+    .technique
+}
+
+/// The arrays' geometry is the declared path's, and every stage comes from the technique's
+/// shader folder or the common one.
+fn check_pipelines(info: &TechniqueInfo, technique: &dyn Technique, what: &str) {
+    assert!(!technique.patch_arrays().is_empty(), "{what}: no arrays");
+    for a in technique.patch_arrays() {
+        let pp = technique.patch_pipeline(a.patch);
+        assert!(
+            info.features.paths.contains(&DrawPath::of(pp.geometry)),
+            "{what}: {:?} draws on an undeclared path",
+            a.patch
+        );
+        assert_eq!(a.control_points, pp.control_points(), "{what}");
+        let mut stages = vec![pp.vertex, pp.fragment];
+        if let tessera::tess::Geometry::Tessellated {
+            control,
+            evaluation,
+            ..
+        } = pp.geometry
+        {
+            stages.extend([control, evaluation]);
+        }
+        for s in stages {
+            let path = s.path();
+            assert!(
+                path.starts_with(&format!("{}/", info.shader_folder))
+                    || path.starts_with("common/"),
+                "{what}: stage {path} is outside glsl/{}/ and glsl/common/",
+                info.shader_folder
+            );
+        }
+    }
+}
+
+/// Cracks, unmapped vertices and base-boundary edges of one capture; also its welded
+/// positions.
+fn capture(
+    ctx: &mut Context,
+    capturer: &Capturer,
+    technique: &mut dyn Technique,
+    mesh: &ControlMesh,
+    params: &FrameParams,
+) -> ((usize, usize, usize), Vec<[f32; 3]>) {
+    let (soup, _) = capturer
+        .capture(ctx, &mut *technique, params, EXTENT)
+        .expect("capture");
+    let welded = soup.weld().expect("weld");
+    let report = welded.open_edges();
+    let map = |p: u32, d: [f32; 2]| technique.face_point(p, d);
+    let c = classify_open_edges(&soup, &welded, &report, &map, mesh);
+    assert_eq!(c.on_base_boundary + c.cracks, report.open.len());
+    ((c.cracks, c.unmapped, c.on_base_boundary), welded.positions)
+}
+
+/// Renders one frame and returns how many pixels differ from the clear colour.
+fn drawn_pixels(ctx: &mut Context, technique: &mut dyn Technique, params: &FrameParams) -> usize {
+    let image = ctx
+        .render_offscreen(technique, params, EXTENT)
+        .expect("render");
+    let clear = params.clear_color.map(|c| (c * 255.0).round() as u8);
+    image
+        .pixels
+        .chunks_exact(4)
+        .filter(|p| p[..3] != clear[..3])
+        .count()
+}
+
+#[test]
+fn every_technique_draws_captures_and_welds_on_every_declared_path() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let capturer = Capturer::new(&ctx).unwrap();
+        let params = FrameParams::uniform(SEGMENTS);
+        for info in techniques::registry() {
+            assert!(!info.features.paths.is_empty(), "{}: no draw path", info.id);
+            for (name, mesh) in meshes() {
+                let what = format!("{} on {name}", info.id);
+                let mut t = build(&mut ctx, info, &mesh);
+                assert_eq!(t.id(), info.id, "{what}");
+                check_pipelines(info, t.as_ref(), &what);
+                assert!(
+                    drawn_pixels(&mut ctx, t.as_mut(), &params) > 100,
+                    "{what}: nothing drawn"
+                );
+                let (classes, rest) = capture(&mut ctx, &capturer, t.as_mut(), &mesh, &params);
+                assert_eq!(classes, (0, 0, 0), "{what}: (cracks, unmapped, boundary)");
+                if info.features.animation {
+                    let base = t.base_mesh().expect("an animated technique's base").clone();
+                    let moved = Wave::new(&base).at(0.37);
+                    t.update_base(0, &moved).expect("animated base");
+                    let (classes, positions) =
+                        capture(&mut ctx, &capturer, t.as_mut(), &mesh, &params);
+                    assert_eq!(classes, (0, 0, 0), "{what}, animated");
+                    assert_ne!(positions, rest, "{what}: the animated surface moved");
+                }
+                println!("{what}: conforms");
+            }
+        }
+    }
+}
+
+/// One frame per option a technique's features decline, each using that option alone.
+fn declined(info: &TechniqueInfo) -> Vec<(&'static str, FrameParams)> {
+    let f = info.features;
+    let base = FrameParams::uniform(SEGMENTS);
+    let mut out = Vec::new();
+    if !f.adaptive_factors {
+        out.push((
+            "screen factors",
+            FrameParams {
+                factors: FactorPolicy::Screen { pixels: 8.0 },
+                ..base
+            },
+        ));
+    }
+    for spacing in [
+        Spacing::Equal,
+        Spacing::FractionalEven,
+        Spacing::FractionalOdd,
+    ] {
+        if !f.spacing(spacing) {
+            out.push(("spacing", FrameParams { spacing, ..base }));
+        }
+    }
+    if !f.patch_colours {
+        out.push((
+            "patch colours",
+            FrameParams {
+                patch_colours: true,
+                ..base
+            },
+        ));
+    }
+    if !f.geometric_normals {
+        out.push((
+            "geometric normals",
+            FrameParams {
+                geometric_normals: true,
+                ..base
+            },
+        ));
+    }
+    if !f.surface {
+        out.push((
+            "displacement",
+            FrameParams {
+                displace: 0.1,
+                ..base
+            },
+        ));
+        out.push((
+            "no reparameterization",
+            FrameParams {
+                reparam: false,
+                ..base
+            },
+        ));
+    }
+    out
+}
+
+#[test]
+fn every_technique_refuses_each_option_it_declares_it_does_not_take() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let (_, cube) = meshes().pop().unwrap();
+        let mut refusals = 0;
+        for info in techniques::registry() {
+            let mut t = build(&mut ctx, info, &cube);
+            for (option, params) in declined(info) {
+                match ctx.prepare(t.as_mut(), &params, &[tessera::tess::Pass::Shaded]) {
+                    Err(TessError::Unsupported { technique, .. }) => {
+                        assert_eq!(technique, info.id, "{option}")
+                    }
+                    other => panic!("{}: {option} was not refused: {other:?}", info.id),
+                }
+                refusals += 1;
+            }
+            if !info.features.animation {
+                let rest = vec![[0.0f32; 3]; cube.positions.len()];
+                assert!(
+                    matches!(t.update_base(0, &rest), Err(TessError::Unsupported { .. })),
+                    "{}: animation was not refused",
+                    info.id
+                );
+                refusals += 1;
+            }
+        }
+        // Not vacuous: the base-face techniques alone decline more than a dozen options.
+        assert!(refusals > 20, "{refusals} refusals checked");
+    }
+}
