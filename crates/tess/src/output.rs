@@ -103,8 +103,10 @@ pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
 mod tests {
     use super::*;
 
-    fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("tess-output-{}", std::process::id()));
+    /// A file `name` in test `test`'s own directory (tests run in parallel: one's temporary
+    /// file must not show up in another's directory).
+    fn scratch(test: &str, name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("tess-output-{}-{test}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         dir.join(name)
     }
@@ -122,7 +124,7 @@ mod tests {
     /// A write that fails half way leaves the old file whole and no temporary file.
     #[test]
     fn a_failed_write_keeps_the_old_file() {
-        let p = scratch("kept.txt");
+        let p = scratch("kept", "kept.txt");
         write_bytes(&p, b"the good contents\n").unwrap();
         let e = write_file(&p, |w| {
             w.write_all(b"half of the new")?;
@@ -142,11 +144,11 @@ mod tests {
     /// directories are made, a directory as the target is refused.
     #[test]
     fn links_directories_and_new_paths() {
-        let real = scratch("real.txt");
+        let real = scratch("links", "real.txt");
         write_bytes(&real, b"old").unwrap();
         #[cfg(unix)]
         {
-            let link = scratch("link.txt");
+            let link = scratch("links", "link.txt");
             let _ = std::fs::remove_file(&link);
             std::os::unix::fs::symlink(&real, &link).unwrap();
             write_bytes(&link, b"new").unwrap();
@@ -156,10 +158,10 @@ mod tests {
                 .is_symlink());
             assert_eq!(std::fs::read(&real).unwrap(), b"new");
         }
-        let deep = scratch("made/for/it.txt");
+        let deep = scratch("links", "made/for/it.txt");
         write_bytes(&deep, b"x").unwrap();
         assert_eq!(std::fs::read(&deep).unwrap(), b"x");
-        let dir = scratch("made");
+        let dir = scratch("links", "made");
         let e = write_bytes(&dir, b"x").unwrap_err().to_string();
         assert!(e.contains("is a directory"), "{e}");
     }
