@@ -1022,7 +1022,8 @@ impl Technique for Adaptive {
     }
 
     /// The patch's point in its base face; a sub-quad of a non-quad maps bilinearly into the
-    /// face's domain ([`face_corner_uv`]): corner, edge midpoint, centre, edge midpoint.
+    /// face's domain ([`face_corner_uv`](topology::limit::eval::face_corner_uv)): corner, edge
+    /// midpoint, centre, edge midpoint.
     fn face_point(&self, patch: u32, domain: [f32; 2]) -> Option<FacePoint> {
         let (face, sub, u, v) = self.base_param(patch, domain[0] as f64, domain[1] as f64)?;
         let n = self.mesh.face(face as usize).len() as u32;
