@@ -335,7 +335,7 @@ pub struct TesseraFrameDesc {
     pub show: TesseraShow,
 }
 
-type Contexts = Registry<ContextState, SurfaceState, tess::limit::LimitEvaluator>;
+type Contexts = Registry<ContextState, SurfaceState, topology::limit::face_domain::LimitEvaluator>;
 
 fn registry() -> &'static Mutex<Contexts> {
     static REGISTRY: OnceLock<Mutex<Contexts>> = OnceLock::new();

@@ -11,7 +11,7 @@
 //! captured vertex's `# p` point evaluates to that vertex's position on the exact limit
 //! surface. Derivatives are along the domain's `u` and `v`; the normal is their normalized
 //! cross product (outward for a consistently oriented mesh). Points up to
-//! `tess::limit::DOMAIN_TOLERANCE` outside a face's domain (captured values are `float`) are
+//! `topology::limit::face_domain::DOMAIN_TOLERANCE` outside a face's domain (captured values are `float`) are
 //! moved onto it.
 //!
 //! # Scheme
@@ -33,8 +33,8 @@ use crate::registry::lock;
 use crate::status::{Error, Result, TesseraStatus};
 use crate::{guard, handle_id, registry, with_surface, TesseraContext, TesseraSurface};
 use crate::{TesseraMeshDesc, TesseraScheme};
-use tess::limit::{LimitEvaluator, PointError};
 use topology::limit::eval::{EvalError, LimitScheme};
+use topology::limit::face_domain::{LimitEvaluator, PointError};
 use topology::Scheme;
 
 /// An opaque limit evaluator: one surface's (or mesh's) exact limit surface on the CPU.
@@ -44,7 +44,7 @@ pub struct TesseraLimitEvaluator {
 }
 
 /// One of a sample's vectors (position, du, dv, normal).
-type SampleField = fn(&tess::limit::FaceSample) -> [f64; 3];
+type SampleField = fn(&topology::limit::face_domain::FaceSample) -> [f64; 3];
 
 fn evaluator_ptr(id: u64) -> *mut TesseraLimitEvaluator {
     id as usize as *mut TesseraLimitEvaluator
@@ -76,7 +76,7 @@ fn eval_error(e: &EvalError, message: String) -> Error {
 }
 
 fn point_error(e: PointError) -> Error {
-    let message = match &e.source {
+    let message = match e.source.as_ref() {
         EvalError::ParamOutOfRange { .. } => format!(
             "{e}: (u, v) must lie in the face's domain (as on the `# p` lines of a capture)"
         ),

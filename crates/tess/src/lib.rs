@@ -14,7 +14,6 @@ pub mod context;
 pub mod error;
 pub mod framing;
 pub mod gpu;
-pub mod limit;
 pub mod output;
 pub mod render_mesh;
 pub mod shaders;

@@ -14,7 +14,7 @@
 //! | [`rules/`](rules) | the schemes ([`Scheme`]), crease sharpness and its decay, the vertex rule, the subdivision options ([`rules::options`]) | `Sdc` (`Sdc::Crease`, `Sdc::Options`) |
 //! | [`mesh/`](mesh) | the control mesh as loaded ([`ControlMesh`]), its validated adjacency ([`mesh::Topology`]), OBJ input and output ([`mesh::obj`]), input files read within a bound ([`mesh::input`]) | the base `Vtr::Level`, `Far::TopologyDescriptor` |
 //! | [`refine/`](refine) | the one refiner, uniform and sparse, its levels and child maps; stencils and stencil tables ([`refine::stencil`]) | `Vtr` refinement, `Far::TopologyRefiner`, `Far::StencilTable` |
-//! | [`limit/`](limit) | limit masks at a vertex ([`limit::masks`]), the regular patches' basis functions ([`limit::basis`]), exact limit evaluation anywhere ([`limit::eval`]), the uniform limit mesh ([`limit::limit_mesh`]) | `Sdc`'s limit masks, `Far`'s patch basis, `Bfr` |
+//! | [`limit/`](limit) | limit masks at a vertex ([`limit::masks`]), the regular patches' basis functions ([`limit::basis`]), exact limit evaluation anywhere ([`limit::eval`]) and at points of the face domains ([`limit::face_domain`]), the uniform limit mesh ([`limit::limit_mesh`]) | `Sdc`'s limit masks, `Far`'s patch basis, `Bfr` |
 //! | [`patches/`](patches) | patch building: Gregory and ACC-1 patches, basis-function tables, feature-adaptive and single-pass plans, reparameterization, texture coordinates | `Far::PatchTable` and its end caps |
 //!
 //! One difference from OpenSubdiv's order: exact evaluation (`Bfr` there, built on `Far`'s

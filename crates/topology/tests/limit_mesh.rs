@@ -1,7 +1,8 @@
 //! The mesh refined uniformly on the CPU and placed on its limit (`topology::limit::limit_mesh`): its
 //! sizes are known before refining, its limit positions by masks equal the exact evaluator's,
 //! and every vertex is the limit surface at the domain point it reports on the base mesh.
-use topology::limit::eval::{face_corner_uv, limit_point, LimitScheme, LocalMesh};
+use topology::limit::eval::{limit_point, LimitScheme};
+use topology::limit::face_domain::{face_corner_uv, LimitEvaluator};
 use topology::limit::limit_mesh::{
     catmark_level_size, evaluator_limit_positions, loop_level_size, mask_limit_positions,
     uniform_limit_mesh, DomainPoint,
@@ -137,11 +138,8 @@ fn catmark_sizes_and_base_vertices_on_the_limit() {
         let want = limit_point(&mesh, LimitScheme::CatmullClark, 0, 1.0, 1.0)
             .unwrap()
             .position;
-        for k in 0..3 {
-            assert!(
-                (cpu.positions[4][k] - want[k]).abs() < 1e-12,
-                "level {level}"
-            );
+        for (got, want) in cpu.positions[4].iter().zip(&want) {
+            assert!((got - want).abs() < 1e-12, "level {level}");
         }
     }
 }
@@ -248,14 +246,14 @@ fn every_vertex_is_the_limit_at_its_domain_point() {
             Scheme::Loop => LimitScheme::Loop,
             _ => LimitScheme::CatmullClark,
         };
-        let lm = LocalMesh::from_control_mesh(&mesh, limit_scheme).unwrap();
+        let evaluator = LimitEvaluator::new(&mesh, limit_scheme).unwrap();
         let (lo, hi) = mesh.bounding_box();
         let diagonal = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
         let mut checked = 0;
         for (v, d) in cpu.domains.iter().enumerate() {
             let Some(d) = d else { continue };
-            let e = lm
-                .evaluate_face_point(d.face as usize, d.uv)
+            let e = evaluator
+                .evaluate(d.face, d.uv[0], d.uv[1])
                 .unwrap_or_else(|e| panic!("{name} vertex {v} at {d:?}: {e}"));
             for k in 0..3 {
                 assert!(

@@ -219,11 +219,11 @@ fn limit_points(
     path: &std::path::Path,
     (points, lines): (&[FacePoint], &[usize]),
 ) -> Result<()> {
-    let evaluator = tess::limit::LimitEvaluator::new(mesh, scheme)
+    let evaluator = topology::limit::face_domain::LimitEvaluator::new(mesh, scheme)
         .map_err(|e| eval_in_file(e, name, mesh, obj_lines))?;
     let samples = evaluator.evaluate_many(points).map_err(|e| {
         let at = format!("{}:{}", path.display(), lines[e.point]);
-        match e.source {
+        match *e.source {
             EvalError::FaceOutOfRange { face, count } => anyhow::anyhow!(
                 "{at}: face {face} out of range: {name} has faces 0 to {} (counted from 0, as on \
                  `# p` lines)",

@@ -17,7 +17,7 @@ pub struct FacePoint {
 /// Maps a captured patch id and domain coordinate to the base mesh; `None` for an unknown patch.
 pub type PatchToFace<'a> = dyn Fn(u32, [f32; 2]) -> Option<FacePoint> + 'a;
 
-pub use topology::limit::eval::face_corner_uv;
+pub use topology::limit::face_domain::face_corner_uv;
 
 /// How far (in domain units) a captured coordinate may sit from a face edge and still count as
 /// on it: the tessellator's edge coordinates are exact 0 or 1 or i/n with 1 − x − y rounding.

@@ -8,6 +8,8 @@
 //! - [`eval`]: exact limit evaluation at any `(face, u, v)` (OpenSubdiv's `Bfr`), refining
 //!   locally with the [`refine`](crate::refine) layer until a regular patch or a limit mask
 //!   applies;
+//! - [`face_domain`]: the face domains points on a base mesh are given in (captures, exports,
+//!   the C ABI) and exact evaluation at such points ([`face_domain::LimitEvaluator`]);
 //! - [`limit_mesh`]: a control mesh refined uniformly and placed on its limit surface, the
 //!   mesh a CPU application would draw, with each vertex's point of the base mesh.
 //!
@@ -15,5 +17,6 @@
 
 pub mod basis;
 pub mod eval;
+pub mod face_domain;
 pub mod limit_mesh;
 pub mod masks;

@@ -1022,7 +1022,7 @@ impl Technique for Adaptive {
     }
 
     /// The patch's point in its base face; a sub-quad of a non-quad maps bilinearly into the
-    /// face's domain ([`face_corner_uv`](topology::limit::eval::face_corner_uv)): corner, edge
+    /// face's domain ([`face_corner_uv`](topology::limit::face_domain::face_corner_uv)): corner, edge
     /// midpoint, centre, edge midpoint.
     fn face_point(&self, patch: u32, domain: [f32; 2]) -> Option<FacePoint> {
         let (face, sub, u, v) = self.base_param(patch, domain[0] as f64, domain[1] as f64)?;
@@ -1034,8 +1034,8 @@ impl Technique for Adaptive {
                 v: v as f32,
             });
         }
-        let quad = topology::limit::eval::subface_domain(n, sub as u32);
-        let uv = topology::limit::eval::bilinear(&quad, u, v);
+        let quad = topology::limit::face_domain::subface_domain(n, sub as u32);
+        let uv = topology::limit::face_domain::bilinear(&quad, u, v);
         Some(FacePoint {
             face,
             u: uv[0] as f32,

@@ -1,10 +1,10 @@
 //! Exact limit evaluation in the face domains of capture's `# p` lines.
 //!
-//! [`topology::limit::eval::LocalMesh`] evaluates the limit surface in its patch domains (Loop: the
+//! [`LocalMesh`] evaluates the limit surface in its patch domains (Loop: the
 //! triangle with corners 0, 1, 2 at (0, 0), (1, 0), (0, 1); Catmull-Clark: the unit square, and
 //! sub-quads after one refinement for other faces). What `tessera export` writes, and what a
 //! host reads back from a capture, is a point of a **base face** in the domain of
-//! [`crate::capture::face_corner_uv`]: triangles with corners 0, 1, 2 at (1, 0), (0, 1), (0, 0);
+//! [`face_corner_uv`]: triangles with corners 0, 1, 2 at (1, 0), (0, 1), (0, 0);
 //! quads the unit square; n-gons the regular n-gon in the unit square's circle.
 //! [`LimitEvaluator`] takes points in that convention, for any face of the control mesh, and
 //! evaluates the exact limit there:
@@ -17,16 +17,66 @@
 //!   midpoint, centre, edge midpoint), inverted here (Newton, to rounding).
 //!
 //! Derivatives are with respect to the face domain's `u` and `v` (the chain rule through those
-//! maps); the normal is `du × dv`, normalized (outward, as [`topology::limit::eval`] orients it).
+//! maps); the normal is `du × dv`, normalized (outward, as [`crate::limit::eval`] orients it).
 //! Points may lie up to [`DOMAIN_TOLERANCE`] outside a face's domain (captured coordinates are
 //! `f32`) and are moved onto it; farther, or NaN, is a
-//! [`topology::limit::eval::EvalError::ParamOutOfRange`].
+//! [`EvalError::ParamOutOfRange`].
 //!
 //! An evaluator holds only immutable data: one may be shared by any number of threads.
-use crate::capture::face_corner_uv;
+use crate::limit::eval::{normal_of, EvalError, LimitSample, LimitScheme, LocalMesh};
+use crate::mesh::ControlMesh;
 use std::collections::BTreeMap;
-use topology::limit::eval::{normal_of, EvalError, LimitSample, LimitScheme, LocalMesh};
-use topology::ControlMesh;
+
+/// Where corner `k` of an `n`-sided face sits in the face's (u, v) domain, the convention of
+/// every point Tessera reports on a base mesh (captures, `# p` lines of exports):
+/// - triangles: corner 0 (1, 0), corner 1 (0, 1), corner 2 (0, 0), so (u, v) are the
+///   barycentric weights of corners 0 and 1 (= `gl_TessCoord.xy` of a triangle patch);
+/// - quads: (0, 0), (1, 0), (1, 1), (0, 1), the bilinear domain of the quad TES;
+/// - n-gons, n ≥ 5: the regular n-gon inscribed in the unit square's circle,
+///   (½ + ½ cos 2πk/n, ½ + ½ sin 2πk/n).
+///
+/// A Catmull-Clark non-quad is evaluated on its sub-quads ([`LocalMesh::evaluate_subface`]);
+/// sub-quad `k` maps bilinearly onto (corner k, midpoint of edge k, centre, midpoint of edge
+/// k − 1) of this domain ([`subface_domain`]).
+pub fn face_corner_uv(n: u32, k: u32) -> [f64; 2] {
+    match (n, k % n.max(1)) {
+        (3, 0) => [1.0, 0.0],
+        (3, 1) => [0.0, 1.0],
+        (3, _) => [0.0, 0.0],
+        (4, 0) => [0.0, 0.0],
+        (4, 1) => [1.0, 0.0],
+        (4, 2) => [1.0, 1.0],
+        (4, _) => [0.0, 1.0],
+        (n, k) => {
+            let a = std::f64::consts::TAU * k as f64 / n as f64;
+            [0.5 + 0.5 * a.cos(), 0.5 + 0.5 * a.sin()]
+        }
+    }
+}
+
+/// The corners of sub-quad `k` of an `n`-gon in the face's domain ([`face_corner_uv`]):
+/// corner k, midpoint of edge k, centre, midpoint of edge k − 1.
+pub fn subface_domain(n: u32, k: u32) -> [[f64; 2]; 4] {
+    let c = |i: u32| face_corner_uv(n, i % n);
+    let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) * 0.5, (a[1] + b[1]) * 0.5];
+    let centre = (0..n).fold([0.0, 0.0], |s, i| {
+        let p = c(i);
+        [s[0] + p[0] / n as f64, s[1] + p[1] / n as f64]
+    });
+    let (corner, next, prev) = (c(k), c(k + 1), c(k + n - 1));
+    [corner, mid(corner, next), centre, mid(prev, corner)]
+}
+
+/// The bilinear map of `quad` at (s, t): weights (1−s)(1−t), s(1−t), st, (1−s)t.
+pub fn bilinear(quad: &[[f64; 2]; 4], s: f64, t: f64) -> [f64; 2] {
+    let w = [(1.0 - s) * (1.0 - t), s * (1.0 - t), s * t, (1.0 - s) * t];
+    let mut out = [0.0; 2];
+    for (p, w) in quad.iter().zip(w) {
+        out[0] += w * p[0];
+        out[1] += w * p[1];
+    }
+    out
+}
 
 /// How far (domain units) a point may lie outside its face's domain and still be evaluated
 /// (on the domain's nearest point).
@@ -51,7 +101,7 @@ pub struct PointError {
     pub u: f64,
     pub v: f64,
     #[source]
-    pub source: EvalError,
+    pub source: Box<EvalError>,
 }
 
 /// Where a face-domain point is evaluated: a face of the evaluated mesh (a fan triangle of the
@@ -165,7 +215,7 @@ impl LimitEvaluator {
                 face,
                 u,
                 v,
-                source,
+                source: Box::new(source),
             }
         };
         let mut patches: BTreeMap<(usize, Option<usize>), Vec<usize>> = BTreeMap::new();
@@ -272,28 +322,17 @@ impl LimitEvaluator {
 /// edge midpoint); `None` if that does not converge.
 fn sub_quad_point(face: usize, corners: &[[f64; 2]], p: [f64; 2]) -> Option<PatchPoint> {
     let n = corners.len();
-    let centre = corners.iter().fold([0.0, 0.0], |s, c| {
-        [s[0] + c[0] / n as f64, s[1] + c[1] / n as f64]
-    });
-    let mid = |k: usize| lerp(corners[k % n], corners[(k + 1) % n], 0.5);
-    let d = sub(p, centre);
+    let quads: Vec<[[f64; 2]; 4]> = (0..n as u32).map(|k| subface_domain(n as u32, k)).collect();
+    // Sub-quad k spans the sector of the centre between the midpoints of edges k − 1 and k.
+    let d = sub(p, quads[0][2]);
     let k = (0..n)
         .find(|&k| {
-            let before = sub(mid(k + n - 1), centre);
-            let after = sub(mid(k), centre);
-            cross(before, d) >= 0.0 && cross(d, after) >= 0.0
+            let q = &quads[k];
+            cross(sub(q[3], q[2]), d) >= 0.0 && cross(d, sub(q[1], q[2])) >= 0.0
         })
         .unwrap_or(0);
-    let q = [corners[k], mid(k), centre, mid(k + n - 1)];
-    let map = |s: f64, t: f64| {
-        let w = [(1.0 - s) * (1.0 - t), s * (1.0 - t), s * t, (1.0 - s) * t];
-        let mut x = [0.0; 2];
-        for (c, w) in q.iter().zip(w) {
-            x[0] += w * c[0];
-            x[1] += w * c[1];
-        }
-        x
-    };
+    let q = quads[k];
+    let map = |s: f64, t: f64| bilinear(&q, s, t);
     // ∂(u, v)/∂(s, t), columns s and t.
     let jacobian = |s: f64, t: f64| {
         let ds = lerp(sub(q[1], q[0]), sub(q[2], q[3]), t);
@@ -344,13 +383,13 @@ fn to_face(s: &LimitSample, p: &PatchPoint) -> FaceSample {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use topology::limit::eval::limit_point;
+    use crate::limit::eval::limit_point;
 
     /// A quad, a triangle and a pentagon sharing edges: every face size the mappings treat.
     fn mixed() -> ControlMesh {
         let text = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0.3\nv 2 1 0\nv 1 2 0\n\
                     v 0 2 0.2\nv 2 2 0.1\nf 1 2 5 4\nf 2 3 6\nf 2 6 9 7 5\nf 4 5 7 8\n";
-        topology::mesh::obj::parse_obj(text, "mixed").unwrap()
+        crate::mesh::obj::parse_obj(text, "mixed").unwrap()
     }
 
     fn close(a: [f64; 3], b: [f64; 3], tol: f64) -> bool {
