@@ -163,7 +163,7 @@ pub struct ParamError {
 }
 
 impl ParamError {
-    pub fn new(param: Param, value: impl ToString, expected: impl Into<String>) -> TessError {
+    pub fn refused(param: Param, value: impl ToString, expected: impl Into<String>) -> TessError {
         TessError::Param(ParamError {
             param,
             value: value.to_string(),
@@ -172,7 +172,7 @@ impl ParamError {
         })
     }
 
-    /// [`Self::new`], naming the parameter to raise for more.
+    /// [`Self::refused`], naming the parameter to raise for more.
     pub fn raising(
         param: Param,
         value: impl ToString,
@@ -294,8 +294,12 @@ mod tests {
             max: 8,
             fits: Some((4, 6)),
         });
-        assert!(tables.to_string().contains("(table level 4, up to 32 segments"));
-        assert!(tables.worded(flag).contains("(--table-level 4, up to 32 segments"));
+        assert!(tables
+            .to_string()
+            .contains("(table level 4, up to 32 segments"));
+        assert!(tables
+            .worded(flag)
+            .contains("(--table-level 4, up to 32 segments"));
         let other = TessError::NoPatchArray { array: 3 };
         assert_eq!(other.worded(flag), other.to_string());
     }

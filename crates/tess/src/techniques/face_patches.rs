@@ -152,9 +152,11 @@ impl<S: FaceStyle> Technique for FacePatches<S> {
     fn check(&self, params: &FrameParams) -> Result<()> {
         match params.factors {
             FactorPolicy::Uniform { segments } if (1.0..=MAX_LEVEL).contains(&segments) => Ok(()),
-            FactorPolicy::Uniform { segments } => {
-                Err(ParamError::new(Param::Segments, segments, "expected 1..64"))
-            }
+            FactorPolicy::Uniform { segments } => Err(ParamError::refused(
+                Param::Segments,
+                segments,
+                "expected 1..64",
+            )),
             _ => Err(TessError::Unsupported {
                 technique: S::ID,
                 what: "adaptive factors",

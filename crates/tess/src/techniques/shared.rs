@@ -72,14 +72,14 @@ pub fn factor_fields(factors: FactorPolicy) -> (u32, f32, f32, f32) {
 pub fn check_adaptive_policy(params: &FrameParams) -> Result<()> {
     match params.factors {
         FactorPolicy::Screen { pixels } if !(pixels.is_finite() && pixels >= 0.5) => {
-            Err(ParamError::new(
+            Err(ParamError::refused(
                 Param::Pixels,
                 pixels,
                 "expected at least 0.5 pixels per segment",
             ))
         }
         FactorPolicy::Distance { reference } if !(reference.is_finite() && reference > 0.0) => Err(
-            ParamError::new(Param::Distance, reference, "expected a positive distance"),
+            ParamError::refused(Param::Distance, reference, "expected a positive distance"),
         ),
         _ => Ok(()),
     }

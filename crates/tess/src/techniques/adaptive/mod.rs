@@ -780,7 +780,7 @@ pub fn check_frame(factor_limit: Option<f32>, params: &FrameParams) -> Result<()
     let half = factor_limit.map_or(f32::INFINITY, |l| (l * 0.5).floor());
     if let FactorPolicy::Uniform { segments } = params.factors {
         if segments.fract() != 0.0 || segments < 1.0 || segments > half {
-            return Err(ParamError::new(
+            return Err(ParamError::refused(
                 Param::Segments,
                 segments,
                 "expected whole segments per patch edge, 1 up to half the device's maximum \

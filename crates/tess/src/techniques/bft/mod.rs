@@ -561,7 +561,7 @@ impl Bft {
         let table_level = options.table_level;
         let max_level = device.info.caps.max_tessellation_generation_level;
         if !(1..=6).contains(&table_level) || (1u32 << table_level) > max_level {
-            return Err(ParamError::new(
+            return Err(ParamError::refused(
                 Param::TableLevel,
                 table_level,
                 format!(

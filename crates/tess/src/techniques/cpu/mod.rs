@@ -263,7 +263,7 @@ impl CpuMesh {
 /// The level a frame of `params` draws (uniform segments S = 2^level), or why it cannot.
 fn level_of(id: TechniqueId, params: &FrameParams) -> Result<u32> {
     let bad = |segments: f32| {
-        ParamError::new(
+        ParamError::refused(
             Param::Segments,
             segments,
             format!(
