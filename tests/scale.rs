@@ -129,7 +129,7 @@ fn adaptive_run(cap: Option<u32>, mesh: &ControlMesh, params: &FrameParams) -> A
         ];
         let sizes = (
             whole.into_iter().max().unwrap_or(0),
-            g.stencil_terms.len() as u64 * 8,
+            g.stencils.terms.len() as u64 * 8,
         );
         (image.pixels, soup.records, surf.chunk_counts(), sizes)
     };
@@ -376,12 +376,12 @@ fn one_million_faces_through_every_technique() {
              stencil terms {} B, (dispatches, window sets) {chunks:?}",
             quad.num_faces(),
             surf.plan.isolation,
-            surf.gpu.stencil_terms.len() * 8,
+            surf.gpu.stencils.terms.len() * 8,
         );
         let clear = &image.pixels[..4];
         let lit = image.pixels.chunks_exact(4).filter(|p| p != &clear).count();
         assert!(lit > 64 * 48 / 8, "adaptive: the grid covers {lit} pixels");
-        let terms = surf.gpu.stencil_terms.len() as u64 * 8;
+        let terms = surf.gpu.stencils.terms.len() as u64 * 8;
         assert_eq!(
             chunks.1 > 1,
             terms > 128 << 20,

@@ -17,6 +17,7 @@ pub mod gpu;
 pub mod output;
 pub mod render_mesh;
 pub mod shaders;
+pub mod stencil;
 pub mod surface;
 pub mod technique;
 pub mod techniques;

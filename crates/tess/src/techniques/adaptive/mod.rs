@@ -6,12 +6,13 @@
 //!    the crate's one sparse refiner, and flattens the result into stencil blocks (one per
 //!    level, then the local points), patches (regular B-spline, Gregory or bilinear end caps)
 //!    and canonical boundary curves.
-//! 2. **Every frame (GPU):** the stencil kernel (`glsl/adaptive/stencil.comp`) copies the base
-//!    positions and applies one block per dispatch (an animated base costs one upload of its
-//!    positions), then evaluates the canonical corners of regular patches and each
-//!    canonical curve's two inner points from their owner patches' control points (no stencil
-//!    rows: a fixed combination per patch kind and corner or edge);
-//!    then one draw per patch kind, one control point per patch.
+//! 2. **Every frame (GPU):** the frame slot's base positions are copied into the head of the
+//!    global vertex buffer, the stencil evaluator ([`crate::stencil`]) applies the blocks in
+//!    place, one pass each (an animated base costs one upload of its positions), then the
+//!    canonical kernel (`glsl/adaptive/canonical.comp`) evaluates the canonical corners of
+//!    regular patches and each canonical curve's two inner points from their owner patches'
+//!    control points (no stencil rows: a fixed combination per patch kind and corner or
+//!    edge); then one draw per patch kind, one control point per patch.
 //! 3. **Crack-free by construction:** every edge level comes from the edge's canonical
 //!    curve(s) only, a coarse transition edge gets twice its fine halves' level (the seed's
 //!    doubled factors: the tessellator makes the missing vertices, no T-junction), and every
@@ -19,15 +20,14 @@
 //!    identically (see `glsl/adaptive/adaptive.glsl`), so shared edges are bit-identical
 //!    under every factor policy, across transitions and end caps.
 //!
-//! 4. **Beyond the storage range:** a block whose stencil terms (or row offsets) exceed
-//!    `maxStorageBufferRange` (lavapipe allows 128 MiB; a 1M-quad grid's terms were 264 MB
-//!    before its regular corners and curve points were evaluated from their patches)
-//!    runs as several dispatches, chunks of rows planned by `techniques::windows`: a row's
-//!    terms are one contiguous run of the term buffer, so each chunk binds only its windows of
-//!    the offsets and the terms and the kernel subtracts the window bases (push constants).
-//!    The vertex buffer, the base positions and the patch buffers (records, control points,
-//!    curves) are bound whole: one that exceeds the range is refused with vk-core's typed
-//!    range error naming the buffer, never a silent overrun.
+//! 4. **Beyond the storage range:** the stencil evaluator windows everything it indexes
+//!    (offsets, terms, and the vertex buffer as source and destination), in chunks of rows
+//!    (`techniques::windows`; lavapipe allows 128 MiB, and a 1M-quad grid's terms were 264 MB
+//!    before its regular corners and curve points were evaluated from their patches). The
+//!    base copy is a transfer, which no range limits. The canonical kernel and the draw bind
+//!    the vertex buffer and the patch buffers (records, control points, curves) whole: one
+//!    that exceeds the range is refused with vk-core's typed range error naming the buffer,
+//!    never a silent overrun.
 //!
 //! The GPU data is [`layout`].
 pub mod layout;
@@ -35,27 +35,27 @@ pub mod layout;
 use super::shared::{
     canonical_zero, check_adaptive_policy, factor_fields, storage, storage_binding,
 };
-use super::windows::{self, Limits, Member, Space};
+use super::windows;
 use crate::capture::FacePoint;
 use crate::context::Context;
 use crate::error::{Param, ParamError, Result, TessError};
 use crate::gpu::bindings::{
-    ADAPTIVE_BASE_POSITIONS_BINDING, ADAPTIVE_CONTROL_POINTS_BINDING, ADAPTIVE_CURVES_BINDING,
-    ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_PLAIN, ADAPTIVE_LOCAL_SIZE, ADAPTIVE_OPTION_FRACTIONAL,
+    ADAPTIVE_CANONICAL_MODE_CORNERS, ADAPTIVE_CANONICAL_MODE_CURVES,
+    ADAPTIVE_CONTROL_POINTS_BINDING, ADAPTIVE_CURVES_BINDING, ADAPTIVE_EDGE_COARSE,
+    ADAPTIVE_EDGE_PLAIN, ADAPTIVE_LOCAL_SIZE, ADAPTIVE_OPTION_FRACTIONAL,
     ADAPTIVE_OPTION_PATCH_COLOURS, ADAPTIVE_OPTION_POW2, ADAPTIVE_PATCHES_BINDING,
-    ADAPTIVE_STENCIL_OFFSETS_BINDING, ADAPTIVE_STENCIL_TERMS_BINDING, ADAPTIVE_VERTICES_BINDING,
+    ADAPTIVE_VERTICES_BINDING,
 };
 use crate::gpu::bindings::{
     ADAPTIVE_CORNER_OWNERS_BINDING, ADAPTIVE_CURVE_OWNERS_BINDING, ADAPTIVE_HEIGHT_BINDING,
     ADAPTIVE_OPTION_CANONICAL_NORMALS, ADAPTIVE_OPTION_DISPLACE, ADAPTIVE_OPTION_HEIGHT_MAP,
     ADAPTIVE_OPTION_REPARAM, ADAPTIVE_OPTION_SHOW_PARAM_ERROR, ADAPTIVE_OPTION_SHOW_PARAM_SHIFT,
     ADAPTIVE_OPTION_TEXTURE, ADAPTIVE_PARAM_ERROR_BINDING, ADAPTIVE_PARAM_ERROR_SIDE,
-    ADAPTIVE_REPARAM_BINDING, ADAPTIVE_STENCIL_MODE_BASE, ADAPTIVE_STENCIL_MODE_CORNERS,
-    ADAPTIVE_STENCIL_MODE_CURVES, ADAPTIVE_STENCIL_MODE_ROWS, ADAPTIVE_SURFACES_BINDING,
-    ADAPTIVE_TEXTURE_BINDING,
+    ADAPTIVE_REPARAM_BINDING, ADAPTIVE_SURFACES_BINDING, ADAPTIVE_TEXTURE_BINDING,
 };
 use crate::gpu::AdaptivePush;
 use crate::shaders::{self, Stage, Variant};
+use crate::stencil::{self, StencilEvaluator, StencilVertices};
 use crate::surface::{SurfaceImage, SurfaceMaps, SurfaceShow};
 use crate::technique::{
     for_each_draw, number_arrays, DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features,
@@ -79,10 +79,7 @@ use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Encoder, MemoryLocation};
 pub const DEFAULT_ISOLATION: u32 = 4;
 
 /// Set 1 of every adaptive pipeline.
-static SET_BINDINGS: [BindingDesc; 14] = [
-    storage_binding(ADAPTIVE_BASE_POSITIONS_BINDING),
-    storage_binding(ADAPTIVE_STENCIL_OFFSETS_BINDING),
-    storage_binding(ADAPTIVE_STENCIL_TERMS_BINDING),
+static SET_BINDINGS: [BindingDesc; 11] = [
     storage_binding(ADAPTIVE_VERTICES_BINDING),
     storage_binding(ADAPTIVE_PATCHES_BINDING),
     storage_binding(ADAPTIVE_CONTROL_POINTS_BINDING),
@@ -164,87 +161,169 @@ pub fn check_texcoords(mesh: &ControlMesh, maps: &SurfaceMaps, name: &str) -> Re
     })
 }
 
-/// Stencil rows: their CSR offsets (row `r` reads `offsets[r + 1]`).
-const ROWS: Space = Space {
-    name: "stencil row",
-    members: &[Member {
-        stride: 4,
-        extra: 1,
-    }],
-};
-/// Stencil terms.
-const TERMS: Space = Space {
-    name: "stencil term",
-    members: &[Member {
-        stride: std::mem::size_of::<layout::StencilTerm>() as u64,
-        extra: 0,
-    }],
-};
-
-/// A set's windows of the stencil offsets (rows) and terms.
-type RowWindows = [Range<u32>; 2];
-
-/// One dispatch of the stencil kernel (`mode`: rows, the base copy or curve points; see
-/// `ADAPTIVE_STENCIL_MODE_*`), its items and the set whose windows it binds.
+/// One dispatch of the canonical kernel: `mode` (`ADAPTIVE_CANONICAL_MODE_*`) over `items`
+/// (regular corners from the first one the kernel evaluates, or curve points).
 #[derive(Clone, Debug, PartialEq, Eq)]
-struct Step {
+struct CanonicalStep {
     mode: u32,
     items: Range<u32>,
-    /// Index into the slot's sets.
-    set: usize,
 }
 
-/// The pre-pass: chunks of rows (over every block) whose offset and term windows fit
-/// `limits`, one descriptor set each; a block runs as one dispatch per chunk it meets, each at
-/// most `max_items` rows (the dispatch's group count). Returns the steps (the base copy
-/// first) and each set's windows, `[rows, terms]`.
-fn plan_pre_pass(
-    g: &GpuAdaptive,
-    limits: Limits,
-    max_items: u32,
-) -> Result<(Vec<Step>, Vec<RowWindows>)> {
+/// The canonical kernel's dispatches, at most `max_items` items each (the dispatch's group
+/// count): the regular corners, then the curves' inner points.
+fn plan_canonical(g: &GpuAdaptive, max_items: u32) -> Vec<CanonicalStep> {
     let max_items = max_items.max(1);
-    let rows = g.stencil_offsets.len().saturating_sub(1) as u32;
-    let chunks = windows::plan("stencil row", rows, &[ROWS, TERMS], limits, |r| {
-        let (k0, k1) = (
-            g.stencil_offsets[r as usize],
-            g.stencil_offsets[r as usize + 1],
-        );
-        [r..r + 1, k0..k1]
-    })?;
+    let corners_from = g.first_regular_corner - g.first_corner;
     let mut steps = Vec::new();
-    let mut split = |mode: u32, items: Range<u32>, set: usize| {
+    for (mode, items) in [
+        (
+            ADAPTIVE_CANONICAL_MODE_CORNERS,
+            corners_from..corners_from + g.regular_corners(),
+        ),
+        (ADAPTIVE_CANONICAL_MODE_CURVES, 0..g.curve_points()),
+    ] {
         let mut first = items.start;
         while first < items.end {
             let end = items.end.min(first.saturating_add(max_items));
-            steps.push(Step {
+            steps.push(CanonicalStep {
                 mode,
                 items: first..end,
-                set,
             });
             first = end;
         }
-    };
-    // The base copy and the curve points read no stencils: any set serves.
-    split(ADAPTIVE_STENCIL_MODE_BASE, 0..g.num_base_vertices, 0);
-    for d in &g.dispatches {
-        let block = d.first_row..d.first_row + d.rows;
-        for (k, c) in chunks.iter().enumerate() {
-            split(
-                ADAPTIVE_STENCIL_MODE_ROWS,
-                block.start.max(c.items.start)..block.end.min(c.items.end),
-                k,
-            );
-        }
     }
-    let corners_from = g.first_regular_corner - g.first_corner;
-    split(
-        ADAPTIVE_STENCIL_MODE_CORNERS,
-        corners_from..corners_from + g.regular_corners(),
-        0,
-    );
-    split(ADAPTIVE_STENCIL_MODE_CURVES, 0..g.curve_points(), 0);
-    Ok((steps, chunks.into_iter().map(|c| c.windows).collect()))
+    steps
+}
+
+/// The Eq. 1 error lattice in array order when `options` ask for it, whether it has any entry,
+/// and its summary; one 0 stands in for an empty or absent lattice (the view is then refused).
+fn param_errors(
+    mesh: &ControlMesh,
+    plan: &AdaptivePlan,
+    gpu: &GpuAdaptive,
+    options: &AdaptiveBuild,
+) -> Result<(Vec<f32>, bool, ParamErrorNote)> {
+    if !options.maps.param_error {
+        return Ok((vec![0.0], false, None));
+    }
+    let lattice = topology::patches::texcoord::param_error_lattice(
+        mesh,
+        plan,
+        ADAPTIVE_PARAM_ERROR_SIDE as usize,
+    )
+    .map_err(|e| TessError::Mesh {
+        name: options.name.clone(),
+        source: e.into(),
+    })?;
+    let summary = Some((lattice.summary(), lattice.reparameterized));
+    let errors = gpu.param_errors(&lattice);
+    if errors.is_empty() {
+        return Ok((vec![0.0], false, summary));
+    }
+    Ok((errors, true, summary))
+}
+
+/// The Eq. 1 lattice's summary and the patches with a reparameterized corner, when built.
+type ParamErrorNote = Option<(topology::patches::texcoord::ParamErrorSummary, usize)>;
+
+/// The buffers the canonical kernel and the draw read whole, by binding: patch records,
+/// control points, curves, patch surfaces, the reparameterization table, curve and corner
+/// owners and the error lattice.
+fn static_buffers(
+    device: &vk_core::Device,
+    gpu: &GpuAdaptive,
+    plan: &AdaptivePlan,
+    mesh: &ControlMesh,
+    param_errors: &[f32],
+) -> Result<Vec<(u32, Buffer)>> {
+    let surfaces = gpu.surfaces(plan, mesh);
+    let reparam = layout::reparam_rows();
+    let arrays: [(u32, &str, &[u8]); 8] = [
+        (
+            ADAPTIVE_PATCHES_BINDING,
+            "adaptive patches",
+            bytemuck::cast_slice(&gpu.patches),
+        ),
+        (
+            ADAPTIVE_CONTROL_POINTS_BINDING,
+            "adaptive control points",
+            bytemuck::cast_slice(&gpu.control_points),
+        ),
+        (
+            ADAPTIVE_CURVES_BINDING,
+            "adaptive curves",
+            bytemuck::cast_slice(&gpu.curves),
+        ),
+        (
+            ADAPTIVE_SURFACES_BINDING,
+            "adaptive patch surfaces",
+            bytemuck::cast_slice(&surfaces),
+        ),
+        (
+            ADAPTIVE_REPARAM_BINDING,
+            "adaptive reparameterization table",
+            bytemuck::cast_slice(&reparam),
+        ),
+        (
+            ADAPTIVE_CURVE_OWNERS_BINDING,
+            "adaptive curve owners",
+            bytemuck::cast_slice(&gpu.curve_owners),
+        ),
+        (
+            ADAPTIVE_CORNER_OWNERS_BINDING,
+            "adaptive corner owners",
+            bytemuck::cast_slice(&gpu.corner_owners),
+        ),
+        (
+            ADAPTIVE_PARAM_ERROR_BINDING,
+            "adaptive Eq. 1 error lattice",
+            bytemuck::cast_slice(param_errors),
+        ),
+    ];
+    arrays
+        .into_iter()
+        .map(|(binding, name, bytes)| Ok((binding, storage(device, name, bytes)?)))
+        .collect()
+}
+
+/// One base-position buffer per frame slot, holding `positions` as the stencil evaluator's
+/// vertices (the source of the copy into the vertex buffer's head).
+fn base_buffers(
+    device: &vk_core::Device,
+    frames: usize,
+    positions: &[[f32; 3]],
+) -> Result<Vec<Buffer>> {
+    let vertices = stencil::vertices(positions);
+    (0..frames)
+        .map(|i| {
+            let mut buf = Buffer::new(
+                device,
+                &BufferDesc {
+                    name: &format!("adaptive base positions {i}"),
+                    size: stencil::vertex_bytes(positions.len() as u32),
+                    usage: vk::BufferUsageFlags::TRANSFER_SRC,
+                    location: MemoryLocation::CpuToGpu,
+                },
+            )?;
+            buf.write(0, bytemuck::cast_slice(&vertices))?;
+            Ok(buf)
+        })
+        .collect()
+}
+
+/// Per array, how many of its patches have each combination of edge kinds.
+fn edge_kind_counts(arrays: &[PatchArray], gpu: &GpuAdaptive) -> Vec<Vec<(u32, u64)>> {
+    arrays
+        .iter()
+        .map(|a| {
+            let mut counts = std::collections::BTreeMap::new();
+            let range = a.first_patch as usize..(a.first_patch + a.patches) as usize;
+            for p in &gpu.patches[range] {
+                *counts.entry(p.edge_info & 0x3333).or_insert(0u64) += 1;
+            }
+            counts.into_iter().collect()
+        })
+        .collect()
 }
 
 impl TechniqueId {
@@ -349,16 +428,20 @@ impl Default for AdaptiveBuild {
 pub struct Adaptive {
     /// Adaptive, or a single-pass technique drawing its plan (`crate::techniques::gregory`).
     id: TechniqueId,
-    stencil: Pipeline,
-    /// Per frame slot, one set per distinct pre-pass window (slots differ only in the base
-    /// positions); the draw binds the slot's first (it reads no stencils).
-    sets: Vec<Vec<DescriptorSet>>,
-    /// The stencil kernel's dispatches, in order.
-    steps: Vec<Step>,
-    /// Per set: its windows of the stencil offsets and terms.
-    windows: Vec<RowWindows>,
+    /// The levels and local points, in place in `vertices`.
+    evaluator: StencilEvaluator,
+    canonical: Pipeline,
+    /// The set of the canonical kernel and the draw (every frame slot's: the slots differ
+    /// only in the base positions, which are copied).
+    set: DescriptorSet,
+    /// The canonical kernel's dispatches, in order.
+    steps: Vec<CanonicalStep>,
     _pool: DescriptorPool,
+    /// Per frame slot, the base positions ([`stencil::StencilVertex`]), copied into the head
+    /// of `vertices` every frame.
     base: Vec<Buffer>,
+    /// The global vertex buffer.
+    vertices: Buffer,
     _static: Vec<Buffer>,
     _textures: [Texture; 2],
     arrays: Vec<PatchArray>,
@@ -375,7 +458,7 @@ pub struct Adaptive {
     /// The Eq. 1 error lattice was built (`SurfaceMaps::param_error`).
     has_param_errors: bool,
     /// Its summary and the patches with a reparameterized corner, when built.
-    param_error_summary: Option<(topology::patches::texcoord::ParamErrorSummary, usize)>,
+    param_error_summary: ParamErrorNote,
 }
 
 impl Adaptive {
@@ -413,190 +496,52 @@ impl Adaptive {
             name: options.name.clone(),
             source: e.into(),
         })?;
-        let frames = ctx.frames_in_flight();
         ctx.ensure_set_layout(id, &SET_BINDINGS)?;
         let set_layout = ctx.set_layout(id)?;
         let max_groups = device.info.caps.max_compute_work_group_count[0];
-        let (steps, windows) = plan_pre_pass(
-            &gpu,
-            Limits::of(&device),
-            max_groups.saturating_mul(ADAPTIVE_LOCAL_SIZE),
-        )?;
-        let pool = DescriptorPool::new(
-            &device,
-            "adaptive descriptor pool",
-            set_layout,
-            (frames * windows.len()) as u32,
-        )?;
+        let steps = plan_canonical(&gpu, max_groups.saturating_mul(ADAPTIVE_LOCAL_SIZE));
+        let pool = DescriptorPool::new(&device, "adaptive descriptor pool", set_layout, 1)?;
         let vertices = Buffer::new(
             &device,
             &BufferDesc {
                 name: "adaptive vertices",
                 size: gpu.vertex_bytes(),
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
                 location: MemoryLocation::GpuOnly,
             },
         )?;
-        // One 0 stands in when the lattice is not asked for (the view is then refused).
-        let mut param_error_summary = None;
-        let param_errors = if options.maps.param_error {
-            let lattice = topology::patches::texcoord::param_error_lattice(
-                mesh,
-                &plan,
-                ADAPTIVE_PARAM_ERROR_SIDE as usize,
-            )
-            .map_err(|e| TessError::Mesh {
-                name: options.name.clone(),
-                source: e.into(),
-            })?;
-            param_error_summary = Some((lattice.summary(), lattice.reparameterized));
-            gpu.param_errors(&lattice)
-        } else {
-            Vec::new()
-        };
-        let has_param_errors = !param_errors.is_empty();
-        let param_errors = if has_param_errors {
-            param_errors
-        } else {
-            vec![0.0f32]
-        };
-        let statics = vec![
-            (ADAPTIVE_VERTICES_BINDING, vertices),
-            (
-                ADAPTIVE_STENCIL_OFFSETS_BINDING,
-                storage(
-                    &device,
-                    "adaptive stencil offsets",
-                    bytemuck::cast_slice(&gpu.stencil_offsets),
-                )?,
-            ),
-            (
-                ADAPTIVE_STENCIL_TERMS_BINDING,
-                storage(
-                    &device,
-                    "adaptive stencil terms",
-                    bytemuck::cast_slice(&gpu.stencil_terms),
-                )?,
-            ),
-            (
-                ADAPTIVE_PATCHES_BINDING,
-                storage(
-                    &device,
-                    "adaptive patches",
-                    bytemuck::cast_slice(&gpu.patches),
-                )?,
-            ),
-            (
-                ADAPTIVE_CONTROL_POINTS_BINDING,
-                storage(
-                    &device,
-                    "adaptive control points",
-                    bytemuck::cast_slice(&gpu.control_points),
-                )?,
-            ),
-            (
-                ADAPTIVE_CURVES_BINDING,
-                storage(
-                    &device,
-                    "adaptive curves",
-                    bytemuck::cast_slice(&gpu.curves),
-                )?,
-            ),
-            (
-                ADAPTIVE_SURFACES_BINDING,
-                storage(
-                    &device,
-                    "adaptive patch surfaces",
-                    bytemuck::cast_slice(&gpu.surfaces(&plan, mesh)),
-                )?,
-            ),
-            (
-                ADAPTIVE_REPARAM_BINDING,
-                storage(
-                    &device,
-                    "adaptive reparameterization table",
-                    bytemuck::cast_slice(&layout::reparam_rows()),
-                )?,
-            ),
-            (
-                ADAPTIVE_CURVE_OWNERS_BINDING,
-                storage(
-                    &device,
-                    "adaptive curve owners",
-                    bytemuck::cast_slice(&gpu.curve_owners),
-                )?,
-            ),
-            (
-                ADAPTIVE_CORNER_OWNERS_BINDING,
-                storage(
-                    &device,
-                    "adaptive corner owners",
-                    bytemuck::cast_slice(&gpu.corner_owners),
-                )?,
-            ),
-            (
-                ADAPTIVE_PARAM_ERROR_BINDING,
-                storage(
-                    &device,
-                    "adaptive Eq. 1 error lattice",
-                    bytemuck::cast_slice(&param_errors),
-                )?,
-            ),
-        ];
+        let (param_errors, has_param_errors, param_error_summary) =
+            param_errors(mesh, &plan, &gpu, options)?;
+        let statics = static_buffers(&device, &gpu, &plan, mesh, &param_errors)?;
         let textures = surface_textures(&device, &options.maps)?;
         let base_positions = base_positions(mesh);
-        let mut base = Vec::new();
-        let mut sets = Vec::new();
-        for i in 0..frames {
-            let mut buf = Buffer::new(
-                &device,
-                &BufferDesc {
-                    name: &format!("adaptive base positions {i}"),
-                    size: (12 * base_positions.len().max(1)) as u64,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-                    location: MemoryLocation::CpuToGpu,
-                },
-            )?;
-            buf.write(0, bytemuck::cast_slice(&base_positions))?;
-            let mut slot_sets = Vec::with_capacity(windows.len());
-            for [rows, terms] in &windows {
-                let set = pool.allocate_set(set_layout)?;
-                windows::write_whole(&set, ADAPTIVE_BASE_POSITIONS_BINDING, &buf)?;
-                for (binding, s) in &statics {
-                    match *binding {
-                        ADAPTIVE_STENCIL_OFFSETS_BINDING => windows::write_window(
-                            &set,
-                            *binding,
-                            s,
-                            ROWS.members[0],
-                            gpu.stencil_offsets.len() as u64,
-                            rows,
-                        )?,
-                        ADAPTIVE_STENCIL_TERMS_BINDING => windows::write_window(
-                            &set,
-                            *binding,
-                            s,
-                            TERMS.members[0],
-                            gpu.stencil_terms.len() as u64,
-                            terms,
-                        )?,
-                        _ => windows::write_whole(&set, *binding, s)?,
-                    }
-                }
-                set.write_texture(ADAPTIVE_TEXTURE_BINDING, &textures[0])?;
-                set.write_texture(ADAPTIVE_HEIGHT_BINDING, &textures[1])?;
-                slot_sets.push(set);
-            }
-            base.push(buf);
-            sets.push(slot_sets);
+        let base = base_buffers(&device, ctx.frames_in_flight(), &base_positions)?;
+        let set = pool.allocate_set(set_layout)?;
+        windows::write_whole(&set, ADAPTIVE_VERTICES_BINDING, &vertices)?;
+        for (binding, s) in &statics {
+            windows::write_whole(&set, *binding, s)?;
         }
-        let layouts = [ctx.frame_set_layout().raw, set_layout.raw];
-        let stencil = Pipeline::compute(
+        set.write_texture(ADAPTIVE_TEXTURE_BINDING, &textures[0])?;
+        set.write_texture(ADAPTIVE_HEIGHT_BINDING, &textures[1])?;
+        let evaluator = StencilEvaluator::new(
             &device,
-            "adaptive stencils",
+            "adaptive",
+            &gpu.stencils,
+            &gpu.blocks,
+            StencilVertices {
+                sources: gpu.num_vertices,
+                destinations: gpu.num_vertices,
+                in_place: true,
+            },
+            &[(&vertices, &vertices)],
+        )?;
+        let layouts = [ctx.frame_set_layout().raw, set_layout.raw];
+        let canonical = Pipeline::compute(
+            &device,
+            "adaptive canonical points",
             ShaderStage::new(
                 vk::ShaderStageFlags::COMPUTE,
-                shaders::spirv(Stage::AdaptiveStencilComp, Variant::default())?,
+                shaders::spirv(Stage::AdaptiveCanonicalComp, Variant::default())?,
             ),
             &layouts,
             std::mem::size_of::<AdaptivePush>() as u32,
@@ -608,26 +553,17 @@ impl Adaptive {
             (PatchType::Bilinear, bilinear, 1),
             (PatchType::GregoryTriangle, triangles, 1),
         ]);
-        let edge_kinds = arrays
-            .iter()
-            .map(|a| {
-                let mut counts = std::collections::BTreeMap::new();
-                let range = a.first_patch as usize..(a.first_patch + a.patches) as usize;
-                for p in &gpu.patches[range] {
-                    *counts.entry(p.edge_info & 0x3333).or_insert(0u64) += 1;
-                }
-                counts.into_iter().collect()
-            })
-            .collect();
+        let edge_kinds = edge_kind_counts(&arrays, &gpu);
         let max_level = device.info.caps.max_tessellation_generation_level as f32;
         Ok(Self {
             id,
-            stencil,
-            sets,
+            evaluator,
+            canonical,
+            set,
             steps,
-            windows,
             _pool: pool,
             base,
+            vertices,
             _static: statics.into_iter().map(|(_, b)| b).collect(),
             _textures: textures,
             arrays,
@@ -659,10 +595,10 @@ impl Adaptive {
         ))
     }
 
-    /// Stencil-kernel dispatches (the base copy included) and distinct window sets: more than
-    /// one set when the stencil tables exceed the storage range.
+    /// The stencil evaluator's dispatches and window sets: more than one set when a buffer it
+    /// indexes (stencil tables, vertices) exceeds the storage range.
     pub fn chunk_counts(&self) -> (usize, usize) {
-        (self.steps.len(), self.windows.len())
+        self.evaluator.counts()
     }
 
     /// Patches of each kind: regular, Gregory, bilinear, Gregory triangle.
@@ -721,11 +657,8 @@ impl Adaptive {
             pixels_per_segment: pixels,
             distance_ref: reference,
             max_level: self.factor_limit(),
-            first_row: 0,
+            first_item: 0,
             count: 0,
-            base_count: self.gpu.num_base_vertices,
-            row_base: 0,
-            term_base: 0,
             displace_scale: params.displace,
             first_corner: self.gpu.first_corner,
         }
@@ -853,10 +786,8 @@ impl Technique for Adaptive {
             || self.options.maps.texture.is_some()
     }
 
-    fn descriptor_set(&self, slot: usize) -> Option<&DescriptorSet> {
-        self.sets
-            .get(slot.min(self.sets.len().saturating_sub(1)))?
-            .first()
+    fn descriptor_set(&self, _slot: usize) -> Option<&DescriptorSet> {
+        Some(&self.set)
     }
 
     /// At the largest level an edge can get (a coarse transition edge's doubled level).
@@ -929,73 +860,70 @@ impl Technique for Adaptive {
             .get_mut(slot)
             .ok_or(TessError::FrameSlot { slot, slots })?;
         let positions: Vec<[f32; 3]> = positions.iter().map(|p| p.map(canonical_zero)).collect();
-        buf.write(0, bytemuck::cast_slice(&positions))?;
+        buf.write(0, bytemuck::cast_slice(&stencil::vertices(&positions)))?;
         self.base_positions = positions;
         Ok(())
     }
 
+    /// The base copy, the stencil evaluator's blocks, then the canonical kernel: each step
+    /// reads what the steps before it wrote, so each is ordered after them.
     fn record_pre_pass<'a>(
         &'a self,
         enc: &mut Encoder<'a>,
         frame_set: &'a DescriptorSet,
         slot: usize,
     ) -> Result<()> {
-        let slots = self.sets.len();
-        let sets = self
-            .sets
-            .get(slot.min(slots.saturating_sub(1)))
+        let slots = self.base.len();
+        let base = self
+            .base
+            .get(slot)
             .ok_or(TessError::FrameSlot { slot, slots })?;
         let tess_stages = vk::PipelineStageFlags::VERTEX_SHADER
             | vk::PipelineStageFlags::TESSELLATION_CONTROL_SHADER
             | vk::PipelineStageFlags::TESSELLATION_EVALUATION_SHADER;
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        let transfer = vk::PipelineStageFlags::TRANSFER;
+        let ordered = (
+            compute,
+            vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
+        );
         enc.begin_label("adaptive subdivision tables");
         // The previous frame's tessellation stages read the vertices before we overwrite them;
         // host writes of the base positions are visible at submit.
         enc.memory_barrier(
             (tess_stages, vk::AccessFlags::SHADER_READ),
-            (compute, vk::AccessFlags::SHADER_WRITE),
+            (
+                transfer | compute,
+                vk::AccessFlags::TRANSFER_WRITE | vk::AccessFlags::SHADER_WRITE,
+            ),
         );
-        enc.bind_pipeline(&self.stencil);
-        let n = self.steps.len();
-        let mut bound = None;
-        for (i, step) in self.steps.iter().enumerate() {
-            let [rows, terms] = self
-                .windows
-                .get(step.set)
-                .ok_or(TessError::FrameSlot { slot, slots })?;
-            let set = sets
-                .get(step.set)
-                .ok_or(TessError::FrameSlot { slot, slots })?;
-            if bound != Some(step.set) {
-                enc.bind_descriptor_sets(0, &[frame_set, set])?;
-                bound = Some(step.set);
-            }
+        enc.copy_buffer(base, &self.vertices)?;
+        enc.memory_barrier((transfer, vk::AccessFlags::TRANSFER_WRITE), ordered);
+        self.evaluator.record(enc, 0)?;
+        enc.bind_pipeline(&self.canonical);
+        enc.bind_descriptor_sets(0, &[frame_set, &self.set])?;
+        for step in &self.steps {
+            // Each step reads what the ones before it wrote (the curve points read the corners).
+            enc.memory_barrier((compute, vk::AccessFlags::SHADER_WRITE), ordered);
             let push = AdaptivePush {
                 mode: step.mode,
-                first_row: step.items.start,
+                first_item: step.items.start,
                 count: step.items.end - step.items.start,
-                base_count: self.gpu.num_base_vertices,
-                row_base: rows.start,
-                term_base: terms.start,
                 first_corner: self.gpu.first_corner,
                 ..Default::default()
             };
             enc.push_constants(&push)?;
             enc.dispatch([push.count.div_ceil(ADAPTIVE_LOCAL_SIZE), 1, 1])?;
-            // Each block reads the ones before it, and chunks of one block write disjoint
-            // vertices of the buffer bound whole (synchronization validation sees the whole
-            // range): every dispatch is ordered; the last feeds the tessellation stages.
-            let next = if i + 1 == n {
-                (tess_stages, vk::AccessFlags::SHADER_READ)
-            } else {
-                (
-                    compute,
-                    vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
-                )
-            };
-            enc.memory_barrier((compute, vk::AccessFlags::SHADER_WRITE), next);
         }
+        // The last step (or the copy, for a plan without rows or canonical points) feeds the
+        // tessellation stages.
+        enc.memory_barrier(
+            (
+                compute | transfer,
+                vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
+            ),
+            (tess_stages, vk::AccessFlags::SHADER_READ),
+        );
         enc.end_label();
         Ok(())
     }
@@ -1050,6 +978,8 @@ impl Technique for Adaptive {
     fn device_memory(&self) -> Vec<DeviceAllocation> {
         self.base
             .iter()
+            .chain([&self.vertices])
+            .chain(self.evaluator.buffers())
             .chain(&self._static)
             .map(DeviceAllocation::of_buffer)
             .chain(self._textures.iter().map(DeviceAllocation::of_texture))
@@ -1087,11 +1017,7 @@ impl Technique for Adaptive {
 mod tests {
     use super::*;
 
-    /// Under a small range and a small group count, the steps run every row exactly once, in
-    /// block order (a block's rows read only earlier blocks), each inside its set's windows,
-    /// with aligned window starts; the base copy comes first.
-    #[test]
-    fn pre_pass_chunks_cover_every_row_once_inside_their_windows() {
+    fn cube_layout() -> GpuAdaptive {
         let mesh = topology::load_obj(concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/../../tests/data/opensubdiv/shapes/catmark_cube_creases0.obj"
@@ -1105,68 +1031,59 @@ mod tests {
             },
         )
         .expect("plan");
-        let g = GpuAdaptive::new(&plan).expect("layout");
-        let whole = plan_pre_pass(&g, limits(1 << 30), u32::MAX).expect("whole");
-        assert_eq!(whole.1.len(), 1, "everything fits: one set");
-        let (steps, sets) = plan_pre_pass(&g, limits(4096), 100).expect("chunked");
-        assert!(sets.len() > 3, "{} sets", sets.len());
-        assert_eq!(steps[0].mode, ADAPTIVE_STENCIL_MODE_BASE);
-        assert_eq!(steps[0].items.start, 0);
-        let copied: u32 = steps
+        GpuAdaptive::new(&plan).expect("layout")
+    }
+
+    /// A frame writes every vertex once: the base copy `0..num_base_vertices`, then the
+    /// evaluator's blocks in order up to the regular corners, then the canonical kernel's
+    /// steps, the corners and then the curve points, in order and at most `max_items` each.
+    #[test]
+    fn the_pre_pass_writes_every_vertex_once_in_order() {
+        let g = cube_layout();
+        let mut next = g.num_base_vertices;
+        for b in &g.blocks {
+            assert_eq!(
+                b.destination, next,
+                "blocks follow the base copy, no gap or overlap"
+            );
+            assert_eq!(b.rows.start + g.num_base_vertices, b.destination);
+            next = b.destinations().end;
+        }
+        assert_eq!(next, g.first_regular_corner);
+        let steps = plan_canonical(&g, 100);
+        let split = steps
             .iter()
-            .filter(|s| s.mode == ADAPTIVE_STENCIL_MODE_BASE)
-            .map(|s| s.items.len() as u32)
-            .sum();
-        assert_eq!(copied, g.num_base_vertices);
-        let mut next = 0;
+            .position(|s| s.mode == ADAPTIVE_CANONICAL_MODE_CURVES)
+            .expect("curve steps");
+        let corners_from = g.first_regular_corner - g.first_corner;
+        let mut next_corner = corners_from;
+        for s in &steps[..split] {
+            assert_eq!(s.mode, ADAPTIVE_CANONICAL_MODE_CORNERS);
+            assert_eq!(s.items.start, next_corner);
+            assert!(s.items.len() <= 100);
+            next_corner = s.items.end;
+        }
+        assert_eq!(next_corner - corners_from, g.regular_corners());
+        assert_eq!(
+            g.first_corner + next_corner,
+            g.first_curve_point,
+            "the corners end where the curve points begin"
+        );
         // The curve points come last, in order, after every row.
-        let curve_steps: Vec<&Step> = steps
-            .iter()
-            .filter(|s| s.mode == ADAPTIVE_STENCIL_MODE_CURVES)
-            .collect();
         let mut next_point = 0;
-        for s in &curve_steps {
+        for s in &steps[split..] {
+            assert_eq!(s.mode, ADAPTIVE_CANONICAL_MODE_CURVES);
             assert_eq!(s.items.start, next_point);
             assert!(s.items.len() <= 100);
             next_point = s.items.end;
         }
         assert_eq!(next_point, g.curve_points());
         assert!(next_point > 0);
-        let first_curve_step = steps
-            .iter()
-            .position(|s| s.mode == ADAPTIVE_STENCIL_MODE_CURVES)
-            .expect("curve steps");
-        assert!(steps[first_curve_step..]
-            .iter()
-            .all(|s| s.mode == ADAPTIVE_STENCIL_MODE_CURVES));
-        for s in steps
-            .iter()
-            .filter(|s| s.mode == ADAPTIVE_STENCIL_MODE_ROWS)
-        {
-            assert_eq!(s.items.start, next, "in order, no gap or overlap");
-            assert!(s.items.len() <= 100);
-            next = s.items.end;
-            let [rows, terms] = &sets[s.set];
-            assert_eq!(rows.start % 4, 0, "row window start aligned to 16 bytes");
-            assert_eq!(terms.start % 2, 0, "term window start aligned to 16 bytes");
-            assert!((rows.end - rows.start + 1) * 4 <= 4096);
-            assert!((terms.end - terms.start) * 8 <= 4096);
-            for r in s.items.clone() {
-                let (k0, k1) = (
-                    g.stencil_offsets[r as usize],
-                    g.stencil_offsets[r as usize + 1],
-                );
-                assert!(rows.start <= r && r < rows.end);
-                assert!(k0 == k1 || (terms.start <= k0 && k1 <= terms.end));
-            }
-        }
-        assert_eq!(next as usize, g.stencil_offsets.len() - 1);
-    }
-
-    fn limits(max_range: u64) -> Limits {
-        Limits {
-            max_range,
-            alignment: 16,
-        }
+        assert_eq!(g.first_curve_point + next_point, g.num_vertices);
+        assert_eq!(
+            plan_canonical(&g, u32::MAX).len(),
+            2,
+            "one dispatch per mode"
+        );
     }
 }

@@ -2,9 +2,11 @@
 //! Boubekeur, the paper's Fig. 2):
 //!
 //! 1. **Initial GPU subdivision step** (the pre-pass, every frame): level-1 positions as
-//!    stencils over the base positions (`glsl/bft/subdivide.comp`), then level-1 limit normals
-//!    from the limit tangent masks (`glsl/bft/normals.comp`). An animated base mesh costs one
-//!    upload of its positions per frame; stencils, patch records and tables never change.
+//!    stencils over the base positions (the stencil evaluator, [`crate::stencil`], reading the
+//!    frame slot's base positions and writing the level-1 positions), then level-1 limit
+//!    normals from the limit tangent masks (`glsl/bft/normals.comp`). An animated base mesh
+//!    costs one upload of its positions per frame; stencils, patch records and tables never
+//!    change.
 //! 2. **Main pass**: one patch (one control point carrying the face index) per level-1 face.
 //!    `bft.tesc` sets power-of-two (or fractional) edge factors from each edge's two endpoints
 //!    only; `bft.tese` evaluates the table row of each tess coordinate (see
@@ -28,10 +30,10 @@
 //! the input's polygons, so callers never see the triangulation.
 //!
 //! **Buffers beyond `maxStorageBufferRange`** (a 1M-triangle mesh has 4M level-1 faces: 160 MB
-//! of patch headers, 190 MB of rings, more than lavapipe's 128 MiB): the pre-pass runs in
-//! chunks of level-1 vertices and the draw in chunks of patches, each with its own descriptor
-//! set of windows into the shared buffers and its bases in the push constants
-//! ([`super::windows`]). A patch's footprint includes its edge and corner owners' headers,
+//! of patch headers, 190 MB of rings, more than lavapipe's 128 MiB): the stencil evaluator
+//! windows its own buffers, the normals pass runs in chunks of level-1 vertices and the draw
+//! in chunks of patches, each with its own descriptor set of windows into the shared buffers
+//! and its bases in the push constants ([`super::windows`]). A patch's footprint includes its edge and corner owners' headers,
 //! rings and ring vertices, since the TES evaluates shared points in the owner's frame. A mesh
 //! that fits is one chunk with bases 0: the same draw as before.
 use crate::capture::{face_corner_uv, FacePoint};
@@ -45,22 +47,22 @@ use super::shared::{
 use super::windows::{self, Chunk, Limits, Member, Space};
 use crate::bench::usage::Laps;
 use crate::gpu::bindings::{
-    BFT_BASE_POSITIONS_BINDING, BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING,
-    BFT_LOCAL_SIZE, BFT_MIRROR_PERMS_BINDING, BFT_OPTION_FRACTIONAL, BFT_OPTION_GEOMETRIC_NORMALS,
+    BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING, BFT_LOCAL_SIZE,
+    BFT_MIRROR_PERMS_BINDING, BFT_OPTION_FRACTIONAL, BFT_OPTION_GEOMETRIC_NORMALS,
     BFT_OPTION_PATCH_COLOURS, BFT_PATCH_HEADERS_BINDING, BFT_PATCH_RINGS_BINDING,
-    BFT_ROW_MAPS_BINDING, BFT_STENCIL_OFFSETS_BINDING, BFT_STENCIL_TERMS_BINDING,
-    BFT_TABLES_BINDING, BFT_TABLE_WEIGHTS_BINDING, BFT_TANGENT_OFFSETS_BINDING,
-    BFT_TANGENT_TERMS_BINDING,
+    BFT_ROW_MAPS_BINDING, BFT_TABLES_BINDING, BFT_TABLE_WEIGHTS_BINDING,
+    BFT_TANGENT_OFFSETS_BINDING, BFT_TANGENT_TERMS_BINDING,
 };
 use crate::gpu::BftPush;
 use crate::shaders::{self, Stage, Variant};
+use crate::stencil::{self, GpuStencils, StencilBlock, StencilEvaluator, StencilVertices};
 use crate::technique::{
     for_each_draw, number_arrays, DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features,
     FrameParams, Pass, PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
 };
 use crate::techniques::{BuildOptions, Built, TechniqueInfo};
 use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, Domain, Spacing};
-use layout::{BasePosition, PackedTables, PatchHeader, StencilTerm, TangentTerm, STORAGE_BINDINGS};
+use layout::{PackedTables, PatchHeader, TangentTerm, STORAGE_BINDINGS};
 use std::ops::Range;
 use topology::patches::bft::{
     build_patch_records, face_rotations, level1_base_domain, loop_level1, loop_tables,
@@ -150,23 +152,15 @@ const fn member(stride: usize, extra: u32) -> Member {
         extra,
     }
 }
-/// Level-1 positions and normals (`vec4`) and the stencil and tangent CSR offsets (one past).
+/// Level-1 positions and normals (`vec4`) and the tangent CSR offsets (one past).
 const LEVEL1_MEMBERS: [Member; 2] = [member(16, 0), member(4, 1)];
 const LEVEL1: Space = Space {
     name: "level-1 vertex",
     members: &LEVEL1_MEMBERS,
 };
-const STENCIL: Space = Space {
-    name: "stencil term",
-    members: &[member(std::mem::size_of::<StencilTerm>(), 0)],
-};
 const TANGENT: Space = Space {
     name: "tangent term",
     members: &[member(std::mem::size_of::<TangentTerm>(), 0)],
-};
-const BASE: Space = Space {
-    name: "base position",
-    members: &[member(std::mem::size_of::<BasePosition>(), 0)],
 };
 const PATCHES: Space = Space {
     name: "patch header",
@@ -181,9 +175,7 @@ const RINGS: Space = Space {
 #[derive(Clone, Debug, Default)]
 struct SetWindows {
     level1: Range<u32>,
-    stencil: Range<u32>,
     tangent: Range<u32>,
-    base: Range<u32>,
     patches: Range<u32>,
     rings: Range<u32>,
 }
@@ -192,9 +184,7 @@ impl SetWindows {
     /// The push constants' bases.
     fn apply(&self, push: &mut BftPush) {
         push.level1_base = self.level1.start;
-        push.stencil_base = self.stencil.start;
         push.tangent_base = self.tangent.start;
-        push.base_vertex_base = self.base.start;
         push.patch_base = self.patches.start;
         push.ring_base = self.rings.start;
     }
@@ -208,50 +198,36 @@ fn span(indices: impl IntoIterator<Item = u32>) -> Range<u32> {
     lo..hi + 1
 }
 
-/// The CSR arrays the pre-pass reads, as packed ([`layout::pack_stencils`],
-/// [`layout::pack_tangents`]).
-struct PrePassData<'a> {
-    stencil_offsets: &'a [u32],
-    stencil_terms: &'a [StencilTerm],
-    tangent_offsets: &'a [u32],
-    tangent_terms: &'a [TangentTerm],
+/// Chunks of level-1 vertices for the normals pass: each reads its tangent rows and their
+/// level-1 vertices; at most `max_items` per dispatch.
+fn plan_normals(
+    tangent_offsets: &[u32],
+    tangent_terms: &[TangentTerm],
     level1_vertices: u32,
-}
-
-/// Chunks of level-1 vertices for the pre-pass: each reads its stencil rows, their base
-/// vertices, its tangent rows and their level-1 vertices; at most `max_items` per dispatch.
-fn plan_pre_pass(
-    g: &PrePassData,
     limits: Limits,
     max_items: u32,
 ) -> Result<Vec<(Range<u32>, SetWindows)>> {
     let chunks = windows::plan(
         "level-1 vertex",
-        g.level1_vertices,
-        &[LEVEL1, STENCIL, TANGENT, BASE],
+        level1_vertices,
+        &[LEVEL1, TANGENT],
         limits,
         |v| {
             let i = v as usize;
-            let (s0, s1) = (g.stencil_offsets[i], g.stencil_offsets[i + 1]);
-            let (t0, t1) = (g.tangent_offsets[i], g.tangent_offsets[i + 1]);
-            let tangent = &g.tangent_terms[t0 as usize..t1 as usize];
-            let stencil = &g.stencil_terms[s0 as usize..s1 as usize];
+            let (t0, t1) = (tangent_offsets[i], tangent_offsets[i + 1]);
+            let tangent = &tangent_terms[t0 as usize..t1 as usize];
             [
                 span(std::iter::once(v).chain(tangent.iter().map(|t| t.index))),
-                s0..s1,
                 t0..t1,
-                span(stencil.iter().map(|t| t.index)),
             ]
         },
     )?;
     let mut out = Vec::new();
     for Chunk { items, windows } in chunks {
-        let [level1, stencil, tangent, base] = windows;
+        let [level1, tangent] = windows;
         let w = SetWindows {
             level1,
-            stencil,
             tangent,
-            base,
             ..Default::default()
         };
         let mut first = items.start;
@@ -370,13 +346,6 @@ fn flag(on: bool, bit: u32) -> u32 {
     }
 }
 
-/// Base positions as the `BasePositions` buffer holds them.
-fn as_base_positions(positions: &[[f32; 3]]) -> &[u8] {
-    bytemuck::cast_slice::<BasePosition, u8>(bytemuck::cast_slice::<[f32; 3], BasePosition>(
-        positions,
-    ))
-}
-
 /// How a BFT surface is built (the per-frame choices are in [`FrameParams`]).
 #[derive(Clone, Debug)]
 pub struct BftOptions {
@@ -419,12 +388,13 @@ fn patch_block_for(device: &vk_core::Device) -> bool {
 /// One base mesh on the GPU with everything the BFT pipeline reads. Drop order: pipelines,
 /// sets (they keep their pool alive), pool, buffers.
 pub struct Bft {
-    subdivide: Pipeline,
+    /// Level-1 positions from the frame slot's base positions (one evaluator target per slot).
+    evaluator: StencilEvaluator,
     normals: Pipeline,
-    /// Per frame slot, one set per pre-pass chunk (slots differ only in the base positions).
-    pre_sets: Vec<Vec<DescriptorSet>>,
-    /// Level-1 vertices of each pre-pass chunk, and its windows.
-    pre_chunks: Vec<(Range<u32>, SetWindows)>,
+    /// One set per normals chunk (the normals never read base positions: shared by every slot).
+    normals_sets: Vec<DescriptorSet>,
+    /// Level-1 vertices of each normals chunk, and its windows.
+    normals_chunks: Vec<(Range<u32>, SetWindows)>,
     /// One set per draw chunk (the draw never reads base positions: shared by every slot).
     draw_sets: Vec<DescriptorSet>,
     /// Patches of each draw chunk, and its windows.
@@ -543,6 +513,100 @@ fn bytes_of<T>(v: &[T]) -> u64 {
     std::mem::size_of_val(v) as u64
 }
 
+/// The initial subdivision step's GPU side: per frame slot a base-position buffer (the
+/// evaluator's vertices), the level-1 positions, and the stencil evaluator from each slot's
+/// base positions to the level-1 positions.
+struct InitialStep {
+    evaluator: StencilEvaluator,
+    base: Vec<Buffer>,
+    level1_positions: Buffer,
+}
+
+impl InitialStep {
+    fn new(
+        device: &vk_core::Device,
+        stencils: &GpuStencils,
+        base_positions: &[[f32; 3]],
+        level1_vertices: u32,
+        frames: usize,
+    ) -> Result<Self> {
+        let base_vertices = base_positions.len() as u32;
+        let vertices = stencil::vertices(base_positions);
+        let mut base = Vec::with_capacity(frames);
+        for i in 0..frames {
+            let mut buf = Buffer::new(
+                device,
+                &BufferDesc {
+                    name: &format!("bft base positions {i}"),
+                    size: stencil::vertex_bytes(base_vertices),
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                    location: MemoryLocation::CpuToGpu,
+                },
+            )?;
+            buf.write(0, bytemuck::cast_slice(&vertices))?;
+            base.push(buf);
+        }
+        let level1_positions = Buffer::new(
+            device,
+            &BufferDesc {
+                name: "bft level-1 positions",
+                size: stencil::vertex_bytes(level1_vertices),
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::GpuOnly,
+            },
+        )?;
+        let targets: Vec<(&Buffer, &Buffer)> =
+            base.iter().map(|b| (b, &level1_positions)).collect();
+        let evaluator = StencilEvaluator::new(
+            device,
+            "bft",
+            stencils,
+            &[StencilBlock {
+                rows: 0..level1_vertices,
+                destination: 0,
+            }],
+            StencilVertices {
+                sources: base_vertices,
+                destinations: level1_vertices,
+                in_place: false,
+            },
+            &targets,
+        )?;
+        Ok(Self {
+            evaluator,
+            base,
+            level1_positions,
+        })
+    }
+}
+
+/// The basis-function tables' buffers, by binding: header and entries, mirror permutations,
+/// row maps, weights.
+fn table_buffers(device: &vk_core::Device, t: &PackedTables) -> Result<Vec<(u32, Buffer)>> {
+    let table_header = t.header_bytes();
+    [
+        (BFT_TABLES_BINDING, "bft tables", &table_header[..]),
+        (
+            BFT_MIRROR_PERMS_BINDING,
+            "bft mirror permutations",
+            bytemuck::cast_slice(&t.mirror_perms),
+        ),
+        (
+            BFT_ROW_MAPS_BINDING,
+            "bft row maps",
+            bytemuck::cast_slice(&t.row_maps),
+        ),
+        (
+            BFT_TABLE_WEIGHTS_BINDING,
+            "bft table weights",
+            bytemuck::cast_slice(&t.weights),
+        ),
+    ]
+    .into_iter()
+    .map(|(binding, name, bytes)| Ok((binding, storage(device, name, bytes)?)))
+    .collect()
+}
+
 impl Bft {
     /// Prepares `mesh` (fan-triangulated first when it has polygons; refined once on the CPU
     /// for the topology; stencils, patch records and the tables at `options.table_level`) and
@@ -578,52 +642,40 @@ impl Bft {
         };
         let (loop_mesh, fans, note) = loop_control_mesh(mesh, &options.name);
         let limits = Limits::of(&device);
-        // The level-1 mesh and the base → level-1 stencils, packed at once (f32 terms).
+        // The level-1 mesh and the base → level-1 stencils, packed at once (f32 terms), handed
+        // to the stencil evaluator and freed.
         let (level1, stencils) = loop_level1(&loop_mesh).map_err(mesh_error)?;
         let base_vertices = loop_mesh.positions.len() as u32;
         let level1_vertices = level1.num_vertices() as u32;
-        let (stencil_offsets, stencil_terms) = layout::pack_stencils(stencils);
-        layout::validate_stencils(
-            &stencil_offsets,
-            &stencil_terms,
+        let stencils = GpuStencils::from_table(stencils);
+        stencils
+            .validate(level1_vertices, base_vertices)
+            .map_err(layout::LayoutError::from)?;
+        let base_positions = base_positions(&loop_mesh);
+        let step = InitialStep::new(
+            &device,
+            &stencils,
+            &base_positions,
             level1_vertices,
-            base_vertices,
+            ctx.frames_in_flight(),
         )?;
+        let (stencil_count, stencil_bytes) = (stencils.terms.len() as u64, stencils.bytes());
+        drop(stencils);
         stages.push(laps.lap("level 1"));
-        // Tangent stencils, then the pre-pass chunks (they window both CSR tables); both
+        // Tangent stencils, then the normals chunks (they window the CSR table); both
         // uploaded and freed.
         let (tangent_offsets, tangent_terms) =
             layout::pack_tangents(loop_tangent_stencils(&level1));
         layout::validate_tangents(&tangent_offsets, &tangent_terms, level1_vertices)?;
         let max_groups = device.info.caps.max_compute_work_group_count[0];
-        let pre_chunks = plan_pre_pass(
-            &PrePassData {
-                stencil_offsets: &stencil_offsets,
-                stencil_terms: &stencil_terms,
-                tangent_offsets: &tangent_offsets,
-                tangent_terms: &tangent_terms,
-                level1_vertices,
-            },
+        let normals_chunks = plan_normals(
+            &tangent_offsets,
+            &tangent_terms,
+            level1_vertices,
             limits,
             max_groups.saturating_mul(BFT_LOCAL_SIZE),
         )?;
         let mut statics = vec![
-            (
-                BFT_STENCIL_OFFSETS_BINDING,
-                storage(
-                    &device,
-                    "bft stencil offsets",
-                    bytemuck::cast_slice(&stencil_offsets),
-                )?,
-            ),
-            (
-                BFT_STENCIL_TERMS_BINDING,
-                storage(
-                    &device,
-                    "bft stencil terms",
-                    bytemuck::cast_slice(&stencil_terms),
-                )?,
-            ),
             (
                 BFT_TANGENT_OFFSETS_BINDING,
                 storage(
@@ -641,16 +693,9 @@ impl Bft {
                 )?,
             ),
         ];
-        let (stencil_count, tangent_count) =
-            (stencil_terms.len() as u64, tangent_terms.len() as u64);
-        let stencil_bytes = bytes_of(&stencil_offsets) + bytes_of(&stencil_terms);
+        let tangent_count = tangent_terms.len() as u64;
         let tangent_bytes = bytes_of(&tangent_offsets) + bytes_of(&tangent_terms);
-        drop((
-            stencil_offsets,
-            stencil_terms,
-            tangent_offsets,
-            tangent_terms,
-        ));
+        drop((tangent_offsets, tangent_terms));
         stages.push(laps.lap("tangent stencils and upload"));
         // Records and tables; then the level-1 mesh is no longer needed.
         let records = build_patch_records(&level1).map_err(mesh_error)?;
@@ -689,27 +734,7 @@ impl Bft {
             )?,
         ));
         drop(patch_rings);
-        let table_header = packed_tables.header_bytes();
-        for (binding, name, bytes) in [
-            (BFT_TABLES_BINDING, "bft tables", &table_header[..]),
-            (
-                BFT_MIRROR_PERMS_BINDING,
-                "bft mirror permutations",
-                bytemuck::cast_slice(&packed_tables.mirror_perms),
-            ),
-            (
-                BFT_ROW_MAPS_BINDING,
-                "bft row maps",
-                bytemuck::cast_slice(&packed_tables.row_maps),
-            ),
-            (
-                BFT_TABLE_WEIGHTS_BINDING,
-                "bft table weights",
-                bytemuck::cast_slice(&packed_tables.weights),
-            ),
-        ] {
-            statics.push((binding, storage(&device, name, bytes)?));
-        }
+        statics.extend(table_buffers(&device, &packed_tables)?);
         let summary = BftSummary {
             base_vertices,
             level1_vertices,
@@ -726,66 +751,40 @@ impl Bft {
         };
         drop(packed_tables);
         stages.push(laps.lap("patches and upload"));
-        let frames = ctx.frames_in_flight();
         ctx.ensure_set_layout(TechniqueId::BFT, &SET_BINDINGS)?;
         let set_layout = ctx.set_layout(TechniqueId::BFT)?;
-        let max_sets = frames * pre_chunks.len() + draw_chunks.len();
+        let max_sets = normals_chunks.len() + draw_chunks.len();
         let pool =
             DescriptorPool::new(&device, "bft descriptor pool", set_layout, max_sets as u32)?;
-        let level1_bytes =
-            (std::mem::size_of::<layout::Level1Point>() * level1_vertices.max(1) as usize) as u64;
-        let level1 = |binding: u32, name: &str| -> Result<(u32, Buffer)> {
-            let desc = BufferDesc {
-                name,
-                size: level1_bytes,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-                location: MemoryLocation::GpuOnly,
-            };
-            Ok((binding, Buffer::new(&device, &desc)?))
-        };
-        statics.push(level1(
-            BFT_LEVEL1_POSITIONS_BINDING,
-            "bft level-1 positions",
-        )?);
-        statics.push(level1(BFT_LEVEL1_NORMALS_BINDING, "bft level-1 normals")?);
-        let base_positions = base_positions(&loop_mesh);
-        let mut base = Vec::new();
-        for i in 0..frames {
-            let mut buf = Buffer::new(
+        let InitialStep {
+            evaluator,
+            base,
+            level1_positions,
+        } = step;
+        statics.push((BFT_LEVEL1_POSITIONS_BINDING, level1_positions));
+        statics.push((
+            BFT_LEVEL1_NORMALS_BINDING,
+            Buffer::new(
                 &device,
                 &BufferDesc {
-                    name: &format!("bft base positions {i}"),
-                    size: (std::mem::size_of::<BasePosition>() * base_positions.len().max(1))
-                        as u64,
+                    name: "bft level-1 normals",
+                    size: stencil::vertex_bytes(level1_vertices),
                     usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-                    location: MemoryLocation::CpuToGpu,
+                    location: MemoryLocation::GpuOnly,
                 },
-            )?;
-            buf.write(0, as_base_positions(&base_positions))?;
-            base.push(buf);
-        }
+            )?,
+        ));
         // Every binding of a set: windowed buffers as the chunk's windows, the tables whole.
-        let (n1, nv) = (level1_vertices as u64, base_vertices as u64);
-        let write_set = |base: &Buffer, w: &SetWindows| -> Result<DescriptorSet> {
+        let n1 = level1_vertices as u64;
+        let write_set = |w: &SetWindows| -> Result<DescriptorSet> {
             let set = pool.allocate_set(set_layout)?;
             let csr = LEVEL1_MEMBERS[1];
-            windows::write_window(
-                &set,
-                BFT_BASE_POSITIONS_BINDING,
-                base,
-                BASE.members[0],
-                nv,
-                &w.base,
-            )?;
             for (binding, buf) in &statics {
                 let (m, len, win) = match *binding {
                     BFT_LEVEL1_POSITIONS_BINDING | BFT_LEVEL1_NORMALS_BINDING => {
                         (LEVEL1_MEMBERS[0], n1, &w.level1)
                     }
-                    BFT_STENCIL_OFFSETS_BINDING | BFT_TANGENT_OFFSETS_BINDING => {
-                        (csr, n1 + 1, &w.level1)
-                    }
-                    BFT_STENCIL_TERMS_BINDING => (STENCIL.members[0], stencil_count, &w.stencil),
+                    BFT_TANGENT_OFFSETS_BINDING => (csr, n1 + 1, &w.level1),
                     BFT_TANGENT_TERMS_BINDING => (TANGENT.members[0], tangent_count, &w.tangent),
                     BFT_PATCH_HEADERS_BINDING => {
                         (PATCHES.members[0], patch_count as u64, &w.patches)
@@ -800,50 +799,41 @@ impl Bft {
             }
             Ok(set)
         };
-        let mut pre_sets = Vec::new();
-        for b in &base {
-            let sets: Result<Vec<_>> = pre_chunks.iter().map(|(_, w)| write_set(b, w)).collect();
-            pre_sets.push(sets?);
-        }
-        let draw_base = base
-            .first()
-            .ok_or(TessError::FrameSlot { slot: 0, slots: 0 })?;
+        let normals_sets = normals_chunks
+            .iter()
+            .map(|(_, w)| write_set(w))
+            .collect::<Result<Vec<_>>>()?;
         let draw_sets = draw_chunks
             .iter()
-            .map(|(_, w)| write_set(draw_base, w))
+            .map(|(_, w)| write_set(w))
             .collect::<Result<Vec<_>>>()?;
-        let layouts = [ctx.frame_set_layout().raw, set_layout.raw];
-        let push = std::mem::size_of::<BftPush>() as u32;
-        let compute = |name: &str, stage: Stage| -> Result<Pipeline> {
-            Ok(Pipeline::compute(
-                &device,
-                name,
-                ShaderStage::new(
-                    vk::ShaderStageFlags::COMPUTE,
-                    shaders::spirv(stage, Variant::default())?,
-                ),
-                &layouts,
-                push,
-            )?)
-        };
-        let subdivide = compute("bft subdivide", Stage::BftSubdivideComp)?;
-        let normals = compute("bft normals", Stage::BftNormalsComp)?;
+        let normals = Pipeline::compute(
+            &device,
+            "bft normals",
+            ShaderStage::new(
+                vk::ShaderStageFlags::COMPUTE,
+                shaders::spirv(Stage::BftNormalsComp, Variant::default())?,
+            ),
+            &[ctx.frame_set_layout().raw, set_layout.raw],
+            std::mem::size_of::<BftPush>() as u32,
+        )?;
         let arrays = number_arrays(&[(PatchType::LoopBft, patch_count, 1)]);
         stages.push(laps.lap("sets and pipelines"));
         log::info!(
-            "bft {}: {}; {} pre-pass and {} draw chunks",
+            "bft {}: {}; {:?} stencil (dispatches, chunks), {} normals and {} draw chunks",
             options.name,
             stages.join("; "),
-            pre_chunks.len(),
+            evaluator.counts(),
+            normals_chunks.len(),
             draw_chunks.len()
         );
         let drawn = drawn_runs(summary.patch_count, &loop_mesh.holes);
         Ok(Self {
             patch_block,
-            subdivide,
+            evaluator,
             normals,
-            pre_sets,
-            pre_chunks,
+            normals_sets,
+            normals_chunks,
             draw_sets,
             draw_chunks,
             _pool: pool,
@@ -882,7 +872,11 @@ impl Bft {
     /// Chunks of the pre-pass and of the draw (one each unless a buffer exceeds the device's
     /// storage-buffer range: see the module header).
     pub fn chunk_counts(&self) -> (usize, usize) {
-        (self.pre_chunks.len(), self.draw_chunks.len())
+        let stencil_chunks = self.evaluator.counts().1;
+        (
+            stencil_chunks.max(self.normals_chunks.len()),
+            self.draw_chunks.len(),
+        )
     }
 
     /// Level-1 faces: patches per frame.
@@ -1047,7 +1041,7 @@ impl Technique for Bft {
             .get_mut(slot)
             .ok_or(TessError::FrameSlot { slot, slots })?;
         let positions: Vec<[f32; 3]> = positions.iter().map(|p| p.map(canonical_zero)).collect();
-        buf.write(0, as_base_positions(&positions))?;
+        buf.write(0, bytemuck::cast_slice(&stencil::vertices(&positions)))?;
         self.base_positions = positions;
         Ok(())
     }
@@ -1058,10 +1052,6 @@ impl Technique for Bft {
         frame_set: &'a DescriptorSet,
         slot: usize,
     ) -> Result<()> {
-        let sets = self.pre_sets.get(slot).ok_or(TessError::FrameSlot {
-            slot,
-            slots: self.pre_sets.len(),
-        })?;
         let tess_stages = vk::PipelineStageFlags::VERTEX_SHADER
             | vk::PipelineStageFlags::TESSELLATION_CONTROL_SHADER
             | vk::PipelineStageFlags::TESSELLATION_EVALUATION_SHADER;
@@ -1071,29 +1061,32 @@ impl Technique for Bft {
         // The previous frame's tessellation stages read level 1 before we overwrite it; host
         // writes of the base positions are visible at submit.
         enc.memory_barrier((tess_stages, vk::AccessFlags::SHADER_READ), write);
-        for (pipeline, next) in [
-            (&self.subdivide, (compute, vk::AccessFlags::SHADER_READ)),
-            (&self.normals, (tess_stages, vk::AccessFlags::SHADER_READ)),
-        ] {
-            enc.bind_pipeline(pipeline);
-            for (k, ((items, w), set)) in self.pre_chunks.iter().zip(sets).enumerate() {
-                // Chunks write disjoint vertices, but their windows overlap (synchronization
-                // validation sees whole ranges): order them.
-                if k > 0 {
-                    enc.memory_barrier(write, write);
-                }
-                let mut push = BftPush {
-                    count: items.end - items.start,
-                    first_vertex: items.start,
-                    ..Default::default()
-                };
-                w.apply(&mut push);
-                enc.bind_descriptor_sets(0, &[frame_set, set])?;
-                enc.push_constants(&push)?;
-                enc.dispatch([push.count.div_ceil(BFT_LOCAL_SIZE).max(1), 1, 1])?;
+        self.evaluator.record(enc, slot)?;
+        // The normals read the level-1 positions.
+        enc.memory_barrier(write, (compute, vk::AccessFlags::SHADER_READ));
+        enc.bind_pipeline(&self.normals);
+        for (k, ((items, w), set)) in self
+            .normals_chunks
+            .iter()
+            .zip(&self.normals_sets)
+            .enumerate()
+        {
+            // Chunks write disjoint vertices, but their windows overlap (synchronization
+            // validation sees whole ranges): order them.
+            if k > 0 {
+                enc.memory_barrier(write, write);
             }
-            enc.memory_barrier(write, next);
+            let mut push = BftPush {
+                count: items.end - items.start,
+                first_vertex: items.start,
+                ..Default::default()
+            };
+            w.apply(&mut push);
+            enc.bind_descriptor_sets(0, &[frame_set, set])?;
+            enc.push_constants(&push)?;
+            enc.dispatch([push.count.div_ceil(BFT_LOCAL_SIZE).max(1), 1, 1])?;
         }
+        enc.memory_barrier(write, (tess_stages, vk::AccessFlags::SHADER_READ));
         enc.end_label();
         Ok(())
     }
@@ -1178,6 +1171,7 @@ impl Technique for Bft {
     fn device_memory(&self) -> Vec<DeviceAllocation> {
         self.base
             .iter()
+            .chain(self.evaluator.buffers())
             .chain(&self._static)
             .map(DeviceAllocation::of_buffer)
             .collect()
