@@ -856,3 +856,20 @@ fn corner_sums_are_precise_and_mix_free() {
         }
     }
 }
+
+/// The stencil evaluator sums each row under `precise`: the products and sums of
+/// `anchor + Σ w (x − anchor)` are not contracted into fused multiply-adds, so every driver
+/// computes what `GpuStencils::row_point` mirrors (BFT's and adaptive's exactness tests, and
+/// the evaluator's bit-for-bit test, rely on it where CI has no GPU to see it).
+#[test]
+fn stencil_rows_are_summed_without_contraction() {
+    for (v, words) in Stage::StencilEvaluateComp.compiled() {
+        let (no_contraction, fmix) = contraction_and_mix(words);
+        println!("{v:?}: {no_contraction} NoContraction decorations");
+        assert!(
+            no_contraction >= 3,
+            "{v:?}: {no_contraction} NoContraction decorations"
+        );
+        assert_eq!(fmix, 0, "{v:?} calls mix()");
+    }
+}

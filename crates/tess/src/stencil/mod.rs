@@ -5,7 +5,9 @@
 //! descriptor, the rows' sizes, offsets, indices and weights, one evaluator per back-end).
 //! Loop's initial subdivision step (`techniques::bft`) and feature-adaptive Catmull-Clark's
 //! levels and local points (`techniques::adaptive`, and so the single-pass Gregory and ACC
-//! plans) use it; a per-level Doo-Sabin refinement would be a third user with nothing new.
+//! plans) use it. A per-level Doo-Sabin refinement would be a third user with nothing new: its
+//! table (one CSR row per refined vertex, over the level before it) and one block per level,
+//! in place over one vertex buffer or between a source and a destination buffer per level.
 //!
 //! Design decisions:
 //! - **Rows, blocks, buffers.** A table ([`GpuStencils`]) is CSR: row `r`'s terms are
@@ -27,6 +29,8 @@
 //!   not to the coordinates' magnitude (absolute sums put the deep levels around a
 //!   valence-360 pole 1.4e-5 of the diagonal off the CPU plan). A row with no term writes the
 //!   origin. [`GpuStencils::row_point`] is the kernel's f32 mirror, operation for operation.
+//!   This was adaptive's convention; BFT's initial step summed absolutely before and keeps its
+//!   exactness tolerances, its bit-welded watertightness and its golden images unchanged.
 //! - **Windows for everything the kernel indexes.** A device binds at most
 //!   `maxStorageBufferRange` bytes per descriptor, so the rows are cut into chunks
 //!   ([`crate::techniques::windows`]) whose windows of the offsets, the terms, the source
@@ -38,6 +42,10 @@
 //! - **Checked before upload**: every term reads an existing source vertex, every block
 //!   writes existing destination vertices, and in place no row reads its own block's
 //!   destinations ([`StencilError`]), so the GPU never indexes out of bounds or races.
+//! - **Its own set and pipeline.** The evaluator's pipeline layout is its one set
+//!   ([`crate::gpu::bindings::STENCIL_SET`]), so it binds nothing of the technique that owns
+//!   it; each evaluator holds its table's buffers, one descriptor set per (target, chunk) and
+//!   its pipeline.
 //! - **Dispatch order.** One dispatch per (block, chunk) pair, at most `maxComputeWorkGroupCount`
 //!   groups each, every one ordered after the one before by a barrier (windows of neighbouring
 //!   chunks can overlap by their alignment, and synchronization validation sees whole ranges).

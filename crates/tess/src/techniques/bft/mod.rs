@@ -513,6 +513,163 @@ fn bytes_of<T>(v: &[T]) -> u64 {
     std::mem::size_of_val(v) as u64
 }
 
+/// A topology error of the mesh `options` name.
+fn mesh_error(options: &BftOptions, e: topology::limit::eval::EvalError) -> TessError {
+    TessError::Mesh {
+        name: options.name.clone(),
+        source: e.into(),
+    }
+}
+
+/// The normals pass's data: the level-1 limit-tangent stencils packed, validated and uploaded
+/// (by binding), its chunks, and the terms' count and bytes.
+struct NormalsStage {
+    buffers: Vec<(u32, Buffer)>,
+    chunks: Vec<(Range<u32>, SetWindows)>,
+    terms: u64,
+    bytes: u64,
+}
+
+impl NormalsStage {
+    fn new(
+        device: &vk_core::Device,
+        stencils: topology::patches::bft::TangentStencils,
+        level1_vertices: u32,
+        limits: Limits,
+    ) -> Result<Self> {
+        let (offsets, terms) = layout::pack_tangents(stencils);
+        layout::validate_tangents(&offsets, &terms, level1_vertices)?;
+        let max_groups = device.info.caps.max_compute_work_group_count[0];
+        let chunks = plan_normals(
+            &offsets,
+            &terms,
+            level1_vertices,
+            limits,
+            max_groups.saturating_mul(BFT_LOCAL_SIZE),
+        )?;
+        let buffers = vec![
+            (
+                BFT_TANGENT_OFFSETS_BINDING,
+                storage(
+                    device,
+                    "bft tangent offsets",
+                    bytemuck::cast_slice(&offsets),
+                )?,
+            ),
+            (
+                BFT_TANGENT_TERMS_BINDING,
+                storage(device, "bft tangent terms", bytemuck::cast_slice(&terms))?,
+            ),
+        ];
+        Ok(Self {
+            buffers,
+            chunks,
+            terms: terms.len() as u64,
+            bytes: bytes_of(&offsets) + bytes_of(&terms),
+        })
+    }
+}
+
+/// The draw's data: patch records and tables built from the level-1 mesh, packed, validated
+/// and uploaded (by binding), the draw chunks, each face's rotation, and the counts and bytes
+/// of the summary.
+struct PatchStage {
+    buffers: Vec<(u32, Buffer)>,
+    draw_chunks: Vec<(Range<u32>, SetWindows)>,
+    rotations: Vec<u8>,
+    count: u32,
+    ring_slots: u64,
+    bytes: u64,
+    table: layout::TableHeader,
+    tangents: bool,
+    table_bytes: u64,
+}
+
+impl PatchStage {
+    /// Takes the level-1 mesh and frees it once the records and tables are built, and each
+    /// product once uploaded; `laps` and `stages` time the records and tables.
+    fn new(
+        device: &vk_core::Device,
+        level1: topology::limit::eval::LocalMesh,
+        options: &BftOptions,
+        limits: Limits,
+        laps: &mut Laps,
+        stages: &mut Vec<String>,
+    ) -> Result<Self> {
+        let records = build_patch_records(&level1).map_err(|e| mesh_error(options, e))?;
+        check_table_range(&records, options.table_level, options, limits.max_range)?;
+        let tables = loop_tables(&level1, &records, options.table_level, options.tangents)
+            .map_err(|e| mesh_error(options, e))?;
+        let rotations = face_rotations(&level1, &records);
+        let level1_vertices = level1.num_vertices() as u32;
+        drop(level1);
+        stages.push(laps.lap("records and tables"));
+        let packed = PackedTables::new(&tables);
+        packed.validate()?;
+        let (patches, rings) = layout::pack_patches(records, &tables)?;
+        let tangents = tables.tangents;
+        drop(tables);
+        layout::validate_patches(&patches, &rings, &packed.entries, level1_vertices)?;
+        let draw_chunks = plan_draw(&patches, &rings, limits)?;
+        let (count, ring_slots) = (patches.len() as u32, rings.len() as u64);
+        let bytes = bytes_of(&patches) + bytes_of(&rings);
+        let mut buffers = vec![(
+            BFT_PATCH_HEADERS_BINDING,
+            storage(device, "bft patch headers", bytemuck::cast_slice(&patches))?,
+        )];
+        drop(patches);
+        buffers.push((
+            BFT_PATCH_RINGS_BINDING,
+            storage(device, "bft patch rings", bytemuck::cast_slice(&rings))?,
+        ));
+        drop(rings);
+        buffers.extend(table_buffers(device, &packed)?);
+        Ok(Self {
+            buffers,
+            draw_chunks,
+            rotations,
+            count,
+            ring_slots,
+            bytes,
+            table: packed.table,
+            tangents,
+            table_bytes: packed.bytes() as u64,
+        })
+    }
+}
+
+/// A set of the BFT layout: the windowed buffers of `statics` as `w`'s windows, the others
+/// whole.
+fn write_set(
+    pool: &DescriptorPool,
+    layout: &vk_core::descriptor::DescriptorSetLayout,
+    statics: &[(u32, Buffer)],
+    summary: &BftSummary,
+    w: &SetWindows,
+) -> Result<DescriptorSet> {
+    let set = pool.allocate_set(layout)?;
+    let n1 = summary.level1_vertices as u64;
+    for (binding, buf) in statics {
+        let (m, len, win) = match *binding {
+            BFT_LEVEL1_POSITIONS_BINDING | BFT_LEVEL1_NORMALS_BINDING => {
+                (LEVEL1_MEMBERS[0], n1, &w.level1)
+            }
+            BFT_TANGENT_OFFSETS_BINDING => (LEVEL1_MEMBERS[1], n1 + 1, &w.level1),
+            BFT_TANGENT_TERMS_BINDING => (TANGENT.members[0], summary.tangent_terms, &w.tangent),
+            BFT_PATCH_HEADERS_BINDING => {
+                (PATCHES.members[0], summary.patch_count as u64, &w.patches)
+            }
+            BFT_PATCH_RINGS_BINDING => (RINGS.members[0], summary.ring_slots, &w.rings),
+            _ => {
+                windows::write_whole(&set, *binding, buf)?;
+                continue;
+            }
+        };
+        windows::write_window(&set, *binding, buf, m, len, win)?;
+    }
+    Ok(set)
+}
+
 /// The initial subdivision step's GPU side: per frame slot a base-position buffer (the
 /// evaluator's vertices), the level-1 positions, and the stencil evaluator from each slot's
 /// base positions to the level-1 positions.
@@ -636,15 +793,11 @@ impl Bft {
         }
         let mut laps = Laps::new();
         let mut stages = Vec::new();
-        let mesh_error = |e: topology::limit::eval::EvalError| TessError::Mesh {
-            name: options.name.clone(),
-            source: e.into(),
-        };
         let (loop_mesh, fans, note) = loop_control_mesh(mesh, &options.name);
         let limits = Limits::of(&device);
         // The level-1 mesh and the base → level-1 stencils, packed at once (f32 terms), handed
         // to the stencil evaluator and freed.
-        let (level1, stencils) = loop_level1(&loop_mesh).map_err(mesh_error)?;
+        let (level1, stencils) = loop_level1(&loop_mesh).map_err(|e| mesh_error(options, e))?;
         let base_vertices = loop_mesh.positions.len() as u32;
         let level1_vertices = level1.num_vertices() as u32;
         let stencils = GpuStencils::from_table(stencils);
@@ -662,105 +815,36 @@ impl Bft {
         let (stencil_count, stencil_bytes) = (stencils.terms.len() as u64, stencils.bytes());
         drop(stencils);
         stages.push(laps.lap("level 1"));
-        // Tangent stencils, then the normals chunks (they window the CSR table); both
-        // uploaded and freed.
-        let (tangent_offsets, tangent_terms) =
-            layout::pack_tangents(loop_tangent_stencils(&level1));
-        layout::validate_tangents(&tangent_offsets, &tangent_terms, level1_vertices)?;
-        let max_groups = device.info.caps.max_compute_work_group_count[0];
-        let normals_chunks = plan_normals(
-            &tangent_offsets,
-            &tangent_terms,
+        let normals = NormalsStage::new(
+            &device,
+            loop_tangent_stencils(&level1),
             level1_vertices,
             limits,
-            max_groups.saturating_mul(BFT_LOCAL_SIZE),
         )?;
-        let mut statics = vec![
-            (
-                BFT_TANGENT_OFFSETS_BINDING,
-                storage(
-                    &device,
-                    "bft tangent offsets",
-                    bytemuck::cast_slice(&tangent_offsets),
-                )?,
-            ),
-            (
-                BFT_TANGENT_TERMS_BINDING,
-                storage(
-                    &device,
-                    "bft tangent terms",
-                    bytemuck::cast_slice(&tangent_terms),
-                )?,
-            ),
-        ];
-        let tangent_count = tangent_terms.len() as u64;
-        let tangent_bytes = bytes_of(&tangent_offsets) + bytes_of(&tangent_terms);
-        drop((tangent_offsets, tangent_terms));
         stages.push(laps.lap("tangent stencils and upload"));
-        // Records and tables; then the level-1 mesh is no longer needed.
-        let records = build_patch_records(&level1).map_err(mesh_error)?;
-        check_table_range(&records, table_level, options, limits.max_range)?;
-        let tables =
-            loop_tables(&level1, &records, table_level, options.tangents).map_err(mesh_error)?;
-        let rotations = face_rotations(&level1, &records);
-        drop(level1);
-        stages.push(laps.lap("records and tables"));
-        let packed_tables = PackedTables::new(&tables);
-        packed_tables.validate()?;
-        let (patches, patch_rings) = layout::pack_patches(records, &tables)?;
-        let tangents = tables.tangents;
-        drop(tables);
-        layout::validate_patches(
-            &patches,
-            &patch_rings,
-            &packed_tables.entries,
-            level1_vertices,
-        )?;
-        let draw_chunks = plan_draw(&patches, &patch_rings, limits)?;
-        let patch_count = patches.len() as u32;
-        let ring_slots = patch_rings.len() as u64;
-        let patch_bytes = bytes_of(&patches) + bytes_of(&patch_rings);
-        statics.push((
-            BFT_PATCH_HEADERS_BINDING,
-            storage(&device, "bft patch headers", bytemuck::cast_slice(&patches))?,
-        ));
-        drop(patches);
-        statics.push((
-            BFT_PATCH_RINGS_BINDING,
-            storage(
-                &device,
-                "bft patch rings",
-                bytemuck::cast_slice(&patch_rings),
-            )?,
-        ));
-        drop(patch_rings);
-        statics.extend(table_buffers(&device, &packed_tables)?);
+        let patches = PatchStage::new(&device, level1, options, limits, &mut laps, &mut stages)?;
         let summary = BftSummary {
             base_vertices,
             level1_vertices,
-            patch_count,
-            table: packed_tables.table,
-            tangents,
+            patch_count: patches.count,
+            table: patches.table,
+            tangents: patches.tangents,
             stencil_terms: stencil_count,
-            tangent_terms: tangent_count,
-            ring_slots,
+            tangent_terms: normals.terms,
+            ring_slots: patches.ring_slots,
             stencil_bytes,
-            tangent_bytes,
-            patch_bytes,
-            table_bytes: packed_tables.bytes() as u64,
+            tangent_bytes: normals.bytes,
+            patch_bytes: patches.bytes,
+            table_bytes: patches.table_bytes,
         };
-        drop(packed_tables);
         stages.push(laps.lap("patches and upload"));
-        ctx.ensure_set_layout(TechniqueId::BFT, &SET_BINDINGS)?;
-        let set_layout = ctx.set_layout(TechniqueId::BFT)?;
-        let max_sets = normals_chunks.len() + draw_chunks.len();
-        let pool =
-            DescriptorPool::new(&device, "bft descriptor pool", set_layout, max_sets as u32)?;
         let InitialStep {
             evaluator,
             base,
             level1_positions,
         } = step;
+        let mut statics = normals.buffers;
+        statics.extend(patches.buffers);
         statics.push((BFT_LEVEL1_POSITIONS_BINDING, level1_positions));
         statics.push((
             BFT_LEVEL1_NORMALS_BINDING,
@@ -774,40 +858,20 @@ impl Bft {
                 },
             )?,
         ));
-        // Every binding of a set: windowed buffers as the chunk's windows, the tables whole.
-        let n1 = level1_vertices as u64;
-        let write_set = |w: &SetWindows| -> Result<DescriptorSet> {
-            let set = pool.allocate_set(set_layout)?;
-            let csr = LEVEL1_MEMBERS[1];
-            for (binding, buf) in &statics {
-                let (m, len, win) = match *binding {
-                    BFT_LEVEL1_POSITIONS_BINDING | BFT_LEVEL1_NORMALS_BINDING => {
-                        (LEVEL1_MEMBERS[0], n1, &w.level1)
-                    }
-                    BFT_TANGENT_OFFSETS_BINDING => (csr, n1 + 1, &w.level1),
-                    BFT_TANGENT_TERMS_BINDING => (TANGENT.members[0], tangent_count, &w.tangent),
-                    BFT_PATCH_HEADERS_BINDING => {
-                        (PATCHES.members[0], patch_count as u64, &w.patches)
-                    }
-                    BFT_PATCH_RINGS_BINDING => (RINGS.members[0], ring_slots, &w.rings),
-                    _ => {
-                        windows::write_whole(&set, *binding, buf)?;
-                        continue;
-                    }
-                };
-                windows::write_window(&set, *binding, buf, m, len, win)?;
-            }
-            Ok(set)
+        ctx.ensure_set_layout(TechniqueId::BFT, &SET_BINDINGS)?;
+        let set_layout = ctx.set_layout(TechniqueId::BFT)?;
+        let max_sets = normals.chunks.len() + patches.draw_chunks.len();
+        let pool =
+            DescriptorPool::new(&device, "bft descriptor pool", set_layout, max_sets as u32)?;
+        let write = |chunks: &[(Range<u32>, SetWindows)]| -> Result<Vec<DescriptorSet>> {
+            chunks
+                .iter()
+                .map(|(_, w)| write_set(&pool, set_layout, &statics, &summary, w))
+                .collect()
         };
-        let normals_sets = normals_chunks
-            .iter()
-            .map(|(_, w)| write_set(w))
-            .collect::<Result<Vec<_>>>()?;
-        let draw_sets = draw_chunks
-            .iter()
-            .map(|(_, w)| write_set(w))
-            .collect::<Result<Vec<_>>>()?;
-        let normals = Pipeline::compute(
+        let normals_sets = write(&normals.chunks)?;
+        let draw_sets = write(&patches.draw_chunks)?;
+        let normals_pipeline = Pipeline::compute(
             &device,
             "bft normals",
             ShaderStage::new(
@@ -817,31 +881,31 @@ impl Bft {
             &[ctx.frame_set_layout().raw, set_layout.raw],
             std::mem::size_of::<BftPush>() as u32,
         )?;
-        let arrays = number_arrays(&[(PatchType::LoopBft, patch_count, 1)]);
+        let arrays = number_arrays(&[(PatchType::LoopBft, summary.patch_count, 1)]);
         stages.push(laps.lap("sets and pipelines"));
         log::info!(
             "bft {}: {}; {:?} stencil (dispatches, chunks), {} normals and {} draw chunks",
             options.name,
             stages.join("; "),
             evaluator.counts(),
-            normals_chunks.len(),
-            draw_chunks.len()
+            normals.chunks.len(),
+            patches.draw_chunks.len()
         );
         let drawn = drawn_runs(summary.patch_count, &loop_mesh.holes);
         Ok(Self {
             patch_block,
             evaluator,
-            normals,
+            normals: normals_pipeline,
             normals_sets,
-            normals_chunks,
+            normals_chunks: normals.chunks,
             draw_sets,
-            draw_chunks,
+            draw_chunks: patches.draw_chunks,
             _pool: pool,
             base,
             _static: statics.into_iter().map(|(_, b)| b).collect(),
             arrays,
             summary,
-            rotations,
+            rotations: patches.rotations,
             fans,
             drawn,
             loop_mesh,
