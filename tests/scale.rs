@@ -167,6 +167,46 @@ fn adaptive_under_a_small_storage_range_matches_the_whole_buffer_run() {
     assert!(capture == capture_w, "captures differ");
 }
 
+/// The stencil evaluator windows the adaptive vertex buffer, but the canonical kernel and the
+/// draw bind it whole (a patch reads its control points, its canonical corners and its curve
+/// points, three far-apart runs of the buffer): a vertex buffer beyond the range is refused
+/// when the surface is built, with vk-core's typed range error naming it, never a silent
+/// overrun.
+#[test]
+fn adaptive_vertices_beyond_the_range_are_refused_by_name() {
+    let mesh = tessera::topology::load_obj(common::data(
+        "tests/data/opensubdiv/shapes/catmark_cube_creases0.obj",
+    ))
+    .expect("shape");
+    let gpu = capped(Some(8 << 10));
+    {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let e = Adaptive::new(
+            &mut ctx,
+            &mesh,
+            &AdaptiveBuild {
+                isolation: 2,
+                name: "creases0".into(),
+                ..Default::default()
+            },
+        )
+        .map(|_| ())
+        .expect_err("the vertex buffer exceeds 8 KiB");
+        println!("{e}");
+        assert!(
+            matches!(
+                &e,
+                tessera::tess::TessError::Vulkan(VkError::Descriptor {
+                    problem: DescriptorError::Range { buffer, max: 8192, .. },
+                    ..
+                }) if buffer == "adaptive vertices"
+            ),
+            "{e}"
+        );
+    }
+    drop(gpu);
+}
+
 /// A descriptor write whose range exceeds the (capped) device limit is a typed error, and one
 /// inside it at an offset is accepted: no silent overrun is possible.
 #[test]

@@ -227,21 +227,26 @@ fn what_cannot_be_bound_is_refused_by_name() {
     let n = base.len() as u32 + table.rows();
     let gpu = capped(Some(64));
     {
+        let refused = |target: (&Buffer, &Buffer)| {
+            let in_place = std::ptr::eq(target.0, target.1);
+            StencilEvaluator::new(
+                gpu.device(),
+                "stencil test",
+                &table,
+                &blocks,
+                StencilVertices {
+                    sources: n,
+                    destinations: n,
+                    in_place,
+                },
+                &[target],
+            )
+            .err()
+            .expect("refused")
+        };
         let buffer = host_buffer(&gpu, "stencil test vertices", n);
-        let e = StencilEvaluator::new(
-            gpu.device(),
-            "stencil test",
-            &table,
-            &blocks,
-            StencilVertices {
-                sources: n,
-                destinations: n,
-                in_place: true,
-            },
-            &[(&buffer, &buffer)],
-        )
-        .err()
-        .expect("a 64-byte range holds no row's sources");
+        // A 64-byte range holds no row's sources.
+        let e = refused((&buffer, &buffer));
         assert!(
             matches!(
                 e,
@@ -252,21 +257,9 @@ fn what_cannot_be_bound_is_refused_by_name() {
             ),
             "{e}"
         );
+        // A destination short of its vertices.
         let small = host_buffer(&gpu, "stencil test short", n - 1);
-        let e = StencilEvaluator::new(
-            gpu.device(),
-            "stencil test",
-            &table,
-            &blocks,
-            StencilVertices {
-                sources: n,
-                destinations: n,
-                in_place: false,
-            },
-            &[(&buffer, &small)],
-        )
-        .err()
-        .expect("a destination short of its vertices");
+        let e = refused((&buffer, &small));
         assert!(e.to_string().contains("stencil test short holds"), "{e}");
     }
     drop(gpu);

@@ -57,14 +57,14 @@ use crate::gpu::bindings::{
     STENCIL_SOURCE_BINDING, STENCIL_TERMS_BINDING,
 };
 use crate::gpu::StencilPush;
-use crate::shaders::{self, Stage, Variant};
-use crate::techniques::shared::storage;
+use crate::shaders::Stage;
+use crate::techniques::shared::{compute_pipeline, storage};
 use crate::techniques::windows::{self, Limits, Member, Space};
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
 use std::ops::Range;
 use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
-use vk_core::pipeline::{Pipeline, ShaderStage};
+use vk_core::pipeline::Pipeline;
 use vk_core::{vk, Buffer, DescriptorSet, Device, Encoder};
 
 /// `StencilTerm` of `stencil.glsl`: one term of a stencil row.
@@ -548,15 +548,12 @@ impl StencilEvaluator {
             }
             sets.push(target_sets);
         }
-        let pipeline = Pipeline::compute(
+        let pipeline = compute_pipeline(
             device,
             &format!("{name} stencils"),
-            ShaderStage::new(
-                vk::ShaderStageFlags::COMPUTE,
-                shaders::spirv(Stage::StencilEvaluateComp, Variant::default())?,
-            ),
+            Stage::StencilEvaluateComp,
             &[layout.raw],
-            size_of::<StencilPush>() as u32,
+            size_of::<StencilPush>(),
         )?;
         Ok(Self {
             pipeline,
@@ -621,20 +618,7 @@ mod tests {
 
     /// The cube's adaptive layout: levels and local points, in place.
     fn cube() -> GpuAdaptive {
-        let mesh = topology::load_obj(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../tests/data/opensubdiv/shapes/catmark_cube_creases0.obj"
-        ))
-        .expect("cube");
-        let plan = topology::patches::adaptive::plan_adaptive(
-            &mesh,
-            &topology::patches::adaptive::AdaptiveOptions {
-                isolation: 2,
-                ..Default::default()
-            },
-        )
-        .expect("plan");
-        GpuAdaptive::new(&plan).expect("layout")
+        crate::techniques::adaptive::tests::cube_layout()
     }
 
     fn in_place(n: u32) -> StencilVertices {

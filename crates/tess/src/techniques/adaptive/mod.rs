@@ -33,7 +33,8 @@
 pub mod layout;
 
 use super::shared::{
-    canonical_zero, check_adaptive_policy, factor_fields, storage, storage_binding,
+    canonical_zero, check_adaptive_policy, compute_pipeline, factor_fields, storage_binding,
+    storage_buffers,
 };
 use super::windows;
 use crate::capture::FacePoint;
@@ -54,7 +55,7 @@ use crate::gpu::bindings::{
     ADAPTIVE_REPARAM_BINDING, ADAPTIVE_SURFACES_BINDING, ADAPTIVE_TEXTURE_BINDING,
 };
 use crate::gpu::AdaptivePush;
-use crate::shaders::{self, Stage, Variant};
+use crate::shaders::Stage;
 use crate::stencil::{self, StencilEvaluator, StencilVertices};
 use crate::surface::{SurfaceImage, SurfaceMaps, SurfaceShow};
 use crate::technique::{
@@ -71,7 +72,7 @@ use std::ops::Range;
 use topology::patches::adaptive::{plan_adaptive, AdaptiveOptions, AdaptivePlan, EndCap};
 use topology::ControlMesh;
 use vk_core::descriptor::{BindingDesc, DescriptorPool};
-use vk_core::pipeline::{Pipeline, ShaderStage};
+use vk_core::pipeline::Pipeline;
 use vk_core::texture::{Texture, TextureDesc, TextureFormat};
 use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Encoder, MemoryLocation};
 
@@ -280,10 +281,7 @@ fn static_buffers(
             bytemuck::cast_slice(param_errors),
         ),
     ];
-    arrays
-        .into_iter()
-        .map(|(binding, name, bytes)| Ok((binding, storage(device, name, bytes)?)))
-        .collect()
+    storage_buffers(device, &arrays)
 }
 
 /// One base-position buffer per frame slot, holding `positions` as the stencil evaluator's
@@ -535,16 +533,12 @@ impl Adaptive {
             },
             &[(&vertices, &vertices)],
         )?;
-        let layouts = [ctx.frame_set_layout().raw, set_layout.raw];
-        let canonical = Pipeline::compute(
+        let canonical = compute_pipeline(
             &device,
             "adaptive canonical points",
-            ShaderStage::new(
-                vk::ShaderStageFlags::COMPUTE,
-                shaders::spirv(Stage::AdaptiveCanonicalComp, Variant::default())?,
-            ),
-            &layouts,
-            std::mem::size_of::<AdaptivePush>() as u32,
+            Stage::AdaptiveCanonicalComp,
+            &[ctx.frame_set_layout().raw, set_layout.raw],
+            std::mem::size_of::<AdaptivePush>(),
         )?;
         let [regular, gregory, bilinear, triangles] = gpu.counts;
         let arrays = number_arrays(&[
@@ -1014,10 +1008,12 @@ impl Technique for Adaptive {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn cube_layout() -> GpuAdaptive {
+    /// The layout of `catmark_cube_creases0` at isolation 2 (the stencil evaluator's tests use
+    /// it too).
+    pub(crate) fn cube_layout() -> GpuAdaptive {
         let mesh = topology::load_obj(concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/../../tests/data/opensubdiv/shapes/catmark_cube_creases0.obj"

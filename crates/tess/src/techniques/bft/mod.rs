@@ -42,7 +42,8 @@ use crate::error::{Param, ParamError, Result, TablesTooLarge, TessError};
 pub mod layout;
 
 use super::shared::{
-    canonical_zero, check_adaptive_policy, factor_fields, gpu_coordinate, storage, storage_binding,
+    canonical_zero, check_adaptive_policy, compute_pipeline, factor_fields, gpu_coordinate,
+    storage, storage_binding, storage_buffers,
 };
 use super::windows::{self, Chunk, Limits, Member, Space};
 use crate::bench::usage::Laps;
@@ -54,7 +55,7 @@ use crate::gpu::bindings::{
     BFT_TANGENT_OFFSETS_BINDING, BFT_TANGENT_TERMS_BINDING,
 };
 use crate::gpu::BftPush;
-use crate::shaders::{self, Stage, Variant};
+use crate::shaders::{Stage, Variant};
 use crate::stencil::{self, GpuStencils, StencilBlock, StencilEvaluator, StencilVertices};
 use crate::technique::{
     for_each_draw, number_arrays, DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features,
@@ -70,7 +71,7 @@ use topology::patches::bft::{
 };
 use topology::ControlMesh;
 use vk_core::descriptor::{BindingDesc, DescriptorPool};
-use vk_core::pipeline::{Pipeline, ShaderStage};
+use vk_core::pipeline::Pipeline;
 use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Encoder, MemoryLocation};
 
 impl TechniqueId {
@@ -741,27 +742,27 @@ impl InitialStep {
 /// row maps, weights.
 fn table_buffers(device: &vk_core::Device, t: &PackedTables) -> Result<Vec<(u32, Buffer)>> {
     let table_header = t.header_bytes();
-    [
-        (BFT_TABLES_BINDING, "bft tables", &table_header[..]),
-        (
-            BFT_MIRROR_PERMS_BINDING,
-            "bft mirror permutations",
-            bytemuck::cast_slice(&t.mirror_perms),
-        ),
-        (
-            BFT_ROW_MAPS_BINDING,
-            "bft row maps",
-            bytemuck::cast_slice(&t.row_maps),
-        ),
-        (
-            BFT_TABLE_WEIGHTS_BINDING,
-            "bft table weights",
-            bytemuck::cast_slice(&t.weights),
-        ),
-    ]
-    .into_iter()
-    .map(|(binding, name, bytes)| Ok((binding, storage(device, name, bytes)?)))
-    .collect()
+    storage_buffers(
+        device,
+        &[
+            (BFT_TABLES_BINDING, "bft tables", &table_header[..]),
+            (
+                BFT_MIRROR_PERMS_BINDING,
+                "bft mirror permutations",
+                bytemuck::cast_slice(&t.mirror_perms),
+            ),
+            (
+                BFT_ROW_MAPS_BINDING,
+                "bft row maps",
+                bytemuck::cast_slice(&t.row_maps),
+            ),
+            (
+                BFT_TABLE_WEIGHTS_BINDING,
+                "bft table weights",
+                bytemuck::cast_slice(&t.weights),
+            ),
+        ],
+    )
 }
 
 impl Bft {
@@ -871,15 +872,12 @@ impl Bft {
         };
         let normals_sets = write(&normals.chunks)?;
         let draw_sets = write(&patches.draw_chunks)?;
-        let normals_pipeline = Pipeline::compute(
+        let normals_pipeline = compute_pipeline(
             &device,
             "bft normals",
-            ShaderStage::new(
-                vk::ShaderStageFlags::COMPUTE,
-                shaders::spirv(Stage::BftNormalsComp, Variant::default())?,
-            ),
+            Stage::BftNormalsComp,
             &[ctx.frame_set_layout().raw, set_layout.raw],
-            std::mem::size_of::<BftPush>() as u32,
+            std::mem::size_of::<BftPush>(),
         )?;
         let arrays = number_arrays(&[(PatchType::LoopBft, summary.patch_count, 1)]);
         stages.push(laps.lap("sets and pipelines"));
