@@ -118,6 +118,8 @@ pub enum StencilError {
         start: u32,
         expected: u32,
     },
+    #[error("stencil table: the blocks cover rows 0..{covered} of its {rows}")]
+    Uncovered { covered: u32, rows: u32 },
     #[error(
         "stencil evaluator: buffer {buffer} holds {bytes} bytes, its {what} vertices need {needed}"
     )]
@@ -265,7 +267,7 @@ pub struct StencilBlock {
 impl StencilBlock {
     /// The destination vertices the block writes.
     pub fn destinations(&self) -> Range<u32> {
-        self.destination..self.destination + (self.rows.end - self.rows.start)
+        self.destination..self.destination.saturating_add(self.rows.len() as u32)
     }
 }
 
@@ -362,14 +364,15 @@ pub fn plan(
             }
             .into());
         }
-        let writes = block.destinations();
-        if !writes.is_empty() {
+        let end = block.destination as u64 + block.rows.len() as u64;
+        if end > block.destination as u64 {
             check(
                 "stencil destination vertex",
-                writes.end as u64 - 1,
+                end - 1,
                 vertices.destinations as u64,
             )?;
         }
+        let writes = block.destinations();
         for r in block.rows.clone() {
             if vertices.in_place {
                 if let Some(t) = stencils.row(r).iter().find(|t| writes.contains(&t.index)) {
@@ -385,10 +388,9 @@ pub fn plan(
         }
     }
     if destination.len() as u32 != rows {
-        return Err(StencilError::Blocks {
-            block: blocks.len(),
-            start: rows,
-            expected: destination.len() as u32,
+        return Err(StencilError::Uncovered {
+            covered: destination.len() as u32,
+            rows,
         }
         .into());
     }
@@ -749,7 +751,28 @@ mod tests {
         let e = stencil_error(plan(&g.stencils, &g.blocks[1..], in_place(n), lim, 64));
         assert!(matches!(e, StencilError::Blocks { block: 0, .. }), "{e}");
         let e = stencil_error(plan(&g.stencils, &g.blocks[..1], in_place(n), lim, 64));
-        assert!(matches!(e, StencilError::Blocks { .. }), "{e}");
+        let covered = g.blocks[0].rows.end;
+        assert_eq!(
+            e,
+            StencilError::Uncovered {
+                covered,
+                rows: g.stencils.rows()
+            }
+        );
+        // A block past the end of the index space is a named error, not an overflow.
+        let mut far = g.blocks.clone();
+        far.last_mut().expect("blocks").destination = u32::MAX - 1;
+        let e = stencil_error(plan(&g.stencils, &far, in_place(n), lim, 64));
+        assert!(
+            matches!(
+                e,
+                StencilError::Index {
+                    what: "stencil destination vertex",
+                    ..
+                }
+            ),
+            "{e}"
+        );
         let mut offsets = g.stencils.clone();
         offsets.offsets.swap(1, 2);
         let e = stencil_error(plan(&offsets, &g.blocks, in_place(n), lim, 64));
