@@ -3,9 +3,10 @@
 //! and animation. Validation is on and any error fails (tests/common).
 mod common;
 use common::Gpu;
+use tessera::tess::animation::{base_normals, base_positions, wave};
 use tessera::tess::capture::{classify_open_edges, CapturedSoup, Capturer};
 use tessera::tess::techniques::bft::layout::GpuBft;
-use tessera::tess::techniques::bft::{base_normals, patch_uv, wave, Bft, BftOptions};
+use tessera::tess::techniques::bft::{patch_uv, Bft, BftOptions};
 use tessera::tess::{Context, FactorPolicy, FrameParams, Spacing, Technique};
 use tessera::topology::limit::eval::{LimitScheme, LocalMesh};
 use tessera::topology::patches::bft::prepare_loop_bft;
@@ -365,7 +366,7 @@ fn animated_base_mesh_gives_the_deformed_limit() {
         let capturer = Capturer::new(&ctx).expect("capturer");
         let mesh = shape("loop_icosahedron");
         let mut surf = surface(&mut ctx, &mesh, "ico", 5, false);
-        let base = tessera::tess::techniques::bft::base_positions(&mesh);
+        let base = base_positions(&mesh);
         let normals = base_normals(&mesh);
         let (lo, hi) = surf.bbox();
         let params = uniform(16);
@@ -444,7 +445,10 @@ fn bad_segments_are_rejected_with_a_clear_error() {
                 .render_offscreen(&mut surf, &uniform(s), EXTENT)
                 .map(|_| ())
                 .expect_err("rejected");
-            assert!(e.to_string().contains("segments ") && !e.to_string().contains("--"), "{e}");
+            assert!(
+                e.to_string().contains("segments ") && !e.to_string().contains("--"),
+                "{e}"
+            );
         }
     }
 }
@@ -551,7 +555,7 @@ fn geometric_normals_are_the_exact_limit_normals() {
         let (soup, _) = capturer
             .capture(&mut ctx, &mut surf, &uniform(8), EXTENT)
             .expect("capture");
-        let base = tessera::tess::techniques::bft::base_positions(&mesh);
+        let base = base_positions(&mesh);
         // The CPU mirror, packed from its own preparation (the surface keeps its arrays only on
         // the GPU).
         let loop_mesh = surf.base_mesh().expect("loop mesh");

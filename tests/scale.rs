@@ -1,4 +1,4 @@
-//! Scale (issue 15): storage buffers beyond the device's `maxStorageBufferRange`, and 1M-face
+//! Scale: storage buffers beyond the device's `maxStorageBufferRange`, and 1M-face
 //! meshes through every technique. Validation is on and any error fails (tests/common).
 //!
 //! The range limit is lowered with `DeviceDesc::storage_buffer_range_cap`, so small meshes take
@@ -9,8 +9,9 @@ mod common;
 mod loop_grid;
 use common::Gpu;
 use tessera::tess::capture::Capturer;
-use tessera::tess::techniques::adaptive::{Adaptive, AdaptiveBuild};
+use tessera::tess::techniques::adaptive;
 use tessera::tess::techniques::bft::{Bft, BftOptions};
+use tessera::tess::techniques::planned_patches::PlanBuild;
 use tessera::tess::{Context, FrameParams, Technique};
 use tessera::topology::ControlMesh;
 use tessera::vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
@@ -103,10 +104,10 @@ fn adaptive_run(cap: Option<u32>, mesh: &ControlMesh, params: &FrameParams) -> A
     let out = {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
         let capturer = Capturer::new(&ctx).expect("capturer");
-        let mut surf = Adaptive::new(
+        let mut surf = adaptive::new(
             &mut ctx,
             mesh,
-            &AdaptiveBuild {
+            &PlanBuild {
                 isolation: 2,
                 name: "creases0".into(),
                 ..Default::default()
@@ -181,10 +182,10 @@ fn adaptive_vertices_beyond_the_range_are_refused_by_name() {
     let gpu = capped(Some(8 << 10));
     {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
-        let e = Adaptive::new(
+        let e = adaptive::new(
             &mut ctx,
             &mesh,
-            &AdaptiveBuild {
+            &PlanBuild {
                 isolation: 2,
                 name: "creases0".into(),
                 ..Default::default()
@@ -395,10 +396,10 @@ fn one_million_faces_through_every_technique() {
         // its regular corners and curve points have no rows (they were 264 MB, two window
         // sets); windows are checked under a small range above and in the pre-pass's test.
         let t = std::time::Instant::now();
-        let mut surf = Adaptive::new(
+        let mut surf = adaptive::new(
             &mut ctx,
             &quad,
-            &AdaptiveBuild {
+            &PlanBuild {
                 name: "1M quad grid".into(),
                 ..Default::default()
             },
@@ -431,10 +432,10 @@ fn one_million_faces_through_every_technique() {
         // Adaptive on the 1M-triangle grid (every vertex extraordinary under Catmull-Clark):
         // refused by the plan's size bound before refining, never an allocation abort.
         let t = std::time::Instant::now();
-        let e = Adaptive::new(
+        let e = adaptive::new(
             &mut ctx,
             &tri,
-            &AdaptiveBuild {
+            &PlanBuild {
                 name: "1M triangle grid".into(),
                 ..Default::default()
             },

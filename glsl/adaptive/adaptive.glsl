@@ -1,6 +1,6 @@
-// Feature-adaptive Catmull-Clark (crates/tess/src/techniques/adaptive): the storage buffers,
-// push constants and the evaluation every stage shares. Mirrors
-// `tess::techniques::adaptive::layout` (offsets checked against the SPIR-V by a test).
+// Catmull-Clark patch plans (adaptive, gregory, acc; crates/tess/src/techniques/planned_patches):
+// the storage buffers, push constants and the evaluation every stage shares. Mirrors
+// `tess::techniques::planned_patches::layout` (offsets checked against the SPIR-V by a test).
 //
 // Watertightness by canonical curves: every patch boundary edge is one cubic Bezier curve of
 // the global vertex buffer (computed once per frame by the canonical kernel, from one owner

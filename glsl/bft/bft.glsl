@@ -252,8 +252,8 @@ bool bft_eval(uint face, vec3 b, bool geometric, out vec3 p, out vec3 n) {
     // path for both faces of an edge, so their bits cannot depend on how a compiler schedules
     // two. (NVIDIA's rounds the unrolled patch-block sum differently from the global loop over
     // the same products, which cracked every shared point; a non-unrolled block loop matches
-    // there but costs lavapipe a quarter more: docs/benchmarks.md, "Session 18".) Only interior
-    // points read the patch block.
+    // there but costs lavapipe a quarter more: docs/benchmarks.md, "Table I on an NVIDIA
+    // H100".) Only interior points read the patch block.
     bool local = g == face && corner < 0 && edge < 0 && (tc_head.y & BFT_INFO_GATHERED) != 0u;
     float grid = float(table.grid);
     float nseg = float(table.segments);

@@ -7,10 +7,10 @@ use super::reflect::Reflection;
 use super::{AdaptivePush, BftPush, CaptureRecord, DrawPush, FrameUniforms, StencilPush, Vertex};
 use crate::shaders::{spirv, Stage, Variant};
 use crate::stencil::{StencilTerm, StencilVertex};
-use crate::techniques::adaptive::layout::PatchRecord;
 use crate::techniques::bft::layout::{
     Level1Point, PatchHeader, TableEntry, TableHeader, TangentTerm, STORAGE_BINDINGS,
 };
+use crate::techniques::planned_patches::layout::PatchRecord;
 use crate::tessellator::Spacing;
 use std::mem::{offset_of, size_of};
 
@@ -840,7 +840,7 @@ fn contraction_and_mix(words: &[u32]) -> (usize, usize) {
 /// form in different orders. Only IEEE sums without contraction to fused multiply-adds
 /// (`precise`: NoContraction) and without mix() (FMix, whose rounding is the driver's) give
 /// both sides the same bits. lavapipe neither fuses nor rewrites mix(), so only a real GPU's
-/// capture tests would see a regression (NVIDIA's cracked, docs/benchmarks.md, session 18):
+/// capture tests would see a regression (NVIDIA's cracked, docs/benchmarks.md, "Table I on an NVIDIA H100"):
 /// this check sees it anywhere.
 #[test]
 fn corner_sums_are_precise_and_mix_free() {

@@ -1,7 +1,7 @@
 //! Rust mirrors of every block shared with GLSL: uniforms, push constants, the
 //! transform-feedback record and the vertex input (the storage buffers' structs live with
 //! their users: [`crate::stencil`], [`crate::techniques::bft::layout`],
-//! [`crate::techniques::adaptive::layout`]).
+//! [`crate::techniques::planned_patches::layout`]).
 //!
 //! Design decisions:
 //! - `#[repr(C)]` + `Pod` with named fields, no `Vec3` (std140/std430 would pad it); sizes and

@@ -3,8 +3,8 @@
 //! setup, fed by every refinement scheme that turns control vertices into refined ones by
 //! stencil rows (OpenSubdiv's stencil evaluators: a source and a destination buffer
 //! descriptor, the rows' sizes, offsets, indices and weights, one evaluator per back-end).
-//! Loop's initial subdivision step (`techniques::bft`) and feature-adaptive Catmull-Clark's
-//! levels and local points (`techniques::adaptive`, and so the single-pass Gregory and ACC
+//! Loop's initial subdivision step (`techniques::bft`) and the Catmull-Clark plans' levels and
+//! local points (`techniques::planned_patches`: adaptive, and the single-pass Gregory and ACC
 //! plans) use it. A per-level Doo-Sabin refinement would be a third user with nothing new: its
 //! table (one CSR row per refined vertex, over the level before it) and one block per level,
 //! in place over one vertex buffer or between a source and a destination buffer per level.
@@ -615,12 +615,12 @@ impl StencilEvaluator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::techniques::adaptive::layout::GpuAdaptive;
+    use crate::techniques::planned_patches::layout::GpuPlan;
     use crate::TessError;
 
     /// The cube's adaptive layout: levels and local points, in place.
-    fn cube() -> GpuAdaptive {
-        crate::techniques::adaptive::tests::cube_layout()
+    fn cube() -> GpuPlan {
+        crate::techniques::planned_patches::tests::cube_layout()
     }
 
     fn in_place(n: u32) -> StencilVertices {

@@ -72,7 +72,7 @@
 //!   ([`AdaptivePlan::regular_corner_point`]), then the curves' inner points, two per curve
 //!   ([`AdaptivePlan::curve_inner_point`]). Dropping their stencil rows made most of the
 //!   drop of catmark_car's plan from 1,444 M to 1,086 M instructions (docs/benchmarks.md,
-//!   session 22). Local points are not shared between patches except the canonical corners
+//!   "The CPU plan against OpenSubdiv's far_perf"). Local points are not shared between patches except the canonical corners
 //!   and curves (two boundary patches each have their own phantoms).
 //! * **Size bound.** Every vertex of a triangle mesh is extraordinary under Catmull-Clark (and
 //!   so is every face centre of level 1), so isolation refines nearly everything at every

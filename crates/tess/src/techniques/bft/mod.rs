@@ -12,7 +12,7 @@
 //!    only; `bft.tese` evaluates the table row of each tess coordinate (see
 //!    `glsl/bft/bft.glsl`, mirrored in f32 by [`layout::GpuBft::eval_tess`]).
 //!
-//! **Cost on a CPU driver** (issue 16; lavapipe runs the TES on the CPU, eight vertices a SIMD
+//! **Cost on a CPU driver** (lavapipe runs the TES on the CPU, eight vertices a SIMD
 //! batch, and executes both sides of every branch, masked): a storage-buffer read indexed by
 //! the patch is a per-lane loop there, a patch input one load for the whole patch. So the TCS
 //! gathers the patch's header words, mirror permutation and ring (level-1 positions and
@@ -42,10 +42,11 @@ use crate::error::{Param, ParamError, Result, TablesTooLarge, TessError};
 pub mod layout;
 
 use super::shared::{
-    canonical_zero, check_adaptive_policy, compute_pipeline, factor_fields, gpu_coordinate,
-    storage, storage_binding, storage_buffers,
+    canonical_zero, check_adaptive_policy, compute_pipeline, factor_fields, storage,
+    storage_binding, storage_buffers,
 };
 use super::windows::{self, Chunk, Limits, Member, Space};
+use crate::animation::base_positions;
 use crate::bench::usage::Laps;
 use crate::gpu::bindings::{
     BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING, BFT_LOCAL_SIZE,
@@ -358,8 +359,8 @@ pub struct BftOptions {
     pub name: String,
     /// Gather each patch's ring into a per-patch block that the TES reads instead of the
     /// global buffers (the `patch_block` shader axis). `None`: by device, on for a CPU
-    /// implementation (lavapipe), off for a GPU (docs/benchmarks.md, "Session 18: the first real GPU"); there
-    /// the environment's `TESSERA_BFT_PATCH_BLOCK=1` or `=0` decides instead, for A/B runs.
+    /// implementation (lavapipe), off for a GPU (docs/benchmarks.md, "Table I on an NVIDIA
+    /// H100"); there the environment's `TESSERA_BFT_PATCH_BLOCK=1` or `=0` decides instead, for A/B runs.
     pub patch_block: Option<bool>,
 }
 
@@ -425,14 +426,6 @@ pub struct Bft {
     pub notes: Vec<String>,
     /// The patch-block build ([`BftOptions::patch_block`]).
     patch_block: bool,
-}
-
-/// The base positions of `mesh` in f32.
-pub fn base_positions(mesh: &ControlMesh) -> Vec<[f32; 3]> {
-    mesh.positions
-        .iter()
-        .map(|p| p.map(gpu_coordinate))
-        .collect()
 }
 
 /// Maximal runs of the `patches` level-1 faces whose base triangle is not among `holes` (a
@@ -1254,91 +1247,6 @@ impl Technique for Bft {
 pub fn patch_uv(domain: [f32; 2]) -> (f64, f64) {
     let (x, y) = (domain[0] as f64, domain[1] as f64);
     (y, 1.0 - x - y)
-}
-
-/// Axis-aligned bounds of points.
-pub fn bbox(points: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
-    let mut lo = [f32::MAX; 3];
-    let mut hi = [f32::MIN; 3];
-    for p in points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    if points.is_empty() {
-        ([0.0; 3], [0.0; 3])
-    } else {
-        (lo, hi)
-    }
-}
-
-/// Per-vertex unit normals of the base mesh (area-weighted face normals), the directions the
-/// animation moves vertices along.
-pub fn base_normals(mesh: &ControlMesh) -> Vec<[f32; 3]> {
-    let mut n = vec![glam::DVec3::ZERO; mesh.positions.len()];
-    for f in mesh.faces() {
-        let p = |i: usize| glam::DVec3::from(mesh.positions[f[i] as usize]);
-        for k in 1..f.len().saturating_sub(1) {
-            let c = (p(k) - p(0)).cross(p(k + 1) - p(0));
-            for &v in f {
-                n[v as usize] += c;
-            }
-        }
-    }
-    n.iter()
-        .map(|v| v.normalize_or_zero().as_vec3().to_array())
-        .collect()
-}
-
-/// The `--animate` deformation (a travelling wave along the vertex normals, as in the Doo-Sabin
-/// paper's §3): base position + `amplitude · sin(2π(k·p/diag − t))` along the normal. Only these
-/// positions are uploaded per frame.
-pub fn wave(
-    base: &[[f32; 3]],
-    normals: &[[f32; 3]],
-    bbox_min: [f32; 3],
-    bbox_max: [f32; 3],
-    time: f32,
-) -> Vec<[f32; 3]> {
-    let lo = glam::Vec3::from(bbox_min);
-    let hi = glam::Vec3::from(bbox_max);
-    let diag = (hi - lo).length().max(1e-6);
-    let dir = glam::Vec3::new(0.6, 0.8, 0.0);
-    let amplitude = 0.03 * diag;
-    base.iter()
-        .zip(normals)
-        .map(|(p, n)| {
-            let p = glam::Vec3::from(*p);
-            let phase = 2.0 * std::f32::consts::PI * (2.0 * dir.dot(p - lo) / diag - 0.5 * time);
-            (p + glam::Vec3::from(*n) * amplitude * phase.sin()).to_array()
-        })
-        .collect()
-}
-
-/// The `--animate` wave at time `t` applied to the rest pose of a mesh: what is uploaded.
-/// Works for any technique that takes [`Technique::update_base`].
-pub struct Wave {
-    rest: Vec<[f32; 3]>,
-    normals: Vec<[f32; 3]>,
-    bbox: ([f32; 3], [f32; 3]),
-}
-
-impl Wave {
-    pub fn new(mesh: &ControlMesh) -> Self {
-        let rest = base_positions(mesh);
-        // The amplitude follows the drawn size, not a far vertex no face uses.
-        let bbox = crate::framing::drawn_bbox(mesh);
-        Self {
-            normals: base_normals(mesh),
-            rest,
-            bbox,
-        }
-    }
-
-    pub fn at(&self, t: f32) -> Vec<[f32; 3]> {
-        wave(&self.rest, &self.normals, self.bbox.0, self.bbox.1, t)
-    }
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@
 //!   in that order, last.
 //! - **Patches in array order** (regular, Gregory, bilinear): a patch's record index is its
 //!   frame-wide id, what the TES captures and [`crate::Technique::face_point`] maps back.
-//! - **Checked before upload**: [`GpuAdaptive::new`] proves every index a shader can form is
+//! - **Checked before upload**: [`GpuPlan::new`] proves every index a shader can form is
 //!   in range and every row reads only earlier blocks, so a bad plan fails here, not as an
 //!   out-of-bounds read on the device.
 use crate::gpu::bindings::{
@@ -142,7 +142,7 @@ pub fn control_point_count(kind: PatchKind) -> usize {
 }
 
 /// Everything the adaptive buffers hold, packed.
-pub struct GpuAdaptive {
+pub struct GpuPlan {
     pub num_base_vertices: u32,
     pub num_vertices: u32,
     /// One row per refined vertex up to the regular corners (row `r`: global vertex
@@ -150,7 +150,7 @@ pub struct GpuAdaptive {
     pub stencils: GpuStencils,
     /// One per non-empty block: the levels in order, then the local points.
     pub blocks: Vec<StencilBlock>,
-    /// Records in array order (see [`GpuAdaptive::order`]).
+    /// Records in array order (see [`GpuPlan::order`]).
     pub patches: Vec<PatchRecord>,
     pub control_points: Vec<u32>,
     pub curves: Vec<[u32; 4]>,
@@ -188,7 +188,7 @@ fn edge_code(kind: EdgeKind) -> u32 {
     }
 }
 
-impl GpuAdaptive {
+impl GpuPlan {
     /// The curves' inner points, which the stencil kernel's last dispatches compute.
     pub fn curve_points(&self) -> u32 {
         2 * self.curves.len() as u32
@@ -199,7 +199,7 @@ impl GpuAdaptive {
         self.first_curve_point - self.first_regular_corner
     }
 
-    pub fn new(plan: &AdaptivePlan) -> Result<GpuAdaptive, LayoutError> {
+    pub fn new(plan: &AdaptivePlan) -> Result<GpuPlan, LayoutError> {
         let nb = plan.num_base_vertices;
         let nv = plan.num_vertices;
         let mut stencils = GpuStencils::default();
@@ -421,7 +421,7 @@ impl GpuAdaptive {
             plan.first_corner as u64 + corner_owners.len() as u64,
             nv as u64 + 1,
         )?;
-        Ok(GpuAdaptive {
+        Ok(GpuPlan {
             first_curve_point: plan.first_curve_point,
             first_regular_corner: plan.first_regular_corner,
             curve_owners,
