@@ -223,6 +223,7 @@ fn cracks(surf: &PlannedPatches, soup: &CapturedSoup, mesh: &ControlMesh) -> (us
 /// Regular patches are the exact limit (≤ 1e-5 of the diagonal, f32 on the GPU); the whole
 /// surface with Gregory end caps at isolation 4 is within 5e-5.
 #[test]
+#[ignore = "sweep tier (every Catmull-Clark shape): tools/test.sh sweeps"]
 fn captured_vertices_are_the_exact_limit() {
     let gpu = Gpu::new();
     {
@@ -262,6 +263,7 @@ fn captured_vertices_are_the_exact_limit() {
 
 /// The end caps' deviation from the exact limit shrinks as the isolation level rises.
 #[test]
+#[ignore = "sweep tier (every isolation level): tools/test.sh sweeps"]
 fn end_cap_deviation_shrinks_with_isolation() {
     let gpu = Gpu::new();
     {
@@ -305,6 +307,7 @@ fn end_cap_deviation_shrinks_with_isolation() {
 /// across transitions, with Gregory and bilinear end caps (positions welded only when
 /// bit-identical).
 #[test]
+#[ignore = "sweep tier (every shape and factor policy): tools/test.sh sweeps"]
 fn watertight_under_every_factor_policy() {
     let gpu = Gpu::new();
     {

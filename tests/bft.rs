@@ -109,6 +109,7 @@ fn cracks(surf: &Bft, soup: &CapturedSoup, mesh: &ControlMesh) -> (usize, usize,
 /// OpenSubdiv's Loop shapes (valences 3 to 64, boundaries, coarse meshes with overlapping
 /// rings, darts) and the triangulated spot; all come from table points (flag bit 0).
 #[test]
+#[ignore = "sweep tier (every level S = 2..64): tools/test.sh sweeps"]
 fn captured_bft_vertices_are_the_exact_limit() {
     let gpu = Gpu::new();
     {
@@ -166,6 +167,7 @@ fn captured_bft_vertices_are_the_exact_limit() {
 /// build. A shape BFT does not take (non-manifold) must be refused with a named error, and the
 /// refusals are listed.
 #[test]
+#[ignore = "sweep tier (every Loop shape): tools/test.sh sweeps"]
 fn every_loop_shape_is_exact_and_watertight() {
     let (dir, other) = common::shapes_dir("BFT_SHAPES_DIR");
     let names = common::shape_names(&dir, "loop_");
@@ -269,6 +271,7 @@ fn hole_faces_are_not_drawn() {
 /// No open edge beyond the base mesh's own boundary, for uniform, both adaptive policies and
 /// fractional factors, on every test mesh (positions welded only when bit-identical).
 #[test]
+#[ignore = "sweep tier (every factor policy): tools/test.sh sweeps"]
 fn bft_is_watertight_under_every_factor_policy() {
     let gpu = Gpu::new();
     {

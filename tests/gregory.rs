@@ -193,6 +193,7 @@ fn back_to_back(m: &ControlMesh) -> bool {
 /// diagonal of the limit at its parameter. Shapes that do not load (non-manifold) or that a
 /// method refuses are listed, named; in tests/data none is.
 #[test]
+#[ignore = "sweep tier (every Catmull-Clark shape): tools/test.sh sweeps"]
 fn every_catmark_shape_welds_and_stays_near_the_limit() {
     let (dir, other) = common::shapes_dir("SINGLE_PASS_SHAPES_DIR");
     let names = common::shape_names(&dir, "catmark_");
@@ -273,6 +274,7 @@ fn every_catmark_shape_welds_and_stays_near_the_limit() {
 /// screen, distance and fractional factors, on spot (triangles, quads, pentagons: split faces
 /// and transition edges) and catmark shapes with boundaries and creases.
 #[test]
+#[ignore = "sweep tier (every shape and factor policy): tools/test.sh sweeps"]
 fn watertight_under_every_factor_policy() {
     let gpu = Gpu::new();
     {

@@ -13,23 +13,14 @@
 //!   into the stencils. Semi-sharp tags are rounded to smooth (< 0.5) or infinitely sharp.
 //! - **Normals** come from the canonical tangents both sides of an edge share (the patches
 //!   are not C1 across edges).
-use crate::context::Context;
-use crate::error::Result;
-use crate::technique::{Features, TechniqueId};
-use crate::techniques::planned_patches::{self, check_frame, PATCH_LEGEND, PLANNED};
-use crate::techniques::{BuildOptions, Built, TechniqueInfo};
+use crate::technique::TechniqueId;
+use crate::techniques::planned_patches::{self, check_frame, PATCH_LEGEND, SINGLE_PASS};
+use crate::techniques::TechniqueInfo;
 use topology::patches::adaptive::single_pass::SinglePassPatch;
-use topology::ControlMesh;
 
 impl TechniqueId {
     pub const GREGORY: TechniqueId = TechniqueId::new("gregory");
 }
-
-/// What the single-pass approximations take: the planned surface's options, no isolation.
-pub const SINGLE_PASS: Features = Features {
-    single_pass: true,
-    ..PLANNED
-};
 
 /// The registry entry.
 pub static INFO: TechniqueInfo = TechniqueInfo {
@@ -41,23 +32,8 @@ pub static INFO: TechniqueInfo = TechniqueInfo {
     shader_folder: "adaptive",
     abi_code: 6,
     legend: PATCH_LEGEND,
-    build,
+    build: |ctx, mesh, options| {
+        planned_patches::build_single_pass(ctx, mesh, options, SinglePassPatch::Gregory)
+    },
     check_options: |_, params| check_frame(TechniqueId::GREGORY, None, params),
 };
-
-/// The registry's constructor: [`planned_patches::single_pass`] with Gregory patches.
-fn build(ctx: &mut Context, mesh: &ControlMesh, options: &BuildOptions) -> Result<Built> {
-    let surface = planned_patches::single_pass(
-        ctx,
-        mesh,
-        SinglePassPatch::Gregory,
-        options.sharpness_scale,
-        !options.split_triangles,
-        &options.name,
-        &options.maps,
-    )?;
-    Ok(Built {
-        notes: surface.param_error_note().into_iter().collect(),
-        technique: Box::new(surface),
-    })
-}

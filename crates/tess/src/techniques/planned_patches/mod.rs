@@ -68,7 +68,7 @@ use crate::technique::{
     for_each_draw, number_arrays, DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features,
     FrameParams, Pass, PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
 };
-use crate::techniques::LegendEntry;
+use crate::techniques::{BuildOptions, Built, LegendEntry};
 use crate::tessellator::{
     quad_triangle_count, triangle_triangle_count, uniform_vertex_count, Domain, Spacing,
 };
@@ -325,6 +325,13 @@ pub const PLANNED: Features = Features {
     surface: true,
     single_pass: false,
     paths: &[DrawPath::Tessellation],
+};
+
+/// What the single-pass techniques (gregory, acc) take: the planned surface's options, no
+/// isolation.
+pub const SINGLE_PASS: Features = Features {
+    single_pass: true,
+    ..PLANNED
 };
 
 /// The patch-colour legend of the planned Catmull-Clark techniques.
@@ -667,9 +674,32 @@ pub fn single_pass(
     )
 }
 
-/// What a planned surface refuses in `params`: uniform factors are whole segments per patch edge, at most
-/// half the device's maximum `factor_limit` (a coarse transition edge doubles them) when it is
-/// known; spacing equal or fractional even. Without a device ([`crate::techniques::check_options`])
+/// The registry constructor of a single-pass technique: [`single_pass`] with `patch` and the
+/// build options the single-pass techniques take.
+pub fn build_single_pass(
+    ctx: &mut Context,
+    mesh: &ControlMesh,
+    options: &BuildOptions,
+    patch: SinglePassPatch,
+) -> Result<Built> {
+    let surface = single_pass(
+        ctx,
+        mesh,
+        patch,
+        options.sharpness_scale,
+        !options.split_triangles,
+        &options.name,
+        &options.maps,
+    )?;
+    Ok(Built {
+        notes: surface.param_error_note().into_iter().collect(),
+        technique: Box::new(surface),
+    })
+}
+
+/// What a planned surface refuses in `params`: uniform factors are whole segments per patch
+/// edge, at most half the device's maximum `factor_limit` (a coarse transition edge doubles
+/// them) when it is known; spacing equal or fractional even. Without a device ([`crate::techniques::check_options`])
 /// only the bound waits for [`Technique::check`].
 pub fn check_frame(
     technique: TechniqueId,
