@@ -23,7 +23,7 @@ use crate::gpu::bindings::{
 use crate::stencil::{GpuStencils, StencilBlock, StencilError, StencilVertex};
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
-use topology::patches::adaptive::{AdaptivePlan, EdgeKind, PatchKind};
+use topology::patches::adaptive::{AdaptivePatch, AdaptivePlan, EdgeKind, PatchKind};
 use topology::ControlMesh;
 
 /// `AdaptivePatch` of `adaptive.glsl`: one patch.
@@ -188,6 +188,269 @@ fn edge_code(kind: EdgeKind) -> u32 {
     }
 }
 
+/// The plan's levels and local points as one stencil table and its blocks, which must tile
+/// the refined part of the vertex buffer in order and read only earlier vertices; returns the
+/// first vertex after them.
+fn stencil_blocks(
+    plan: &AdaptivePlan,
+) -> Result<(GpuStencils, Vec<StencilBlock>, u32), LayoutError> {
+    let nb = plan.num_base_vertices;
+    let mut stencils = GpuStencils::default();
+    let mut blocks = Vec::new();
+    let mut next = nb;
+    for block in plan.steps.iter().chain(std::iter::once(&plan.local_points)) {
+        if block.first_vertex != next {
+            return Err(LayoutError::Index {
+                what: "stencil block start",
+                index: block.first_vertex as u64,
+                len: next as u64,
+            });
+        }
+        let t = &block.table;
+        let rows = t.len() as u32;
+        for r in 0..t.len() {
+            let (idx, w) = t.stencil(r);
+            if let Some(&i) = idx.iter().find(|&&i| i >= block.first_vertex) {
+                return Err(LayoutError::BlockOrder {
+                    vertex: block.first_vertex + r as u32,
+                    reads: i,
+                    block_start: block.first_vertex,
+                });
+            }
+            stencils.push_row(idx, w)?;
+        }
+        if rows > 0 {
+            let first = block.first_vertex - nb;
+            blocks.push(StencilBlock {
+                rows: first..first + rows,
+                destination: block.first_vertex,
+            });
+        }
+        next = block.first_vertex + rows;
+    }
+    Ok((stencils, blocks, next))
+}
+
+/// After the blocks (ending at `next`) come the canonical corners of regular patches (computed
+/// from their owner's 3×3 points), then the curves' inner points, two per curve in curve order:
+/// the kernel writes point `i` to `curves[i / 2][1 + i % 2]`, so those must be exactly that run
+/// of the buffer (no two curves write one vertex, nothing else is overwritten), ending the
+/// buffer. Returns the number of regular corners.
+fn check_point_runs(plan: &AdaptivePlan, next: u32) -> Result<u32, LayoutError> {
+    if next != plan.first_regular_corner || plan.first_regular_corner < plan.first_corner {
+        return Err(LayoutError::Index {
+            what: "first regular corner",
+            index: plan.first_regular_corner as u64,
+            len: next as u64,
+        });
+    }
+    let regular_corners = plan
+        .first_curve_point
+        .checked_sub(plan.first_regular_corner)
+        .ok_or(LayoutError::Index {
+            what: "first curve point",
+            index: plan.first_curve_point as u64,
+            len: plan.first_regular_corner as u64,
+        })?;
+    let next = plan.first_curve_point;
+    for (c, curve) in plan.curves.iter().enumerate() {
+        let first = next as u64 + 2 * c as u64;
+        if curve[1] as u64 != first || curve[2] as u64 != first + 1 {
+            return Err(LayoutError::Index {
+                what: "curve inner point",
+                index: curve[1] as u64,
+                len: first,
+            });
+        }
+    }
+    let end = next as u64 + 2 * plan.curves.len() as u64;
+    if end != plan.num_vertices as u64 {
+        return Err(LayoutError::Index {
+            what: "vertex count",
+            index: end,
+            len: plan.num_vertices as u64,
+        });
+    }
+    for c in &plan.curves {
+        for &v in c {
+            check("curve point", v as u64, plan.num_vertices as u64)?;
+        }
+    }
+    Ok(regular_corners)
+}
+
+/// Patch records, their control points, and the patches per kind.
+type PatchRecords = (Vec<PatchRecord>, Vec<u32>, [u32; 4]);
+
+/// The patch records and control points in array `order`, and the patches per kind.
+fn patch_records(plan: &AdaptivePlan, order: &[u32]) -> Result<PatchRecords, LayoutError> {
+    let mut counts = [0u32; 4];
+    let mut patches = Vec::with_capacity(order.len());
+    let mut control_points = Vec::new();
+    for &pi in order {
+        let p = &plan.patches[pi as usize];
+        counts[kind_code(p.kind) as usize] += 1;
+        let cp_offset = control_points.len() as u32;
+        push_control_points(plan, p, &mut control_points)?;
+        patches.push(patch_record(p, cp_offset, plan.curves.len() as u64)?);
+    }
+    Ok((patches, control_points, counts))
+}
+
+/// Appends `p`'s control points, checked: as many as its kind has (ACC-1 patches carry 8
+/// limit-tangent points past their 20), each before the curve points, which the kernel computes
+/// from them in one dispatch (a control point among them would be read while written).
+fn push_control_points(
+    plan: &AdaptivePlan,
+    p: &AdaptivePatch,
+    out: &mut Vec<u32>,
+) -> Result<(), LayoutError> {
+    let tangents = p.kind == PatchKind::Gregory && p.tangent_valences != [0; 4];
+    let need = control_point_count(p.kind) + if tangents { 8 } else { 0 };
+    if p.control_points.len() != need {
+        return Err(LayoutError::Index {
+            what: "control points of a patch",
+            index: p.control_points.len() as u64,
+            len: need as u64,
+        });
+    }
+    for &c in &p.control_points {
+        check("control point", c as u64, plan.first_curve_point as u64)?;
+        out.push(c);
+    }
+    Ok(())
+}
+
+/// `p`'s record: kind, level, boundary and transition masks, and per edge its kind, the
+/// direction of its curves and the curves (a triangle's fourth edge is zeros).
+fn patch_record(
+    p: &AdaptivePatch,
+    cp_offset: u32,
+    ncurves: u64,
+) -> Result<PatchRecord, LayoutError> {
+    let mut edge_info = 0u32;
+    let mut curves = [0u32; 8];
+    for (e, edge) in p.edges.iter().enumerate().take(p.corners()) {
+        let bits =
+            edge_code(edge.kind) | (edge.reversed[0] as u32) << 2 | (edge.reversed[1] as u32) << 3;
+        edge_info |= bits << (4 * e);
+        for h in 0..2 {
+            check("curve", edge.curves[h] as u64, ncurves)?;
+            curves[2 * e + h] = edge.curves[h];
+        }
+    }
+    if p.level > 15 {
+        return Err(LayoutError::TooLarge {
+            what: "patch level",
+            value: p.level as u64,
+        });
+    }
+    Ok(PatchRecord {
+        cp_offset,
+        info: kind_code(p.kind)
+            | (p.level as u32) << 4
+            | ((p.boundary_mask & 15) as u32) << 8
+            | ((p.transition_mask & 15) as u32) << 12,
+        edge_info,
+        pad: 0,
+        curves,
+    })
+}
+
+/// Per curve, its owner patch by frame-wide id (`frame_id`) and the owner's edge, part and
+/// direction. The curve kernel reads the owner's control points of that edge: an edge past the
+/// owner's corners (a triangle's fourth) would read past its points.
+fn curve_owners(plan: &AdaptivePlan, frame_id: &[u32]) -> Result<Vec<CurveOwner>, LayoutError> {
+    if plan.curve_owners.len() != plan.curves.len() {
+        return Err(LayoutError::Index {
+            what: "curve owners",
+            index: plan.curve_owners.len() as u64,
+            len: plan.curves.len() as u64,
+        });
+    }
+    let patches = frame_id.len() as u64;
+    let mut owners = Vec::with_capacity(plan.curve_owners.len());
+    for o in &plan.curve_owners {
+        check("curve owner", o.patch as u64, patches)?;
+        let owner = &plan.patches[o.patch as usize];
+        check("curve owner edge", o.edge as u64, owner.corners() as u64)?;
+        check("curve owner part", o.part as u64, 3)?;
+        if o.triangle != (owner.kind == PatchKind::GregoryTriangle) {
+            return Err(LayoutError::Index {
+                what: "curve owner kind",
+                index: o.patch as u64,
+                len: patches,
+            });
+        }
+        owners.push(CurveOwner {
+            patch: frame_id[o.patch as usize],
+            info: o.edge as u32
+                | (o.part as u32) << 2
+                | (o.forward as u32) << 4
+                | (o.triangle as u32) << 5,
+        });
+    }
+    Ok(owners)
+}
+
+/// Per canonical corner, `[frame-wide owner patch, corner]` (corner 4 + e of a triangle patch:
+/// the midpoint of its edge e). The canonical corners are one run up to the curve points: rows,
+/// then the `regular_corners` the kernel evaluates from the 3×3 points around corner `c` of
+/// their owner, a regular patch whose points (phantoms included) all come earlier. The TES
+/// reads `corner_owners[end - first_corner]` at every curve end.
+fn corner_owners(
+    plan: &AdaptivePlan,
+    frame_id: &[u32],
+    regular_corners: u32,
+) -> Result<Vec<[u32; 2]>, LayoutError> {
+    let mut owners = Vec::with_capacity(plan.corner_owners.len());
+    for &[pi, c] in &plan.corner_owners {
+        check("corner owner", pi as u64, frame_id.len() as u64)?;
+        check("corner owner corner", c as u64, 8)?;
+        owners.push([frame_id[pi as usize], c]);
+    }
+    let first_regular = (plan.first_regular_corner - plan.first_corner) as usize;
+    if first_regular as u64 + regular_corners as u64 != plan.corner_owners.len() as u64 {
+        return Err(LayoutError::Index {
+            what: "regular corner owners",
+            index: plan.first_curve_point as u64,
+            len: plan.first_corner as u64 + plan.corner_owners.len() as u64,
+        });
+    }
+    for &[pi, c] in &plan.corner_owners[first_regular..] {
+        let owner = &plan.patches[pi as usize];
+        if owner.kind != PatchKind::Regular || c >= 4 {
+            return Err(LayoutError::Index {
+                what: "regular corner owner",
+                index: pi as u64,
+                len: plan.patches.len() as u64,
+            });
+        }
+        for &cp in &owner.control_points {
+            check(
+                "regular corner point",
+                cp as u64,
+                plan.first_regular_corner as u64,
+            )?;
+        }
+    }
+    for c in &plan.curves {
+        for v in [c[0], c[3]] {
+            check(
+                "curve end (canonical corner)",
+                (v as u64).wrapping_sub(plan.first_corner as u64),
+                owners.len() as u64,
+            )?;
+        }
+    }
+    check(
+        "last canonical corner",
+        plan.first_corner as u64 + owners.len() as u64,
+        plan.num_vertices as u64 + 1,
+    )?;
+    Ok(owners)
+}
+
 impl GpuPlan {
     /// The curves' inner points, which the stencil kernel's last dispatches compute.
     pub fn curve_points(&self) -> u32 {
@@ -199,236 +462,29 @@ impl GpuPlan {
         self.first_curve_point - self.first_regular_corner
     }
 
+    /// Lays `plan` out for the GPU, in the order the module doc names: the stencil blocks,
+    /// the runs of canonical points after them, the patch records in array order, then the
+    /// curve and corner owners, each checked so the GPU never indexes out of bounds.
     pub fn new(plan: &AdaptivePlan) -> Result<GpuPlan, LayoutError> {
-        let nb = plan.num_base_vertices;
-        let nv = plan.num_vertices;
-        let mut stencils = GpuStencils::default();
-        let mut blocks = Vec::new();
-        let mut next = nb;
-        for block in plan.steps.iter().chain(std::iter::once(&plan.local_points)) {
-            // Blocks must tile the refined part of the vertex buffer in order.
-            if block.first_vertex != next {
-                return Err(LayoutError::Index {
-                    what: "stencil block start",
-                    index: block.first_vertex as u64,
-                    len: next as u64,
-                });
-            }
-            let t = &block.table;
-            let rows = t.len() as u32;
-            for r in 0..t.len() {
-                let (idx, w) = t.stencil(r);
-                if let Some(&i) = idx.iter().find(|&&i| i >= block.first_vertex) {
-                    return Err(LayoutError::BlockOrder {
-                        vertex: block.first_vertex + r as u32,
-                        reads: i,
-                        block_start: block.first_vertex,
-                    });
-                }
-                stencils.push_row(idx, w)?;
-            }
-            if rows > 0 {
-                let first = block.first_vertex - nb;
-                blocks.push(StencilBlock {
-                    rows: first..first + rows,
-                    destination: block.first_vertex,
-                });
-            }
-            next = block.first_vertex + rows;
-        }
-        // Then the canonical corners of regular patches (computed from their owner's
-        // 3×3 points), then the curves' inner points, two per curve in curve order: the kernel
-        // writes point `i` to `curves[i / 2][1 + i % 2]`, so those must be exactly that run of
-        // the buffer (no two curves write one vertex, nothing else is overwritten).
-        if next != plan.first_regular_corner || plan.first_regular_corner < plan.first_corner {
-            return Err(LayoutError::Index {
-                what: "first regular corner",
-                index: plan.first_regular_corner as u64,
-                len: next as u64,
-            });
-        }
-        let regular_corners = plan
-            .first_curve_point
-            .checked_sub(plan.first_regular_corner)
-            .ok_or(LayoutError::Index {
-                what: "first curve point",
-                index: plan.first_curve_point as u64,
-                len: plan.first_regular_corner as u64,
-            })?;
-        let next = plan.first_curve_point;
-        for (c, curve) in plan.curves.iter().enumerate() {
-            let first = next as u64 + 2 * c as u64;
-            if curve[1] as u64 != first || curve[2] as u64 != first + 1 {
-                return Err(LayoutError::Index {
-                    what: "curve inner point",
-                    index: curve[1] as u64,
-                    len: first,
-                });
-            }
-        }
-        if next as u64 + 2 * plan.curves.len() as u64 != nv as u64 {
-            return Err(LayoutError::Index {
-                what: "vertex count",
-                index: next as u64 + 2 * plan.curves.len() as u64,
-                len: nv as u64,
-            });
-        }
+        let (stencils, blocks, next) = stencil_blocks(plan)?;
+        let regular_corners = check_point_runs(plan, next)?;
         let mut order: Vec<u32> = (0..plan.patches.len() as u32).collect();
         order.sort_by_key(|&i| kind_code(plan.patches[i as usize].kind));
-        let mut counts = [0u32; 4];
-        let mut patches = Vec::with_capacity(order.len());
-        let mut control_points = Vec::new();
-        let ncurves = plan.curves.len() as u64;
-        for &pi in &order {
-            let p = &plan.patches[pi as usize];
-            counts[kind_code(p.kind) as usize] += 1;
-            // ACC-1 patches carry 8 limit-tangent points past their 20 (tangent patches).
-            let tangents = p.kind == PatchKind::Gregory && p.tangent_valences != [0; 4];
-            let need = control_point_count(p.kind) + if tangents { 8 } else { 0 };
-            if p.control_points.len() != need {
-                return Err(LayoutError::Index {
-                    what: "control points of a patch",
-                    index: p.control_points.len() as u64,
-                    len: need as u64,
-                });
-            }
-            let cp_offset = control_points.len() as u32;
-            // Control points precede the curve points, which the kernel computes from them
-            // in one dispatch (a control point among them would be read while written).
-            for &c in &p.control_points {
-                check("control point", c as u64, plan.first_curve_point as u64)?;
-                control_points.push(c);
-            }
-            let mut edge_info = 0u32;
-            let mut curves = [0u32; 8];
-            // A triangle's fourth edge is unused (record zeros).
-            for (e, edge) in p.edges.iter().enumerate().take(p.corners()) {
-                let bits = edge_code(edge.kind)
-                    | (edge.reversed[0] as u32) << 2
-                    | (edge.reversed[1] as u32) << 3;
-                edge_info |= bits << (4 * e);
-                for h in 0..2 {
-                    check("curve", edge.curves[h] as u64, ncurves)?;
-                    curves[2 * e + h] = edge.curves[h];
-                }
-            }
-            if p.level > 15 {
-                return Err(LayoutError::TooLarge {
-                    what: "patch level",
-                    value: p.level as u64,
-                });
-            }
-            patches.push(PatchRecord {
-                cp_offset,
-                info: kind_code(p.kind)
-                    | (p.level as u32) << 4
-                    | ((p.boundary_mask & 15) as u32) << 8
-                    | ((p.transition_mask & 15) as u32) << 12,
-                edge_info,
-                pad: 0,
-                curves,
-            });
-        }
-        for c in &plan.curves {
-            for &v in c {
-                check("curve point", v as u64, nv as u64)?;
-            }
-        }
-        if plan.curve_owners.len() != plan.curves.len() {
-            return Err(LayoutError::Index {
-                what: "curve owners",
-                index: plan.curve_owners.len() as u64,
-                len: plan.curves.len() as u64,
-            });
-        }
+        let (patches, control_points, counts) = patch_records(plan, &order)?;
         let mut frame_id = vec![0u32; order.len()];
         for (id, &pi) in order.iter().enumerate() {
             frame_id[pi as usize] = id as u32;
         }
-        let mut curve_owners = Vec::with_capacity(plan.curve_owners.len());
-        for o in &plan.curve_owners {
-            check("curve owner", o.patch as u64, order.len() as u64)?;
-            // The curve kernel reads the owner's control points of that edge: an edge past
-            // the owner's corners (a triangle's fourth) would read past its points.
-            let owner = &plan.patches[o.patch as usize];
-            check("curve owner edge", o.edge as u64, owner.corners() as u64)?;
-            check("curve owner part", o.part as u64, 3)?;
-            if o.triangle != (owner.kind == PatchKind::GregoryTriangle) {
-                return Err(LayoutError::Index {
-                    what: "curve owner kind",
-                    index: o.patch as u64,
-                    len: order.len() as u64,
-                });
-            }
-            curve_owners.push(CurveOwner {
-                patch: frame_id[o.patch as usize],
-                info: o.edge as u32
-                    | (o.part as u32) << 2
-                    | (o.forward as u32) << 4
-                    | (o.triangle as u32) << 5,
-            });
-        }
-        let mut corner_owners = Vec::with_capacity(plan.corner_owners.len());
-        for &[pi, c] in &plan.corner_owners {
-            check("corner owner", pi as u64, order.len() as u64)?;
-            // Corner 4 + e of a triangle patch: the midpoint of its edge e.
-            check("corner owner corner", c as u64, 8)?;
-            corner_owners.push([frame_id[pi as usize], c]);
-        }
-        // The kernel evaluates corner `first_regular_corner + i` from the 3×3 points around
-        // corner `c` of its owner, a regular patch whose points (phantoms included) all come earlier.
-        // The canonical corners are one run up to the curve points: rows, then regular ones.
-        if (plan.first_regular_corner - plan.first_corner) as u64 + regular_corners as u64
-            != plan.corner_owners.len() as u64
-        {
-            return Err(LayoutError::Index {
-                what: "regular corner owners",
-                index: plan.first_curve_point as u64,
-                len: plan.first_corner as u64 + plan.corner_owners.len() as u64,
-            });
-        }
-        for &[pi, c] in
-            &plan.corner_owners[(plan.first_regular_corner - plan.first_corner) as usize..]
-        {
-            let owner = &plan.patches[pi as usize];
-            if owner.kind != PatchKind::Regular || c >= 4 {
-                return Err(LayoutError::Index {
-                    what: "regular corner owner",
-                    index: pi as u64,
-                    len: plan.patches.len() as u64,
-                });
-            }
-            for &cp in &owner.control_points {
-                check(
-                    "regular corner point",
-                    cp as u64,
-                    plan.first_regular_corner as u64,
-                )?;
-            }
-        }
-        // The TES reads `corner_owners[end - first_corner]` at every curve end.
-        for c in &plan.curves {
-            for v in [c[0], c[3]] {
-                check(
-                    "curve end (canonical corner)",
-                    (v as u64).wrapping_sub(plan.first_corner as u64),
-                    corner_owners.len() as u64,
-                )?;
-            }
-        }
-        check(
-            "last canonical corner",
-            plan.first_corner as u64 + corner_owners.len() as u64,
-            nv as u64 + 1,
-        )?;
+        let curve_owners = curve_owners(plan, &frame_id)?;
+        let corner_owners = corner_owners(plan, &frame_id, regular_corners)?;
         Ok(GpuPlan {
             first_curve_point: plan.first_curve_point,
             first_regular_corner: plan.first_regular_corner,
             curve_owners,
             first_corner: plan.first_corner,
             corner_owners,
-            num_base_vertices: nb,
-            num_vertices: nv,
+            num_base_vertices: plan.num_base_vertices,
+            num_vertices: plan.num_vertices,
             stencils,
             blocks,
             patches,
