@@ -339,8 +339,8 @@ type Contexts =
     HandleTable<ContextState, SurfaceState, topology::limit::face_domain::LimitEvaluator>;
 
 fn handles() -> &'static Mutex<Contexts> {
-    static REGISTRY: OnceLock<Mutex<Contexts>> = OnceLock::new();
-    REGISTRY.get_or_init(|| Mutex::new(HandleTable::default()))
+    static HANDLES: OnceLock<Mutex<Contexts>> = OnceLock::new();
+    HANDLES.get_or_init(|| Mutex::new(HandleTable::default()))
 }
 
 thread_local! {
