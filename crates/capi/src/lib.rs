@@ -335,7 +335,8 @@ pub struct TesseraFrameDesc {
     pub show: TesseraShow,
 }
 
-type Contexts = HandleTable<ContextState, SurfaceState, topology::limit::face_domain::LimitEvaluator>;
+type Contexts =
+    HandleTable<ContextState, SurfaceState, topology::limit::face_domain::LimitEvaluator>;
 
 fn handles() -> &'static Mutex<Contexts> {
     static REGISTRY: OnceLock<Mutex<Contexts>> = OnceLock::new();
