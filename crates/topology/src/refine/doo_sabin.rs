@@ -20,7 +20,7 @@ use crate::mesh::{ControlMesh, Topology, INVALID};
 use crate::refine::stencil::{build_rows, StencilTable};
 use crate::refine::Level;
 use crate::rules::boundary_edge_sharpness;
-use crate::rules::doo_sabin::{corner_weights, strip_edge};
+use crate::rules::doo_sabin::{corner_weights, strip_edge, NotOneBoundaryEdge};
 
 /// Where a child vertex of a Doo-Sabin step comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -178,8 +178,8 @@ fn interior_faces(p: &Topology) -> (Vec<Vec<u32>>, Vec<DualFace>) {
         origins.push(DualFace::Edge(e as u32));
     }
     let boundary = boundary_vertices(p);
-    for v in 0..p.num_vertices() {
-        if p.vertex_faces(v).is_empty() || boundary[v] {
+    for (v, &on_boundary) in boundary.iter().enumerate() {
+        if p.vertex_faces(v).is_empty() || on_boundary {
             continue;
         }
         let ring: Vec<u32> = fan(p, v, p.vertex_faces(v)[0])
@@ -234,9 +234,9 @@ fn boundary_faces(
     vertices: &mut Vec<DualVertex>,
 ) -> Result<(), TopologyError> {
     let mut first_point = vec![INVALID; p.num_edges()];
-    for e in 0..p.num_edges() {
+    for (e, first) in first_point.iter_mut().enumerate() {
         if p.is_boundary_edge(e) {
-            first_point[e] = vertices.len() as u32;
+            *first = vertices.len() as u32;
             for end in 0..2 {
                 vertices.push(DualVertex::Chaikin {
                     edge: e as u32,
@@ -269,8 +269,8 @@ fn boundary_faces(
         origins.push(DualFace::EdgeStrip(e as u32));
     }
     let boundary = boundary_vertices(p);
-    for v in 0..p.num_vertices() {
-        if !boundary[v] || p.vertex_faces(v).is_empty() {
+    for (v, &on_boundary) in boundary.iter().enumerate() {
+        if !on_boundary || p.vertex_faces(v).is_empty() {
             continue;
         }
         let vf = p.vertex_faces(v);
@@ -312,7 +312,7 @@ fn dual_rows(
         for (f, strip) in strips.iter_mut().enumerate() {
             let fv = p.face_vertices(f);
             *strip = strip_edge(fv.len(), |k| boundary_points[fv[k] as usize])
-                .map_err(|()| TopologyError::UnsupportedScheme {
+                .map_err(|NotOneBoundaryEdge| TopologyError::UnsupportedScheme {
                     scheme: "doo-sabin",
                     operation: "a refined level whose face holds boundary points that are not one boundary edge",
                 })?;

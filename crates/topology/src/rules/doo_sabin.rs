@@ -94,16 +94,23 @@ pub fn corner_weights(n: usize, boundary_edge: Option<usize>, i: usize, out: &mu
     }
 }
 
+/// A face whose boundary points are not the two ends of one of its edges.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NotOneBoundaryEdge;
+
 /// The corner `p` that starts the boundary edge of a face whose corners are boundary points
 /// where `is_boundary(k)` holds: `Some(p)` when exactly corners `p` and `p + 1` are, `None`
-/// when none is, and `Err(())` for any other pattern (no level of the refiner makes one).
-pub fn strip_edge(n: usize, is_boundary: impl Fn(usize) -> bool) -> Result<Option<usize>, ()> {
+/// when none is, and [`NotOneBoundaryEdge`] for any other pattern (no level of the refiner makes one).
+pub fn strip_edge(
+    n: usize,
+    is_boundary: impl Fn(usize) -> bool,
+) -> Result<Option<usize>, NotOneBoundaryEdge> {
     let marked: Vec<usize> = (0..n).filter(|&k| is_boundary(k)).collect();
     match marked[..] {
         [] => Ok(None),
         [a, b] if b == a + 1 => Ok(Some(a)),
         [0, b] if b == n - 1 => Ok(Some(n - 1)),
-        _ => Err(()),
+        _ => Err(NotOneBoundaryEdge),
     }
 }
 
@@ -158,7 +165,7 @@ mod tests {
         assert_eq!(strip_edge(4, |k| k == 2 || k == 3), Ok(Some(2)));
         assert_eq!(strip_edge(4, |k| k == 0 || k == 3), Ok(Some(3)));
         assert_eq!(strip_edge(5, |_| false), Ok(None));
-        assert_eq!(strip_edge(4, |k| k == 0 || k == 2), Err(()));
-        assert_eq!(strip_edge(4, |k| k < 3), Err(()));
+        assert_eq!(strip_edge(4, |k| k == 0 || k == 2), Err(NotOneBoundaryEdge));
+        assert_eq!(strip_edge(4, |k| k < 3), Err(NotOneBoundaryEdge));
     }
 }

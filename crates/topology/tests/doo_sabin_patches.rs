@@ -1,0 +1,240 @@
+//! Doo-Sabin vertex patches against the refiner: the layout's index maps, run on level-1 vertex
+//! ids, name exactly the refiner's faces and child vertices at every depth; run on positions,
+//! they reproduce the refiner's points; drawn with ownership, they cover each refined face once.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+use topology::mesh::INVALID;
+use topology::patches::doo_sabin::{vertex_patches, PatchLayout, VertexPatch};
+use topology::refine::doo_sabin::refine_dual;
+use topology::refine::{refine_uniform, Level, UniformRefinement};
+use topology::{load_obj, ControlMesh, Scheme};
+
+fn shape(name: &str) -> ControlMesh {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join(format!("../../tests/data/opensubdiv/shapes/{name}.obj"));
+    load_obj(p).unwrap()
+}
+
+/// A pentagonal prism: two pentagons, five quads, valence 3 everywhere.
+fn pentagonal_prism() -> ControlMesh {
+    let mut positions = Vec::new();
+    for z in [0.0, 1.0] {
+        for k in 0..5 {
+            let a = std::f64::consts::TAU * k as f64 / 5.0;
+            positions.push([a.cos(), a.sin(), z]);
+        }
+    }
+    let mut faces: Vec<Vec<u32>> = vec![vec![4, 3, 2, 1, 0], vec![5, 6, 7, 8, 9]];
+    for k in 0..5u32 {
+        let k1 = (k + 1) % 5;
+        faces.push(vec![k, k1, k1 + 5, k + 5]);
+    }
+    ControlMesh::from_polygons(positions, &faces)
+}
+
+/// A pentagonal prism with its top pentagon split into a fan of triangles around a valence-5
+/// vertex (triangles, a pentagon, valence 3, 4 and 5).
+fn capped_prism() -> ControlMesh {
+    let mut mesh = pentagonal_prism();
+    let mut positions = mesh.positions.clone();
+    positions.push([0.0, 0.0, 1.5]);
+    let mut faces: Vec<Vec<u32>> = vec![vec![4, 3, 2, 1, 0]];
+    for k in 0..5u32 {
+        let k1 = (k + 1) % 5;
+        faces.push(vec![k, k1, k1 + 5, k + 5]);
+        faces.push(vec![k + 5, k1 + 5, 10]);
+    }
+    mesh = ControlMesh::from_polygons(positions, &faces);
+    mesh
+}
+
+/// The faces of a level by their first directed edge.
+fn faces_by_edge(level: &Level) -> HashMap<(u32, u32), usize> {
+    let t = &level.topology;
+    let mut out = HashMap::new();
+    for f in 0..t.num_faces() {
+        let fv = t.face_vertices(f);
+        for i in 0..fv.len() {
+            out.insert((fv[i], fv[(i + 1) % fv.len()]), f);
+        }
+    }
+    out
+}
+
+/// The level face whose corners are `corners` (same cyclic order, same orientation).
+fn find_face(level: &Level, by_edge: &HashMap<(u32, u32), usize>, corners: &[u32]) -> usize {
+    let f = *by_edge
+        .get(&(corners[0], corners[1]))
+        .unwrap_or_else(|| panic!("no face through {corners:?}"));
+    let fv = level.topology.face_vertices(f);
+    let start = fv.iter().position(|&x| x == corners[0]).unwrap();
+    let rotated: Vec<u32> = (0..fv.len()).map(|k| fv[(start + k) % fv.len()]).collect();
+    assert_eq!(rotated, corners, "patch face is not a refined face");
+    f
+}
+
+/// The patch array as level-`d` vertex ids, for `d = 1..=depth` (the layout's maps run on ids).
+fn patch_ids(patch: &VertexPatch, r: &UniformRefinement, depth: u32) -> Vec<Vec<u32>> {
+    let layout = patch.layout();
+    let mut all = vec![patch.points.clone()];
+    for d in 1..depth {
+        let level = r.level(d as usize);
+        let by_edge = faces_by_edge(level);
+        let ids = all.last().unwrap();
+        let mut next = vec![INVALID; layout.len(d + 1)];
+        for face in layout.faces(d) {
+            let corners: Vec<u32> = face.corners.iter().map(|&i| ids[i]).collect();
+            let f = find_face(level, &by_edge, &corners);
+            let offset = level.topology.face_tables().0[f];
+            let fv = level.topology.face_vertices(f);
+            for (i, targets) in face.children.iter().enumerate() {
+                // The refiner numbers the child of corner k of face f as offset + k.
+                let k = fv.iter().position(|&x| x == corners[i]).unwrap() as u32;
+                for &t in targets {
+                    assert_eq!(
+                        next[t],
+                        INVALID,
+                        "point {t} written twice at depth {}",
+                        d + 1
+                    );
+                    next[t] = offset + k;
+                }
+            }
+        }
+        for (i, &x) in next.iter().enumerate() {
+            assert_eq!(
+                x == INVALID,
+                layout.is_dead(d + 1, i),
+                "point {i} at depth {}",
+                d + 1
+            );
+        }
+        all.push(next);
+    }
+    all
+}
+
+fn diagonal(points: &[[f64; 3]]) -> f64 {
+    let mut lo = [f64::MAX; 3];
+    let mut hi = [f64::MIN; 3];
+    for p in points {
+        for c in 0..3 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    (0..3).map(|c| (hi[c] - lo[c]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// The patches of `mesh` against the refiner to `depth`: ids, positions and, when `closed`,
+/// every refined face drawn exactly once (else at most once).
+fn check(mesh: &ControlMesh, depth: u32, closed: bool) -> usize {
+    let r = refine_uniform(mesh, Scheme::DooSabin, depth as usize).unwrap();
+    let base = r.level(0);
+    let step = refine_dual(base, true).unwrap();
+    assert_eq!(step.level.positions, r.level(1).positions);
+    let patches = vertex_patches(&base.topology, &step).unwrap();
+    let want = &r.level(depth as usize);
+    let tolerance = 1e-12 * diagonal(&want.positions);
+    let mut drawn = vec![0u32; want.topology.num_faces()];
+    let by_edge = faces_by_edge(want);
+    for patch in &patches {
+        let layout = patch.layout();
+        let ids = patch_ids(patch, &r, depth);
+        let mut points: Vec<[f64; 3]> = patch
+            .points
+            .iter()
+            .map(|&x| {
+                if x == INVALID {
+                    [0.0; 3]
+                } else {
+                    step.level.positions[x as usize]
+                }
+            })
+            .collect();
+        for d in 1..depth {
+            points = layout.refine(d, &points);
+        }
+        let last = ids.last().unwrap();
+        for (i, (&id, p)) in last.iter().zip(&points).enumerate() {
+            if id == INVALID {
+                continue;
+            }
+            let q = want.positions[id as usize];
+            let err = (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0, f64::max);
+            assert!(
+                err <= tolerance,
+                "patch {} point {i}: {p:?} vs {q:?}",
+                patch.vertex
+            );
+        }
+        for face in layout.faces(depth) {
+            if patch.draws(depth, &face) {
+                let corners: Vec<u32> = face.corners.iter().map(|&i| last[i]).collect();
+                drawn[find_face(want, &by_edge, &corners)] += 1;
+            }
+        }
+    }
+    if closed {
+        assert!(drawn.iter().all(|&c| c == 1), "draw counts {drawn:?}");
+    } else {
+        assert!(drawn.iter().all(|&c| c <= 1), "draw counts {drawn:?}");
+        assert!(drawn.contains(&1));
+    }
+    patches.len()
+}
+
+#[test]
+fn layout_counts_follow_the_seed() {
+    let sizes = [4, 4, 4, 4, 4];
+    let layout = PatchLayout {
+        valence: 5,
+        corner_sizes: &sizes,
+    };
+    for depth in 1..6u32 {
+        let l = PatchLayout::outer_layer(depth);
+        assert_eq!(layout.layer_points(depth), (l + 1) * (l + 1) * 5);
+        // v-face, (2l + 1) n regular quads and n corner faces per face layer.
+        assert_eq!(layout.faces(depth).len(), 1 + 5 * l * (l + 1));
+    }
+    // Side 1 of layer 2 starts after the 5 points of side 0 (0-based C(2, 1) = 4·5 + 5).
+    assert_eq!(layout.corner_point(2, 1), 25);
+    assert_eq!(layout.delta(2, 1), 5 * 5 + 3);
+}
+
+#[test]
+fn quad_patches_match_the_refiner() {
+    for depth in 1..=4 {
+        assert_eq!(check(&shape("catmark_cube"), depth, true), 8);
+    }
+}
+
+#[test]
+fn triangle_and_valence_five_patches_match_the_refiner() {
+    for depth in 1..=4 {
+        assert_eq!(check(&shape("loop_icosahedron"), depth, true), 12);
+        assert_eq!(check(&shape("catmark_pyramid"), depth, true), 5);
+    }
+}
+
+#[test]
+fn pentagon_patches_match_the_refiner() {
+    for depth in 1..=4 {
+        assert_eq!(check(&pentagonal_prism(), depth, true), 10);
+        assert_eq!(check(&capped_prism(), depth, true), 11);
+    }
+}
+
+#[test]
+fn interior_patches_of_open_meshes_match_the_refiner() {
+    for depth in 1..=4 {
+        for name in [
+            "catmark_hole_test2",
+            "catmark_tent",
+            "loop_triangle_edgeonly",
+        ] {
+            assert!(check(&shape(name), depth, false) > 0, "{name}");
+        }
+    }
+}
