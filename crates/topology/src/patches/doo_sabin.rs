@@ -1,6 +1,6 @@
 //! Doo-Sabin vertex patches (Fan and Cheng, "GPU supported patch-based tessellation for dual
 //! subdivision", §2): after one Doo-Sabin step of the control mesh
-//! ([`crate::refine::doo_sabin::refine_dual`]), each interior control vertex `v` of valence
+//! ([`crate::refine::doo_sabin::refine_dual`]), each control vertex `v` of valence
 //! `n` owns a *vertex patch*: its v-face, the `n` e-faces of its edges and the `n` f-faces of
 //! its faces. A patch is refined on its own, as a one-dimensional array, and its faces are read
 //! back from the array by index arithmetic alone.
@@ -46,18 +46,21 @@
 //! shared: side `j`'s strip with the patch across the edge from `v` to the corner before `v` in
 //! `f_j`, corner face `j` with the patches of all corners of `f_j`. For drawing each is *owned*
 //! by one patch ([`VertexPatch::owns_side`], [`VertexPatch::owns_corner`]): a strip by the patch
-//! of the smaller vertex, a corner face by the patch of the face's first interior vertex (in its
+//! of the smaller vertex, a corner face by the patch of the face's first vertex (in its
 //! face-vertex order). Inner faces belong to their patch alone.
 //!
-//! Only interior vertices have patches: a boundary vertex has no v-face (its level-1 face is a
-//! strip face, [`crate::rules::doo_sabin`]), and its region is not covered by vertex patches.
-//! Faces of an interior vertex's patch never hold boundary points, so every face of a patch is
-//! refined with Doo-Sabin's own mask ([`crate::rules::doo_sabin::alpha`]).
+//! A boundary vertex's patch has its strip face ([`crate::rules::doo_sabin`]'s boundary rule)
+//! for a v-face, and a wedge of *absent* points and faces beyond its boundary edge
+//! ([`vertex_patches`]). Which points are present and which are boundary points is carried
+//! from depth to depth ([`PointFlags`], [`PatchLayout::next_flags`]): a face is present when
+//! its corners are, and a face holding boundary points is refined by the strip mask, as the
+//! refiner does. Faces of an interior vertex's patch never hold boundary points.
 
 use crate::error::TopologyError;
 use crate::mesh::{Topology, INVALID};
-use crate::refine::doo_sabin::{boundary_vertices, corner_child, fan, DualStep};
-use crate::rules::doo_sabin::alpha;
+use crate::refine::doo_sabin::{boundary_vertices, corner_child, fan, DualStep, DualVertex};
+use crate::rules::doo_sabin::{corner_weights, strip_edge};
+use std::collections::HashMap;
 
 /// The shape of a vertex patch: the valence of its vertex and the sizes of its corner faces.
 #[derive(Clone, Copy, Debug)]
@@ -186,7 +189,7 @@ impl PatchLayout<'_> {
                 }
             }
         }
-        for j in 0..n {
+        for j in (0..n).filter(|&j| self.corner_sizes[j] > 0) {
             out.push(self.outer_corner(depth, j));
         }
         out
@@ -232,18 +235,56 @@ impl PatchLayout<'_> {
         }
     }
 
-    /// One Doo-Sabin step of a patch array from depth `d` to `d + 1` (dead points stay 0).
-    pub fn refine(&self, depth: u32, points: &[[f64; 3]]) -> Vec<[f64; 3]> {
-        let mut out = vec![[0.0; 3]; self.len(depth + 1)];
+    /// The flags of every point at depth `d + 1` from those at depth `d`: a face is present when
+    /// all its corners are, and its children are present and on the boundary when their parent
+    /// corners are.
+    pub fn next_flags(&self, depth: u32, flags: &[PointFlags]) -> Vec<PointFlags> {
+        let mut out = vec![PointFlags::ABSENT; self.len(depth + 1)];
         for face in self.faces(depth) {
+            if !face.corners.iter().all(|&c| flags[c].present) {
+                continue;
+            }
+            for (&c, targets) in face.corners.iter().zip(&face.children) {
+                for &t in targets {
+                    out[t] = PointFlags {
+                        present: true,
+                        boundary: flags[c].boundary,
+                    };
+                }
+            }
+        }
+        out
+    }
+
+    /// One Doo-Sabin step of a patch array from depth `d` to `d + 1`, each present face by its
+    /// mask ([`corner_weights`]: a strip face's where it holds boundary points); points no
+    /// present face writes stay 0.
+    pub fn refine(
+        &self,
+        depth: u32,
+        points: &[[f64; 3]],
+        flags: &[PointFlags],
+    ) -> Result<Vec<[f64; 3]>, TopologyError> {
+        let mut out = vec![[0.0; 3]; self.len(depth + 1)];
+        let mut w = Vec::new();
+        for face in self.faces(depth) {
+            if !face.corners.iter().all(|&c| flags[c].present) {
+                continue;
+            }
             let m = face.corners.len();
+            let strip = strip_edge(m, |k| flags[face.corners[k]].boundary).map_err(|_| {
+                TopologyError::UnsupportedScheme {
+                    scheme: "doo-sabin",
+                    operation: "a vertex patch face whose boundary points are not one edge",
+                }
+            })?;
             for (i, targets) in face.children.iter().enumerate() {
+                corner_weights(m, strip, i, &mut w);
                 let mut p = [0.0; 3];
-                for k in 0..m {
-                    let w = alpha(m, k);
+                for (k, &wk) in w.iter().enumerate() {
                     let q = points[face.corners[(i + k) % m]];
                     for c in 0..3 {
-                        p[c] += w * q[c];
+                        p[c] += wk * q[c];
                     }
                 }
                 for &t in targets {
@@ -251,21 +292,48 @@ impl PatchLayout<'_> {
                 }
             }
         }
-        out
+        Ok(out)
     }
 }
 
-/// The vertex patch of one interior control vertex, at depth 1.
+/// What a point of a patch array is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PointFlags {
+    /// Whether the point is a vertex of the refined mesh (not dead, not beyond the boundary).
+    pub present: bool,
+    /// Whether it is a boundary point (on the boundary polygon of its level).
+    pub boundary: bool,
+}
+
+impl PointFlags {
+    pub const ABSENT: PointFlags = PointFlags {
+        present: false,
+        boundary: false,
+    };
+    const INNER: PointFlags = PointFlags {
+        present: true,
+        boundary: false,
+    };
+    const BOUNDARY: PointFlags = PointFlags {
+        present: true,
+        boundary: true,
+    };
+}
+
+/// The vertex patch of one control vertex, at depth 1.
 #[derive(Clone, Debug)]
 pub struct VertexPatch {
     /// The control vertex.
     pub vertex: u32,
-    /// The control faces around it, `f_0 … f_{n−1}` (corner face `j` descends from `f_j`).
+    /// The control faces around it, `f_0 … f_{n−1}` (corner face `j` descends from `f_j`);
+    /// `INVALID` for the two sides a boundary vertex has beyond its boundary edges.
     pub faces: Vec<u32>,
-    /// `m_j`, the size of `f_j`.
+    /// `m_j`, the size of `f_j` (0 where there is no face).
     pub corner_sizes: Vec<usize>,
-    /// The patch array at depth 1, as level-1 vertices (`INVALID` at dead points).
+    /// The patch array at depth 1, as level-1 vertices (`INVALID` where no point is).
     pub points: Vec<u32>,
+    /// The flags of the points at depth 1.
+    pub flags: Vec<PointFlags>,
     /// Whether this patch draws the strip of side `j` of its outer face layer.
     pub owns_side: Vec<bool>,
     /// Whether this patch draws outer corner face `j`.
@@ -281,9 +349,23 @@ impl VertexPatch {
         }
     }
 
-    /// Whether face `face` of the patch (from [`PatchLayout::faces`] at depth `d`) is drawn by
-    /// this patch.
-    pub fn draws(&self, depth: u32, face: &PatchFace) -> bool {
+    /// The flags of its points at depths `1..=depth`.
+    pub fn flags_to(&self, depth: u32) -> Vec<Vec<PointFlags>> {
+        let layout = self.layout();
+        let mut out = vec![self.flags.clone()];
+        for d in 1..depth {
+            let next = layout.next_flags(d, out.last().expect("depth 1 present"));
+            out.push(next);
+        }
+        out
+    }
+
+    /// Whether face `face` of the patch (from [`PatchLayout::faces`] at depth `d`, `flags` its
+    /// points' flags there) is drawn by this patch: present, and owned where shared.
+    pub fn draws(&self, depth: u32, face: &PatchFace, flags: &[PointFlags]) -> bool {
+        if !face.corners.iter().all(|&c| flags[c].present) {
+            return false;
+        }
         let outer = PatchLayout::outer_layer(depth);
         match face.kind {
             PatchFaceKind::VFace | PatchFaceKind::Corner { .. } => true,
@@ -293,30 +375,73 @@ impl VertexPatch {
     }
 }
 
-/// The vertex patches of the interior vertices of control mesh `p`, over `step`, its first
-/// Doo-Sabin step ([`crate::refine::doo_sabin::refine_dual`] with `first`).
+/// The vertex patches of control mesh `p` (one per vertex with faces, in vertex order), over
+/// `step`, its first Doo-Sabin step ([`crate::refine::doo_sabin::refine_dual`] with `first`).
+///
+/// A boundary vertex with `k` faces has a patch of valence `k + 2`: its layer 0 is its strip
+/// face (the children of its corners, then the Chaikin points of its last and first boundary
+/// edges), sides `k − 1` and `k + 1` hold the strip quads of those edges, and side `k` (across
+/// its boundary edge) and the corner faces of sides `k` and `k + 1` are absent.
 pub fn vertex_patches(p: &Topology, step: &DualStep) -> Result<Vec<VertexPatch>, TopologyError> {
     let boundary = boundary_vertices(p);
-    let interior = |v: u32| !boundary[v as usize] && !p.vertex_faces(v as usize).is_empty();
+    let chaikin = chaikin_points(p, step);
     let mut out = Vec::new();
-    for v in 0..p.num_vertices() {
-        if !interior(v as u32) {
+    for (v, &on_boundary) in boundary.iter().enumerate() {
+        let vf = p.vertex_faces(v);
+        if vf.is_empty() {
             continue;
         }
-        let faces = fan(p, v, p.vertex_faces(v)[0]);
-        if faces.len() != p.vertex_faces(v).len() || faces.len() < 3 {
-            return Err(TopologyError::NonManifoldVertex {
-                vertex: v as u32,
-                fans: 2,
+        let non_manifold = || TopologyError::NonManifoldVertex {
+            vertex: v as u32,
+            fans: 2,
+        };
+        let start = if on_boundary {
+            let first = vf.iter().copied().find(|&f| {
+                let ring = from_corner(p, f, v as u32);
+                edge_between(p, f, v as u32, ring[1]).is_some_and(|e| p.is_boundary_edge(e))
             });
+            first.ok_or_else(non_manifold)?
+        } else {
+            vf[0]
+        };
+        let faces = fan(p, v, start);
+        if faces.len() != vf.len() || (!on_boundary && faces.len() < 3) {
+            return Err(non_manifold());
         }
-        out.push(patch_of(p, v as u32, faces, &interior));
+        out.push(if on_boundary {
+            boundary_patch(p, v as u32, faces, &chaikin)?
+        } else {
+            interior_patch(p, v as u32, faces)
+        });
     }
     debug_assert!(out.iter().all(|patch| patch
         .points
         .iter()
         .all(|&x| x == INVALID || (x as usize) < step.vertices.len())));
     Ok(out)
+}
+
+/// The Chaikin point of boundary edge `e` next to its end `x`, by `(e, x)`.
+fn chaikin_points(p: &Topology, step: &DualStep) -> HashMap<(u32, u32), u32> {
+    let mut out = HashMap::new();
+    for (i, origin) in step.vertices.iter().enumerate() {
+        if let DualVertex::Chaikin { edge, end } = *origin {
+            let x = p.edge_vertices(edge as usize)[end as usize];
+            out.insert((edge, x), i as u32);
+        }
+    }
+    out
+}
+
+/// The edge of face `f` joining `a` and `b`.
+fn edge_between(p: &Topology, f: u32, a: u32, b: u32) -> Option<usize> {
+    p.face_edge_list(f as usize)
+        .iter()
+        .map(|&e| e as usize)
+        .find(|&e| {
+            let [x, y] = p.edge_vertices(e);
+            (x, y) == (a, b) || (x, y) == (b, a)
+        })
 }
 
 /// The corners of `f` from `v` on, in the face's order.
@@ -326,49 +451,119 @@ fn from_corner(p: &Topology, f: u32, v: u32) -> Vec<u32> {
     (0..fv.len()).map(|k| fv[(i + k) % fv.len()]).collect()
 }
 
-fn patch_of(p: &Topology, v: u32, faces: Vec<u32>, interior: &dyn Fn(u32) -> bool) -> VertexPatch {
+/// A patch at depth 1 with its points unset, `faces` padded to the valence.
+fn empty_patch(v: u32, faces: Vec<u32>, sizes: Vec<usize>) -> VertexPatch {
     let n = faces.len();
-    let corner_sizes: Vec<usize> = faces
-        .iter()
-        .map(|&f| p.face_vertices(f as usize).len())
-        .collect();
-    let layout = PatchLayout {
+    let len = PatchLayout {
         valence: n,
-        corner_sizes: &corner_sizes,
-    };
-    let mut points = vec![INVALID; layout.len(1)];
-    let mut owns_side = Vec::with_capacity(n);
-    let mut owns_corner = Vec::with_capacity(n);
-    for (j, &f) in faces.iter().enumerate() {
-        let ring = from_corner(p, f, v);
-        let m = ring.len();
-        let (slot, c) = (layout.slot(1, j), layout.corner_point(1, j));
-        for (i, &x) in ring.iter().enumerate() {
-            points[slot + i] = corner_child(p, f, x);
-        }
-        points[j] = corner_child(p, f, v);
-        points[layout.step(1, c, true)] = corner_child(p, f, ring[1]);
-        points[c + 1] = corner_child(p, f, ring[m - 1]);
-        if m == 4 {
-            points[c] = corner_child(p, f, ring[2]);
-        }
-        // Side j's strip: the e-face of the edge from v to the corner before it in f_j.
-        let u = ring[m - 1];
-        points[c + 2] = corner_child(p, faces[(j + 1) % n], u);
-        owns_side.push(!interior(u) || v < u);
-        let first_interior = p
-            .face_vertices(f as usize)
-            .iter()
-            .copied()
-            .find(|&x| interior(x));
-        owns_corner.push(first_interior == Some(v));
+        corner_sizes: &sizes,
     }
+    .len(1);
     VertexPatch {
         vertex: v,
         faces,
-        corner_sizes,
-        points,
-        owns_side,
-        owns_corner,
+        corner_sizes: sizes,
+        points: vec![INVALID; len],
+        flags: vec![PointFlags::ABSENT; len],
+        owns_side: vec![false; n],
+        owns_corner: vec![false; n],
     }
+}
+
+impl VertexPatch {
+    fn set(&mut self, i: usize, id: u32, flags: PointFlags) {
+        self.points[i] = id;
+        self.flags[i] = flags;
+    }
+
+    /// Corner face `j` (control face `f`, corners `ring` from the patch's vertex): its slots,
+    /// its layer-0 point, the layer-1 points it shares with the layout, and its owner.
+    fn set_corner_face(&mut self, p: &Topology, j: usize, f: u32, ring: &[u32]) {
+        let layout = self.layout();
+        let (slot, c) = (layout.slot(1, j), layout.corner_point(1, j));
+        let before = layout.step(1, c, true);
+        let m = ring.len();
+        for (i, &x) in ring.iter().enumerate() {
+            self.set(slot + i, corner_child(p, f, x), PointFlags::INNER);
+        }
+        self.set(j, corner_child(p, f, ring[0]), PointFlags::INNER);
+        self.set(before, corner_child(p, f, ring[1]), PointFlags::INNER);
+        self.set(c + 1, corner_child(p, f, ring[m - 1]), PointFlags::INNER);
+        if m == 4 {
+            self.set(c, corner_child(p, f, ring[2]), PointFlags::INNER);
+        }
+        self.owns_corner[j] = p.face_vertices(f as usize)[0] == ring[0];
+    }
+}
+
+fn interior_patch(p: &Topology, v: u32, faces: Vec<u32>) -> VertexPatch {
+    let n = faces.len();
+    let sizes = faces
+        .iter()
+        .map(|&f| p.face_vertices(f as usize).len())
+        .collect();
+    let mut patch = empty_patch(v, faces.clone(), sizes);
+    for (j, &f) in faces.iter().enumerate() {
+        let ring = from_corner(p, f, v);
+        patch.set_corner_face(p, j, f, &ring);
+        // Side j's strip: the e-face of the edge from v to the corner before it in f_j.
+        let u = ring[ring.len() - 1];
+        let c = patch.layout().corner_point(1, j);
+        patch.set(
+            c + 2,
+            corner_child(p, faces[(j + 1) % n], u),
+            PointFlags::INNER,
+        );
+        patch.owns_side[j] = v < u;
+    }
+    patch
+}
+
+fn boundary_patch(
+    p: &Topology,
+    v: u32,
+    faces: Vec<u32>,
+    chaikin: &HashMap<(u32, u32), u32>,
+) -> Result<VertexPatch, TopologyError> {
+    let k = faces.len();
+    let mut padded = faces.clone();
+    padded.extend([INVALID, INVALID]);
+    let mut sizes: Vec<usize> = faces
+        .iter()
+        .map(|&f| p.face_vertices(f as usize).len())
+        .collect();
+    sizes.extend([0, 0]);
+    let mut patch = empty_patch(v, padded, sizes);
+    let first_ring = from_corner(p, faces[0], v);
+    let last_ring = from_corner(p, faces[k - 1], v);
+    let (w, u) = (first_ring[1], last_ring[last_ring.len() - 1]);
+    let e_first = edge_between(p, faces[0], v, w).unwrap_or(0) as u32;
+    let e_last = edge_between(p, faces[k - 1], u, v).unwrap_or(0) as u32;
+    let point = |e: u32, x: u32| {
+        chaikin
+            .get(&(e, x))
+            .copied()
+            .ok_or(TopologyError::UnsupportedScheme {
+                scheme: "doo-sabin",
+                operation: "vertex patches over a step without the control mesh's Chaikin points",
+            })
+    };
+    for (j, &f) in faces.iter().enumerate() {
+        let ring = from_corner(p, f, v);
+        patch.set_corner_face(p, j, f, &ring);
+        let u_j = ring[ring.len() - 1];
+        if j + 1 < k {
+            let c = patch.layout().corner_point(1, j);
+            patch.set(c + 2, corner_child(p, faces[j + 1], u_j), PointFlags::INNER);
+        }
+        patch.owns_side[j] = v < u_j;
+    }
+    let layout = patch.layout();
+    let (c_last, c_first) = (layout.corner_point(1, k - 1), layout.corner_point(1, k + 1));
+    patch.set(k, point(e_last, v)?, PointFlags::BOUNDARY);
+    patch.set(k + 1, point(e_first, v)?, PointFlags::BOUNDARY);
+    patch.set(c_last + 2, point(e_last, u)?, PointFlags::BOUNDARY);
+    patch.set(c_first + 1, point(e_first, w)?, PointFlags::BOUNDARY);
+    patch.owns_side[k + 1] = v < w;
+    Ok(patch)
 }
