@@ -167,6 +167,7 @@ fn check(mesh: &ControlMesh, depth: u32) -> usize {
     let want = &r.level(depth as usize);
     let tolerance = 1e-12 * diagonal(&want.positions);
     let mut drawn = vec![0u32; want.topology.num_faces()];
+    let mut copies: HashMap<u32, [f64; 3]> = HashMap::new();
     let by_edge = faces_by_edge(want);
     for patch in &patches {
         let layout = patch.layout();
@@ -197,6 +198,13 @@ fn check(mesh: &ControlMesh, depth: u32) -> usize {
                 err <= tolerance,
                 "patch {} point {i}: {p:?} vs {q:?}",
                 patch.vertex
+            );
+            // Every patch's copy of a shared point has the same bits (no gaps between patches).
+            let first = *copies.entry(id).or_insert(*p);
+            assert_eq!(
+                first.map(f64::to_bits),
+                p.map(f64::to_bits),
+                "point {id} differs"
             );
         }
         for face in layout.faces(depth) {

@@ -256,8 +256,9 @@ impl PatchLayout<'_> {
         out
     }
 
-    /// One Doo-Sabin step of a patch array from depth `d` to `d + 1`, each present face by its
-    /// mask ([`corner_weights`]: a strip face's where it holds boundary points); points no
+    /// One Doo-Sabin step of a patch array from depth `d` to `d + 1` (the seed's "no numerical
+    /// roundoff gaps": every copy of a shared point is computed by the same sum), each present
+    /// face by its mask ([`corner_weights`]: a strip face's where it holds boundary points); points no
     /// present face writes stay 0.
     pub fn refine(
         &self,
@@ -280,6 +281,9 @@ impl PatchLayout<'_> {
             })?;
             for (i, targets) in face.children.iter().enumerate() {
                 corner_weights(m, strip, i, &mut w);
+                // From the child's own corner on, in face order: the same sum in every patch
+                // that holds the face (patches list a shared face from different corners, in
+                // the same orientation), so all copies of a shared point have the same bits.
                 let mut p = [0.0; 3];
                 for (k, &wk) in w.iter().enumerate() {
                     let q = points[face.corners[(i + k) % m]];
