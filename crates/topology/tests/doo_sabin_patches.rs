@@ -231,6 +231,12 @@ fn layout_counts_follow_the_seed() {
         // v-face, (2l + 1) n regular quads and n corner faces per face layer.
         assert_eq!(layout.faces(depth).len(), 1 + 5 * l * (l + 1));
     }
+    // Every point's (layer, side, offset) decodes back to it.
+    for i in 0..layout.layer_points(6) {
+        let (l, j, k) = layout.point_position(i);
+        assert!(k <= 2 * l && j < 5, "{i}");
+        assert_eq!(layout.corner_point(l, j) + k, i);
+    }
     // Side 1 of layer 2 starts after the 5 points of side 0 (0-based C(2, 1) = 4·5 + 5).
     assert_eq!(layout.corner_point(2, 1), 25);
     assert_eq!(layout.delta(2, 1), 5 * 5 + 3);

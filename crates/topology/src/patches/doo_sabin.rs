@@ -29,6 +29,11 @@
 //!   `C(L, j) − 1` and `C(L, j) + 1`, slot `0` is `C(L − 1, j)`, and slot `2` is `C(L, j)` when
 //!   `m_j = 4`. When `m_j ≠ 4`, `C(L, j)` is a *dead* point, never read.
 //!
+//! Every face but the v-face and the outer corner faces is found from one inner point `i`
+//! (`i < L² n`), as in the seed's algorithm: its layer is `⌊√⌊i / n⌋⌋`, and it starts its
+//! regular quad, and its corner quad when it is a corner point ([`PatchLayout::faces_at_point`]),
+//! so a step runs one thread per point with index arithmetic alone.
+//!
 //! One step (depth `d` → `d + 1`) makes the Doo-Sabin children of every face and writes them
 //! where they belong at depth `d + 1`; every point of depth `d + 1` is written by exactly one
 //! face (its corner slots and their copies by the outer corner face):
@@ -174,23 +179,36 @@ impl PatchLayout<'_> {
             corners: (0..n).collect(),
             children: (0..n).map(|j| vec![j]).collect(),
         }];
-        for l in 0..outer {
-            for j in 0..n {
-                for k in 0..=2 * l {
-                    out.push(self.regular(l, j, k));
-                }
-                if l + 1 < outer {
-                    let child = self.corner_quad(2 * l + 1, j);
-                    out.push(PatchFace {
-                        kind: PatchFaceKind::Corner { layer: l, side: j },
-                        corners: self.corner_quad(l, j).to_vec(),
-                        children: child.iter().map(|&c| vec![c]).collect(),
-                    });
-                }
-            }
+        for i in 0..outer * outer * n {
+            out.extend(self.faces_at_point(depth, i));
         }
         for j in (0..n).filter(|&j| self.corner_sizes[j] > 0) {
             out.push(self.outer_corner(depth, j));
+        }
+        out
+    }
+
+    /// `(l, j, k)`: the layer, side and offset of point `i` (`l = ⌊√⌊i / n⌋⌋`, since layer `l`
+    /// starts at `l² n`).
+    pub fn point_position(&self, i: usize) -> (usize, usize, usize) {
+        let l = (i / self.valence).isqrt();
+        let r = i - l * l * self.valence;
+        (l, r / (2 * l + 1), r % (2 * l + 1))
+    }
+
+    /// The faces point `i` of an inner layer (`i < L² n`) starts at depth `d`, as in the seed's
+    /// algorithm (one thread per point): its regular quad, and its corner quad when it is a
+    /// corner point below layer `L − 1`.
+    pub fn faces_at_point(&self, depth: u32, i: usize) -> Vec<PatchFace> {
+        let (l, j, k) = self.point_position(i);
+        let mut out = vec![self.regular(l, j, k)];
+        if k == 0 && l + 1 < Self::outer_layer(depth) {
+            let child = self.corner_quad(2 * l + 1, j);
+            out.push(PatchFace {
+                kind: PatchFaceKind::Corner { layer: l, side: j },
+                corners: self.corner_quad(l, j).to_vec(),
+                children: child.iter().map(|&c| vec![c]).collect(),
+            });
         }
         out
     }
