@@ -3,11 +3,11 @@
 //! name. The CPU baselines are techniques too (`cpu`, `cpu-catmark`: refined on the CPU, drawn
 //! from the vertex stage), so a new technique needs no entry here.
 use super::{BenchConfig, BenchMesh};
+use crate::animation::Wave;
 use crate::camera::Camera;
 use crate::context::{statistics_query_safe, Context};
 use crate::error::{Result, TessError};
 use crate::technique::{FrameParams, Technique};
-use crate::techniques::bft::Wave;
 use crate::techniques::{self, BuildOptions, TechniqueInfo};
 use std::time::Instant;
 use vk_core::{vk, Device, Encoder};

@@ -5,6 +5,7 @@
 //! [`REGISTRY`] holds one line per technique. Callers (viewer, HUD, bench, export, C ABI,
 //! tests) build through [`build`], check options against [`TechniqueInfo::features`] and
 //! iterate [`registry`]; none of them matches on techniques.
+pub mod acc;
 pub mod adaptive;
 pub mod bft;
 pub mod cpu;
@@ -12,6 +13,7 @@ pub mod face_patches;
 pub mod flat;
 pub mod gregory;
 pub mod phong;
+pub mod planned_patches;
 pub mod pn;
 pub mod shared;
 pub mod windows;
@@ -63,7 +65,7 @@ pub static REGISTRY: [&TechniqueInfo; 9] = [
     &bft::INFO,
     &adaptive::INFO,
     &gregory::INFO,
-    &gregory::ACC_INFO,
+    &acc::INFO,
     &cpu::INFO,
     &cpu::CATMARK_INFO,
 ];

@@ -6,32 +6,25 @@
 //! - **One global vertex buffer** (`vec4`): base vertices, then each level's refined vertices,
 //!   then the local points (phantom points, Gregory points, limit corners with rows), then
 //!   the limit corners of regular patches, then the curves' inner Bezier points.
-//!   Every stencil row is over global vertices, so one kernel applies every block; a block's
-//!   rows read only earlier blocks, so each block is one dispatch. The regular corners and
-//!   the curve points have no rows: the kernel evaluates them from their owner patches'
-//!   control points (corner owners, `CurveOwner`), in that order, last.
+//!   Every stencil row is over global vertices, so the stencil evaluator ([`crate::stencil`])
+//!   applies every block in place; a block's rows read only earlier blocks, so each block is
+//!   one pass. The regular corners and the curve points have no rows: the canonical kernel
+//!   evaluates them from their owner patches' control points (corner owners, `CurveOwner`),
+//!   in that order, last.
 //! - **Patches in array order** (regular, Gregory, bilinear): a patch's record index is its
 //!   frame-wide id, what the TES captures and [`crate::Technique::face_point`] maps back.
-//! - **Checked before upload**: [`GpuAdaptive::new`] proves every index a shader can form is
+//! - **Checked before upload**: [`GpuPlan::new`] proves every index a shader can form is
 //!   in range and every row reads only earlier blocks, so a bad plan fails here, not as an
 //!   out-of-bounds read on the device.
 use crate::gpu::bindings::{
     ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_FINE, ADAPTIVE_EDGE_PLAIN, ADAPTIVE_KIND_BILINEAR,
     ADAPTIVE_KIND_GREGORY, ADAPTIVE_KIND_GREGORY_TRIANGLE, ADAPTIVE_KIND_REGULAR,
 };
+use crate::stencil::{GpuStencils, StencilBlock, StencilError, StencilVertex};
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
 use topology::patches::adaptive::{AdaptivePlan, EdgeKind, PatchKind};
 use topology::ControlMesh;
-
-/// `StencilTerm` of `adaptive.glsl`: one term of a stencil row.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct StencilTerm {
-    /// Global vertex.
-    pub index: u32,
-    pub weight: f32,
-}
 
 /// `AdaptivePatch` of `adaptive.glsl`: one patch.
 #[repr(C)]
@@ -85,7 +78,6 @@ pub struct ReparamRow {
 }
 
 const _: () = {
-    assert!(size_of::<StencilTerm>() == 8);
     assert!(size_of::<PatchRecord>() == 48);
     assert!(size_of::<PatchSurface>() == 48);
     assert!(size_of::<CurveOwner>() == 8);
@@ -123,6 +115,8 @@ pub enum LayoutError {
     },
     #[error("adaptive plan: {what} ({value}) does not fit the GPU layout")]
     TooLarge { what: &'static str, value: u64 },
+    #[error("adaptive plan: {0}")]
+    Stencil(#[from] StencilError),
 }
 
 /// The GPU kind of a patch.
@@ -147,23 +141,16 @@ pub fn control_point_count(kind: PatchKind) -> usize {
     }
 }
 
-/// One dispatch of the stencil kernel: rows `first_row .. first_row + rows`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Dispatch {
-    pub first_row: u32,
-    pub rows: u32,
-}
-
 /// Everything the adaptive buffers hold, packed.
-pub struct GpuAdaptive {
+pub struct GpuPlan {
     pub num_base_vertices: u32,
     pub num_vertices: u32,
-    /// CSR offsets, one per refined vertex (global vertex − base count) plus one.
-    pub stencil_offsets: Vec<u32>,
-    pub stencil_terms: Vec<StencilTerm>,
-    /// One per block: the levels in order, then the local points.
-    pub dispatches: Vec<Dispatch>,
-    /// Records in array order (see [`GpuAdaptive::order`]).
+    /// One row per refined vertex up to the regular corners (row `r`: global vertex
+    /// `num_base_vertices + r`), over global vertices.
+    pub stencils: GpuStencils,
+    /// One per non-empty block: the levels in order, then the local points.
+    pub blocks: Vec<StencilBlock>,
+    /// Records in array order (see [`GpuPlan::order`]).
     pub patches: Vec<PatchRecord>,
     pub control_points: Vec<u32>,
     pub curves: Vec<[u32; 4]>,
@@ -201,7 +188,7 @@ fn edge_code(kind: EdgeKind) -> u32 {
     }
 }
 
-impl GpuAdaptive {
+impl GpuPlan {
     /// The curves' inner points, which the stencil kernel's last dispatches compute.
     pub fn curve_points(&self) -> u32 {
         2 * self.curves.len() as u32
@@ -212,12 +199,11 @@ impl GpuAdaptive {
         self.first_curve_point - self.first_regular_corner
     }
 
-    pub fn new(plan: &AdaptivePlan) -> Result<GpuAdaptive, LayoutError> {
+    pub fn new(plan: &AdaptivePlan) -> Result<GpuPlan, LayoutError> {
         let nb = plan.num_base_vertices;
         let nv = plan.num_vertices;
-        let mut stencil_offsets = vec![0u32];
-        let mut stencil_terms = Vec::new();
-        let mut dispatches = Vec::new();
+        let mut stencils = GpuStencils::default();
+        let mut blocks = Vec::new();
         let mut next = nb;
         for block in plan.steps.iter().chain(std::iter::once(&plan.local_points)) {
             // Blocks must tile the refined part of the vertex buffer in order.
@@ -232,30 +218,20 @@ impl GpuAdaptive {
             let rows = t.len() as u32;
             for r in 0..t.len() {
                 let (idx, w) = t.stencil(r);
-                for (&i, &wt) in idx.iter().zip(w) {
-                    if i >= block.first_vertex {
-                        return Err(LayoutError::BlockOrder {
-                            vertex: block.first_vertex + r as u32,
-                            reads: i,
-                            block_start: block.first_vertex,
-                        });
-                    }
-                    stencil_terms.push(StencilTerm {
-                        index: i,
-                        weight: wt as f32,
+                if let Some(&i) = idx.iter().find(|&&i| i >= block.first_vertex) {
+                    return Err(LayoutError::BlockOrder {
+                        vertex: block.first_vertex + r as u32,
+                        reads: i,
+                        block_start: block.first_vertex,
                     });
                 }
-                let len =
-                    u32::try_from(stencil_terms.len()).map_err(|_| LayoutError::TooLarge {
-                        what: "stencil terms",
-                        value: stencil_terms.len() as u64,
-                    })?;
-                stencil_offsets.push(len);
+                stencils.push_row(idx, w)?;
             }
             if rows > 0 {
-                dispatches.push(Dispatch {
-                    first_row: block.first_vertex - nb,
-                    rows,
+                let first = block.first_vertex - nb;
+                blocks.push(StencilBlock {
+                    rows: first..first + rows,
+                    destination: block.first_vertex,
                 });
             }
             next = block.first_vertex + rows;
@@ -445,7 +421,7 @@ impl GpuAdaptive {
             plan.first_corner as u64 + corner_owners.len() as u64,
             nv as u64 + 1,
         )?;
-        Ok(GpuAdaptive {
+        Ok(GpuPlan {
             first_curve_point: plan.first_curve_point,
             first_regular_corner: plan.first_regular_corner,
             curve_owners,
@@ -453,9 +429,8 @@ impl GpuAdaptive {
             corner_owners,
             num_base_vertices: nb,
             num_vertices: nv,
-            stencil_offsets,
-            stencil_terms,
-            dispatches,
+            stencils,
+            blocks,
             patches,
             control_points,
             curves: plan.curves.clone(),
@@ -519,8 +494,7 @@ impl GpuAdaptive {
     /// Bytes of tables on the GPU (stencils, patch records, control points, curves), without
     /// the vertex buffer.
     pub fn table_bytes(&self) -> usize {
-        self.stencil_offsets.len() * 4
-            + self.stencil_terms.len() * size_of::<StencilTerm>()
+        self.stencils.bytes() as usize
             + self.patches.len() * size_of::<PatchRecord>()
             + self.control_points.len() * 4
             + self.curves.len() * (16 + size_of::<CurveOwner>())
@@ -530,6 +504,6 @@ impl GpuAdaptive {
 
     /// Bytes of the global vertex buffer.
     pub fn vertex_bytes(&self) -> u64 {
-        self.num_vertices.max(1) as u64 * 16
+        self.num_vertices.max(1) as u64 * size_of::<StencilVertex>() as u64
     }
 }
