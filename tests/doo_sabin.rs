@@ -80,9 +80,12 @@ fn compare(
     let mut worst = 0.0f64;
     let mut normals = vec![None; level.num_vertices()];
     for rec in &soup.records {
-        let want = level.positions[rec.patch as usize];
-        for k in 0..3 {
-            worst = worst.max((rec.position[k] as f64 - want[k]).abs() / diagonal);
+        let want = level
+            .positions
+            .get(rec.patch as usize)
+            .unwrap_or_else(|| panic!("captured id {} is no point of the level", rec.patch));
+        for (got, want) in rec.position.iter().zip(want) {
+            worst = worst.max((*got as f64 - want).abs() / diagonal);
         }
         normals[rec.patch as usize] = Some(rec.normal);
     }
