@@ -267,8 +267,8 @@ fn segments_that_are_not_a_level_are_refused_by_name() {
     }
 }
 
-/// The deepest levels on every shape above: points equal, no crack, and every Doo-Sabin shape
-/// of the OpenSubdiv set (`catmark_*`, `loop_*`) at D = 3.
+/// The deepest levels on every shape above: points equal, no crack; and every shape of the
+/// OpenSubdiv set (`catmark_*`, `loop_*`) at D = 3, those with holes refused by name.
 #[test]
 #[ignore = "sweep tier (levels 5 and 6, every OpenSubdiv shape): tools/test.sh sweeps"]
 fn deep_levels_and_every_shape_match_the_cpu_refiner() {
@@ -297,6 +297,11 @@ fn deep_levels_and_every_shape_match_the_cpu_refiner() {
             );
             let mut t = match built {
                 Ok(b) => b.technique,
+                Err(e) if !mesh.holes.is_empty() => {
+                    assert!(e.to_string().contains("hole"), "{name}: {e}");
+                    println!("{name}: {e}");
+                    continue;
+                }
                 Err(e) => {
                     refused.push(format!("{name}: {e}"));
                     continue;

@@ -65,7 +65,8 @@ pub fn first_level_size(base: &Level) -> Result<LevelSize, TopologyError> {
     Ok(LevelSize::of(&refine_dual(base, true)?.level.topology))
 }
 
-/// Sizes of levels 1..=`depth` from level 1's, the deeper ones counted by [`LevelSize::next`].
+/// Sizes of levels 1..=`depth` from level 1's, the deeper ones counted by the dual scheme's
+/// recurrence (every point past level 1 lies in four faces, two on the boundary).
 pub fn level_sizes(first: LevelSize, depth: u32) -> Vec<LevelSize> {
     let mut sizes = Vec::with_capacity(depth as usize);
     let mut size = first;
@@ -117,6 +118,8 @@ pub enum LayoutError {
         point: u32,
         corners: u32,
     },
+    #[error("face {face} is tagged a hole: Doo-Sabin's refinement has no holes (it would draw the face)")]
+    Hole { face: u32 },
     #[error("Doo-Sabin level {level}: {vertices} vertices overflow 32-bit indices")]
     TooLarge { level: u32, vertices: u64 },
 }

@@ -148,6 +148,12 @@ fn depth_of(params: &FrameParams) -> Result<u32> {
 
 impl DooSabin {
     pub fn new(ctx: &mut Context, mesh: &ControlMesh, options: &BuildOptions) -> Result<Self> {
+        if let Some(&face) = mesh.holes.first() {
+            return Err(TessError::Mesh {
+                name: options.name.clone(),
+                source: Box::new(LayoutError::Hole { face }),
+            });
+        }
         let base = Level::from_mesh(mesh, Scheme::DooSabin).map_err(|e| TessError::Mesh {
             name: options.name.clone(),
             source: e.into(),
