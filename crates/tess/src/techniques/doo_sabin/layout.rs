@@ -237,8 +237,8 @@ fn inherited_face_points(
                 let p = parent.face_vertices(face as usize)[corner as usize];
                 parent_points[p as usize]
             }
-            // Made by the level-0 step only.
-            DualVertex::Chaikin { .. } => parent_points[0],
+            // Made by the level-0 step only (`refine_dual` with `first`): never past level 1.
+            DualVertex::Chaikin { .. } => unreachable!("a Chaikin point past level 1"),
         })
         .collect()
 }

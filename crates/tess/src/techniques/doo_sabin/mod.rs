@@ -216,8 +216,18 @@ impl DooSabin {
                 });
             }
         }
+        self.arrays[0].patches = layout.points;
+        self.depth = Some(DepthMesh::new(&self.device, &self.set_layout, layout)?);
+        Ok(())
+    }
+}
+
+impl DepthMesh {
+    /// The vertex buffer, the evaluator of `layout`'s blocks over it, the corner table, the
+    /// index buffer and the set binding the deepest level's range and the corners.
+    fn new(device: &Device, set_layout: &DescriptorSetLayout, layout: DepthLayout) -> Result<Self> {
         let vertices = Buffer::new(
-            &self.device,
+            device,
             &BufferDesc {
                 name: "doo-sabin vertices",
                 size: stencil::vertex_bytes(layout.num_vertices),
@@ -226,7 +236,7 @@ impl DooSabin {
             },
         )?;
         let evaluator = StencilEvaluator::new(
-            &self.device,
+            device,
             "doo-sabin",
             &layout.stencils,
             &layout.blocks,
@@ -238,33 +248,27 @@ impl DooSabin {
             &[(&vertices, &vertices)],
         )?;
         let corners = storage(
-            &self.device,
+            device,
             "doo-sabin corners",
             bytemuck::cast_slice(&layout.corners),
         )?;
         let indices = Buffer::with_data(
-            &self.device,
+            device,
             "doo-sabin indices",
             vk::BufferUsageFlags::INDEX_BUFFER,
             bytemuck::cast_slice(&layout.triangles),
         )?;
-        let pool = DescriptorPool::new(
-            &self.device,
-            "doo-sabin descriptor pool",
-            &self.set_layout,
-            1,
-        )?;
-        let set = pool.allocate_set(&self.set_layout)?;
+        let pool = DescriptorPool::new(device, "doo-sabin descriptor pool", set_layout, 1)?;
+        let set = pool.allocate_set(set_layout)?;
         set.write_buffer_range(
             DOO_SABIN_POINTS_BINDING,
             vk::DescriptorType::STORAGE_BUFFER,
             &vertices,
             layout.first_point as u64 * size_of::<StencilVertex>() as u64,
-            point_bytes,
+            stencil::vertex_bytes(layout.points),
         )?;
         crate::techniques::windows::write_whole(&set, DOO_SABIN_CORNERS_BINDING, &corners)?;
-        self.arrays[0].patches = layout.points;
-        self.depth = Some(DepthMesh {
+        Ok(Self {
             layout,
             evaluator,
             set,
@@ -272,8 +276,7 @@ impl DooSabin {
             vertices,
             corners,
             indices,
-        });
-        Ok(())
+        })
     }
 }
 
