@@ -244,7 +244,11 @@ mod tests {
         codes.dedup();
         assert_eq!(names.len(), registry().len());
         assert_eq!(codes.len(), registry().len());
-        for scheme in [topology::Scheme::Loop, topology::Scheme::CatmullClark] {
+        for scheme in [
+            topology::Scheme::Loop,
+            topology::Scheme::CatmullClark,
+            topology::Scheme::DooSabin,
+        ] {
             let defaults = registry()
                 .iter()
                 .filter(|i| i.default_for_scheme && i.scheme == Some(scheme))
