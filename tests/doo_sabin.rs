@@ -241,6 +241,7 @@ fn shaded_normals_approach_the_exact_limit_normals_at_face_centres() {
     }
 }
 
+/// Segments that are not a level, and a level over the vertex limit, are refused by name.
 #[test]
 fn segments_that_are_not_a_level_are_refused_by_name() {
     let gpu = Gpu::new();
@@ -263,6 +264,28 @@ fn segments_that_are_not_a_level_are_refused_by_name() {
             let params = FrameParams::uniform((1u32 << d) as f32);
             ctx.prepare(t.as_mut(), &params, &[tessera::tess::Pass::Shaded])
                 .unwrap_or_else(|e| panic!("D = {d}: {e}"));
+        }
+        // A level beyond the build's vertex limit is refused by name before it is refined
+        // (base 8 + levels 1-4 of the cube: 24 + 96 + 384 + 1,536 points).
+        let small = tessera::tess::BuildOptions {
+            max_refined_vertices: 1_000,
+            ..Default::default()
+        };
+        let mut t =
+            tessera::tess::techniques::build(&mut ctx, TechniqueId::DOO_SABIN, &mesh, &small)
+                .expect("build")
+                .technique;
+        let pass = [tessera::tess::Pass::Shaded];
+        ctx.prepare(t.as_mut(), &FrameParams::uniform(8.0), &pass)
+            .expect("level 3: 512 vertices");
+        match ctx.prepare(t.as_mut(), &FrameParams::uniform(16.0), &pass) {
+            Err(TessError::RefinedTooLarge {
+                level: 4,
+                vertices: 2048,
+                max: 1_000,
+                ..
+            }) => {}
+            other => panic!("level 4 was not refused: {:?}", other.err()),
         }
     }
 }
