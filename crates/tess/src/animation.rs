@@ -77,7 +77,7 @@ pub fn wave(
 }
 
 /// The `--animate` wave at time `t` applied to the rest pose of a mesh: what is uploaded.
-/// Works for any technique that takes [`Technique::update_base`].
+/// Works for any technique that takes [`Technique::update_base`](crate::technique::Technique::update_base).
 pub struct Wave {
     rest: Vec<[f32; 3]>,
     normals: Vec<[f32; 3]>,

@@ -225,12 +225,20 @@ fn panel(ui: &mut egui::Ui, s: &Shown<'_>, history: &[f32], actions: &mut Vec<Ac
 /// The technique box (number keys 1..n).
 fn technique_choice(ui: &mut egui::Ui, s: &Shown<'_>, actions: &mut Vec<Action>) {
     ui.horizontal(|ui| {
-        ui.label(format!("technique (1-{})", techniques::registry().len()));
+        // Digit keys reach the first nine; the list reaches every technique.
+        ui.label(format!(
+            "technique (1-{})",
+            techniques::registry().len().min(9)
+        ));
         egui::ComboBox::from_id_salt("technique")
             .selected_text(s.technique.name())
             .show_ui(ui, |ui| {
                 for (i, t) in techniques::registry().iter().enumerate() {
-                    let text = format!("{} {}", i + 1, t.id.name());
+                    let text = if i < 9 {
+                        format!("{} {}", i + 1, t.id.name())
+                    } else {
+                        t.id.name().to_owned()
+                    };
                     if ui.selectable_label(t.id == s.technique, text).clicked() {
                         actions.push(Action::Technique(t.id));
                     }

@@ -152,9 +152,10 @@ fn parse_factors(s: &str) -> Result<Factors, String> {
 /// Options of the subdivision-surface techniques; techniques that do not take one refuse it.
 #[derive(Args, Debug, Clone)]
 pub struct SurfaceArgs {
-    /// Subdivision scheme whose limit surface is drawn: catmull-clark (--method adaptive) or
-    /// loop (--method bft; polygons are fan-triangulated first). Defaults to catmull-clark
-    /// unless every face is a triangle.
+    /// Subdivision scheme whose limit surface is drawn: catmull-clark (--method adaptive),
+    /// loop (--method bft; polygons are fan-triangulated first) or doo-sabin (--method
+    /// doo-sabin, refined to level log2 S). Defaults to catmull-clark unless every face is a
+    /// triangle.
     #[arg(long)]
     pub scheme: Option<String>,
     /// Isolation level of feature-adaptive refinement (adaptive): 1 to 8.

@@ -1012,9 +1012,10 @@ mod tests {
 
     #[test]
     fn keys_map_to_their_actions() {
-        // Method keys: the registry's order, gregory and acc last.
+        // Method keys: the registry's order; the digits 1-9 reach the first nine techniques
+        // (the others are chosen from the HUD's list).
         let order: Vec<TechniqueId> = techniques::registry().iter().map(|i| i.id).collect();
-        for (i, id) in order.iter().enumerate() {
+        for (i, id) in order.iter().enumerate().take(9) {
             assert_eq!(key(&(i + 1).to_string()), Some(Action::Technique(*id)));
         }
         assert_eq!(

@@ -96,9 +96,10 @@ pub struct TechniqueRow {
 impl TechniqueRow {
     pub fn new(ctx: &RowContext<'_>, info: &TechniqueInfo, animated: bool) -> Result<Self> {
         let mut context = Context::new(ctx.device, ctx.color_format, ctx.depth_format, 1)?;
-        // Catmull-Clark techniques take the mesh as loaded; the others its fan triangulation
-        // (the paper's Table I).
-        let mesh = if info.scheme == Some(topology::Scheme::CatmullClark) {
+        // Catmull-Clark and Doo-Sabin techniques take the mesh as loaded (a fan triangulation
+        // is another surface for them); the others its fan triangulation (the paper's Table I).
+        let as_loaded = [topology::Scheme::CatmullClark, topology::Scheme::DooSabin];
+        let mesh = if info.scheme.is_some_and(|s| as_loaded.contains(&s)) {
             &ctx.mesh.input
         } else {
             &ctx.mesh.mesh

@@ -107,6 +107,19 @@ gpu_constants! {
     /// Mask of an owner's local edge or corner index.
     BFT_OWNER_LOCAL_MASK = 3;
 
+    /// Descriptor set of one Doo-Sabin surface (`glsl/doo_sabin/mesh.vert`).
+    DOO_SABIN_SET = 1;
+    /// The deepest level's points (`vec4`, level-local numbering): the range of the refined
+    /// vertex buffer the stencil evaluator writes that level into ([`crate::stencil`]).
+    DOO_SABIN_POINTS_BINDING = 0;
+    /// Per deepest-level point, its face corners as `uvec2(next, previous)` neighbours
+    /// (`DOO_SABIN_MAX_CORNERS` slots; an unused slot names the point itself twice, adding
+    /// nothing): what its normal is summed from.
+    DOO_SABIN_CORNERS_BINDING = 1;
+    /// Face corners a refined Doo-Sabin point lies in at most (one f-face, two e-faces or
+    /// boundary strips, one v-face or vertex strip).
+    DOO_SABIN_MAX_CORNERS = 4;
+
     /// Descriptor set of one feature-adaptive Catmull-Clark surface (`glsl/adaptive/adaptive.glsl`).
     ADAPTIVE_SET = 1;
     /// The global vertex buffer (`vec4`): base (copied from the frame slot's base positions), level 1..L and the local points (written by the stencil evaluator, [`crate::stencil`]), regular corners and curve points (written by `canonical.comp`).

@@ -198,6 +198,28 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
                 size: size_of::<[f32; 3]>(),
             },
         ),
+        // Doo-Sabin's vertex stage: the deepest level's points and their face corners.
+        (Stage::DooSabinMeshVert, PLAIN, frame()),
+        (
+            Stage::DooSabinMeshVert,
+            PLAIN,
+            Buffer {
+                block: "Points",
+                binding: DOO_SABIN_POINTS_BINDING,
+                members: vec![0],
+                stride: size_of::<StencilVertex>(),
+            },
+        ),
+        (
+            Stage::DooSabinMeshVert,
+            PLAIN,
+            Buffer {
+                block: "Corners",
+                binding: DOO_SABIN_CORNERS_BINDING,
+                members: vec![0],
+                stride: size_of::<[u32; 2]>(),
+            },
+        ),
         // The stencil evaluator: its push constant, its term and its four buffers.
         (
             Stage::StencilEvaluateComp,
@@ -693,6 +715,13 @@ fn the_table_covers_every_storage_binding_and_capture_build() {
             "adaptive binding {binding} is not checked"
         );
     }
+    for binding in [DOO_SABIN_POINTS_BINDING, DOO_SABIN_CORNERS_BINDING] {
+        assert!(
+            rows.iter().any(|(s, _, c)| *s == Stage::DooSabinMeshVert
+                && matches!(c, Check::Buffer { binding: b, .. } if *b == binding)),
+            "Doo-Sabin binding {binding} is not checked"
+        );
+    }
     let capture_builds = Stage::ALL
         .iter()
         .flat_map(|s| s.compiled())
@@ -703,8 +732,8 @@ fn the_table_covers_every_storage_binding_and_capture_build() {
         .filter(|(_, _, c)| matches!(c, Check::Xfb { .. }))
         .count();
     // Nine TESs in three spacings, the four adaptive ones and BFT's also with their surface code,
-    // BFT's also with and without its patch block; the CPU mesh's vertex stage.
-    assert_eq!(capture_builds, 49);
+    // BFT's also with and without its patch block; the CPU mesh's and Doo-Sabin's vertex stages.
+    assert_eq!(capture_builds, 50);
     assert_eq!(xfb_rows, capture_builds);
 }
 
@@ -755,7 +784,7 @@ fn capture_variants_and_only_they_have_xfb() {
             captures += v.capture as usize;
         }
     }
-    assert_eq!(captures, 49);
+    assert_eq!(captures, 50);
 }
 
 #[test]

@@ -9,6 +9,7 @@ pub mod acc;
 pub mod adaptive;
 pub mod bft;
 pub mod cpu;
+pub mod doo_sabin;
 pub mod face_patches;
 pub mod flat;
 pub mod gregory;
@@ -58,7 +59,7 @@ pub struct TechniqueInfo {
 
 /// Every technique, one line each, in the order reports and the window's number keys list
 /// them (flat first: ratios divide by it).
-pub static REGISTRY: [&TechniqueInfo; 9] = [
+pub static REGISTRY: [&TechniqueInfo; 10] = [
     &flat::INFO,
     &phong::INFO,
     &pn::INFO,
@@ -68,6 +69,7 @@ pub static REGISTRY: [&TechniqueInfo; 9] = [
     &acc::INFO,
     &cpu::INFO,
     &cpu::CATMARK_INFO,
+    &doo_sabin::INFO,
 ];
 
 /// Every technique, in the order reports list them (flat first: ratios divide by it).
@@ -242,7 +244,11 @@ mod tests {
         codes.dedup();
         assert_eq!(names.len(), registry().len());
         assert_eq!(codes.len(), registry().len());
-        for scheme in [topology::Scheme::Loop, topology::Scheme::CatmullClark] {
+        for scheme in [
+            topology::Scheme::Loop,
+            topology::Scheme::CatmullClark,
+            topology::Scheme::DooSabin,
+        ] {
             let defaults = registry()
                 .iter()
                 .filter(|i| i.default_for_scheme && i.scheme == Some(scheme))
