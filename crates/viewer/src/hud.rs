@@ -225,17 +225,18 @@ fn panel(ui: &mut egui::Ui, s: &Shown<'_>, history: &[f32], actions: &mut Vec<Ac
 /// The technique box (number keys 1..n).
 fn technique_choice(ui: &mut egui::Ui, s: &Shown<'_>, actions: &mut Vec<Action>) {
     ui.horizontal(|ui| {
-        // Digit keys reach the first nine; the list reaches every technique.
-        ui.label(format!(
-            "technique (1-{})",
-            techniques::registry().len().min(9)
-        ));
+        // Digit keys 1-9 then 0 reach the first ten; the list reaches every technique.
+        let n = techniques::registry().len();
+        ui.label(match n {
+            ..=9 => format!("technique (1-{n})"),
+            _ => "technique (1-9, 0)".to_owned(),
+        });
         egui::ComboBox::from_id_salt("technique")
             .selected_text(s.technique.name())
             .show_ui(ui, |ui| {
                 for (i, t) in techniques::registry().iter().enumerate() {
-                    let text = if i < 9 {
-                        format!("{} {}", i + 1, t.id.name())
+                    let text = if i < 10 {
+                        format!("{} {}", (i + 1) % 10, t.id.name())
                     } else {
                         t.id.name().to_owned()
                     };

@@ -521,7 +521,7 @@ impl App {
         self.setup.params.factors = FactorPolicy::Uniform { segments };
     }
 
-    /// Switches technique (keys 1, 2, 3, ...: the registry's order), keeping the level where
+    /// Switches technique (keys 1, 2, …, 9, 0: the registry's order), keeping the level where
     /// the new technique takes it.
     fn switch_technique(&mut self, id: TechniqueId) {
         self.setup.technique = id;
@@ -539,10 +539,9 @@ impl App {
         Some(match key {
             Key::Character(c) => match c.as_str() {
                 d if d.len() == 1 && d.as_bytes()[0].is_ascii_digit() => {
+                    // 1..9 then 0, in the keyboard's order: the first ten techniques.
                     let k = (d.as_bytes()[0] - b'0') as usize;
-                    let info = k
-                        .checked_sub(1)
-                        .and_then(|i| techniques::registry().get(i))?;
+                    let info = techniques::registry().get((k + 9) % 10)?;
                     Action::Technique(info.id)
                 }
                 "+" | "=" => Action::LevelUp,
@@ -1012,11 +1011,14 @@ mod tests {
 
     #[test]
     fn keys_map_to_their_actions() {
-        // Method keys: the registry's order; the digits 1-9 reach the first nine techniques
-        // (the others are chosen from the HUD's list).
+        // Method keys: the registry's order, 1-9 then 0 (the tenth); more are chosen from the
+        // HUD's list.
         let order: Vec<TechniqueId> = techniques::registry().iter().map(|i| i.id).collect();
-        for (i, id) in order.iter().enumerate().take(9) {
-            assert_eq!(key(&(i + 1).to_string()), Some(Action::Technique(*id)));
+        for (i, id) in order.iter().enumerate().take(10) {
+            assert_eq!(
+                key(&((i + 1) % 10).to_string()),
+                Some(Action::Technique(*id))
+            );
         }
         assert_eq!(
             key("6"),
@@ -1028,10 +1030,9 @@ mod tests {
             Some(Action::Technique("adaptive".parse().unwrap()))
         );
         let past = techniques::registry().len() + 1;
-        if past <= 9 {
-            assert_eq!(key(&past.to_string()), None);
+        if past <= 10 {
+            assert_eq!(key(&(past % 10).to_string()), None);
         }
-        assert_eq!(key("0"), None);
         for (c, action) in [
             ("r", Action::Reparam),
             ("R", Action::Reparam),
