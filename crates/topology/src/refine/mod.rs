@@ -61,6 +61,7 @@ use crate::rules::{
 };
 use rayon::prelude::*;
 
+pub mod joined;
 pub mod stencil;
 
 /// One level of a refinement: topology, positions and (propagated) sharpness.
