@@ -129,6 +129,6 @@ fn the_level_follows_the_segments() {
             .render_offscreen(t.as_mut(), &FrameParams::uniform(3.0), EXTENT)
             .map(|_| ())
             .expect_err("S = 3 is refused");
-        assert!(e.to_string().contains("--segments 3"), "{e}");
+        assert!(e.to_string().contains("segments 3"), "{e}");
     }
 }

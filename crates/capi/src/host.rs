@@ -56,10 +56,10 @@
 //! or `vkDeviceWaitIdle`), as it must before destroying its own device. The host's device,
 //! queue and instance are left alive.
 use crate::ffi::{out_write, read_required};
-use crate::registry::lock;
+use crate::handles::lock;
 use crate::status::{Error, Result, TesseraStatus};
 use crate::{
-    context_ptr, flag, guard, registry, surface_frame_params, with_context, with_surface,
+    context_ptr, flag, guard, handles, surface_frame_params, with_context, with_surface,
     ContextState, Mode, TesseraContext, TesseraFrameDesc, TesseraSurface,
 };
 use vk_core::{vk, Device, Encoder, HostDevice, HostScope, Instance};
@@ -234,7 +234,7 @@ pub unsafe extern "C" fn tessera_context_create_host(
         };
         // SAFETY: as above.
         let device = unsafe { Device::from_host(&instance, &host, cache.as_deref()) }?;
-        let id = lock(registry())?.add_context(ContextState {
+        let id = lock(handles())?.add_context(ContextState {
             graveyard: Vec::new(),
             device,
             instance,

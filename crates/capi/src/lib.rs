@@ -4,8 +4,8 @@
 //! # Handles
 //! `TesseraContext*` (a device and how Tessera uses it), `TesseraSurface*` (one control mesh
 //! built for one technique on one context) and `TesseraLimitEvaluator*` (a surface's or mesh's
-//! exact limit surface on the CPU, [`limit`]) are opaque. They are numbers in a registry
-//! (the `registry` module), never pointers into Rust memory: a null, forged, destroyed or
+//! exact limit surface on the CPU, [`limit`]) are opaque. They are numbers in a handle table
+//! (the `handles` module), never pointers into Rust memory: a null, forged, destroyed or
 //! twice-destroyed handle is answered with `TESSERA_STATUS_NULL_HANDLE`,
 //! `TESSERA_STATUS_INVALID_HANDLE` or `TESSERA_STATUS_DESTROYED_HANDLE`, never undefined
 //! behaviour. Destroying a context destroys the surfaces still created on it.
@@ -57,7 +57,7 @@
 //! raw pointers. Those reads are gathered in [`ffi`] (slices, strings, output writes), each
 //! with its contract; everything past them is safe Rust.
 pub mod ffi;
-mod registry;
+mod handles;
 pub mod status;
 
 pub use capture::{tessera_capture, tessera_capture_obj, TesseraCaptureReport};
@@ -68,7 +68,7 @@ pub use limit::{
 pub use status::TesseraStatus;
 
 use ffi::{out_write, read_slice, read_str};
-use registry::{lock, Registry};
+use handles::{lock, HandleTable};
 use status::{Error, Result};
 use std::cell::RefCell;
 use std::ffi::c_char;
@@ -335,11 +335,12 @@ pub struct TesseraFrameDesc {
     pub show: TesseraShow,
 }
 
-type Contexts = Registry<ContextState, SurfaceState, topology::limit::face_domain::LimitEvaluator>;
+type Contexts =
+    HandleTable<ContextState, SurfaceState, topology::limit::face_domain::LimitEvaluator>;
 
-fn registry() -> &'static Mutex<Contexts> {
+fn handles() -> &'static Mutex<Contexts> {
     static REGISTRY: OnceLock<Mutex<Contexts>> = OnceLock::new();
-    REGISTRY.get_or_init(|| Mutex::new(Registry::default()))
+    REGISTRY.get_or_init(|| Mutex::new(HandleTable::default()))
 }
 
 thread_local! {
@@ -486,7 +487,7 @@ fn with_context(
     let id = handle_id(ctx);
     let mut state = None;
     let status = guard(|| {
-        let c = lock(registry())?.context(id)?;
+        let c = lock(handles())?.context(id)?;
         state = Some(c.clone());
         let mut s = lock(&c)?;
         body(&mut s)
@@ -510,7 +511,7 @@ fn with_surface(
 ) -> TesseraStatus {
     let ctx_id = handle_id(ctx);
     with_context(ctx, |c| {
-        let (owner, s) = lock(registry())?.surface(handle_id(surface))?;
+        let (owner, s) = lock(handles())?.surface(handle_id(surface))?;
         if owner != ctx_id {
             return Err(Error::new(
                 TesseraStatus::WrongContext,
@@ -577,7 +578,7 @@ pub unsafe extern "C" fn tessera_last_error(
     capacity: usize,
 ) -> usize {
     let read = || -> String {
-        let from_context = registry()
+        let from_context = handles()
             .lock()
             .ok()
             .and_then(|r| r.context(handle_id(ctx)).ok())
@@ -863,7 +864,7 @@ pub unsafe extern "C" fn tessera_context_create_standalone(
             },
             &[],
         )?;
-        let id = lock(registry())?.add_context(ContextState {
+        let id = lock(handles())?.add_context(ContextState {
             graveyard: Vec::new(),
             device,
             instance,
@@ -886,7 +887,7 @@ pub unsafe extern "C" fn tessera_context_destroy(ctx: *mut TesseraContext) -> Te
     guard(|| {
         let id = handle_id(ctx);
         let (context, surfaces) = {
-            let mut r = lock(registry())?;
+            let mut r = lock(handles())?;
             let c = r.remove_context(id)?;
             (c, r.remove_surfaces_of(id))
         };
@@ -1200,7 +1201,7 @@ unsafe fn create_surface(
         slot_versions: vec![0; slots],
         mesh,
     };
-    Ok(lock(registry())?.add_surface(ctx_id, state))
+    Ok(lock(handles())?.add_surface(ctx_id, state))
 }
 
 /// The control mesh `d` describes, every count and index checked.
@@ -1462,7 +1463,7 @@ pub unsafe extern "C" fn tessera_surface_destroy(
 ) -> TesseraStatus {
     let ctx_id = handle_id(ctx);
     with_context(ctx, |c| {
-        let mut r = lock(registry())?;
+        let mut r = lock(handles())?;
         let (owner, _) = r.surface(handle_id(surface))?;
         if owner != ctx_id {
             return Err(Error::new(

@@ -25,13 +25,13 @@
 //!
 //! # Threads
 //! An evaluator is immutable: [`tessera_limit_evaluate`] may run on any number of threads at
-//! once with one evaluator, without locks (the handle is looked up under the registry's lock
+//! once with one evaluator, without locks (the handle is looked up under the handle table's lock
 //! for an instant). It holds CPU data only and outlives the context and surface it was made
 //! from; destroying it while another thread evaluates lets that evaluation finish.
 use crate::ffi::{out_write, read_required, read_slice};
-use crate::registry::lock;
+use crate::handles::lock;
 use crate::status::{Error, Result, TesseraStatus};
-use crate::{guard, handle_id, registry, with_surface, TesseraContext, TesseraSurface};
+use crate::{guard, handle_id, handles, with_surface, TesseraContext, TesseraSurface};
 use crate::{TesseraMeshDesc, TesseraScheme};
 use topology::limit::eval::{EvalError, LimitScheme};
 use topology::limit::face_domain::{LimitEvaluator, PointError};
@@ -90,7 +90,7 @@ fn with_evaluator(
     body: impl FnOnce(&LimitEvaluator) -> Result<()>,
 ) -> TesseraStatus {
     guard(|| {
-        let e = lock(registry())?.evaluator(handle_id(ev))?;
+        let e = lock(handles())?.evaluator(handle_id(ev))?;
         body(&e)
     })
 }
@@ -110,7 +110,7 @@ pub unsafe extern "C" fn tessera_limit_evaluator_create(
         // SAFETY: the caller's contract.
         unsafe { out_write(out, std::ptr::null_mut(), "out") }?;
         let e = build(&s.limit_mesh(), s.scheme)?;
-        let id = lock(registry())?.add_evaluator(e);
+        let id = lock(handles())?.add_evaluator(e);
         // SAFETY: the caller's contract.
         unsafe { out_write(out, evaluator_ptr(id), "out") }
     })
@@ -141,7 +141,7 @@ pub unsafe extern "C" fn tessera_limit_evaluator_create_mesh(
         mesh.validate()?;
         let scheme = crate::surface_scheme(scheme, None, &mesh)?;
         let e = build(&mesh, scheme)?;
-        let id = lock(registry())?.add_evaluator(e);
+        let id = lock(handles())?.add_evaluator(e);
         // SAFETY: the caller's contract.
         unsafe { out_write(out, evaluator_ptr(id), "out") }
     })
@@ -157,7 +157,7 @@ pub unsafe extern "C" fn tessera_limit_evaluator_destroy(
     ev: *mut TesseraLimitEvaluator,
 ) -> TesseraStatus {
     guard(|| {
-        lock(registry())?.remove_evaluator(handle_id(ev))?;
+        lock(handles())?.remove_evaluator(handle_id(ev))?;
         Ok(())
     })
 }

@@ -166,17 +166,13 @@ pub(crate) fn tess_status(e: &TessError) -> TesseraStatus {
             Some(t) => topology_status(t),
             None => TesseraStatus::Mesh,
         },
-        E::OutOfRange { .. }
-        | E::UnknownTechnique { .. }
-        | E::BftSegments { .. }
-        | E::RefinedSegments { .. }
-        | E::TableLevel { .. }
-        | E::BenchConfig { .. }
-        | E::Csv { .. } => TesseraStatus::InvalidArgument,
+        E::Param(_) | E::UnknownTechnique { .. } | E::BenchConfig { .. } | E::Csv { .. } => {
+            TesseraStatus::InvalidArgument
+        }
         E::Unsupported { .. }
         | E::NeedsTangentTables
         | E::StorageWindow { .. }
-        | E::BftTablesTooLarge { .. }
+        | E::BftTablesTooLarge(_)
         | E::RefinedTooLarge { .. } => TesseraStatus::Unsupported,
         E::BasePositionCount { .. } => TesseraStatus::WrongSize,
         E::FrameSlot { .. } | E::IndexOutOfRange { .. } => TesseraStatus::IndexOutOfRange,
@@ -195,7 +191,19 @@ pub(crate) fn tess_status(e: &TessError) -> TesseraStatus {
 
 impl From<TessError> for Error {
     fn from(e: TessError) -> Self {
-        Error::new(tess_status(&e), e.to_string())
+        let message = e.worded(descriptor_field);
+        Error::new(tess_status(&e), message)
+    }
+}
+
+/// Where a parameter the library names lives in the C ABI's descriptors.
+fn descriptor_field(p: tess::error::Param) -> &'static str {
+    use tess::error::Param;
+    match p {
+        Param::Segments => "TesseraFrameDesc.factor (segments)",
+        Param::Pixels => "TesseraFrameDesc.factor (pixels per segment)",
+        Param::Distance => "TesseraFrameDesc.factor (distance)",
+        Param::TableLevel => "TesseraSurfaceDesc.table_level",
     }
 }
 

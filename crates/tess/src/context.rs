@@ -223,7 +223,7 @@ impl Context {
     }
 
     /// Layout of set 0 (the frame uniforms), for pipelines built outside the cache (compute
-    /// pre-passes, the plain CPU-refined draw).
+    /// pre-passes).
     pub fn frame_set_layout(&self) -> &DescriptorSetLayout {
         &self.frames.layout
     }

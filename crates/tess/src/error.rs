@@ -20,13 +20,10 @@ pub enum TessError {
     /// An image (texture or height map) that could not be read.
     #[error("{file}: {message}")]
     Image { file: String, message: String },
-    /// An option's value outside what it accepts.
-    #[error("{option} {value}: expected {range}")]
-    OutOfRange {
-        option: &'static str,
-        value: String,
-        range: &'static str,
-    },
+    /// A frame or build parameter's value the technique does not take (named in the
+    /// library's words; each front end rewords it: [`ParamError::worded`]).
+    #[error("{0}")]
+    Param(ParamError),
     /// A technique asked for something it does not do.
     #[error("{technique} does not support {what}")]
     Unsupported {
@@ -35,46 +32,10 @@ pub enum TessError {
     },
     #[error("unknown method '{name}' ({known})")]
     UnknownTechnique { name: String, known: String },
-    /// Basis-function tables reach `2^(L+1)` segments per base edge.
-    #[error(
-        "--segments {segments}: BFT takes a power of two in 2..={max} segments per base edge \
-         (tables at level {table_level}; raise --table-level for more)"
-    )]
-    BftSegments {
-        segments: f32,
-        max: u32,
-        table_level: u32,
-    },
-    #[error(
-        "--table-level {level}: tables must be at level 1..6 and need tessellation level 2^level \
-         (the device allows {max_tessellation_level})"
-    )]
-    TableLevel {
-        level: u32,
-        max_tessellation_level: u32,
-    },
     /// Basis-function tables that cannot be bound in one storage-buffer range, counted from
     /// the patch records before any table is evaluated.
-    #[error(
-        "{name}: basis-function tables at level {level} would take {bytes} bytes \
-         ({private_faces} of {faces} level-1 faces need a private table: creases, corners or \
-         overlapping rings), more than the device's storage-buffer range of {max} bytes; {hint}"
-    )]
-    BftTablesTooLarge {
-        name: String,
-        level: u32,
-        bytes: u64,
-        private_faces: usize,
-        faces: usize,
-        max: u64,
-        hint: String,
-    },
-    /// A mesh refined on the CPU halves every edge per level.
-    #[error(
-        "--segments {segments}: a mesh refined on the CPU takes a power of two in 1..={max} \
-         segments per base edge (each level halves every edge)"
-    )]
-    RefinedSegments { segments: f32, max: u32 },
+    #[error("{0}")]
+    BftTablesTooLarge(TablesTooLarge),
     /// A CPU refinement too large to hold.
     #[error(
         "{scheme} level {level} would have {vertices} vertices, more than the limit of {max} \
@@ -159,4 +120,187 @@ pub enum TessError {
     /// operating system's reason is said in the message, not chained.
     #[error("cannot write {path}: {error}")]
     Write { path: String, error: std::io::Error },
+}
+
+/// A parameter of a frame ([`crate::FrameParams`]) or a build ([`crate::BuildOptions`]) that an
+/// error names. The library names it by its field ([`Param::name`]); a front end by its own
+/// words ([`ParamError::worded`]): the command line by its option, the C ABI by its
+/// descriptor's field.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Param {
+    /// Uniform segments per edge (`FactorPolicy::Uniform`).
+    Segments,
+    /// Pixels per segment (`FactorPolicy::Screen`).
+    Pixels,
+    /// Reference distance (`FactorPolicy::Distance`).
+    Distance,
+    /// Basis-function table level (`BuildOptions::table_level`).
+    TableLevel,
+}
+
+impl Param {
+    /// The library's name: the field of `FrameParams` or `BuildOptions`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Param::Segments => "segments",
+            Param::Pixels => "pixels per segment",
+            Param::Distance => "reference distance",
+            Param::TableLevel => "table level",
+        }
+    }
+}
+
+/// A parameter's value that is not taken, and why ([`TessError::Param`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParamError {
+    pub param: Param,
+    /// The value as given.
+    pub value: String,
+    /// What is taken instead, in the library's words (no front end's option names).
+    pub expected: String,
+    /// Another parameter that would let the value be taken ("raise the table level for more").
+    pub raise: Option<Param>,
+}
+
+impl ParamError {
+    pub fn refused(param: Param, value: impl ToString, expected: impl Into<String>) -> TessError {
+        TessError::Param(ParamError {
+            param,
+            value: value.to_string(),
+            expected: expected.into(),
+            raise: None,
+        })
+    }
+
+    /// [`Self::refused`], naming the parameter to raise for more.
+    pub fn raising(
+        param: Param,
+        value: impl ToString,
+        expected: impl Into<String>,
+        raise: Param,
+    ) -> TessError {
+        TessError::Param(ParamError {
+            param,
+            value: value.to_string(),
+            expected: expected.into(),
+            raise: Some(raise),
+        })
+    }
+
+    /// The message with each parameter named by `name` (the library's [`Param::name`], a
+    /// command-line option, a C ABI field).
+    pub fn worded(&self, name: impl Fn(Param) -> &'static str) -> String {
+        let raise = self
+            .raise
+            .map(|p| format!("; raise {} for more", name(p)))
+            .unwrap_or_default();
+        format!(
+            "{} {}: {}{raise}",
+            name(self.param),
+            self.value,
+            self.expected
+        )
+    }
+}
+
+/// Basis-function tables over the storage-buffer range ([`TessError::BftTablesTooLarge`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TablesTooLarge {
+    /// The mesh.
+    pub name: String,
+    pub level: u32,
+    pub bytes: u64,
+    /// Level-1 faces whose rings need a table of their own, of `faces`.
+    pub private_faces: usize,
+    pub faces: usize,
+    /// The device's storage-buffer range.
+    pub max: u64,
+    /// The highest lower level whose tables fit, and their bytes.
+    pub fits: Option<(u32, u64)>,
+}
+
+impl TablesTooLarge {
+    /// The message with the table-level parameter named by `name`.
+    pub fn worded(&self, name: impl Fn(Param) -> &'static str) -> String {
+        let hint = match self.fits {
+            Some((l, bytes)) => format!(
+                "at level {l} they take {bytes} bytes ({} {l}, up to {} segments per base edge)",
+                name(Param::TableLevel),
+                2u32 << l
+            ),
+            None => "no table level fits".to_string(),
+        };
+        format!(
+            "{}: basis-function tables at level {} would take {} bytes ({} of {} level-1 faces \
+             need a private table: creases, corners or overlapping rings), more than the \
+             device's storage-buffer range of {} bytes; {hint}",
+            self.name, self.level, self.bytes, self.private_faces, self.faces, self.max
+        )
+    }
+}
+
+impl std::fmt::Display for TablesTooLarge {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.worded(Param::name))
+    }
+}
+
+impl TessError {
+    /// The message with every parameter it names worded by `name` (a front end's option or
+    /// field names); the library's own words elsewhere.
+    pub fn worded(&self, name: impl Fn(Param) -> &'static str) -> String {
+        match self {
+            TessError::Param(p) => p.worded(name),
+            TessError::BftTablesTooLarge(t) => t.worded(name),
+            other => other.to_string(),
+        }
+    }
+}
+
+impl std::fmt::Display for ParamError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.worded(Param::name))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The library names parameters by their fields; a front end words them its own way, every
+    /// one of them, and other errors are unchanged.
+    #[test]
+    fn parameters_are_worded_by_each_front_end() {
+        let e = ParamError::raising(Param::Segments, 128, "at most 64", Param::TableLevel);
+        assert_eq!(
+            e.to_string(),
+            "segments 128: at most 64; raise table level for more"
+        );
+        let flag = |p: Param| match p {
+            Param::Segments => "--segments",
+            Param::TableLevel => "--table-level",
+            _ => "--other",
+        };
+        assert_eq!(
+            e.worded(flag),
+            "--segments 128: at most 64; raise --table-level for more"
+        );
+        let tables = TessError::BftTablesTooLarge(TablesTooLarge {
+            name: "car".into(),
+            level: 5,
+            bytes: 10,
+            private_faces: 1,
+            faces: 2,
+            max: 8,
+            fits: Some((4, 6)),
+        });
+        assert!(tables
+            .to_string()
+            .contains("(table level 4, up to 32 segments"));
+        assert!(tables
+            .worded(flag)
+            .contains("(--table-level 4, up to 32 segments"));
+        let other = TessError::NoPatchArray { array: 3 };
+        assert_eq!(other.worded(flag), other.to_string());
+    }
 }

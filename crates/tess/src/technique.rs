@@ -304,7 +304,7 @@ impl Features {
         let refused = [
             (
                 !self.adaptive_factors && params.uniform_segments().is_none(),
-                "screen-space and distance factors (--adaptive)",
+                "screen-space and distance factors",
             ),
             (!self.spacing(params.spacing), "this --spacing"),
             (

@@ -62,7 +62,7 @@ pub struct ExportArgs {
     pub method: Option<TechniqueId>,
     /// Segments per base edge, the tessellation level (outer and inner): 1 to 64; bft takes
     /// powers of two from 2 to 2^(table level + 1) unless --fractional; adaptive: segments per
-    /// patch edge, 1 to 32. Ignored with --adaptive.
+    /// patch edge, 1 to 32. Ignored with --factors screen or distance.
     #[arg(long, alias = "level", default_value_t = 8.0, allow_hyphen_values = true, value_parser = parse_segments)]
     pub segments: f32,
     #[arg(long, default_value = "equal", value_parser = parse_spacing)]
@@ -72,10 +72,10 @@ pub struct ExportArgs {
     /// Phong tessellation shape factor α, 0 to 1.
     #[arg(long, default_value_t = 0.75, allow_hyphen_values = true, value_parser = parse_alpha)]
     pub alpha: f32,
-    /// The view --adaptive screen and distance see.
+    /// The view --factors screen and distance see.
     #[command(flatten)]
     pub camera: CameraArgs,
-    /// Viewport --adaptive screen sees, WIDTHxHEIGHT.
+    /// Viewport --factors screen sees, WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", allow_hyphen_values = true, value_parser = parse_size)]
     pub size: (u32, u32),
     /// Exit with status 1 when any crack (an open edge not on the base mesh's boundary or a

@@ -55,14 +55,29 @@ fn main() -> std::process::ExitCode {
     }
 }
 
+/// The command-line option of a parameter the library names.
+fn option_of(p: tess::error::Param) -> &'static str {
+    use tess::error::Param;
+    match p {
+        Param::Segments => "--segments",
+        Param::Pixels => "--pixels",
+        Param::Distance => "--distance",
+        Param::TableLevel => "--table-level",
+    }
+}
+
 /// `e` and its causes joined by ": " (anyhow's `{:#}`), leaving out a cause whose text the
 /// message already shows: an error that embeds its source in its own message and also returns
 /// it from `source()` (thiserror does both for a field named `source`) would otherwise say it
-/// twice.
+/// twice. Library errors that name a parameter name it by its command-line option.
 fn message(e: &anyhow::Error) -> String {
     let mut out = String::new();
     for cause in e.chain() {
-        let text = cause.to_string();
+        // The library names a parameter by its field; here it is an option.
+        let text = match cause.downcast_ref::<tess::TessError>() {
+            Some(t) => t.worded(option_of),
+            None => cause.to_string(),
+        };
         if out.contains(&text) {
             continue;
         }

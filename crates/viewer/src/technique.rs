@@ -115,9 +115,7 @@ pub fn resolve_method(
         }
         None => default_scheme(mesh),
     };
-    techniques::registry()
-        .iter()
-        .find(|i| i.scheme == Some(scheme))
+    techniques::default_for(scheme)
         .map(|i| i.id)
         .ok_or_else(|| {
             anyhow::anyhow!(
@@ -127,18 +125,25 @@ pub fn resolve_method(
         })
 }
 
-/// Adaptive factor policies.
+/// How edge factors are chosen (`--factors`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Adaptive {
+pub enum Factors {
+    /// `--segments` per base edge.
+    Uniform,
+    /// Projected edge length over `--pixels`.
     Screen,
+    /// Halving each time the eye's distance doubles past `--distance`.
     Distance,
 }
 
-fn parse_adaptive(s: &str) -> Result<Adaptive, String> {
+fn parse_factors(s: &str) -> Result<Factors, String> {
     match s {
-        "screen" => Ok(Adaptive::Screen),
-        "distance" => Ok(Adaptive::Distance),
-        _ => Err(format!("unknown adaptive policy '{s}' (screen, distance)")),
+        "uniform" => Ok(Factors::Uniform),
+        "screen" => Ok(Factors::Screen),
+        "distance" => Ok(Factors::Distance),
+        _ => Err(format!(
+            "unknown factor policy '{s}' (uniform, screen, distance)"
+        )),
     }
 }
 
@@ -175,15 +180,17 @@ pub struct SurfaceArgs {
     /// isolation level promises.
     #[arg(long)]
     pub creases_at_isolation: bool,
-    /// Adaptive edge factors (bft): screen (projected edge length / --pixels) or distance
-    /// (halving each time the eye's distance doubles past --distance). Powers of two, or any
-    /// value with --fractional; computed from an edge's two endpoints only, so no cracks.
-    #[arg(long, value_parser = parse_adaptive)]
-    pub adaptive: Option<Adaptive>,
-    /// --adaptive screen: target pixels per segment, 0.5 to 16384.
+    /// Edge factors: uniform (--segments per edge, the default), screen (projected edge length
+    /// / --pixels) or distance (halving each time the eye's distance doubles past --distance);
+    /// screen and distance for the techniques that take them (bft, adaptive, gregory, acc).
+    /// Powers of two, or any value with --fractional; computed from an edge's two endpoints
+    /// only, so no cracks. (`--adaptive screen|distance` is the old spelling.)
+    #[arg(long = "factors", alias = "adaptive", value_parser = parse_factors)]
+    pub factors: Option<Factors>,
+    /// --factors screen: target pixels per segment, 0.5 to 16384.
     #[arg(long, default_value_t = 8.0, allow_hyphen_values = true, value_parser = parse_pixels)]
     pub pixels: f32,
-    /// --adaptive distance: eye distance, in bounding-box diagonals, at which an edge gets the
+    /// --factors distance: eye distance, in bounding-box diagonals, at which an edge gets the
     /// tables' maximum level (above 0, at most 1000000).
     #[arg(long, default_value_t = 1.0, allow_hyphen_values = true, value_parser = parse_distance)]
     pub distance: f32,
@@ -237,9 +244,9 @@ pub struct SurfaceArgs {
 pub struct Setup {
     pub technique: TechniqueId,
     pub build: BuildOptions,
-    /// Per frame; `--adaptive distance` is in diagonals here until [`Setup::world_params`].
+    /// Per frame; `--factors distance` is in diagonals here until [`Setup::world_params`].
     pub params: FrameParams,
-    /// `--adaptive distance` in diagonals (turned into world units once the mesh is known).
+    /// `--factors distance` in diagonals (turned into world units once the mesh is known).
     pub distance_diagonals: Option<f32>,
     pub animate: bool,
     pub frame: Option<f32>,
@@ -292,8 +299,8 @@ impl SurfaceArgs {
         }
         let uses = [
             OptionUse {
-                name: "--adaptive",
-                given: self.adaptive.is_some(),
+                name: "--factors",
+                given: matches!(self.factors, Some(Factors::Screen | Factors::Distance)),
                 feature: |f| f.adaptive_factors,
             },
             OptionUse {
@@ -441,13 +448,13 @@ impl SurfaceArgs {
         params.spacing = spacing;
         params.geometric_normals = self.geometric_normals;
         params.patch_colours = self.patch_colours;
-        params.factors = match self.adaptive {
-            None => FactorPolicy::Uniform { segments },
-            Some(Adaptive::Screen) => FactorPolicy::Screen {
+        params.factors = match self.factors {
+            None | Some(Factors::Uniform) => FactorPolicy::Uniform { segments },
+            Some(Factors::Screen) => FactorPolicy::Screen {
                 pixels: self.pixels,
             },
             // Set in world units by `world_params` once the mesh is loaded.
-            Some(Adaptive::Distance) => FactorPolicy::Distance {
+            Some(Factors::Distance) => FactorPolicy::Distance {
                 reference: self.distance,
             },
         };
@@ -490,8 +497,7 @@ impl SurfaceArgs {
                 ..BuildOptions::default()
             },
             params,
-            distance_diagonals: (self.adaptive == Some(Adaptive::Distance))
-                .then_some(self.distance),
+            distance_diagonals: (self.factors == Some(Factors::Distance)).then_some(self.distance),
             animate,
             frame: self.frame,
         })

@@ -981,9 +981,10 @@ fn export_bft_adaptive_and_fractional_are_watertight() {
     let cube = data("tests/data/meshes/cube.obj");
     let out = tmp("bft_adaptive.obj");
     for extra in [
-        &["--adaptive", "screen", "--pixels", "6"][..],
+        &["--factors", "screen", "--pixels", "6"][..],
+        // The old spelling of --factors is still accepted.
         &["--adaptive", "distance", "--distance", "0.8"],
-        &["--adaptive", "screen", "--pixels", "5", "--fractional"],
+        &["--factors", "screen", "--pixels", "5", "--fractional"],
         &["--segments", "6", "--fractional"],
         &["--segments", "16", "--yaw", "-70", "--table-level", "4"],
     ] {
@@ -1034,7 +1035,7 @@ fn bft_bad_options_are_named_errors() {
         &["fractional-odd", "--fractional"],
     );
     render(
-        &["--method", "bft", "--adaptive", "screen", "--pixels", "0"],
+        &["--method", "bft", "--factors", "screen", "--pixels", "0"],
         &["--pixels 0"],
     );
     // A value clap itself refuses: its usage error (exit 2), naming the choices.
@@ -1044,7 +1045,7 @@ fn bft_bad_options_are_named_errors() {
             cube.as_str(),
             "--method",
             "bft",
-            "--adaptive",
+            "--factors",
             "nearby",
             "-o",
             out,
@@ -1052,7 +1053,11 @@ fn bft_bad_options_are_named_errors() {
         &[],
     );
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("screen, distance"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("uniform, screen, distance"),
+        "{}",
+        stderr(&o)
+    );
     render(
         &["--method", "flat", "--patch-colours", "--animate"],
         &["--patch-colours", "--animate", "--method bft"],

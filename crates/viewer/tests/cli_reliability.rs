@@ -398,14 +398,14 @@ fn every_numeric_option_names_its_range() {
         (
             &bft,
             "--pixels",
-            &["--adaptive", "screen"],
+            &["--factors", "screen"],
             ["0.5", "16384"],
             "16385",
         ),
         (
             &bft,
             "--distance",
-            &["--adaptive", "distance"],
+            &["--factors", "distance"],
             ["0", "1000000"],
             "1e7",
         ),

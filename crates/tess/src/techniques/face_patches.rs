@@ -3,7 +3,7 @@
 //! techniques differ only in which arrays they draw and in their control and evaluation
 //! stages, which a [`FaceStyle`] states. [`FacePatches`] implements [`Technique`] once for all.
 use crate::capture::{FacePoint, PatchFaceTable};
-use crate::error::{Result, TessError};
+use crate::error::{Param, ParamError, Result, TessError};
 use crate::gpu::DrawPush;
 use crate::render_mesh::{PatchOrigin, RenderMesh};
 use crate::technique::{
@@ -152,11 +152,11 @@ impl<S: FaceStyle> Technique for FacePatches<S> {
     fn check(&self, params: &FrameParams) -> Result<()> {
         match params.factors {
             FactorPolicy::Uniform { segments } if (1.0..=MAX_LEVEL).contains(&segments) => Ok(()),
-            FactorPolicy::Uniform { segments } => Err(TessError::OutOfRange {
-                option: "--segments",
-                value: segments.to_string(),
-                range: "1..64",
-            }),
+            FactorPolicy::Uniform { segments } => Err(ParamError::refused(
+                Param::Segments,
+                segments,
+                "expected 1..64",
+            )),
             _ => Err(TessError::Unsupported {
                 technique: S::ID,
                 what: "adaptive factors",

@@ -1,7 +1,7 @@
 //! What the techniques with storage-buffer sets and adaptive factors (BFT, adaptive) share:
 //! the stages their sets are visible to, static storage buffers, and the factor-policy fields
 //! and checks of their push constants.
-use crate::error::{Result, TessError};
+use crate::error::{Param, ParamError, Result};
 use crate::gpu::bindings::{BFT_FACTORS_DISTANCE, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM};
 use crate::technique::{FactorPolicy, FrameParams};
 use vk_core::descriptor::BindingDesc;
@@ -72,19 +72,15 @@ pub fn factor_fields(factors: FactorPolicy) -> (u32, f32, f32, f32) {
 pub fn check_adaptive_policy(params: &FrameParams) -> Result<()> {
     match params.factors {
         FactorPolicy::Screen { pixels } if !(pixels.is_finite() && pixels >= 0.5) => {
-            Err(TessError::OutOfRange {
-                option: "--pixels",
-                value: pixels.to_string(),
-                range: "at least 0.5 pixels per segment",
-            })
+            Err(ParamError::refused(
+                Param::Pixels,
+                pixels,
+                "expected at least 0.5 pixels per segment",
+            ))
         }
-        FactorPolicy::Distance { reference } if !(reference.is_finite() && reference > 0.0) => {
-            Err(TessError::OutOfRange {
-                option: "--distance",
-                value: reference.to_string(),
-                range: "a positive distance",
-            })
-        }
+        FactorPolicy::Distance { reference } if !(reference.is_finite() && reference > 0.0) => Err(
+            ParamError::refused(Param::Distance, reference, "expected a positive distance"),
+        ),
         _ => Ok(()),
     }
 }

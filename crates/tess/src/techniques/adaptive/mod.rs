@@ -38,7 +38,7 @@ use super::shared::{
 use super::windows::{self, Limits, Member, Space};
 use crate::capture::FacePoint;
 use crate::context::Context;
-use crate::error::{Result, TessError};
+use crate::error::{Param, ParamError, Result, TessError};
 use crate::gpu::bindings::{
     ADAPTIVE_BASE_POSITIONS_BINDING, ADAPTIVE_CONTROL_POINTS_BINDING, ADAPTIVE_CURVES_BINDING,
     ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_PLAIN, ADAPTIVE_LOCAL_SIZE, ADAPTIVE_OPTION_FRACTIONAL,
@@ -774,17 +774,18 @@ pub fn check_frame(factor_limit: Option<f32>, params: &FrameParams) -> Result<()
     if params.spacing == Spacing::FractionalOdd {
         return Err(TessError::Unsupported {
             technique: TechniqueId::ADAPTIVE,
-            what: "--spacing fractional-odd (transition edges need even levels: use --fractional, i.e. fractional-even)",
+            what: "fractional-odd spacing (transition edges need even levels: use fractional-even spacing)",
         });
     }
     let half = factor_limit.map_or(f32::INFINITY, |l| (l * 0.5).floor());
     if let FactorPolicy::Uniform { segments } = params.factors {
         if segments.fract() != 0.0 || segments < 1.0 || segments > half {
-            return Err(TessError::OutOfRange {
-                option: "--segments",
-                value: segments.to_string(),
-                range: "whole segments per patch edge, 1 up to half the device's maximum tessellation level (transition edges double it)",
-            });
+            return Err(ParamError::refused(
+                Param::Segments,
+                segments,
+                "expected whole segments per patch edge, 1 up to half the device's maximum \
+                 tessellation level (transition edges double it)",
+            ));
         }
     }
     check_adaptive_policy(params)
@@ -808,7 +809,7 @@ impl Technique for Adaptive {
         if params.show == SurfaceShow::ParamError && !self.has_param_errors {
             return Err(TessError::Unsupported {
                 technique: self.id,
-                what: "--show param-error on a surface built without its Eq. 1 error lattice (build with SurfaceMaps::param_error)",
+                what: "the param-error view on a surface built without its Eq. 1 error lattice (build with SurfaceMaps::param_error)",
             });
         }
         check_frame(Some(self.factor_limit()), params)

@@ -36,7 +36,7 @@
 //! that fits is one chunk with bases 0: the same draw as before.
 use crate::capture::{face_corner_uv, FacePoint};
 use crate::context::Context;
-use crate::error::{Result, TessError};
+use crate::error::{Param, ParamError, Result, TablesTooLarge, TessError};
 pub mod layout;
 
 use super::shared::{
@@ -343,15 +343,11 @@ fn check_table_range(
     if bytes <= max_range {
         return Ok(());
     }
-    let hint = match (1..level).rev().find(|&l| bytes_at(l) <= max_range) {
-        Some(l) => format!(
-            "at level {l} they take {} bytes (--table-level {l}, up to {} segments per base edge)",
-            bytes_at(l),
-            2u32 << l
-        ),
-        None => "no table level fits".to_string(),
-    };
-    Err(TessError::BftTablesTooLarge {
+    let fits = (1..level)
+        .rev()
+        .find(|&l| bytes_at(l) <= max_range)
+        .map(|l| (l, bytes_at(l)));
+    Err(TessError::BftTablesTooLarge(TablesTooLarge {
         name: options.name.clone(),
         level,
         bytes,
@@ -361,8 +357,8 @@ fn check_table_range(
             .count(),
         faces: records.len(),
         max: max_range,
-        hint,
-    })
+        fits,
+    }))
 }
 
 /// `bit` when `on`.
@@ -565,10 +561,14 @@ impl Bft {
         let table_level = options.table_level;
         let max_level = device.info.caps.max_tessellation_generation_level;
         if !(1..=6).contains(&table_level) || (1u32 << table_level) > max_level {
-            return Err(TessError::TableLevel {
-                level: table_level,
-                max_tessellation_level: max_level,
-            });
+            return Err(ParamError::refused(
+                Param::TableLevel,
+                table_level,
+                format!(
+                    "tables must be at level 1..6 and need tessellation level 2^level (the \
+                     device allows {max_level})"
+                ),
+            ));
         }
         let mut laps = Laps::new();
         let mut stages = Vec::new();
@@ -928,7 +928,7 @@ pub fn check_frame(table_level: u32, params: &FrameParams) -> Result<()> {
     if params.spacing == Spacing::FractionalOdd {
         return Err(TessError::Unsupported {
             technique: TechniqueId::BFT,
-            what: "--spacing fractional-odd (it morphs between dyadic levels: use --fractional, i.e. fractional-even)",
+            what: "fractional-odd spacing (it morphs between dyadic levels: use fractional-even spacing)",
         });
     }
     let fractional = params.spacing == Spacing::FractionalEven;
@@ -938,11 +938,15 @@ pub fn check_frame(table_level: u32, params: &FrameParams) -> Result<()> {
         let whole = segments.fract() == 0.0 && segments >= 1.0;
         let s = segments as u32;
         if !whole || s < 2 || s > max || (!fractional && !s.is_power_of_two()) {
-            return Err(TessError::BftSegments {
+            return Err(ParamError::raising(
+                Param::Segments,
                 segments,
-                max,
-                table_level,
-            });
+                format!(
+                    "BFT takes a power of two in 2..={max} segments per base edge (tables at \
+                     level {table_level})"
+                ),
+                Param::TableLevel,
+            ));
         }
     }
     check_adaptive_policy(params)
@@ -1312,14 +1316,14 @@ mod tests {
             "at level 5",
             &format!("{at5} bytes"),
             "need a private table",
-            &format!("at level 4 they take {at4} bytes (--table-level 4"),
+            &format!("at level 4 they take {at4} bytes (table level 4"),
         ] {
             assert!(err.contains(needle), "{needle:?} in {err}");
         }
         let err = check_table_range(&records, 5, &options, at4 - 1)
             .expect_err("level 4 does not fit either")
             .to_string();
-        assert!(err.contains("--table-level 3"), "{err}");
+        assert!(err.contains("table level 3"), "{err}");
         let err = check_table_range(&records, 5, &options, 1)
             .expect_err("nothing fits")
             .to_string();

@@ -17,7 +17,7 @@
 //!   polygons); Catmull-Clark and bilinear refine the mesh as given.
 use crate::capture::{face_corner_uv, FacePoint};
 use crate::context::Context;
-use crate::error::{Result, TessError};
+use crate::error::{Param, ParamError, Result, TessError};
 use crate::gpu::{DrawPush, Vertex};
 use crate::shaders::Stage;
 use crate::technique::{
@@ -262,9 +262,16 @@ impl CpuMesh {
 
 /// The level a frame of `params` draws (uniform segments S = 2^level), or why it cannot.
 fn level_of(id: TechniqueId, params: &FrameParams) -> Result<u32> {
-    let bad = |segments: f32| TessError::RefinedSegments {
-        segments,
-        max: 1 << MAX_LEVEL,
+    let bad = |segments: f32| {
+        ParamError::refused(
+            Param::Segments,
+            segments,
+            format!(
+                "a mesh refined on the CPU takes a power of two in 1..={} segments per base \
+                 edge (each level halves every edge)",
+                1 << MAX_LEVEL
+            ),
+        )
     };
     let segments = match params.factors {
         FactorPolicy::Uniform { segments } => segments,

@@ -29,7 +29,7 @@ impl Kind {
 
 /// Every handle issued: its kind and whether it is live. Destroyed entries stay (a few bytes
 /// each) so double destroy and use after destroy are told apart from a forged handle.
-pub(crate) struct Registry<C, S, E> {
+pub(crate) struct HandleTable<C, S, E> {
     next: u64,
     issued: HashMap<u64, Kind>,
     contexts: HashMap<u64, Arc<Mutex<C>>>,
@@ -39,7 +39,7 @@ pub(crate) struct Registry<C, S, E> {
     evaluators: HashMap<u64, Arc<E>>,
 }
 
-impl<C, S, E> Default for Registry<C, S, E> {
+impl<C, S, E> Default for HandleTable<C, S, E> {
     fn default() -> Self {
         Self {
             // 0 is the null handle; start high enough that small forged integers are unissued.
@@ -52,7 +52,7 @@ impl<C, S, E> Default for Registry<C, S, E> {
     }
 }
 
-impl<C, S, E> Registry<C, S, E> {
+impl<C, S, E> HandleTable<C, S, E> {
     fn issue(&mut self, kind: Kind) -> u64 {
         // Ids step by 16 so that the pointer a host sees is aligned like a real one.
         let id = self.next;
