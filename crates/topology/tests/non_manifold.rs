@@ -598,3 +598,34 @@ fn refinement_and_limit_match_opensubdiv_far() {
     }
     println!("{}", report.join("\n"));
 }
+
+
+/// Vertices no face uses (OpenSubdiv keeps them) have no surface: the CPU limit mesh keeps
+/// their positions instead of failing or making NaN, in both schemes.
+#[test]
+fn vertices_no_face_uses_keep_their_position_in_the_limit_mesh() {
+    use topology::limit::limit_mesh::{uniform_limit_mesh, DomainPoint};
+    for name in ["catmark_nonman_bareverts", "loop_nonman_verts"] {
+        let (mesh, scheme) = shape(name);
+        let split = ManifoldSplit::of(&mesh).expect(name);
+        let corners = vec![
+            DomainPoint {
+                face: 0,
+                uv: [0.0, 0.0]
+            };
+            split.mesh.face_vertices.len()
+        ];
+        let topology = Topology::from_mesh(&split.mesh).expect(name);
+        let bare: Vec<usize> = (0..topology.num_vertices())
+            .filter(|&v| topology.vertex_faces(v).is_empty())
+            .collect();
+        assert!(!bare.is_empty(), "{name} has vertices no face uses");
+        for level in 0..3 {
+            let lm = uniform_limit_mesh(&split.mesh, scheme, level, &corners).expect(name);
+            assert!(lm.positions.iter().flatten().all(|c| c.is_finite()), "{name} {level}");
+            for &v in &bare {
+                assert_eq!(lm.positions[v], split.mesh.positions[v], "{name} {level}");
+            }
+        }
+    }
+}

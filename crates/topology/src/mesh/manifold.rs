@@ -166,7 +166,15 @@ struct Edges {
 }
 
 impl Edges {
-    fn of(mesh: &ControlMesh, corner_face: &[u32], next: &impl Fn(usize) -> usize) -> Edges {
+    fn of(mesh: &ControlMesh, corner_face: &[u32]) -> Edges {
+        let next = |c: usize| {
+            let f = corner_face[c] as usize;
+            if c + 1 == mesh.face_offsets[f + 1] as usize {
+                mesh.face_offsets[f] as usize
+            } else {
+                c + 1
+            }
+        };
         let half = sorted_half_edges(
             mesh.positions.len(),
             &mesh.face_offsets,
@@ -458,6 +466,19 @@ impl Split<'_> {
     }
 }
 
+/// The input's non-manifold edges (vertex pairs, smaller first, ascending) and how their
+/// faces use them, without splitting: what a capture needs to tell an open edge along a
+/// non-manifold edge from a crack. Refuses what [`ControlMesh::validate`] refuses.
+pub fn non_manifold_edges(mesh: &ControlMesh) -> Result<Vec<([u32; 2], EdgeUse)>, TopologyError> {
+    check_faces(mesh, false)?;
+    let corner_face = corner_faces(&mesh.face_offsets, mesh.face_vertices.len());
+    let edges = Edges::of(mesh, &corner_face);
+    Ok((0..edges.keys.len())
+        .filter(|&e| edges.uses[e].is_non_manifold())
+        .map(|e| (edges.ends(e), edges.uses[e]))
+        .collect())
+}
+
 impl ManifoldSplit {
     /// The manifold split of `mesh` (module documentation). A manifold mesh comes back as it
     /// is, with no copies. Refuses what [`ControlMesh::validate`] refuses, and a face that
@@ -466,15 +487,7 @@ impl ManifoldSplit {
         check_faces(mesh, false)?;
         let nv = mesh.positions.len();
         let corner_face = corner_faces(&mesh.face_offsets, mesh.face_vertices.len());
-        let next = |c: usize| {
-            let f = corner_face[c] as usize;
-            if c + 1 == mesh.face_offsets[f + 1] as usize {
-                mesh.face_offsets[f] as usize
-            } else {
-                c + 1
-            }
-        };
-        let edges = Edges::of(mesh, &corner_face, &next);
+        let edges = Edges::of(mesh, &corner_face);
         let (vertex_offsets, vertex_corners) = vertex_corners(nv, &mesh.face_vertices);
         let mut split = Split {
             mesh,

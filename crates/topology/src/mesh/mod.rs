@@ -7,6 +7,7 @@ use rayon::prelude::*;
 pub mod input;
 pub mod manifold;
 pub mod obj;
+pub mod weld;
 
 /// Sentinel for "no face" / "no edge" in adjacency tables.
 pub const INVALID: u32 = u32::MAX;

@@ -139,6 +139,19 @@ impl ObjLines {
         self.vertices.get(v).copied()
     }
 
+    /// The lines of a mesh that keeps, of this one's faces, those of `kept` (per new face, its
+    /// old number: [`crate::mesh::weld::weld_vertices`] drops faces). Vertices and tags keep
+    /// their lines.
+    pub fn for_faces(&self, kept: &[u32]) -> ObjLines {
+        ObjLines {
+            faces: kept
+                .iter()
+                .map(|&f| self.faces.get(f as usize).copied().unwrap_or(0))
+                .collect(),
+            ..self.clone()
+        }
+    }
+
     /// `e`, an error about the mesh read from `file` with these lines, in the file's terms
     /// ([`TopologyError::in_file`] with the line at fault when there is one).
     pub fn locate(&self, e: TopologyError, mesh: &ControlMesh, file: &str) -> TopologyError {
