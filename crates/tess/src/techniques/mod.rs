@@ -14,6 +14,7 @@ pub mod gregory;
 pub mod phong;
 pub mod pn;
 pub mod shared;
+pub mod split;
 pub mod windows;
 
 use crate::context::Context;
@@ -197,13 +198,20 @@ pub fn check_options(id: TechniqueId, build: &BuildOptions, params: &FrameParams
 }
 
 /// Builds technique `id` for `mesh` on `ctx`'s device, with one frame slot per slot of `ctx`.
+/// The subdivision techniques take a non-manifold mesh through its manifold split
+/// ([`split::build_split`]); the others draw its faces as given.
 pub fn build(
     ctx: &mut Context,
     id: TechniqueId,
     mesh: &ControlMesh,
     options: &BuildOptions,
 ) -> Result<Built> {
-    (info(id).build)(ctx, mesh, options)
+    let info = info(id);
+    if info.scheme.is_some() {
+        split::build_split(ctx, info, mesh, options)
+    } else {
+        (info.build)(ctx, mesh, options)
+    }
 }
 
 /// A [`Built`] with no notes.
