@@ -444,7 +444,10 @@ fn bad_segments_are_rejected_with_a_clear_error() {
                 .render_offscreen(&mut surf, &uniform(s), EXTENT)
                 .map(|_| ())
                 .expect_err("rejected");
-            assert!(e.to_string().contains("segments ") && !e.to_string().contains("--"), "{e}");
+            assert!(
+                e.to_string().contains("segments ") && !e.to_string().contains("--"),
+                "{e}"
+            );
         }
     }
 }

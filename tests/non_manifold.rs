@@ -41,7 +41,7 @@ const SHAPES: [&str; 10] = [
 
 fn shape(name: &str) -> (ControlMesh, Scheme) {
     let mesh = load_obj(common::data(&format!(
-        "tests/data/opensubdiv/shapes/{name}.obj"
+        "tests/data/opensubdiv/nonmanifold/{name}.obj"
     )))
     .unwrap_or_else(|e| panic!("{name}: {e}"));
     (mesh, Scheme::from_shape_name(name).expect("scheme"))
@@ -57,7 +57,12 @@ fn shapes_for(info: &TechniqueInfo) -> Vec<(&'static str, ControlMesh)> {
         .collect()
 }
 
-fn build(ctx: &mut Context, info: &TechniqueInfo, mesh: &ControlMesh, name: &str) -> Box<dyn Technique> {
+fn build(
+    ctx: &mut Context,
+    info: &TechniqueInfo,
+    mesh: &ControlMesh,
+    name: &str,
+) -> Box<dyn Technique> {
     techniques::build(
         ctx,
         info.id,
@@ -133,9 +138,18 @@ fn capture(
 
 /// Whether face `f`'s corners all lie on one line (exactly, in the file's coordinates).
 fn has_no_area(mesh: &ControlMesh, f: usize) -> bool {
-    let p: Vec<[f64; 3]> = mesh.face(f).iter().map(|&v| mesh.positions[v as usize]).collect();
+    let p: Vec<[f64; 3]> = mesh
+        .face(f)
+        .iter()
+        .map(|&v| mesh.positions[v as usize])
+        .collect();
     let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    let Some(&d) = p.iter().map(|&q| sub(q, p[0])).find(|d| *d != [0.0; 3]).as_ref() else {
+    let Some(&d) = p
+        .iter()
+        .map(|&q| sub(q, p[0]))
+        .find(|d| *d != [0.0; 3])
+        .as_ref()
+    else {
         return true;
     };
     p.iter().all(|&q| {
@@ -254,4 +268,3 @@ fn meshes_refined_on_the_cpu_are_the_exact_limit_of_the_split() {
     }
     assert!(gpu.errors().is_empty(), "{:#?}", gpu.errors());
 }
-

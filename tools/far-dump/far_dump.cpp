@@ -1,4 +1,4 @@
-// Reference dumps from OpenSubdiv's Far: a shape of tests/data/opensubdiv/shapes refined
+// Reference dumps from OpenSubdiv's Far: a shape of tests/data/opensubdiv (nonmanifold/) refined
 // uniformly to level N, every level's points and the last level's limit points.
 //
 // Build (Debian: apt-get install libosd-dev):

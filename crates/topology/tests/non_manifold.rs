@@ -18,8 +18,10 @@ use topology::refine::joined::joined_vertices;
 use topology::refine::refine_uniform;
 use topology::{load_obj, ControlMesh, Scheme};
 
+/// OpenSubdiv's non-manifold shapes, apart from tests/data's manifold `shapes/` (whose
+/// whole-set tests hold every shape to manifold rules).
 fn shapes_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/opensubdiv/shapes")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/opensubdiv/nonmanifold")
 }
 
 /// The non-manifold regression shapes of tests/data.
@@ -428,7 +430,9 @@ fn degenerate_edges_split_and_faces_joined_to_themselves_are_refused() {
 /// A manifold mesh comes back as it is.
 #[test]
 fn a_manifold_mesh_is_its_own_split() {
-    let (mesh, _) = shape("catmark_cube_creases1");
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tests/data/opensubdiv/shapes/catmark_cube_creases1.obj");
+    let mesh = load_obj(path).expect("cube");
     let split = ManifoldSplit::of(&mesh).expect("cube");
     assert!(split.is_identity());
     assert_eq!(split.mesh, mesh);
@@ -599,7 +603,6 @@ fn refinement_and_limit_match_opensubdiv_far() {
     println!("{}", report.join("\n"));
 }
 
-
 /// Vertices no face uses (OpenSubdiv keeps them) have no surface: the CPU limit mesh keeps
 /// their positions instead of failing or making NaN, in both schemes.
 #[test]
@@ -622,7 +625,10 @@ fn vertices_no_face_uses_keep_their_position_in_the_limit_mesh() {
         assert!(!bare.is_empty(), "{name} has vertices no face uses");
         for level in 0..3 {
             let lm = uniform_limit_mesh(&split.mesh, scheme, level, &corners).expect(name);
-            assert!(lm.positions.iter().flatten().all(|c| c.is_finite()), "{name} {level}");
+            assert!(
+                lm.positions.iter().flatten().all(|c| c.is_finite()),
+                "{name} {level}"
+            );
             for &v in &bare {
                 assert_eq!(lm.positions[v], split.mesh.positions[v], "{name} {level}");
             }

@@ -15,18 +15,32 @@ f 1 2 3 4\nf 5 7 8 6\nt crease 2/1/0 4 5 2.0\n";
 fn an_exact_weld_closes_a_seam_and_moves_tags() {
     let (mesh, _) = parse_obj_with_lines(SEAM, "seam.obj").unwrap();
     let topology = Topology::from_mesh(&mesh).unwrap();
-    let open = |t: &Topology| (0..t.num_edges()).filter(|&e| t.is_boundary_edge(e)).count();
+    let open = |t: &Topology| {
+        (0..t.num_edges())
+            .filter(|&e| t.is_boundary_edge(e))
+            .count()
+    };
     assert_eq!(open(&topology), 8, "as given: two separate quads");
     let (welded, kept, report) = weld_vertices(&mesh, 0.0);
     assert_eq!((report.groups, report.merged), (2, 2));
     assert_eq!(report.collapsed_edges, 0);
     assert_eq!(kept, vec![0, 1]);
     assert_eq!(welded.face(1), &[1, 6, 7, 2]);
-    assert_eq!(welded.creases[0].vertices, [1, 2], "the tag follows its vertices");
-    assert_eq!(welded.positions.len(), 8, "vertex numbers keep their meaning");
+    assert_eq!(
+        welded.creases[0].vertices,
+        [1, 2],
+        "the tag follows its vertices"
+    );
+    assert_eq!(
+        welded.positions.len(),
+        8,
+        "vertex numbers keep their meaning"
+    );
     let t = Topology::from_mesh(&welded).unwrap();
     assert_eq!(open(&t), 6, "the seam is an interior edge");
-    assert!(report.summary().contains("welded 4 vertices at identical positions into 2"));
+    assert!(report
+        .summary()
+        .contains("welded 4 vertices at identical positions into 2"));
 }
 
 #[test]

@@ -1422,7 +1422,7 @@ fn export_weld_merges_a_polygon_soup_and_reports_it() {
 #[test]
 fn export_reports_non_manifold_edges_as_such() {
     let out = tmp("nonman_edges.obj");
-    let shape = data("tests/data/opensubdiv/shapes/catmark_nonman_edges.obj");
+    let shape = data("tests/data/opensubdiv/nonmanifold/catmark_nonman_edges.obj");
     let o = tessera(
         &[
             "export",
