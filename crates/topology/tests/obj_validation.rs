@@ -242,9 +242,7 @@ fn write_obj_round_trips() {
 
 mod never_panics {
     use proptest::prelude::*;
-    use topology::mesh::manifold::{ManifoldSplit, NonManifoldReport};
-    use topology::mesh::obj::{parse_obj, parse_obj_with_lines};
-    use topology::mesh::Topology;
+    use topology::mesh::obj::parse_obj;
     use topology::refine::refine_uniform;
     use topology::{ControlMesh, Scheme};
 

@@ -139,9 +139,8 @@ pub fn classify_open_edges(
             continue;
         };
         let (ea, eb) = (edges.at(base, &fa), edges.at(base, &fb));
-        let shared = |class: &dyn Fn(&[u32; 2]) -> bool| {
-            ea.iter().any(|k| eb.contains(k) && class(k))
-        };
+        let shared =
+            |class: &dyn Fn(&[u32; 2]) -> bool| ea.iter().any(|k| eb.contains(k) && class(k));
         if shared(&|k| edges.is_boundary(*k)) {
             out.on_base_boundary += 1;
         } else if shared(&|k| edges.non_manifold.contains(k)) {

@@ -89,17 +89,18 @@ pub fn weld_vertices(mesh: &ControlMesh, tolerance: f64) -> (ControlMesh, Vec<u3
     let mut normals = mesh.normals.as_ref().map(|_| Vec::new());
     let mut kept: Vec<u32> = Vec::with_capacity(mesh.num_faces());
     let mut new_face: Vec<Option<u32>> = vec![None; mesh.num_faces()];
-    for f in 0..mesh.num_faces() {
+    for (f, slot) in new_face.iter_mut().enumerate() {
         let start = mesh.face_offsets[f] as usize;
         let corners = welded_corners(mesh.face(f), &target, &mut report);
         if corners.len() < 3 {
             report.dropped_faces.push(f as u32);
             continue;
         }
-        new_face[f] = Some(kept.len() as u32);
+        *slot = Some(kept.len() as u32);
         kept.push(f as u32);
         for &i in &corners {
-            out.face_vertices.push(target[mesh.face_vertices[start + i] as usize]);
+            out.face_vertices
+                .push(target[mesh.face_vertices[start + i] as usize]);
             if let (Some(dst), Some(src)) = (uvs.as_mut(), mesh.uvs.as_ref()) {
                 dst.push(src[start + i]);
             }
