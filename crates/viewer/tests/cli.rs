@@ -1454,3 +1454,38 @@ fn export_reports_non_manifold_edges_as_such() {
     let triple: usize = reported(&s, "edges of three or more triangles:");
     assert!(along + triple > 0, "the non-manifold edges show: {s}");
 }
+
+/// `tessera subdivide` refines a non-manifold mesh through its manifold split (as the
+/// subdivision techniques draw it), says so, and writes every face of the level: 20 faces of
+/// catmark_nonman_verts make OpenSubdiv's 316 at level 2, every vertex finite at the limit.
+#[test]
+fn subdivide_refines_a_non_manifold_mesh() {
+    let out = tmp("nonman_verts_l2.obj");
+    let shape = data("tests/data/opensubdiv/nonmanifold/catmark_nonman_verts.obj");
+    let o = tessera(
+        &[
+            "subdivide",
+            &shape,
+            "--scheme",
+            "catmull-clark",
+            "--level",
+            "2",
+            "--limit",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("non-manifold:"), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 316);
+    for l in text.lines().filter(|l| l.starts_with("v ")) {
+        assert!(
+            l[2..]
+                .split_whitespace()
+                .all(|x| x.parse::<f64>().is_ok_and(f64::is_finite)),
+            "{l}"
+        );
+    }
+}
