@@ -635,3 +635,41 @@ fn vertices_no_face_uses_keep_their_position_in_the_limit_mesh() {
         }
     }
 }
+
+mod random_soups {
+    use proptest::prelude::*;
+    use topology::mesh::manifold::ManifoldSplit;
+    use topology::mesh::Topology;
+    use topology::refine::refine_uniform;
+    use topology::{ControlMesh, Scheme};
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(512))]
+
+        /// Any polygon soup that validation takes either splits into a mesh the manifold
+        /// adjacency accepts (every edge one face or two opposite ones, every vertex one fan),
+        /// which then refines, or is refused by name (a face joined to itself at a vertex).
+        #[test]
+        fn every_split_is_manifold_and_refines(
+            faces in prop::collection::vec(prop::collection::vec(0u32..9, 3..6), 1..10),
+        ) {
+            let positions = (0..9)
+                .map(|i| [f64::from(i), f64::from(i * i % 7), f64::from(i % 3)])
+                .collect();
+            let mesh = ControlMesh::from_polygons(positions, &faces);
+            prop_assume!(mesh.validate().is_ok());
+            match ManifoldSplit::of(&mesh) {
+                Ok(split) => {
+                    prop_assert_eq!(split.mesh.num_faces(), mesh.num_faces());
+                    let t = Topology::from_mesh(&split.mesh);
+                    prop_assert!(t.is_ok(), "{:?}: {:?}", faces, t.err());
+                    prop_assert!(refine_uniform(&split.mesh, Scheme::CatmullClark, 1).is_ok());
+                }
+                Err(e) => prop_assert!(
+                    matches!(e, topology::TopologyError::RepeatedVertex { .. }),
+                    "{e}"
+                ),
+            }
+        }
+    }
+}
