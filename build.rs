@@ -319,7 +319,7 @@ fn vk_stage_flag(file: &str) -> &'static str {
     }
 }
 
-/// `pn/tri.tese` → `PnTriTese`; `bft/subdivide.comp` → `BftSubdivideComp`.
+/// `pn/tri.tese` → `PnTriTese`; `stencil/evaluate.comp` → `StencilEvaluateComp`.
 fn stage_ident(file: &str) -> String {
     file.split(['/', '.', '_', '-'])
         .filter(|w| !w.is_empty())

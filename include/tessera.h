@@ -313,6 +313,10 @@ typedef struct TesseraHostDesc {
 // Catmull-Clark subdivision on the CPU, drawn as a static mesh (`--method cpu-catmark`).
 #define TESSERA_TECHNIQUE_CPU_CATMARK 9
 
+// Doo-Sabin subdivision refined on the GPU every frame to level log2 S, drawn from the vertex
+// stage (`--method doo-sabin`; levels are powers of two from 2 to 64 segments).
+#define TESSERA_TECHNIQUE_DOO_SABIN 10
+
 // Catmull-Clark unless every face is a triangle (then Loop); a Loop technique fan-triangulates.
 #define TESSERA_SCHEME_AUTO 0
 

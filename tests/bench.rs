@@ -380,14 +380,14 @@ fn bench_equal_triangles_and_memory_per_face() {
         1,
     )
     .unwrap();
-    use tessera::tess::techniques::gregory;
+    use tessera::tess::techniques::planned_patches;
     use tessera::tess::Technique;
     use tessera::topology::patches::adaptive::single_pass::SinglePassPatch;
     for (name, patch) in [
         ("gregory", SinglePassPatch::Gregory),
         ("acc", SinglePassPatch::Acc1),
     ] {
-        let surf = gregory::build(
+        let surf = planned_patches::single_pass(
             &mut tctx,
             &pyramid,
             patch,

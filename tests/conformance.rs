@@ -12,8 +12,8 @@
 mod common;
 
 use common::Gpu;
+use tessera::tess::animation::Wave;
 use tessera::tess::capture::classify_open_edges;
-use tessera::tess::techniques::bft::Wave;
 use tessera::tess::techniques::{self, TechniqueInfo};
 use tessera::tess::{
     BuildOptions, Capturer, Context, DrawPath, FactorPolicy, FrameParams, Spacing, Technique,

@@ -126,7 +126,7 @@ const BFT_MESHES: [&str; 3] = [
 /// BFT images per mesh: shaded (subdivision shading at S segments, posed by the animation wave
 /// at `time`) and wireframe with patch colours.
 fn render_bft(segments: u32, time: f32) -> Vec<(String, Rgba8)> {
-    use tessera::tess::techniques::bft::{base_normals, base_positions, wave};
+    use tessera::tess::animation::{base_normals, base_positions, wave};
     let gpu = Gpu::new();
     note_device(&gpu);
     let mut ctx = Context::offscreen(gpu.device()).unwrap();

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes a planar grid OBJ for the scale runs (issue 15; docs/benchmarks.md, "Scale").
+"""Writes a planar grid OBJ for the scale runs (docs/benchmarks.md, "Scale: 1M-face meshes").
 
     tools/grid.py --nx 708 --ny 707 --triangles out.obj   # 1,001,112 triangles (the issue's mesh)
     tools/grid.py --nx 1000 --ny 1000 out.obj             # 1,000,000 quads

@@ -1,20 +1,15 @@
-// Feature-adaptive Catmull-Clark (crates/tess/src/techniques/adaptive): the storage buffers,
-// push constants and the evaluation every stage shares. Mirrors
-// `tess::techniques::adaptive::layout` (offsets checked against the SPIR-V by a test).
+// Catmull-Clark patch plans (adaptive, gregory, acc; crates/tess/src/techniques/planned_patches):
+// the storage buffers, push constants and the evaluation every stage shares. Mirrors
+// `tess::techniques::planned_patches::layout` (offsets checked against the SPIR-V by a test).
 //
 // Watertightness by canonical curves: every patch boundary edge is one cubic Bezier curve of
-// the global vertex buffer (computed once per frame by the stencil kernel, from one owner
+// the global vertex buffer (computed once per frame by the canonical kernel, from one owner
 // patch). A TES vertex on a patch boundary is evaluated from that curve, at a parameter both
 // sides of the edge derive identically (from the vertex's index along the edge when the
 // factor is an integer, else from the mirrored tess coordinate), with `precise` arithmetic in
 // one fixed operand order. So the two sides produce the same bits, across level transitions
 // and end caps too.
 #include "bindings.glsl"
-
-struct StencilTerm {
-    uint index;   // global vertex
-    float weight;
-};
 
 struct AdaptivePatch {
     uint cp_offset;   // first control-point index in control_points[]
@@ -24,9 +19,6 @@ struct AdaptivePatch {
     uint curves[8];   // edge i: curves[2i], curves[2i + 1]
 };
 
-layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_BASE_POSITIONS_BINDING) readonly buffer BasePositions { float base_positions[]; };
-layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_STENCIL_OFFSETS_BINDING) readonly buffer StencilOffsets { uint stencil_offsets[]; };
-layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_STENCIL_TERMS_BINDING) readonly buffer StencilTerms { StencilTerm stencil_terms[]; };
 #ifdef ADAPTIVE_WRITES_VERTICES
 layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_VERTICES_BINDING) buffer Vertices { vec4 vertices[]; };
 #else
@@ -72,11 +64,8 @@ layout(push_constant) uniform AdaptivePush {
     float pixels_per_segment;
     float distance_ref;    // distance at which an edge gets max_level segments
     float max_level;       // the device's maximum tessellation level
-    uint first_row;        // compute: first stencil row of this dispatch (global vertex - base count; mode 1: first base vertex)
-    uint count;            // compute: rows in this dispatch (or base vertices to copy)
-    uint base_count;       // compute: base vertices (row r writes vertex base_count + r)
-    uint row_base;         // compute: the chunk's first stencil_offsets element (window base)
-    uint term_base;        // compute: the chunk's first stencil_terms element (window base)
+    uint first_item;       // canonical kernel: first regular corner or curve point of this dispatch
+    uint count;            // canonical kernel: items in this dispatch
     float displace_scale;  // displacement along the normal per unit of height
     uint first_corner;     // global id of the first canonical corner (corner_owners[0])
 } adaptive;

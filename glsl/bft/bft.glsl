@@ -7,9 +7,6 @@
 // `GpuBft::eval_tess` is this file's f32 mirror, kept in step.
 #include "bindings.glsl"
 
-struct BasePosition { float x; float y; float z; };
-// One term of a CSR stencil row.
-struct StencilTerm { uint index; float weight; };
 // One term of the two limit-tangent masks of a level-1 vertex (same control points).
 struct TangentTerm { uint index; float weight_t1; float weight_t2; };
 // Owners pack `face << BFT_OWNER_SHIFT | local index` (owner_face, owner_local); edge e runs
@@ -41,9 +38,6 @@ struct TableEntry {
     uint kind;            // BFT_KIND_*: regular, extraordinary, boundary, private
 };
 
-layout(std430, set = BFT_SET, binding = BFT_BASE_POSITIONS_BINDING) readonly buffer BasePositions { BasePosition base_positions[]; };
-layout(std430, set = BFT_SET, binding = BFT_STENCIL_OFFSETS_BINDING) readonly buffer StencilOffsets { uint stencil_offsets[]; };
-layout(std430, set = BFT_SET, binding = BFT_STENCIL_TERMS_BINDING) readonly buffer StencilTerms { StencilTerm stencil_terms[]; };
 layout(std430, set = BFT_SET, binding = BFT_TANGENT_OFFSETS_BINDING) readonly buffer TangentOffsets { uint tangent_offsets[]; };
 layout(std430, set = BFT_SET, binding = BFT_TANGENT_TERMS_BINDING) readonly buffer TangentTerms { TangentTerm tangent_terms[]; };
 #ifdef BFT_WRITES_LEVEL1
@@ -76,10 +70,8 @@ layout(push_constant) uniform BftPush {
     // buffer is global and has its space's base subtracted (the PATCH/RING/L1/... macros).
     uint patch_base;      // patches
     uint ring_base;       // patch_rings
-    uint level1_base;     // level1_pos, level1_nrm, stencil_offsets, tangent_offsets
-    uint stencil_base;    // stencil_terms
+    uint level1_base;     // level1_pos, level1_nrm, tangent_offsets
     uint tangent_base;    // tangent_terms
-    uint base_vertex_base; // base_positions
 } bft;
 
 // Windowed reads by global index.
@@ -260,8 +252,8 @@ bool bft_eval(uint face, vec3 b, bool geometric, out vec3 p, out vec3 n) {
     // path for both faces of an edge, so their bits cannot depend on how a compiler schedules
     // two. (NVIDIA's rounds the unrolled patch-block sum differently from the global loop over
     // the same products, which cracked every shared point; a non-unrolled block loop matches
-    // there but costs lavapipe a quarter more: docs/benchmarks.md, "Session 18".) Only interior
-    // points read the patch block.
+    // there but costs lavapipe a quarter more: docs/benchmarks.md, "Table I on an NVIDIA
+    // H100".) Only interior points read the patch block.
     bool local = g == face && corner < 0 && edge < 0 && (tc_head.y & BFT_INFO_GATHERED) != 0u;
     float grid = float(table.grid);
     float nseg = float(table.segments);

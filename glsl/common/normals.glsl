@@ -1,4 +1,4 @@
-// Normalisation that stays finite for every finite vector (issue 15: no NaN out of finite input).
+// Normalisation that stays finite for every finite vector (no NaN out of finite input).
 // normalize(v) is v * inversesqrt(dot(v, v)): NaN for a zero vector (a degenerate patch, a
 // collapsed face, cancelling normals), and for v beyond about 1.8e19 (the cross product of
 // tangents of a mesh near topology::MAX_COORDINATE) dot(v, v) overflows, while for tiny v it

@@ -109,6 +109,9 @@ pub const TESSERA_TECHNIQUE_ACC: TesseraTechnique = 7;
 pub const TESSERA_TECHNIQUE_CPU: TesseraTechnique = 8;
 /// Catmull-Clark subdivision on the CPU, drawn as a static mesh (`--method cpu-catmark`).
 pub const TESSERA_TECHNIQUE_CPU_CATMARK: TesseraTechnique = 9;
+/// Doo-Sabin subdivision refined on the GPU every frame to level log2 S, drawn from the vertex
+/// stage (`--method doo-sabin`; levels are powers of two from 2 to 64 segments).
+pub const TESSERA_TECHNIQUE_DOO_SABIN: TesseraTechnique = 10;
 
 /// The subdivision scheme (`TESSERA_SCHEME_*`).
 pub type TesseraScheme = u32;
@@ -339,8 +342,8 @@ type Contexts =
     HandleTable<ContextState, SurfaceState, topology::limit::face_domain::LimitEvaluator>;
 
 fn handles() -> &'static Mutex<Contexts> {
-    static REGISTRY: OnceLock<Mutex<Contexts>> = OnceLock::new();
-    REGISTRY.get_or_init(|| Mutex::new(HandleTable::default()))
+    static HANDLES: OnceLock<Mutex<Contexts>> = OnceLock::new();
+    HANDLES.get_or_init(|| Mutex::new(HandleTable::default()))
 }
 
 thread_local! {

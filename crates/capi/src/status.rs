@@ -181,6 +181,7 @@ pub(crate) fn tess_status(e: &TessError) -> TesseraStatus {
         | E::PipelineNotPrepared { .. }
         | E::ShaderVariant { .. }
         | E::BftLayout(_)
+        | E::Stencil(_)
         | E::UnmappedPatch { .. } => TesseraStatus::Internal,
         E::CaptureTooLarge { .. } | E::CaptureOverflow { .. } | E::PartialTriangle { .. } => {
             TesseraStatus::Capture

@@ -1,4 +1,4 @@
-//! Issue 12's features through the C ABI: the single-pass techniques (`TESSERA_TECHNIQUE_GREGORY`,
+//! Surface maps and the single-pass techniques through the C ABI: the single-pass techniques (`TESSERA_TECHNIQUE_GREGORY`,
 //! `_ACC`), a colour texture and a height map given as arrays, the frame's `no_reparam`,
 //! `displace` and `show`. Each must change what is drawn or captured (a texture changes the
 //! image, a height map moves the captured positions, a zero height map moves nothing), and

@@ -85,6 +85,9 @@ pub enum TessError {
     /// BFT data that cannot be laid out for the GPU.
     #[error(transparent)]
     BftLayout(#[from] crate::techniques::bft::layout::LayoutError),
+    /// A stencil table that cannot be laid out for the GPU ([`crate::stencil`]).
+    #[error(transparent)]
+    Stencil(#[from] crate::stencil::StencilError),
     /// A capture larger than the transform-feedback buffer limit or the caller's budget.
     #[error("capturing {triangles} triangles needs {bytes} bytes of transform feedback, over the limit of {limit} bytes (lower the level or raise the limit)")]
     CaptureTooLarge {

@@ -7,6 +7,7 @@
 //! rasterization emitted (transform feedback) and checks it for cracks. Techniques are built by
 //! name from [`techniques::registry`], where each declares itself once.
 #![forbid(unsafe_code)]
+pub mod animation;
 pub mod bench;
 pub mod camera;
 pub mod capture;
@@ -17,6 +18,7 @@ pub mod gpu;
 pub mod output;
 pub mod render_mesh;
 pub mod shaders;
+pub mod stencil;
 pub mod surface;
 pub mod technique;
 pub mod techniques;

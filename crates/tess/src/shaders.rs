@@ -48,7 +48,7 @@ mod tests {
             assert!(!stage.compiled().is_empty(), "{stage:?}");
             let camel: String = stage
                 .path()
-                .split(['/', '.'])
+                .split(['/', '.', '_'])
                 .map(|w| w[..1].to_uppercase() + &w[1..])
                 .collect();
             assert_eq!(format!("{stage:?}"), camel);

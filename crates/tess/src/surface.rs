@@ -3,6 +3,7 @@
 use crate::error::{Result, TessError};
 use std::path::Path;
 use std::sync::Arc;
+use topology::ControlMesh;
 use vk_core::texture::TextureFormat;
 
 /// Texels ready for upload.
@@ -125,6 +126,28 @@ pub fn load_height(path: impl AsRef<Path>) -> Result<SurfaceImage> {
     })
 }
 
+/// A colour texture or height map needs the mesh's `vt` at every face corner: without them
+/// each face would show the whole image, which is never what was meant. Checked before the
+/// surface is planned. Procedural displacement works without `vt` (the (sub)face parameter
+/// stands in).
+pub fn check_texcoords(mesh: &ControlMesh, maps: &SurfaceMaps, name: &str) -> Result<()> {
+    let wanted = match (&maps.texture, &maps.height) {
+        (Some(_), _) => "a colour texture",
+        (None, Some(_)) => "a height map",
+        (None, None) => return Ok(()),
+    };
+    if topology::patches::texcoord::has_texcoords(mesh) {
+        return Ok(());
+    }
+    Err(TessError::Mesh {
+        name: name.to_string(),
+        source: format!(
+            "{wanted} was given, but the mesh has no `vt` texture coordinate at every face corner (procedural displacement works without them)"
+        )
+        .into(),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -136,7 +159,7 @@ mod tests {
         dir
     }
 
-    /// Issue 12's bad input: a colour texture or height map that is missing, or a file that is
+    /// Bad surface maps: a colour texture or height map that is missing, or a file that is
     /// not an image (text, with and without an image's extension), is `TessError::Image`
     /// naming the file, whose message says it once, with the reader's reason after it.
     #[test]

@@ -208,8 +208,8 @@ fn validation_rejects_out_of_range_indices() {
     gpu.patch_rings[ring_start] = gpu.level1_vertices;
     assert!(gpu.validate().is_err());
     let (_, mut gpu, _) = load("loop_tetrahedron", 2);
-    let last = gpu.stencil_terms.len() - 1;
-    gpu.stencil_terms[last].index = gpu.base_vertices + 7;
+    let last = gpu.stencils.terms.len() - 1;
+    gpu.stencils.terms[last].index = gpu.base_vertices + 7;
     assert!(gpu.validate().is_err());
     let (_, mut gpu, _) = load("loop_tetrahedron", 2);
     gpu.patches[0].edge_owner[0] = pack_owner(9999, 0);

@@ -396,7 +396,7 @@ fn high_valence_disk(n: usize) -> ControlMesh {
     mesh
 }
 
-/// Issue 12's documented fallback above the table: a Gregory corner of valence 20 (beyond the
+/// The documented fallback above the table: a Gregory corner of valence 20 (beyond the
 /// fitted 3–16) is reparameterized with the valence-16 row (the GPU's row 14), not refused and
 /// not the identity. Its texture coordinates with the reparameterization on are finite and stay
 /// inside the face's `vt` range (the rational map keeps the unit square), they differ from the

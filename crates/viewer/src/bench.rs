@@ -222,7 +222,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
                 || format!("{}.obj (embedded)", m.name),
                 |p| p.display().to_string(),
             );
-            tess::techniques::adaptive::check_texcoords(&m.input, &config.maps, &file)?;
+            tess::surface::check_texcoords(&m.input, &config.maps, &file)?;
         }
     }
     if bench::build_profile() != "release" {

@@ -3,7 +3,7 @@ use crate::cli::{CameraArgs, Cli, Command, GpuArgs, RenderArgs, SceneArgs};
 use crate::technique::{describe, Setup};
 use anyhow::{bail, Context as _, Result};
 use std::sync::Arc;
-use tess::techniques::bft::Wave;
+use tess::animation::Wave;
 use tess::{Camera, Context, FrameParams, Technique, TechniqueId};
 use topology::mesh::obj::ObjLines;
 use vk_core::{vk, Device, DeviceDesc, Instance, InstanceDesc, Validation};
@@ -158,7 +158,7 @@ pub fn scene_setup(s: &SceneArgs, name: &str, mesh: &topology::ControlMesh) -> R
     setup.build.name = name.to_string();
     // A texture or height map without `vt`: said before the device is opened (the build
     // checks it too).
-    tess::techniques::adaptive::check_texcoords(mesh, &setup.build.maps, name)?;
+    tess::surface::check_texcoords(mesh, &setup.build.maps, name)?;
     Ok(setup)
 }
 

@@ -66,7 +66,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
         .setup(method, a.segments, a.spacing, false, params)?;
     crate::technique::check_segments(&setup)?;
     setup.build.name = mesh_name(a.input.as_deref());
-    tess::techniques::adaptive::check_texcoords(&base, &setup.build.maps, &setup.build.name)?;
+    tess::surface::check_texcoords(&base, &setup.build.maps, &setup.build.name)?;
     let extent = vk::Extent2D {
         width: a.size.0,
         height: a.size.1,

@@ -191,76 +191,114 @@ fn toggle(ui: &mut egui::Ui, on: Option<bool>, text: &str) -> bool {
     .clicked()
 }
 
+/// The HUD panel, section by section: mesh and technique, factors and level buttons, the
+/// isolation options, the toggles, the surface options, the patch-colour legend, then what is
+/// drawn and the GPU times.
 fn panel(ui: &mut egui::Ui, s: &Shown<'_>, history: &[f32], actions: &mut Vec<Action>) {
     let info = techniques::info(s.technique);
-    let f = info.features;
-    let p = s.params;
     ui.label(format!("mesh: {}", s.mesh));
     if let Some(status) = s.status {
         ui.colored_label(Color32::from_rgb(255, 110, 90), status);
     }
+    technique_choice(ui, s, actions);
+    ui.label(match info.scheme {
+        Some(scheme) => format!("scheme: {scheme}"),
+        None => "scheme: none (base faces)".to_owned(),
+    });
+    ui.label(format!("factors: {}", s.params.factors));
+    if let FactorPolicy::Uniform { .. } = s.params.factors {
+        level_buttons(ui, actions);
+    }
+    if info.features.isolation {
+        isolation_options(ui, s, actions);
+    }
+    toggles(ui, s, actions);
+    if info.features.surface {
+        surface_options(ui, s, actions);
+    }
+    if s.params.patch_colours {
+        patch_legend(ui, s.technique);
+    }
+    drawn(ui, s, history, actions);
+}
+
+/// The technique box (number keys 1..n).
+fn technique_choice(ui: &mut egui::Ui, s: &Shown<'_>, actions: &mut Vec<Action>) {
     ui.horizontal(|ui| {
-        ui.label(format!("technique (1-{})", techniques::registry().len()));
+        // Digit keys reach the first nine; the list reaches every technique.
+        ui.label(format!(
+            "technique (1-{})",
+            techniques::registry().len().min(9)
+        ));
         egui::ComboBox::from_id_salt("technique")
             .selected_text(s.technique.name())
             .show_ui(ui, |ui| {
                 for (i, t) in techniques::registry().iter().enumerate() {
-                    let text = format!("{} {}", i + 1, t.id.name());
+                    let text = if i < 9 {
+                        format!("{} {}", i + 1, t.id.name())
+                    } else {
+                        t.id.name().to_owned()
+                    };
                     if ui.selectable_label(t.id == s.technique, text).clicked() {
                         actions.push(Action::Technique(t.id));
                     }
                 }
             });
     });
-    ui.label(match info.scheme {
-        Some(scheme) => format!("scheme: {scheme}"),
-        None => "scheme: none (base faces)".to_owned(),
+}
+
+/// The uniform level's buttons.
+fn level_buttons(ui: &mut egui::Ui, actions: &mut Vec<Action>) {
+    ui.horizontal(|ui| {
+        for (text, action) in [
+            ("− (-)", Action::LevelDown),
+            ("+ (+)", Action::LevelUp),
+            ("÷2 (Down)", Action::LevelHalve),
+            ("×2 (Up)", Action::LevelDouble),
+        ] {
+            if ui.button(text).clicked() {
+                actions.push(action);
+            }
+        }
     });
-    ui.label(format!("factors: {}", p.factors));
-    if let FactorPolicy::Uniform { .. } = p.factors {
-        ui.horizontal(|ui| {
-            for (text, action) in [
-                ("− (-)", Action::LevelDown),
-                ("+ (+)", Action::LevelUp),
-                ("÷2 (Down)", Action::LevelHalve),
-                ("×2 (Up)", Action::LevelDouble),
-            ] {
-                if ui.button(text).clicked() {
-                    actions.push(action);
-                }
-            }
-        });
-    }
-    if f.isolation {
-        let b = s.build;
-        ui.horizontal(|ui| {
-            ui.label(format!("isolation {}", b.isolation));
-            if ui.button("− (Shift+I)").clicked() {
-                actions.push(Action::IsolationDown);
-            }
-            if ui.button("+ (I)").clicked() {
-                actions.push(Action::IsolationUp);
-            }
-        });
-        ui.horizontal(|ui| {
-            ui.label(format!(
-                "end caps: {}",
-                crate::view::end_cap_name(b.end_cap)
-            ));
-            if ui.button("switch (E)").clicked() {
-                actions.push(Action::EndCaps);
-            }
-        });
-        ui.horizontal(|ui| {
-            ui.label(format!("sharpness ×{:.2}", b.sharpness_scale));
-            if ui.button("− (Shift+S)").clicked() {
-                actions.push(Action::SharpnessDown);
-            }
-            if ui.button("+ (S)").clicked() {
-                actions.push(Action::SharpnessUp);
-            }
-        });
-    }
+}
+
+/// Isolation, end caps and sharpness scale.
+fn isolation_options(ui: &mut egui::Ui, s: &Shown<'_>, actions: &mut Vec<Action>) {
+    let b = s.build;
+    ui.horizontal(|ui| {
+        ui.label(format!("isolation {}", b.isolation));
+        if ui.button("− (Shift+I)").clicked() {
+            actions.push(Action::IsolationDown);
+        }
+        if ui.button("+ (I)").clicked() {
+            actions.push(Action::IsolationUp);
+        }
+    });
+    ui.horizontal(|ui| {
+        ui.label(format!(
+            "end caps: {}",
+            crate::view::end_cap_name(b.end_cap)
+        ));
+        if ui.button("switch (E)").clicked() {
+            actions.push(Action::EndCaps);
+        }
+    });
+    ui.horizontal(|ui| {
+        ui.label(format!("sharpness ×{:.2}", b.sharpness_scale));
+        if ui.button("− (Shift+S)").clicked() {
+            actions.push(Action::SharpnessDown);
+        }
+        if ui.button("+ (S)").clicked() {
+            actions.push(Action::SharpnessUp);
+        }
+    });
+}
+
+/// Fractional spacing, wireframe, patch colours, geometric normals and animation, each enabled
+/// where the technique takes it.
+fn toggles(ui: &mut egui::Ui, s: &Shown<'_>, actions: &mut Vec<Action>) {
+    let (f, p) = (techniques::info(s.technique).features, s.params);
     let fractional_ok = f.spacing(Spacing::FractionalEven);
     ui.horizontal_wrapped(|ui| {
         for (on, text, action) in [
@@ -291,45 +329,53 @@ fn panel(ui: &mut egui::Ui, s: &Shown<'_>, history: &[f32], actions: &mut Vec<Ac
             }
         }
     });
-    if f.surface {
-        ui.horizontal_wrapped(|ui| {
-            if toggle(ui, Some(p.reparam), "reparameterization (R)") {
-                actions.push(Action::Reparam);
-            }
-            if toggle(ui, Some(p.displace != 0.0), "displacement (D)") {
-                actions.push(Action::Displace);
-            }
-            if ui
-                .button(format!("view: {} (V)", show_name(p.show)))
-                .clicked()
-            {
-                actions.push(Action::Show);
-            }
-        });
-        ui.horizontal(|ui| {
-            ui.label(format!(
-                "displacement ×{:.4}{}",
-                s.displace_scale,
-                if p.displace == 0.0 { " (off)" } else { "" }
-            ));
-            if ui.button("÷1.25 ([)").clicked() {
-                actions.push(Action::DisplaceDown);
-            }
-            if ui.button("×1.25 (])").clicked() {
-                actions.push(Action::DisplaceUp);
-            }
-        });
-    }
-    if p.patch_colours {
-        for &(rgb, name) in legend(s.technique) {
-            ui.horizontal(|ui| {
-                let (rect, _) =
-                    ui.allocate_exact_size(egui::vec2(12.0, 12.0), egui::Sense::hover());
-                ui.painter().rect_filled(rect, 2.0, colour(rgb));
-                ui.label(name);
-            });
+}
+
+/// Reparameterization, displacement and the parameter views.
+fn surface_options(ui: &mut egui::Ui, s: &Shown<'_>, actions: &mut Vec<Action>) {
+    let p = s.params;
+    ui.horizontal_wrapped(|ui| {
+        if toggle(ui, Some(p.reparam), "reparameterization (R)") {
+            actions.push(Action::Reparam);
         }
+        if toggle(ui, Some(p.displace != 0.0), "displacement (D)") {
+            actions.push(Action::Displace);
+        }
+        if ui
+            .button(format!("view: {} (V)", show_name(p.show)))
+            .clicked()
+        {
+            actions.push(Action::Show);
+        }
+    });
+    ui.horizontal(|ui| {
+        ui.label(format!(
+            "displacement ×{:.4}{}",
+            s.displace_scale,
+            if p.displace == 0.0 { " (off)" } else { "" }
+        ));
+        if ui.button("÷1.25 ([)").clicked() {
+            actions.push(Action::DisplaceDown);
+        }
+        if ui.button("×1.25 (])").clicked() {
+            actions.push(Action::DisplaceUp);
+        }
+    });
+}
+
+/// The technique's patch-colour legend.
+fn patch_legend(ui: &mut egui::Ui, technique: TechniqueId) {
+    for &(rgb, name) in legend(technique) {
+        ui.horizontal(|ui| {
+            let (rect, _) = ui.allocate_exact_size(egui::vec2(12.0, 12.0), egui::Sense::hover());
+            ui.painter().rect_filled(rect, 2.0, colour(rgb));
+            ui.label(name);
+        });
     }
+}
+
+/// What is drawn, the GPU times, the frame graph and the window's buttons.
+fn drawn(ui: &mut egui::Ui, s: &Shown<'_>, history: &[f32], actions: &mut Vec<Action>) {
     ui.separator();
     ui.label(format!(
         "drawn: {} triangles, {} patches",

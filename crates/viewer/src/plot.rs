@@ -197,7 +197,8 @@ fn padded(lo: f64, hi: f64, pad: f64, min_span: f64) -> (f64, f64) {
     (mid - half, mid + half)
 }
 
-/// Draws every mesh's two charts on `root`; returns each chart's map.
+/// Draws every mesh's two charts on `root` (frame time, ratio to Flat); returns each chart's
+/// map.
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     rows: &[BenchRow],
@@ -205,8 +206,7 @@ fn draw<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("drawing the plot: {e}");
-    root.fill(&WHITE).map_err(err)?;
+    root.fill(&WHITE).map_err(plot_error::<DB>)?;
     let (meshes, methods) = order(rows);
     let panels = root.split_evenly((meshes.len(), 2));
     let mut maps = Vec::new();
@@ -218,157 +218,209 @@ where
         if mine.is_empty() {
             continue;
         }
-        let xs: Vec<f64> = mine.iter().map(|r| f64::from(r.segments).log2()).collect();
-        let (x_lo, x_hi) = padded(
-            xs.iter().copied().fold(f64::INFINITY, f64::min),
-            xs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            0.3,
-            1.0,
-        );
-        let mut segments: Vec<u32> = mine.iter().map(|r| r.segments).collect();
-        segments.sort_unstable();
-        segments.dedup();
-        let x_keys: Vec<f64> = segments.iter().map(|&s| f64::from(s).log2()).collect();
-
-        // Frame time, log10 ms.
-        let ys: Vec<f64> = mine.iter().map(|r| r.total_median_ms.log10()).collect();
-        let (y_lo, y_hi) = padded(
-            ys.iter().copied().fold(f64::INFINITY, f64::min),
-            ys.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            0.08,
-            0.5,
-        );
-        let y_keys: Vec<f64> = (-3..=5)
-            .flat_map(|e| [1.0, 2.0, 5.0].map(|m| (m * 10f64.powi(e)).log10()))
-            .filter(|y| (y_lo..=y_hi).contains(y))
-            .collect();
-        let x_axis = Axis {
-            lo: x_lo,
-            hi: x_hi,
-            ticks: x_keys,
-            label: |x| format!("{:.0}", 2f64.powf(x)),
-        };
-        let mut chart = ChartBuilder::on(&panels[2 * i])
-            .caption(format!("{mesh}: frame time"), ("sans-serif", 18))
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(56)
-            .build_cartesian_2d(
-                x_axis.clone(),
-                Axis {
-                    lo: y_lo,
-                    hi: y_hi,
-                    ticks: y_keys,
-                    label: |y| ms_label(10f64.powf(y)),
-                },
-            )
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("segments per edge")
-            .y_desc("median ms per frame (CPU + GPU)")
-            .draw()
-            .map_err(err)?;
-        for (k, method) in methods.iter().enumerate() {
-            let colour = Palette99::pick(k).to_rgba();
-            let points: Vec<(f64, f64)> = mine
-                .iter()
-                .filter(|r| &r.method == method)
-                .map(|r| (f64::from(r.segments).log2(), r.total_median_ms.log10()))
-                .collect();
-            if points.is_empty() {
-                continue;
-            }
-            chart
-                .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
-                .map_err(err)?
-                .label(method.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2))
-                });
-            chart
-                .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
-                .map_err(err)?;
-        }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.4))
-            .label_font(("sans-serif", 12))
-            .draw()
-            .map_err(err)?;
-        let spec = chart.as_coord_spec();
-        maps.push(ChartMap {
-            mesh: mesh.clone(),
-            axis: "log2-segments,log10-ms",
-            from: ((x_lo, y_lo), spec.translate(&(x_lo, y_lo))),
-            to: ((x_hi, y_hi), spec.translate(&(x_hi, y_hi))),
-        });
-
-        // Ratio to Flat, linear.
-        let ratios: Vec<(u32, &str, f64)> = mine
-            .iter()
-            .filter_map(|r| {
-                let x = r.ratio_to_flat?;
-                x.is_finite().then_some((r.segments, r.method.as_str(), x))
-            })
-            .collect();
-        let r_hi = ratios.iter().map(|r| r.2).fold(1.0f64, f64::max) * 1.1;
-        let mut chart = ChartBuilder::on(&panels[2 * i + 1])
-            .caption(format!("{mesh}: ratio to Flat"), ("sans-serif", 18))
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(56)
-            .build_cartesian_2d(
-                x_axis,
-                Axis {
-                    lo: 0.0,
-                    hi: r_hi,
-                    ticks: linear_ticks(r_hi),
-                    label: |y| format!("{y:.2}"),
-                },
-            )
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("segments per edge")
-            .y_desc("× Flat (median total ms)")
-            .draw()
-            .map_err(err)?;
-        chart
-            .draw_series(LineSeries::new(
-                [(x_lo, 1.0), (x_hi, 1.0)],
-                BLACK.mix(0.3).stroke_width(1),
-            ))
-            .map_err(err)?;
-        for (k, method) in methods.iter().enumerate() {
-            let colour = Palette99::pick(k).to_rgba();
-            let points: Vec<(f64, f64)> = ratios
-                .iter()
-                .filter(|r| r.1 == method)
-                .map(|r| (f64::from(r.0).log2(), r.2))
-                .collect();
-            if points.is_empty() {
-                continue;
-            }
-            chart
-                .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
-                .map_err(err)?;
-            chart
-                .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
-                .map_err(err)?;
-        }
-        let spec = chart.as_coord_spec();
-        maps.push(ChartMap {
-            mesh: mesh.clone(),
-            axis: "log2-segments,ratio",
-            from: ((x_lo, 0.0), spec.translate(&(x_lo, 0.0))),
-            to: ((x_hi, r_hi), spec.translate(&(x_hi, r_hi))),
-        });
+        let x_axis = segments_axis(&mine);
+        maps.push(time_chart(
+            &panels[2 * i],
+            mesh,
+            &mine,
+            &methods,
+            x_axis.clone(),
+        )?);
+        maps.push(ratio_chart(
+            &panels[2 * i + 1],
+            mesh,
+            &mine,
+            &methods,
+            x_axis,
+        )?);
     }
-    root.present().map_err(err)?;
+    root.present().map_err(plot_error::<DB>)?;
     Ok(maps)
+}
+
+fn plot_error<DB: DrawingBackend>(e: DrawingAreaErrorKind<DB::ErrorType>) -> anyhow::Error
+where
+    DB::ErrorType: 'static,
+{
+    anyhow!("drawing the plot: {e}")
+}
+
+/// The x axis of a mesh's charts: log2 of the segments, ticks at the measured ones.
+fn segments_axis(mine: &[&BenchRow]) -> Axis {
+    let xs: Vec<f64> = mine.iter().map(|r| f64::from(r.segments).log2()).collect();
+    let (x_lo, x_hi) = padded(
+        xs.iter().copied().fold(f64::INFINITY, f64::min),
+        xs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        0.3,
+        1.0,
+    );
+    let mut segments: Vec<u32> = mine.iter().map(|r| r.segments).collect();
+    segments.sort_unstable();
+    segments.dedup();
+    let x_keys: Vec<f64> = segments.iter().map(|&s| f64::from(s).log2()).collect();
+    Axis {
+        lo: x_lo,
+        hi: x_hi,
+        ticks: x_keys,
+        label: |x| format!("{:.0}", 2f64.powf(x)),
+    }
+}
+
+/// A mesh's frame-time chart (log10 ms, one line per method) on `panel`.
+fn time_chart<DB: DrawingBackend>(
+    panel: &DrawingArea<DB, Shift>,
+    mesh: &str,
+    mine: &[&BenchRow],
+    methods: &[String],
+    x_axis: Axis,
+) -> Result<ChartMap>
+where
+    DB::ErrorType: 'static,
+{
+    let err = plot_error::<DB>;
+    let (x_lo, x_hi) = (x_axis.lo, x_axis.hi);
+    let ys: Vec<f64> = mine.iter().map(|r| r.total_median_ms.log10()).collect();
+    let (y_lo, y_hi) = padded(
+        ys.iter().copied().fold(f64::INFINITY, f64::min),
+        ys.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        0.08,
+        0.5,
+    );
+    let y_keys: Vec<f64> = (-3..=5)
+        .flat_map(|e| [1.0, 2.0, 5.0].map(|m| (m * 10f64.powi(e)).log10()))
+        .filter(|y| (y_lo..=y_hi).contains(y))
+        .collect();
+    let mut chart = ChartBuilder::on(panel)
+        .caption(format!("{mesh}: frame time"), ("sans-serif", 18))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(56)
+        .build_cartesian_2d(
+            x_axis.clone(),
+            Axis {
+                lo: y_lo,
+                hi: y_hi,
+                ticks: y_keys,
+                label: |y| ms_label(10f64.powf(y)),
+            },
+        )
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("segments per edge")
+        .y_desc("median ms per frame (CPU + GPU)")
+        .draw()
+        .map_err(err)?;
+    for (k, method) in methods.iter().enumerate() {
+        let colour = Palette99::pick(k).to_rgba();
+        let points: Vec<(f64, f64)> = mine
+            .iter()
+            .filter(|r| &r.method == method)
+            .map(|r| (f64::from(r.segments).log2(), r.total_median_ms.log10()))
+            .collect();
+        if points.is_empty() {
+            continue;
+        }
+        chart
+            .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
+            .map_err(err)?
+            .label(method.as_str())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2))
+            });
+        chart
+            .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+            .map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK.mix(0.4))
+        .label_font(("sans-serif", 12))
+        .draw()
+        .map_err(err)?;
+    let spec = chart.as_coord_spec();
+    Ok(ChartMap {
+        mesh: mesh.to_string(),
+        axis: "log2-segments,log10-ms",
+        from: ((x_lo, y_lo), spec.translate(&(x_lo, y_lo))),
+        to: ((x_hi, y_hi), spec.translate(&(x_hi, y_hi))),
+    })
+}
+
+/// A mesh's ratio-to-Flat chart (linear, one line per method) on `panel`.
+fn ratio_chart<DB: DrawingBackend>(
+    panel: &DrawingArea<DB, Shift>,
+    mesh: &str,
+    mine: &[&BenchRow],
+    methods: &[String],
+    x_axis: Axis,
+) -> Result<ChartMap>
+where
+    DB::ErrorType: 'static,
+{
+    let err = plot_error::<DB>;
+    let (x_lo, x_hi) = (x_axis.lo, x_axis.hi);
+    let ratios: Vec<(u32, &str, f64)> = mine
+        .iter()
+        .filter_map(|r| {
+            let x = r.ratio_to_flat?;
+            x.is_finite().then_some((r.segments, r.method.as_str(), x))
+        })
+        .collect();
+    let r_hi = ratios.iter().map(|r| r.2).fold(1.0f64, f64::max) * 1.1;
+    let mut chart = ChartBuilder::on(panel)
+        .caption(format!("{mesh}: ratio to Flat"), ("sans-serif", 18))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(56)
+        .build_cartesian_2d(
+            x_axis,
+            Axis {
+                lo: 0.0,
+                hi: r_hi,
+                ticks: linear_ticks(r_hi),
+                label: |y| format!("{y:.2}"),
+            },
+        )
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("segments per edge")
+        .y_desc("× Flat (median total ms)")
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(LineSeries::new(
+            [(x_lo, 1.0), (x_hi, 1.0)],
+            BLACK.mix(0.3).stroke_width(1),
+        ))
+        .map_err(err)?;
+    for (k, method) in methods.iter().enumerate() {
+        let colour = Palette99::pick(k).to_rgba();
+        let points: Vec<(f64, f64)> = ratios
+            .iter()
+            .filter(|r| r.1 == method)
+            .map(|r| (f64::from(r.0).log2(), r.2))
+            .collect();
+        if points.is_empty() {
+            continue;
+        }
+        chart
+            .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
+            .map_err(err)?;
+        chart
+            .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+            .map_err(err)?;
+    }
+    let spec = chart.as_coord_spec();
+    Ok(ChartMap {
+        mesh: mesh.to_string(),
+        axis: "log2-segments,ratio",
+        from: ((x_lo, 0.0), spec.translate(&(x_lo, 0.0))),
+        to: ((x_hi, r_hi), spec.translate(&(x_hi, r_hi))),
+    })
 }
 
 /// Writes the plot of `rows` to `path` (SVG or PNG by its extension; `option` names how the

@@ -6,7 +6,9 @@ use anyhow::{bail, Result};
 use clap::Args;
 use std::path::Path;
 use std::sync::Arc;
-use tess::techniques::{self, adaptive::DEFAULT_ISOLATION, bft::DEFAULT_TABLE_LEVEL, BuildOptions};
+use tess::techniques::{
+    self, adaptive::DEFAULT_ISOLATION, bft::DEFAULT_TABLE_LEVEL, BuildOptions, TechniqueInfo,
+};
 use tess::{FactorPolicy, Features, FrameParams, Spacing, TechniqueId};
 use topology::patches::adaptive::EndCap;
 
@@ -161,9 +163,10 @@ fn parse_factors(s: &str) -> Result<Factors, String> {
 /// Options of the subdivision-surface techniques; techniques that do not take one refuse it.
 #[derive(Args, Debug, Clone)]
 pub struct SurfaceArgs {
-    /// Subdivision scheme whose limit surface is drawn: catmull-clark (--method adaptive) or
-    /// loop (--method bft; polygons are fan-triangulated first). Defaults to catmull-clark
-    /// unless every face is a triangle.
+    /// Subdivision scheme whose limit surface is drawn: catmull-clark (--method adaptive),
+    /// loop (--method bft; polygons are fan-triangulated first) or doo-sabin (--method
+    /// doo-sabin, refined to level log2 S). Defaults to catmull-clark unless every face is a
+    /// triangle.
     #[arg(long)]
     pub scheme: Option<String>,
     /// Merge coincident vertices before drawing: `--weld` alone merges vertices at identical
@@ -278,9 +281,10 @@ struct OptionUse {
 }
 
 impl SurfaceArgs {
-    /// Checks the options against `technique`'s features and builds the setup. `segments` is
-    /// the uniform segments per base edge, `spacing` the `--spacing` option, `params` the
-    /// shared frame parameters (camera, wireframe, α) to complete.
+    /// Checks the options against `technique`'s features and builds the setup, in steps: the
+    /// scheme, the options the technique refuses, the spacing and ranges, then the frame
+    /// parameters. `segments` is the uniform segments per base edge, `spacing` the `--spacing`
+    /// option, `params` the shared frame parameters (camera, wireframe, α) to complete.
     pub fn setup(
         &self,
         technique: TechniqueId,
@@ -291,30 +295,91 @@ impl SurfaceArgs {
     ) -> Result<Setup> {
         let info = techniques::info(technique);
         let f = info.features;
-        if let Some(scheme) = &self.scheme {
-            let wanted = crate::topo_cmds::parse_scheme(scheme)
-                .map_err(|e| anyhow::anyhow!("--scheme {scheme}: {e}"))?;
-            // A technique without a scheme of its own (the base faces as patches) takes any
-            // scheme some technique draws; one with a scheme takes only its own.
-            let drawn_by_any = techniques::registry()
-                .iter()
-                .any(|i| i.scheme == Some(wanted));
-            if info.scheme.map_or(!drawn_by_any, |s| s != wanted) {
-                let drawn: Vec<String> = techniques::registry()
-                    .iter()
-                    .filter_map(|i| {
-                        i.scheme
-                            .map(|s| format!("{} (--method {})", scheme_name(s), i.id))
-                    })
-                    .collect();
-                bail!(
-                    "--scheme {scheme}: --method {technique} does not draw it; limit surfaces \
-                     drawn so far: {}",
-                    drawn.join(", ")
-                );
-            }
+        self.check_scheme(info)?;
+        self.check_refused(&f, technique, animate)?;
+        let spacing = if self.fractional {
+            Spacing::FractionalEven
+        } else {
+            spacing
+        };
+        if !f.spacing(spacing) {
+            bail!(
+                "--spacing {}: --method {technique} does not take it (--fractional is \
+                 fractional-even)",
+                spacing_name(spacing)
+            );
         }
-        let uses = [
+        self.check_ranges(&f)?;
+        check_displacement(self.displace, self.height.as_deref())?;
+        params.show = self.show()?;
+        params.reparam = !self.no_reparam;
+        params.displace = self.displace.unwrap_or(0.0);
+        let maps = load_maps(
+            self.texture.as_deref(),
+            self.height.as_deref(),
+            params.show == tess::surface::SurfaceShow::ParamError,
+        )?;
+        params.spacing = spacing;
+        params.geometric_normals = self.geometric_normals;
+        params.patch_colours = self.patch_colours;
+        params.factors = self.factor_policy(segments)?;
+        self.check_frame()?;
+        Ok(Setup {
+            technique,
+            build: BuildOptions {
+                name: String::new(),
+                table_level: self.table_level,
+                tangents: self.geometric_normals,
+                isolation: self.isolation,
+                end_cap: self.end_cap,
+                sharpness_scale: self.sharpness_scale,
+                follow_semi_sharp: !self.creases_at_isolation,
+                split_triangles: self.split_triangles,
+                maps,
+                ..BuildOptions::default()
+            },
+            params,
+            distance_diagonals: (self.factors == Some(Factors::Distance)).then_some(self.distance),
+            animate,
+            frame: self.frame,
+        })
+    }
+
+    /// `--scheme`: a technique without a scheme of its own (the base faces as patches) takes
+    /// any scheme some technique draws; one with a scheme takes only its own.
+    fn check_scheme(&self, info: &TechniqueInfo) -> Result<()> {
+        let Some(scheme) = &self.scheme else {
+            return Ok(());
+        };
+        let technique = info.id;
+        let wanted = crate::topo_cmds::parse_scheme(scheme)
+            .map_err(|e| anyhow::anyhow!("--scheme {scheme}: {e}"))?;
+        // A technique without a scheme of its own (the base faces as patches) takes any
+        // scheme some technique draws; one with a scheme takes only its own.
+        let drawn_by_any = techniques::registry()
+            .iter()
+            .any(|i| i.scheme == Some(wanted));
+        if info.scheme.map_or(!drawn_by_any, |s| s != wanted) {
+            let drawn: Vec<String> = techniques::registry()
+                .iter()
+                .filter_map(|i| {
+                    i.scheme
+                        .map(|s| format!("{} (--method {})", scheme_name(s), i.id))
+                })
+                .collect();
+            bail!(
+                "--scheme {scheme}: --method {technique} does not draw it; limit surfaces \
+                 drawn so far: {}",
+                drawn.join(", ")
+            );
+        }
+        Ok(())
+    }
+
+    /// Each option a technique may refuse: its name, whether it was given, which feature takes
+    /// it.
+    fn option_uses(&self, animate: bool) -> [OptionUse; 16] {
+        [
             OptionUse {
                 name: "--factors",
                 given: matches!(self.factors, Some(Factors::Screen | Factors::Distance)),
@@ -395,11 +460,14 @@ impl SurfaceArgs {
                 given: self.table_level != DEFAULT_TABLE_LEVEL,
                 feature: |f| f.table_level,
             },
-        ];
-        let refused: Vec<&OptionUse> = uses
-            .iter()
-            .filter(|u| u.given && !(u.feature)(&f))
-            .collect();
+        ]
+    }
+
+    /// Refuses, in one message, every given option `technique`'s features decline, naming the
+    /// techniques that take them.
+    fn check_refused(&self, f: &Features, technique: TechniqueId, animate: bool) -> Result<()> {
+        let uses = self.option_uses(animate);
+        let refused: Vec<&OptionUse> = uses.iter().filter(|u| u.given && !(u.feature)(f)).collect();
         if !refused.is_empty() {
             let mut takers: Vec<&str> = Vec::new();
             for u in &refused {
@@ -417,18 +485,11 @@ impl SurfaceArgs {
                 takers.join(" or --method ")
             );
         }
-        let spacing = if self.fractional {
-            Spacing::FractionalEven
-        } else {
-            spacing
-        };
-        if !f.spacing(spacing) {
-            bail!(
-                "--spacing {}: --method {technique} does not take it (--fractional is \
-                 fractional-even)",
-                spacing_name(spacing)
-            );
-        }
+        Ok(())
+    }
+
+    /// The ranges of the options `f` takes: isolation, sharpness scale, table level.
+    fn check_ranges(&self, f: &Features) -> Result<()> {
         if f.isolation && !(1..=8).contains(&self.isolation) {
             bail!("--isolation {} is outside 1..8", self.isolation);
         }
@@ -444,8 +505,12 @@ impl SurfaceArgs {
         if f.table_level && !(1..=6).contains(&self.table_level) {
             bail!("--table-level {} is outside 1..6", self.table_level);
         }
-        check_displacement(self.displace, self.height.as_deref())?;
-        params.show = match self.show.as_deref() {
+        Ok(())
+    }
+
+    /// `--show`.
+    fn show(&self) -> Result<tess::surface::SurfaceShow> {
+        Ok(match self.show.as_deref() {
             None => tess::surface::SurfaceShow::Shading,
             Some(name) => match tess::surface::SurfaceShow::parse(name) {
                 Some(show) => show,
@@ -454,18 +519,13 @@ impl SurfaceArgs {
                     tess::surface::SurfaceShow::NAMES
                 ),
             },
-        };
-        params.reparam = !self.no_reparam;
-        params.displace = self.displace.unwrap_or(0.0);
-        let maps = load_maps(
-            self.texture.as_deref(),
-            self.height.as_deref(),
-            params.show == tess::surface::SurfaceShow::ParamError,
-        )?;
-        params.spacing = spacing;
-        params.geometric_normals = self.geometric_normals;
-        params.patch_colours = self.patch_colours;
-        params.factors = match self.factors {
+        })
+    }
+
+    /// `--factors` with `--pixels` or `--distance` (distance in diagonals until
+    /// [`Setup::world_params`]), checked.
+    fn factor_policy(&self, segments: f32) -> Result<FactorPolicy> {
+        let factors = match self.factors {
             None | Some(Factors::Uniform) => FactorPolicy::Uniform { segments },
             Some(Factors::Screen) => FactorPolicy::Screen {
                 pixels: self.pixels,
@@ -475,7 +535,7 @@ impl SurfaceArgs {
                 reference: self.distance,
             },
         };
-        if let FactorPolicy::Screen { pixels } = params.factors {
+        if let FactorPolicy::Screen { pixels } = factors {
             if !(pixels.is_finite() && (0.5..=16384.0).contains(&pixels)) {
                 bail!(
                     "--pixels {}: give 0.5 to 16384 pixels per segment",
@@ -483,7 +543,7 @@ impl SurfaceArgs {
                 );
             }
         }
-        if let FactorPolicy::Distance { reference } = params.factors {
+        if let FactorPolicy::Distance { reference } = factors {
             if !(reference.is_finite() && reference > 0.0 && reference <= 1e6) {
                 bail!(
                     "--distance {}: give a number of diagonals above 0, at most 1000000",
@@ -491,6 +551,11 @@ impl SurfaceArgs {
                 );
             }
         }
+        Ok(factors)
+    }
+
+    /// `--frame`: a finite time within ±MAX_FRAME seconds.
+    fn check_frame(&self) -> Result<()> {
         if let Some(t) = self.frame {
             if !(t.is_finite() && t.abs() <= MAX_FRAME) {
                 bail!(
@@ -499,25 +564,7 @@ impl SurfaceArgs {
                 );
             }
         }
-        Ok(Setup {
-            technique,
-            build: BuildOptions {
-                name: String::new(),
-                table_level: self.table_level,
-                tangents: self.geometric_normals,
-                isolation: self.isolation,
-                end_cap: self.end_cap,
-                sharpness_scale: self.sharpness_scale,
-                follow_semi_sharp: !self.creases_at_isolation,
-                split_triangles: self.split_triangles,
-                maps,
-                ..BuildOptions::default()
-            },
-            params,
-            distance_diagonals: (self.factors == Some(Factors::Distance)).then_some(self.distance),
-            animate,
-            frame: self.frame,
-        })
+        Ok(())
     }
 }
 

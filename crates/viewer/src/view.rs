@@ -46,7 +46,8 @@ use raw_window_handle::HasDisplayHandle;
 use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Instant;
-use tess::techniques::{self, bft::Wave};
+use tess::animation::Wave;
+use tess::techniques;
 use tess::{Context, FactorPolicy, Spacing, Technique, TechniqueId};
 use topology::mesh::obj::ObjLines;
 use topology::ControlMesh;
@@ -277,32 +278,12 @@ impl App {
         }
     }
 
+    /// One frame, in steps: the surface (re)built, the HUD laid out, the pass times of the
+    /// slot's previous frame read, the frame recorded and presented, then the bookkeeping
+    /// (stats, frame time, title, screenshots) and the HUD's actions.
     fn draw(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
-        let Some(gpu) = self.gpu.as_mut() else {
+        if !self.ensure_surface()? {
             return Ok(());
-        };
-        if std::mem::take(&mut self.rebuild) {
-            // Frames in flight keep their buffers alive (vk-core defers destruction).
-            gpu.surfaces.remove(&self.setup.technique);
-        }
-        if let Err(e) = Self::surface(gpu, (&self.mesh, &self.lines), &self.setup) {
-            // A key asked for it: go back to what was drawn. The first build is the command
-            // line's: it fails the command.
-            let Some(good) = self.last_good.clone() else {
-                return Err(e);
-            };
-            let what = format!(
-                "cannot draw {} that way: {}",
-                self.setup.technique,
-                crate::message(&e)
-            );
-            self.setup = good;
-            self.pending_level = None;
-            self.report(what);
-            return Ok(());
-        }
-        if let Some(l) = self.pending_level.take() {
-            self.set_level(l, true);
         }
         let Some(gpu) = self.gpu.as_mut() else {
             return Ok(());
@@ -339,14 +320,7 @@ impl App {
                     gpu: self.pass_times,
                     status: self.status.as_deref(),
                 };
-                match hud.run(window, &shown, &mut self.actions) {
-                    Some(mut out) => {
-                        overlay.update_textures(&mut out.textures_delta)?;
-                        let ppp = out.pixels_per_point;
-                        Some((hud.tessellate(out.shapes, ppp), ppp))
-                    }
-                    None => None,
-                }
+                lay_out_hud(hud, window, &shown, &mut self.actions, overlay)?
             }
             _ => None,
         };
@@ -354,19 +328,8 @@ impl App {
             return Ok(());
         };
         let (slot, extent) = (frame.slot(), frame.extent());
-        if let Some(t) = timer.as_mut() {
-            if t.written[slot] {
-                // The slot's previous frame completed (acquire waited for it): no stall.
-                let d = t.pools[slot].durations_ns()?;
-                if let [pre_pass, draw, hud] = d[..] {
-                    self.pass_times = Some(PassTimes {
-                        pre_pass: pre_pass * 1e-6,
-                        draw: draw * 1e-6,
-                        hud: hud * 1e-6,
-                    });
-                }
-            }
-            t.written[slot] = true;
+        if let Some(times) = read_pass_times(timer.as_mut(), slot)? {
+            self.pass_times = Some(times);
         }
         let pool = timer.as_ref().map(|t| &t.pools[slot]);
         let dt = self.last_frame.elapsed().as_secs_f32();
@@ -385,27 +348,14 @@ impl App {
         let technique = surface.technique.as_ref();
         context.write_frame(slot, technique.bbox(), &params, extent)?;
         let last = self.args.frames.is_some_and(|n| self.frames_drawn + 1 >= n);
-        let context = &*context;
-        let (top, bottom) = (
-            vk::PipelineStageFlags::TOP_OF_PIPE,
-            vk::PipelineStageFlags::BOTTOM_OF_PIPE,
-        );
-        if let Some(pool) = pool {
-            frame.encoder().reset_queries(pool);
-        }
-        stamp(frame.encoder(), pool, 0, top)?;
-        context.record_pre_pass(frame.encoder(), technique, slot)?;
-        stamp(frame.encoder(), pool, 1, bottom)?;
-        stamp(frame.encoder(), pool, 2, top)?;
-        frame.begin_frame_rendering(params.clear_color);
-        context.record_frame(frame.encoder(), technique, slot, &params)?;
-        stamp(frame.encoder(), pool, 3, bottom)?;
-        stamp(frame.encoder(), pool, 4, top)?;
-        if let Some((primitives, ppp)) = &hud {
-            overlay.draw(frame.encoder(), extent, *ppp, primitives)?;
-        }
-        frame.encoder().end_rendering();
-        stamp(frame.encoder(), pool, 5, bottom)?;
+        let recorded = Recorded {
+            context,
+            technique,
+            params: &params,
+            pool,
+            hud: hud.as_ref(),
+        };
+        record_frame(&mut frame, overlay, &recorded)?;
         let final_shot = last && self.args.screenshot.is_some();
         let asked = std::mem::take(&mut self.shot_requested);
         let shot = frame.present(final_shot || asked)?;
@@ -424,10 +374,59 @@ impl App {
             hud.push_frame_time(interval);
         }
         self.last_frame = now;
+        self.set_title(&params);
+        if let Some(img) = shot {
+            self.save_shots(&img, asked, final_shot, &params)?;
+        }
+        for action in std::mem::take(&mut self.actions) {
+            self.act(action, event_loop);
+        }
+        if last {
+            event_loop.exit();
+        }
+        Ok(())
+    }
+
+    /// Builds the current technique's surface if it is missing or a key asked for a rebuild.
+    /// When a key's choice cannot be drawn, goes back to what was drawn and says why (false:
+    /// skip this frame); the first build is the command line's and fails the command.
+    fn ensure_surface(&mut self) -> Result<bool> {
+        let Some(gpu) = self.gpu.as_mut() else {
+            return Ok(false);
+        };
+        if std::mem::take(&mut self.rebuild) {
+            // Frames in flight keep their buffers alive (vk-core defers destruction).
+            gpu.surfaces.remove(&self.setup.technique);
+        }
+        if let Err(e) = Self::surface(gpu, (&self.mesh, &self.lines), &self.setup) {
+            // A key asked for it: go back to what was drawn. The first build is the command
+            // line's: it fails the command.
+            let Some(good) = self.last_good.clone() else {
+                return Err(e);
+            };
+            let what = format!(
+                "cannot draw {} that way: {}",
+                self.setup.technique,
+                crate::message(&e)
+            );
+            self.setup = good;
+            self.pending_level = None;
+            self.report(what);
+            return Ok(false);
+        }
+        if let Some(l) = self.pending_level.take() {
+            self.set_level(l, true);
+        }
+        Ok(true)
+    }
+
+    /// The window title: the technique and its frame, isolation options, animation, the
+    /// frame time and the status line.
+    fn set_title(&self, params: &tess::FrameParams) {
         if let Some(w) = &self.window {
             w.set_title(&format!(
                 "tessera — {}{}{} — {:.2} ms/frame{}",
-                describe(self.setup.technique, &params),
+                describe(self.setup.technique, params),
                 if techniques::info(self.setup.technique).features.isolation {
                     let b = &self.setup.build;
                     format!(
@@ -447,40 +446,42 @@ impl App {
                     .unwrap_or_default()
             ));
         }
-        if let Some(img) = shot {
-            if asked {
-                self.shots += 1;
-                let path =
-                    std::path::PathBuf::from(format!("tessera-screenshot-{}.png", self.shots));
-                match crate::output::write_png(&path, &img) {
-                    Ok(()) => out!("wrote {} (P)", path.display()),
-                    Err(e) => self.report(crate::message(&e)),
-                }
+    }
+
+    /// Writes the screenshot a key asked for (`P`, numbered) and the command line's final
+    /// `--screenshot`, refusing a blank final image.
+    fn save_shots(
+        &mut self,
+        img: &vk_core::target::Rgba8,
+        asked: bool,
+        final_shot: bool,
+        params: &tess::FrameParams,
+    ) -> Result<()> {
+        if asked {
+            self.shots += 1;
+            let path = std::path::PathBuf::from(format!("tessera-screenshot-{}.png", self.shots));
+            match crate::output::write_png(&path, img) {
+                Ok(()) => out!("wrote {} (P)", path.display()),
+                Err(e) => self.report(crate::message(&e)),
             }
-            if let (true, Some(path)) = (final_shot, &self.args.screenshot) {
-                if crate::output::is_blank(&img, params.clear_color) {
-                    anyhow::bail!(
-                        "{}: nothing was drawn in frame {} (every pixel is the background); \
-                         {} not written",
-                        self.setup.build.name,
-                        self.frames_drawn,
-                        path.display()
-                    );
-                }
-                crate::output::write_png(path, &img)?;
-                out!(
-                    "wrote {} after {} frame{}",
-                    path.display(),
+        }
+        if let (true, Some(path)) = (final_shot, &self.args.screenshot) {
+            if crate::output::is_blank(img, params.clear_color) {
+                anyhow::bail!(
+                    "{}: nothing was drawn in frame {} (every pixel is the background); \
+                     {} not written",
+                    self.setup.build.name,
                     self.frames_drawn,
-                    if self.frames_drawn == 1 { "" } else { "s" }
+                    path.display()
                 );
             }
-        }
-        for action in std::mem::take(&mut self.actions) {
-            self.act(action, event_loop);
-        }
-        if last {
-            event_loop.exit();
+            crate::output::write_png(path, img)?;
+            out!(
+                "wrote {} after {} frame{}",
+                path.display(),
+                self.frames_drawn,
+                if self.frames_drawn == 1 { "" } else { "s" }
+            );
         }
         Ok(())
     }
@@ -877,6 +878,86 @@ fn surface_key(params: &mut tess::FrameParams, scale: &mut f32, action: Action) 
     }
 }
 
+/// The HUD laid out for `shown`: its tessellated primitives and pixels per point, its
+/// textures uploaded (None when egui has nothing to draw).
+fn lay_out_hud(
+    hud: &mut Hud,
+    window: &Window,
+    shown: &Shown,
+    actions: &mut Vec<Action>,
+    overlay: &mut Overlay,
+) -> Result<Option<(Vec<egui::ClippedPrimitive>, f32)>> {
+    let Some(mut out) = hud.run(window, shown, actions) else {
+        return Ok(None);
+    };
+    overlay.update_textures(&mut out.textures_delta)?;
+    let ppp = out.pixels_per_point;
+    Ok(Some((hud.tessellate(out.shapes, ppp), ppp)))
+}
+
+/// The pass times of the slot's previous frame, once written (acquire waited for that frame:
+/// no stall).
+fn read_pass_times(timer: Option<&mut Timer>, slot: usize) -> Result<Option<PassTimes>> {
+    let Some(t) = timer else {
+        return Ok(None);
+    };
+    let mut times = None;
+    if t.written[slot] {
+        if let [pre_pass, draw, hud] = t.pools[slot].durations_ns()?[..] {
+            times = Some(PassTimes {
+                pre_pass: pre_pass * 1e-6,
+                draw: draw * 1e-6,
+                hud: hud * 1e-6,
+            });
+        }
+    }
+    t.written[slot] = true;
+    Ok(times)
+}
+
+/// What a frame records: the technique's passes with `params`, timestamps into `pool`, and the
+/// HUD's primitives.
+struct Recorded<'a> {
+    context: &'a Context,
+    technique: &'a dyn Technique,
+    params: &'a tess::FrameParams,
+    pool: Option<&'a QueryPool>,
+    hud: Option<&'a (Vec<egui::ClippedPrimitive>, f32)>,
+}
+
+/// Records the pre-pass, the drawn surface and the HUD, each between timestamps.
+fn record_frame<'a>(
+    frame: &mut vk_core::swapchain::SwapchainFrame<'a>,
+    overlay: &'a mut Overlay,
+    r: &Recorded<'a>,
+) -> Result<()> {
+    let (top, bottom) = (
+        vk::PipelineStageFlags::TOP_OF_PIPE,
+        vk::PipelineStageFlags::BOTTOM_OF_PIPE,
+    );
+    let slot = frame.slot();
+    let extent = frame.extent();
+    if let Some(pool) = r.pool {
+        frame.encoder().reset_queries(pool);
+    }
+    stamp(frame.encoder(), r.pool, 0, top)?;
+    r.context
+        .record_pre_pass(frame.encoder(), r.technique, slot)?;
+    stamp(frame.encoder(), r.pool, 1, bottom)?;
+    stamp(frame.encoder(), r.pool, 2, top)?;
+    frame.begin_frame_rendering(r.params.clear_color);
+    r.context
+        .record_frame(frame.encoder(), r.technique, slot, r.params)?;
+    stamp(frame.encoder(), r.pool, 3, bottom)?;
+    stamp(frame.encoder(), r.pool, 4, top)?;
+    if let Some((primitives, ppp)) = r.hud {
+        overlay.draw(frame.encoder(), extent, *ppp, primitives)?;
+    }
+    frame.encoder().end_rendering();
+    stamp(frame.encoder(), r.pool, 5, bottom)?;
+    Ok(())
+}
+
 /// Writes timestamp `index` of the frame's pool, where the queue has timestamps.
 fn stamp<'a>(
     encoder: &mut vk_core::Encoder<'a>,
@@ -931,9 +1012,10 @@ mod tests {
 
     #[test]
     fn keys_map_to_their_actions() {
-        // Method keys: the registry's order, gregory and acc last.
+        // Method keys: the registry's order; the digits 1-9 reach the first nine techniques
+        // (the others are chosen from the HUD's list).
         let order: Vec<TechniqueId> = techniques::registry().iter().map(|i| i.id).collect();
-        for (i, id) in order.iter().enumerate() {
+        for (i, id) in order.iter().enumerate().take(9) {
             assert_eq!(key(&(i + 1).to_string()), Some(Action::Technique(*id)));
         }
         assert_eq!(

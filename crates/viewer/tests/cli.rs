@@ -948,10 +948,10 @@ fn export_bft_writes_the_exact_limit_at_each_vertex() {
         let mut mesh = topology::load_obj(input).unwrap();
         if let Some(t) = frame {
             // The deformation the GPU saw: the same wave on the same rest pose.
-            let rest = tess::techniques::bft::base_positions(&mesh);
-            let normals = tess::techniques::bft::base_normals(&mesh);
-            let (lo, hi) = tess::techniques::bft::bbox(&rest);
-            let moved = tess::techniques::bft::wave(&rest, &normals, lo, hi, t.parse().unwrap());
+            let rest = tess::animation::base_positions(&mesh);
+            let normals = tess::animation::base_normals(&mesh);
+            let (lo, hi) = tess::animation::bbox(&rest);
+            let moved = tess::animation::wave(&rest, &normals, lo, hi, t.parse().unwrap());
             for (p, q) in mesh.positions.iter_mut().zip(moved) {
                 *p = q.map(f64::from);
             }

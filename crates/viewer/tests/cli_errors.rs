@@ -1,4 +1,4 @@
-//! Issue 15, as a hostile user would try it: input whose f32 intermediates overflow is refused
+//! Bad input, as a hostile user would try it: input whose f32 intermediates overflow is refused
 //! with its line and vertex, degenerate input gives finite output through every technique,
 //! view options are checked when parsed, a UTF-8 BOM is skipped, and every message says its
 //! cause once, in the OBJ's own numbers, before any device is opened. Also runs each CPU and
@@ -508,7 +508,7 @@ fn segments_are_checked_before_the_device_and_named_as_given() {
                 &["--segments"],
             );
         }
-        // One vocabulary (issue 14): render says `--segments` too, also when given the old
+        // One vocabulary: render says `--segments` too, also when given the old
         // spelling `--level`, which stays a hidden alias.
         for option in ["--segments", "--level"] {
             let e = fails(
@@ -768,7 +768,7 @@ fn one_line_naming(e: &str, file: &str) {
     assert_eq!(e.matches(file).count(), 1, "names {file} once: {e}");
 }
 
-/// Issue 12's bad input: a colour texture or height map that is missing or not an image is a
+/// Bad surface maps: a colour texture or height map that is missing or not an image is a
 /// one-line error naming the file, given before any device is opened (no loader is even
 /// looked for), by render, export and bench alike.
 #[test]
@@ -952,7 +952,7 @@ fn bench_csv_rows(path: &str) -> Vec<(String, String)> {
         .collect()
 }
 
-/// `tessera bench` takes render's surface options (issue 12's interface list): the texture,
+/// `tessera bench` takes render's surface options (the surface-map interface): the texture,
 /// height map and displacement are built into the gregory rows (their device memory holds
 /// both images) and their notes say so, Flat draws as always; `--no-reparam` is accepted and
 /// noted; bad combinations are refused as render refuses them.
@@ -990,7 +990,7 @@ fn bench_applies_the_surface_options_to_the_surface_rows() {
     ];
     args.extend_from_slice(&cheap);
     let text = stdout(&succeeds(&args));
-    // The binary's heap policy is part of what was measured (docs/benchmarks.md, Session 21).
+    // The binary's heap policy is part of what was measured (docs/benchmarks.md, "Devices, and how to read the figures").
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     assert!(
         text.contains("Host heap: glibc mmap threshold fixed at 128 KiB, heap top never trimmed"),

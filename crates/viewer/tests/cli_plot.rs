@@ -1,4 +1,4 @@
-//! Issue 14's pictures: `tessera bench --plot out.svg` and `tessera plot run.csv -o out.png`.
+//! Pictures: `tessera bench --plot out.svg` and `tessera plot run.csv -o out.png`.
 //! A small bench (two meshes, two segment counts, two techniques, one frame) writes its CSV and
 //! its SVG; every row of the CSV is found as a circle in the SVG where the chart's axis mapping
 //! (stated per chart in a `tessera-chart` comment) puts it, in both the frame-time and the

@@ -1,4 +1,4 @@
-//! Issue 14's progress: `tessera bench` draws a bar over its groups, and `render`/`export` a
+//! Progress: `tessera bench` draws a bar over its groups, and `render`/`export` a
 //! spinner while they build, on a terminal only. Without one (as here, under `cargo test`)
 //! the output has no carriage return and no escape code; under a pseudo-terminal made by
 //! util-linux's `script` the bar is drawn.

@@ -1,4 +1,4 @@
-//! Issue 14's one vocabulary: every command that takes a tessellation factor calls it
+//! One vocabulary: every command that takes a tessellation factor calls it
 //! `--segments` (the old `--level` of render and view is a hidden alias), every command that
 //! takes a mesh defaults to the embedded spot, and what the commands print reads as prose, with
 //! no Rust debug formatting.

@@ -45,7 +45,7 @@ fn text(o: &Output) -> (String, String) {
 /// A window run that ends without a screenshot destroys nothing the GPU still uses: it exits 0
 /// with validation on, for every technique, animated where the technique animates (the base
 /// mesh rewritten every frame while the previous frame may still read it).
-/// The issue-15 report: `view --validation --frames 5` failed with
+/// The reported defect: `view --validation --frames 5` failed with
 /// VUID-vkDestroyPipeline-pipeline-00765, VUID-vkDestroyBuffer-buffer-00922 and
 /// VUID-vkDestroyDescriptorPool-descriptorPool-00303 before objects were retired through
 /// vk-core's deferred destruction.

@@ -43,6 +43,10 @@ impl Drop for LayoutShared {
     }
 }
 
+/// A descriptor-set layout; clones share the one handle (destroyed with the last of them and
+/// of the sets allocated with it), so an owner may hand it to a surface that allocates sets
+/// later.
+#[derive(Clone)]
 pub struct DescriptorSetLayout {
     pub raw: vk::DescriptorSetLayout,
     pub bindings: Vec<BindingDesc>,

@@ -173,156 +173,190 @@ pub fn enumerate_adapters(instance: &Instance) -> Result<Vec<AdapterInfo>> {
     // SAFETY: instance.raw is a live instance.
     let physicals =
         unsafe { instance.raw.enumerate_physical_devices() }.ctx("vkEnumeratePhysicalDevices")?;
-    let mut out = Vec::new();
-    for (index, &physical) in physicals.iter().enumerate() {
-        // SAFETY: physical comes from this instance.
-        let extensions = unsafe { instance.raw.enumerate_device_extension_properties(physical) }
-            .ctx("vkEnumerateDeviceExtensionProperties")?;
-        let has_xfb_extension = extensions
-            .iter()
-            .any(|e| e.extension_name_as_c_str().ok() == Some(ash::ext::transform_feedback::NAME));
-        let mut driver = vk::PhysicalDeviceDriverProperties::default();
-        let mut xfb_props = vk::PhysicalDeviceTransformFeedbackPropertiesEXT::default();
-        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
-        if has_xfb_extension {
-            props2 = props2.push_next(&mut xfb_props);
-        }
-        let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
-        let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
-        let mut xfb_feats = vk::PhysicalDeviceTransformFeedbackFeaturesEXT::default();
-        let mut features2 = vk::PhysicalDeviceFeatures2::default()
-            .push_next(&mut f12)
-            .push_next(&mut f13);
-        if has_xfb_extension {
-            features2 = features2.push_next(&mut xfb_feats);
-        }
-        // SAFETY: physical comes from this instance; the out-structs are valid chains (the
-        // transform-feedback structs are chained only when the device reports the extension).
-        let families = unsafe {
-            instance
-                .raw
-                .get_physical_device_properties2(physical, &mut props2);
-            instance
-                .raw
-                .get_physical_device_features2(physical, &mut features2);
-            instance
-                .raw
-                .get_physical_device_queue_family_properties(physical)
-        };
-        let props = props2.properties;
-        let feats = features2.features;
-        let queue_family = families
-            .iter()
-            .position(|q| {
-                q.queue_flags
-                    .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
-            })
-            .map(|i| i as u32);
-        let timestamps = queue_family
-            .map(|q| families[q as usize].timestamp_valid_bits > 0)
-            .unwrap_or(false);
-        let caps = Capabilities {
-            tessellation_shader: feats.tessellation_shader == vk::TRUE,
-            fill_mode_non_solid: feats.fill_mode_non_solid == vk::TRUE,
-            pipeline_statistics_query: feats.pipeline_statistics_query == vk::TRUE,
-            vertex_pipeline_stores_and_atomics: feats.vertex_pipeline_stores_and_atomics
-                == vk::TRUE,
-            multi_draw_indirect: feats.multi_draw_indirect == vk::TRUE,
-            draw_indirect_first_instance: feats.draw_indirect_first_instance == vk::TRUE,
-            max_draw_indirect_count: props.limits.max_draw_indirect_count,
-            dynamic_rendering: f13.dynamic_rendering == vk::TRUE,
-            maintenance4: f13.maintenance4 == vk::TRUE,
-            timestamps,
-            max_tessellation_generation_level: props.limits.max_tessellation_generation_level,
-            max_tessellation_patch_size: props.limits.max_tessellation_patch_size,
-            max_tess_evaluation_output_components: props
-                .limits
-                .max_tessellation_evaluation_output_components,
-            timestamp_period_ns: props.limits.timestamp_period,
-            transform_feedback: has_xfb_extension && xfb_feats.transform_feedback == vk::TRUE,
-            transform_feedback_queries: has_xfb_extension
-                && xfb_feats.transform_feedback == vk::TRUE
-                && xfb_props.transform_feedback_queries == vk::TRUE,
-            max_transform_feedback_buffer_size: if has_xfb_extension {
-                xfb_props.max_transform_feedback_buffer_size
-            } else {
-                0
-            },
-            max_transform_feedback_stride: if has_xfb_extension {
-                xfb_props.max_transform_feedback_buffer_data_stride
-            } else {
-                0
-            },
-            max_transform_feedback_buffers: if has_xfb_extension {
-                xfb_props.max_transform_feedback_buffers
-            } else {
-                0
-            },
-            max_transform_feedback_streams: if has_xfb_extension {
-                xfb_props.max_transform_feedback_streams
-            } else {
-                0
-            },
-            max_uniform_buffer_range: props.limits.max_uniform_buffer_range,
-            max_storage_buffer_range: props.limits.max_storage_buffer_range,
-            min_storage_buffer_offset_alignment: props
-                .limits
-                .min_storage_buffer_offset_alignment
-                .max(1),
-            max_compute_work_group_count: props.limits.max_compute_work_group_count,
-            timeline_semaphore: f12.timeline_semaphore == vk::TRUE,
-            max_image_dimension_2d: props.limits.max_image_dimension2_d,
-        };
-        let mut missing = Vec::new();
-        if props.api_version < vk::API_VERSION_1_3 {
-            missing.push("Vulkan 1.3".to_owned());
-        }
-        if !caps.tessellation_shader {
-            missing.push("tessellationShader".to_owned());
-        }
-        if !caps.fill_mode_non_solid {
-            missing.push("fillModeNonSolid".to_owned());
-        }
-        if !caps.dynamic_rendering {
-            missing.push("dynamicRendering".to_owned());
-        }
-        if !caps.timeline_semaphore {
-            missing.push("timelineSemaphore".to_owned());
-        }
-        if caps.tessellation_shader && caps.max_tessellation_generation_level < 64 {
-            missing.push(format!(
-                "maxTessellationGenerationLevel ≥ 64 (has {})",
-                caps.max_tessellation_generation_level
-            ));
-        }
-        if caps.tessellation_shader && caps.max_tessellation_patch_size < 32 {
-            missing.push(format!(
-                "maxTessellationPatchSize ≥ 32 (has {})",
-                caps.max_tessellation_patch_size
-            ));
-        }
-        if queue_family.is_none() {
-            missing.push("a graphics+compute queue".to_owned());
-        }
-        out.push(AdapterInfo {
-            index,
-            name: cstr_field(&props.device_name),
-            device_type: props.device_type,
-            driver_id: driver.driver_id,
-            driver_name: cstr_field(&driver.driver_name),
-            driver_info: cstr_field(&driver.driver_info),
-            driver_version: props.driver_version,
-            api_version: props.api_version,
-            vendor_id: props.vendor_id,
-            device_id: props.device_id,
-            pipeline_cache_uuid: props.pipeline_cache_uuid,
-            caps,
-            queue_family,
-            missing,
-            physical,
-        });
+    physicals
+        .iter()
+        .enumerate()
+        .map(|(index, &physical)| adapter_info(instance, index, physical))
+        .collect()
+}
+
+/// What one physical device reports (properties, features, queue families, extensions),
+/// read as [`Capabilities`], and what it lacks.
+fn adapter_info(
+    instance: &Instance,
+    index: usize,
+    physical: vk::PhysicalDevice,
+) -> Result<AdapterInfo> {
+    // SAFETY: physical comes from this instance.
+    let extensions = unsafe { instance.raw.enumerate_device_extension_properties(physical) }
+        .ctx("vkEnumerateDeviceExtensionProperties")?;
+    let has_xfb_extension = extensions
+        .iter()
+        .any(|e| e.extension_name_as_c_str().ok() == Some(ash::ext::transform_feedback::NAME));
+    let mut driver = vk::PhysicalDeviceDriverProperties::default();
+    let mut xfb_props = vk::PhysicalDeviceTransformFeedbackPropertiesEXT::default();
+    let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+    if has_xfb_extension {
+        props2 = props2.push_next(&mut xfb_props);
     }
-    Ok(out)
+    let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
+    let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+    let mut xfb_feats = vk::PhysicalDeviceTransformFeedbackFeaturesEXT::default();
+    let mut features2 = vk::PhysicalDeviceFeatures2::default()
+        .push_next(&mut f12)
+        .push_next(&mut f13);
+    if has_xfb_extension {
+        features2 = features2.push_next(&mut xfb_feats);
+    }
+    // SAFETY: physical comes from this instance; the out-structs are valid chains (the
+    // transform-feedback structs are chained only when the device reports the extension).
+    let families = unsafe {
+        instance
+            .raw
+            .get_physical_device_properties2(physical, &mut props2);
+        instance
+            .raw
+            .get_physical_device_features2(physical, &mut features2);
+        instance
+            .raw
+            .get_physical_device_queue_family_properties(physical)
+    };
+    let props = props2.properties;
+    let feats = features2.features;
+    let queue_family = families
+        .iter()
+        .position(|q| {
+            q.queue_flags
+                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+        })
+        .map(|i| i as u32);
+    let timestamps = queue_family
+        .map(|q| families[q as usize].timestamp_valid_bits > 0)
+        .unwrap_or(false);
+    let reported = Reported {
+        props: &props,
+        feats: &feats,
+        f12: &f12,
+        f13: &f13,
+        xfb: has_xfb_extension.then_some((&xfb_feats, &xfb_props)),
+    };
+    let caps = capabilities(&reported, timestamps);
+    let missing = missing_requirements(props.api_version, &caps, queue_family);
+    Ok(AdapterInfo {
+        index,
+        name: cstr_field(&props.device_name),
+        device_type: props.device_type,
+        driver_id: driver.driver_id,
+        driver_name: cstr_field(&driver.driver_name),
+        driver_info: cstr_field(&driver.driver_info),
+        driver_version: props.driver_version,
+        api_version: props.api_version,
+        vendor_id: props.vendor_id,
+        device_id: props.device_id,
+        pipeline_cache_uuid: props.pipeline_cache_uuid,
+        caps,
+        queue_family,
+        missing,
+        physical,
+    })
+}
+
+/// What a physical device reports, as [`capabilities`] reads it (the transform-feedback
+/// structs only when the device has the extension).
+struct Reported<'a> {
+    props: &'a vk::PhysicalDeviceProperties,
+    feats: &'a vk::PhysicalDeviceFeatures,
+    f12: &'a vk::PhysicalDeviceVulkan12Features<'a>,
+    f13: &'a vk::PhysicalDeviceVulkan13Features<'a>,
+    xfb: Option<(
+        &'a vk::PhysicalDeviceTransformFeedbackFeaturesEXT<'a>,
+        &'a vk::PhysicalDeviceTransformFeedbackPropertiesEXT<'a>,
+    )>,
+}
+
+/// The capabilities Tessera reads from what a device reports.
+fn capabilities(r: &Reported<'_>, timestamps: bool) -> Capabilities {
+    let (props, feats, f12, f13) = (r.props, r.feats, r.f12, r.f13);
+    let xfb_feature = r.xfb.is_some_and(|(f, _)| f.transform_feedback == vk::TRUE);
+    Capabilities {
+        tessellation_shader: feats.tessellation_shader == vk::TRUE,
+        fill_mode_non_solid: feats.fill_mode_non_solid == vk::TRUE,
+        pipeline_statistics_query: feats.pipeline_statistics_query == vk::TRUE,
+        vertex_pipeline_stores_and_atomics: feats.vertex_pipeline_stores_and_atomics == vk::TRUE,
+        multi_draw_indirect: feats.multi_draw_indirect == vk::TRUE,
+        draw_indirect_first_instance: feats.draw_indirect_first_instance == vk::TRUE,
+        max_draw_indirect_count: props.limits.max_draw_indirect_count,
+        dynamic_rendering: f13.dynamic_rendering == vk::TRUE,
+        maintenance4: f13.maintenance4 == vk::TRUE,
+        timestamps,
+        max_tessellation_generation_level: props.limits.max_tessellation_generation_level,
+        max_tessellation_patch_size: props.limits.max_tessellation_patch_size,
+        max_tess_evaluation_output_components: props
+            .limits
+            .max_tessellation_evaluation_output_components,
+        timestamp_period_ns: props.limits.timestamp_period,
+        transform_feedback: xfb_feature,
+        transform_feedback_queries: xfb_feature
+            && r.xfb
+                .is_some_and(|(_, p)| p.transform_feedback_queries == vk::TRUE),
+        max_transform_feedback_buffer_size: r
+            .xfb
+            .map_or(0, |(_, p)| p.max_transform_feedback_buffer_size),
+        max_transform_feedback_stride: r
+            .xfb
+            .map_or(0, |(_, p)| p.max_transform_feedback_buffer_data_stride),
+        max_transform_feedback_buffers: r.xfb.map_or(0, |(_, p)| p.max_transform_feedback_buffers),
+        max_transform_feedback_streams: r.xfb.map_or(0, |(_, p)| p.max_transform_feedback_streams),
+        max_uniform_buffer_range: props.limits.max_uniform_buffer_range,
+        max_storage_buffer_range: props.limits.max_storage_buffer_range,
+        min_storage_buffer_offset_alignment: props
+            .limits
+            .min_storage_buffer_offset_alignment
+            .max(1),
+        max_compute_work_group_count: props.limits.max_compute_work_group_count,
+        timeline_semaphore: f12.timeline_semaphore == vk::TRUE,
+        max_image_dimension_2d: props.limits.max_image_dimension2_d,
+    }
+}
+
+/// What Tessera needs and the device lacks, each named.
+fn missing_requirements(
+    api_version: u32,
+    caps: &Capabilities,
+    queue_family: Option<u32>,
+) -> Vec<String> {
+    let mut missing = Vec::new();
+    if api_version < vk::API_VERSION_1_3 {
+        missing.push("Vulkan 1.3".to_owned());
+    }
+    if !caps.tessellation_shader {
+        missing.push("tessellationShader".to_owned());
+    }
+    if !caps.fill_mode_non_solid {
+        missing.push("fillModeNonSolid".to_owned());
+    }
+    if !caps.dynamic_rendering {
+        missing.push("dynamicRendering".to_owned());
+    }
+    if !caps.timeline_semaphore {
+        missing.push("timelineSemaphore".to_owned());
+    }
+    if caps.tessellation_shader && caps.max_tessellation_generation_level < 64 {
+        missing.push(format!(
+            "maxTessellationGenerationLevel ≥ 64 (has {})",
+            caps.max_tessellation_generation_level
+        ));
+    }
+    if caps.tessellation_shader && caps.max_tessellation_patch_size < 32 {
+        missing.push(format!(
+            "maxTessellationPatchSize ≥ 32 (has {})",
+            caps.max_tessellation_patch_size
+        ));
+    }
+    if queue_family.is_none() {
+        missing.push("a graphics+compute queue".to_owned());
+    }
+    missing
 }
 
 /// Chooses deterministically: highest score, ties broken by the lowest index.

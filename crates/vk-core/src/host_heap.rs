@@ -14,7 +14,7 @@
 //! on every draw, so a frame could give pages back and fault them in again, draw after draw,
 //! depending on what the heap's top held: Flat's frame on the spot control mesh took 74-80 ms
 //! when BFT's frames were interleaved in the same process and 55-63 ms alone or with trimming
-//! off, while BFT's stayed at 93 (docs/benchmarks.md, "Session 21"). The heap's top is
+//! off, while BFT's stayed at 93 (docs/benchmarks.md, "Devices, and how to read the figures"). The heap's top is
 //! therefore never trimmed; the large blocks above still leave the process when freed.
 
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -182,6 +182,31 @@ fn format_bytes(format: vk::Format) -> u32 {
     }
 }
 
+/// The rasterization state of `desc`: polygon mode, culling, winding, discard, depth bias.
+fn rasterization_state(
+    desc: &GraphicsPipelineDesc<'_>,
+) -> vk::PipelineRasterizationStateCreateInfo<'static> {
+    vk::PipelineRasterizationStateCreateInfo::default()
+        .polygon_mode(desc.polygon_mode)
+        .cull_mode(desc.cull_mode)
+        .front_face(desc.front_face)
+        .line_width(1.0)
+        .rasterizer_discard_enable(desc.rasterizer_discard)
+        .depth_bias_enable(desc.depth_bias.is_some())
+        .depth_bias_constant_factor(desc.depth_bias.map(|b| b.0).unwrap_or(0.0))
+        .depth_bias_slope_factor(desc.depth_bias.map(|b| b.1).unwrap_or(0.0))
+}
+
+/// The depth state of `desc` (no stencil).
+fn depth_stencil_state(
+    desc: &GraphicsPipelineDesc<'_>,
+) -> vk::PipelineDepthStencilStateCreateInfo<'static> {
+    vk::PipelineDepthStencilStateCreateInfo::default()
+        .depth_test_enable(desc.depth_test)
+        .depth_write_enable(desc.depth_write)
+        .depth_compare_op(desc.depth_compare)
+}
+
 fn vertex_bindings(desc: &GraphicsPipelineDesc<'_>) -> Vec<VertexBinding> {
     desc.vertex_bindings
         .iter()
@@ -260,6 +285,31 @@ fn pipeline_layout(
 }
 
 impl Pipeline {
+    /// The pipeline object of `raw`, created from `desc` with `layout`.
+    fn graphics_from(
+        device: &Device,
+        desc: &GraphicsPipelineDesc<'_>,
+        raw: vk::Pipeline,
+        layout: vk::PipelineLayout,
+    ) -> Self {
+        Self {
+            raw,
+            layout,
+            bind_point: vk::PipelineBindPoint::GRAPHICS,
+            name: desc.name.to_owned(),
+            set_layouts: desc.set_layouts.clone(),
+            push_constant_bytes: desc.push_constant_bytes,
+            attachment_formats: [desc.color_format, desc.depth_format],
+            subpass: desc.subpass,
+            vertex_bindings: vertex_bindings(desc),
+            transform_feedback_output: desc
+                .stages
+                .iter()
+                .any(|s| writes_transform_feedback(s.spirv)),
+            device: device.shared.clone(),
+        }
+    }
+
     pub fn graphics(device: &Device, desc: &GraphicsPipelineDesc<'_>) -> Result<Self> {
         let layout = pipeline_layout(
             device,
@@ -324,23 +374,12 @@ impl Pipeline {
         let viewport = vk::PipelineViewportStateCreateInfo::default()
             .viewport_count(1)
             .scissor_count(1);
-        let raster = vk::PipelineRasterizationStateCreateInfo::default()
-            .polygon_mode(desc.polygon_mode)
-            .cull_mode(desc.cull_mode)
-            .front_face(desc.front_face)
-            .line_width(1.0)
-            .rasterizer_discard_enable(desc.rasterizer_discard)
-            .depth_bias_enable(desc.depth_bias.is_some())
-            .depth_bias_constant_factor(desc.depth_bias.map(|b| b.0).unwrap_or(0.0))
-            .depth_bias_slope_factor(desc.depth_bias.map(|b| b.1).unwrap_or(0.0));
+        let raster = rasterization_state(desc);
         let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(
             desc.subpass
                 .map_or(vk::SampleCountFlags::TYPE_1, |s| s.samples),
         );
-        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
-            .depth_test_enable(desc.depth_test)
-            .depth_write_enable(desc.depth_write)
-            .depth_compare_op(desc.depth_compare);
+        let depth = depth_stencil_state(desc);
         // VK_FORMAT_UNDEFINED as the colour format means no colour attachment at all (capture
         // passes render into nothing), so the attachment count matches the rendering scope.
         let color_count = usize::from(desc.color_format != vk::Format::UNDEFINED);
@@ -383,22 +422,7 @@ impl Pipeline {
             Ok(p) => {
                 device.created(1);
                 device.set_name(p[0], desc.name);
-                Ok(Self {
-                    raw: p[0],
-                    layout,
-                    bind_point: vk::PipelineBindPoint::GRAPHICS,
-                    name: desc.name.to_owned(),
-                    set_layouts: desc.set_layouts.clone(),
-                    push_constant_bytes: desc.push_constant_bytes,
-                    attachment_formats: [desc.color_format, desc.depth_format],
-                    subpass: desc.subpass,
-                    vertex_bindings: vertex_bindings(desc),
-                    transform_feedback_output: desc
-                        .stages
-                        .iter()
-                        .any(|s| writes_transform_feedback(s.spirv)),
-                    device: device.shared.clone(),
-                })
+                Ok(Self::graphics_from(device, desc, p[0], layout))
             }
             Err((_, e)) => {
                 // SAFETY: layout unused.

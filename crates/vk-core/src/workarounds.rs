@@ -21,9 +21,9 @@ pub enum WorkaroundId {
     /// draws so that no chunk can exceed 65,536 vertices at the largest factor the draw can use.
     /// This is likely the cause of OpenSubdiv's holes on llvmpipe. The super-linear cost starts
     /// long before the corruption, so the split gives each draw a budget of
-    /// [`LAVAPIPE_DRAW_VERTEX_BUDGET`] vertices, not the limit: measured on the issue-11 car frame
+    /// [`LAVAPIPE_DRAW_VERTEX_BUDGET`] vertices, not the limit: measured on the catmark_car frame
     /// (6.9 M triangles), 4,096 vertices a draw is 1.2x faster than 65,536 for the adaptive
-    /// surface and 1.3x for Flat (docs/benchmarks.md, "Session 14").
+    /// surface and 1.3x for Flat (docs/benchmarks.md, "What lavapipe charges for: code size, varyings, draw size").
     LavapipeTessChunkVertexLimit,
     /// lavapipe, Mesa 22.3: a pipeline-statistics query around a draw of one-control-point
     /// patches with no vertex input (the BFT main pass) crashes a worker thread (SIGSEGV); the

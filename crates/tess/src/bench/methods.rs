@@ -3,11 +3,11 @@
 //! name. The CPU baselines are techniques too (`cpu`, `cpu-catmark`: refined on the CPU, drawn
 //! from the vertex stage), so a new technique needs no entry here.
 use super::{BenchConfig, BenchMesh};
+use crate::animation::Wave;
 use crate::camera::Camera;
 use crate::context::{statistics_query_safe, Context};
 use crate::error::{Result, TessError};
 use crate::technique::{FrameParams, Technique};
-use crate::techniques::bft::Wave;
 use crate::techniques::{self, BuildOptions, TechniqueInfo};
 use std::time::Instant;
 use vk_core::{vk, Device, Encoder};
@@ -96,9 +96,10 @@ pub struct TechniqueRow {
 impl TechniqueRow {
     pub fn new(ctx: &RowContext<'_>, info: &TechniqueInfo, animated: bool) -> Result<Self> {
         let mut context = Context::new(ctx.device, ctx.color_format, ctx.depth_format, 1)?;
-        // Catmull-Clark techniques take the mesh as loaded; the others its fan triangulation
-        // (the paper's Table I).
-        let mesh = if info.scheme == Some(topology::Scheme::CatmullClark) {
+        // Catmull-Clark and Doo-Sabin techniques take the mesh as loaded (a fan triangulation
+        // is another surface for them); the others its fan triangulation (the paper's Table I).
+        let as_loaded = [topology::Scheme::CatmullClark, topology::Scheme::DooSabin];
+        let mesh = if info.scheme.is_some_and(|s| as_loaded.contains(&s)) {
             &ctx.mesh.input
         } else {
             &ctx.mesh.mesh

@@ -1,5 +1,5 @@
 //! The process's own CPU time and memory, for the preparation figures the techniques log
-//! (issue 15's scale bench compares them with `subdivide`'s in the same run). Linux `/proc`;
+//! (the scale bench compares them with `subdivide`'s in the same run). Linux `/proc`;
 //! `None` elsewhere.
 
 /// User + system CPU seconds of the whole process (every thread) so far.

@@ -21,34 +21,42 @@ gpu_constants! {
 
     /// Descriptor set of one BFT surface's storage buffers (`glsl/bft/bft.glsl`).
     BFT_SET = 1;
-    /// Base positions, one [`crate::techniques::bft::layout::BasePosition`] per base vertex; rewritten per frame.
-    BFT_BASE_POSITIONS_BINDING = 0;
-    /// CSR offsets of the base → level-1 stencils (level-1 vertex count + 1).
-    BFT_STENCIL_OFFSETS_BINDING = 1;
-    /// Base → level-1 stencil terms ([`crate::techniques::bft::layout::StencilTerm`]).
-    BFT_STENCIL_TERMS_BINDING = 2;
     /// CSR offsets of the level-1 limit-tangent stencils.
-    BFT_TANGENT_OFFSETS_BINDING = 3;
+    BFT_TANGENT_OFFSETS_BINDING = 0;
     /// Level-1 limit-tangent terms ([`crate::techniques::bft::layout::TangentTerm`]).
-    BFT_TANGENT_TERMS_BINDING = 4;
-    /// Level-1 positions (`vec4`), written by `subdivide.comp`.
-    BFT_LEVEL1_POSITIONS_BINDING = 5;
+    BFT_TANGENT_TERMS_BINDING = 1;
+    /// Level-1 positions (`vec4`), written by the stencil evaluator ([`crate::stencil`]).
+    BFT_LEVEL1_POSITIONS_BINDING = 2;
     /// Level-1 limit normals (`vec4`), written by `normals.comp`.
-    BFT_LEVEL1_NORMALS_BINDING = 6;
+    BFT_LEVEL1_NORMALS_BINDING = 3;
     /// One [`crate::techniques::bft::layout::PatchHeader`] per level-1 face.
-    BFT_PATCH_HEADERS_BINDING = 7;
+    BFT_PATCH_HEADERS_BINDING = 4;
     /// Every patch's control ring (level-1 vertex indices), back to back.
-    BFT_PATCH_RINGS_BINDING = 8;
+    BFT_PATCH_RINGS_BINDING = 5;
     /// [`crate::techniques::bft::layout::TableHeader`], then one [`crate::techniques::bft::layout::TableEntry`] per table.
-    BFT_TABLES_BINDING = 9;
+    BFT_TABLES_BINDING = 6;
     /// Mirror permutations of the tables' ring slots.
-    BFT_MIRROR_PERMS_BINDING = 10;
+    BFT_MIRROR_PERMS_BINDING = 7;
     /// Row maps: grid point → table row, full tables then half tables.
-    BFT_ROW_MAPS_BINDING = 11;
+    BFT_ROW_MAPS_BINDING = 8;
     /// Basis-function weights of every table.
-    BFT_TABLE_WEIGHTS_BINDING = 12;
+    BFT_TABLE_WEIGHTS_BINDING = 9;
     /// Work-group size of the BFT compute passes.
     BFT_LOCAL_SIZE = 64;
+
+    /// Descriptor set of the stencil evaluator (`glsl/stencil/stencil.glsl`, [`crate::stencil`]):
+    /// its own pipeline layout, this set alone.
+    STENCIL_SET = 0;
+    /// CSR offsets of the stencil rows (rows + 1), windowed.
+    STENCIL_OFFSETS_BINDING = 0;
+    /// Stencil terms ([`crate::stencil::StencilTerm`]: source vertex, weight), windowed.
+    STENCIL_TERMS_BINDING = 1;
+    /// The vertices the rows read (`vec4`), windowed.
+    STENCIL_SOURCE_BINDING = 2;
+    /// The vertices the rows write (`vec4`), windowed; may be the source buffer itself.
+    STENCIL_DESTINATION_BINDING = 3;
+    /// Work-group size of the stencil evaluator.
+    STENCIL_LOCAL_SIZE = 64;
 
     /// Transform-feedback buffer the capture variants write ([`crate::gpu::CaptureRecord`]).
     CAPTURE_XFB_BUFFER = 0;
@@ -99,48 +107,51 @@ gpu_constants! {
     /// Mask of an owner's local edge or corner index.
     BFT_OWNER_LOCAL_MASK = 3;
 
+    /// Descriptor set of one Doo-Sabin surface (`glsl/doo_sabin/mesh.vert`).
+    DOO_SABIN_SET = 1;
+    /// The deepest level's points (`vec4`, level-local numbering): the range of the refined
+    /// vertex buffer the stencil evaluator writes that level into ([`crate::stencil`]).
+    DOO_SABIN_POINTS_BINDING = 0;
+    /// Per deepest-level point, its face corners as `uvec2(next, previous)` neighbours
+    /// (`DOO_SABIN_MAX_CORNERS` slots; an unused slot names the point itself twice, adding
+    /// nothing): what its normal is summed from.
+    DOO_SABIN_CORNERS_BINDING = 1;
+    /// Face corners a refined Doo-Sabin point lies in at most (one f-face, two e-faces or
+    /// boundary strips, one v-face or vertex strip).
+    DOO_SABIN_MAX_CORNERS = 4;
+
     /// Descriptor set of one feature-adaptive Catmull-Clark surface (`glsl/adaptive/adaptive.glsl`).
     ADAPTIVE_SET = 1;
-    /// Base positions (three floats per base vertex), one buffer per frame slot; rewritten per frame when animated.
-    ADAPTIVE_BASE_POSITIONS_BINDING = 0;
-    /// CSR offsets of the stencil of every refined vertex up to the regular corners (levels, then local points), over the global vertex buffer.
-    ADAPTIVE_STENCIL_OFFSETS_BINDING = 1;
-    /// Stencil terms (`StencilTerm`: global vertex, weight).
-    ADAPTIVE_STENCIL_TERMS_BINDING = 2;
-    /// The global vertex buffer (`vec4`): base, level 1..L, local points, regular corners, curve points; written by `stencil.comp`.
-    ADAPTIVE_VERTICES_BINDING = 3;
+    /// The global vertex buffer (`vec4`): base (copied from the frame slot's base positions), level 1..L and the local points (written by the stencil evaluator, [`crate::stencil`]), regular corners and curve points (written by `canonical.comp`).
+    ADAPTIVE_VERTICES_BINDING = 0;
     /// One `AdaptivePatch` record per patch, in frame-wide patch order.
-    ADAPTIVE_PATCHES_BINDING = 4;
+    ADAPTIVE_PATCHES_BINDING = 1;
     /// Control-point indices (global vertices) of every patch, back to back.
-    ADAPTIVE_CONTROL_POINTS_BINDING = 5;
+    ADAPTIVE_CONTROL_POINTS_BINDING = 2;
     /// Canonical boundary curves: four global vertices (cubic Bezier) each.
-    ADAPTIVE_CURVES_BINDING = 6;
+    ADAPTIVE_CURVES_BINDING = 3;
     /// Per patch, in frame-wide order: texture coordinates at its corners and its corners' rows of the reparameterization table (`PatchSurface`).
-    ADAPTIVE_SURFACES_BINDING = 7;
+    ADAPTIVE_SURFACES_BINDING = 4;
     /// The texture reparameterization's corner blocks (seed 003, Table 1), two `vec4` per row: row 0 the identity, row `v - 2` valence `v`.
-    ADAPTIVE_REPARAM_BINDING = 8;
+    ADAPTIVE_REPARAM_BINDING = 5;
     /// Per canonical curve: the patch whose evaluation defines the curve's normals and texture coordinates (`CurveOwner`).
-    ADAPTIVE_CURVE_OWNERS_BINDING = 9;
+    ADAPTIVE_CURVE_OWNERS_BINDING = 6;
     /// Colour texture (combined image sampler; a 1x1 white texel when none is given).
-    ADAPTIVE_TEXTURE_BINDING = 10;
+    ADAPTIVE_TEXTURE_BINDING = 7;
     /// Height map (combined image sampler, red channel; a 1x1 texel when none is given).
-    ADAPTIVE_HEIGHT_BINDING = 11;
+    ADAPTIVE_HEIGHT_BINDING = 8;
     /// Per canonical corner (global vertex - `first_corner`): `uvec2(patch, corner)` of the patch whose evaluation defines its normal and texture coordinate.
-    ADAPTIVE_CORNER_OWNERS_BINDING = 12;
+    ADAPTIVE_CORNER_OWNERS_BINDING = 9;
     /// Per patch: the Eq. 1 error lattice (`float`, `ADAPTIVE_PARAM_ERROR_SIDE`² without then with the reparameterization); one 0 when not built.
-    ADAPTIVE_PARAM_ERROR_BINDING = 13;
+    ADAPTIVE_PARAM_ERROR_BINDING = 10;
     /// Lattice points per patch side of the Eq. 1 error view.
     ADAPTIVE_PARAM_ERROR_SIDE = 9;
-    /// Work-group size of the adaptive stencil kernel.
+    /// Work-group size of the adaptive canonical kernel (`canonical.comp`).
     ADAPTIVE_LOCAL_SIZE = 64;
-    /// `mode` of the stencil kernel (`AdaptivePush`): apply stencil rows,
-    ADAPTIVE_STENCIL_MODE_ROWS = 0;
-    /// copy the base positions in,
-    ADAPTIVE_STENCIL_MODE_BASE = 1;
-    /// evaluate the canonical curves' inner points from their owner patches' control points (two per curve),
-    ADAPTIVE_STENCIL_MODE_CURVES = 2;
+    /// `mode` of the canonical kernel (`AdaptivePush`): evaluate the canonical curves' inner points from their owner patches' control points (two per curve),
+    ADAPTIVE_CANONICAL_MODE_CURVES = 2;
     /// evaluate the canonical corners owned by regular patches from their 3x3 points, phantoms included (the B-spline value at the corner).
-    ADAPTIVE_STENCIL_MODE_CORNERS = 3;
+    ADAPTIVE_CANONICAL_MODE_CORNERS = 3;
     /// Patch kinds (low 4 bits of `AdaptivePatch::info`): bicubic B-spline,
     ADAPTIVE_KIND_REGULAR = 0;
     /// Gregory end cap,

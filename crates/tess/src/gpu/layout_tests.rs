@@ -4,13 +4,13 @@
 //! missing fails.
 use super::bindings::*;
 use super::reflect::Reflection;
-use super::{AdaptivePush, BftPush, CaptureRecord, DrawPush, FrameUniforms, Vertex};
+use super::{AdaptivePush, BftPush, CaptureRecord, DrawPush, FrameUniforms, StencilPush, Vertex};
 use crate::shaders::{spirv, Stage, Variant};
-use crate::techniques::adaptive::layout::{PatchRecord, StencilTerm as AdaptiveTerm};
+use crate::stencil::{StencilTerm, StencilVertex};
 use crate::techniques::bft::layout::{
-    BasePosition, Level1Point, PatchHeader, StencilTerm, TableEntry, TableHeader, TangentTerm,
-    STORAGE_BINDINGS,
+    Level1Point, PatchHeader, TableEntry, TableHeader, TangentTerm, STORAGE_BINDINGS,
 };
+use crate::techniques::planned_patches::layout::PatchRecord;
 use crate::tessellator::Spacing;
 use std::mem::{offset_of, size_of};
 
@@ -102,7 +102,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
     };
     let bft_push = || Layout {
         name: "BftPush",
-        offsets: offsets!(BftPush: mode, first_patch, factor_mode, options, uniform_level, pixels_per_segment, distance_ref, max_level, count, first_vertex, patch_base, ring_base, level1_base, stencil_base, tangent_base, base_vertex_base),
+        offsets: offsets!(BftPush: mode, first_patch, factor_mode, options, uniform_level, pixels_per_segment, distance_ref, max_level, count, first_vertex, patch_base, ring_base, level1_base, tangent_base),
         size: size_of::<BftPush>(),
     };
     let frame_binding = || Uniform {
@@ -160,7 +160,6 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
             },
             bft_push(),
         ),
-        (Stage::BftSubdivideComp, PLAIN, bft_push()),
         (Stage::BftNormalsComp, PLAIN, bft_push()),
         // Vertex input.
         (
@@ -199,43 +198,55 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
                 size: size_of::<[f32; 3]>(),
             },
         ),
-        // BFT storage buffers: the compute passes.
+        // Doo-Sabin's vertex stage: the deepest level's points and their face corners.
+        (Stage::DooSabinMeshVert, PLAIN, frame()),
         (
-            Stage::BftSubdivideComp,
+            Stage::DooSabinMeshVert,
             PLAIN,
             Buffer {
-                block: "BasePositions",
-                binding: BFT_BASE_POSITIONS_BINDING,
+                block: "Points",
+                binding: DOO_SABIN_POINTS_BINDING,
                 members: vec![0],
-                stride: size_of::<BasePosition>(),
+                stride: size_of::<StencilVertex>(),
             },
         ),
         (
-            Stage::BftSubdivideComp,
+            Stage::DooSabinMeshVert,
+            PLAIN,
+            Buffer {
+                block: "Corners",
+                binding: DOO_SABIN_CORNERS_BINDING,
+                members: vec![0],
+                stride: size_of::<[u32; 2]>(),
+            },
+        ),
+        // The stencil evaluator: its push constant, its term and its four buffers.
+        (
+            Stage::StencilEvaluateComp,
             PLAIN,
             Layout {
-                name: "BasePosition",
-                offsets: offsets!(BasePosition: x, y, z),
-                size: size_of::<BasePosition>(),
+                name: "StencilPush",
+                offsets: offsets!(StencilPush: first_row, count, row_base, term_base, source_base, destination_first),
+                size: size_of::<StencilPush>(),
             },
         ),
         (
-            Stage::BftSubdivideComp,
+            Stage::StencilEvaluateComp,
             PLAIN,
-            words("StencilOffsets", BFT_STENCIL_OFFSETS_BINDING),
+            words("StencilOffsets", STENCIL_OFFSETS_BINDING),
         ),
         (
-            Stage::BftSubdivideComp,
+            Stage::StencilEvaluateComp,
             PLAIN,
             Buffer {
                 block: "StencilTerms",
-                binding: BFT_STENCIL_TERMS_BINDING,
+                binding: STENCIL_TERMS_BINDING,
                 members: vec![0],
                 stride: size_of::<StencilTerm>(),
             },
         ),
         (
-            Stage::BftSubdivideComp,
+            Stage::StencilEvaluateComp,
             PLAIN,
             Layout {
                 name: "StencilTerm",
@@ -244,10 +255,26 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
             },
         ),
         (
-            Stage::BftSubdivideComp,
+            Stage::StencilEvaluateComp,
             PLAIN,
-            level1("Level1Positions", BFT_LEVEL1_POSITIONS_BINDING),
+            Buffer {
+                block: "StencilSource",
+                binding: STENCIL_SOURCE_BINDING,
+                members: vec![0],
+                stride: size_of::<StencilVertex>(),
+            },
         ),
+        (
+            Stage::StencilEvaluateComp,
+            PLAIN,
+            Buffer {
+                block: "StencilDestination",
+                binding: STENCIL_DESTINATION_BINDING,
+                members: vec![0],
+                stride: size_of::<StencilVertex>(),
+            },
+        ),
+        // BFT storage buffers: the normals pass.
         (
             Stage::BftNormalsComp,
             PLAIN,
@@ -413,7 +440,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
     // patch records, control points and curves.
     let adaptive_push = || Layout {
         name: "AdaptivePush",
-        offsets: offsets!(AdaptivePush: mode, first_patch, factor_mode, options, uniform_level, pixels_per_segment, distance_ref, max_level, first_row, count, base_count, row_base, term_base, displace_scale, first_corner),
+        offsets: offsets!(AdaptivePush: mode, first_patch, factor_mode, options, uniform_level, pixels_per_segment, distance_ref, max_level, first_item, count, displace_scale, first_corner),
         size: size_of::<AdaptivePush>(),
     };
     let adaptive_tese = [
@@ -423,7 +450,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         Stage::AdaptiveTriangleTese,
     ];
     rows.extend([
-        (Stage::AdaptiveStencilComp, PLAIN, adaptive_push()),
+        (Stage::AdaptiveCanonicalComp, PLAIN, adaptive_push()),
         (Stage::AdaptivePatchVert, PLAIN, adaptive_push()),
         (Stage::AdaptivePatchTesc, PLAIN, adaptive_push()),
         (Stage::AdaptiveRegularTesc, PLAIN, adaptive_push()),
@@ -431,41 +458,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         (Stage::AdaptiveTriangleTesc, PLAIN, adaptive_push()),
         (Stage::AdaptiveAdaptiveFrag, PLAIN, adaptive_push()),
         (
-            Stage::AdaptiveStencilComp,
-            PLAIN,
-            Buffer {
-                block: "BasePositions",
-                binding: ADAPTIVE_BASE_POSITIONS_BINDING,
-                members: vec![0],
-                stride: size_of::<f32>(),
-            },
-        ),
-        (
-            Stage::AdaptiveStencilComp,
-            PLAIN,
-            words("StencilOffsets", ADAPTIVE_STENCIL_OFFSETS_BINDING),
-        ),
-        (
-            Stage::AdaptiveStencilComp,
-            PLAIN,
-            Buffer {
-                block: "StencilTerms",
-                binding: ADAPTIVE_STENCIL_TERMS_BINDING,
-                members: vec![0],
-                stride: size_of::<AdaptiveTerm>(),
-            },
-        ),
-        (
-            Stage::AdaptiveStencilComp,
-            PLAIN,
-            Layout {
-                name: "StencilTerm",
-                offsets: offsets!(AdaptiveTerm: index, weight),
-                size: size_of::<AdaptiveTerm>(),
-            },
-        ),
-        (
-            Stage::AdaptiveStencilComp,
+            Stage::AdaptiveCanonicalComp,
             PLAIN,
             Buffer {
                 block: "Vertices",
@@ -556,10 +549,12 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
     rows
 }
 
-/// The set a stage's storage buffers live in: its technique's.
+/// The set a stage's storage buffers live in: its technique's, or the stencil evaluator's.
 fn technique_set(stage: Stage) -> u32 {
     if stage.path().starts_with("adaptive/") {
         ADAPTIVE_SET
+    } else if stage.path().starts_with("stencil/") {
+        STENCIL_SET
     } else {
         BFT_SET
     }
@@ -686,7 +681,7 @@ fn every_gpu_block_matches_its_rust_mirror() {
 }
 
 #[test]
-fn the_table_covers_every_bft_binding_and_capture_build() {
+fn the_table_covers_every_storage_binding_and_capture_build() {
     let rows = rows();
     for binding in STORAGE_BINDINGS {
         assert!(
@@ -696,9 +691,18 @@ fn the_table_covers_every_bft_binding_and_capture_build() {
         );
     }
     for binding in [
-        ADAPTIVE_BASE_POSITIONS_BINDING,
-        ADAPTIVE_STENCIL_OFFSETS_BINDING,
-        ADAPTIVE_STENCIL_TERMS_BINDING,
+        STENCIL_OFFSETS_BINDING,
+        STENCIL_TERMS_BINDING,
+        STENCIL_SOURCE_BINDING,
+        STENCIL_DESTINATION_BINDING,
+    ] {
+        assert!(
+            rows.iter().any(|(s, _, c)| *s == Stage::StencilEvaluateComp
+                && matches!(c, Check::Buffer { binding: b, .. } if *b == binding)),
+            "stencil binding {binding} is not checked"
+        );
+    }
+    for binding in [
         ADAPTIVE_VERTICES_BINDING,
         ADAPTIVE_PATCHES_BINDING,
         ADAPTIVE_CONTROL_POINTS_BINDING,
@@ -711,6 +715,13 @@ fn the_table_covers_every_bft_binding_and_capture_build() {
             "adaptive binding {binding} is not checked"
         );
     }
+    for binding in [DOO_SABIN_POINTS_BINDING, DOO_SABIN_CORNERS_BINDING] {
+        assert!(
+            rows.iter().any(|(s, _, c)| *s == Stage::DooSabinMeshVert
+                && matches!(c, Check::Buffer { binding: b, .. } if *b == binding)),
+            "Doo-Sabin binding {binding} is not checked"
+        );
+    }
     let capture_builds = Stage::ALL
         .iter()
         .flat_map(|s| s.compiled())
@@ -721,8 +732,8 @@ fn the_table_covers_every_bft_binding_and_capture_build() {
         .filter(|(_, _, c)| matches!(c, Check::Xfb { .. }))
         .count();
     // Nine TESs in three spacings, the four adaptive ones and BFT's also with their surface code,
-    // BFT's also with and without its patch block; the CPU mesh's vertex stage.
-    assert_eq!(capture_builds, 49);
+    // BFT's also with and without its patch block; the CPU mesh's and Doo-Sabin's vertex stages.
+    assert_eq!(capture_builds, 50);
     assert_eq!(xfb_rows, capture_builds);
 }
 
@@ -773,7 +784,7 @@ fn capture_variants_and_only_they_have_xfb() {
             captures += v.capture as usize;
         }
     }
-    assert_eq!(captures, 49);
+    assert_eq!(captures, 50);
 }
 
 #[test]
@@ -858,7 +869,7 @@ fn contraction_and_mix(words: &[u32]) -> (usize, usize) {
 /// form in different orders. Only IEEE sums without contraction to fused multiply-adds
 /// (`precise`: NoContraction) and without mix() (FMix, whose rounding is the driver's) give
 /// both sides the same bits. lavapipe neither fuses nor rewrites mix(), so only a real GPU's
-/// capture tests would see a regression (NVIDIA's cracked, docs/benchmarks.md, session 18):
+/// capture tests would see a regression (NVIDIA's cracked, docs/benchmarks.md, "Table I on an NVIDIA H100"):
 /// this check sees it anywhere.
 #[test]
 fn corner_sums_are_precise_and_mix_free() {
@@ -872,5 +883,22 @@ fn corner_sums_are_precise_and_mix_free() {
             );
             assert_eq!(fmix, 0, "{} {v:?} calls mix()", stage.path());
         }
+    }
+}
+
+/// The stencil evaluator sums each row under `precise`: the products and sums of
+/// `anchor + Σ w (x − anchor)` are not contracted into fused multiply-adds, so every driver
+/// computes what `GpuStencils::row_point` mirrors (BFT's and adaptive's exactness tests, and
+/// the evaluator's bit-for-bit test, rely on it where CI has no GPU to see it).
+#[test]
+fn stencil_rows_are_summed_without_contraction() {
+    for (v, words) in Stage::StencilEvaluateComp.compiled() {
+        let (no_contraction, fmix) = contraction_and_mix(words);
+        println!("{v:?}: {no_contraction} NoContraction decorations");
+        assert!(
+            no_contraction >= 3,
+            "{v:?}: {no_contraction} NoContraction decorations"
+        );
+        assert_eq!(fmix, 0, "{v:?} calls mix()");
     }
 }

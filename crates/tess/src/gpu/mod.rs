@@ -1,6 +1,7 @@
 //! Rust mirrors of every block shared with GLSL: uniforms, push constants, the
-//! transform-feedback record and the vertex input (the BFT storage buffers' structs live with
-//! their technique, [`crate::techniques::bft::layout`]).
+//! transform-feedback record and the vertex input (the storage buffers' structs live with
+//! their users: [`crate::stencil`], [`crate::techniques::bft::layout`],
+//! [`crate::techniques::planned_patches::layout`]).
 //!
 //! Design decisions:
 //! - `#[repr(C)]` + `Pod` with named fields, no `Vec3` (std140/std430 would pad it); sizes and
@@ -87,24 +88,21 @@ pub struct BftPush {
     pub patch_base: u32,
     /// Patch rings.
     pub ring_base: u32,
-    /// Level-1 positions, normals, and the stencil and tangent CSR offsets.
+    /// Level-1 positions, normals, and the tangent CSR offsets.
     pub level1_base: u32,
-    /// Stencil terms.
-    pub stencil_base: u32,
     /// Tangent terms.
     pub tangent_base: u32,
-    /// Base positions.
-    pub base_vertex_base: u32,
 }
 
-const _: () = assert!(size_of::<BftPush>() == 64);
+const _: () = assert!(size_of::<BftPush>() == 56);
 
 /// `AdaptivePush` push constant of every feature-adaptive stage, `glsl/adaptive/adaptive.glsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct AdaptivePush {
-    /// [`bindings::DRAW_MODE_SHADED`] or [`bindings::DRAW_MODE_WIREFRAME`]; the stencil kernel:
-    /// 0 applies stencil rows, 1 copies the base positions.
+    /// [`bindings::DRAW_MODE_SHADED`] or [`bindings::DRAW_MODE_WIREFRAME`]; the canonical
+    /// kernel: [`bindings::ADAPTIVE_CANONICAL_MODE_CORNERS`] or
+    /// [`bindings::ADAPTIVE_CANONICAL_MODE_CURVES`].
     pub mode: u32,
     /// Frame-wide id of the drawn array's first patch.
     pub first_patch: u32,
@@ -118,23 +116,38 @@ pub struct AdaptivePush {
     pub distance_ref: f32,
     /// The device's maximum tessellation level.
     pub max_level: f32,
-    /// Stencil kernel: first row of the dispatch (copying: first base vertex).
-    pub first_row: u32,
-    /// Stencil kernel: rows (or base vertices) in the dispatch.
+    /// Canonical kernel: the dispatch's first regular corner or curve point.
+    pub first_item: u32,
+    /// Canonical kernel: corners or curve points in the dispatch.
     pub count: u32,
-    /// Stencil kernel: base vertices; row `r` writes global vertex `base_count + r`.
-    pub base_count: u32,
-    /// Stencil kernel: the chunk's window bases (`techniques::windows`), subtracted from
-    /// every index into the stencil offsets (a row) and the stencil terms.
-    pub row_base: u32,
-    pub term_base: u32,
     /// Displacement along the normal per unit of height (`ADAPTIVE_OPTION_DISPLACE`).
     pub displace_scale: f32,
     /// Global id of the first canonical corner (`ADAPTIVE_CORNER_OWNERS_BINDING`).
     pub first_corner: u32,
 }
 
-const _: () = assert!(size_of::<AdaptivePush>() == 60);
+const _: () = assert!(size_of::<AdaptivePush>() == 48);
+
+/// `StencilPush` push constant of the stencil evaluator, `glsl/stencil/stencil.glsl`
+/// ([`crate::stencil`]): one dispatch, rows `first_row .. first_row + count`, and the window
+/// bases of its chunk (`techniques::windows`), subtracted from every index into a windowed
+/// buffer.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct StencilPush {
+    pub first_row: u32,
+    pub count: u32,
+    /// The window base of the CSR offsets (row `r` reads `offsets[r − row_base]`).
+    pub row_base: u32,
+    /// The window base of the terms.
+    pub term_base: u32,
+    /// The window base of the source vertices (a term reads `source[index − source_base]`).
+    pub source_base: u32,
+    /// The destination of row `first_row`, in the destination window.
+    pub destination_first: u32,
+}
+
+const _: () = assert!(size_of::<StencilPush>() == 24);
 
 /// Interleaved vertex of the mesh vertex buffer (`common/mesh.vert` and `plain/plain.vert`
 /// locations 0 and 1).

@@ -5,13 +5,16 @@
 //! [`REGISTRY`] holds one line per technique. Callers (viewer, HUD, bench, export, C ABI,
 //! tests) build through [`build`], check options against [`TechniqueInfo::features`] and
 //! iterate [`registry`]; none of them matches on techniques.
+pub mod acc;
 pub mod adaptive;
 pub mod bft;
 pub mod cpu;
+pub mod doo_sabin;
 pub mod face_patches;
 pub mod flat;
 pub mod gregory;
 pub mod phong;
+pub mod planned_patches;
 pub mod pn;
 pub mod shared;
 pub mod split;
@@ -57,16 +60,17 @@ pub struct TechniqueInfo {
 
 /// Every technique, one line each, in the order reports and the window's number keys list
 /// them (flat first: ratios divide by it).
-pub static REGISTRY: [&TechniqueInfo; 9] = [
+pub static REGISTRY: [&TechniqueInfo; 10] = [
     &flat::INFO,
     &phong::INFO,
     &pn::INFO,
     &bft::INFO,
     &adaptive::INFO,
     &gregory::INFO,
-    &gregory::ACC_INFO,
+    &acc::INFO,
     &cpu::INFO,
     &cpu::CATMARK_INFO,
+    &doo_sabin::INFO,
 ];
 
 /// Every technique, in the order reports list them (flat first: ratios divide by it).
@@ -248,7 +252,11 @@ mod tests {
         codes.dedup();
         assert_eq!(names.len(), registry().len());
         assert_eq!(codes.len(), registry().len());
-        for scheme in [topology::Scheme::Loop, topology::Scheme::CatmullClark] {
+        for scheme in [
+            topology::Scheme::Loop,
+            topology::Scheme::CatmullClark,
+            topology::Scheme::DooSabin,
+        ] {
             let defaults = registry()
                 .iter()
                 .filter(|i| i.default_for_scheme && i.scheme == Some(scheme))

@@ -3,8 +3,10 @@
 //! and checks of their push constants.
 use crate::error::{Param, ParamError, Result};
 use crate::gpu::bindings::{BFT_FACTORS_DISTANCE, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM};
+use crate::shaders::{self, Stage, Variant};
 use crate::technique::{FactorPolicy, FrameParams};
 use vk_core::descriptor::BindingDesc;
+use vk_core::pipeline::{Pipeline, ShaderStage};
 use vk_core::{vk, Buffer, Device};
 
 /// A coordinate as the GPU receives it: f32, with a zero always `+0.0`. A shared edge's points
@@ -54,6 +56,38 @@ pub fn storage(device: &Device, name: &str, bytes: &[u8]) -> Result<Buffer> {
         vk::BufferUsageFlags::STORAGE_BUFFER,
         data,
     )?)
+}
+
+/// The compute pipeline `name` of `stage` (its one build) over the set `layouts`, with
+/// `push_bytes` of push constants.
+pub fn compute_pipeline(
+    device: &Device,
+    name: &str,
+    stage: Stage,
+    layouts: &[vk::DescriptorSetLayout],
+    push_bytes: usize,
+) -> Result<Pipeline> {
+    Ok(Pipeline::compute(
+        device,
+        name,
+        ShaderStage::new(
+            vk::ShaderStageFlags::COMPUTE,
+            shaders::spirv(stage, Variant::default())?,
+        ),
+        layouts,
+        push_bytes as u32,
+    )?)
+}
+
+/// One [`storage`] buffer per `(binding, name, bytes)`, by binding.
+pub fn storage_buffers(
+    device: &Device,
+    arrays: &[(u32, &str, &[u8])],
+) -> Result<Vec<(u32, Buffer)>> {
+    arrays
+        .iter()
+        .map(|&(binding, name, bytes)| Ok((binding, storage(device, name, bytes)?)))
+        .collect()
 }
 
 /// The push-constant fields of a factor policy: (`BFT_FACTORS_*` mode, uniform segments,

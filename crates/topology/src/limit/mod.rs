@@ -5,6 +5,7 @@
 //! - [`basis`]: the basis functions of the regular patches (Loop's quartic box spline,
 //!   Catmull-Clark's bicubic B-spline) and the cubic Bézier and B-spline curves, the surface in
 //!   closed form where the mesh is regular;
+//! - [`doo_sabin`]: the exact Doo-Sabin limit point and normal at the centre of any face;
 //! - [`eval`]: exact limit evaluation at any `(face, u, v)` (OpenSubdiv's `Bfr`), refining
 //!   locally with the [`refine`](crate::refine) layer until a regular patch or a limit mask
 //!   applies;
@@ -16,6 +17,7 @@
 //! Builds on `rules/`, `mesh/` and `refine/`; the `patches/` layer builds on it.
 
 pub mod basis;
+pub mod doo_sabin;
 pub mod eval;
 pub mod face_domain;
 pub mod limit_mesh;

@@ -72,7 +72,7 @@
 //!   ([`AdaptivePlan::regular_corner_point`]), then the curves' inner points, two per curve
 //!   ([`AdaptivePlan::curve_inner_point`]). Dropping their stencil rows made most of the
 //!   drop of catmark_car's plan from 1,444 M to 1,086 M instructions (docs/benchmarks.md,
-//!   session 22). Local points are not shared between patches except the canonical corners
+//!   "The CPU plan against OpenSubdiv's far_perf"). Local points are not shared between patches except the canonical corners
 //!   and curves (two boundary patches each have their own phantoms).
 //! * **Size bound.** Every vertex of a triangle mesh is extraordinary under Catmull-Clark (and
 //!   so is every face centre of level 1), so isolation refines nearly everything at every
@@ -519,7 +519,7 @@ impl AdaptivePlan {
     /// valence-4 limit mask over the owner's 3×3 points around that corner, summed as offsets
     /// from the corner's own point. With phantoms across a boundary or crease it is the
     /// crease (or corner) limit rule, exactly: the B-spline's value at the patch corner.
-    /// `glsl/adaptive/stencil.comp` (mode 3) computes the same.
+    /// `glsl/adaptive/canonical.comp` (corners mode) computes the same.
     pub fn regular_corner_point(&self, verts: &[[f64; 3]], id: u32) -> [f64; 3] {
         let [pi, corner] = self.corner_owners[(id - self.first_corner) as usize];
         let pa = &self.patches[pi as usize];
@@ -545,8 +545,8 @@ impl AdaptivePlan {
     /// the curve is (de Casteljau), read at point `k` of the segment in the curve's direction.
     /// The edge's Bézier points are the regular patch's B-spline edge, a Gregory patch's
     /// `[P, Ep, Em, P']` or a bilinear end cap's straight line between its corners; a Gregory
-    /// triangle's halves are its own points. `glsl/adaptive/stencil.comp` (mode 2) computes
-    /// the same, so both sides of an edge read one curve.
+    /// triangle's halves are its own points. `glsl/adaptive/canonical.comp` (curves mode)
+    /// computes the same, so both sides of an edge read one curve.
     pub fn curve_inner_point(&self, verts: &[[f64; 3]], c: usize, slot: usize) -> [f64; 3] {
         let o = &self.curve_owners[c];
         let pa = &self.patches[o.patch as usize];

@@ -3,6 +3,7 @@
 //! - [`gregory`]: Gregory end caps (quads and triangles), 20 (or 15) points as stencils;
 //! - [`acc`]: ACC-1 bicubic Bézier patches and their tangent patches;
 //! - [`bft`]: Loop basis-function tables and the patch records that index them;
+//! - [`doo_sabin`]: Doo-Sabin vertex patches and the index maps of their one-dimensional layout;
 //! - [`adaptive`]: the feature-adaptive Catmull-Clark plan (sparse refinement to the isolation
 //!   level, regular patches, end caps, stencil blocks, canonical curves) and the single-pass
 //!   plan ([`adaptive::single_pass`]);
@@ -16,6 +17,7 @@
 pub mod acc;
 pub mod adaptive;
 pub mod bft;
+pub mod doo_sabin;
 pub mod gregory;
 pub mod reparam;
 pub mod texcoord;

@@ -47,7 +47,8 @@
 //! face-vertex; three per triangle for Loop, inner edge `j` joining the edge-vertices at
 //! corner `j`).
 //!
-//! Doo-Sabin makes one child vertex per parent face corner and is uniform only.
+//! Doo-Sabin makes one child vertex per parent face corner and is uniform only ([`doo_sabin`]:
+//! its numbering, faces and boundary rule).
 
 use crate::error::{TagKind, TopologyError};
 use crate::mesh::{corner_faces, par_fill_ragged, prefix_sum, ControlMesh, Topology, INVALID};
@@ -61,6 +62,7 @@ use crate::rules::{
 };
 use rayon::prelude::*;
 
+pub mod doo_sabin;
 pub mod joined;
 pub mod stencil;
 
@@ -245,9 +247,14 @@ pub fn refine_uniform(
     let base = Level::from_mesh(mesh, scheme)?;
     let mut levels = vec![base];
     let mut steps = Vec::with_capacity(level);
-    for _ in 0..level {
+    for k in 0..level {
         let parent = levels.last().expect("base level present");
-        let (child, step) = refine_level(parent, scheme, &mesh.options)?;
+        let (child, step) = if scheme == Scheme::DooSabin {
+            check_size(&parent.topology, scheme)?;
+            doo_sabin::refine_doo_sabin(parent, k == 0)?
+        } else {
+            refine_level(parent, scheme, &mesh.options)?
+        };
         levels.push(child);
         steps.push(step);
     }
@@ -358,6 +365,9 @@ fn child_sharpness(
 }
 
 /// One uniform refinement step: child level and its stencils over the parent vertices.
+///
+/// Doo-Sabin takes `parent` as a control mesh (the step that makes the boundary points,
+/// [`doo_sabin`]); [`refine_uniform`] takes the later steps, from refined levels.
 pub fn refine_level(
     parent: &Level,
     scheme: Scheme,
@@ -366,7 +376,7 @@ pub fn refine_level(
     let p = &parent.topology;
     check_size(p, scheme)?;
     if scheme == Scheme::DooSabin {
-        return refine_doo_sabin(parent);
+        return doo_sabin::refine_doo_sabin(parent, true);
     }
     let (edge_sharpness, vertex_sharpness) = child_sharpness(
         p,
@@ -2223,151 +2233,6 @@ fn other_end(p: &Topology, e: u32, v: usize) -> u32 {
     } else {
         a
     }
-}
-
-/// Doo-Sabin: one child vertex per face corner; faces from parent faces, interior edges and
-/// interior vertices. At a boundary no face is made for boundary edges or boundary vertices,
-/// so the refined mesh pulls away from the control boundary (sharpness is ignored).
-fn refine_doo_sabin(parent: &Level) -> Result<(Level, StencilTable), TopologyError> {
-    let p = &parent.topology;
-    let faces = doo_sabin_faces(p);
-    let step = doo_sabin_rows(p);
-    let positions = step.apply(&parent.positions);
-    let mesh = ControlMesh::from_polygons(positions.clone(), &faces);
-    let topology = Topology::from_mesh(&mesh)?;
-    let edge_sharpness = (0..topology.num_edges())
-        .map(|e| {
-            if topology.is_boundary_edge(e) {
-                boundary_edge_sharpness()
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    let vertex_sharpness = vec![0.0; topology.num_vertices()];
-    Ok((
-        Level {
-            topology,
-            positions,
-            edge_sharpness,
-            vertex_sharpness,
-        },
-        step,
-    ))
-}
-
-/// The corner of face `f` at vertex `v` (a Doo-Sabin child vertex).
-fn doo_sabin_corner(p: &Topology, f: u32, v: u32) -> u32 {
-    let s = p.face_offsets[f as usize];
-    let i = p
-        .face_vertices(f as usize)
-        .iter()
-        .position(|&x| x == v)
-        .unwrap_or(0);
-    s + i as u32
-}
-
-/// The Doo-Sabin child faces over the child vertices (the parent's corners): one per parent
-/// face, one per interior edge, one per interior vertex.
-fn doo_sabin_faces(p: &Topology) -> Vec<Vec<u32>> {
-    let corner_of = |f: u32, v: u32| doo_sabin_corner(p, f, v);
-    let mut faces: Vec<Vec<u32>> = Vec::new();
-    for f in 0..p.num_faces() {
-        faces.push((p.face_offsets[f]..p.face_offsets[f + 1]).collect());
-    }
-    for e in 0..p.num_edges() {
-        let [f, g] = p.edge_faces[e];
-        if g == INVALID {
-            continue;
-        }
-        // Orient by the face that traverses the edge as a → b.
-        let (f, g) = {
-            let s = p.face_offsets[f as usize] as usize;
-            let i = p
-                .face_edge_list(f as usize)
-                .iter()
-                .position(|&x| x == e as u32)
-                .unwrap_or(0);
-            if p.face_verts[s + i] == p.edge_verts[e][0] {
-                (f, g)
-            } else {
-                (g, f)
-            }
-        };
-        let [a, b] = p.edge_verts[e];
-        faces.push(vec![
-            corner_of(f, b),
-            corner_of(f, a),
-            corner_of(g, a),
-            corner_of(g, b),
-        ]);
-    }
-    for v in 0..p.num_vertices() {
-        let vf = p.vertex_faces(v);
-        if vf.is_empty()
-            || p.vertex_edges(v)
-                .iter()
-                .any(|&e| p.is_boundary_edge(e as usize))
-        {
-            continue;
-        }
-        faces.push(doo_sabin_vertex_face(p, v));
-    }
-    faces
-}
-
-/// The child face of interior vertex `v`: the corners at `v`, walking around it through each
-/// face's incoming edge.
-fn doo_sabin_vertex_face(p: &Topology, v: usize) -> Vec<u32> {
-    let vf = p.vertex_faces(v);
-    let mut ring = Vec::with_capacity(vf.len());
-    let mut f = vf[0];
-    for _ in 0..vf.len() {
-        ring.push(doo_sabin_corner(p, f, v as u32));
-        let fv = p.face_vertices(f as usize);
-        let fe = p.face_edge_list(f as usize);
-        let i = fv.iter().position(|&x| x == v as u32).unwrap_or(0);
-        let e_in = fe[(i + fv.len() - 1) % fv.len()];
-        let [x, y] = p.edge_faces[e_in as usize];
-        f = if x == f { y } else { x };
-        if f == vf[0] || f == INVALID {
-            break;
-        }
-    }
-    ring
-}
-
-/// The Doo-Sabin stencils: child vertex `c` (corner `i` of an `n`-gon) over the face's
-/// vertices, `(n + 5) / 4n` at its own corner and `(3 + 2 cos(2π d / n)) / 4n` at distance
-/// `d`.
-fn doo_sabin_rows(p: &Topology) -> StencilTable {
-    let corners = p.face_verts.len();
-    let corner_face = {
-        let mut cf = vec![0u32; corners];
-        for f in 0..p.num_faces() {
-            for c in p.face_offsets[f]..p.face_offsets[f + 1] {
-                cf[c as usize] = f as u32;
-            }
-        }
-        cf
-    };
-    build_rows(corners, p.num_vertices(), |c, out| {
-        let f = corner_face[c] as usize;
-        let fv = p.face_vertices(f);
-        let n = fv.len();
-        let i = c - p.face_offsets[f] as usize;
-        let nf = n as f64;
-        for (j, &v) in fv.iter().enumerate() {
-            let w = if i == j {
-                (nf + 5.0) / (4.0 * nf)
-            } else {
-                let d = (i + n - j) % n;
-                (3.0 + 2.0 * (2.0 * std::f64::consts::PI * d as f64 / nf).cos()) / (4.0 * nf)
-            };
-            out.raw.push((v, w));
-        }
-        false
-    })
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@
 //! refiner ([`crate::refine`]) gathers the incident sharpness values and calls these functions,
 //! and the evaluator ([`crate::limit::eval`]) refines through the refiner, so a crease fix is made once.
 
+pub mod doo_sabin;
 pub mod options;
 
 use crate::error::TopologyError;
@@ -20,9 +21,9 @@ pub enum Scheme {
     Loop,
     /// Catmull-Clark: any polygons, split into quads; bicubic B-spline on regular regions.
     CatmullClark,
-    /// Doo-Sabin: the dual quadratic scheme (one vertex per face corner). Sharpness tags are
-    /// ignored; boundary edges and boundary vertices get no new face, so the refined surface
-    /// pulls away from an open boundary instead of interpolating it.
+    /// Doo-Sabin: the dual quadratic scheme (one vertex per face corner); biquadratic B-spline
+    /// on regular regions. Sharpness tags are ignored; the boundary is the quadratic B-spline
+    /// of the boundary polygon ([`doo_sabin`]).
     DooSabin,
     /// Bilinear: the same quad split as Catmull-Clark with linear interpolation.
     Bilinear,

@@ -528,7 +528,7 @@ impl Drop for Gate {
     }
 }
 
-/// The issue-15 defect: objects dropped right after a submission that is not waited for (a
+/// A defect once shipped: objects dropped right after a submission that is not waited for (a
 /// frame) were destroyed while the GPU still used them. A timeline "gate" the host signals last
 /// holds the submission back, so the drops certainly happen while it is pending.
 #[test]

@@ -11,8 +11,9 @@
 //!   binding, member offsets and array stride back from the SPIR-V (`gpu::tests`).
 //! - **Bindings from one place**: the `BFT_*_BINDING` constants of [`crate::gpu::bindings`],
 //!   which the build script also writes into `bindings.glsl`.
-//! - **No `vec3` in a buffer** (std430 would pad it to 16 bytes): base positions are three
-//!   floats, level-1 points are `vec4` written and read only on the GPU.
+//! - **No `vec3` in a buffer** (std430 would pad it to 16 bytes): level-1 points are `vec4`
+//!   written and read only on the GPU. The base → level-1 stencils and the base positions are
+//!   the stencil evaluator's ([`crate::stencil`]).
 //! - **Owners stay packed** (`face << 2 | local index`, like OpenSubdiv's `PatchParam`), read
 //!   only through [`owner_face`] / [`owner_local`] here and their namesakes in GLSL.
 //! - **Checked before upload**: [`GpuBft::validate`] proves every index the shaders can form is
@@ -20,39 +21,18 @@
 //! - [`GpuBft::eval_tess`] is the f32 mirror of `bft.glsl`'s evaluation, operation for operation
 //!   (the shader sums with `precise`), so tests can demand the GPU's bits.
 use crate::gpu::bindings::{
-    BFT_BASE_POSITIONS_BINDING, BFT_KIND_BOUNDARY, BFT_KIND_EXTRAORDINARY, BFT_KIND_PRIVATE,
-    BFT_KIND_REGULAR, BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING,
-    BFT_MIRROR_PERMS_BINDING, BFT_OWNER_LOCAL_MASK, BFT_OWNER_SHIFT, BFT_PATCH_HEADERS_BINDING,
-    BFT_PATCH_RINGS_BINDING, BFT_ROW_MAPS_BINDING, BFT_SET, BFT_STENCIL_OFFSETS_BINDING,
-    BFT_STENCIL_TERMS_BINDING, BFT_TABLES_BINDING, BFT_TABLE_WEIGHTS_BINDING,
+    BFT_KIND_BOUNDARY, BFT_KIND_EXTRAORDINARY, BFT_KIND_PRIVATE, BFT_KIND_REGULAR,
+    BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING, BFT_MIRROR_PERMS_BINDING,
+    BFT_OWNER_LOCAL_MASK, BFT_OWNER_SHIFT, BFT_PATCH_HEADERS_BINDING, BFT_PATCH_RINGS_BINDING,
+    BFT_ROW_MAPS_BINDING, BFT_SET, BFT_TABLES_BINDING, BFT_TABLE_WEIGHTS_BINDING,
     BFT_TANGENT_OFFSETS_BINDING, BFT_TANGENT_TERMS_BINDING, FRAME_SET,
 };
+use crate::stencil::{GpuStencils, StencilError};
 use bytemuck::{Pod, Zeroable};
 use std::mem::{offset_of, size_of};
 use topology::patches::bft::{
     BasisTables, BftCase, BftKey, LoopBft, Owner, PatchRecords, TangentStencils,
 };
-use topology::refine::stencil::StencilTable;
-
-/// `BasePosition` of `bft.glsl`: one base vertex (binding [`BFT_BASE_POSITIONS_BINDING`]),
-/// rewritten every frame of an animation.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct BasePosition {
-    pub x: f32,
-    pub y: f32,
-    pub z: f32,
-}
-
-/// `StencilTerm`: one term of a base → level-1 stencil row ([`BFT_STENCIL_TERMS_BINDING`]); the
-/// rows are delimited by the CSR offsets of [`BFT_STENCIL_OFFSETS_BINDING`].
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct StencilTerm {
-    /// Base vertex.
-    pub index: u32,
-    pub weight: f32,
-}
 
 /// `TangentTerm`: one term of both limit-tangent masks of a level-1 vertex
 /// ([`BFT_TANGENT_TERMS_BINDING`], rows by [`BFT_TANGENT_OFFSETS_BINDING`]).
@@ -125,8 +105,9 @@ pub struct TableEntry {
     pub kind: u32,
 }
 
-/// A level-1 position or normal on the GPU (`vec4`, `w` unused): written by the compute passes
-/// into [`BFT_LEVEL1_POSITIONS_BINDING`] and [`BFT_LEVEL1_NORMALS_BINDING`].
+/// A level-1 position or normal on the GPU (`vec4`, `w` unused): written by the stencil
+/// evaluator into [`BFT_LEVEL1_POSITIONS_BINDING`] and by `normals.comp` into
+/// [`BFT_LEVEL1_NORMALS_BINDING`].
 pub type Level1Point = [f32; 4];
 
 /// A weight offset that names no block (tangent tables not built).
@@ -135,8 +116,6 @@ pub const NO_WEIGHTS: u32 = u32::MAX;
 pub const NO_ROW: u32 = u32::MAX;
 
 const _: () = {
-    assert!(size_of::<BasePosition>() == 12);
-    assert!(size_of::<StencilTerm>() == 8);
     assert!(size_of::<TangentTerm>() == 12);
     assert!(size_of::<PatchHeader>() == 40);
     assert!(offset_of!(PatchHeader, edge_owner) == 16);
@@ -149,10 +128,7 @@ const _: () = {
 const _: () = assert!(FRAME_SET == 0 && BFT_SET == FRAME_SET + 1);
 
 /// Every binding of the BFT descriptor set, in binding order.
-pub const STORAGE_BINDINGS: [u32; 13] = [
-    BFT_BASE_POSITIONS_BINDING,
-    BFT_STENCIL_OFFSETS_BINDING,
-    BFT_STENCIL_TERMS_BINDING,
+pub const STORAGE_BINDINGS: [u32; 10] = [
     BFT_TANGENT_OFFSETS_BINDING,
     BFT_TANGENT_TERMS_BINDING,
     BFT_LEVEL1_POSITIONS_BINDING,
@@ -193,6 +169,9 @@ pub enum LayoutError {
         buffer: &'static str,
         detail: String,
     },
+    /// The base → level-1 stencils.
+    #[error("BFT base → level-1 stencils: {0}")]
+    Stencil(#[from] StencilError),
 }
 
 fn invalid(buffer: &'static str, detail: impl Into<String>) -> LayoutError {
@@ -206,9 +185,8 @@ fn invalid(buffer: &'static str, detail: impl Into<String>) -> LayoutError {
 /// every index the shaders can form from these arrays is in range ([`GpuBft::validate`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct GpuBft {
-    /// CSR offsets of the base → level-1 stencils (level-1 vertex count + 1).
-    pub stencil_offsets: Vec<u32>,
-    pub stencil_terms: Vec<StencilTerm>,
+    /// The base → level-1 stencils: one row per level-1 vertex over the base vertices.
+    pub stencils: GpuStencils,
     /// CSR offsets of the level-1 limit-tangent stencils.
     pub tangent_offsets: Vec<u32>,
     pub tangent_terms: Vec<TangentTerm>,
@@ -328,21 +306,6 @@ fn header_bytes(table: &TableHeader, entries: &[TableEntry]) -> Vec<u8> {
     out
 }
 
-/// The base → level-1 stencils as CSR offsets and f32 terms, taking `st` (its f64 weights are
-/// freed here, not kept beside the packed copy).
-pub fn pack_stencils(st: StencilTable) -> (Vec<u32>, Vec<StencilTerm>) {
-    let terms = st
-        .indices
-        .iter()
-        .zip(&st.weights)
-        .map(|(&index, &w)| StencilTerm {
-            index,
-            weight: w as f32,
-        })
-        .collect();
-    (st.offsets, terms)
-}
-
 /// The level-1 limit-tangent stencils as CSR offsets and f32 terms, taking `ts`.
 pub fn pack_tangents(ts: TangentStencils) -> (Vec<u32>, Vec<TangentTerm>) {
     let terms = ts
@@ -391,7 +354,7 @@ impl GpuBft {
     /// Packs `bft` and validates the result (a copy: `bft` stays whole for the CPU reference;
     /// the technique packs stage by stage instead, freeing each input once packed).
     pub fn new(bft: &LoopBft) -> Result<GpuBft, LayoutError> {
-        let (stencil_offsets, stencil_terms) = pack_stencils(bft.stencils.clone());
+        let stencils = GpuStencils::from_table(bft.stencils.clone());
         let (tangent_offsets, tangent_terms) = pack_tangents(bft.tangent_stencils.clone());
         let (patches, patch_rings) = pack_patches(bft.records.clone(), &bft.tables)?;
         let PackedTables {
@@ -402,8 +365,7 @@ impl GpuBft {
             weights,
         } = PackedTables::new(&bft.tables);
         let g = GpuBft {
-            stencil_offsets,
-            stencil_terms,
+            stencils,
             tangent_offsets,
             tangent_terms,
             patches,
@@ -441,7 +403,7 @@ impl GpuBft {
 
     /// Bytes of the base → level-1 stencils.
     pub fn stencil_bytes(&self) -> usize {
-        4 * self.stencil_offsets.len() + size_of::<StencilTerm>() * self.stencil_terms.len()
+        self.stencils.bytes() as usize
     }
 
     /// Proves every read the shaders make is in bounds: stencil and ring indices name existing
@@ -449,12 +411,8 @@ impl GpuBft {
     /// equals the face's, rows and permutations lie inside the weight and permutation arrays,
     /// and every dyadic point has a row (the interpolating path reads them unchecked).
     pub fn validate(&self) -> Result<(), LayoutError> {
-        validate_stencils(
-            &self.stencil_offsets,
-            &self.stencil_terms,
-            self.level1_vertices,
-            self.base_vertices,
-        )?;
+        self.stencils
+            .validate(self.level1_vertices, self.base_vertices)?;
         validate_tangents(
             &self.tangent_offsets,
             &self.tangent_terms,
@@ -477,22 +435,6 @@ impl GpuBft {
             self.level1_vertices,
         )
     }
-}
-
-/// The base → level-1 stencils: one CSR row per level-1 vertex over the base vertices.
-pub fn validate_stencils(
-    offsets: &[u32],
-    terms: &[StencilTerm],
-    level1_vertices: u32,
-    base_vertices: u32,
-) -> Result<(), LayoutError> {
-    csr(
-        offsets,
-        terms.iter().map(|t| t.index),
-        level1_vertices,
-        base_vertices,
-        "StencilTerms",
-    )
 }
 
 /// The tangent stencils: one CSR row per level-1 vertex over the level-1 vertices.
@@ -811,23 +753,13 @@ impl GpuBft {
         }
     }
 
-    /// Level-1 positions from base positions, as `glsl/bft/subdivide.comp` computes them.
+    /// Level-1 positions from base positions, as the stencil evaluator computes them
+    /// ([`GpuStencils::row_point`]).
     pub fn subdivide(&self, base: &[[f32; 3]]) -> Vec<Level1Point> {
-        (0..self.level1_vertices as usize)
+        (0..self.level1_vertices)
             .map(|v| {
-                let (a, b) = (
-                    self.stencil_offsets[v] as usize,
-                    self.stencil_offsets[v + 1] as usize,
-                );
-                let mut p = [0f32; 4];
-                for term in &self.stencil_terms[a..b] {
-                    let q = base[term.index as usize];
-                    for c in 0..3 {
-                        let t = term.weight * q[c];
-                        p[c] += t;
-                    }
-                }
-                p
+                let [x, y, z] = self.stencils.row_point(v, |i| base[i as usize]);
+                [x, y, z, 1.0]
             })
             .collect()
     }

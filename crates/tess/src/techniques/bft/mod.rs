@@ -2,15 +2,17 @@
 //! Boubekeur, the paper's Fig. 2):
 //!
 //! 1. **Initial GPU subdivision step** (the pre-pass, every frame): level-1 positions as
-//!    stencils over the base positions (`glsl/bft/subdivide.comp`), then level-1 limit normals
-//!    from the limit tangent masks (`glsl/bft/normals.comp`). An animated base mesh costs one
-//!    upload of its positions per frame; stencils, patch records and tables never change.
+//!    stencils over the base positions (the stencil evaluator, [`crate::stencil`], reading the
+//!    frame slot's base positions and writing the level-1 positions), then level-1 limit
+//!    normals from the limit tangent masks (`glsl/bft/normals.comp`). An animated base mesh
+//!    costs one upload of its positions per frame; stencils, patch records and tables never
+//!    change.
 //! 2. **Main pass**: one patch (one control point carrying the face index) per level-1 face.
 //!    `bft.tesc` sets power-of-two (or fractional) edge factors from each edge's two endpoints
 //!    only; `bft.tese` evaluates the table row of each tess coordinate (see
 //!    `glsl/bft/bft.glsl`, mirrored in f32 by [`layout::GpuBft::eval_tess`]).
 //!
-//! **Cost on a CPU driver** (issue 16; lavapipe runs the TES on the CPU, eight vertices a SIMD
+//! **Cost on a CPU driver** (lavapipe runs the TES on the CPU, eight vertices a SIMD
 //! batch, and executes both sides of every branch, masked): a storage-buffer read indexed by
 //! the patch is a per-lane loop there, a patch input one load for the whole patch. So the TCS
 //! gathers the patch's header words, mirror permutation and ring (level-1 positions and
@@ -28,10 +30,10 @@
 //! the input's polygons, so callers never see the triangulation.
 //!
 //! **Buffers beyond `maxStorageBufferRange`** (a 1M-triangle mesh has 4M level-1 faces: 160 MB
-//! of patch headers, 190 MB of rings, more than lavapipe's 128 MiB): the pre-pass runs in
-//! chunks of level-1 vertices and the draw in chunks of patches, each with its own descriptor
-//! set of windows into the shared buffers and its bases in the push constants
-//! ([`super::windows`]). A patch's footprint includes its edge and corner owners' headers,
+//! of patch headers, 190 MB of rings, more than lavapipe's 128 MiB): the stencil evaluator
+//! windows its own buffers, the normals pass runs in chunks of level-1 vertices and the draw
+//! in chunks of patches, each with its own descriptor set of windows into the shared buffers
+//! and its bases in the push constants ([`super::windows`]). A patch's footprint includes its edge and corner owners' headers,
 //! rings and ring vertices, since the TES evaluates shared points in the owner's frame. A mesh
 //! that fits is one chunk with bases 0: the same draw as before.
 use crate::capture::{face_corner_uv, FacePoint};
@@ -40,27 +42,29 @@ use crate::error::{Param, ParamError, Result, TablesTooLarge, TessError};
 pub mod layout;
 
 use super::shared::{
-    canonical_zero, check_adaptive_policy, factor_fields, gpu_coordinate, storage, storage_binding,
+    canonical_zero, check_adaptive_policy, compute_pipeline, factor_fields, storage,
+    storage_binding, storage_buffers,
 };
 use super::windows::{self, Chunk, Limits, Member, Space};
+use crate::animation::base_positions;
 use crate::bench::usage::Laps;
 use crate::gpu::bindings::{
-    BFT_BASE_POSITIONS_BINDING, BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING,
-    BFT_LOCAL_SIZE, BFT_MIRROR_PERMS_BINDING, BFT_OPTION_FRACTIONAL, BFT_OPTION_GEOMETRIC_NORMALS,
+    BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING, BFT_LOCAL_SIZE,
+    BFT_MIRROR_PERMS_BINDING, BFT_OPTION_FRACTIONAL, BFT_OPTION_GEOMETRIC_NORMALS,
     BFT_OPTION_PATCH_COLOURS, BFT_PATCH_HEADERS_BINDING, BFT_PATCH_RINGS_BINDING,
-    BFT_ROW_MAPS_BINDING, BFT_STENCIL_OFFSETS_BINDING, BFT_STENCIL_TERMS_BINDING,
-    BFT_TABLES_BINDING, BFT_TABLE_WEIGHTS_BINDING, BFT_TANGENT_OFFSETS_BINDING,
-    BFT_TANGENT_TERMS_BINDING,
+    BFT_ROW_MAPS_BINDING, BFT_TABLES_BINDING, BFT_TABLE_WEIGHTS_BINDING,
+    BFT_TANGENT_OFFSETS_BINDING, BFT_TANGENT_TERMS_BINDING,
 };
 use crate::gpu::BftPush;
-use crate::shaders::{self, Stage, Variant};
+use crate::shaders::{Stage, Variant};
+use crate::stencil::{self, GpuStencils, StencilBlock, StencilEvaluator, StencilVertices};
 use crate::technique::{
     for_each_draw, number_arrays, DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features,
     FrameParams, Pass, PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
 };
 use crate::techniques::{BuildOptions, Built, TechniqueInfo};
 use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, Domain, Spacing};
-use layout::{BasePosition, PackedTables, PatchHeader, StencilTerm, TangentTerm, STORAGE_BINDINGS};
+use layout::{PackedTables, PatchHeader, TangentTerm, STORAGE_BINDINGS};
 use std::ops::Range;
 use topology::patches::bft::{
     build_patch_records, face_rotations, level1_base_domain, loop_level1, loop_tables,
@@ -68,7 +72,7 @@ use topology::patches::bft::{
 };
 use topology::ControlMesh;
 use vk_core::descriptor::{BindingDesc, DescriptorPool};
-use vk_core::pipeline::{Pipeline, ShaderStage};
+use vk_core::pipeline::Pipeline;
 use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Encoder, MemoryLocation};
 
 impl TechniqueId {
@@ -150,23 +154,15 @@ const fn member(stride: usize, extra: u32) -> Member {
         extra,
     }
 }
-/// Level-1 positions and normals (`vec4`) and the stencil and tangent CSR offsets (one past).
+/// Level-1 positions and normals (`vec4`) and the tangent CSR offsets (one past).
 const LEVEL1_MEMBERS: [Member; 2] = [member(16, 0), member(4, 1)];
 const LEVEL1: Space = Space {
     name: "level-1 vertex",
     members: &LEVEL1_MEMBERS,
 };
-const STENCIL: Space = Space {
-    name: "stencil term",
-    members: &[member(std::mem::size_of::<StencilTerm>(), 0)],
-};
 const TANGENT: Space = Space {
     name: "tangent term",
     members: &[member(std::mem::size_of::<TangentTerm>(), 0)],
-};
-const BASE: Space = Space {
-    name: "base position",
-    members: &[member(std::mem::size_of::<BasePosition>(), 0)],
 };
 const PATCHES: Space = Space {
     name: "patch header",
@@ -181,9 +177,7 @@ const RINGS: Space = Space {
 #[derive(Clone, Debug, Default)]
 struct SetWindows {
     level1: Range<u32>,
-    stencil: Range<u32>,
     tangent: Range<u32>,
-    base: Range<u32>,
     patches: Range<u32>,
     rings: Range<u32>,
 }
@@ -192,9 +186,7 @@ impl SetWindows {
     /// The push constants' bases.
     fn apply(&self, push: &mut BftPush) {
         push.level1_base = self.level1.start;
-        push.stencil_base = self.stencil.start;
         push.tangent_base = self.tangent.start;
-        push.base_vertex_base = self.base.start;
         push.patch_base = self.patches.start;
         push.ring_base = self.rings.start;
     }
@@ -208,50 +200,36 @@ fn span(indices: impl IntoIterator<Item = u32>) -> Range<u32> {
     lo..hi + 1
 }
 
-/// The CSR arrays the pre-pass reads, as packed ([`layout::pack_stencils`],
-/// [`layout::pack_tangents`]).
-struct PrePassData<'a> {
-    stencil_offsets: &'a [u32],
-    stencil_terms: &'a [StencilTerm],
-    tangent_offsets: &'a [u32],
-    tangent_terms: &'a [TangentTerm],
+/// Chunks of level-1 vertices for the normals pass: each reads its tangent rows and their
+/// level-1 vertices; at most `max_items` per dispatch.
+fn plan_normals(
+    tangent_offsets: &[u32],
+    tangent_terms: &[TangentTerm],
     level1_vertices: u32,
-}
-
-/// Chunks of level-1 vertices for the pre-pass: each reads its stencil rows, their base
-/// vertices, its tangent rows and their level-1 vertices; at most `max_items` per dispatch.
-fn plan_pre_pass(
-    g: &PrePassData,
     limits: Limits,
     max_items: u32,
 ) -> Result<Vec<(Range<u32>, SetWindows)>> {
     let chunks = windows::plan(
         "level-1 vertex",
-        g.level1_vertices,
-        &[LEVEL1, STENCIL, TANGENT, BASE],
+        level1_vertices,
+        &[LEVEL1, TANGENT],
         limits,
         |v| {
             let i = v as usize;
-            let (s0, s1) = (g.stencil_offsets[i], g.stencil_offsets[i + 1]);
-            let (t0, t1) = (g.tangent_offsets[i], g.tangent_offsets[i + 1]);
-            let tangent = &g.tangent_terms[t0 as usize..t1 as usize];
-            let stencil = &g.stencil_terms[s0 as usize..s1 as usize];
+            let (t0, t1) = (tangent_offsets[i], tangent_offsets[i + 1]);
+            let tangent = &tangent_terms[t0 as usize..t1 as usize];
             [
                 span(std::iter::once(v).chain(tangent.iter().map(|t| t.index))),
-                s0..s1,
                 t0..t1,
-                span(stencil.iter().map(|t| t.index)),
             ]
         },
     )?;
     let mut out = Vec::new();
     for Chunk { items, windows } in chunks {
-        let [level1, stencil, tangent, base] = windows;
+        let [level1, tangent] = windows;
         let w = SetWindows {
             level1,
-            stencil,
             tangent,
-            base,
             ..Default::default()
         };
         let mut first = items.start;
@@ -370,13 +348,6 @@ fn flag(on: bool, bit: u32) -> u32 {
     }
 }
 
-/// Base positions as the `BasePositions` buffer holds them.
-fn as_base_positions(positions: &[[f32; 3]]) -> &[u8] {
-    bytemuck::cast_slice::<BasePosition, u8>(bytemuck::cast_slice::<[f32; 3], BasePosition>(
-        positions,
-    ))
-}
-
 /// How a BFT surface is built (the per-frame choices are in [`FrameParams`]).
 #[derive(Clone, Debug)]
 pub struct BftOptions {
@@ -388,8 +359,8 @@ pub struct BftOptions {
     pub name: String,
     /// Gather each patch's ring into a per-patch block that the TES reads instead of the
     /// global buffers (the `patch_block` shader axis). `None`: by device, on for a CPU
-    /// implementation (lavapipe), off for a GPU (docs/benchmarks.md, "Session 18: the first real GPU"); there
-    /// the environment's `TESSERA_BFT_PATCH_BLOCK=1` or `=0` decides instead, for A/B runs.
+    /// implementation (lavapipe), off for a GPU (docs/benchmarks.md, "Table I on an NVIDIA
+    /// H100"); there the environment's `TESSERA_BFT_PATCH_BLOCK=1` or `=0` decides instead, for A/B runs.
     pub patch_block: Option<bool>,
 }
 
@@ -419,12 +390,13 @@ fn patch_block_for(device: &vk_core::Device) -> bool {
 /// One base mesh on the GPU with everything the BFT pipeline reads. Drop order: pipelines,
 /// sets (they keep their pool alive), pool, buffers.
 pub struct Bft {
-    subdivide: Pipeline,
+    /// Level-1 positions from the frame slot's base positions (one evaluator target per slot).
+    evaluator: StencilEvaluator,
     normals: Pipeline,
-    /// Per frame slot, one set per pre-pass chunk (slots differ only in the base positions).
-    pre_sets: Vec<Vec<DescriptorSet>>,
-    /// Level-1 vertices of each pre-pass chunk, and its windows.
-    pre_chunks: Vec<(Range<u32>, SetWindows)>,
+    /// One set per normals chunk (the normals never read base positions: shared by every slot).
+    normals_sets: Vec<DescriptorSet>,
+    /// Level-1 vertices of each normals chunk, and its windows.
+    normals_chunks: Vec<(Range<u32>, SetWindows)>,
     /// One set per draw chunk (the draw never reads base positions: shared by every slot).
     draw_sets: Vec<DescriptorSet>,
     /// Patches of each draw chunk, and its windows.
@@ -454,14 +426,6 @@ pub struct Bft {
     pub notes: Vec<String>,
     /// The patch-block build ([`BftOptions::patch_block`]).
     patch_block: bool,
-}
-
-/// The base positions of `mesh` in f32.
-pub fn base_positions(mesh: &ControlMesh) -> Vec<[f32; 3]> {
-    mesh.positions
-        .iter()
-        .map(|p| p.map(gpu_coordinate))
-        .collect()
 }
 
 /// Maximal runs of the `patches` level-1 faces whose base triangle is not among `holes` (a
@@ -543,6 +507,257 @@ fn bytes_of<T>(v: &[T]) -> u64 {
     std::mem::size_of_val(v) as u64
 }
 
+/// A topology error of the mesh `options` name.
+fn mesh_error(options: &BftOptions, e: topology::limit::eval::EvalError) -> TessError {
+    TessError::Mesh {
+        name: options.name.clone(),
+        source: e.into(),
+    }
+}
+
+/// The normals pass's data: the level-1 limit-tangent stencils packed, validated and uploaded
+/// (by binding), its chunks, and the terms' count and bytes.
+struct NormalsStage {
+    buffers: Vec<(u32, Buffer)>,
+    chunks: Vec<(Range<u32>, SetWindows)>,
+    terms: u64,
+    bytes: u64,
+}
+
+impl NormalsStage {
+    fn new(
+        device: &vk_core::Device,
+        stencils: topology::patches::bft::TangentStencils,
+        level1_vertices: u32,
+        limits: Limits,
+    ) -> Result<Self> {
+        let (offsets, terms) = layout::pack_tangents(stencils);
+        layout::validate_tangents(&offsets, &terms, level1_vertices)?;
+        let max_groups = device.info.caps.max_compute_work_group_count[0];
+        let chunks = plan_normals(
+            &offsets,
+            &terms,
+            level1_vertices,
+            limits,
+            max_groups.saturating_mul(BFT_LOCAL_SIZE),
+        )?;
+        let buffers = vec![
+            (
+                BFT_TANGENT_OFFSETS_BINDING,
+                storage(
+                    device,
+                    "bft tangent offsets",
+                    bytemuck::cast_slice(&offsets),
+                )?,
+            ),
+            (
+                BFT_TANGENT_TERMS_BINDING,
+                storage(device, "bft tangent terms", bytemuck::cast_slice(&terms))?,
+            ),
+        ];
+        Ok(Self {
+            buffers,
+            chunks,
+            terms: terms.len() as u64,
+            bytes: bytes_of(&offsets) + bytes_of(&terms),
+        })
+    }
+}
+
+/// The draw's data: patch records and tables built from the level-1 mesh, packed, validated
+/// and uploaded (by binding), the draw chunks, each face's rotation, and the counts and bytes
+/// of the summary.
+struct PatchStage {
+    buffers: Vec<(u32, Buffer)>,
+    draw_chunks: Vec<(Range<u32>, SetWindows)>,
+    rotations: Vec<u8>,
+    count: u32,
+    ring_slots: u64,
+    bytes: u64,
+    table: layout::TableHeader,
+    tangents: bool,
+    table_bytes: u64,
+}
+
+impl PatchStage {
+    /// Takes the level-1 mesh and frees it once the records and tables are built, and each
+    /// product once uploaded; `laps` and `stages` time the records and tables.
+    fn new(
+        device: &vk_core::Device,
+        level1: topology::limit::eval::LocalMesh,
+        options: &BftOptions,
+        limits: Limits,
+        laps: &mut Laps,
+        stages: &mut Vec<String>,
+    ) -> Result<Self> {
+        let records = build_patch_records(&level1).map_err(|e| mesh_error(options, e))?;
+        check_table_range(&records, options.table_level, options, limits.max_range)?;
+        let tables = loop_tables(&level1, &records, options.table_level, options.tangents)
+            .map_err(|e| mesh_error(options, e))?;
+        let rotations = face_rotations(&level1, &records);
+        let level1_vertices = level1.num_vertices() as u32;
+        drop(level1);
+        stages.push(laps.lap("records and tables"));
+        let packed = PackedTables::new(&tables);
+        packed.validate()?;
+        let (patches, rings) = layout::pack_patches(records, &tables)?;
+        let tangents = tables.tangents;
+        drop(tables);
+        layout::validate_patches(&patches, &rings, &packed.entries, level1_vertices)?;
+        let draw_chunks = plan_draw(&patches, &rings, limits)?;
+        let (count, ring_slots) = (patches.len() as u32, rings.len() as u64);
+        let bytes = bytes_of(&patches) + bytes_of(&rings);
+        let mut buffers = vec![(
+            BFT_PATCH_HEADERS_BINDING,
+            storage(device, "bft patch headers", bytemuck::cast_slice(&patches))?,
+        )];
+        drop(patches);
+        buffers.push((
+            BFT_PATCH_RINGS_BINDING,
+            storage(device, "bft patch rings", bytemuck::cast_slice(&rings))?,
+        ));
+        drop(rings);
+        buffers.extend(table_buffers(device, &packed)?);
+        Ok(Self {
+            buffers,
+            draw_chunks,
+            rotations,
+            count,
+            ring_slots,
+            bytes,
+            table: packed.table,
+            tangents,
+            table_bytes: packed.bytes() as u64,
+        })
+    }
+}
+
+/// A set of the BFT layout: the windowed buffers of `statics` as `w`'s windows, the others
+/// whole.
+fn write_set(
+    pool: &DescriptorPool,
+    layout: &vk_core::descriptor::DescriptorSetLayout,
+    statics: &[(u32, Buffer)],
+    summary: &BftSummary,
+    w: &SetWindows,
+) -> Result<DescriptorSet> {
+    let set = pool.allocate_set(layout)?;
+    let n1 = summary.level1_vertices as u64;
+    for (binding, buf) in statics {
+        let (m, len, win) = match *binding {
+            BFT_LEVEL1_POSITIONS_BINDING | BFT_LEVEL1_NORMALS_BINDING => {
+                (LEVEL1_MEMBERS[0], n1, &w.level1)
+            }
+            BFT_TANGENT_OFFSETS_BINDING => (LEVEL1_MEMBERS[1], n1 + 1, &w.level1),
+            BFT_TANGENT_TERMS_BINDING => (TANGENT.members[0], summary.tangent_terms, &w.tangent),
+            BFT_PATCH_HEADERS_BINDING => {
+                (PATCHES.members[0], summary.patch_count as u64, &w.patches)
+            }
+            BFT_PATCH_RINGS_BINDING => (RINGS.members[0], summary.ring_slots, &w.rings),
+            _ => {
+                windows::write_whole(&set, *binding, buf)?;
+                continue;
+            }
+        };
+        windows::write_window(&set, *binding, buf, m, len, win)?;
+    }
+    Ok(set)
+}
+
+/// The initial subdivision step's GPU side: per frame slot a base-position buffer (the
+/// evaluator's vertices), the level-1 positions, and the stencil evaluator from each slot's
+/// base positions to the level-1 positions.
+struct InitialStep {
+    evaluator: StencilEvaluator,
+    base: Vec<Buffer>,
+    level1_positions: Buffer,
+}
+
+impl InitialStep {
+    fn new(
+        device: &vk_core::Device,
+        stencils: &GpuStencils,
+        base_positions: &[[f32; 3]],
+        level1_vertices: u32,
+        frames: usize,
+    ) -> Result<Self> {
+        let base_vertices = base_positions.len() as u32;
+        let vertices = stencil::vertices(base_positions);
+        let mut base = Vec::with_capacity(frames);
+        for i in 0..frames {
+            let mut buf = Buffer::new(
+                device,
+                &BufferDesc {
+                    name: &format!("bft base positions {i}"),
+                    size: stencil::vertex_bytes(base_vertices),
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                    location: MemoryLocation::CpuToGpu,
+                },
+            )?;
+            buf.write(0, bytemuck::cast_slice(&vertices))?;
+            base.push(buf);
+        }
+        let level1_positions = Buffer::new(
+            device,
+            &BufferDesc {
+                name: "bft level-1 positions",
+                size: stencil::vertex_bytes(level1_vertices),
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::GpuOnly,
+            },
+        )?;
+        let targets: Vec<(&Buffer, &Buffer)> =
+            base.iter().map(|b| (b, &level1_positions)).collect();
+        let evaluator = StencilEvaluator::new(
+            device,
+            "bft",
+            stencils,
+            &[StencilBlock {
+                rows: 0..level1_vertices,
+                destination: 0,
+            }],
+            StencilVertices {
+                sources: base_vertices,
+                destinations: level1_vertices,
+                in_place: false,
+            },
+            &targets,
+        )?;
+        Ok(Self {
+            evaluator,
+            base,
+            level1_positions,
+        })
+    }
+}
+
+/// The basis-function tables' buffers, by binding: header and entries, mirror permutations,
+/// row maps, weights.
+fn table_buffers(device: &vk_core::Device, t: &PackedTables) -> Result<Vec<(u32, Buffer)>> {
+    let table_header = t.header_bytes();
+    storage_buffers(
+        device,
+        &[
+            (BFT_TABLES_BINDING, "bft tables", &table_header[..]),
+            (
+                BFT_MIRROR_PERMS_BINDING,
+                "bft mirror permutations",
+                bytemuck::cast_slice(&t.mirror_perms),
+            ),
+            (
+                BFT_ROW_MAPS_BINDING,
+                "bft row maps",
+                bytemuck::cast_slice(&t.row_maps),
+            ),
+            (
+                BFT_TABLE_WEIGHTS_BINDING,
+                "bft table weights",
+                bytemuck::cast_slice(&t.weights),
+            ),
+        ],
+    )
+}
+
 impl Bft {
     /// Prepares `mesh` (fan-triangulated first when it has polygons; refined once on the CPU
     /// for the topology; stencils, patch records and the tables at `options.table_level`) and
@@ -572,286 +787,116 @@ impl Bft {
         }
         let mut laps = Laps::new();
         let mut stages = Vec::new();
-        let mesh_error = |e: topology::limit::eval::EvalError| TessError::Mesh {
-            name: options.name.clone(),
-            source: e.into(),
-        };
         let (loop_mesh, fans, note) = loop_control_mesh(mesh, &options.name);
         let limits = Limits::of(&device);
-        // The level-1 mesh and the base → level-1 stencils, packed at once (f32 terms).
-        let (level1, stencils) = loop_level1(&loop_mesh).map_err(mesh_error)?;
+        // The level-1 mesh and the base → level-1 stencils, packed at once (f32 terms), handed
+        // to the stencil evaluator and freed.
+        let (level1, stencils) = loop_level1(&loop_mesh).map_err(|e| mesh_error(options, e))?;
         let base_vertices = loop_mesh.positions.len() as u32;
         let level1_vertices = level1.num_vertices() as u32;
-        let (stencil_offsets, stencil_terms) = layout::pack_stencils(stencils);
-        layout::validate_stencils(
-            &stencil_offsets,
-            &stencil_terms,
+        let stencils = GpuStencils::from_table(stencils);
+        stencils
+            .validate(level1_vertices, base_vertices)
+            .map_err(layout::LayoutError::from)?;
+        let base_positions = base_positions(&loop_mesh);
+        let step = InitialStep::new(
+            &device,
+            &stencils,
+            &base_positions,
             level1_vertices,
-            base_vertices,
+            ctx.frames_in_flight(),
         )?;
+        let (stencil_count, stencil_bytes) = (stencils.terms.len() as u64, stencils.bytes());
+        drop(stencils);
         stages.push(laps.lap("level 1"));
-        // Tangent stencils, then the pre-pass chunks (they window both CSR tables); both
-        // uploaded and freed.
-        let (tangent_offsets, tangent_terms) =
-            layout::pack_tangents(loop_tangent_stencils(&level1));
-        layout::validate_tangents(&tangent_offsets, &tangent_terms, level1_vertices)?;
-        let max_groups = device.info.caps.max_compute_work_group_count[0];
-        let pre_chunks = plan_pre_pass(
-            &PrePassData {
-                stencil_offsets: &stencil_offsets,
-                stencil_terms: &stencil_terms,
-                tangent_offsets: &tangent_offsets,
-                tangent_terms: &tangent_terms,
-                level1_vertices,
-            },
-            limits,
-            max_groups.saturating_mul(BFT_LOCAL_SIZE),
-        )?;
-        let mut statics = vec![
-            (
-                BFT_STENCIL_OFFSETS_BINDING,
-                storage(
-                    &device,
-                    "bft stencil offsets",
-                    bytemuck::cast_slice(&stencil_offsets),
-                )?,
-            ),
-            (
-                BFT_STENCIL_TERMS_BINDING,
-                storage(
-                    &device,
-                    "bft stencil terms",
-                    bytemuck::cast_slice(&stencil_terms),
-                )?,
-            ),
-            (
-                BFT_TANGENT_OFFSETS_BINDING,
-                storage(
-                    &device,
-                    "bft tangent offsets",
-                    bytemuck::cast_slice(&tangent_offsets),
-                )?,
-            ),
-            (
-                BFT_TANGENT_TERMS_BINDING,
-                storage(
-                    &device,
-                    "bft tangent terms",
-                    bytemuck::cast_slice(&tangent_terms),
-                )?,
-            ),
-        ];
-        let (stencil_count, tangent_count) =
-            (stencil_terms.len() as u64, tangent_terms.len() as u64);
-        let stencil_bytes = bytes_of(&stencil_offsets) + bytes_of(&stencil_terms);
-        let tangent_bytes = bytes_of(&tangent_offsets) + bytes_of(&tangent_terms);
-        drop((
-            stencil_offsets,
-            stencil_terms,
-            tangent_offsets,
-            tangent_terms,
-        ));
-        stages.push(laps.lap("tangent stencils and upload"));
-        // Records and tables; then the level-1 mesh is no longer needed.
-        let records = build_patch_records(&level1).map_err(mesh_error)?;
-        check_table_range(&records, table_level, options, limits.max_range)?;
-        let tables =
-            loop_tables(&level1, &records, table_level, options.tangents).map_err(mesh_error)?;
-        let rotations = face_rotations(&level1, &records);
-        drop(level1);
-        stages.push(laps.lap("records and tables"));
-        let packed_tables = PackedTables::new(&tables);
-        packed_tables.validate()?;
-        let (patches, patch_rings) = layout::pack_patches(records, &tables)?;
-        let tangents = tables.tangents;
-        drop(tables);
-        layout::validate_patches(
-            &patches,
-            &patch_rings,
-            &packed_tables.entries,
+        let normals = NormalsStage::new(
+            &device,
+            loop_tangent_stencils(&level1),
             level1_vertices,
+            limits,
         )?;
-        let draw_chunks = plan_draw(&patches, &patch_rings, limits)?;
-        let patch_count = patches.len() as u32;
-        let ring_slots = patch_rings.len() as u64;
-        let patch_bytes = bytes_of(&patches) + bytes_of(&patch_rings);
-        statics.push((
-            BFT_PATCH_HEADERS_BINDING,
-            storage(&device, "bft patch headers", bytemuck::cast_slice(&patches))?,
-        ));
-        drop(patches);
-        statics.push((
-            BFT_PATCH_RINGS_BINDING,
-            storage(
-                &device,
-                "bft patch rings",
-                bytemuck::cast_slice(&patch_rings),
-            )?,
-        ));
-        drop(patch_rings);
-        let table_header = packed_tables.header_bytes();
-        for (binding, name, bytes) in [
-            (BFT_TABLES_BINDING, "bft tables", &table_header[..]),
-            (
-                BFT_MIRROR_PERMS_BINDING,
-                "bft mirror permutations",
-                bytemuck::cast_slice(&packed_tables.mirror_perms),
-            ),
-            (
-                BFT_ROW_MAPS_BINDING,
-                "bft row maps",
-                bytemuck::cast_slice(&packed_tables.row_maps),
-            ),
-            (
-                BFT_TABLE_WEIGHTS_BINDING,
-                "bft table weights",
-                bytemuck::cast_slice(&packed_tables.weights),
-            ),
-        ] {
-            statics.push((binding, storage(&device, name, bytes)?));
-        }
+        stages.push(laps.lap("tangent stencils and upload"));
+        let patches = PatchStage::new(&device, level1, options, limits, &mut laps, &mut stages)?;
         let summary = BftSummary {
             base_vertices,
             level1_vertices,
-            patch_count,
-            table: packed_tables.table,
-            tangents,
+            patch_count: patches.count,
+            table: patches.table,
+            tangents: patches.tangents,
             stencil_terms: stencil_count,
-            tangent_terms: tangent_count,
-            ring_slots,
+            tangent_terms: normals.terms,
+            ring_slots: patches.ring_slots,
             stencil_bytes,
-            tangent_bytes,
-            patch_bytes,
-            table_bytes: packed_tables.bytes() as u64,
+            tangent_bytes: normals.bytes,
+            patch_bytes: patches.bytes,
+            table_bytes: patches.table_bytes,
         };
-        drop(packed_tables);
         stages.push(laps.lap("patches and upload"));
-        let frames = ctx.frames_in_flight();
-        ctx.ensure_set_layout(TechniqueId::BFT, &SET_BINDINGS)?;
-        let set_layout = ctx.set_layout(TechniqueId::BFT)?;
-        let max_sets = frames * pre_chunks.len() + draw_chunks.len();
-        let pool =
-            DescriptorPool::new(&device, "bft descriptor pool", set_layout, max_sets as u32)?;
-        let level1_bytes =
-            (std::mem::size_of::<layout::Level1Point>() * level1_vertices.max(1) as usize) as u64;
-        let level1 = |binding: u32, name: &str| -> Result<(u32, Buffer)> {
-            let desc = BufferDesc {
-                name,
-                size: level1_bytes,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-                location: MemoryLocation::GpuOnly,
-            };
-            Ok((binding, Buffer::new(&device, &desc)?))
-        };
-        statics.push(level1(
-            BFT_LEVEL1_POSITIONS_BINDING,
-            "bft level-1 positions",
-        )?);
-        statics.push(level1(BFT_LEVEL1_NORMALS_BINDING, "bft level-1 normals")?);
-        let base_positions = base_positions(&loop_mesh);
-        let mut base = Vec::new();
-        for i in 0..frames {
-            let mut buf = Buffer::new(
+        let InitialStep {
+            evaluator,
+            base,
+            level1_positions,
+        } = step;
+        let mut statics = normals.buffers;
+        statics.extend(patches.buffers);
+        statics.push((BFT_LEVEL1_POSITIONS_BINDING, level1_positions));
+        statics.push((
+            BFT_LEVEL1_NORMALS_BINDING,
+            Buffer::new(
                 &device,
                 &BufferDesc {
-                    name: &format!("bft base positions {i}"),
-                    size: (std::mem::size_of::<BasePosition>() * base_positions.len().max(1))
-                        as u64,
+                    name: "bft level-1 normals",
+                    size: stencil::vertex_bytes(level1_vertices),
                     usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-                    location: MemoryLocation::CpuToGpu,
+                    location: MemoryLocation::GpuOnly,
                 },
-            )?;
-            buf.write(0, as_base_positions(&base_positions))?;
-            base.push(buf);
-        }
-        // Every binding of a set: windowed buffers as the chunk's windows, the tables whole.
-        let (n1, nv) = (level1_vertices as u64, base_vertices as u64);
-        let write_set = |base: &Buffer, w: &SetWindows| -> Result<DescriptorSet> {
-            let set = pool.allocate_set(set_layout)?;
-            let csr = LEVEL1_MEMBERS[1];
-            windows::write_window(
-                &set,
-                BFT_BASE_POSITIONS_BINDING,
-                base,
-                BASE.members[0],
-                nv,
-                &w.base,
-            )?;
-            for (binding, buf) in &statics {
-                let (m, len, win) = match *binding {
-                    BFT_LEVEL1_POSITIONS_BINDING | BFT_LEVEL1_NORMALS_BINDING => {
-                        (LEVEL1_MEMBERS[0], n1, &w.level1)
-                    }
-                    BFT_STENCIL_OFFSETS_BINDING | BFT_TANGENT_OFFSETS_BINDING => {
-                        (csr, n1 + 1, &w.level1)
-                    }
-                    BFT_STENCIL_TERMS_BINDING => (STENCIL.members[0], stencil_count, &w.stencil),
-                    BFT_TANGENT_TERMS_BINDING => (TANGENT.members[0], tangent_count, &w.tangent),
-                    BFT_PATCH_HEADERS_BINDING => {
-                        (PATCHES.members[0], patch_count as u64, &w.patches)
-                    }
-                    BFT_PATCH_RINGS_BINDING => (RINGS.members[0], ring_slots, &w.rings),
-                    _ => {
-                        windows::write_whole(&set, *binding, buf)?;
-                        continue;
-                    }
-                };
-                windows::write_window(&set, *binding, buf, m, len, win)?;
-            }
-            Ok(set)
+            )?,
+        ));
+        ctx.ensure_set_layout(TechniqueId::BFT, &SET_BINDINGS)?;
+        let set_layout = ctx.set_layout(TechniqueId::BFT)?;
+        let max_sets = normals.chunks.len() + patches.draw_chunks.len();
+        let pool =
+            DescriptorPool::new(&device, "bft descriptor pool", set_layout, max_sets as u32)?;
+        let write = |chunks: &[(Range<u32>, SetWindows)]| -> Result<Vec<DescriptorSet>> {
+            chunks
+                .iter()
+                .map(|(_, w)| write_set(&pool, set_layout, &statics, &summary, w))
+                .collect()
         };
-        let mut pre_sets = Vec::new();
-        for b in &base {
-            let sets: Result<Vec<_>> = pre_chunks.iter().map(|(_, w)| write_set(b, w)).collect();
-            pre_sets.push(sets?);
-        }
-        let draw_base = base
-            .first()
-            .ok_or(TessError::FrameSlot { slot: 0, slots: 0 })?;
-        let draw_sets = draw_chunks
-            .iter()
-            .map(|(_, w)| write_set(draw_base, w))
-            .collect::<Result<Vec<_>>>()?;
-        let layouts = [ctx.frame_set_layout().raw, set_layout.raw];
-        let push = std::mem::size_of::<BftPush>() as u32;
-        let compute = |name: &str, stage: Stage| -> Result<Pipeline> {
-            Ok(Pipeline::compute(
-                &device,
-                name,
-                ShaderStage::new(
-                    vk::ShaderStageFlags::COMPUTE,
-                    shaders::spirv(stage, Variant::default())?,
-                ),
-                &layouts,
-                push,
-            )?)
-        };
-        let subdivide = compute("bft subdivide", Stage::BftSubdivideComp)?;
-        let normals = compute("bft normals", Stage::BftNormalsComp)?;
-        let arrays = number_arrays(&[(PatchType::LoopBft, patch_count, 1)]);
+        let normals_sets = write(&normals.chunks)?;
+        let draw_sets = write(&patches.draw_chunks)?;
+        let normals_pipeline = compute_pipeline(
+            &device,
+            "bft normals",
+            Stage::BftNormalsComp,
+            &[ctx.frame_set_layout().raw, set_layout.raw],
+            std::mem::size_of::<BftPush>(),
+        )?;
+        let arrays = number_arrays(&[(PatchType::LoopBft, summary.patch_count, 1)]);
         stages.push(laps.lap("sets and pipelines"));
         log::info!(
-            "bft {}: {}; {} pre-pass and {} draw chunks",
+            "bft {}: {}; {:?} stencil (dispatches, chunks), {} normals and {} draw chunks",
             options.name,
             stages.join("; "),
-            pre_chunks.len(),
-            draw_chunks.len()
+            evaluator.counts(),
+            normals.chunks.len(),
+            patches.draw_chunks.len()
         );
         let drawn = drawn_runs(summary.patch_count, &loop_mesh.holes);
         Ok(Self {
             patch_block,
-            subdivide,
-            normals,
-            pre_sets,
-            pre_chunks,
+            evaluator,
+            normals: normals_pipeline,
+            normals_sets,
+            normals_chunks: normals.chunks,
             draw_sets,
-            draw_chunks,
+            draw_chunks: patches.draw_chunks,
             _pool: pool,
             base,
             _static: statics.into_iter().map(|(_, b)| b).collect(),
             arrays,
             summary,
-            rotations,
+            rotations: patches.rotations,
             fans,
             drawn,
             loop_mesh,
@@ -882,7 +927,11 @@ impl Bft {
     /// Chunks of the pre-pass and of the draw (one each unless a buffer exceeds the device's
     /// storage-buffer range: see the module header).
     pub fn chunk_counts(&self) -> (usize, usize) {
-        (self.pre_chunks.len(), self.draw_chunks.len())
+        let stencil_chunks = self.evaluator.counts().1;
+        (
+            stencil_chunks.max(self.normals_chunks.len()),
+            self.draw_chunks.len(),
+        )
     }
 
     /// Level-1 faces: patches per frame.
@@ -1047,7 +1096,7 @@ impl Technique for Bft {
             .get_mut(slot)
             .ok_or(TessError::FrameSlot { slot, slots })?;
         let positions: Vec<[f32; 3]> = positions.iter().map(|p| p.map(canonical_zero)).collect();
-        buf.write(0, as_base_positions(&positions))?;
+        buf.write(0, bytemuck::cast_slice(&stencil::vertices(&positions)))?;
         self.base_positions = positions;
         Ok(())
     }
@@ -1058,10 +1107,6 @@ impl Technique for Bft {
         frame_set: &'a DescriptorSet,
         slot: usize,
     ) -> Result<()> {
-        let sets = self.pre_sets.get(slot).ok_or(TessError::FrameSlot {
-            slot,
-            slots: self.pre_sets.len(),
-        })?;
         let tess_stages = vk::PipelineStageFlags::VERTEX_SHADER
             | vk::PipelineStageFlags::TESSELLATION_CONTROL_SHADER
             | vk::PipelineStageFlags::TESSELLATION_EVALUATION_SHADER;
@@ -1071,29 +1116,32 @@ impl Technique for Bft {
         // The previous frame's tessellation stages read level 1 before we overwrite it; host
         // writes of the base positions are visible at submit.
         enc.memory_barrier((tess_stages, vk::AccessFlags::SHADER_READ), write);
-        for (pipeline, next) in [
-            (&self.subdivide, (compute, vk::AccessFlags::SHADER_READ)),
-            (&self.normals, (tess_stages, vk::AccessFlags::SHADER_READ)),
-        ] {
-            enc.bind_pipeline(pipeline);
-            for (k, ((items, w), set)) in self.pre_chunks.iter().zip(sets).enumerate() {
-                // Chunks write disjoint vertices, but their windows overlap (synchronization
-                // validation sees whole ranges): order them.
-                if k > 0 {
-                    enc.memory_barrier(write, write);
-                }
-                let mut push = BftPush {
-                    count: items.end - items.start,
-                    first_vertex: items.start,
-                    ..Default::default()
-                };
-                w.apply(&mut push);
-                enc.bind_descriptor_sets(0, &[frame_set, set])?;
-                enc.push_constants(&push)?;
-                enc.dispatch([push.count.div_ceil(BFT_LOCAL_SIZE).max(1), 1, 1])?;
+        self.evaluator.record(enc, slot)?;
+        // The normals read the level-1 positions.
+        enc.memory_barrier(write, (compute, vk::AccessFlags::SHADER_READ));
+        enc.bind_pipeline(&self.normals);
+        for (k, ((items, w), set)) in self
+            .normals_chunks
+            .iter()
+            .zip(&self.normals_sets)
+            .enumerate()
+        {
+            // Chunks write disjoint vertices, but their windows overlap (synchronization
+            // validation sees whole ranges): order them.
+            if k > 0 {
+                enc.memory_barrier(write, write);
             }
-            enc.memory_barrier(write, next);
+            let mut push = BftPush {
+                count: items.end - items.start,
+                first_vertex: items.start,
+                ..Default::default()
+            };
+            w.apply(&mut push);
+            enc.bind_descriptor_sets(0, &[frame_set, set])?;
+            enc.push_constants(&push)?;
+            enc.dispatch([push.count.div_ceil(BFT_LOCAL_SIZE).max(1), 1, 1])?;
         }
+        enc.memory_barrier(write, (tess_stages, vk::AccessFlags::SHADER_READ));
         enc.end_label();
         Ok(())
     }
@@ -1178,6 +1226,7 @@ impl Technique for Bft {
     fn device_memory(&self) -> Vec<DeviceAllocation> {
         self.base
             .iter()
+            .chain(self.evaluator.buffers())
             .chain(&self._static)
             .map(DeviceAllocation::of_buffer)
             .collect()
@@ -1198,91 +1247,6 @@ impl Technique for Bft {
 pub fn patch_uv(domain: [f32; 2]) -> (f64, f64) {
     let (x, y) = (domain[0] as f64, domain[1] as f64);
     (y, 1.0 - x - y)
-}
-
-/// Axis-aligned bounds of points.
-pub fn bbox(points: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
-    let mut lo = [f32::MAX; 3];
-    let mut hi = [f32::MIN; 3];
-    for p in points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    if points.is_empty() {
-        ([0.0; 3], [0.0; 3])
-    } else {
-        (lo, hi)
-    }
-}
-
-/// Per-vertex unit normals of the base mesh (area-weighted face normals), the directions the
-/// animation moves vertices along.
-pub fn base_normals(mesh: &ControlMesh) -> Vec<[f32; 3]> {
-    let mut n = vec![glam::DVec3::ZERO; mesh.positions.len()];
-    for f in mesh.faces() {
-        let p = |i: usize| glam::DVec3::from(mesh.positions[f[i] as usize]);
-        for k in 1..f.len().saturating_sub(1) {
-            let c = (p(k) - p(0)).cross(p(k + 1) - p(0));
-            for &v in f {
-                n[v as usize] += c;
-            }
-        }
-    }
-    n.iter()
-        .map(|v| v.normalize_or_zero().as_vec3().to_array())
-        .collect()
-}
-
-/// The `--animate` deformation (a travelling wave along the vertex normals, as in the Doo-Sabin
-/// paper's §3): base position + `amplitude · sin(2π(k·p/diag − t))` along the normal. Only these
-/// positions are uploaded per frame.
-pub fn wave(
-    base: &[[f32; 3]],
-    normals: &[[f32; 3]],
-    bbox_min: [f32; 3],
-    bbox_max: [f32; 3],
-    time: f32,
-) -> Vec<[f32; 3]> {
-    let lo = glam::Vec3::from(bbox_min);
-    let hi = glam::Vec3::from(bbox_max);
-    let diag = (hi - lo).length().max(1e-6);
-    let dir = glam::Vec3::new(0.6, 0.8, 0.0);
-    let amplitude = 0.03 * diag;
-    base.iter()
-        .zip(normals)
-        .map(|(p, n)| {
-            let p = glam::Vec3::from(*p);
-            let phase = 2.0 * std::f32::consts::PI * (2.0 * dir.dot(p - lo) / diag - 0.5 * time);
-            (p + glam::Vec3::from(*n) * amplitude * phase.sin()).to_array()
-        })
-        .collect()
-}
-
-/// The `--animate` wave at time `t` applied to the rest pose of a mesh: what is uploaded.
-/// Works for any technique that takes [`Technique::update_base`].
-pub struct Wave {
-    rest: Vec<[f32; 3]>,
-    normals: Vec<[f32; 3]>,
-    bbox: ([f32; 3], [f32; 3]),
-}
-
-impl Wave {
-    pub fn new(mesh: &ControlMesh) -> Self {
-        let rest = base_positions(mesh);
-        // The amplitude follows the drawn size, not a far vertex no face uses.
-        let bbox = crate::framing::drawn_bbox(mesh);
-        Self {
-            normals: base_normals(mesh),
-            rest,
-            bbox,
-        }
-    }
-
-    pub fn at(&self, t: f32) -> Vec<[f32; 3]> {
-        wave(&self.rest, &self.normals, self.bbox.0, self.bbox.1, t)
-    }
 }
 
 #[cfg(test)]

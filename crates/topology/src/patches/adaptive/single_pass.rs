@@ -1,4 +1,4 @@
-//! Single-pass Catmull-Clark approximations (issue 12): one patch per base face, no
+//! Single-pass Catmull-Clark approximations: one patch per base face, no
 //! refinement on the device, as real-time engines ship them: Gregory patches (Loop, Schaefer,
 //! Ni, Castaño 2009) or ACC-1 geometry patches (Loop & Schaefer 2008), bicubic B-spline
 //! patches where the face is regular (exact there).

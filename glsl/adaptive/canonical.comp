@@ -1,14 +1,10 @@
 #version 450
-// The GPU subdivision tables, applied every frame: one dispatch per refinement level (its rows
-// read only earlier levels), then one for the local points (phantom B-spline points, Gregory
-// points, limit corners with rows), then the limit corners of regular patches, then
-// the canonical curves' inner Bezier points. `mode` ADAPTIVE_STENCIL_MODE_BASE copies the base
-// positions in first.
-// Rows are stencils over the global vertex buffer, summed in table order with `precise`, as
-// offsets from the row's first vertex (rows are affine).
-// A block larger than the storage range runs as several dispatches (chunks of rows), each
-// bound to a window of the stencil offsets and terms: indices into them subtract the window
-// bases (`row_base`, `term_base`); the vertex buffer is bound whole.
+// The canonical points of a feature-adaptive frame that have no stencil rows, after the stencil
+// evaluator (crates/tess/src/stencil) has written the levels and the local points: `mode`
+// ADAPTIVE_CANONICAL_MODE_CORNERS evaluates the limit corners of regular patches, then
+// ADAPTIVE_CANONICAL_MODE_CURVES the canonical curves' inner Bezier points, each from its
+// owner patch's control points (a fixed combination per patch kind and corner or edge). Items
+// `first_item .. first_item + count` per dispatch; the vertex buffer is bound whole.
 #define ADAPTIVE_WRITES_VERTICES
 #define TECHNIQUE_PUSH_CONSTANTS
 #include "frame.glsl"
@@ -95,36 +91,12 @@ vec3 regular_corner_point(uint k) {
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= adaptive.count) return;
-    if (adaptive.mode == ADAPTIVE_STENCIL_MODE_BASE) {
-        uint v = adaptive.first_row + i;
-        vertices[v] = vec4(base_positions[3u * v], base_positions[3u * v + 1u], base_positions[3u * v + 2u], 1.0);
-        return;
-    }
-    if (adaptive.mode == ADAPTIVE_STENCIL_MODE_CORNERS) {
-        uint k = adaptive.first_row + i;
+    if (adaptive.mode == ADAPTIVE_CANONICAL_MODE_CORNERS) {
+        uint k = adaptive.first_item + i;
         vertices[adaptive.first_corner + k] = vec4(regular_corner_point(k), 1.0);
         return;
     }
-    if (adaptive.mode == ADAPTIVE_STENCIL_MODE_CURVES) {
-        uint pi = adaptive.first_row + i;
-        uvec4 curve = curves[pi >> 1u];
-        vertices[(pi & 1u) == 0u ? curve.y : curve.z] = vec4(curve_inner_point(pi), 1.0);
-        return;
-    }
-    uint r = adaptive.first_row + i;
-    uint k0 = stencil_offsets[r - adaptive.row_base];
-    uint k1 = stencil_offsets[r + 1u - adaptive.row_base];
-    // Every row is affine (its weights sum to 1), so it is summed as offsets from its first
-    // term's vertex: the f32 rounding is then relative to the row's spread, not to the
-    // coordinates' magnitude. Deep levels around a pole chain many wide rows (721 terms at a
-    // valence-360 pole), and absolute sums made catmark_pole360's regular patches 1.4e-5 of the
-    // diagonal off the CPU plan.
-    vec3 anchor = k0 < k1 ? vertices[stencil_terms[k0 - adaptive.term_base].index].xyz : vec3(0.0);
-    precise vec3 d = vec3(0.0);
-    for (uint k = k0; k < k1; ++k) {
-        StencilTerm t = stencil_terms[k - adaptive.term_base];
-        d += t.weight * (vertices[t.index].xyz - anchor);
-    }
-    precise vec3 p = anchor + d;
-    vertices[adaptive.base_count + r] = vec4(p, 1.0);
+    uint pi = adaptive.first_item + i;
+    uvec4 curve = curves[pi >> 1u];
+    vertices[(pi & 1u) == 0u ? curve.y : curve.z] = vec4(curve_inner_point(pi), 1.0);
 }

@@ -1,0 +1,349 @@
+//! The host half of the Doo-Sabin technique: the levels of a uniform Doo-Sabin refinement as
+//! stencil rows per level for the GPU evaluator, the deepest level's faces as triangle fans and
+//! its points' face corners (what the vertex stage sums a normal from), each point's base face
+//! point, and the sizes of the levels counted without refining.
+//!
+//! Every level is a block of the stencil evaluator over one vertex buffer, in place: the base
+//! positions at its head (copied there every frame), then levels 1, 2, ..., each block's rows
+//! reading the level before it ([`topology::refine::doo_sabin::refine_dual`]'s rows, their
+//! indices moved to where that level lies in the buffer). The deepest level starts at a
+//! storage-buffer offset the device can bind, so the vertex stage reads it as a range of its
+//! own with level-local numbers.
+use crate::capture::{face_corner_uv, FacePoint};
+use crate::gpu::bindings::DOO_SABIN_MAX_CORNERS;
+use crate::stencil::{GpuStencils, StencilBlock, StencilError};
+use topology::mesh::{Topology, INVALID};
+use topology::refine::doo_sabin::{refine_dual, DualVertex};
+use topology::refine::Level;
+use topology::TopologyError;
+
+/// Vertices, faces, face corners and boundary edges of one Doo-Sabin level.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LevelSize {
+    pub vertices: u64,
+    pub faces: u64,
+    pub corners: u64,
+    pub boundary_edges: u64,
+}
+
+impl LevelSize {
+    /// Triangles of the level's faces drawn as fans.
+    pub fn triangles(&self) -> u64 {
+        self.corners - 2 * self.faces
+    }
+
+    /// The next level's size. From level 1 on, every interior point lies in four faces and
+    /// every boundary point (a point of the boundary curve's control polygon) in two, every
+    /// interior edge makes an e-face (a quad), every interior point a v-face (a quad), every
+    /// face an f-face of its own size, and the boundary polygon doubles (Chaikin).
+    fn next(&self) -> LevelSize {
+        let b = self.boundary_edges;
+        let edges = (self.corners + b) / 2;
+        let (inner_edges, inner_points) = (edges - b, self.vertices - b);
+        LevelSize {
+            vertices: self.corners,
+            faces: self.faces + inner_edges + inner_points,
+            corners: self.corners + 4 * inner_edges + 4 * inner_points,
+            boundary_edges: 2 * b,
+        }
+    }
+
+    fn of(t: &Topology) -> LevelSize {
+        LevelSize {
+            vertices: t.num_vertices() as u64,
+            faces: t.num_faces() as u64,
+            corners: t.face_tables().1.len() as u64,
+            boundary_edges: (0..t.num_edges())
+                .filter(|&e| t.is_boundary_edge(e))
+                .count() as u64,
+        }
+    }
+}
+
+/// The size of level 1 (one step of the base mesh: made, then counted).
+pub fn first_level_size(base: &Level) -> Result<LevelSize, TopologyError> {
+    Ok(LevelSize::of(&refine_dual(base, true)?.level.topology))
+}
+
+/// Sizes of levels 1..=`depth` from level 1's, the deeper ones counted by the dual scheme's
+/// recurrence (every point past level 1 lies in four faces, two on the boundary).
+pub fn level_sizes(first: LevelSize, depth: u32) -> Vec<LevelSize> {
+    let mut sizes = Vec::with_capacity(depth as usize);
+    let mut size = first;
+    for _ in 0..depth {
+        sizes.push(size);
+        size = size.next();
+    }
+    sizes
+}
+
+/// Everything the GPU needs for one depth, built on the host once per depth.
+#[derive(Clone, Debug)]
+pub struct DepthLayout {
+    pub depth: u32,
+    /// Rows of every level over the vertex buffer, one block per level.
+    pub stencils: GpuStencils,
+    pub blocks: Vec<StencilBlock>,
+    /// Vertices of the whole buffer (base, every level, the alignment gap).
+    pub num_vertices: u32,
+    /// Where the deepest level starts in the buffer, and its point count.
+    pub first_point: u32,
+    pub points: u32,
+    /// The deepest level's faces as triangle fans (level-local point numbers).
+    pub triangles: Vec<u32>,
+    /// Per deepest-level point, [`DOO_SABIN_MAX_CORNERS`] `(next, previous)` neighbour pairs,
+    /// unused slots naming the point itself.
+    pub corners: Vec<[u32; 2]>,
+    /// Per deepest-level point, its base face point.
+    pub face_points: Vec<FacePoint>,
+    /// The deepest level as the CPU refined it (positions of the base it was built from).
+    pub level: Level,
+}
+
+/// `x` rounded up to a multiple of `step`.
+fn align_up(x: u32, step: u32) -> Option<u32> {
+    x.checked_next_multiple_of(step.max(1))
+}
+
+/// Why a depth cannot be laid out.
+#[derive(Debug, thiserror::Error)]
+pub enum LayoutError {
+    #[error(transparent)]
+    Topology(#[from] TopologyError),
+    #[error(transparent)]
+    Stencil(#[from] StencilError),
+    #[error("Doo-Sabin level {level}: point {point} lies in {corners} face corners, more than {DOO_SABIN_MAX_CORNERS}")]
+    Corners {
+        level: u32,
+        point: u32,
+        corners: u32,
+    },
+    #[error("face {face} is tagged a hole: Doo-Sabin's refinement has no holes (it would draw the face)")]
+    Hole { face: u32 },
+    #[error("Doo-Sabin level {level}: {vertices} vertices overflow 32-bit indices")]
+    TooLarge { level: u32, vertices: u64 },
+}
+
+/// Lays out `depth` levels of `base`, the deepest starting at a multiple of `align` vertices.
+pub fn layout(base: &Level, depth: u32, align: u32) -> Result<DepthLayout, LayoutError> {
+    let mut stencils = GpuStencils::default();
+    let mut blocks = Vec::with_capacity(depth as usize);
+    let mut level = base.clone();
+    let mut source = 0u32;
+    let mut next = base.num_vertices() as u32;
+    let mut points: Vec<FacePoint> = Vec::new();
+    for k in 0..depth {
+        let step = refine_dual(&level, k == 0)?;
+        let n = step.level.num_vertices() as u32;
+        let last = k + 1 == depth;
+        let start = if last {
+            align_up(next, align)
+        } else {
+            Some(next)
+        };
+        let too_large = LayoutError::TooLarge {
+            level: k + 1,
+            vertices: next as u64 + n as u64,
+        };
+        let start = start.ok_or(too_large)?;
+        start.checked_add(n).ok_or(LayoutError::TooLarge {
+            level: k + 1,
+            vertices: start as u64 + n as u64,
+        })?;
+        let table = &step.stencils;
+        let first_row = stencils.rows();
+        for r in 0..n as usize {
+            let (k0, k1) = (table.offsets[r] as usize, table.offsets[r + 1] as usize);
+            let indices: Vec<u32> = table.indices[k0..k1].iter().map(|i| i + source).collect();
+            stencils.push_row(&indices, &table.weights[k0..k1])?;
+        }
+        blocks.push(StencilBlock {
+            rows: first_row..first_row + n,
+            destination: start,
+        });
+        points = if k == 0 {
+            first_face_points(&level.topology, &step.vertices)
+        } else {
+            inherited_face_points(&level.topology, &step.vertices, &points)
+        };
+        source = start;
+        next = start + n;
+        level = step.level;
+    }
+    let t = &level.topology;
+    Ok(DepthLayout {
+        depth,
+        stencils,
+        blocks,
+        num_vertices: next,
+        first_point: source,
+        points: t.num_vertices() as u32,
+        triangles: fans(t),
+        corners: corners(t, depth)?,
+        face_points: points,
+        level,
+    })
+}
+
+/// The base face point of each level-1 point: the child of a face corner lies halfway from
+/// the corner to the face's centre in the face's domain (for a quad, the (1/4, 1/4) its
+/// weights 9/16, 3/16, 3/16, 1/16 give bilinearly); a Chaikin point on the base vertex it
+/// is next to (its boundary edge's face, that corner), so that consecutive points of the
+/// boundary share a base boundary edge for capture's classification.
+fn first_face_points(base: &Topology, vertices: &[DualVertex]) -> Vec<FacePoint> {
+    let corner_point = |face: u32, corner: u32, towards_centre: f64| {
+        let fv = base.face_vertices(face as usize);
+        let n = fv.len() as u32;
+        let mut centre = [0.0; 2];
+        for k in 0..n {
+            let c = face_corner_uv(n, k);
+            centre = [centre[0] + c[0] / n as f64, centre[1] + c[1] / n as f64];
+        }
+        let c = face_corner_uv(n, corner);
+        let t = towards_centre;
+        FacePoint {
+            face,
+            u: (c[0] + t * (centre[0] - c[0])) as f32,
+            v: (c[1] + t * (centre[1] - c[1])) as f32,
+        }
+    };
+    vertices
+        .iter()
+        .map(|&v| match v {
+            DualVertex::Corner { face, corner } => corner_point(face, corner, 0.5),
+            DualVertex::Chaikin { edge, end } => {
+                let vertex = base.edge_vertices(edge as usize)[end as usize];
+                let [a, b] = base.edge_faces(edge as usize);
+                let face = if a == INVALID { b } else { a };
+                let fv = base.face_vertices(face as usize);
+                let corner = fv.iter().position(|&x| x == vertex).unwrap_or(0) as u32;
+                corner_point(face, corner, 0.0)
+            }
+        })
+        .collect()
+}
+
+/// The base face point of each point of a level past the first: its parent corner's point's
+/// (a point stays within its level-1 ancestor's face; boundary points stay on the boundary).
+fn inherited_face_points(
+    parent: &Topology,
+    vertices: &[DualVertex],
+    parent_points: &[FacePoint],
+) -> Vec<FacePoint> {
+    vertices
+        .iter()
+        .map(|&v| match v {
+            DualVertex::Corner { face, corner } => {
+                let p = parent.face_vertices(face as usize)[corner as usize];
+                parent_points[p as usize]
+            }
+            // Made by the level-0 step only (`refine_dual` with `first`): never past level 1.
+            DualVertex::Chaikin { .. } => unreachable!("a Chaikin point past level 1"),
+        })
+        .collect()
+}
+
+/// The faces of `t` as triangle fans from each face's first corner.
+fn fans(t: &Topology) -> Vec<u32> {
+    let mut out = Vec::new();
+    for f in 0..t.num_faces() {
+        let fv = t.face_vertices(f);
+        for j in 1..fv.len().saturating_sub(1) {
+            out.extend([fv[0], fv[j], fv[j + 1]]);
+        }
+    }
+    out
+}
+
+/// Per point of `t`, its face corners as `(next, previous)` pairs, padded with the point.
+fn corners(t: &Topology, level: u32) -> Result<Vec<[u32; 2]>, LayoutError> {
+    let max = DOO_SABIN_MAX_CORNERS as usize;
+    let n = t.num_vertices();
+    let mut out: Vec<[u32; 2]> = (0..n as u32).flat_map(|v| [[v, v]; 4]).collect();
+    let mut used = vec![0u32; n];
+    for f in 0..t.num_faces() {
+        let fv = t.face_vertices(f);
+        let len = fv.len();
+        for (i, &v) in fv.iter().enumerate() {
+            let slot = used[v as usize];
+            if slot as usize >= max {
+                return Err(LayoutError::Corners {
+                    level,
+                    point: v,
+                    corners: slot + 1,
+                });
+            }
+            out[v as usize * max + slot as usize] = [fv[(i + 1) % len], fv[(i + len - 1) % len]];
+            used[v as usize] += 1;
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use topology::refine::refine_uniform;
+    use topology::{load_obj, ControlMesh, Scheme};
+
+    /// A mesh of the repository's test data (`path` from its root).
+    fn mesh(path: &str) -> ControlMesh {
+        let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+        load_obj(format!("{root}/{path}")).expect(path)
+    }
+
+    /// Valence 3 (cube), valence 5 and triangles (icosahedron), triangles around a quad
+    /// (pyramid), pentagons (spot), boundaries (edge-corner, extraordinary boundary vertex).
+    pub(crate) const SHAPES: [&str; 6] = [
+        "tests/data/opensubdiv/shapes/catmark_cube.obj",
+        "tests/data/opensubdiv/shapes/loop_icosahedron.obj",
+        "tests/data/opensubdiv/shapes/catmark_pyramid.obj",
+        "assets/spot_control_mesh.obj",
+        "tests/data/opensubdiv/shapes/catmark_edgecorner.obj",
+        "tests/data/opensubdiv/shapes/catmark_xord_boundary.obj",
+    ];
+
+    /// The counted sizes are the refiner's, level for level, on closed and open meshes with
+    /// triangles, pentagons and valences 3 and 5; the layout's rows give the refiner's points.
+    #[test]
+    fn counted_sizes_and_laid_out_rows_match_the_refiner() {
+        for name in SHAPES {
+            let mesh = mesh(name);
+            let base = Level::from_mesh(&mesh, Scheme::DooSabin).expect("base");
+            let r = refine_uniform(&mesh, Scheme::DooSabin, 4).expect("refine");
+            let sizes = level_sizes(first_level_size(&base).expect("level 1"), 4);
+            for (k, s) in sizes.iter().enumerate() {
+                assert_eq!(
+                    *s,
+                    LevelSize::of(&r.level(k + 1).topology),
+                    "{name} level {}",
+                    k + 1
+                );
+            }
+            let l = layout(&base, 3, 16).expect("layout");
+            assert_eq!(l.first_point % 16, 0);
+            assert_eq!(l.points as usize, r.level(3).num_vertices());
+            assert_eq!(l.triangles.len() as u64, 3 * sizes[2].triangles());
+            let mut buffer = vec![[0f32; 3]; l.num_vertices as usize];
+            for (v, p) in mesh.positions.iter().enumerate() {
+                buffer[v] = p.map(|c| c as f32);
+            }
+            for b in &l.blocks {
+                for row in b.rows.clone() {
+                    let p = l.stencils.row_point(row, |i| buffer[i as usize]);
+                    buffer[(b.destination + row - b.rows.start) as usize] = p;
+                }
+            }
+            let diagonal = mesh.bbox_diagonal();
+            for (v, want) in r.level(3).positions.iter().enumerate() {
+                let got = buffer[l.first_point as usize + v];
+                for c in 0..3 {
+                    assert!(
+                        (got[c] as f64 - want[c]).abs() < 1e-6 * diagonal,
+                        "{name} point {v}"
+                    );
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,534 @@
+//! Doo-Sabin subdivision refined on the GPU every frame to depth D = log2 S and drawn from the
+//! vertex stage (`--method doo-sabin`): the seed's refinement of the control mesh's vertex
+//! patches, on the stencil evaluator.
+//!
+//! Design decisions:
+//! - **Levels are stencil blocks.** Each Doo-Sabin step is linear in the level before it, so
+//!   the refinement is one block of [`crate::stencil`] rows per level
+//!   ([`topology::refine::doo_sabin::refine_dual`]'s rows), evaluated in place over one vertex
+//!   buffer: the frame slot's base positions copied to its head, then levels 1..D. The first
+//!   step (with the boundary's Chaikin points and strip faces) is rows over the base
+//!   positions like every other, so an animated frame costs one upload of base positions and
+//!   every level is refined on the GPU. The vertex patches of
+//!   [`topology::patches::doo_sabin`] partition the same points by the vertex they surround;
+//!   the global buffer computes each shared point once, so every shared strip and corner face
+//!   is drawn once by construction and every vertex of it welds by bits.
+//! - **One indexed draw** of the deepest level's faces as triangle fans
+//!   (`glsl/doo_sabin/mesh.vert`), reading the points from a storage-buffer range bound at
+//!   the deepest level (its start aligned for that) with level-local numbers.
+//! - **Normals per point from its face corners**: the sum over the (at most four) faces a
+//!   point lies in of `(next − p) × (previous − p)`, in the vertex stage, from a table of the
+//!   corners' neighbours; no normal pass. Against the exact limit normal at face centres
+//!   ([`topology::limit::doo_sabin::face_limit`]) the corners' mean normal converges about
+//!   like the level's edge length (`tests/doo_sabin.rs` measures it).
+//! - **A captured id is a point** of the deepest level; [`Technique::face_point`] gives its
+//!   level-1 ancestor's base face point ([`layout`]): Doo-Sabin's limit has no
+//!   parameterization over the base faces here, so the point is where it comes from, not an
+//!   exact parameter; boundary points map onto their base boundary vertex, which keeps
+//!   capture's classification of boundary edges exact.
+//! - **The depth follows the frame's segments** (S = 2^D, D in 1..=6, others refused by name)
+//!   and its tables are rebuilt in [`Technique::prepare_frame`] when it changes.
+pub mod layout;
+
+use crate::capture::FacePoint;
+use crate::context::Context;
+use crate::error::{Param, ParamError, Result, TessError};
+use crate::gpu::bindings::{DOO_SABIN_CORNERS_BINDING, DOO_SABIN_POINTS_BINDING};
+use crate::gpu::DrawPush;
+use crate::shaders::Stage;
+use crate::stencil::{self, StencilEvaluator, StencilVertex, StencilVertices};
+use crate::technique::{
+    DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features, FrameParams, Pass, PatchArray,
+    PatchPipeline, PatchType, Technique, TechniqueId,
+};
+use crate::techniques::shared::{canonical_zero, storage, storage_binding};
+use crate::techniques::{BuildOptions, Built, TechniqueInfo};
+use layout::{first_level_size, level_sizes, DepthLayout, LayoutError, LevelSize};
+use std::mem::size_of;
+use topology::refine::Level;
+use topology::{ControlMesh, Scheme};
+use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
+use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Device, Encoder, MemoryLocation};
+
+impl TechniqueId {
+    pub const DOO_SABIN: TechniqueId = TechniqueId::new("doo-sabin");
+}
+
+/// The registry entry of `--method doo-sabin`.
+pub static INFO: TechniqueInfo = TechniqueInfo {
+    id: TechniqueId::DOO_SABIN,
+    help: "Doo-Sabin subdivision refined on the GPU every frame to level log2 S (stencil rows per level from the base positions), drawn from the vertex stage",
+    features: Features {
+        adaptive_factors: false,
+        spacings: [true, false, false],
+        animation: true,
+        patch_colours: false,
+        geometric_normals: false,
+        phong_alpha: false,
+        table_level: false,
+        triangles_only: false,
+        isolation: false,
+        surface: false,
+        single_pass: false,
+        paths: &[DrawPath::VertexStage],
+    },
+    scheme: Some(Scheme::DooSabin),
+    default_for_scheme: true,
+    shader_folder: "doo_sabin",
+    abi_code: 10,
+    legend: &[],
+    build,
+    check_options: |_, params| depth_of(params).map(|_| ()),
+};
+
+/// Deepest level a frame may ask for: 2^6 = 64 segments per base edge, the tessellator's
+/// maximum, as for the other vertex-stage techniques.
+pub const MAX_DEPTH: u32 = 6;
+
+static SET_BINDINGS: [BindingDesc; 2] = [
+    storage_binding(DOO_SABIN_POINTS_BINDING),
+    storage_binding(DOO_SABIN_CORNERS_BINDING),
+];
+
+/// One depth on the device. Drop order: the evaluator, the set (it keeps its pool and
+/// buffers alive), the pool, the buffers.
+struct DepthMesh {
+    layout: DepthLayout,
+    evaluator: StencilEvaluator,
+    set: DescriptorSet,
+    _pool: DescriptorPool,
+    vertices: Buffer,
+    corners: Buffer,
+    indices: Buffer,
+}
+
+/// See the module docs.
+pub struct DooSabin {
+    depth: Option<DepthMesh>,
+    arrays: [PatchArray; 1],
+    mesh: ControlMesh,
+    base: Level,
+    /// The size of level 1, from which the deeper levels' sizes are counted.
+    first_size: LevelSize,
+    /// Per frame slot, the base positions the next frame copies to the buffer's head.
+    base_buffers: Vec<Buffer>,
+    bbox: ([f32; 3], [f32; 3]),
+    max_vertices: u64,
+    set_layout: DescriptorSetLayout,
+    device: Device,
+}
+
+/// The depth a frame of `params` draws (uniform segments S = 2^D), or why it cannot.
+fn depth_of(params: &FrameParams) -> Result<u32> {
+    let segments = match params.factors {
+        FactorPolicy::Uniform { segments } => segments,
+        _ => {
+            return Err(TessError::Unsupported {
+                technique: TechniqueId::DOO_SABIN,
+                what: "adaptive factors (a uniform refinement has one level)",
+            })
+        }
+    };
+    let ok = segments.fract() == 0.0
+        && (2.0..=(1u32 << MAX_DEPTH) as f32).contains(&segments)
+        && (segments as u32).is_power_of_two();
+    if !ok {
+        return Err(ParamError::refused(
+            Param::Segments,
+            segments,
+            format!(
+                "Doo-Sabin refines to a level: a power of two in 2..={} segments per base edge \
+                 (each level halves every edge)",
+                1 << MAX_DEPTH
+            ),
+        ));
+    }
+    Ok((segments as u32).trailing_zeros())
+}
+
+impl DooSabin {
+    pub fn new(ctx: &mut Context, mesh: &ControlMesh, options: &BuildOptions) -> Result<Self> {
+        if let Some(&face) = mesh.holes.first() {
+            return Err(TessError::Mesh {
+                name: options.name.clone(),
+                source: Box::new(LayoutError::Hole { face }),
+            });
+        }
+        let base = Level::from_mesh(mesh, Scheme::DooSabin).map_err(|e| TessError::Mesh {
+            name: options.name.clone(),
+            source: e.into(),
+        })?;
+        let first_size = first_level_size(&base).map_err(|e| TessError::Mesh {
+            name: options.name.clone(),
+            source: e.into(),
+        })?;
+        let device = ctx.device().clone();
+        let positions = crate::animation::base_positions(mesh);
+        let base_buffers = (0..ctx.frames_in_flight())
+            .map(|slot| base_buffer(&device, slot, &positions))
+            .collect::<Result<Vec<_>>>()?;
+        // The context's layout, which the pipelines are built with: sets are allocated when a
+        // depth is laid out (after the build, without the context).
+        ctx.ensure_set_layout(TechniqueId::DOO_SABIN, &SET_BINDINGS)?;
+        let set_layout = ctx.set_layout(TechniqueId::DOO_SABIN)?.clone();
+        Ok(Self {
+            depth: None,
+            arrays: [PatchArray {
+                patch: PatchType::MeshTriangles,
+                patches: 0,
+                control_points: 0,
+                first_patch: 0,
+            }],
+            mesh: mesh.clone(),
+            base,
+            first_size,
+            base_buffers,
+            bbox: crate::animation::bbox(&positions),
+            max_vertices: options.max_refined_vertices,
+            set_layout,
+            device,
+        })
+    }
+
+    /// Refines the tables of `depth` on the host and puts them on the device.
+    fn build_depth(&mut self, depth: u32) -> Result<()> {
+        let limits = crate::techniques::windows::Limits::of(&self.device);
+        let align = (limits.alignment / gcd(limits.alignment, 16)) as u32;
+        let layout = layout::layout(&self.base, depth, align).map_err(|e| match e {
+            LayoutError::Topology(t) => TessError::Topology(t),
+            LayoutError::Stencil(s) => TessError::Stencil(s),
+            other => TessError::Mesh {
+                name: format!("Doo-Sabin level {depth}"),
+                source: Box::new(other),
+            },
+        })?;
+        check_indices(&layout)?;
+        let point_bytes = stencil::vertex_bytes(layout.points);
+        let corner_bytes = std::mem::size_of_val(layout.corners.as_slice()) as u64;
+        for (what, bytes) in [("points", point_bytes), ("corners", corner_bytes)] {
+            if bytes > limits.max_range {
+                return Err(TessError::StorageWindow {
+                    what: "Doo-Sabin deepest level",
+                    item: depth,
+                    space: what,
+                    bytes,
+                    max: limits.max_range,
+                });
+            }
+        }
+        self.arrays[0].patches = layout.points;
+        self.depth = Some(DepthMesh::new(&self.device, &self.set_layout, layout)?);
+        Ok(())
+    }
+}
+
+impl DepthMesh {
+    /// The vertex buffer, the evaluator of `layout`'s blocks over it, the corner table, the
+    /// index buffer and the set binding the deepest level's range and the corners.
+    fn new(device: &Device, set_layout: &DescriptorSetLayout, layout: DepthLayout) -> Result<Self> {
+        let vertices = Buffer::new(
+            device,
+            &BufferDesc {
+                name: "doo-sabin vertices",
+                size: stencil::vertex_bytes(layout.num_vertices),
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuOnly,
+            },
+        )?;
+        let evaluator = StencilEvaluator::new(
+            device,
+            "doo-sabin",
+            &layout.stencils,
+            &layout.blocks,
+            StencilVertices {
+                sources: layout.num_vertices,
+                destinations: layout.num_vertices,
+                in_place: true,
+            },
+            &[(&vertices, &vertices)],
+        )?;
+        let corners = storage(
+            device,
+            "doo-sabin corners",
+            bytemuck::cast_slice(&layout.corners),
+        )?;
+        let indices = Buffer::with_data(
+            device,
+            "doo-sabin indices",
+            vk::BufferUsageFlags::INDEX_BUFFER,
+            bytemuck::cast_slice(&layout.triangles),
+        )?;
+        let pool = DescriptorPool::new(device, "doo-sabin descriptor pool", set_layout, 1)?;
+        let set = pool.allocate_set(set_layout)?;
+        set.write_buffer_range(
+            DOO_SABIN_POINTS_BINDING,
+            vk::DescriptorType::STORAGE_BUFFER,
+            &vertices,
+            layout.first_point as u64 * size_of::<StencilVertex>() as u64,
+            stencil::vertex_bytes(layout.points),
+        )?;
+        crate::techniques::windows::write_whole(&set, DOO_SABIN_CORNERS_BINDING, &corners)?;
+        Ok(Self {
+            layout,
+            evaluator,
+            set,
+            _pool: pool,
+            vertices,
+            corners,
+            indices,
+        })
+    }
+}
+
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 {
+        a.max(1)
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+/// The vertex stage reads points by the index buffer and the corner table: every index in
+/// range of the deepest level.
+fn check_indices(layout: &DepthLayout) -> Result<()> {
+    let n = layout.points;
+    let corners = layout.corners.iter().flatten();
+    for (what, &i) in layout
+        .triangles
+        .iter()
+        .map(|i| ("Doo-Sabin triangle index", i))
+        .chain(corners.map(|i| ("Doo-Sabin corner neighbour", i)))
+    {
+        if i >= n {
+            return Err(TessError::IndexOutOfRange {
+                what,
+                index: i as u64,
+                len: n as u64,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// A host-visible buffer of `positions` as the evaluator's vertices, the copy source of frame
+/// slot `slot`.
+fn base_buffer(device: &Device, slot: usize, positions: &[[f32; 3]]) -> Result<Buffer> {
+    let mut b = Buffer::new(
+        device,
+        &BufferDesc {
+            name: &format!("doo-sabin base positions {slot}"),
+            size: stencil::vertex_bytes(positions.len() as u32),
+            usage: vk::BufferUsageFlags::TRANSFER_SRC,
+            location: MemoryLocation::CpuToGpu,
+        },
+    )?;
+    b.write(0, bytemuck::cast_slice(&stencil::vertices(positions)))?;
+    Ok(b)
+}
+
+impl Technique for DooSabin {
+    fn id(&self) -> TechniqueId {
+        TechniqueId::DOO_SABIN
+    }
+
+    fn bbox(&self) -> ([f32; 3], [f32; 3]) {
+        self.bbox
+    }
+
+    fn patch_arrays(&self) -> &[PatchArray] {
+        &self.arrays
+    }
+
+    fn check(&self, params: &FrameParams) -> Result<()> {
+        let depth = depth_of(params)?;
+        let sizes = level_sizes(self.first_size, depth);
+        let vertices =
+            self.base.num_vertices() as u64 + sizes.iter().map(|s| s.vertices).sum::<u64>();
+        if vertices > self.max_vertices {
+            return Err(TessError::RefinedTooLarge {
+                scheme: Scheme::DooSabin,
+                level: depth as usize,
+                vertices,
+                max: self.max_vertices,
+            });
+        }
+        Ok(())
+    }
+
+    fn prepare_frame(&mut self, params: &FrameParams) -> Result<()> {
+        let depth = depth_of(params)?;
+        if self.depth.as_ref().map(|d| d.layout.depth) != Some(depth) {
+            self.depth = None;
+            self.arrays[0].patches = 0;
+            self.build_depth(depth)?;
+        }
+        Ok(())
+    }
+
+    fn patch_pipeline(&self, _patch: PatchType) -> PatchPipeline {
+        PatchPipeline::triangles(Stage::DooSabinMeshVert, Stage::CommonShadeFrag)
+    }
+
+    fn set_layout_bindings(&self) -> &'static [BindingDesc] {
+        &SET_BINDINGS
+    }
+
+    fn descriptor_set(&self, _slot: usize) -> Option<&DescriptorSet> {
+        self.depth.as_ref().map(|d| &d.set)
+    }
+
+    fn max_vertices_per_patch(&self, _params: &FrameParams, _array: usize) -> u64 {
+        1
+    }
+
+    fn triangles(&self, params: &FrameParams, array: usize) -> Option<u64> {
+        (array == 0).then_some(())?;
+        let depth = depth_of(params).ok()?;
+        level_sizes(self.first_size, depth)
+            .last()
+            .map(|s| s.triangles())
+    }
+
+    fn base_mesh(&self) -> Option<&ControlMesh> {
+        Some(&self.mesh)
+    }
+
+    /// Writes the base positions of frame slot `slot`: the one upload an animated frame makes.
+    fn update_base(&mut self, slot: usize, positions: &[[f32; 3]]) -> Result<()> {
+        if positions.len() != self.mesh.positions.len() {
+            return Err(TessError::BasePositionCount {
+                given: positions.len(),
+                expected: self.mesh.positions.len(),
+            });
+        }
+        if let Some(v) = positions
+            .iter()
+            .position(|p| p.iter().any(|c| !c.is_finite()))
+        {
+            return Err(TessError::NonFiniteVertex { vertex: v });
+        }
+        let slots = self.base_buffers.len();
+        let buf = self
+            .base_buffers
+            .get_mut(slot)
+            .ok_or(TessError::FrameSlot { slot, slots })?;
+        let positions: Vec<[f32; 3]> = positions.iter().map(|p| p.map(canonical_zero)).collect();
+        buf.write(0, bytemuck::cast_slice(&stencil::vertices(&positions)))?;
+        Ok(())
+    }
+
+    /// The base copy, then one evaluator block per level, each ordered after the one before;
+    /// the previous frame's vertex stage reads the points before they are overwritten.
+    fn record_pre_pass<'a>(
+        &'a self,
+        enc: &mut Encoder<'a>,
+        _frame_set: &'a DescriptorSet,
+        slot: usize,
+    ) -> Result<()> {
+        let Some(d) = self.depth.as_ref() else {
+            return Ok(());
+        };
+        let slots = self.base_buffers.len();
+        let base = self
+            .base_buffers
+            .get(slot)
+            .ok_or(TessError::FrameSlot { slot, slots })?;
+        let vertex = vk::PipelineStageFlags::VERTEX_SHADER;
+        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        let transfer = vk::PipelineStageFlags::TRANSFER;
+        enc.begin_label("doo-sabin levels");
+        enc.memory_barrier(
+            (vertex, vk::AccessFlags::SHADER_READ),
+            (
+                transfer | compute,
+                vk::AccessFlags::TRANSFER_WRITE | vk::AccessFlags::SHADER_WRITE,
+            ),
+        );
+        enc.copy_buffer(base, &d.vertices)?;
+        enc.memory_barrier(
+            (transfer, vk::AccessFlags::TRANSFER_WRITE),
+            (
+                compute,
+                vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
+            ),
+        );
+        d.evaluator.record(enc, 0)?;
+        enc.memory_barrier(
+            (compute, vk::AccessFlags::SHADER_WRITE),
+            (vertex, vk::AccessFlags::SHADER_READ),
+        );
+        enc.end_label();
+        Ok(())
+    }
+
+    fn record_array<'a>(
+        &'a self,
+        enc: &mut Encoder<'a>,
+        array: usize,
+        _slot: usize,
+        _params: &FrameParams,
+        pass: Pass,
+        _per_draw: u32,
+    ) -> Result<DrawCounts> {
+        let (Some(a), Some(d)) = (self.arrays.get(array), self.depth.as_ref()) else {
+            return Err(TessError::NoPatchArray { array });
+        };
+        enc.push_constants(&DrawPush {
+            mode: pass.mode(),
+            first_patch: a.first_patch,
+        })?;
+        enc.bind_index_buffer_u32(&d.indices);
+        enc.draw_indexed(0..d.layout.triangles.len() as u32)?;
+        Ok(DrawCounts {
+            draws: 1,
+            patches: a.patches,
+        })
+    }
+
+    /// The captured point's level-1 ancestor's base face point (the domain is unused).
+    fn face_point(&self, patch: u32, _domain: [f32; 2]) -> Option<FacePoint> {
+        let d = self.depth.as_ref()?;
+        let v = patch.checked_sub(self.arrays[0].first_patch)?;
+        d.layout.face_points.get(v as usize).copied()
+    }
+
+    fn device_memory(&self) -> Vec<DeviceAllocation> {
+        let mut out: Vec<DeviceAllocation> = self
+            .base_buffers
+            .iter()
+            .map(DeviceAllocation::of_buffer)
+            .collect();
+        if let Some(d) = &self.depth {
+            out.extend(
+                [&d.vertices, &d.corners, &d.indices]
+                    .into_iter()
+                    .chain(d.evaluator.buffers())
+                    .map(DeviceAllocation::of_buffer),
+            );
+        }
+        out
+    }
+
+    fn report_notes(&self) -> Vec<String> {
+        self.depth
+            .iter()
+            .map(|d| {
+                format!(
+                    "Doo-Sabin level {}: {} points, {} triangles refined on the GPU from {} stencil rows",
+                    d.layout.depth,
+                    d.layout.points,
+                    d.layout.triangles.len() / 3,
+                    d.layout.stencils.rows()
+                )
+            })
+            .collect()
+    }
+}
+
+/// Builds `--method doo-sabin` for `mesh` (nothing is refined before a frame asks for a level).
+pub fn build(ctx: &mut Context, mesh: &ControlMesh, options: &BuildOptions) -> Result<Built> {
+    Ok(Built {
+        technique: Box::new(DooSabin::new(ctx, mesh, options)?),
+        notes: Vec::new(),
+    })
+}
