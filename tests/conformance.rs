@@ -108,7 +108,10 @@ fn capture(
     let report = welded.open_edges();
     let map = |p: u32, d: [f32; 2]| technique.face_point(p, d);
     let c = classify_open_edges(&soup, &welded, &report, &map, mesh);
-    assert_eq!(c.on_base_boundary + c.cracks, report.open.len());
+    assert_eq!(
+        c.on_base_boundary + c.on_non_manifold_edge + c.cracks,
+        report.open.len()
+    );
     ((c.cracks, c.unmapped, c.on_base_boundary), welded.positions)
 }
 

@@ -109,7 +109,7 @@ impl Harness {
         let map = |patch, d| technique.face_point(patch, d);
         let classes = classify_open_edges(&soup, &welded, &report, &map, base);
         assert_eq!(
-            classes.on_base_boundary + classes.cracks,
+            classes.on_base_boundary + classes.on_non_manifold_edge + classes.cracks,
             report.open.len(),
             "every open edge is classified"
         );

@@ -1,7 +1,9 @@
 //! OBJ parsing, OpenSubdiv tags and every validation error on small inline meshes.
 
 use topology::error::TagKind;
-use topology::mesh::obj::parse_obj;
+use topology::mesh::manifold::{ManifoldSplit, NonManifoldReport};
+use topology::mesh::obj::{parse_obj, parse_obj_with_lines};
+use topology::mesh::Topology;
 use topology::rules::options::{BoundaryInterpolation, CreaseMethod, TriangleSubdivision};
 use topology::TopologyError;
 
@@ -9,6 +11,16 @@ const QUAD_PAIR: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\n"
 
 fn err(text: &str) -> TopologyError {
     parse_obj(text, "inline.obj").expect_err("mesh should be rejected")
+}
+
+/// A mesh that loads (non-manifold input is drawn as OpenSubdiv draws it) but that the
+/// manifold-only adjacency ([`Topology::from_mesh`]) refuses, located in the file; and what
+/// the manifold split found.
+fn manifold_err(text: &str) -> (TopologyError, NonManifoldReport) {
+    let (mesh, lines) = parse_obj_with_lines(text, "inline.obj").expect("non-manifold loads");
+    let report = ManifoldSplit::of(&mesh).expect("splits").report;
+    let e = Topology::from_mesh(&mesh).expect_err("not manifold");
+    (lines.locate(e, &mesh, "inline.obj"), report)
 }
 
 #[test]
@@ -123,17 +135,23 @@ fn face_with_too_few_or_repeated_vertices() {
         e.root(),
         TopologyError::DegenerateFace { face: 0, size: 2 }
     ));
-    let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 2 3\n");
+    // A vertex named twice in a row is a degenerate edge (OpenSubdiv's quad poles): it loads,
+    // the refiner takes it through the manifold split, the manifold adjacency names it.
+    let (e, report) = manifold_err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 2 3\n");
     assert!(matches!(
         e.root(),
         TopologyError::RepeatedVertex { face: 1, vertex: 1 }
     ));
+    assert!(e.to_string().contains("inline.obj:5"), "{e}");
+    assert_eq!(report.sharpened, 3, "{report:?}");
 }
 
 #[test]
 fn non_manifold_edge() {
     // Three triangles on edge 0-1.
-    let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n");
+    let (e, report) =
+        manifold_err("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n");
+    assert_eq!(report.shared_edges, 1);
     match e.root() {
         TopologyError::NonManifoldEdge { v0, v1, faces } => {
             assert_eq!((*v0, *v1, *faces), (0, 1, 3));
@@ -145,7 +163,8 @@ fn non_manifold_edge() {
 #[test]
 fn inconsistent_orientation() {
     // The second quad walks the shared edge 1->2 the same way as the first.
-    let e = err(&format!("{QUAD_PAIR}f 1 2 3 4\nf 2 3 6 5\n"));
+    let (e, report) = manifold_err(&format!("{QUAD_PAIR}f 1 2 3 4\nf 2 3 6 5\n"));
+    assert_eq!(report.opposite_winding_edges, 1);
     match e.root() {
         TopologyError::InconsistentOrientation {
             face0,
@@ -163,7 +182,9 @@ fn inconsistent_orientation() {
 #[test]
 fn non_manifold_vertex() {
     // Two triangles touching only at vertex 0 (a bow tie).
-    let e = err("v 0 0 0\nv 1 0 0\nv 1 1 0\nv -1 0 0\nv -1 -1 0\nf 1 2 3\nf 1 4 5\n");
+    let (e, report) =
+        manifold_err("v 0 0 0\nv 1 0 0\nv 1 1 0\nv -1 0 0\nv -1 -1 0\nf 1 2 3\nf 1 4 5\n");
+    assert_eq!(report.vertices_with_fans, 1);
     match e.root() {
         TopologyError::NonManifoldVertex { vertex, fans } => {
             assert_eq!((*vertex, *fans), (0, 2));

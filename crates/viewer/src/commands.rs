@@ -57,6 +57,28 @@ pub fn load_mesh_with_lines(
     Ok((mesh, lines))
 }
 
+/// The mesh of `path` (as [`load_mesh_with_lines`]) with its coincident vertices merged when
+/// `weld` asks for it (`--weld`: the distance, 0 for identical positions), reporting what was
+/// merged on stderr.
+pub fn load_mesh_welded(
+    path: Option<&std::path::Path>,
+    weld: Option<f64>,
+) -> Result<(topology::ControlMesh, ObjLines)> {
+    let (mesh, lines) = load_mesh_with_lines(path)?;
+    let Some(tolerance) = weld else {
+        return Ok((mesh, lines));
+    };
+    let (welded, kept, report) = topology::mesh::weld::weld_vertices(&mesh, tolerance);
+    eprintln!("{}: {}", mesh_name(path), report.summary());
+    if welded.num_faces() == 0 {
+        bail!(
+            "{}: --weld {tolerance} merged every face away",
+            mesh_name(path)
+        );
+    }
+    Ok((welded, lines.for_faces(&kept)))
+}
+
 /// Refuses, before any device is opened, a mesh the GPU's f32 cannot draw
 /// ([`tess::framing::check_drawable`]) or, for a picture (`shaded`), cannot shade
 /// ([`tess::framing::check_shaded`]), naming the file and the face's line.
@@ -244,7 +266,7 @@ pub fn check_validation(instance: &Instance) -> Result<()> {
 
 fn render(a: RenderArgs) -> Result<()> {
     let name = mesh_name(a.scene.mesh.as_deref());
-    let (mesh, lines) = load_mesh_with_lines(a.scene.mesh.as_deref())?;
+    let (mesh, lines) = load_mesh_welded(a.scene.mesh.as_deref(), a.scene.surface.weld)?;
     check_drawable(&mesh, &lines, &name, true)?;
     let setup = scene_setup(&a.scene, &name, &mesh)?;
     // Before the device and any work.

@@ -6,7 +6,7 @@
 //! shared, so a new technique needs nothing here.
 use crate::cli::ExportArgs;
 use crate::commands::{
-    build_technique, camera, check_drawable, check_validation, load_mesh_with_lines, mesh_name,
+    build_technique, camera, check_drawable, check_validation, load_mesh_welded, mesh_name,
     open_device,
 };
 use crate::technique::describe;
@@ -23,6 +23,9 @@ pub struct ExportReport {
     pub welded_vertices: usize,
     pub open_edges: usize,
     pub on_base_boundary: usize,
+    /// Open edges along the base mesh's non-manifold edges (sheets meeting there without
+    /// sharing vertices): not cracks.
+    pub on_non_manifold_edge: usize,
     pub cracks: usize,
     pub unmapped: usize,
     pub non_manifold: usize,
@@ -55,7 +58,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
         phong_alpha: a.alpha,
         ..FrameParams::default()
     };
-    let (base, lines) = load_mesh_with_lines(a.input.as_deref())?;
+    let (base, lines) = load_mesh_welded(a.input.as_deref(), a.surface.weld)?;
     check_drawable(&base, &lines, &mesh_name(a.input.as_deref()), false)?;
     let method = crate::technique::resolve_method(a.method, a.surface.scheme.as_deref(), &base)?;
     let mut setup = a
@@ -103,6 +106,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
             welded_vertices: welded.positions.len(),
             open_edges: edges.open.len(),
             on_base_boundary: classes.on_base_boundary,
+            on_non_manifold_edge: classes.on_non_manifold_edge,
             cracks: classes.cracks,
             unmapped: classes.unmapped,
             non_manifold: edges.non_manifold.len(),
@@ -136,7 +140,8 @@ pub fn run(a: ExportArgs) -> Result<()> {
         r.welded_vertices
     );
     out!(
-        "open edges: {} ({} on the base mesh's boundary, {} cracks{})",
+        "open edges: {} ({} on the base mesh's boundary, {} cracks{}, {} along its non-manifold \
+         edges)",
         r.open_edges,
         r.on_base_boundary,
         r.cracks,
@@ -144,9 +149,14 @@ pub fn run(a: ExportArgs) -> Result<()> {
             format!(", {} of them on patches with no base face", r.unmapped)
         } else {
             String::new()
-        }
+        },
+        r.on_non_manifold_edge,
     );
-    out!("non-manifold edges: {}", r.non_manifold);
+    out!(
+        "edges of three or more triangles: {} (where sheets of a non-manifold edge share \
+         their vertices)",
+        r.non_manifold
+    );
     out!("zero-area triangles: {}", r.zero_area);
     out!("wrote {}", a.output.display());
     if a.fail_on_cracks && r.cracks > 0 {

@@ -25,6 +25,17 @@ fn parse_sharpness_scale(s: &str) -> Result<f32, String> {
     float(s, "--sharpness-scale", 0.0, MAX_SHARPNESS_SCALE)
 }
 
+fn parse_weld(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && (0.0..=1e6).contains(&x) => Ok(x),
+        _ => Err(
+            "--weld takes a distance from 0 to 1e6 (model units), or nothing for \
+                  identical positions"
+                .into(),
+        ),
+    }
+}
+
 fn parse_pixels(s: &str) -> Result<f32, String> {
     float(s, "--pixels", 0.5, 16384.0)
 }
@@ -158,6 +169,12 @@ pub struct SurfaceArgs {
     /// triangle.
     #[arg(long)]
     pub scheme: Option<String>,
+    /// Merge coincident vertices before drawing: `--weld` alone merges vertices at identical
+    /// positions, `--weld D` those within distance D (0 to 1e6, model units; chains of near
+    /// vertices merge whole). What was merged is reported. Without it the mesh is drawn as
+    /// given: a seam written as two rows of vertices stays open.
+    #[arg(long, num_args = 0..=1, default_missing_value = "0", value_parser = parse_weld)]
+    pub weld: Option<f64>,
     /// Isolation level of feature-adaptive refinement (adaptive): 1 to 8.
     #[arg(long, default_value_t = DEFAULT_ISOLATION, allow_hyphen_values = true, value_parser = parse_isolation)]
     pub isolation: u32,

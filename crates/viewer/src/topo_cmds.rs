@@ -5,6 +5,7 @@
 use crate::cli::{LimitArgs, SubdivideArgs};
 use anyhow::{bail, Context, Result};
 use topology::limit::eval::{limit_point, EvalError, LimitScheme, LocalMesh};
+use topology::mesh::manifold::ManifoldSplit;
 use topology::mesh::obj::ObjLines;
 use topology::refine::{refine_uniform, Level};
 use topology::{ControlMesh, Scheme};
@@ -28,6 +29,10 @@ fn limit_positions(level: &Level, base: &ControlMesh, scheme: Scheme) -> Result<
     let lm = LocalMesh::from_refined_level(level, ls, &base.options)?;
     (0..lm.num_vertices() as u32)
         .map(|v| {
+            // A vertex no face uses has no surface: it keeps its position (as in OpenSubdiv).
+            if level.topology.vertex_faces(v as usize).is_empty() {
+                return Ok(level.positions[v as usize]);
+            }
             let p = lm
                 .vertex_limit_exact(v)
                 .with_context(|| format!("limit position of vertex {v}"))?;
@@ -62,6 +67,13 @@ pub fn subdivide(a: SubdivideArgs) -> Result<()> {
     }
     let name = crate::commands::mesh_name(a.input.as_deref());
     let (mesh, lines) = read_mesh(a.input.as_deref())?;
+    // A non-manifold mesh is refined through its manifold split, as every subdivision technique
+    // draws it: the output has one vertex per copy (coincident where the sheets meet).
+    let split = ManifoldSplit::of(&mesh).map_err(|e| lines.locate(e, &mesh, &name))?;
+    if split.report.any() {
+        eprintln!("{name}: {}", split.report.summary());
+    }
+    let mesh = split.mesh;
     let r = refine_uniform(&mesh, a.scheme, a.level).map_err(|e| lines.locate(e, &mesh, &name))?;
     let level = r.level(a.level);
     let positions = if a.limit {

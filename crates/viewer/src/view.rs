@@ -36,8 +36,8 @@
 //! it completed (the swapchain's own objects after an idle wait in its drop).
 use crate::cli::ViewArgs;
 use crate::commands::{
-    check_drawable, check_validation, in_mesh_file, load_mesh_with_lines, mesh_name, open_device,
-    scene_setup,
+    check_drawable, check_validation, in_mesh_file, load_mesh_welded, load_mesh_with_lines,
+    mesh_name, open_device, scene_setup,
 };
 use crate::hud::{Action, Hud, PassTimes, Shown};
 use crate::technique::{describe, Setup};
@@ -745,7 +745,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         crate::output::check_png_name(p, "--screenshot")?;
     }
     let name = mesh_name(args.scene.mesh.as_deref());
-    let (mesh, lines) = load_mesh_with_lines(args.scene.mesh.as_deref())?;
+    let (mesh, lines) = load_mesh_welded(args.scene.mesh.as_deref(), args.scene.surface.weld)?;
     check_drawable(&mesh, &lines, &name, true)?;
     let setup = scene_setup(&args.scene, &name, &mesh)?;
     // winit's OS errors name a source file of winit itself: not for users.

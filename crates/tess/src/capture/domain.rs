@@ -92,6 +92,11 @@ pub struct OpenEdgeClasses {
     /// Both endpoints lie on one edge of one base face, and that base edge is a boundary edge
     /// of the drawn surface (used by one face that is not a hole).
     pub on_base_boundary: usize,
+    /// Both endpoints lie on one base edge that is non-manifold (three or more faces, two
+    /// faces of opposite winding, a vertex to itself): where sheets meet along it without
+    /// sharing their vertices' bits, each sheet's side is open. Not a crack: OpenSubdiv's rules
+    /// draw each sheet to the edge, but nothing joins the sheets there.
+    pub on_non_manifold_edge: usize,
     /// Every other open edge: a gap the GPU left inside the surface.
     pub cracks: usize,
     /// Of the cracks, those whose patch id maps to no base face (a mapping bug, not geometry).
@@ -134,8 +139,12 @@ pub fn classify_open_edges(
             continue;
         };
         let (ea, eb) = (edges.at(base, &fa), edges.at(base, &fb));
-        if ea.iter().any(|k| eb.contains(k) && edges.is_boundary(*k)) {
+        let shared =
+            |class: &dyn Fn(&[u32; 2]) -> bool| ea.iter().any(|k| eb.contains(k) && class(k));
+        if shared(&|k| edges.is_boundary(*k)) {
             out.on_base_boundary += 1;
+        } else if shared(&|k| edges.non_manifold.contains(k)) {
+            out.on_non_manifold_edge += 1;
         } else {
             out.cracks += 1;
         }
@@ -149,6 +158,9 @@ pub fn classify_open_edges(
 struct BaseEdges {
     uses: HashMap<[u32; 2], u32>,
     at_vertex: HashMap<u32, Vec<[u32; 2]>>,
+    /// Non-manifold edges ([`topology::mesh::manifold::non_manifold_edges`]; none for a mesh
+    /// that validation refuses).
+    non_manifold: std::collections::HashSet<[u32; 2]>,
 }
 
 impl BaseEdges {
@@ -168,7 +180,14 @@ impl BaseEdges {
                 *u += u32::from(!holes.contains(&(i as u32)));
             }
         }
-        Self { uses, at_vertex }
+        let non_manifold = topology::mesh::manifold::non_manifold_edges(base)
+            .map(|edges| edges.into_iter().map(|(e, _)| e).collect())
+            .unwrap_or_default();
+        Self {
+            uses,
+            at_vertex,
+            non_manifold,
+        }
     }
 
     fn is_boundary(&self, edge: [u32; 2]) -> bool {

@@ -21,8 +21,9 @@
 //! - [`WeldedMesh::open_edges`] counts edges used by exactly one triangle, edges used by three or
 //!   more (non-manifold) and zero-area triangles (two identical welded corners; reported, kept in
 //!   the mesh, left out of edge use).
-//! - [`classify_open_edges`] splits open edges into those on the base mesh's own boundary and
-//!   cracks, from the base mesh topology and the captured domain coordinates only.
+//! - [`classify_open_edges`] splits open edges into those on the base mesh's own boundary,
+//!   those along its non-manifold edges, and cracks, from the base mesh topology and the
+//!   captured domain coordinates only.
 //!
 //! # Patch ids and base faces
 //! A captured patch id is the frame-wide patch number of [`crate::Technique::patch_arrays`];
@@ -343,6 +344,7 @@ mod tests {
             c,
             OpenEdgeClasses {
                 on_base_boundary: 4,
+                on_non_manifold_edge: 0,
                 cracks: 0,
                 unmapped: 0
             }
@@ -358,6 +360,66 @@ mod tests {
         let none = |_: u32, _: [f32; 2]| None;
         let c = classify_open_edges(&soup, &w, &r, &none, &base);
         assert_eq!((c.on_base_boundary, c.cracks, c.unmapped), (0, 6, 6));
+    }
+
+    /// Two triangles walking base edge 0-1 the same way (opposite windings: a non-manifold
+    /// edge), drawn as two sheets whose copies of 0 and 1 differ by an ulp: their open sides
+    /// along 0-1 are the non-manifold edge, not cracks; the same soup over a manifold base
+    /// (the second triangle wound to match) has them as cracks.
+    #[test]
+    fn open_sides_along_a_non_manifold_edge_are_not_cracks() {
+        let positions = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+        ];
+        let base = ControlMesh::from_polygons(positions.clone(), &[[0u32, 1, 2], [0, 1, 3]]);
+        let ulp = f32::from_bits(1);
+        let corner = |k: u32| face_corner_uv(3, k).map(|c| c as f32);
+        let soup = CapturedSoup {
+            records: vec![
+                rec([0.0, 0.0, 0.0], 0, corner(0)),
+                rec([1.0, 0.0, 0.0], 0, corner(1)),
+                rec([0.0, 1.0, 0.0], 0, corner(2)),
+                rec([0.0, ulp, 0.0], 1, corner(0)),
+                rec([1.0, ulp, 0.0], 1, corner(1)),
+                rec([0.0, -1.0, 0.0], 1, corner(2)),
+            ],
+        };
+        let identity = |patch: u32, d: [f32; 2]| {
+            Some(FacePoint {
+                face: patch,
+                u: d[0],
+                v: d[1],
+            })
+        };
+        let w = soup.weld().unwrap();
+        let r = w.open_edges();
+        assert_eq!(r.open.len(), 6);
+        let c = classify_open_edges(&soup, &w, &r, &identity, &base);
+        assert_eq!(
+            (c.on_base_boundary, c.on_non_manifold_edge, c.cracks),
+            (4, 2, 0)
+        );
+        let manifold = ControlMesh::from_polygons(positions, &[[0u32, 1, 2], [1, 0, 3]]);
+        let soup = CapturedSoup {
+            records: vec![
+                soup.records[0],
+                soup.records[1],
+                soup.records[2],
+                rec([1.0, ulp, 0.0], 1, corner(0)),
+                rec([0.0, ulp, 0.0], 1, corner(1)),
+                rec([0.0, -1.0, 0.0], 1, corner(2)),
+            ],
+        };
+        let w = soup.weld().unwrap();
+        let r = w.open_edges();
+        let c = classify_open_edges(&soup, &w, &r, &identity, &manifold);
+        assert_eq!(
+            (c.on_base_boundary, c.on_non_manifold_edge, c.cracks),
+            (4, 0, 2)
+        );
     }
 
     /// Ends mapped into different faces: a vertex-stage technique maps each vertex into one of

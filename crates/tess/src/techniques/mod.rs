@@ -17,6 +17,7 @@ pub mod phong;
 pub mod planned_patches;
 pub mod pn;
 pub mod shared;
+pub mod split;
 pub mod windows;
 
 use crate::context::Context;
@@ -201,13 +202,20 @@ pub fn check_options(id: TechniqueId, build: &BuildOptions, params: &FrameParams
 }
 
 /// Builds technique `id` for `mesh` on `ctx`'s device, with one frame slot per slot of `ctx`.
+/// The subdivision techniques take a non-manifold mesh through its manifold split
+/// ([`split::build_split`]); the others draw its faces as given.
 pub fn build(
     ctx: &mut Context,
     id: TechniqueId,
     mesh: &ControlMesh,
     options: &BuildOptions,
 ) -> Result<Built> {
-    (info(id).build)(ctx, mesh, options)
+    let info = info(id);
+    if info.scheme.is_some() {
+        split::build_split(ctx, info, mesh, options)
+    } else {
+        (info.build)(ctx, mesh, options)
+    }
 }
 
 /// A [`Built`] with no notes.

@@ -159,8 +159,13 @@ fn barycentric(t: [[f64; 2]; 3], p: [f64; 2]) -> [f64; 3] {
 
 impl LimitEvaluator {
     /// An evaluator of `mesh`'s limit surface under `scheme` (any face sizes: Loop evaluates
-    /// the fan triangulation). The mesh is validated as every control mesh is.
+    /// the fan triangulation). The mesh is validated as every control mesh is; a non-manifold
+    /// mesh is evaluated through its manifold split
+    /// ([`crate::mesh::manifold::ManifoldSplit`]: same faces, same face domains, OpenSubdiv's
+    /// rules for the non-manifold parts).
     pub fn new(mesh: &ControlMesh, scheme: LimitScheme) -> Result<Self, EvalError> {
+        let split = crate::mesh::manifold::ManifoldSplit::of(mesh)?;
+        let mesh = &split.mesh;
         let sizes: Vec<u32> = mesh.faces().map(|f| f.len() as u32).collect();
         let (local, first_triangle) = match scheme {
             LimitScheme::CatmullClark => (LocalMesh::from_control_mesh(mesh, scheme)?, Vec::new()),

@@ -277,6 +277,11 @@ pub fn mask_limit_positions(level: &Level) -> Option<Vec<[f64; 3]>> {
     let mut smooth: std::collections::HashMap<usize, (f64, f64)> = Default::default();
     let mut out = Vec::with_capacity(level.num_vertices());
     for v in 0..level.num_vertices() {
+        // A vertex no face uses has no surface: it keeps its position (as in OpenSubdiv).
+        if t.vertex_faces(v).is_empty() {
+            out.push(level.positions[v]);
+            continue;
+        }
         let vs = level.vertex_sharpness[v];
         if is_semi_sharp(vs) {
             return None;
@@ -384,6 +389,10 @@ pub fn evaluator_limit_positions(
     let local = LocalMesh::from_refined_level(current, scheme, options).map_err(err)?;
     (0..current.num_vertices())
         .map(|v| {
+            // A vertex no face uses has no surface: it keeps its position (as in OpenSubdiv).
+            if current.topology.vertex_faces(v).is_empty() {
+                return Ok(current.positions[v]);
+            }
             let p = local.vertex_limit_exact(v as u32).map_err(err)?;
             Ok([p[0], p[1], p[2]])
         })

@@ -5,7 +5,9 @@ use crate::rules::options::SubdivOptions;
 use rayon::prelude::*;
 
 pub mod input;
+pub mod manifold;
 pub mod obj;
+pub mod weld;
 
 /// Sentinel for "no face" / "no edge" in adjacency tables.
 pub const INVALID: u32 = u32::MAX;
@@ -209,9 +211,15 @@ impl ControlMesh {
         (out, origin)
     }
 
-    /// Check everything the refiner relies on; see [`TopologyError`] for the cases.
+    /// Check what every technique relies on: a face table whose faces have three or more
+    /// corners naming existing vertices, finite positions within [`MAX_COORDINATE`],
+    /// per-corner attributes of the right length. Non-manifold edges and vertices and
+    /// opposite windings are not errors: the subdivision techniques refine them as
+    /// OpenSubdiv does ([`manifold::ManifoldSplit`]), the others draw the faces as given. A
+    /// face visiting a vertex twice is not an error here either (flat shading draws it); the
+    /// refiner refuses it.
     pub fn validate(&self) -> Result<(), TopologyError> {
-        Topology::from_mesh(self).map(|_| ())
+        check_faces(self, false)
     }
 }
 
@@ -234,77 +242,11 @@ pub struct Topology {
 }
 
 impl Topology {
-    /// Validate `mesh` and build its adjacency.
+    /// Validate `mesh` and build its adjacency: the mesh must be manifold (split a non-manifold
+    /// one first, [`manifold::ManifoldSplit`]).
     pub fn from_mesh(mesh: &ControlMesh) -> Result<Topology, TopologyError> {
-        if mesh.positions.is_empty() {
-            return Err(TopologyError::EmptyMesh {
-                what: "no vertices",
-            });
-        }
-        if mesh.num_faces() == 0 {
-            return Err(TopologyError::EmptyMesh { what: "no faces" });
-        }
-        if mesh.face_offsets.first() != Some(&0)
-            || mesh.face_offsets.windows(2).any(|w| w[0] > w[1])
-            || *mesh.face_offsets.last().unwrap_or(&0) as usize != mesh.face_vertices.len()
-        {
-            return Err(TopologyError::MalformedFaceTable {
-                faces: mesh.num_faces(),
-                corners: mesh.face_vertices.len(),
-            });
-        }
-        check_positions(&mesh.positions)?;
-        let corners = mesh.face_vertices.len();
-        if let Some(n) = &mesh.normals {
-            if n.len() != corners {
-                return Err(TopologyError::AttributeLength {
-                    attribute: "normals",
-                    len: n.len(),
-                    expected: corners,
-                });
-            }
-        }
-        if let Some(uv) = &mesh.uvs {
-            if uv.len() != corners {
-                return Err(TopologyError::AttributeLength {
-                    attribute: "uvs",
-                    len: uv.len(),
-                    expected: corners,
-                });
-            }
-        }
+        check_faces(mesh, true)?;
         let nv = mesh.positions.len();
-        let bad_face = (0..mesh.num_faces())
-            .into_par_iter()
-            .with_min_len(4096)
-            .find_map_first(|face| {
-                let fv = mesh.face(face);
-                if fv.len() < 3 {
-                    return Some(TopologyError::DegenerateFace {
-                        face,
-                        size: fv.len(),
-                    });
-                }
-                for (i, &v) in fv.iter().enumerate() {
-                    if v as usize >= nv {
-                        return Some(TopologyError::IndexOutOfRange {
-                            face,
-                            index: v as i64,
-                            count: nv,
-                        });
-                    }
-                    if fv[..i].contains(&v) {
-                        return Some(TopologyError::RepeatedVertex { face, vertex: v });
-                    }
-                }
-                None
-            });
-        if let Some(e) = bad_face {
-            return Err(e);
-        }
-        if corners >= INVALID as usize / 4 {
-            return Err(TopologyError::TooManyCorners { corners });
-        }
         let topo = Topology::build(nv, mesh.face_offsets.clone(), mesh.face_vertices.clone())?;
         topo.check_manifold_vertices()?;
         Ok(topo)
@@ -602,6 +544,77 @@ impl Topology {
             (x == a && y == b) || (x == b && y == a)
         })
     }
+}
+
+/// What every technique relies on, manifold or not: vertices and faces, a consistent face table,
+/// finite positions within range, per-corner attributes of the corners' length, faces of
+/// three or more corners naming existing vertices, indices within 32 bits; and, when
+/// `distinct_corners`, no face visiting a vertex twice (the refiner's requirement).
+pub(crate) fn check_faces(mesh: &ControlMesh, distinct_corners: bool) -> Result<(), TopologyError> {
+    if mesh.positions.is_empty() {
+        return Err(TopologyError::EmptyMesh {
+            what: "no vertices",
+        });
+    }
+    if mesh.num_faces() == 0 {
+        return Err(TopologyError::EmptyMesh { what: "no faces" });
+    }
+    if mesh.face_offsets.first() != Some(&0)
+        || mesh.face_offsets.windows(2).any(|w| w[0] > w[1])
+        || *mesh.face_offsets.last().unwrap_or(&0) as usize != mesh.face_vertices.len()
+    {
+        return Err(TopologyError::MalformedFaceTable {
+            faces: mesh.num_faces(),
+            corners: mesh.face_vertices.len(),
+        });
+    }
+    check_positions(&mesh.positions)?;
+    let corners = mesh.face_vertices.len();
+    for (attribute, len) in [
+        ("normals", mesh.normals.as_ref().map(Vec::len)),
+        ("uvs", mesh.uvs.as_ref().map(Vec::len)),
+    ] {
+        if let Some(len) = len.filter(|&n| n != corners) {
+            return Err(TopologyError::AttributeLength {
+                attribute,
+                len,
+                expected: corners,
+            });
+        }
+    }
+    let nv = mesh.positions.len();
+    let bad_face = (0..mesh.num_faces())
+        .into_par_iter()
+        .with_min_len(4096)
+        .find_map_first(|face| {
+            let fv = mesh.face(face);
+            if fv.len() < 3 {
+                return Some(TopologyError::DegenerateFace {
+                    face,
+                    size: fv.len(),
+                });
+            }
+            for (i, &v) in fv.iter().enumerate() {
+                if v as usize >= nv {
+                    return Some(TopologyError::IndexOutOfRange {
+                        face,
+                        index: v as i64,
+                        count: nv,
+                    });
+                }
+                if distinct_corners && fv[..i].contains(&v) {
+                    return Some(TopologyError::RepeatedVertex { face, vertex: v });
+                }
+            }
+            None
+        });
+    if let Some(e) = bad_face {
+        return Err(e);
+    }
+    if corners >= INVALID as usize / 4 {
+        return Err(TopologyError::TooManyCorners { corners });
+    }
+    Ok(())
 }
 
 /// The half-edges of the faces as (min, max, corner) keys, `(min << 32 | max, corner)`,

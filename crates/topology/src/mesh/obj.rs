@@ -139,6 +139,19 @@ impl ObjLines {
         self.vertices.get(v).copied()
     }
 
+    /// The lines of a mesh that keeps, of this one's faces, those of `kept` (per new face, its
+    /// old number: [`crate::mesh::weld::weld_vertices`] drops faces). Vertices and tags keep
+    /// their lines.
+    pub fn for_faces(&self, kept: &[u32]) -> ObjLines {
+        ObjLines {
+            faces: kept
+                .iter()
+                .map(|&f| self.faces.get(f as usize).copied().unwrap_or(0))
+                .collect(),
+            ..self.clone()
+        }
+    }
+
     /// `e`, an error about the mesh read from `file` with these lines, in the file's terms
     /// ([`TopologyError::in_file`] with the line at fault when there is one).
     pub fn locate(&self, e: TopologyError, mesh: &ControlMesh, file: &str) -> TopologyError {
@@ -848,6 +861,14 @@ mod tests {
         parse_obj(text, "t.obj").expect_err("mesh should be rejected")
     }
 
+    /// A non-manifold mesh loads (the techniques draw it); the manifold-only adjacency refuses
+    /// it, located in the file's terms.
+    fn manifold_err(text: &str) -> TopologyError {
+        let (mesh, lines) = parse_obj_with_lines(text, "t.obj").expect("non-manifold loads");
+        let e = crate::mesh::Topology::from_mesh(&mesh).expect_err("not manifold");
+        lines.locate(e, &mesh, "t.obj")
+    }
+
     const TRI: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
 
     /// The issue's repro: a finite coordinate whose f32 intermediates overflow is refused, with
@@ -910,17 +931,21 @@ mod tests {
                 count: 3
             }
         ));
-        let e = err(&format!("{TRI}# comment\nf 1 2 3\nf 1 2 2\n"));
+        let e = manifold_err(&format!("{TRI}# comment\nf 1 2 3\nf 1 2 2\n"));
         assert_eq!(
             e.to_string(),
             "t.obj:6: face 2 uses vertex 2 more than once"
         );
-        let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n");
+        let e = manifold_err(
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n",
+        );
         assert_eq!(
             e.to_string(),
             "t.obj:8: edge 1-2 is shared by 3 faces (non-manifold edge)"
         );
-        let e = err("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nf 1 2 3 4\nf 2 3 6 5\n");
+        let e = manifold_err(
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nf 1 2 3 4\nf 2 3 6 5\n",
+        );
         assert_eq!(
             e.to_string(),
             "t.obj:8: faces 1 and 2 both traverse edge 2->3 in the same direction \
