@@ -813,15 +813,16 @@ fn export_bad_inputs_are_named_errors() {
             "--segments",
             "4",
             "--scheme",
-            "doo-sabin",
+            "bilinear",
             "-o",
             out,
         ],
         &[],
         &[
-            "--scheme doo-sabin",
+            "--scheme bilinear",
             "loop (--method bft)",
             "catmull-clark (--method adaptive)",
+            "doo-sabin (--method doo-sabin)",
         ],
     );
     fails_with(
