@@ -325,6 +325,10 @@ typedef struct TesseraHostDesc {
 // Loop, strictly: a mesh with a face that is not a triangle is refused (`TESSERA_STATUS_MESH`).
 #define TESSERA_SCHEME_LOOP 2
 
+// Doo-Sabin (drawn by `TESSERA_TECHNIQUE_DOO_SABIN`; no limit evaluation: an evaluator of it
+// is refused with `TESSERA_STATUS_UNSUPPORTED`).
+#define TESSERA_SCHEME_DOO_SABIN 3
+
 // `factor` segments per base edge.
 #define TESSERA_FACTORS_UNIFORM 0
 

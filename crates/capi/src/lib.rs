@@ -120,6 +120,9 @@ pub const TESSERA_SCHEME_AUTO: TesseraScheme = 0;
 pub const TESSERA_SCHEME_CATMULL_CLARK: TesseraScheme = 1;
 /// Loop, strictly: a mesh with a face that is not a triangle is refused (`TESSERA_STATUS_MESH`).
 pub const TESSERA_SCHEME_LOOP: TesseraScheme = 2;
+/// Doo-Sabin (drawn by `TESSERA_TECHNIQUE_DOO_SABIN`; no limit evaluation: an evaluator of it
+/// is refused with `TESSERA_STATUS_UNSUPPORTED`).
+pub const TESSERA_SCHEME_DOO_SABIN: TesseraScheme = 3;
 
 /// How tessellation factors are chosen (`TESSERA_FACTORS_*`).
 pub type TesseraFactorPolicy = u32;
@@ -925,6 +928,7 @@ fn given_scheme(scheme: TesseraScheme) -> Result<Option<topology::Scheme>> {
         TESSERA_SCHEME_AUTO => Ok(None),
         TESSERA_SCHEME_CATMULL_CLARK => Ok(Some(Scheme::CatmullClark)),
         TESSERA_SCHEME_LOOP => Ok(Some(Scheme::Loop)),
+        TESSERA_SCHEME_DOO_SABIN => Ok(Some(Scheme::DooSabin)),
         v => Err(invalid("scheme", v, "a TESSERA_SCHEME_* value")),
     }
 }

@@ -439,3 +439,36 @@ fn evaluators_of_meshes_and_of_moved_surfaces() {
         assert_eq!(*a, b.map(|x| 2.0 * x));
     }
 }
+
+/// `TESSERA_SCHEME_DOO_SABIN` with `TESSERA_TECHNIQUE_AUTO` builds the doo-sabin technique;
+/// its limit evaluator is refused as unsupported (there is no exact Doo-Sabin evaluation at
+/// arbitrary points), as is the scheme under a technique that draws another.
+#[test]
+fn doo_sabin_surfaces_build_and_refuse_limit_evaluation() {
+    let c = Standalone::new();
+    let mut d = surface_desc(TESSERA_TECHNIQUE_AUTO);
+    d.scheme = TESSERA_SCHEME_DOO_SABIN;
+    let mut s = null_mut();
+    // SAFETY: NULL text builds the embedded mesh; `d` and `s` are live locals.
+    let status = unsafe { tessera_surface_create_obj(c.ctx, null(), 0, null(), &d, &mut s) };
+    assert_eq!(status, TesseraStatus::Ok, "{}", last_error());
+    let mut e = null_mut();
+    // SAFETY: `s` is live; `e` is a live local.
+    let status = unsafe { tessera_limit_evaluator_create(c.ctx, s, &mut e) };
+    assert_eq!(status, TesseraStatus::Unsupported);
+    assert!(e.is_null());
+    let message = last_error();
+    assert!(message.to_lowercase().contains("doo"), "{message}");
+    // SAFETY: `s` is live and destroyed once.
+    assert_eq!(
+        unsafe { tessera_surface_destroy(c.ctx, s) },
+        TesseraStatus::Ok
+    );
+    let mut d = surface_desc(TESSERA_TECHNIQUE_ADAPTIVE);
+    d.scheme = TESSERA_SCHEME_DOO_SABIN;
+    let mut s = null_mut();
+    // SAFETY: as above.
+    let status = unsafe { tessera_surface_create_obj(c.ctx, null(), 0, null(), &d, &mut s) };
+    assert_eq!(status, TesseraStatus::Unsupported, "{}", last_error());
+    assert!(s.is_null());
+}
