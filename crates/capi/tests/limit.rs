@@ -460,10 +460,8 @@ fn doo_sabin_surfaces_build_and_refuse_limit_evaluation() {
     let message = last_error();
     assert!(message.to_lowercase().contains("doo"), "{message}");
     // SAFETY: `s` is live and destroyed once.
-    assert_eq!(
-        unsafe { tessera_surface_destroy(c.ctx, s) },
-        TesseraStatus::Ok
-    );
+    let status = unsafe { tessera_surface_destroy(c.ctx, s) };
+    assert_eq!(status, TesseraStatus::Ok);
     let mut d = surface_desc(TESSERA_TECHNIQUE_ADAPTIVE);
     d.scheme = TESSERA_SCHEME_DOO_SABIN;
     let mut s = null_mut();
