@@ -1,7 +1,7 @@
 //! What the techniques with storage-buffer sets and adaptive factors (BFT, adaptive) share:
 //! the stages their sets are visible to, static storage buffers, and the factor-policy fields
 //! and checks of their push constants.
-use crate::error::{Param, ParamError, Result};
+use crate::error::{Param, ParamError, Result, TessError};
 use crate::gpu::bindings::{BFT_FACTORS_DISTANCE, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM};
 use crate::shaders::{self, Stage, Variant};
 use crate::technique::{FactorPolicy, FrameParams};
@@ -117,4 +117,39 @@ pub fn check_adaptive_policy(params: &FrameParams) -> Result<()> {
         ),
         _ => Ok(()),
     }
+}
+
+/// Uploads an animated base into frame slot `slot` of `buffers`, the base-position buffers of a
+/// technique that refines from them on the GPU (the stencil evaluator's `vec4` vertices):
+/// checks the count against `expected`, every coordinate finite and the slot, writes them with
+/// negative zeros made positive (both sides of a shared edge start from the same bits), and
+/// returns what was written.
+pub fn upload_base(
+    buffers: &mut [Buffer],
+    slot: usize,
+    positions: &[[f32; 3]],
+    expected: usize,
+) -> Result<Vec<[f32; 3]>> {
+    if positions.len() != expected {
+        return Err(TessError::BasePositionCount {
+            given: positions.len(),
+            expected,
+        });
+    }
+    if let Some(v) = positions
+        .iter()
+        .position(|p| p.iter().any(|c| !c.is_finite()))
+    {
+        return Err(TessError::NonFiniteVertex { vertex: v });
+    }
+    let slots = buffers.len();
+    let buf = buffers
+        .get_mut(slot)
+        .ok_or(TessError::FrameSlot { slot, slots })?;
+    let positions: Vec<[f32; 3]> = positions.iter().map(|p| p.map(canonical_zero)).collect();
+    buf.write(
+        0,
+        bytemuck::cast_slice(&crate::stencil::vertices(&positions)),
+    )?;
+    Ok(positions)
 }

@@ -42,8 +42,8 @@ use crate::error::{Param, ParamError, Result, TablesTooLarge, TessError};
 pub mod layout;
 
 use super::shared::{
-    canonical_zero, check_adaptive_policy, compute_pipeline, factor_fields, storage,
-    storage_binding, storage_buffers,
+    check_adaptive_policy, compute_pipeline, factor_fields, storage, storage_binding,
+    storage_buffers, upload_base,
 };
 use super::windows::{self, Chunk, Limits, Member, Space};
 use crate::animation::base_positions;
@@ -1084,20 +1084,8 @@ impl Technique for Bft {
     }
 
     fn update_base(&mut self, slot: usize, positions: &[[f32; 3]]) -> Result<()> {
-        if positions.len() != self.base_positions.len() {
-            return Err(TessError::BasePositionCount {
-                given: positions.len(),
-                expected: self.base_positions.len(),
-            });
-        }
-        let slots = self.base.len();
-        let buf = self
-            .base
-            .get_mut(slot)
-            .ok_or(TessError::FrameSlot { slot, slots })?;
-        let positions: Vec<[f32; 3]> = positions.iter().map(|p| p.map(canonical_zero)).collect();
-        buf.write(0, bytemuck::cast_slice(&stencil::vertices(&positions)))?;
-        self.base_positions = positions;
+        self.base_positions =
+            upload_base(&mut self.base, slot, positions, self.base_positions.len())?;
         Ok(())
     }
 

@@ -41,7 +41,7 @@ use crate::technique::{
     DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features, FrameParams, Pass, PatchArray,
     PatchPipeline, PatchType, Technique, TechniqueId,
 };
-use crate::techniques::shared::{canonical_zero, storage, storage_binding};
+use crate::techniques::shared::{storage, storage_binding, upload_base};
 use crate::techniques::{BuildOptions, Built, TechniqueInfo};
 use layout::{first_level_size, level_sizes, DepthLayout, LayoutError, LevelSize};
 use std::mem::size_of;
@@ -395,25 +395,12 @@ impl Technique for DooSabin {
 
     /// Writes the base positions of frame slot `slot`: the one upload an animated frame makes.
     fn update_base(&mut self, slot: usize, positions: &[[f32; 3]]) -> Result<()> {
-        if positions.len() != self.mesh.positions.len() {
-            return Err(TessError::BasePositionCount {
-                given: positions.len(),
-                expected: self.mesh.positions.len(),
-            });
-        }
-        if let Some(v) = positions
-            .iter()
-            .position(|p| p.iter().any(|c| !c.is_finite()))
-        {
-            return Err(TessError::NonFiniteVertex { vertex: v });
-        }
-        let slots = self.base_buffers.len();
-        let buf = self
-            .base_buffers
-            .get_mut(slot)
-            .ok_or(TessError::FrameSlot { slot, slots })?;
-        let positions: Vec<[f32; 3]> = positions.iter().map(|p| p.map(canonical_zero)).collect();
-        buf.write(0, bytemuck::cast_slice(&stencil::vertices(&positions)))?;
+        upload_base(
+            &mut self.base_buffers,
+            slot,
+            positions,
+            self.mesh.positions.len(),
+        )?;
         Ok(())
     }
 

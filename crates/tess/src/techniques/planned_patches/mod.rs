@@ -38,8 +38,8 @@
 pub mod layout;
 
 use super::shared::{
-    canonical_zero, check_adaptive_policy, compute_pipeline, factor_fields, storage_binding,
-    storage_buffers,
+    check_adaptive_policy, compute_pipeline, factor_fields, storage_binding, storage_buffers,
+    upload_base,
 };
 use super::windows;
 use crate::animation::base_positions;
@@ -844,26 +844,8 @@ impl Technique for PlannedPatches {
     }
 
     fn update_base(&mut self, slot: usize, positions: &[[f32; 3]]) -> Result<()> {
-        if positions.len() != self.base_positions.len() {
-            return Err(TessError::BasePositionCount {
-                given: positions.len(),
-                expected: self.base_positions.len(),
-            });
-        }
-        if let Some(v) = positions
-            .iter()
-            .position(|p| p.iter().any(|c| !c.is_finite()))
-        {
-            return Err(TessError::NonFiniteVertex { vertex: v });
-        }
-        let slots = self.base.len();
-        let buf = self
-            .base
-            .get_mut(slot)
-            .ok_or(TessError::FrameSlot { slot, slots })?;
-        let positions: Vec<[f32; 3]> = positions.iter().map(|p| p.map(canonical_zero)).collect();
-        buf.write(0, bytemuck::cast_slice(&stencil::vertices(&positions)))?;
-        self.base_positions = positions;
+        self.base_positions =
+            upload_base(&mut self.base, slot, positions, self.base_positions.len())?;
         Ok(())
     }
 
