@@ -99,6 +99,8 @@ pub enum TessError {
     CaptureOverflow { needed: u64, capacity: u64 },
     #[error("captured soup has {corners} corners, not whole triangles")]
     PartialTriangle { corners: usize },
+    #[error("a refinement pattern of {segments} segments per edge: expected 1..64")]
+    PatternLevel { segments: u32 },
     #[error("{path}: vertex {vertex} has patch id {patch}, which maps to no base face")]
     UnmappedPatch {
         path: String,

@@ -16,6 +16,7 @@ pub mod error;
 pub mod framing;
 pub mod gpu;
 pub mod output;
+pub mod pattern;
 pub mod render_mesh;
 pub mod shaders;
 pub mod stencil;
