@@ -16,8 +16,8 @@ use tessera::tess::animation::Wave;
 use tessera::tess::capture::classify_open_edges;
 use tessera::tess::techniques::{self, TechniqueInfo};
 use tessera::tess::{
-    BuildOptions, Capturer, Context, DrawPath, FactorPolicy, FrameParams, Spacing, Technique,
-    TessError,
+    BuildOptions, Capturer, Context, DrawPath, FactorPolicy, FrameParams, PipelineChoice, Spacing,
+    Technique, TessError,
 };
 use tessera::topology::{load_obj, ControlMesh};
 use tessera::vk_core::vk;
@@ -44,7 +44,21 @@ fn meshes() -> Vec<(&'static str, ControlMesh)> {
     ]
 }
 
-fn build(ctx: &mut Context, info: &TechniqueInfo, mesh: &ControlMesh) -> Box<dyn Technique> {
+/// The `--pipeline` choice that builds `path`.
+fn choice(path: DrawPath) -> PipelineChoice {
+    match path {
+        DrawPath::Tessellation => PipelineChoice::Tessellation,
+        DrawPath::Pattern => PipelineChoice::Pattern,
+        DrawPath::VertexStage => PipelineChoice::Auto,
+    }
+}
+
+fn build(
+    ctx: &mut Context,
+    info: &TechniqueInfo,
+    mesh: &ControlMesh,
+    path: DrawPath,
+) -> Box<dyn Technique> {
     techniques::build(
         ctx,
         info.id,
@@ -52,6 +66,7 @@ fn build(ctx: &mut Context, info: &TechniqueInfo, mesh: &ControlMesh) -> Box<dyn
         &BuildOptions {
             name: "conformance".into(),
             tangents: info.features.geometric_normals,
+            pipeline: choice(path),
             ..BuildOptions::default()
         },
     )
@@ -59,15 +74,16 @@ fn build(ctx: &mut Context, info: &TechniqueInfo, mesh: &ControlMesh) -> Box<dyn
     .technique
 }
 
-/// The arrays' geometry is the declared path's, and every stage comes from the technique's
-/// shader folder or the common one.
-fn check_pipelines(info: &TechniqueInfo, technique: &dyn Technique, what: &str) {
+/// The arrays are on the path they were built for, their geometry is that path's, and every
+/// stage comes from the technique's shader folder or the common one.
+fn check_pipelines(info: &TechniqueInfo, technique: &dyn Technique, path: DrawPath, what: &str) {
     assert!(!technique.patch_arrays().is_empty(), "{what}: no arrays");
     for a in technique.patch_arrays() {
         let pp = technique.patch_pipeline(a.patch);
+        assert_eq!(a.patch.path(), path, "{what}: {:?}", a.patch);
         assert!(
-            info.features.paths.contains(&DrawPath::of(pp.geometry)),
-            "{what}: {:?} draws on an undeclared path",
+            path.draws(pp.geometry),
+            "{what}: {:?} is not drawn as its path draws",
             a.patch
         );
         assert_eq!(a.control_points, pp.control_points(), "{what}");
@@ -138,26 +154,28 @@ fn every_technique_draws_captures_and_welds_on_every_declared_path() {
         for info in techniques::registry() {
             assert!(!info.features.paths.is_empty(), "{}: no draw path", info.id);
             for (name, mesh) in meshes() {
-                let what = format!("{} on {name}", info.id);
-                let mut t = build(&mut ctx, info, &mesh);
-                assert_eq!(t.id(), info.id, "{what}");
-                check_pipelines(info, t.as_ref(), &what);
-                assert!(
-                    drawn_pixels(&mut ctx, t.as_mut(), &params) > 100,
-                    "{what}: nothing drawn"
-                );
-                let (classes, rest) = capture(&mut ctx, &capturer, t.as_mut(), &mesh, &params);
-                assert_eq!(classes, (0, 0, 0), "{what}: (cracks, unmapped, boundary)");
-                if info.features.animation {
-                    let base = t.base_mesh().expect("an animated technique's base").clone();
-                    let moved = Wave::new(&base).at(0.37);
-                    t.update_base(0, &moved).expect("animated base");
-                    let (classes, positions) =
-                        capture(&mut ctx, &capturer, t.as_mut(), &mesh, &params);
-                    assert_eq!(classes, (0, 0, 0), "{what}, animated");
-                    assert_ne!(positions, rest, "{what}: the animated surface moved");
+                for &path in info.features.paths {
+                    let what = format!("{} on {name}, {path} path", info.id);
+                    let mut t = build(&mut ctx, info, &mesh, path);
+                    assert_eq!(t.id(), info.id, "{what}");
+                    check_pipelines(info, t.as_ref(), path, &what);
+                    assert!(
+                        drawn_pixels(&mut ctx, t.as_mut(), &params) > 100,
+                        "{what}: nothing drawn"
+                    );
+                    let (classes, rest) = capture(&mut ctx, &capturer, t.as_mut(), &mesh, &params);
+                    assert_eq!(classes, (0, 0, 0), "{what}: (cracks, unmapped, boundary)");
+                    if info.features.animation {
+                        let base = t.base_mesh().expect("an animated technique's base").clone();
+                        let moved = Wave::new(&base).at(0.37);
+                        t.update_base(0, &moved).expect("animated base");
+                        let (classes, positions) =
+                            capture(&mut ctx, &capturer, t.as_mut(), &mesh, &params);
+                        assert_eq!(classes, (0, 0, 0), "{what}, animated");
+                        assert_ne!(positions, rest, "{what}: the animated surface moved");
+                    }
+                    println!("{what}: conforms");
                 }
-                println!("{what}: conforms");
             }
         }
     }
@@ -231,7 +249,25 @@ fn every_technique_refuses_each_option_it_declares_it_does_not_take() {
         let (_, cube) = meshes().pop().unwrap();
         let mut refusals = 0;
         for info in techniques::registry() {
-            let mut t = build(&mut ctx, info, &cube);
+            for path in [DrawPath::Tessellation, DrawPath::Pattern] {
+                if info.features.paths.contains(&path) {
+                    continue;
+                }
+                let options = BuildOptions {
+                    pipeline: choice(path),
+                    ..BuildOptions::default()
+                };
+                match techniques::build(&mut ctx, info.id, &cube, &options) {
+                    Err(e @ TessError::Unsupported { technique, .. }) => {
+                        assert_eq!(technique, info.id, "{e}");
+                        assert!(e.to_string().contains("--pipeline"), "{e}");
+                    }
+                    Err(e) => panic!("{}: --pipeline {path} refused as {e}", info.id),
+                    Ok(_) => panic!("{}: --pipeline {path} was not refused", info.id),
+                }
+                refusals += 1;
+            }
+            let mut t = build(&mut ctx, info, &cube, info.features.paths[0]);
             for (option, params) in declined(info) {
                 match ctx.prepare(t.as_mut(), &params, &[tessera::tess::Pass::Shaded]) {
                     Err(TessError::Unsupported { technique, .. }) => {

@@ -63,3 +63,76 @@ vec3 pn_edge_quadratic(vec3 na, vec3 nab, vec3 nb, float wa, float wb) {
     precise vec3 n = na * (wa * wa) + nab * (wa * wb) + nb * (wb * wb);
     return n;
 }
+
+// A curved PN triangle's coefficients beyond its corners: edge points b_edge (for edge e,
+// corners e and e + 1 mod 3: b_edge[2e] next to corner e, b_edge[2e + 1] next to corner e + 1,
+// that is b210, b120, b021, b012, b102, b201), the centre b111 and the mid-edge normal
+// coefficients n_edge (n110, n011, n101), each computed from the edge's lower corner.
+struct PnPatch {
+    vec3 b_edge[6];
+    vec3 b111;
+    vec3 n_edge[3];
+};
+
+PnPatch pn_patch(vec3 c[3], vec3 n[3]) {
+    PnPatch q;
+    for (int e = 0; e < 3; e++) {
+        int i = e, j = (e + 1) % 3;
+        q.b_edge[2 * e] = pn_edge_point(c[i], c[j], n[i]);
+        q.b_edge[2 * e + 1] = pn_edge_point(c[j], c[i], n[j]);
+        q.n_edge[e] = pn_corner_below(c[i], n[i], c[j], n[j]) ? pn_edge_normal(c[i], n[i], c[j], n[j])
+                                                            : pn_edge_normal(c[j], n[j], c[i], n[i]);
+    }
+    // b111 = 1/4 sum(edge points) - 1/6 sum(corners), as e + (e - v) / 2 with e and v the
+    // means; only interior points use it.
+    precise vec3 e = (q.b_edge[0] + q.b_edge[1] + q.b_edge[2] + q.b_edge[3] + q.b_edge[4] + q.b_edge[5]) / 6.0;
+    precise vec3 v = (c[0] + c[1] + c[2]) / 3.0;
+    precise vec3 b111 = e + 0.5 * (e - v);
+    q.b111 = b111;
+    return q;
+}
+
+// The position (cubic Bézier, Vlachos et al.'s Bernstein weights with the multinomial factors
+// 3 and 6) and the unnormalised quadratic normal field
+// n = N1 u^2 + N2 v^2 + N3 w^2 + n110 uv + n011 vw + n101 wu at barycentric b = (u, v, w),
+// the weights of corners 0, 1, 2. Corners are the control points themselves; points on an
+// edge come from the edge's canonical formula, so the two patches of a shared edge get the
+// same bits; only interior points sum the whole patch.
+void pn_evaluate(vec3 c[3], vec3 n[3], PnPatch q, vec3 b, out vec3 p, out vec3 m) {
+    float u = b.x, v = b.y, w = b.z;
+    int corner = u == 1.0 ? 0 : (v == 1.0 ? 1 : (w == 1.0 ? 2 : -1));
+    // Edge e joins corners e and e + 1 mod 3: the third weight is exactly 0 on it.
+    int edge = w == 0.0 ? 0 : (u == 0.0 ? 1 : (v == 0.0 ? 2 : -1));
+    if (corner >= 0) {
+        p = c[corner];
+        m = n[corner];
+    } else if (edge >= 0) {
+        int i = edge, j = (edge + 1) % 3;
+        vec3 pa = c[i], na = n[i], bab = q.b_edge[2 * edge];
+        vec3 pb = c[j], nb = n[j], bba = q.b_edge[2 * edge + 1];
+        float wa = b[i], wb = b[j];
+        // From the lower corner; a corner pair with equal data is one point twice, ordered by
+        // weight so that both sides still agree.
+        bool keep = pn_corner_below(pa, na, pb, nb)
+            || (!pn_corner_below(pb, nb, pa, na) && wa >= wb);
+        if (!keep) {
+            vec3 t3 = pa; pa = pb; pb = t3;
+            t3 = na; na = nb; nb = t3;
+            t3 = bab; bab = bba; bba = t3;
+            float t = wa; wa = wb; wb = t;
+        }
+        p = pn_edge_cubic(pa, bab, bba, pb, wa, wb);
+        m = pn_edge_quadratic(na, q.n_edge[edge], nb, wa, wb);
+    } else {
+        // `precise`: the same bits in the evaluation stage and the pattern vertex stage.
+        precise vec3 pi = c[0] * (u * u * u) + c[1] * (v * v * v) + c[2] * (w * w * w)
+            + q.b_edge[0] * (3.0 * u * u * v) + q.b_edge[1] * (3.0 * u * v * v)
+            + q.b_edge[2] * (3.0 * v * v * w) + q.b_edge[3] * (3.0 * v * w * w)
+            + q.b_edge[4] * (3.0 * w * w * u) + q.b_edge[5] * (3.0 * w * u * u)
+            + q.b111 * (6.0 * u * v * w);
+        precise vec3 mi = n[0] * (u * u) + n[1] * (v * v) + n[2] * (w * w)
+            + q.n_edge[0] * (u * v) + q.n_edge[1] * (v * w) + q.n_edge[2] * (w * u);
+        p = pi;
+        m = mi;
+    }
+}

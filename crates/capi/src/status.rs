@@ -170,6 +170,8 @@ pub(crate) fn tess_status(e: &TessError) -> TesseraStatus {
             TesseraStatus::InvalidArgument
         }
         E::Unsupported { .. }
+        | E::NoTessellationShader { .. }
+        | E::PatternSpacing { .. }
         | E::NeedsTangentTables
         | E::StorageWindow { .. }
         | E::BftTablesTooLarge(_)
@@ -181,6 +183,7 @@ pub(crate) fn tess_status(e: &TessError) -> TesseraStatus {
         | E::PipelineNotPrepared { .. }
         | E::ShaderVariant { .. }
         | E::BftLayout(_)
+        | E::PatternLevel { .. }
         | E::Stencil(_)
         | E::UnmappedPatch { .. } => TesseraStatus::Internal,
         E::CaptureTooLarge { .. } | E::CaptureOverflow { .. } | E::PartialTriangle { .. } => {

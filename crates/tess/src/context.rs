@@ -116,6 +116,8 @@ impl FrameSets {
 /// See the module docs.
 pub struct Context {
     pipelines: HashMap<PipelineKey, Pipeline>,
+    /// Refinement patterns made so far (host data; techniques upload what they draw).
+    patterns: crate::pattern::PatternCache,
     set_layouts: HashMap<TechniqueId, DescriptorSetLayout>,
     frames: FrameSets,
     color_format: vk::Format,
@@ -140,6 +142,7 @@ impl Context {
         }
         Ok(Self {
             pipelines: HashMap::new(),
+            patterns: Default::default(),
             set_layouts: HashMap::new(),
             frames: FrameSets::new(device, frames_in_flight)?,
             color_format,
@@ -167,6 +170,24 @@ impl Context {
     /// A context for offscreen targets (RGBA8 + D32) and captures, one frame slot.
     pub fn offscreen(device: &Device) -> Result<Self> {
         Self::new(device, COLOR_FORMAT, DEPTH_FORMAT, 1)
+    }
+
+    /// The refinement pattern of one patch of `domain` at uniform `level` with `spacing`, made
+    /// on first use ([`crate::pattern::PatternCache::get`]) and shared by every surface drawn
+    /// through this context.
+    pub fn refinement_pattern(
+        &mut self,
+        domain: crate::tessellator::Domain,
+        spacing: Spacing,
+        level: f32,
+    ) -> Result<std::sync::Arc<crate::pattern::RefinementPattern>> {
+        let key = crate::pattern::PatternKey::new(domain, spacing, level);
+        if let Some(p) = self.patterns.cached(key) {
+            return Ok(p);
+        }
+        let pattern = std::sync::Arc::new(crate::pattern::make(self, key)?);
+        self.patterns.insert(key, pattern.clone());
+        Ok(pattern)
     }
 
     pub fn device(&self) -> &Device {
@@ -267,7 +288,7 @@ impl Context {
             .features
             .refuse(technique.id(), params)?;
         technique.check(params)?;
-        technique.prepare_frame(params)?;
+        technique.prepare_frame(self, params)?;
         let technique = &*technique;
         let bindings = technique.set_layout_bindings();
         if !bindings.is_empty() {

@@ -32,7 +32,8 @@ pub use error::{Result, TessError};
 pub use render_mesh::RenderMesh;
 pub use technique::{
     DeviceAllocation, DrawCounts, DrawPath, DrawSplit, FactorPolicy, Features, FrameParams,
-    Geometry, Pass, PatchArray, PatchPipeline, PatchType, Technique, TechniqueId, VertexInput,
+    Geometry, Pass, PatchArray, PatchPipeline, PatchType, PipelineChoice, Technique, TechniqueId,
+    VertexInput,
 };
 pub use techniques::{build, registry, BuildOptions};
 pub use tessellator::{Domain, Spacing};

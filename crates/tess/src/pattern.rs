@@ -20,10 +20,15 @@
 //!   there (the techniques' canonical-edge evaluation keys on that).
 //! - **Counter-clockwise in the domain**: triangles turn counter-clockwise in `(u, v)` (`u`
 //!   right, `v` up), which maps to the base face's own winding on both domains.
-use crate::capture::CapturedSoup;
+use crate::capture::{CapturedSoup, Capturer};
+use crate::context::Context;
 use crate::error::{Result, TessError};
-use crate::tessellator::Domain;
+use crate::technique::{DrawPath, FactorPolicy, FrameParams};
+use crate::techniques::flat::Flat;
+use crate::tessellator::{Domain, Spacing};
 use std::collections::HashMap;
+use std::sync::Arc;
+use topology::ControlMesh;
 
 /// Fixed-point denominator of generated coordinates.
 const FIXED_ONE: u32 = 1 << 16;
@@ -141,7 +146,10 @@ impl RefinementPattern {
             });
             corners.push(id);
         }
-        let triangles = corners.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let triangles = corners
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
         Ok(Self {
             domain,
             points,
@@ -153,6 +161,90 @@ impl RefinementPattern {
     pub fn indices(&self) -> Vec<u32> {
         self.triangles.iter().flatten().copied().collect()
     }
+}
+
+/// What selects a pattern: domain, spacing and the uniform level (its bits: fractional levels
+/// are patterns of their own).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PatternKey {
+    pub domain: Domain,
+    pub spacing: Spacing,
+    level_bits: u32,
+}
+
+impl PatternKey {
+    pub fn new(domain: Domain, spacing: Spacing, level: f32) -> Self {
+        Self {
+            domain,
+            spacing,
+            level_bits: level.to_bits(),
+        }
+    }
+
+    pub fn level(&self) -> f32 {
+        f32::from_bits(self.level_bits)
+    }
+}
+
+/// The patterns a context made, by key.
+#[derive(Default)]
+pub struct PatternCache {
+    made: HashMap<PatternKey, Arc<RefinementPattern>>,
+}
+
+impl PatternCache {
+    pub fn cached(&self, key: PatternKey) -> Option<Arc<RefinementPattern>> {
+        self.made.get(&key).cloned()
+    }
+
+    pub fn insert(&mut self, key: PatternKey, pattern: Arc<RefinementPattern>) {
+        self.made.insert(key, pattern);
+    }
+}
+
+/// Makes the pattern of `key` on `ctx`'s device: the tessellator's own where the device has one
+/// and can capture ([`tessellator_pattern`]); otherwise generated, in equal spacing only.
+pub fn make(ctx: &mut Context, key: PatternKey) -> Result<RefinementPattern> {
+    let device = ctx.device();
+    if device.info.caps.tessellation_shader && device.require_transform_feedback().is_ok() {
+        return tessellator_pattern(ctx, key);
+    }
+    if key.spacing != Spacing::Equal {
+        return Err(TessError::PatternSpacing {
+            spacing: key.spacing,
+        });
+    }
+    RefinementPattern::generate(key.domain, Spacing::Equal.segments(key.level()))
+}
+
+/// One patch of `key`'s domain over the unit domain, drawn flat through the tessellator at
+/// `key`'s level and spacing and captured: the tessellator's points and triangles.
+fn tessellator_pattern(ctx: &mut Context, key: PatternKey) -> Result<RefinementPattern> {
+    let corners: &[[f64; 3]] = match key.domain {
+        Domain::Quad => &[
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ],
+        Domain::Triangle => &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+    };
+    let face: Vec<u32> = (0..corners.len() as u32).collect();
+    let mesh = ControlMesh::from_polygons(corners.to_vec(), &[face]);
+    let mut patch = Flat::new(ctx.device(), &mesh, DrawPath::Tessellation)?;
+    let params = FrameParams {
+        factors: FactorPolicy::Uniform {
+            segments: key.level(),
+        },
+        spacing: key.spacing,
+        ..FrameParams::default()
+    };
+    let extent = vk_core::vk::Extent2D {
+        width: 1,
+        height: 1,
+    };
+    let (soup, _) = Capturer::new(ctx)?.capture(ctx, &mut patch, &params, extent)?;
+    RefinementPattern::from_capture(key.domain, &soup)
 }
 
 #[cfg(test)]

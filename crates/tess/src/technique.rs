@@ -75,18 +75,36 @@ pub enum PatchType {
     /// Triangles of a mesh refined before the draw (no tessellation stage): the vertex stage
     /// reads each vertex as it is. A captured id names a vertex of the mesh.
     MeshTriangles,
+    /// A base triangle drawn through a refinement pattern ([`crate::pattern`]): one instance
+    /// of the pattern per patch, the vertex stage evaluating the patch at each pattern vertex.
+    /// A captured id names the patch, its domain coordinate the pattern vertex's `(u, v)`.
+    PatternTriangle,
+    /// A base quad drawn through a refinement pattern.
+    PatternQuad,
 }
 
 impl PatchType {
     pub fn domain(self) -> Domain {
         match self {
-            PatchType::Quad | PatchType::BSpline | PatchType::Gregory | PatchType::Bilinear => {
-                Domain::Quad
-            }
+            PatchType::Quad
+            | PatchType::BSpline
+            | PatchType::Gregory
+            | PatchType::Bilinear
+            | PatchType::PatternQuad => Domain::Quad,
             PatchType::Triangle
             | PatchType::LoopBft
             | PatchType::GregoryTriangle
-            | PatchType::MeshTriangles => Domain::Triangle,
+            | PatchType::MeshTriangles
+            | PatchType::PatternTriangle => Domain::Triangle,
+        }
+    }
+
+    /// The draw path its patches take.
+    pub fn path(self) -> DrawPath {
+        match self {
+            PatchType::MeshTriangles => DrawPath::VertexStage,
+            PatchType::PatternTriangle | PatchType::PatternQuad => DrawPath::Pattern,
+            _ => DrawPath::Tessellation,
         }
     }
 }
@@ -282,16 +300,93 @@ pub struct Features {
 pub enum DrawPath {
     /// Patches through the tessellation stage ([`Geometry::Tessellated`]).
     Tessellation,
-    /// Triangles from the vertex stage ([`Geometry::Triangles`]).
+    /// Refinement patterns: a tessellated domain stored once and drawn instanced over the
+    /// patches, each patch evaluated in the vertex stage ([`Geometry::Triangles`]).
+    Pattern,
+    /// Triangles of a mesh refined before the draw, from the vertex stage
+    /// ([`Geometry::Triangles`]).
     VertexStage,
 }
 
 impl DrawPath {
-    /// The path `geometry` belongs to.
-    pub fn of(geometry: Geometry) -> Self {
-        match geometry {
-            Geometry::Tessellated { .. } => DrawPath::Tessellation,
-            Geometry::Triangles => DrawPath::VertexStage,
+    /// Whether `geometry` is this path's: tessellated patches on the tessellation path only.
+    pub fn draws(self, geometry: Geometry) -> bool {
+        geometry.is_tessellated() == (self == DrawPath::Tessellation)
+    }
+
+    /// The name `--pipeline` takes, where the path is a choice.
+    pub fn name(self) -> &'static str {
+        match self {
+            DrawPath::Tessellation => "tessellation",
+            DrawPath::Pattern => "pattern",
+            DrawPath::VertexStage => "vertex-stage",
+        }
+    }
+}
+
+impl std::fmt::Display for DrawPath {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Which draw path a surface is built for (`--pipeline`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum PipelineChoice {
+    /// The tessellation stage where the device has one and the technique draws through it;
+    /// otherwise refinement patterns; techniques with only a vertex-stage path take that.
+    #[default]
+    Auto,
+    Tessellation,
+    Pattern,
+}
+
+impl std::str::FromStr for PipelineChoice {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "auto" => Ok(PipelineChoice::Auto),
+            "tessellation" => Ok(PipelineChoice::Tessellation),
+            "pattern" => Ok(PipelineChoice::Pattern),
+            _ => Err(format!(
+                "unknown pipeline '{s}' (tessellation, pattern, auto)"
+            )),
+        }
+    }
+}
+
+impl PipelineChoice {
+    /// The path a technique declaring `paths` draws on a device that has (or lacks) tessellation
+    /// shaders; an error names `--pipeline` or the missing device feature.
+    pub fn resolve(
+        self,
+        technique: TechniqueId,
+        paths: &[DrawPath],
+        tessellation_shader: bool,
+    ) -> Result<DrawPath> {
+        let has = |p: DrawPath| paths.contains(&p);
+        match self {
+            PipelineChoice::Tessellation if !has(DrawPath::Tessellation) => {
+                Err(TessError::Unsupported {
+                    technique,
+                    what: "the tessellation path (--pipeline tessellation)",
+                })
+            }
+            PipelineChoice::Tessellation if !tessellation_shader => {
+                Err(TessError::NoTessellationShader { technique })
+            }
+            PipelineChoice::Tessellation => Ok(DrawPath::Tessellation),
+            PipelineChoice::Pattern if has(DrawPath::Pattern) => Ok(DrawPath::Pattern),
+            PipelineChoice::Pattern => Err(TessError::Unsupported {
+                technique,
+                what: "the refinement-pattern path (--pipeline pattern)",
+            }),
+            PipelineChoice::Auto if has(DrawPath::Tessellation) && tessellation_shader => {
+                Ok(DrawPath::Tessellation)
+            }
+            PipelineChoice::Auto if has(DrawPath::Pattern) => Ok(DrawPath::Pattern),
+            PipelineChoice::Auto if has(DrawPath::VertexStage) => Ok(DrawPath::VertexStage),
+            PipelineChoice::Auto => Err(TessError::NoTessellationShader { technique }),
         }
     }
 }
@@ -519,9 +614,10 @@ pub trait Technique: Send {
     }
 
     /// Host work a frame of `params` needs before it is recorded, such as refining a mesh to the
-    /// level the frame asks for. Called by [`crate::Context::prepare`] after [`Self::check`].
-    fn prepare_frame(&mut self, params: &FrameParams) -> Result<()> {
-        let _ = params;
+    /// level the frame asks for or taking the frame's refinement patterns from `ctx`. Called by
+    /// [`crate::Context::prepare`] after [`Self::check`].
+    fn prepare_frame(&mut self, ctx: &mut crate::Context, params: &FrameParams) -> Result<()> {
+        let _ = (ctx, params);
         Ok(())
     }
 

@@ -329,9 +329,6 @@ fn missing_requirements(
     if api_version < vk::API_VERSION_1_3 {
         missing.push("Vulkan 1.3".to_owned());
     }
-    if !caps.tessellation_shader {
-        missing.push("tessellationShader".to_owned());
-    }
     if !caps.fill_mode_non_solid {
         missing.push("fillModeNonSolid".to_owned());
     }
@@ -384,20 +381,26 @@ pub fn choose_adapter(adapters: &[AdapterInfo], selector: &DeviceSelector) -> Re
         }
     };
     match (pick, selector) {
-        (None, DeviceSelector::Auto) if adapters.is_empty() => {
-            Err(VkError::NoSuitableDevice("the loader reports no Vulkan device (install mesa-vulkan-drivers for lavapipe)".into()))
-        }
+        (None, DeviceSelector::Auto) if adapters.is_empty() => Err(VkError::NoSuitableDevice(
+            "the loader reports no Vulkan device (install mesa-vulkan-drivers for lavapipe)".into(),
+        )),
         (None, DeviceSelector::Auto) => Err(VkError::NoSuitableDevice(format!(
-            "no device has tessellation shaders and the other features Tessera needs; devices seen:\n{}",
+            "no device has the features Tessera needs; devices seen:\n{}",
             listing()
         ))),
-        (None, s) => Err(VkError::NoSuchDevice { selector: format!("{s:?}"), devices: listing() }),
+        (None, s) => Err(VkError::NoSuchDevice {
+            selector: format!("{s:?}"),
+            devices: listing(),
+        }),
         (Some(i), _) => {
             let a = &adapters[i];
             if a.missing.is_empty() {
                 Ok(i)
             } else {
-                Err(VkError::MissingFeatures { name: a.name.clone(), missing: a.missing.join(", ") })
+                Err(VkError::MissingFeatures {
+                    name: a.name.clone(),
+                    missing: a.missing.join(", "),
+                })
             }
         }
     }
@@ -416,6 +419,10 @@ pub struct DeviceDesc {
     /// Caps the storage-buffer range Tessera uses at `min(device limit, cap)` bytes, so the
     /// paths that split buffers larger than the limit can be tested with small meshes.
     pub storage_buffer_range_cap: Option<u32>,
+    /// Leaves `tessellationShader` off even where the device has it, so the path of devices
+    /// without tessellation (refinement patterns; any tessellation pipeline is then a
+    /// validation error) can be tested on any device.
+    pub without_tessellation_shader: bool,
 }
 
 /// The state every resource shares. Drop order: idle wait, retired objects, one-shot command
@@ -540,6 +547,9 @@ impl Device {
         if let Some(cap) = desc.storage_buffer_range_cap {
             info.caps.max_storage_buffer_range = info.caps.max_storage_buffer_range.min(cap);
         }
+        if desc.without_tessellation_shader {
+            info.caps.tessellation_shader = false;
+        }
         let physical = info.physical;
         let queue_family = info
             .queue_family
@@ -549,7 +559,7 @@ impl Device {
             .queue_family_index(queue_family)
             .queue_priorities(&priorities)];
         let features = vk::PhysicalDeviceFeatures::default()
-            .tessellation_shader(true)
+            .tessellation_shader(info.caps.tessellation_shader)
             .fill_mode_non_solid(true)
             .pipeline_statistics_query(info.caps.pipeline_statistics_query)
             .vertex_pipeline_stores_and_atomics(info.caps.vertex_pipeline_stores_and_atomics)
@@ -980,7 +990,7 @@ impl Drop for DeviceShared {
 mod tests {
     use super::*;
 
-    fn adapter(index: usize, ty: vk::PhysicalDeviceType, tess: bool) -> AdapterInfo {
+    fn adapter(index: usize, ty: vk::PhysicalDeviceType, complete: bool) -> AdapterInfo {
         AdapterInfo {
             index,
             name: format!("device{index}"),
@@ -994,16 +1004,16 @@ mod tests {
             device_id: 0,
             pipeline_cache_uuid: [0; 16],
             caps: Capabilities {
-                tessellation_shader: tess,
-                fill_mode_non_solid: true,
+                tessellation_shader: true,
+                fill_mode_non_solid: complete,
                 dynamic_rendering: true,
                 ..Default::default()
             },
             queue_family: Some(0),
-            missing: if tess {
+            missing: if complete {
                 vec![]
             } else {
-                vec!["tessellationShader".into()]
+                vec!["fillModeNonSolid".into()]
             },
             physical: vk::PhysicalDevice::null(),
         }
@@ -1036,7 +1046,17 @@ mod tests {
     }
 
     #[test]
-    fn no_tessellation_is_a_typed_error_listing_devices() {
+    fn tessellation_is_optional() {
+        use vk::PhysicalDeviceType as T;
+        let mut a = adapter(0, T::CPU, true);
+        a.caps.tessellation_shader = false;
+        a.missing = missing_requirements(a.api_version, &a.caps, a.queue_family);
+        assert!(a.score() > 0 && a.missing.is_empty(), "{:?}", a.missing);
+        assert_eq!(choose_adapter(&[a], &DeviceSelector::Auto).unwrap(), 0);
+    }
+
+    #[test]
+    fn a_missing_feature_is_a_typed_error_listing_devices() {
         use vk::PhysicalDeviceType as T;
         let a = [
             adapter(0, T::DISCRETE_GPU, false),
@@ -1048,7 +1068,7 @@ mod tests {
         assert!(
             text.contains("device0")
                 && text.contains("device1")
-                && text.contains("tessellationShader"),
+                && text.contains("fillModeNonSolid"),
             "{text}"
         );
         let e = choose_adapter(&a, &DeviceSelector::Index(0)).unwrap_err();

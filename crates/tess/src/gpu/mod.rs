@@ -185,6 +185,71 @@ impl Vertex {
     ];
 }
 
+/// The refinement-pattern path's vertex input (`glsl/common/pattern_in.glsl`): binding 0 per
+/// pattern vertex, its domain point (three floats, [`crate::pattern::RefinementPattern`]) at
+/// location 0; binding 1 per instance, the patch's corners as [`Vertex`]es, corner `i`'s
+/// position at location `1 + 2i` and normal at `2 + 2i`.
+pub mod pattern_input {
+    use super::Vertex;
+    use crate::technique::VertexInput;
+    use std::mem::size_of;
+    use vk_core::vk;
+
+    const fn bindings(corners: usize) -> [vk::VertexInputBindingDescription; 2] {
+        [
+            vk::VertexInputBindingDescription {
+                binding: 0,
+                stride: size_of::<[f32; 3]>() as u32,
+                input_rate: vk::VertexInputRate::VERTEX,
+            },
+            vk::VertexInputBindingDescription {
+                binding: 1,
+                stride: (corners * size_of::<Vertex>()) as u32,
+                input_rate: vk::VertexInputRate::INSTANCE,
+            },
+        ]
+    }
+
+    /// Location 0, then position and normal of each corner.
+    const fn attributes<const N: usize>() -> [vk::VertexInputAttributeDescription; N] {
+        let float3 = vk::Format::R32G32B32_SFLOAT;
+        let mut out = [vk::VertexInputAttributeDescription {
+            location: 0,
+            binding: 0,
+            format: float3,
+            offset: 0,
+        }; N];
+        let mut i = 1;
+        while i < N {
+            let (corner, normal) = ((i - 1) / 2, (i - 1) % 2);
+            out[i] = vk::VertexInputAttributeDescription {
+                location: i as u32,
+                binding: 1,
+                format: float3,
+                offset: (corner * size_of::<Vertex>() + normal * size_of::<[f32; 3]>()) as u32,
+            };
+            i += 1;
+        }
+        out
+    }
+
+    const TRIANGLE_BINDINGS: [vk::VertexInputBindingDescription; 2] = bindings(3);
+    const TRIANGLE_ATTRIBUTES: [vk::VertexInputAttributeDescription; 7] = attributes();
+    const QUAD_BINDINGS: [vk::VertexInputBindingDescription; 2] = bindings(4);
+    const QUAD_ATTRIBUTES: [vk::VertexInputAttributeDescription; 9] = attributes();
+
+    /// Triangle patches: three corners per instance.
+    pub const TRIANGLE: VertexInput = VertexInput {
+        bindings: &TRIANGLE_BINDINGS,
+        attributes: &TRIANGLE_ATTRIBUTES,
+    };
+    /// Quad patches: four corners per instance.
+    pub const QUAD: VertexInput = VertexInput {
+        bindings: &QUAD_BINDINGS,
+        attributes: &QUAD_ATTRIBUTES,
+    };
+}
+
 /// One captured triangle corner: the transform-feedback record of `glsl/common/tese_out.glsl`
 /// (buffer [`bindings::CAPTURE_XFB_BUFFER`], stride [`bindings::CAPTURE_XFB_STRIDE`]).
 #[repr(C)]

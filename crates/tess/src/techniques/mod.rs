@@ -22,7 +22,7 @@ pub mod windows;
 
 use crate::context::Context;
 use crate::error::{Result, TessError};
-use crate::technique::{Features, FrameParams, Technique, TechniqueId};
+use crate::technique::{Features, FrameParams, PipelineChoice, Technique, TechniqueId};
 use topology::ControlMesh;
 
 /// Builds a technique for a mesh on a context's device.
@@ -168,6 +168,9 @@ pub struct BuildOptions {
     /// Meshes refined on the CPU refuse levels with more vertices than this (3 M vertices
     /// peak at about 1.6 GB of host memory).
     pub max_refined_vertices: u64,
+    /// The draw path (`--pipeline`): resolved per technique and device by
+    /// [`PipelineChoice::resolve`].
+    pub pipeline: PipelineChoice,
 }
 
 impl Default for BuildOptions {
@@ -183,6 +186,7 @@ impl Default for BuildOptions {
             split_triangles: false,
             maps: Default::default(),
             max_refined_vertices: 4_000_000,
+            pipeline: PipelineChoice::Auto,
         }
     }
 }
@@ -201,7 +205,9 @@ pub fn check_options(id: TechniqueId, build: &BuildOptions, params: &FrameParams
     (info(id).check_options)(build, params)
 }
 
-/// Builds technique `id` for `mesh` on `ctx`'s device, with one frame slot per slot of `ctx`.
+/// Builds technique `id` for `mesh` on `ctx`'s device, with one frame slot per slot of `ctx`,
+/// for the draw path `options.pipeline` chooses (refused by name where the technique or the
+/// device has no such path).
 /// The subdivision techniques take a non-manifold mesh through its manifold split
 /// ([`split::build_split`]); the others draw its faces as given.
 pub fn build(
@@ -211,6 +217,10 @@ pub fn build(
     options: &BuildOptions,
 ) -> Result<Built> {
     let info = info(id);
+    let tessellation_shader = ctx.device().info.caps.tessellation_shader;
+    options
+        .pipeline
+        .resolve(id, info.features.paths, tessellation_shader)?;
     if info.scheme.is_some() {
         split::build_split(ctx, info, mesh, options)
     } else {

@@ -105,8 +105,8 @@ impl Technique for SplitInput {
         self.inner.base_mesh().map(|_| &self.input)
     }
 
-    fn prepare_frame(&mut self, params: &FrameParams) -> Result<()> {
-        self.inner.prepare_frame(params)
+    fn prepare_frame(&mut self, ctx: &mut crate::Context, params: &FrameParams) -> Result<()> {
+        self.inner.prepare_frame(ctx, params)
     }
 
     /// The input's positions, each copy of a vertex given its source's.

@@ -384,7 +384,7 @@ impl Technique for CpuMesh {
         Ok(())
     }
 
-    fn prepare_frame(&mut self, params: &FrameParams) -> Result<()> {
+    fn prepare_frame(&mut self, _ctx: &mut Context, params: &FrameParams) -> Result<()> {
         let level = self.level_of(params)?;
         if self.level.as_ref().map(|l| l.level) != Some(level) {
             self.level = None;

@@ -355,7 +355,7 @@ impl Technique for DooSabin {
         Ok(())
     }
 
-    fn prepare_frame(&mut self, params: &FrameParams) -> Result<()> {
+    fn prepare_frame(&mut self, _ctx: &mut crate::Context, params: &FrameParams) -> Result<()> {
         let depth = depth_of(params)?;
         if self.depth.as_ref().map(|d| d.layout.depth) != Some(depth) {
             self.depth = None;

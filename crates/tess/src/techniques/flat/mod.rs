@@ -4,6 +4,7 @@ use crate::shaders::Stage;
 use crate::technique::{PatchPipeline, PatchType, TechniqueId, VertexInput};
 use crate::techniques::face_patches::{FacePatches, FaceStyle, BASE_FACES};
 use crate::techniques::{built, no_early_checks, TechniqueInfo};
+use crate::tessellator::Domain;
 
 impl TechniqueId {
     pub const FLAT: TechniqueId = TechniqueId::new("flat");
@@ -19,7 +20,7 @@ pub static INFO: TechniqueInfo = TechniqueInfo {
     shader_folder: "flat",
     abi_code: 1,
     legend: &[],
-    build: |ctx, mesh, _| built(Flat::new(ctx.device(), mesh)?),
+    build: |ctx, mesh, options| built(Flat::build(ctx, mesh, options)?),
     check_options: no_early_checks,
 };
 
@@ -43,6 +44,12 @@ impl FaceStyle for FlatStyle {
                 Stage::CommonShadeFrag,
                 control_points,
             )
+        }
+    }
+    fn pattern_stage(domain: Domain) -> Stage {
+        match domain {
+            Domain::Quad => Stage::FlatPatternQuadVert,
+            Domain::Triangle => Stage::FlatPatternTriVert,
         }
     }
 }

@@ -5,6 +5,7 @@ use crate::technique::Features;
 use crate::technique::{PatchPipeline, PatchType, TechniqueId, VertexInput};
 use crate::techniques::face_patches::{FacePatches, FaceStyle, BASE_FACES};
 use crate::techniques::{built, no_early_checks, TechniqueInfo};
+use crate::tessellator::Domain;
 
 impl TechniqueId {
     pub const PHONG: TechniqueId = TechniqueId::new("phong");
@@ -23,7 +24,7 @@ pub static INFO: TechniqueInfo = TechniqueInfo {
     shader_folder: "phong",
     abi_code: 2,
     legend: &[],
-    build: |ctx, mesh, _| built(Phong::new(ctx.device(), mesh)?),
+    build: |ctx, mesh, options| built(Phong::build(ctx, mesh, options)?),
     check_options: no_early_checks,
 };
 
@@ -31,6 +32,9 @@ pub static INFO: TechniqueInfo = TechniqueInfo {
 pub struct PhongStyle;
 
 impl FaceStyle for PhongStyle {
+    fn pattern_stage(_domain: Domain) -> Stage {
+        Stage::PhongPatternTriVert
+    }
     const ID: TechniqueId = TechniqueId::PHONG;
     const QUADS: bool = false;
     fn pipeline(_patch: PatchType) -> PatchPipeline {

@@ -10,6 +10,7 @@ use crate::shaders::Stage;
 use crate::technique::{PatchPipeline, PatchType, TechniqueId, VertexInput};
 use crate::techniques::face_patches::{FacePatches, FaceStyle, BASE_FACES};
 use crate::techniques::{built, no_early_checks, TechniqueInfo};
+use crate::tessellator::Domain;
 
 impl TechniqueId {
     pub const PN: TechniqueId = TechniqueId::new("pn");
@@ -25,7 +26,7 @@ pub static INFO: TechniqueInfo = TechniqueInfo {
     shader_folder: "pn",
     abi_code: 3,
     legend: &[],
-    build: |ctx, mesh, _| built(Pn::new(ctx.device(), mesh)?),
+    build: |ctx, mesh, options| built(Pn::build(ctx, mesh, options)?),
     check_options: no_early_checks,
 };
 
@@ -33,6 +34,9 @@ pub static INFO: TechniqueInfo = TechniqueInfo {
 pub struct PnStyle;
 
 impl FaceStyle for PnStyle {
+    fn pattern_stage(_domain: Domain) -> Stage {
+        Stage::PnPatternTriVert
+    }
     const ID: TechniqueId = TechniqueId::PN;
     const QUADS: bool = false;
     fn pipeline(_patch: PatchType) -> PatchPipeline {
