@@ -324,6 +324,65 @@ fn capture_across_draw_split_numbers_patches_frame_wide() {
     }
 }
 
+/// Patch ids count on through a whole array of multi-point patches: lavapipe restarts
+/// `gl_PrimitiveID` every 1,024 control points of a draw (341 triangles, 256 quads), and the
+/// draw split keeps each draw within that (`LavapipeTessPrimitiveIdRestart`).
+#[test]
+fn patch_ids_count_on_through_every_draw() {
+    use std::collections::BTreeSet;
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let capturer = Capturer::new(&ctx).unwrap();
+        let n = 24u32;
+        let positions: Vec<[f64; 3]> = (0..=n)
+            .flat_map(|j| (0..=n).map(move |i| [i as f64, j as f64, 0.0]))
+            .collect();
+        let at = |i: u32, j: u32| j * (n + 1) + i;
+        let quads: Vec<Vec<u32>> = (0..n)
+            .flat_map(|j| {
+                (0..n).map(move |i| vec![at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)])
+            })
+            .collect();
+        let triangles: Vec<Vec<u32>> = quads
+            .iter()
+            .flat_map(|q| [vec![q[0], q[1], q[2]], vec![q[0], q[2], q[3]]])
+            .collect();
+        for faces in [quads, triangles] {
+            let mesh = ControlMesh::from_polygons(positions.clone(), &faces);
+            let mut t =
+                tessera::tess::build(&mut ctx, TechniqueId::FLAT, &mesh, &Default::default())
+                    .unwrap()
+                    .technique;
+            let patches = faces.len();
+            let mut distinct = |split: DrawSplit, ctx: &mut Context| {
+                let params = FrameParams {
+                    split,
+                    ..FrameParams::uniform(1.0)
+                };
+                let (soup, _) = capturer.capture(ctx, t.as_mut(), &params, EXTENT).unwrap();
+                soup.records
+                    .iter()
+                    .map(|r| r.patch)
+                    .collect::<BTreeSet<u32>>()
+                    .len()
+            };
+            assert_eq!(
+                distinct(DrawSplit::Auto, &mut ctx),
+                patches,
+                "{patches} patches"
+            );
+            if gpu.device().info.is_lavapipe() {
+                // The driver bug the split works around: unsplit, ids repeat.
+                assert!(
+                    distinct(DrawSplit::Off, &mut ctx) < patches,
+                    "{patches} patches"
+                );
+            }
+        }
+    }
+}
+
 /// Without transform feedback the device still renders, and capture is a typed error.
 #[test]
 fn capture_without_transform_feedback_is_a_typed_error() {

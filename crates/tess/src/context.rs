@@ -343,8 +343,9 @@ impl Context {
     }
 
     /// Patches per draw of `array`: all, unless a driver workaround limits the vertices one
-    /// draw may emit (`vk_core::workarounds::WorkaroundId::LavapipeTessChunkVertexLimit`),
-    /// computed at the largest factor the policy can reach.
+    /// draw may emit (`vk_core::workarounds::WorkaroundId::LavapipeTessChunkVertexLimit`,
+    /// computed at the largest factor the policy can reach) or the patches whose
+    /// `gl_PrimitiveID` it counts right (`LavapipeTessPrimitiveIdRestart`).
     pub fn patches_per_draw(
         &self,
         technique: &dyn Technique,
@@ -365,7 +366,10 @@ impl Context {
                     return u32::MAX;
                 }
                 let max = technique.max_vertices_per_patch(params, array);
-                self.device.workarounds.max_patches_per_draw(max)
+                let control_points = technique.patch_arrays()[array].control_points;
+                self.device
+                    .workarounds
+                    .max_patches_per_draw(max, control_points)
             }
         }
     }

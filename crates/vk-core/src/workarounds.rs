@@ -30,6 +30,12 @@ pub enum WorkaroundId {
     /// same draw without the query renders correctly. Tessera does not query statistics for
     /// such draws there and counts their output through transform feedback instead.
     LavapipeStatisticsQueryPointPatches,
+    /// lavapipe, Mesa 22.3: in a tessellated draw of patches of more than one control point,
+    /// `gl_PrimitiveID` restarts at 0 every ⌊1,024 / control points⌋ patches (measured: every
+    /// 341 three-point and every 256 four-point patches; one-point patches count on correctly
+    /// through hundreds of thousands). Patch ids written to captures, and any patch fetched by
+    /// its id, would repeat. Tessera draws at most that many such patches per draw.
+    LavapipeTessPrimitiveIdRestart,
 }
 
 /// The list of every known workaround; `Workarounds::for_adapter` picks the active ones.
@@ -39,6 +45,11 @@ pub fn known() -> Vec<Workaround> {
             id: WorkaroundId::LavapipeTessChunkVertexLimit,
             driver: vk::DriverId::MESA_LLVMPIPE,
             summary: "lavapipe: tessellated draws split so no internal chunk emits > 65,536 vertices (16-bit chunk indices); 4,096 a draw, where its cost is still linear",
+        },
+        Workaround {
+            id: WorkaroundId::LavapipeTessPrimitiveIdRestart,
+            driver: vk::DriverId::MESA_LLVMPIPE,
+            summary: "lavapipe: tessellated draws of multi-point patches split every 1,024 control points, where gl_PrimitiveID restarts",
         },
         Workaround {
             id: WorkaroundId::LavapipeStatisticsQueryPointPatches,
@@ -56,6 +67,9 @@ pub struct Workarounds {
 
 /// Vertices a lavapipe chunk may emit before its 16-bit indices overflow.
 pub const LAVAPIPE_CHUNK_VERTEX_LIMIT: u64 = 65_536;
+
+/// Control points of multi-point patches after which lavapipe restarts `gl_PrimitiveID`.
+pub const LAVAPIPE_PRIMITIVE_ID_CONTROL_POINTS: u32 = 1_024;
 
 /// Vertices one tessellated draw may emit on lavapipe (at the draw's largest factors): within
 /// the chunk limit, and small enough that a chunk's super-linear cost has not set in (each
@@ -82,13 +96,17 @@ impl Workarounds {
         self.active.iter().any(|w| w.id == id)
     }
 
-    /// How many patches one tessellated draw may hold, given the most vertices one patch can
-    /// emit at the draw's largest factors. `u32::MAX` when no limit applies.
-    pub fn max_patches_per_draw(&self, max_vertices_per_patch: u64) -> u32 {
+    /// How many patches of `control_points` points one tessellated draw may hold, given the
+    /// most vertices one patch can emit at the draw's largest factors. `u32::MAX` when no limit
+    /// applies.
+    pub fn max_patches_per_draw(&self, max_vertices_per_patch: u64, control_points: u32) -> u32 {
+        let mut most = u32::MAX;
         if self.has(WorkaroundId::LavapipeTessChunkVertexLimit) {
-            (LAVAPIPE_DRAW_VERTEX_BUDGET / max_vertices_per_patch.max(1)).max(1) as u32
-        } else {
-            u32::MAX
+            most = (LAVAPIPE_DRAW_VERTEX_BUDGET / max_vertices_per_patch.max(1)).max(1) as u32;
         }
+        if self.has(WorkaroundId::LavapipeTessPrimitiveIdRestart) && control_points > 1 {
+            most = most.min(LAVAPIPE_PRIMITIVE_ID_CONTROL_POINTS / control_points);
+        }
+        most.max(1)
     }
 }

@@ -1,0 +1,376 @@
+//! Refinement patterns: the base-face techniques (flat, Phong, PN) on the pattern path.
+//! - With the device's tessellator, patterns are its own captured output, so both paths emit
+//!   the same triangles with the same bits at every domain point, in every spacing.
+//! - Without tessellation shaders (the device made without the feature, validation on: any
+//!   tessellation pipeline would be an error), every such technique draws through generated
+//!   patterns, watertight by bits, each vertex equal to an independent f64 evaluation of its
+//!   patch at its own domain point; what has no pattern path is refused by name.
+mod common;
+
+use common::Gpu;
+use std::collections::{BTreeSet, HashMap};
+use tessera::tess::capture::classify_open_edges;
+use tessera::tess::techniques::{flat::Flat, phong::Phong, pn::Pn};
+use tessera::tess::{
+    BuildOptions, CapturedSoup, Capturer, Context, DrawPath, FrameParams, PipelineChoice,
+    RenderMesh, Spacing, Technique, TechniqueId, TessError,
+};
+use tessera::topology::{load_obj, ControlMesh};
+use tessera::vk_core::{vk, DeviceDesc};
+
+const EXTENT: vk::Extent2D = vk::Extent2D {
+    width: 64,
+    height: 64,
+};
+
+const BASE_FACE_TECHNIQUES: [TechniqueId; 3] =
+    [TechniqueId::FLAT, TechniqueId::PHONG, TechniqueId::PN];
+
+fn spot() -> ControlMesh {
+    load_obj(common::data("assets/spot_control_mesh.obj")).unwrap()
+}
+
+fn cube() -> ControlMesh {
+    load_obj(common::data("tests/data/meshes/cube.obj")).unwrap()
+}
+
+fn build(
+    ctx: &mut Context,
+    id: TechniqueId,
+    mesh: &ControlMesh,
+    pipeline: PipelineChoice,
+) -> tessera::tess::Result<Box<dyn Technique>> {
+    let options = BuildOptions {
+        name: "patterns test".into(),
+        pipeline,
+        ..BuildOptions::default()
+    };
+    Ok(tessera::tess::build(ctx, id, mesh, &options)?.technique)
+}
+
+fn params(level: f32, spacing: Spacing) -> FrameParams {
+    FrameParams {
+        spacing,
+        ..FrameParams::uniform(level)
+    }
+}
+
+fn capture(ctx: &mut Context, t: &mut dyn Technique, p: &FrameParams) -> CapturedSoup {
+    let capturer = Capturer::new(ctx).unwrap();
+    capturer.capture(ctx, t, p, EXTENT).expect("capture").0
+}
+
+/// Position and normal bits at each (patch, domain bits).
+type Samples = HashMap<(u32, [u32; 2]), ([u32; 3], [u32; 3])>;
+
+fn samples(soup: &CapturedSoup) -> Samples {
+    let mut out = Samples::new();
+    for r in &soup.records {
+        let key = (r.patch, r.domain.map(f32::to_bits));
+        let value = (r.position.map(f32::to_bits), r.normal.map(f32::to_bits));
+        let old = out.insert(key, value);
+        assert!(old.is_none() || old == Some(value), "{key:?}: two values");
+    }
+    out
+}
+
+/// Each triangle as its patch and corner domain bits, rotated to start at the least corner
+/// (orientation kept).
+fn triangles(soup: &CapturedSoup) -> BTreeSet<(u32, [[u32; 2]; 3])> {
+    soup.triangles()
+        .map(|t| {
+            let c = [0, 1, 2].map(|i| t[i].domain.map(f32::to_bits));
+            let first = (0..3).min_by_key(|&i| c[i]).unwrap();
+            (t[0].patch, [0, 1, 2].map(|i| c[(first + i) % 3]))
+        })
+        .collect()
+}
+
+#[test]
+fn with_the_devices_tessellator_both_paths_emit_the_same_triangles_and_bits() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let cases: [(&str, ControlMesh, &[f32]); 2] = [
+            ("spot", spot(), &[1.0, 2.0, 3.0, 5.0, 7.5]),
+            ("cube", cube(), &[13.0, 31.0, 64.0]),
+        ];
+        let mut compared = 0;
+        for id in BASE_FACE_TECHNIQUES {
+            for (name, mesh, levels) in &cases {
+                let mut tess = build(&mut ctx, id, mesh, PipelineChoice::Tessellation).unwrap();
+                let mut pattern = build(&mut ctx, id, mesh, PipelineChoice::Pattern).unwrap();
+                assert!(pattern
+                    .patch_arrays()
+                    .iter()
+                    .all(|a| a.patch.path() == DrawPath::Pattern));
+                for &level in *levels {
+                    for spacing in [
+                        Spacing::Equal,
+                        Spacing::FractionalEven,
+                        Spacing::FractionalOdd,
+                    ] {
+                        let what = format!("{id} on {name}, level {level}, {spacing:?}");
+                        let p = params(level, spacing);
+                        let a = capture(&mut ctx, tess.as_mut(), &p);
+                        let b = capture(&mut ctx, pattern.as_mut(), &p);
+                        assert!(a.triangle_count() > 0, "{what}");
+                        assert_eq!(a.triangle_count(), b.triangle_count(), "{what}");
+                        let (ta, tb) = (triangles(&a), triangles(&b));
+                        if ta != tb {
+                            let only_a: Vec<_> = ta.difference(&tb).take(4).collect();
+                            let only_b: Vec<_> = tb.difference(&ta).take(4).collect();
+                            panic!("{what}: triangles differ: tessellation path only {only_a:?}, pattern path only {only_b:?}");
+                        }
+                        let (sa, sb) = (samples(&a), samples(&b));
+                        let differing = sa.iter().filter(|(k, v)| sb.get(k) != Some(v)).count();
+                        assert_eq!(differing, 0, "{what}: of {} samples", sa.len());
+                        assert_eq!(sa.len(), sb.len(), "{what}");
+                        compared += sa.len();
+                    }
+                }
+            }
+        }
+        println!("{compared} samples bit-identical on both paths");
+        assert!(compared > 100_000, "{compared}");
+    }
+}
+
+/// An f64 evaluation of each base-face technique at a domain point, written from the papers'
+/// formulas independently of the shaders.
+mod oracle {
+    pub type V = [f64; 3];
+
+    fn add(a: V, b: V) -> V {
+        [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+    }
+    fn sub(a: V, b: V) -> V {
+        [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+    }
+    fn mul(a: V, s: f64) -> V {
+        a.map(|x| x * s)
+    }
+    fn dot(a: V, b: V) -> f64 {
+        a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    }
+    pub fn normalize(a: V) -> V {
+        let l = dot(a, a).sqrt();
+        if l > 0.0 {
+            mul(a, 1.0 / l)
+        } else {
+            a
+        }
+    }
+    fn weighted(points: &[V], w: &[f64]) -> V {
+        points
+            .iter()
+            .zip(w)
+            .fold([0.0; 3], |s, (p, &w)| add(s, mul(*p, w)))
+    }
+
+    /// Flat: the bilinear quad point (corners at (0,0), (1,0), (1,1), (0,1)) or the
+    /// barycentric triangle point; the normal likewise (unnormalised, as drawn).
+    pub fn flat(p: &[V], n: &[V], b: [f64; 3]) -> (V, V) {
+        let w: Vec<f64> = if p.len() == 4 {
+            let (u, v) = (b[0], b[1]);
+            vec![(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v]
+        } else {
+            b.to_vec()
+        };
+        (weighted(p, &w), weighted(n, &w))
+    }
+
+    /// Phong tessellation (Boubekeur & Alexa 2008) with shape factor `alpha`.
+    pub fn phong(p: &[V], n: &[V], b: [f64; 3], alpha: f64) -> (V, V) {
+        let q = weighted(p, &b);
+        let projected: Vec<V> = (0..3)
+            .map(|i| sub(q, mul(n[i], dot(sub(q, p[i]), n[i]))))
+            .collect();
+        let phong = weighted(&projected, &b);
+        (add(mul(q, 1.0 - alpha), mul(phong, alpha)), weighted(n, &b))
+    }
+
+    /// Curved PN triangles with the corrected normal field (Boubekeur & Schlick 2005,
+    /// appendix A): cubic position, normalised quadratic normal.
+    pub fn pn(p: &[V], n: &[V], b: [f64; 3]) -> (V, V) {
+        let edge = |i: usize, j: usize| {
+            let s = dot(sub(p[j], p[i]), n[i]);
+            mul(sub(add(mul(p[i], 2.0), p[j]), mul(n[i], s)), 1.0 / 3.0)
+        };
+        let normal = |i: usize, j: usize| {
+            let d = sub(p[j], p[i]);
+            let s = add(n[i], n[j]);
+            let t = 4.0 * dot(d, s) / dot(d, d);
+            sub(s, mul(d, t))
+        };
+        let (b210, b120, b021, b012, b102, b201) = (
+            edge(0, 1),
+            edge(1, 0),
+            edge(1, 2),
+            edge(2, 1),
+            edge(2, 0),
+            edge(0, 2),
+        );
+        let e = mul(
+            [b210, b120, b021, b012, b102, b201]
+                .iter()
+                .fold([0.0; 3], |s, x| add(s, *x)),
+            1.0 / 6.0,
+        );
+        let v = mul(add(add(p[0], p[1]), p[2]), 1.0 / 3.0);
+        let b111 = add(e, mul(sub(e, v), 0.5));
+        let [u, v, w] = b;
+        let points = [p[0], p[1], p[2], b210, b120, b021, b012, b102, b201, b111];
+        let weights = [
+            u * u * u,
+            v * v * v,
+            w * w * w,
+            3.0 * u * u * v,
+            3.0 * u * v * v,
+            3.0 * v * v * w,
+            3.0 * v * w * w,
+            3.0 * w * w * u,
+            3.0 * w * u * u,
+            6.0 * u * v * w,
+        ];
+        let normals = [n[0], n[1], n[2], normal(0, 1), normal(1, 2), normal(2, 0)];
+        let nw = [u * u, v * v, w * w, u * v, v * w, w * u];
+        (
+            weighted(&points, &weights),
+            normalize(weighted(&normals, &nw)),
+        )
+    }
+}
+
+/// The corners (positions, normals) of each patch in frame-wide patch order, as the base-face
+/// techniques number them (flat: quads, then the other faces' fan triangles; Phong and PN:
+/// every face's fan triangles).
+fn patch_corners(mesh: &ControlMesh, quads: bool) -> Vec<(Vec<oracle::V>, Vec<oracle::V>)> {
+    let rm = RenderMesh::from_control_mesh(mesh).unwrap();
+    let corner = |i: u32| {
+        let v = rm.vertices[i as usize];
+        (v.position.map(f64::from), v.normal.map(f64::from))
+    };
+    let lists: Vec<Vec<u32>> = if quads {
+        rm.quads
+            .iter()
+            .map(|q| q.to_vec())
+            .chain(rm.quad_mode_triangles.iter().map(|t| t.to_vec()))
+            .collect()
+    } else {
+        rm.triangles.iter().map(|t| t.to_vec()).collect()
+    };
+    lists
+        .iter()
+        .map(|l| l.iter().map(|&i| corner(i)).unzip())
+        .collect()
+}
+
+/// The largest distance between a captured position (normal) and the oracle's, over `soup`.
+fn oracle_error(id: TechniqueId, mesh: &ControlMesh, soup: &CapturedSoup) -> (f64, f64) {
+    let corners = patch_corners(mesh, id == TechniqueId::FLAT);
+    let (mut dp, mut dn) = (0.0f64, 0.0f64);
+    for r in &soup.records {
+        let (p, n) = &corners[r.patch as usize];
+        let [u, v] = r.domain.map(f64::from);
+        let b = [u, v, 1.0 - u - v];
+        let (want_p, want_n) = match id {
+            TechniqueId::FLAT => oracle::flat(p, n, b),
+            TechniqueId::PHONG => oracle::phong(p, n, b, FrameParams::default().phong_alpha as f64),
+            _ => oracle::pn(p, n, b),
+        };
+        let dist = |a: [f32; 3], b: oracle::V| {
+            (0..3)
+                .map(|i| (a[i] as f64 - b[i]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        };
+        dp = dp.max(dist(r.position, want_p));
+        dn = dn.max(dist(r.normal, want_n));
+    }
+    (dp, dn)
+}
+
+#[test]
+fn without_tessellation_shaders_the_base_face_techniques_draw_generated_patterns() {
+    let gpu = Gpu::with(&DeviceDesc {
+        without_tessellation_shader: true,
+        ..DeviceDesc::default()
+    });
+    {
+        assert!(!gpu.device().info.caps.tessellation_shader);
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        for (name, mesh) in [("spot", spot()), ("cube", cube())] {
+            let diagonal = mesh.bbox_diagonal();
+            for id in BASE_FACE_TECHNIQUES {
+                let mut t = build(&mut ctx, id, &mesh, PipelineChoice::Auto).unwrap();
+                assert!(t
+                    .patch_arrays()
+                    .iter()
+                    .all(|a| a.patch.path() == DrawPath::Pattern));
+                let image = ctx
+                    .render_offscreen(t.as_mut(), &params(4.0, Spacing::Equal), EXTENT)
+                    .expect("render");
+                assert!(image
+                    .pixels
+                    .chunks_exact(4)
+                    .any(|p| p[0] != image.pixels[0]));
+                for level in [1.0, 3.0, 7.0, 16.0] {
+                    let what = format!("{id} on {name}, level {level}");
+                    let soup = capture(&mut ctx, t.as_mut(), &params(level, Spacing::Equal));
+                    let welded = soup.weld().unwrap();
+                    let report = welded.open_edges();
+                    let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
+                    let c = classify_open_edges(&soup, &welded, &report, &map, &mesh);
+                    assert_eq!((c.cracks, c.unmapped), (0, 0), "{what}");
+                    let (dp, dn) = oracle_error(id, &mesh, &soup);
+                    println!("{what}: position error {dp:.2e}, normal error {dn:.2e}");
+                    assert!(dp <= 2e-6 * diagonal, "{what}: position off by {dp}");
+                    assert!(dn <= 2e-5, "{what}: normal off by {dn}");
+                }
+                let fractional = ctx.prepare(
+                    t.as_mut(),
+                    &params(4.0, Spacing::FractionalOdd),
+                    &[tessera::tess::Pass::Shaded],
+                );
+                assert!(
+                    matches!(fractional, Err(TessError::PatternSpacing { .. })),
+                    "{fractional:?}"
+                );
+            }
+        }
+        let cube = cube();
+        for (id, choice) in [
+            (TechniqueId::FLAT, PipelineChoice::Tessellation),
+            (TechniqueId::BFT, PipelineChoice::Auto),
+            (TechniqueId::ADAPTIVE, PipelineChoice::Auto),
+        ] {
+            match build(&mut ctx, id, &cube, choice) {
+                Err(e @ TessError::NoTessellationShader { .. }) => {
+                    assert!(e.to_string().contains(id.name()), "{e}")
+                }
+                Err(e) => panic!("{id}: refused as {e}"),
+                Ok(_) => panic!("{id} built without tessellation shaders"),
+            }
+        }
+    }
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+}
+
+#[test]
+fn a_built_surface_keeps_its_path() {
+    let gpu = Gpu::new();
+    {
+        let ctx = Context::offscreen(gpu.device()).unwrap();
+        let mesh = cube();
+        let flat = Flat::new(ctx.device(), &mesh, DrawPath::Pattern).unwrap();
+        let phong = Phong::new(ctx.device(), &mesh, DrawPath::Tessellation).unwrap();
+        let pn = Pn::new(ctx.device(), &mesh, DrawPath::Pattern).unwrap();
+        assert_eq!(flat.patch_arrays()[0].control_points, 0);
+        assert_eq!(phong.patch_arrays()[0].control_points, 3);
+        assert!(pn
+            .device_memory()
+            .iter()
+            .any(|m| m.name.contains("pattern corners")));
+    }
+}
