@@ -1007,6 +1007,7 @@ mod tests {
                 tessellation_shader: true,
                 fill_mode_non_solid: complete,
                 dynamic_rendering: true,
+                timeline_semaphore: true,
                 ..Default::default()
             },
             queue_family: Some(0),
