@@ -573,6 +573,13 @@ pub trait Technique: Send {
     /// The patch arrays, frame-wide numbered (see [`number_arrays`]).
     fn patch_arrays(&self) -> &[PatchArray];
 
+    /// The draw path its arrays take (one per surface).
+    fn draw_path(&self) -> DrawPath {
+        self.patch_arrays()
+            .first()
+            .map_or(DrawPath::Tessellation, |a| a.patch.path())
+    }
+
     /// Checks `params` against what this technique and this surface can draw; errors name the
     /// option at fault. Called before anything is recorded.
     fn check(&self, params: &FrameParams) -> Result<()>;

@@ -314,6 +314,11 @@ pub struct GpuArgs {
     /// TESSERA_PIPELINE_CACHE=off does the same for every run).
     #[arg(long)]
     pub no_pipeline_cache: bool,
+    /// Create the device without tessellation shaders even where it has them (as a device
+    /// without them): techniques with a refinement-pattern path draw through it, the others
+    /// are refused by name.
+    #[arg(long)]
+    pub no_tessellation_shader: bool,
 }
 
 #[derive(Args, Debug, Clone)]

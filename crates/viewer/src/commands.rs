@@ -244,6 +244,7 @@ pub fn open_device(
         &DeviceDesc {
             selector,
             pipeline_cache_dir: cache,
+            without_tessellation_shader: g.no_tessellation_shader,
             ..DeviceDesc::default()
         },
         device_extensions,
@@ -305,8 +306,9 @@ fn render_offscreen(
     let frame = ctx.render_offscreen_stats(technique.as_mut(), &params, extent, false)?;
     let patches: u32 = technique.patch_arrays().iter().map(|a| a.patches).sum();
     let what = format!(
-        "{}, {patches} patches in {} draws",
+        "{}, {} path, {patches} patches in {} draws",
         describe(setup.technique, &params),
+        technique.draw_path(),
         frame.counts.draws
     );
     if crate::output::is_blank(&frame.image, params.clear_color) {

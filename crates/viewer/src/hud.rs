@@ -44,6 +44,9 @@ pub enum Action {
     DisplaceDown,
     /// What the surface is coloured by: shading, parameter shift, Eq. 1 error (V).
     Show,
+    /// Draw path: the tessellation stage or refinement patterns (T), where the technique has
+    /// both.
+    Pipeline,
     ToggleHud,
     Quit,
 }
@@ -63,6 +66,8 @@ pub struct Shown<'a> {
     /// The frame parameters as drawn (distances in world units).
     pub params: &'a FrameParams,
     pub build: &'a tess::BuildOptions,
+    /// The draw path the surface takes.
+    pub path: tess::DrawPath,
     pub animate: bool,
     /// The displacement scale D turns on (`params.displace` is 0 while it is off).
     pub displace_scale: f32,
@@ -201,6 +206,7 @@ fn panel(ui: &mut egui::Ui, s: &Shown<'_>, history: &[f32], actions: &mut Vec<Ac
         ui.colored_label(Color32::from_rgb(255, 110, 90), status);
     }
     technique_choice(ui, s, actions);
+    path_choice(ui, s, actions);
     ui.label(match info.scheme {
         Some(scheme) => format!("scheme: {scheme}"),
         None => "scheme: none (base faces)".to_owned(),
@@ -245,6 +251,24 @@ fn technique_choice(ui: &mut egui::Ui, s: &Shown<'_>, actions: &mut Vec<Action>)
                     }
                 }
             });
+    });
+}
+
+/// The draw path, and its switch where the technique has both the tessellation and the
+/// pattern path.
+fn path_choice(ui: &mut egui::Ui, s: &Shown<'_>, actions: &mut Vec<Action>) {
+    let paths = techniques::info(s.technique).features.paths;
+    ui.horizontal(|ui| {
+        ui.label(format!("draw path: {}", s.path));
+        let both = [tess::DrawPath::Tessellation, tess::DrawPath::Pattern]
+            .iter()
+            .all(|p| paths.contains(p));
+        if ui
+            .add_enabled(both, egui::Button::new("switch (T)"))
+            .clicked()
+        {
+            actions.push(Action::Pipeline);
+        }
     });
 }
 

@@ -9,7 +9,7 @@ use std::sync::Arc;
 use tess::techniques::{
     self, adaptive::DEFAULT_ISOLATION, bft::DEFAULT_TABLE_LEVEL, BuildOptions, TechniqueInfo,
 };
-use tess::{FactorPolicy, Features, FrameParams, Spacing, TechniqueId};
+use tess::{FactorPolicy, Features, FrameParams, PipelineChoice, Spacing, TechniqueId};
 use topology::patches::adaptive::EndCap;
 
 /// The largest `--frame`: the wave's phase keeps f32 precision well past it (its period is 2).
@@ -58,6 +58,10 @@ pub fn parse_displace(s: &str) -> Result<f32, String> {
 
 /// The largest `--sharpness-scale`.
 const MAX_SHARPNESS_SCALE: f32 = 1000.0;
+
+pub fn parse_pipeline(s: &str) -> Result<PipelineChoice, String> {
+    s.parse()
+}
 
 pub fn parse_technique(s: &str) -> Result<TechniqueId, String> {
     s.parse::<TechniqueId>().map_err(|e| e.to_string())
@@ -169,6 +173,12 @@ pub struct SurfaceArgs {
     /// triangle.
     #[arg(long)]
     pub scheme: Option<String>,
+    /// Draw path: tessellation (the tessellation stage), pattern (refinement patterns: a
+    /// tessellated domain stored once and instanced over the patches, evaluated in the vertex
+    /// stage; flat, phong and pn so far) or auto (tessellation where the device has tessellation
+    /// shaders and the technique draws through them, else patterns).
+    #[arg(long, default_value = "auto", value_parser = parse_pipeline)]
+    pub pipeline: PipelineChoice,
     /// Merge coincident vertices before drawing: `--weld` alone merges vertices at identical
     /// positions, `--weld D` those within distance D (0 to 1e6, model units; chains of near
     /// vertices merge whole). What was merged is reported. Without it the mesh is drawn as
@@ -336,6 +346,7 @@ impl SurfaceArgs {
                 follow_semi_sharp: !self.creases_at_isolation,
                 split_triangles: self.split_triangles,
                 maps,
+                pipeline: self.pipeline,
                 ..BuildOptions::default()
             },
             params,

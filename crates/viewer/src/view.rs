@@ -311,6 +311,7 @@ impl App {
                     technique: self.setup.technique,
                     params: &params,
                     build: &self.setup.build,
+                    path: technique.draw_path(),
                     animate: self.setup.animate,
                     displace_scale: self.displace_scale,
                     triangles: (0..arrays.len())
@@ -486,6 +487,17 @@ impl App {
         Ok(())
     }
 
+    /// The draw path of the current technique's built surface.
+    fn gpu_path(&self) -> Option<tess::DrawPath> {
+        let gpu = self.gpu.as_ref()?;
+        Some(
+            gpu.surfaces
+                .get(&self.setup.technique)?
+                .technique
+                .draw_path(),
+        )
+    }
+
     /// Whether the current technique (its surface already built) draws `params`.
     fn accepts(&self, params: &tess::FrameParams) -> bool {
         let Some(gpu) = &self.gpu else {
@@ -562,6 +574,7 @@ impl App {
                 "d" | "D" => Action::Displace,
                 "]" => Action::DisplaceUp,
                 "v" | "V" => Action::Show,
+                "t" | "T" => Action::Pipeline,
                 "[" => Action::DisplaceDown,
                 _ => return None,
             },
@@ -591,6 +604,13 @@ impl App {
                 }
             }
             Action::Quit => event_loop.exit(),
+            Action::Pipeline if features.paths.contains(&tess::DrawPath::Pattern) => {
+                self.setup.build.pipeline = match self.gpu_path() {
+                    Some(tess::DrawPath::Pattern) => tess::PipelineChoice::Tessellation,
+                    _ => tess::PipelineChoice::Pattern,
+                };
+                self.rebuild = true;
+            }
             Action::Animate if features.animation => self.setup.animate = !self.setup.animate,
             Action::PatchColours if features.patch_colours => p.patch_colours = !p.patch_colours,
             Action::Fractional => {
@@ -1042,6 +1062,8 @@ mod tests {
             ("[", Action::DisplaceDown),
             ("v", Action::Show),
             ("V", Action::Show),
+            ("t", Action::Pipeline),
+            ("T", Action::Pipeline),
             // The keys that were there before keep their meaning.
             ("w", Action::Wireframe),
             ("s", Action::SharpnessUp),
