@@ -197,7 +197,7 @@ fn toggle(ui: &mut egui::Ui, on: Option<bool>, text: &str) -> bool {
 }
 
 /// The HUD panel, section by section: mesh and technique, factors and level buttons, the
-/// isolation options, the toggles, the surface options, the patch-colour legend, then what is
+/// isolation options, the toggles, the draw path, the surface options, the patch-colour legend, then what is
 /// drawn and the GPU times.
 fn panel(ui: &mut egui::Ui, s: &Shown<'_>, history: &[f32], actions: &mut Vec<Action>) {
     let info = techniques::info(s.technique);
@@ -206,7 +206,6 @@ fn panel(ui: &mut egui::Ui, s: &Shown<'_>, history: &[f32], actions: &mut Vec<Ac
         ui.colored_label(Color32::from_rgb(255, 110, 90), status);
     }
     technique_choice(ui, s, actions);
-    path_choice(ui, s, actions);
     ui.label(match info.scheme {
         Some(scheme) => format!("scheme: {scheme}"),
         None => "scheme: none (base faces)".to_owned(),
@@ -219,6 +218,7 @@ fn panel(ui: &mut egui::Ui, s: &Shown<'_>, history: &[f32], actions: &mut Vec<Ac
         isolation_options(ui, s, actions);
     }
     toggles(ui, s, actions);
+    path_choice(ui, s, actions);
     if info.features.surface {
         surface_options(ui, s, actions);
     }

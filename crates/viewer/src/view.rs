@@ -426,8 +426,9 @@ impl App {
     fn set_title(&self, params: &tess::FrameParams) {
         if let Some(w) = &self.window {
             w.set_title(&format!(
-                "tessera — {}{}{} — {:.2} ms/frame{}",
+                "tessera — {}, {} path{}{} — {:.2} ms/frame{}",
                 describe(self.setup.technique, params),
+                self.gpu_path().unwrap_or(tess::DrawPath::Tessellation),
                 if techniques::info(self.setup.technique).features.isolation {
                     let b = &self.setup.build;
                     format!(
