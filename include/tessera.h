@@ -84,6 +84,9 @@ typedef uint32_t TesseraScheme;
 // End caps of the adaptive technique (`TESSERA_END_CAP_*`).
 typedef uint32_t TesseraEndCap;
 
+// The draw path a surface is built for (`TESSERA_PIPELINE_*`, the CLI's `--pipeline`).
+typedef uint32_t TesseraPipeline;
+
 // How a surface is built. [`tessera_surface_desc_default`] fills the defaults.
 typedef struct TesseraSurfaceDesc {
   TesseraTechnique technique;
@@ -117,6 +120,8 @@ typedef struct TesseraSurfaceDesc {
   // Split each triangle into three quad patches instead of one Gregory triangle patch; 0 or
   // 1 (gregory, acc).
   uint32_t split_triangles;
+  // `TESSERA_PIPELINE_*`: the draw path.
+  TesseraPipeline pipeline;
 } TesseraSurfaceDesc;
 
 // How tessellation factors are chosen (`TESSERA_FACTORS_*`).
@@ -243,9 +248,9 @@ typedef struct TesseraHostDesc {
   // Created for Vulkan 1.3 or later.
   VkInstance instance;
   VkPhysicalDevice physical_device;
-  // Created from `physical_device` with `tessellationShader`, `fillModeNonSolid` and
-  // `timelineSemaphore` enabled, and `dynamicRendering` for dynamic-rendering scopes and
-  // captures.
+  // Created from `physical_device` with `fillModeNonSolid` and `timelineSemaphore`
+  // enabled, `tessellationShader` unless `without_tessellation_shader` says otherwise, and
+  // `dynamicRendering` for dynamic-rendering scopes and captures.
   VkDevice device;
   // A family with graphics and compute; `queue` is its queue 0.
   uint32_t queue_family;
@@ -284,6 +289,10 @@ typedef struct TesseraHostDesc {
   TesseraPipelineCache pipeline_cache;
   // NULL (the user's cache directory) or a NUL-terminated directory for it.
   const char *pipeline_cache_dir;
+  // 0 or 1: `tessellationShader` is not enabled on the device. Surfaces then draw through
+  // refinement patterns (`TESSERA_PIPELINE_AUTO` picks them; flat, phong, pn), and the
+  // techniques without that path are refused as UNSUPPORTED.
+  uint32_t without_tessellation_shader;
 } TesseraHostDesc;
 
 // The technique of the scheme: `adaptive` for Catmull-Clark, `bft` for Loop.
@@ -343,6 +352,16 @@ typedef struct TesseraHostDesc {
 #define TESSERA_SPACING_FRACTIONAL_EVEN 1
 
 #define TESSERA_SPACING_FRACTIONAL_ODD 2
+
+// The tessellation stage where the device has it and the technique draws through it, else
+// refinement patterns.
+#define TESSERA_PIPELINE_AUTO 0
+
+#define TESSERA_PIPELINE_TESSELLATION 1
+
+// Refinement patterns: a tessellated domain instanced over the patches, evaluated in the
+// vertex stage (flat, phong, pn).
+#define TESSERA_PIPELINE_PATTERN 2
 
 #define TESSERA_END_CAP_GREGORY 0
 

@@ -84,9 +84,9 @@ pub struct TesseraHostDesc {
     /// Created for Vulkan 1.3 or later.
     pub instance: VkInstance,
     pub physical_device: VkPhysicalDevice,
-    /// Created from `physical_device` with `tessellationShader`, `fillModeNonSolid` and
-    /// `timelineSemaphore` enabled, and `dynamicRendering` for dynamic-rendering scopes and
-    /// captures.
+    /// Created from `physical_device` with `fillModeNonSolid` and `timelineSemaphore`
+    /// enabled, `tessellationShader` unless `without_tessellation_shader` says otherwise, and
+    /// `dynamicRendering` for dynamic-rendering scopes and captures.
     pub device: VkDevice,
     /// A family with graphics and compute; `queue` is its queue 0.
     pub queue_family: u32,
@@ -125,6 +125,10 @@ pub struct TesseraHostDesc {
     pub pipeline_cache: crate::TesseraPipelineCache,
     /// NULL (the user's cache directory) or a NUL-terminated directory for it.
     pub pipeline_cache_dir: *const std::ffi::c_char,
+    /// 0 or 1: `tessellationShader` is not enabled on the device. Surfaces then draw through
+    /// refinement patterns (`TESSERA_PIPELINE_AUTO` picks them; flat, phong, pn), and the
+    /// techniques without that path are refused as UNSUPPORTED.
+    pub without_tessellation_shader: u32,
 }
 
 /// The subpass `d` names, checked; `None` for dynamic rendering.
@@ -230,6 +234,10 @@ pub unsafe extern "C" fn tessera_context_create_host(
             vertex_pipeline_stores_and_atomics: flag(
                 d.vertex_pipeline_stores_and_atomics,
                 "vertex_pipeline_stores_and_atomics",
+            )?,
+            tessellation_shader: !flag(
+                d.without_tessellation_shader,
+                "without_tessellation_shader",
             )?,
         };
         // SAFETY: as above.

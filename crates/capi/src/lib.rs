@@ -139,6 +139,16 @@ pub const TESSERA_SPACING_EQUAL: TesseraSpacing = 0;
 pub const TESSERA_SPACING_FRACTIONAL_EVEN: TesseraSpacing = 1;
 pub const TESSERA_SPACING_FRACTIONAL_ODD: TesseraSpacing = 2;
 
+/// The draw path a surface is built for (`TESSERA_PIPELINE_*`, the CLI's `--pipeline`).
+pub type TesseraPipeline = u32;
+/// The tessellation stage where the device has it and the technique draws through it, else
+/// refinement patterns.
+pub const TESSERA_PIPELINE_AUTO: TesseraPipeline = 0;
+pub const TESSERA_PIPELINE_TESSELLATION: TesseraPipeline = 1;
+/// Refinement patterns: a tessellated domain instanced over the patches, evaluated in the
+/// vertex stage (flat, phong, pn).
+pub const TESSERA_PIPELINE_PATTERN: TesseraPipeline = 2;
+
 /// End caps of the adaptive technique (`TESSERA_END_CAP_*`).
 pub type TesseraEndCap = u32;
 pub const TESSERA_END_CAP_GREGORY: TesseraEndCap = 0;
@@ -299,6 +309,8 @@ pub struct TesseraSurfaceDesc {
     /// Split each triangle into three quad patches instead of one Gregory triangle patch; 0 or
     /// 1 (gregory, acc).
     pub split_triangles: u32,
+    /// `TESSERA_PIPELINE_*`: the draw path.
+    pub pipeline: TesseraPipeline,
 }
 
 /// What one frame shows. [`tessera_frame_desc_default`] fills the defaults.
@@ -625,6 +637,7 @@ pub unsafe extern "C" fn tessera_surface_desc_default(
             height_map_height: 0,
             param_error: 0,
             split_triangles: 0,
+            pipeline: TESSERA_PIPELINE_AUTO,
         };
         // SAFETY: the caller's contract.
         unsafe { out_write(desc, d, "desc") }
@@ -1156,6 +1169,12 @@ unsafe fn create_surface(
         sharpness_scale: d.sharpness_scale,
         split_triangles,
         maps,
+        pipeline: match d.pipeline {
+            TESSERA_PIPELINE_AUTO => tess::PipelineChoice::Auto,
+            TESSERA_PIPELINE_TESSELLATION => tess::PipelineChoice::Tessellation,
+            TESSERA_PIPELINE_PATTERN => tess::PipelineChoice::Pattern,
+            v => return Err(invalid("pipeline", v, "a TESSERA_PIPELINE_* value")),
+        },
         ..tess::BuildOptions::default()
     };
     let mut t = match &c.mode {

@@ -190,6 +190,18 @@ impl Context {
         Ok(pattern)
     }
 
+    /// Makes `pattern` the one this context draws for its domain at `spacing` and `level` (a
+    /// benchmark comparing paths on one pattern); surfaces take it from their next frame.
+    pub fn set_refinement_pattern(
+        &mut self,
+        spacing: Spacing,
+        level: f32,
+        pattern: std::sync::Arc<crate::pattern::RefinementPattern>,
+    ) {
+        let key = crate::pattern::PatternKey::new(pattern.domain, spacing, level);
+        self.patterns.insert(key, pattern);
+    }
+
     pub fn device(&self) -> &Device {
         &self.device
     }

@@ -101,11 +101,11 @@ pub enum TessError {
     PartialTriangle { corners: usize },
     #[error("{technique} on the tessellation path needs tessellation shaders, which this device lacks or --no-tessellation-shader turned off (techniques with a refinement-pattern path draw with --pipeline pattern)")]
     NoTessellationShader { technique: TechniqueId },
-    #[error("refinement patterns on a device without tessellation shaders (or transform feedback) are generated in equal spacing only, not {spacing:?} (--spacing equal)")]
+    #[error("refinement patterns beyond the tessellator (a device without tessellation shaders or transform feedback, or above 64 segments) are generated in equal spacing only, not {spacing:?} (--spacing equal)")]
     PatternSpacing {
         spacing: crate::tessellator::Spacing,
     },
-    #[error("a refinement pattern of {segments} segments per edge: expected 1..64")]
+    #[error("a refinement pattern of {segments} segments per edge: expected 1..256")]
     PatternLevel { segments: u32 },
     #[error("{path}: vertex {vertex} has patch id {patch}, which maps to no base face")]
     UnmappedPatch {

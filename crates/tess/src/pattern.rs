@@ -33,6 +33,10 @@ use topology::ControlMesh;
 /// Fixed-point denominator of generated coordinates.
 const FIXED_ONE: u32 = 1 << 16;
 
+/// The most segments per edge a generated pattern has: beyond the tessellator's 64, the pattern
+/// path refines further (the seed's Fig. 7 goes to 128 × 128).
+pub const MAX_GENERATED_SEGMENTS: u32 = 256;
+
 /// One refinement pattern: domain points and the triangles over them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RefinementPattern {
@@ -57,9 +61,10 @@ fn to_f32(fixed: u32) -> f32 {
 }
 
 impl RefinementPattern {
-    /// The equal-spacing pattern of `segments` segments per edge (1..=64; see the module docs).
+    /// The equal-spacing pattern of `segments` segments per edge (1..=
+    /// [`MAX_GENERATED_SEGMENTS`]; see the module docs).
     pub fn generate(domain: Domain, segments: u32) -> Result<Self> {
-        if !(1..=64).contains(&segments) {
+        if !(1..=MAX_GENERATED_SEGMENTS).contains(&segments) {
             return Err(TessError::PatternLevel { segments });
         }
         Ok(match domain {
@@ -126,7 +131,7 @@ impl RefinementPattern {
     /// `gl_TessCoord.xy`. Points are merged by their coordinate bits; on triangles
     /// `w = 1 − u − v`.
     pub fn from_capture(domain: Domain, soup: &CapturedSoup) -> Result<Self> {
-        if soup.records.is_empty() || soup.records.len() % 3 != 0 {
+        if soup.records.is_empty() || !soup.records.len().is_multiple_of(3) {
             return Err(TessError::PartialTriangle {
                 corners: soup.records.len(),
             });
@@ -203,10 +208,14 @@ impl PatternCache {
 }
 
 /// Makes the pattern of `key` on `ctx`'s device: the tessellator's own where the device has one
-/// and can capture ([`tessellator_pattern`]); otherwise generated, in equal spacing only.
+/// and can capture and the level is within its 64 ([`tessellator_pattern`]); otherwise
+/// generated, in equal spacing only.
 pub fn make(ctx: &mut Context, key: PatternKey) -> Result<RefinementPattern> {
     let device = ctx.device();
-    if device.info.caps.tessellation_shader && device.require_transform_feedback().is_ok() {
+    let tessellator = device.info.caps.tessellation_shader
+        && device.require_transform_feedback().is_ok()
+        && key.level() <= crate::tessellator::MAX_LEVEL;
+    if tessellator {
         return tessellator_pattern(ctx, key);
     }
     if key.spacing != Spacing::Equal {
@@ -214,7 +223,9 @@ pub fn make(ctx: &mut Context, key: PatternKey) -> Result<RefinementPattern> {
             spacing: key.spacing,
         });
     }
-    RefinementPattern::generate(key.domain, Spacing::Equal.segments(key.level()))
+    // Equal spacing rounds a level up to whole segments, as the tessellator does.
+    let segments = key.level().ceil().clamp(1.0, MAX_GENERATED_SEGMENTS as f32) as u32;
+    RefinementPattern::generate(key.domain, segments)
 }
 
 /// One patch of `key`'s domain over the unit domain, drawn flat through the tessellator at
@@ -325,7 +336,7 @@ mod tests {
 
     #[test]
     fn levels_outside_the_tessellators_range_are_refused_by_name() {
-        for n in [0, 65] {
+        for n in [0, MAX_GENERATED_SEGMENTS + 1] {
             let e = RefinementPattern::generate(Domain::Quad, n).unwrap_err();
             assert!(e.to_string().contains(&n.to_string()), "{e}");
         }

@@ -105,11 +105,8 @@ impl bench::BenchProgress for Progress {
 }
 
 fn config(a: &BenchArgs) -> Result<BenchConfig> {
-    let known = bench::method_names();
     for m in &a.methods {
-        if !known.contains(&m.as_str()) {
-            bail!("unknown method '{m}' (known: {})", known.join(", "));
-        }
+        bench::parse_method(m).map_err(|e| anyhow::anyhow!("--methods {m}: {e}"))?;
     }
     if !(1..=8).contains(&a.isolation) {
         bail!("--isolation {} is outside 1..8", a.isolation);
@@ -206,7 +203,47 @@ pub fn plot(a: PlotArgs) -> Result<()> {
     Ok(())
 }
 
+/// `--figure7`: the seed's Fig. 7 on the chosen device, printed and (with --markdown) written.
+fn figure7(a: &BenchArgs) -> Result<()> {
+    if a.csv.is_some() || a.plot.is_some() {
+        bail!("--figure7 writes its table with --markdown only (not --csv or --plot)");
+    }
+    let config = config(a)?;
+    let (instance, device) = open_device(&a.gpu, vec![], &[])?;
+    let cases = bench::figure7::SEED_CASES;
+    eprintln!(
+        "measuring Fig. 7's {} cases: {} timed frames after {} warm-up frames per row",
+        cases.len(),
+        config.frames,
+        config.warmup
+    );
+    let rows = crate::progress::during("Fig. 7".to_string(), || {
+        bench::figure7::run_figure7(&device, &cases, &config)
+    });
+    let settings = format!(
+        "{} build, {}×{} pixels, {} timed frames after {} warm-up frames, medians of GPU time.",
+        bench::build_profile(),
+        config.extent.width,
+        config.extent.height,
+        config.frames,
+        config.warmup
+    );
+    let name = device.info.to_string();
+    drop(device);
+    check_validation(&instance)?;
+    let table = bench::figure7::figure7_markdown(&rows?, &name, &settings);
+    out!("{table}");
+    if let Some(p) = &a.markdown {
+        crate::output::write_text(p, &table)?;
+        out!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
 pub fn run(a: BenchArgs) -> Result<()> {
+    if a.figure7 {
+        return figure7(&a);
+    }
     if let Some(p) = &a.plot {
         // Before minutes of measuring, not after.
         crate::plot::format_of(p, "--plot")?;

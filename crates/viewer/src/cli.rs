@@ -158,6 +158,11 @@ pub struct BenchArgs {
     /// reparameterization of Schäfer et al. (seed 003, Eq. 3), in the same rows.
     #[arg(long)]
     pub no_reparam: bool,
+    /// Reproduce the refinement-pattern seed's Fig. 7 instead of the table: 10, 100 and 1,000
+    /// coarse triangles at 64×64 and 128×128 segments, flat, a static pre-tessellated mesh (one
+    /// indexed draw) against one refinement pattern, measured together; --markdown writes it.
+    #[arg(long)]
+    pub figure7: bool,
     /// Write the rows as CSV.
     #[arg(long)]
     pub csv: Option<PathBuf>,

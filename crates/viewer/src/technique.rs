@@ -95,6 +95,10 @@ pub fn methods_long_help() -> String {
         };
         out.push_str(&format!("\n  {}{animated}", info.id.name()));
     }
+    out.push_str(
+        "\nA method may name its draw path: flat@pattern, pn@tessellation (rows of both paths \
+         side by side; without one, the device's --pipeline auto choice).",
+    );
     out
 }
 

@@ -480,6 +480,8 @@ pub struct HostDevice {
     pub pipeline_statistics_query: bool,
     /// `vertexPipelineStoresAndAtomics` was enabled.
     pub vertex_pipeline_stores_and_atomics: bool,
+    /// `tessellationShader` was enabled.
+    pub tessellation_shader: bool,
 }
 
 /// A handle to the logical device; clones share it.
@@ -615,7 +617,8 @@ impl Device {
     ///
     /// # Safety
     /// - `host.device` is a live device created from `host.physical` of `instance`, with
-    ///   `tessellationShader`, `fillModeNonSolid` and `timelineSemaphore` enabled,
+    ///   `fillModeNonSolid` and `timelineSemaphore` enabled, `tessellationShader` as
+    ///   `host.tessellation_shader` says,
     ///   `dynamicRendering` too unless nothing vk-core records on it begins a rendering scope
     ///   of its own or is recorded into a dynamic-rendering scope (a host that draws only into
     ///   render pass subpasses and never captures), and each optional feature `host` claims
@@ -668,6 +671,7 @@ impl Device {
         info.queue_family = Some(host.queue_family);
         info.caps.pipeline_statistics_query &= host.pipeline_statistics_query;
         info.caps.vertex_pipeline_stores_and_atomics &= host.vertex_pipeline_stores_and_atomics;
+        info.caps.tessellation_shader &= host.tessellation_shader;
         // The host does not say whether it enabled these: indirect draws hold one draw each
         // and start at instance 0 on its device.
         info.caps.multi_draw_indirect = false;

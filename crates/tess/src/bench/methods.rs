@@ -7,7 +7,7 @@ use crate::animation::Wave;
 use crate::camera::Camera;
 use crate::context::{statistics_query_safe, Context};
 use crate::error::{Result, TessError};
-use crate::technique::{FrameParams, Technique};
+use crate::technique::{FrameParams, PipelineChoice, Technique};
 use crate::techniques::{self, BuildOptions, TechniqueInfo};
 use std::time::Instant;
 use vk_core::{vk, Device, Encoder};
@@ -42,24 +42,50 @@ pub fn method_names() -> Vec<&'static str> {
     techniques::registry().iter().map(|i| i.id.name()).collect()
 }
 
+/// A bench method: a registry name, optionally with the draw path its rows take
+/// (`flat@pattern`, `pn@tessellation`; without one, `--pipeline auto`).
+pub fn parse_method(name: &str) -> Result<(&'static TechniqueInfo, PipelineChoice)> {
+    let (technique, path) = match name.split_once('@') {
+        Some((t, p)) => (t, Some(p)),
+        None => (name, None),
+    };
+    let unknown = |reason: String| TessError::BenchConfig {
+        option: "--methods".into(),
+        reason,
+    };
+    let info = techniques::named(technique).map_err(|_| {
+        unknown(format!(
+            "unknown bench method '{name}' (known: {}; a draw path may follow as @tessellation or @pattern)",
+            method_names().join(", ")
+        ))
+    })?;
+    let choice = match path {
+        None => PipelineChoice::Auto,
+        Some(p) => match p.parse::<PipelineChoice>() {
+            Ok(c @ (PipelineChoice::Tessellation | PipelineChoice::Pattern)) => c,
+            _ => {
+                return Err(unknown(format!(
+                    "'{name}': the draw path after @ is tessellation or pattern"
+                )))
+            }
+        },
+    };
+    Ok((info, choice))
+}
+
 /// Builds the rows of the techniques named in `names` for one mesh, in registry order: each
 /// technique's static row, and its `-animated` row when it animates.
 pub fn build_rows(names: &[String], ctx: &RowContext<'_>) -> Result<Vec<TechniqueRow>> {
-    if let Some(bad) = names.iter().find(|n| techniques::named(n).is_err()) {
-        return Err(TessError::BenchConfig {
-            option: "--methods".into(),
-            reason: format!(
-                "unknown bench method '{bad}' (known: {})",
-                method_names().join(", ")
-            ),
-        });
-    }
+    let methods = names
+        .iter()
+        .map(|n| Ok((n.as_str(), parse_method(n)?)))
+        .collect::<Result<Vec<_>>>()?;
     let mut out = Vec::new();
     for info in techniques::registry() {
-        if names.iter().any(|n| n == info.id.name()) {
-            out.push(TechniqueRow::new(ctx, info, false)?);
+        for &(name, (_, choice)) in methods.iter().filter(|m| m.1 .0.id == info.id) {
+            out.push(TechniqueRow::new(ctx, info, (name, choice), false)?);
             if info.features.animation {
-                out.push(TechniqueRow::new(ctx, info, true)?);
+                out.push(TechniqueRow::new(ctx, info, (name, choice), true)?);
             }
         }
     }
@@ -94,7 +120,14 @@ pub struct TechniqueRow {
 }
 
 impl TechniqueRow {
-    pub fn new(ctx: &RowContext<'_>, info: &TechniqueInfo, animated: bool) -> Result<Self> {
+    /// The row of `info` named `name` (its registry name, or with the draw path `choice`:
+    /// `flat@pattern`), animated or not.
+    pub fn new(
+        ctx: &RowContext<'_>,
+        info: &TechniqueInfo,
+        (name, choice): (&str, PipelineChoice),
+        animated: bool,
+    ) -> Result<Self> {
         let mut context = Context::new(ctx.device, ctx.color_format, ctx.depth_format, 1)?;
         // Catmull-Clark and Doo-Sabin techniques take the mesh as loaded (a fan triangulation
         // is another surface for them); the others its fan triangulation (the paper's Table I).
@@ -121,6 +154,7 @@ impl TechniqueRow {
                     Default::default()
                 },
                 max_refined_vertices: ctx.config.cpu_max_vertices,
+                pipeline: choice,
                 ..BuildOptions::default()
             },
         )?;
@@ -130,9 +164,9 @@ impl TechniqueRow {
         };
         Ok(Self {
             label: if animated {
-                format!("{}-animated", info.id)
+                format!("{name}-animated")
             } else {
-                info.id.name().to_string()
+                name.to_string()
             },
             mesh_name: ctx.mesh.name.clone(),
             animated,
@@ -148,6 +182,28 @@ impl TechniqueRow {
                 None
             },
         })
+    }
+
+    /// A row of a technique built elsewhere (the benchmark's own comparisons, such as the
+    /// seed's Fig. 7), drawn through its own context.
+    pub fn from_technique(
+        label: &str,
+        technique: Box<dyn Technique>,
+        context: Context,
+        mesh: &BenchMesh,
+    ) -> Self {
+        Self {
+            label: label.to_owned(),
+            mesh_name: mesh.name.clone(),
+            animated: false,
+            technique,
+            wave: None,
+            context,
+            base_faces: mesh.input.num_faces(),
+            displace: 0.0,
+            reparam: true,
+            surface_note: None,
+        }
     }
 
     fn params(&self, segments: u32, camera: Camera) -> FrameParams {

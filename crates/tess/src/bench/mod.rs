@@ -8,12 +8,13 @@
 //! structure (timestamps, pipeline statistics, rendering scope) so every technique is timed the
 //! same way, and interleaves the techniques' frames at each mesh and S so that a machine's
 //! drift does not bias one of them. Speed is measured here, never asserted by tests.
+pub mod figure7;
 mod methods;
 mod report;
 pub mod stats;
 pub mod usage;
 
-pub use methods::{build_rows, method_names, BenchFrame, RowContext, TechniqueRow};
+pub use methods::{build_rows, method_names, parse_method, BenchFrame, RowContext, TechniqueRow};
 pub use report::{parse_csv, CSV_HEADER, CSV_HEADER_V1};
 
 use crate::camera::Camera;
@@ -665,12 +666,8 @@ fn validate(config: &BenchConfig, meshes: &[BenchMesh]) -> Result<()> {
             return bad(format!("row budget {b} s must be a positive number"));
         }
     }
-    let names = method_names();
-    if let Some(m) = config.methods.iter().find(|m| !names.contains(&m.as_str())) {
-        return bad(format!(
-            "unknown bench method '{m}' (known: {})",
-            names.join(", ")
-        ));
+    for m in &config.methods {
+        methods::parse_method(m)?;
     }
     if !config.displace.is_finite() {
         return Err(TessError::BenchConfig {

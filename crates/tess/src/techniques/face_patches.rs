@@ -263,7 +263,15 @@ impl<S: FaceStyle> FacePatches<S> {
         params
             .uniform_segments()
             .unwrap_or(1.0)
-            .clamp(1.0, MAX_LEVEL)
+            .clamp(1.0, self.max_level())
+    }
+
+    /// The tessellator's 64; on the pattern path, what generated patterns reach beyond it.
+    fn max_level(&self) -> f32 {
+        match self.draws {
+            Draws::Tessellated { .. } => MAX_LEVEL,
+            Draws::Patterns { .. } => crate::pattern::MAX_GENERATED_SEGMENTS as f32,
+        }
     }
 
     /// The frame's pattern of `array`'s domain, once [`Technique::prepare_frame`] made it.
@@ -326,12 +334,19 @@ impl<S: FaceStyle> Technique for FacePatches<S> {
     }
 
     fn check(&self, params: &FrameParams) -> Result<()> {
+        let patterns = matches!(self.draws, Draws::Patterns { .. });
         match params.factors {
-            FactorPolicy::Uniform { segments } if (1.0..=MAX_LEVEL).contains(&segments) => Ok(()),
+            FactorPolicy::Uniform { segments } if (1.0..=self.max_level()).contains(&segments) => {
+                Ok(())
+            }
             FactorPolicy::Uniform { segments } => Err(ParamError::refused(
                 Param::Segments,
                 segments,
-                "expected 1..64",
+                if patterns {
+                    "expected 1..256 on the pattern path"
+                } else {
+                    "expected 1..64"
+                },
             )),
             _ => Err(TessError::Unsupported {
                 technique: S::ID,
