@@ -62,6 +62,15 @@ enum Check {
         offset: usize,
         size: usize,
     },
+    /// A refinement-pattern vertex input (`common/pattern_in.glsl`): the attribute at the
+    /// input's location in `input` reads 12 bytes from `binding` at `offset`, and the input
+    /// is a vec3.
+    PatternInput {
+        name: &'static str,
+        input: crate::technique::VertexInput,
+        binding: u32,
+        offset: usize,
+    },
 }
 
 fn variant(spacing: Option<Spacing>, capture: bool) -> Variant {
@@ -87,6 +96,43 @@ const BLOCK: Variant = Variant {
 };
 
 /// The table. Each BFT storage buffer appears with a stage that reads or writes it.
+
+/// The refinement-pattern vertex stages: the frame block, and every input against
+/// [`super::pattern_input`] (the domain point per vertex, each corner's position and normal
+/// per instance).
+fn pattern_input_rows() -> Vec<(Stage, Variant, Check)> {
+    use super::pattern_input::{QUAD, TRIANGLE};
+    let corner = size_of::<Vertex>();
+    let mut out = Vec::new();
+    for (stage, input, corners) in [
+        (Stage::FlatPatternTriVert, TRIANGLE, 3),
+        (Stage::FlatPatternQuadVert, QUAD, 4),
+        (Stage::PhongPatternTriVert, TRIANGLE, 3),
+        (Stage::PnPatternTriVert, TRIANGLE, 3),
+    ] {
+        let frame = Check::Uniform {
+            block: "Frame",
+            set: FRAME_SET,
+            binding: FRAME_UNIFORMS_BINDING,
+        };
+        out.push((stage, PLAIN, frame));
+        let at = |name, binding, offset| Check::PatternInput {
+            name,
+            input,
+            binding,
+            offset,
+        };
+        out.push((stage, PLAIN, at("in_domain", 0, 0)));
+        const POSITIONS: [&str; 4] = ["in_p0", "in_p1", "in_p2", "in_p3"];
+        const NORMALS: [&str; 4] = ["in_n0", "in_n1", "in_n2", "in_n3"];
+        for i in 0..corners {
+            out.push((stage, PLAIN, at(POSITIONS[i], 1, i * corner)));
+            out.push((stage, PLAIN, at(NORMALS[i], 1, i * corner + 12)));
+        }
+    }
+    out
+}
+
 fn rows() -> Vec<(Stage, Variant, Check)> {
     use Check::*;
     let equal = Some(Spacing::Equal);
@@ -199,6 +245,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
             },
         ),
         // Doo-Sabin's vertex stage: the deepest level's points and their face corners.
+        // (The refinement-pattern vertex stages' inputs are appended below.)
         (Stage::DooSabinMeshVert, PLAIN, frame()),
         (
             Stage::DooSabinMeshVert,
@@ -546,6 +593,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
             }
         }
     }
+    rows.extend(pattern_input_rows());
     rows
 }
 
@@ -664,6 +712,26 @@ fn check(stage: Stage, v: Variant, check: &Check) -> Result<(), String> {
             }
             Ok(())
         }
+        Check::PatternInput {
+            name,
+            input,
+            binding,
+            offset,
+        } => {
+            let (location, bytes) = r.input(name).ok_or_else(|| format!("no input {name}"))?;
+            let attr = input
+                .attributes
+                .iter()
+                .find(|a| a.location == location)
+                .ok_or_else(|| format!("{name}: location {location} has no vertex attribute"))?;
+            if attr.binding != *binding || attr.offset as usize != *offset || bytes != 12 {
+                return Err(format!(
+                    "{name}: attribute at binding {} offset {}, input {bytes} bytes; expected binding {binding} offset {offset}, 12 bytes",
+                    attr.binding, attr.offset
+                ));
+            }
+            Ok(())
+        }
     }
 }
 
@@ -732,8 +800,9 @@ fn the_table_covers_every_storage_binding_and_capture_build() {
         .filter(|(_, _, c)| matches!(c, Check::Xfb { .. }))
         .count();
     // Nine TESs in three spacings, the four adaptive ones and BFT's also with their surface code,
-    // BFT's also with and without its patch block; the CPU mesh's and Doo-Sabin's vertex stages.
-    assert_eq!(capture_builds, 50);
+    // BFT's also with and without its patch block; the CPU mesh's and Doo-Sabin's vertex stages,
+    // and the four refinement-pattern vertex stages.
+    assert_eq!(capture_builds, 54);
     assert_eq!(xfb_rows, capture_builds);
 }
 
@@ -764,6 +833,13 @@ fn a_wrong_offset_or_binding_is_caught() {
         size: 4,
     };
     assert!(check(Stage::CommonShadeFrag, PLAIN, &missing).is_err());
+    let wrong = Check::PatternInput {
+        name: "in_n0",
+        input: super::pattern_input::TRIANGLE,
+        binding: 1,
+        offset: 0,
+    };
+    assert!(check(Stage::PnPatternTriVert, PLAIN, &wrong).is_err());
 }
 
 /// `-DCAPTURE` really changes the build: every capture variant writes transform feedback, and
@@ -784,7 +860,7 @@ fn capture_variants_and_only_they_have_xfb() {
             captures += v.capture as usize;
         }
     }
-    assert_eq!(captures, 50);
+    assert_eq!(captures, 54);
 }
 
 #[test]
