@@ -238,6 +238,15 @@ fn declined(info: &TechniqueInfo) -> Vec<(&'static str, FrameParams)> {
             },
         ));
     }
+    if !f.sine_displacement {
+        out.push((
+            "sine displacement",
+            FrameParams {
+                displace_sine: [0.05, 20.0],
+                ..base
+            },
+        ));
+    }
     out
 }
 

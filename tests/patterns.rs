@@ -23,6 +23,10 @@ const EXTENT: vk::Extent2D = vk::Extent2D {
     height: 64,
 };
 
+/// The seed's procedural displacement a·sin(f·‖P‖) (§4), at a frequency that ripples the test
+/// meshes several times.
+const SINE: [f32; 2] = [0.02, 25.0];
+
 const BASE_FACE_TECHNIQUES: [TechniqueId; 3] =
     [TechniqueId::FLAT, TechniqueId::PHONG, TechniqueId::PN];
 
@@ -105,13 +109,18 @@ fn with_the_devices_tessellator_both_paths_emit_the_same_triangles_and_bits() {
                     .iter()
                     .all(|a| a.patch.path() == DrawPath::Pattern));
                 for &level in *levels {
-                    for spacing in [
-                        Spacing::Equal,
-                        Spacing::FractionalEven,
-                        Spacing::FractionalOdd,
+                    for (spacing, sine) in [
+                        (Spacing::Equal, [0.0, 0.0]),
+                        (Spacing::FractionalEven, [0.0, 0.0]),
+                        (Spacing::FractionalOdd, [0.0, 0.0]),
+                        (Spacing::Equal, SINE),
                     ] {
-                        let what = format!("{id} on {name}, level {level}, {spacing:?}");
-                        let p = params(level, spacing);
+                        let what =
+                            format!("{id} on {name}, level {level}, {spacing:?}, sine {sine:?}");
+                        let p = FrameParams {
+                            displace_sine: sine,
+                            ..params(level, spacing)
+                        };
                         let a = capture(&mut ctx, tess.as_mut(), &p);
                         let b = capture(&mut ctx, pattern.as_mut(), &p);
                         assert!(a.triangle_count() > 0, "{what}");
@@ -153,6 +162,12 @@ mod oracle {
     fn dot(a: V, b: V) -> f64 {
         a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
     }
+    /// The seed's procedural displacement: `p + a·sin(f·|p|)` along the unit normal.
+    pub fn displaced(p: V, n: V, [a, f]: [f64; 2]) -> V {
+        let h = a * (f * dot(p, p).sqrt()).sin();
+        add(p, mul(normalize(n), h))
+    }
+
     pub fn normalize(a: V) -> V {
         let l = dot(a, a).sqrt();
         if l > 0.0 {
@@ -266,8 +281,14 @@ fn patch_corners(mesh: &ControlMesh, quads: bool) -> Vec<(Vec<oracle::V>, Vec<or
         .collect()
 }
 
-/// The largest distance between a captured position (normal) and the oracle's, over `soup`.
-fn oracle_error(id: TechniqueId, mesh: &ControlMesh, soup: &CapturedSoup) -> (f64, f64) {
+/// The largest distance between a captured position (normal) and the oracle's, over `soup`,
+/// drawn with the displacement `sine` (amplitude, frequency).
+fn oracle_error(
+    id: TechniqueId,
+    mesh: &ControlMesh,
+    soup: &CapturedSoup,
+    sine: [f32; 2],
+) -> (f64, f64) {
     let corners = patch_corners(mesh, id == TechniqueId::FLAT);
     let (mut dp, mut dn) = (0.0f64, 0.0f64);
     for r in &soup.records {
@@ -279,6 +300,7 @@ fn oracle_error(id: TechniqueId, mesh: &ControlMesh, soup: &CapturedSoup) -> (f6
             TechniqueId::PHONG => oracle::phong(p, n, b, FrameParams::default().phong_alpha as f64),
             _ => oracle::pn(p, n, b),
         };
+        let want_p = oracle::displaced(want_p, want_n, sine.map(f64::from));
         let dist = |a: [f32; 3], b: oracle::V| {
             (0..3)
                 .map(|i| (a[i] as f64 - b[i]).powi(2))
@@ -315,15 +337,25 @@ fn without_tessellation_shaders_the_base_face_techniques_draw_generated_patterns
                     .pixels
                     .chunks_exact(4)
                     .any(|p| p[0] != image.pixels[0]));
-                for level in [1.0, 3.0, 7.0, 16.0] {
-                    let what = format!("{id} on {name}, level {level}");
-                    let soup = capture(&mut ctx, t.as_mut(), &params(level, Spacing::Equal));
+                for (level, sine) in [
+                    (1.0, [0.0, 0.0]),
+                    (3.0, [0.0, 0.0]),
+                    (7.0, [0.0, 0.0]),
+                    (16.0, [0.0, 0.0]),
+                    (16.0, SINE),
+                ] {
+                    let what = format!("{id} on {name}, level {level}, sine {sine:?}");
+                    let p = FrameParams {
+                        displace_sine: sine,
+                        ..params(level, Spacing::Equal)
+                    };
+                    let soup = capture(&mut ctx, t.as_mut(), &p);
                     let welded = soup.weld().unwrap();
                     let report = welded.open_edges();
                     let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
                     let c = classify_open_edges(&soup, &welded, &report, &map, &mesh);
                     assert_eq!((c.cracks, c.unmapped), (0, 0), "{what}");
-                    let (dp, dn) = oracle_error(id, &mesh, &soup);
+                    let (dp, dn) = oracle_error(id, &mesh, &soup, sine);
                     println!("{what}: position error {dp:.2e}, normal error {dn:.2e}");
                     assert!(dp <= 2e-6 * diagonal, "{what}: position off by {dp}");
                     assert!(dn <= 2e-5, "{what}: normal off by {dn}");

@@ -10,6 +10,7 @@ layout(std140, set = FRAME_SET, binding = FRAME_UNIFORMS_BINDING) uniform Frame 
     vec4 base_color;   // rgb: surface albedo
     vec4 wire_color;   // rgb: wireframe overlay
     vec4 viewport;     // xy: size in pixels
+    vec4 sine;         // x: amplitude a, y: frequency f of a sin(f |P|) along the normal (0: none)
 } frame;
 
 // Push constant: what a draw is for, and where it starts in the frame's patch numbering.

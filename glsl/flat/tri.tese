@@ -3,6 +3,7 @@
 // (flat.glsl). Built in every spacing, with and without capture (glsl/manifest.toml;
 // tese_out.glsl).
 #include "frame.glsl"
+#include "sine.glsl"
 #include "tese_out.glsl"
 #include "flat.glsl"
 layout(triangles, SPACING, ccw) in;
@@ -12,5 +13,6 @@ void main() {
     vec3 b = gl_TessCoord;
     vec3 p[3] = vec3[3](in_position[0], in_position[1], in_position[2]);
     vec3 n[3] = vec3[3](in_normal[0], in_normal[1], in_normal[2]);
-    emit_sample(flat_triangle(p, b), flat_triangle(n, b), draw.first_patch + uint(gl_PrimitiveID), 0u);
+    vec3 m = flat_triangle(n, b);
+    emit_sample(displace_sine(flat_triangle(p, b), m), m, draw.first_patch + uint(gl_PrimitiveID), 0u);
 }

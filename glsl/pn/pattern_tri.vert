@@ -3,6 +3,7 @@
 // pn_patch, what the control stage computes once per patch on the tessellation path) and its
 // evaluation at the pattern vertex's barycentric domain point, the same functions as tri.tese.
 #include "frame.glsl"
+#include "sine.glsl"
 #include "stage_out.glsl"
 #include "pattern_in.glsl"
 #include "normals.glsl"
@@ -12,5 +13,6 @@ void main() {
     vec3 n[3] = vec3[3](in_n0, in_n1, in_n2);
     vec3 p, m;
     pn_evaluate(c, n, pn_patch(c, n), in_domain, p, m);
-    emit_vertex_at(p, safe_normalize(m, vec3(0.0)), pattern_patch_id(), 0u, in_domain.xy);
+    m = safe_normalize(m, vec3(0.0));
+    emit_vertex_at(displace_sine(p, m), m, pattern_patch_id(), 0u, in_domain.xy);
 }

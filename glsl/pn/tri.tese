@@ -3,6 +3,7 @@
 // the coefficients the control stage computed), normal normalised.
 // Built in every spacing, with and without capture (glsl/manifest.toml; tese_out.glsl).
 #include "frame.glsl"
+#include "sine.glsl"
 #include "tese_out.glsl"
 #include "normals.glsl"
 #include "pn.glsl"
@@ -18,5 +19,6 @@ void main() {
     PnPatch q = PnPatch(b_edge, b111, n_edge);
     vec3 p, m;
     pn_evaluate(c, n, q, gl_TessCoord, p, m);
-    emit_sample(p, safe_normalize(m, vec3(0.0)), draw.first_patch + uint(gl_PrimitiveID), 0u);
+    m = safe_normalize(m, vec3(0.0));
+    emit_sample(displace_sine(p, m), m, draw.first_patch + uint(gl_PrimitiveID), 0u);
 }

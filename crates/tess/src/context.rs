@@ -689,6 +689,7 @@ pub fn frame_uniforms_with(
         ],
         wire_color: [0.05, 0.05, 0.08, 1.0],
         viewport: [extent.width as f32, extent.height as f32, 0.0, 0.0],
+        sine: [params.displace_sine[0], params.displace_sine[1], 0.0, 0.0],
     }
 }
 

@@ -223,6 +223,9 @@ pub struct FrameParams {
     pub reparam: bool,
     /// Displacement along the normal per unit of height (0: none).
     pub displace: f32,
+    /// The refinement-pattern seed's procedural displacement a·sin(f·‖P‖) along the normal:
+    /// (amplitude a, frequency f); a = 0: none.
+    pub displace_sine: [f32; 2],
     /// What the surface is coloured by (shading, or a view of the texture parameterization).
     pub show: crate::surface::SurfaceShow,
     pub split: DrawSplit,
@@ -242,6 +245,7 @@ impl Default for FrameParams {
             patch_colours: false,
             reparam: true,
             displace: 0.0,
+            displace_sine: [0.0, 0.0],
             show: crate::surface::SurfaceShow::Shading,
             split: DrawSplit::Auto,
             base_color: [0.85, 0.72, 0.55],
@@ -291,6 +295,8 @@ pub struct Features {
     pub surface: bool,
     /// One patch per base face (gregory, acc): triangles as Gregory triangle patches or split.
     pub single_pass: bool,
+    /// The procedural displacement a·sin(f·‖P‖) along the normal (`--displace-sine`).
+    pub sine_displacement: bool,
     /// The draw paths it has (the conformance suite runs each).
     pub paths: &'static [DrawPath],
 }
@@ -413,6 +419,10 @@ impl Features {
             (
                 !self.surface && params.displace != 0.0,
                 "displacement (--displace)",
+            ),
+            (
+                !self.sine_displacement && params.displace_sine[0] != 0.0,
+                "sine displacement (--displace-sine)",
             ),
             (
                 !self.surface && params.show != crate::surface::SurfaceShow::Shading,

@@ -1,7 +1,7 @@
 //! The technique options shared by `render`, `view` and `export`, checked against what the
 //! chosen technique declares it takes ([`tess::Features`] in [`tess::techniques::registry`]):
 //! no per-technique code here, so a new technique needs no change in the viewer.
-use crate::numbers::{float, number32, whole};
+use crate::numbers::{float, float_in, number32, whole};
 use anyhow::{bail, Result};
 use clap::Args;
 use std::path::Path;
@@ -54,6 +54,17 @@ fn parse_frame(s: &str) -> Result<f32, String> {
 
 pub fn parse_displace(s: &str) -> Result<f32, String> {
     float(s, "--displace", -1000.0, 1000.0)
+}
+
+/// `--displace-sine A,F`: amplitude and frequency.
+pub fn parse_displace_sine(s: &str) -> Result<[f32; 2], String> {
+    let Some((a, f)) = s.split_once(',') else {
+        return Err("--displace-sine takes A,F: an amplitude and a frequency".into());
+    };
+    Ok([
+        float_in(a, "--displace-sine's amplitude", -1000.0, 1000.0)?,
+        float_in(f, "--displace-sine's frequency", 0.0, 1e6)?,
+    ])
 }
 
 /// The largest `--sharpness-scale`.
@@ -259,6 +270,11 @@ pub struct SurfaceArgs {
     /// Height map (PNG, luminance in [0, 1]) for --displace.
     #[arg(long, value_name = "PNG")]
     pub height: Option<std::path::PathBuf>,
+    /// The refinement-pattern seed's procedural displacement (flat, phong, pn): each point
+    /// moves by A·sin(F·|P|) along its unit normal, on both draw paths. A and F finite, |A| ≤
+    /// 1000, 0 ≤ F ≤ 1e6. Meshes whose OBJ normals differ across an edge open there.
+    #[arg(long, value_name = "A,F", allow_hyphen_values = true, value_parser = parse_displace_sine)]
+    pub displace_sine: Option<[f32; 2]>,
     /// Texture coordinates at the Gregory patches' own parameter instead of the rational
     /// reparameterization of Schäfer et al. (seed 003, Eq. 3).
     #[arg(long)]
@@ -328,6 +344,7 @@ impl SurfaceArgs {
         params.show = self.show()?;
         params.reparam = !self.no_reparam;
         params.displace = self.displace.unwrap_or(0.0);
+        params.displace_sine = self.displace_sine.unwrap_or([0.0, 0.0]);
         let maps = load_maps(
             self.texture.as_deref(),
             self.height.as_deref(),
@@ -393,7 +410,7 @@ impl SurfaceArgs {
 
     /// Each option a technique may refuse: its name, whether it was given, which feature takes
     /// it.
-    fn option_uses(&self, animate: bool) -> [OptionUse; 16] {
+    fn option_uses(&self, animate: bool) -> [OptionUse; 17] {
         [
             OptionUse {
                 name: "--factors",
@@ -454,6 +471,11 @@ impl SurfaceArgs {
                 name: "--displace",
                 given: self.displace.is_some(),
                 feature: |f| f.surface,
+            },
+            OptionUse {
+                name: "--displace-sine",
+                given: self.displace_sine.is_some(),
+                feature: |f| f.sine_displacement,
             },
             OptionUse {
                 name: "--height",

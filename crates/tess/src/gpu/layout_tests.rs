@@ -138,7 +138,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
     let equal = Some(Spacing::Equal);
     let frame = || Layout {
         name: "Frame",
-        offsets: offsets!(FrameUniforms: view_proj, view, camera_pos, light_dir, tess, base_color, wire_color, viewport),
+        offsets: offsets!(FrameUniforms: view_proj, view, camera_pos, light_dir, tess, base_color, wire_color, viewport, sine),
         size: size_of::<FrameUniforms>(),
     };
     let draw = || Layout {

@@ -34,10 +34,14 @@ pub struct FrameUniforms {
     pub base_color: [f32; 4],
     pub wire_color: [f32; 4],
     pub viewport: [f32; 4],
+    /// x: amplitude a, y: frequency f of the refinement-pattern seed's procedural displacement
+    /// a·sin(f·‖P‖) along the normal (flat, Phong, PN; a = 0: none).
+    pub sine: [f32; 4],
 }
 
 const _: () = {
-    assert!(size_of::<FrameUniforms>() == 224);
+    assert!(size_of::<FrameUniforms>() == 240);
+    assert!(offset_of!(FrameUniforms, sine) == 224);
     assert!(offset_of!(FrameUniforms, view) == 64);
     assert!(offset_of!(FrameUniforms, camera_pos) == 128);
     assert!(offset_of!(FrameUniforms, light_dir) == 144);

@@ -39,6 +39,7 @@ pub const BASE_FACES: Features = Features {
     isolation: false,
     surface: false,
     single_pass: false,
+    sine_displacement: true,
     paths: &[DrawPath::Tessellation, DrawPath::Pattern],
 };
 

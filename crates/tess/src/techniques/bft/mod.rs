@@ -95,6 +95,7 @@ pub static INFO: TechniqueInfo = TechniqueInfo {
         isolation: false,
         surface: false,
         single_pass: false,
+        sine_displacement: false,
         paths: &[DrawPath::Tessellation],
     },
     scheme: Some(topology::Scheme::Loop),

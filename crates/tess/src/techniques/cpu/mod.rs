@@ -52,6 +52,7 @@ pub static INFO: TechniqueInfo = TechniqueInfo {
         isolation: false,
         surface: false,
         single_pass: false,
+        sine_displacement: false,
         paths: &[DrawPath::VertexStage],
     },
     scheme: Some(Scheme::Loop),

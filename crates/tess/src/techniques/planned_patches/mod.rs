@@ -324,6 +324,7 @@ pub const PLANNED: Features = Features {
     isolation: false,
     surface: true,
     single_pass: false,
+    sine_displacement: false,
     paths: &[DrawPath::Tessellation],
 };
 
@@ -331,6 +332,7 @@ pub const PLANNED: Features = Features {
 /// isolation.
 pub const SINGLE_PASS: Features = Features {
     single_pass: true,
+    sine_displacement: false,
     ..PLANNED
 };
 
