@@ -1166,3 +1166,108 @@ fn a_corner_above_the_reparameterization_table_renders() {
         "the reparameterization should move the texture: {differing} pixels differ"
     );
 }
+
+/// The draw path: `render` says which it drew; patterns draw without tessellation shaders;
+/// what cannot be drawn on a path is refused naming the option, and malformed values of the
+/// path and displacement options are refused with their forms.
+#[test]
+fn the_draw_path_options_draw_or_name_what_is_wrong() {
+    let png = tmp("path.png");
+    let png = png.to_str().unwrap();
+    for (args, path) in [
+        (
+            vec!["--method", "flat", "--pipeline", "pattern"],
+            "pattern path",
+        ),
+        (
+            vec!["--method", "pn", "--no-tessellation-shader"],
+            "pattern path",
+        ),
+        (
+            vec!["--method", "phong", "--pipeline", "tessellation"],
+            "tessellation path",
+        ),
+        (
+            vec![
+                "--method",
+                "pn",
+                "--pipeline",
+                "pattern",
+                "--displace-sine",
+                "0.02,25",
+            ],
+            "pattern path",
+        ),
+    ] {
+        let mut all = vec!["render", "--size", "96x72", "-o", png];
+        all.extend(args);
+        let o = succeeds(&all);
+        assert!(stdout(&o).contains(path), "{all:?}: {}", stdout(&o));
+    }
+    let render = |extra: &[&'static str]| {
+        let mut all = vec!["render", "--size", "96x72", "-o", png];
+        all.extend(extra);
+        all
+    };
+    fails(
+        &render(&["--method", "adaptive", "--pipeline", "pattern"]),
+        &[],
+        1,
+        &["adaptive", "--pipeline pattern"],
+    );
+    fails(
+        &render(&["--method", "bft", "--no-tessellation-shader"]),
+        &[],
+        1,
+        &["bft", "--no-tessellation-shader", "--pipeline pattern"],
+    );
+    fails(
+        &render(&[
+            "--method",
+            "pn",
+            "--no-tessellation-shader",
+            "--spacing",
+            "fractional-odd",
+        ]),
+        &[],
+        1,
+        &["equal spacing", "--spacing equal"],
+    );
+    fails(
+        &render(&["--pipeline", "mesh"]),
+        &[],
+        2,
+        &["tessellation, pattern, auto"],
+    );
+    for bad in ["1", "nan,1", "1,-1", "2000,1", "1,x"] {
+        fails(
+            &render(&["--method", "pn", "--displace-sine", bad]),
+            &[],
+            2,
+            &["--displace-sine"],
+        );
+    }
+    fails(
+        &render(&["--method", "bft", "--displace-sine", "0.1,2"]),
+        &[],
+        1,
+        &["--displace-sine", "--method pn"],
+    );
+    fails(
+        &["bench", "--methods", "flat@mesh", "--frames", "1"],
+        &[],
+        1,
+        &["flat@mesh", "tessellation or pattern"],
+    );
+    fails(
+        &[
+            "bench",
+            "--figure7",
+            "--csv",
+            tmp("f7.csv").to_str().unwrap(),
+        ],
+        &[],
+        1,
+        &["--figure7", "--markdown"],
+    );
+}

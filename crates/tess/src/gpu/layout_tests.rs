@@ -95,8 +95,6 @@ const BLOCK: Variant = Variant {
     ..PLAIN
 };
 
-/// The table. Each BFT storage buffer appears with a stage that reads or writes it.
-
 /// The refinement-pattern vertex stages: the frame block, and every input against
 /// [`super::pattern_input`] (the domain point per vertex, each corner's position and normal
 /// per instance).
@@ -133,6 +131,7 @@ fn pattern_input_rows() -> Vec<(Stage, Variant, Check)> {
     out
 }
 
+/// The table. Each BFT storage buffer appears with a stage that reads or writes it.
 fn rows() -> Vec<(Stage, Variant, Check)> {
     use Check::*;
     let equal = Some(Spacing::Equal);
