@@ -265,6 +265,11 @@ typedef struct TesseraHostDesc {
   uint32_t pipeline_statistics_query;
   // 0 or 1: `vertexPipelineStoresAndAtomics` is enabled.
   uint32_t vertex_pipeline_stores_and_atomics;
+  // 0 or 1: `bufferDeviceAddress` (required in Vulkan 1.3) is enabled. The planned-patch
+  // techniques (`TESSERA_TECHNIQUE_ADAPTIVE`, `_GREGORY`, `_ACC`, and whatever `_AUTO` makes
+  // of them) read their vertex and patch arrays by address, so that no
+  // `maxStorageBufferRange` limits them; with 0 they are UNSUPPORTED.
+  uint32_t buffer_device_address;
   // VK_NULL_HANDLE: Tessera's draws go into the host's dynamic-rendering scopes. Otherwise
   // they go into subpass `subpass` of instances of this render pass (or of one compatible
   // with it): its pipelines are made for that subpass, which must have exactly one colour

@@ -38,6 +38,8 @@
 //! # Device features
 //! Dynamic rendering needs `dynamicRendering` enabled; a render pass does not, except for
 //! captures, which render into an attachment-less dynamic-rendering scope of Tessera's own.
+//! The planned-patch techniques (adaptive, gregory, acc) need `bufferDeviceAddress` enabled
+//! and `buffer_device_address` set: they read their vertex and patch arrays by address.
 //!
 //! # Frames in flight
 //! The host says how many frames it keeps in flight (`frames_in_flight`); every surface keeps
@@ -106,6 +108,11 @@ pub struct TesseraHostDesc {
     pub pipeline_statistics_query: u32,
     /// 0 or 1: `vertexPipelineStoresAndAtomics` is enabled.
     pub vertex_pipeline_stores_and_atomics: u32,
+    /// 0 or 1: `bufferDeviceAddress` (required in Vulkan 1.3) is enabled. The planned-patch
+    /// techniques (`TESSERA_TECHNIQUE_ADAPTIVE`, `_GREGORY`, `_ACC`, and whatever `_AUTO` makes
+    /// of them) read their vertex and patch arrays by address, so that no
+    /// `maxStorageBufferRange` limits them; with 0 they are UNSUPPORTED.
+    pub buffer_device_address: u32,
     /// VK_NULL_HANDLE: Tessera's draws go into the host's dynamic-rendering scopes. Otherwise
     /// they go into subpass `subpass` of instances of this render pass (or of one compatible
     /// with it): its pipelines are made for that subpass, which must have exactly one colour
@@ -231,6 +238,7 @@ pub unsafe extern "C" fn tessera_context_create_host(
                 d.vertex_pipeline_stores_and_atomics,
                 "vertex_pipeline_stores_and_atomics",
             )?,
+            buffer_device_address: flag(d.buffer_device_address, "buffer_device_address")?,
         };
         // SAFETY: as above.
         let device = unsafe { Device::from_host(&instance, &host, cache.as_deref()) }?;
