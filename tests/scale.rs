@@ -9,9 +9,9 @@ mod common;
 mod loop_grid;
 use common::Gpu;
 use tessera::tess::capture::Capturer;
-use tessera::tess::techniques::{adaptive, planned_patches};
 use tessera::tess::techniques::bft::{Bft, BftOptions};
 use tessera::tess::techniques::planned_patches::PlanBuild;
+use tessera::tess::techniques::{adaptive, planned_patches};
 use tessera::tess::{Context, FrameParams, Technique};
 use tessera::topology::ControlMesh;
 use tessera::vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
@@ -150,11 +150,12 @@ fn adaptive_under_a_small_storage_range_matches_the_whole_buffer_run() {
     let params = FrameParams::uniform(4.0);
     let (image, capture, chunks, (whole, terms)) = adaptive_run(None, &mesh, &params);
     assert_eq!(chunks.1, 1, "uncapped: one window set");
-    // The smallest range that still holds every buffer bound whole, rounded up to 256 bytes.
+    // A range just above the largest array (the vertices), rounded up to 256 bytes: the
+    // stencil rows still need several windows of it.
     let cap = whole.div_ceil(256) * 256;
-    println!("largest whole buffer {whole} B, stencil terms {terms} B, cap {cap} B");
-    // The rows are 1.8 times the largest buffer bound whole (the vertices) since the regular
-    // corners and the curve points have none; no shape in tests/data has over 2.2.
+    println!("largest array {whole} B, stencil terms {terms} B, cap {cap} B");
+    // The rows are 1.8 times the largest array (the vertices) since the regular corners and
+    // the curve points have none; no shape in tests/data has over 2.2.
     assert!(
         2 * terms > 3 * cap,
         "the terms ({terms} B) need several windows of {cap} B"
@@ -229,7 +230,11 @@ fn planned_patches_beyond_the_storage_range_match_the_uncapped_run() {
     ))
     .expect("shape");
     let params = FrameParams::uniform(4.0);
-    for (which, mesh) in [("adaptive", &cube), ("gregory", &pyramid), ("acc", &pyramid)] {
+    for (which, mesh) in [
+        ("adaptive", &cube),
+        ("gregory", &pyramid),
+        ("acc", &pyramid),
+    ] {
         let (image, capture, vertex_bytes) = planned_run(None, which, mesh, &params);
         // A quarter of the vertex buffer, in 256-byte steps (the offset alignment).
         let cap = (vertex_bytes / 4 / 256 * 256) as u32;
