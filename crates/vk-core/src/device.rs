@@ -479,8 +479,8 @@ pub struct HostDevice {
     pub pipeline_statistics_query: bool,
     /// `vertexPipelineStoresAndAtomics` was enabled.
     pub vertex_pipeline_stores_and_atomics: bool,
-    /// `bufferDeviceAddress` was enabled (the planned-patch techniques read their arrays by
-    /// address and are refused without it).
+    /// `bufferDeviceAddress` was enabled: buffers with `SHADER_DEVICE_ADDRESS` usage (read by
+    /// address) are refused without it.
     pub buffer_device_address: bool,
 }
 
