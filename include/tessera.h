@@ -293,6 +293,11 @@ typedef struct TesseraHostDesc {
   // refinement patterns (`TESSERA_PIPELINE_AUTO` picks them; flat, phong, pn), and the
   // techniques without that path are refused as UNSUPPORTED.
   uint32_t without_tessellation_shader;
+  // 0 or 1: `bufferDeviceAddress` (required in Vulkan 1.3) is enabled. The planned-patch
+  // techniques (`TESSERA_TECHNIQUE_ADAPTIVE`, `_GREGORY`, `_ACC`, and whatever `_AUTO` makes
+  // of them) read their vertex and patch arrays by address, so that no
+  // `maxStorageBufferRange` limits them; with 0 they are UNSUPPORTED.
+  uint32_t buffer_device_address;
 } TesseraHostDesc;
 
 // The technique of the scheme: `adaptive` for Catmull-Clark, `bft` for Loop.

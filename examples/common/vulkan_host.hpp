@@ -261,6 +261,8 @@ private:
         f13.pNext = transform_feedback ? &xfb : nullptr;
         VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
         f12.timelineSemaphore = VK_TRUE;
+        // Required in Vulkan 1.3; Tessera's planned-patch techniques read their arrays by address.
+        f12.bufferDeviceAddress = VK_TRUE;
         f12.pNext = &f13;
         VkPhysicalDeviceFeatures base{};
         base.tessellationShader = VK_TRUE;

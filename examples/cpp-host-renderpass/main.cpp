@@ -147,6 +147,7 @@ TesseraHostDesc host_desc(const host::Vulkan &vk, const Pass &pass) {
     desc.debug_utils = 1;
     desc.transform_feedback = vk.transform_feedback ? 1 : 0;
     desc.vertex_pipeline_stores_and_atomics = vk.supported.vertexPipelineStoresAndAtomics;
+    desc.buffer_device_address = 1;
     desc.render_pass = pass.render_pass;
     desc.subpass = 0;
     desc.samples = uint32_t(pass.samples);
@@ -237,6 +238,17 @@ int check_misuse(const host::Vulkan &vk, tessera::Context &ctx, const Pass &pass
     TesseraFrameDesc frame = tessera::default_frame_desc();
     expect(tessera_capture(ctx.get(), s.get(), &frame, nullptr, nullptr),
            TESSERA_STATUS_UNSUPPORTED, "capture without dynamicRendering", "dynamicRendering");
+    // The planned-patch techniques read their arrays by device address: refused by name on a
+    // host that does not say it enabled bufferDeviceAddress.
+    TesseraHostDesc no_address = host_desc(vk, pass);
+    no_address.buffer_device_address = 0;
+    tessera::Context plain = tessera::Context::host(no_address);
+    TesseraSurfaceDesc sdesc = tessera::default_surface_desc();
+    sdesc.technique = TESSERA_TECHNIQUE_ADAPTIVE;
+    TesseraSurface *none = nullptr;
+    expect(tessera_surface_create_obj(plain.get(), nullptr, 0, nullptr, &sdesc, &none),
+           TESSERA_STATUS_UNSUPPORTED, "adaptive without bufferDeviceAddress",
+           "bufferDeviceAddress");
     return failures;
 }
 

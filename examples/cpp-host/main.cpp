@@ -245,6 +245,7 @@ int run(const std::string &out_dir, bool misuse) {
         desc.debug_utils = 1;
         desc.transform_feedback = vk.transform_feedback ? 1 : 0;
         desc.vertex_pipeline_stores_and_atomics = vk.supported.vertexPipelineStoresAndAtomics;
+        desc.buffer_device_address = 1;
         desc.pipeline_cache = TESSERA_PIPELINE_CACHE_OFF;
         tessera::Context ctx = tessera::Context::host(desc);
 

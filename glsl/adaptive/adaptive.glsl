@@ -1,6 +1,11 @@
 // Catmull-Clark patch plans (adaptive, gregory, acc; crates/tess/src/techniques/planned_patches):
-// the storage buffers, push constants and the evaluation every stage shares. Mirrors
+// the arrays, push constants and the evaluation every stage shares. Mirrors
 // `tess::techniques::planned_patches::layout` (offsets checked against the SPIR-V by a test).
+//
+// Every array is read through a buffer reference (GL_EXT_buffer_reference) at the device
+// address the uniform block `AdaptiveArrays` holds, not through a descriptor: no
+// `maxStorageBufferRange` limits them, so a plan is drawn whatever its size, as long as it
+// fits in device memory. `VERTICES[i]`, `PATCHES[i]`, ... name them as arrays.
 //
 // Watertightness by canonical curves: every patch boundary edge is one cubic Bezier curve of
 // the global vertex buffer (computed once per frame by the canonical kernel, from one owner
@@ -9,10 +14,12 @@
 // factor is an integer, else from the mirrored tess coordinate), with `precise` arithmetic in
 // one fixed operand order. So the two sides produce the same bits, across level transitions
 // and end caps too.
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_buffer_reference_uvec2 : require
 #include "bindings.glsl"
 
 struct AdaptivePatch {
-    uint cp_offset;   // first control-point index in control_points[]
+    uint cp_offset;   // first control-point index in CONTROL_POINTS[]
     uint info;        // kind | level << 4 | boundary mask << 8 | transition mask << 12
     uint edge_info;   // per edge i, 4 bits at 4i: kind (2 bits), reversed[0], reversed[1]
     uint pad;
@@ -20,13 +27,13 @@ struct AdaptivePatch {
 };
 
 #ifdef ADAPTIVE_WRITES_VERTICES
-layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_VERTICES_BINDING) buffer Vertices { vec4 vertices[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer VertexArray { vec4 v[]; };
 #else
-layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_VERTICES_BINDING) readonly buffer Vertices { vec4 vertices[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer VertexArray { vec4 v[]; };
 #endif
-layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_PATCHES_BINDING) readonly buffer Patches { AdaptivePatch patches[]; };
-layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_CONTROL_POINTS_BINDING) readonly buffer ControlPoints { uint control_points[]; };
-layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_CURVES_BINDING) readonly buffer Curves { uvec4 curves[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer PatchArray { AdaptivePatch v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer ControlPointArray { uint v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer CurveArray { uvec4 v[]; };
 
 // Texture coordinates (topology::texcoord): per patch, the coordinates at its corners and each
 // corner's row of the reparameterization table; per curve, the patch that defines its normals
@@ -46,11 +53,35 @@ struct ReparamRow {
     vec4 a;             // c0, c1, c2, c3
     vec4 b;             // c4
 };
-layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_SURFACES_BINDING) readonly buffer Surfaces { PatchSurface surfaces[]; };
-layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_REPARAM_BINDING) readonly buffer Reparam { ReparamRow reparam_table[]; };
-layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_CURVE_OWNERS_BINDING) readonly buffer CurveOwners { CurveOwner curve_owners[]; };
-layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_CORNER_OWNERS_BINDING) readonly buffer CornerOwners { uvec2 corner_owners[]; };
-layout(std430, set = ADAPTIVE_SET, binding = ADAPTIVE_PARAM_ERROR_BINDING) readonly buffer ParamErrors { float param_errors[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer SurfaceArray { PatchSurface v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer ReparamArray { ReparamRow v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer CurveOwnerArray { CurveOwner v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer CornerOwnerArray { uvec2 v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer ParamErrorArray { float v[]; };
+
+// The arrays' device addresses (`tess::gpu::AdaptiveArrays`; each a uvec2, low word first).
+layout(std140, set = ADAPTIVE_SET, binding = ADAPTIVE_ARRAYS_BINDING) uniform AdaptiveArrays {
+    uvec2 vertices;        // vec4 per global vertex: base, levels, local points, canonical points
+    uvec2 patches;         // one AdaptivePatch per patch, frame-wide order
+    uvec2 control_points;  // global vertex indices of every patch, back to back
+    uvec2 curves;          // canonical boundary curves, four global vertices each
+    uvec2 surfaces;        // PatchSurface per patch
+    uvec2 reparam;         // ReparamRow: row 0 the identity, row v - 2 valence v
+    uvec2 curve_owners;    // CurveOwner per canonical curve
+    uvec2 corner_owners;   // uvec2(patch, corner) per canonical corner (global vertex - first_corner)
+    uvec2 param_errors;    // the Eq. 1 error lattice per patch
+    uint param_error_count; // its entries (0: not built)
+    uint pad;
+} arrays;
+#define VERTICES VertexArray(arrays.vertices).v
+#define PATCHES PatchArray(arrays.patches).v
+#define CONTROL_POINTS ControlPointArray(arrays.control_points).v
+#define CURVES CurveArray(arrays.curves).v
+#define SURFACES SurfaceArray(arrays.surfaces).v
+#define REPARAM_TABLE ReparamArray(arrays.reparam).v
+#define CURVE_OWNERS CurveOwnerArray(arrays.curve_owners).v
+#define CORNER_OWNERS CornerOwnerArray(arrays.corner_owners).v
+#define PARAM_ERRORS ParamErrorArray(arrays.param_errors).v
 layout(set = ADAPTIVE_SET, binding = ADAPTIVE_TEXTURE_BINDING) uniform sampler2D surface_texture;
 layout(set = ADAPTIVE_SET, binding = ADAPTIVE_HEIGHT_BINDING) uniform sampler2D height_map;
 
@@ -67,7 +98,7 @@ layout(push_constant) uniform AdaptivePush {
     uint first_item;       // canonical kernel: first regular corner or curve point of this dispatch
     uint count;            // canonical kernel: items in this dispatch
     float displace_scale;  // displacement along the normal per unit of height
-    uint first_corner;     // global id of the first canonical corner (corner_owners[0])
+    uint first_corner;     // global id of the first canonical corner (CORNER_OWNERS[0])
 } adaptive;
 
 uint patch_kind(AdaptivePatch p) { return p.info & 15u; }
@@ -75,13 +106,13 @@ uint patch_level(AdaptivePatch p) { return (p.info >> 4) & 15u; }
 uint edge_kind(AdaptivePatch p, uint e) { return (p.edge_info >> (4u * e)) & 3u; }
 bool edge_reversed(AdaptivePatch p, uint e, uint half_) { return ((p.edge_info >> (4u * e + 2u + half_)) & 1u) != 0u; }
 
-vec3 vtx(uint i) { return vertices[i].xyz; }
+vec3 vtx(uint i) { return VERTICES[i].xyz; }
 
 // The canonical curve evaluation: one formula, one operand order, `precise`, so every patch
 // that reads a curve at the same parameter gets the same bits. s = 0 and s = 1 give the end
 // points exactly (the weights are exactly 1, 0, 0, 0).
 vec3 curve_point(uint c, float s) {
-    uvec4 b = curves[c];
+    uvec4 b = CURVES[c];
     precise float r = 1.0 - s;
     precise float w0 = r * r * r;
     precise float w1 = 3.0 * s * r * r;
@@ -133,7 +164,7 @@ vec3 canonical_edge_point(AdaptivePatch p, uint e, float t, float n, bool intege
 // The factor one curve asks for under the frame's policy: computed from the curve's own four
 // points (data both sides of an edge share), in the curve's order.
 float curve_factor(uint c) {
-    uvec4 b = curves[c];
+    uvec4 b = CURVES[c];
     vec3 p0 = vtx(b.x), p1 = vtx(b.y), p2 = vtx(b.z), p3 = vtx(b.w);
     float f;
     if (adaptive.factor_mode == BFT_FACTORS_SCREEN) {

@@ -10,7 +10,7 @@
 layout(quads, SPACING, ccw) in;
 
 void evaluate(uint id, vec2 uv, out vec3 pos, out vec3 du, out vec3 dv) {
-    AdaptivePatch p = patches[id];
+    AdaptivePatch p = PATCHES[id];
     float u = uv.x, v = uv.y;
     // Boundary curves in the patch's (u, v): bottom (v = 0), right (u = 1), top (v = 1), left (u = 0).
     vec3 b = edge_point(p, 0u, u), r = edge_point(p, 1u, v);

@@ -4,7 +4,7 @@
 // ADAPTIVE_CANONICAL_MODE_CORNERS evaluates the limit corners of regular patches, then
 // ADAPTIVE_CANONICAL_MODE_CURVES the canonical curves' inner Bezier points, each from its
 // owner patch's control points (a fixed combination per patch kind and corner or edge). Items
-// `first_item .. first_item + count` per dispatch; the vertex buffer is bound whole.
+// `first_item .. first_item + count` per dispatch; the vertex buffer is read and written by address.
 #define ADAPTIVE_WRITES_VERTICES
 #define TECHNIQUE_PUSH_CONSTANTS
 #include "frame.glsl"
@@ -16,7 +16,7 @@ layout(local_size_x = ADAPTIVE_LOCAL_SIZE) in;
 const uvec4 REGULAR_EDGE_LINE[4] = uvec4[4](uvec4(4u, 5u, 6u, 7u), uvec4(2u, 6u, 10u, 14u), uvec4(11u, 10u, 9u, 8u), uvec4(13u, 9u, 5u, 1u));
 const uint REGULAR_EDGE_STEP[4] = uint[4](4u, 1u, 4u, 1u);
 
-vec3 cp_vtx(AdaptivePatch p, uint k) { return vtx(control_points[p.cp_offset + k]); }
+vec3 cp_vtx(AdaptivePatch p, uint k) { return vtx(CONTROL_POINTS[p.cp_offset + k]); }
 
 // Curve point `i` (curve i / 2, inner point 1 + i % 2): its owner's edge as a cubic Bezier
 // curve B0..B3 in the edge's direction (a regular patch's B-spline edge, a Gregory patch's
@@ -27,8 +27,8 @@ vec3 cp_vtx(AdaptivePatch p, uint k) { return vtx(control_points[p.cp_offset + k
 vec3 curve_inner_point(uint i) {
     uint c = i >> 1u;
     uint slot = 1u + (i & 1u);
-    CurveOwner o = curve_owners[c];
-    AdaptivePatch p = patches[o.patch_id];
+    CurveOwner o = CURVE_OWNERS[c];
+    AdaptivePatch p = PATCHES[o.patch_id];
     uint e = o.info & 3u;
     uint part = (o.info >> 2u) & 3u;
     uint k = ((o.info >> 4u) & 1u) != 0u ? slot : 3u - slot;
@@ -77,8 +77,8 @@ vec3 curve_inner_point(uint i) {
 // the corner's own point (`AdaptivePlan::regular_corner_point`).
 const ivec2 CORNER_POS[4] = ivec2[4](ivec2(0, 0), ivec2(1, 0), ivec2(1, 1), ivec2(0, 1));
 vec3 regular_corner_point(uint k) {
-    uvec2 o = corner_owners[k];
-    AdaptivePatch p = patches[o.x];
+    uvec2 o = CORNER_OWNERS[k];
+    AdaptivePatch p = PATCHES[o.x];
     ivec2 c = CORNER_POS[o.y & 3u];
     // slot(a, b) = 4 (b + 1) + (a + 1)
     uint s = uint(4 * (c.y + 1) + (c.x + 1));
@@ -93,10 +93,10 @@ void main() {
     if (i >= adaptive.count) return;
     if (adaptive.mode == ADAPTIVE_CANONICAL_MODE_CORNERS) {
         uint k = adaptive.first_item + i;
-        vertices[adaptive.first_corner + k] = vec4(regular_corner_point(k), 1.0);
+        VERTICES[adaptive.first_corner + k] = vec4(regular_corner_point(k), 1.0);
         return;
     }
     uint pi = adaptive.first_item + i;
-    uvec4 curve = curves[pi >> 1u];
-    vertices[(pi & 1u) == 0u ? curve.y : curve.z] = vec4(curve_inner_point(pi), 1.0);
+    uvec4 curve = CURVES[pi >> 1u];
+    VERTICES[(pi & 1u) == 0u ? curve.y : curve.z] = vec4(curve_inner_point(pi), 1.0);
 }

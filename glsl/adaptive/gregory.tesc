@@ -12,8 +12,8 @@ layout(location = 2) patch out uint tc_info;
 layout(location = 1) out vec3 tc_points[];
 void main() {
     uint id = in_patch[0];
-    AdaptivePatch p = patches[id];
-    tc_points[gl_InvocationID] = vtx(control_points[p.cp_offset + uint(gl_InvocationID)]);
+    AdaptivePatch p = PATCHES[id];
+    tc_points[gl_InvocationID] = vtx(CONTROL_POINTS[p.cp_offset + uint(gl_InvocationID)]);
     if (gl_InvocationID == 0) {
         tc_patch = id;
         tc_info = p.info;

@@ -12,7 +12,7 @@ layout(location = 2) patch out uint tc_info;
 void main() {
     uint id = in_patch[0];
     tc_patch = id;
-    AdaptivePatch p = patches[id];
+    AdaptivePatch p = PATCHES[id];
     tc_info = p.info;
     set_patch_levels(p);
 }

@@ -21,7 +21,7 @@ const mat4 TO_BEZIER = mat4(
 
 void main() {
     uint id = in_patch[0];
-    AdaptivePatch p = patches[id];
+    AdaptivePatch p = PATCHES[id];
     uint k = uint(gl_InvocationID);
     uint i = k & 3u, j = k >> 2;
     vec3 b = vec3(0.0);
@@ -31,7 +31,7 @@ void main() {
         vec3 row = vec3(0.0);
         for (uint c = 0u; c < 4u; ++c) {
             float wu = TO_BEZIER[c][i];
-            if (wu != 0.0) row += wu * vtx(control_points[p.cp_offset + 4u * r + c]);
+            if (wu != 0.0) row += wu * vtx(CONTROL_POINTS[p.cp_offset + 4u * r + c]);
         }
         b += wv * row;
     }

@@ -18,8 +18,8 @@ vec2 reparameterize(uint rows, vec2 uv) {
     for (uint k = 0u; k < 4u; ++k) {
         uint row = (rows >> (8u * k)) & 255u;
         if (row == 0u) continue;
-        vec4 a = reparam_table[row].a;
-        float c0 = a.x, c1 = a.y, c2 = a.z, c3 = a.w, c4 = reparam_table[row].b.x;
+        vec4 a = REPARAM_TABLE[row].a;
+        float c0 = a.x, c1 = a.y, c2 = a.z, c3 = a.w, c4 = REPARAM_TABLE[row].b.x;
         bool cu = k == 1u || k == 2u, cv = k >= 2u;
         // Local block (a, b): (0,0) -> (0, 0, c0), (0,1) -> (0, c1, c2), (1,0) -> (c1, 0, c2),
         // (1,1) -> (c3, c3, c4); mirrored into the corner (c -> 1 - c).
@@ -53,13 +53,13 @@ bool reparam_on() { return (adaptive.options & uint(ADAPTIVE_OPTION_REPARAM)) !=
 float param_error(uint id, vec2 uv) {
     const uint side = uint(ADAPTIVE_PARAM_ERROR_SIDE), n = side * side;
     uint base = id * 2u * n + (reparam_on() ? n : 0u);
-    if (base + n > uint(param_errors.length())) return 0.0;
+    if (base + n > arrays.param_error_count) return 0.0;
     vec2 x = clamp(uv, 0.0, 1.0) * float(side - 1u);
     uvec2 i = min(uvec2(x), uvec2(side - 2u));
     vec2 f = x - vec2(i);
     uint k = base + i.x + side * i.y;
-    float a = mix(param_errors[k], param_errors[k + 1u], f.x);
-    float b = mix(param_errors[k + side], param_errors[k + side + 1u], f.x);
+    float a = mix(PARAM_ERRORS[k], PARAM_ERRORS[k + 1u], f.x);
+    float b = mix(PARAM_ERRORS[k + side], PARAM_ERRORS[k + side + 1u], f.x);
     return mix(a, b, f.y);
 }
 
@@ -79,7 +79,7 @@ vec2 texcoord_at(PatchSurface sf, vec2 st) {
 
 // The texture coordinate patch `id` shows at its (u, v).
 vec2 patch_texcoord(uint id, vec2 uv) {
-    PatchSurface sf = surfaces[id];
+    PatchSurface sf = SURFACES[id];
     vec2 st = reparam_on() ? reparameterize(sf.reparam_rows, uv) : uv;
     return texcoord_at(sf, st);
 }
@@ -227,7 +227,7 @@ void gregory_triangle(vec3 c[15], vec2 uv, out vec3 pos, out vec3 du, out vec3 d
 // Also its derivatives (the geometry patch's, on ACC-1 nets too, whose normal is the tangent
 // patches').
 void owner_frame(uint id, vec2 uv, out vec3 n_out, out vec3 du_out, out vec3 dv_out) {
-    AdaptivePatch p = patches[id];
+    AdaptivePatch p = PATCHES[id];
     uint kind = patch_kind(p);
     precise vec3 du = vec3(0.0), dv = vec3(0.0);
     float u = uv.x, v = uv.y;
@@ -237,7 +237,7 @@ void owner_frame(uint id, vec2 uv, out vec3 n_out, out vec3 du_out, out vec3 dv_
         bspline3(v, bv, dv_w);
         for (uint j = 0u; j < 4u; ++j)
             for (uint i = 0u; i < 4u; ++i) {
-                vec3 c = vtx(control_points[p.cp_offset + 4u * j + i]);
+                vec3 c = vtx(CONTROL_POINTS[p.cp_offset + 4u * j + i]);
                 du += (du_w[i] * bv[j]) * c;
                 dv += (bu[i] * dv_w[j]) * c;
             }
@@ -246,12 +246,12 @@ void owner_frame(uint id, vec2 uv, out vec3 n_out, out vec3 du_out, out vec3 dv_
         // it owns only where its own boundary is those halves) and corners, where the boundary
         // correction of triangle.tese vanishes with its derivatives: the quartic alone.
         vec3 c[15];
-        for (uint k = 0u; k < 15u; ++k) c[k] = vtx(control_points[p.cp_offset + k]);
+        for (uint k = 0u; k < 15u; ++k) c[k] = vtx(CONTROL_POINTS[p.cp_offset + k]);
         vec3 pos;
         gregory_triangle(c, uv, pos, du, dv);
     } else if (kind == ADAPTIVE_KIND_GREGORY) {
         vec3 c[20];
-        for (uint k = 0u; k < 20u; ++k) c[k] = vtx(control_points[p.cp_offset + k]);
+        for (uint k = 0u; k < 20u; ++k) c[k] = vtx(CONTROL_POINTS[p.cp_offset + k]);
         // The interior Bezier points as gregory.tese blends them. Their blend derivatives are
         // left out: they carry B1 or B2 in both directions, which vanish on the patch edges,
         // the only place an owner is evaluated.
@@ -280,10 +280,10 @@ void owner_frame(uint id, vec2 uv, out vec3 n_out, out vec3 du_out, out vec3 dv_
         dv = (1.0 - u) * (c3 - c0) + u * (c2 - c1);
     }
     precise vec3 r = safe_normalize(cross(du, dv), vec3(0.0, 0.0, 1.0));
-    uint tangent_valences = surfaces[id].tangent_valences;
+    uint tangent_valences = SURFACES[id].tangent_valences;
     if (tangent_valences != 0u) {
         vec3 c[28];
-        for (uint k = 0u; k < 28u; ++k) c[k] = vtx(control_points[p.cp_offset + k]);
+        for (uint k = 0u; k < 28u; ++k) c[k] = vtx(CONTROL_POINTS[p.cp_offset + k]);
         r = acc_tangent_normal(c, tangent_valences, uv);
     }
     n_out = r;
@@ -337,12 +337,12 @@ vec3 displaced_normal(vec3 n, vec3 du, vec3 dv, float hu, float hv) {
 // there: the corner's owner at the curve's ends, else the curve's.
 void canonical_owner(uint curve, float s, out uint owner, out vec2 ouv) {
     if (s == 0.0 || s == 1.0) {
-        uint v = s == 0.0 ? curves[curve].x : curves[curve].w;
-        uvec2 o = corner_owners[v - adaptive.first_corner];
+        uint v = s == 0.0 ? CURVES[curve].x : CURVES[curve].w;
+        uvec2 o = CORNER_OWNERS[v - adaptive.first_corner];
         owner = o.x;
-        ouv = patch_kind(patches[owner]) == ADAPTIVE_KIND_GREGORY_TRIANGLE ? TRIANGLE_CORNER_PARAMS[min(o.y, 6u)] : CORNER_PARAMS[o.y & 3u];
+        ouv = patch_kind(PATCHES[owner]) == ADAPTIVE_KIND_GREGORY_TRIANGLE ? TRIANGLE_CORNER_PARAMS[min(o.y, 6u)] : CORNER_PARAMS[o.y & 3u];
     } else {
-        CurveOwner o = curve_owners[curve];
+        CurveOwner o = CURVE_OWNERS[curve];
         owner = o.patch_id;
         ouv = owner_param(o, s);
     }

@@ -34,7 +34,7 @@ void main() {
     bool canonical = uv.x == 0.0 || uv.x == 1.0 || uv.y == 0.0 || uv.y == 1.0;
 #endif
     AdaptivePatch p;
-    if (canonical) p = patches[tc_patch];
+    if (canonical) p = PATCHES[tc_patch];
     // Patch edge e and the parameter along it (edges run v0 -> v1 -> v2 -> v3 -> v0);
     // 1 - x is exact for tess coordinates. Corners take either edge: both give the curve's end
     // point, the same global vertex.
@@ -78,7 +78,7 @@ void main() {
     // smaller TES with two varyings fewer.
     // The reparameterized parameter once, for the texture coordinate and the shift view (a
     // second call would be a second inlined copy).
-    PatchSurface own_surface = surfaces[tc_patch];
+    PatchSurface own_surface = SURFACES[tc_patch];
     bool show_shift = (adaptive.options & uint(ADAPTIVE_OPTION_SHOW_PARAM_SHIFT)) != 0u;
     vec2 st = (reparam_on() || show_shift) ? reparameterize(own_surface.reparam_rows, uv) : uv;
     vec2 tex = texcoord_at(own_surface, reparam_on() ? st : uv);

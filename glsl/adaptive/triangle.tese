@@ -26,7 +26,7 @@ void edge_sample(AdaptivePatch p, uint e, float t, out vec3 x, out vec3 dx) {
         scale = 2.0;
     }
     if (edge_reversed(p, e, h)) { s = 1.0 - s; scale = -scale; }
-    uvec4 b = curves[p.curves[2u * e + h]];
+    uvec4 b = CURVES[p.curves[2u * e + h]];
     vec4 w, d;
     bernstein3(s, w, d);
     vec3 p0 = vtx(b.x), p1 = vtx(b.y), p2 = vtx(b.z), p3 = vtx(b.w);
@@ -38,7 +38,7 @@ void evaluate(uint id, vec2 uv, out vec3 pos, out vec3 du, out vec3 dv) {
     vec3 c[15];
     for (int k = 0; k < 15; ++k) c[k] = tc_points[k];
     gregory_triangle(c, uv, pos, du, dv);
-    AdaptivePatch p = patches[id];
+    AdaptivePatch p = PATCHES[id];
     float l[3] = float[3](1.0 - uv.x - uv.y, uv.x, uv.y);
     const vec2 DL[3] = vec2[3](vec2(-1.0, -1.0), vec2(1.0, 0.0), vec2(0.0, 1.0));
     // Edge e (corner e to e + 1) adds (l_e + l_q)^2 (C(t) - B(t)), t = l_q / (l_e + l_q).

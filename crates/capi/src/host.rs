@@ -38,6 +38,8 @@
 //! # Device features
 //! Dynamic rendering needs `dynamicRendering` enabled; a render pass does not, except for
 //! captures, which render into an attachment-less dynamic-rendering scope of Tessera's own.
+//! The planned-patch techniques (adaptive, gregory, acc) need `bufferDeviceAddress` enabled
+//! and `buffer_device_address` set: they read their vertex and patch arrays by address.
 //!
 //! # Frames in flight
 //! The host says how many frames it keeps in flight (`frames_in_flight`); every surface keeps
@@ -129,6 +131,11 @@ pub struct TesseraHostDesc {
     /// refinement patterns (`TESSERA_PIPELINE_AUTO` picks them; flat, phong, pn), and the
     /// techniques without that path are refused as UNSUPPORTED.
     pub without_tessellation_shader: u32,
+    /// 0 or 1: `bufferDeviceAddress` (required in Vulkan 1.3) is enabled. The planned-patch
+    /// techniques (`TESSERA_TECHNIQUE_ADAPTIVE`, `_GREGORY`, `_ACC`, and whatever `_AUTO` makes
+    /// of them) read their vertex and patch arrays by address, so that no
+    /// `maxStorageBufferRange` limits them; with 0 they are UNSUPPORTED.
+    pub buffer_device_address: u32,
 }
 
 /// The subpass `d` names, checked; `None` for dynamic rendering.
@@ -239,6 +246,7 @@ pub unsafe extern "C" fn tessera_context_create_host(
                 d.without_tessellation_shader,
                 "without_tessellation_shader",
             )?,
+            buffer_device_address: flag(d.buffer_device_address, "buffer_device_address")?,
         };
         // SAFETY: as above.
         let device = unsafe { Device::from_host(&instance, &host, cache.as_deref()) }?;

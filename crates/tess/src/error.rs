@@ -88,12 +88,16 @@ pub enum TessError {
     /// A stencil table that cannot be laid out for the GPU ([`crate::stencil`]).
     #[error(transparent)]
     Stencil(#[from] crate::stencil::StencilError),
-    /// A capture larger than the transform-feedback buffer limit or the caller's budget.
-    #[error("capturing {triangles} triangles needs {bytes} bytes of transform feedback, over the limit of {limit} bytes (lower the level or raise the limit)")]
+    /// A capture larger than the caller's budget ([`crate::capture::Capturer::max_bytes`], for
+    /// the whole capture) or one patch array's larger than the device's
+    /// `maxTransformFeedbackBufferSize` (each array is captured into a buffer of its own).
+    #[error("capturing {triangles} triangles needs {bytes} bytes of transform feedback, over {bound} of {limit} bytes: capture fewer triangles (fewer segments per edge, --segments, or with --factors screen more --pixels per segment)")]
     CaptureTooLarge {
         triangles: u64,
         bytes: u64,
         limit: u64,
+        /// Which limit: the capture budget, or the device's per-buffer limit.
+        bound: &'static str,
     },
     #[error("transform feedback overflowed twice: {needed} triangles needed, {capacity} captured")]
     CaptureOverflow { needed: u64, capacity: u64 },

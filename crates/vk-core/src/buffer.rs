@@ -60,7 +60,19 @@ unsafe impl Send for Buffer {}
 unsafe impl Sync for Buffer {}
 
 impl Buffer {
+    /// A buffer with `SHADER_DEVICE_ADDRESS` usage is refused ([`VkError::Unsupported`]) on a
+    /// device without `bufferDeviceAddress` enabled.
     pub fn new(device: &Device, desc: &BufferDesc<'_>) -> Result<Self> {
+        if desc
+            .usage
+            .contains(vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS)
+            && !device.info.caps.buffer_device_address
+        {
+            return Err(VkError::Unsupported {
+                device: device.info.name.clone(),
+                what: "bufferDeviceAddress (buffers read by address)",
+            });
+        }
         let size = desc.size.max(4);
         let info = vk::BufferCreateInfo::default()
             .size(size)
@@ -148,6 +160,29 @@ impl Buffer {
 
     pub fn usage(&self) -> vk::BufferUsageFlags {
         self.shared.usage
+    }
+
+    /// The buffer's device address, for shaders that read it through a buffer reference
+    /// (`GL_EXT_buffer_reference`): no descriptor, so no `maxStorageBufferRange`. The buffer
+    /// must have `SHADER_DEVICE_ADDRESS` usage (a typed error otherwise). The address is valid
+    /// while the buffer lives; the retire queue keeps it alive until the submissions that may
+    /// use it complete.
+    pub fn device_address(&self) -> Result<u64> {
+        let needed = vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
+        if !self.shared.usage.contains(needed) {
+            return Err(VkError::Recording {
+                command: "vkGetBufferDeviceAddress",
+                problem: crate::error::RecordingError::BufferUsage {
+                    buffer: self.shared.name.clone(),
+                    needed,
+                },
+            });
+        }
+        let info = vk::BufferDeviceAddressInfo::default().buffer(self.raw);
+        // SAFETY: the buffer is live, bound to memory, and was created with
+        // SHADER_DEVICE_ADDRESS usage, which `new` allows only with bufferDeviceAddress enabled
+        // (gpu-allocator then allocates its memory with the DEVICE_ADDRESS flag).
+        Ok(unsafe { self.shared.device.raw.get_buffer_device_address(&info) })
     }
 
     pub fn mapped(&self) -> Option<&[u8]> {

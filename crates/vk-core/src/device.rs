@@ -85,6 +85,11 @@ pub struct Capabilities {
     /// stage write an output the next stage does not read (a plain build's TES leaves the
     /// TCS's patch flags unread), which the validation layer otherwise reports every run.
     pub maintenance4: bool,
+    /// `bufferDeviceAddress` (required in Vulkan 1.3), enabled where present, and for a host's
+    /// device where the host says it enabled it: shaders then read buffers made with
+    /// `SHADER_DEVICE_ADDRESS` usage through their addresses ([`crate::Buffer::device_address`]),
+    /// which no `maxStorageBufferRange` limits.
+    pub buffer_device_address: bool,
 }
 
 /// One physical device as seen at start-up: identity, capabilities, and what it lacks.
@@ -315,6 +320,7 @@ fn capabilities(r: &Reported<'_>, timestamps: bool) -> Capabilities {
             .max(1),
         max_compute_work_group_count: props.limits.max_compute_work_group_count,
         timeline_semaphore: f12.timeline_semaphore == vk::TRUE,
+        buffer_device_address: f12.buffer_device_address == vk::TRUE,
         max_image_dimension_2d: props.limits.max_image_dimension2_d,
     }
 }
@@ -482,6 +488,9 @@ pub struct HostDevice {
     pub vertex_pipeline_stores_and_atomics: bool,
     /// `tessellationShader` was enabled.
     pub tessellation_shader: bool,
+    /// `bufferDeviceAddress` was enabled: buffers with `SHADER_DEVICE_ADDRESS` usage (read by
+    /// address) are refused without it.
+    pub buffer_device_address: bool,
 }
 
 /// A handle to the logical device; clones share it.
@@ -567,7 +576,9 @@ impl Device {
             .vertex_pipeline_stores_and_atomics(info.caps.vertex_pipeline_stores_and_atomics)
             .multi_draw_indirect(info.caps.multi_draw_indirect)
             .draw_indirect_first_instance(info.caps.draw_indirect_first_instance);
-        let mut f12 = vk::PhysicalDeviceVulkan12Features::default().timeline_semaphore(true);
+        let mut f12 = vk::PhysicalDeviceVulkan12Features::default()
+            .timeline_semaphore(true)
+            .buffer_device_address(info.caps.buffer_device_address);
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
             .dynamic_rendering(true)
             .maintenance4(info.caps.maintenance4);
@@ -623,7 +634,7 @@ impl Device {
     ///   of its own or is recorded into a dynamic-rendering scope (a host that draws only into
     ///   render pass subpasses and never captures), and each optional feature `host` claims
     ///   enabled (transform feedback with its extension, pipeline statistics queries,
-    ///   vertex-pipeline stores) enabled.
+    ///   vertex-pipeline stores, buffer device addresses) enabled.
     /// - `host.queue` is queue 0 of `host.queue_family`, a family with graphics and compute.
     /// - The device outlives every object made from the result; the host does not use the
     ///   queue on another thread while a vk-core call that submits runs (Vulkan's external
@@ -672,6 +683,7 @@ impl Device {
         info.caps.pipeline_statistics_query &= host.pipeline_statistics_query;
         info.caps.vertex_pipeline_stores_and_atomics &= host.vertex_pipeline_stores_and_atomics;
         info.caps.tessellation_shader &= host.tessellation_shader;
+        info.caps.buffer_device_address &= host.buffer_device_address;
         // The host does not say whether it enabled these: indirect draws hold one draw each
         // and start at instance 0 on its device.
         info.caps.multi_draw_indirect = false;
@@ -706,7 +718,7 @@ impl Device {
             device: raw.clone(),
             physical_device: physical,
             debug_settings: Default::default(),
-            buffer_device_address: false,
+            buffer_device_address: info.caps.buffer_device_address,
             allocation_sizes: Default::default(),
         });
         let allocator = match allocator {

@@ -92,6 +92,33 @@ pub enum CaptureSizing {
     Measure,
 }
 
+/// Refuses capacities (triangles per patch array) whose records exceed `budget` bytes in all,
+/// or `per_buffer` bytes in one array (the device binds each array's buffer on its own).
+fn check_capacity(capacity: &[u64], budget: u64, per_buffer: u64) -> Result<()> {
+    let triangles: u64 = capacity.iter().sum();
+    let bytes = triangles.max(1).saturating_mul(TRIANGLE_BYTES);
+    if bytes > budget {
+        return Err(TessError::CaptureTooLarge {
+            triangles,
+            bytes,
+            limit: budget,
+            bound: "the capture budget (Capturer::max_bytes)",
+        });
+    }
+    if let Some(&largest) = capacity.iter().max() {
+        let bytes = largest.max(1).saturating_mul(TRIANGLE_BYTES);
+        if bytes > per_buffer {
+            return Err(TessError::CaptureTooLarge {
+                triangles: largest,
+                bytes,
+                limit: per_buffer,
+                bound: "the device's transform-feedback buffer size for one patch array",
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Largest capture by default (bytes of records): beyond this the caller must raise
 /// [`Capturer::max_bytes`] deliberately.
 pub const DEFAULT_MAX_CAPTURE_BYTES: u64 = 1 << 30;
@@ -192,18 +219,11 @@ impl Capturer {
         capacity: &[u64],
     ) -> Result<(CapturedSoup, Vec<TransformFeedbackCounts>, DrawCounts)> {
         let device = ctx.device().clone();
-        let triangles: u64 = capacity.iter().sum();
-        let bytes = triangles.max(1) * TRIANGLE_BYTES;
-        let limit = self
-            .max_bytes
-            .min(device.info.caps.max_transform_feedback_buffer_size);
-        if bytes > limit {
-            return Err(TessError::CaptureTooLarge {
-                triangles,
-                bytes,
-                limit,
-            });
-        }
+        check_capacity(
+            capacity,
+            self.max_bytes,
+            device.info.caps.max_transform_feedback_buffer_size,
+        )?;
         let arrays = technique.patch_arrays().len();
         if arrays == 0 {
             // Nothing to draw; a query that is never begun would never become available.
@@ -268,6 +288,37 @@ mod tests {
     use super::*;
     use crate::tessellator::Domain;
     use topology::ControlMesh;
+
+    /// Each patch array has a transform-feedback buffer of its own: the device's per-buffer
+    /// limit bounds the largest array, the budget the sum; the refusal says which and names
+    /// the options that capture fewer triangles.
+    #[test]
+    fn capture_capacity_is_checked_per_buffer_and_in_all() {
+        let t = TRIANGLE_BYTES;
+        // Three arrays of 10 triangles: 30 in all over a device buffer limit of 15: fine.
+        assert!(check_capacity(&[10, 10, 10], 100 * t, 15 * t).is_ok());
+        let e = check_capacity(&[10, 20, 10], 100 * t, 15 * t).unwrap_err();
+        assert!(
+            matches!(e, TessError::CaptureTooLarge { triangles: 20, .. }),
+            "{e}"
+        );
+        assert!(
+            e.to_string().contains("transform-feedback buffer size"),
+            "{e}"
+        );
+        let e = check_capacity(&[10, 10, 10], 25 * t, 15 * t).unwrap_err();
+        let text = e.to_string();
+        assert!(
+            matches!(e, TessError::CaptureTooLarge { triangles: 30, limit, .. } if limit == 25 * t),
+            "{text}"
+        );
+        assert!(text.contains("capture budget"), "{text}");
+        assert!(
+            text.contains("--segments") && text.contains("--pixels"),
+            "{text}"
+        );
+        assert!(!text.contains("raise the limit"), "{text}");
+    }
 
     fn rec(p: [f32; 3], patch: u32, d: [f32; 2]) -> CaptureRecord {
         CaptureRecord {

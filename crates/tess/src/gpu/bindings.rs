@@ -122,28 +122,12 @@ gpu_constants! {
 
     /// Descriptor set of one feature-adaptive Catmull-Clark surface (`glsl/adaptive/adaptive.glsl`).
     ADAPTIVE_SET = 1;
-    /// The global vertex buffer (`vec4`): base (copied from the frame slot's base positions), level 1..L and the local points (written by the stencil evaluator, [`crate::stencil`]), regular corners and curve points (written by `canonical.comp`).
-    ADAPTIVE_VERTICES_BINDING = 0;
-    /// One `AdaptivePatch` record per patch, in frame-wide patch order.
-    ADAPTIVE_PATCHES_BINDING = 1;
-    /// Control-point indices (global vertices) of every patch, back to back.
-    ADAPTIVE_CONTROL_POINTS_BINDING = 2;
-    /// Canonical boundary curves: four global vertices (cubic Bezier) each.
-    ADAPTIVE_CURVES_BINDING = 3;
-    /// Per patch, in frame-wide order: texture coordinates at its corners and its corners' rows of the reparameterization table (`PatchSurface`).
-    ADAPTIVE_SURFACES_BINDING = 4;
-    /// The texture reparameterization's corner blocks (seed 003, Table 1), two `vec4` per row: row 0 the identity, row `v - 2` valence `v`.
-    ADAPTIVE_REPARAM_BINDING = 5;
-    /// Per canonical curve: the patch whose evaluation defines the curve's normals and texture coordinates (`CurveOwner`).
-    ADAPTIVE_CURVE_OWNERS_BINDING = 6;
+    /// The uniform block `AdaptiveArrays` ([`crate::gpu::AdaptiveArrays`]): the device address of every array the canonical kernel and the draw read (vertices, patch records, control points, curves, patch surfaces, the reparameterization table, curve and corner owners, the Eq. 1 error lattice). Read through buffer references, no descriptor range limits them.
+    ADAPTIVE_ARRAYS_BINDING = 0;
     /// Colour texture (combined image sampler; a 1x1 white texel when none is given).
-    ADAPTIVE_TEXTURE_BINDING = 7;
+    ADAPTIVE_TEXTURE_BINDING = 1;
     /// Height map (combined image sampler, red channel; a 1x1 texel when none is given).
-    ADAPTIVE_HEIGHT_BINDING = 8;
-    /// Per canonical corner (global vertex - `first_corner`): `uvec2(patch, corner)` of the patch whose evaluation defines its normal and texture coordinate.
-    ADAPTIVE_CORNER_OWNERS_BINDING = 9;
-    /// Per patch: the Eq. 1 error lattice (`float`, `ADAPTIVE_PARAM_ERROR_SIDE`² without then with the reparameterization); one 0 when not built.
-    ADAPTIVE_PARAM_ERROR_BINDING = 10;
+    ADAPTIVE_HEIGHT_BINDING = 2;
     /// Lattice points per patch side of the Eq. 1 error view.
     ADAPTIVE_PARAM_ERROR_SIDE = 9;
     /// Work-group size of the adaptive canonical kernel (`canonical.comp`).

@@ -4,13 +4,18 @@
 //! missing fails.
 use super::bindings::*;
 use super::reflect::Reflection;
-use super::{AdaptivePush, BftPush, CaptureRecord, DrawPush, FrameUniforms, StencilPush, Vertex};
+use super::{
+    AdaptiveArrays, AdaptivePush, BftPush, CaptureRecord, DrawPush, FrameUniforms, StencilPush,
+    Vertex,
+};
 use crate::shaders::{spirv, Stage, Variant};
 use crate::stencil::{StencilTerm, StencilVertex};
 use crate::techniques::bft::layout::{
     Level1Point, PatchHeader, TableEntry, TableHeader, TangentTerm, STORAGE_BINDINGS,
 };
-use crate::techniques::planned_patches::layout::PatchRecord;
+use crate::techniques::planned_patches::layout::{
+    CurveOwner, PatchRecord, PatchSurface, ReparamRow,
+};
 use crate::tessellator::Spacing;
 use std::mem::{offset_of, size_of};
 
@@ -34,6 +39,13 @@ enum Check {
     Buffer {
         block: &'static str,
         binding: u32,
+        members: Vec<u32>,
+        stride: usize,
+    },
+    /// A buffer-reference block (read by device address): no set or binding, its members'
+    /// offsets, and the stride of the runtime array that ends it.
+    Referenced {
+        block: &'static str,
         members: Vec<u32>,
         stride: usize,
     },
@@ -489,6 +501,25 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         offsets: offsets!(AdaptivePush: mode, first_patch, factor_mode, options, uniform_level, pixels_per_segment, distance_ref, max_level, first_item, count, displace_scale, first_corner),
         size: size_of::<AdaptivePush>(),
     };
+    let adaptive_arrays = || Layout {
+        name: "AdaptiveArrays",
+        offsets: offsets!(AdaptiveArrays: vertices, patches, control_points, curves, surfaces, reparam, curve_owners, corner_owners, param_errors, param_error_count, pad),
+        size: size_of::<AdaptiveArrays>(),
+    };
+    let adaptive_arrays_binding = || Uniform {
+        block: "AdaptiveArrays",
+        set: ADAPTIVE_SET,
+        binding: ADAPTIVE_ARRAYS_BINDING,
+    };
+    let referenced = |block, stride| Referenced {
+        block,
+        members: vec![0],
+        stride,
+    };
+    let surface_tese = Variant {
+        surface: true,
+        ..variant(equal, false)
+    };
     let adaptive_tese = [
         Stage::AdaptiveRegularTese,
         Stage::AdaptiveGregoryTese,
@@ -503,25 +534,27 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         (Stage::AdaptiveGregoryTesc, PLAIN, adaptive_push()),
         (Stage::AdaptiveTriangleTesc, PLAIN, adaptive_push()),
         (Stage::AdaptiveAdaptiveFrag, PLAIN, adaptive_push()),
+        (Stage::AdaptiveCanonicalComp, PLAIN, adaptive_arrays()),
         (
             Stage::AdaptiveCanonicalComp,
             PLAIN,
-            Buffer {
-                block: "Vertices",
-                binding: ADAPTIVE_VERTICES_BINDING,
-                members: vec![0],
-                stride: size_of::<[f32; 4]>(),
-            },
+            adaptive_arrays_binding(),
+        ),
+        (Stage::AdaptiveRegularTesc, PLAIN, adaptive_arrays()),
+        (
+            Stage::AdaptiveCanonicalComp,
+            PLAIN,
+            referenced("VertexArray", size_of::<[f32; 4]>()),
+        ),
+        (
+            Stage::AdaptivePatchTesc,
+            PLAIN,
+            referenced("VertexArray", size_of::<[f32; 4]>()),
         ),
         (
             Stage::AdaptiveRegularTesc,
             PLAIN,
-            Buffer {
-                block: "Patches",
-                binding: ADAPTIVE_PATCHES_BINDING,
-                members: vec![0],
-                stride: size_of::<PatchRecord>(),
-            },
+            referenced("PatchArray", size_of::<PatchRecord>()),
         ),
         (
             Stage::AdaptiveRegularTesc,
@@ -544,27 +577,52 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         (
             Stage::AdaptiveGregoryTesc,
             PLAIN,
-            words("ControlPoints", ADAPTIVE_CONTROL_POINTS_BINDING),
+            referenced("ControlPointArray", size_of::<u32>()),
         ),
         (
             Stage::AdaptivePatchTesc,
             PLAIN,
-            Buffer {
-                block: "Curves",
-                binding: ADAPTIVE_CURVES_BINDING,
-                members: vec![0],
-                stride: size_of::<[u32; 4]>(),
+            referenced("CurveArray", size_of::<[u32; 4]>()),
+        ),
+        (
+            Stage::AdaptiveCanonicalComp,
+            PLAIN,
+            referenced("CurveOwnerArray", size_of::<CurveOwner>()),
+        ),
+        (
+            Stage::AdaptiveCanonicalComp,
+            PLAIN,
+            referenced("CornerOwnerArray", size_of::<[u32; 2]>()),
+        ),
+        (
+            Stage::AdaptiveRegularTese,
+            surface_tese,
+            Layout {
+                name: "CurveOwner",
+                offsets: offsets!(CurveOwner: patch, info),
+                size: size_of::<CurveOwner>(),
             },
         ),
         (
-            Stage::AdaptivePatchTesc,
-            PLAIN,
-            Buffer {
-                block: "Vertices",
-                binding: ADAPTIVE_VERTICES_BINDING,
-                members: vec![0],
-                stride: size_of::<[f32; 4]>(),
-            },
+            Stage::AdaptiveRegularTese,
+            surface_tese,
+            referenced("SurfaceArray", size_of::<PatchSurface>()),
+        ),
+        (
+            Stage::AdaptiveRegularTese,
+            surface_tese,
+            referenced("ReparamArray", size_of::<ReparamRow>()),
+        ),
+        (
+            Stage::AdaptiveRegularTese,
+            surface_tese,
+            referenced("ParamErrorArray", size_of::<f32>()),
+        ),
+        (Stage::AdaptiveRegularTese, surface_tese, adaptive_arrays()),
+        (
+            Stage::AdaptiveRegularTese,
+            surface_tese,
+            adaptive_arrays_binding(),
         ),
     ]);
     for stage in adaptive_tese {
@@ -648,6 +706,25 @@ fn check(stage: Stage, v: Variant, check: &Check) -> Result<(), String> {
             }
             let found = r.member_offsets(block);
             if found != [members.clone()] {
+                return Err(format!(
+                    "{block}: member offsets {found:?}, Rust {members:?}"
+                ));
+            }
+            match r.runtime_array_stride(block) {
+                Some(s) if s as usize == *stride => Ok(()),
+                s => Err(format!("{block}: array stride {s:?}, Rust {stride}")),
+            }
+        }
+        Check::Referenced {
+            block,
+            members,
+            stride,
+        } => {
+            if let Some(b) = r.binding(block) {
+                return Err(format!("{block}: bound at {b:?}, not read by address"));
+            }
+            let found = r.member_offsets(block);
+            if found.is_empty() || found.iter().any(|f| f != members) {
                 return Err(format!(
                     "{block}: member offsets {found:?}, Rust {members:?}"
                 ));
@@ -769,17 +846,22 @@ fn the_table_covers_every_storage_binding_and_capture_build() {
             "stencil binding {binding} is not checked"
         );
     }
-    for binding in [
-        ADAPTIVE_VERTICES_BINDING,
-        ADAPTIVE_PATCHES_BINDING,
-        ADAPTIVE_CONTROL_POINTS_BINDING,
-        ADAPTIVE_CURVES_BINDING,
+    for block in [
+        "VertexArray",
+        "PatchArray",
+        "ControlPointArray",
+        "CurveArray",
+        "SurfaceArray",
+        "ReparamArray",
+        "CurveOwnerArray",
+        "CornerOwnerArray",
+        "ParamErrorArray",
     ] {
         assert!(
             rows.iter()
                 .any(|(s, _, c)| format!("{s:?}").starts_with("Adaptive")
-                    && matches!(c, Check::Buffer { binding: b, .. } if *b == binding)),
-            "adaptive binding {binding} is not checked"
+                    && matches!(c, Check::Referenced { block: b, .. } if *b == block)),
+            "adaptive array {block} is not checked"
         );
     }
     for binding in [DOO_SABIN_POINTS_BINDING, DOO_SABIN_CORNERS_BINDING] {
@@ -839,6 +921,26 @@ fn a_wrong_offset_or_binding_is_caught() {
         offset: 0,
     };
     assert!(check(Stage::PnPatternTriVert, PLAIN, &wrong).is_err());
+    // A wrong stride of an array read by address, and a descriptor-bound block taken for one.
+    let wrong = Check::Referenced {
+        block: "VertexArray",
+        members: vec![0],
+        stride: 12,
+    };
+    assert!(check(Stage::AdaptiveCanonicalComp, PLAIN, &wrong).is_err());
+    let bound = Check::Referenced {
+        block: "AdaptiveArrays",
+        members: offsets!(AdaptiveArrays: vertices, patches, control_points, curves, surfaces, reparam, curve_owners, corner_owners, param_errors, param_error_count, pad),
+        stride: 4,
+    };
+    let e = check(Stage::AdaptiveCanonicalComp, PLAIN, &bound).unwrap_err();
+    assert!(e.contains("not read by address"), "{e}");
+    let right = Check::Referenced {
+        block: "VertexArray",
+        members: vec![0],
+        stride: 16,
+    };
+    assert_eq!(check(Stage::AdaptiveCanonicalComp, PLAIN, &right), Ok(()));
 }
 
 /// `-DCAPTURE` really changes the build: every capture variant writes transform feedback, and

@@ -126,11 +126,43 @@ pub struct AdaptivePush {
     pub count: u32,
     /// Displacement along the normal per unit of height (`ADAPTIVE_OPTION_DISPLACE`).
     pub displace_scale: f32,
-    /// Global id of the first canonical corner (`ADAPTIVE_CORNER_OWNERS_BINDING`).
+    /// Global id of the first canonical corner (the first of [`AdaptiveArrays::corner_owners`]).
     pub first_corner: u32,
 }
 
 const _: () = assert!(size_of::<AdaptivePush>() == 48);
+
+/// `AdaptiveArrays` uniform block of every planned-patch stage, `glsl/adaptive/adaptive.glsl`
+/// ([`bindings::ADAPTIVE_ARRAYS_BINDING`]): the device address of each array the canonical
+/// kernel and the draw read through buffer references (`Buffer::device_address`). A `u64`
+/// here is a `uvec2` there, low word first.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct AdaptiveArrays {
+    /// `vec4` per global vertex: base, refined levels, local points, canonical points.
+    pub vertices: u64,
+    /// One patch record per patch, frame-wide order.
+    pub patches: u64,
+    /// Global vertex indices of every patch's control points, back to back.
+    pub control_points: u64,
+    /// Canonical boundary curves, four global vertices each.
+    pub curves: u64,
+    /// Per patch: texture coordinates at its corners and its corners' reparameterization rows.
+    pub surfaces: u64,
+    /// The texture reparameterization's rows: row 0 the identity, row `v - 2` valence `v`.
+    pub reparam: u64,
+    /// Per canonical curve: the patch defining its normals and texture coordinates.
+    pub curve_owners: u64,
+    /// Per canonical corner (global vertex − `first_corner`): `(patch, corner)` of its owner.
+    pub corner_owners: u64,
+    /// The Eq. 1 error lattice per patch.
+    pub param_errors: u64,
+    /// Entries of the lattice (0: not built; the view then reads nothing).
+    pub param_error_count: u32,
+    pub pad: u32,
+}
+
+const _: () = assert!(size_of::<AdaptiveArrays>() == 80);
 
 /// `StencilPush` push constant of the stencil evaluator, `glsl/stencil/stencil.glsl`
 /// ([`crate::stencil`]): one dispatch, rows `first_row .. first_row + count`, and the window

@@ -4,8 +4,10 @@
 //! Design decisions:
 //! - **Windows, not buffer device addresses.** A descriptor may name at most
 //!   `maxStorageBufferRange` bytes (128 MiB on lavapipe; a 1M-triangle mesh's BFT patch rings
-//!   alone are 190 MB). Buffer device addresses would lift the limit, but not on every device;
-//!   windows work on all of them with one shader path. Each technique's work (level-1 vertices
+//!   alone are 190 MB). Buffer device addresses would lift the limit, but a host's device
+//!   (the C ABI) may not enable them; windows work on every device with one shader path. (The planned-patch techniques' draw is
+//!   the exception: a patch reads three far-apart runs of its vertex buffer, so it reads its
+//!   arrays by address, `techniques::planned_patches`.) Each technique's work (level-1 vertices
 //!   of a compute pre-pass, patches of a draw) is cut into chunks; a chunk gets its own
 //!   descriptor set whose bindings are `(offset, range)` windows of the shared buffers, and the
 //!   shaders subtract the chunk's base index (push constants) from every index into a

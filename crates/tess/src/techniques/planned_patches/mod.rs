@@ -27,40 +27,36 @@
 //!
 //! 4. **Beyond the storage range:** the stencil evaluator windows everything it indexes
 //!    (offsets, terms, and the vertex buffer as source and destination), in chunks of rows
-//!    (`techniques::windows`; lavapipe allows 128 MiB, and a 1M-quad grid's terms were 264 MB
-//!    before its regular corners and curve points were evaluated from their patches). The
-//!    base copy is a transfer, which no range limits. The canonical kernel and the draw bind
-//!    the vertex buffer and the patch buffers (records, control points, curves) whole: one
-//!    that exceeds the range is refused with vk-core's typed range error naming the buffer,
-//!    never a silent overrun.
+//!    (`techniques::windows`; lavapipe allows 128 MiB per descriptor). The base copy is a
+//!    transfer, which no range limits. The canonical kernel and the draw read the vertex
+//!    buffer and every patch array by device address (`GL_EXT_buffer_reference`, the addresses
+//!    in the uniform block [`AdaptiveArrays`]): no descriptor names them, so
+//!    `maxStorageBufferRange` does not limit them and a plan is drawn whenever it fits in
+//!    device memory (a 12,946-triangle CAD mesh at isolation 4 has 139 MB of vertices). Windows
+//!    would not serve here: a patch reads its level's vertices, the canonical corners and the
+//!    curve points, three far-apart ranges of one buffer. `bufferDeviceAddress` is required in
+//!    Vulkan 1.3 and Tessera enables it; a host's device that did not is refused by name.
 //!
 //! The GPU data is [`layout`].
 pub mod layout;
 
-use super::shared::{
-    check_adaptive_policy, compute_pipeline, factor_fields, storage_binding, storage_buffers,
-    upload_base,
-};
-use super::windows;
+use super::shared::{check_adaptive_policy, compute_pipeline, factor_fields, upload_base, STAGES};
 use crate::animation::base_positions;
 use crate::capture::FacePoint;
 use crate::context::Context;
 use crate::error::{Param, ParamError, Result, TessError};
 use crate::gpu::bindings::{
-    ADAPTIVE_CANONICAL_MODE_CORNERS, ADAPTIVE_CANONICAL_MODE_CURVES,
-    ADAPTIVE_CONTROL_POINTS_BINDING, ADAPTIVE_CURVES_BINDING, ADAPTIVE_EDGE_COARSE,
-    ADAPTIVE_EDGE_PLAIN, ADAPTIVE_LOCAL_SIZE, ADAPTIVE_OPTION_FRACTIONAL,
-    ADAPTIVE_OPTION_PATCH_COLOURS, ADAPTIVE_OPTION_POW2, ADAPTIVE_PATCHES_BINDING,
-    ADAPTIVE_VERTICES_BINDING,
+    ADAPTIVE_ARRAYS_BINDING, ADAPTIVE_CANONICAL_MODE_CORNERS, ADAPTIVE_CANONICAL_MODE_CURVES,
+    ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_PLAIN, ADAPTIVE_LOCAL_SIZE, ADAPTIVE_OPTION_FRACTIONAL,
+    ADAPTIVE_OPTION_PATCH_COLOURS, ADAPTIVE_OPTION_POW2,
 };
 use crate::gpu::bindings::{
-    ADAPTIVE_CORNER_OWNERS_BINDING, ADAPTIVE_CURVE_OWNERS_BINDING, ADAPTIVE_HEIGHT_BINDING,
-    ADAPTIVE_OPTION_CANONICAL_NORMALS, ADAPTIVE_OPTION_DISPLACE, ADAPTIVE_OPTION_HEIGHT_MAP,
-    ADAPTIVE_OPTION_REPARAM, ADAPTIVE_OPTION_SHOW_PARAM_ERROR, ADAPTIVE_OPTION_SHOW_PARAM_SHIFT,
-    ADAPTIVE_OPTION_TEXTURE, ADAPTIVE_PARAM_ERROR_BINDING, ADAPTIVE_PARAM_ERROR_SIDE,
-    ADAPTIVE_REPARAM_BINDING, ADAPTIVE_SURFACES_BINDING, ADAPTIVE_TEXTURE_BINDING,
+    ADAPTIVE_HEIGHT_BINDING, ADAPTIVE_OPTION_CANONICAL_NORMALS, ADAPTIVE_OPTION_DISPLACE,
+    ADAPTIVE_OPTION_HEIGHT_MAP, ADAPTIVE_OPTION_REPARAM, ADAPTIVE_OPTION_SHOW_PARAM_ERROR,
+    ADAPTIVE_OPTION_SHOW_PARAM_SHIFT, ADAPTIVE_OPTION_TEXTURE, ADAPTIVE_PARAM_ERROR_SIDE,
+    ADAPTIVE_TEXTURE_BINDING,
 };
-use crate::gpu::AdaptivePush;
+use crate::gpu::{AdaptiveArrays, AdaptivePush};
 use crate::shaders::Stage;
 use crate::stencil::{self, StencilEvaluator, StencilVertices};
 use crate::surface::{check_texcoords, SurfaceImage, SurfaceMaps, SurfaceShow};
@@ -87,20 +83,19 @@ use vk_core::{vk, Buffer, BufferDesc, DescriptorSet, Encoder, MemoryLocation};
 /// Default isolation level (OpenSubdiv's and the issue's).
 pub const DEFAULT_ISOLATION: u32 = 4;
 
-/// Set 1 of every adaptive pipeline.
-static SET_BINDINGS: [BindingDesc; 11] = [
-    storage_binding(ADAPTIVE_VERTICES_BINDING),
-    storage_binding(ADAPTIVE_PATCHES_BINDING),
-    storage_binding(ADAPTIVE_CONTROL_POINTS_BINDING),
-    storage_binding(ADAPTIVE_CURVES_BINDING),
-    storage_binding(ADAPTIVE_SURFACES_BINDING),
-    storage_binding(ADAPTIVE_REPARAM_BINDING),
-    storage_binding(ADAPTIVE_CURVE_OWNERS_BINDING),
-    storage_binding(ADAPTIVE_CORNER_OWNERS_BINDING),
-    storage_binding(ADAPTIVE_PARAM_ERROR_BINDING),
+/// Set 1 of every adaptive pipeline: the arrays' addresses, the texture and the height map.
+static SET_BINDINGS: [BindingDesc; 3] = [
+    BindingDesc {
+        binding: ADAPTIVE_ARRAYS_BINDING,
+        ty: vk::DescriptorType::UNIFORM_BUFFER,
+        stages: STAGES,
+    },
     sampler_binding(ADAPTIVE_TEXTURE_BINDING),
     sampler_binding(ADAPTIVE_HEIGHT_BINDING),
 ];
+
+/// Usage of every array the shaders read by address.
+const BY_ADDRESS: vk::BufferUsageFlags = vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
 
 /// A combined image sampler of the set (the fragment stage reads the texture, the TES both).
 const fn sampler_binding(binding: u32) -> BindingDesc {
@@ -213,61 +208,79 @@ fn param_errors(
 /// The Eq. 1 lattice's summary and the patches with a reparameterized corner, when built.
 type ParamErrorNote = Option<(topology::patches::texcoord::ParamErrorSummary, usize)>;
 
-/// The buffers the canonical kernel and the draw read whole, by binding: patch records,
-/// control points, curves, patch surfaces, the reparameterization table, curve and corner
-/// owners and the error lattice.
+/// The arrays the canonical kernel and the draw read by address besides the vertices, in
+/// [`AdaptiveArrays`] order: patch records, control points, curves, patch surfaces, the
+/// reparameterization table, curve and corner owners and the error lattice.
 fn static_buffers(
     device: &vk_core::Device,
     gpu: &GpuPlan,
     plan: &AdaptivePlan,
     mesh: &ControlMesh,
     param_errors: &[f32],
-) -> Result<Vec<(u32, Buffer)>> {
+) -> Result<[Buffer; 8]> {
     let surfaces = gpu.surfaces(plan, mesh);
     let reparam = layout::reparam_rows();
-    let arrays: [(u32, &str, &[u8]); 8] = [
+    let arrays: [(&str, &[u8]); 8] = [
+        ("adaptive patches", bytemuck::cast_slice(&gpu.patches)),
         (
-            ADAPTIVE_PATCHES_BINDING,
-            "adaptive patches",
-            bytemuck::cast_slice(&gpu.patches),
-        ),
-        (
-            ADAPTIVE_CONTROL_POINTS_BINDING,
             "adaptive control points",
             bytemuck::cast_slice(&gpu.control_points),
         ),
+        ("adaptive curves", bytemuck::cast_slice(&gpu.curves)),
+        ("adaptive patch surfaces", bytemuck::cast_slice(&surfaces)),
         (
-            ADAPTIVE_CURVES_BINDING,
-            "adaptive curves",
-            bytemuck::cast_slice(&gpu.curves),
-        ),
-        (
-            ADAPTIVE_SURFACES_BINDING,
-            "adaptive patch surfaces",
-            bytemuck::cast_slice(&surfaces),
-        ),
-        (
-            ADAPTIVE_REPARAM_BINDING,
             "adaptive reparameterization table",
             bytemuck::cast_slice(&reparam),
         ),
         (
-            ADAPTIVE_CURVE_OWNERS_BINDING,
             "adaptive curve owners",
             bytemuck::cast_slice(&gpu.curve_owners),
         ),
         (
-            ADAPTIVE_CORNER_OWNERS_BINDING,
             "adaptive corner owners",
             bytemuck::cast_slice(&gpu.corner_owners),
         ),
         (
-            ADAPTIVE_PARAM_ERROR_BINDING,
             "adaptive Eq. 1 error lattice",
             bytemuck::cast_slice(param_errors),
         ),
     ];
-    storage_buffers(device, &arrays)
+    // An empty array is padded (zero-length buffers are invalid); nothing indexes it.
+    let pad = [0u8; 16];
+    let [p, c, k, s, r, o, q, e] = arrays.map(|(name, bytes)| {
+        let data = if bytes.is_empty() { &pad[..] } else { bytes };
+        Buffer::with_data(device, name, BY_ADDRESS, data)
+    });
+    Ok([p?, c?, k?, s?, r?, o?, q?, e?])
+}
+
+/// The uniform buffer of [`AdaptiveArrays`]: the address of `vertices` and of each of `statics`.
+fn address_table(
+    device: &vk_core::Device,
+    vertices: &Buffer,
+    statics: &[Buffer; 8],
+    param_error_count: u32,
+) -> Result<Buffer> {
+    let a = |b: &Buffer| b.device_address();
+    let table = AdaptiveArrays {
+        vertices: a(vertices)?,
+        patches: a(&statics[0])?,
+        control_points: a(&statics[1])?,
+        curves: a(&statics[2])?,
+        surfaces: a(&statics[3])?,
+        reparam: a(&statics[4])?,
+        curve_owners: a(&statics[5])?,
+        corner_owners: a(&statics[6])?,
+        param_errors: a(&statics[7])?,
+        param_error_count,
+        pad: 0,
+    };
+    Ok(Buffer::with_data(
+        device,
+        "adaptive array addresses",
+        vk::BufferUsageFlags::UNIFORM_BUFFER,
+        bytemuck::bytes_of(&table),
+    )?)
 }
 
 /// One base-position buffer per frame slot, holding `positions` as the stencil evaluator's
@@ -398,6 +411,8 @@ pub struct PlannedPatches {
     base: Vec<Buffer>,
     /// The global vertex buffer.
     vertices: Buffer,
+    /// The patch arrays and the uniform buffer of their addresses: the shaders read them (and
+    /// `vertices`) by address, so they live as long as the technique.
     _static: Vec<Buffer>,
     _textures: [Texture; 2],
     arrays: Vec<PatchArray>,
@@ -428,6 +443,13 @@ impl PlannedPatches {
         id: TechniqueId,
     ) -> Result<Self> {
         let device = ctx.device().clone();
+        if !device.info.caps.buffer_device_address {
+            return Err(TessError::Unsupported {
+                technique: id,
+                what: "a device without bufferDeviceAddress enabled (the planned patches read \
+                       their arrays by address; a host device sets buffer_device_address)",
+            });
+        }
         let gpu = GpuPlan::new(&plan).map_err(|e| TessError::Mesh {
             name: options.name.clone(),
             source: e.into(),
@@ -442,21 +464,31 @@ impl PlannedPatches {
             &BufferDesc {
                 name: "adaptive vertices",
                 size: gpu.vertex_bytes(),
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                // Storage: the stencil evaluator binds windows of it.
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER
+                    | vk::BufferUsageFlags::TRANSFER_DST
+                    | BY_ADDRESS,
                 location: MemoryLocation::GpuOnly,
             },
         )?;
         let (param_errors, has_param_errors, param_error_summary) =
             param_errors(mesh, &plan, &gpu, options)?;
         let statics = static_buffers(&device, &gpu, &plan, mesh, &param_errors)?;
+        let error_count = if has_param_errors {
+            param_errors.len() as u32
+        } else {
+            0
+        };
+        let addresses = address_table(&device, &vertices, &statics, error_count)?;
         let textures = surface_textures(&device, &options.maps)?;
         let base_positions = base_positions(mesh);
         let base = base_buffers(&device, ctx.frames_in_flight(), &base_positions)?;
         let set = pool.allocate_set(set_layout)?;
-        windows::write_whole(&set, ADAPTIVE_VERTICES_BINDING, &vertices)?;
-        for (binding, s) in &statics {
-            windows::write_whole(&set, *binding, s)?;
-        }
+        set.write_buffer(
+            ADAPTIVE_ARRAYS_BINDING,
+            vk::DescriptorType::UNIFORM_BUFFER,
+            &addresses,
+        )?;
         set.write_texture(ADAPTIVE_TEXTURE_BINDING, &textures[0])?;
         set.write_texture(ADAPTIVE_HEIGHT_BINDING, &textures[1])?;
         let evaluator = StencilEvaluator::new(
@@ -496,7 +528,7 @@ impl PlannedPatches {
             _pool: pool,
             base,
             vertices,
-            _static: statics.into_iter().map(|(_, b)| b).collect(),
+            _static: statics.into_iter().chain([addresses]).collect(),
             _textures: textures,
             arrays,
             edge_kinds,
