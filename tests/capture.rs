@@ -324,6 +324,52 @@ fn capture_across_draw_split_numbers_patches_frame_wide() {
     }
 }
 
+/// (e) lavapipe starts `gl_PrimitiveID` again every 1,024 control points of a tessellated draw
+/// (256 quads): a draw within the vertex budget may hold more patches than that (1,024 quads at
+/// one segment), and Flat, Phong and PN name their patches by it. The split keeps every
+/// captured patch id right for both patch sizes; unsplit, later patches took the ids of earlier
+/// ones.
+#[test]
+fn capture_numbers_patches_past_the_primitive_id_restart() {
+    let gpu = Gpu::new();
+    let mut h = Harness::new(&gpu);
+    for (triangles, domain) in [(true, Domain::Triangle), (false, Domain::Quad)] {
+        let base = strip(600, triangles);
+        let patches = base.num_faces() as u32;
+        let params = FrameParams::uniform(1.0);
+        let per_patch = uniform_triangle_count(domain, Spacing::Equal, 1.0) as usize;
+        let ids = |c: &Captured| -> Vec<u32> { c.soup.triangles().map(|t| t[0].patch).collect() };
+        let split = capture(&mut h, &base, TechniqueId::FLAT, &params);
+        assert_eq!(split.stats.patches, patches);
+        let expected: Vec<u32> = (0..patches)
+            .flat_map(|p| std::iter::repeat_n(p, per_patch))
+            .collect();
+        assert_eq!(ids(&split), expected, "{domain:?}: captured patch ids");
+        if gpu.device().info.is_lavapipe() {
+            let off = FrameParams {
+                split: DrawSplit::Off,
+                ..params
+            };
+            let unsplit = capture(&mut h, &base, TechniqueId::FLAT, &off);
+            let wrong = ids(&unsplit)
+                .iter()
+                .zip(&expected)
+                .filter(|(a, b)| a != b)
+                .count();
+            // Measured: every triangle past the first 341 triangle patches (859 of 1,200), or
+            // past the first 256 quads (688 of 1,200).
+            println!(
+                "{domain:?}, unsplit: {wrong} of {} triangles misnamed",
+                expected.len()
+            );
+            assert!(
+                wrong > 0,
+                "{domain:?}: lavapipe no longer restarts gl_PrimitiveID"
+            );
+        }
+    }
+}
+
 /// Without transform feedback the device still renders, and capture is a typed error.
 #[test]
 fn capture_without_transform_feedback_is_a_typed_error() {

@@ -323,7 +323,8 @@ impl Context {
 
     /// Patches per draw of `array`: all, unless a driver workaround limits the vertices one
     /// draw may emit (`vk_core::workarounds::WorkaroundId::LavapipeTessChunkVertexLimit`),
-    /// computed at the largest factor the policy can reach.
+    /// computed at the largest factor the policy can reach, or the patches one draw may name
+    /// by `gl_PrimitiveID` (`LavapipeTessPrimitiveIdRestart`).
     pub fn patches_per_draw(
         &self,
         technique: &dyn Technique,
@@ -334,17 +335,19 @@ impl Context {
             DrawSplit::Off => u32::MAX,
             DrawSplit::PerPatch => 1,
             DrawSplit::Auto => {
-                let tessellated = technique
+                let pipeline = technique
                     .patch_arrays()
                     .get(array)
-                    .is_some_and(|a| technique.patch_pipeline(a.patch).geometry.is_tessellated());
-                if !tessellated {
+                    .map(|a| technique.patch_pipeline(a.patch));
+                let Some(pipeline) = pipeline.filter(|p| p.geometry.is_tessellated()) else {
                     // The split works around the tessellator's chunking; a vertex-stage draw
                     // is one draw.
                     return u32::MAX;
-                }
+                };
                 let max = technique.max_vertices_per_patch(params, array);
-                self.device.workarounds.max_patches_per_draw(max)
+                self.device
+                    .workarounds
+                    .max_patches_per_draw(max, pipeline.control_points())
             }
         }
     }

@@ -25,6 +25,13 @@ pub enum WorkaroundId {
     /// (6.9 M triangles), 4,096 vertices a draw is 1.2x faster than 65,536 for the adaptive
     /// surface and 1.3x for Flat (docs/benchmarks.md, "What lavapipe charges for: code size, varyings, draw size").
     LavapipeTessChunkVertexLimit,
+    /// lavapipe, measured on Mesa 22.3: within one tessellated draw, the TES's `gl_PrimitiveID`
+    /// starts again at 0 every [`LAVAPIPE_PRIMITIVE_ID_VERTICES`] / (control points per patch)
+    /// patches (every 341 triangle patches, every 256 quad patches); the positions drawn stay
+    /// right. Flat, Phong and PN name their captured patch `first_patch + gl_PrimitiveID`, so a
+    /// longer draw (the teapot's 6,320 triangles at 1 or 2 segments) gave later patches the ids
+    /// of earlier ones. We split such draws at that many patches.
+    LavapipeTessPrimitiveIdRestart,
     /// lavapipe, Mesa 22.3: a pipeline-statistics query around a draw of one-control-point
     /// patches with no vertex input (the BFT main pass) crashes a worker thread (SIGSEGV); the
     /// same draw without the query renders correctly. Tessera does not query statistics for
@@ -39,6 +46,11 @@ pub fn known() -> Vec<Workaround> {
             id: WorkaroundId::LavapipeTessChunkVertexLimit,
             driver: vk::DriverId::MESA_LLVMPIPE,
             summary: "lavapipe: tessellated draws split so no internal chunk emits > 65,536 vertices (16-bit chunk indices); 4,096 a draw, where its cost is still linear",
+        },
+        Workaround {
+            id: WorkaroundId::LavapipeTessPrimitiveIdRestart,
+            driver: vk::DriverId::MESA_LLVMPIPE,
+            summary: "lavapipe: tessellated draws split so that gl_PrimitiveID, which starts again every 1,024 control points, names each patch",
         },
         Workaround {
             id: WorkaroundId::LavapipeStatisticsQueryPointPatches,
@@ -63,6 +75,10 @@ pub const LAVAPIPE_CHUNK_VERTEX_LIMIT: u64 = 65_536;
 pub const LAVAPIPE_DRAW_VERTEX_BUDGET: u64 = 4_096;
 const _: () = assert!(LAVAPIPE_DRAW_VERTEX_BUDGET <= LAVAPIPE_CHUNK_VERTEX_LIMIT);
 
+/// Control points of one tessellated draw after which lavapipe's `gl_PrimitiveID` starts
+/// again at 0 (whole patches: 341 of three control points, 256 of four).
+pub const LAVAPIPE_PRIMITIVE_ID_VERTICES: u64 = 1_024;
+
 impl Workarounds {
     pub fn for_adapter(info: &AdapterInfo) -> Self {
         // No fixed Mesa version is known yet: every lavapipe gets the split.
@@ -82,13 +98,18 @@ impl Workarounds {
         self.active.iter().any(|w| w.id == id)
     }
 
-    /// How many patches one tessellated draw may hold, given the most vertices one patch can
-    /// emit at the draw's largest factors. `u32::MAX` when no limit applies.
-    pub fn max_patches_per_draw(&self, max_vertices_per_patch: u64) -> u32 {
+    /// How many patches of `control_points` control points one tessellated draw may hold,
+    /// given the most vertices one patch can emit at the draw's largest factors. `u32::MAX`
+    /// when no limit applies.
+    pub fn max_patches_per_draw(&self, max_vertices_per_patch: u64, control_points: u32) -> u32 {
+        let mut most = u64::from(u32::MAX);
         if self.has(WorkaroundId::LavapipeTessChunkVertexLimit) {
-            (LAVAPIPE_DRAW_VERTEX_BUDGET / max_vertices_per_patch.max(1)).max(1) as u32
-        } else {
-            u32::MAX
+            most = most.min((LAVAPIPE_DRAW_VERTEX_BUDGET / max_vertices_per_patch.max(1)).max(1));
         }
+        if self.has(WorkaroundId::LavapipeTessPrimitiveIdRestart) {
+            let points = u64::from(control_points.max(1));
+            most = most.min((LAVAPIPE_PRIMITIVE_ID_VERTICES / points).max(1));
+        }
+        most as u32
     }
 }
