@@ -18,7 +18,7 @@ mod common;
 
 use common::Gpu;
 use tessera::tess::animation::Wave;
-use tessera::tess::capture::{classify_open_edges, CapturedSoup, EdgeReport};
+use tessera::tess::capture::{classify_open_edges, CapturedSoup};
 use tessera::tess::gpu::bindings::ADAPTIVE_KIND_REGULAR;
 use tessera::tess::techniques::{self, TechniqueInfo};
 use tessera::tess::{BuildOptions, Capturer, Context, FrameParams, Technique, TechniqueId};
@@ -112,11 +112,10 @@ fn build_noted(
 /// non-manifold edge, inside a face of no area), then the edges of three or more triangles
 /// (where sheets meeting at a non-manifold edge weld); and the welded positions.
 ///
-/// A face of no area (catmark_nonman_edges' face 41 names two vertices twice each: a
+/// A face of no area (catmark_nonman_edges' face 40 names two vertices twice each: a
 /// segment) has no surface to keep closed: its patch's sliver triangles all lie on the
 /// segment, and where two of them sample points whose positions round to one float they weld
-/// into a fan with open sides. Such an open edge, both ends inside one face whose corners lie
-/// on a line, is counted apart, not as a crack.
+/// into a fan with open sides (`OpenEdgeClasses::in_face_of_no_area`).
 fn capture(
     ctx: &mut Context,
     capturer: &Capturer,
@@ -132,68 +131,20 @@ fn capture(
     let map = |p: u32, d: [f32; 2]| technique.face_point(p, d);
     let c = classify_open_edges(&soup, &welded, &report, &map, mesh);
     assert_eq!(
-        c.on_base_boundary + c.on_non_manifold_edge + c.cracks,
+        c.on_base_boundary + c.on_non_manifold_edge + c.in_face_of_no_area + c.cracks,
         report.open.len()
     );
-    let mut in_no_area = 0;
-    if c.cracks > c.unmapped {
-        for e in &report.open {
-            let one = EdgeReport {
-                open: vec![*e],
-                ..EdgeReport::default()
-            };
-            if classify_open_edges(&soup, &welded, &one, &map, mesh).cracks == 0 {
-                continue;
-            }
-            let t = e.triangle as usize;
-            let faces: Vec<Option<u32>> = (0..3)
-                .filter(|&i| e.vertices.contains(&welded.triangles[t][i]))
-                .map(|i| soup.records[3 * t + i])
-                .map(|r| map(r.patch, r.domain).map(|p| p.face))
-                .collect();
-            if let [Some(a), Some(b)] = faces[..] {
-                in_no_area += usize::from(a == b && has_no_area(mesh, a as usize));
-            }
-        }
-    }
     (
         [
-            c.cracks - in_no_area,
+            c.cracks,
             c.unmapped,
             c.on_base_boundary,
             c.on_non_manifold_edge,
-            in_no_area,
+            c.in_face_of_no_area,
             report.non_manifold.len(),
         ],
         welded.positions,
     )
-}
-
-/// Whether face `f`'s corners all lie on one line (exactly, in the file's coordinates).
-fn has_no_area(mesh: &ControlMesh, f: usize) -> bool {
-    let p: Vec<[f64; 3]> = mesh
-        .face(f)
-        .iter()
-        .map(|&v| mesh.positions[v as usize])
-        .collect();
-    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    let Some(&d) = p
-        .iter()
-        .map(|&q| sub(q, p[0]))
-        .find(|d| *d != [0.0; 3])
-        .as_ref()
-    else {
-        return true;
-    };
-    p.iter().all(|&q| {
-        let e = sub(q, p[0]);
-        let cross = [
-            d[1] * e[2] - d[2] * e[1],
-            d[2] * e[0] - d[0] * e[2],
-            d[0] * e[1] - d[1] * e[0],
-        ];
-        cross == [0.0; 3]
-    })
 }
 
 fn drawn_pixels(ctx: &mut Context, technique: &mut dyn Technique, params: &FrameParams) -> usize {
