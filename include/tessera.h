@@ -229,8 +229,8 @@ typedef struct TesseraCaptureReport {
   uint64_t vertices;
   // Edges used by exactly one triangle: `on_base_boundary + cracks`.
   uint64_t open_edges;
-  // Open edges on the control mesh's own boundary, or along one of its non-manifold edges
-  // (sheets meeting there without sharing vertices).
+  // Open edges on the control mesh's own boundary, along one of its non-manifold edges
+  // (sheets meeting there without sharing vertices), or inside one of its faces of no area.
   uint64_t on_base_boundary;
   // Open edges inside the surface: cracks in what the GPU drew.
   uint64_t cracks;

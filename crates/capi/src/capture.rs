@@ -34,8 +34,8 @@ pub struct TesseraCaptureReport {
     pub vertices: u64,
     /// Edges used by exactly one triangle: `on_base_boundary + cracks`.
     pub open_edges: u64,
-    /// Open edges on the control mesh's own boundary, or along one of its non-manifold edges
-    /// (sheets meeting there without sharing vertices).
+    /// Open edges on the control mesh's own boundary, along one of its non-manifold edges
+    /// (sheets meeting there without sharing vertices), or inside one of its faces of no area.
     pub on_base_boundary: u64,
     /// Open edges inside the surface: cracks in what the GPU drew.
     pub cracks: u64,
@@ -99,7 +99,9 @@ fn capture(
         triangles: soup.triangle_count() as u64,
         vertices: welded.positions.len() as u64,
         open_edges: edges.open.len() as u64,
-        on_base_boundary: (classes.on_base_boundary + classes.on_non_manifold_edge) as u64,
+        on_base_boundary: (classes.on_base_boundary
+            + classes.on_non_manifold_edge
+            + classes.in_face_of_no_area) as u64,
         cracks: classes.cracks as u64,
         unmapped: classes.unmapped as u64,
         non_manifold_edges: edges.non_manifold.len() as u64,

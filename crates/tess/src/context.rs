@@ -368,20 +368,19 @@ impl Context {
             DrawSplit::Off => u32::MAX,
             DrawSplit::PerPatch => 1,
             DrawSplit::Auto => {
-                let tessellated = technique
+                let pipeline = technique
                     .patch_arrays()
                     .get(array)
-                    .is_some_and(|a| technique.patch_pipeline(a.patch).geometry.is_tessellated());
-                if !tessellated {
+                    .map(|a| technique.patch_pipeline(a.patch));
+                let Some(pipeline) = pipeline.filter(|p| p.geometry.is_tessellated()) else {
                     // The split works around the tessellator's chunking; a vertex-stage draw
                     // is one draw.
                     return u32::MAX;
-                }
+                };
                 let max = technique.max_vertices_per_patch(params, array);
-                let control_points = technique.patch_arrays()[array].control_points;
                 self.device
                     .workarounds
-                    .max_patches_per_draw(max, control_points)
+                    .max_patches_per_draw(max, pipeline.control_points())
             }
         }
     }

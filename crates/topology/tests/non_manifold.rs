@@ -673,3 +673,70 @@ mod random_soups {
         }
     }
 }
+
+/// catmark_nonman_edges' face 40 names two vertices twice each (`f 67 67 68 68`): its corners
+/// lie on one line and every one of its edges is non-manifold (a vertex to itself, or the edge
+/// 67–68 that it uses twice and its neighbour once), so every edge is an infinitely sharp
+/// crease and its limit surface is the segment between the two vertices: no area. What a
+/// capture classifies as open edges inside a face of no area (`tess::capture::
+/// OpenEdgeClasses::in_face_of_no_area`) rests on this: the exact limit at every point of the
+/// face's domain lies on that segment, and its two partial derivatives are parallel.
+#[test]
+fn a_quad_naming_two_vertices_twice_each_has_no_area() {
+    use topology::limit::face_domain::LimitEvaluator;
+    use topology::mesh::manifold::non_manifold_edges;
+    let (mesh, _) = shape("catmark_nonman_edges");
+    let face = 40;
+    assert_eq!(
+        mesh.face(face),
+        &[66, 66, 67, 67],
+        "0-based vertices of face 40"
+    );
+    let non_manifold: HashSet<[u32; 2]> = non_manifold_edges(&mesh)
+        .unwrap()
+        .into_iter()
+        .map(|(e, _)| e)
+        .collect();
+    for e in [[66, 66], [66, 67], [67, 67]] {
+        assert!(non_manifold.contains(&e), "edge {e:?} is non-manifold");
+    }
+    let (a, b) = (mesh.positions[66], mesh.positions[67]);
+    let d = diagonal(&mesh.positions);
+    let lm = LimitEvaluator::new(&mesh, LimitScheme::CatmullClark).unwrap();
+    let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let len = dist(a, b);
+    let (mut off_line, mut area) = (0.0f64, 0.0f64);
+    let cross = |x: [f64; 3], y: [f64; 3]| {
+        [
+            x[1] * y[2] - x[2] * y[1],
+            x[2] * y[0] - x[0] * y[2],
+            x[0] * y[1] - x[1] * y[0],
+        ]
+    };
+    let norm = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+    let mut along = Vec::new();
+    for i in 0..=8 {
+        for j in 0..=8 {
+            let s = lm
+                .evaluate(face as u32, i as f64 / 8.0, j as f64 / 8.0)
+                .unwrap();
+            let p = s.position;
+            let ap = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
+            off_line = off_line.max(norm(cross(ab, ap)) / len / d);
+            along.push((ap[0] * ab[0] + ap[1] * ab[1] + ap[2] * ab[2]) / (len * len));
+            let du = [s.du[0], s.du[1], s.du[2]];
+            let dv = [s.dv[0], s.dv[1], s.dv[2]];
+            area = area.max(norm(cross(du, dv)) / (d * d));
+        }
+    }
+    let (lo, hi) = along
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(lo, hi), &t| (lo.min(t), hi.max(t)));
+    println!(
+        "face 40: limit {off_line:.1e} of the diagonal off the line, |du × dv| {area:.1e}, \
+         along the segment from {lo:.3} to {hi:.3}"
+    );
+    assert!(off_line < 1e-12, "{off_line:e}");
+    assert!(area < 1e-12, "{area:e}");
+    assert!(lo >= -1e-12 && hi <= 1.0 + 1e-12, "{lo} {hi}");
+}

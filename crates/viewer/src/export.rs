@@ -26,6 +26,8 @@ pub struct ExportReport {
     /// Open edges along the base mesh's non-manifold edges (sheets meeting there without
     /// sharing vertices): not cracks.
     pub on_non_manifold_edge: usize,
+    /// Open edges inside a base face of no area (`tess::capture::OpenEdgeClasses`): not cracks.
+    pub in_face_of_no_area: usize,
     pub cracks: usize,
     pub unmapped: usize,
     pub non_manifold: usize,
@@ -107,6 +109,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
             open_edges: edges.open.len(),
             on_base_boundary: classes.on_base_boundary,
             on_non_manifold_edge: classes.on_non_manifold_edge,
+            in_face_of_no_area: classes.in_face_of_no_area,
             cracks: classes.cracks,
             unmapped: classes.unmapped,
             non_manifold: edges.non_manifold.len(),
@@ -141,7 +144,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
     );
     out!(
         "open edges: {} ({} on the base mesh's boundary, {} cracks{}, {} along its non-manifold \
-         edges)",
+         edges, {} inside its faces of no area)",
         r.open_edges,
         r.on_base_boundary,
         r.cracks,
@@ -151,6 +154,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
             String::new()
         },
         r.on_non_manifold_edge,
+        r.in_face_of_no_area,
     );
     out!(
         "edges of three or more triangles: {} (where sheets of a non-manifold edge share \

@@ -1449,11 +1449,45 @@ fn export_reports_non_manifold_edges_as_such() {
     let line = s.lines().find(|l| l.starts_with("open edges:")).unwrap();
     let along: usize = line
         .split(", ")
-        .find(|p| p.ends_with("along its non-manifold edges)"))
+        .find(|p| p.ends_with("along its non-manifold edges"))
         .and_then(|p| p.split_whitespace().next()?.parse().ok())
         .unwrap_or_else(|| panic!("{line}"));
     let triple: usize = reported(&s, "edges of three or more triangles:");
     assert!(along + triple > 0, "the non-manifold edges show: {s}");
+}
+
+/// Adaptive on OpenSubdiv's non-manifold edges shape: face 40 names two vertices twice each,
+/// a face of no area whose patch's triangles all lie on one segment and weld into fans with
+/// open sides. The export counts those open edges apart ("inside its faces of no area"), not
+/// as cracks, and `--fail-on-cracks` passes.
+#[test]
+fn export_reports_open_edges_in_a_face_of_no_area_as_such() {
+    let out = tmp("nonman_edges_adaptive.obj");
+    let shape = data("tests/data/opensubdiv/nonmanifold/catmark_nonman_edges.obj");
+    let o = tessera(
+        &[
+            "export",
+            &shape,
+            "--method",
+            "adaptive",
+            "--segments",
+            "4",
+            "--fail-on-cracks",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    let s = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let line = s.lines().find(|l| l.starts_with("open edges:")).unwrap();
+    assert!(line.contains(" 0 cracks"), "{line}");
+    let inside: usize = line
+        .split(", ")
+        .find(|p| p.ends_with("inside its faces of no area)"))
+        .and_then(|p| p.split_whitespace().next()?.parse().ok())
+        .unwrap_or_else(|| panic!("{line}"));
+    assert!(inside > 0, "face 40's open edges are counted apart: {line}");
 }
 
 /// `tessera subdivide` refines a non-manifold mesh through its manifold split (as the

@@ -97,6 +97,14 @@ pub struct OpenEdgeClasses {
     /// sharing their vertices' bits, each sheet's side is open. Not a crack: OpenSubdiv's rules
     /// draw each sheet to the edge, but nothing joins the sheets there.
     pub on_non_manifold_edge: usize,
+    /// Both endpoints inside one base face of no area: its corners lie on one line and every
+    /// one of its edges is non-manifold (OpenSubdiv's quad that names two vertices twice each,
+    /// catmark_nonman_edges' face 40). Every such edge is an infinitely sharp crease, so the
+    /// face's limit surface is the segment its corners span (`crates/topology/tests/
+    /// non_manifold.rs` checks it on the exact limit): the tessellation's triangles all lie on
+    /// it, and where distinct points of the domain round to one float they weld into fans with
+    /// open sides. No surface is there to open, so no crack.
+    pub in_face_of_no_area: usize,
     /// Every other open edge: a gap the GPU left inside the surface.
     pub cracks: usize,
     /// Of the cracks, those whose patch id maps to no base face (a mapping bug, not geometry).
@@ -145,11 +153,31 @@ pub fn classify_open_edges(
             out.on_base_boundary += 1;
         } else if shared(&|k| edges.non_manifold.contains(k)) {
             out.on_non_manifold_edge += 1;
+        } else if fa.face == fb.face && edges.no_area.contains(&fa.face) {
+            out.in_face_of_no_area += 1;
         } else {
             out.cracks += 1;
         }
     }
     out
+}
+
+/// Whether the corners `face` names lie on one line, exactly (in the mesh's coordinates).
+fn corners_on_a_line(base: &ControlMesh, face: &[u32]) -> bool {
+    let p: Vec<[f64; 3]> = face.iter().map(|&v| base.positions[v as usize]).collect();
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let Some(d) = p.iter().map(|&q| sub(q, p[0])).find(|d| *d != [0.0; 3]) else {
+        return true;
+    };
+    p.iter().all(|&q| {
+        let e = sub(q, p[0]);
+        let cross = [
+            d[1] * e[2] - d[2] * e[1],
+            d[2] * e[0] - d[0] * e[2],
+            d[0] * e[1] - d[1] * e[0],
+        ];
+        cross == [0.0; 3]
+    })
 }
 
 /// The base mesh's edges as sorted vertex pairs: how many drawn faces use each (a hole's faces
@@ -161,6 +189,8 @@ struct BaseEdges {
     /// Non-manifold edges ([`topology::mesh::manifold::non_manifold_edges`]; none for a mesh
     /// that validation refuses).
     non_manifold: std::collections::HashSet<[u32; 2]>,
+    /// Faces of no area ([`OpenEdgeClasses::in_face_of_no_area`]).
+    no_area: std::collections::HashSet<u32>,
 }
 
 impl BaseEdges {
@@ -180,13 +210,26 @@ impl BaseEdges {
                 *u += u32::from(!holes.contains(&(i as u32)));
             }
         }
-        let non_manifold = topology::mesh::manifold::non_manifold_edges(base)
-            .map(|edges| edges.into_iter().map(|(e, _)| e).collect())
-            .unwrap_or_default();
+        let non_manifold: std::collections::HashSet<[u32; 2]> =
+            topology::mesh::manifold::non_manifold_edges(base)
+                .map(|edges| edges.into_iter().map(|(e, _)| e).collect())
+                .unwrap_or_default();
+        let no_area = (0..base.num_faces())
+            .filter(|&f| {
+                let face = base.face(f);
+                let n = face.len();
+                (0..n).all(|k| {
+                    let (a, b) = (face[k], face[(k + 1) % n]);
+                    non_manifold.contains(&[a.min(b), a.max(b)])
+                }) && corners_on_a_line(base, face)
+            })
+            .map(|f| f as u32)
+            .collect();
         Self {
             uses,
             at_vertex,
             non_manifold,
+            no_area,
         }
     }
 

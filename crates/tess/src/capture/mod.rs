@@ -396,6 +396,7 @@ mod tests {
             OpenEdgeClasses {
                 on_base_boundary: 4,
                 on_non_manifold_edge: 0,
+                in_face_of_no_area: 0,
                 cracks: 0,
                 unmapped: 0
             }

@@ -244,6 +244,21 @@ impl LimitEvaluator {
         Ok(out.into_iter().flatten().collect())
     }
 
+    /// Distance from `p` to the limit surface near face point `(u, v)` of base face `face`:
+    /// [`LocalMesh::nearest_limit_distance`] over the patch holding that point, searched from
+    /// it. Says how close an approximation is where it parameterizes the surface differently.
+    pub fn nearest_limit_distance(
+        &self,
+        face: u32,
+        u: f64,
+        v: f64,
+        p: &[f64],
+    ) -> Result<f64, EvalError> {
+        let at = self.patch_point(face, u, v)?;
+        self.mesh
+            .nearest_limit_distance(at.face, at.sub, at.param, p)
+    }
+
     /// Where `(u, v)` of base face `face` is evaluated, with the map's inverse Jacobian.
     fn patch_point(&self, face: u32, u: f64, v: f64) -> Result<PatchPoint, EvalError> {
         let Some(&n) = self.sizes.get(face as usize) else {
