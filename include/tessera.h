@@ -358,8 +358,9 @@ typedef struct TesseraHostDesc {
 
 #define TESSERA_SPACING_FRACTIONAL_ODD 2
 
-// The tessellation stage where the device has it and the technique draws through it, else
-// refinement patterns.
+// Where a technique has both paths, the one measured faster on the device's driver (patterns
+// on lavapipe, the tessellation stage elsewhere); refinement patterns without tessellation
+// shaders.
 #define TESSERA_PIPELINE_AUTO 0
 
 #define TESSERA_PIPELINE_TESSELLATION 1

@@ -350,10 +350,17 @@ fn patch_ids_count_on_through_every_draw() {
             .collect();
         for faces in [quads, triangles] {
             let mesh = ControlMesh::from_polygons(positions.clone(), &faces);
-            let mut t =
-                tessera::tess::build(&mut ctx, TechniqueId::FLAT, &mesh, &Default::default())
-                    .unwrap()
-                    .technique;
+            let mut t = tessera::tess::build(
+                &mut ctx,
+                TechniqueId::FLAT,
+                &mesh,
+                &tessera::tess::BuildOptions {
+                    pipeline: tessera::tess::PipelineChoice::Tessellation,
+                    ..Default::default()
+                },
+            )
+            .unwrap()
+            .technique;
             let patches = faces.len();
             let mut distinct = |split: DrawSplit, ctx: &mut Context| {
                 let params = FrameParams {

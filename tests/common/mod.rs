@@ -116,7 +116,9 @@ pub fn whole_set_verdict(refused: &[String], other: bool, failures: &[String]) {
 }
 
 /// Builds technique `id` for `mesh` on `ctx` with default options (tangent tables included,
-/// so geometric normals can be drawn).
+/// so geometric normals can be drawn), on the tessellation path where the technique has one:
+/// these tests check what the tessellator emits. The refinement-pattern path emits the same
+/// triangles and bits (`tests/patterns.rs`) and has its own tests.
 pub fn build(
     ctx: &mut tessera::tess::Context,
     id: tessera::tess::TechniqueId,
@@ -141,11 +143,23 @@ pub fn build_with(
             name: "test mesh".into(),
             table_level,
             tangents,
+            pipeline: tessellation_where_drawn(id),
             ..Default::default()
         },
     )
     .unwrap_or_else(|e| panic!("building {id}: {e}"))
     .technique
+}
+
+/// `--pipeline tessellation` for a technique that draws through the tessellation stage, else
+/// `auto` (the meshes refined before the draw).
+pub fn tessellation_where_drawn(id: tessera::tess::TechniqueId) -> tessera::tess::PipelineChoice {
+    let paths = tessera::tess::techniques::info(id).features.paths;
+    if paths.contains(&tessera::tess::DrawPath::Tessellation) {
+        tessera::tess::PipelineChoice::Tessellation
+    } else {
+        tessera::tess::PipelineChoice::Auto
+    }
 }
 
 /// Faces of a strip of `k` quads over `2k + 2` vertices laid out in pairs (bottom, top), or of

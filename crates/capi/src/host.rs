@@ -247,6 +247,7 @@ pub unsafe extern "C" fn tessera_context_create_host(
                 "without_tessellation_shader",
             )?,
             buffer_device_address: flag(d.buffer_device_address, "buffer_device_address")?,
+            dynamic_rendering,
         };
         // SAFETY: as above.
         let device = unsafe { Device::from_host(&instance, &host, cache.as_deref()) }?;

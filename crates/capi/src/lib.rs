@@ -141,8 +141,9 @@ pub const TESSERA_SPACING_FRACTIONAL_ODD: TesseraSpacing = 2;
 
 /// The draw path a surface is built for (`TESSERA_PIPELINE_*`, the CLI's `--pipeline`).
 pub type TesseraPipeline = u32;
-/// The tessellation stage where the device has it and the technique draws through it, else
-/// refinement patterns.
+/// Where a technique has both paths, the one measured faster on the device's driver (patterns
+/// on lavapipe, the tessellation stage elsewhere); refinement patterns without tessellation
+/// shaders.
 pub const TESSERA_PIPELINE_AUTO: TesseraPipeline = 0;
 pub const TESSERA_PIPELINE_TESSELLATION: TesseraPipeline = 1;
 /// Refinement patterns: a tessellated domain instanced over the patches, evaluated in the

@@ -207,15 +207,35 @@ impl PatternCache {
     }
 }
 
-/// Makes the pattern of `key` on `ctx`'s device: the tessellator's own where the device has one
-/// and can capture and the level is within its 64 ([`tessellator_pattern`]); otherwise
+/// Triangles of the pattern [`make`] generates for `domain` at `level` (equal spacing: whole
+/// segments, rounded up).
+pub fn generated_triangle_count(domain: Domain, level: f32) -> u64 {
+    let n = generated_segments(level) as u64;
+    match domain {
+        Domain::Quad => 2 * n * n,
+        Domain::Triangle => n * n,
+    }
+}
+
+/// Whole segments of a generated pattern at `level`, as the tessellator rounds equal spacing.
+fn generated_segments(level: f32) -> u32 {
+    level.ceil().clamp(1.0, MAX_GENERATED_SEGMENTS as f32) as u32
+}
+
+/// Whether `device`'s patterns are its tessellator's own: it has tessellation shaders, and can
+/// capture them in a rendering scope of its own (transform feedback, dynamic rendering).
+pub fn from_tessellator(device: &vk_core::Device) -> bool {
+    let caps = &device.info.caps;
+    caps.tessellation_shader
+        && caps.dynamic_rendering
+        && device.require_transform_feedback().is_ok()
+}
+
+/// Makes the pattern of `key` on `ctx`'s device: the tessellator's own where
+/// [`from_tessellator`] and the level is within its 64 ([`tessellator_pattern`]); otherwise
 /// generated, in equal spacing only.
 pub fn make(ctx: &mut Context, key: PatternKey) -> Result<RefinementPattern> {
-    let device = ctx.device();
-    let tessellator = device.info.caps.tessellation_shader
-        && device.require_transform_feedback().is_ok()
-        && key.level() <= crate::tessellator::MAX_LEVEL;
-    if tessellator {
+    if from_tessellator(ctx.device()) && key.level() <= crate::tessellator::MAX_LEVEL {
         return tessellator_pattern(ctx, key);
     }
     if key.spacing != Spacing::Equal {
@@ -223,9 +243,7 @@ pub fn make(ctx: &mut Context, key: PatternKey) -> Result<RefinementPattern> {
             spacing: key.spacing,
         });
     }
-    // Equal spacing rounds a level up to whole segments, as the tessellator does.
-    let segments = key.level().ceil().clamp(1.0, MAX_GENERATED_SEGMENTS as f32) as u32;
-    RefinementPattern::generate(key.domain, segments)
+    RefinementPattern::generate(key.domain, generated_segments(key.level()))
 }
 
 /// One patch of `key`'s domain over the unit domain, drawn flat through the tessellator at

@@ -339,8 +339,9 @@ impl std::fmt::Display for DrawPath {
 /// Which draw path a surface is built for (`--pipeline`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum PipelineChoice {
-    /// The tessellation stage where the device has one and the technique draws through it;
-    /// otherwise refinement patterns; techniques with only a vertex-stage path take that.
+    /// Where a technique has both the tessellation and the pattern path, the one measured
+    /// faster on the device's driver ([`prefers_patterns`]); the pattern path where the device
+    /// has no tessellation shaders; techniques with only a vertex-stage path take that.
     #[default]
     Auto,
     Tessellation,
@@ -361,14 +362,42 @@ impl std::str::FromStr for PipelineChoice {
     }
 }
 
+/// Whether `--pipeline auto` draws through refinement patterns where a technique also has the
+/// tessellation path, by the device's driver, as measured (docs/benchmarks.md, "Refinement
+/// patterns against the tessellation stage"): on lavapipe the pattern path, its patterns the
+/// tessellator's own ([`crate::pattern::from_tessellator`]: the same triangles as the
+/// tessellation path), drew every measured row of flat, Phong and PN in 0.59–1.00 times the
+/// tessellation path's time. Elsewhere the tessellation stage, until a device measures
+/// otherwise.
+pub fn prefers_patterns(device: &vk_core::Device) -> bool {
+    device.info.is_lavapipe() && crate::pattern::from_tessellator(device)
+}
+
 impl PipelineChoice {
-    /// The path a technique declaring `paths` draws on a device that has (or lacks) tessellation
-    /// shaders; an error names `--pipeline` or the missing device feature.
+    /// The path a technique declaring `paths` draws on `device`; an error names `--pipeline`
+    /// or the missing device feature.
     pub fn resolve(
         self,
         technique: TechniqueId,
         paths: &[DrawPath],
+        device: &vk_core::Device,
+    ) -> Result<DrawPath> {
+        self.resolve_with(
+            technique,
+            paths,
+            device.info.caps.tessellation_shader,
+            prefers_patterns(device),
+        )
+    }
+
+    /// [`Self::resolve`] on a device with (or without) tessellation shaders whose driver does
+    /// (or does not) prefer patterns.
+    pub fn resolve_with(
+        self,
+        technique: TechniqueId,
+        paths: &[DrawPath],
         tessellation_shader: bool,
+        prefer_patterns: bool,
     ) -> Result<DrawPath> {
         let has = |p: DrawPath| paths.contains(&p);
         match self {
@@ -387,6 +416,9 @@ impl PipelineChoice {
                 technique,
                 what: "the refinement-pattern path (--pipeline pattern)",
             }),
+            PipelineChoice::Auto if prefer_patterns && has(DrawPath::Pattern) => {
+                Ok(DrawPath::Pattern)
+            }
             PipelineChoice::Auto if has(DrawPath::Tessellation) && tessellation_shader => {
                 Ok(DrawPath::Tessellation)
             }
@@ -740,4 +772,51 @@ pub fn for_each_draw(
         first += n;
     }
     Ok(counts)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const BOTH: &[DrawPath] = &[DrawPath::Tessellation, DrawPath::Pattern];
+    const TESSELLATION: &[DrawPath] = &[DrawPath::Tessellation];
+    const VERTEX: &[DrawPath] = &[DrawPath::VertexStage];
+    const ID: TechniqueId = TechniqueId::new("probe");
+
+    fn auto(paths: &[DrawPath], tessellation: bool, prefer: bool) -> Result<DrawPath> {
+        PipelineChoice::Auto.resolve_with(ID, paths, tessellation, prefer)
+    }
+
+    #[test]
+    fn auto_follows_the_device_and_the_measured_preference() {
+        assert_eq!(auto(BOTH, true, false).unwrap(), DrawPath::Tessellation);
+        assert_eq!(auto(BOTH, true, true).unwrap(), DrawPath::Pattern);
+        assert_eq!(auto(BOTH, false, false).unwrap(), DrawPath::Pattern);
+        assert_eq!(
+            auto(TESSELLATION, true, true).unwrap(),
+            DrawPath::Tessellation
+        );
+        assert_eq!(auto(VERTEX, false, true).unwrap(), DrawPath::VertexStage);
+        assert!(matches!(
+            auto(TESSELLATION, false, false),
+            Err(TessError::NoTessellationShader { .. })
+        ));
+    }
+
+    #[test]
+    fn an_explicit_path_is_drawn_or_refused_by_name() {
+        let pattern = |paths| PipelineChoice::Pattern.resolve_with(ID, paths, true, false);
+        let tessellation =
+            |paths, device| PipelineChoice::Tessellation.resolve_with(ID, paths, device, true);
+        assert_eq!(pattern(BOTH).unwrap(), DrawPath::Pattern);
+        assert_eq!(tessellation(BOTH, true).unwrap(), DrawPath::Tessellation);
+        for e in [pattern(TESSELLATION), tessellation(VERTEX, true)] {
+            let e = e.unwrap_err();
+            assert!(e.to_string().contains("--pipeline"), "{e}");
+        }
+        assert!(matches!(
+            tessellation(BOTH, false),
+            Err(TessError::NoTessellationShader { .. })
+        ));
+    }
 }

@@ -60,9 +60,9 @@ pub struct ExportArgs {
     #[arg(long, value_parser = crate::technique::parse_technique,
           long_help = crate::technique::method_long_help())]
     pub method: Option<TechniqueId>,
-    /// Segments per base edge, the tessellation level (outer and inner): 1 to 64; bft takes
-    /// powers of two from 2 to 2^(table level + 1) unless --fractional; adaptive: segments per
-    /// patch edge, 1 to 32. Ignored with --factors screen or distance.
+    /// Segments per base edge, the tessellation level (outer and inner): 1 to 64; flat, phong
+    /// and pn on the pattern path up to 256; bft takes powers of two from 2 to
+    /// 2^(table level + 1) unless --fractional; adaptive: segments per patch edge, 1 to 32. Ignored with --factors screen or distance.
     #[arg(long, alias = "level", default_value_t = 8.0, allow_hyphen_values = true, value_parser = parse_segments)]
     pub segments: f32,
     #[arg(long, default_value = "equal", value_parser = parse_spacing)]

@@ -108,7 +108,8 @@ pub fn methods_long_help() -> String {
     }
     out.push_str(
         "\nA method may name its draw path: flat@pattern, pn@tessellation (rows of both paths \
-         side by side; without one, the device's --pipeline auto choice).",
+         side by side). Without one it draws as the papers' methods do: through the \
+         tessellation stage where the technique and the device have it.",
     );
     out
 }
@@ -190,8 +191,9 @@ pub struct SurfaceArgs {
     pub scheme: Option<String>,
     /// Draw path: tessellation (the tessellation stage), pattern (refinement patterns: a
     /// tessellated domain stored once and instanced over the patches, evaluated in the vertex
-    /// stage; flat, phong and pn so far) or auto (tessellation where the device has tessellation
-    /// shaders and the technique draws through them, else patterns).
+    /// stage; flat, phong and pn so far) or auto (where a technique has both, the one measured
+    /// faster on the device's driver: patterns on lavapipe, the tessellation stage elsewhere;
+    /// patterns without tessellation shaders).
     #[arg(long, default_value = "auto", value_parser = parse_pipeline)]
     pub pipeline: PipelineChoice,
     /// Merge coincident vertices before drawing: `--weld` alone merges vertices at identical
@@ -684,9 +686,10 @@ impl Setup {
     }
 }
 
-/// The most uniform segments per base edge any technique takes: BFT at table level 6 draws
-/// level-1 faces at tessellation level 64, i.e. 2^(6+1) per base edge.
-pub const MAX_SEGMENTS: f32 = 128.0;
+/// The most uniform segments per base edge any technique takes: flat, Phong and PN on the
+/// refinement-pattern path, whose generated patterns reach 256 (BFT at table level 6 draws
+/// level-1 faces at tessellation level 64, i.e. 2^(6+1) = 128 per base edge).
+pub const MAX_SEGMENTS: f32 = tess::pattern::MAX_GENERATED_SEGMENTS as f32;
 
 /// `--segments` (every command's name for the uniform segments per edge; `--level` is a hidden
 /// alias), checked before any device is opened: a finite number of segments from 1 to
@@ -699,7 +702,8 @@ pub fn check_segments(setup: &Setup) -> Result<()> {
         if !(segments.is_finite() && (1.0..=MAX_SEGMENTS).contains(&segments)) {
             bail!(
                 "--segments {}: give a number of segments per edge (the tessellation \
-                 level) from 1 to 64 (--method bft: up to 2^(--table-level + 1))",
+                 level) from 1 to 64 (--method bft: up to 2^(--table-level + 1); flat, phong \
+                 and pn on the pattern path: up to 256)",
                 number32(segments)
             );
         }

@@ -825,20 +825,25 @@ fn export_bad_inputs_are_named_errors() {
             "doo-sabin (--method doo-sabin)",
         ],
     );
-    fails_with(
-        &[
-            "export",
-            &cube,
-            "--method",
-            "flat",
-            "--segments",
-            "65",
-            "-o",
-            out,
-        ],
-        &[],
-        &["--segments"],
-    );
+    // The tessellation stage stops at 64 segments; generated refinement patterns at 256.
+    for (pipeline, segments) in [("tessellation", "65"), ("pattern", "257")] {
+        fails_with(
+            &[
+                "export",
+                &cube,
+                "--method",
+                "flat",
+                "--pipeline",
+                pipeline,
+                "--segments",
+                segments,
+                "-o",
+                out,
+            ],
+            &[],
+            &["--segments"],
+        );
+    }
     let bad = write("bad_export.obj", "v 0 0 0\nv 1 0 0\nv 0 1 zero\nf 1 2 3\n");
     fails_with(
         &[

@@ -488,6 +488,9 @@ pub struct HostDevice {
     pub vertex_pipeline_stores_and_atomics: bool,
     /// `tessellationShader` was enabled.
     pub tessellation_shader: bool,
+    /// `dynamicRendering` was enabled (vk-core's own rendering scopes, such as captures, need
+    /// it).
+    pub dynamic_rendering: bool,
     /// `bufferDeviceAddress` was enabled: buffers with `SHADER_DEVICE_ADDRESS` usage (read by
     /// address) are refused without it.
     pub buffer_device_address: bool,
@@ -683,6 +686,7 @@ impl Device {
         info.caps.pipeline_statistics_query &= host.pipeline_statistics_query;
         info.caps.vertex_pipeline_stores_and_atomics &= host.vertex_pipeline_stores_and_atomics;
         info.caps.tessellation_shader &= host.tessellation_shader;
+        info.caps.dynamic_rendering &= host.dynamic_rendering;
         info.caps.buffer_device_address &= host.buffer_device_address;
         // The host does not say whether it enabled these: indirect draws hold one draw each
         // and start at instance 0 on its device.

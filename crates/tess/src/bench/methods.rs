@@ -7,7 +7,7 @@ use crate::animation::Wave;
 use crate::camera::Camera;
 use crate::context::{statistics_query_safe, Context};
 use crate::error::{Result, TessError};
-use crate::technique::{FrameParams, PipelineChoice, Technique};
+use crate::technique::{DrawPath, FrameParams, PipelineChoice, Technique};
 use crate::techniques::{self, BuildOptions, TechniqueInfo};
 use std::time::Instant;
 use vk_core::{vk, Device, Encoder};
@@ -43,8 +43,10 @@ pub fn method_names() -> Vec<&'static str> {
 }
 
 /// A bench method: a registry name, optionally with the draw path its rows take
-/// (`flat@pattern`, `pn@tessellation`; without one, `--pipeline auto`).
-pub fn parse_method(name: &str) -> Result<(&'static TechniqueInfo, PipelineChoice)> {
+/// (`flat@pattern`, `pn@tessellation`). Without one a row draws as the papers' methods do:
+/// through the tessellation stage where the technique and the device have it (Table I's Flat
+/// is the hardware tessellator's), else as `--pipeline auto` chooses.
+pub fn parse_method(name: &str) -> Result<(&'static TechniqueInfo, Option<PipelineChoice>)> {
     let (technique, path) = match name.split_once('@') {
         Some((t, p)) => (t, Some(p)),
         None => (name, None),
@@ -60,9 +62,9 @@ pub fn parse_method(name: &str) -> Result<(&'static TechniqueInfo, PipelineChoic
         ))
     })?;
     let choice = match path {
-        None => PipelineChoice::Auto,
+        None => None,
         Some(p) => match p.parse::<PipelineChoice>() {
-            Ok(c @ (PipelineChoice::Tessellation | PipelineChoice::Pattern)) => c,
+            Ok(c @ (PipelineChoice::Tessellation | PipelineChoice::Pattern)) => Some(c),
             _ => {
                 return Err(unknown(format!(
                     "'{name}': the draw path after @ is tessellation or pattern"
@@ -121,13 +123,20 @@ pub struct TechniqueRow {
 
 impl TechniqueRow {
     /// The row of `info` named `name` (its registry name, or with the draw path `choice`:
-    /// `flat@pattern`), animated or not.
+    /// `flat@pattern`; see [`parse_method`] for a name without one), animated or not.
     pub fn new(
         ctx: &RowContext<'_>,
         info: &TechniqueInfo,
-        (name, choice): (&str, PipelineChoice),
+        (name, choice): (&str, Option<PipelineChoice>),
         animated: bool,
     ) -> Result<Self> {
+        let tessellation = ctx.device.info.caps.tessellation_shader
+            && info.features.paths.contains(&DrawPath::Tessellation);
+        let choice = match choice {
+            Some(c) => c,
+            None if tessellation => PipelineChoice::Tessellation,
+            None => PipelineChoice::Auto,
+        };
         let mut context = Context::new(ctx.device, ctx.color_format, ctx.depth_format, 1)?;
         // Catmull-Clark and Doo-Sabin techniques take the mesh as loaded (a fan triangulation
         // is another surface for them); the others its fan triangulation (the paper's Table I).

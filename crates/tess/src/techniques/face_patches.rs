@@ -12,7 +12,7 @@ use crate::capture::{FacePoint, PatchFaceTable};
 use crate::context::Context;
 use crate::error::{Param, ParamError, Result, TessError};
 use crate::gpu::{pattern_input, DrawPush, Vertex};
-use crate::pattern::RefinementPattern;
+use crate::pattern::{PatternKey, RefinementPattern};
 use crate::render_mesh::{PatchOrigin, RenderMesh};
 use crate::shaders::Stage;
 use crate::technique::{
@@ -63,13 +63,14 @@ struct IndexArray {
 
 /// A refinement pattern on the device.
 struct PatternBuffers {
+    key: PatternKey,
     pattern: Arc<RefinementPattern>,
     points: Buffer,
     indices: Buffer,
 }
 
 impl PatternBuffers {
-    fn new(device: &Device, pattern: Arc<RefinementPattern>) -> Result<Self> {
+    fn new(device: &Device, key: PatternKey, pattern: Arc<RefinementPattern>) -> Result<Self> {
         let n = pattern.points.len() as u32;
         let indices = pattern.indices();
         if let Some(&bad) = indices.iter().find(|&&i| i >= n) {
@@ -93,6 +94,7 @@ impl PatternBuffers {
                 vk::BufferUsageFlags::INDEX_BUFFER,
                 bytemuck::cast_slice(&indices),
             )?,
+            key,
             pattern,
         })
     }
@@ -110,6 +112,10 @@ enum Draws {
         corners: Vec<Buffer>,
         /// The frame's patterns, per domain (triangle, quad).
         current: [Option<PatternBuffers>; 2],
+        /// Whether the device's patterns are its tessellator's
+        /// ([`crate::pattern::from_tessellator`]), so a pattern not yet made has the
+        /// tessellator's triangle count.
+        from_tessellator: bool,
     },
 }
 
@@ -136,11 +142,9 @@ type PatchList<'a> = (PatchType, Vec<u32>, u32, &'a [PatchOrigin]);
 impl<S: FaceStyle> FacePatches<S> {
     /// Builds `mesh` for the draw path `options.pipeline` chooses on `ctx`'s device.
     pub fn build(ctx: &Context, mesh: &ControlMesh, options: &BuildOptions) -> Result<Self> {
-        let path = options.pipeline.resolve(
-            S::ID,
-            BASE_FACES.paths,
-            ctx.device().info.caps.tessellation_shader,
-        )?;
+        let path = options
+            .pipeline
+            .resolve(S::ID, BASE_FACES.paths, ctx.device())?;
         Self::new(ctx.device(), mesh, path)
     }
 
@@ -256,6 +260,7 @@ impl<S: FaceStyle> FacePatches<S> {
         Ok(Draws::Patterns {
             corners,
             current: [None, None],
+            from_tessellator: crate::pattern::from_tessellator(device),
         })
     }
 
@@ -385,7 +390,8 @@ impl<S: FaceStyle> Technique for FacePatches<S> {
                 .as_ref()
                 .is_some_and(|p| Arc::ptr_eq(&p.pattern, &pattern))
             {
-                *slot = Some(PatternBuffers::new(ctx.device(), pattern)?);
+                let key = PatternKey::new(domain, params.spacing, level);
+                *slot = Some(PatternBuffers::new(ctx.device(), key, pattern)?);
             }
         }
         Ok(())
@@ -401,9 +407,21 @@ impl<S: FaceStyle> Technique for FacePatches<S> {
 
     fn triangles(&self, params: &FrameParams, array: usize) -> Option<u64> {
         let a = self.arrays.get(array)?;
-        if let Draws::Patterns { .. } = self.draws {
-            let p = self.pattern(array)?;
-            return Some(a.patches as u64 * p.pattern.triangles.len() as u64);
+        if let Draws::Patterns {
+            from_tessellator, ..
+        } = self.draws
+        {
+            let level = self.level(params);
+            let per_patch = match self.pattern(array) {
+                Some(p) if p.key == PatternKey::new(a.patch.domain(), params.spacing, level) => {
+                    p.pattern.triangles.len() as u64
+                }
+                _ if from_tessellator && level <= MAX_LEVEL => {
+                    uniform_triangle_count(a.patch.domain(), params.spacing, level)
+                }
+                _ => crate::pattern::generated_triangle_count(a.patch.domain(), level),
+            };
+            return Some(a.patches as u64 * per_patch);
         }
         Some(
             a.patches as u64
@@ -451,7 +469,9 @@ impl<S: FaceStyle> Technique for FacePatches<S> {
             Draws::Tessellated { vertices, indices } => std::iter::once(vertices)
                 .chain(indices.iter().map(|a| &a.indices))
                 .collect(),
-            Draws::Patterns { corners, current } => corners
+            Draws::Patterns {
+                corners, current, ..
+            } => corners
                 .iter()
                 .chain(
                     current

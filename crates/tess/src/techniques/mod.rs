@@ -217,10 +217,9 @@ pub fn build(
     options: &BuildOptions,
 ) -> Result<Built> {
     let info = info(id);
-    let tessellation_shader = ctx.device().info.caps.tessellation_shader;
     options
         .pipeline
-        .resolve(id, info.features.paths, tessellation_shader)?;
+        .resolve(id, info.features.paths, ctx.device())?;
     if info.scheme.is_some() {
         split::build_split(ctx, info, mesh, options)
     } else {
