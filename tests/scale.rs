@@ -254,6 +254,67 @@ fn planned_patches_beyond_the_storage_range_match_the_uncapped_run() {
     }
 }
 
+/// Doo-Sabin of `mesh` at `segments` (level log2 S) rendered and captured on a device capped
+/// at `cap`: (image, capture, bytes of the deepest level's points and of its corner table).
+fn doo_sabin_run(
+    cap: Option<u32>,
+    mesh: &ControlMesh,
+    segments: f32,
+) -> (Vec<u8>, Vec<tessera::tess::gpu::CaptureRecord>, (u64, u64)) {
+    let gpu = capped(cap);
+    let out = {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
+        let mut surf = common::build_with(
+            &mut ctx,
+            tessera::tess::TechniqueId::DOO_SABIN,
+            mesh,
+            1,
+            false,
+        );
+        let params = FrameParams::uniform(segments);
+        let image = ctx
+            .render_offscreen(surf.as_mut(), &params, SMALL)
+            .unwrap_or_else(|e| panic!("doo-sabin under a range of {cap:?} B: {e}"));
+        let (soup, _) = capturer
+            .capture(&mut ctx, surf.as_mut(), &params, SMALL)
+            .expect("capture");
+        let points = surf.patch_arrays()[0].patches as u64;
+        (image.pixels, soup.records, (16 * points, 32 * points))
+    };
+    drop(gpu);
+    out
+}
+
+/// Doo-Sabin's vertex stage reads the deepest level's points and its corner table by device
+/// address, so a storage range far below both (a quarter of the points) changes nothing: the
+/// level is drawn and captured bit for bit as on the uncapped device (the stencil evaluator
+/// windows the refined vertex buffer it writes).
+#[test]
+fn doo_sabin_beyond_the_storage_range_matches_the_uncapped_run() {
+    let mesh = tessera::topology::load_obj(common::data(
+        "tests/data/opensubdiv/shapes/catmark_pyramid_creases0.obj",
+    ))
+    .expect("shape");
+    let (image, capture, (points, corners)) = doo_sabin_run(None, &mesh, 16.0);
+    // A quarter of the points, in 256-byte steps (the offset alignment).
+    let cap = (points / 4 / 256 * 256) as u32;
+    assert!(
+        cap >= 256 && points >= 4 * cap as u64 && corners > points,
+        "the points ({points} B) are four ranges ({cap} B)"
+    );
+    let (image_c, capture_c, _) = doo_sabin_run(Some(cap), &mesh, 16.0);
+    println!(
+        "doo-sabin level 4: {points} B of points, {corners} B of corners under a {cap} B range, \
+         {} records",
+        capture.len()
+    );
+    assert!(image.iter().any(|&b| b != 0), "something is drawn");
+    assert!(image == image_c, "images differ");
+    assert_eq!(capture.len(), capture_c.len());
+    assert!(capture == capture_c, "captures differ");
+}
+
 /// A descriptor write whose range exceeds the (capped) device limit is a typed error, and one
 /// inside it at an offset is accepted: no silent overrun is possible.
 #[test]

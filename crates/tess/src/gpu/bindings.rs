@@ -109,13 +109,13 @@ gpu_constants! {
 
     /// Descriptor set of one Doo-Sabin surface (`glsl/doo_sabin/mesh.vert`).
     DOO_SABIN_SET = 1;
-    /// The deepest level's points (`vec4`, level-local numbering): the range of the refined
-    /// vertex buffer the stencil evaluator writes that level into ([`crate::stencil`]).
-    DOO_SABIN_POINTS_BINDING = 0;
-    /// Per deepest-level point, its face corners as `uvec2(next, previous)` neighbours
-    /// (`DOO_SABIN_MAX_CORNERS` slots; an unused slot names the point itself twice, adding
-    /// nothing): what its normal is summed from.
-    DOO_SABIN_CORNERS_BINDING = 1;
+    /// The uniform block `DooSabinArrays` ([`crate::gpu::DooSabinArrays`]): the device
+    /// addresses of the deepest level's points (`vec4`, level-local numbering: where the
+    /// stencil evaluator writes that level in the refined vertex buffer, [`crate::stencil`]) and
+    /// of its face corners, per point `DOO_SABIN_MAX_CORNERS` `uvec2(next, previous)` neighbours
+    /// (an unused slot names the point itself twice, adding nothing): what its normal is summed
+    /// from. Read through buffer references, no descriptor range limits them.
+    DOO_SABIN_ARRAYS_BINDING = 0;
     /// Face corners a refined Doo-Sabin point lies in at most (one f-face, two e-faces or
     /// boundary strips, one v-face or vertex strip).
     DOO_SABIN_MAX_CORNERS = 4;

@@ -5,8 +5,8 @@
 use super::bindings::*;
 use super::reflect::Reflection;
 use super::{
-    AdaptiveArrays, AdaptivePush, BftPush, CaptureRecord, DrawPush, FrameUniforms, StencilPush,
-    Vertex,
+    AdaptiveArrays, AdaptivePush, BftPush, CaptureRecord, DooSabinArrays, DrawPush, FrameUniforms,
+    StencilPush, Vertex,
 };
 use crate::shaders::{spirv, Stage, Variant};
 use crate::stencil::{StencilTerm, StencilVertex};
@@ -261,9 +261,26 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         (
             Stage::DooSabinMeshVert,
             PLAIN,
-            Buffer {
-                block: "Points",
-                binding: DOO_SABIN_POINTS_BINDING,
+            Layout {
+                name: "DooSabinArrays",
+                offsets: offsets!(DooSabinArrays: points, corners),
+                size: size_of::<DooSabinArrays>(),
+            },
+        ),
+        (
+            Stage::DooSabinMeshVert,
+            PLAIN,
+            Uniform {
+                block: "DooSabinArrays",
+                set: DOO_SABIN_SET,
+                binding: DOO_SABIN_ARRAYS_BINDING,
+            },
+        ),
+        (
+            Stage::DooSabinMeshVert,
+            PLAIN,
+            Referenced {
+                block: "DooSabinPointArray",
                 members: vec![0],
                 stride: size_of::<StencilVertex>(),
             },
@@ -271,9 +288,8 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         (
             Stage::DooSabinMeshVert,
             PLAIN,
-            Buffer {
-                block: "Corners",
-                binding: DOO_SABIN_CORNERS_BINDING,
+            Referenced {
+                block: "DooSabinCornerArray",
                 members: vec![0],
                 stride: size_of::<[u32; 2]>(),
             },
@@ -864,11 +880,11 @@ fn the_table_covers_every_storage_binding_and_capture_build() {
             "adaptive array {block} is not checked"
         );
     }
-    for binding in [DOO_SABIN_POINTS_BINDING, DOO_SABIN_CORNERS_BINDING] {
+    for block in ["DooSabinPointArray", "DooSabinCornerArray"] {
         assert!(
             rows.iter().any(|(s, _, c)| *s == Stage::DooSabinMeshVert
-                && matches!(c, Check::Buffer { binding: b, .. } if *b == binding)),
-            "Doo-Sabin binding {binding} is not checked"
+                && matches!(c, Check::Referenced { block: b, .. } if *b == block)),
+            "Doo-Sabin array {block} is not checked"
         );
     }
     let capture_builds = Stage::ALL
