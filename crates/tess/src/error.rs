@@ -32,8 +32,8 @@ pub enum TessError {
     },
     #[error("unknown method '{name}' ({known})")]
     UnknownTechnique { name: String, known: String },
-    /// Basis-function tables that cannot be bound in one storage-buffer range, counted from
-    /// the patch records before any table is evaluated.
+    /// Basis-function tables beyond what their 32-bit weight offsets address, counted from the
+    /// patch records before any table is evaluated.
     #[error("{0}")]
     BftTablesTooLarge(TablesTooLarge),
     /// A CPU refinement too large to hold.
@@ -218,7 +218,7 @@ impl ParamError {
     }
 }
 
-/// Basis-function tables over the storage-buffer range ([`TessError::BftTablesTooLarge`]).
+/// Basis-function tables beyond what their weight offsets address ([`TessError::BftTablesTooLarge`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TablesTooLarge {
     /// The mesh.
@@ -228,7 +228,7 @@ pub struct TablesTooLarge {
     /// Level-1 faces whose rings need a table of their own, of `faces`.
     pub private_faces: usize,
     pub faces: usize,
-    /// The device's storage-buffer range.
+    /// The most bytes the tables' 32-bit weight offsets address.
     pub max: u64,
     /// The highest lower level whose tables fit, and their bytes.
     pub fits: Option<(u32, u64)>,
@@ -247,8 +247,8 @@ impl TablesTooLarge {
         };
         format!(
             "{}: basis-function tables at level {} would take {} bytes ({} of {} level-1 faces \
-             need a private table: creases, corners or overlapping rings), more than the \
-             device's storage-buffer range of {} bytes; {hint}",
+             need a private table: creases, corners or overlapping rings), more than the {} \
+             bytes their 32-bit weight offsets address; {hint}",
             self.name, self.level, self.bytes, self.private_faces, self.faces, self.max
         )
     }

@@ -33,14 +33,13 @@ gpu_constants! {
     BFT_PATCH_HEADERS_BINDING = 4;
     /// Every patch's control ring (level-1 vertex indices), back to back.
     BFT_PATCH_RINGS_BINDING = 5;
-    /// [`crate::techniques::bft::layout::TableHeader`], then one [`crate::techniques::bft::layout::TableEntry`] per table.
-    BFT_TABLES_BINDING = 6;
-    /// Mirror permutations of the tables' ring slots.
-    BFT_MIRROR_PERMS_BINDING = 7;
-    /// Row maps: grid point → table row, full tables then half tables.
-    BFT_ROW_MAPS_BINDING = 8;
-    /// Basis-function weights of every table.
-    BFT_TABLE_WEIGHTS_BINDING = 9;
+    /// The uniform block `BftTableArrays` ([`crate::gpu::BftTableArrays`]): the device
+    /// addresses of the basis-function tables ([`crate::techniques::bft::layout::TableHeader`],
+    /// then one [`crate::techniques::bft::layout::TableEntry`] per table), their mirror
+    /// permutations of ring slots, their row maps (grid point → table row, full tables then
+    /// half tables) and their weights. Read through buffer references: every patch may read any
+    /// table, and no descriptor range limits them.
+    BFT_TABLE_ARRAYS_BINDING = 6;
     /// Work-group size of the BFT compute passes.
     BFT_LOCAL_SIZE = 64;
 

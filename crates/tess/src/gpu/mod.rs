@@ -164,6 +164,25 @@ pub struct AdaptiveArrays {
 
 const _: () = assert!(size_of::<AdaptiveArrays>() == 80);
 
+/// `BftTableArrays` uniform block of `glsl/bft/bft.glsl`
+/// ([`bindings::BFT_TABLE_ARRAYS_BINDING`]): the device addresses of the basis-function tables'
+/// arrays, read through buffer references (`Buffer::device_address`). A `u64` here is a
+/// `uvec2` there, low word first.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct BftTableArrays {
+    /// The table header, then one entry per table.
+    pub tables: u64,
+    /// Mirror permutations of the tables' ring slots.
+    pub perms: u64,
+    /// Row maps: grid point → table row, full tables then half tables.
+    pub maps: u64,
+    /// Basis-function weights of every table.
+    pub weights: u64,
+}
+
+const _: () = assert!(size_of::<BftTableArrays>() == 32);
+
 /// `DooSabinArrays` uniform block of `glsl/doo_sabin/mesh.vert`
 /// ([`bindings::DOO_SABIN_ARRAYS_BINDING`]): the device addresses of the arrays its vertex stage
 /// reads through buffer references (`Buffer::device_address`). A `u64` here is a `uvec2`
