@@ -20,7 +20,9 @@
 //!   `maxStorageBufferRange` does not limit the level drawn, only device memory does (the
 //!   stencil evaluator windows what it binds, `techniques::windows`). An address rather than
 //!   windows of the draw: a fan's corners and their neighbours may lie anywhere in the level.
-//!   A device without `bufferDeviceAddress` (a host's) is refused by name.
+//!   A device without `bufferDeviceAddress` (a host's) is refused by name. The price is
+//!   lavapipe's: its address loads run lane by lane, and the level-6 draw is about 1.6–1.9×
+//!   the descriptor path's GPU time there (docs/benchmarks.md).
 //! - **Normals per point from its face corners**: the sum over the (at most four) faces a
 //!   point lies in of `(next − p) × (previous − p)`, in the vertex stage, from a table of the
 //!   corners' neighbours; no normal pass. Against the exact limit normal at face centres
