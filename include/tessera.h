@@ -294,9 +294,10 @@ typedef struct TesseraHostDesc {
   // techniques without that path are refused as UNSUPPORTED.
   uint32_t without_tessellation_shader;
   // 0 or 1: `bufferDeviceAddress` (required in Vulkan 1.3) is enabled. The planned-patch
-  // techniques (`TESSERA_TECHNIQUE_ADAPTIVE`, `_GREGORY`, `_ACC`, and whatever `_AUTO` makes
-  // of them) read their vertex and patch arrays by address, so that no
-  // `maxStorageBufferRange` limits them; with 0 they are UNSUPPORTED.
+  // techniques (`TESSERA_TECHNIQUE_ADAPTIVE`, `_GREGORY`, `_ACC`), `_BFT` and `_DOO_SABIN`
+  // (and whatever `_AUTO` makes of them) read arrays by address (vertex and patch arrays,
+  // basis-function tables, the deepest level), so that no `maxStorageBufferRange` limits
+  // them; with 0 they are UNSUPPORTED.
   uint32_t buffer_device_address;
 } TesseraHostDesc;
 

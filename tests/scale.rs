@@ -31,17 +31,17 @@ fn capped(cap: Option<u32>) -> Gpu {
     })
 }
 
-/// (image, capture) of a BFT surface of `mesh` under `params` on a device capped at `cap`, and
-/// its (pre-pass, draw) chunk counts.
-fn bft_run(
-    cap: Option<u32>,
-    mesh: &ControlMesh,
-    params: &FrameParams,
-) -> (
+/// What a BFT run gives: image, capture, (pre-pass, draw) chunk counts, table bytes.
+type BftRun = (
     Vec<u8>,
     Vec<tessera::tess::gpu::CaptureRecord>,
     (usize, usize),
-) {
+    usize,
+);
+
+/// (image, capture) of a BFT surface of `mesh` under `params` on a device capped at `cap`, its
+/// (pre-pass, draw) chunk counts and the bytes of its basis-function tables.
+fn bft_run(cap: Option<u32>, mesh: &ControlMesh, params: &FrameParams) -> BftRun {
     let gpu = capped(cap);
     let out = {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
@@ -63,7 +63,12 @@ fn bft_run(
         let (soup, _) = capturer
             .capture(&mut ctx, &mut surf, params, SMALL)
             .expect("capture");
-        (image.pixels, soup.records, surf.chunk_counts())
+        (
+            image.pixels,
+            soup.records,
+            surf.chunk_counts(),
+            surf.table_bytes(),
+        )
     };
     drop(gpu);
     out
@@ -78,9 +83,9 @@ fn bft_under_a_tiny_storage_range_matches_the_whole_buffer_run() {
     screen.factors = tessera::tess::FactorPolicy::Screen { pixels: 6.0 };
     screen.geometric_normals = true;
     for params in [FrameParams::uniform(8.0), screen] {
-        let (image, capture, chunks) = bft_run(None, &mesh, &params);
+        let (image, capture, chunks, _) = bft_run(None, &mesh, &params);
         assert_eq!(chunks, (1, 1));
-        let (image_w, capture_w, chunks_w) = bft_run(Some(128 << 10), &mesh, &params);
+        let (image_w, capture_w, chunks_w, _) = bft_run(Some(128 << 10), &mesh, &params);
         println!("chunks under a 128 KiB range: {chunks_w:?}");
         assert!(chunks_w.0 > 1 && chunks_w.1 > 2, "{chunks_w:?}");
         assert!(image.iter().any(|&b| b != 0), "something is drawn");
@@ -88,6 +93,36 @@ fn bft_under_a_tiny_storage_range_matches_the_whole_buffer_run() {
         assert_eq!(capture.len(), capture_w.len());
         assert!(capture == capture_w, "captures differ");
     }
+}
+
+/// BFT's shaders read the basis-function tables by device address, so a storage range far
+/// below them (an eighth of the tables of a creased cube, whose faces beside the creases need
+/// private tables; the weights alone were refused above the range before) neither refuses the
+/// surface nor changes it: it renders and captures bit for bit as on the uncapped device.
+#[test]
+fn bft_tables_beyond_the_storage_range_match_the_uncapped_run() {
+    let mesh = tessera::topology::load_obj(common::data(
+        "tests/data/opensubdiv/shapes/loop_cube_creases0.obj",
+    ))
+    .expect("shape");
+    let params = FrameParams::uniform(8.0);
+    let (image, capture, _, tables) = bft_run(None, &mesh, &params);
+    // An eighth of the tables, in 256-byte steps (the offset alignment): the weights, most
+    // of the tables, are several ranges.
+    let cap = (tables / 8 / 256 * 256) as u32;
+    assert!(
+        cap >= 256 && tables >= 8 * cap as usize,
+        "the tables ({tables} B) are eight ranges ({cap} B)"
+    );
+    let (image_c, capture_c, chunks_c, _) = bft_run(Some(cap), &mesh, &params);
+    println!(
+        "bft tables {tables} B under a {cap} B range: chunks {chunks_c:?}, {} records",
+        capture.len()
+    );
+    assert!(image.iter().any(|&b| b != 0), "something is drawn");
+    assert!(image == image_c, "images differ");
+    assert_eq!(capture.len(), capture_c.len());
+    assert!(capture == capture_c, "captures differ");
 }
 
 /// What an adaptive run gives: image, capture, (stencil dispatches, window sets), and the
@@ -252,6 +287,67 @@ fn planned_patches_beyond_the_storage_range_match_the_uncapped_run() {
         assert_eq!(capture.len(), capture_c.len(), "{which}");
         assert!(capture == capture_c, "{which}: captures differ");
     }
+}
+
+/// Doo-Sabin of `mesh` at `segments` (level log2 S) rendered and captured on a device capped
+/// at `cap`: (image, capture, bytes of the deepest level's points and of its corner table).
+fn doo_sabin_run(
+    cap: Option<u32>,
+    mesh: &ControlMesh,
+    segments: f32,
+) -> (Vec<u8>, Vec<tessera::tess::gpu::CaptureRecord>, (u64, u64)) {
+    let gpu = capped(cap);
+    let out = {
+        let mut ctx = Context::offscreen(gpu.device()).expect("context");
+        let capturer = Capturer::new(&ctx).expect("capturer");
+        let mut surf = common::build_with(
+            &mut ctx,
+            tessera::tess::TechniqueId::DOO_SABIN,
+            mesh,
+            1,
+            false,
+        );
+        let params = FrameParams::uniform(segments);
+        let image = ctx
+            .render_offscreen(surf.as_mut(), &params, SMALL)
+            .unwrap_or_else(|e| panic!("doo-sabin under a range of {cap:?} B: {e}"));
+        let (soup, _) = capturer
+            .capture(&mut ctx, surf.as_mut(), &params, SMALL)
+            .expect("capture");
+        let points = surf.patch_arrays()[0].patches as u64;
+        (image.pixels, soup.records, (16 * points, 32 * points))
+    };
+    drop(gpu);
+    out
+}
+
+/// Doo-Sabin's vertex stage reads the deepest level's points and its corner table by device
+/// address, so a storage range far below both (a quarter of the points) changes nothing: the
+/// level is drawn and captured bit for bit as on the uncapped device (the stencil evaluator
+/// windows the refined vertex buffer it writes).
+#[test]
+fn doo_sabin_beyond_the_storage_range_matches_the_uncapped_run() {
+    let mesh = tessera::topology::load_obj(common::data(
+        "tests/data/opensubdiv/shapes/catmark_pyramid_creases0.obj",
+    ))
+    .expect("shape");
+    let (image, capture, (points, corners)) = doo_sabin_run(None, &mesh, 16.0);
+    // A quarter of the points, in 256-byte steps (the offset alignment).
+    let cap = (points / 4 / 256 * 256) as u32;
+    assert!(
+        cap >= 256 && points >= 4 * cap as u64 && corners > points,
+        "the points ({points} B) are four ranges ({cap} B)"
+    );
+    let (image_c, capture_c, _) = doo_sabin_run(Some(cap), &mesh, 16.0);
+    println!(
+        "doo-sabin level 4: {points} B of points, {corners} B of corners under a {cap} B range, \
+         {} records",
+        capture.len()
+    );
+    assert!(image.iter().any(|&b| b != 0), "something is drawn");
+    assert!(image == image_c, "images differ");
+    assert_eq!(capture.len(), capture_c.len());
+    assert!(capture == capture_c, "captures differ");
 }
 
 /// A descriptor write whose range exceeds the (capped) device limit is a typed error, and one

@@ -15,6 +15,7 @@
 #include "vulkan_host.hpp"
 
 #include <cstring>
+#include <utility>
 
 namespace {
 
@@ -238,17 +239,24 @@ int check_misuse(const host::Vulkan &vk, tessera::Context &ctx, const Pass &pass
     TesseraFrameDesc frame = tessera::default_frame_desc();
     expect(tessera_capture(ctx.get(), s.get(), &frame, nullptr, nullptr),
            TESSERA_STATUS_UNSUPPORTED, "capture without dynamicRendering", "dynamicRendering");
-    // The planned-patch techniques read their arrays by device address: refused by name on a
-    // host that does not say it enabled bufferDeviceAddress.
+    // The planned-patch techniques, BFT (its tables) and Doo-Sabin (its deepest level) read
+    // arrays by device address: refused by name on a host that does not say it enabled
+    // bufferDeviceAddress.
     TesseraHostDesc no_address = host_desc(vk, pass);
     no_address.buffer_device_address = 0;
     tessera::Context plain = tessera::Context::host(no_address);
-    TesseraSurfaceDesc sdesc = tessera::default_surface_desc();
-    sdesc.technique = TESSERA_TECHNIQUE_ADAPTIVE;
-    TesseraSurface *none = nullptr;
-    expect(tessera_surface_create_obj(plain.get(), nullptr, 0, nullptr, &sdesc, &none),
-           TESSERA_STATUS_UNSUPPORTED, "adaptive without bufferDeviceAddress",
-           "bufferDeviceAddress");
+    const std::pair<TesseraTechnique, const char *> by_address[] = {
+        {TESSERA_TECHNIQUE_ADAPTIVE, "adaptive without bufferDeviceAddress"},
+        {TESSERA_TECHNIQUE_BFT, "bft without bufferDeviceAddress"},
+        {TESSERA_TECHNIQUE_DOO_SABIN, "doo-sabin without bufferDeviceAddress"},
+    };
+    for (const auto &[technique, what] : by_address) {
+        TesseraSurfaceDesc sdesc = tessera::default_surface_desc();
+        sdesc.technique = technique;
+        TesseraSurface *none = nullptr;
+        expect(tessera_surface_create_obj(plain.get(), nullptr, 0, nullptr, &sdesc, &none),
+               TESSERA_STATUS_UNSUPPORTED, what, "bufferDeviceAddress");
+    }
     return failures;
 }
 

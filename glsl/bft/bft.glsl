@@ -5,6 +5,8 @@
 // read by field name; set and binding numbers come from bindings.glsl; a test checks each
 // block's binding, member offsets and array stride in the SPIR-V against the Rust structs.
 // `GpuBft::eval_tess` is this file's f32 mirror, kept in step.
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_buffer_reference_uvec2 : require
 #include "bindings.glsl"
 
 // One term of the two limit-tangent masks of a level-1 vertex (same control points).
@@ -49,10 +51,25 @@ layout(std430, set = BFT_SET, binding = BFT_LEVEL1_NORMALS_BINDING) readonly buf
 #endif
 layout(std430, set = BFT_SET, binding = BFT_PATCH_HEADERS_BINDING) readonly buffer PatchHeaders { PatchHeader patches[]; };
 layout(std430, set = BFT_SET, binding = BFT_PATCH_RINGS_BINDING) readonly buffer PatchRings { uint patch_rings[]; };
-layout(std430, set = BFT_SET, binding = BFT_TABLES_BINDING) readonly buffer Tables { TableHeader table; TableEntry table_entries[]; };
-layout(std430, set = BFT_SET, binding = BFT_MIRROR_PERMS_BINDING) readonly buffer MirrorPerms { uint mirror_perms[]; };
-layout(std430, set = BFT_SET, binding = BFT_ROW_MAPS_BINDING) readonly buffer RowMaps { uint row_maps[]; };
-layout(std430, set = BFT_SET, binding = BFT_TABLE_WEIGHTS_BINDING) readonly buffer TableWeights { float table_weights[]; };
+// The tables are read through buffer references (GL_EXT_buffer_reference) at the device
+// addresses the uniform block `BftTableArrays` holds, not through descriptors: every patch may
+// read any table, so they cannot be windowed, and no `maxStorageBufferRange` limits them.
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer Tables { TableHeader header; TableEntry entries[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer MirrorPerms { uint v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer RowMaps { uint v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer TableWeights { float v[]; };
+// `tess::gpu::BftTableArrays`: each address a uvec2, low word first.
+layout(std140, set = BFT_SET, binding = BFT_TABLE_ARRAYS_BINDING) uniform BftTableArrays {
+    uvec2 tables;   // TableHeader, then one TableEntry per table
+    uvec2 perms;    // mirror permutations of the tables' ring slots
+    uvec2 maps;     // row maps: grid point -> table row, full tables then half tables
+    uvec2 weights;  // basis-function weights of every table
+} table_arrays;
+#define table Tables(table_arrays.tables).header
+#define table_entries Tables(table_arrays.tables).entries
+#define mirror_perms MirrorPerms(table_arrays.perms).v
+#define row_maps RowMaps(table_arrays.maps).v
+#define table_weights TableWeights(table_arrays.weights).v
 
 // Push constant of every BFT pipeline (`tess::gpu::BftPush`).
 layout(push_constant) uniform BftPush {

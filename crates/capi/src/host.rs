@@ -38,8 +38,9 @@
 //! # Device features
 //! Dynamic rendering needs `dynamicRendering` enabled; a render pass does not, except for
 //! captures, which render into an attachment-less dynamic-rendering scope of Tessera's own.
-//! The planned-patch techniques (adaptive, gregory, acc) need `bufferDeviceAddress` enabled
-//! and `buffer_device_address` set: they read their vertex and patch arrays by address.
+//! The planned-patch techniques (adaptive, gregory, acc), bft and doo-sabin need
+//! `bufferDeviceAddress` enabled and `buffer_device_address` set: they read arrays by address
+//! (vertex and patch arrays, basis-function tables, the deepest Doo-Sabin level).
 //!
 //! # Frames in flight
 //! The host says how many frames it keeps in flight (`frames_in_flight`); every surface keeps
@@ -132,9 +133,10 @@ pub struct TesseraHostDesc {
     /// techniques without that path are refused as UNSUPPORTED.
     pub without_tessellation_shader: u32,
     /// 0 or 1: `bufferDeviceAddress` (required in Vulkan 1.3) is enabled. The planned-patch
-    /// techniques (`TESSERA_TECHNIQUE_ADAPTIVE`, `_GREGORY`, `_ACC`, and whatever `_AUTO` makes
-    /// of them) read their vertex and patch arrays by address, so that no
-    /// `maxStorageBufferRange` limits them; with 0 they are UNSUPPORTED.
+    /// techniques (`TESSERA_TECHNIQUE_ADAPTIVE`, `_GREGORY`, `_ACC`), `_BFT` and `_DOO_SABIN`
+    /// (and whatever `_AUTO` makes of them) read arrays by address (vertex and patch arrays,
+    /// basis-function tables, the deepest level), so that no `maxStorageBufferRange` limits
+    /// them; with 0 they are UNSUPPORTED.
     pub buffer_device_address: u32,
 }
 

@@ -208,6 +208,7 @@ fn descriptor_field(p: tess::error::Param) -> &'static str {
         Param::Pixels => "TesseraFrameDesc.factor (pixels per segment)",
         Param::Distance => "TesseraFrameDesc.factor (distance)",
         Param::TableLevel => "TesseraSurfaceDesc.table_level",
+        Param::Isolation => "TesseraSurfaceDesc.isolation",
     }
 }
 

@@ -32,8 +32,8 @@ pub enum TessError {
     },
     #[error("unknown method '{name}' ({known})")]
     UnknownTechnique { name: String, known: String },
-    /// Basis-function tables that cannot be bound in one storage-buffer range, counted from
-    /// the patch records before any table is evaluated.
+    /// Basis-function tables beyond what their 32-bit weight offsets address, counted from the
+    /// patch records before any table is evaluated.
     #[error("{0}")]
     BftTablesTooLarge(TablesTooLarge),
     /// A CPU refinement too large to hold.
@@ -50,11 +50,8 @@ pub enum TessError {
     #[error("geometric normals need the tangent tables (this surface was built without them)")]
     NeedsTangentTables,
     /// One item's reach in a buffer exceeds the device's storage-buffer range: it cannot be
-    /// windowed (see `techniques::windows`).
-    #[error(
-        "{what} {item} reaches {bytes} bytes of its {space} buffers, more than the device's \
-         storage-buffer range of {max} bytes"
-    )]
+    /// windowed (see `techniques::windows`). The message names what makes the reach shorter.
+    #[error("{}", storage_window(.what, *.item, .space, *.bytes, *.max, Param::name))]
     StorageWindow {
         what: &'static str,
         item: u32,
@@ -151,6 +148,8 @@ pub enum Param {
     Distance,
     /// Basis-function table level (`BuildOptions::table_level`).
     TableLevel,
+    /// Adaptive's isolation level (`BuildOptions::isolation`).
+    Isolation,
 }
 
 impl Param {
@@ -161,6 +160,7 @@ impl Param {
             Param::Pixels => "pixels per segment",
             Param::Distance => "reference distance",
             Param::TableLevel => "table level",
+            Param::Isolation => "isolation level",
         }
     }
 }
@@ -218,7 +218,7 @@ impl ParamError {
     }
 }
 
-/// Basis-function tables over the storage-buffer range ([`TessError::BftTablesTooLarge`]).
+/// Basis-function tables beyond what their weight offsets address ([`TessError::BftTablesTooLarge`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TablesTooLarge {
     /// The mesh.
@@ -228,7 +228,7 @@ pub struct TablesTooLarge {
     /// Level-1 faces whose rings need a table of their own, of `faces`.
     pub private_faces: usize,
     pub faces: usize,
-    /// The device's storage-buffer range.
+    /// The most bytes the tables' 32-bit weight offsets address.
     pub max: u64,
     /// The highest lower level whose tables fit, and their bytes.
     pub fits: Option<(u32, u64)>,
@@ -247,8 +247,8 @@ impl TablesTooLarge {
         };
         format!(
             "{}: basis-function tables at level {} would take {} bytes ({} of {} level-1 faces \
-             need a private table: creases, corners or overlapping rings), more than the \
-             device's storage-buffer range of {} bytes; {hint}",
+             need a private table: creases, corners or overlapping rings), more than the {} \
+             bytes their 32-bit weight offsets address; {hint}",
             self.name, self.level, self.bytes, self.private_faces, self.faces, self.max
         )
     }
@@ -267,9 +267,38 @@ impl TessError {
         match self {
             TessError::Param(p) => p.worded(name),
             TessError::BftTablesTooLarge(t) => t.worded(name),
+            TessError::StorageWindow {
+                what,
+                item,
+                space,
+                bytes,
+                max,
+            } => storage_window(what, *item, space, *bytes, *max, name),
             other => other.to_string(),
         }
     }
+}
+
+/// [`TessError::StorageWindow`]'s message, with the parameters that shorten an item's reach
+/// named by `name`. An item is bound in one window, so its reach (the hull of the indices it
+/// reads: a stencil row's source vertices, a patch's owners' rings) must fit one range; the
+/// reach grows with the level's size and with how far apart neighbouring vertices are numbered.
+fn storage_window(
+    what: &str,
+    item: u32,
+    space: &str,
+    bytes: u64,
+    max: u64,
+    name: impl Fn(Param) -> &'static str,
+) -> String {
+    format!(
+        "{what} {item} reaches {bytes} bytes of its {space} buffers, more than the device's \
+         storage-buffer range of {max} bytes (an item is read through one window); a lower {} \
+         (adaptive) or fewer {} (doo-sabin), a smaller mesh, or one whose neighbouring vertices \
+         are numbered close together shortens the reach, or a device with a larger range takes it",
+        name(Param::Isolation),
+        name(Param::Segments)
+    )
 }
 
 impl std::fmt::Display for ParamError {
@@ -315,6 +344,30 @@ mod tests {
         assert!(tables
             .worded(flag)
             .contains("(--table-level 4, up to 32 segments"));
+        // A reach beyond the storage range names what shortens it, in each front end's words.
+        let window = TessError::StorageWindow {
+            what: "stencil row",
+            item: 7,
+            space: "stencil source vertex",
+            bytes: 300,
+            max: 256,
+        };
+        let text = window.to_string();
+        assert!(text.contains("stencil row 7 reaches 300 bytes"), "{text}");
+        assert!(
+            text.contains("a lower isolation level (adaptive) or fewer segments (doo-sabin)"),
+            "{text}"
+        );
+        let flag = |p: Param| match p {
+            Param::Isolation => "--isolation",
+            Param::Segments => "--segments",
+            _ => "--other",
+        };
+        let text = window.worded(flag);
+        assert!(
+            text.contains("a lower --isolation (adaptive) or fewer --segments (doo-sabin)"),
+            "{text}"
+        );
         let other = TessError::NoPatchArray { array: 3 };
         assert_eq!(other.worded(flag), other.to_string());
     }

@@ -63,6 +63,7 @@ fn option_of(p: tess::error::Param) -> &'static str {
         Param::Pixels => "--pixels",
         Param::Distance => "--distance",
         Param::TableLevel => "--table-level",
+        Param::Isolation => "--isolation",
     }
 }
 

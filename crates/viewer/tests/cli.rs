@@ -752,39 +752,6 @@ fn export_counts_a_holes_border_as_boundary() {
     }
 }
 
-/// BFT tables over the device's storage-buffer range are refused from the patch records,
-/// before any table is evaluated (catmark_car's 2,619 private tables at level 5 come to
-/// 136.8 MB, over lavapipe's 128 MiB; evaluating them took 70 s before the draw was refused),
-/// and the error names the level that fits.
-#[test]
-fn export_refuses_bft_tables_over_the_storage_range_before_building_them() {
-    let mesh = data("tests/data/opensubdiv/shapes/catmark_car.obj");
-    let out = tmp("car_bft.obj");
-    fails_with(
-        &[
-            "export",
-            &mesh,
-            "--method",
-            "bft",
-            "--segments",
-            "4",
-            "--device",
-            "llvmpipe",
-            "-o",
-            out.to_str().unwrap(),
-        ],
-        &[],
-        &[
-            "catmark_car.obj",
-            "basis-function tables at level 5 would take 136824816 bytes",
-            "2619 of 12600 level-1 faces need a private table",
-            "storage-buffer range of 134217728 bytes",
-            "--table-level 4",
-        ],
-    );
-    assert!(!out.exists(), "nothing is written");
-}
-
 #[test]
 fn export_bad_inputs_are_named_errors() {
     let out = tmp("never.obj");

@@ -33,14 +33,13 @@ gpu_constants! {
     BFT_PATCH_HEADERS_BINDING = 4;
     /// Every patch's control ring (level-1 vertex indices), back to back.
     BFT_PATCH_RINGS_BINDING = 5;
-    /// [`crate::techniques::bft::layout::TableHeader`], then one [`crate::techniques::bft::layout::TableEntry`] per table.
-    BFT_TABLES_BINDING = 6;
-    /// Mirror permutations of the tables' ring slots.
-    BFT_MIRROR_PERMS_BINDING = 7;
-    /// Row maps: grid point → table row, full tables then half tables.
-    BFT_ROW_MAPS_BINDING = 8;
-    /// Basis-function weights of every table.
-    BFT_TABLE_WEIGHTS_BINDING = 9;
+    /// The uniform block `BftTableArrays` ([`crate::gpu::BftTableArrays`]): the device
+    /// addresses of the basis-function tables ([`crate::techniques::bft::layout::TableHeader`],
+    /// then one [`crate::techniques::bft::layout::TableEntry`] per table), their mirror
+    /// permutations of ring slots, their row maps (grid point → table row, full tables then
+    /// half tables) and their weights. Read through buffer references: every patch may read any
+    /// table, and no descriptor range limits them.
+    BFT_TABLE_ARRAYS_BINDING = 6;
     /// Work-group size of the BFT compute passes.
     BFT_LOCAL_SIZE = 64;
 
@@ -109,13 +108,13 @@ gpu_constants! {
 
     /// Descriptor set of one Doo-Sabin surface (`glsl/doo_sabin/mesh.vert`).
     DOO_SABIN_SET = 1;
-    /// The deepest level's points (`vec4`, level-local numbering): the range of the refined
-    /// vertex buffer the stencil evaluator writes that level into ([`crate::stencil`]).
-    DOO_SABIN_POINTS_BINDING = 0;
-    /// Per deepest-level point, its face corners as `uvec2(next, previous)` neighbours
-    /// (`DOO_SABIN_MAX_CORNERS` slots; an unused slot names the point itself twice, adding
-    /// nothing): what its normal is summed from.
-    DOO_SABIN_CORNERS_BINDING = 1;
+    /// The uniform block `DooSabinArrays` ([`crate::gpu::DooSabinArrays`]): the device
+    /// addresses of the deepest level's points (`vec4`, level-local numbering: where the
+    /// stencil evaluator writes that level in the refined vertex buffer, [`crate::stencil`]) and
+    /// of its face corners, per point `DOO_SABIN_MAX_CORNERS` `uvec2(next, previous)` neighbours
+    /// (an unused slot names the point itself twice, adding nothing): what its normal is summed
+    /// from. Read through buffer references, no descriptor range limits them.
+    DOO_SABIN_ARRAYS_BINDING = 0;
     /// Face corners a refined Doo-Sabin point lies in at most (one f-face, two e-faces or
     /// boundary strips, one v-face or vertex strip).
     DOO_SABIN_MAX_CORNERS = 4;

@@ -5,8 +5,8 @@
 use super::bindings::*;
 use super::reflect::Reflection;
 use super::{
-    AdaptiveArrays, AdaptivePush, BftPush, CaptureRecord, DrawPush, FrameUniforms, StencilPush,
-    Vertex,
+    AdaptiveArrays, AdaptivePush, BftPush, BftTableArrays, CaptureRecord, DooSabinArrays, DrawPush,
+    FrameUniforms, StencilPush, Vertex,
 };
 use crate::shaders::{spirv, Stage, Variant};
 use crate::stencil::{StencilTerm, StencilVertex};
@@ -261,9 +261,26 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         (
             Stage::DooSabinMeshVert,
             PLAIN,
-            Buffer {
-                block: "Points",
-                binding: DOO_SABIN_POINTS_BINDING,
+            Layout {
+                name: "DooSabinArrays",
+                offsets: offsets!(DooSabinArrays: points, corners),
+                size: size_of::<DooSabinArrays>(),
+            },
+        ),
+        (
+            Stage::DooSabinMeshVert,
+            PLAIN,
+            Uniform {
+                block: "DooSabinArrays",
+                set: DOO_SABIN_SET,
+                binding: DOO_SABIN_ARRAYS_BINDING,
+            },
+        ),
+        (
+            Stage::DooSabinMeshVert,
+            PLAIN,
+            Referenced {
+                block: "DooSabinPointArray",
                 members: vec![0],
                 stride: size_of::<StencilVertex>(),
             },
@@ -271,9 +288,8 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         (
             Stage::DooSabinMeshVert,
             PLAIN,
-            Buffer {
-                block: "Corners",
-                binding: DOO_SABIN_CORNERS_BINDING,
+            Referenced {
+                block: "DooSabinCornerArray",
                 members: vec![0],
                 stride: size_of::<[u32; 2]>(),
             },
@@ -446,9 +462,26 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
             (
                 tese,
                 v,
-                Buffer {
+                Layout {
+                    name: "BftTableArrays",
+                    offsets: offsets!(BftTableArrays: tables, perms, maps, weights),
+                    size: size_of::<BftTableArrays>(),
+                },
+            ),
+            (
+                tese,
+                v,
+                Uniform {
+                    block: "BftTableArrays",
+                    set: BFT_SET,
+                    binding: BFT_TABLE_ARRAYS_BINDING,
+                },
+            ),
+            (
+                tese,
+                v,
+                Referenced {
                     block: "Tables",
-                    binding: BFT_TABLES_BINDING,
                     members: vec![0, size_of::<TableHeader>() as u32],
                     stride: size_of::<TableEntry>(),
                 },
@@ -474,15 +507,26 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
             (
                 tese,
                 v,
-                words("MirrorPerms", BFT_MIRROR_PERMS_BINDING),
+                Referenced {
+                    block: "MirrorPerms",
+                    members: vec![0],
+                    stride: size_of::<u32>(),
+                },
             ),
-            (tese, v, words("RowMaps", BFT_ROW_MAPS_BINDING)),
             (
                 tese,
                 v,
-                Buffer {
+                Referenced {
+                    block: "RowMaps",
+                    members: vec![0],
+                    stride: size_of::<u32>(),
+                },
+            ),
+            (
+                tese,
+                v,
+                Referenced {
                     block: "TableWeights",
-                    binding: BFT_TABLE_WEIGHTS_BINDING,
                     members: vec![0],
                     stride: size_of::<f32>(),
                 },
@@ -834,6 +878,13 @@ fn the_table_covers_every_storage_binding_and_capture_build() {
             "BFT binding {binding} is not checked"
         );
     }
+    for block in ["Tables", "MirrorPerms", "RowMaps", "TableWeights"] {
+        assert!(
+            rows.iter().any(|(s, _, c)| *s == Stage::BftBftTese
+                && matches!(c, Check::Referenced { block: b, .. } if *b == block)),
+            "BFT table array {block} is not checked"
+        );
+    }
     for binding in [
         STENCIL_OFFSETS_BINDING,
         STENCIL_TERMS_BINDING,
@@ -864,11 +915,11 @@ fn the_table_covers_every_storage_binding_and_capture_build() {
             "adaptive array {block} is not checked"
         );
     }
-    for binding in [DOO_SABIN_POINTS_BINDING, DOO_SABIN_CORNERS_BINDING] {
+    for block in ["DooSabinPointArray", "DooSabinCornerArray"] {
         assert!(
             rows.iter().any(|(s, _, c)| *s == Stage::DooSabinMeshVert
-                && matches!(c, Check::Buffer { binding: b, .. } if *b == binding)),
-            "Doo-Sabin binding {binding} is not checked"
+                && matches!(c, Check::Referenced { block: b, .. } if *b == block)),
+            "Doo-Sabin array {block} is not checked"
         );
     }
     let capture_builds = Stage::ALL
@@ -897,8 +948,8 @@ fn a_wrong_offset_or_binding_is_caught() {
     };
     assert!(check(Stage::CommonShadeFrag, PLAIN, &wrong).is_err());
     let wrong = Check::Buffer {
-        block: "RowMaps",
-        binding: BFT_TABLE_WEIGHTS_BINDING,
+        block: "PatchRings",
+        binding: BFT_PATCH_HEADERS_BINDING,
         members: vec![0],
         stride: 4,
     };

@@ -164,6 +164,41 @@ pub struct AdaptiveArrays {
 
 const _: () = assert!(size_of::<AdaptiveArrays>() == 80);
 
+/// `BftTableArrays` uniform block of `glsl/bft/bft.glsl`
+/// ([`bindings::BFT_TABLE_ARRAYS_BINDING`]): the device addresses of the basis-function tables'
+/// arrays, read through buffer references (`Buffer::device_address`). A `u64` here is a
+/// `uvec2` there, low word first.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct BftTableArrays {
+    /// The table header, then one entry per table.
+    pub tables: u64,
+    /// Mirror permutations of the tables' ring slots.
+    pub perms: u64,
+    /// Row maps: grid point → table row, full tables then half tables.
+    pub maps: u64,
+    /// Basis-function weights of every table.
+    pub weights: u64,
+}
+
+const _: () = assert!(size_of::<BftTableArrays>() == 32);
+
+/// `DooSabinArrays` uniform block of `glsl/doo_sabin/mesh.vert`
+/// ([`bindings::DOO_SABIN_ARRAYS_BINDING`]): the device addresses of the arrays its vertex stage
+/// reads through buffer references (`Buffer::device_address`). A `u64` here is a `uvec2`
+/// there, low word first.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct DooSabinArrays {
+    /// `vec4` per point of the deepest level: the address of its first point in the refined
+    /// vertex buffer.
+    pub points: u64,
+    /// Per point of the deepest level, `DOO_SABIN_MAX_CORNERS` `(next, previous)` neighbours.
+    pub corners: u64,
+}
+
+const _: () = assert!(size_of::<DooSabinArrays>() == 16);
+
 /// `StencilPush` push constant of the stencil evaluator, `glsl/stencil/stencil.glsl`
 /// ([`crate::stencil`]): one dispatch, rows `first_row .. first_row + count`, and the window
 /// bases of its chunk (`techniques::windows`), subtracted from every index into a windowed

@@ -38,7 +38,8 @@
 //!   chunk has its own descriptor set and the kernel subtracts the window bases (push
 //!   constants, [`crate::gpu::StencilPush`]). An in-place evaluator binds its one buffer twice,
 //!   as two windows. A mesh whose tables fit is one chunk with bases 0 (or the hulls' aligned
-//!   starts); a row whose own reach does not fit is a typed error naming it.
+//!   starts); a row whose own reach does not fit is a typed error naming it and what shortens
+//!   the reach ([`crate::TessError::StorageWindow`]).
 //! - **Checked before upload**: every term reads an existing source vertex, every block
 //!   writes existing destination vertices, and in place no row reads its own block's
 //!   destinations ([`StencilError`]), so the GPU never indexes out of bounds or races.

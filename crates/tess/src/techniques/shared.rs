@@ -79,17 +79,6 @@ pub fn compute_pipeline(
     )?)
 }
 
-/// One [`storage`] buffer per `(binding, name, bytes)`, by binding.
-pub fn storage_buffers(
-    device: &Device,
-    arrays: &[(u32, &str, &[u8])],
-) -> Result<Vec<(u32, Buffer)>> {
-    arrays
-        .iter()
-        .map(|&(binding, name, bytes)| Ok((binding, storage(device, name, bytes)?)))
-        .collect()
-}
-
 /// The push-constant fields of a factor policy: (`BFT_FACTORS_*` mode, uniform segments,
 /// pixels per segment, reference distance), the segments as the policy gives them.
 pub fn factor_fields(factors: FactorPolicy) -> (u32, f32, f32, f32) {

@@ -5,9 +5,11 @@
 //! - **Windows, not buffer device addresses.** A descriptor may name at most
 //!   `maxStorageBufferRange` bytes (128 MiB on lavapipe; a 1M-triangle mesh's BFT patch rings
 //!   alone are 190 MB). Buffer device addresses would lift the limit, but a host's device
-//!   (the C ABI) may not enable them; windows work on every device with one shader path. (The planned-patch techniques' draw is
-//!   the exception: a patch reads three far-apart runs of its vertex buffer, so it reads its
-//!   arrays by address, `techniques::planned_patches`.) Each technique's work (level-1 vertices
+//!   (the C ABI) may not enable them; windows work on every device with one shader path.
+//!   Arrays no window can cut are read by address instead: the planned-patch techniques' draw
+//!   (a patch reads three far-apart runs of its vertex buffer, `techniques::planned_patches`),
+//!   BFT's basis-function tables (any patch may read any shared table) and Doo-Sabin's deepest
+//!   level (`techniques::doo_sabin`). Each technique's work (level-1 vertices
 //!   of a compute pre-pass, patches of a draw) is cut into chunks; a chunk gets its own
 //!   descriptor set whose bindings are `(offset, range)` windows of the shared buffers, and the
 //!   shaders subtract the chunk's base index (push constants) from every index into a
@@ -192,12 +194,6 @@ pub fn write_window(
         offset,
         range,
     )?)
-}
-
-/// Writes `binding` as the whole of `buffer`: buffers every chunk reads in full (tables).
-/// Their size against the limit is checked by vk-core (a typed error).
-pub fn write_whole(set: &DescriptorSet, binding: u32, buffer: &Buffer) -> Result<()> {
-    Ok(set.write_buffer(binding, vk::DescriptorType::STORAGE_BUFFER, buffer)?)
 }
 
 #[cfg(test)]

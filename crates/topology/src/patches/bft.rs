@@ -1461,7 +1461,7 @@ pub fn loop_tables(
 /// The number of f32 weights [`loop_tables`] will store for `records` at `level` (with the
 /// `du`/`dv` blocks when `tangents`), counted from the records alone: no table is evaluated.
 /// Private tables (one per face next to creases, corners and overlapping rings) cost a full
-/// table each, so a mesh with many of them can outgrow a device's storage-buffer range; this
+/// table each, so a mesh with many of them can outgrow what a caller can address or hold; this
 /// lets a caller refuse it in milliseconds instead of after minutes of evaluation.
 pub fn table_weight_count(records: &PatchRecords, level: u32, tangents: bool) -> u64 {
     let pts = table_points(level);

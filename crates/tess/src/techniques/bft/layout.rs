@@ -22,9 +22,8 @@
 //!   (the shader sums with `precise`), so tests can demand the GPU's bits.
 use crate::gpu::bindings::{
     BFT_KIND_BOUNDARY, BFT_KIND_EXTRAORDINARY, BFT_KIND_PRIVATE, BFT_KIND_REGULAR,
-    BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING, BFT_MIRROR_PERMS_BINDING,
-    BFT_OWNER_LOCAL_MASK, BFT_OWNER_SHIFT, BFT_PATCH_HEADERS_BINDING, BFT_PATCH_RINGS_BINDING,
-    BFT_ROW_MAPS_BINDING, BFT_SET, BFT_TABLES_BINDING, BFT_TABLE_WEIGHTS_BINDING,
+    BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING, BFT_OWNER_LOCAL_MASK,
+    BFT_OWNER_SHIFT, BFT_PATCH_HEADERS_BINDING, BFT_PATCH_RINGS_BINDING, BFT_SET,
     BFT_TANGENT_OFFSETS_BINDING, BFT_TANGENT_TERMS_BINDING, FRAME_SET,
 };
 use crate::stencil::{GpuStencils, StencilError};
@@ -68,8 +67,8 @@ pub struct PatchHeader {
     pub corner_owner: [u32; 3],
 }
 
-/// `TableHeader`: the first member of the `Tables` block ([`BFT_TABLES_BINDING`]), followed by
-/// one [`TableEntry`] per table.
+/// `TableHeader`: the first member of the `Tables` block (read by address,
+/// [`BFT_TABLE_ARRAYS_BINDING`](crate::gpu::bindings::BFT_TABLE_ARRAYS_BINDING)), followed by one [`TableEntry`] per table.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct TableHeader {
@@ -80,7 +79,7 @@ pub struct TableHeader {
     /// `3 · 2^L`: the lattice the row maps are indexed on (tessellator points included).
     pub grid: u32,
     pub entry_count: u32,
-    /// Offset of the full tables' row map in `row_maps` ([`BFT_ROW_MAPS_BINDING`]).
+    /// Offset of the full tables' row map in `row_maps`.
     pub full_map_offset: u32,
     /// Offset of the half (mirror-symmetric) tables' row map.
     pub half_map_offset: u32,
@@ -94,12 +93,12 @@ pub struct TableEntry {
     /// 1: only grid points `a ≥ b` are stored (the configuration is mirror-symmetric).
     pub half_table: u32,
     pub rows: u32,
-    /// Weight blocks in `table_weights` ([`BFT_TABLE_WEIGHTS_BINDING`]), `rows × ring_size`
+    /// Weight blocks in `table_weights`, `rows × ring_size`
     /// each; `du_offset`, `dv_offset` are [`NO_WEIGHTS`] without tangent tables.
     pub position_offset: u32,
     pub du_offset: u32,
     pub dv_offset: u32,
-    /// The table's slot permutation in `mirror_perms` ([`BFT_MIRROR_PERMS_BINDING`]).
+    /// The table's slot permutation in `mirror_perms`.
     pub perm_offset: u32,
     /// `BFT_KIND_*`: regular, extraordinary, boundary, private.
     pub kind: u32,
@@ -127,18 +126,16 @@ const _: () = {
 // Pipeline layouts list the frame set, then the BFT set: their numbers must be that order.
 const _: () = assert!(FRAME_SET == 0 && BFT_SET == FRAME_SET + 1);
 
-/// Every binding of the BFT descriptor set, in binding order.
-pub const STORAGE_BINDINGS: [u32; 10] = [
+/// Every storage-buffer binding of the BFT descriptor set, in binding order: each bound in
+/// windows ([`crate::techniques::windows`]). The set's last binding,
+/// [`BFT_TABLE_ARRAYS_BINDING`](crate::gpu::bindings::BFT_TABLE_ARRAYS_BINDING), is the uniform block of the tables' addresses.
+pub const STORAGE_BINDINGS: [u32; 6] = [
     BFT_TANGENT_OFFSETS_BINDING,
     BFT_TANGENT_TERMS_BINDING,
     BFT_LEVEL1_POSITIONS_BINDING,
     BFT_LEVEL1_NORMALS_BINDING,
     BFT_PATCH_HEADERS_BINDING,
     BFT_PATCH_RINGS_BINDING,
-    BFT_TABLES_BINDING,
-    BFT_MIRROR_PERMS_BINDING,
-    BFT_ROW_MAPS_BINDING,
-    BFT_TABLE_WEIGHTS_BINDING,
 ];
 
 /// Packs an owner: face `face`, local edge or corner `local` (0..=2).

@@ -35,27 +35,32 @@
 //! in chunks of patches, each with its own descriptor set of windows into the shared buffers
 //! and its bases in the push constants ([`super::windows`]). A patch's footprint includes its edge and corner owners' headers,
 //! rings and ring vertices, since the TES evaluates shared points in the owner's frame. A mesh
-//! that fits is one chunk with bases 0: the same draw as before.
+//! that fits is one chunk with bases 0: the same draw as before. The basis-function tables
+//! (header and entries, mirror permutations, row maps, weights) are not windowed: a shared
+//! table serves patches anywhere in the mesh, so every chunk may read any of them. The shaders
+//! read them by device address (`GL_EXT_buffer_reference`, the addresses in the uniform block
+//! [`BftTableArrays`]), so no range limits them either; tables are refused only past what
+//! their 32-bit weight offsets address. A device without `bufferDeviceAddress` (a host's) is
+//! refused by name.
 use crate::capture::{face_corner_uv, FacePoint};
 use crate::context::Context;
 use crate::error::{Param, ParamError, Result, TablesTooLarge, TessError};
 pub mod layout;
 
 use super::shared::{
-    check_adaptive_policy, compute_pipeline, factor_fields, storage, storage_binding,
-    storage_buffers, upload_base,
+    check_adaptive_policy, compute_pipeline, factor_fields, storage, storage_binding, upload_base,
+    STAGES,
 };
 use super::windows::{self, Chunk, Limits, Member, Space};
 use crate::animation::base_positions;
 use crate::bench::usage::Laps;
 use crate::gpu::bindings::{
     BFT_LEVEL1_NORMALS_BINDING, BFT_LEVEL1_POSITIONS_BINDING, BFT_LOCAL_SIZE,
-    BFT_MIRROR_PERMS_BINDING, BFT_OPTION_FRACTIONAL, BFT_OPTION_GEOMETRIC_NORMALS,
-    BFT_OPTION_PATCH_COLOURS, BFT_PATCH_HEADERS_BINDING, BFT_PATCH_RINGS_BINDING,
-    BFT_ROW_MAPS_BINDING, BFT_TABLES_BINDING, BFT_TABLE_WEIGHTS_BINDING,
+    BFT_OPTION_FRACTIONAL, BFT_OPTION_GEOMETRIC_NORMALS, BFT_OPTION_PATCH_COLOURS,
+    BFT_PATCH_HEADERS_BINDING, BFT_PATCH_RINGS_BINDING, BFT_TABLE_ARRAYS_BINDING,
     BFT_TANGENT_OFFSETS_BINDING, BFT_TANGENT_TERMS_BINDING,
 };
-use crate::gpu::BftPush;
+use crate::gpu::{BftPush, BftTableArrays};
 use crate::shaders::{Stage, Variant};
 use crate::stencil::{self, GpuStencils, StencilBlock, StencilEvaluator, StencilVertices};
 use crate::technique::{
@@ -138,16 +143,25 @@ fn build_registered(
 /// Default maximum table level: 32 segments per level-1 edge, 64 per base edge.
 pub const DEFAULT_TABLE_LEVEL: u32 = 5;
 
-/// Set 1 of every BFT pipeline: the storage buffers of [`STORAGE_BINDINGS`].
-static SET_BINDINGS: [BindingDesc; STORAGE_BINDINGS.len()] = {
-    let mut out = [storage_binding(0); STORAGE_BINDINGS.len()];
+/// Set 1 of every BFT pipeline: the storage buffers of [`STORAGE_BINDINGS`] (windowed), then
+/// the uniform block of the tables' addresses.
+static SET_BINDINGS: [BindingDesc; STORAGE_BINDINGS.len() + 1] = {
+    let mut out = [storage_binding(0); STORAGE_BINDINGS.len() + 1];
     let mut i = 0;
-    while i < out.len() {
+    while i < STORAGE_BINDINGS.len() {
         out[i] = storage_binding(STORAGE_BINDINGS[i]);
         i += 1;
     }
+    out[i] = BindingDesc {
+        binding: BFT_TABLE_ARRAYS_BINDING,
+        ty: vk::DescriptorType::UNIFORM_BUFFER,
+        stages: STAGES,
+    };
     out
 };
+
+/// The most bytes of table weights: what the entries' 32-bit word offsets address.
+const MAX_TABLE_BYTES: u64 = 4 * u32::MAX as u64;
 
 const fn member(stride: usize, extra: u32) -> Member {
     Member {
@@ -307,24 +321,26 @@ fn plan_draw(
         .collect())
 }
 
-/// Refuses tables whose weights exceed one storage-buffer range before evaluating any (the
-/// weights are one binding that every draw chunk reads whole: a shared table serves patches
-/// anywhere in the mesh). Counting takes milliseconds; evaluating the tables of a mesh with
-/// thousands of private ones takes minutes. The error names the largest level that fits.
+/// Refuses tables whose weights exceed `max_bytes` before evaluating any. The shaders read the
+/// tables by device address (a shared table serves patches anywhere in the mesh, so they are
+/// not windowed), so no storage-buffer range limits them: `max_bytes` is what the entries'
+/// 32-bit word offsets address ([`MAX_TABLE_BYTES`]); device memory is the allocation's to
+/// refuse. Counting takes milliseconds; evaluating the tables of a mesh with thousands of
+/// private ones takes minutes. The error names the largest level that fits.
 fn check_table_range(
     records: &topology::patches::bft::PatchRecords,
     level: u32,
     options: &BftOptions,
-    max_range: u64,
+    max_bytes: u64,
 ) -> Result<()> {
     let bytes_at = |l: u32| 4 * table_weight_count(records, l, options.tangents);
     let bytes = bytes_at(level);
-    if bytes <= max_range {
+    if bytes <= max_bytes {
         return Ok(());
     }
     let fits = (1..level)
         .rev()
-        .find(|&l| bytes_at(l) <= max_range)
+        .find(|&l| bytes_at(l) <= max_bytes)
         .map(|l| (l, bytes_at(l)));
     Err(TessError::BftTablesTooLarge(TablesTooLarge {
         name: options.name.clone(),
@@ -335,7 +351,7 @@ fn check_table_range(
             .filter(|r| matches!(r.key.case, topology::patches::bft::BftCase::Private { .. }))
             .count(),
         faces: records.len(),
-        max: max_range,
+        max: max_bytes,
         fits,
     }))
 }
@@ -570,6 +586,8 @@ impl NormalsStage {
 /// of the summary.
 struct PatchStage {
     buffers: Vec<(u32, Buffer)>,
+    /// The tables' arrays, read at the addresses the [`BFT_TABLE_ARRAYS_BINDING`] block holds.
+    tables: [Buffer; 4],
     draw_chunks: Vec<(Range<u32>, SetWindows)>,
     rotations: Vec<u8>,
     count: u32,
@@ -592,7 +610,7 @@ impl PatchStage {
         stages: &mut Vec<String>,
     ) -> Result<Self> {
         let records = build_patch_records(&level1).map_err(|e| mesh_error(options, e))?;
-        check_table_range(&records, options.table_level, options, limits.max_range)?;
+        check_table_range(&records, options.table_level, options, MAX_TABLE_BYTES)?;
         let tables = loop_tables(&level1, &records, options.table_level, options.tangents)
             .map_err(|e| mesh_error(options, e))?;
         let rotations = face_rotations(&level1, &records);
@@ -618,9 +636,11 @@ impl PatchStage {
             storage(device, "bft patch rings", bytemuck::cast_slice(&rings))?,
         ));
         drop(rings);
-        buffers.extend(table_buffers(device, &packed)?);
+        let (addresses, tables) = table_buffers(device, &packed)?;
+        buffers.push((BFT_TABLE_ARRAYS_BINDING, addresses));
         Ok(Self {
             buffers,
+            tables,
             draw_chunks,
             rotations,
             count,
@@ -633,8 +653,8 @@ impl PatchStage {
     }
 }
 
-/// A set of the BFT layout: the windowed buffers of `statics` as `w`'s windows, the others
-/// whole.
+/// A set of the BFT layout: the windowed buffers of `statics` as `w`'s windows, and the
+/// uniform block of the tables' addresses.
 fn write_set(
     pool: &DescriptorPool,
     layout: &vk_core::descriptor::DescriptorSetLayout,
@@ -655,8 +675,9 @@ fn write_set(
                 (PATCHES.members[0], summary.patch_count as u64, &w.patches)
             }
             BFT_PATCH_RINGS_BINDING => (RINGS.members[0], summary.ring_slots, &w.rings),
+            // BFT_TABLE_ARRAYS_BINDING, the one binding not windowed: a uniform block.
             _ => {
-                windows::write_whole(&set, *binding, buf)?;
+                set.write_buffer(*binding, vk::DescriptorType::UNIFORM_BUFFER, buf)?;
                 continue;
             }
         };
@@ -732,31 +753,46 @@ impl InitialStep {
     }
 }
 
-/// The basis-function tables' buffers, by binding: header and entries, mirror permutations,
-/// row maps, weights.
-fn table_buffers(device: &vk_core::Device, t: &PackedTables) -> Result<Vec<(u32, Buffer)>> {
+/// The basis-function tables' arrays, read by address (header and entries, mirror
+/// permutations, row maps, weights), and the uniform buffer of their addresses
+/// ([`BftTableArrays`]).
+fn table_buffers(device: &vk_core::Device, t: &PackedTables) -> Result<(Buffer, [Buffer; 4])> {
     let table_header = t.header_bytes();
-    storage_buffers(
+    let arrays: [(&str, &[u8]); 4] = [
+        ("bft tables", &table_header[..]),
+        (
+            "bft mirror permutations",
+            bytemuck::cast_slice(&t.mirror_perms),
+        ),
+        ("bft row maps", bytemuck::cast_slice(&t.row_maps)),
+        ("bft table weights", bytemuck::cast_slice(&t.weights)),
+    ];
+    // An empty array is padded (zero-length buffers are invalid); nothing indexes it.
+    let pad = [0u8; 4];
+    let [h, p, m, w] = arrays.map(|(name, bytes)| {
+        let data = if bytes.is_empty() { &pad[..] } else { bytes };
+        Buffer::with_data(
+            device,
+            name,
+            vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
+            data,
+        )
+    });
+    let tables = [h?, p?, m?, w?];
+    let a = |b: &Buffer| b.device_address();
+    let block = BftTableArrays {
+        tables: a(&tables[0])?,
+        perms: a(&tables[1])?,
+        maps: a(&tables[2])?,
+        weights: a(&tables[3])?,
+    };
+    let addresses = Buffer::with_data(
         device,
-        &[
-            (BFT_TABLES_BINDING, "bft tables", &table_header[..]),
-            (
-                BFT_MIRROR_PERMS_BINDING,
-                "bft mirror permutations",
-                bytemuck::cast_slice(&t.mirror_perms),
-            ),
-            (
-                BFT_ROW_MAPS_BINDING,
-                "bft row maps",
-                bytemuck::cast_slice(&t.row_maps),
-            ),
-            (
-                BFT_TABLE_WEIGHTS_BINDING,
-                "bft table weights",
-                bytemuck::cast_slice(&t.weights),
-            ),
-        ],
-    )
+        "bft table addresses",
+        vk::BufferUsageFlags::UNIFORM_BUFFER,
+        bytemuck::bytes_of(&block),
+    )?;
+    Ok((addresses, tables))
 }
 
 impl Bft {
@@ -771,6 +807,14 @@ impl Bft {
     /// [`GpuBft::validate`](layout::GpuBft::validate) does for the whole.
     pub fn new(ctx: &mut Context, mesh: &ControlMesh, options: &BftOptions) -> Result<Self> {
         let device = ctx.device().clone();
+        if !device.info.caps.buffer_device_address {
+            return Err(TessError::Unsupported {
+                technique: TechniqueId::BFT,
+                what: "a device without bufferDeviceAddress enabled (BFT reads its \
+                       basis-function tables by address; a host device sets \
+                       buffer_device_address)",
+            });
+        }
         let patch_block = options
             .patch_block
             .unwrap_or_else(|| patch_block_for(&device));
@@ -894,7 +938,11 @@ impl Bft {
             draw_chunks: patches.draw_chunks,
             _pool: pool,
             base,
-            _static: statics.into_iter().map(|(_, b)| b).collect(),
+            _static: statics
+                .into_iter()
+                .map(|(_, b)| b)
+                .chain(patches.tables)
+                .collect(),
             arrays,
             summary,
             rotations: patches.rotations,
@@ -1243,9 +1291,11 @@ mod tests {
     use super::*;
 
     /// The early size check refuses by the count alone, names the mesh, the level, the private
-    /// faces and the largest level that fits, and passes what fits.
+    /// faces, the bound and the largest level that fits, and passes what fits. (The bound is
+    /// what 32-bit weight offsets address, [`MAX_TABLE_BYTES`]; no storage-buffer range, since
+    /// the tables are read by address: `tests/scale.rs` draws them under a range below them.)
     #[test]
-    fn tables_over_the_storage_range_are_refused_before_evaluation() {
+    fn tables_beyond_the_bound_are_refused_before_evaluation() {
         let path = concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/../../tests/data/opensubdiv/shapes/loop_cube_creases1.obj"
@@ -1269,6 +1319,10 @@ mod tests {
             "at level 5",
             &format!("{at5} bytes"),
             "need a private table",
+            &format!(
+                "more than the {} bytes their 32-bit weight offsets",
+                at5 - 1
+            ),
             &format!("at level 4 they take {at4} bytes (table level 4"),
         ] {
             assert!(err.contains(needle), "{needle:?} in {err}");
@@ -1281,5 +1335,6 @@ mod tests {
             .expect_err("nothing fits")
             .to_string();
         assert!(err.contains("no table level fits"), "{err}");
+        check_table_range(&records, 6, &options, MAX_TABLE_BYTES).expect("level 6 is addressed");
     }
 }

@@ -14,8 +14,15 @@
 //!   the global buffer computes each shared point once, so every shared strip and corner face
 //!   is drawn once by construction and every vertex of it welds by bits.
 //! - **One indexed draw** of the deepest level's faces as triangle fans
-//!   (`glsl/doo_sabin/mesh.vert`), reading the points from a storage-buffer range bound at
-//!   the deepest level (its start aligned for that) with level-local numbers.
+//!   (`glsl/doo_sabin/mesh.vert`), reading the points (level-local numbers from the deepest
+//!   level's first point) and the corner table by device address (`GL_EXT_buffer_reference`,
+//!   the addresses in the uniform block [`DooSabinArrays`]): no descriptor names them, so
+//!   `maxStorageBufferRange` does not limit the level drawn, only device memory does (the
+//!   stencil evaluator windows what it binds, `techniques::windows`). An address rather than
+//!   windows of the draw: a fan's corners and their neighbours may lie anywhere in the level.
+//!   A device without `bufferDeviceAddress` (a host's) is refused by name. The price is
+//!   lavapipe's: its address loads run lane by lane, and the level-6 draw is about 1.6–1.9×
+//!   the descriptor path's GPU time there (docs/benchmarks.md).
 //! - **Normals per point from its face corners**: the sum over the (at most four) faces a
 //!   point lies in of `(next − p) × (previous − p)`, in the vertex stage, from a table of the
 //!   corners' neighbours; no normal pass. Against the exact limit normal at face centres
@@ -33,15 +40,15 @@ pub mod layout;
 use crate::capture::FacePoint;
 use crate::context::Context;
 use crate::error::{Param, ParamError, Result, TessError};
-use crate::gpu::bindings::{DOO_SABIN_CORNERS_BINDING, DOO_SABIN_POINTS_BINDING};
-use crate::gpu::DrawPush;
+use crate::gpu::bindings::DOO_SABIN_ARRAYS_BINDING;
+use crate::gpu::{DooSabinArrays, DrawPush};
 use crate::shaders::Stage;
 use crate::stencil::{self, StencilEvaluator, StencilVertex, StencilVertices};
 use crate::technique::{
     DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features, FrameParams, Pass, PatchArray,
     PatchPipeline, PatchType, Technique, TechniqueId,
 };
-use crate::techniques::shared::{storage, storage_binding, upload_base};
+use crate::techniques::shared::{upload_base, STAGES};
 use crate::techniques::{BuildOptions, Built, TechniqueInfo};
 use layout::{first_level_size, level_sizes, DepthLayout, LayoutError, LevelSize};
 use std::mem::size_of;
@@ -86,13 +93,19 @@ pub static INFO: TechniqueInfo = TechniqueInfo {
 /// maximum, as for the other vertex-stage techniques.
 pub const MAX_DEPTH: u32 = 6;
 
-static SET_BINDINGS: [BindingDesc; 2] = [
-    storage_binding(DOO_SABIN_POINTS_BINDING),
-    storage_binding(DOO_SABIN_CORNERS_BINDING),
-];
+/// Set 1: the uniform block of the arrays' addresses.
+static SET_BINDINGS: [BindingDesc; 1] = [BindingDesc {
+    binding: DOO_SABIN_ARRAYS_BINDING,
+    ty: vk::DescriptorType::UNIFORM_BUFFER,
+    stages: STAGES,
+}];
+
+/// Usage of the buffers the vertex stage reads by address.
+const BY_ADDRESS: vk::BufferUsageFlags = vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
 
 /// One depth on the device. Drop order: the evaluator, the set (it keeps its pool and
-/// buffers alive), the pool, the buffers.
+/// buffers alive), the pool, the buffers (the vertex stage reads `vertices` and `corners` at
+/// the addresses in `addresses`).
 struct DepthMesh {
     layout: DepthLayout,
     evaluator: StencilEvaluator,
@@ -100,6 +113,7 @@ struct DepthMesh {
     _pool: DescriptorPool,
     vertices: Buffer,
     corners: Buffer,
+    addresses: Buffer,
     indices: Buffer,
 }
 
@@ -149,6 +163,14 @@ fn depth_of(params: &FrameParams) -> Result<u32> {
 
 impl DooSabin {
     pub fn new(ctx: &mut Context, mesh: &ControlMesh, options: &BuildOptions) -> Result<Self> {
+        if !ctx.device().info.caps.buffer_device_address {
+            return Err(TessError::Unsupported {
+                technique: TechniqueId::DOO_SABIN,
+                what: "a device without bufferDeviceAddress enabled (Doo-Sabin's vertex stage \
+                       reads its points and corners by address; a host device sets \
+                       buffer_device_address)",
+            });
+        }
         if let Some(&face) = mesh.holes.first() {
             return Err(TessError::Mesh {
                 name: options.name.clone(),
@@ -193,9 +215,8 @@ impl DooSabin {
 
     /// Refines the tables of `depth` on the host and puts them on the device.
     fn build_depth(&mut self, depth: u32) -> Result<()> {
-        let limits = crate::techniques::windows::Limits::of(&self.device);
-        let align = (limits.alignment / gcd(limits.alignment, 16)) as u32;
-        let layout = layout::layout(&self.base, depth, align).map_err(|e| match e {
+        // The deepest level needs no alignment: it is read by address, 16 bytes a point.
+        let layout = layout::layout(&self.base, depth, 1).map_err(|e| match e {
             LayoutError::Topology(t) => TessError::Topology(t),
             LayoutError::Stencil(s) => TessError::Stencil(s),
             other => TessError::Mesh {
@@ -204,19 +225,6 @@ impl DooSabin {
             },
         })?;
         check_indices(&layout)?;
-        let point_bytes = stencil::vertex_bytes(layout.points);
-        let corner_bytes = std::mem::size_of_val(layout.corners.as_slice()) as u64;
-        for (what, bytes) in [("points", point_bytes), ("corners", corner_bytes)] {
-            if bytes > limits.max_range {
-                return Err(TessError::StorageWindow {
-                    what: "Doo-Sabin deepest level",
-                    item: depth,
-                    space: what,
-                    bytes,
-                    max: limits.max_range,
-                });
-            }
-        }
         self.arrays[0].patches = layout.points;
         self.depth = Some(DepthMesh::new(&self.device, &self.set_layout, layout)?);
         Ok(())
@@ -225,14 +233,18 @@ impl DooSabin {
 
 impl DepthMesh {
     /// The vertex buffer, the evaluator of `layout`'s blocks over it, the corner table, the
-    /// index buffer and the set binding the deepest level's range and the corners.
+    /// index buffer, and the set of the uniform buffer holding the addresses of the deepest
+    /// level's first point and of the corners.
     fn new(device: &Device, set_layout: &DescriptorSetLayout, layout: DepthLayout) -> Result<Self> {
         let vertices = Buffer::new(
             device,
             &BufferDesc {
                 name: "doo-sabin vertices",
                 size: stencil::vertex_bytes(layout.num_vertices),
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                // Storage: the stencil evaluator binds windows of it.
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER
+                    | vk::BufferUsageFlags::TRANSFER_DST
+                    | BY_ADDRESS,
                 location: MemoryLocation::GpuOnly,
             },
         )?;
@@ -248,10 +260,22 @@ impl DepthMesh {
             },
             &[(&vertices, &vertices)],
         )?;
-        let corners = storage(
+        let corners = Buffer::with_data(
             device,
             "doo-sabin corners",
+            BY_ADDRESS,
             bytemuck::cast_slice(&layout.corners),
+        )?;
+        let arrays = DooSabinArrays {
+            points: vertices.device_address()?
+                + layout.first_point as u64 * size_of::<StencilVertex>() as u64,
+            corners: corners.device_address()?,
+        };
+        let addresses = Buffer::with_data(
+            device,
+            "doo-sabin array addresses",
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+            bytemuck::bytes_of(&arrays),
         )?;
         let indices = Buffer::with_data(
             device,
@@ -261,14 +285,11 @@ impl DepthMesh {
         )?;
         let pool = DescriptorPool::new(device, "doo-sabin descriptor pool", set_layout, 1)?;
         let set = pool.allocate_set(set_layout)?;
-        set.write_buffer_range(
-            DOO_SABIN_POINTS_BINDING,
-            vk::DescriptorType::STORAGE_BUFFER,
-            &vertices,
-            layout.first_point as u64 * size_of::<StencilVertex>() as u64,
-            stencil::vertex_bytes(layout.points),
+        set.write_buffer(
+            DOO_SABIN_ARRAYS_BINDING,
+            vk::DescriptorType::UNIFORM_BUFFER,
+            &addresses,
         )?;
-        crate::techniques::windows::write_whole(&set, DOO_SABIN_CORNERS_BINDING, &corners)?;
         Ok(Self {
             layout,
             evaluator,
@@ -276,16 +297,9 @@ impl DepthMesh {
             _pool: pool,
             vertices,
             corners,
+            addresses,
             indices,
         })
-    }
-}
-
-fn gcd(a: u64, b: u64) -> u64 {
-    if b == 0 {
-        a.max(1)
-    } else {
-        gcd(b, a % b)
     }
 }
 
@@ -488,7 +502,7 @@ impl Technique for DooSabin {
             .collect();
         if let Some(d) = &self.depth {
             out.extend(
-                [&d.vertices, &d.corners, &d.indices]
+                [&d.vertices, &d.corners, &d.addresses, &d.indices]
                     .into_iter()
                     .chain(d.evaluator.buffers())
                     .map(DeviceAllocation::of_buffer),
