@@ -426,7 +426,7 @@ fn a_storage_write_beyond_the_range_is_refused() {
     drop(gpu);
 }
 
-/// The grid: `nx × ny` quads over the unit square with a gentle height field, split
+/// The 1M-face grid: `nx × ny` quads over the unit square with a gentle height field, split
 /// into two triangles each when `triangles` (tools/grid.py writes the same meshes as OBJ).
 fn grid(nx: u32, ny: u32, triangles: bool) -> ControlMesh {
     let mut pos = Vec::with_capacity(((nx + 1) * (ny + 1)) as usize);
@@ -461,7 +461,7 @@ fn topology_error(e: &tessera::tess::TessError) -> Option<&tessera::topology::To
     source.downcast_ref::<tessera::topology::TopologyError>()
 }
 
-/// Flat, Phong, PN and BFT draw the 1,001,112-triangle grid validation-clean at a
+/// Flat, Phong, PN and BFT draw the 1,001,112-triangle grid validation-clean at a
 /// small viewport (BFT's tangent terms, patch headers and rings exceed lavapipe's 128 MiB
 /// storage range: the windowed path), and adaptive the 1M-quad grid (its stencil terms, 264 MB,
 /// are windowed by rows); adaptive on the triangle grid is refused by the plan's size bound

@@ -173,7 +173,7 @@ impl Context {
     }
 
     /// The refinement pattern of one patch of `domain` at uniform `level` with `spacing`, made
-    /// on first use ([`crate::pattern::PatternCache::get`]) and shared by every surface drawn
+    /// on first use ([`crate::pattern::make`]) and shared by every surface drawn
     /// through this context.
     pub fn refinement_pattern(
         &mut self,

@@ -232,7 +232,8 @@ pub fn from_tessellator(device: &vk_core::Device) -> bool {
 }
 
 /// Makes the pattern of `key` on `ctx`'s device: the tessellator's own where
-/// [`from_tessellator`] and the level is within its 64 ([`tessellator_pattern`]); otherwise
+/// [`from_tessellator`] and the level is within its 64 (one flat patch over the unit domain,
+/// drawn through the tessellator and captured); otherwise
 /// generated, in equal spacing only.
 pub fn make(ctx: &mut Context, key: PatternKey) -> Result<RefinementPattern> {
     if from_tessellator(ctx.device()) && key.level() <= crate::tessellator::MAX_LEVEL {
