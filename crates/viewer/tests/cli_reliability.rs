@@ -379,7 +379,7 @@ fn every_numeric_option_names_its_range() {
     let view = vec!["view", cube.as_str()];
     type Case<'a> = (&'a [&'a str], &'a str, &'a [&'a str], [&'a str; 2], &'a str);
     let cases: Vec<Case> = vec![
-        (&render, "--segments", &[], ["1", "64"], "129"),
+        (&render, "--segments", &[], ["1", "64"], "257"),
         (&render, "--size", &[], ["1", "16384"], "16385x5"),
         (&render, "--yaw", &[], ["-360", "360"], "361"),
         (&render, "--pitch", &[], ["-90", "90"], "91"),
@@ -410,7 +410,7 @@ fn every_numeric_option_names_its_range() {
             "1e7",
         ),
         (&bft, "--frame", &[], ["-1000000", "1000000"], "3.4e38"),
-        (&export, "--segments", &[], ["1", "64"], "129"),
+        (&export, "--segments", &[], ["1", "64"], "257"),
         (&export, "--size", &[], ["1", "16384"], "0x5"),
         (&bench, "--segments", &[], ["1", "64"], "65"),
         (&bench, "--frames", &[], ["1", "4294967295"], "4294967296"),
