@@ -74,6 +74,19 @@ fn bft_run(cap: Option<u32>, mesh: &ControlMesh, params: &FrameParams) -> BftRun
     out
 }
 
+/// A run under a capped storage range against the uncapped one (`what` names the case): the
+/// uncapped run draws something, and both give the same image and capture bit for bit.
+fn assert_same_run(
+    what: &str,
+    (image, capture): (&[u8], &[tessera::tess::gpu::CaptureRecord]),
+    (image_c, capture_c): (&[u8], &[tessera::tess::gpu::CaptureRecord]),
+) {
+    assert!(image.iter().any(|&b| b != 0), "{what}: something is drawn");
+    assert!(image == image_c, "{what}: images differ");
+    assert_eq!(capture.len(), capture_c.len(), "{what}");
+    assert!(capture == capture_c, "{what}: captures differ");
+}
+
 /// The windowed path (a 128 KiB range: several pre-pass and draw chunks; 12,800 patches) draws exactly what the
 /// whole-buffer path draws, under uniform and screen-space factors and geometric normals.
 #[test]
@@ -88,10 +101,7 @@ fn bft_under_a_tiny_storage_range_matches_the_whole_buffer_run() {
         let (image_w, capture_w, chunks_w, _) = bft_run(Some(128 << 10), &mesh, &params);
         println!("chunks under a 128 KiB range: {chunks_w:?}");
         assert!(chunks_w.0 > 1 && chunks_w.1 > 2, "{chunks_w:?}");
-        assert!(image.iter().any(|&b| b != 0), "something is drawn");
-        assert!(image == image_w, "images differ");
-        assert_eq!(capture.len(), capture_w.len());
-        assert!(capture == capture_w, "captures differ");
+        assert_same_run("bft windows", (&image, &capture), (&image_w, &capture_w));
     }
 }
 
@@ -119,10 +129,7 @@ fn bft_tables_beyond_the_storage_range_match_the_uncapped_run() {
         "bft tables {tables} B under a {cap} B range: chunks {chunks_c:?}, {} records",
         capture.len()
     );
-    assert!(image.iter().any(|&b| b != 0), "something is drawn");
-    assert!(image == image_c, "images differ");
-    assert_eq!(capture.len(), capture_c.len());
-    assert!(capture == capture_c, "captures differ");
+    assert_same_run("bft tables", (&image, &capture), (&image_c, &capture_c));
 }
 
 /// What an adaptive run gives: image, capture, (stencil dispatches, window sets), and the
@@ -198,10 +205,11 @@ fn adaptive_under_a_small_storage_range_matches_the_whole_buffer_run() {
     let (image_w, capture_w, chunks_w, _) = adaptive_run(Some(cap as u32), &mesh, &params);
     println!("chunks under a {cap} B range: {chunks_w:?} (uncapped {chunks:?})");
     assert!(chunks_w.1 >= 2 && chunks_w.0 > chunks.0, "{chunks_w:?}");
-    assert!(image.iter().any(|&b| b != 0), "something is drawn");
-    assert!(image == image_w, "images differ");
-    assert_eq!(capture.len(), capture_w.len());
-    assert!(capture == capture_w, "captures differ");
+    assert_same_run(
+        "adaptive stencils",
+        (&image, &capture),
+        (&image_w, &capture_w),
+    );
 }
 
 /// The planned-patch technique `which` of `mesh` ("adaptive" at isolation 2, "gregory" or
@@ -282,10 +290,7 @@ fn planned_patches_beyond_the_storage_range_match_the_uncapped_run() {
             "{which}: {vertex_bytes} B of vertices under a {cap} B range, {} records",
             capture.len()
         );
-        assert!(image.iter().any(|&b| b != 0), "{which}: something is drawn");
-        assert!(image == image_c, "{which}: images differ");
-        assert_eq!(capture.len(), capture_c.len(), "{which}");
-        assert!(capture == capture_c, "{which}: captures differ");
+        assert_same_run(which, (&image, &capture), (&image_c, &capture_c));
     }
 }
 
@@ -344,10 +349,7 @@ fn doo_sabin_beyond_the_storage_range_matches_the_uncapped_run() {
          {} records",
         capture.len()
     );
-    assert!(image.iter().any(|&b| b != 0), "something is drawn");
-    assert!(image == image_c, "images differ");
-    assert_eq!(capture.len(), capture_c.len());
-    assert!(capture == capture_c, "captures differ");
+    assert_same_run("doo-sabin", (&image, &capture), (&image_c, &capture_c));
 }
 
 /// A descriptor write whose range exceeds the (capped) device limit is a typed error, and one

@@ -1,8 +1,25 @@
 //! Capture through the C ABI: what the GPU's tessellation emitted for one frame, written as
 //! OBJ (as `tessera export` writes it), one face per reported triangle.
+mod common;
+
 use std::ffi::CString;
 use std::ptr::{null, null_mut};
 use tessera_capi::*;
+
+/// A standalone context with synchronization validation on (its messages are counted by
+/// `tessera_context_validation_errors`, which each test checks).
+fn standalone_context() -> *mut TesseraContext {
+    let desc = TesseraStandaloneDesc {
+        device: null(),
+        validation: TESSERA_VALIDATION_SYNCHRONIZATION,
+        ..Default::default()
+    };
+    let mut ctx = null_mut();
+    // SAFETY: `desc` and `ctx` are live locals of the types the call reads and writes.
+    let status = unsafe { tessera_context_create_standalone(&desc, &mut ctx) };
+    assert_eq!(status, TesseraStatus::Ok);
+    ctx
+}
 
 #[test]
 fn capture_writes_the_triangles_the_gpu_drew() {
@@ -12,34 +29,14 @@ fn capture_writes_the_triangles_the_gpu_drew() {
     let c_path = CString::new(path.to_str().unwrap()).unwrap();
     // SAFETY: every pointer is null or addresses a live local of the type the call reads.
     unsafe {
-        let desc = TesseraStandaloneDesc {
-            device: null(),
-            validation: TESSERA_VALIDATION_SYNCHRONIZATION,
-            ..Default::default()
-        };
-        let mut ctx = null_mut();
-        assert_eq!(
-            tessera_context_create_standalone(&desc, &mut ctx),
-            TesseraStatus::Ok
-        );
-        let mut sdesc = std::mem::MaybeUninit::uninit();
-        assert_eq!(
-            tessera_surface_desc_default(sdesc.as_mut_ptr()),
-            TesseraStatus::Ok
-        );
-        let mut sdesc = sdesc.assume_init();
-        sdesc.technique = TESSERA_TECHNIQUE_FLAT;
+        let ctx = standalone_context();
+        let sdesc = common::surface_desc(TESSERA_TECHNIQUE_FLAT);
         let mut surface = null_mut();
         assert_eq!(
             tessera_surface_create_obj(ctx, null(), 0, null(), &sdesc, &mut surface),
             TesseraStatus::Ok
         );
-        let mut frame = std::mem::MaybeUninit::uninit();
-        assert_eq!(
-            tessera_frame_desc_default(frame.as_mut_ptr()),
-            TesseraStatus::Ok
-        );
-        let mut frame = frame.assume_init();
+        let mut frame = common::frame_desc(640, 480);
         frame.factor = 2.0;
         let mut triangles = 0u64;
         let status = tessera_capture_obj(ctx, surface, &frame, c_path.as_ptr(), &mut triangles);
@@ -94,29 +91,10 @@ fn the_pipeline_choice_draws_patterns_or_is_refused() {
     std::fs::create_dir_all(&dir).unwrap();
     // SAFETY: every pointer is null or addresses a live local of the type the call reads.
     unsafe {
-        let desc = TesseraStandaloneDesc {
-            device: null(),
-            validation: TESSERA_VALIDATION_SYNCHRONIZATION,
-            ..Default::default()
-        };
-        let mut ctx = null_mut();
-        assert_eq!(
-            tessera_context_create_standalone(&desc, &mut ctx),
-            TesseraStatus::Ok
-        );
-        let mut sdesc = std::mem::MaybeUninit::uninit();
-        assert_eq!(
-            tessera_surface_desc_default(sdesc.as_mut_ptr()),
-            TesseraStatus::Ok
-        );
-        let mut sdesc = sdesc.assume_init();
+        let ctx = standalone_context();
+        let mut sdesc = common::surface_desc(TESSERA_TECHNIQUE_AUTO);
         assert_eq!(sdesc.pipeline, TESSERA_PIPELINE_AUTO);
-        let mut frame = std::mem::MaybeUninit::uninit();
-        assert_eq!(
-            tessera_frame_desc_default(frame.as_mut_ptr()),
-            TesseraStatus::Ok
-        );
-        let mut frame = frame.assume_init();
+        let mut frame = common::frame_desc(640, 480);
         frame.factor = 3.0;
         let mut objs = Vec::new();
         for (pipeline, name) in [
