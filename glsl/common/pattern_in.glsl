@@ -9,6 +9,16 @@ layout(location = 3) in vec3 in_p1;
 layout(location = 4) in vec3 in_n1;
 layout(location = 5) in vec3 in_p2;
 layout(location = 6) in vec3 in_n2;
+#ifdef SCALAR_TAGS
+// A scalar-tagged PN triangle's corners' edge control points (tess::gpu::pattern_input::
+// TAGGED_TRIANGLE): per instance, corner i's next and previous edge points.
+layout(location = 7) in vec4 in_bn0;
+layout(location = 8) in vec4 in_bp0;
+layout(location = 9) in vec4 in_bn1;
+layout(location = 10) in vec4 in_bp1;
+layout(location = 11) in vec4 in_bn2;
+layout(location = 12) in vec4 in_bp2;
+#endif
 #ifdef PATTERN_QUAD
 layout(location = 7) in vec3 in_p3;
 layout(location = 8) in vec3 in_n3;

@@ -74,6 +74,15 @@ struct PnPatch {
     vec3 n_edge[3];
 };
 
+// b111 = 1/4 sum(edge points) - 1/6 sum(corners), as e + (e - v) / 2 with e and v the means;
+// only interior points use it.
+vec3 pn_centre(vec3 b_edge[6], vec3 c[3]) {
+    precise vec3 e = (b_edge[0] + b_edge[1] + b_edge[2] + b_edge[3] + b_edge[4] + b_edge[5]) / 6.0;
+    precise vec3 v = (c[0] + c[1] + c[2]) / 3.0;
+    precise vec3 b111 = e + 0.5 * (e - v);
+    return b111;
+}
+
 PnPatch pn_patch(vec3 c[3], vec3 n[3]) {
     PnPatch q;
     for (int e = 0; e < 3; e++) {
@@ -83,12 +92,7 @@ PnPatch pn_patch(vec3 c[3], vec3 n[3]) {
         q.n_edge[e] = pn_corner_below(c[i], n[i], c[j], n[j]) ? pn_edge_normal(c[i], n[i], c[j], n[j])
                                                             : pn_edge_normal(c[j], n[j], c[i], n[i]);
     }
-    // b111 = 1/4 sum(edge points) - 1/6 sum(corners), as e + (e - v) / 2 with e and v the
-    // means; only interior points use it.
-    precise vec3 e = (q.b_edge[0] + q.b_edge[1] + q.b_edge[2] + q.b_edge[3] + q.b_edge[4] + q.b_edge[5]) / 6.0;
-    precise vec3 v = (c[0] + c[1] + c[2]) / 3.0;
-    precise vec3 b111 = e + 0.5 * (e - v);
-    q.b111 = b111;
+    q.b111 = pn_centre(q.b_edge, c);
     return q;
 }
 
@@ -136,3 +140,23 @@ void pn_evaluate(vec3 c[3], vec3 n[3], PnPatch q, vec3 b, out vec3 p, out vec3 m
         m = mi;
     }
 }
+
+#ifdef SCALAR_TAGS
+// A curved PN triangle of a scalar-tagged mesh (Boubekeur et al., appendix B): where corner k
+// is tagged (bn[k].w != 0), its two edge control points are the ones its tags make,
+// computed on the CPU from the edge alone (tess::techniques::pn::scalar_tags): bn[k] on the
+// edge to corner k + 1, bp[k] on the edge to corner k - 1. Untagged corners keep PN's
+// (pn_patch), so a triangle without tags is PN's to the bit, and both patches of an edge
+// get the same edge points. The corner normals n are the sides' sharp normals.
+PnPatch pn_patch_tagged(vec3 c[3], vec3 n[3], vec4 bn[3], vec4 bp[3]) {
+    PnPatch q = pn_patch(c, n);
+    for (int k = 0; k < 3; k++) {
+        if (bn[k].w != 0.0) {
+            q.b_edge[2 * k] = bn[k].xyz;
+            q.b_edge[2 * ((k + 2) % 3) + 1] = bp[k].xyz;
+        }
+    }
+    q.b111 = pn_centre(q.b_edge, c);
+    return q;
+}
+#endif

@@ -1362,6 +1362,7 @@ unsafe fn read_mesh(d: &TesseraMeshDesc) -> Result<(topology::ControlMesh, Strin
         creases,
         corners,
         holes: Vec::new(),
+        scalar_tags: Vec::new(),
         options: Default::default(),
     };
     Ok((mesh, name))

@@ -86,6 +86,17 @@ pub enum TopologyError {
         index: u32,
         count: usize,
     },
+    /// A scalar tag (an ST-mesh's per-vertex shape parameters) that cannot shape its vertex:
+    /// a value out of its range, a second tag on one vertex, or a vertex on two creases.
+    #[error("scalar tag of vertex {vertex}: {problem}")]
+    ScalarTag { vertex: u32, problem: String },
+    /// A fan triangle of a face with three vertices carrying a deviation vector: an ST-mesh
+    /// takes at most two per triangle (one crease edge).
+    #[error(
+        "face {face}: a triangle of it has three vertices with a deviation vector (scalar tags \
+         allow two per triangle: a crease crosses a triangle along one edge)"
+    )]
+    ScalarTagTriangle { face: usize },
     /// `face_offsets` does not start at 0, decreases, or does not end at the corner count.
     #[error(
         "malformed face table: face_offsets ({faces} faces) is not a valid prefix table over {corners} face_vertices"
@@ -204,13 +215,14 @@ pub enum TagKind {
     Crease,
     Corner,
     Hole,
+    ScalarTag,
 }
 
 impl TagKind {
     /// What the tag's indices name.
     pub fn element(self) -> &'static str {
         match self {
-            TagKind::Crease | TagKind::Corner => "vertex",
+            TagKind::Crease | TagKind::Corner | TagKind::ScalarTag => "vertex",
             TagKind::Hole => "face",
         }
     }
@@ -218,7 +230,7 @@ impl TagKind {
     /// [`TagKind::element`] in the plural.
     pub fn elements(self) -> &'static str {
         match self {
-            TagKind::Crease | TagKind::Corner => "vertices",
+            TagKind::Crease | TagKind::Corner | TagKind::ScalarTag => "vertices",
             TagKind::Hole => "faces",
         }
     }
@@ -230,6 +242,7 @@ impl std::fmt::Display for TagKind {
             TagKind::Crease => "crease",
             TagKind::Corner => "corner",
             TagKind::Hole => "hole",
+            TagKind::ScalarTag => "scalartag",
         })
     }
 }
@@ -462,6 +475,11 @@ pub enum ObjSyntax {
     CornerNeedsVertices,
     #[error("tag 'hole' needs at least one face")]
     HoleNeedsFaces,
+    #[error(
+        "tag 'scalartag' takes one vertex and six numbers (1/6/0: v Dx Dy Dz tension sharpness \
+         bias), found {ints} integers and {floats} numbers"
+    )]
+    ScalarTagShape { ints: usize, floats: usize },
     #[error("tag '{option}': {value}; expected {expected}")]
     BadOptionValue {
         option: String,

@@ -18,6 +18,7 @@ use crate::techniques::planned_patches::layout::{
 };
 use crate::tessellator::Spacing;
 use std::mem::{offset_of, size_of};
+use vk_core::vk;
 
 /// Member offsets of a Rust struct, in declaration order.
 macro_rules! offsets {
@@ -91,6 +92,7 @@ fn variant(spacing: Option<Spacing>, capture: bool) -> Variant {
         capture,
         surface: false,
         patch_block: false,
+        scalar_tags: false,
     }
 }
 
@@ -99,6 +101,7 @@ const PLAIN: Variant = Variant {
     capture: false,
     surface: false,
     patch_block: false,
+    scalar_tags: false,
 };
 
 /// BFT's patch-block build (its control stage reads the ring and level-1 buffers too).
@@ -140,6 +143,47 @@ fn pattern_input_rows() -> Vec<(Stage, Variant, Check)> {
             out.push((stage, PLAIN, at(NORMALS[i], 1, i * corner + 12)));
         }
     }
+    out
+}
+
+/// The scalar-tagged PN stages' inputs: the pattern vertex stage's tagged corners against
+/// [`super::pattern_input::TAGGED_TRIANGLE`] (with the untagged corners still where
+/// [`super::pattern_input::TRIANGLE`] has them), and the tessellation path's vertex stage
+/// against [`super::TaggedCorner::MESH`].
+fn tagged_input_rows() -> Vec<(Stage, Variant, Check)> {
+    use super::pattern_input::TAGGED_TRIANGLE;
+    let tagged = Variant {
+        scalar_tags: true,
+        ..PLAIN
+    };
+    let corner = size_of::<Vertex>();
+    let tag = size_of::<super::TaggedCorner>();
+    let at = |name, input, binding, offset| Check::PatternInput {
+        name,
+        input,
+        binding,
+        offset,
+    };
+    let stage = Stage::PnPatternTriVert;
+    let mut out = vec![(stage, tagged, at("in_domain", TAGGED_TRIANGLE, 0, 0))];
+    const NEXT: [&str; 3] = ["in_bn0", "in_bn1", "in_bn2"];
+    const PREV: [&str; 3] = ["in_bp0", "in_bp1", "in_bp2"];
+    const POSITIONS: [&str; 3] = ["in_p0", "in_p1", "in_p2"];
+    for i in 0..3 {
+        out.push((
+            stage,
+            tagged,
+            at(POSITIONS[i], TAGGED_TRIANGLE, 1, i * corner),
+        ));
+        out.push((stage, tagged, at(NEXT[i], TAGGED_TRIANGLE, 2, i * tag)));
+        out.push((stage, tagged, at(PREV[i], TAGGED_TRIANGLE, 2, i * tag + 16)));
+    }
+    let mesh = super::TaggedCorner::MESH;
+    let stage = Stage::PnTaggedMeshVert;
+    out.push((stage, PLAIN, at("in_position", mesh, 0, 0)));
+    out.push((stage, PLAIN, at("in_normal", mesh, 0, 12)));
+    out.push((stage, PLAIN, at("in_b_next", mesh, 1, 0)));
+    out.push((stage, PLAIN, at("in_b_prev", mesh, 1, 16)));
     out
 }
 
@@ -695,6 +739,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         }
     }
     rows.extend(pattern_input_rows());
+    rows.extend(tagged_input_rows());
     rows
 }
 
@@ -844,9 +889,13 @@ fn check(stage: Stage, v: Variant, check: &Check) -> Result<(), String> {
                 .iter()
                 .find(|a| a.location == location)
                 .ok_or_else(|| format!("{name}: location {location} has no vertex attribute"))?;
-            if attr.binding != *binding || attr.offset as usize != *offset || bytes != 12 {
+            let size = match attr.format {
+                vk::Format::R32G32B32A32_SFLOAT => 16,
+                _ => 12,
+            };
+            if attr.binding != *binding || attr.offset as usize != *offset || bytes != size {
                 return Err(format!(
-                    "{name}: attribute at binding {} offset {}, input {bytes} bytes; expected binding {binding} offset {offset}, 12 bytes",
+                    "{name}: attribute at binding {} offset {} of {size} bytes, input {bytes} bytes; expected binding {binding} offset {offset}",
                     attr.binding, attr.offset
                 ));
             }
@@ -933,8 +982,8 @@ fn the_table_covers_every_storage_binding_and_capture_build() {
         .count();
     // Nine TESs in three spacings, the four adaptive ones and BFT's also with their surface code,
     // BFT's also with and without its patch block; the CPU mesh's and Doo-Sabin's vertex stages,
-    // and the four refinement-pattern vertex stages.
-    assert_eq!(capture_builds, 54);
+    // and the four refinement-pattern vertex stages, PN's also in its scalar-tagged build.
+    assert_eq!(capture_builds, 55);
     assert_eq!(xfb_rows, capture_builds);
 }
 
@@ -1012,7 +1061,7 @@ fn capture_variants_and_only_they_have_xfb() {
             captures += v.capture as usize;
         }
     }
-    assert_eq!(captures, 54);
+    assert_eq!(captures, 55);
 }
 
 #[test]

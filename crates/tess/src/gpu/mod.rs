@@ -256,12 +256,59 @@ impl Vertex {
     ];
 }
 
+/// A scalar-tagged PN triangle's corner beyond its [`Vertex`]: the edge control points its tags
+/// make on the edge to the next corner and on the edge to the previous one, `w` 1 where the
+/// corner is tagged (else 0, and PN's own points are used; `glsl/pn/pn.glsl`,
+/// `pn_patch_tagged`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct TaggedCorner {
+    pub b_next: [f32; 4],
+    pub b_prev: [f32; 4],
+}
+
+const _: () = assert!(size_of::<TaggedCorner>() == 32);
+
+impl TaggedCorner {
+    const MESH_BINDINGS: [vk::VertexInputBindingDescription; 2] = [
+        Vertex::BINDING,
+        vk::VertexInputBindingDescription {
+            binding: 1,
+            stride: size_of::<TaggedCorner>() as u32,
+            input_rate: vk::VertexInputRate::VERTEX,
+        },
+    ];
+    const MESH_ATTRIBUTES: [vk::VertexInputAttributeDescription; 4] = [
+        Vertex::ATTRIBUTES[0],
+        Vertex::ATTRIBUTES[1],
+        vk::VertexInputAttributeDescription {
+            location: 2,
+            binding: 1,
+            format: vk::Format::R32G32B32A32_SFLOAT,
+            offset: offset_of!(TaggedCorner, b_next) as u32,
+        },
+        vk::VertexInputAttributeDescription {
+            location: 3,
+            binding: 1,
+            format: vk::Format::R32G32B32A32_SFLOAT,
+            offset: offset_of!(TaggedCorner, b_prev) as u32,
+        },
+    ];
+
+    /// The tessellation path's input (`glsl/pn/tagged_mesh.vert`): the corners' [`Vertex`]es
+    /// at binding 0 and their tagged corners, parallel, at binding 1 (locations 2 and 3).
+    pub const MESH: crate::technique::VertexInput = crate::technique::VertexInput {
+        bindings: &Self::MESH_BINDINGS,
+        attributes: &Self::MESH_ATTRIBUTES,
+    };
+}
+
 /// The refinement-pattern path's vertex input (`glsl/common/pattern_in.glsl`): binding 0 per
 /// pattern vertex, its domain point (three floats, [`crate::pattern::RefinementPattern`]) at
 /// location 0; binding 1 per instance, the patch's corners as [`Vertex`]es, corner `i`'s
 /// position at location `1 + 2i` and normal at `2 + 2i`.
 pub mod pattern_input {
-    use super::Vertex;
+    use super::{TaggedCorner, Vertex};
     use crate::technique::VertexInput;
     use std::mem::size_of;
     use vk_core::vk;
@@ -309,6 +356,45 @@ pub mod pattern_input {
     const QUAD_BINDINGS: [vk::VertexInputBindingDescription; 2] = bindings(4);
     const QUAD_ATTRIBUTES: [vk::VertexInputAttributeDescription; 9] = attributes();
 
+    const TAGGED_BINDINGS: [vk::VertexInputBindingDescription; 3] = [
+        TRIANGLE_BINDINGS[0],
+        TRIANGLE_BINDINGS[1],
+        vk::VertexInputBindingDescription {
+            binding: 2,
+            stride: (3 * size_of::<TaggedCorner>()) as u32,
+            input_rate: vk::VertexInputRate::INSTANCE,
+        },
+    ];
+
+    /// The triangle attributes, then each corner's next and previous tagged edge points.
+    const fn tagged_attributes() -> [vk::VertexInputAttributeDescription; 13] {
+        let mut out = [TRIANGLE_ATTRIBUTES[0]; 13];
+        let mut i = 0;
+        while i < 13 {
+            out[i] = if i < 7 {
+                TRIANGLE_ATTRIBUTES[i]
+            } else {
+                let (corner, prev) = ((i - 7) / 2, (i - 7) % 2);
+                vk::VertexInputAttributeDescription {
+                    location: i as u32,
+                    binding: 2,
+                    format: vk::Format::R32G32B32A32_SFLOAT,
+                    offset: (corner * size_of::<TaggedCorner>() + prev * 16) as u32,
+                }
+            };
+            i += 1;
+        }
+        out
+    }
+    const TAGGED_ATTRIBUTES: [vk::VertexInputAttributeDescription; 13] = tagged_attributes();
+
+    /// Scalar-tagged PN triangles: [`TRIANGLE`], and per instance at binding 2 the three
+    /// corners' [`TaggedCorner`]s (corner `i`'s next point at location `7 + 2i`, previous at
+    /// `8 + 2i`).
+    pub const TAGGED_TRIANGLE: VertexInput = VertexInput {
+        bindings: &TAGGED_BINDINGS,
+        attributes: &TAGGED_ATTRIBUTES,
+    };
     /// Triangle patches: three corners per instance.
     pub const TRIANGLE: VertexInput = VertexInput {
         bindings: &TRIANGLE_BINDINGS,

@@ -8,10 +8,14 @@
 //!   corners (read per instance), and the pattern of the frame's domain, spacing and level
 //!   (the [`Context`]'s, made once); one instanced indexed draw per array, the vertex stage
 //!   evaluating the patch with the same shader functions as the evaluation stage.
+//! - **Scalar-tagged meshes** (PN only, [`FaceStyle::SCALAR_TAGS`]): the corners come unshared
+//!   with a [`TaggedCorner`] each (`techniques::pn::scalar_tags`), in a second vertex buffer on
+//!   the tessellation path and a second per-instance buffer on the pattern path, drawn with
+//!   the style's [`FaceStyle::tagged_pipeline`].
 use crate::capture::{FacePoint, PatchFaceTable};
 use crate::context::Context;
 use crate::error::{Param, ParamError, Result, TessError};
-use crate::gpu::{pattern_input, DrawPush, Vertex};
+use crate::gpu::{pattern_input, DrawPush, TaggedCorner, Vertex};
 use crate::pattern::{PatternKey, RefinementPattern};
 use crate::render_mesh::{PatchOrigin, RenderMesh};
 use crate::shaders::Stage;
@@ -53,6 +57,13 @@ pub trait FaceStyle: Send + 'static {
     fn pipeline(patch: PatchType) -> PatchPipeline;
     /// The vertex stage evaluating a patch of `domain` at a pattern vertex.
     fn pattern_stage(domain: Domain) -> Stage;
+    /// Whether the style draws a mesh's scalar tags (`t scalartag`); the others draw the
+    /// faces untagged.
+    const SCALAR_TAGS: bool = false;
+    /// The pipeline of `patch` (either path) for a scalar-tagged mesh.
+    fn tagged_pipeline(_patch: PatchType) -> Option<PatchPipeline> {
+        None
+    }
 }
 
 /// An index buffer of one patch array.
@@ -104,12 +115,16 @@ impl PatternBuffers {
 enum Draws {
     Tessellated {
         vertices: Buffer,
+        /// A scalar-tagged mesh's [`TaggedCorner`]s, parallel to `vertices`.
+        tagged: Option<Buffer>,
         /// Parallel to the arrays.
         indices: Vec<IndexArray>,
     },
     Patterns {
         /// Per array, each patch's corners (per-instance data), parallel to the arrays.
         corners: Vec<Buffer>,
+        /// A scalar-tagged mesh's per-array [`TaggedCorner`]s of each patch's corners.
+        tagged: Option<Vec<Buffer>>,
         /// The frame's patterns, per domain (triangle, quad).
         current: [Option<PatternBuffers>; 2],
         /// Whether the device's patterns are its tessellator's
@@ -150,11 +165,27 @@ impl<S: FaceStyle> FacePatches<S> {
 
     /// Builds normals and patch lists of `mesh` for `path` (indices checked by [`RenderMesh`],
     /// and again here before upload: the GPU never receives one out of range).
+    /// A mesh with scalar tags is drawn as an ST-mesh where the style takes tags.
     pub fn new(device: &Device, mesh: &ControlMesh, path: DrawPath) -> Result<Self> {
-        Self::from_render_mesh(device, &RenderMesh::from_control_mesh(mesh)?, path)
+        let render = RenderMesh::from_control_mesh(mesh)?;
+        if S::SCALAR_TAGS && !mesh.scalar_tags.is_empty() {
+            let tagged = crate::techniques::pn::scalar_tags::tag_mesh(mesh, &render)?;
+            return Self::from_parts(device, &tagged.render, Some(&tagged.corners), path);
+        }
+        Self::from_render_mesh(device, &render, path)
     }
 
     pub fn from_render_mesh(device: &Device, mesh: &RenderMesh, path: DrawPath) -> Result<Self> {
+        Self::from_parts(device, mesh, None, path)
+    }
+
+    /// `mesh`'s patches, with `tagged` parallel to its vertices for a scalar-tagged mesh.
+    fn from_parts(
+        device: &Device,
+        mesh: &RenderMesh,
+        tagged: Option<&[TaggedCorner]>,
+        path: DrawPath,
+    ) -> Result<Self> {
         let lists = Self::patch_lists(mesh);
         let n = mesh.vertices.len() as u32;
         if let Some(&bad) = lists.iter().flat_map(|l| &l.1).find(|&&i| i >= n) {
@@ -175,8 +206,8 @@ impl<S: FaceStyle> FacePatches<S> {
             origins.extend_from_slice(o);
         }
         let draws = match path {
-            DrawPath::Pattern => Self::pattern_draws(device, mesh, &lists)?,
-            _ => Self::tessellated_draws(device, mesh, &lists)?,
+            DrawPath::Pattern => Self::pattern_draws(device, mesh, tagged, &lists)?,
+            _ => Self::tessellated_draws(device, mesh, tagged, &lists)?,
         };
         Ok(Self {
             draws,
@@ -216,6 +247,7 @@ impl<S: FaceStyle> FacePatches<S> {
     fn tessellated_draws(
         device: &Device,
         mesh: &RenderMesh,
+        tagged: Option<&[TaggedCorner]>,
         lists: &[PatchList<'_>],
     ) -> Result<Draws> {
         let vertices = Buffer::with_data(
@@ -224,6 +256,16 @@ impl<S: FaceStyle> FacePatches<S> {
             vk::BufferUsageFlags::VERTEX_BUFFER,
             bytemuck::cast_slice(&mesh.vertices),
         )?;
+        let tagged = tagged
+            .map(|t| {
+                Buffer::with_data(
+                    device,
+                    "scalar-tagged corners",
+                    vk::BufferUsageFlags::VERTEX_BUFFER,
+                    bytemuck::cast_slice(t),
+                )
+            })
+            .transpose()?;
         let indices = lists
             .iter()
             .map(|(patch, list, cp, _)| {
@@ -238,12 +280,38 @@ impl<S: FaceStyle> FacePatches<S> {
                 })
             })
             .collect::<Result<_>>()?;
-        Ok(Draws::Tessellated { vertices, indices })
+        Ok(Draws::Tessellated {
+            vertices,
+            tagged,
+            indices,
+        })
     }
 
     /// The pattern path's per-array corner buffers (each patch's corners, read per instance);
     /// the patterns come with the first frame.
-    fn pattern_draws(device: &Device, mesh: &RenderMesh, lists: &[PatchList<'_>]) -> Result<Draws> {
+    fn pattern_draws(
+        device: &Device,
+        mesh: &RenderMesh,
+        tagged: Option<&[TaggedCorner]>,
+        lists: &[PatchList<'_>],
+    ) -> Result<Draws> {
+        let tagged = tagged
+            .map(|t| {
+                lists
+                    .iter()
+                    .map(|(patch, list, _, _)| {
+                        let corners: Vec<TaggedCorner> =
+                            list.iter().map(|&i| t[i as usize]).collect();
+                        Ok(Buffer::with_data(
+                            device,
+                            &format!("{} {patch:?} pattern tagged corners", S::ID),
+                            vk::BufferUsageFlags::VERTEX_BUFFER,
+                            bytemuck::cast_slice(&corners),
+                        )?)
+                    })
+                    .collect::<Result<Vec<_>>>()
+            })
+            .transpose()?;
         let corners = lists
             .iter()
             .map(|(patch, list, _, _)| {
@@ -259,9 +327,18 @@ impl<S: FaceStyle> FacePatches<S> {
             .collect::<Result<_>>()?;
         Ok(Draws::Patterns {
             corners,
+            tagged,
             current: [None, None],
             from_tessellator: crate::pattern::from_tessellator(device),
         })
+    }
+
+    /// Whether the mesh is drawn with its scalar tags.
+    fn is_tagged(&self) -> bool {
+        match &self.draws {
+            Draws::Tessellated { tagged, .. } => tagged.is_some(),
+            Draws::Patterns { tagged, .. } => tagged.is_some(),
+        }
     }
 
     /// Uniform level of `params` (base-face patches take uniform factors only).
@@ -296,7 +373,12 @@ impl<S: FaceStyle> FacePatches<S> {
         array: usize,
         pass: Pass,
     ) -> Result<DrawCounts> {
-        let (Some(a), Draws::Patterns { corners, .. }) = (self.arrays.get(array), &self.draws)
+        let (
+            Some(a),
+            Draws::Patterns {
+                corners, tagged, ..
+            },
+        ) = (self.arrays.get(array), &self.draws)
         else {
             return Err(TessError::NoPatchArray { array });
         };
@@ -305,6 +387,10 @@ impl<S: FaceStyle> FacePatches<S> {
         };
         enc.bind_vertex_buffer(0, &p.points);
         enc.bind_vertex_buffer(1, corners);
+        if let Some(t) = tagged {
+            let t = t.get(array).ok_or(TessError::NoPatchArray { array })?;
+            enc.bind_vertex_buffer(2, t);
+        }
         enc.bind_index_buffer_u32(&p.indices);
         enc.push_constants(&DrawPush {
             mode: pass.mode(),
@@ -362,6 +448,13 @@ impl<S: FaceStyle> Technique for FacePatches<S> {
     }
 
     fn patch_pipeline(&self, patch: PatchType) -> PatchPipeline {
+        if let Some(p) = self
+            .is_tagged()
+            .then(|| S::tagged_pipeline(patch))
+            .flatten()
+        {
+            return p;
+        }
         if patch.path() != DrawPath::Pattern {
             return S::pipeline(patch);
         }
@@ -438,7 +531,12 @@ impl<S: FaceStyle> Technique for FacePatches<S> {
         pass: Pass,
         per_draw: u32,
     ) -> Result<DrawCounts> {
-        let Draws::Tessellated { vertices, indices } = &self.draws else {
+        let Draws::Tessellated {
+            vertices,
+            tagged,
+            indices,
+        } = &self.draws
+        else {
             return self.record_patterns(enc, array, pass);
         };
         let (a, list) = match (self.arrays.get(array), indices.get(array)) {
@@ -446,6 +544,9 @@ impl<S: FaceStyle> Technique for FacePatches<S> {
             _ => return Err(TessError::NoPatchArray { array }),
         };
         enc.bind_vertex_buffer(0, vertices);
+        if let Some(t) = tagged {
+            enc.bind_vertex_buffer(1, t);
+        }
         enc.bind_index_buffer_u32(&list.indices);
         let cp = list.control_points;
         for_each_draw(a.patches, per_draw, |first, n| {
@@ -466,13 +567,22 @@ impl<S: FaceStyle> Technique for FacePatches<S> {
     /// the pattern path, the patches' corners and the frame's patterns.
     fn device_memory(&self) -> Vec<DeviceAllocation> {
         let buffers: Vec<&Buffer> = match &self.draws {
-            Draws::Tessellated { vertices, indices } => std::iter::once(vertices)
+            Draws::Tessellated {
+                vertices,
+                tagged,
+                indices,
+            } => std::iter::once(vertices)
+                .chain(tagged)
                 .chain(indices.iter().map(|a| &a.indices))
                 .collect(),
             Draws::Patterns {
-                corners, current, ..
+                corners,
+                tagged,
+                current,
+                ..
             } => corners
                 .iter()
+                .chain(tagged.iter().flatten())
                 .chain(
                     current
                         .iter()

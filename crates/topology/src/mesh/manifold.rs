@@ -594,6 +594,7 @@ impl Split<'_> {
             creases: self.creases(),
             corners: self.corners(rules),
             holes: mesh.holes.clone(),
+            scalar_tags: mesh.scalar_tags.clone(),
             options: mesh.options,
         };
         ManifoldSplit {

@@ -7,6 +7,7 @@ use rayon::prelude::*;
 pub mod input;
 pub mod manifold;
 pub mod obj;
+pub mod scalar_tags;
 pub mod weld;
 
 /// Sentinel for "no face" / "no edge" in adjacency tables.
@@ -96,6 +97,9 @@ pub struct ControlMesh {
     pub corners: Vec<VertexCorner>,
     /// Faces tagged as holes (`t hole`). Stored only: refinement keeps them.
     pub holes: Vec<u32>,
+    /// Scalar tags of an ST-mesh (`t scalartag`): shape parameters of curved PN triangles
+    /// ([`scalar_tags`]); the subdivision schemes ignore them.
+    pub scalar_tags: Vec<scalar_tags::ScalarTag>,
     pub options: SubdivOptions,
 }
 
@@ -217,9 +221,10 @@ impl ControlMesh {
     /// opposite windings are not errors: the subdivision techniques refine them as
     /// OpenSubdiv does ([`manifold::ManifoldSplit`]), the others draw the faces as given. A
     /// face visiting a vertex twice is not an error here either (flat shading draws it); the
-    /// refiner refuses it.
+    /// refiner refuses it. Scalar tags are checked ([`scalar_tags::check`]).
     pub fn validate(&self) -> Result<(), TopologyError> {
-        check_faces(self, false)
+        check_faces(self, false)?;
+        scalar_tags::check(self).map(|_| ())
     }
 }
 

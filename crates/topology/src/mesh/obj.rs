@@ -13,6 +13,7 @@
 
 use crate::error::{ObjSyntax, TagKind, TopologyError};
 use crate::mesh::input::{read_regular_file, MAX_OBJ_BYTES};
+use crate::mesh::scalar_tags::ScalarTag;
 use crate::mesh::{ControlMesh, EdgeCrease, VertexCorner};
 use crate::rules::options::{
     BoundaryInterpolation, CreaseMethod, SubdivOptions, TriangleSubdivision,
@@ -126,6 +127,7 @@ pub struct ObjLines {
     creases: Vec<usize>,
     corners: Vec<usize>,
     holes: Vec<usize>,
+    scalar_tags: Vec<usize>,
 }
 
 impl ObjLines {
@@ -199,6 +201,11 @@ impl ObjLines {
                 let k = mesh.corners.iter().position(|c| c.vertex == vertex)?;
                 self.corners.get(k).copied()
             }
+            E::ScalarTag { vertex, .. } => {
+                let k = mesh.scalar_tags.iter().position(|t| t.vertex == vertex)?;
+                self.scalar_tags.get(k).copied()
+            }
+            E::ScalarTagTriangle { face: f } => face(f),
             E::TagOutOfRange { tag, index, .. } => {
                 let k = match tag {
                     TagKind::Crease => mesh
@@ -207,11 +214,13 @@ impl ObjLines {
                         .position(|c| c.vertices.contains(&index)),
                     TagKind::Corner => mesh.corners.iter().position(|c| c.vertex == index),
                     TagKind::Hole => mesh.holes.iter().position(|&h| h == index),
+                    TagKind::ScalarTag => mesh.scalar_tags.iter().position(|t| t.vertex == index),
                 }?;
                 match tag {
                     TagKind::Crease => self.creases.get(k),
                     TagKind::Corner => self.corners.get(k),
                     TagKind::Hole => self.holes.get(k),
+                    TagKind::ScalarTag => self.scalar_tags.get(k),
                 }
                 .copied()
             }
@@ -667,6 +676,10 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
         "interpolateboundary" | "creasemethod" | "smoothtriangles" => {
             option_tag(&t, &mut mesh.options, line, perr)?
         }
+        "scalartag" => {
+            mesh.scalar_tags.push(scalar_tag(&t, line, perr, to_u32)?);
+            lines.scalar_tags.push(line);
+        }
         "hole" => {
             if t.ints.is_empty() {
                 return Err(perr(line, ObjSyntax::HoleNeedsFaces));
@@ -679,6 +692,34 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
         other => log::warn!("{file}:{line}: ignoring unsupported tag '{other}'"),
     }
     Ok(())
+}
+
+/// `t scalartag 1/6/0 v Dx Dy Dz tension sharpness bias` (one vertex per line;
+/// [`crate::mesh::scalar_tags`]). Value ranges are checked with the mesh
+/// ([`crate::mesh::scalar_tags::check`]).
+fn scalar_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
+    t: &TagValues<'_>,
+    line: usize,
+    perr: &E,
+    to_u32: impl Fn(i64) -> Result<u32, TopologyError>,
+) -> Result<ScalarTag, TopologyError> {
+    let (&[v], &[dx, dy, dz, tension, sharpness, bias]) = (t.ints.as_slice(), t.floats.as_slice())
+    else {
+        return Err(perr(
+            line,
+            ObjSyntax::ScalarTagShape {
+                ints: t.ints.len(),
+                floats: t.floats.len(),
+            },
+        ));
+    };
+    Ok(ScalarTag {
+        vertex: to_u32(v)?,
+        deviation: [dx, dy, dz],
+        tension,
+        sharpness,
+        bias,
+    })
 }
 
 /// The option tags: `interpolateboundary` (one integer), `creasemethod` and `smoothtriangles`

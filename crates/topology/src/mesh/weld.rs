@@ -8,8 +8,8 @@
 //! and so tag and error lines, keep their meaning). Faces are rewritten: where two consecutive
 //! corners become one vertex the edge between them has collapsed and the second corner is
 //! removed (with its texture coordinate and normal); a face left with fewer than three
-//! corners is dropped. Crease and corner tags follow their vertices; a crease whose two ends
-//! merged is dropped; holes follow their faces.
+//! corners is dropped. Crease, corner and scalar tags follow their vertices (a group keeps its
+//! first scalar tag); a crease whose two ends merged is dropped; holes follow their faces.
 use super::ControlMesh;
 use std::collections::HashMap;
 
@@ -128,6 +128,17 @@ pub fn weld_vertices(mesh: &ControlMesh, tolerance: f64) -> (ControlMesh, Vec<u3
             vertex: at(c.vertex),
             ..*c
         })
+        .collect();
+    // A welded group keeps the first of its scalar tags (one tag per vertex).
+    let mut tagged = std::collections::HashSet::new();
+    out.scalar_tags = mesh
+        .scalar_tags
+        .iter()
+        .map(|t| super::scalar_tags::ScalarTag {
+            vertex: at(t.vertex),
+            ..*t
+        })
+        .filter(|t| tagged.insert(t.vertex))
         .collect();
     out.holes = mesh
         .holes

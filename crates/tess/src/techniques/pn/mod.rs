@@ -6,8 +6,13 @@
 //! lower position (then normal) bits, with `precise` arithmetic; corners are the control points
 //! themselves. Both patches of a shared edge thus emit the same position and normal bits
 //! (`tests/watertight.rs`), without vertex indices: repeated vertices with equal data weld too.
+//!
+//! A mesh with scalar tags (`t scalartag`) is drawn as an ST-mesh ([`scalar_tags`]): tagged
+//! corners bring their own edge control points and sides' normals, on both draw paths.
+pub mod scalar_tags;
 use crate::shaders::Stage;
-use crate::technique::{PatchPipeline, PatchType, TechniqueId, VertexInput};
+use crate::shaders::Variant;
+use crate::technique::{DrawPath, PatchPipeline, PatchType, TechniqueId, VertexInput};
 use crate::techniques::face_patches::{FacePatches, FaceStyle, BASE_FACES};
 use crate::techniques::{built, no_early_checks, TechniqueInfo};
 use crate::tessellator::Domain;
@@ -34,6 +39,10 @@ pub static INFO: TechniqueInfo = TechniqueInfo {
 pub struct PnStyle;
 
 impl FaceStyle for PnStyle {
+    const SCALAR_TAGS: bool = true;
+    fn tagged_pipeline(patch: PatchType) -> Option<PatchPipeline> {
+        Some(Self::tagged(patch))
+    }
     fn pattern_stage(_domain: Domain) -> Stage {
         Stage::PnPatternTriVert
     }
@@ -49,6 +58,29 @@ impl FaceStyle for PnStyle {
                 Stage::CommonShadeFrag,
                 3,
             )
+        }
+    }
+}
+
+impl PnStyle {
+    /// The scalar-tagged build of `patch`'s pipeline ([`scalar_tags`]).
+    fn tagged(patch: PatchType) -> PatchPipeline {
+        let axes = Variant {
+            scalar_tags: true,
+            ..Variant::default()
+        };
+        match patch.path() {
+            DrawPath::Pattern => PatchPipeline {
+                vertex_input: crate::gpu::pattern_input::TAGGED_TRIANGLE,
+                axes,
+                ..PatchPipeline::triangles(Stage::PnPatternTriVert, Stage::CommonShadeFrag)
+            },
+            _ => PatchPipeline {
+                vertex_input: crate::gpu::TaggedCorner::MESH,
+                vertex: Stage::PnTaggedMeshVert,
+                axes,
+                ..Self::pipeline(patch)
+            },
         }
     }
 }
