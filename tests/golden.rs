@@ -492,3 +492,59 @@ fn surface_golden_images_match_and_show_reparameterization_and_displacement() {
         "the displaced image passes the undisplaced golden"
     );
 }
+
+/// The scalar-tagged ridge (the seed's Fig. 6 kind of crease): PN on both draw paths matches
+/// its golden, and the same dome without its tags does not (the crease is what the image
+/// shows).
+#[test]
+fn scalar_tagged_ridge_golden_shows_the_crease_on_both_paths() {
+    use tessera::tess::{BuildOptions, PipelineChoice};
+    let gpu = Gpu::new();
+    note_device(&gpu);
+    let dir = common::data("tests/data/golden");
+    let golden_path = dir.join("st_ridge_pn.png");
+    let tagged = tessera::topology::load_obj(common::data("tests/data/meshes/st_ridge.obj"))
+        .unwrap();
+    let untagged = tessera::topology::ControlMesh {
+        scalar_tags: Vec::new(),
+        ..tagged.clone()
+    };
+    let params = FrameParams {
+        camera: tessera::tess::Camera {
+            pitch: 25.0,
+            yaw: 20.0,
+            ..Default::default()
+        },
+        ..FrameParams::uniform(12.0)
+    };
+    let mut ctx = Context::offscreen(gpu.device()).unwrap();
+    let mut render = |mesh: &tessera::topology::ControlMesh, pipeline| {
+        let options = BuildOptions {
+            name: "st_ridge".into(),
+            pipeline,
+            ..BuildOptions::default()
+        };
+        let mut t = tessera::tess::build(&mut ctx, TechniqueId::PN, mesh, &options)
+            .unwrap()
+            .technique;
+        ctx.render_offscreen(t.as_mut(), &params, BFT_EXTENT).unwrap()
+    };
+    let tess = render(&tagged, PipelineChoice::Tessellation);
+    let pattern = render(&tagged, PipelineChoice::Pattern);
+    let smooth = render(&untagged, PipelineChoice::Tessellation);
+    if std::env::var_os("TESSERA_UPDATE_GOLDEN").is_some() {
+        tess.save_png(&golden_path).unwrap();
+    }
+    let golden = Rgba8::load_png(&golden_path)
+        .unwrap_or_else(|e| panic!("st_ridge_pn: {e} (TESSERA_UPDATE_GOLDEN=1 writes it)"));
+    let (d1, d2, d3) = (
+        differing_fraction(&tess, &golden),
+        differing_fraction(&pattern, &golden),
+        differing_fraction(&smooth, &golden),
+    );
+    eprintln!("st_ridge_pn: tessellation {d1:.5}, pattern {d2:.5}, untagged {d3:.5}");
+    assert!(d1 <= match_tolerance() && d2 <= match_tolerance(), "{d1} {d2}");
+    assert!(d3 > 4.0 * TOLERANCE, "without tags only {d3:.5} of pixels change");
+    drop(ctx);
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+}

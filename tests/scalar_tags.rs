@@ -304,3 +304,31 @@ fn a_tagged_ridge_is_welded_by_bits_and_follows_its_cubics() {
     }
     assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
 }
+
+#[test]
+fn without_tessellation_shaders_the_ridge_draws_through_patterns() {
+    use tessera::tess::DrawPath;
+    let gpu = Gpu::with(&tessera::vk_core::DeviceDesc {
+        without_tessellation_shader: true,
+        ..Default::default()
+    });
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let mesh = ridge();
+        let mut t = build(&mut ctx, &mesh, PipelineChoice::Auto);
+        assert!(t
+            .patch_arrays()
+            .iter()
+            .all(|a| a.patch.path() == DrawPath::Pattern));
+        for level in [2.0, 9.0, 100.0] {
+            let soup = capture(&mut ctx, t.as_mut(), &params(level, Spacing::Equal));
+            let welded = soup.weld().unwrap();
+            let report = welded.open_edges();
+            let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
+            let c = classify_open_edges(&soup, &welded, &report, &map, &mesh);
+            assert_eq!((c.cracks, c.unmapped), (0, 0), "level {level}");
+            assert_sharp_along_the_ridge(&soup, &format!("generated level {level}"));
+        }
+    }
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+}
