@@ -219,6 +219,13 @@ typedef struct TesseraMeshDesc {
   size_t corner_count;
   // NULL, or `2 * index_count` floats: one (u, v) per face corner.
   const float *uvs;
+  // Scalar tags of an ST-mesh (the PN technique's sharp creases; docs/scalar-tags.md):
+  // `scalar_tag_count` vertex indices and `6 * scalar_tag_count` floats, per tag its
+  // deviation vector (x, y, z), tension (0..=1), sharpness (0..=1) and bias (-1..=1). NULL
+  // when `scalar_tag_count` is 0.
+  const uint32_t *scalar_tag_vertices;
+  const float *scalar_tag_values;
+  size_t scalar_tag_count;
 } TesseraMeshDesc;
 
 // What a capture found (as `tessera export` reports it).

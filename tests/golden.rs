@@ -503,8 +503,8 @@ fn scalar_tagged_ridge_golden_shows_the_crease_on_both_paths() {
     note_device(&gpu);
     let dir = common::data("tests/data/golden");
     let golden_path = dir.join("st_ridge_pn.png");
-    let tagged = tessera::topology::load_obj(common::data("tests/data/meshes/st_ridge.obj"))
-        .unwrap();
+    let tagged =
+        tessera::topology::load_obj(common::data("tests/data/meshes/st_ridge.obj")).unwrap();
     let untagged = tessera::topology::ControlMesh {
         scalar_tags: Vec::new(),
         ..tagged.clone()
@@ -527,7 +527,8 @@ fn scalar_tagged_ridge_golden_shows_the_crease_on_both_paths() {
         let mut t = tessera::tess::build(&mut ctx, TechniqueId::PN, mesh, &options)
             .unwrap()
             .technique;
-        ctx.render_offscreen(t.as_mut(), &params, BFT_EXTENT).unwrap()
+        ctx.render_offscreen(t.as_mut(), &params, BFT_EXTENT)
+            .unwrap()
     };
     let tess = render(&tagged, PipelineChoice::Tessellation);
     let pattern = render(&tagged, PipelineChoice::Pattern);
@@ -543,8 +544,14 @@ fn scalar_tagged_ridge_golden_shows_the_crease_on_both_paths() {
         differing_fraction(&smooth, &golden),
     );
     eprintln!("st_ridge_pn: tessellation {d1:.5}, pattern {d2:.5}, untagged {d3:.5}");
-    assert!(d1 <= match_tolerance() && d2 <= match_tolerance(), "{d1} {d2}");
-    assert!(d3 > 4.0 * TOLERANCE, "without tags only {d3:.5} of pixels change");
+    assert!(
+        d1 <= match_tolerance() && d2 <= match_tolerance(),
+        "{d1} {d2}"
+    );
+    assert!(
+        d3 > 4.0 * TOLERANCE,
+        "without tags only {d3:.5} of pixels change"
+    );
     drop(ctx);
     assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
 }

@@ -273,6 +273,13 @@ pub struct TesseraMeshDesc {
     pub corner_count: usize,
     /// NULL, or `2 * index_count` floats: one (u, v) per face corner.
     pub uvs: *const f32,
+    /// Scalar tags of an ST-mesh (the PN technique's sharp creases; docs/scalar-tags.md):
+    /// `scalar_tag_count` vertex indices and `6 * scalar_tag_count` floats, per tag its
+    /// deviation vector (x, y, z), tension (0..=1), sharpness (0..=1) and bias (-1..=1). NULL
+    /// when `scalar_tag_count` is 0.
+    pub scalar_tag_vertices: *const u32,
+    pub scalar_tag_values: *const f32,
+    pub scalar_tag_count: usize,
 }
 
 /// How a surface is built. [`tessera_surface_desc_default`] fills the defaults.
@@ -1326,6 +1333,8 @@ unsafe fn read_mesh(d: &TesseraMeshDesc) -> Result<(topology::ControlMesh, Strin
             format!("{name}: {what}: sharpness {x}: expected a finite number of at least 0"),
         ));
     }
+    // SAFETY: the caller's contract (see this function's `# Safety`).
+    let scalar_tags = unsafe { scalar_tags(d, &name) }?;
     let uvs = if d.uvs.is_null() {
         None
     } else {
@@ -1362,10 +1371,51 @@ unsafe fn read_mesh(d: &TesseraMeshDesc) -> Result<(topology::ControlMesh, Strin
         creases,
         corners,
         holes: Vec::new(),
-        scalar_tags: Vec::new(),
+        scalar_tags,
         options: Default::default(),
     };
     Ok((mesh, name))
+}
+
+/// The mesh's scalar tags; an index out of range is the host's bug (values are checked with
+/// the mesh, `topology::mesh::scalar_tags::check`).
+///
+/// # Safety
+/// As [`tessera_surface_create`]'s `mesh`.
+unsafe fn scalar_tags(
+    d: &TesseraMeshDesc,
+    name: &str,
+) -> Result<Vec<topology::mesh::scalar_tags::ScalarTag>> {
+    let vertices =
+        // SAFETY: the caller's contract (see this function's `# Safety`).
+        unsafe { read_slice(d.scalar_tag_vertices, d.scalar_tag_count, 1, "scalar_tag_vertices") }?;
+    let values =
+        // SAFETY: the caller's contract (see this function's `# Safety`).
+        unsafe { read_slice(d.scalar_tag_values, d.scalar_tag_count, 6, "scalar_tag_values") }?;
+    if let Some((i, &v)) = vertices
+        .iter()
+        .enumerate()
+        .find(|(_, &v)| v as usize >= d.vertex_count)
+    {
+        return Err(Error::new(
+            TesseraStatus::IndexOutOfRange,
+            format!(
+                "{name}: scalar tag {i}: vertex index {v} out of range (mesh has {} vertices)",
+                d.vertex_count
+            ),
+        ));
+    }
+    Ok(vertices
+        .iter()
+        .zip(values.chunks_exact(6))
+        .map(|(&vertex, t)| topology::mesh::scalar_tags::ScalarTag {
+            vertex,
+            deviation: [t[0], t[1], t[2]],
+            tension: t[3],
+            sharpness: t[4],
+            bias: t[5],
+        })
+        .collect())
 }
 
 /// Builds a surface from a mesh given as arrays. Thread-safe (serialized per context).

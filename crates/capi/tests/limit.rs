@@ -391,6 +391,9 @@ fn evaluators_of_meshes_and_of_moved_surfaces() {
         corner_sharpness: null(),
         corner_count: 0,
         uvs: null(),
+        scalar_tag_vertices: null(),
+        scalar_tag_values: null(),
+        scalar_tag_count: 0,
     };
     let mut raw = null_mut();
     // SAFETY: `mesh`'s arrays are as long as its counts say.

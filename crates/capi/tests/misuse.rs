@@ -75,6 +75,9 @@ fn mesh_desc(c: &Cube) -> TesseraMeshDesc {
         corner_sharpness: null(),
         corner_count: 0,
         uvs: null(),
+        scalar_tag_vertices: null(),
+        scalar_tag_values: null(),
+        scalar_tag_count: 0,
     }
 }
 
@@ -194,6 +197,41 @@ fn misuse_gets_codes_and_messages_never_undefined_behaviour() {
             TesseraStatus::IndexOutOfRange,
             "crease 0: vertex index 77",
         );
+        // Scalar tags: an index out of range, a value out of its range, then a crease along the
+        // edge from vertex 0 to 1 that PN draws (and that changes its picture).
+        let tag_vertices = [0u32, 77];
+        let tag_values = [[0.0f32, -1.0, -1.0, 0.0, 1.0, 0.0]; 2];
+        let mut m = mesh_desc(&c);
+        m.scalar_tag_vertices = tag_vertices.as_ptr();
+        m.scalar_tag_values = tag_values.as_ptr().cast();
+        m.scalar_tag_count = 2;
+        expect(
+            create_surface(ctx, &m, &flat).0,
+            TesseraStatus::IndexOutOfRange,
+            "scalar tag 1: vertex index 77",
+        );
+        let crease = [0u32, 1];
+        m.scalar_tag_vertices = crease.as_ptr();
+        let too_sharp = [[0.0f32, -1.0, -1.0, 0.0, 2.0, 0.0]; 2];
+        m.scalar_tag_values = too_sharp.as_ptr().cast();
+        expect(
+            create_surface(ctx, &m, &flat).0,
+            TesseraStatus::Mesh,
+            "vertex 0: sharpness 2",
+        );
+        m.scalar_tag_values = tag_values.as_ptr().cast();
+        let pn = surface_desc(TESSERA_TECHNIQUE_PN);
+        let (status, tagged) = create_surface(ctx, &m, &pn);
+        assert_eq!(status, TesseraStatus::Ok, "{}", last_error(ctx));
+        let (status, smooth) = create_surface(ctx, &mesh_desc(&c), &pn);
+        assert_eq!(status, TesseraStatus::Ok, "{}", last_error(ctx));
+        assert_ne!(
+            render(ctx, tagged),
+            render(ctx, smooth),
+            "the tags changed nothing"
+        );
+        assert_eq!(tessera_surface_destroy(ctx, tagged), TesseraStatus::Ok);
+        assert_eq!(tessera_surface_destroy(ctx, smooth), TesseraStatus::Ok);
         let mut nan = cube();
         nan.positions[4] = f32::NAN;
         expect(

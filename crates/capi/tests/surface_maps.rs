@@ -298,6 +298,9 @@ fn bad_maps_and_frame_options_get_named_statuses() {
         corner_sharpness: null(),
         corner_count: 0,
         uvs: uvs.as_ptr(),
+        scalar_tag_vertices: null(),
+        scalar_tag_values: null(),
+        scalar_tag_count: 0,
     };
     let create = |d: &TesseraSurfaceDesc| {
         let mut s = null_mut();

@@ -133,8 +133,25 @@ pub fn default_scheme(mesh: &topology::ControlMesh) -> topology::Scheme {
 }
 
 /// `--method`, or by default the technique that draws the limit surface of `--scheme` (or of
-/// the mesh's default scheme).
+/// the mesh's default scheme); a scalar-tagged mesh (an ST-mesh) without either is drawn by
+/// PN, the technique its tags shape. Any other technique for such a mesh is said on stderr.
 pub fn resolve_method(
+    method: Option<TechniqueId>,
+    scheme: Option<&str>,
+    mesh: &topology::ControlMesh,
+) -> Result<TechniqueId> {
+    let tagged = !mesh.scalar_tags.is_empty();
+    let id = match (method, scheme) {
+        (None, None) if tagged => TechniqueId::PN,
+        _ => method_or_scheme_default(method, scheme, mesh)?,
+    };
+    if tagged && id != TechniqueId::PN {
+        eprintln!("note: scalar tags shape curved PN triangles only (--method pn); {id} draws the mesh without them");
+    }
+    Ok(id)
+}
+
+fn method_or_scheme_default(
     method: Option<TechniqueId>,
     scheme: Option<&str>,
     mesh: &topology::ControlMesh,
