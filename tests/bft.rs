@@ -40,6 +40,7 @@ fn surface_built(
             tangents,
             name: name.into(),
             patch_block,
+            ..BftOptions::default()
         },
     )
     .expect(name)
@@ -195,6 +196,7 @@ fn every_loop_shape_is_exact_and_watertight() {
                     tangents: false,
                     name: name.clone(),
                     patch_block: None,
+                    ..BftOptions::default()
                 },
             ) {
                 Ok(s) => s,

@@ -15,6 +15,7 @@ use tessera::tess::{
     BuildOptions, CapturedSoup, Capturer, Context, DrawPath, FrameParams, PipelineChoice,
     RenderMesh, Spacing, Technique, TechniqueId, TessError,
 };
+use tessera::topology::limit::eval::{LimitScheme, LocalMesh};
 use tessera::topology::{load_obj, ControlMesh};
 use tessera::vk_core::{vk, DeviceDesc};
 
@@ -374,7 +375,7 @@ fn without_tessellation_shaders_the_base_face_techniques_draw_generated_patterns
         let cube = cube();
         for (id, choice) in [
             (TechniqueId::FLAT, PipelineChoice::Tessellation),
-            (TechniqueId::BFT, PipelineChoice::Auto),
+            (TechniqueId::BFT, PipelineChoice::Tessellation),
             (TechniqueId::ADAPTIVE, PipelineChoice::Auto),
         ] {
             match build(&mut ctx, id, &cube, choice) {
@@ -405,4 +406,154 @@ fn a_built_surface_keeps_its_path() {
             .iter()
             .any(|m| m.name.contains("pattern corners")));
     }
+}
+
+/// BFT on the refinement-pattern path: with the device's tessellator its patterns are the
+/// tessellator's, so at every power-of-two level both paths emit the same triangles and bits,
+/// also animated; screen-space factors and fractional spacing are refused there by name; and
+/// `auto` keeps BFT on the tessellation stage (patterns take uniform factors only).
+#[test]
+fn bft_draws_the_same_bits_through_patterns() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let meshes = [
+            ("spot", spot().triangulated().0),
+            (
+                "loop_xord_boundary",
+                load_obj(common::data(
+                    "tests/data/opensubdiv/shapes/loop_xord_boundary.obj",
+                ))
+                .unwrap(),
+            ),
+        ];
+        let mut compared = 0;
+        for (name, mesh) in &meshes {
+            let auto = build(&mut ctx, TechniqueId::BFT, mesh, PipelineChoice::Auto).unwrap();
+            assert_eq!(auto.patch_arrays()[0].patch.path(), DrawPath::Tessellation);
+            let mut tess = build(&mut ctx, TechniqueId::BFT, mesh, PipelineChoice::Tessellation)
+                .unwrap();
+            let mut pattern =
+                build(&mut ctx, TechniqueId::BFT, mesh, PipelineChoice::Pattern).unwrap();
+            assert_eq!(pattern.patch_arrays()[0].patch.path(), DrawPath::Pattern);
+            for (segments, time) in [(2.0, None), (4.0, None), (16.0, None), (8.0, Some(0.3))] {
+                if let Some(t) = time {
+                    use tessera::tess::animation::{base_normals, base_positions, wave};
+                    let base = tess.base_mesh().unwrap().clone();
+                    let (lo, hi) = tess.bbox();
+                    let posed = wave(&base_positions(&base), &base_normals(&base), lo, hi, t);
+                    tess.update_base(0, &posed).unwrap();
+                    pattern.update_base(0, &posed).unwrap();
+                }
+                let what = format!("bft on {name}, S = {segments}, animated {time:?}");
+                let p = params(segments, Spacing::Equal);
+                let a = capture(&mut ctx, tess.as_mut(), &p);
+                let b = capture(&mut ctx, pattern.as_mut(), &p);
+                assert!(a.triangle_count() > 0, "{what}");
+                assert_eq!(triangles(&a), triangles(&b), "{what}");
+                let (sa, sb) = (samples(&a), samples(&b));
+                let differing = sa.iter().filter(|(k, v)| sb.get(k) != Some(v)).count();
+                assert_eq!(differing, 0, "{what}: of {} samples", sa.len());
+                // The flags too: exact table point, patch kind.
+                let flags = |s: &CapturedSoup| -> HashMap<(u32, [u32; 2]), u32> {
+                    s.records
+                        .iter()
+                        .map(|r| ((r.patch, r.domain.map(f32::to_bits)), r.flags))
+                        .collect()
+                };
+                assert_eq!(flags(&a), flags(&b), "{what}");
+                compared += sa.len();
+            }
+            for (p, expected) in [
+                (
+                    FrameParams {
+                        factors: tessera::tess::FactorPolicy::Screen { pixels: 8.0 },
+                        ..FrameParams::default()
+                    },
+                    "screen-space",
+                ),
+                (params(4.0, Spacing::FractionalEven), "spacing"),
+            ] {
+                let e = ctx
+                    .prepare(pattern.as_mut(), &p, &[tessera::tess::Pass::Shaded])
+                    .unwrap_err()
+                    .to_string();
+                assert!(e.contains(expected), "{e}");
+            }
+        }
+        println!("{compared} BFT samples bit-identical on both paths");
+        assert!(compared > 50_000, "{compared}");
+    }
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+}
+
+/// BFT without tessellation shaders: `auto` draws generated patterns, welded by bits. At every
+/// power-of-two level each sample at a domain point the tessellator also emits (edges,
+/// corners, shared lattice points) equals, bit for bit, what the tessellation path of a device
+/// with a tessellator evaluates there, and every sample is the exact Loop limit at its own
+/// domain point (to the tolerance of BFT's own tests).
+#[test]
+fn without_tessellation_shaders_bft_draws_generated_patterns() {
+    let mesh = spot().triangulated().0;
+    let levels = [2.0, 8.0, 16.0];
+    let reference: Vec<Samples> = {
+        let gpu = Gpu::new();
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let mut t = build(&mut ctx, TechniqueId::BFT, &mesh, PipelineChoice::Tessellation).unwrap();
+        let out = levels
+            .iter()
+            .map(|&s| samples(&capture(&mut ctx, t.as_mut(), &params(s, Spacing::Equal))))
+            .collect();
+        drop(t);
+        drop(ctx);
+        assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+        out
+    };
+    let gpu = Gpu::with(&DeviceDesc {
+        without_tessellation_shader: true,
+        ..DeviceDesc::default()
+    });
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let mut t = build(&mut ctx, TechniqueId::BFT, &mesh, PipelineChoice::Auto).unwrap();
+        assert_eq!(t.patch_arrays()[0].patch.path(), DrawPath::Pattern);
+        let cpu = LocalMesh::from_control_mesh(&mesh, LimitScheme::Loop).unwrap();
+        for (&s, want) in levels.iter().zip(&reference) {
+            let soup = capture(&mut ctx, t.as_mut(), &params(s, Spacing::Equal));
+            let welded = soup.weld().unwrap();
+            let report = welded.open_edges();
+            let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
+            let c = classify_open_edges(&soup, &welded, &report, &map, &mesh);
+            assert_eq!((c.cracks, c.unmapped), (0, 0), "S = {s}");
+            let got = samples(&soup);
+            let common: Vec<_> = got.keys().filter(|k| want.contains_key(k)).collect();
+            let differing = common.iter().filter(|k| got[k] != want[k]).count();
+            assert_eq!(differing, 0, "S = {s}: of {} common samples", common.len());
+            assert!(common.len() * 2 > got.len(), "S = {s}: {} of {}", common.len(), got.len());
+            let worst = exact_limit_error(t.as_ref(), &soup, &cpu) / mesh.bbox_diagonal();
+            println!("S = {s}: {} samples, {} common, limit error {worst:.2e}", got.len(), common.len());
+            assert!(worst <= 5e-6, "S = {s}: {worst}");
+        }
+    }
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+}
+
+/// The largest distance between a captured vertex of a Loop surface drawn over the triangle
+/// mesh `cpu` evaluates and the exact limit at the captured vertex's base-face point.
+fn exact_limit_error(t: &dyn Technique, soup: &CapturedSoup, cpu: &LocalMesh) -> f64 {
+    let mut worst = 0.0f64;
+    for r in &soup.records {
+        let p = t.face_point(r.patch, r.domain).expect("a drawn patch");
+        // face_point's (u, v) weigh the triangle's corners 0 and 1; evaluate takes 1 and 2.
+        let (u, v) = (p.u as f64, p.v as f64);
+        let e = cpu
+            .evaluate(p.face as usize, v, 1.0 - u - v)
+            .expect("exact limit");
+        let d = (0..3)
+            .map(|k| (r.position[k] as f64 - e.position[k]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        worst = worst.max(d);
+    }
+    worst
 }

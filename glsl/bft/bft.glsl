@@ -174,6 +174,12 @@ void bft_accumulate_global(uint face, uint row, bool flip, bool geometric,
 #elif defined(BFT_PATCH_IN)
 #define BFT_PATCH_QUALIFIER patch in
 #endif
+#ifdef BFT_PATCH_LOCAL
+// The refinement-pattern vertex stage (pattern.vert): no control stage gathers the patch, so
+// its head is a plain variable the stage fills (face only: no ring gathered, every row read
+// from the global buffers, as the evaluation stage reads shared points).
+uvec4 tc_head;
+#endif
 #ifdef BFT_PATCH_QUALIFIER
 // x: face, y: info (ring size, BFT_INFO_* bits, kind), z: position_offset, w: du_offset.
 layout(location = 0) BFT_PATCH_QUALIFIER uvec4 tc_head;
@@ -218,7 +224,7 @@ void bft_accumulate_patch(uint row, bool flip, bool geometric,
 }
 #endif
 
-#ifdef BFT_PATCH_IN
+#if defined(BFT_PATCH_IN) || defined(BFT_PATCH_LOCAL)
 // One row of face g: from the patch block when g is this patch and its ring was gathered,
 // else from the global buffers (the same arithmetic either way).
 uint bft_row_at(uint g, bool local, uint a, uint b, out bool flip) {

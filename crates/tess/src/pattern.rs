@@ -29,6 +29,7 @@ use crate::tessellator::{Domain, Spacing};
 use std::collections::HashMap;
 use std::sync::Arc;
 use topology::ControlMesh;
+use vk_core::{vk, Buffer};
 
 /// Fixed-point denominator of generated coordinates.
 const FIXED_ONE: u32 = 1 << 16;
@@ -165,6 +166,45 @@ impl RefinementPattern {
     /// Triangle corners as one index list.
     pub fn indices(&self) -> Vec<u32> {
         self.triangles.iter().flatten().copied().collect()
+    }
+}
+
+/// A refinement pattern on the device.
+pub(crate) struct PatternBuffers {
+    pub key: PatternKey,
+    pub pattern: Arc<RefinementPattern>,
+    pub points: Buffer,
+    pub indices: Buffer,
+}
+
+impl PatternBuffers {
+    pub fn new(device: &vk_core::Device, key: PatternKey, pattern: Arc<RefinementPattern>) -> Result<Self> {
+        let n = pattern.points.len() as u32;
+        let indices = pattern.indices();
+        if let Some(&bad) = indices.iter().find(|&&i| i >= n) {
+            return Err(TessError::IndexOutOfRange {
+                what: "refinement pattern index",
+                index: bad as u64,
+                len: n as u64,
+            });
+        }
+        let name = format!("refinement pattern {:?}", pattern.domain);
+        Ok(Self {
+            points: Buffer::with_data(
+                device,
+                &format!("{name} points"),
+                vk::BufferUsageFlags::VERTEX_BUFFER,
+                bytemuck::cast_slice(&pattern.points),
+            )?,
+            indices: Buffer::with_data(
+                device,
+                &format!("{name} indices"),
+                vk::BufferUsageFlags::INDEX_BUFFER,
+                bytemuck::cast_slice(&indices),
+            )?,
+            key,
+            pattern,
+        })
     }
 }
 

@@ -208,9 +208,10 @@ pub struct SurfaceArgs {
     pub scheme: Option<String>,
     /// Draw path: tessellation (the tessellation stage), pattern (refinement patterns: a
     /// tessellated domain stored once and instanced over the patches, evaluated in the vertex
-    /// stage; flat, phong and pn so far) or auto (where a technique has both, the one measured
-    /// faster on the device's driver: patterns on lavapipe, the tessellation stage elsewhere;
-    /// patterns without tessellation shaders).
+    /// stage; flat, phong, pn and bft so far) or auto (where a technique has both, the one
+    /// measured faster on the device's driver: patterns on lavapipe, the tessellation stage
+    /// elsewhere, and for bft, whose patterns take uniform factors only, the tessellation stage
+    /// wherever there is one; patterns without tessellation shaders).
     #[arg(long, default_value = "auto", value_parser = parse_pipeline)]
     pub pipeline: PipelineChoice,
     /// Merge coincident vertices before drawing: `--weld` alone merges vertices at identical

@@ -395,6 +395,15 @@ pub mod pattern_input {
         bindings: &TAGGED_BINDINGS,
         attributes: &TAGGED_ATTRIBUTES,
     };
+    const POINT_BINDINGS: [vk::VertexInputBindingDescription; 1] = [TRIANGLE_BINDINGS[0]];
+    const POINT_ATTRIBUTES: [vk::VertexInputAttributeDescription; 1] = [TRIANGLE_ATTRIBUTES[0]];
+
+    /// The pattern's domain points only (location 0): techniques whose vertex stage reads the
+    /// patch from its own buffers by the instance (BFT).
+    pub const POINTS: VertexInput = VertexInput {
+        bindings: &POINT_BINDINGS,
+        attributes: &POINT_ATTRIBUTES,
+    };
     /// Triangle patches: three corners per instance.
     pub const TRIANGLE: VertexInput = VertexInput {
         bindings: &TRIANGLE_BINDINGS,

@@ -16,7 +16,7 @@ use crate::capture::{FacePoint, PatchFaceTable};
 use crate::context::Context;
 use crate::error::{Param, ParamError, Result, TessError};
 use crate::gpu::{pattern_input, DrawPush, TaggedCorner, Vertex};
-use crate::pattern::{PatternKey, RefinementPattern};
+use crate::pattern::{PatternBuffers, PatternKey};
 use crate::render_mesh::{PatchOrigin, RenderMesh};
 use crate::shaders::Stage;
 use crate::technique::{
@@ -70,45 +70,6 @@ pub trait FaceStyle: Send + 'static {
 struct IndexArray {
     indices: Buffer,
     control_points: u32,
-}
-
-/// A refinement pattern on the device.
-struct PatternBuffers {
-    key: PatternKey,
-    pattern: Arc<RefinementPattern>,
-    points: Buffer,
-    indices: Buffer,
-}
-
-impl PatternBuffers {
-    fn new(device: &Device, key: PatternKey, pattern: Arc<RefinementPattern>) -> Result<Self> {
-        let n = pattern.points.len() as u32;
-        let indices = pattern.indices();
-        if let Some(&bad) = indices.iter().find(|&&i| i >= n) {
-            return Err(TessError::IndexOutOfRange {
-                what: "refinement pattern index",
-                index: bad as u64,
-                len: n as u64,
-            });
-        }
-        let name = format!("refinement pattern {:?}", pattern.domain);
-        Ok(Self {
-            points: Buffer::with_data(
-                device,
-                &format!("{name} points"),
-                vk::BufferUsageFlags::VERTEX_BUFFER,
-                bytemuck::cast_slice(&pattern.points),
-            )?,
-            indices: Buffer::with_data(
-                device,
-                &format!("{name} indices"),
-                vk::BufferUsageFlags::INDEX_BUFFER,
-                bytemuck::cast_slice(&indices),
-            )?,
-            key,
-            pattern,
-        })
-    }
 }
 
 /// What one path keeps on the device.

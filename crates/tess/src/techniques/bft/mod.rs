@@ -65,9 +65,11 @@ use crate::shaders::{Stage, Variant};
 use crate::stencil::{self, GpuStencils, StencilBlock, StencilEvaluator, StencilVertices};
 use crate::technique::{
     for_each_draw, number_arrays, DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features,
-    FrameParams, Pass, PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
+    FrameParams, Pass, PatchArray, PatchPipeline, PatchType, PipelineChoice, Technique,
+    TechniqueId,
 };
 use crate::techniques::{BuildOptions, Built, TechniqueInfo};
+use crate::pattern::{PatternBuffers, PatternKey};
 use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, Domain, Spacing};
 use layout::{PackedTables, PatchHeader, TangentTerm, STORAGE_BINDINGS};
 use std::ops::Range;
@@ -101,7 +103,7 @@ pub static INFO: TechniqueInfo = TechniqueInfo {
         surface: false,
         single_pass: false,
         sine_displacement: false,
-        paths: &[DrawPath::Tessellation],
+        paths: &[DrawPath::Tessellation, DrawPath::Pattern],
     },
     scheme: Some(topology::Scheme::Loop),
     default_for_scheme: true,
@@ -131,6 +133,7 @@ fn build_registered(
             tangents: options.tangents,
             name: options.name.clone(),
             patch_block: None,
+            pipeline: options.pipeline,
         },
     )?;
     let notes = b.notes.clone();
@@ -379,6 +382,8 @@ pub struct BftOptions {
     /// implementation (lavapipe), off for a GPU (docs/benchmarks.md, "Table I on an NVIDIA
     /// H100"); there the environment's `TESSERA_BFT_PATCH_BLOCK=1` or `=0` decides instead, for A/B runs.
     pub patch_block: Option<bool>,
+    /// The draw path ([`resolve_path`]).
+    pub pipeline: PipelineChoice,
 }
 
 impl Default for BftOptions {
@@ -388,7 +393,20 @@ impl Default for BftOptions {
             tangents: false,
             name: "mesh".into(),
             patch_block: None,
+            pipeline: PipelineChoice::Auto,
         }
+    }
+}
+
+/// BFT's draw path for `choice` on `device`. On the refinement-pattern path BFT takes uniform
+/// factors only (no pattern family per edge level exists yet), so `auto` keeps the tessellation
+/// stage wherever the device has one and draws patterns only where it has none.
+pub fn resolve_path(choice: PipelineChoice, device: &vk_core::Device) -> Result<DrawPath> {
+    match choice {
+        PipelineChoice::Auto if device.info.caps.tessellation_shader => {
+            Ok(DrawPath::Tessellation)
+        }
+        choice => choice.resolve(TechniqueId::BFT, INFO.features.paths, device),
     }
 }
 
@@ -443,6 +461,9 @@ pub struct Bft {
     pub notes: Vec<String>,
     /// The patch-block build ([`BftOptions::patch_block`]).
     patch_block: bool,
+    /// On the refinement-pattern path: the frame's pattern, once [`Technique::prepare_frame`]
+    /// made it; `None` on the tessellation path.
+    pattern: Option<Option<PatternBuffers>>,
 }
 
 /// Maximal runs of the `patches` level-1 faces whose base triangle is not among `holes` (a
@@ -819,7 +840,12 @@ impl Bft {
             .patch_block
             .unwrap_or_else(|| patch_block_for(&device));
         let table_level = options.table_level;
-        let max_level = device.info.caps.max_tessellation_generation_level;
+        let path = resolve_path(options.pipeline, &device)?;
+        // Patterns are not bound by the tessellator's level (generated up to 256).
+        let max_level = match path {
+            DrawPath::Pattern => crate::pattern::MAX_GENERATED_SEGMENTS,
+            _ => device.info.caps.max_tessellation_generation_level,
+        };
         if !(1..=6).contains(&table_level) || (1u32 << table_level) > max_level {
             return Err(ParamError::refused(
                 Param::TableLevel,
@@ -917,7 +943,12 @@ impl Bft {
             &[ctx.frame_set_layout().raw, set_layout.raw],
             std::mem::size_of::<BftPush>(),
         )?;
-        let arrays = number_arrays(&[(PatchType::LoopBft, summary.patch_count, 1)]);
+        let arrays = match path {
+            DrawPath::Pattern => {
+                number_arrays(&[(PatchType::PatternTriangle, summary.patch_count, 0)])
+            }
+            _ => number_arrays(&[(PatchType::LoopBft, summary.patch_count, 1)]),
+        };
         stages.push(laps.lap("sets and pipelines"));
         log::info!(
             "bft {}: {}; {:?} stencil (dispatches, chunks), {} normals and {} draw chunks",
@@ -952,6 +983,7 @@ impl Bft {
             rest_bbox: crate::framing::drawn_bbox(mesh),
             base_positions,
             notes: note.into_iter().collect(),
+            pattern: (path == DrawPath::Pattern).then_some(None),
         })
     }
 
@@ -1050,6 +1082,24 @@ pub fn check_frame(table_level: u32, params: &FrameParams) -> Result<()> {
     check_adaptive_policy(params)
 }
 
+/// What BFT's pattern path refuses beyond [`check_frame`]: factors other than uniform (a family
+/// of patterns per edge level is not built), and fractional spacing.
+fn check_pattern_frame(params: &FrameParams) -> Result<()> {
+    if !matches!(params.factors, FactorPolicy::Uniform { .. }) {
+        return Err(TessError::Unsupported {
+            technique: TechniqueId::BFT,
+            what: "screen-space and distance factors on the refinement-pattern path (uniform \
+                   only; --pipeline tessellation takes them)",
+        });
+    }
+    if params.spacing != Spacing::Equal {
+        return Err(TessError::PatternSpacing {
+            spacing: params.spacing,
+        });
+    }
+    Ok(())
+}
+
 impl Technique for Bft {
     fn id(&self) -> TechniqueId {
         TechniqueId::BFT
@@ -1069,7 +1119,11 @@ impl Technique for Bft {
         if params.geometric_normals && !self.summary.tangents {
             return Err(TessError::NeedsTangentTables);
         }
-        check_frame(self.summary.table.level, params)
+        check_frame(self.summary.table.level, params)?;
+        if self.pattern.is_some() {
+            check_pattern_frame(params)?;
+        }
+        Ok(())
     }
 
     /// Only patch colours need the surface build (its albedo varying).
@@ -1077,7 +1131,14 @@ impl Technique for Bft {
         params.patch_colours
     }
 
-    fn patch_pipeline(&self, _patch: PatchType) -> PatchPipeline {
+    fn patch_pipeline(&self, patch: PatchType) -> PatchPipeline {
+        if patch.path() == DrawPath::Pattern {
+            return PatchPipeline {
+                vertex_input: crate::gpu::pattern_input::POINTS,
+                push_constant_bytes: std::mem::size_of::<BftPush>() as u32,
+                ..PatchPipeline::triangles(Stage::BftPatternVert, Stage::BftBftFrag)
+            };
+        }
         PatchPipeline {
             push_constant_bytes: std::mem::size_of::<BftPush>() as u32,
             axes: Variant {
@@ -1106,6 +1167,9 @@ impl Technique for Bft {
 
     /// At the largest factor the policy can reach.
     fn max_vertices_per_patch(&self, params: &FrameParams, _array: usize) -> u64 {
+        if let Some(Some(p)) = &self.pattern {
+            return p.pattern.points.len() as u64;
+        }
         let max = match params.factors {
             FactorPolicy::Uniform { segments } => segments * 0.5,
             _ => self.max_level() as f32,
@@ -1114,6 +1178,8 @@ impl Technique for Bft {
     }
 
     fn triangles(&self, params: &FrameParams, _array: usize) -> Option<u64> {
+        // Patterns are the tessellator's where it has one, and equal spacing's lattice
+        // otherwise: the same count at the powers of two BFT takes.
         match params.factors {
             FactorPolicy::Uniform { segments } => Some(
                 self.drawn
@@ -1138,15 +1204,41 @@ impl Technique for Bft {
         Ok(())
     }
 
+    /// On the pattern path, takes the frame's pattern from the context (one triangle per
+    /// level-1 face at half the base edge's segments) and uploads it when it changed.
+    fn prepare_frame(&mut self, ctx: &mut Context, params: &FrameParams) -> Result<()> {
+        let (Some(slot), FactorPolicy::Uniform { segments }) = (&mut self.pattern, params.factors)
+        else {
+            return Ok(());
+        };
+        let level = segments * 0.5;
+        let pattern = ctx.refinement_pattern(Domain::Triangle, params.spacing, level)?;
+        if !slot
+            .as_ref()
+            .is_some_and(|p| std::sync::Arc::ptr_eq(&p.pattern, &pattern))
+        {
+            let key = PatternKey::new(Domain::Triangle, params.spacing, level);
+            *slot = Some(PatternBuffers::new(ctx.device(), key, pattern)?);
+        }
+        Ok(())
+    }
+
     fn record_pre_pass<'a>(
         &'a self,
         enc: &mut Encoder<'a>,
         frame_set: &'a DescriptorSet,
         slot: usize,
     ) -> Result<()> {
-        let tess_stages = vk::PipelineStageFlags::VERTEX_SHADER
-            | vk::PipelineStageFlags::TESSELLATION_CONTROL_SHADER
-            | vk::PipelineStageFlags::TESSELLATION_EVALUATION_SHADER;
+        // The stages that read level 1: the pattern path's vertex stage alone (a device
+        // without tessellation shaders may name no tessellation stage in a barrier).
+        let tess_stages = match self.pattern {
+            Some(_) => vk::PipelineStageFlags::VERTEX_SHADER,
+            None => {
+                vk::PipelineStageFlags::VERTEX_SHADER
+                    | vk::PipelineStageFlags::TESSELLATION_CONTROL_SHADER
+                    | vk::PipelineStageFlags::TESSELLATION_EVALUATION_SHADER
+            }
+        };
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let write = (compute, vk::AccessFlags::SHADER_WRITE);
         enc.begin_label("bft initial subdivision step");
@@ -1197,6 +1289,15 @@ impl Technique for Bft {
             .get(array)
             .ok_or(TessError::NoPatchArray { array })?;
         let mut push = self.push(params, pass.mode());
+        let pattern = match &self.pattern {
+            Some(Some(p)) => {
+                enc.bind_vertex_buffer(0, &p.points);
+                enc.bind_index_buffer_u32(&p.indices);
+                Some(3 * p.pattern.triangles.len() as u32)
+            }
+            Some(None) => return Err(TessError::NoPatchArray { array }),
+            None => None,
+        };
         let mut counts = DrawCounts::default();
         let array_end = a.first_patch + a.patches;
         for (k, ((items, w), set)) in self.draw_chunks.iter().zip(&self.draw_sets).enumerate() {
@@ -1219,7 +1320,11 @@ impl Technique for Bft {
                     let first = start - a.first_patch + first;
                     push.first_patch = a.first_patch + first;
                     enc.push_constants(&push)?;
-                    enc.draw(first..first + n)?;
+                    match pattern {
+                        // One instance of the pattern per patch: the instance is the patch.
+                        Some(indices) => enc.draw_indexed_instanced(0..indices, 0..n)?,
+                        None => enc.draw(first..first + n)?,
+                    }
                     Ok(())
                 })?;
             }
@@ -1261,10 +1366,12 @@ impl Technique for Bft {
     /// Per frame slot, the base positions; the tables, patch records, stencils, level-1
     /// vertices and normals.
     fn device_memory(&self) -> Vec<DeviceAllocation> {
+        let pattern = self.pattern.iter().flatten();
         self.base
             .iter()
             .chain(self.evaluator.buffers())
             .chain(&self._static)
+            .chain(pattern.flat_map(|p| [&p.points, &p.indices]))
             .map(DeviceAllocation::of_buffer)
             .collect()
     }
