@@ -431,8 +431,13 @@ fn bft_draws_the_same_bits_through_patterns() {
         for (name, mesh) in &meshes {
             let auto = build(&mut ctx, TechniqueId::BFT, mesh, PipelineChoice::Auto).unwrap();
             assert_eq!(auto.patch_arrays()[0].patch.path(), DrawPath::Tessellation);
-            let mut tess = build(&mut ctx, TechniqueId::BFT, mesh, PipelineChoice::Tessellation)
-                .unwrap();
+            let mut tess = build(
+                &mut ctx,
+                TechniqueId::BFT,
+                mesh,
+                PipelineChoice::Tessellation,
+            )
+            .unwrap();
             let mut pattern =
                 build(&mut ctx, TechniqueId::BFT, mesh, PipelineChoice::Pattern).unwrap();
             assert_eq!(pattern.patch_arrays()[0].patch.path(), DrawPath::Pattern);
@@ -499,7 +504,13 @@ fn without_tessellation_shaders_bft_draws_generated_patterns() {
     let reference: Vec<Samples> = {
         let gpu = Gpu::new();
         let mut ctx = Context::offscreen(gpu.device()).unwrap();
-        let mut t = build(&mut ctx, TechniqueId::BFT, &mesh, PipelineChoice::Tessellation).unwrap();
+        let mut t = build(
+            &mut ctx,
+            TechniqueId::BFT,
+            &mesh,
+            PipelineChoice::Tessellation,
+        )
+        .unwrap();
         let out = levels
             .iter()
             .map(|&s| samples(&capture(&mut ctx, t.as_mut(), &params(s, Spacing::Equal))))
@@ -529,9 +540,18 @@ fn without_tessellation_shaders_bft_draws_generated_patterns() {
             let common: Vec<_> = got.keys().filter(|k| want.contains_key(k)).collect();
             let differing = common.iter().filter(|k| got[k] != want[k]).count();
             assert_eq!(differing, 0, "S = {s}: of {} common samples", common.len());
-            assert!(common.len() * 2 > got.len(), "S = {s}: {} of {}", common.len(), got.len());
+            assert!(
+                common.len() * 2 > got.len(),
+                "S = {s}: {} of {}",
+                common.len(),
+                got.len()
+            );
             let worst = exact_limit_error(t.as_ref(), &soup, &cpu) / mesh.bbox_diagonal();
-            println!("S = {s}: {} samples, {} common, limit error {worst:.2e}", got.len(), common.len());
+            println!(
+                "S = {s}: {} samples, {} common, limit error {worst:.2e}",
+                got.len(),
+                common.len()
+            );
             assert!(worst <= 5e-6, "S = {s}: {worst}");
         }
     }

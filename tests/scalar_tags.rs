@@ -195,7 +195,10 @@ fn cubic(c: &[[f64; 3]; 3], e: &[[f64; 3]; 6], b: [f64; 3]) -> [f64; 3] {
 
 /// Each patch's corners and edge control points: the tags' where a corner is tagged, PN's
 /// `(2 P_i + P_j − ((P_j − P_i)·N_i) N_i) / 3` elsewhere.
-fn tagged_patches(mesh: &ControlMesh) -> Vec<([[f64; 3]; 3], [[f64; 3]; 6])> {
+/// A patch's corners and its six edge control points.
+type PatchPoints = ([[f64; 3]; 3], [[f64; 3]; 6]);
+
+fn tagged_patches(mesh: &ControlMesh) -> Vec<PatchPoints> {
     let render = RenderMesh::from_control_mesh(mesh).unwrap();
     let tagged = tag_mesh(mesh, &render).unwrap();
     let v = |i: usize| tagged.render.vertices[i];

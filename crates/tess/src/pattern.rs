@@ -178,7 +178,11 @@ pub(crate) struct PatternBuffers {
 }
 
 impl PatternBuffers {
-    pub fn new(device: &vk_core::Device, key: PatternKey, pattern: Arc<RefinementPattern>) -> Result<Self> {
+    pub fn new(
+        device: &vk_core::Device,
+        key: PatternKey,
+        pattern: Arc<RefinementPattern>,
+    ) -> Result<Self> {
         let n = pattern.points.len() as u32;
         let indices = pattern.indices();
         if let Some(&bad) = indices.iter().find(|&&i| i >= n) {

@@ -61,6 +61,7 @@ use crate::gpu::bindings::{
     BFT_TANGENT_OFFSETS_BINDING, BFT_TANGENT_TERMS_BINDING,
 };
 use crate::gpu::{BftPush, BftTableArrays};
+use crate::pattern::{PatternBuffers, PatternKey};
 use crate::shaders::{Stage, Variant};
 use crate::stencil::{self, GpuStencils, StencilBlock, StencilEvaluator, StencilVertices};
 use crate::technique::{
@@ -69,7 +70,6 @@ use crate::technique::{
     TechniqueId,
 };
 use crate::techniques::{BuildOptions, Built, TechniqueInfo};
-use crate::pattern::{PatternBuffers, PatternKey};
 use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, Domain, Spacing};
 use layout::{PackedTables, PatchHeader, TangentTerm, STORAGE_BINDINGS};
 use std::ops::Range;
@@ -403,9 +403,7 @@ impl Default for BftOptions {
 /// stage wherever the device has one and draws patterns only where it has none.
 pub fn resolve_path(choice: PipelineChoice, device: &vk_core::Device) -> Result<DrawPath> {
     match choice {
-        PipelineChoice::Auto if device.info.caps.tessellation_shader => {
-            Ok(DrawPath::Tessellation)
-        }
+        PipelineChoice::Auto if device.info.caps.tessellation_shader => Ok(DrawPath::Tessellation),
         choice => choice.resolve(TechniqueId::BFT, INFO.features.paths, device),
     }
 }
