@@ -326,6 +326,29 @@ fn doo_sabin_points_are_face_corner_uv() {
     );
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("needs --corner"));
+    // The dual refiner's refusal of a non-manifold vertex, in the OBJ's terms.
+    let nonman = data("tests/data/opensubdiv/nonmanifold/catmark_nonman_verts.obj");
+    let o = tessera(
+        &[
+            "limit",
+            &nonman,
+            "--scheme",
+            "doo-sabin",
+            "--face",
+            "1",
+            "--corner",
+            "1",
+            "--uv",
+            "0.5,0.5",
+        ],
+        &[],
+    );
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("non-manifold vertex") && !e.contains("panicked"),
+        "{e}"
+    );
 }
 
 /// `subdivide --scheme doo-sabin --limit`: a level-1 vertex (the child of a face's corner,
