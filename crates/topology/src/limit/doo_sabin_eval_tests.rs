@@ -1,6 +1,6 @@
 use super::*;
+use crate::limit::doo_sabin_domain::{DomainPoint, DomainRefinement};
 use crate::mesh::obj::parse_obj;
-use crate::refine::doo_sabin::{DualFace, DualStep, DualVertex};
 use crate::refine::refine_uniform;
 
 const SHAPES: &str = "../../tests/data/opensubdiv/shapes";
@@ -346,102 +346,6 @@ fn owners_of_a_shared_side_agree() {
     }
 }
 
-/// A level-`k` real vertex's domain square: base face and corner, origin, size, and its four
-/// faces of level `k` in ring order.
-#[derive(Clone, Copy, Debug)]
-struct Square {
-    f: usize,
-    i: usize,
-    origin: [f64; 2],
-    size: f64,
-    faces: [u32; 4],
-}
-
-impl Square {
-    fn corner(&self, j: usize) -> [f64; 2] {
-        [
-            self.origin[0] + CORNERS[j][0] * self.size,
-            self.origin[1] + CORNERS[j][1] * self.size,
-        ]
-    }
-}
-
-/// The squares of the level-1 vertices (the corner children; Chaikin points have none).
-fn first_squares(step: &DualStep) -> Vec<Option<Square>> {
-    let t = &step.level.topology;
-    step.vertices
-        .iter()
-        .enumerate()
-        .map(|(w, o)| match *o {
-            DualVertex::Corner { face, corner } => {
-                let ring = fan(t, w, face);
-                Some(Square {
-                    f: face as usize,
-                    i: corner as usize,
-                    origin: [0.0; 2],
-                    size: 1.0,
-                    faces: std::array::from_fn(|j| ring[(j + 2) % 4]),
-                })
-            }
-            DualVertex::Chaikin { .. } => None,
-        })
-        .collect()
-}
-
-/// The squares of the next level from the global refiner's origins of its vertices and faces.
-fn next_squares(
-    parent: &Level,
-    squares: &[Option<Square>],
-    step: &DualStep,
-) -> Vec<Option<Square>> {
-    let p = &parent.topology;
-    let mut v_face = vec![u32::MAX; p.num_vertices()];
-    let mut e_face = vec![u32::MAX; p.num_edges()];
-    for (k, o) in step.faces.iter().enumerate() {
-        match *o {
-            DualFace::Vertex(x) => v_face[x as usize] = k as u32,
-            DualFace::Edge(e) => e_face[e as usize] = k as u32,
-            _ => {}
-        }
-    }
-    step.vertices
-        .iter()
-        .map(|o| {
-            let DualVertex::Corner { face, corner } = *o else {
-                return None;
-            };
-            let fv = p.face_vertices(face as usize);
-            let n = fv.len();
-            let x = fv[corner as usize];
-            let sq = squares[x as usize].as_ref()?;
-            let q = sq.faces.iter().position(|&g| g == face).unwrap();
-            let e_in = p.find_edge(fv[(corner as usize + n - 1) % n], x).unwrap();
-            let e_out = p.find_edge(x, fv[(corner as usize + 1) % n]).unwrap();
-            let order = [
-                face,
-                e_face[e_in as usize],
-                v_face[x as usize],
-                e_face[e_out as usize],
-            ];
-            let mut faces = [0; 4];
-            for (k, g) in order.into_iter().enumerate() {
-                faces[(q + k) % 4] = g;
-            }
-            let size = sq.size * 0.5;
-            Some(Square {
-                f: sq.f,
-                i: sq.i,
-                origin: [
-                    sq.origin[0] + CORNERS[q][0] * size,
-                    sq.origin[1] + CORNERS[q][1] * size,
-                ],
-                size,
-                faces,
-            })
-        })
-        .collect()
-}
-
 /// The exact limit at a face's centre: its centroid, or its boundary edge's midpoint.
 fn centre_of(level: &Level, boundary: &[bool], g: usize) -> [f64; 3] {
     let fv = level.topology.face_vertices(g);
@@ -456,48 +360,37 @@ fn centre_of(level: &Level, boundary: &[bool], g: usize) -> [f64; 3] {
 }
 
 /// Per level `1..=depth`: the largest distance between a face's exact centre and the evaluation
-/// at its domain point, between a real vertex's [`vertex_limits`] and the evaluation at its
-/// square's centre, and between a real vertex and its limit.
+/// at its domain point, between a vertex's [`vertex_limits`] and the evaluation at its domain
+/// point (real vertices and boundary points), and between a real vertex and its limit.
 fn track(mesh: &ControlMesh, depth: usize) -> Vec<[f64; 3]> {
     let ev = DooSabinEvaluator::new(mesh).unwrap();
-    let base = Level::from_mesh(mesh, Scheme::DooSabin).unwrap();
-    let mut step = refine_dual(&base, true).unwrap();
-    let mut squares = first_squares(&step);
+    let domains = DomainRefinement::new(mesh, depth).unwrap();
     let uniform = refine_uniform(mesh, Scheme::DooSabin, depth).unwrap();
+    let at = |p: DomainPoint| {
+        ev.evaluate(p.face as usize, p.corner as usize, p.uv[0], p.uv[1])
+            .unwrap()
+            .position
+    };
     let mut out = Vec::new();
     for k in 1..=depth {
-        let level = &step.level;
-        // The steps tracked here are refine_uniform's.
+        let level = domains.level(k);
+        // The levels here are refine_uniform's.
         assert_eq!(level.positions, uniform.level(k).positions);
-        let boundary = boundary_vertices(&level.topology);
+        let boundary = domains.boundary_points(k);
         let mut worst = [0.0f64; 3];
         for g in 0..level.num_faces() {
-            let fv = level.topology.face_vertices(g);
-            let (sq, j) = fv
-                .iter()
-                .find_map(|&x| {
-                    let sq = squares[x as usize]?;
-                    Some((sq, sq.faces.iter().position(|&h| h == g as u32)?))
-                })
-                .unwrap();
-            let [u, v] = sq.corner(j);
-            let s = ev.evaluate(sq.f, sq.i, u, v).unwrap();
-            worst[0] = worst[0].max(dist(s.position, centre_of(level, &boundary, g)));
+            let exact = centre_of(level, &boundary, g);
+            worst[0] = worst[0].max(dist(at(domains.face_point(k, g).unwrap()), exact));
         }
         let limits = vertex_limits(level, true).unwrap();
-        for (x, sq) in squares.iter().enumerate() {
-            let Some(sq) = sq else { continue };
-            let [u, v] = sq.corner(0).map(|c| c + 0.5 * sq.size);
-            let s = ev.evaluate(sq.f, sq.i, u, v).unwrap();
-            worst[1] = worst[1].max(dist(s.position, limits[x]));
-            worst[2] = worst[2].max(dist(s.position, level.positions[x]));
+        for (x, limit) in limits.iter().enumerate() {
+            let p = at(domains.vertex_point(k, x).unwrap());
+            worst[1] = worst[1].max(dist(p, *limit));
+            if domains.square(k, x).is_some() {
+                worst[2] = worst[2].max(dist(p, level.positions[x]));
+            }
         }
         out.push(worst);
-        if k < depth {
-            let next = refine_dual(level, false).unwrap();
-            squares = next_squares(level, &squares, &next);
-            step = next;
-        }
     }
     out
 }
