@@ -448,9 +448,19 @@ fn points_near_an_extraordinary_centre_approach_it() {
         assert!(turn < 2.0 * d, "2^-{k}: normal turned {turn:e}");
     }
     assert!(last < 1e-10);
-    // Within 2^−MAX_DEPTH: the centre itself.
-    let s = ev.evaluate(0, 2, 1.0 - 1e-300, 1.0).unwrap();
-    assert_eq!(s.position, centre.position);
+    // Within 2^−MAX_DEPTH of a v-face's centre (the prism's vertices have valence 3, their
+    // v-faces are triangles at (0, 0)): the centre itself, after MAX_DEPTH steps.
+    let vertex = ev.evaluate(0, 2, 0.0, 0.0).unwrap();
+    assert!(vertex.derivatives.is_none());
+    let s = ev.evaluate(0, 2, 1e-300, 0.0).unwrap();
+    assert!(
+        dist(s.position, vertex.position) < 1e-15,
+        "{s:?} {vertex:?}"
+    );
+    assert!(s.derivatives.is_none());
+    let s = ev.evaluate(0, 2, 2f64.powi(-60), 0.0).unwrap();
+    assert!(s.derivatives.is_some());
+    assert!(dist(s.position, vertex.position) < 1e-15);
 }
 
 #[test]
