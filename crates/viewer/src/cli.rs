@@ -186,7 +186,8 @@ pub struct SubdivideArgs {
     /// Refinement level, 0 to 6 (meshes grow 4× per level).
     #[arg(long, allow_hyphen_values = true, value_parser = parse_subdivide_level)]
     pub level: usize,
-    /// Move every vertex to its limit position.
+    /// Move every vertex to its limit position (Doo-Sabin: the limit at the centre of the
+    /// vertex's domain square, a boundary vertex's on the boundary's quadratic B-spline).
     #[arg(long)]
     pub limit: bool,
     #[arg(short, long)]
