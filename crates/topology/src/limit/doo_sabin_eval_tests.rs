@@ -500,3 +500,40 @@ fn bad_domain_points_are_named() {
         Err(EvalError::Topology(_))
     ));
 }
+
+/// Points approaching a boundary vertex's strip-face centre (a boundary vertex of one face, of
+/// three faces) converge to it, at the rate of the strip's real children: (3/4)^k for one
+/// face (see the convergence test).
+#[test]
+fn points_near_a_boundary_centre_approach_it() {
+    let mesh = open_fan();
+    let ev = DooSabinEvaluator::new(&mesh).unwrap();
+    let t = Topology::from_mesh(&mesh).unwrap();
+    let boundary = boundary_vertices(&t);
+    let mut checked = [0usize; 4];
+    for f in 0..mesh.num_faces() {
+        for (i, &x) in mesh.face(f).iter().enumerate() {
+            let valence = t.vertex_faces(x as usize).len();
+            if !boundary[x as usize] || valence == 2 {
+                continue;
+            }
+            let centre = ev.evaluate(f, i, 0.0, 0.0).unwrap();
+            assert!(centre.normal.is_none() && centre.derivatives.is_none());
+            let mut last = f64::INFINITY;
+            for k in 1..=60 {
+                let d = 0.5f64.powi(k);
+                let s = ev.evaluate(f, i, d, 0.7 * d).unwrap();
+                let gap = dist(s.position, centre.position);
+                assert!(
+                    gap < last || gap < 1e-14,
+                    "face {f} corner {i} at 2^-{k}: {gap:e}"
+                );
+                last = gap;
+            }
+            eprintln!("boundary vertex {x} of {valence} faces: 2^-60 away, {last:.1e}");
+            assert!(last < 1e-6 * mesh.bbox_diagonal());
+            checked[valence.min(3)] += 1;
+        }
+    }
+    assert!(checked[1] >= 3 && checked[3] >= 2, "{checked:?}");
+}
