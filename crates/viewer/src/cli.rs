@@ -186,7 +186,8 @@ pub struct SubdivideArgs {
     /// Refinement level, 0 to 6 (meshes grow 4× per level).
     #[arg(long, allow_hyphen_values = true, value_parser = parse_subdivide_level)]
     pub level: usize,
-    /// Move every vertex to its limit position.
+    /// Move every vertex to its limit position (Doo-Sabin: the limit at the centre of the
+    /// vertex's domain square, a boundary vertex's on the boundary's quadratic B-spline).
     #[arg(long)]
     pub limit: bool,
     #[arg(short, long)]
@@ -197,7 +198,7 @@ pub struct SubdivideArgs {
 pub struct LimitArgs {
     /// OBJ control mesh; the embedded spot control mesh when absent.
     pub input: Option<PathBuf>,
-    /// loop or catmull-clark
+    /// loop, catmull-clark or doo-sabin (doo-sabin needs --corner, or `F C U V` points)
     #[arg(long)]
     pub scheme: String,
     /// Face number, 1-based as in the OBJ (the N-th `f` line), like every message.
@@ -219,10 +220,18 @@ pub struct LimitArgs {
         conflicts_with = "points"
     )]
     pub uv: Option<(f64, f64)>,
+    /// Doo-Sabin: corner K of --face, 1-based (the K-th vertex of its `f` line). --uv is then
+    /// the point of that corner's quad, 0 to 1 in u and v: (0,0) the corner's vertex, (1,0) the
+    /// midpoint of the edge leaving it, (1,1) the face's centre, (0,1) the midpoint of the edge
+    /// entering it.
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_corner, conflicts_with = "points")]
+    pub corner: Option<usize>,
     /// Many points at once: a file of `F U V` lines in the domain of `tessera export`'s
     /// `# p F U V` lines (F 0-based; triangles weigh corners 0 and 1, quads the unit square,
     /// n-gons the regular n-gon); `# p` lines count as points too and other OBJ lines are
     /// skipped, so an exported OBJ can be given as it is. Writes one `X Y Z` line per point.
+    /// Doo-Sabin: `F C U V` lines, face and corner from 0, (U, V) in the corner's quad as for
+    /// --corner.
     #[arg(long)]
     pub points: Option<PathBuf>,
     /// Where --points writes its positions (default: standard output).
@@ -284,6 +293,10 @@ fn parse_subdivide_level(s: &str) -> Result<usize, String> {
 
 fn parse_face(s: &str) -> Result<usize, String> {
     numbers::whole(s, "--face", 1, u32::MAX as usize)
+}
+
+fn parse_corner(s: &str) -> Result<usize, String> {
+    numbers::whole(s, "--corner", 1, u32::MAX as usize)
 }
 
 /// `--segments` of render, view and export: a number (from 1 to

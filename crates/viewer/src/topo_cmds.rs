@@ -1,9 +1,14 @@
 //! `tessera subdivide` and `tessera limit`: the CPU reference, from the command line.
 //!
+//! Doo-Sabin's points are `(face, corner, u, v)` in a corner's quad
+//! ([`topology::limit::doo_sabin_eval`]); a level's vertex limits are
+//! [`topology::limit::doo_sabin_eval::vertex_limits`].
+//!
 //! Options are checked before the mesh is read; errors about the mesh use the OBJ's 1-based
 //! numbers ([`topology::TopologyError::in_file`]); nothing non-finite is written or printed.
 use crate::cli::{LimitArgs, SubdivideArgs};
 use anyhow::{bail, Context, Result};
+use topology::limit::doo_sabin_eval::{vertex_limits, DooSabinEvaluator, DooSabinSample};
 use topology::limit::eval::{limit_point, EvalError, LimitScheme, LocalMesh};
 use topology::mesh::manifold::ManifoldSplit;
 use topology::mesh::obj::ObjLines;
@@ -17,13 +22,18 @@ pub fn parse_scheme(s: &str) -> Result<Scheme, String> {
 
 /// Limit positions of every vertex of `level` ([`LocalMesh::vertex_limit_exact`]: masks, or
 /// the exact evaluator next to semi-sharp features). Refining the whole level further instead
-/// would cost 4× per extra level, and sharpness just below 10 needs 9 more.
-fn limit_positions(level: &Level, base: &ControlMesh, scheme: Scheme) -> Result<Vec<[f64; 3]>> {
+/// would cost 4× per extra level, and sharpness just below 10 needs 9 more. A Doo-Sabin
+/// vertex's limit is the limit at the centre of its domain square (`refined`: above level 0,
+/// where boundary vertices are boundary points).
+fn limit_positions(
+    level: &Level,
+    base: &ControlMesh,
+    scheme: Scheme,
+    refined: bool,
+) -> Result<Vec<[f64; 3]>> {
     let ls = match scheme {
         Scheme::Bilinear => return Ok(level.positions.clone()),
-        Scheme::DooSabin => bail!(
-            "--limit is supported for loop and catmull-clark (Doo-Sabin has no limit masks here)"
-        ),
+        Scheme::DooSabin => return Ok(vertex_limits(level, refined)?),
         other => LimitScheme::try_from(other)?,
     };
     let lm = LocalMesh::from_refined_level(level, ls, &base.options)?;
@@ -77,7 +87,7 @@ pub fn subdivide(a: SubdivideArgs) -> Result<()> {
     let r = refine_uniform(&mesh, a.scheme, a.level).map_err(|e| lines.locate(e, &mesh, &name))?;
     let level = r.level(a.level);
     let positions = if a.limit {
-        limit_positions(level, &mesh, a.scheme)?
+        limit_positions(level, &mesh, a.scheme, a.level > 0)?
     } else {
         level.positions.clone()
     };
@@ -129,13 +139,21 @@ fn eval_in_file(e: EvalError, name: &str, mesh: &ControlMesh, lines: &ObjLines) 
 }
 
 pub fn limit(a: LimitArgs) -> Result<()> {
-    let scheme: LimitScheme = a
-        .scheme
-        .parse()
-        .map_err(|e| anyhow::anyhow!("--scheme {}: {e}", a.scheme))?;
+    let bad_scheme = |e: &dyn std::fmt::Display| anyhow::anyhow!("--scheme {}: {e}", a.scheme);
+    let scheme: Scheme = a.scheme.parse().map_err(|e| bad_scheme(&e))?;
+    if scheme == Scheme::DooSabin {
+        return doo_sabin_limit(a);
+    }
+    let scheme = LimitScheme::try_from(scheme).map_err(|e| bad_scheme(&e))?;
+    if let Some(k) = a.corner {
+        bail!(
+            "--corner {k}: corners are Doo-Sabin's domain; {scheme} takes --face and --uv",
+            scheme = scheme.scheme()
+        );
+    }
     let name = crate::commands::mesh_name(a.input.as_deref());
     let points = match &a.points {
-        Some(path) => Some(read_points(path)?),
+        Some(path) => Some(read_points(path, false)?),
         None => None,
     };
     let (mesh, lines) = read_mesh(a.input.as_deref())?;
@@ -176,8 +194,17 @@ const OBJ_STATEMENTS: [&str; 10] = ["v", "vn", "vt", "f", "l", "o", "g", "s", "u
 /// A face (from 0) and its domain coordinates, as on a `# p` line.
 type FacePoint = (u32, [f64; 2]);
 
-/// The points of a `--points` file and the 1-based line of each.
-fn read_points(path: &std::path::Path) -> Result<(Vec<FacePoint>, Vec<usize>)> {
+/// A point of a `--points` file: its face, its corner (Doo-Sabin's `F C U V`; 0 for `F U V`),
+/// both from 0, and its coordinates.
+struct PointRow {
+    face: u32,
+    corner: u32,
+    uv: [f64; 2],
+}
+
+/// The points of a `--points` file (`F C U V` lines when `corners`) and the 1-based line of
+/// each.
+fn read_points(path: &std::path::Path, corners: bool) -> Result<(Vec<PointRow>, Vec<usize>)> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("--points {}: cannot read it", path.display()))?;
     let (mut points, mut lines) = (Vec::new(), Vec::new());
@@ -197,27 +224,43 @@ fn read_points(path: &std::path::Path) -> Result<(Vec<FacePoint>, Vec<usize>)> {
         };
         let at = || format!("{}:{}", path.display(), i + 1);
         let w: Vec<&str> = words.split_whitespace().collect();
-        let [f, u, v] = w[..] else {
-            bail!(
+        let (f, c, u, v) = match (corners, &w[..]) {
+            (false, &[f, u, v]) => (f, "0", u, v),
+            (true, &[f, c, u, v]) => (f, c, u, v),
+            (false, _) => bail!(
                 "{}: expected `F U V` (a face from 0 and its domain coordinates), found {line:?}",
                 at()
-            );
+            ),
+            (true, _) => bail!(
+                "{}: expected `F C U V` (a face and its corner from 0, and the corner quad's \
+                 coordinates), found {line:?}",
+                at()
+            ),
         };
         let face: u32 = f
             .parse()
             .map_err(|_| anyhow::anyhow!("{}: face {f:?} is not a number from 0", at()))?;
+        let corner: u32 = c
+            .parse()
+            .map_err(|_| anyhow::anyhow!("{}: corner {c:?} is not a number from 0", at()))?;
         let coord = |x: &str| -> Result<f64> {
             x.parse()
                 .map_err(|_| anyhow::anyhow!("{}: {x:?} is not a number", at()))
         };
-        points.push((face, [coord(u)?, coord(v)?]));
+        points.push(PointRow {
+            face,
+            corner,
+            uv: [coord(u)?, coord(v)?],
+        });
         lines.push(i + 1);
     }
     if points.is_empty() {
-        bail!(
-            "--points {}: no `F U V` or `# p F U V` lines in it",
-            path.display()
-        );
+        let form = if corners {
+            "`F C U V`"
+        } else {
+            "`F U V` or `# p F U V`"
+        };
+        bail!("--points {}: no {form} lines in it", path.display());
     }
     Ok((points, lines))
 }
@@ -229,11 +272,12 @@ fn limit_points(
     scheme: LimitScheme,
     name: &str,
     path: &std::path::Path,
-    (points, lines): (&[FacePoint], &[usize]),
+    (rows, lines): (&[PointRow], &[usize]),
 ) -> Result<()> {
     let evaluator = topology::limit::face_domain::LimitEvaluator::new(mesh, scheme)
         .map_err(|e| eval_in_file(e, name, mesh, obj_lines))?;
-    let samples = evaluator.evaluate_many(points).map_err(|e| {
+    let points: Vec<FacePoint> = rows.iter().map(|r| (r.face, r.uv)).collect();
+    let samples = evaluator.evaluate_many(&points).map_err(|e| {
         let at = format!("{}:{}", path.display(), lines[e.point]);
         match *e.source {
             EvalError::FaceOutOfRange { face, count } => anyhow::anyhow!(
@@ -249,13 +293,30 @@ fn limit_points(
             other => anyhow::Error::new(other).context(at),
         }
     })?;
-    let mut text = String::with_capacity(samples.len() * 64);
-    for (s, &line) in samples.iter().zip(lines) {
-        let mut values = vec![s.position];
-        if a.derivatives {
-            values.extend([s.du, s.dv, s.normal]);
-        }
-        if non_finite(&values).is_some() {
+    let values: Vec<Vec<[f64; 3]>> = samples
+        .iter()
+        .map(|s| {
+            let mut values = vec![s.position];
+            if a.derivatives {
+                values.extend([s.du, s.dv, s.normal]);
+            }
+            values
+        })
+        .collect();
+    write_points(a, &values, (name, path, lines), scheme.scheme())
+}
+
+/// The values of each point (`X Y Z` and, with --derivatives, three more vectors), one line
+/// each, to --output or standard output; nothing when any is not finite.
+fn write_points(
+    a: &LimitArgs,
+    rows: &[Vec<[f64; 3]>],
+    (name, path, lines): (&str, &std::path::Path, &[usize]),
+    scheme: Scheme,
+) -> Result<()> {
+    let mut text = String::with_capacity(rows.len() * 64);
+    for (values, &line) in rows.iter().zip(lines) {
+        if non_finite(values).is_some() {
             bail!(
                 "{}:{line}: the limit there is not finite; nothing written",
                 path.display()
@@ -269,13 +330,129 @@ fn limit_points(
         Some(out) => {
             tess::output::write_file(out, |w| w.write_all(text.as_bytes()))?;
             out!(
-                "wrote {}: {} limit points of {name} ({})",
+                "wrote {}: {} limit points of {name} ({scheme})",
                 out.display(),
-                samples.len(),
-                scheme.scheme()
+                rows.len(),
             );
         }
         None => out!("{}", text.trim_end()),
     }
     Ok(())
+}
+
+/// `limit --scheme doo-sabin`: at `--face --corner --uv`, or at every `F C U V` of --points.
+fn doo_sabin_limit(a: LimitArgs) -> Result<()> {
+    let name = crate::commands::mesh_name(a.input.as_deref());
+    let points = match &a.points {
+        Some(path) => Some((path.as_path(), read_points(path, true)?)),
+        None => None,
+    };
+    let (mesh, lines) = read_mesh(a.input.as_deref())?;
+    let ev = DooSabinEvaluator::new(&mesh).map_err(|e| eval_in_file(e, &name, &mesh, &lines))?;
+    if let Some((path, (rows, point_lines))) = points {
+        return doo_sabin_points(&a, &ev, &name, path, (&rows, &point_lines));
+    }
+    let (Some(face), Some(uv)) = (a.face, a.uv) else {
+        bail!("--face, --corner and --uv, or --points, say where to evaluate");
+    };
+    let Some(corner) = a.corner else {
+        bail!(
+            "--scheme doo-sabin needs --corner K: the corner of --face whose quad --uv is in \
+             (see `tessera limit --help`)"
+        );
+    };
+    let faces = ev.num_faces();
+    if face == 0 || face > faces {
+        bail!("--face {face}: {name} has faces 1 to {faces} (numbered as its `f` lines, from 1)");
+    }
+    let size = ev.face_size(face - 1);
+    if corner > size {
+        bail!("--corner {corner}: face {face} of {name} has corners 1 to {size}");
+    }
+    if !(0.0..=1.0).contains(&uv.0) || !(0.0..=1.0).contains(&uv.1) {
+        bail!(
+            "--uv {},{}: outside the corner's quad (0 to 1 in u and v)",
+            topology::error::number(uv.0),
+            topology::error::number(uv.1)
+        );
+    }
+    let s = ev
+        .evaluate(face - 1, corner - 1, uv.0, uv.1)
+        .map_err(|e| eval_in_file(e, &name, &mesh, &lines))?;
+    if non_finite(&[s.position]).is_some() {
+        bail!("{name}: the limit at face {face} corner {corner} is not finite");
+    }
+    let v3 = |p: &[f64; 3]| format!("{:.12} {:.12} {:.12}", p[0], p[1], p[2]);
+    out!(
+        "scheme doo-sabin face {face} corner {corner} uv {} {}",
+        topology::error::number(uv.0),
+        topology::error::number(uv.1)
+    );
+    out!("position {}", v3(&s.position));
+    match s.derivatives {
+        Some((du, dv)) => out!("du {}\ndv {}", v3(&du), v3(&dv)),
+        None => out!("du none (the centre of an extraordinary face)\ndv none"),
+    }
+    match s.normal {
+        Some(n) => out!("normal {}", v3(&n)),
+        None => out!("normal none (degenerate, or a boundary face's centre)"),
+    }
+    Ok(())
+}
+
+/// `limit --scheme doo-sabin --points`: every `F C U V` of the file, one line each.
+fn doo_sabin_points(
+    a: &LimitArgs,
+    ev: &DooSabinEvaluator,
+    name: &str,
+    path: &std::path::Path,
+    (rows, lines): (&[PointRow], &[usize]),
+) -> Result<()> {
+    let mut values = Vec::with_capacity(rows.len());
+    for (r, &line) in rows.iter().zip(lines) {
+        let at = format!("{}:{line}", path.display());
+        let s = ev
+            .evaluate(r.face as usize, r.corner as usize, r.uv[0], r.uv[1])
+            .map_err(|e| doo_sabin_point_error(e, &at, name))?;
+        values.push(doo_sabin_values(&s, a.derivatives, &at)?);
+    }
+    write_points(a, &values, (name, path, lines), Scheme::DooSabin)
+}
+
+/// A sample's position and, with `derivatives`, its partials and normal (refused where the
+/// limit has none).
+fn doo_sabin_values(s: &DooSabinSample, derivatives: bool, at: &str) -> Result<Vec<[f64; 3]>> {
+    if !derivatives {
+        return Ok(vec![s.position]);
+    }
+    let Some((du, dv)) = s.derivatives else {
+        bail!(
+            "{at}: the centre of an extraordinary face has no parametric derivatives; \
+             nothing written (drop --derivatives or move off the centre)"
+        );
+    };
+    let Some(normal) = s.normal else {
+        bail!("{at}: the limit there has no normal (degenerate); nothing written");
+    };
+    Ok(vec![s.position, du, dv, normal])
+}
+
+/// A Doo-Sabin point's evaluation error, at `at` (file:line), in the points file's terms.
+fn doo_sabin_point_error(e: EvalError, at: &str, name: &str) -> anyhow::Error {
+    match e {
+        EvalError::FaceOutOfRange { face, count } => anyhow::anyhow!(
+            "{at}: face {face} out of range: {name} has faces 0 to {} (counted from 0)",
+            count.saturating_sub(1)
+        ),
+        EvalError::CornerOutOfRange { face, corner, size } => anyhow::anyhow!(
+            "{at}: corner {corner} out of range: face {face} has corners 0 to {} (counted \
+             from 0)",
+            size.saturating_sub(1)
+        ),
+        EvalError::ParamOutOfRange { u, v } => anyhow::anyhow!(
+            "{at}: ({u}, {v}) is not in the corner's quad (0 to 1 in u and v; NaN and infinity \
+             never are)"
+        ),
+        other => anyhow::Error::new(other).context(at.to_string()),
+    }
 }

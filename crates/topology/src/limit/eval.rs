@@ -95,6 +95,17 @@ impl std::str::FromStr for LimitScheme {
 pub enum EvalError {
     #[error("face {face} out of range (the mesh has {count} faces)")]
     FaceOutOfRange { face: usize, count: usize },
+    /// A Doo-Sabin domain point's corner ([`crate::limit::doo_sabin_eval`]).
+    #[error("corner {corner} out of range: face {face} has {size} corners")]
+    CornerOutOfRange {
+        face: usize,
+        corner: usize,
+        size: usize,
+    },
+    /// The Doo-Sabin child of a corner without the four faces of a domain square (a
+    /// neighbourhood the dual refiner should have refused).
+    #[error("the Doo-Sabin child of face {face}'s corner {corner} does not have four faces")]
+    NoDomainSquare { face: usize, corner: usize },
     #[error("parameter ({}, {}) outside the face domain", number(*.u), number(*.v))]
     ParamOutOfRange { u: f64, v: f64 },
     #[error("face {face} has {size} corners; {} evaluation needs {need}", scheme.scheme())]

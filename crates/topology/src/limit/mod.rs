@@ -6,6 +6,9 @@
 //!   Catmull-Clark's bicubic B-spline) and the cubic Bézier and B-spline curves, the surface in
 //!   closed form where the mesh is regular;
 //! - [`doo_sabin`]: the exact Doo-Sabin limit point and normal at the centre of any face;
+//! - [`doo_sabin_eval`]: exact Doo-Sabin limit evaluation at any point of a corner quad
+//!   (biquadratic patches, local refinement next to extraordinary faces, Chaikin boundaries);
+//! - [`doo_sabin_domain`]: the domain points of refined Doo-Sabin levels' vertices and faces;
 //! - [`eval`]: exact limit evaluation at any `(face, u, v)` (OpenSubdiv's `Bfr`), refining
 //!   locally with the [`refine`](crate::refine) layer until a regular patch or a limit mask
 //!   applies;
@@ -18,6 +21,8 @@
 
 pub mod basis;
 pub mod doo_sabin;
+pub mod doo_sabin_domain;
+pub mod doo_sabin_eval;
 pub mod eval;
 pub mod face_domain;
 pub mod limit_mesh;
