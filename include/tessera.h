@@ -339,6 +339,10 @@ typedef struct TesseraHostDesc {
 // stage (`--method doo-sabin`; levels are powers of two from 2 to 64 segments).
 #define TESSERA_TECHNIQUE_DOO_SABIN 10
 
+// Doo-Sabin subdivision on the CPU to level log2 S, drawn as a static mesh
+// (`--method cpu-doo-sabin`: the CPU baseline of `TESSERA_TECHNIQUE_DOO_SABIN`).
+#define TESSERA_TECHNIQUE_CPU_DOO_SABIN 11
+
 // Catmull-Clark unless every face is a triangle (then Loop); a Loop technique fan-triangulates.
 #define TESSERA_SCHEME_AUTO 0
 

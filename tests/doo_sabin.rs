@@ -131,6 +131,36 @@ fn captured_points_are_the_cpu_refiners_points_and_weld_without_cracks() {
     }
 }
 
+/// `cpu-doo-sabin`, the Doo-Sabin seed's CPU baseline: the same refined points as the refiner
+/// (and so as `doo-sabin` on the GPU), every one drawn, the same triangle count, 0 cracks with
+/// its vertices mapped to where their limits lie (boundary points to their corner's vertex).
+#[test]
+fn the_cpu_baseline_draws_the_refiners_level() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let capturer = Capturer::new(&ctx).unwrap();
+        for (name, path) in SHAPES {
+            let mesh = mesh(path);
+            let mut cpu = common::build(&mut ctx, TechniqueId::CPU_DOO_SABIN, &mesh);
+            let gpu_t = common::build(&mut ctx, TechniqueId::DOO_SABIN, &mesh);
+            let open = name == "edgecorner" || name == "xord_boundary";
+            for depth in 1..=3u32 {
+                let c = compare(&mut ctx, &capturer, cpu.as_mut(), &mesh, &mesh, depth);
+                let what = format!("cpu-doo-sabin on {name}, D = {depth}");
+                assert!(c.worst <= 1e-6, "{what}: {:e}", c.worst);
+                assert_eq!(c.covered, c.points, "{what}: every point drawn");
+                let params = FrameParams::uniform((1u32 << depth) as f32);
+                assert_eq!(Some(c.triangles as u64), cpu.triangles(&params, 0), "{what}");
+                assert_eq!(gpu_t.triangles(&params, 0), cpu.triangles(&params, 0), "{what}");
+                assert_eq!((c.classes.0, c.classes.1), (0, 0), "{what}");
+                assert_eq!(c.classes.2 > 0, open, "{what}: boundary edges");
+            }
+        }
+    }
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+}
+
 #[test]
 fn an_animated_frame_is_the_refinement_of_the_moved_base() {
     let gpu = Gpu::new();

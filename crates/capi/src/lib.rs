@@ -112,6 +112,9 @@ pub const TESSERA_TECHNIQUE_CPU_CATMARK: TesseraTechnique = 9;
 /// Doo-Sabin subdivision refined on the GPU every frame to level log2 S, drawn from the vertex
 /// stage (`--method doo-sabin`; levels are powers of two from 2 to 64 segments).
 pub const TESSERA_TECHNIQUE_DOO_SABIN: TesseraTechnique = 10;
+/// Doo-Sabin subdivision on the CPU to level log2 S, drawn as a static mesh
+/// (`--method cpu-doo-sabin`: the CPU baseline of `TESSERA_TECHNIQUE_DOO_SABIN`).
+pub const TESSERA_TECHNIQUE_CPU_DOO_SABIN: TesseraTechnique = 11;
 
 /// The subdivision scheme (`TESSERA_SCHEME_*`).
 pub type TesseraScheme = u32;

@@ -60,7 +60,7 @@ pub struct TechniqueInfo {
 
 /// Every technique, one line each, in the order reports and the window's number keys list
 /// them (flat first: ratios divide by it).
-pub static REGISTRY: [&TechniqueInfo; 10] = [
+pub static REGISTRY: [&TechniqueInfo; 11] = [
     &flat::INFO,
     &phong::INFO,
     &pn::INFO,
@@ -71,6 +71,7 @@ pub static REGISTRY: [&TechniqueInfo; 10] = [
     &cpu::INFO,
     &cpu::CATMARK_INFO,
     &doo_sabin::INFO,
+    &cpu::DOO_SABIN_INFO,
 ];
 
 /// Every technique, in the order reports list them (flat first: ratios divide by it).

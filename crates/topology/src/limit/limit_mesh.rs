@@ -93,6 +93,51 @@ pub fn uniform_limit_mesh(
     })
 }
 
+/// Doo-Sabin refinement of `mesh` to `level` on the CPU, the vertices where the refinement puts
+/// them (not on the limit: the seed's CPU baseline refines, as its GPU vertex patches do), with
+/// angle-weighted normals, fan triangles, and each vertex's point on the base mesh: where its
+/// limit lies ([`crate::limit::doo_sabin_domain`]), in [`crate::limit::face_domain`]'s face
+/// domains (a corner quad `(u, v)` mapped bilinearly onto its sub-quad of the face).
+///
+/// Except boundary points, which map onto their corner's base vertex, as the GPU technique maps
+/// them: a refined boundary edge of a dual scheme cuts the corner of a base boundary vertex,
+/// from one base edge to the next, so only there do both its ends lie on one base edge (what
+/// a capture's classification of open edges asks of a boundary edge).
+pub fn doo_sabin_level_mesh(mesh: &ControlMesh, level: usize) -> Result<LimitMesh, LimitMeshError> {
+    let eval = |source| LimitMeshError::Eval {
+        scheme: Scheme::DooSabin,
+        level,
+        source,
+    };
+    let refinement = crate::limit::doo_sabin_domain::DomainRefinement::new(mesh, level)
+        .map_err(eval)?;
+    let current = refinement.level(level);
+    let (offsets, corners) = current.topology.face_tables();
+    let positions = current.positions.clone();
+    let normals = angle_weighted_normals(&positions, offsets, corners);
+    let boundary = refinement.boundary_points(level);
+    let domains = (0..positions.len())
+        .map(|x| {
+            let mut d = refinement.vertex_point(level, x)?;
+            if boundary.get(x).copied().unwrap_or(false) {
+                d.uv = [0.0, 0.0];
+            }
+            let n = mesh.face(d.face as usize).len() as u32;
+            let q = crate::limit::face_domain::subface_domain(n, d.corner);
+            let [u, v] = d.uv;
+            let w = [(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v];
+            let uv = [0, 1].map(|k| (0..4).map(|j| w[j] * q[j][k]).sum::<f64>());
+            Some(DomainPoint { face: d.face, uv })
+        })
+        .collect();
+    Ok(LimitMesh {
+        domains,
+        triangles: fan_triangles(offsets, corners),
+        positions,
+        normals,
+    })
+}
+
 /// Limit positions of every vertex of `current` (refined `level` times).
 fn limit_positions(
     current: &Level,

@@ -14,7 +14,9 @@
 //! - **Animation re-refines on the CPU** and uploads the whole refined mesh into the frame
 //!   slot's own host-visible vertex buffer: exactly the cost the papers' animated baseline pays.
 //! - Loop refines the fan triangulation of polygons (captured points map back into the input's
-//!   polygons); Catmull-Clark and bilinear refine the mesh as given.
+//!   polygons); Catmull-Clark and bilinear refine the mesh as given, and so does Doo-Sabin
+//!   (`cpu-doo-sabin`), whose vertices stay where the refinement puts them (the Doo-Sabin seed's
+//!   CPU baseline, the mesh `doo-sabin` refines on the GPU), each mapped to where its limit lies.
 use crate::capture::{face_corner_uv, FacePoint};
 use crate::context::Context;
 use crate::error::{Param, ParamError, Result, TessError};
@@ -25,8 +27,10 @@ use crate::technique::{
     PatchPipeline, PatchType, Technique, TechniqueId, VertexInput,
 };
 use crate::techniques::{BuildOptions, Built, TechniqueInfo};
+use crate::techniques::doo_sabin::layout::{first_level_size, level_sizes, LevelSize};
 use topology::limit::limit_mesh::{
-    catmark_level_size, loop_level_size, uniform_limit_mesh, DomainPoint, LimitMesh,
+    catmark_level_size, doo_sabin_level_mesh, loop_level_size, uniform_limit_mesh, DomainPoint,
+    LimitMesh,
 };
 use topology::{ControlMesh, Scheme};
 use vk_core::{vk, Buffer, BufferDesc, Device, Encoder, MemoryLocation};
@@ -34,6 +38,7 @@ use vk_core::{vk, Buffer, BufferDesc, Device, Encoder, MemoryLocation};
 impl TechniqueId {
     pub const CPU: TechniqueId = TechniqueId::new("cpu");
     pub const CPU_CATMARK: TechniqueId = TechniqueId::new("cpu-catmark");
+    pub const CPU_DOO_SABIN: TechniqueId = TechniqueId::new("cpu-doo-sabin");
 }
 
 /// The registry entry of `--method cpu`: Loop on the CPU (the seeds' Table I baseline).
@@ -80,6 +85,23 @@ pub static CATMARK_INFO: TechniqueInfo = TechniqueInfo {
     ..INFO
 };
 
+/// The registry entry of `--method cpu-doo-sabin`: Doo-Sabin refined on the CPU (the baseline
+/// of the Doo-Sabin seed's §3, against `doo-sabin`'s refinement on the GPU).
+pub static DOO_SABIN_INFO: TechniqueInfo = TechniqueInfo {
+    id: TechniqueId::CPU_DOO_SABIN,
+    help: "Doo-Sabin subdivision on the CPU to level log2 S (refined, as doo-sabin draws it), drawn as a static indexed mesh from the vertex stage",
+    features: Features {
+        triangles_only: false,
+        ..INFO.features
+    },
+    scheme: Some(Scheme::DooSabin),
+    abi_code: 11,
+    build: |ctx, mesh, options| {
+        build(ctx, TechniqueId::CPU_DOO_SABIN, Scheme::DooSabin, mesh, options)
+    },
+    ..INFO
+};
+
 /// Deepest level a frame may ask for: 2^6 = 64 segments per base edge, the tessellator's
 /// maximum, so both paths draw the same range of levels.
 pub const MAX_LEVEL: u32 = 6;
@@ -113,6 +135,8 @@ pub struct CpuMesh {
     slots: usize,
     animated: bool,
     device: Device,
+    /// Doo-Sabin's level-1 size, from which every level's is counted before refining.
+    doo_sabin_first: Option<LevelSize>,
 }
 
 impl CpuMesh {
@@ -126,10 +150,17 @@ impl CpuMesh {
         options: &BuildOptions,
     ) -> Result<Self> {
         let (refined, fans) = refined_control_mesh(mesh, scheme);
-        topology::refine::Level::from_mesh(&refined, scheme).map_err(|e| TessError::Mesh {
+        let mesh_error = |e: topology::TopologyError| TessError::Mesh {
             name: options.name.clone(),
             source: e.into(),
-        })?;
+        };
+        let base = topology::refine::Level::from_mesh(&refined, scheme).map_err(mesh_error)?;
+        // Doo-Sabin's first step refuses what the dual scheme cannot refine (a vertex of two
+        // faces), before any frame asks for a level.
+        let doo_sabin_first = match scheme {
+            Scheme::DooSabin => Some(first_level_size(&base).map_err(mesh_error)?),
+            _ => None,
+        };
         let base_corners = corner_domains(&refined, &fans);
         let (lo, hi) = mesh.bounding_box();
         Ok(Self {
@@ -147,6 +178,7 @@ impl CpuMesh {
             base_corners,
             bbox: (lo.map(|c| c as f32), hi.map(|c| c as f32)),
             max_vertices: options.max_refined_vertices,
+            doo_sabin_first,
             slots: ctx.frames_in_flight(),
             animated: false,
             device: ctx.device().clone(),
@@ -170,6 +202,13 @@ impl CpuMesh {
                 let (v, _, f) = loop_level_size(&self.refined, level);
                 (v, f)
             }
+            Scheme::DooSabin => match self.doo_sabin_first {
+                Some(first) => {
+                    let size = level_sizes(first, level as u32)[level - 1];
+                    (size.vertices, size.triangles())
+                }
+                None => (0, 0),
+            },
             _ => {
                 let (v, _, f) = catmark_level_size(&self.refined, level);
                 (v, 2 * f)
@@ -179,13 +218,11 @@ impl CpuMesh {
 
     /// Refines to `level` on the CPU (the current base positions).
     fn refine(&self, level: u32) -> Result<LimitMesh> {
-        uniform_limit_mesh(
-            &self.refined,
-            self.scheme,
-            level as usize,
-            &self.base_corners,
-        )
-        .map_err(|e| TessError::Mesh {
+        let refined = match self.scheme {
+            Scheme::DooSabin => doo_sabin_level_mesh(&self.refined, level as usize),
+            scheme => uniform_limit_mesh(&self.refined, scheme, level as usize, &self.base_corners),
+        };
+        refined.map_err(|e| TessError::Mesh {
             name: format!("{} level {level}", self.scheme),
             source: e.into(),
         })
