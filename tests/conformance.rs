@@ -300,3 +300,70 @@ fn every_technique_refuses_each_option_it_declares_it_does_not_take() {
         assert!(refusals > 20, "{refusals} refusals checked");
     }
 }
+
+/// On a device without tessellation shaders (lavapipe's, made without the feature, so any
+/// tessellation pipeline would be a validation error), `auto` draws every technique that has
+/// another path (refinement patterns, or the vertex stage) validation-clean, capturing with 0
+/// cracks; every technique with only the tessellation path is refused by name.
+#[test]
+fn without_tessellation_shaders_every_technique_draws_or_is_refused_by_name() {
+    let gpu = Gpu::with(&tessera::vk_core::DeviceDesc {
+        without_tessellation_shader: true,
+        ..Default::default()
+    });
+    let (mut drawn, mut refused) = (Vec::new(), Vec::new());
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let capturer = Capturer::new(&ctx).unwrap();
+        let params = FrameParams::uniform(SEGMENTS);
+        let (_, mesh) = meshes().remove(0);
+        for info in techniques::registry() {
+            let other_path = info
+                .features
+                .paths
+                .iter()
+                .any(|&p| p != DrawPath::Tessellation);
+            let options = BuildOptions {
+                name: "no tessellation".into(),
+                ..BuildOptions::default()
+            };
+            match techniques::build(&mut ctx, info.id, &mesh, &options) {
+                Ok(built) if other_path => {
+                    let mut t = built.technique;
+                    assert!(
+                        t.patch_arrays()
+                            .iter()
+                            .all(|a| a.patch.path() != DrawPath::Tessellation),
+                        "{}",
+                        info.id
+                    );
+                    assert!(
+                        drawn_pixels(&mut ctx, t.as_mut(), &params) > 100,
+                        "{}",
+                        info.id
+                    );
+                    let (classes, _) = capture(&mut ctx, &capturer, t.as_mut(), &mesh, &params);
+                    assert_eq!(
+                        classes,
+                        (0, 0, 0),
+                        "{}: (cracks, unmapped, boundary)",
+                        info.id
+                    );
+                    drawn.push(info.id);
+                }
+                Err(e @ TessError::NoTessellationShader { .. }) if !other_path => {
+                    assert!(e.to_string().contains(info.id.name()), "{e}");
+                    refused.push(info.id);
+                }
+                Ok(_) => panic!("{} built without tessellation shaders", info.id),
+                Err(e) => panic!("{}: {e}", info.id),
+            }
+        }
+    }
+    println!("drawn: {drawn:?}; refused by name: {refused:?}");
+    assert!(
+        drawn.len() >= 8 && !refused.is_empty(),
+        "{drawn:?} {refused:?}"
+    );
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+}

@@ -151,8 +151,16 @@ fn the_cpu_baseline_draws_the_refiners_level() {
                 assert!(c.worst <= 1e-6, "{what}: {:e}", c.worst);
                 assert_eq!(c.covered, c.points, "{what}: every point drawn");
                 let params = FrameParams::uniform((1u32 << depth) as f32);
-                assert_eq!(Some(c.triangles as u64), cpu.triangles(&params, 0), "{what}");
-                assert_eq!(gpu_t.triangles(&params, 0), cpu.triangles(&params, 0), "{what}");
+                assert_eq!(
+                    Some(c.triangles as u64),
+                    cpu.triangles(&params, 0),
+                    "{what}"
+                );
+                assert_eq!(
+                    gpu_t.triangles(&params, 0),
+                    cpu.triangles(&params, 0),
+                    "{what}"
+                );
                 assert_eq!((c.classes.0, c.classes.1), (0, 0), "{what}");
                 assert_eq!(c.classes.2 > 0, open, "{what}: boundary edges");
             }

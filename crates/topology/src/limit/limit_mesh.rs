@@ -109,8 +109,8 @@ pub fn doo_sabin_level_mesh(mesh: &ControlMesh, level: usize) -> Result<LimitMes
         level,
         source,
     };
-    let refinement = crate::limit::doo_sabin_domain::DomainRefinement::new(mesh, level)
-        .map_err(eval)?;
+    let refinement =
+        crate::limit::doo_sabin_domain::DomainRefinement::new(mesh, level).map_err(eval)?;
     let current = refinement.level(level);
     let (offsets, corners) = current.topology.face_tables();
     let positions = current.positions.clone();

@@ -26,8 +26,8 @@ use crate::technique::{
     DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features, FrameParams, Pass, PatchArray,
     PatchPipeline, PatchType, Technique, TechniqueId, VertexInput,
 };
-use crate::techniques::{BuildOptions, Built, TechniqueInfo};
 use crate::techniques::doo_sabin::layout::{first_level_size, level_sizes, LevelSize};
+use crate::techniques::{BuildOptions, Built, TechniqueInfo};
 use topology::limit::limit_mesh::{
     catmark_level_size, doo_sabin_level_mesh, loop_level_size, uniform_limit_mesh, DomainPoint,
     LimitMesh,
