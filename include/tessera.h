@@ -351,8 +351,8 @@ typedef struct TesseraHostDesc {
 // Loop, strictly: a mesh with a face that is not a triangle is refused (`TESSERA_STATUS_MESH`).
 #define TESSERA_SCHEME_LOOP 2
 
-// Doo-Sabin (drawn by `TESSERA_TECHNIQUE_DOO_SABIN`; no limit evaluation: an evaluator of it
-// is refused with `TESSERA_STATUS_UNSUPPORTED`).
+// Doo-Sabin (drawn by `TESSERA_TECHNIQUE_DOO_SABIN` and `TESSERA_TECHNIQUE_CPU_DOO_SABIN`; its
+// limit evaluator evaluates the exact Doo-Sabin limit).
 #define TESSERA_SCHEME_DOO_SABIN 3
 
 // `factor` segments per base edge.

@@ -123,8 +123,8 @@ pub const TESSERA_SCHEME_AUTO: TesseraScheme = 0;
 pub const TESSERA_SCHEME_CATMULL_CLARK: TesseraScheme = 1;
 /// Loop, strictly: a mesh with a face that is not a triangle is refused (`TESSERA_STATUS_MESH`).
 pub const TESSERA_SCHEME_LOOP: TesseraScheme = 2;
-/// Doo-Sabin (drawn by `TESSERA_TECHNIQUE_DOO_SABIN`; no limit evaluation: an evaluator of it
-/// is refused with `TESSERA_STATUS_UNSUPPORTED`).
+/// Doo-Sabin (drawn by `TESSERA_TECHNIQUE_DOO_SABIN` and `TESSERA_TECHNIQUE_CPU_DOO_SABIN`; its
+/// limit evaluator evaluates the exact Doo-Sabin limit).
 pub const TESSERA_SCHEME_DOO_SABIN: TesseraScheme = 3;
 
 /// How tessellation factors are chosen (`TESSERA_FACTORS_*`).

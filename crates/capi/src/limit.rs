@@ -19,7 +19,9 @@
 //! else its technique's (adaptive, gregory, acc: Catmull-Clark; bft: Loop), else Catmull-Clark
 //! unless every face is a triangle. Loop evaluates the fan triangulation of other faces (what
 //! the Loop technique draws); gregory and acc approximate the Catmull-Clark limit this
-//! evaluates exactly. Creases and corners count, scaled by the surface's `sharpness_scale`
+//! evaluates exactly. Doo-Sabin evaluates its exact limit in the same face domains (each face
+//! through the sub-quads of its corners); at the centre of a face that is not a quad, where
+//! that limit has no parametric derivatives, `du` and `dv` are zero. Creases and corners count, scaled by the surface's `sharpness_scale`
 //! where its technique scales them (adaptive, gregory, acc). Positions are the surface's
 //! newest ([`crate::tessera_surface_update_positions`]) when the evaluator is made.
 //!
@@ -33,7 +35,7 @@ use crate::handles::lock;
 use crate::status::{Error, Result, TesseraStatus};
 use crate::{guard, handle_id, handles, with_surface, TesseraContext, TesseraSurface};
 use crate::{TesseraMeshDesc, TesseraScheme};
-use topology::limit::eval::{EvalError, LimitScheme};
+use topology::limit::eval::EvalError;
 use topology::limit::face_domain::{LimitEvaluator, PointError};
 use topology::Scheme;
 
@@ -52,13 +54,13 @@ fn evaluator_ptr(id: u64) -> *mut TesseraLimitEvaluator {
 
 /// The evaluator of `mesh` under `scheme`, with its message for a scheme without one.
 pub(crate) fn build(mesh: &topology::ControlMesh, scheme: Scheme) -> Result<LimitEvaluator> {
-    let limit = LimitScheme::try_from(scheme).map_err(|e| {
-        Error::new(
+    LimitEvaluator::of_scheme(mesh, scheme).map_err(|e| match e {
+        EvalError::NoLimitEvaluation { .. } => Error::new(
             TesseraStatus::Unsupported,
             format!("limit evaluation of {scheme}: {e}"),
-        )
-    })?;
-    LimitEvaluator::new(mesh, limit).map_err(|e| eval_error(&e, e.to_string()))
+        ),
+        e => eval_error(&e, e.to_string()),
+    })
 }
 
 /// The status of an evaluation error, with `message`.
@@ -176,8 +178,9 @@ pub unsafe extern "C" fn tessera_limit_evaluator_info(
 ) -> TesseraStatus {
     with_evaluator(ev, |e| {
         let s = match e.scheme() {
-            LimitScheme::CatmullClark => crate::TESSERA_SCHEME_CATMULL_CLARK,
-            LimitScheme::Loop => crate::TESSERA_SCHEME_LOOP,
+            Scheme::Loop => crate::TESSERA_SCHEME_LOOP,
+            Scheme::DooSabin => crate::TESSERA_SCHEME_DOO_SABIN,
+            _ => crate::TESSERA_SCHEME_CATMULL_CLARK,
         };
         // SAFETY: the caller's contract; NULL outputs are skipped.
         unsafe {

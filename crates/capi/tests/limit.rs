@@ -443,11 +443,13 @@ fn evaluators_of_meshes_and_of_moved_surfaces() {
     }
 }
 
-/// `TESSERA_SCHEME_DOO_SABIN` with `TESSERA_TECHNIQUE_AUTO` builds the doo-sabin technique;
-/// its limit evaluator is refused as unsupported (there is no exact Doo-Sabin evaluation at
-/// arbitrary points), as is the scheme under a technique that draws another.
+/// `TESSERA_SCHEME_DOO_SABIN` with `TESSERA_TECHNIQUE_AUTO` builds the doo-sabin technique, and
+/// its limit evaluator evaluates the exact Doo-Sabin limit (topology's, in the same face
+/// domains): at every face's centre the face's centroid (the limit there), elsewhere what
+/// `topology::limit::face_domain::LimitEvaluator::doo_sabin` gives, bit for bit. The scheme under
+/// a technique that draws another is refused.
 #[test]
-fn doo_sabin_surfaces_build_and_refuse_limit_evaluation() {
+fn doo_sabin_surfaces_build_and_evaluate_the_exact_limit() {
     let c = Standalone::new();
     let mut d = surface_desc(TESSERA_TECHNIQUE_AUTO);
     d.scheme = TESSERA_SCHEME_DOO_SABIN;
@@ -458,10 +460,62 @@ fn doo_sabin_surfaces_build_and_refuse_limit_evaluation() {
     let mut e = null_mut();
     // SAFETY: `s` is live; `e` is a live local.
     let status = unsafe { tessera_limit_evaluator_create(c.ctx, s, &mut e) };
-    assert_eq!(status, TesseraStatus::Unsupported);
-    assert!(e.is_null());
-    let message = last_error();
-    assert!(message.to_lowercase().contains("doo"), "{message}");
+    assert_eq!(status, TesseraStatus::Ok, "{}", last_error());
+    let ev = Evaluator(e);
+    let mesh = spot_mesh();
+    let cpu = topology::limit::face_domain::LimitEvaluator::doo_sabin(&mesh).unwrap();
+    let mut points = Vec::new();
+    for f in 0..mesh.num_faces() as u32 {
+        let n = mesh.face(f as usize).len() as u32;
+        let corners: Vec<[f64; 2]> = (0..n)
+            .map(|k| topology::limit::face_domain::face_corner_uv(n, k))
+            .collect();
+        let centre = corners.iter().fold([0.0; 2], |a, c| {
+            [a[0] + c[0] / n as f64, a[1] + c[1] / n as f64]
+        });
+        points.push((f, centre));
+        points.push((
+            f,
+            [
+                0.7 * corners[0][0] + 0.3 * centre[0],
+                0.7 * corners[0][1] + 0.3 * centre[1],
+            ],
+        ));
+    }
+    let [positions, _, _, normals] = ev.evaluate(&points).unwrap();
+    let mut centres = 0;
+    for (i, &(f, [u, v])) in points.iter().enumerate() {
+        let want = cpu.evaluate(f, u, v).unwrap();
+        assert_eq!(positions[i], want.position, "point {i}");
+        assert_eq!(normals[i], want.normal, "point {i}");
+        if i % 2 == 0 {
+            let face = mesh.face(f as usize);
+            let centroid: Vec<f64> = (0..3)
+                .map(|k| {
+                    face.iter()
+                        .map(|&x| mesh.positions[x as usize][k])
+                        .sum::<f64>()
+                        / face.len() as f64
+                })
+                .collect();
+            for k in 0..3 {
+                assert!(
+                    (positions[i][k] - centroid[k]).abs() < 1e-9,
+                    "face {f} centre"
+                );
+            }
+            centres += 1;
+        }
+    }
+    assert_eq!(centres, mesh.num_faces());
+    let mut scheme = 0;
+    // SAFETY: `e` is live; `scheme` a live local.
+    let status = unsafe { tessera_limit_evaluator_info(e, null_mut(), &mut scheme) };
+    assert_eq!(
+        (status, scheme),
+        (TesseraStatus::Ok, TESSERA_SCHEME_DOO_SABIN)
+    );
+    drop(ev);
     // SAFETY: `s` is live and destroyed once.
     let status = unsafe { tessera_surface_destroy(c.ctx, s) };
     assert_eq!(status, TesseraStatus::Ok);

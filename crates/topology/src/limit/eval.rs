@@ -123,7 +123,7 @@ pub enum EvalError {
     },
     #[error("sub-faces are a Catmull-Clark parameterisation; {} has none", scheme.scheme())]
     SubfaceNeedsCatmullClark { scheme: LimitScheme },
-    #[error("{scheme} has no limit evaluation here (use loop or catmull-clark)")]
+    #[error("{scheme} has no limit evaluation here (use loop, catmull-clark or doo-sabin)")]
     NoLimitEvaluation { scheme: Scheme },
     #[error("{count} values are not {dim} per vertex for {vertices} vertices")]
     PointCount {

@@ -15,6 +15,10 @@
 //! - **Catmull-Clark**: quads directly; any other face through its sub-quads, each mapping
 //!   bilinearly into the face's domain as the adaptive technique maps them (corner, edge
 //!   midpoint, centre, edge midpoint), inverted here (Newton, to rounding).
+//! - **Doo-Sabin** ([`LimitEvaluator::doo_sabin`]): every face through the same sub-quads,
+//!   which are [`crate::limit::doo_sabin_eval`]'s corner quads. At the centre of a non-quad
+//!   face the limit has no parametric derivatives: `du` and `dv` are zero there and the normal
+//!   is the centre's.
 //!
 //! Derivatives are with respect to the face domain's `u` and `v` (the chain rule through those
 //! maps); the normal is `du × dv`, normalized (outward, as [`crate::limit::eval`] orients it).
@@ -23,8 +27,10 @@
 //! [`EvalError::ParamOutOfRange`].
 //!
 //! An evaluator holds only immutable data: one may be shared by any number of threads.
+use crate::limit::doo_sabin_eval::DooSabinEvaluator;
 use crate::limit::eval::{normal_of, EvalError, LimitSample, LimitScheme, LocalMesh};
 use crate::mesh::ControlMesh;
+use crate::rules::Scheme;
 use std::collections::BTreeMap;
 
 /// Where corner `k` of an `n`-sided face sits in the face's (u, v) domain, the convention of
@@ -117,9 +123,10 @@ struct PatchPoint {
 
 /// Exact limit positions, derivatives and normals of one control mesh at face-domain points.
 pub struct LimitEvaluator {
-    scheme: LimitScheme,
-    /// The mesh evaluated: the control mesh (Catmull-Clark) or its fan triangulation (Loop).
-    mesh: LocalMesh,
+    scheme: Scheme,
+    /// What is evaluated: the control mesh (Catmull-Clark) or its fan triangulation (Loop), or
+    /// the Doo-Sabin evaluator of the control mesh.
+    surface: Surface,
     /// Corners of each base face.
     sizes: Vec<u32>,
     /// Loop: each base face's first fan triangle.
@@ -157,7 +164,36 @@ fn barycentric(t: [[f64; 2]; 3], p: [f64; 2]) -> [f64; 3] {
     [1.0 - w1 - w2, w1, w2]
 }
 
+/// The surface a [`LimitEvaluator`] evaluates.
+enum Surface {
+    Local(LocalMesh),
+    /// Doo-Sabin's limit ([`crate::limit::doo_sabin_eval`]): a face-domain point is mapped to
+    /// its corner quad, the Catmull-Clark sub-quad of the same corner.
+    DooSabin(Box<DooSabinEvaluator>),
+}
+
 impl LimitEvaluator {
+    /// An evaluator of `mesh`'s Doo-Sabin limit surface (non-manifold meshes through their
+    /// manifold split, as [`Self::new`]).
+    pub fn doo_sabin(mesh: &ControlMesh) -> Result<Self, EvalError> {
+        let split = crate::mesh::manifold::ManifoldSplit::of(mesh)?;
+        Ok(Self {
+            scheme: Scheme::DooSabin,
+            surface: Surface::DooSabin(Box::new(DooSabinEvaluator::new(&split.mesh)?)),
+            sizes: split.mesh.faces().map(|f| f.len() as u32).collect(),
+            first_triangle: Vec::new(),
+        })
+    }
+
+    /// An evaluator of `mesh`'s limit surface under `scheme`: [`Self::new`], or
+    /// [`Self::doo_sabin`]; bilinear has none here.
+    pub fn of_scheme(mesh: &ControlMesh, scheme: Scheme) -> Result<Self, EvalError> {
+        match scheme {
+            Scheme::DooSabin => Self::doo_sabin(mesh),
+            other => Self::new(mesh, LimitScheme::try_from(other)?),
+        }
+    }
+
     /// An evaluator of `mesh`'s limit surface under `scheme` (any face sizes: Loop evaluates
     /// the fan triangulation). The mesh is validated as every control mesh is; a non-manifold
     /// mesh is evaluated through its manifold split
@@ -181,14 +217,14 @@ impl LimitEvaluator {
             }
         };
         Ok(Self {
-            scheme,
-            mesh: local,
+            scheme: scheme.scheme(),
+            surface: Surface::Local(local),
             sizes,
             first_triangle,
         })
     }
 
-    pub fn scheme(&self) -> LimitScheme {
+    pub fn scheme(&self) -> Scheme {
         self.scheme
     }
 
@@ -200,11 +236,13 @@ impl LimitEvaluator {
     /// The limit at `(u, v)` of base face `face`, in the `# p` convention.
     pub fn evaluate(&self, face: u32, u: f64, v: f64) -> Result<FaceSample, EvalError> {
         let p = self.patch_point(face, u, v)?;
+        let mesh = match &self.surface {
+            Surface::Local(mesh) => mesh,
+            Surface::DooSabin(ds) => return doo_sabin_sample(ds, &p),
+        };
         let s = match p.sub {
-            Some(k) => self
-                .mesh
-                .evaluate_subface(p.face, k, p.param[0], p.param[1])?,
-            None => self.mesh.evaluate(p.face, p.param[0], p.param[1])?,
+            Some(k) => mesh.evaluate_subface(p.face, k, p.param[0], p.param[1])?,
+            None => mesh.evaluate(p.face, p.param[0], p.param[1])?,
         };
         Ok(to_face(&s, &p))
     }
@@ -223,6 +261,14 @@ impl LimitEvaluator {
                 source: Box::new(source),
             }
         };
+        let mesh = match &self.surface {
+            Surface::Local(mesh) => mesh,
+            Surface::DooSabin(_) => {
+                return (points.iter().enumerate())
+                    .map(|(i, &(face, [u, v]))| self.evaluate(face, u, v).map_err(|e| at(i, e)))
+                    .collect();
+            }
+        };
         let mut patches: BTreeMap<(usize, Option<usize>), Vec<usize>> = BTreeMap::new();
         let mut mapped = Vec::with_capacity(points.len());
         for (i, &(face, [u, v])) in points.iter().enumerate() {
@@ -233,8 +279,7 @@ impl LimitEvaluator {
         let mut out = vec![None; points.len()];
         for ((face, sub), members) in patches {
             let params: Vec<[f64; 2]> = members.iter().map(|&i| mapped[i].param).collect();
-            let samples = self
-                .mesh
+            let samples = mesh
                 .evaluate_many(face, sub, &params)
                 .map_err(|e| at(members[0], e))?;
             for (&i, s) in members.iter().zip(&samples) {
@@ -255,8 +300,12 @@ impl LimitEvaluator {
         p: &[f64],
     ) -> Result<f64, EvalError> {
         let at = self.patch_point(face, u, v)?;
-        self.mesh
-            .nearest_limit_distance(at.face, at.sub, at.param, p)
+        match &self.surface {
+            Surface::Local(mesh) => mesh.nearest_limit_distance(at.face, at.sub, at.param, p),
+            Surface::DooSabin(_) => Err(EvalError::NoLimitEvaluation {
+                scheme: Scheme::DooSabin,
+            }),
+        }
     }
 
     /// Where `(u, v)` of base face `face` is evaluated, with the map's inverse Jacobian.
@@ -283,20 +332,19 @@ impl LimitEvaluator {
             return Err(EvalError::ParamOutOfRange { u, v });
         }
         match self.scheme {
-            LimitScheme::Loop => Ok(self.fan_point(face as usize, &corners, p)),
-            LimitScheme::CatmullClark if n == 4 => Ok(PatchPoint {
+            Scheme::Loop => Ok(self.fan_point(face as usize, &corners, p)),
+            Scheme::CatmullClark if n == 4 => Ok(PatchPoint {
                 face: face as usize,
                 sub: None,
                 param: [u.clamp(0.0, 1.0), v.clamp(0.0, 1.0)],
                 inverse_jacobian: [[1.0, 0.0], [0.0, 1.0]],
             }),
-            LimitScheme::CatmullClark => {
-                sub_quad_point(face as usize, &corners, p).ok_or(EvalError::NotConverged {
-                    face: face as usize,
-                    u,
-                    v,
-                })
-            }
+            // Catmull-Clark's other faces, and every Doo-Sabin face: the corner's sub-quad.
+            _ => sub_quad_point(face as usize, &corners, p).ok_or(EvalError::NotConverged {
+                face: face as usize,
+                u,
+                v,
+            }),
         }
     }
 
@@ -383,6 +431,29 @@ fn sub_quad_point(face: usize, corners: &[[f64; 2]], p: [f64; 2]) -> Option<Patc
         param: [s, t],
         inverse_jacobian: inverse(jacobian(s, t))?,
     })
+}
+
+/// The Doo-Sabin limit at the corner-quad point `p` (its sub-quad is the corner quad): at an
+/// extraordinary face's centre, where the limit has no parametric derivatives, `du` and `dv`
+/// are zero and the normal is the centre's (zero where none is given).
+fn doo_sabin_sample(ds: &DooSabinEvaluator, p: &PatchPoint) -> Result<FaceSample, EvalError> {
+    let corner = p.sub.unwrap_or(0);
+    let s = ds.evaluate(p.face, corner, p.param[0], p.param[1])?;
+    let normal = s.normal.unwrap_or([0.0; 3]);
+    let Some((du, dv)) = s.derivatives else {
+        return Ok(FaceSample {
+            position: s.position,
+            du: [0.0; 3],
+            dv: [0.0; 3],
+            normal,
+        });
+    };
+    let sample = LimitSample {
+        position: s.position.to_vec(),
+        du: du.to_vec(),
+        dv: dv.to_vec(),
+    };
+    Ok(to_face(&sample, p))
 }
 
 /// A patch sample in the face domain: derivatives through the inverse Jacobian.
