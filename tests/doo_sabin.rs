@@ -169,6 +169,50 @@ fn the_cpu_baseline_draws_the_refiners_level() {
     assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
 }
 
+/// Each drawn point's face point is where its limit lies: evaluating the exact Doo-Sabin limit
+/// there gives a point the drawn one approaches as the level deepens (about halving per level,
+/// the dual scheme's rate next to extraordinary faces), on closed meshes.
+#[test]
+fn drawn_points_approach_the_exact_limit_at_their_face_points() {
+    use tessera::topology::limit::face_domain::LimitEvaluator;
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let capturer = Capturer::new(&ctx).unwrap();
+        for (name, path) in &SHAPES[..4] {
+            let mesh = mesh(path);
+            let limit = LimitEvaluator::doo_sabin(&mesh).unwrap();
+            let mut t = common::build(&mut ctx, TechniqueId::DOO_SABIN, &mesh);
+            let mut errors = Vec::new();
+            for depth in 1..=4u32 {
+                let params = FrameParams::uniform((1u32 << depth) as f32);
+                let (soup, _) = capturer
+                    .capture(&mut ctx, t.as_mut(), &params, EXTENT)
+                    .unwrap();
+                let mut worst = 0.0f64;
+                for r in &soup.records {
+                    let p = t.face_point(r.patch, r.domain).expect("a drawn point");
+                    let e = limit.evaluate(p.face, p.u as f64, p.v as f64).unwrap();
+                    let d = (0..3)
+                        .map(|k| (r.position[k] as f64 - e.position[k]).powi(2))
+                        .sum::<f64>()
+                        .sqrt();
+                    worst = worst.max(d / mesh.bbox_diagonal());
+                }
+                errors.push(worst);
+            }
+            let shown: Vec<String> = errors.iter().map(|e| format!("{e:.2e}")).collect();
+            println!("{name}: drawn point to its limit, levels 1..4: {shown:?}");
+            assert!(
+                errors.windows(2).all(|w| w[1] < 0.75 * w[0]),
+                "{name}: {errors:?}"
+            );
+            assert!(errors[3] < 5e-3, "{name}: {errors:?}");
+        }
+    }
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+}
+
 #[test]
 fn an_animated_frame_is_the_refinement_of_the_moved_base() {
     let gpu = Gpu::new();

@@ -95,28 +95,60 @@ pub fn uniform_limit_mesh(
 
 /// Doo-Sabin refinement of `mesh` to `level` on the CPU, the vertices where the refinement puts
 /// them (not on the limit: the seed's CPU baseline refines, as its GPU vertex patches do), with
-/// angle-weighted normals, fan triangles, and each vertex's point on the base mesh: where its
-/// limit lies ([`crate::limit::doo_sabin_domain`]), in [`crate::limit::face_domain`]'s face
-/// domains (a corner quad `(u, v)` mapped bilinearly onto its sub-quad of the face).
-///
-/// Except boundary points, which map onto their corner's base vertex, as the GPU technique maps
-/// them: a refined boundary edge of a dual scheme cuts the corner of a base boundary vertex,
-/// from one base edge to the next, so only there do both its ends lie on one base edge (what
-/// a capture's classification of open edges asks of a boundary edge).
+/// angle-weighted normals, fan triangles, and each vertex's point on the base mesh
+/// ([`doo_sabin_domain_points`]).
 pub fn doo_sabin_level_mesh(mesh: &ControlMesh, level: usize) -> Result<LimitMesh, LimitMeshError> {
-    let eval = |source| LimitMeshError::Eval {
-        scheme: Scheme::DooSabin,
-        level,
-        source,
-    };
-    let refinement =
-        crate::limit::doo_sabin_domain::DomainRefinement::new(mesh, level).map_err(eval)?;
+    let refinement = doo_sabin_refinement(mesh, level)?;
     let current = refinement.level(level);
     let (offsets, corners) = current.topology.face_tables();
     let positions = current.positions.clone();
     let normals = angle_weighted_normals(&positions, offsets, corners);
+    Ok(LimitMesh {
+        domains: domain_points_of(mesh, &refinement, level),
+        triangles: fan_triangles(offsets, corners),
+        positions,
+        normals,
+    })
+}
+
+/// Where each vertex of `mesh`'s Doo-Sabin level `level` lies on the base mesh: where its limit
+/// lies ([`crate::limit::doo_sabin_domain`]), in [`crate::limit::face_domain`]'s face domains (a
+/// corner quad `(u, v)` mapped bilinearly onto its sub-quad of the face); `None` for a vertex
+/// of no face.
+///
+/// Except boundary points, which map onto their corner's base vertex: a refined boundary edge
+/// of a dual scheme cuts the corner of a base boundary vertex, from one base edge to the next,
+/// so only there do both its ends lie on one base edge (what a capture's classification of
+/// open edges asks of a boundary edge).
+pub fn doo_sabin_domain_points(
+    mesh: &ControlMesh,
+    level: usize,
+) -> Result<Vec<Option<DomainPoint>>, LimitMeshError> {
+    let refinement = doo_sabin_refinement(mesh, level)?;
+    Ok(domain_points_of(mesh, &refinement, level))
+}
+
+fn doo_sabin_refinement(
+    mesh: &ControlMesh,
+    level: usize,
+) -> Result<crate::limit::doo_sabin_domain::DomainRefinement, LimitMeshError> {
+    crate::limit::doo_sabin_domain::DomainRefinement::new(mesh, level).map_err(|source| {
+        LimitMeshError::Eval {
+            scheme: Scheme::DooSabin,
+            level,
+            source,
+        }
+    })
+}
+
+/// [`doo_sabin_domain_points`] of a refinement already made.
+fn domain_points_of(
+    mesh: &ControlMesh,
+    refinement: &crate::limit::doo_sabin_domain::DomainRefinement,
+    level: usize,
+) -> Vec<Option<DomainPoint>> {
     let boundary = refinement.boundary_points(level);
-    let domains = (0..positions.len())
+    (0..refinement.level(level).num_vertices())
         .map(|x| {
             let mut d = refinement.vertex_point(level, x)?;
             if boundary.get(x).copied().unwrap_or(false) {
@@ -124,18 +156,10 @@ pub fn doo_sabin_level_mesh(mesh: &ControlMesh, level: usize) -> Result<LimitMes
             }
             let n = mesh.face(d.face as usize).len() as u32;
             let q = crate::limit::face_domain::subface_domain(n, d.corner);
-            let [u, v] = d.uv;
-            let w = [(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v];
-            let uv = [0, 1].map(|k| (0..4).map(|j| w[j] * q[j][k]).sum::<f64>());
+            let uv = crate::limit::face_domain::bilinear(&q, d.uv[0], d.uv[1]);
             Some(DomainPoint { face: d.face, uv })
         })
-        .collect();
-    Ok(LimitMesh {
-        domains,
-        triangles: fan_triangles(offsets, corners),
-        positions,
-        normals,
-    })
+        .collect()
 }
 
 /// Limit positions of every vertex of `current` (refined `level` times).

@@ -9,11 +9,10 @@
 //! indices moved to where that level lies in the buffer). The deepest level starts at a
 //! storage-buffer offset the device can bind, so the vertex stage reads it as a range of its
 //! own with level-local numbers.
-use crate::capture::{face_corner_uv, FacePoint};
 use crate::gpu::bindings::DOO_SABIN_MAX_CORNERS;
 use crate::stencil::{GpuStencils, StencilBlock, StencilError};
-use topology::mesh::{Topology, INVALID};
-use topology::refine::doo_sabin::{refine_dual, DualVertex};
+use topology::mesh::Topology;
+use topology::refine::doo_sabin::refine_dual;
 use topology::refine::Level;
 use topology::TopologyError;
 
@@ -94,8 +93,6 @@ pub struct DepthLayout {
     /// Per deepest-level point, [`DOO_SABIN_MAX_CORNERS`] `(next, previous)` neighbour pairs,
     /// unused slots naming the point itself.
     pub corners: Vec<[u32; 2]>,
-    /// Per deepest-level point, its base face point.
-    pub face_points: Vec<FacePoint>,
     /// The deepest level as the CPU refined it (positions of the base it was built from).
     pub level: Level,
 }
@@ -131,7 +128,6 @@ pub fn layout(base: &Level, depth: u32, align: u32) -> Result<DepthLayout, Layou
     let mut level = base.clone();
     let mut source = 0u32;
     let mut next = base.num_vertices() as u32;
-    let mut points: Vec<FacePoint> = Vec::new();
     for k in 0..depth {
         let step = refine_dual(&level, k == 0)?;
         let n = step.level.num_vertices() as u32;
@@ -161,11 +157,6 @@ pub fn layout(base: &Level, depth: u32, align: u32) -> Result<DepthLayout, Layou
             rows: first_row..first_row + n,
             destination: start,
         });
-        points = if k == 0 {
-            first_face_points(&level.topology, &step.vertices)
-        } else {
-            inherited_face_points(&level.topology, &step.vertices, &points)
-        };
         source = start;
         next = start + n;
         level = step.level;
@@ -180,67 +171,8 @@ pub fn layout(base: &Level, depth: u32, align: u32) -> Result<DepthLayout, Layou
         points: t.num_vertices() as u32,
         triangles: fans(t),
         corners: corners(t, depth)?,
-        face_points: points,
         level,
     })
-}
-
-/// The base face point of each level-1 point: the child of a face corner lies halfway from
-/// the corner to the face's centre in the face's domain (for a quad, the (1/4, 1/4) its
-/// weights 9/16, 3/16, 3/16, 1/16 give bilinearly); a Chaikin point on the base vertex it
-/// is next to (its boundary edge's face, that corner), so that consecutive points of the
-/// boundary share a base boundary edge for capture's classification.
-fn first_face_points(base: &Topology, vertices: &[DualVertex]) -> Vec<FacePoint> {
-    let corner_point = |face: u32, corner: u32, towards_centre: f64| {
-        let fv = base.face_vertices(face as usize);
-        let n = fv.len() as u32;
-        let mut centre = [0.0; 2];
-        for k in 0..n {
-            let c = face_corner_uv(n, k);
-            centre = [centre[0] + c[0] / n as f64, centre[1] + c[1] / n as f64];
-        }
-        let c = face_corner_uv(n, corner);
-        let t = towards_centre;
-        FacePoint {
-            face,
-            u: (c[0] + t * (centre[0] - c[0])) as f32,
-            v: (c[1] + t * (centre[1] - c[1])) as f32,
-        }
-    };
-    vertices
-        .iter()
-        .map(|&v| match v {
-            DualVertex::Corner { face, corner } => corner_point(face, corner, 0.5),
-            DualVertex::Chaikin { edge, end } => {
-                let vertex = base.edge_vertices(edge as usize)[end as usize];
-                let [a, b] = base.edge_faces(edge as usize);
-                let face = if a == INVALID { b } else { a };
-                let fv = base.face_vertices(face as usize);
-                let corner = fv.iter().position(|&x| x == vertex).unwrap_or(0) as u32;
-                corner_point(face, corner, 0.0)
-            }
-        })
-        .collect()
-}
-
-/// The base face point of each point of a level past the first: its parent corner's point's
-/// (a point stays within its level-1 ancestor's face; boundary points stay on the boundary).
-fn inherited_face_points(
-    parent: &Topology,
-    vertices: &[DualVertex],
-    parent_points: &[FacePoint],
-) -> Vec<FacePoint> {
-    vertices
-        .iter()
-        .map(|&v| match v {
-            DualVertex::Corner { face, corner } => {
-                let p = parent.face_vertices(face as usize)[corner as usize];
-                parent_points[p as usize]
-            }
-            // Made by the level-0 step only (`refine_dual` with `first`): never past level 1.
-            DualVertex::Chaikin { .. } => unreachable!("a Chaikin point past level 1"),
-        })
-        .collect()
 }
 
 /// The faces of `t` as triangle fans from each face's first corner.

@@ -28,11 +28,12 @@
 //!   corners' neighbours; no normal pass. Against the exact limit normal at face centres
 //!   ([`topology::limit::doo_sabin::face_limit`]) the corners' mean normal converges about
 //!   like the level's edge length (`tests/doo_sabin.rs` measures it).
-//! - **A captured id is a point** of the deepest level; [`Technique::face_point`] gives its
-//!   level-1 ancestor's base face point ([`layout`]): Doo-Sabin's limit has no
-//!   parameterization over the base faces here, so the point is where it comes from, not an
-//!   exact parameter; boundary points map onto their base boundary vertex, which keeps
-//!   capture's classification of boundary edges exact.
+//! - **A captured id is a point** of the deepest level; [`Technique::face_point`] gives where
+//!   that point's limit lies on the base mesh
+//!   ([`topology::limit::limit_mesh::doo_sabin_domain_points`], made on the first capture), so
+//!   an export's `# p` line evaluates, through the exact Doo-Sabin limit, to the limit of the
+//!   point drawn; boundary points map onto their corner's base vertex, which keeps capture's
+//!   classification of boundary edges exact.
 //! - **The depth follows the frame's segments** (S = 2^D, D in 1..=6, others refused by name)
 //!   and its tables are rebuilt in [`Technique::prepare_frame`] when it changes.
 pub mod layout;
@@ -115,6 +116,9 @@ struct DepthMesh {
     corners: Buffer,
     addresses: Buffer,
     indices: Buffer,
+    /// Per point of the level, where its limit lies on the base mesh (made on the first
+    /// [`Technique::face_point`]: captures ask, frames do not).
+    face_points: std::sync::OnceLock<Vec<Option<FacePoint>>>,
 }
 
 /// See the module docs.
@@ -231,6 +235,24 @@ impl DooSabin {
     }
 }
 
+/// [`topology::limit::limit_mesh::doo_sabin_domain_points`] of `mesh` at `depth` as capture's
+/// face points (none if the refinement fails, which the layout of the same depth already
+/// passed).
+fn exact_face_points(mesh: &ControlMesh, depth: u32) -> Vec<Option<FacePoint>> {
+    let points = topology::limit::limit_mesh::doo_sabin_domain_points(mesh, depth as usize);
+    points
+        .unwrap_or_default()
+        .into_iter()
+        .map(|d| {
+            d.map(|d| FacePoint {
+                face: d.face,
+                u: d.uv[0] as f32,
+                v: d.uv[1] as f32,
+            })
+        })
+        .collect()
+}
+
 impl DepthMesh {
     /// The vertex buffer, the evaluator of `layout`'s blocks over it, the corner table, the
     /// index buffer, and the set of the uniform buffer holding the addresses of the deepest
@@ -299,6 +321,7 @@ impl DepthMesh {
             corners,
             addresses,
             indices,
+            face_points: std::sync::OnceLock::new(),
         })
     }
 }
@@ -487,11 +510,16 @@ impl Technique for DooSabin {
         })
     }
 
-    /// The captured point's level-1 ancestor's base face point (the domain is unused).
+    /// Where the captured point's limit lies on the base mesh
+    /// ([`topology::limit::limit_mesh::doo_sabin_domain_points`]: boundary points on their
+    /// corner's base vertex); the domain is unused.
     fn face_point(&self, patch: u32, _domain: [f32; 2]) -> Option<FacePoint> {
         let d = self.depth.as_ref()?;
         let v = patch.checked_sub(self.arrays[0].first_patch)?;
-        d.layout.face_points.get(v as usize).copied()
+        let points = d
+            .face_points
+            .get_or_init(|| exact_face_points(&self.mesh, d.layout.depth));
+        points.get(v as usize).copied().flatten()
     }
 
     fn device_memory(&self) -> Vec<DeviceAllocation> {
