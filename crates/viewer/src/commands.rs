@@ -305,8 +305,13 @@ fn render_offscreen(
     let params = setup.world_params(technique.bbox());
     let frame = ctx.render_offscreen_stats(technique.as_mut(), &params, extent, false)?;
     let patches: u32 = technique.patch_arrays().iter().map(|a| a.patches).sum();
+    // The scheme whose surface the technique drew (none for flat, Phong and PN).
+    let scheme = tess::techniques::info(setup.technique)
+        .scheme
+        .map(|s| format!(", {s} scheme"))
+        .unwrap_or_default();
     let what = format!(
-        "{}, {} path, {patches} patches in {} draws",
+        "{}, {} path, {patches} patches in {} draws{scheme}",
         describe(setup.technique, &params),
         technique.draw_path(),
         frame.counts.draws

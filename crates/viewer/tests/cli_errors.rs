@@ -1184,6 +1184,10 @@ fn the_draw_path_options_draw_or_name_what_is_wrong() {
             "pattern path",
         ),
         (
+            vec!["--method", "bft", "--no-tessellation-shader"],
+            "pattern path",
+        ),
+        (
             vec!["--method", "phong", "--pipeline", "tessellation"],
             "tessellation path",
         ),
@@ -1216,10 +1220,23 @@ fn the_draw_path_options_draw_or_name_what_is_wrong() {
         &["adaptive", "--pipeline pattern"],
     );
     fails(
-        &render(&["--method", "bft", "--no-tessellation-shader"]),
+        &render(&["--method", "gregory", "--no-tessellation-shader"]),
         &[],
         1,
-        &["bft", "--no-tessellation-shader", "--pipeline pattern"],
+        &["gregory", "--no-tessellation-shader", "--pipeline pattern"],
+    );
+    fails(
+        &render(&[
+            "--method",
+            "bft",
+            "--pipeline",
+            "pattern",
+            "--factors",
+            "screen",
+        ]),
+        &[],
+        1,
+        &["bft", "screen-space", "--pipeline tessellation"],
     );
     fails(
         &render(&[

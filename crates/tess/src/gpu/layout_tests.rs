@@ -262,6 +262,20 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
             bft_push(),
         ),
         (Stage::BftNormalsComp, PLAIN, bft_push()),
+        // BFT's refinement-pattern vertex stage: its push constant and the pattern's domain
+        // point, its only vertex input.
+        (Stage::BftPatternVert, PLAIN, bft_push()),
+        (Stage::BftPatternVert, PLAIN, frame_binding()),
+        (
+            Stage::BftPatternVert,
+            PLAIN,
+            PatternInput {
+                name: "in_domain",
+                input: super::pattern_input::POINTS,
+                binding: 0,
+                offset: 0,
+            },
+        ),
         // Vertex input.
         (
             Stage::CommonMeshVert,
@@ -732,7 +746,9 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
                 rows.push((stage, v, capture()));
                 if adaptive_tese.contains(&stage) {
                     rows.push((stage, v, adaptive_push()));
-                } else if stage != Stage::BftBftTese {
+                } else if [Stage::BftBftTese, Stage::BftPatternVert].contains(&stage) {
+                    rows.push((stage, v, bft_push()));
+                } else {
                     rows.push((stage, v, draw()));
                 }
             }
@@ -982,8 +998,9 @@ fn the_table_covers_every_storage_binding_and_capture_build() {
         .count();
     // Nine TESs in three spacings, the four adaptive ones and BFT's also with their surface code,
     // BFT's also with and without its patch block; the CPU mesh's and Doo-Sabin's vertex stages,
-    // and the four refinement-pattern vertex stages, PN's also in its scalar-tagged build.
-    assert_eq!(capture_builds, 55);
+    // the four refinement-pattern vertex stages, PN's also in its scalar-tagged build, and BFT's
+    // with and without its surface code.
+    assert_eq!(capture_builds, 57);
     assert_eq!(xfb_rows, capture_builds);
 }
 
@@ -1061,7 +1078,7 @@ fn capture_variants_and_only_they_have_xfb() {
             captures += v.capture as usize;
         }
     }
-    assert_eq!(captures, 55);
+    assert_eq!(captures, 57);
 }
 
 #[test]

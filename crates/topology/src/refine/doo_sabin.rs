@@ -348,3 +348,64 @@ pub(crate) fn refine_doo_sabin(
     let step = refine_dual(parent, first)?;
     Ok((step.level, step.stencils))
 }
+
+/// Vertices, faces, face corners and boundary edges of one Doo-Sabin level.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LevelSize {
+    pub vertices: u64,
+    pub faces: u64,
+    pub corners: u64,
+    pub boundary_edges: u64,
+}
+
+impl LevelSize {
+    /// Triangles of the level's faces drawn as fans.
+    pub fn triangles(&self) -> u64 {
+        self.corners - 2 * self.faces
+    }
+
+    /// The next level's size. From level 1 on, every interior point lies in four faces and
+    /// every boundary point (a point of the boundary curve's control polygon) in two, every
+    /// interior edge makes an e-face (a quad), every interior point a v-face (a quad), every
+    /// face an f-face of its own size, and the boundary polygon doubles (Chaikin).
+    fn next(&self) -> LevelSize {
+        let b = self.boundary_edges;
+        let edges = (self.corners + b) / 2;
+        let (inner_edges, inner_points) = (edges - b, self.vertices - b);
+        LevelSize {
+            vertices: self.corners,
+            faces: self.faces + inner_edges + inner_points,
+            corners: self.corners + 4 * inner_edges + 4 * inner_points,
+            boundary_edges: 2 * b,
+        }
+    }
+
+    /// The size of the level whose topology is `t`.
+    pub fn of(t: &Topology) -> LevelSize {
+        LevelSize {
+            vertices: t.num_vertices() as u64,
+            faces: t.num_faces() as u64,
+            corners: t.face_tables().1.len() as u64,
+            boundary_edges: (0..t.num_edges())
+                .filter(|&e| t.is_boundary_edge(e))
+                .count() as u64,
+        }
+    }
+}
+
+/// The size of level 1 (one step of the base mesh: made, then counted).
+pub fn first_level_size(base: &Level) -> Result<LevelSize, TopologyError> {
+    Ok(LevelSize::of(&refine_dual(base, true)?.level.topology))
+}
+
+/// Sizes of levels 1..=`depth` from level 1's, the deeper ones counted by the dual scheme's
+/// recurrence (every point past level 1 lies in four faces, two on the boundary).
+pub fn level_sizes(first: LevelSize, depth: u32) -> Vec<LevelSize> {
+    let mut sizes = Vec::with_capacity(depth as usize);
+    let mut size = first;
+    for _ in 0..depth {
+        sizes.push(size);
+        size = size.next();
+    }
+    sizes
+}

@@ -26,12 +26,12 @@ use crate::technique::{
     DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features, FrameParams, Pass, PatchArray,
     PatchPipeline, PatchType, Technique, TechniqueId, VertexInput,
 };
-use crate::techniques::doo_sabin::layout::{first_level_size, level_sizes, LevelSize};
 use crate::techniques::{BuildOptions, Built, TechniqueInfo};
 use topology::limit::limit_mesh::{
     catmark_level_size, doo_sabin_level_mesh, loop_level_size, uniform_limit_mesh, DomainPoint,
     LimitMesh,
 };
+use topology::refine::doo_sabin::{first_level_size, level_sizes, LevelSize};
 use topology::{ControlMesh, Scheme};
 use vk_core::{vk, Buffer, BufferDesc, Device, Encoder, MemoryLocation};
 

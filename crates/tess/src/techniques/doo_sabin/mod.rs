@@ -51,8 +51,9 @@ use crate::technique::{
 };
 use crate::techniques::shared::{upload_base, STAGES};
 use crate::techniques::{BuildOptions, Built, TechniqueInfo};
-use layout::{first_level_size, level_sizes, DepthLayout, LayoutError, LevelSize};
+use layout::{DepthLayout, LayoutError};
 use std::mem::size_of;
+use topology::refine::doo_sabin::{first_level_size, level_sizes, LevelSize};
 use topology::refine::Level;
 use topology::{ControlMesh, Scheme};
 use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
