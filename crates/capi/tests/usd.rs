@@ -57,7 +57,10 @@ fn a_usd_file_and_its_obj_twin_capture_the_same() {
     let ctx = standalone_context();
     let usd = captured(ctx, &data.join("cube_tags.usda"), &dir.join("usd.obj"));
     let obj = captured(ctx, &data.join("cube_tags.obj"), &dir.join("obj.obj"));
-    assert!(usd == obj, "the captures of cube_tags.usda and cube_tags.obj differ");
+    assert!(
+        usd == obj,
+        "the captures of cube_tags.usda and cube_tags.obj differ"
+    );
     let mut errors = 1;
     // SAFETY: `errors` is a live local; the context is live until destroyed.
     unsafe {

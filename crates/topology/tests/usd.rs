@@ -12,7 +12,9 @@ use topology::rules::options::{BoundaryInterpolation, TriangleSubdivision};
 use topology::{ControlMesh, Scheme, TopologyError};
 
 fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/usd").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tests/data/usd")
+        .join(name)
 }
 
 /// Asserts `usd` is `obj` but for the scheme (OBJ has none) and positions within 1e-12.
@@ -60,8 +62,15 @@ fn two_transformed_meshes_merge_and_hidden_ones_are_skipped() {
         prims,
         vec![("/World/Grid", 0, 0), ("/World/Group/Scaled/Tetra", 6, 2)]
     );
-    assert_eq!(usd.num_faces(), 6, "the guide and the invisible mesh are not read");
-    assert_eq!(usd.corners[0].vertex, 9, "the second mesh's tags are offset");
+    assert_eq!(
+        usd.num_faces(),
+        6,
+        "the guide and the invisible mesh are not read"
+    );
+    assert_eq!(
+        usd.corners[0].vertex, 9,
+        "the second mesh's tags are offset"
+    );
 }
 
 #[test]
@@ -79,10 +88,16 @@ fn loop_triangles_with_vertex_uvs_and_per_edge_crease() {
 fn left_handed_faces_are_reversed_with_their_uvs() {
     let (usd, _) = twins("left_handed");
     assert_eq!(usd.face(0), &[0, 1, 4, 3]);
-    assert_eq!(usd.options.triangle_subdivision, TriangleSubdivision::Smooth);
+    assert_eq!(
+        usd.options.triangle_subdivision,
+        TriangleSubdivision::Smooth
+    );
     assert_eq!(usd.options.boundary, BoundaryInterpolation::None);
     let read = read_usd(data("left_handed.usda")).unwrap();
-    assert_eq!(read.prims[0].face_varying_linear_interpolation, "cornersPlus1");
+    assert_eq!(
+        read.prims[0].face_varying_linear_interpolation,
+        "cornersPlus1"
+    );
 }
 
 /// `stem.usda` written as `.usdc` and packed into a `.usdz` in `dir`.
@@ -151,7 +166,16 @@ fn counts_that_do_not_add_up_are_refused_by_name() {
     let text = quad_with("").replace("faceVertexCounts = [4]", "faceVertexCounts = [-4]");
     let (e, file) = usda_error("negative.usda", &text);
     let p = usd_problem(&e, &file, "faceVertexCounts");
-    assert!(matches!(p, UsdProblem::NegativeCount { position: 0, value: -4 }), "{p:?}");
+    assert!(
+        matches!(
+            p,
+            UsdProblem::NegativeCount {
+                position: 0,
+                value: -4
+            }
+        ),
+        "{p:?}"
+    );
 }
 
 #[test]
@@ -174,7 +198,15 @@ fn indices_out_of_range_are_refused_by_name() {
     let (e, file) = usda_error("index.usda", &text);
     let p = usd_problem(&e, &file, "faceVertexIndices");
     assert!(
-        matches!(p, UsdProblem::IndexOutOfRange { position: 3, index: 7, count: 4, .. }),
+        matches!(
+            p,
+            UsdProblem::IndexOutOfRange {
+                position: 3,
+                index: 7,
+                count: 4,
+                ..
+            }
+        ),
         "{p:?}"
     );
     for (extra, attribute) in [
@@ -222,10 +254,19 @@ fn a_stage_without_a_mesh_to_draw_is_refused() {
     let text = "#usda 1.0\n\ndef Xform \"World\"\n{\n}\n\ndef Mesh \"Guide\"\n{\n    uniform token purpose = \"guide\"\n}\n";
     let (e, file) = usda_error("empty.usda", text);
     assert!(
-        matches!(&e, TopologyError::Usd { problem: UsdProblem::NoMesh { skipped: 1 }, .. }),
+        matches!(
+            &e,
+            TopologyError::Usd {
+                problem: UsdProblem::NoMesh { skipped: 1 },
+                ..
+            }
+        ),
         "{e:?}"
     );
-    assert!(e.to_string().starts_with(&format!("{file}: no Mesh prim")), "{e}");
+    assert!(
+        e.to_string().starts_with(&format!("{file}: no Mesh prim")),
+        "{e}"
+    );
 }
 
 #[test]
@@ -233,12 +274,21 @@ fn a_mesh_that_fails_validation_names_its_prim() {
     // A coordinate beyond the drawable range, at the prim's point 2.
     let text = quad_with("").replace("(1, 1, 0)", "(1, 1e13, 0)");
     let (e, file) = usda_error("far.usda", &text);
-    assert!(matches!(&e, TopologyError::InUsdPrim { prim, .. } if prim == "/Quad"), "{e:?}");
     assert!(
-        matches!(e.root(), TopologyError::CoordinateOutOfRange { vertex: 2, .. }),
+        matches!(&e, TopologyError::InUsdPrim { prim, .. } if prim == "/Quad"),
         "{e:?}"
     );
-    assert!(e.to_string().starts_with(&format!("{file}: /Quad: ")), "{e}");
+    assert!(
+        matches!(
+            e.root(),
+            TopologyError::CoordinateOutOfRange { vertex: 2, .. }
+        ),
+        "{e:?}"
+    );
+    assert!(
+        e.to_string().starts_with(&format!("{file}: /Quad: ")),
+        "{e}"
+    );
 }
 
 #[test]
@@ -251,13 +301,19 @@ fn truncated_usdc_and_empty_usdz_are_named_errors() {
         std::fs::write(&path, &bytes[..cut]).unwrap();
         let e = load_usd(&path).expect_err("a cut crate file is refused");
         assert!(matches!(e, TopologyError::Usd { .. }), "{e:?}");
-        assert!(e.to_string().starts_with(&path.display().to_string()), "{e}");
+        assert!(
+            e.to_string().starts_with(&path.display().to_string()),
+            "{e}"
+        );
     }
     let empty = dir.path().join("empty.usdz");
     ArchiveWriter::create(&empty).unwrap().finish().unwrap();
     let e = load_usd(&empty).expect_err("an empty package is refused");
     assert!(matches!(e, TopologyError::Usd { .. }), "{e:?}");
-    assert!(e.to_string().starts_with(&empty.display().to_string()), "{e}");
+    assert!(
+        e.to_string().starts_with(&empty.display().to_string()),
+        "{e}"
+    );
 }
 
 #[test]
@@ -267,8 +323,14 @@ fn missing_file_and_garbage_are_named_errors() {
     let e = load_usd(&missing).expect_err("missing");
     assert!(matches!(e, TopologyError::Io { .. }), "{e:?}");
     for (name, bytes) in [
-        ("garbage.usda", &b"#usda 1.0\ndef Mesh \"A\" { int[] faceVertexCounts = [ }"[..]),
-        ("garbage.usdc", &b"PXR-USDC\0\0\0\0\0\0\0\0\xff\xff\xff\xff\xff\xff\xff\xff"[..]),
+        (
+            "garbage.usda",
+            &b"#usda 1.0\ndef Mesh \"A\" { int[] faceVertexCounts = [ }"[..],
+        ),
+        (
+            "garbage.usdc",
+            &b"PXR-USDC\0\0\0\0\0\0\0\0\xff\xff\xff\xff\xff\xff\xff\xff"[..],
+        ),
         ("garbage.usdz", &b"PK\x03\x04garbage"[..]),
     ] {
         let path = dir.path().join(name);
@@ -276,4 +338,87 @@ fn missing_file_and_garbage_are_named_errors() {
         let e = load_usd(&path).expect_err(name);
         assert!(matches!(e, TopologyError::Usd { .. }), "{name}: {e:?}");
     }
+}
+
+/// Pixar's own test files (`tests/data/usd/real/`, see its README): time samples only, a
+/// left-handed cube with indexed face-varying st, the `none` scheme; a file with legacy type
+/// names openusd does not parse is refused by name.
+#[test]
+fn pixar_test_files_load() {
+    let cube = load_usd(data("real/indexedTextureCoordinates.def.usda")).unwrap();
+    assert_eq!((cube.positions.len(), cube.num_faces()), (8, 6));
+    assert_eq!(
+        cube.scheme,
+        Some(Scheme::Bilinear),
+        "subdivisionScheme none"
+    );
+    assert_eq!(cube.positions[0], [-1.0, -1.0, 1.0]);
+    // Left-handed [2, 3, 1, 0] is drawn [2, 0, 1, 3]; its st follows its corners.
+    assert_eq!(cube.face(0), &[2, 0, 1, 3]);
+    let st = cube.uvs.as_ref().unwrap();
+    assert_eq!(st.len(), 24);
+    assert_eq!(st[1], [0.9999133f32 as f64, 0.5000001f32 as f64]);
+    let ring = load_usd(data("real/ring.usda")).unwrap();
+    assert_eq!((ring.positions.len(), ring.num_faces()), (32, 16));
+    assert_eq!(
+        ring.scheme,
+        Some(Scheme::Bilinear),
+        "subdivisionScheme none"
+    );
+    let legacy = data("real/subdivMesh.usda");
+    let e = load_usd(&legacy).expect_err("legacy type names");
+    assert!(matches!(e, TopologyError::Usd { .. }), "{e:?}");
+    let message = e.to_string();
+    assert!(
+        message.starts_with(&legacy.display().to_string()) && message.contains("Vec3f"),
+        "{message}"
+    );
+}
+
+/// Writes `text` as `name` in a temporary folder and reads it.
+fn read_text(name: &str, text: &str) -> ControlMesh {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(name);
+    std::fs::write(&path, text).unwrap();
+    load_usd(&path).unwrap()
+}
+
+#[test]
+fn time_sampled_points_read_their_earliest_sample() {
+    let text = quad_with("").replace(
+        "point3f[] points = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]",
+        "point3f[] points.timeSamples = {\n        2: [(0, 0, 2), (1, 0, 2), (1, 1, 2), (0, 1, 2)],\n        \
+         1: [(0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)],\n    }",
+    );
+    let mesh = read_text("sampled.usda", &text);
+    assert!(
+        mesh.positions.iter().all(|p| p[2] == 1.0),
+        "{:?}",
+        mesh.positions
+    );
+}
+
+#[test]
+fn a_mirroring_transform_reverses_faces_and_left_handed_cancels_it() {
+    let mirror =
+        "float3 xformOp:scale = (-1, 1, 1)\n    uniform token[] xformOpOrder = [\"xformOp:scale\"]";
+    let mesh = read_text("mirror.usda", &quad_with(mirror));
+    assert_eq!(mesh.face(0), &[0, 3, 2, 1]);
+    assert_eq!(mesh.positions[1], [-1.0, 0.0, 0.0]);
+    let both = format!("{mirror}\n    uniform token orientation = \"leftHanded\"");
+    let mesh = read_text("mirror_left.usda", &quad_with(&both));
+    assert_eq!(mesh.face(0), &[0, 1, 2, 3]);
+}
+
+#[test]
+fn an_xform_op_order_entry_that_is_no_attribute_name_is_refused() {
+    // openusd loops forever composing a property path it cannot parse; the reader refuses it.
+    let order =
+        "float3 xformOp:scale = (2, 2, 2)\n    uniform token[] xformOpOrder = [\"xfor}Op:scale\"]";
+    let (e, file) = usda_error("op.usda", &quad_with(order));
+    let p = usd_problem(&e, &file, "xformOpOrder");
+    assert!(
+        matches!(p, UsdProblem::Transform(m) if m.contains("'xfor}Op:scale'")),
+        "{p:?}"
+    );
 }

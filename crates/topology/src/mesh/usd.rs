@@ -160,8 +160,8 @@ fn read_stage(stage: &Stage, file: &str) -> Result<UsdMeshes, TopologyError> {
                 usd_error(file, &prim, &attribute, UsdProblem::Read(format!("{e:#}")))
             }
         };
-        let hidden = mesh.compute_visibility().map_err(at("visibility"))?
-            == geom::Visibility::Invisible;
+        let hidden =
+            mesh.compute_visibility().map_err(at("visibility"))? == geom::Visibility::Invisible;
         let purpose = mesh.compute_purpose().map_err(at("purpose"))?;
         if hidden || matches!(purpose, geom::Purpose::Guide | geom::Purpose::Proxy) {
             skipped += 1;
@@ -248,7 +248,8 @@ impl Merge {
         });
         let m = &mut self.mesh;
         m.positions.extend_from_slice(&p.positions);
-        m.face_vertices.extend(p.face_vertices.iter().map(|v| v + v0));
+        m.face_vertices
+            .extend(p.face_vertices.iter().map(|v| v + v0));
         m.face_offsets
             .extend(p.face_offsets[1..].iter().map(|o| o + c0));
         m.creases.extend(p.creases.iter().map(|c| EdgeCrease {
@@ -313,15 +314,24 @@ impl PrimReader<'_> {
     fn value(&self, attribute: &str) -> Result<Option<Value>, TopologyError> {
         let attr = self.mesh.attribute(attribute);
         let read = |e: anyhow::Error| self.err(attribute, UsdProblem::Read(format!("{e:#}")));
-        match attr.get::<Value>().map_err(read)? {
-            Some(v) => Ok(Some(v)),
-            None => attr.get_at::<Value>(TimeCode::EARLIEST).map_err(read),
+        if let Some(v) = attr.get::<Value>().map_err(read)? {
+            return Ok(Some(v));
         }
+        // The sample of the smallest time (openusd keeps samples in the file's order).
+        let samples = attr.time_samples().map_err(read)?.unwrap_or_default();
+        Ok(samples
+            .into_iter()
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(_, v)| v))
     }
 
     fn wrong_type(&self, attribute: &str, found: &Value, expected: &'static str) -> TopologyError {
         let found = format!("{found:?}");
-        let found = found.split('(').next().unwrap_or("another type").to_string();
+        let found = found
+            .split('(')
+            .next()
+            .unwrap_or("another type")
+            .to_string();
         self.err(attribute, UsdProblem::WrongType { found, expected })
     }
 
@@ -399,7 +409,11 @@ impl PrimReader<'_> {
         };
         let (counts, corners) = self.faces(mesh.positions.len())?;
         let mirrored = self.transform_points(&mut mesh.positions)?;
-        let left_handed = self.token("orientation", &["rightHanded", "leftHanded"], "rightHanded, leftHanded")? == 1;
+        let left_handed = self.token(
+            "orientation",
+            &["rightHanded", "leftHanded"],
+            "rightHanded, leftHanded",
+        )? == 1;
         mesh.face_offsets = std::iter::once(0)
             .chain(counts.iter().scan(0u32, |acc, &n| {
                 *acc += n;
@@ -510,11 +524,21 @@ impl PrimReader<'_> {
                 break;
             }
             let x = AnyXformable(stage.prim(p.clone()));
-            let fail = |e: anyhow::Error| {
-                let at = format!("{}.xformOpOrder", p.as_str());
-                self.err(&at, UsdProblem::Transform(format!("{e:#}")))
-            };
-            let local = x.local_to_parent_transform(TimeCode::EARLIEST).map_err(fail)?;
+            // Errors name the prim whose ops fail (the mesh or an ancestor).
+            let at = |problem| usd_error(self.file, p.as_str(), "xformOpOrder", problem);
+            let fail = |e: anyhow::Error| at(UsdProblem::Transform(format!("{e:#}")));
+            if let Some(bad) = x
+                .xform_op_order()
+                .map_err(fail)?
+                .and_then(|o| bad_op_name(&o))
+            {
+                return Err(at(UsdProblem::Transform(format!(
+                    "'{bad}' is not an xformOp attribute's name (xformOp:<op>[:<suffix>])"
+                ))));
+            }
+            let local = x
+                .local_to_parent_transform(TimeCode::EARLIEST)
+                .map_err(fail)?;
             m = m * local;
             if x.resets_xform_stack().map_err(fail)? {
                 break;
@@ -530,7 +554,12 @@ impl PrimReader<'_> {
             &["catmullClark", "loop", "bilinear", "none"],
             "catmullClark, loop, bilinear, none",
         )?;
-        Ok([Scheme::CatmullClark, Scheme::Loop, Scheme::Bilinear, Scheme::Bilinear][k])
+        Ok([
+            Scheme::CatmullClark,
+            Scheme::Loop,
+            Scheme::Bilinear,
+            Scheme::Bilinear,
+        ][k])
     }
 
     fn options(&self) -> Result<SubdivOptions, TopologyError> {
@@ -628,7 +657,11 @@ impl PrimReader<'_> {
             for k in 0..n - 1 {
                 out.push(EdgeCrease {
                     vertices: [indices[start + k], indices[start + k + 1]],
-                    sharpness: if per_edge { sharp[out.len()] } else { sharp[crease] },
+                    sharpness: if per_edge {
+                        sharp[out.len()]
+                    } else {
+                        sharp[crease]
+                    },
                 });
             }
             start += n;
@@ -735,6 +768,29 @@ impl PrimReader<'_> {
             },
         ))
     }
+}
+
+/// The first entry of an `xformOpOrder` that does not name an xformOp attribute: a name that
+/// is not `xformOp:` and identifier characters (after an optional `!invert!`), other than
+/// `!resetXformStack!`. Checked before openusd composes the ops: it loops forever on a
+/// property path it cannot parse.
+fn bad_op_name(order: &[String]) -> Option<String> {
+    let identifier = |part: &str| {
+        part.chars()
+            .next()
+            .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+            && part.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+    };
+    order
+        .iter()
+        .find(|op| {
+            let name = op.strip_prefix("!invert!").unwrap_or(op);
+            let valid = name
+                .strip_prefix("xformOp:")
+                .is_some_and(|rest| rest.split(':').all(identifier));
+            !valid && op.as_str() != "!resetXformStack!"
+        })
+        .cloned()
 }
 
 /// USD's `faceVaryingLinearInterpolation` tokens, the default first.
