@@ -36,7 +36,8 @@ pub enum TopologyError {
         file: String,
         prim: String,
         attribute: String,
-        problem: UsdProblem,
+        /// Boxed: keeps every `Result<_, TopologyError>` small.
+        problem: Box<UsdProblem>,
     },
     /// A validation error about one Mesh prim of a USD file, with the 0-based point and face
     /// numbers of that prim (as USD's arrays count them). Said in the message, not chained.

@@ -135,7 +135,7 @@ fn usd_error(file: &str, prim: &str, attribute: &str, problem: UsdProblem) -> To
         file: file.to_string(),
         prim: prim.to_string(),
         attribute: attribute.to_string(),
-        problem,
+        problem: Box::new(problem),
     }
 }
 
