@@ -416,3 +416,16 @@ fn an_xform_op_order_entry_that_is_no_attribute_name_is_refused() {
         "{p:?}"
     );
 }
+
+#[test]
+fn a_prim_name_that_is_no_identifier_is_refused() {
+    // openusd recurses without end on such a prim's path (a stack overflow); found by fuzzing.
+    let text = "#usda 1.0\ndef Xform \"}orld\"\n{\n    def Mesh \"Quad\"\n    {\n    }\n}\n";
+    let (e, file) = usda_error("name.usda", text);
+    let message = e.to_string();
+    assert!(message.starts_with(&format!("{file}: /: ")), "{message}");
+    assert!(message.contains("'}orld'"), "{message}");
+    // Unicode identifiers are names.
+    let unicode = quad_with("").replace("\"Quad\"", "\"Würfel\"");
+    assert_eq!(read_text("unicode.usda", &unicode).num_faces(), 1);
+}

@@ -142,6 +142,7 @@ fn usd_error(file: &str, prim: &str, attribute: &str, problem: UsdProblem) -> To
 /// The drawn Mesh prims of `stage`, merged.
 fn read_stage(stage: &Stage, file: &str) -> Result<UsdMeshes, TopologyError> {
     let read_err = |e: anyhow::Error| usd_error(file, "", "", UsdProblem::Read(format!("{e:#}")));
+    check_prim_names(stage, file)?;
     let mut paths = Vec::new();
     stage
         .traverse(PrimPredicate::DEFAULT, |p| paths.push(p.clone()))
@@ -183,6 +184,38 @@ fn read_stage(stage: &Stage, file: &str) -> Result<UsdMeshes, TopologyError> {
         mesh: merged.mesh,
         prims: merged.prims,
     })
+}
+
+/// Refuses a prim whose name is not an identifier (a letter or `_`, then letters, digits or
+/// `_`; USD's Unicode identifiers included), walking every prim's children by name before
+/// anything else reads the stage: openusd 0.6.0 recurses without end on the path of such a
+/// prim (a stack overflow, which no `catch_unwind` catches).
+fn check_prim_names(stage: &Stage, file: &str) -> Result<(), TopologyError> {
+    let identifier = |name: &str| {
+        name.chars()
+            .next()
+            .is_some_and(|c| c.is_alphabetic() || c == '_')
+            && name.chars().all(|c| c.is_alphanumeric() || c == '_')
+    };
+    let mut stack = vec![openusd::sdf::Path::abs_root()];
+    while let Some(path) = stack.pop() {
+        let names = stage
+            .prim(path.clone())
+            .child_names()
+            .map_err(|e| usd_error(file, path.as_str(), "", UsdProblem::Read(format!("{e:#}"))))?;
+        for name in names {
+            let name = name.as_str();
+            if !identifier(name) {
+                let problem = UsdProblem::Read(format!("child prim '{name}': not an identifier"));
+                return Err(usd_error(file, path.as_str(), "", problem));
+            }
+            let child = path.append_path(name).map_err(|e| {
+                usd_error(file, path.as_str(), "", UsdProblem::Read(format!("{e:#}")))
+            })?;
+            stack.push(child);
+        }
+    }
+    Ok(())
 }
 
 /// One prim's mesh as read, before merging.
@@ -778,8 +811,8 @@ fn bad_op_name(order: &[String]) -> Option<String> {
     let identifier = |part: &str| {
         part.chars()
             .next()
-            .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
-            && part.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+            .is_some_and(|c| c.is_alphabetic() || c == '_')
+            && part.chars().all(|c| c.is_alphanumeric() || c == '_')
     };
     order
         .iter()
