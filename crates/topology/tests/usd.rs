@@ -316,6 +316,11 @@ fn missing_file_and_garbage_are_named_errors() {
     let missing = dir.path().join("missing.usda");
     let e = load_usd(&missing).expect_err("missing");
     assert!(matches!(e, TopologyError::Io { .. }), "{e:?}");
+    let e = load_usd(dir.path()).expect_err("a directory");
+    assert!(
+        e.to_string().contains("is a directory, not a regular file"),
+        "{e}"
+    );
     for (name, bytes) in [
         (
             "garbage.usda",

@@ -100,7 +100,7 @@ pub fn read_usd(path: impl AsRef<Path>) -> Result<UsdMeshes, TopologyError> {
     let path = path.as_ref();
     let file = path.display().to_string();
     // A FIFO, a device or a directory is refused unopened; a file beyond the bound by its size.
-    crate::mesh::input::read_regular_file(path, MAX_USD_BYTES, "a USD file").map_err(|error| {
+    crate::mesh::input::check_regular_file(path, MAX_USD_BYTES, "a USD file").map_err(|error| {
         TopologyError::Io {
             file: file.clone(),
             error,
