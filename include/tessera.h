@@ -500,6 +500,20 @@ enum TesseraStatus tessera_surface_create_obj(struct TesseraContext *ctx,
                                               const struct TesseraSurfaceDesc *desc,
                                               struct TesseraSurface **out);
 
+// Builds a surface from a mesh file: `.usda`, `.usdc`, `.usdz` or `.usd` read as USD (every
+// drawn Mesh prim, merged: `topology::mesh::usd`), any other name as OBJ with OpenSubdiv's
+// tags. The surface is named by the file's stem. Errors name the file (and for USD the prim
+// and the attribute; for OBJ the line). Thread-safe (serialized per context).
+//
+// # Safety
+// `path` is NULL (refused) or NUL-terminated; `desc` is NULL (defaults) or readable, its
+// `texture` and `height_map` NULL or as long as their sizes say; `out` points to a writable
+// `TesseraSurface*` (set to NULL on failure).
+enum TesseraStatus tessera_surface_create_file(struct TesseraContext *ctx,
+                                               const char *path,
+                                               const struct TesseraSurfaceDesc *desc,
+                                               struct TesseraSurface **out);
+
 // Destroys a surface: its handle is invalid at once. Standalone: its objects are freed at
 // once (Tessera's own submissions are waited for). Host-owned: they are freed by the first
 // [`host::tessera_begin_frame`] whose frame is `frames_in_flight` past the frame current at

@@ -1376,6 +1376,7 @@ unsafe fn read_mesh(d: &TesseraMeshDesc) -> Result<(topology::ControlMesh, Strin
         holes: Vec::new(),
         scalar_tags,
         options: Default::default(),
+        scheme: None,
     };
     Ok((mesh, name))
 }
@@ -1522,6 +1523,48 @@ pub unsafe extern "C" fn tessera_surface_create_obj(
             (text, given.unwrap_or_else(|| "mesh".into()))
         };
         let mesh = topology::mesh::obj::parse_obj(&text, &name)?;
+        // SAFETY: the caller's contract for the images `desc` points to.
+        let id = unsafe { create_surface(ctx_id, c, mesh, &d, name) }?;
+        // SAFETY: the caller's contract (see this function's `# Safety`).
+        unsafe { out_write(out, surface_ptr(id), "out") }
+    })
+}
+
+/// Builds a surface from a mesh file: `.usda`, `.usdc`, `.usdz` or `.usd` read as USD (every
+/// drawn Mesh prim, merged: `topology::mesh::usd`), any other name as OBJ with OpenSubdiv's
+/// tags. The surface is named by the file's stem. Errors name the file (and for USD the prim
+/// and the attribute; for OBJ the line). Thread-safe (serialized per context).
+///
+/// # Safety
+/// `path` is NULL (refused) or NUL-terminated; `desc` is NULL (defaults) or readable, its
+/// `texture` and `height_map` NULL or as long as their sizes say; `out` points to a writable
+/// `TesseraSurface*` (set to NULL on failure).
+#[no_mangle]
+pub unsafe extern "C" fn tessera_surface_create_file(
+    ctx: *mut TesseraContext,
+    path: *const c_char,
+    desc: *const TesseraSurfaceDesc,
+    out: *mut *mut TesseraSurface,
+) -> TesseraStatus {
+    let ctx_id = handle_id(ctx);
+    with_context(ctx, |c| {
+        // SAFETY: the caller's contract for every pointer.
+        unsafe { out_write(out, std::ptr::null_mut(), "out") }?;
+        // SAFETY: the caller's contract (see this function's `# Safety`).
+        let d = unsafe { surface_desc(desc) }?;
+        // SAFETY: the caller's contract (see this function's `# Safety`).
+        let path = unsafe { read_str(path, "path") }?
+            .ok_or_else(|| Error::new(TesseraStatus::InvalidArgument, "path is NULL"))?;
+        let path = std::path::Path::new(&path);
+        let mesh = if topology::mesh::usd::is_usd_path(path) {
+            topology::mesh::usd::load_usd(path)?
+        } else {
+            topology::mesh::obj::load_obj(path)?
+        };
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| path.display().to_string());
         // SAFETY: the caller's contract for the images `desc` points to.
         let id = unsafe { create_surface(ctx_id, c, mesh, &d, name) }?;
         // SAFETY: the caller's contract (see this function's `# Safety`).

@@ -114,7 +114,8 @@ pub(crate) fn topology_status(e: &TopologyError) -> TesseraStatus {
     match e {
         T::Io { .. } => TesseraStatus::Io,
         T::Parse { .. } => TesseraStatus::Parse,
-        T::InFile { error, .. } => topology_status(error),
+        T::InFile { error, .. } | T::InUsdPrim { error, .. } => topology_status(error),
+        T::Usd { problem, .. } => usd_status(problem),
         T::IndexOutOfRange { .. } | T::TagOutOfRange { .. } | T::FaceOutOfRange { .. } => {
             TesseraStatus::IndexOutOfRange
         }
@@ -124,6 +125,23 @@ pub(crate) fn topology_status(e: &TopologyError) -> TesseraStatus {
             TesseraStatus::InvalidArgument
         }
         _ => TesseraStatus::Mesh,
+    }
+}
+
+fn usd_status(p: &topology::error::UsdProblem) -> TesseraStatus {
+    use topology::error::UsdProblem as U;
+    match p {
+        U::IndexOutOfRange { .. } => TesseraStatus::IndexOutOfRange,
+        U::Length { .. } | U::NegativeCount { .. } | U::ShortCrease { .. } => {
+            TesseraStatus::WrongSize
+        }
+        U::NoMesh { .. } | U::Mixed { .. } => TesseraStatus::Mesh,
+        U::Read(_)
+        | U::ReaderPanicked(_)
+        | U::Missing
+        | U::WrongType { .. }
+        | U::UnknownToken { .. }
+        | U::Transform(_) => TesseraStatus::Parse,
     }
 }
 

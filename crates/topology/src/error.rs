@@ -28,6 +28,25 @@ pub enum TopologyError {
         line: Option<usize>,
         error: Box<TopologyError>,
     },
+    /// A USD file that cannot be read, or a Mesh prim's attribute that cannot be mapped to a
+    /// control mesh ([`crate::mesh::usd`]): the file, the prim's path and the attribute's name
+    /// (each left out where the problem is not about one).
+    #[error("{file}{}: {problem}", usd_site(prim, attribute))]
+    Usd {
+        file: String,
+        prim: String,
+        attribute: String,
+        /// Boxed: keeps every `Result<_, TopologyError>` small.
+        problem: Box<UsdProblem>,
+    },
+    /// A validation error about one Mesh prim of a USD file, with the 0-based point and face
+    /// numbers of that prim (as USD's arrays count them). Said in the message, not chained.
+    #[error("{file}: {prim}: {error}")]
+    InUsdPrim {
+        file: String,
+        prim: String,
+        error: Box<TopologyError>,
+    },
     /// The mesh has no faces (or no vertices): there is nothing to subdivide.
     #[error("empty mesh: {what}")]
     EmptyMesh { what: &'static str },
@@ -251,7 +270,9 @@ impl TopologyError {
     /// The underlying error with any file wrapper removed (useful to match on the kind).
     pub fn root(&self) -> &TopologyError {
         match self {
-            TopologyError::InFile { error, .. } => error.root(),
+            TopologyError::InFile { error, .. } | TopologyError::InUsdPrim { error, .. } => {
+                error.root()
+            }
             other => other,
         }
     }
@@ -264,6 +285,8 @@ impl TopologyError {
         match self {
             e @ (TopologyError::Io { .. }
             | TopologyError::Parse { .. }
+            | TopologyError::Usd { .. }
+            | TopologyError::InUsdPrim { .. }
             | TopologyError::InFile { .. }) => e,
             other => TopologyError::InFile {
                 file: file.to_string(),
@@ -272,6 +295,74 @@ impl TopologyError {
             },
         }
     }
+}
+
+/// ` <prim>.<attribute>` of a [`TopologyError::Usd`], as much of it as is known.
+fn usd_site(prim: &str, attribute: &str) -> String {
+    match (prim.is_empty(), attribute.is_empty()) {
+        (true, true) => String::new(),
+        (false, true) => format!(": {prim}"),
+        (true, false) => format!(": {attribute}"),
+        (false, false) => format!(": {prim}.{attribute}"),
+    }
+}
+
+/// What is wrong with a USD file or one of its Mesh prims' attributes
+/// ([`TopologyError::Usd`]).
+#[derive(Debug, thiserror::Error)]
+pub enum UsdProblem {
+    /// The USD reader refused the file (its message).
+    #[error("cannot read USD: {0}")]
+    Read(String),
+    /// The USD reader panicked on the file (a malformed file it does not check); the panic's
+    /// message.
+    #[error("the USD reader failed on malformed input: {0}")]
+    ReaderPanicked(String),
+    /// The composed stage has no Mesh prim to draw.
+    #[error("no Mesh prim to draw ({skipped} skipped: invisible, guide or proxy)")]
+    NoMesh { skipped: usize },
+    /// A required attribute is not authored.
+    #[error("not authored (a Mesh needs it)")]
+    Missing,
+    /// The attribute holds another type than the schema's.
+    #[error("holds {found}; expected {expected}")]
+    WrongType {
+        found: String,
+        expected: &'static str,
+    },
+    /// A token outside the attribute's allowed tokens.
+    #[error("unknown token '{value}' (expected one of: {expected})")]
+    UnknownToken {
+        value: String,
+        expected: &'static str,
+    },
+    /// A negative entry in a count array (`faceVertexCounts`).
+    #[error("entry {position} is {value}; counts cannot be negative")]
+    NegativeCount { position: usize, value: i64 },
+    /// An array whose length disagrees with what the other attributes ask for.
+    #[error("has {len} entries; expected {expected}")]
+    Length { len: usize, expected: String },
+    /// An index out of its range.
+    #[error("entry {position} is {index}, but there are {count} {of}")]
+    IndexOutOfRange {
+        position: usize,
+        index: i64,
+        count: usize,
+        of: &'static str,
+    },
+    /// A crease of fewer than two points (`creaseLengths`).
+    #[error("crease {crease} has length {length}; a crease needs at least 2 points")]
+    ShortCrease { crease: usize, length: i64 },
+    /// Meshes merged into one control mesh must share the scheme and subdivision options.
+    #[error("{value} differs from {first_prim}'s {first_value}; meshes merged into one control mesh must share the subdivision scheme and options")]
+    Mixed {
+        value: String,
+        first_prim: String,
+        first_value: String,
+    },
+    /// The prim's transform could not be composed (the reader's message).
+    #[error("cannot compose the transform: {0}")]
+    Transform(String),
 }
 
 fn at_line(line: Option<usize>) -> String {

@@ -24,7 +24,7 @@ pub enum Command {
     /// Render a mesh (the embedded spot control mesh by default) to a PNG.
     Render(RenderArgs),
     /// Open a window: drag to orbit, wheel to zoom, 1/2/3 method, +/- segments, W wireframe, P
-    /// screenshot; drop an OBJ on it to open it.
+    /// screenshot; drop an OBJ or USD file on it to open it.
     View(ViewArgs),
     /// List Vulkan devices, their tessellation features and limits, and which would be chosen.
     Info(GpuArgs),
@@ -54,7 +54,7 @@ pub struct PlotArgs {
 
 #[derive(Args, Debug)]
 pub struct ExportArgs {
-    /// OBJ control mesh; the embedded spot control mesh when absent.
+    /// OBJ or USD (.usda, .usdc, .usdz) control mesh; the embedded spot control mesh when absent.
     pub input: Option<PathBuf>,
     /// The technique (the list: --help); by default the limit surface of --scheme.
     #[arg(long, value_parser = crate::technique::parse_technique,
@@ -112,7 +112,7 @@ pub struct BenchArgs {
     /// Untimed frames before them.
     #[arg(long, default_value_t = 5, allow_hyphen_values = true, value_parser = parse_warmup)]
     pub warmup: u32,
-    /// OBJ control mesh (repeatable); replaces the default set.
+    /// OBJ or USD (.usda, .usdc, .usdz) control mesh (repeatable); replaces the default set.
     #[arg(long)]
     pub mesh: Vec<PathBuf>,
     /// Offscreen size, WIDTHxHEIGHT.
@@ -179,7 +179,7 @@ pub struct BenchArgs {
 
 #[derive(Args, Debug)]
 pub struct SubdivideArgs {
-    /// OBJ control mesh; the embedded spot control mesh when absent.
+    /// OBJ or USD (.usda, .usdc, .usdz) control mesh; the embedded spot control mesh when absent.
     pub input: Option<PathBuf>,
     #[arg(long, value_parser = crate::topo_cmds::parse_scheme)]
     pub scheme: topology::Scheme,
@@ -196,7 +196,7 @@ pub struct SubdivideArgs {
 
 #[derive(Args, Debug)]
 pub struct LimitArgs {
-    /// OBJ control mesh; the embedded spot control mesh when absent.
+    /// OBJ or USD (.usda, .usdc, .usdz) control mesh; the embedded spot control mesh when absent.
     pub input: Option<PathBuf>,
     /// loop, catmull-clark or doo-sabin (doo-sabin needs --corner, or `F C U V` points)
     #[arg(long)]
@@ -373,7 +373,7 @@ pub fn parse_alpha(s: &str) -> Result<f32, String> {
 
 #[derive(Args, Debug, Clone)]
 pub struct SceneArgs {
-    /// OBJ control mesh; the embedded spot control mesh when absent.
+    /// OBJ or USD (.usda, .usdc, .usdz) control mesh; the embedded spot control mesh when absent.
     pub mesh: Option<PathBuf>,
     /// The technique (the list: --help); by default the limit surface of --scheme.
     #[arg(long, value_parser = crate::technique::parse_technique,

@@ -35,13 +35,18 @@ pub fn validation(g: &GpuArgs) -> Validation {
     }
 }
 
-/// Loads and validates the mesh (the embedded spot without a path); errors say the file, the
-/// line and the OBJ's 1-based numbers (`topology::mesh::obj`). With the line of every element, for
+/// Loads and validates the mesh (the embedded spot without a path): a `.usda`, `.usdc`,
+/// `.usdz` or `.usd` file through `topology::mesh::usd` (errors name the prim and the
+/// attribute; no lines), anything else as OBJ (errors say the file, the line and the OBJ's
+/// 1-based numbers, `topology::mesh::obj`). With the line of every element, for
 /// errors found later ([`in_mesh_file`]).
 pub fn load_mesh_with_lines(
     path: Option<&std::path::Path>,
 ) -> Result<(topology::ControlMesh, ObjLines)> {
     let (mesh, lines) = match path {
+        Some(p) if topology::mesh::usd::is_usd_path(p) => {
+            (topology::mesh::usd::load_usd(p)?, ObjLines::default())
+        }
         Some(p) => topology::mesh::obj::load_obj_with_lines(p)?,
         None => topology::mesh::obj::parse_obj_with_lines(
             DEFAULT_MESH,

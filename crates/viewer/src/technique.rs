@@ -122,9 +122,12 @@ pub fn parse_end_cap(s: &str) -> Result<EndCap, String> {
     }
 }
 
-/// The scheme a mesh is drawn with when `--scheme` is absent: Catmull-Clark unless every face
-/// is a triangle (then Loop).
+/// The scheme a mesh is drawn with when `--scheme` is absent: the file's (a USD mesh's
+/// `subdivisionScheme`), else Catmull-Clark unless every face is a triangle (then Loop).
 pub fn default_scheme(mesh: &topology::ControlMesh) -> topology::Scheme {
+    if let Some(scheme) = mesh.scheme {
+        return scheme;
+    }
     if mesh.faces().all(|f| f.len() == 3) {
         topology::Scheme::Loop
     } else {
@@ -163,6 +166,9 @@ fn method_or_scheme_default(
         Some(s) => {
             crate::topo_cmds::parse_scheme(s).map_err(|e| anyhow::anyhow!("--scheme {s}: {e}"))?
         }
+        // A USD mesh whose scheme is bilinear or none: its faces, drawn flat (quads as
+        // bilinear patches).
+        None if mesh.scheme == Some(topology::Scheme::Bilinear) => return Ok(TechniqueId::FLAT),
         None => default_scheme(mesh),
     };
     techniques::default_for(scheme)

@@ -242,7 +242,7 @@ impl App {
         self.status = Some(what);
     }
 
-    /// Opens the OBJ dropped on the window: read, built with the current setup and shown in
+    /// Opens the OBJ or USD file dropped on the window: read, built with the current setup and shown in
     /// place of the mesh; on any error the window keeps the mesh it had.
     fn open_dropped(&mut self, path: &std::path::Path) {
         let name = path.display().to_string();

@@ -62,6 +62,31 @@ fn invalid(text: String) -> std::io::Error {
     std::io::Error::new(std::io::ErrorKind::InvalidInput, text)
 }
 
+fn too_large(size: u64, max_bytes: u64, what: &str) -> std::io::Error {
+    invalid(format!(
+        "is {}, more than the {} {what} may have",
+        bytes_text(size),
+        bytes_text(max_bytes)
+    ))
+}
+
+/// The checks of [`read_regular_file`] without reading: for a reader that opens the file itself
+/// (the USD reader). Returns the file's metadata.
+pub fn check_regular_file(
+    path: &Path,
+    max_bytes: u64,
+    what: &str,
+) -> std::io::Result<std::fs::Metadata> {
+    let meta = std::fs::metadata(path)?;
+    if let Some(kind) = not_regular(meta.file_type()) {
+        return Err(invalid(format!("is {kind}, not a regular file")));
+    }
+    if meta.len() > max_bytes {
+        return Err(too_large(meta.len(), max_bytes, what));
+    }
+    Ok(meta)
+}
+
 /// The whole of the regular file at `path` (symbolic links followed), at most `max_bytes`
 /// long; `what` names the kind of input in the size error ("an OBJ file", "a texture").
 ///
@@ -70,20 +95,8 @@ fn invalid(text: String) -> std::io::Error {
 /// ("is 3 GiB, more than the 1 GiB an OBJ file may have"). A file that grows past the bound
 /// while it is read is refused too.
 pub fn read_regular_file(path: &Path, max_bytes: u64, what: &str) -> std::io::Result<Vec<u8>> {
-    let meta = std::fs::metadata(path)?;
-    let too_large = |size: u64| {
-        invalid(format!(
-            "is {}, more than the {} {what} may have",
-            bytes_text(size),
-            bytes_text(max_bytes)
-        ))
-    };
-    if let Some(kind) = not_regular(meta.file_type()) {
-        return Err(invalid(format!("is {kind}, not a regular file")));
-    }
-    if meta.len() > max_bytes {
-        return Err(too_large(meta.len()));
-    }
+    let meta = check_regular_file(path, max_bytes, what)?;
+    let too_large = |size: u64| too_large(size, max_bytes, what);
     let file = std::fs::File::open(path)?;
     // The path may have been replaced between the two looks; what was opened decides.
     if let Some(kind) = not_regular(file.metadata()?.file_type()) {

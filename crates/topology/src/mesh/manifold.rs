@@ -596,6 +596,7 @@ impl Split<'_> {
             holes: mesh.holes.clone(),
             scalar_tags: mesh.scalar_tags.clone(),
             options: mesh.options,
+            scheme: mesh.scheme,
         };
         ManifoldSplit {
             mesh: out,

@@ -8,6 +8,7 @@ pub mod input;
 pub mod manifold;
 pub mod obj;
 pub mod scalar_tags;
+pub mod usd;
 pub mod weld;
 
 /// Sentinel for "no face" / "no edge" in adjacency tables.
@@ -101,6 +102,10 @@ pub struct ControlMesh {
     /// ([`scalar_tags`]); the subdivision schemes ignore them.
     pub scalar_tags: Vec<scalar_tags::ScalarTag>,
     pub options: SubdivOptions,
+    /// The subdivision scheme the file names (a USD mesh's `subdivisionScheme`), which
+    /// drawing uses when none is asked for; `None` for OBJ, whose scheme is chosen from the
+    /// faces (triangles: Loop, else Catmull-Clark).
+    pub scheme: Option<crate::rules::Scheme>,
 }
 
 impl ControlMesh {
@@ -172,6 +177,7 @@ impl ControlMesh {
             creases: self.creases.clone(),
             corners: self.corners.clone(),
             options: self.options,
+            scheme: self.scheme,
             ..ControlMesh::default()
         };
         let corners = self.face_vertices.len();

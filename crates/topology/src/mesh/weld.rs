@@ -83,6 +83,7 @@ pub fn weld_vertices(mesh: &ControlMesh, tolerance: f64) -> (ControlMesh, Vec<u3
         positions: mesh.positions.clone(),
         face_offsets: vec![0],
         options: mesh.options,
+        scheme: mesh.scheme,
         ..ControlMesh::default()
     };
     let mut uvs = mesh.uvs.as_ref().map(|_| Vec::new());

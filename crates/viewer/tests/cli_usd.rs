@@ -1,0 +1,119 @@
+//! USD files on the command line (`tests/data/usd/`): render, export, bench and subdivide take
+//! a `.usda` as they take an OBJ; the file's `subdivisionScheme` picks the default technique
+//! (Catmull-Clark: adaptive, Loop: bft, none: flat); the bench row is named by the file's
+//! stem; a bad file is refused before any device is opened, naming the file, the prim and the
+//! attribute. GPU commands run with validation on.
+mod common;
+use common::tessera;
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+fn data(p: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tests/data/usd")
+        .join(p)
+        .to_str()
+        .unwrap()
+        .to_owned()
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tessera-cli-usd-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn succeeds(args: &[&str]) -> Output {
+    let o = tessera(args, &[]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{args:?}: {e}");
+    assert!(!e.contains("validation error"), "{args:?}: {e}");
+    o
+}
+
+#[test]
+fn the_usd_scheme_picks_the_default_technique() {
+    let png = tmp("r.png");
+    let png = png.to_str().unwrap();
+    for (file, technique) in [
+        ("cube_tags.usda", "adaptive"),
+        ("two_meshes.usda", "adaptive"),
+        ("loop_octahedron.usda", "bft"),
+        ("real/ring.usda", "flat"),
+    ] {
+        let o = succeeds(&["render", &data(file), "--size", "64x48", "-o", png]);
+        let said =
+            String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+        assert!(said.contains(&format!(", {technique},")), "{file}: {said}");
+    }
+}
+
+#[test]
+fn export_bench_and_subdivide_take_usd() {
+    let out = tmp("out.obj");
+    let out = out.to_str().unwrap();
+    let cube = data("cube_tags.usda");
+    succeeds(&[
+        "export",
+        &data("two_meshes.usda"),
+        "--segments",
+        "2",
+        "-o",
+        out,
+    ]);
+    assert!(std::fs::read_to_string(out).unwrap().contains("\nf "));
+    let o = succeeds(&[
+        "bench",
+        "--mesh",
+        &cube,
+        "--methods",
+        "flat",
+        "--segments",
+        "2",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--size",
+        "64x48",
+    ]);
+    let rows = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(rows.contains("cube_tags"), "{rows}");
+    succeeds(&[
+        "subdivide",
+        &cube,
+        "--scheme",
+        "catmull-clark",
+        "--level",
+        "1",
+        "-o",
+        out,
+    ]);
+    let refined = std::fs::read_to_string(out).unwrap();
+    let faces = refined.lines().filter(|l| l.starts_with("f ")).count();
+    assert_eq!(faces, 24, "six quads split into four each");
+}
+
+#[test]
+fn a_bad_usd_file_is_refused_by_file_prim_and_attribute() {
+    let bad = tmp("bad.usda");
+    std::fs::write(
+        &bad,
+        "#usda 1.0\ndef Mesh \"M\" {\n int[] faceVertexCounts = [3]\n int[] faceVertexIndices = \
+         [0, 1, 5]\n point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]\n}\n",
+    )
+    .unwrap();
+    let bad = bad.to_str().unwrap();
+    let png = tmp("bad.png");
+    let o = tessera(&["render", bad, "-o", png.to_str().unwrap()], &[]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(!e.contains("panicked"), "{e}");
+    assert!(
+        e.contains(&format!(
+            "{bad}: /M.faceVertexIndices: entry 2 is 5, but there are 3 points"
+        )),
+        "{e}"
+    );
+    assert!(!png.exists());
+}
