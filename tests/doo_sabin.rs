@@ -165,6 +165,20 @@ fn the_cpu_baseline_draws_the_refiners_level() {
                 assert_eq!(c.classes.2 > 0, open, "{what}: boundary edges");
             }
         }
+        // Holes: Doo-Sabin's refinement has none, and both refuse them alike.
+        let holed = mesh("tests/data/opensubdiv/shapes/catmark_hole_test1.obj");
+        let mut refusal = |id| {
+            tessera::tess::techniques::build(&mut ctx, id, &holed, &Default::default())
+                .err()
+                .expect("a hole refused")
+                .to_string()
+        };
+        let (gpu_e, cpu_e) = (
+            refusal(TechniqueId::DOO_SABIN),
+            refusal(TechniqueId::CPU_DOO_SABIN),
+        );
+        assert!(gpu_e.contains("has no holes"), "{gpu_e}");
+        assert_eq!(gpu_e, cpu_e);
     }
     assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
 }

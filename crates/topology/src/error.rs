@@ -116,6 +116,10 @@ pub enum TopologyError {
          allow two per triangle: a crease crosses a triangle along one edge)"
     )]
     ScalarTagTriangle { face: usize },
+    /// A face tagged as a hole under Doo-Sabin, whose dual refinement has no holes (every face
+    /// becomes an f-face of the next level: the hole would be drawn).
+    #[error("face {face} is tagged a hole: Doo-Sabin's refinement has no holes (it would draw the face)")]
+    DooSabinHole { face: u32 },
     /// `face_offsets` does not start at 0, decreases, or does not end at the corner count.
     #[error(
         "malformed face table: face_offsets ({faces} faces) is not a valid prefix table over {corners} face_vertices"

@@ -206,6 +206,7 @@ impl ObjLines {
                 self.scalar_tags.get(k).copied()
             }
             E::ScalarTagTriangle { face: f } => face(f),
+            E::DooSabinHole { face: f } => face(f as usize),
             E::TagOutOfRange { tag, index, .. } => {
                 let k = match tag {
                     TagKind::Crease => mesh

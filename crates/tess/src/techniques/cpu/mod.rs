@@ -158,7 +158,12 @@ impl CpuMesh {
         // Doo-Sabin's first step refuses what the dual scheme cannot refine (a vertex of two
         // faces), before any frame asks for a level.
         let doo_sabin_first = match scheme {
-            Scheme::DooSabin => Some(first_level_size(&base).map_err(mesh_error)?),
+            Scheme::DooSabin => {
+                if let Some(&face) = mesh.holes.first() {
+                    return Err(mesh_error(topology::TopologyError::DooSabinHole { face }));
+                }
+                Some(first_level_size(&base).map_err(mesh_error)?)
+            }
             _ => None,
         };
         let base_corners = corner_domains(&refined, &fans);

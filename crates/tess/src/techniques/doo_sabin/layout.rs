@@ -55,8 +55,6 @@ pub enum LayoutError {
         point: u32,
         corners: u32,
     },
-    #[error("face {face} is tagged a hole: Doo-Sabin's refinement has no holes (it would draw the face)")]
-    Hole { face: u32 },
     #[error("Doo-Sabin level {level}: {vertices} vertices overflow 32-bit indices")]
     TooLarge { level: u32, vertices: u64 },
 }

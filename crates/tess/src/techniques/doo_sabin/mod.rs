@@ -179,7 +179,7 @@ impl DooSabin {
         if let Some(&face) = mesh.holes.first() {
             return Err(TessError::Mesh {
                 name: options.name.clone(),
-                source: Box::new(LayoutError::Hole { face }),
+                source: Box::new(topology::TopologyError::DooSabinHole { face }),
             });
         }
         let base = Level::from_mesh(mesh, Scheme::DooSabin).map_err(|e| TessError::Mesh {
