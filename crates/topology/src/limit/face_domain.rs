@@ -166,7 +166,7 @@ fn barycentric(t: [[f64; 2]; 3], p: [f64; 2]) -> [f64; 3] {
 
 /// The surface a [`LimitEvaluator`] evaluates.
 enum Surface {
-    Local(LocalMesh),
+    Local(Box<LocalMesh>),
     /// Doo-Sabin's limit ([`crate::limit::doo_sabin_eval`]): a face-domain point is mapped to
     /// its corner quad, the Catmull-Clark sub-quad of the same corner.
     DooSabin(Box<DooSabinEvaluator>),
@@ -218,7 +218,7 @@ impl LimitEvaluator {
         };
         Ok(Self {
             scheme: scheme.scheme(),
-            surface: Surface::Local(local),
+            surface: Surface::Local(Box::new(local)),
             sizes,
             first_triangle,
         })
