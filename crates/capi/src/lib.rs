@@ -1556,11 +1556,7 @@ pub unsafe extern "C" fn tessera_surface_create_file(
         let path = unsafe { read_str(path, "path") }?
             .ok_or_else(|| Error::new(TesseraStatus::InvalidArgument, "path is NULL"))?;
         let path = std::path::Path::new(&path);
-        let mesh = if topology::mesh::usd::is_usd_path(path) {
-            topology::mesh::usd::load_usd(path)?
-        } else {
-            topology::mesh::obj::load_obj(path)?
-        };
+        let (mesh, _) = topology::mesh::usd::load_mesh_file(path)?;
         let name = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())

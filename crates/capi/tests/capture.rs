@@ -1,25 +1,11 @@
 //! Capture through the C ABI: what the GPU's tessellation emitted for one frame, written as
 //! OBJ (as `tessera export` writes it), one face per reported triangle.
 mod common;
+use common::standalone_context;
 
 use std::ffi::CString;
 use std::ptr::{null, null_mut};
 use tessera_capi::*;
-
-/// A standalone context with synchronization validation on (its messages are counted by
-/// `tessera_context_validation_errors`, which each test checks).
-fn standalone_context() -> *mut TesseraContext {
-    let desc = TesseraStandaloneDesc {
-        device: null(),
-        validation: TESSERA_VALIDATION_SYNCHRONIZATION,
-        ..Default::default()
-    };
-    let mut ctx = null_mut();
-    // SAFETY: `desc` and `ctx` are live locals of the types the call reads and writes.
-    let status = unsafe { tessera_context_create_standalone(&desc, &mut ctx) };
-    assert_eq!(status, TesseraStatus::Ok);
-    ctx
-}
 
 #[test]
 fn capture_writes_the_triangles_the_gpu_drew() {

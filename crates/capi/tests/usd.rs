@@ -2,23 +2,11 @@
 //! (`tests/data/usd/`) build surfaces whose captures are the same OBJ text; a bad USD file and
 //! a NULL path are refused by status, the message naming the file, the prim and the attribute.
 mod common;
+use common::standalone_context;
 
 use std::ffi::{CStr, CString};
 use std::ptr::{null, null_mut};
 use tessera_capi::*;
-
-fn standalone_context() -> *mut TesseraContext {
-    let desc = TesseraStandaloneDesc {
-        device: null(),
-        validation: TESSERA_VALIDATION_SYNCHRONIZATION,
-        ..Default::default()
-    };
-    let mut ctx = null_mut();
-    // SAFETY: `desc` and `ctx` are live locals of the types the call reads and writes.
-    let status = unsafe { tessera_context_create_standalone(&desc, &mut ctx) };
-    assert_eq!(status, TesseraStatus::Ok);
-    ctx
-}
 
 fn last_error(ctx: *mut TesseraContext) -> String {
     let mut buf = vec![0 as std::ffi::c_char; 1024];

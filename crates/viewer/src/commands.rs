@@ -44,10 +44,7 @@ pub fn load_mesh_with_lines(
     path: Option<&std::path::Path>,
 ) -> Result<(topology::ControlMesh, ObjLines)> {
     let (mesh, lines) = match path {
-        Some(p) if topology::mesh::usd::is_usd_path(p) => {
-            (topology::mesh::usd::load_usd(p)?, ObjLines::default())
-        }
-        Some(p) => topology::mesh::obj::load_obj_with_lines(p)?,
+        Some(p) => topology::mesh::usd::load_mesh_file(p)?,
         None => topology::mesh::obj::parse_obj_with_lines(
             DEFAULT_MESH,
             "spot_control_mesh.obj (embedded)",

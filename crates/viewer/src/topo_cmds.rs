@@ -63,10 +63,7 @@ fn non_finite(positions: &[[f64; 3]]) -> Option<usize> {
 /// embedded spot control mesh, with the lines of its elements.
 fn read_mesh(path: Option<&std::path::Path>) -> Result<(ControlMesh, ObjLines)> {
     match path {
-        Some(p) if topology::mesh::usd::is_usd_path(p) => {
-            Ok((topology::mesh::usd::load_usd(p)?, ObjLines::default()))
-        }
-        Some(p) => Ok(topology::mesh::obj::load_obj_with_lines(p)?),
+        Some(p) => Ok(topology::mesh::usd::load_mesh_file(p)?),
         None => crate::commands::load_mesh_with_lines(None),
     }
 }

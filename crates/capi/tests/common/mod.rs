@@ -215,6 +215,22 @@ impl Host {
     }
 }
 
+/// A standalone context with synchronization validation on (its messages are counted by
+/// `tessera_context_validation_errors`, which the tests check).
+pub fn standalone_context() -> *mut tessera_capi::TesseraContext {
+    use tessera_capi::*;
+    let desc = TesseraStandaloneDesc {
+        device: std::ptr::null(),
+        validation: TESSERA_VALIDATION_SYNCHRONIZATION,
+        ..Default::default()
+    };
+    let mut ctx = std::ptr::null_mut();
+    // SAFETY: `desc` and `ctx` are live locals of the types the call reads and writes.
+    let status = unsafe { tessera_context_create_standalone(&desc, &mut ctx) };
+    assert_eq!(status, TesseraStatus::Ok);
+    ctx
+}
+
 /// Captures spot drawn by technique `name` on a standalone context through the C ABI, with
 /// the surface and frame descriptions the example hosts use (defaults, 160×120, 4 uniform
 /// segments), into `dir/<name>.standalone.obj`; returns the file and the report.

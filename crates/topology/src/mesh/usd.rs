@@ -55,6 +55,19 @@ use openusd::sdf::Value;
 use openusd::usd::{Prim, PrimPredicate, SchemaBase, SchemaKind, Stage, TimeCode};
 use std::path::Path;
 
+/// The mesh file at `path`: USD through [`load_usd`] when [`is_usd_path`] says so (no element
+/// lines: its errors name the prim and the attribute), else OBJ with OpenSubdiv's tags and the
+/// line of every element ([`crate::mesh::obj::load_obj_with_lines`]). The one place a file's
+/// format is chosen by its name.
+pub fn load_mesh_file(
+    path: &Path,
+) -> Result<(ControlMesh, crate::mesh::obj::ObjLines), TopologyError> {
+    if is_usd_path(path) {
+        return Ok((load_usd(path)?, Default::default()));
+    }
+    crate::mesh::obj::load_obj_with_lines(path)
+}
+
 /// The largest USD file [`load_usd`] opens: 1 GiB, as for OBJ.
 pub const MAX_USD_BYTES: u64 = crate::mesh::input::MAX_OBJ_BYTES;
 
