@@ -1148,12 +1148,13 @@ unsafe fn read_maps(
 unsafe fn create_surface(
     ctx_id: u64,
     c: &mut ContextState,
-    mesh: topology::ControlMesh,
+    mut mesh: topology::ControlMesh,
     d: &TesseraSurfaceDesc,
     name: String,
 ) -> Result<u64> {
     topology::mesh::check_positions(&mesh.positions)?;
     mesh.validate()?;
+    mesh.apply_boundary_none();
     let technique = choose_technique(d, &mesh)?;
     let end_cap = match d.end_cap {
         TESSERA_END_CAP_GREGORY => topology::patches::adaptive::EndCap::Gregory,

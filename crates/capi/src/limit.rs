@@ -138,9 +138,10 @@ pub unsafe extern "C" fn tessera_limit_evaluator_create_mesh(
         // SAFETY: the caller's contract.
         let m = unsafe { read_required(mesh, "mesh") }?;
         // SAFETY: the caller's contract for the arrays.
-        let (mesh, _) = unsafe { crate::read_mesh(&m) }?;
+        let (mut mesh, _) = unsafe { crate::read_mesh(&m) }?;
         topology::mesh::check_positions(&mesh.positions)?;
         mesh.validate()?;
+        mesh.apply_boundary_none();
         let scheme = crate::surface_scheme(scheme, None, &mesh)?;
         let e = build(&mesh, scheme)?;
         let id = lock(handles())?.add_evaluator(e);

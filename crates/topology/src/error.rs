@@ -116,10 +116,27 @@ pub enum TopologyError {
          allow two per triangle: a crease crosses a triangle along one edge)"
     )]
     ScalarTagTriangle { face: usize },
-    /// A face tagged as a hole under Doo-Sabin, whose dual refinement has no holes (every face
-    /// becomes an f-face of the next level: the hole would be drawn).
-    #[error("face {face} is tagged a hole: Doo-Sabin's refinement has no holes (it would draw the face)")]
+    /// A face that is a hole (tagged, or a boundary face under boundary interpolation
+    /// `none`) under Doo-Sabin, whose dual refinement has no holes (every face becomes an
+    /// f-face of the next level: the hole would be drawn).
+    #[error(
+        "face {face} is a hole (tagged, or a boundary face under interpolateboundary none): \
+         Doo-Sabin's refinement has no holes (it would draw the face)"
+    )]
     DooSabinHole { face: u32 },
+    /// A crease tag under Doo-Sabin, whose rules have no sharp edges (the edge would be drawn
+    /// smooth).
+    #[error(
+        "the edge {v0}-{v1} has crease sharpness {sharpness}: Doo-Sabin's refinement has no \
+         creases (it would draw the edge smooth)"
+    )]
+    DooSabinCrease { v0: u32, v1: u32, sharpness: f32 },
+    /// A corner tag under Doo-Sabin, whose rules have no sharp vertices.
+    #[error(
+        "vertex {vertex} has corner sharpness {sharpness}: Doo-Sabin's refinement has no sharp \
+         vertices (it would draw the vertex smooth)"
+    )]
+    DooSabinCorner { vertex: u32, sharpness: f32 },
     /// `face_offsets` does not start at 0, decreases, or does not end at the corner count.
     #[error(
         "malformed face table: face_offsets ({faces} faces) is not a valid prefix table over {corners} face_vertices"

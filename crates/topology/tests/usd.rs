@@ -92,12 +92,28 @@ fn left_handed_faces_are_reversed_with_their_uvs() {
         usd.options.triangle_subdivision,
         TriangleSubdivision::Smooth
     );
-    assert_eq!(usd.options.boundary, BoundaryInterpolation::None);
+    assert_eq!(usd.options.boundary, BoundaryInterpolation::EdgesOnly);
     let read = read_usd(data("left_handed.usda")).unwrap();
     assert_eq!(
         read.prims[0].face_varying_linear_interpolation,
         "cornersPlus1"
     );
+}
+
+/// `interpolateBoundary = "none"` is OpenSubdiv's: the faces around boundary vertices become
+/// holes (a lone quad is all boundary).
+#[test]
+fn boundary_none_makes_boundary_faces_holes() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("none.usda");
+    std::fs::write(
+        &path,
+        quad_with("uniform token interpolateBoundary = \"none\""),
+    )
+    .unwrap();
+    let mesh = load_usd(&path).unwrap();
+    assert_eq!(mesh.options.boundary, BoundaryInterpolation::None);
+    assert_eq!(mesh.holes, vec![0]);
 }
 
 /// `stem.usda` written as `.usdc` and packed into a `.usdz` in `dir`.

@@ -244,6 +244,9 @@ pub fn run(a: BenchArgs) -> Result<()> {
     if a.figure7 {
         return figure7(&a);
     }
+    if a.load_to_first_frame {
+        return crate::load_bench::run(&a);
+    }
     if let Some(p) = &a.plot {
         // Before minutes of measuring, not after.
         crate::plot::format_of(p, "--plot")?;

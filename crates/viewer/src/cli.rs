@@ -163,6 +163,12 @@ pub struct BenchArgs {
     /// indexed draw) against one refinement pattern, measured together; --markdown writes it.
     #[arg(long)]
     pub figure7: bool,
+    /// Time loading instead of drawing: for each --mesh (e.g. a USD asset and the same asset
+    /// as OBJ) and each --methods entry, parse, plan and the first frame at the first
+    /// --segments value, in rounds (--warmup untimed, --frames timed); medians, and each
+    /// total over the same method's first mesh's. --markdown writes the table.
+    #[arg(long, conflicts_with = "figure7")]
+    pub load_to_first_frame: bool,
     /// Write the rows as CSV.
     #[arg(long)]
     pub csv: Option<PathBuf>,

@@ -15,6 +15,7 @@ mod cli;
 mod commands;
 mod export;
 mod hud;
+mod load_bench;
 mod numbers;
 mod output;
 mod plot;

@@ -79,6 +79,9 @@ pub fn subdivide(a: SubdivideArgs) -> Result<()> {
     let (mesh, lines) = read_mesh(a.input.as_deref())?;
     // A non-manifold mesh is refined through its manifold split, as every subdivision technique
     // draws it: the output has one vertex per copy (coincident where the sheets meet).
+    if a.scheme == topology::Scheme::DooSabin {
+        topology::refine::check_doo_sabin_tags(&mesh).map_err(|e| lines.locate(e, &mesh, &name))?;
+    }
     let split = ManifoldSplit::of(&mesh).map_err(|e| lines.locate(e, &mesh, &name))?;
     if split.report.any() {
         eprintln!("{name}: {}", split.report.summary());

@@ -117,3 +117,52 @@ fn a_bad_usd_file_is_refused_by_file_prim_and_attribute() {
     );
     assert!(!png.exists());
 }
+
+/// `bench --load-to-first-frame`: a USD file and its OBJ twin, each parsed, planned and drawn
+/// once per round; the table has one row per (method, file) with positive phase times, the
+/// first file's ratio 1, and --markdown writes it. Without --mesh it says what it needs.
+#[test]
+fn bench_times_load_to_first_frame() {
+    let md = tmp("load.md");
+    let (usd, obj) = (data("cube_tags.usda"), data("cube_tags.obj"));
+    let o = succeeds(&[
+        "bench",
+        "--load-to-first-frame",
+        "--mesh",
+        &usd,
+        "--mesh",
+        &obj,
+        "--methods",
+        "flat,adaptive",
+        "--segments",
+        "4",
+        "--size",
+        "64x48",
+        "--frames",
+        "2",
+        "--warmup",
+        "1",
+        "--markdown",
+        md.to_str().unwrap(),
+    ]);
+    let table = std::fs::read_to_string(&md).unwrap();
+    assert!(String::from_utf8_lossy(&o.stdout).contains(&table));
+    let rows: Vec<Vec<&str>> = table
+        .lines()
+        .filter(|l| l.starts_with("| flat") || l.starts_with("| adaptive"))
+        .map(|l| l.trim_matches('|').split('|').map(str::trim).collect())
+        .collect();
+    assert_eq!(rows.len(), 4, "{table}");
+    for (row, file) in rows.iter().zip([&usd, &obj, &usd, &obj]) {
+        assert_eq!(row[1], file.as_str(), "{table}");
+        for ms in &row[2..6] {
+            assert!(ms.parse::<f64>().unwrap() > 0.0, "{table}");
+        }
+    }
+    assert_eq!(rows[0][6], "1.000");
+    assert_eq!(rows[2][6], "1.000");
+
+    let o = tessera(&["bench", "--load-to-first-frame"], &[]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--load-to-first-frame needs the files"));
+}

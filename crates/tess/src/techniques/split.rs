@@ -30,6 +30,12 @@ pub fn build_split(
     mesh: &ControlMesh,
     options: &BuildOptions,
 ) -> Result<Built> {
+    if info.scheme == Some(topology::Scheme::DooSabin) {
+        topology::refine::check_doo_sabin_tags(mesh).map_err(|e| TessError::Mesh {
+            name: options.name.clone(),
+            source: e.into(),
+        })?;
+    }
     let split = ManifoldSplit::of(mesh).map_err(|e| TessError::Mesh {
         name: options.name.clone(),
         source: e.into(),

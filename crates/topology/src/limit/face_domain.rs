@@ -176,6 +176,7 @@ impl LimitEvaluator {
     /// An evaluator of `mesh`'s Doo-Sabin limit surface (non-manifold meshes through their
     /// manifold split, as [`Self::new`]).
     pub fn doo_sabin(mesh: &ControlMesh) -> Result<Self, EvalError> {
+        crate::refine::check_doo_sabin_tags(mesh)?;
         let split = crate::mesh::manifold::ManifoldSplit::of(mesh)?;
         Ok(Self {
             scheme: Scheme::DooSabin,

@@ -85,9 +85,10 @@ pub fn uniform_limit_mesh(
     let (offsets, corners) = current.topology.face_tables();
     let normals = angle_weighted_normals(&positions, offsets, corners);
     let topologies: Vec<&Topology> = levels.iter().map(|l| &l.topology).collect();
+    let drawn = drawn_faces(&topologies, scheme, &mesh.holes);
     Ok(LimitMesh {
         domains: level_domain_points(&topologies, scheme, base_corners),
-        triangles: fan_triangles(offsets, corners),
+        triangles: fan_triangles_of(offsets, corners, &drawn),
         positions,
         normals,
     })
@@ -181,14 +182,50 @@ fn limit_positions(
 
 /// Every face of `offsets`/`corners` as a fan of triangles from its first corner.
 fn fan_triangles(offsets: &[u32], corners: &[u32]) -> Vec<[u32; 3]> {
+    fan_triangles_of(
+        offsets,
+        corners,
+        &vec![true; offsets.len().saturating_sub(1)],
+    )
+}
+
+/// [`fan_triangles`] of the faces marked `drawn`.
+fn fan_triangles_of(offsets: &[u32], corners: &[u32], drawn: &[bool]) -> Vec<[u32; 3]> {
     let mut out = Vec::with_capacity(corners.len());
-    for w in offsets.windows(2) {
+    for (w, _) in offsets.windows(2).zip(drawn).filter(|(_, &d)| d) {
         let f = &corners[w[0] as usize..w[1] as usize];
         for k in 1..f.len().saturating_sub(1) {
             out.push([f[0], f[k], f[k + 1]]);
         }
     }
     out
+}
+
+/// Per face of the last of `levels` (uniform refinements of the first by `scheme`), whether
+/// it is drawn: whether the base face it refines is not among `holes`. A uniform step keeps a
+/// face's children together: Catmull-Clark's child face `c` is the parent's face corner `c`,
+/// Loop's children of face `f` are `4f..4f + 4`.
+fn drawn_faces(levels: &[&Topology], scheme: Scheme, holes: &[u32]) -> Vec<bool> {
+    let mut drawn = vec![true; levels[0].num_faces()];
+    for &h in holes {
+        if let Some(d) = drawn.get_mut(h as usize) {
+            *d = false;
+        }
+    }
+    for parent in &levels[..levels.len() - 1] {
+        drawn = match scheme {
+            Scheme::Loop => drawn.iter().flat_map(|&d| [d; 4]).collect(),
+            _ => {
+                let (offsets, _) = parent.face_tables();
+                (0..parent.num_faces())
+                    .flat_map(|f| {
+                        std::iter::repeat_n(drawn[f], (offsets[f + 1] - offsets[f]) as usize)
+                    })
+                    .collect()
+            }
+        };
+    }
+    drawn
 }
 
 /// The domain point of every vertex of the last of `levels` (uniform refinements of the first,

@@ -232,6 +232,59 @@ impl ControlMesh {
         check_faces(self, false)?;
         scalar_tags::check(self).map(|_| ())
     }
+
+    /// The faces OpenSubdiv's boundary interpolation `none` leaves without a surface: every
+    /// face around a vertex that ends a boundary edge (an edge of one face) not tagged
+    /// infinitely sharp. The remaining faces keep their whole one-ring, so their limit does
+    /// not depend on any boundary rule; an explicitly sharpened boundary keeps its faces. Sorted,
+    /// whatever the option.
+    pub fn boundary_none_faces(&self) -> Vec<u32> {
+        let key = |a: u32, b: u32| if a < b { (a, b) } else { (b, a) };
+        let mut edge_faces: std::collections::HashMap<(u32, u32), u32> = Default::default();
+        for f in self.faces() {
+            for (i, &a) in f.iter().enumerate() {
+                *edge_faces.entry(key(a, f[(i + 1) % f.len()])).or_default() += 1;
+            }
+        }
+        let sharp: std::collections::HashSet<(u32, u32)> = self
+            .creases
+            .iter()
+            .filter(|c| crate::rules::is_infinite(c.sharpness))
+            .map(|c| key(c.vertices[0], c.vertices[1]))
+            .collect();
+        let mut open = vec![false; self.positions.len()];
+        for (&(a, b), &n) in &edge_faces {
+            if n == 1 && !sharp.contains(&(a, b)) {
+                open[a as usize] = true;
+                open[b as usize] = true;
+            }
+        }
+        (0..self.num_faces() as u32)
+            .filter(|&f| self.face(f as usize).iter().any(|&v| open[v as usize]))
+            .collect()
+    }
+
+    /// Applies boundary interpolation `none` as OpenSubdiv does: the faces of
+    /// [`ControlMesh::boundary_none_faces`] become holes (appended to [`ControlMesh::holes`]
+    /// after the tagged ones, which keep their order). Under the other boundary options, and
+    /// for bilinear meshes (whose faces need no neighbourhood), nothing changes. The loaders
+    /// (OBJ, USD, the C ABI) call it; a mesh built in code calls it after setting its options.
+    /// Idempotent.
+    pub fn apply_boundary_none(&mut self) {
+        use crate::rules::options::BoundaryInterpolation;
+        if self.options.boundary != BoundaryInterpolation::None
+            || self.scheme == Some(crate::rules::Scheme::Bilinear)
+        {
+            return;
+        }
+        let tagged: std::collections::HashSet<u32> = self.holes.iter().copied().collect();
+        let added: Vec<u32> = self
+            .boundary_none_faces()
+            .into_iter()
+            .filter(|f| !tagged.contains(f))
+            .collect();
+        self.holes.extend(added);
+    }
 }
 
 /// Validated adjacency of a manifold, consistently oriented polygon mesh.

@@ -193,11 +193,11 @@ impl ObjLines {
                     .nth(2)?;
                 face(f)
             }
-            E::BadEdgeSharpness { v0, v1, .. } => {
+            E::BadEdgeSharpness { v0, v1, .. } | E::DooSabinCrease { v0, v1, .. } => {
                 let k = mesh.creases.iter().position(|c| c.vertices == [v0, v1])?;
                 self.creases.get(k).copied()
             }
-            E::BadVertexSharpness { vertex, .. } => {
+            E::BadVertexSharpness { vertex, .. } | E::DooSabinCorner { vertex, .. } => {
                 let k = mesh.corners.iter().position(|c| c.vertex == vertex)?;
                 self.corners.get(k).copied()
             }
@@ -303,6 +303,7 @@ pub fn parse_obj_with_lines(
     resolve_corners(&mut mesh, &lines, &corners, &uvs, &normals, name)?;
     check_tags(&mesh, &lines).map_err(|(e, line)| e.in_file(name, Some(line)))?;
     mesh.validate().map_err(|e| lines.locate(e, &mesh, name))?;
+    mesh.apply_boundary_none();
     drop_creases_off_edges(&mut mesh, &mut lines, name);
     Ok((mesh, lines))
 }

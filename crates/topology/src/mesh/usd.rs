@@ -485,6 +485,7 @@ impl PrimReader<'_> {
             prim: self.prim.to_string(),
             error: Box::new(e),
         })?;
+        mesh.apply_boundary_none();
         drop_creases_off_edges(&mut mesh, self.file, self.prim);
         Ok(PrimMesh {
             mesh,

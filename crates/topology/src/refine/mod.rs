@@ -122,6 +122,33 @@ fn base_topology(mesh: &ControlMesh, scheme: Scheme) -> Result<Topology, Topolog
     Ok(topology)
 }
 
+/// Doo-Sabin's rules (the seed's, and the boundary as the polygon's quadratic B-spline) have
+/// no sharp edges, sharp vertices or holes: a crease or corner tag with sharpness, or a hole,
+/// of the mesh a user gives is refused by name rather than drawn smooth. The front doors
+/// apply it to the input (the Doo-Sabin techniques, [`crate::limit::face_domain::LimitEvaluator`],
+/// `tessera subdivide`), before a non-manifold mesh's split, whose sharpness tags carry
+/// OpenSubdiv's non-manifold rules and which Doo-Sabin's refinement, having none, ignores.
+pub fn check_doo_sabin_tags(mesh: &ControlMesh) -> Result<(), TopologyError> {
+    if let Some(&face) = mesh.holes.first() {
+        return Err(TopologyError::DooSabinHole { face });
+    }
+    if let Some(c) = mesh.creases.iter().find(|c| c.sharpness > 0.0) {
+        let [v0, v1] = c.vertices;
+        return Err(TopologyError::DooSabinCrease {
+            v0,
+            v1,
+            sharpness: c.sharpness,
+        });
+    }
+    match mesh.corners.iter().find(|c| c.sharpness > 0.0) {
+        Some(c) => Err(TopologyError::DooSabinCorner {
+            vertex: c.vertex,
+            sharpness: c.sharpness,
+        }),
+        None => Ok(()),
+    }
+}
+
 /// Edge and vertex sharpness of the base level from tags and boundary rules.
 fn base_sharpness(
     mesh: &ControlMesh,

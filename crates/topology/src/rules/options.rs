@@ -4,8 +4,10 @@
 /// How boundary vertices are treated (OpenSubdiv `VtxBoundaryInterpolation`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum BoundaryInterpolation {
-    /// OBJ tag value 0. OpenSubdiv turns the boundary faces into holes; this crate still
-    /// refines them like [`BoundaryInterpolation::EdgesOnly`] (boundary edges stay sharp).
+    /// OBJ tag value 0: the faces around a boundary vertex whose boundary edges are not all
+    /// tagged infinitely sharp are holes, as in OpenSubdiv
+    /// ([`crate::mesh::ControlMesh::apply_boundary_none`]); what remains refines as under
+    /// [`BoundaryInterpolation::EdgesOnly`].
     None,
     /// OBJ tag value 2 (the default): boundary edges are infinitely sharp creases.
     #[default]

@@ -156,14 +156,10 @@ impl CpuMesh {
         };
         let base = topology::refine::Level::from_mesh(&refined, scheme).map_err(mesh_error)?;
         // Doo-Sabin's first step refuses what the dual scheme cannot refine (a vertex of two
-        // faces), before any frame asks for a level.
+        // faces; holes and sharpness tags are refused by the base level), before any frame
+        // asks for a level.
         let doo_sabin_first = match scheme {
-            Scheme::DooSabin => {
-                if let Some(&face) = mesh.holes.first() {
-                    return Err(mesh_error(topology::TopologyError::DooSabinHole { face }));
-                }
-                Some(first_level_size(&base).map_err(mesh_error)?)
-            }
+            Scheme::DooSabin => Some(first_level_size(&base).map_err(mesh_error)?),
             _ => None,
         };
         let base_corners = corner_domains(&refined, &fans);
@@ -195,17 +191,26 @@ impl CpuMesh {
         level_of(self.id, params)
     }
 
-    /// (vertices, triangles) of the refined mesh at `level`.
+    /// (vertices, triangles) of the refined mesh at `level`; the faces refining a hole are
+    /// not drawn.
     fn size_at(&self, level: u32) -> (u64, u64) {
         let level = level as usize;
+        let holes: std::collections::BTreeSet<u32> = self.refined.holes.iter().copied().collect();
+        let hole_sides = || {
+            holes
+                .iter()
+                .map(|&h| self.refined.face(h as usize).len() as u64)
+        };
         if level == 0 {
-            let triangles = self.refined.faces().map(|f| f.len() as u64 - 2).sum();
-            return (self.refined.positions.len() as u64, triangles);
+            let faces: u64 = self.refined.faces().map(|f| f.len() as u64 - 2).sum();
+            let in_holes: u64 = hole_sides().map(|n| n - 2).sum();
+            return (self.refined.positions.len() as u64, faces - in_holes);
         }
+        let quarters = 4u64.pow(level as u32 - 1);
         match self.scheme {
             Scheme::Loop => {
                 let (v, _, f) = loop_level_size(&self.refined, level);
-                (v, f)
+                (v, f - 4 * quarters * holes.len() as u64)
             }
             Scheme::DooSabin => match self.doo_sabin_first {
                 Some(first) => {
@@ -216,7 +221,7 @@ impl CpuMesh {
             },
             _ => {
                 let (v, _, f) = catmark_level_size(&self.refined, level);
-                (v, 2 * f)
+                (v, 2 * (f - quarters * hole_sides().sum::<u64>()))
             }
         }
     }

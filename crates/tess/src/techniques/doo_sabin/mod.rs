@@ -176,12 +176,7 @@ impl DooSabin {
                        buffer_device_address)",
             });
         }
-        if let Some(&face) = mesh.holes.first() {
-            return Err(TessError::Mesh {
-                name: options.name.clone(),
-                source: Box::new(topology::TopologyError::DooSabinHole { face }),
-            });
-        }
+        // Refuses holes and sharpness tags by name (Doo-Sabin has neither).
         let base = Level::from_mesh(mesh, Scheme::DooSabin).map_err(|e| TessError::Mesh {
             name: options.name.clone(),
             source: e.into(),
