@@ -450,3 +450,40 @@ fn a_prim_name_that_is_no_identifier_is_refused() {
     let unicode = quad_with("").replace("\"Quad\"", "\"Würfel\"");
     assert_eq!(read_text("unicode.usda", &unicode).num_faces(), 1);
 }
+
+/// `write_usda` writes what `load_usd` reads: spot's control mesh (triangles, quads,
+/// pentagons) comes back with the same faces, its positions rounded to `f32` as USD stores
+/// them, and the scheme named.
+#[test]
+fn written_usda_reads_back() {
+    let spot = topology::load_obj(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/spot_control_mesh.obj"),
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("spot.usda");
+    let mut text = Vec::new();
+    topology::mesh::usda::write_usda(
+        &mut text,
+        &spot.positions,
+        &spot.face_offsets,
+        &spot.face_vertices,
+        "catmullClark",
+    )
+    .unwrap();
+    std::fs::write(&path, text).unwrap();
+    let back = load_usd(&path).unwrap();
+    assert_eq!(back.face_offsets, spot.face_offsets);
+    assert_eq!(back.face_vertices, spot.face_vertices);
+    let rounded: Vec<[f64; 3]> = spot
+        .positions
+        .iter()
+        .map(|p| p.map(|x| x as f32 as f64))
+        .collect();
+    assert_eq!(back.positions, rounded);
+    assert_eq!(back.scheme, Some(Scheme::CatmullClark));
+    assert!(
+        back.positions != spot.positions,
+        "some coordinate needs rounding"
+    );
+}

@@ -196,6 +196,8 @@ pub struct SubdivideArgs {
     /// vertex's domain square, a boundary vertex's on the boundary's quadratic B-spline).
     #[arg(long)]
     pub limit: bool,
+    /// Output: OBJ, or a USD text layer when named .usda (one Mesh prim: the level's points,
+    /// faces and subdivision scheme).
     #[arg(short, long)]
     pub output: PathBuf,
 }

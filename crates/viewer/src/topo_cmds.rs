@@ -68,6 +68,24 @@ fn read_mesh(path: Option<&std::path::Path>) -> Result<(ControlMesh, ObjLines)> 
     }
 }
 
+/// For an output named `.usda`, the `subdivisionScheme` it is written with (`scheme`'s; none
+/// for Doo-Sabin, which USD does not name); `None` for OBJ output.
+fn usda_token(output: &std::path::Path, scheme: topology::Scheme) -> Result<Option<&'static str>> {
+    let usda = output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("usda"));
+    if !usda {
+        return Ok(None);
+    }
+    match topology::mesh::usda::scheme_token(scheme) {
+        Some(token) => Ok(Some(token)),
+        None => bail!(
+            "-o {}: USD has no {scheme} subdivision scheme; write an .obj",
+            output.display()
+        ),
+    }
+}
+
 pub fn subdivide(a: SubdivideArgs) -> Result<()> {
     if a.level > 6 {
         bail!(
@@ -75,6 +93,8 @@ pub fn subdivide(a: SubdivideArgs) -> Result<()> {
             a.level
         );
     }
+    // Before any work: an output USD cannot name every scheme.
+    let usda = usda_token(&a.output, a.scheme)?;
     let name = crate::commands::mesh_name(a.input.as_deref());
     let (mesh, lines) = read_mesh(a.input.as_deref())?;
     // A non-manifold mesh is refined through its manifold split, as every subdivision technique
@@ -101,9 +121,14 @@ pub fn subdivide(a: SubdivideArgs) -> Result<()> {
         );
     }
     let (offsets, verts) = level.topology.face_tables();
-    tess::output::write_file(&a.output, |w| {
-        topology::mesh::obj::write_obj(w, &positions, offsets, verts)
-    })?;
+    match usda {
+        Some(token) => tess::output::write_file(&a.output, |w| {
+            topology::mesh::usda::write_usda(w, &positions, offsets, verts, token)
+        })?,
+        None => tess::output::write_file(&a.output, |w| {
+            topology::mesh::obj::write_obj(w, &positions, offsets, verts)
+        })?,
+    }
     out!(
         "wrote {}: {} vertices, {} faces (level {}, {}{})",
         a.output.display(),

@@ -92,6 +92,38 @@ fn export_bench_and_subdivide_take_usd() {
     let refined = std::fs::read_to_string(out).unwrap();
     let faces = refined.lines().filter(|l| l.starts_with("f ")).count();
     assert_eq!(faces, 24, "six quads split into four each");
+
+    // The same level as USD text: read back by render as the OBJ is; Doo-Sabin has no USD
+    // scheme and is refused before any work.
+    let usda = tmp("out.usda");
+    let usda = usda.to_str().unwrap();
+    let args = |scheme| {
+        [
+            "subdivide",
+            &cube,
+            "--scheme",
+            scheme,
+            "--level",
+            "1",
+            "-o",
+            usda,
+        ]
+    };
+    let o = succeeds(&args("catmull-clark"));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("24 faces"));
+    let png = tmp("usda.png");
+    let o = succeeds(&[
+        "render",
+        usda,
+        "--size",
+        "32x24",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains(", adaptive,"));
+    let o = tessera(&args("doo-sabin"), &[]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("USD has no doo-sabin subdivision scheme"));
 }
 
 #[test]

@@ -9,6 +9,7 @@ pub mod manifold;
 pub mod obj;
 pub mod scalar_tags;
 pub mod usd;
+pub mod usda;
 pub mod weld;
 
 /// Sentinel for "no face" / "no edge" in adjacency tables.
