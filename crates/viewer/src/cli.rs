@@ -166,7 +166,8 @@ pub struct BenchArgs {
     /// Time loading instead of drawing: for each --mesh (e.g. a USD asset and the same asset
     /// as OBJ) and each --methods entry, parse, plan and the first frame at the first
     /// --segments value, in rounds (--warmup untimed, --frames timed); medians, and each
-    /// total over the same method's first mesh's. --markdown writes the table.
+    /// total over its OBJ twin's (the --mesh of the same name ending .obj). --markdown writes
+    /// the table.
     #[arg(long, conflicts_with = "figure7")]
     pub load_to_first_frame: bool,
     /// Write the rows as CSV.

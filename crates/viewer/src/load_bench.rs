@@ -8,7 +8,8 @@
 //!   way, drawn offscreen and read back.
 //!
 //! Rounds visit every (method, mesh) pair in turn (`--warmup` untimed rounds, then `--frames`
-//! timed ones), so a pair's medians and its ratio to the first mesh's are within one run.
+//! timed ones), so the medians and a file's ratio to its OBJ twin (the `.obj` of the same
+//! name among the `--mesh` files) are within one run.
 use crate::cli::BenchArgs;
 use crate::commands::{check_drawable, check_validation, load_mesh_with_lines, open_device};
 use anyhow::{bail, Context as _, Result};
@@ -99,23 +100,33 @@ fn measure(device: &Device, a: &BenchArgs, methods: &[&'static TechniqueInfo]) -
         .collect())
 }
 
-/// The rows in markdown, each total also over the same method's first mesh's.
+/// The row of the same method whose file is `row`'s OBJ twin: the same path with the
+/// extension `.obj` (the row itself for an OBJ).
+fn obj_twin<'a>(rows: &'a [Row], row: &Row) -> Option<&'a Row> {
+    let twin = Path::new(&row.file).with_extension("obj");
+    rows.iter()
+        .find(|r| r.method == row.method && Path::new(&r.file) == twin)
+}
+
+/// The rows in markdown, each total also over its OBJ twin's ("-" without one).
 fn markdown(rows: &[Row], device: &str, settings: &str) -> String {
     let mut out = format!(
         "Device: {device}. {settings}\n\n| method | file | parse ms | plan ms | first frame ms | \
-         total ms | total / first file's |\n|-|-|---:|---:|---:|---:|---:|\n"
+         total ms | total / OBJ twin's |\n|-|-|---:|---:|---:|---:|---:|\n"
     );
     for r in rows {
-        let first = rows.iter().find(|f| f.method == r.method).expect("own row");
+        let ratio = obj_twin(rows, r).map_or_else(
+            || "-".to_string(),
+            |t| format!("{:.3}", r.total_ms() / t.total_ms()),
+        );
         out.push_str(&format!(
-            "| {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.3} |\n",
+            "| {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {ratio} |\n",
             r.method,
             r.file,
             r.parse_ms,
             r.plan_ms,
             r.frame_ms,
             r.total_ms(),
-            r.total_ms() / first.total_ms()
         ));
     }
     out

@@ -151,12 +151,17 @@ fn a_bad_usd_file_is_refused_by_file_prim_and_attribute() {
 }
 
 /// `bench --load-to-first-frame`: a USD file and its OBJ twin, each parsed, planned and drawn
-/// once per round; the table has one row per (method, file) with positive phase times, the
-/// first file's ratio 1, and --markdown writes it. Without --mesh it says what it needs.
+/// once per round; the table has one row per (method, file) with positive phase times, each
+/// total over its OBJ twin's (1 for the OBJ itself, "-" for a file without a twin), and
+/// --markdown writes it. Without --mesh it says what it needs.
 #[test]
 fn bench_times_load_to_first_frame() {
     let md = tmp("load.md");
-    let (usd, obj) = (data("cube_tags.usda"), data("cube_tags.obj"));
+    let (usd, obj, lone) = (
+        data("cube_tags.usda"),
+        data("cube_tags.obj"),
+        data("two_meshes.usda"),
+    );
     let o = succeeds(&[
         "bench",
         "--load-to-first-frame",
@@ -164,6 +169,8 @@ fn bench_times_load_to_first_frame() {
         &usd,
         "--mesh",
         &obj,
+        "--mesh",
+        &lone,
         "--methods",
         "flat,adaptive",
         "--segments",
@@ -184,15 +191,23 @@ fn bench_times_load_to_first_frame() {
         .filter(|l| l.starts_with("| flat") || l.starts_with("| adaptive"))
         .map(|l| l.trim_matches('|').split('|').map(str::trim).collect())
         .collect();
-    assert_eq!(rows.len(), 4, "{table}");
-    for (row, file) in rows.iter().zip([&usd, &obj, &usd, &obj]) {
+    assert_eq!(rows.len(), 6, "{table}");
+    for (row, file) in rows.iter().zip([&usd, &obj, &lone, &usd, &obj, &lone]) {
         assert_eq!(row[1], file.as_str(), "{table}");
         for ms in &row[2..6] {
             assert!(ms.parse::<f64>().unwrap() > 0.0, "{table}");
         }
     }
-    assert_eq!(rows[0][6], "1.000");
-    assert_eq!(rows[2][6], "1.000");
+    for method in rows.chunks(3) {
+        let total = |r: &Vec<&str>| r[5].parse::<f64>().unwrap();
+        // The ratio of the unrounded totals; the table's totals are rounded to 0.1 ms.
+        let (a, b) = (total(&method[0]), total(&method[1]));
+        let ratio: f64 = method[0][6].parse().unwrap();
+        let slack = ratio * (0.05 / a + 0.05 / b) + 1e-3;
+        assert!((ratio - a / b).abs() <= slack, "{table}");
+        assert_eq!(method[1][6], "1.000");
+        assert_eq!(method[2][6], "-");
+    }
 
     let o = tessera(&["bench", "--load-to-first-frame"], &[]);
     assert_eq!(o.status.code(), Some(1));
