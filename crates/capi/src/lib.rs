@@ -1370,6 +1370,7 @@ unsafe fn read_mesh(d: &TesseraMeshDesc) -> Result<(topology::ControlMesh, Strin
         face_offsets,
         face_vertices: indices.to_vec(),
         uvs,
+        uv_indices: None,
         normals: None,
         creases,
         corners,
