@@ -7,11 +7,13 @@ mod common;
 
 use common::Gpu;
 use tessera::tess::capture::{CapturedSoup, Capturer, FacePoint, Winding};
+use tessera::tess::surface::SurfaceMaps;
 use tessera::tess::techniques::adaptive;
-use tessera::tess::techniques::planned_patches::{PlanBuild, PlannedPatches};
+use tessera::tess::techniques::planned_patches::{self, PlanBuild, PlannedPatches};
 use tessera::tess::{Context, FrameParams, Technique};
 use tessera::topology::limit::eval::LimitScheme;
 use tessera::topology::limit::face_domain::LimitEvaluator;
+use tessera::topology::patches::adaptive::single_pass::SinglePassPatch;
 use tessera::topology::rules::options::FVarLinearInterpolation as Mode;
 use tessera::topology::ControlMesh;
 use tessera::vk_core::vk;
@@ -272,7 +274,8 @@ fn seams_stay_seams_in_every_mode() {
 
 /// Displacement reads the TES's own texture coordinate (glsl/adaptive/fvar.glsl): on a flat
 /// grid every captured point rises by the procedural height at it, which the host's
-/// evaluation of the same patches (`PlannedPatches::texcoord_at`) predicts.
+/// evaluation of the same patches (`PlannedPatches::texcoord_at`) predicts; for adaptive and
+/// for the single-pass gregory and acc.
 #[test]
 fn the_shaders_texture_coordinates_are_the_hosts() {
     let gpu = Gpu::new();
@@ -283,9 +286,30 @@ fn the_shaders_texture_coordinates_are_the_hosts() {
             let w = std::f64::consts::TAU * 8.0;
             0.5 + 0.25 * ((w * t[0]).sin() + (w * t[1]).sin())
         };
-        for mode in [Mode::None, Mode::CornersPlus1, Mode::All] {
+        let kinds = ["adaptive", "gregory", "acc"];
+        for (mode, kind) in [Mode::None, Mode::CornersPlus1, Mode::All]
+            .into_iter()
+            .flat_map(|m| kinds.map(|k| (m, k)))
+        {
             let mesh = curved_grid(6, mode);
-            let mut surf = surface(&mut ctx, &mesh, mode.name());
+            let mut surf = match kind {
+                "adaptive" => surface(&mut ctx, &mesh, mode.name()),
+                _ => planned_patches::single_pass(
+                    &mut ctx,
+                    &mesh,
+                    if kind == "gregory" {
+                        SinglePassPatch::Gregory
+                    } else {
+                        SinglePassPatch::Acc1
+                    },
+                    1.0,
+                    true,
+                    mode.name(),
+                    &SurfaceMaps::default(),
+                )
+                .expect("single-pass surface"),
+            };
+            assert_eq!(surf.fvar.is_some(), mode != Mode::All, "{kind} {mode}");
             let params = FrameParams {
                 displace: 1.0,
                 ..FrameParams::uniform(4.0)
@@ -306,8 +330,8 @@ fn the_shaders_texture_coordinates_are_the_hosts() {
                 let want = height(t);
                 worst = worst.max((f64::from(r.position[2]).abs() - want).abs());
             }
-            println!("{mode}: displaced heights within {worst:.2e} of the host's");
-            assert!(worst < 1e-3, "{mode}: {worst:e}");
+            println!("{kind} {mode}: displaced heights within {worst:.2e} of the host's");
+            assert!(worst < 1e-3, "{kind} {mode}: {worst:e}");
         }
     }
 }
