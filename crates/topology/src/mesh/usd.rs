@@ -38,7 +38,8 @@
 //! Several Mesh prims merge into one control mesh: their points are appended in traversal
 //! order and each prim's vertex and face indices (faces, tags, holes) are offset by the points
 //! and faces before it. They must share the scheme and options (else
-//! [`UsdProblem::Mixed`]). [`read_usd`] also returns where each prim's points and faces start.
+//! [`UsdProblem::Mixed`]), but for `faceVaryingLinearInterpolation`: the first prim's applies
+//! to the merged mesh, with a warning naming a prim that differs. [`read_usd`] also returns where each prim's points and faces start.
 //!
 //! What is refused, with [`TopologyError::Usd`] naming the file, the prim's path and the
 //! attribute: a file the reader refuses, an unknown token, counts that do not add up to the
@@ -274,12 +275,27 @@ impl Merge {
                     format!("{:?}", self.mesh.scheme),
                 ));
             }
-            if p.options != self.mesh.options {
+            let fvar = self.mesh.options.fvar_interpolation;
+            let same_fvar = SubdivOptions {
+                fvar_interpolation: fvar,
+                ..p.options
+            };
+            if same_fvar != self.mesh.options {
                 return Err(mixed(
-                    "interpolateBoundary/triangleSubdivisionRule/faceVaryingLinearInterpolation",
+                    "interpolateBoundary/triangleSubdivisionRule",
                     format!("{:?}", p.options),
                     format!("{:?}", self.mesh.options),
                 ));
+            }
+            if p.options.fvar_interpolation != fvar {
+                log::warn!(
+                    "{file}: {prim}: faceVaryingLinearInterpolation {} differs from {}'s {}: \
+                     the merged mesh's texture coordinates use {}",
+                    p.options.fvar_interpolation,
+                    first.path,
+                    fvar,
+                    fvar
+                );
             }
         } else {
             self.mesh.face_offsets.push(0);
