@@ -98,7 +98,7 @@ pub struct ControlMesh {
     pub uvs: Option<Vec<[f64; 2]>>,
     /// Per face corner, the index of its texture coordinate as the file numbers them: two
     /// corners at one vertex share a face-varying value when their indices are equal. `None`:
-    /// they share it when their `uvs` are bit-equal.
+    /// they share it when their `uvs` are bit-equal. Ignored without `uvs`.
     pub uv_indices: Option<Vec<u32>>,
     pub normals: Option<Vec<[f64; 3]>>,
     pub creases: Vec<EdgeCrease>,
@@ -610,12 +610,13 @@ pub(crate) fn check_faces(mesh: &ControlMesh, distinct_corners: bool) -> Result<
             });
         }
     }
-    if let Some(ix) = &mesh.uv_indices {
-        if ix.len() != corners || mesh.uvs.is_none() {
+    // Without uvs the indices number nothing and are ignored.
+    if let (Some(ix), Some(_)) = (&mesh.uv_indices, &mesh.uvs) {
+        if ix.len() != corners {
             return Err(TopologyError::AttributeLength {
                 attribute: "uv_indices",
                 len: ix.len(),
-                expected: if mesh.uvs.is_some() { corners } else { 0 },
+                expected: corners,
             });
         }
     }

@@ -91,10 +91,10 @@ struct Span {
     semi_sharp: f32,
 }
 
-/// Per corner, its value's key: its uv index when the mesh has them, else the number of its
-/// value's bits among the distinct ones.
+/// Per corner, its value's key: its uv index when the mesh has one per corner, else the
+/// number of its value's bits among the distinct ones.
 fn corner_keys(mesh: &ControlMesh, uvs: &[[f64; 2]]) -> Vec<u64> {
-    if let Some(ix) = &mesh.uv_indices {
+    if let Some(ix) = mesh.uv_indices.as_ref().filter(|ix| ix.len() == uvs.len()) {
         return ix.iter().map(|&i| i as u64).collect();
     }
     let mut ids: HashMap<[u64; 2], u64> = HashMap::new();

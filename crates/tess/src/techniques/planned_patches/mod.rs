@@ -706,15 +706,20 @@ impl PlannedPatches {
         let pi = *self.gpu.order.get(patch as usize)?;
         let p = self.plan.patches.get(pi as usize)?;
         let [s, t] = topology::patches::texcoord::patch_parameter(p, u, v, reparam);
-        if let Some(f) = &self.fvar {
-            let root = f.root_of(p);
+        // As `layout::GpuPlan::surfaces` and the TES: a patch without a root keeps its
+        // bilinear corners; a descent that finds no leaf gives the parameter itself.
+        let root = self
+            .fvar
+            .as_ref()
+            .map_or(topology::patches::fvar::FVAR_EMPTY, |f| f.root_of(p));
+        if let (Some(f), false) = (&self.fvar, root == topology::patches::fvar::FVAR_EMPTY) {
             let param = if p.kind == PatchKind::GregoryTriangle {
                 [s, t]
             } else {
                 let [u0, v0] = p.origin;
                 [u0 + p.size * s, v0 + p.size * t]
             };
-            return f.texcoord(root, param);
+            return Some(f.texcoord(root, param).unwrap_or(param));
         }
         let corners = topology::patches::texcoord::patch_corners(&self.mesh, p)?;
         Some(topology::patches::texcoord::bilinear(&corners, s, t))
