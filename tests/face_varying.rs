@@ -274,8 +274,9 @@ fn seams_stay_seams_in_every_mode() {
 
 /// Displacement reads the TES's own texture coordinate (glsl/adaptive/fvar.glsl): on a flat
 /// grid every captured point rises by the procedural height at it, which the host's
-/// evaluation of the same patches (`PlannedPatches::texcoord_at`) predicts; for adaptive and
-/// for the single-pass gregory and acc.
+/// evaluation of the same patches (`PlannedPatches::texcoord_at`) predicts; for adaptive, for
+/// the single-pass gregory and acc, and for gregory on the grid's triangles (Gregory-triangle
+/// leaves of the layout).
 #[test]
 fn the_shaders_texture_coordinates_are_the_hosts() {
     let gpu = Gpu::new();
@@ -286,21 +287,24 @@ fn the_shaders_texture_coordinates_are_the_hosts() {
             let w = std::f64::consts::TAU * 8.0;
             0.5 + 0.25 * ((w * t[0]).sin() + (w * t[1]).sin())
         };
-        let kinds = ["adaptive", "gregory", "acc"];
+        let kinds = ["adaptive", "gregory", "acc", "gregory triangles"];
         for (mode, kind) in [Mode::None, Mode::CornersPlus1, Mode::All]
             .into_iter()
             .flat_map(|m| kinds.map(|k| (m, k)))
         {
-            let mesh = curved_grid(6, mode);
+            let mut mesh = curved_grid(6, mode);
+            if kind == "gregory triangles" {
+                mesh = mesh.triangulated().0;
+            }
             let mut surf = match kind {
                 "adaptive" => surface(&mut ctx, &mesh, mode.name()),
                 _ => planned_patches::single_pass(
                     &mut ctx,
                     &mesh,
-                    if kind == "gregory" {
-                        SinglePassPatch::Gregory
-                    } else {
+                    if kind == "acc" {
                         SinglePassPatch::Acc1
+                    } else {
+                        SinglePassPatch::Gregory
                     },
                     1.0,
                     true,
@@ -310,6 +314,9 @@ fn the_shaders_texture_coordinates_are_the_hosts() {
                 .expect("single-pass surface"),
             };
             assert_eq!(surf.fvar.is_some(), mode != Mode::All, "{kind} {mode}");
+            if let (Some(f), "gregory triangles") = (&surf.fvar, kind) {
+                assert!(f.patches.iter().all(|p| p.is_triangle()), "triangle leaves");
+            }
             let params = FrameParams {
                 displace: 1.0,
                 ..FrameParams::uniform(4.0)
