@@ -244,7 +244,7 @@ fn seams_stay_seams_in_every_mode() {
             let mut mesh = base.clone();
             mesh.options.fvar_interpolation = mode;
             let mut surf = surface(&mut ctx, &mesh, mode.name());
-            let (_, e) = export(&mut ctx, &capturer, &mut surf, mode.name());
+            let (_, e) = export(&mut ctx, &capturer, &mut surf, &format!("seams-{mode}"));
             let mut first: Vec<Option<[f64; 2]>> = vec![None; e.points.len()];
             let mut seam = vec![false; e.points.len()];
             for &(v, t) in &e.corners {
