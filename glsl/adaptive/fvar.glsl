@@ -29,26 +29,25 @@ vec2 fvar_blend(float a, float b, vec2 f, vec2 g) {
     return d < 1e-7 ? 0.5 * (f + g) : (a * f + b * g) / d;
 }
 
-// A 20-point Gregory patch (gregory.tese's point order) at (u, v): the point only.
+// A 20-point Gregory patch (gregory.tese's point order) at (u, v): the point only. The
+// Bezier net is summed in a loop that stays a loop, reading each point where it is used: no
+// local arrays (this runs in every surface-build TES, and lavapipe pays for its code size
+// even where no patch has face-varying coordinates).
 vec2 fvar_gregory(uint first, vec2 uv) {
-    vec2 c[20];
-    for (uint i = 0u; i < 20u; ++i) c[i] = fvar_point(first + i);
-    float u = uv.x, v = uv.y;
-    vec2 b[16];
-    b[0] = c[0];  b[1] = c[1];  b[2] = c[7];  b[3] = c[5];
-    b[7] = c[6];  b[11] = c[12]; b[15] = c[10];
-    b[14] = c[11]; b[13] = c[17]; b[12] = c[15];
-    b[8] = c[16]; b[4] = c[2];
-    b[5] = fvar_blend(u, v, c[3], c[4]);
-    b[6] = fvar_blend(1.0 - u, v, c[9], c[8]);
-    b[10] = fvar_blend(1.0 - v, 1.0 - u, c[14], c[13]);
-    b[9] = fvar_blend(1.0 - v, u, c[18], c[19]);
-    float s = 1.0 - u, t = 1.0 - v;
+    // Bezier point b[i + 4 j] -> Gregory point; the four interior ones are blended first.
+    const uint SLOT[16] = uint[16](0u, 1u, 7u, 5u, 2u, 0u, 0u, 6u, 16u, 0u, 0u, 12u, 15u, 17u, 11u, 10u);
+    float u = uv.x, v = uv.y, s = 1.0 - u, t = 1.0 - v;
+    vec2 b5 = fvar_blend(u, v, fvar_point(first + 3u), fvar_point(first + 4u));
+    vec2 b6 = fvar_blend(s, v, fvar_point(first + 9u), fvar_point(first + 8u));
+    vec2 b10 = fvar_blend(t, s, fvar_point(first + 14u), fvar_point(first + 13u));
+    vec2 b9 = fvar_blend(t, u, fvar_point(first + 18u), fvar_point(first + 19u));
     vec4 bu = vec4(s * s * s, 3.0 * u * s * s, 3.0 * u * u * s, u * u * u);
     vec4 bv = vec4(t * t * t, 3.0 * v * t * t, 3.0 * v * v * t, v * v * v);
     vec2 acc = vec2(0.0);
-    for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 4; ++i) acc += bu[i] * bv[j] * b[i + 4 * j];
+    [[dont_unroll]] for (uint k = 0u; k < 16u; ++k) {
+        vec2 b = k == 5u ? b5 : k == 6u ? b6 : k == 9u ? b9 : k == 10u ? b10 : fvar_point(first + SLOT[k]);
+        acc += bu[k & 3u] * bv[k >> 2u] * b;
+    }
     return acc;
 }
 
