@@ -87,6 +87,12 @@ typedef uint32_t TesseraEndCap;
 // The draw path a surface is built for (`TESSERA_PIPELINE_*`, the CLI's `--pipeline`).
 typedef uint32_t TesseraPipeline;
 
+// How texture coordinates are interpolated (`TESSERA_UV_INTERPOLATION_*`; adaptive, gregory,
+// acc): OpenSubdiv's face-varying linear-interpolation modes (docs/face-varying.md), or the
+// mesh's own (a file's `faceVaryingLinearInterpolation` or `t facevaryinginterpolateboundary`;
+// `all` for a `TesseraMeshDesc`, whose corners share a value where their uvs are bit-equal).
+typedef uint32_t TesseraUvInterpolation;
+
 // How a surface is built. [`tessera_surface_desc_default`] fills the defaults.
 typedef struct TesseraSurfaceDesc {
   TesseraTechnique technique;
@@ -122,6 +128,9 @@ typedef struct TesseraSurfaceDesc {
   uint32_t split_triangles;
   // `TESSERA_PIPELINE_*`: the draw path.
   TesseraPipeline pipeline;
+  // `TESSERA_UV_INTERPOLATION_*`: how texture coordinates are interpolated
+  // (`TESSERA_UV_INTERPOLATION_MESH`: the mesh's own mode).
+  TesseraUvInterpolation uv_interpolation;
 } TesseraSurfaceDesc;
 
 // How tessellation factors are chosen (`TESSERA_FACTORS_*`).
@@ -384,6 +393,21 @@ typedef struct TesseraHostDesc {
 #define TESSERA_END_CAP_GREGORY 0
 
 #define TESSERA_END_CAP_BILINEAR 1
+
+#define TESSERA_UV_INTERPOLATION_MESH 0
+
+#define TESSERA_UV_INTERPOLATION_NONE 1
+
+#define TESSERA_UV_INTERPOLATION_CORNERS_ONLY 2
+
+#define TESSERA_UV_INTERPOLATION_CORNERS_PLUS1 3
+
+#define TESSERA_UV_INTERPOLATION_CORNERS_PLUS2 4
+
+#define TESSERA_UV_INTERPOLATION_BOUNDARIES 5
+
+// Bilinear on each face.
+#define TESSERA_UV_INTERPOLATION_ALL 6
 
 // Lighting of the albedo (texture, patch colours or base colour).
 #define TESSERA_SHOW_SHADING 0

@@ -42,8 +42,9 @@ struct PatchSurface {
     vec2 uv[4];         // corners (0,0), (1,0), (1,1), (0,1)
     uint reparam_rows;  // 8 bits per corner: row of reparam_rows[] (0 = identity)
     uint tangent_valences; // ACC-1: 8 bits per corner, its valence (tangent patches); else 0
-    uint pad1;
-    uint pad2;
+    uint fvar_root;     // smooth texture coordinates: root entry in FVAR, uv[] then the (sub-)face
+                        // parameter; FVAR_EMPTY (fvar.glsl): uv[] are the texture coordinates
+    uint pad;
 };
 struct CurveOwner {
     uint patch_id;      // frame-wide patch id
@@ -58,6 +59,7 @@ layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Re
 layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer CurveOwnerArray { CurveOwner v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer CornerOwnerArray { uvec2 v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer ParamErrorArray { float v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer FVarArray { uint v[]; };
 
 // The arrays' device addresses (`tess::gpu::AdaptiveArrays`; each a uvec2, low word first).
 layout(std140, set = ADAPTIVE_SET, binding = ADAPTIVE_ARRAYS_BINDING) uniform AdaptiveArrays {
@@ -71,7 +73,8 @@ layout(std140, set = ADAPTIVE_SET, binding = ADAPTIVE_ARRAYS_BINDING) uniform Ad
     uvec2 corner_owners;   // uvec2(patch, corner) per canonical corner (global vertex - first_corner)
     uvec2 param_errors;    // the Eq. 1 error lattice per patch
     uint param_error_count; // its entries (0: not built)
-    uint pad;
+    uint fvar_count;       // words of the face-varying patches
+    uvec2 fvar;            // the face-varying patches (fvar.glsl)
 } arrays;
 #define VERTICES VertexArray(arrays.vertices).v
 #define PATCHES PatchArray(arrays.patches).v
@@ -82,6 +85,7 @@ layout(std140, set = ADAPTIVE_SET, binding = ADAPTIVE_ARRAYS_BINDING) uniform Ad
 #define CURVE_OWNERS CurveOwnerArray(arrays.curve_owners).v
 #define CORNER_OWNERS CornerOwnerArray(arrays.corner_owners).v
 #define PARAM_ERRORS ParamErrorArray(arrays.param_errors).v
+#define FVAR FVarArray(arrays.fvar).v
 layout(set = ADAPTIVE_SET, binding = ADAPTIVE_TEXTURE_BINDING) uniform sampler2D surface_texture;
 layout(set = ADAPTIVE_SET, binding = ADAPTIVE_HEIGHT_BINDING) uniform sampler2D height_map;
 

@@ -72,9 +72,15 @@ vec3 param_error_colour(float e) {
     return mix(ramp[k], ramp[k + 1u], t - float(k));
 }
 
-// The texture coordinate of a patch with surface record `sf` at texture parameter `st`.
+#include "fvar.glsl"
+
+// The texture coordinate of a patch with surface record `sf` at texture parameter `st`: the
+// corners' bilinear blend, which with face-varying patches is the (sub-)face parameter they
+// are looked up at (fvar.glsl).
 vec2 texcoord_at(PatchSurface sf, vec2 st) {
-    return mix(mix(sf.uv[0], sf.uv[1], st.x), mix(sf.uv[3], sf.uv[2], st.x), st.y);
+    vec2 blend = mix(mix(sf.uv[0], sf.uv[1], st.x), mix(sf.uv[3], sf.uv[2], st.x), st.y);
+    if (sf.fvar_root == FVAR_EMPTY) return blend;
+    return fvar_texcoord(sf.fvar_root, blend, blend);
 }
 
 // The texture coordinate patch `id` shows at its (u, v).

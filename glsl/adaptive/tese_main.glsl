@@ -76,13 +76,11 @@ void main() {
     // The surface build (Technique::surface_build): texture coordinates, displacement, owners'
     // normals, the parameter views, patch colours. The plain build leaves them out, a much
     // smaller TES with two varyings fewer.
-    // The reparameterized parameter once, for the texture coordinate and the shift view (a
-    // second call would be a second inlined copy).
+    // The reparameterized parameter, for the shift view (the texture coordinate is the loop's
+    // below).
     PatchSurface own_surface = SURFACES[tc_patch];
     bool show_shift = (adaptive.options & uint(ADAPTIVE_OPTION_SHOW_PARAM_SHIFT)) != 0u;
     vec2 st = (reparam_on() || show_shift) ? reparameterize(own_surface.reparam_rows, uv) : uv;
-    vec2 tex = texcoord_at(own_surface, reparam_on() ? st : uv);
-    out_texcoord = tex;
     // A boundary point is displaced by its curve's owner (normal and height), so both sides of
     // every edge move it identically; with ADAPTIVE_OPTION_CANONICAL_NORMALS (single-pass
     // methods) it is shaded in the owner's frame too. Each heavy function below has one call
@@ -97,24 +95,32 @@ void main() {
         canonical_owner(curve, s, oid, ouv);
         owner_frame(oid, ouv, on, odu, odv);
     }
+    // Shaded in this frame: the owner's with canonical normals, else the patch's own.
+    uint sid = owner_shading ? oid : tc_patch;
+    vec2 suv = owner_shading ? ouv : uv;
+    const float h = 1.0 / 1024.0;
+    vec2 lo = max(suv - vec2(h), vec2(0.0)), hi = min(suv + vec2(h), vec2(1.0));
+    // The patch's own texture coordinate and, displacing, five heights, in one loop that stays
+    // a loop (one inlined texture-coordinate look-up, the face-varying descent of fvar.glsl
+    // included: a second copy made lavapipe's textured frames 2x slower): the own coordinate,
+    // then where the point moves (its owner's on a boundary), then around the shading point for
+    // the displaced normal's slope.
+    uint ids[6] = uint[6](tc_patch, oid, sid, sid, sid, sid);
+    vec2 at[6] = vec2[6](uv, ouv, vec2(hi.x, suv.y), vec2(lo.x, suv.y), vec2(suv.x, hi.y), vec2(suv.x, lo.y));
+    float height[6];
+    vec2 tex = vec2(0.0);
+    int looks = displace ? 6 : 1;
+    [[dont_unroll]] for (int k = 0; k < looks; ++k) {
+        vec2 t = patch_texcoord(ids[k], at[k]);
+        if (k == 0) tex = t; else height[k] = surface_height(t);
+    }
+    out_texcoord = tex;
     if (displace) {
-        // Shaded in this frame: the owner's with canonical normals, else the patch's own.
-        uint sid = owner_shading ? oid : tc_patch;
-        vec2 suv = owner_shading ? ouv : uv;
         vec3 sn = owner_shading ? on : n, sdu = owner_shading ? odu : du, sdv = owner_shading ? odv : dv;
-        // Five heights in one loop that stays a loop (one inlined texture look-up): where the
-        // point moves (its owner's on a boundary), then around the shading point for the
-        // displaced normal's slope.
-        const float h = 1.0 / 1024.0;
-        vec2 lo = max(suv - vec2(h), vec2(0.0)), hi = min(suv + vec2(h), vec2(1.0));
-        uint ids[5] = uint[5](oid, sid, sid, sid, sid);
-        vec2 at[5] = vec2[5](ouv, vec2(hi.x, suv.y), vec2(lo.x, suv.y), vec2(suv.x, hi.y), vec2(suv.x, lo.y));
-        float height[5];
-        [[dont_unroll]] for (int k = 0; k < 5; ++k) height[k] = surface_height(patch_texcoord(ids[k], at[k]));
-        precise vec3 moved = pos + (canonical ? on : n) * (adaptive.displace_scale * height[0]);
+        precise vec3 moved = pos + (canonical ? on : n) * (adaptive.displace_scale * height[1]);
         pos = moved;
         // Shade the displaced surface, not the base one (positions above are already final).
-        n = displaced_normal(sn, sdu, sdv, (height[1] - height[2]) / (hi.x - lo.x), (height[3] - height[4]) / (hi.y - lo.y));
+        n = displaced_normal(sn, sdu, sdv, (height[2] - height[3]) / (hi.x - lo.x), (height[4] - height[5]) / (hi.y - lo.y));
     } else if (owner_shading) {
         n = on;
     }

@@ -93,7 +93,8 @@ fn capture(
     let edges = welded.open_edges();
     let classes = classify_open_edges(&soup, &welded, &edges, &map, &s.mesh);
     if let Some(path) = path {
-        welded.write_obj(path, &map, Winding::Reversed)?;
+        let texcoords = welded.corner_texcoords(|p, d| technique.texcoord(p, d, params.reparam));
+        welded.write_obj(path, &map, texcoords.as_deref(), Winding::Reversed)?;
     }
     Ok(TesseraCaptureReport {
         triangles: soup.triangle_count() as u64,

@@ -158,6 +158,20 @@ pub type TesseraEndCap = u32;
 pub const TESSERA_END_CAP_GREGORY: TesseraEndCap = 0;
 pub const TESSERA_END_CAP_BILINEAR: TesseraEndCap = 1;
 
+/// How texture coordinates are interpolated (`TESSERA_UV_INTERPOLATION_*`; adaptive, gregory,
+/// acc): OpenSubdiv's face-varying linear-interpolation modes (docs/face-varying.md), or the
+/// mesh's own (a file's `faceVaryingLinearInterpolation` or `t facevaryinginterpolateboundary`;
+/// `all` for a `TesseraMeshDesc`, whose corners share a value where their uvs are bit-equal).
+pub type TesseraUvInterpolation = u32;
+pub const TESSERA_UV_INTERPOLATION_MESH: TesseraUvInterpolation = 0;
+pub const TESSERA_UV_INTERPOLATION_NONE: TesseraUvInterpolation = 1;
+pub const TESSERA_UV_INTERPOLATION_CORNERS_ONLY: TesseraUvInterpolation = 2;
+pub const TESSERA_UV_INTERPOLATION_CORNERS_PLUS1: TesseraUvInterpolation = 3;
+pub const TESSERA_UV_INTERPOLATION_CORNERS_PLUS2: TesseraUvInterpolation = 4;
+pub const TESSERA_UV_INTERPOLATION_BOUNDARIES: TesseraUvInterpolation = 5;
+/// Bilinear on each face.
+pub const TESSERA_UV_INTERPOLATION_ALL: TesseraUvInterpolation = 6;
+
 /// What a surface is coloured by (`TESSERA_SHOW_*`; adaptive, gregory, acc).
 pub type TesseraShow = u32;
 /// Lighting of the albedo (texture, patch colours or base colour).
@@ -322,6 +336,9 @@ pub struct TesseraSurfaceDesc {
     pub split_triangles: u32,
     /// `TESSERA_PIPELINE_*`: the draw path.
     pub pipeline: TesseraPipeline,
+    /// `TESSERA_UV_INTERPOLATION_*`: how texture coordinates are interpolated
+    /// (`TESSERA_UV_INTERPOLATION_MESH`: the mesh's own mode).
+    pub uv_interpolation: TesseraUvInterpolation,
 }
 
 /// What one frame shows. [`tessera_frame_desc_default`] fills the defaults.
@@ -649,6 +666,7 @@ pub unsafe extern "C" fn tessera_surface_desc_default(
             param_error: 0,
             split_triangles: 0,
             pipeline: TESSERA_PIPELINE_AUTO,
+            uv_interpolation: TESSERA_UV_INTERPOLATION_MESH,
         };
         // SAFETY: the caller's contract.
         unsafe { out_write(desc, d, "desc") }
@@ -1152,6 +1170,21 @@ unsafe fn create_surface(
     d: &TesseraSurfaceDesc,
     name: String,
 ) -> Result<u64> {
+    let mut mesh = mesh;
+    use topology::rules::options::FVarLinearInterpolation as Fvar;
+    match d.uv_interpolation {
+        TESSERA_UV_INTERPOLATION_MESH => {}
+        v @ TESSERA_UV_INTERPOLATION_NONE..=TESSERA_UV_INTERPOLATION_ALL => {
+            mesh.options.fvar_interpolation = Fvar::ALL_MODES[(v - 1) as usize];
+        }
+        v => {
+            return Err(invalid(
+                "uv_interpolation",
+                v,
+                "a TESSERA_UV_INTERPOLATION_* value",
+            ))
+        }
+    }
     topology::mesh::check_positions(&mesh.positions)?;
     mesh.validate()?;
     mesh.apply_boundary_none();
@@ -1371,6 +1404,7 @@ unsafe fn read_mesh(d: &TesseraMeshDesc) -> Result<(topology::ControlMesh, Strin
         face_offsets,
         face_vertices: indices.to_vec(),
         uvs,
+        uv_indices: None,
         normals: None,
         creases,
         corners,

@@ -278,6 +278,18 @@ fn misuse_gets_codes_and_messages_never_undefined_behaviour() {
             TesseraStatus::InvalidArgument,
             "split_triangles 3",
         );
+        let mut uv_mode = surface_desc(TESSERA_TECHNIQUE_ADAPTIVE);
+        assert_eq!(uv_mode.uv_interpolation, TESSERA_UV_INTERPOLATION_MESH);
+        uv_mode.uv_interpolation = 7;
+        expect(
+            create_surface(ctx, &mesh_desc(&c), &uv_mode).0,
+            TesseraStatus::InvalidArgument,
+            "uv_interpolation 7",
+        );
+        uv_mode.uv_interpolation = TESSERA_UV_INTERPOLATION_NONE;
+        let (status, u) = create_surface(ctx, &mesh_desc(&c), &uv_mode);
+        assert_eq!(status, TesseraStatus::Ok, "{}", last_error(ctx));
+        expect(tessera_surface_destroy(ctx, u), TesseraStatus::Ok, "");
         let mut gregory_split = surface_desc(TESSERA_TECHNIQUE_GREGORY);
         gregory_split.split_triangles = 1;
         let (status, g) = create_surface(ctx, &mesh_desc(&c), &gregory_split);

@@ -712,6 +712,14 @@ pub trait Technique: Send {
     /// [`crate::capture::face_corner_uv`]'s convention; `None` for an id it never drew.
     fn face_point(&self, patch: u32, domain: [f32; 2]) -> Option<FacePoint>;
 
+    /// The texture coordinate the surface shows at a captured (patch id, domain coordinate),
+    /// as its shaders compute it, in `f64` on the host (`reparam`: with the texture
+    /// reparameterization, [`FrameParams::reparam`]); `None` for a technique that draws no
+    /// texture coordinates, a mesh without them, or an id it never drew.
+    fn texcoord(&self, _patch: u32, _domain: [f32; 2], _reparam: bool) -> Option<[f64; 2]> {
+        None
+    }
+
     /// Lines for reports (e.g. the memory of its tables).
     fn report_notes(&self) -> Vec<String> {
         Vec::new()

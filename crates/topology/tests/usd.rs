@@ -8,7 +8,9 @@ use openusd::usdz::ArchiveWriter;
 use std::path::{Path, PathBuf};
 use topology::error::UsdProblem;
 use topology::mesh::usd::{is_usd_path, load_usd, read_usd};
-use topology::rules::options::{BoundaryInterpolation, TriangleSubdivision};
+use topology::rules::options::{
+    BoundaryInterpolation, FVarLinearInterpolation, TriangleSubdivision,
+};
 use topology::{ControlMesh, Scheme, TopologyError};
 
 fn data(name: &str) -> PathBuf {
@@ -28,7 +30,39 @@ fn assert_twins(usd: &ControlMesh, obj: &ControlMesh) {
     let mut usd = usd.clone();
     usd.positions = obj.positions.clone();
     usd.scheme = None;
+    assert_eq!(
+        same_value_classes(&usd),
+        same_value_classes(obj),
+        "the texture layouts share values at the same corners"
+    );
+    usd.uv_indices = obj.uv_indices.clone();
     assert_eq!(&usd, obj);
+}
+
+/// Per corner, the first corner with its value number (its `uv_indices`, else its value's
+/// bits): the layout's topology whatever the numbers are (a primvar's indices, an OBJ's `vt`
+/// numbers).
+fn same_value_classes(mesh: &ControlMesh) -> Option<Vec<usize>> {
+    let uvs = mesh.uvs.as_ref()?;
+    let keys: Vec<u64> = match &mesh.uv_indices {
+        Some(ix) => ix.iter().map(|&i| u64::from(i)).collect(),
+        None => {
+            let mut ids = std::collections::HashMap::new();
+            uvs.iter()
+                .map(|uv| {
+                    let n = ids.len() as u64;
+                    *ids.entry(uv.map(f64::to_bits)).or_insert(n)
+                })
+                .collect()
+        }
+    };
+    let mut first = std::collections::HashMap::new();
+    Some(
+        keys.iter()
+            .enumerate()
+            .map(|(c, &k)| *first.entry(k).or_insert(c))
+            .collect(),
+    )
 }
 
 fn twins(stem: &str) -> (ControlMesh, ControlMesh) {
@@ -82,6 +116,7 @@ fn loop_triangles_with_vertex_uvs_and_per_edge_crease() {
     assert_eq!(s, vec![1.0, 2.0, 3.0, 4.0]);
     let read = read_usd(data("loop_octahedron.usda")).unwrap();
     assert_eq!(read.prims[0].face_varying_linear_interpolation, "all");
+    assert_eq!(usd.options.fvar_interpolation, FVarLinearInterpolation::All);
 }
 
 #[test]
@@ -97,6 +132,11 @@ fn left_handed_faces_are_reversed_with_their_uvs() {
     assert_eq!(
         read.prims[0].face_varying_linear_interpolation,
         "cornersPlus1"
+    );
+    assert_eq!(
+        usd.options.fvar_interpolation,
+        FVarLinearInterpolation::CornersPlus1,
+        "USD's default applies"
     );
 }
 

@@ -27,11 +27,19 @@ const DEFAULT_MESHES: [(&str, &str); 4] = [
     ),
 ];
 
-fn load_meshes(paths: &[std::path::PathBuf]) -> Result<Vec<BenchMesh>> {
+/// The bench's meshes, their texture coordinates' interpolation set to `uv_interpolation`
+/// (`--uv-interpolation`) when given, else the file's.
+fn load_meshes(
+    paths: &[std::path::PathBuf],
+    uv_interpolation: Option<topology::rules::options::FVarLinearInterpolation>,
+) -> Result<Vec<BenchMesh>> {
     let mut out = Vec::new();
     if paths.is_empty() {
         for (name, text) in DEFAULT_MESHES {
-            let mesh = topology::mesh::obj::parse_obj(text, &format!("{name}.obj (embedded)"))?;
+            let mut mesh = topology::mesh::obj::parse_obj(text, &format!("{name}.obj (embedded)"))?;
+            if let Some(mode) = uv_interpolation {
+                mesh.options.fvar_interpolation = mode;
+            }
             let prepared = crate::progress::during(format!("preparing {name}"), || {
                 BenchMesh::new(name, &mesh)
             });
@@ -39,7 +47,10 @@ fn load_meshes(paths: &[std::path::PathBuf]) -> Result<Vec<BenchMesh>> {
         }
     } else {
         for p in paths {
-            let (mesh, lines) = crate::commands::load_mesh_with_lines(Some(p))?;
+            let (mut mesh, lines) = crate::commands::load_mesh_with_lines(Some(p))?;
+            if let Some(mode) = uv_interpolation {
+                mesh.options.fvar_interpolation = mode;
+            }
             crate::commands::check_drawable(&mesh, &lines, &p.display().to_string(), true)?;
             let name = p
                 .file_stem()
@@ -252,7 +263,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
         crate::plot::format_of(p, "--plot")?;
     }
     let config = config(&a)?;
-    let meshes = load_meshes(&a.mesh)?;
+    let meshes = load_meshes(&a.mesh, a.uv_interpolation)?;
     // A texture or height map needs `vt` on every mesh the surface techniques draw (as
     // loaded: they take the mesh before fan triangulation); said before the device is opened.
     let takers = tess::techniques::names_with(|f| f.surface);

@@ -61,12 +61,17 @@ pub fn load_mesh_with_lines(
 
 /// The mesh of `path` (as [`load_mesh_with_lines`]) with its coincident vertices merged when
 /// `weld` asks for it (`--weld`: the distance, 0 for identical positions), reporting what was
-/// merged on stderr.
+/// merged on stderr, and its texture coordinates' interpolation set to `uv_interpolation`
+/// (`--uv-interpolation`) when given, else the file's.
 pub fn load_mesh_welded(
     path: Option<&std::path::Path>,
     weld: Option<f64>,
+    uv_interpolation: Option<topology::rules::options::FVarLinearInterpolation>,
 ) -> Result<(topology::ControlMesh, ObjLines)> {
-    let (mesh, lines) = load_mesh_with_lines(path)?;
+    let (mut mesh, lines) = load_mesh_with_lines(path)?;
+    if let Some(mode) = uv_interpolation {
+        mesh.options.fvar_interpolation = mode;
+    }
     let Some(tolerance) = weld else {
         return Ok((mesh, lines));
     };
@@ -269,7 +274,11 @@ pub fn check_validation(instance: &Instance) -> Result<()> {
 
 fn render(a: RenderArgs) -> Result<()> {
     let name = mesh_name(a.scene.mesh.as_deref());
-    let (mesh, lines) = load_mesh_welded(a.scene.mesh.as_deref(), a.scene.surface.weld)?;
+    let (mesh, lines) = load_mesh_welded(
+        a.scene.mesh.as_deref(),
+        a.scene.surface.weld,
+        a.scene.surface.uv_interpolation,
+    )?;
     check_drawable(&mesh, &lines, &name, true)?;
     let setup = scene_setup(&a.scene, &name, &mesh)?;
     // Before the device and any work.

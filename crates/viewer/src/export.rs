@@ -60,7 +60,11 @@ pub fn run(a: ExportArgs) -> Result<()> {
         phong_alpha: a.alpha,
         ..FrameParams::default()
     };
-    let (base, lines) = load_mesh_welded(a.input.as_deref(), a.surface.weld)?;
+    let (base, lines) = load_mesh_welded(
+        a.input.as_deref(),
+        a.surface.weld,
+        a.surface.uv_interpolation,
+    )?;
     check_drawable(&base, &lines, &mesh_name(a.input.as_deref()), false)?;
     let method = crate::technique::resolve_method(a.method, a.surface.scheme.as_deref(), &base)?;
     let mut setup = a
@@ -76,7 +80,14 @@ pub fn run(a: ExportArgs) -> Result<()> {
     let (instance, device) = open_device(&a.gpu, vec![], &[])?;
     // Everything that holds GPU objects (the technique maps patch ids to base faces) lives in
     // this closure, so the validation check below sees the device destroyed.
-    let result = (|| -> Result<(ExportReport, String, tess::WeldedMesh, FaceMap)> {
+    type Captured = (
+        ExportReport,
+        String,
+        tess::WeldedMesh,
+        FaceMap,
+        Option<Vec<[f64; 2]>>,
+    );
+    let result = (|| -> Result<Captured> {
         let mut ctx = Context::offscreen(&device)?;
         let capturer = Capturer::new(&ctx)
             .context("tessera export captures through VK_EXT_transform_feedback")?;
@@ -123,15 +134,18 @@ pub fn run(a: ExportArgs) -> Result<()> {
             .zip(&welded.domain)
             .filter_map(|(&p, &d)| Some(((p, d.map(f32::to_bits)), map(p, d)?)))
             .collect();
-        Ok((r, summary, welded, faces))
+        // Each corner's texture coordinate as the technique's shaders compute it (on the
+        // host, from the same tables); none where the technique draws none.
+        let texcoords = welded.corner_texcoords(|p, d| technique.texcoord(p, d, params.reparam));
+        Ok((r, summary, welded, faces, texcoords))
     })();
     drop(device);
     check_validation(&instance)?;
-    let (r, summary, welded, faces) = result?;
+    let (r, summary, welded, faces, texcoords) = result?;
     check_finite(&welded)?;
     let map = |patch: u32, domain: [f32; 2]| faces.get(&(patch, domain.map(f32::to_bits))).copied();
     // Every TES declares `ccw` in the upper-left domain: clockwise seen from outside.
-    welded.write_obj(&a.output, &map, Winding::Reversed)?;
+    welded.write_obj(&a.output, &map, texcoords.as_deref(), Winding::Reversed)?;
     out!(
         "captured: {} triangles, {} vertices ({})",
         r.triangles,

@@ -289,6 +289,13 @@ pub struct SurfaceArgs {
     /// Colour texture (PNG) shown at the mesh's `vt` coordinates (adaptive, gregory, acc).
     #[arg(long, value_name = "PNG")]
     pub texture: Option<std::path::PathBuf>,
+    /// How texture coordinates are interpolated (OpenSubdiv's face-varying linear
+    /// interpolation, USD's `faceVaryingLinearInterpolation`): none, cornersOnly,
+    /// cornersPlus1, cornersPlus2, boundaries or all (bilinear on each face). Default: the
+    /// file's (a USD mesh's attribute, cornersPlus1 when unauthored; an OBJ's `t
+    /// facevaryinginterpolateboundary` tag, else all). See docs/face-varying.md.
+    #[arg(long, value_name = "MODE")]
+    pub uv_interpolation: Option<topology::rules::options::FVarLinearInterpolation>,
     /// Displace along the normal by S times the height (the --height map's, else a procedural
     /// bump pattern), seamlessly: shared edges stay bit-identical. -1000 to 1000.
     #[arg(long, value_name = "S", allow_hyphen_values = true, value_parser = parse_displace)]

@@ -766,7 +766,11 @@ pub fn run(args: ViewArgs) -> Result<()> {
         crate::output::check_png_name(p, "--screenshot")?;
     }
     let name = mesh_name(args.scene.mesh.as_deref());
-    let (mesh, lines) = load_mesh_welded(args.scene.mesh.as_deref(), args.scene.surface.weld)?;
+    let (mesh, lines) = load_mesh_welded(
+        args.scene.mesh.as_deref(),
+        args.scene.surface.weld,
+        args.scene.surface.uv_interpolation,
+    )?;
     check_drawable(&mesh, &lines, &name, true)?;
     let setup = scene_setup(&args.scene, &name, &mesh)?;
     // winit's OS errors name a source file of winit itself: not for users.

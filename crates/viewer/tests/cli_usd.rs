@@ -126,6 +126,73 @@ fn export_bench_and_subdivide_take_usd() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("USD has no doo-sabin subdivision scheme"));
 }
 
+/// The file's face-varying mode (USD's default `cornersPlus1` for cube_tags.usda) shapes the
+/// exported `vt`; `--uv-interpolation all` gives the bilinear ones instead, `--uv-interpolation`
+/// with an unknown mode is refused by name, and `render` and `bench` take the option too.
+#[test]
+fn uv_interpolation_comes_from_the_file_or_the_command_line() {
+    let out = tmp("uv.obj");
+    let out = out.to_str().unwrap();
+    let cube = data("cube_tags.usda");
+    let vt = |extra: &[&str]| {
+        let mut args = vec!["export", cube.as_str(), "--segments", "2", "-o", out];
+        args.extend_from_slice(extra);
+        succeeds(&args);
+        let text = std::fs::read_to_string(out).unwrap();
+        assert!(text.contains("\nf 1/"), "faces name their vt");
+        text.lines()
+            .filter(|l| l.starts_with("vt "))
+            .map(str::to_owned)
+            .collect::<Vec<_>>()
+    };
+    let file_mode = vt(&[]);
+    assert!(!file_mode.is_empty(), "cube_tags has texture coordinates");
+    assert_eq!(file_mode, vt(&["--uv-interpolation", "cornersPlus1"]));
+    assert_ne!(
+        file_mode,
+        vt(&["--uv-interpolation", "all"]),
+        "smooth vs bilinear"
+    );
+    let o = tessera(
+        &["export", &cube, "--uv-interpolation", "smooth", "-o", out],
+        &[],
+    );
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("unknown face-varying interpolation 'smooth'"),
+        "{e}"
+    );
+    let png = tmp("uv.png");
+    succeeds(&[
+        "render",
+        &cube,
+        "--uv-interpolation",
+        "none",
+        "--size",
+        "64x48",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    succeeds(&[
+        "bench",
+        "--mesh",
+        &cube,
+        "--methods",
+        "adaptive",
+        "--segments",
+        "2",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--size",
+        "64x48",
+        "--uv-interpolation",
+        "boundaries",
+    ]);
+}
+
 #[test]
 fn a_bad_usd_file_is_refused_by_file_prim_and_attribute() {
     let bad = tmp("bad.usda");

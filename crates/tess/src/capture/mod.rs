@@ -39,9 +39,17 @@
 //! # p F U V        its base face F (0-based, in the base OBJ's face order) and (U, V) in that
 //!                  face's domain (first corner welded into it; a vertex on a shared edge has
 //!                  one such line, for one of its faces)
+//! vt S T           with texture coordinates ([`WeldedMesh::corner_texcoords`]): one per
+//!                  distinct (by bits) coordinate of the triangle corners, after every vertex
 //! f A//A B//B C//C  one per captured triangle, 1-based, zero-area ones included; corners in
-//!                  captured order, or reversed with [`Winding::Reversed`]
+//!                  captured order, or reversed with [`Winding::Reversed`]; `f A/TA/A ...` with
+//!                  texture coordinates
 //! ```
+//!
+//! A corner's texture coordinate is the one its own captured (patch id, domain coordinate)
+//! shows ([`crate::Technique::texcoord`]: computed on the host from the technique's tables, as
+//! its shaders compute it, not read back from the GPU), so a vertex on a `vt` seam has one per
+//! side.
 //!
 //! Winding: the triangle/quad TESs declare `ccw`, but with Vulkan's upper-left domain origin
 //! their triangles come out clockwise seen from the side the base face faces (the captured cube

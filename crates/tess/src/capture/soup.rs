@@ -33,6 +33,8 @@ impl CapturedSoup {
         let mut index: HashMap<[u32; 3], u32> = HashMap::with_capacity(self.records.len() / 4);
         let mut out = WeldedMesh::default();
         let mut corner_vertex = Vec::with_capacity(self.records.len());
+        out.corner_patch = self.records.iter().map(|r| r.patch).collect();
+        out.corner_domain = self.records.iter().map(|r| r.domain).collect();
         for r in &self.records {
             let key = r.position.map(f32::to_bits);
             let id = *index.entry(key).or_insert_with(|| {
@@ -63,6 +65,9 @@ pub struct WeldedMesh {
     pub domain: Vec<[f32; 2]>,
     pub flags: Vec<u32>,
     pub triangles: Vec<[u32; 3]>,
+    /// Per triangle corner (`3t + i`), its own captured patch id and domain coordinate.
+    pub corner_patch: Vec<u32>,
+    pub corner_domain: Vec<[f32; 2]>,
 }
 
 /// An edge used by exactly one triangle.
@@ -116,10 +121,40 @@ impl WeldedMesh {
         report
     }
 
-    /// Writes the mesh as OBJ (format in the module doc); `map` names each vertex's base face.
+    /// Per triangle corner, the texture coordinate `texcoord` gives its captured (patch id,
+    /// domain coordinate) ([`crate::Technique::texcoord`]); `None` if any corner has none.
+    pub fn corner_texcoords(
+        &self,
+        texcoord: impl Fn(u32, [f32; 2]) -> Option<[f64; 2]>,
+    ) -> Option<Vec<[f64; 2]>> {
+        self.corner_patch
+            .iter()
+            .zip(&self.corner_domain)
+            .map(|(&p, &d)| texcoord(p, d))
+            .collect()
+    }
+
+    /// Writes the mesh as OBJ (format in the module doc); `map` names each vertex's base face;
+    /// `texcoords`, one per triangle corner ([`Self::corner_texcoords`]), add `vt` lines.
     /// Every vertex is mapped before the file is touched; the file is written whole or not at
     /// all ([`crate::output::write_file`]).
-    pub fn write_obj(&self, path: &Path, map: &PatchToFace<'_>, winding: Winding) -> Result<()> {
+    pub fn write_obj(
+        &self,
+        path: &Path,
+        map: &PatchToFace<'_>,
+        texcoords: Option<&[[f64; 2]]>,
+        winding: Winding,
+    ) -> Result<()> {
+        if let Some(t) = texcoords.filter(|t| t.len() != 3 * self.triangles.len()) {
+            return Err(TessError::Io {
+                path: path.display().to_string(),
+                source: std::io::Error::other(format!(
+                    "{} texture coordinates for {} triangle corners",
+                    t.len(),
+                    3 * self.triangles.len()
+                )),
+            });
+        }
         for (vertex, (&patch, &domain)) in self.patch.iter().zip(&self.domain).enumerate() {
             if map(patch, domain).is_none() {
                 return Err(TessError::UnmappedPatch {
@@ -130,12 +165,13 @@ impl WeldedMesh {
             }
         }
         crate::output::write_file(path, |w| {
-            self.write_obj_to(w, map, winding).map_err(|e| match e {
-                ObjWriteError::Io(e) => e,
-                ObjWriteError::Unmapped { vertex, patch } => std::io::Error::other(format!(
-                    "vertex {vertex} has patch id {patch}, which maps to no base face"
-                )),
-            })
+            self.write_obj_to(w, map, texcoords, winding)
+                .map_err(|e| match e {
+                    ObjWriteError::Io(e) => e,
+                    ObjWriteError::Unmapped { vertex, patch } => std::io::Error::other(format!(
+                        "vertex {vertex} has patch id {patch}, which maps to no base face"
+                    )),
+                })
         })
     }
 
@@ -143,6 +179,7 @@ impl WeldedMesh {
         &self,
         w: &mut dyn std::io::Write,
         map: &PatchToFace<'_>,
+        texcoords: Option<&[[f64; 2]]>,
         winding: Winding,
     ) -> std::result::Result<(), ObjWriteError> {
         writeln!(
@@ -164,15 +201,42 @@ impl WeldedMesh {
             writeln!(w, "vn {} {} {}", n[0], n[1], n[2])?;
             writeln!(w, "# p {} {} {}", fp.face, fp.u, fp.v)?;
         }
-        for t in &self.triangles {
-            let [a, b, c] = match winding {
-                Winding::AsCaptured => t.map(|i| i + 1),
-                Winding::Reversed => [t[0] + 1, t[2] + 1, t[1] + 1],
-            };
-            writeln!(w, "f {a}//{a} {b}//{b} {c}//{c}")?;
+        let corner_vt = texcoords.map(|t| write_texcoords(w, t)).transpose()?;
+        let order = match winding {
+            Winding::AsCaptured => [0, 1, 2],
+            Winding::Reversed => [0, 2, 1],
+        };
+        for (k, t) in self.triangles.iter().enumerate() {
+            let [a, b, c] = order.map(|i| t[i] + 1);
+            match &corner_vt {
+                Some(vt) => {
+                    let [ta, tb, tc] = order.map(|i| vt[3 * k + i] + 1);
+                    writeln!(w, "f {a}/{ta}/{a} {b}/{tb}/{b} {c}/{tc}/{c}")?;
+                }
+                None => writeln!(w, "f {a}//{a} {b}//{b} {c}//{c}")?,
+            }
         }
         Ok(())
     }
+}
+
+/// Writes one `vt` per distinct (by bits) coordinate of `texcoords` (per triangle corner) and
+/// returns each corner's 0-based `vt` number.
+fn write_texcoords(
+    w: &mut dyn std::io::Write,
+    texcoords: &[[f64; 2]],
+) -> std::io::Result<Vec<usize>> {
+    let mut index: HashMap<[u64; 2], usize> = HashMap::new();
+    let mut out = Vec::with_capacity(texcoords.len());
+    for t in texcoords {
+        let next = index.len();
+        let i = *index.entry(t.map(f64::to_bits)).or_insert(next);
+        if i == next {
+            writeln!(w, "vt {} {}", t[0], t[1])?;
+        }
+        out.push(i);
+    }
+    Ok(out)
 }
 
 /// Corner order of the faces [`WeldedMesh::write_obj`] writes.

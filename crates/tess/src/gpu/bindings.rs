@@ -129,6 +129,11 @@ gpu_constants! {
     ADAPTIVE_HEIGHT_BINDING = 2;
     /// Lattice points per patch side of the Eq. 1 error view.
     ADAPTIVE_PARAM_ERROR_SIDE = 9;
+    /// The deepest face-varying descent (`topology::patches::fvar::FVAR_MAX_DEPTH`). Its
+    /// leaf and empty entries (`FVAR_LEAF`, `FVAR_EMPTY`, the latter also a patch's "no
+    /// face-varying root") need the high bit, which a `#define`d decimal cannot carry:
+    /// `glsl/adaptive/fvar.glsl` writes them in hex, checked against `topology` by a test.
+    ADAPTIVE_FVAR_MAX_DEPTH = 16;
     /// Work-group size of the adaptive canonical kernel (`canonical.comp`).
     ADAPTIVE_LOCAL_SIZE = 64;
     /// `mode` of the canonical kernel (`AdaptivePush`): evaluate the canonical curves' inner points from their owner patches' control points (two per curve),

@@ -605,7 +605,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
     };
     let adaptive_arrays = || Layout {
         name: "AdaptiveArrays",
-        offsets: offsets!(AdaptiveArrays: vertices, patches, control_points, curves, surfaces, reparam, curve_owners, corner_owners, param_errors, param_error_count, pad),
+        offsets: offsets!(AdaptiveArrays: vertices, patches, control_points, curves, surfaces, reparam, curve_owners, corner_owners, param_errors, param_error_count, fvar_count, fvar),
         size: size_of::<AdaptiveArrays>(),
     };
     let adaptive_arrays_binding = || Uniform {
@@ -719,6 +719,20 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
             Stage::AdaptiveRegularTese,
             surface_tese,
             referenced("ParamErrorArray", size_of::<f32>()),
+        ),
+        (
+            Stage::AdaptiveRegularTese,
+            surface_tese,
+            referenced("FVarArray", size_of::<u32>()),
+        ),
+        (
+            Stage::AdaptiveRegularTese,
+            surface_tese,
+            Layout {
+                name: "PatchSurface",
+                offsets: offsets!(PatchSurface: uv, reparam_rows, tangent_valences, fvar_root, pad),
+                size: size_of::<PatchSurface>(),
+            },
         ),
         (Stage::AdaptiveRegularTese, surface_tese, adaptive_arrays()),
         (
@@ -972,6 +986,7 @@ fn the_table_covers_every_storage_binding_and_capture_build() {
         "CurveOwnerArray",
         "CornerOwnerArray",
         "ParamErrorArray",
+        "FVarArray",
     ] {
         assert!(
             rows.iter()
@@ -1047,7 +1062,7 @@ fn a_wrong_offset_or_binding_is_caught() {
     assert!(check(Stage::AdaptiveCanonicalComp, PLAIN, &wrong).is_err());
     let bound = Check::Referenced {
         block: "AdaptiveArrays",
-        members: offsets!(AdaptiveArrays: vertices, patches, control_points, curves, surfaces, reparam, curve_owners, corner_owners, param_errors, param_error_count, pad),
+        members: offsets!(AdaptiveArrays: vertices, patches, control_points, curves, surfaces, reparam, curve_owners, corner_owners, param_errors, param_error_count, fvar_count, fvar),
         stride: 4,
     };
     let e = check(Stage::AdaptiveCanonicalComp, PLAIN, &bound).unwrap_err();

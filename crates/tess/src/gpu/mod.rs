@@ -159,10 +159,13 @@ pub struct AdaptiveArrays {
     pub param_errors: u64,
     /// Entries of the lattice (0: not built; the view then reads nothing).
     pub param_error_count: u32,
-    pub pad: u32,
+    /// Words of the face-varying array (every read of it is checked against this).
+    pub fvar_count: u32,
+    /// The face-varying patches (`techniques::planned_patches::layout::fvar_words`).
+    pub fvar: u64,
 }
 
-const _: () = assert!(size_of::<AdaptiveArrays>() == 80);
+const _: () = assert!(size_of::<AdaptiveArrays>() == 88);
 
 /// `BftTableArrays` uniform block of `glsl/bft/bft.glsl`
 /// ([`bindings::BFT_TABLE_ARRAYS_BINDING`]): the device addresses of the basis-function tables'

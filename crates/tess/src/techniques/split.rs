@@ -152,6 +152,10 @@ impl Technique for SplitInput {
         self.inner.face_point(patch, domain)
     }
 
+    fn texcoord(&self, patch: u32, domain: [f32; 2], reparam: bool) -> Option<[f64; 2]> {
+        self.inner.texcoord(patch, domain, reparam)
+    }
+
     fn report_notes(&self) -> Vec<String> {
         let mut notes = self.inner.report_notes();
         notes.push(self.split.report.summary());

@@ -590,6 +590,7 @@ impl Split<'_> {
             face_offsets: mesh.face_offsets.clone(),
             face_vertices: self.corner_vertex.clone(),
             uvs: mesh.uvs.clone(),
+            uv_indices: mesh.uv_indices.clone(),
             normals: mesh.normals.clone(),
             creases: self.creases(),
             corners: self.corners(rules),

@@ -88,16 +88,24 @@ pub struct VertexCorner {
 ///
 /// Faces are stored flat: face `f` has corners `face_vertices[face_offsets[f]..face_offsets[f + 1]]`.
 /// `uvs` and `normals`, when present, have one entry per face corner (aligned with `face_vertices`).
+/// `uv_indices`, when present, gives each corner's texture coordinate its index in the file
+/// (an OBJ `vt` number, a USD primvar index): it is the texture layout's topology, which
+/// face-varying subdivision follows ([`crate::refine::fvar`]).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ControlMesh {
     pub positions: Vec<[f64; 3]>,
     pub face_offsets: Vec<u32>,
     pub face_vertices: Vec<u32>,
     pub uvs: Option<Vec<[f64; 2]>>,
+    /// Per face corner, the index of its texture coordinate as the file numbers them: two
+    /// corners at one vertex share a face-varying value when their indices are equal. `None`:
+    /// they share it when their `uvs` are bit-equal. Ignored without `uvs`.
+    pub uv_indices: Option<Vec<u32>>,
     pub normals: Option<Vec<[f64; 3]>>,
     pub creases: Vec<EdgeCrease>,
     pub corners: Vec<VertexCorner>,
-    /// Faces tagged as holes (`t hole`). Stored only: refinement keeps them.
+    /// Faces tagged as holes (`t hole`, USD's `holeIndices`). Refinement keeps them (they
+    /// shape their neighbours); patch plans and draws leave them out.
     pub holes: Vec<u32>,
     /// Scalar tags of an ST-mesh (`t scalartag`): shape parameters of curved PN triangles
     /// ([`scalar_tags`]); the subdivision schemes ignore them.
@@ -167,7 +175,7 @@ impl ControlMesh {
     /// The mesh with every polygon of more than three sides fan-triangulated from its first
     /// corner (Loop needs triangles; the techniques draw triangles). Vertex indices, creases,
     /// corners and options are kept (fans only add diagonals, so crease tags keep naming the
-    /// same edges); per-corner uvs and normals follow their corners (and are dropped if they do
+    /// same edges); per-corner uvs, their indices and normals follow their corners (and are dropped if they do
     /// not have one value per corner); a hole tag becomes all triangles of the holed face;
     /// faces of fewer than three corners make no triangle. Also returns, per new face, the
     /// face it came from.
@@ -186,7 +194,12 @@ impl ControlMesh {
             self.uvs.as_ref().filter(|a| a.len() == corners),
             self.normals.as_ref().filter(|a| a.len() == corners),
         );
+        let src_uv_indices = self
+            .uv_indices
+            .as_ref()
+            .filter(|a| a.len() == corners && src_uvs.is_some());
         let mut uvs = src_uvs.map(|_| Vec::new());
+        let mut uv_indices = src_uv_indices.map(|_| Vec::new());
         let mut normals = src_normals.map(|_| Vec::new());
         let mut origin = Vec::new();
         let mut first_triangle = Vec::with_capacity(self.num_faces() + 1);
@@ -198,6 +211,9 @@ impl ControlMesh {
                 for c in [start, start + k, start + k + 1] {
                     out.face_vertices.push(self.face_vertices[c]);
                     if let (Some(o), Some(src)) = (uvs.as_mut(), src_uvs) {
+                        o.push(src[c]);
+                    }
+                    if let (Some(o), Some(src)) = (uv_indices.as_mut(), src_uv_indices) {
                         o.push(src[c]);
                     }
                     if let (Some(o), Some(src)) = (normals.as_mut(), src_normals) {
@@ -218,6 +234,7 @@ impl ControlMesh {
             }
         }
         out.uvs = uvs;
+        out.uv_indices = uv_indices;
         out.normals = normals;
         (out, origin)
     }
@@ -643,6 +660,16 @@ pub(crate) fn check_faces(mesh: &ControlMesh, distinct_corners: bool) -> Result<
             return Err(TopologyError::AttributeLength {
                 attribute,
                 len,
+                expected: corners,
+            });
+        }
+    }
+    // Without uvs the indices number nothing and are ignored.
+    if let (Some(ix), Some(_)) = (&mesh.uv_indices, &mesh.uvs) {
+        if ix.len() != corners {
+            return Err(TopologyError::AttributeLength {
+                attribute: "uv_indices",
+                len: ix.len(),
                 expected: corners,
             });
         }

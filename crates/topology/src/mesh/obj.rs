@@ -16,7 +16,8 @@ use crate::mesh::input::{read_regular_file, MAX_OBJ_BYTES};
 use crate::mesh::scalar_tags::ScalarTag;
 use crate::mesh::{ControlMesh, EdgeCrease, VertexCorner};
 use crate::rules::options::{
-    BoundaryInterpolation, CreaseMethod, SubdivOptions, TriangleSubdivision,
+    BoundaryInterpolation, CreaseMethod, FVarLinearInterpolation, SubdivOptions,
+    TriangleSubdivision,
 };
 use std::borrow::Cow;
 use std::io::Write;
@@ -324,6 +325,7 @@ fn resolve_corners(
     let all_uv = !corners.is_empty() && corners.iter().all(|c| c.1.is_some());
     let all_n = !corners.is_empty() && corners.iter().all(|c| c.2.is_some());
     let mut corner_uvs = Vec::with_capacity(if all_uv { corners.len() } else { 0 });
+    let mut corner_uv_indices = Vec::with_capacity(corner_uvs.capacity());
     let mut corner_normals = Vec::with_capacity(if all_n { corners.len() } else { 0 });
     let perr = |line: usize, kind: ObjSyntax| TopologyError::Parse {
         file: name.to_string(),
@@ -358,6 +360,9 @@ fn resolve_corners(
                 })?;
                 if all_uv {
                     corner_uvs.push(uv);
+                    // In range of `uvs`, whose length came from a `Vec` of 16-byte entries
+                    // built from a file of at most `MAX_OBJ_BYTES`: it fits u32.
+                    corner_uv_indices.push(t as u32);
                 }
             }
             if let Some(n) = n {
@@ -379,6 +384,7 @@ fn resolve_corners(
     }
     if all_uv {
         mesh.uvs = Some(corner_uvs);
+        mesh.uv_indices = Some(corner_uv_indices);
     }
     if all_n {
         mesh.normals = Some(corner_normals);
@@ -675,9 +681,10 @@ fn parse_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
                 lines.corners.push(line);
             }
         }
-        "interpolateboundary" | "creasemethod" | "smoothtriangles" => {
-            option_tag(&t, &mut mesh.options, line, perr)?
-        }
+        "interpolateboundary"
+        | "creasemethod"
+        | "smoothtriangles"
+        | "facevaryinginterpolateboundary" => option_tag(&t, &mut mesh.options, line, perr)?,
         "scalartag" => {
             mesh.scalar_tags.push(scalar_tag(&t, line, perr, to_u32)?);
             lines.scalar_tags.push(line);
@@ -725,8 +732,9 @@ fn scalar_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
 }
 
 /// The option tags: `interpolateboundary` (one integer), `creasemethod` and `smoothtriangles`
-/// (one string; `smoothtriangles` also one integer). Anything else is refused with the value as
-/// written and what the tag takes.
+/// (one string; `smoothtriangles` also one integer), `facevaryinginterpolateboundary` (one
+/// integer, 0 none … 5 all as OpenSubdiv's `Far` reads it, or USD's token). Anything else is
+/// refused with the value as written and what the tag takes.
 fn option_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
     t: &TagValues<'_>,
     options: &mut SubdivOptions,
@@ -767,6 +775,20 @@ fn option_tag<E: Fn(usize, ObjSyntax) -> TopologyError>(
                     ))
                 }
             }
+        }
+        "facevaryinginterpolateboundary" => {
+            options.fvar_interpolation = match (t.strings, &t.ints[..]) {
+                ([], &[i]) => FVarLinearInterpolation::from_tag_value(i),
+                ([name], []) => FVarLinearInterpolation::from_name(name),
+                _ => None,
+            }
+            .ok_or_else(|| {
+                bad(
+                    "one integer: 0 (none), 1 (corners only), 2 (corners plus1), 3 (corners \
+                     plus2), 4 (boundaries) or 5 (all), as in 't facevaryinginterpolateboundary \
+                     1/0/0 1', or USD's name as one string",
+                )
+            })?
         }
         _ => {
             options.triangle_subdivision = match (t.strings, &t.ints[..]) {

@@ -21,12 +21,16 @@
 //!   dropped with a warning, as the OBJ reader does;
 //! - `interpolateBoundary` (`none`, `edgeOnly`, `edgeAndCorner`: USD's default, unlike OBJ's)
 //!   and `triangleSubdivisionRule` (`catmullClark`, `smooth`) → [`SubdivOptions`];
-//! - `faceVaryingLinearInterpolation`: its token is checked and kept per prim
-//!   ([`UsdMeshPrim::face_varying_linear_interpolation`]); the control mesh has no
-//!   face-varying option yet, so texture coordinates stay bilinear on each face;
+//! - `faceVaryingLinearInterpolation` (`cornersPlus1` when unauthored) →
+//!   [`SubdivOptions::fvar_interpolation`], how the texture coordinates are interpolated
+//!   ([`crate::refine::fvar`]); also kept per prim as its token
+//!   ([`UsdMeshPrim::face_varying_linear_interpolation`]);
 //! - `primvars:st` (else `primvars:uv`), float or double, with or without `:indices`, of any
 //!   interpolation (`faceVarying`, `vertex`, `varying`, `uniform`, `constant`) → one uv per
-//!   face corner. A merged mesh keeps uvs only if every prim has them.
+//!   face corner. The primvar's indices, else its elements' numbers (an unindexed
+//!   `faceVarying` primvar gives every corner a value of its own, as USD's face-varying
+//!   topology does), are the layout's topology ([`ControlMesh::uv_indices`]). A merged mesh
+//!   keeps uvs only if every prim has them.
 //!
 //! Values are the default value, else the earliest time sample; transforms are composed at the
 //! earliest time (an op's default where it has no samples).
@@ -34,7 +38,8 @@
 //! Several Mesh prims merge into one control mesh: their points are appended in traversal
 //! order and each prim's vertex and face indices (faces, tags, holes) are offset by the points
 //! and faces before it. They must share the scheme and options (else
-//! [`UsdProblem::Mixed`]). [`read_usd`] also returns where each prim's points and faces start.
+//! [`UsdProblem::Mixed`]), but for `faceVaryingLinearInterpolation`: the first prim's applies
+//! to the merged mesh, with a warning naming a prim that differs. [`read_usd`] also returns where each prim's points and faces start.
 //!
 //! What is refused, with [`TopologyError::Usd`] naming the file, the prim's path and the
 //! attribute: a file the reader refuses, an unknown token, counts that do not add up to the
@@ -47,7 +52,9 @@
 
 use crate::error::{TopologyError, UsdProblem};
 use crate::mesh::{ControlMesh, EdgeCrease, VertexCorner};
-use crate::rules::options::{BoundaryInterpolation, SubdivOptions, TriangleSubdivision};
+use crate::rules::options::{
+    BoundaryInterpolation, FVarLinearInterpolation, SubdivOptions, TriangleSubdivision,
+};
 use crate::rules::Scheme;
 use openusd::gf;
 use openusd::schemas::geom::{self, Imageable, Mesh, Xformable};
@@ -89,8 +96,8 @@ pub struct UsdMeshPrim {
     pub first_vertex: u32,
     /// Its first face in the merged mesh's faces.
     pub first_face: u32,
-    /// Its `faceVaryingLinearInterpolation` token (`cornersPlus1` when unauthored), checked
-    /// but not yet applied (see the module documentation).
+    /// Its `faceVaryingLinearInterpolation` token (`cornersPlus1` when unauthored), which
+    /// the merged mesh's [`SubdivOptions::fvar_interpolation`] applies.
     pub face_varying_linear_interpolation: String,
 }
 
@@ -268,12 +275,27 @@ impl Merge {
                     format!("{:?}", self.mesh.scheme),
                 ));
             }
-            if p.options != self.mesh.options {
+            let fvar = self.mesh.options.fvar_interpolation;
+            let same_fvar = SubdivOptions {
+                fvar_interpolation: fvar,
+                ..p.options
+            };
+            if same_fvar != self.mesh.options {
                 return Err(mixed(
                     "interpolateBoundary/triangleSubdivisionRule",
                     format!("{:?}", p.options),
                     format!("{:?}", self.mesh.options),
                 ));
+            }
+            if p.options.fvar_interpolation != fvar {
+                log::warn!(
+                    "{file}: {prim}: faceVaryingLinearInterpolation {} differs from {}'s {}: \
+                     the merged mesh's texture coordinates use {}",
+                    p.options.fvar_interpolation,
+                    first.path,
+                    fvar,
+                    fvar
+                );
             }
         } else {
             self.mesh.face_offsets.push(0);
@@ -310,9 +332,22 @@ impl Merge {
         let had_uvs = self.all_uvs;
         self.all_uvs &= p.uvs.is_some();
         if let (true, Some(uvs)) = (self.all_uvs, p.uvs) {
+            let first = m.uvs.is_none();
             m.uvs.get_or_insert_with(Vec::new).extend(uvs);
+            // Keys are compared only among one vertex's corners, so prims need no offset;
+            // one prim without indices makes the whole mesh compare values.
+            match (p.uv_indices, first) {
+                (Some(ix), true) => m.uv_indices = Some(ix),
+                (Some(ix), false) => {
+                    if let Some(all) = m.uv_indices.as_mut() {
+                        all.extend(ix);
+                    }
+                }
+                (None, _) => m.uv_indices = None,
+            }
         } else if had_uvs && self.prims.len() > 1 {
             m.uvs = None;
+            m.uv_indices = None;
             log::warn!(
                 "{file}: {prim} has no primvars:st or primvars:uv, or an earlier prim has none: \
                  the merged mesh keeps no texture coordinates"
@@ -469,9 +504,10 @@ impl PrimReader<'_> {
         let reverse = left_handed != mirrored;
         let order = corner_order(&mesh.face_offsets, reverse);
         mesh.face_vertices = order.iter().map(|&c| corners[c]).collect();
-        mesh.uvs = self
-            .uvs(&mesh.face_offsets, &corners, mesh.positions.len())?
-            .map(|uvs| order.iter().map(|&c| uvs[c]).collect());
+        if let Some((uvs, keys)) = self.uvs(&mesh.face_offsets, &corners, mesh.positions.len())? {
+            mesh.uvs = Some(order.iter().map(|&c| uvs[c]).collect());
+            mesh.uv_indices = Some(order.iter().map(|&c| keys[c]).collect());
+        }
         mesh.scheme = Some(self.scheme()?);
         mesh.options = self.options()?;
         self.tags(&mut mesh)?;
@@ -480,6 +516,8 @@ impl PrimReader<'_> {
             &FACE_VARYING,
             "cornersPlus1, none, cornersOnly, cornersPlus2, boundaries, all",
         )?;
+        mesh.options.fvar_interpolation =
+            FVarLinearInterpolation::from_name(FACE_VARYING[face_varying]).unwrap_or_default();
         mesh.validate().map_err(|e| TopologyError::InUsdPrim {
             file: self.file.to_string(),
             prim: self.prim.to_string(),
@@ -717,13 +755,15 @@ impl PrimReader<'_> {
     }
 
     /// Per face corner (in the file's order), the texture coordinate of `primvars:st`, else
-    /// `primvars:uv`; `None` without either.
+    /// `primvars:uv`, and its value's number (the primvar's index, else its element's);
+    /// `None` without either primvar.
+    #[allow(clippy::type_complexity)]
     fn uvs(
         &self,
         offsets: &[u32],
         corners: &[u32],
         points: usize,
-    ) -> Result<Option<Vec<[f64; 2]>>, TopologyError> {
+    ) -> Result<Option<(Vec<[f64; 2]>, Vec<u32>)>, TopologyError> {
         for name in ["primvars:st", "primvars:uv"] {
             let Some(value) = self.value(name)? else {
                 continue;
@@ -742,27 +782,36 @@ impl PrimReader<'_> {
                 Spread::FaceVarying => corners.len(),
             };
             let indices_name = format!("{name}:indices");
-            let element_values: Vec<[f64; 2]> = match self.ints(&indices_name)? {
+            let indices = match self.ints(&indices_name)? {
                 Some(ix) => {
                     let ix = self.check_indices(&indices_name, &ix, values.len(), "values")?;
                     self.expect_len(&indices_name, ix.len(), elements, spread)?;
-                    ix.iter().map(|&i| values[i as usize]).collect()
+                    Some(ix)
                 }
                 None => {
                     self.expect_len(name, values.len(), elements, spread)?;
-                    values
+                    None
                 }
             };
-            let per_corner = (0..faces)
-                .flat_map(|f| (offsets[f]..offsets[f + 1]).map(move |c| (f, c as usize)))
-                .map(|(f, c)| match spread {
-                    Spread::Constant => element_values[0],
-                    Spread::Uniform => element_values[f],
-                    Spread::Vertex => element_values[corners[c] as usize],
-                    Spread::FaceVarying => element_values[c],
-                })
+            let element = |f: usize, c: usize| match spread {
+                Spread::Constant => 0,
+                Spread::Uniform => f,
+                Spread::Vertex => corners[c] as usize,
+                Spread::FaceVarying => c,
+            };
+            let corner_elements: Vec<usize> = (0..faces)
+                .flat_map(|f| (offsets[f]..offsets[f + 1]).map(move |c| element(f, c as usize)))
                 .collect();
-            return Ok(Some(per_corner));
+            // The value number of each element: its index, else the element itself (an
+            // unindexed primvar's elements are distinct values, as USD's face-varying
+            // topology numbers them).
+            let value_of: Vec<u32> = indices.unwrap_or_else(|| (0..elements as u32).collect());
+            let per_corner = corner_elements
+                .iter()
+                .map(|&e| values[value_of[e] as usize])
+                .collect();
+            let keys = corner_elements.iter().map(|&e| value_of[e]).collect();
+            return Ok(Some((per_corner, keys)));
         }
         Ok(None)
     }

@@ -87,6 +87,7 @@ pub fn weld_vertices(mesh: &ControlMesh, tolerance: f64) -> (ControlMesh, Vec<u3
         ..ControlMesh::default()
     };
     let mut uvs = mesh.uvs.as_ref().map(|_| Vec::new());
+    let mut uv_indices = mesh.uv_indices.as_ref().map(|_| Vec::new());
     let mut normals = mesh.normals.as_ref().map(|_| Vec::new());
     let mut kept: Vec<u32> = Vec::with_capacity(mesh.num_faces());
     let mut new_face: Vec<Option<u32>> = vec![None; mesh.num_faces()];
@@ -105,6 +106,9 @@ pub fn weld_vertices(mesh: &ControlMesh, tolerance: f64) -> (ControlMesh, Vec<u3
             if let (Some(dst), Some(src)) = (uvs.as_mut(), mesh.uvs.as_ref()) {
                 dst.push(src[start + i]);
             }
+            if let (Some(dst), Some(src)) = (uv_indices.as_mut(), mesh.uv_indices.as_ref()) {
+                dst.push(src[start + i]);
+            }
             if let (Some(dst), Some(src)) = (normals.as_mut(), mesh.normals.as_ref()) {
                 dst.push(src[start + i]);
             }
@@ -112,6 +116,7 @@ pub fn weld_vertices(mesh: &ControlMesh, tolerance: f64) -> (ControlMesh, Vec<u3
         out.face_offsets.push(out.face_vertices.len() as u32);
     }
     out.uvs = uvs;
+    out.uv_indices = uv_indices;
     out.normals = normals;
     let at = |v: u32| target.get(v as usize).copied().unwrap_or(v);
     for c in &mesh.creases {

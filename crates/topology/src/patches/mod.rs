@@ -9,7 +9,8 @@
 //!   plan ([`adaptive::single_pass`]);
 //! - [`reparam`]: the texture reparameterization of Gregory patches (characteristic maps and
 //!   their fitted corner blocks);
-//! - [`texcoord`]: texture coordinates of the limit surface at a patch's parameter.
+//! - [`texcoord`]: texture coordinates of the limit surface at a patch's parameter;
+//! - [`fvar`]: face-varying patches, the smooth texture coordinates of a planned surface.
 //!
 //! The top layer: builds on every layer below it (`rules/`, `mesh/`, `refine/`, `limit/`),
 //! as OpenSubdiv's `Far` patch tables build on `Vtr`.
@@ -18,6 +19,7 @@ pub mod acc;
 pub mod adaptive;
 pub mod bft;
 pub mod doo_sabin;
+pub mod fvar;
 pub mod gregory;
 pub mod reparam;
 pub mod texcoord;

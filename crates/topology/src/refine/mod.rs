@@ -63,6 +63,7 @@ use crate::rules::{
 use rayon::prelude::*;
 
 pub mod doo_sabin;
+pub mod fvar;
 pub mod joined;
 pub mod stencil;
 

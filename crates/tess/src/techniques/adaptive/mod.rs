@@ -13,6 +13,7 @@ use crate::techniques::planned_patches::{
 };
 use crate::techniques::{BuildOptions, Built, TechniqueInfo};
 use topology::patches::adaptive::{plan_adaptive, AdaptiveOptions};
+use topology::patches::fvar::FVarPlan;
 use topology::ControlMesh;
 
 pub use planned_patches::DEFAULT_ISOLATION;
@@ -71,18 +72,17 @@ fn build_registered(
 /// uploads it, with one base-position buffer per frame slot of `ctx`.
 pub fn new(ctx: &mut Context, mesh: &ControlMesh, options: &PlanBuild) -> Result<PlannedPatches> {
     check_texcoords(mesh, &options.maps, &options.name)?;
-    let plan = plan_adaptive(
-        mesh,
-        &AdaptiveOptions {
-            isolation: options.isolation,
-            end_cap: options.end_cap,
-            sharpness_scale: options.sharpness_scale,
-            follow_semi_sharp: options.follow_semi_sharp,
-        },
-    )
-    .map_err(|e| TessError::Mesh {
+    let plan_options = AdaptiveOptions {
+        isolation: options.isolation,
+        end_cap: options.end_cap,
+        sharpness_scale: options.sharpness_scale,
+        follow_semi_sharp: options.follow_semi_sharp,
+    };
+    let plan = plan_adaptive(mesh, &plan_options).map_err(|e| TessError::Mesh {
         name: options.name.clone(),
         source: e.into(),
     })?;
-    PlannedPatches::from_plan(ctx, mesh, plan, options, TechniqueId::ADAPTIVE)
+    let fvar =
+        planned_patches::fvar_patches(mesh, &FVarPlan::Adaptive(plan_options), &options.name)?;
+    PlannedPatches::from_plan(ctx, mesh, plan, fvar, options, TechniqueId::ADAPTIVE)
 }

@@ -17,13 +17,15 @@
 //!   in range and every row reads only earlier blocks, so a bad plan fails here, not as an
 //!   out-of-bounds read on the device.
 use crate::gpu::bindings::{
-    ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_FINE, ADAPTIVE_EDGE_PLAIN, ADAPTIVE_KIND_BILINEAR,
-    ADAPTIVE_KIND_GREGORY, ADAPTIVE_KIND_GREGORY_TRIANGLE, ADAPTIVE_KIND_REGULAR,
+    ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_FINE, ADAPTIVE_EDGE_PLAIN, ADAPTIVE_FVAR_MAX_DEPTH,
+    ADAPTIVE_KIND_BILINEAR, ADAPTIVE_KIND_GREGORY, ADAPTIVE_KIND_GREGORY_TRIANGLE,
+    ADAPTIVE_KIND_REGULAR,
 };
 use crate::stencil::{GpuStencils, StencilBlock, StencilError, StencilVertex};
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
 use topology::patches::adaptive::{AdaptivePatch, AdaptivePlan, EdgeKind, PatchKind};
+use topology::patches::fvar::{FVarPatches, FVAR_EMPTY, FVAR_MAX_DEPTH};
 use topology::ControlMesh;
 
 /// `AdaptivePatch` of `adaptive.glsl`: one patch.
@@ -55,7 +57,12 @@ pub struct PatchSurface {
     /// ACC-1 patches: per corner `i`, 8 bits at `8i`, its valence for the tangent patches
     /// (`topology::patches::acc::tangent_normal`); 0 on every other patch.
     pub tangent_valences: u32,
-    pub pad: [u32; 2],
+    /// Smooth texture coordinates: the root entry, in the face-varying array
+    /// ([`fvar_words`]), of the patch's (sub-)face, whose parameter `uv` then holds (a
+    /// triangle patch's: its barycentric parallelogram); `FVAR_EMPTY`: `uv` are the texture
+    /// coordinates.
+    pub fvar_root: u32,
+    pub pad: u32,
 }
 
 /// `CurveOwner` of `adaptive.glsl`: the patch whose evaluation along a canonical curve gives
@@ -78,6 +85,7 @@ pub struct ReparamRow {
 }
 
 const _: () = {
+    assert!(ADAPTIVE_FVAR_MAX_DEPTH == FVAR_MAX_DEPTH);
     assert!(size_of::<PatchRecord>() == 48);
     assert!(size_of::<PatchSurface>() == 48);
     assert!(size_of::<CurveOwner>() == 8);
@@ -96,6 +104,30 @@ pub fn reparam_rows() -> Vec<ReparamRow> {
             ReparamRow { c }
         })
         .collect()
+}
+
+/// The face-varying patches as the one `uint` array `glsl/adaptive/fvar.glsl` reads: a
+/// header (the first word of the nodes, of the leaves and of the points, then 0), the tree
+/// nodes (four entries each), the leaves (`1` for a Gregory triangle else `0`, first point)
+/// and the points (two `f32` bit patterns each). Without patches, the header alone (nothing
+/// reads it: every patch's root is `ADAPTIVE_FVAR_NONE`).
+pub fn fvar_words(fvar: Option<&FVarPatches>) -> Vec<u32> {
+    let Some(f) = fvar else {
+        return vec![4, 4, 4, 0];
+    };
+    let node_base = 4usize;
+    let leaf_base = node_base + 4 * f.nodes.len();
+    let point_base = leaf_base + 2 * f.patches.len();
+    let mut out = Vec::with_capacity(point_base + 2 * f.points.len());
+    out.extend([node_base as u32, leaf_base as u32, point_base as u32, 0]);
+    out.extend(f.nodes.iter().flatten());
+    for p in &f.patches {
+        out.extend([u32::from(p.is_triangle()), p.first_point]);
+    }
+    for p in &f.points {
+        out.extend([(p[0] as f32).to_bits(), (p[1] as f32).to_bits()]);
+    }
+    out
 }
 
 /// Why a plan cannot go to the GPU.
@@ -496,22 +528,36 @@ impl GpuPlan {
     }
 
     /// Per frame-wide patch: texture coordinates at its corners and its reparameterization
-    /// rows (`topology::patches::texcoord`).
-    pub fn surfaces(&self, plan: &AdaptivePlan, mesh: &ControlMesh) -> Vec<PatchSurface> {
+    /// rows (`topology::patches::texcoord`); with face-varying patches `fvar` (made for this
+    /// plan), its (sub-)face parameter and its root among them instead.
+    pub fn surfaces(
+        &self,
+        plan: &AdaptivePlan,
+        mesh: &ControlMesh,
+        fvar: Option<&FVarPatches>,
+    ) -> Vec<PatchSurface> {
         let f32x2 = |p: [f64; 2]| [p[0] as f32, p[1] as f32];
+        let domain = |p: &AdaptivePatch| {
+            if p.corners() == 3 {
+                // Barycentric (u, v) stands in; (1, 1) completes the parallelogram.
+                return [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+            }
+            let [u0, v0] = p.origin;
+            let h = p.size;
+            [[u0, v0], [u0 + h, v0], [u0 + h, v0 + h], [u0, v0 + h]]
+        };
         self.order
             .iter()
             .map(|&pi| {
                 let p = &plan.patches[pi as usize];
-                let uv = topology::patches::texcoord::patch_corners(mesh, p).unwrap_or_else(|| {
-                    if p.corners() == 3 {
-                        // Barycentric (u, v) stands in; (1, 1) completes the parallelogram.
-                        return [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
-                    }
-                    let [u0, v0] = p.origin;
-                    let h = p.size;
-                    [[u0, v0], [u0 + h, v0], [u0 + h, v0 + h], [u0, v0 + h]]
-                });
+                let root = fvar.map_or(FVAR_EMPTY, |f| f.root_of(p));
+                let (uv, fvar_root) = if root != FVAR_EMPTY {
+                    (domain(p), root)
+                } else {
+                    let uv = topology::patches::texcoord::patch_corners(mesh, p)
+                        .unwrap_or_else(|| domain(p));
+                    (uv, FVAR_EMPTY)
+                };
                 let mut rows = 0u32;
                 for (i, &v) in p.reparam_valences.iter().enumerate() {
                     rows |= topology::patches::texcoord::reparam_row(v) << (8 * i);
@@ -527,7 +573,8 @@ impl GpuPlan {
                     uv: uv.map(f32x2),
                     reparam_rows: rows,
                     tangent_valences,
-                    pad: [0; 2],
+                    fvar_root,
+                    pad: 0,
                 }
             })
             .collect()
@@ -561,5 +608,54 @@ impl GpuPlan {
     /// Bytes of the global vertex buffer.
     pub fn vertex_bytes(&self) -> u64 {
         self.num_vertices.max(1) as u64 * size_of::<StencilVertex>() as u64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use topology::patches::fvar::FVAR_LEAF;
+
+    /// `glsl/adaptive/fvar.glsl` writes the tree's leaf and empty entries in hex (a `#define`
+    /// cannot carry the high bit): they are `topology`'s.
+    #[test]
+    fn fvar_glsl_entries_are_topologys() {
+        let glsl = include_str!("../../../../../glsl/adaptive/fvar.glsl");
+        for line in [
+            format!("const uint FVAR_LEAF = {FVAR_LEAF:#x}u;"),
+            format!("const uint FVAR_EMPTY = {FVAR_EMPTY:#x}u;"),
+        ] {
+            assert!(glsl.contains(&line), "fvar.glsl lacks '{line}'");
+        }
+    }
+
+    /// Without face-varying patches the array is its header; with them, every section
+    /// starts where the header says and holds what the patches hold.
+    #[test]
+    fn fvar_words_follow_the_header() {
+        assert_eq!(fvar_words(None), vec![4, 4, 4, 0]);
+        let f = FVarPatches {
+            nodes: vec![[FVAR_LEAF, FVAR_EMPTY, FVAR_LEAF | 1, FVAR_EMPTY]],
+            roots: vec![0],
+            root_offsets: vec![0, 1],
+            patches: vec![
+                topology::patches::fvar::FVarPatch {
+                    kind: PatchKind::Regular,
+                    first_point: 0,
+                },
+                topology::patches::fvar::FVarPatch {
+                    kind: PatchKind::GregoryTriangle,
+                    first_point: 20,
+                },
+            ],
+            points: (0..35).map(|k| [k as f64, 0.5]).collect(),
+        };
+        let w = fvar_words(Some(&f));
+        let [nodes, leaves, points] = [w[0], w[1], w[2]].map(|x| x as usize);
+        assert_eq!(&w[nodes..nodes + 4], &f.nodes[0]);
+        assert_eq!(&w[leaves..leaves + 4], &[0, 0, 1, 20]);
+        assert_eq!(w.len(), points + 70);
+        assert_eq!(f32::from_bits(w[points + 2 * 34]), 34.0);
+        assert_eq!(f32::from_bits(w[points + 2 * 34 + 1]), 0.5);
     }
 }

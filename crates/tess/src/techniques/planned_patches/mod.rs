@@ -73,7 +73,8 @@ use std::ops::Range;
 use topology::patches::adaptive::single_pass::{
     plan_single_pass, SinglePassOptions, SinglePassPatch,
 };
-use topology::patches::adaptive::{AdaptivePlan, EndCap};
+use topology::patches::adaptive::{AdaptivePlan, EndCap, PatchKind};
+use topology::patches::fvar::{FVarPatches, FVarPlan};
 use topology::ControlMesh;
 use vk_core::descriptor::{BindingDesc, DescriptorPool};
 use vk_core::pipeline::Pipeline;
@@ -208,19 +209,39 @@ fn param_errors(
 /// The Eq. 1 lattice's summary and the patches with a reparameterized corner, when built.
 type ParamErrorNote = Option<(topology::patches::texcoord::ParamErrorSummary, usize)>;
 
+/// The face-varying patches of `mesh`'s texture coordinates for a surface planned as `plan`
+/// (`topology::patches::fvar`), or `None` where they are bilinear on each face (the mesh's
+/// [`fvar_interpolation`](topology::rules::options::SubdivOptions::fvar_interpolation) is
+/// `all`, or it has no texture coordinates).
+pub fn fvar_patches(
+    mesh: &ControlMesh,
+    plan: &FVarPlan,
+    name: &str,
+) -> Result<Option<FVarPatches>> {
+    topology::patches::fvar::texcoord_patches(mesh, plan)
+        .transpose()
+        .map_err(|e| TessError::Mesh {
+            name: name.to_string(),
+            source: e.into(),
+        })
+}
+
 /// The arrays the canonical kernel and the draw read by address besides the vertices, in
 /// [`AdaptiveArrays`] order: patch records, control points, curves, patch surfaces, the
-/// reparameterization table, curve and corner owners and the error lattice.
+/// reparameterization table, curve and corner owners, the error lattice and the face-varying
+/// patches.
 fn static_buffers(
     device: &vk_core::Device,
     gpu: &GpuPlan,
     plan: &AdaptivePlan,
     mesh: &ControlMesh,
     param_errors: &[f32],
-) -> Result<[Buffer; 8]> {
-    let surfaces = gpu.surfaces(plan, mesh);
+    fvar: &[u32],
+    fvar_patches: Option<&FVarPatches>,
+) -> Result<[Buffer; 9]> {
+    let surfaces = gpu.surfaces(plan, mesh, fvar_patches);
     let reparam = layout::reparam_rows();
-    let arrays: [(&str, &[u8]); 8] = [
+    let arrays: [(&str, &[u8]); 9] = [
         ("adaptive patches", bytemuck::cast_slice(&gpu.patches)),
         (
             "adaptive control points",
@@ -244,22 +265,24 @@ fn static_buffers(
             "adaptive Eq. 1 error lattice",
             bytemuck::cast_slice(param_errors),
         ),
+        ("adaptive face-varying patches", bytemuck::cast_slice(fvar)),
     ];
     // An empty array is padded (zero-length buffers are invalid); nothing indexes it.
     let pad = [0u8; 16];
-    let [p, c, k, s, r, o, q, e] = arrays.map(|(name, bytes)| {
+    let [p, c, k, s, r, o, q, e, f] = arrays.map(|(name, bytes)| {
         let data = if bytes.is_empty() { &pad[..] } else { bytes };
         Buffer::with_data(device, name, BY_ADDRESS, data)
     });
-    Ok([p?, c?, k?, s?, r?, o?, q?, e?])
+    Ok([p?, c?, k?, s?, r?, o?, q?, e?, f?])
 }
 
 /// The uniform buffer of [`AdaptiveArrays`]: the address of `vertices` and of each of `statics`.
 fn address_table(
     device: &vk_core::Device,
     vertices: &Buffer,
-    statics: &[Buffer; 8],
+    statics: &[Buffer; 9],
     param_error_count: u32,
+    fvar_count: u32,
 ) -> Result<Buffer> {
     let a = |b: &Buffer| b.device_address();
     let table = AdaptiveArrays {
@@ -273,7 +296,8 @@ fn address_table(
         corner_owners: a(&statics[6])?,
         param_errors: a(&statics[7])?,
         param_error_count,
-        pad: 0,
+        fvar_count,
+        fvar: a(&statics[8])?,
     };
     Ok(Buffer::with_data(
         device,
@@ -430,15 +454,18 @@ pub struct PlannedPatches {
     has_param_errors: bool,
     /// Its summary and the patches with a reparameterized corner, when built.
     param_error_summary: ParamErrorNote,
+    /// Smooth texture coordinates (`None`: bilinear on each face), as uploaded.
+    pub fvar: Option<FVarPatches>,
 }
 
 impl PlannedPatches {
     /// Uploads a plan, drawn as technique `id`, with one base-position buffer per frame slot
-    /// of `ctx`.
+    /// of `ctx`, and the face-varying patches `fvar` made for it ([`fvar_patches`]).
     pub fn from_plan(
         ctx: &mut Context,
         mesh: &ControlMesh,
         plan: AdaptivePlan,
+        fvar: Option<FVarPatches>,
         options: &PlanBuild,
         id: TechniqueId,
     ) -> Result<Self> {
@@ -473,13 +500,30 @@ impl PlannedPatches {
         )?;
         let (param_errors, has_param_errors, param_error_summary) =
             param_errors(mesh, &plan, &gpu, options)?;
-        let statics = static_buffers(&device, &gpu, &plan, mesh, &param_errors)?;
+        let fvar_words = layout::fvar_words(fvar.as_ref());
+        let statics = static_buffers(
+            &device,
+            &gpu,
+            &plan,
+            mesh,
+            &param_errors,
+            &fvar_words,
+            fvar.as_ref(),
+        )?;
         let error_count = if has_param_errors {
             param_errors.len() as u32
         } else {
             0
         };
-        let addresses = address_table(&device, &vertices, &statics, error_count)?;
+        let fvar_count = u32::try_from(fvar_words.len()).map_err(|_| TessError::Mesh {
+            name: options.name.clone(),
+            source: format!(
+                "face-varying patches of {} words exceed the u32 the shaders index with",
+                fvar_words.len()
+            )
+            .into(),
+        })?;
+        let addresses = address_table(&device, &vertices, &statics, error_count, fvar_count)?;
         let textures = surface_textures(&device, &options.maps)?;
         let base_positions = base_positions(mesh);
         let base = base_buffers(&device, ctx.frames_in_flight(), &base_positions)?;
@@ -541,6 +585,7 @@ impl PlannedPatches {
             max_level,
             has_param_errors,
             param_error_summary,
+            fvar,
         })
     }
 
@@ -652,6 +697,34 @@ impl PlannedPatches {
         }
     }
 
+    /// The texture coordinate patch `patch` (frame-wide id) shows at patch coordinate `(u, v)`,
+    /// as the TES computes it (`glsl/adaptive/surface.glsl`'s `texcoord_at`, in `f64`): the
+    /// texture parameter (Eq. 3's when `reparam`), then the corners' bilinear blend, then,
+    /// with face-varying patches, their look-up at that (sub-)face parameter. `None` for an
+    /// unknown patch or a mesh without texture coordinates.
+    pub fn texcoord_at(&self, patch: u32, u: f64, v: f64, reparam: bool) -> Option<[f64; 2]> {
+        let pi = *self.gpu.order.get(patch as usize)?;
+        let p = self.plan.patches.get(pi as usize)?;
+        let [s, t] = topology::patches::texcoord::patch_parameter(p, u, v, reparam);
+        // As `layout::GpuPlan::surfaces` and the TES: a patch without a root keeps its
+        // bilinear corners; a descent that finds no leaf gives the parameter itself.
+        let root = self
+            .fvar
+            .as_ref()
+            .map_or(topology::patches::fvar::FVAR_EMPTY, |f| f.root_of(p));
+        if let (Some(f), false) = (&self.fvar, root == topology::patches::fvar::FVAR_EMPTY) {
+            let param = if p.kind == PatchKind::GregoryTriangle {
+                [s, t]
+            } else {
+                let [u0, v0] = p.origin;
+                [u0 + p.size * s, v0 + p.size * t]
+            };
+            return Some(f.texcoord(root, param).unwrap_or(param));
+        }
+        let corners = topology::patches::texcoord::patch_corners(&self.mesh, p)?;
+        Some(topology::patches::texcoord::bilinear(&corners, s, t))
+    }
+
     /// Where patch `patch` (frame-wide id) at patch coordinate `(u, v)` lies in its base face:
     /// `(base face, sub-face, u, v)` in `topology::limit::eval`'s convention (sub-quads of
     /// non-quads as `LocalMesh::evaluate_subface` numbers them).
@@ -675,18 +748,16 @@ pub fn single_pass(
     maps: &crate::surface::SurfaceMaps,
 ) -> Result<PlannedPatches> {
     check_texcoords(mesh, maps, name)?;
-    let plan = plan_single_pass(
-        mesh,
-        &SinglePassOptions {
-            patch,
-            sharpness_scale,
-            gregory_triangles,
-        },
-    )
-    .map_err(|e| TessError::Mesh {
+    let plan_options = SinglePassOptions {
+        patch,
+        sharpness_scale,
+        gregory_triangles,
+    };
+    let plan = plan_single_pass(mesh, &plan_options).map_err(|e| TessError::Mesh {
         name: name.to_string(),
         source: e.into(),
     })?;
+    let fvar = fvar_patches(mesh, &FVarPlan::SinglePass(plan_options), name)?;
     let id = match patch {
         SinglePassPatch::Gregory => TechniqueId::GREGORY,
         SinglePassPatch::Acc1 => TechniqueId::ACC,
@@ -695,6 +766,7 @@ pub fn single_pass(
         ctx,
         mesh,
         plan,
+        fvar,
         &PlanBuild {
             single_pass: true,
             isolation: 1,
@@ -971,6 +1043,10 @@ impl Technique for PlannedPatches {
     /// The patch's point in its base face; a sub-quad of a non-quad maps bilinearly into the
     /// face's domain ([`face_corner_uv`](topology::limit::face_domain::face_corner_uv)): corner, edge
     /// midpoint, centre, edge midpoint.
+    fn texcoord(&self, patch: u32, domain: [f32; 2], reparam: bool) -> Option<[f64; 2]> {
+        self.texcoord_at(patch, domain[0] as f64, domain[1] as f64, reparam)
+    }
+
     fn face_point(&self, patch: u32, domain: [f32; 2]) -> Option<FacePoint> {
         let (face, sub, u, v) = self.base_param(patch, domain[0] as f64, domain[1] as f64)?;
         let n = self.mesh.face(face as usize).len() as u32;
