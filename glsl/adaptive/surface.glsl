@@ -72,15 +72,19 @@ vec3 param_error_colour(float e) {
     return mix(ramp[k], ramp[k + 1u], t - float(k));
 }
 
+#ifdef FACE_VARYING
 #include "fvar.glsl"
+#endif
 
 // The texture coordinate of a patch with surface record `sf` at texture parameter `st`: the
-// corners' bilinear blend, which with face-varying patches is the (sub-)face parameter they
-// are looked up at (fvar.glsl).
+// corners' bilinear blend, which in the face-varying build (-DFACE_VARYING, for surfaces with
+// face-varying patches) is the (sub-)face parameter they are looked up at (fvar.glsl).
 vec2 texcoord_at(PatchSurface sf, vec2 st) {
     vec2 blend = mix(mix(sf.uv[0], sf.uv[1], st.x), mix(sf.uv[3], sf.uv[2], st.x), st.y);
-    if (sf.fvar_root == FVAR_EMPTY) return blend;
-    return fvar_texcoord(sf.fvar_root, blend, blend);
+#ifdef FACE_VARYING
+    if (sf.fvar_root != FVAR_EMPTY) return fvar_texcoord(sf.fvar_root, blend, blend);
+#endif
+    return blend;
 }
 
 // The texture coordinate patch `id` shows at its (u, v).

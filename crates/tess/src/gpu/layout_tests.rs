@@ -93,6 +93,7 @@ fn variant(spacing: Option<Spacing>, capture: bool) -> Variant {
         surface: false,
         patch_block: false,
         scalar_tags: false,
+        face_varying: false,
     }
 }
 
@@ -102,6 +103,7 @@ const PLAIN: Variant = Variant {
     surface: false,
     patch_block: false,
     scalar_tags: false,
+    face_varying: false,
 };
 
 /// BFT's patch-block build (its control stage reads the ring and level-1 buffers too).
@@ -622,6 +624,10 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         surface: true,
         ..variant(equal, false)
     };
+    let face_varying_tese = Variant {
+        face_varying: true,
+        ..surface_tese
+    };
     let adaptive_tese = [
         Stage::AdaptiveRegularTese,
         Stage::AdaptiveGregoryTese,
@@ -722,7 +728,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         ),
         (
             Stage::AdaptiveRegularTese,
-            surface_tese,
+            face_varying_tese,
             referenced("FVarArray", size_of::<u32>()),
         ),
         (
@@ -1012,10 +1018,10 @@ fn the_table_covers_every_storage_binding_and_capture_build() {
         .filter(|(_, _, c)| matches!(c, Check::Xfb { .. }))
         .count();
     // Nine TESs in three spacings, the four adaptive ones and BFT's also with their surface code,
-    // BFT's also with and without its patch block; the CPU mesh's and Doo-Sabin's vertex stages,
-    // the four refinement-pattern vertex stages, PN's also in its scalar-tagged build, and BFT's
-    // with and without its surface code.
-    assert_eq!(capture_builds, 57);
+    // the adaptive ones also in their face-varying build, BFT's also with and without its patch
+    // block; the CPU mesh's and Doo-Sabin's vertex stages, the four refinement-pattern vertex
+    // stages, PN's also in its scalar-tagged build, and BFT's with and without its surface code.
+    assert_eq!(capture_builds, 81);
     assert_eq!(xfb_rows, capture_builds);
 }
 
@@ -1093,7 +1099,7 @@ fn capture_variants_and_only_they_have_xfb() {
             captures += v.capture as usize;
         }
     }
-    assert_eq!(captures, 57);
+    assert_eq!(captures, 81);
 }
 
 #[test]
@@ -1143,9 +1149,10 @@ fn plain_builds_have_no_surface_varyings() {
             checked += 1;
         }
     }
-    // Four adaptive TESs and BFT's, three spacings, capture or not, plain or surface; BFT's
-    // with and without its patch block.
-    assert_eq!(checked, 72);
+    // Four adaptive TESs and BFT's, three spacings, capture or not, plain or surface; the
+    // adaptive ones with and without their face-varying look-up, BFT's with and without its
+    // patch block.
+    assert_eq!(checked, 120);
 }
 
 /// (NoContraction decorations, GLSL.std.450 FMix calls) in a SPIR-V module.

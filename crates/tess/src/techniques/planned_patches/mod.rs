@@ -869,6 +869,12 @@ impl Technique for PlannedPatches {
         };
         PatchPipeline {
             push_constant_bytes: std::mem::size_of::<AdaptivePush>() as u32,
+            // The texture look-up of face-varying patches only where there are some (its code
+            // costs every vertex on lavapipe).
+            axes: crate::shaders::Variant {
+                face_varying: self.fvar.is_some(),
+                ..Default::default()
+            },
             ..PatchPipeline::tessellated(
                 Stage::AdaptivePatchVert,
                 control,
