@@ -1170,7 +1170,6 @@ unsafe fn create_surface(
     d: &TesseraSurfaceDesc,
     name: String,
 ) -> Result<u64> {
-    let mut mesh = mesh;
     use topology::rules::options::FVarLinearInterpolation as Fvar;
     match d.uv_interpolation {
         TESSERA_UV_INTERPOLATION_MESH => {}
