@@ -21,7 +21,9 @@ use tessera::tess::techniques::{self, TechniqueInfo};
 use tessera::tess::{BuildOptions, Capturer, Context, FrameParams, TechniqueId};
 use tessera::topology::limit::face_domain::LimitEvaluator;
 use tessera::topology::mesh::VertexCorner;
-use tessera::topology::rules::options::{BoundaryInterpolation, CreaseMethod, TriangleSubdivision};
+use tessera::topology::rules::options::{
+    BoundaryInterpolation, CreaseMethod, FVarLinearInterpolation, TriangleSubdivision,
+};
 use tessera::topology::{load_obj, ControlMesh, Scheme};
 use tessera::vk_core::vk;
 
@@ -41,11 +43,13 @@ struct Column {
     without: fn(&mut ControlMesh),
     /// The option makes holes (the cells also check that holes are not drawn).
     holes: bool,
+    /// The option shapes texture coordinates: the cells compare them, not positions.
+    texcoords: bool,
 }
 
 fn nothing(_: &mut ControlMesh, _: Scheme) {}
 
-const COLUMNS: [Column; 9] = [
+const COLUMNS: [Column; 10] = [
     Column {
         name: "boundary: edges only",
         catmark: "catmark_tent",
@@ -53,6 +57,7 @@ const COLUMNS: [Column; 9] = [
         with: nothing,
         without: |m| m.options.boundary = BoundaryInterpolation::EdgesAndCorners,
         holes: false,
+        texcoords: false,
     },
     Column {
         name: "boundary: edges and corners",
@@ -61,6 +66,7 @@ const COLUMNS: [Column; 9] = [
         with: nothing,
         without: |m| m.options.boundary = BoundaryInterpolation::EdgesOnly,
         holes: false,
+        texcoords: false,
     },
     Column {
         name: "boundary: none",
@@ -72,6 +78,7 @@ const COLUMNS: [Column; 9] = [
             m.options.boundary = BoundaryInterpolation::EdgesOnly;
         },
         holes: true,
+        texcoords: false,
     },
     Column {
         name: "holes",
@@ -84,6 +91,7 @@ const COLUMNS: [Column; 9] = [
         },
         without: |m| m.holes.clear(),
         holes: true,
+        texcoords: false,
     },
     Column {
         name: "semi-sharp creases",
@@ -92,6 +100,7 @@ const COLUMNS: [Column; 9] = [
         with: nothing,
         without: |m| m.creases.clear(),
         holes: false,
+        texcoords: false,
     },
     Column {
         name: "Chaikin creasing",
@@ -100,6 +109,7 @@ const COLUMNS: [Column; 9] = [
         with: nothing,
         without: |m| m.options.crease_method = CreaseMethod::Uniform,
         holes: false,
+        texcoords: false,
     },
     Column {
         name: "infinitely sharp creases",
@@ -112,6 +122,7 @@ const COLUMNS: [Column; 9] = [
         },
         without: |m| m.creases.clear(),
         holes: false,
+        texcoords: false,
     },
     Column {
         name: "corners",
@@ -133,6 +144,7 @@ const COLUMNS: [Column; 9] = [
         },
         without: |m| m.corners.clear(),
         holes: false,
+        texcoords: false,
     },
     Column {
         name: "smooth triangles",
@@ -141,8 +153,50 @@ const COLUMNS: [Column; 9] = [
         with: |m, _| m.options.triangle_subdivision = TriangleSubdivision::Smooth,
         without: |m| m.options.triangle_subdivision = TriangleSubdivision::Catmark,
         holes: false,
+        texcoords: false,
+    },
+    Column {
+        name: "face-varying: none",
+        catmark: "catmark_cube",
+        loop_: "loop_cube",
+        with: |m, _| {
+            with_curved_layout(m);
+            m.options.fvar_interpolation = FVarLinearInterpolation::None;
+        },
+        without: |m| m.options.fvar_interpolation = FVarLinearInterpolation::All,
+        holes: false,
+        texcoords: true,
     },
 ];
+
+/// A continuous layout, one value per vertex (`vt` numbered as the vertices), curved in the
+/// positions: `(x + 0.3 y², y − 0.2 x² + 0.1 z)`.
+fn with_curved_layout(mesh: &mut ControlMesh) {
+    let uv = |p: [f64; 3]| {
+        [
+            p[0] + 0.3 * p[1] * p[1],
+            p[1] - 0.2 * p[0] * p[0] + 0.1 * p[2],
+        ]
+    };
+    let uvs = mesh
+        .face_vertices
+        .iter()
+        .map(|&v| uv(mesh.positions[v as usize]));
+    mesh.uvs = Some(uvs.collect());
+    mesh.uv_indices = Some(mesh.face_vertices.clone());
+}
+
+/// The mesh with its (continuous) texture coordinates as positions `(u, v, 0)`: its limit is
+/// the texture coordinates' limit under face-varying mode `none`.
+fn uvs_as_positions(mesh: &ControlMesh) -> ControlMesh {
+    let mut out = mesh.clone();
+    let uvs = mesh.uvs.as_ref().expect("uvs");
+    for (c, &v) in mesh.face_vertices.iter().enumerate() {
+        out.positions[v as usize] = [uvs[c][0], uvs[c][1], 0.0];
+    }
+    (out.uvs, out.uv_indices) = (None, None);
+    out
+}
 
 /// What a technique does with an option.
 #[derive(Clone, Copy, Debug)]
@@ -179,8 +233,10 @@ impl Cell {
 const INTERPOLANT: Cell = Cell::Ignored("interpolates the control mesh: not a subdivision surface");
 const CATMARK_RULE: Cell = Cell::Ignored("a Catmull-Clark rule");
 
+const NO_TEXCOORDS: Cell = Cell::Ignored("draws no texture coordinates");
+
 /// The row of technique `id`, one cell per column of [`COLUMNS`].
-fn row(id: TechniqueId) -> [Cell; 9] {
+fn row(id: TechniqueId) -> [Cell; 10] {
     use Cell::*;
     let holes = Exact;
     match id.name() {
@@ -194,6 +250,7 @@ fn row(id: TechniqueId) -> [Cell; 9] {
             INTERPOLANT,
             INTERPOLANT,
             INTERPOLANT,
+            NO_TEXCOORDS,
         ],
         "bft" | "cpu" => [
             Exact,
@@ -205,11 +262,24 @@ fn row(id: TechniqueId) -> [Cell; 9] {
             Exact,
             Exact,
             CATMARK_RULE,
+            NO_TEXCOORDS,
         ],
-        "adaptive" | "cpu-catmark" => [Exact; 9],
+        "adaptive" => [Exact; 10],
+        "cpu-catmark" => [
+            Exact,
+            Exact,
+            Exact,
+            Exact,
+            Exact,
+            Exact,
+            Exact,
+            Exact,
+            Exact,
+            NO_TEXCOORDS,
+        ],
         // One patch per base face: the bounds are those measured on the column's shape at 4
         // segments, with a margin (docs/options.md has the figures).
-        "gregory" | "acc" => [2e-3, 1e-5, 1e-3, 1e-2, 4e-2, 3e-2, 4e-2, 0.15, 1e-2]
+        "gregory" | "acc" => [2e-3, 1e-5, 1e-3, 1e-2, 4e-2, 3e-2, 4e-2, 0.15, 1e-2, 2e-2]
             .map(|bound| Approximated("one patch per base face", bound)),
         "doo-sabin" | "cpu-doo-sabin" => [
             Approximated("the refined mesh at depth D", 6e-2),
@@ -221,6 +291,7 @@ fn row(id: TechniqueId) -> [Cell; 9] {
             Refused("has no creases"),
             Refused("has no sharp vertices"),
             CATMARK_RULE,
+            NO_TEXCOORDS,
         ],
         other => panic!("{other}: no row in the option table"),
     }
@@ -319,6 +390,40 @@ fn limit_deviation(c: &Captured, mesh: &ControlMesh, scheme: Scheme, planned: bo
     (held, elsewhere)
 }
 
+/// As [`limit_deviation`], for the texture coordinates the technique shows at each captured
+/// vertex (`Technique::texcoord`, the shaders' evaluation on the host) against the exact
+/// Catmull-Clark limit of the layout taken as positions (mode `none` with the layout's
+/// topology the mesh's), over the layout's diagonal.
+fn texcoord_deviation(c: &Captured, mesh: &ControlMesh, planned: bool) -> (f64, f64) {
+    let layout = uvs_as_positions(mesh);
+    let limit = LimitEvaluator::of_scheme(&layout, Scheme::CatmullClark).expect("exact limit");
+    let diagonal = layout.bbox_diagonal();
+    let (mut held, mut elsewhere) = (0.0f64, 0.0f64);
+    for r in &c.soup.records {
+        let at = c
+            .technique
+            .face_point(r.patch, r.domain)
+            .expect("a base face");
+        let uv = c
+            .technique
+            .texcoord(r.patch, r.domain, false)
+            .unwrap_or_else(|| panic!("patch {} shows no texture coordinate", r.patch));
+        let e = limit
+            .evaluate(at.face, at.u as f64, at.v as f64)
+            .expect("limit");
+        let d = (0..2)
+            .map(|k| (uv[k] - e.position[k]).abs())
+            .fold(0.0, f64::max)
+            / diagonal;
+        if !planned || r.flags & 15 == ADAPTIVE_KIND_REGULAR {
+            held = held.max(d);
+        } else {
+            elsewhere = elsewhere.max(d);
+        }
+    }
+    (held, elsewhere)
+}
+
 /// No captured vertex lies inside a hole (a vertex on its border belongs to a neighbour too;
 /// at four segments every drawn face has vertices inside it). The holes of the option shapes
 /// are triangles and quads.
@@ -376,6 +481,12 @@ fn check_cell(
             if bits(&drawn) != bits(&plain) {
                 return Err("the capture differs from the one without the option".into());
             }
+            let shown = |r: &tessera::tess::CaptureRecord| {
+                drawn.technique.texcoord(r.patch, r.domain, false).is_some()
+            };
+            if column.texcoords && drawn.soup.records.iter().any(shown) {
+                return Err("it shows texture coordinates".into());
+            }
             Ok(format!(
                 "{} corners, bit-identical without it",
                 drawn.soup.records.len()
@@ -393,7 +504,11 @@ fn check_cell(
             ))
         }
         Cell::Exact => {
-            let (held, elsewhere) = limit_deviation(&drawn, &with, scheme, planned);
+            let (held, elsewhere) = if column.texcoords {
+                texcoord_deviation(&drawn, &with, planned)
+            } else {
+                limit_deviation(&drawn, &with, scheme, planned)
+            };
             if held > 1e-5 {
                 return Err(format!("{held:.1e} from the exact limit"));
             }
@@ -404,7 +519,11 @@ fn check_cell(
             })
         }
         Cell::Approximated(_, bound) => {
-            let (held, elsewhere) = limit_deviation(&drawn, &with, scheme, planned);
+            let (held, elsewhere) = if column.texcoords {
+                texcoord_deviation(&drawn, &with, planned)
+            } else {
+                limit_deviation(&drawn, &with, scheme, planned)
+            };
             let worst = held.max(elsewhere);
             if worst > bound {
                 return Err(format!(
