@@ -38,38 +38,9 @@ fn curved_grid(n: usize, mode: Mode) -> ControlMesh {
         .map(|(i, j)| [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)])
         .collect();
     let mut mesh = ControlMesh::from_polygons(positions, &faces);
-    with_curved_layout(&mut mesh);
+    common::with_curved_layout(&mut mesh);
     mesh.options.fvar_interpolation = mode;
     mesh
-}
-
-/// Gives `mesh` the continuous layout `(x + 0.3 y², y − 0.2 x² + 0.1 z)` of its positions.
-fn with_curved_layout(mesh: &mut ControlMesh) {
-    let uv = |p: [f64; 3]| {
-        [
-            p[0] + 0.3 * p[1] * p[1],
-            p[1] - 0.2 * p[0] * p[0] + 0.1 * p[2],
-        ]
-    };
-    mesh.uvs = Some(
-        mesh.face_vertices
-            .iter()
-            .map(|&v| uv(mesh.positions[v as usize]))
-            .collect(),
-    );
-    mesh.uv_indices = Some(mesh.face_vertices.clone());
-}
-
-/// The mesh with its (continuous) texture coordinates as positions `(u, v, 0)`.
-fn uvs_as_positions(mesh: &ControlMesh) -> ControlMesh {
-    let mut out = mesh.clone();
-    let uvs = mesh.uvs.as_ref().expect("uvs");
-    for (c, &v) in mesh.face_vertices.iter().enumerate() {
-        out.positions[v as usize] = [uvs[c][0], uvs[c][1], 0.0];
-    }
-    out.uvs = None;
-    out.uv_indices = None;
-    out
 }
 
 fn surface(ctx: &mut Context, mesh: &ControlMesh, name: &str) -> PlannedPatches {
@@ -151,7 +122,7 @@ fn export(
 /// Worst distance, over the layout's range, between each exported corner's `vt` and the exact
 /// limit of the coordinates as positions at its vertex's `# p` point.
 fn worst_against_limit(mesh: &ControlMesh, e: &Exported) -> f64 {
-    let uv_mesh = uvs_as_positions(mesh);
+    let uv_mesh = common::uvs_as_positions(mesh);
     let exact = LimitEvaluator::new(&uv_mesh, LimitScheme::CatmullClark).expect("evaluator");
     let (lo, hi) = uv_mesh.bounding_box();
     let range = (hi[0] - lo[0]).max(hi[1] - lo[1]);
@@ -217,7 +188,7 @@ fn none_is_the_exact_limit_of_the_coordinates_and_all_is_bilinear() {
             "tests/data/opensubdiv/shapes/catmark_cube.obj",
         ))
         .expect("cube");
-        with_curved_layout(&mut cube);
+        common::with_curved_layout(&mut cube);
         cube.options.fvar_interpolation = Mode::None;
         let mut surf = surface(&mut ctx, &cube, "cube none");
         let (_, e) = export(&mut ctx, &capturer, &mut surf, "cube");

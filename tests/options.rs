@@ -160,7 +160,7 @@ const COLUMNS: [Column; 10] = [
         catmark: "catmark_cube",
         loop_: "loop_cube",
         with: |m, _| {
-            with_curved_layout(m);
+            common::with_curved_layout(m);
             m.options.fvar_interpolation = FVarLinearInterpolation::None;
         },
         without: |m| m.options.fvar_interpolation = FVarLinearInterpolation::All,
@@ -168,35 +168,6 @@ const COLUMNS: [Column; 10] = [
         texcoords: true,
     },
 ];
-
-/// A continuous layout, one value per vertex (`vt` numbered as the vertices), curved in the
-/// positions: `(x + 0.3 y², y − 0.2 x² + 0.1 z)`.
-fn with_curved_layout(mesh: &mut ControlMesh) {
-    let uv = |p: [f64; 3]| {
-        [
-            p[0] + 0.3 * p[1] * p[1],
-            p[1] - 0.2 * p[0] * p[0] + 0.1 * p[2],
-        ]
-    };
-    let uvs = mesh
-        .face_vertices
-        .iter()
-        .map(|&v| uv(mesh.positions[v as usize]));
-    mesh.uvs = Some(uvs.collect());
-    mesh.uv_indices = Some(mesh.face_vertices.clone());
-}
-
-/// The mesh with its (continuous) texture coordinates as positions `(u, v, 0)`: its limit is
-/// the texture coordinates' limit under face-varying mode `none`.
-fn uvs_as_positions(mesh: &ControlMesh) -> ControlMesh {
-    let mut out = mesh.clone();
-    let uvs = mesh.uvs.as_ref().expect("uvs");
-    for (c, &v) in mesh.face_vertices.iter().enumerate() {
-        out.positions[v as usize] = [uvs[c][0], uvs[c][1], 0.0];
-    }
-    (out.uvs, out.uv_indices) = (None, None);
-    out
-}
 
 /// What a technique does with an option.
 #[derive(Clone, Copy, Debug)]
@@ -362,57 +333,48 @@ fn bits(c: &Captured) -> Vec<[u32; 7]> {
         .collect()
 }
 
-/// (worst distance over the diagonal on the vertices held exact, worst elsewhere): the
-/// captured positions against the exact limit of `scheme` at each vertex's own point. The
+/// (worst distance over the diagonal on the vertices held exact, worst elsewhere): what each
+/// captured vertex shows against the exact limit of `scheme` at the vertex's own point. The
 /// planned techniques hold their B-spline patches exact; the others every vertex.
-fn limit_deviation(c: &Captured, mesh: &ControlMesh, scheme: Scheme, planned: bool) -> (f64, f64) {
-    let limit = LimitEvaluator::of_scheme(mesh, scheme).expect("exact limit");
-    let diagonal = mesh.bbox_diagonal();
+/// - positions (`texcoords` false): the captured position against `mesh`'s limit;
+/// - texture coordinates (`texcoords` true): the coordinate the technique shows there
+///   (`Technique::texcoord`, the shaders' evaluation on the host) against the Catmull-Clark
+///   limit of the layout taken as positions (mode `none`, the layout's topology the mesh's),
+///   over the layout's diagonal.
+fn limit_deviation(
+    c: &Captured,
+    mesh: &ControlMesh,
+    scheme: Scheme,
+    planned: bool,
+    texcoords: bool,
+) -> (f64, f64) {
+    let (surface, scheme) = if texcoords {
+        (common::uvs_as_positions(mesh), Scheme::CatmullClark)
+    } else {
+        (mesh.clone(), scheme)
+    };
+    let limit = LimitEvaluator::of_scheme(&surface, scheme).expect("exact limit");
+    let diagonal = surface.bbox_diagonal();
     let (mut held, mut elsewhere) = (0.0f64, 0.0f64);
     for r in &c.soup.records {
         let at = c
             .technique
             .face_point(r.patch, r.domain)
             .unwrap_or_else(|| panic!("a vertex of patch {} maps to no base face", r.patch));
+        let shown = if texcoords {
+            let uv = c
+                .technique
+                .texcoord(r.patch, r.domain, false)
+                .unwrap_or_else(|| panic!("patch {} shows no texture coordinate", r.patch));
+            [uv[0], uv[1], 0.0]
+        } else {
+            r.position.map(f64::from)
+        };
         let e = limit
             .evaluate(at.face, at.u as f64, at.v as f64)
             .expect("limit");
         let d = (0..3)
-            .map(|k| (r.position[k] as f64 - e.position[k]).abs())
-            .fold(0.0, f64::max)
-            / diagonal;
-        if !planned || r.flags & 15 == ADAPTIVE_KIND_REGULAR {
-            held = held.max(d);
-        } else {
-            elsewhere = elsewhere.max(d);
-        }
-    }
-    (held, elsewhere)
-}
-
-/// As [`limit_deviation`], for the texture coordinates the technique shows at each captured
-/// vertex (`Technique::texcoord`, the shaders' evaluation on the host) against the exact
-/// Catmull-Clark limit of the layout taken as positions (mode `none` with the layout's
-/// topology the mesh's), over the layout's diagonal.
-fn texcoord_deviation(c: &Captured, mesh: &ControlMesh, planned: bool) -> (f64, f64) {
-    let layout = uvs_as_positions(mesh);
-    let limit = LimitEvaluator::of_scheme(&layout, Scheme::CatmullClark).expect("exact limit");
-    let diagonal = layout.bbox_diagonal();
-    let (mut held, mut elsewhere) = (0.0f64, 0.0f64);
-    for r in &c.soup.records {
-        let at = c
-            .technique
-            .face_point(r.patch, r.domain)
-            .expect("a base face");
-        let uv = c
-            .technique
-            .texcoord(r.patch, r.domain, false)
-            .unwrap_or_else(|| panic!("patch {} shows no texture coordinate", r.patch));
-        let e = limit
-            .evaluate(at.face, at.u as f64, at.v as f64)
-            .expect("limit");
-        let d = (0..2)
-            .map(|k| (uv[k] - e.position[k]).abs())
+            .map(|k| (shown[k] - e.position[k]).abs())
             .fold(0.0, f64::max)
             / diagonal;
         if !planned || r.flags & 15 == ADAPTIVE_KIND_REGULAR {
@@ -504,11 +466,8 @@ fn check_cell(
             ))
         }
         Cell::Exact => {
-            let (held, elsewhere) = if column.texcoords {
-                texcoord_deviation(&drawn, &with, planned)
-            } else {
-                limit_deviation(&drawn, &with, scheme, planned)
-            };
+            let (held, elsewhere) =
+                limit_deviation(&drawn, &with, scheme, planned, column.texcoords);
             if held > 1e-5 {
                 return Err(format!("{held:.1e} from the exact limit"));
             }
@@ -519,11 +478,8 @@ fn check_cell(
             })
         }
         Cell::Approximated(_, bound) => {
-            let (held, elsewhere) = if column.texcoords {
-                texcoord_deviation(&drawn, &with, planned)
-            } else {
-                limit_deviation(&drawn, &with, scheme, planned)
-            };
+            let (held, elsewhere) =
+                limit_deviation(&drawn, &with, scheme, planned, column.texcoords);
             let worst = held.max(elsewhere);
             if worst > bound {
                 return Err(format!(

@@ -177,3 +177,32 @@ pub fn strip_faces(k: u32, triangles: bool) -> Vec<Vec<u32>> {
     }
     faces
 }
+
+/// Gives `mesh` a continuous texture layout curved in its positions, one value per vertex (the
+/// layout's topology is the mesh's): `(x + 0.3 y², y − 0.2 x² + 0.1 z)`.
+pub fn with_curved_layout(mesh: &mut tessera::topology::ControlMesh) {
+    let uv = |p: [f64; 3]| {
+        [
+            p[0] + 0.3 * p[1] * p[1],
+            p[1] - 0.2 * p[0] * p[0] + 0.1 * p[2],
+        ]
+    };
+    let uvs = mesh
+        .face_vertices
+        .iter()
+        .map(|&v| uv(mesh.positions[v as usize]));
+    mesh.uvs = Some(uvs.collect());
+    mesh.uv_indices = Some(mesh.face_vertices.clone());
+}
+
+/// The mesh with its (continuous) texture coordinates as positions `(u, v, 0)`: under
+/// face-varying mode `none` its limit is the texture coordinates' limit.
+pub fn uvs_as_positions(mesh: &tessera::topology::ControlMesh) -> tessera::topology::ControlMesh {
+    let mut out = mesh.clone();
+    let uvs = mesh.uvs.as_ref().expect("uvs");
+    for (c, &v) in mesh.face_vertices.iter().enumerate() {
+        out.positions[v as usize] = [uvs[c][0], uvs[c][1], 0.0];
+    }
+    (out.uvs, out.uv_indices) = (None, None);
+    out
+}
