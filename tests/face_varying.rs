@@ -272,15 +272,18 @@ fn the_shaders_texture_coordinates_are_the_hosts() {
                 _ => planned_patches::single_pass(
                     &mut ctx,
                     &mesh,
-                    if kind == "acc" {
-                        SinglePassPatch::Acc1
-                    } else {
-                        SinglePassPatch::Gregory
+                    &planned_patches::SinglePassBuild {
+                        patch: if kind == "acc" {
+                            SinglePassPatch::Acc1
+                        } else {
+                            SinglePassPatch::Gregory
+                        },
+                        sharpness_scale: 1.0,
+                        gregory_triangles: true,
+                        name: mode.name(),
+                        maps: &SurfaceMaps::default(),
+                        path: tessera::tess::DrawPath::Tessellation,
                     },
-                    1.0,
-                    true,
-                    mode.name(),
-                    &SurfaceMaps::default(),
                 )
                 .expect("single-pass surface"),
             };

@@ -152,11 +152,14 @@ fn captured_vertices_against_the_exact_limit() {
                 let mut surf = planned_patches::single_pass(
                     &mut ctx,
                     &mesh,
-                    patch,
-                    1.0,
-                    true,
-                    name,
-                    &Default::default(),
+                    &planned_patches::SinglePassBuild {
+                        patch: patch,
+                        sharpness_scale: 1.0,
+                        gregory_triangles: true,
+                        name: name,
+                        maps: &Default::default(),
+                        path: tessera::tess::DrawPath::Tessellation,
+                    },
                 )
                 .expect("build");
                 let (soup, _) = capturer
@@ -219,11 +222,14 @@ fn every_catmark_shape_welds_and_stays_near_the_limit() {
                 let mut surf = match planned_patches::single_pass(
                     &mut ctx,
                     &mesh,
-                    patch,
-                    1.0,
-                    true,
-                    name,
-                    &Default::default(),
+                    &planned_patches::SinglePassBuild {
+                        patch: patch,
+                        sharpness_scale: 1.0,
+                        gregory_triangles: true,
+                        name: name,
+                        maps: &Default::default(),
+                        path: tessera::tess::DrawPath::Tessellation,
+                    },
                 ) {
                     Ok(s) => s,
                     Err(e) => {
@@ -298,11 +304,14 @@ fn watertight_under_every_factor_policy() {
                 let mut surf = planned_patches::single_pass(
                     &mut ctx,
                     &mesh,
-                    patch,
-                    1.0,
-                    true,
-                    name,
-                    &Default::default(),
+                    &planned_patches::SinglePassBuild {
+                        patch: patch,
+                        sharpness_scale: 1.0,
+                        gregory_triangles: true,
+                        name: name,
+                        maps: &Default::default(),
+                        path: tessera::tess::DrawPath::Tessellation,
+                    },
                 )
                 .expect("build");
                 let mut maps_surface = None;
@@ -351,7 +360,16 @@ fn watertight_under_every_factor_policy() {
                                 )),
                             };
                             planned_patches::single_pass(
-                                &mut ctx, &mesh, patch, 1.0, true, name, &maps,
+                                &mut ctx,
+                                &mesh,
+                                &planned_patches::SinglePassBuild {
+                                    patch: patch,
+                                    sharpness_scale: 1.0,
+                                    gregory_triangles: true,
+                                    name: name,
+                                    maps: &maps,
+                                    path: tessera::tess::DrawPath::Tessellation,
+                                },
                             )
                             .expect("build")
                         })
@@ -401,11 +419,14 @@ fn bad_input_gives_named_errors() {
             let e = planned_patches::single_pass(
                 &mut ctx,
                 &mesh,
-                SinglePassPatch::Gregory,
-                scale,
-                true,
-                "cube",
-                &Default::default(),
+                &planned_patches::SinglePassBuild {
+                    patch: SinglePassPatch::Gregory,
+                    sharpness_scale: scale,
+                    gregory_triangles: true,
+                    name: "cube",
+                    maps: &Default::default(),
+                    path: tessera::tess::DrawPath::Tessellation,
+                },
             )
             .err()
             .expect("refused");
@@ -427,21 +448,27 @@ fn bad_input_gives_named_errors() {
         assert!(planned_patches::single_pass(
             &mut ctx,
             &fan,
-            SinglePassPatch::Acc1,
-            1.0,
-            true,
-            "fan",
-            &Default::default()
+            &planned_patches::SinglePassBuild {
+                patch: SinglePassPatch::Acc1,
+                sharpness_scale: 1.0,
+                gregory_triangles: true,
+                name: "fan",
+                maps: &Default::default(),
+                path: tessera::tess::DrawPath::Tessellation
+            }
         )
         .is_err());
         let ok = planned_patches::single_pass(
             &mut ctx,
             &mesh,
-            SinglePassPatch::Gregory,
-            1.0,
-            true,
-            "cube",
-            &Default::default(),
+            &planned_patches::SinglePassBuild {
+                patch: SinglePassPatch::Gregory,
+                sharpness_scale: 1.0,
+                gregory_triangles: true,
+                name: "cube",
+                maps: &Default::default(),
+                path: tessera::tess::DrawPath::Tessellation,
+            },
         )
         .expect("cube");
         for bad in [
@@ -466,7 +493,16 @@ fn bad_input_gives_named_errors() {
         };
         for patch in PATCHES {
             let e = planned_patches::single_pass(
-                &mut ctx, &bare, patch, 1.0, true, "bare.obj", &textured,
+                &mut ctx,
+                &bare,
+                &planned_patches::SinglePassBuild {
+                    patch: patch,
+                    sharpness_scale: 1.0,
+                    gregory_triangles: true,
+                    name: "bare.obj",
+                    maps: &textured,
+                    path: tessera::tess::DrawPath::Tessellation,
+                },
             )
             .err()
             .expect("texture without vt");
@@ -488,11 +524,14 @@ fn bad_input_gives_named_errors() {
             let e = planned_patches::single_pass(
                 &mut ctx,
                 &bare,
-                patch,
-                1.0,
-                true,
-                "bare.obj",
-                &height_only,
+                &planned_patches::SinglePassBuild {
+                    patch: patch,
+                    sharpness_scale: 1.0,
+                    gregory_triangles: true,
+                    name: "bare.obj",
+                    maps: &height_only,
+                    path: tessera::tess::DrawPath::Tessellation,
+                },
             )
             .err()
             .expect("height map without vt");
@@ -505,21 +544,27 @@ fn bad_input_gives_named_errors() {
         assert!(planned_patches::single_pass(
             &mut ctx,
             &bare,
-            SinglePassPatch::Gregory,
-            1.0,
-            true,
-            "bare.obj",
-            &Default::default()
+            &planned_patches::SinglePassBuild {
+                patch: SinglePassPatch::Gregory,
+                sharpness_scale: 1.0,
+                gregory_triangles: true,
+                name: "bare.obj",
+                maps: &Default::default(),
+                path: tessera::tess::DrawPath::Tessellation
+            }
         )
         .is_ok());
         assert!(planned_patches::single_pass(
             &mut ctx,
             &mesh,
-            SinglePassPatch::Gregory,
-            1.0,
-            true,
-            "cube",
-            &textured
+            &planned_patches::SinglePassBuild {
+                patch: SinglePassPatch::Gregory,
+                sharpness_scale: 1.0,
+                gregory_triangles: true,
+                name: "cube",
+                maps: &textured,
+                path: tessera::tess::DrawPath::Tessellation
+            }
         )
         .is_ok());
         // The Eq. 1 view needs the lattice, which is built only on request.
@@ -588,11 +633,14 @@ fn param_error_view_follows_the_cpu_lattice() {
     let mut surf = planned_patches::single_pass(
         &mut ctx,
         &edgecorner,
-        SinglePassPatch::Gregory,
-        1.0,
-        true,
-        "edgecorner",
-        &maps,
+        &planned_patches::SinglePassBuild {
+            patch: SinglePassPatch::Gregory,
+            sharpness_scale: 1.0,
+            gregory_triangles: true,
+            name: "edgecorner",
+            maps: &maps,
+            path: tessera::tess::DrawPath::Tessellation,
+        },
     )
     .expect("build");
     let hues = surface_hues(&render(&mut ctx, &mut surf, true));
@@ -609,9 +657,19 @@ fn param_error_view_follows_the_cpu_lattice() {
 
     let spot = shape("spot");
     for patch in [SinglePassPatch::Gregory, SinglePassPatch::Acc1] {
-        let mut surf =
-            planned_patches::single_pass(&mut ctx, &spot, patch, 1.0, true, "spot", &maps)
-                .expect("build");
+        let mut surf = planned_patches::single_pass(
+            &mut ctx,
+            &spot,
+            &planned_patches::SinglePassBuild {
+                patch: patch,
+                sharpness_scale: 1.0,
+                gregory_triangles: true,
+                name: "spot",
+                maps: &maps,
+                path: tessera::tess::DrawPath::Tessellation,
+            },
+        )
+        .expect("build");
         let note = surf.param_error_note().expect("a lattice summary");
         println!("{note}");
         let patches: u32 = surf.patch_counts().iter().sum();
@@ -663,11 +721,14 @@ fn acc_tangent_patch_normals_on_the_gpu() {
         let mut surf = planned_patches::single_pass(
             &mut ctx,
             &mesh,
-            SinglePassPatch::Acc1,
-            1.0,
-            true,
-            name,
-            &Default::default(),
+            &planned_patches::SinglePassBuild {
+                patch: SinglePassPatch::Acc1,
+                sharpness_scale: 1.0,
+                gregory_triangles: true,
+                name: name,
+                maps: &Default::default(),
+                path: tessera::tess::DrawPath::Tessellation,
+            },
         )
         .expect("build");
         let (soup, _) = capturer
@@ -764,9 +825,19 @@ fn displaced_surfaces_shade_with_displaced_normals() {
         ("height map", height, 32.0, 0.5),
     ] {
         for patch in PATCHES {
-            let mut surf =
-                planned_patches::single_pass(&mut ctx, &mesh, patch, 1.0, true, "spot", &maps)
-                    .expect("build");
+            let mut surf = planned_patches::single_pass(
+                &mut ctx,
+                &mesh,
+                &planned_patches::SinglePassBuild {
+                    patch: patch,
+                    sharpness_scale: 1.0,
+                    gregory_triangles: true,
+                    name: "spot",
+                    maps: &maps,
+                    path: tessera::tess::DrawPath::Tessellation,
+                },
+            )
+            .expect("build");
             let mut capture = |ctx: &mut Context, displace: f32| {
                 capturer
                     .capture(
@@ -886,22 +957,28 @@ fn gregory_triangle_patches_on_the_gpu() {
             let mut surf = planned_patches::single_pass(
                 &mut ctx,
                 &mesh,
-                patch,
-                1.0,
-                true,
-                name,
-                &Default::default(),
+                &planned_patches::SinglePassBuild {
+                    patch: patch,
+                    sharpness_scale: 1.0,
+                    gregory_triangles: true,
+                    name: name,
+                    maps: &Default::default(),
+                    path: tessera::tess::DrawPath::Tessellation,
+                },
             )
             .expect("build");
             assert_eq!(surf.patch_counts()[3], triangles, "{name} {patch:?}");
             let split = planned_patches::single_pass(
                 &mut ctx,
                 &mesh,
-                patch,
-                1.0,
-                false,
-                name,
-                &Default::default(),
+                &planned_patches::SinglePassBuild {
+                    patch: patch,
+                    sharpness_scale: 1.0,
+                    gregory_triangles: false,
+                    name: name,
+                    maps: &Default::default(),
+                    path: tessera::tess::DrawPath::Tessellation,
+                },
             )
             .expect("build");
             assert_eq!(split.patch_counts()[3], 0, "{name} {patch:?} split");

@@ -376,7 +376,8 @@ fn without_tessellation_shaders_the_base_face_techniques_draw_generated_patterns
         for (id, choice) in [
             (TechniqueId::FLAT, PipelineChoice::Tessellation),
             (TechniqueId::BFT, PipelineChoice::Tessellation),
-            (TechniqueId::ADAPTIVE, PipelineChoice::Auto),
+            (TechniqueId::ADAPTIVE, PipelineChoice::Tessellation),
+            (TechniqueId::CPU, PipelineChoice::Tessellation),
         ] {
             match build(&mut ctx, id, &cube, choice) {
                 Err(e @ TessError::NoTessellationShader { .. }) => {
@@ -576,4 +577,164 @@ fn exact_limit_error(t: &dyn Technique, soup: &CapturedSoup, cpu: &LocalMesh) ->
         worst = worst.max(d);
     }
     worst
+}
+
+/// The planned Catmull-Clark surfaces (feature-adaptive, Gregory, ACC-1), which evaluate at a
+/// patch domain point.
+const PLANNED_TECHNIQUES: [TechniqueId; 3] = [
+    TechniqueId::ADAPTIVE,
+    TechniqueId::GREGORY,
+    TechniqueId::ACC,
+];
+
+fn build_isolated(
+    ctx: &mut Context,
+    id: TechniqueId,
+    mesh: &ControlMesh,
+    pipeline: PipelineChoice,
+) -> tessera::tess::Result<Box<dyn Technique>> {
+    let options = BuildOptions {
+        name: "patterns test".into(),
+        pipeline,
+        isolation: 2,
+        ..BuildOptions::default()
+    };
+    Ok(tessera::tess::build(ctx, id, mesh, &options)?.technique)
+}
+
+/// Samples of `pattern` at the tessellation path's domain points, and how many of them differ
+/// in any bit from `tess`'s; every pattern sample must have such a point.
+fn compare_samples(tess: &CapturedSoup, pattern: &CapturedSoup, what: &str) -> usize {
+    let (a, b) = (samples(tess), samples(pattern));
+    let missing: Vec<_> = b.keys().filter(|k| !a.contains_key(k)).take(4).collect();
+    assert!(
+        missing.is_empty(),
+        "{what}: pattern samples at points the tessellator never emits: {missing:?}"
+    );
+    let differing = b.iter().filter(|(k, v)| a.get(k) != Some(v)).count();
+    assert_eq!(differing, 0, "{what}: of {} samples", b.len());
+    b.len()
+}
+
+/// The planned Catmull-Clark surfaces on the refinement-pattern path, with the device's
+/// tessellator: one pattern per edge-level key (a transition patch's doubled edge has its own),
+/// the uniform ones the tessellator's own. Every pattern vertex lies at a domain point the
+/// tessellation path also emits and has its bits there (so it is the limit, or the end cap,
+/// exactly as that path draws it); the surface is welded by bits with 0 cracks, also animated;
+/// screen-space factors and fractional spacing are refused there by name, and `auto` keeps the
+/// tessellation stage.
+#[test]
+fn planned_patches_draw_the_tessellation_paths_bits_through_patterns() {
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let mut compared = 0;
+        for id in PLANNED_TECHNIQUES {
+            for (name, mesh) in [("spot", spot()), ("cube", cube())] {
+                let mut tess =
+                    build_isolated(&mut ctx, id, &mesh, PipelineChoice::Tessellation).unwrap();
+                let mut pattern =
+                    build_isolated(&mut ctx, id, &mesh, PipelineChoice::Pattern).unwrap();
+                assert!(pattern
+                    .patch_arrays()
+                    .iter()
+                    .all(|a| a.patch.path() == DrawPath::Pattern));
+                for (level, time) in [(1.0, 0.0), (2.0, 0.0), (3.0, 0.0), (8.0, 0.0), (4.0, 0.37)] {
+                    let what = format!("{id} on {name}, level {level}, time {time}");
+                    if time != 0.0 {
+                        let moved = tessera::tess::animation::Wave::new(&mesh).at(time);
+                        tess.update_base(0, &moved).unwrap();
+                        pattern.update_base(0, &moved).unwrap();
+                    }
+                    let p = params(level, Spacing::Equal);
+                    let a = capture(&mut ctx, tess.as_mut(), &p);
+                    let b = capture(&mut ctx, pattern.as_mut(), &p);
+                    compared += compare_samples(&a, &b, &what);
+                    let welded = b.weld().unwrap();
+                    let report = welded.open_edges();
+                    let map = |p: u32, d: [f32; 2]| pattern.face_point(p, d);
+                    let c = classify_open_edges(&b, &welded, &report, &map, &mesh);
+                    assert_eq!((c.cracks, c.unmapped), (0, 0), "{what}");
+                }
+                for refused in [
+                    FrameParams {
+                        factors: tessera::tess::FactorPolicy::Screen { pixels: 8.0 },
+                        ..params(4.0, Spacing::Equal)
+                    },
+                    params(4.0, Spacing::FractionalEven),
+                ] {
+                    let e = ctx.prepare(pattern.as_mut(), &refused, &[tessera::tess::Pass::Shaded]);
+                    assert!(e.is_err(), "{id}: {refused:?} drawn through patterns");
+                }
+            }
+            let auto = build_isolated(&mut ctx, id, &cube(), PipelineChoice::Auto).unwrap();
+            assert!(auto
+                .patch_arrays()
+                .iter()
+                .all(|a| a.patch.path() == DrawPath::Tessellation));
+        }
+        println!("{compared} planned-patch samples bit-identical on both paths");
+    }
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+}
+
+/// Without tessellation shaders `auto` draws the planned surfaces through generated patterns,
+/// welded by bits with 0 cracks; each vertex at a domain point a tessellator's path also
+/// emits has that path's bits (the reference drawn on a device with one).
+#[test]
+fn without_tessellation_shaders_the_planned_patches_draw_generated_patterns() {
+    let mesh = spot();
+    let level = 4.0;
+    let reference: Vec<Samples> = {
+        let gpu = Gpu::new();
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let out = PLANNED_TECHNIQUES
+            .iter()
+            .map(|&id| {
+                let mut t =
+                    build_isolated(&mut ctx, id, &mesh, PipelineChoice::Tessellation).unwrap();
+                samples(&capture(
+                    &mut ctx,
+                    t.as_mut(),
+                    &params(level, Spacing::Equal),
+                ))
+            })
+            .collect();
+        drop(ctx);
+        assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+        out
+    };
+    let gpu = Gpu::with(&DeviceDesc {
+        without_tessellation_shader: true,
+        ..DeviceDesc::default()
+    });
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        for (id, want) in PLANNED_TECHNIQUES.into_iter().zip(&reference) {
+            let mut t = build_isolated(&mut ctx, id, &mesh, PipelineChoice::Auto).unwrap();
+            assert!(t
+                .patch_arrays()
+                .iter()
+                .all(|a| a.patch.path() == DrawPath::Pattern));
+            let soup = capture(&mut ctx, t.as_mut(), &params(level, Spacing::Equal));
+            let welded = soup.weld().unwrap();
+            let report = welded.open_edges();
+            let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
+            let c = classify_open_edges(&soup, &welded, &report, &map, &mesh);
+            assert_eq!((c.cracks, c.unmapped), (0, 0), "{id}");
+            let got = samples(&soup);
+            let common = got.keys().filter(|k| want.contains_key(k)).count();
+            let differing = got
+                .iter()
+                .filter(|(k, v)| want.get(k).is_some_and(|w| w != *v))
+                .count();
+            println!(
+                "{id}: {} samples, {common} at the tessellation path's points",
+                got.len()
+            );
+            assert_eq!(differing, 0, "{id}: of {common} common samples");
+            assert!(common * 2 > got.len(), "{id}: {common} of {}", got.len());
+        }
+    }
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
 }

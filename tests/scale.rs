@@ -228,7 +228,18 @@ fn planned_run(
         let capturer = Capturer::new(&ctx).expect("capturer");
         let maps = Default::default();
         let single = |ctx: &mut Context, patch| {
-            planned_patches::single_pass(ctx, mesh, patch, 1.0, true, which, &maps)
+            planned_patches::single_pass(
+                ctx,
+                mesh,
+                &planned_patches::SinglePassBuild {
+                    patch: patch,
+                    sharpness_scale: 1.0,
+                    gregory_triangles: true,
+                    name: which,
+                    maps: &maps,
+                    path: tessera::tess::DrawPath::Tessellation,
+                },
+            )
         };
         let mut surf = match which {
             "gregory" => single(&mut ctx, SinglePassPatch::Gregory),

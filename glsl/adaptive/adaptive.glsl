@@ -103,6 +103,7 @@ layout(push_constant) uniform AdaptivePush {
     uint count;            // canonical kernel: items in this dispatch
     float displace_scale;  // displacement along the normal per unit of height
     uint first_corner;     // global id of the first canonical corner (CORNER_OWNERS[0])
+    vec4 pattern_outer;    // pattern path: the drawn pattern's edge levels (gl_TessLevelOuter's order)
 } adaptive;
 
 uint patch_kind(AdaptivePatch p) { return p.info & 15u; }

@@ -2,9 +2,19 @@
 // `void evaluate(uint id, vec2 uv, out vec3 pos, out vec3 du, out vec3 dv)` for its patch kind
 // (patch `id`). Only boundary vertices read the patch record (its curves). Points on the patch boundary come from the canonical curves instead (see
 // adaptive.glsl), so shared edges are bit-identical; normals always come from the patch.
+//
+// The refinement-pattern path's vertex stages (pattern_*.vert) include it too: they define
+// PATTERN_PATH, the globals tc_patch and tc_info, TESS_COORD (the pattern vertex's domain
+// point), OUTER_LEVEL(i) (the drawn pattern's edge levels, in gl_TessLevelOuter's order),
+// emit_sample, and pattern_begin(), which sets the globals and the patch's control points
+// (what the control stage does on the tessellation path).
 #include "normals.glsl"
+#ifndef PATTERN_PATH
 layout(location = 0) patch in uint tc_patch;
 layout(location = 2) patch in uint tc_info;
+#define TESS_COORD gl_TessCoord
+#define OUTER_LEVEL(i) gl_TessLevelOuter[i]
+#endif
 #ifdef SURFACE_BUILD
 // Only the surface build hands the fragment stage an albedo and a texture coordinate: each
 // varying costs lavapipe's rasterizer on every triangle (docs/benchmarks.md, "varyings are
@@ -23,12 +33,15 @@ vec3 patch_shading_normal(uint id, vec2 uv, vec3 n);
 const vec3 KIND_COLOURS[4] = vec3[4](vec3(0.45, 0.65, 0.95), vec3(0.95, 0.45, 0.35), vec3(0.95, 0.8, 0.3), vec3(0.75, 0.4, 0.85));
 
 void main() {
-    vec2 uv = gl_TessCoord.xy;
+#ifdef PATTERN_PATH
+    pattern_begin();
+#endif
+    vec2 uv = TESS_COORD.xy;
     vec3 pos, du, dv;
     evaluate(tc_patch, uv, pos, du, dv);
 #ifdef TRIANGLE_DOMAIN
-    // gl_TessCoord = (u, v, 1 - u - v): the weights of patch corners 1, 2, 0.
-    float w0 = gl_TessCoord.z;
+    // TESS_COORD = (u, v, 1 - u - v): the weights of patch corners 1, 2, 0.
+    float w0 = TESS_COORD.z;
     bool canonical = uv.x == 0.0 || uv.y == 0.0 || w0 == 0.0;
 #else
     bool canonical = uv.x == 0.0 || uv.x == 1.0 || uv.y == 0.0 || uv.y == 1.0;
@@ -46,21 +59,21 @@ void main() {
 #ifdef TRIANGLE_DOMAIN
     // Every triangle edge is a transition edge (two level-1 halves): integer levels.
     if (uv.y == 0.0) {
-        e = 0u; t = uv.x; tess_level = gl_TessLevelOuter[1];
+        e = 0u; t = uv.x; tess_level = OUTER_LEVEL(1);
     } else if (w0 == 0.0) {
-        e = 1u; t = uv.y; tess_level = gl_TessLevelOuter[2];
+        e = 1u; t = uv.y; tess_level = OUTER_LEVEL(2);
     } else {
-        e = 2u; t = w0; tess_level = gl_TessLevelOuter[0];
+        e = 2u; t = w0; tess_level = OUTER_LEVEL(0);
     }
 #else
     if (uv.y == 0.0) {
-        e = 0u; t = uv.x; tess_level = gl_TessLevelOuter[1];
+        e = 0u; t = uv.x; tess_level = OUTER_LEVEL(1);
     } else if (uv.x == 1.0) {
-        e = 1u; t = uv.y; tess_level = gl_TessLevelOuter[2];
+        e = 1u; t = uv.y; tess_level = OUTER_LEVEL(2);
     } else if (uv.y == 1.0) {
-        e = 2u; t = 1.0 - uv.x; tess_level = gl_TessLevelOuter[3];
+        e = 2u; t = 1.0 - uv.x; tess_level = OUTER_LEVEL(3);
     } else {
-        e = 3u; t = 1.0 - uv.y; tess_level = gl_TessLevelOuter[0];
+        e = 3u; t = 1.0 - uv.y; tess_level = OUTER_LEVEL(0);
     }
 #endif
     if (canonical) {

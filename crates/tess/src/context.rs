@@ -181,7 +181,15 @@ impl Context {
         spacing: Spacing,
         level: f32,
     ) -> Result<std::sync::Arc<crate::pattern::RefinementPattern>> {
-        let key = crate::pattern::PatternKey::new(domain, spacing, level);
+        self.refinement_pattern_for(crate::pattern::PatternKey::new(domain, spacing, level))
+    }
+
+    /// The refinement pattern of `key` (per-edge levels too), made on first use
+    /// ([`crate::pattern::make`]) and shared by every surface drawn through this context.
+    pub fn refinement_pattern_for(
+        &mut self,
+        key: crate::pattern::PatternKey,
+    ) -> Result<std::sync::Arc<crate::pattern::RefinementPattern>> {
         if let Some(p) = self.patterns.cached(key) {
             return Ok(p);
         }

@@ -108,6 +108,16 @@ pub enum TessError {
     },
     #[error("a refinement pattern of {segments} segments per edge: expected 1..256")]
     PatternLevel { segments: u32 },
+    #[error(
+        "a {domain:?} refinement pattern with edge levels {outer:?} and inner levels {inner:?}: \
+         {why}"
+    )]
+    PatternEdges {
+        domain: crate::tessellator::Domain,
+        outer: Vec<f32>,
+        inner: Vec<f32>,
+        why: &'static str,
+    },
     #[error("{path}: vertex {vertex} has patch id {patch}, which maps to no base face")]
     UnmappedPatch {
         path: String,

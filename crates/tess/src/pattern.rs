@@ -74,6 +74,63 @@ impl RefinementPattern {
         })
     }
 
+    /// The quad pattern of per-edge levels `outer` (`gl_TessLevelOuter`'s order: the edges
+    /// u = 0, v = 0, u = 1, v = 1) and inner levels `inner` (segments along u, along v), whole
+    /// segments in equal spacing, each point where `params` puts a level's points: each edge's
+    /// at its own level, the inner lattice's at the inner levels, so two patterns sharing an
+    /// edge level meet point for point along it. [`LevelParameters::generated`] gives the
+    /// uniform levels [`Self::generate`]'s grid. Otherwise the inner lattice (its points
+    /// `1..n − 1` per direction) is a grid of cells, and each edge is joined to the lattice side
+    /// facing it by a strip zipped along both in step; an inner level of 1 has no lattice in
+    /// that direction, and its two edges facing each other are zipped directly (which needs
+    /// the edges across them at level 1).
+    pub fn generate_edges(
+        outer: [u32; 4],
+        inner: [u32; 2],
+        params: &dyn Fn(u32) -> Result<LevelParameters>,
+    ) -> Result<Self> {
+        let all = [outer[0], outer[1], outer[2], outer[3], inner[0], inner[1]];
+        let refuse = |why| TessError::PatternEdges {
+            domain: Domain::Quad,
+            outer: outer.map(|l| l as f32).to_vec(),
+            inner: inner.map(|l| l as f32).to_vec(),
+            why,
+        };
+        if all
+            .iter()
+            .any(|&l| !(1..=MAX_GENERATED_SEGMENTS).contains(&l))
+        {
+            return Err(refuse("expected levels 1..256"));
+        }
+        let mut levels = HashMap::new();
+        for l in all {
+            if let std::collections::hash_map::Entry::Vacant(e) = levels.entry(l) {
+                e.insert(params(l)?);
+            }
+        }
+        let mut b = QuadStitch {
+            levels,
+            ..QuadStitch::default()
+        };
+        let [iu, iv] = inner;
+        match (iu >= 2, iv >= 2) {
+            (true, true) => b.lattice_and_strips(outer, inner),
+            (false, false) if all.iter().all(|&l| l == 1) => return Ok(Self::quad_grid(1)),
+            (true, false) if outer[0] == 1 && outer[2] == 1 => {
+                b.facing_edges((1, outer[1]), (3, outer[3]))
+            }
+            (false, true) if outer[1] == 1 && outer[3] == 1 => {
+                b.facing_edges((2, outer[2]), (0, outer[0]))
+            }
+            _ => {
+                return Err(refuse(
+                    "an inner level of 1 needs the two edges across it at level 1",
+                ))
+            }
+        }
+        Ok(b.finish())
+    }
+
     /// (n + 1)² points, 2n² triangles: each cell split along its (i, j)–(i + 1, j + 1) diagonal.
     fn quad_grid(n: u32) -> Self {
         let at = |i: u32, j: u32| j * (n + 1) + i;
@@ -169,6 +226,193 @@ impl RefinementPattern {
     }
 }
 
+/// Builds [`RefinementPattern::generate_edges`]'s quad: points merged by their parameters'
+/// bits, triangles counter-clockwise in `(u, v)`.
+#[derive(Default)]
+struct QuadStitch {
+    /// Where each level used puts its points.
+    levels: HashMap<u32, LevelParameters>,
+    index: HashMap<[u32; 2], u32>,
+    points: Vec<[f32; 3]>,
+    triangles: Vec<[u32; 3]>,
+}
+
+/// Where the points of one level lie on a quad, as 16.16 numerators in ascending order: on each
+/// square edge (`gl_TessLevelOuter`'s order: u = 0, v = 0, u = 1, v = 1; `n + 1` each, ends
+/// included) and along u and along v inside (`n + 1` each, 0 and 1 included).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LevelParameters {
+    pub edges: [Vec<u32>; 4],
+    pub inner: [Vec<u32>; 2],
+}
+
+impl LevelParameters {
+    /// The mirrored 16.16 parameters of [`RefinementPattern::generate`].
+    pub fn generated(n: u32) -> Self {
+        let along: Vec<u32> = (0..=n).map(|k| fixed_parameter(k, n)).collect();
+        Self {
+            edges: std::array::from_fn(|_| along.clone()),
+            inner: [along.clone(), along],
+        }
+    }
+
+    /// The parameters of the uniform quad pattern `p` of level `n` (a tessellator's): its
+    /// points on each edge and the coordinates of its inner lattice. `None` unless every
+    /// coordinate is a 16.16 number and each list has `n + 1` entries.
+    pub fn of_pattern(p: &RefinementPattern, n: u32) -> Option<Self> {
+        let fixed = |x: f32| {
+            let f = x as f64 * FIXED_ONE as f64;
+            (f.fract() == 0.0 && (0.0..=FIXED_ONE as f64).contains(&f)).then_some(f as u32)
+        };
+        let sorted = |mut v: Vec<u32>| {
+            v.sort_unstable();
+            v.dedup();
+            (v.len() == n as usize + 1).then_some(v)
+        };
+        let on = |axis: usize, at: f32| {
+            let along = 1 - axis;
+            p.points
+                .iter()
+                .filter(|q| q[axis] == at)
+                .map(|q| fixed(q[along]))
+                .collect::<Option<Vec<u32>>>()
+                .and_then(sorted)
+        };
+        let inside = |axis: usize| {
+            let interior = p
+                .points
+                .iter()
+                .filter(|q| q[..2].iter().all(|&c| c > 0.0 && c < 1.0));
+            let mut v: Vec<u32> = interior.map(|q| fixed(q[axis])).collect::<Option<_>>()?;
+            v.extend([0, FIXED_ONE]);
+            sorted(v)
+        };
+        Some(Self {
+            edges: [on(0, 0.0)?, on(1, 0.0)?, on(0, 1.0)?, on(1, 1.0)?],
+            inner: [inside(0)?, inside(1)?],
+        })
+    }
+}
+
+impl QuadStitch {
+    /// The point at fixed-point parameters `(u, v)`.
+    fn point(&mut self, u: u32, v: u32) -> u32 {
+        let points = &mut self.points;
+        *self.index.entry([u, v]).or_insert_with(|| {
+            points.push([to_f32(u), to_f32(v), 0.0]);
+            points.len() as u32 - 1
+        })
+    }
+
+    /// The `n + 1` points of square edge `e` (0: u = 0, 1: v = 0, 2: u = 1, 3: v = 1) at level
+    /// `n`, in the square's counter-clockwise direction (v = 0 left to right, u = 1 upwards,
+    /// v = 1 right to left, u = 0 downwards).
+    fn edge(&mut self, e: usize, n: u32) -> Vec<u32> {
+        let along = self.levels[&n].edges[e].clone();
+        let mut out: Vec<u32> = along
+            .iter()
+            .map(|&t| match e {
+                0 => self.point(0, t),
+                1 => self.point(t, 0),
+                2 => self.point(FIXED_ONE, t),
+                _ => self.point(t, FIXED_ONE),
+            })
+            .collect();
+        // Edges 0 and 3 run against their parameter.
+        if e == 0 || e == 3 {
+            out.reverse();
+        }
+        out
+    }
+
+    /// Parameter of a point along the direction from `first` to `last` of a polyline (the
+    /// coordinate that changes along it).
+    fn along(&self, p: u32, first: u32, last: u32) -> f32 {
+        let (a, b, q) = (
+            self.points[first as usize],
+            self.points[last as usize],
+            self.points[p as usize],
+        );
+        let axis = if a[0] != b[0] { 0 } else { 1 };
+        let t = (q[axis] - a[axis]) / (b[axis] - a[axis]);
+        if t.is_finite() {
+            t
+        } else {
+            0.0
+        }
+    }
+
+    /// Triangles between `outer` and `inner`, two polylines running the same way with the
+    /// region on their left (`outer` on its right side): each step advances the one whose next
+    /// point comes first along the way.
+    fn zip(&mut self, outer: &[u32], inner: &[u32]) {
+        let (mut i, mut j) = (0, 0);
+        let (o_first, o_last) = (outer[0], outer[outer.len() - 1]);
+        let (i_first, i_last) = (inner[0], inner[inner.len() - 1]);
+        while i + 1 < outer.len() || j + 1 < inner.len() {
+            let advance_outer = j + 1 == inner.len()
+                || (i + 1 < outer.len()
+                    && self.along(outer[i + 1], o_first, o_last)
+                        <= self.along(inner[j + 1], i_first, i_last));
+            if advance_outer {
+                self.triangles.push([outer[i], outer[i + 1], inner[j]]);
+                i += 1;
+            } else {
+                self.triangles.push([outer[i], inner[j + 1], inner[j]]);
+                j += 1;
+            }
+        }
+    }
+
+    /// Two facing edges `(edge, level)` zipped together (an inner level of 1): `lower` in the
+    /// square's direction, `upper` against it, so both run the same way.
+    fn facing_edges(&mut self, lower: (usize, u32), upper: (usize, u32)) {
+        let lower = self.edge(lower.0, lower.1);
+        let mut upper = self.edge(upper.0, upper.1);
+        upper.reverse();
+        self.zip(&lower, &upper);
+    }
+
+    /// The inner lattice's cells, then a strip from each edge to the lattice side facing it.
+    fn lattice_and_strips(&mut self, outer: [u32; 4], [iu, iv]: [u32; 2]) {
+        let (us, vs) = (
+            self.levels[&iu].inner[0].clone(),
+            self.levels[&iv].inner[1].clone(),
+        );
+        let lattice = |s: &mut Self, i: u32, j: u32| s.point(us[i as usize], vs[j as usize]);
+        for j in 1..iv - 1 {
+            for i in 1..iu - 1 {
+                let [a, b, c, d] = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)]
+                    .map(|(x, y)| lattice(self, x, y));
+                self.triangles.push([a, b, c]);
+                self.triangles.push([a, c, d]);
+            }
+        }
+        // The lattice's sides in the square's counter-clockwise direction, each from the
+        // lattice corner its edge starts beside.
+        let (hi_u, hi_v) = (iu - 1, iv - 1);
+        let sides: [Vec<(u32, u32)>; 4] = [
+            (1..=hi_v).rev().map(|j| (1, j)).collect(),
+            (1..=hi_u).map(|i| (i, 1)).collect(),
+            (1..=hi_v).map(|j| (hi_u, j)).collect(),
+            (1..=hi_u).rev().map(|i| (i, hi_v)).collect(),
+        ];
+        for (e, side) in sides.iter().enumerate() {
+            let edge = self.edge(e, outer[e]);
+            let inner: Vec<u32> = side.iter().map(|&(i, j)| lattice(self, i, j)).collect();
+            self.zip(&edge, &inner);
+        }
+    }
+
+    fn finish(self) -> RefinementPattern {
+        RefinementPattern {
+            domain: Domain::Quad,
+            points: self.points,
+            triangles: self.triangles,
+        }
+    }
+}
+
 /// A refinement pattern on the device.
 pub(crate) struct PatternBuffers {
     pub key: PatternKey,
@@ -212,26 +456,71 @@ impl PatternBuffers {
     }
 }
 
-/// What selects a pattern: domain, spacing and the uniform level (its bits: fractional levels
-/// are patterns of their own).
+/// What selects a pattern: domain, spacing and the tessellation levels (their bits: fractional
+/// levels are patterns of their own), outer in `gl_TessLevelOuter`'s order and inner in
+/// `gl_TessLevelInner`'s; a triangle's fourth outer and second inner level are 0.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct PatternKey {
     pub domain: Domain,
     pub spacing: Spacing,
-    level_bits: u32,
+    outer_bits: [u32; 4],
+    inner_bits: [u32; 2],
 }
 
 impl PatternKey {
+    /// Every level `level`.
     pub fn new(domain: Domain, spacing: Spacing, level: f32) -> Self {
+        Self::with_levels(domain, spacing, [level; 4], [level; 2])
+    }
+
+    /// Per-edge levels (see the type).
+    pub fn with_levels(domain: Domain, spacing: Spacing, outer: [f32; 4], inner: [f32; 2]) -> Self {
+        let (outer, inner) = match domain {
+            Domain::Quad => (outer, inner),
+            Domain::Triangle => ([outer[0], outer[1], outer[2], 0.0], [inner[0], 0.0]),
+        };
         Self {
             domain,
             spacing,
-            level_bits: level.to_bits(),
+            outer_bits: outer.map(f32::to_bits),
+            inner_bits: inner.map(f32::to_bits),
         }
     }
 
-    pub fn level(&self) -> f32 {
-        f32::from_bits(self.level_bits)
+    pub fn outer(&self) -> [f32; 4] {
+        self.outer_bits.map(f32::from_bits)
+    }
+
+    pub fn inner(&self) -> [f32; 2] {
+        self.inner_bits.map(f32::from_bits)
+    }
+
+    /// The levels that mean something on the key's domain: outer, then inner.
+    fn levels(&self) -> Vec<f32> {
+        let (o, i) = match self.domain {
+            Domain::Quad => (4, 2),
+            Domain::Triangle => (3, 1),
+        };
+        self.outer()[..o]
+            .iter()
+            .chain(&self.inner()[..i])
+            .copied()
+            .collect()
+    }
+
+    /// The level every edge and the inside share, if they do.
+    pub fn uniform_level(&self) -> Option<f32> {
+        let levels = self.levels();
+        let first = levels[0];
+        levels
+            .iter()
+            .all(|l| l.to_bits() == first.to_bits())
+            .then_some(first)
+    }
+
+    /// The largest level of the key.
+    pub fn max_level(&self) -> f32 {
+        self.levels().into_iter().fold(0.0, f32::max)
     }
 }
 
@@ -275,26 +564,83 @@ pub fn from_tessellator(device: &vk_core::Device) -> bool {
         && device.require_transform_feedback().is_ok()
 }
 
-/// Makes the pattern of `key` on `ctx`'s device: the tessellator's own where
+/// Makes the pattern of `key` on `ctx`'s device. A uniform key: the tessellator's own where
 /// [`from_tessellator`] and the level is within its 64 (one flat patch over the unit domain,
-/// drawn through the tessellator and captured); otherwise
-/// generated, in equal spacing only.
+/// drawn through the tessellator and captured), otherwise generated, in equal spacing only.
+/// A key with unequal levels (a transition patch's) is generated
+/// ([`RefinementPattern::generate_edges`]): its points lie where the tessellator's would, on
+/// each edge and inside, so shared edges meet; the triangulation is the pattern's own.
 pub fn make(ctx: &mut Context, key: PatternKey) -> Result<RefinementPattern> {
-    if from_tessellator(ctx.device()) && key.level() <= crate::tessellator::MAX_LEVEL {
-        return tessellator_pattern(ctx, key);
+    let Some(level) = key.uniform_level() else {
+        return generate_for_edges(ctx, key);
+    };
+    if from_tessellator(ctx.device()) && level <= crate::tessellator::MAX_LEVEL {
+        return tessellator_pattern(ctx, key.domain, key.spacing, level);
     }
     if key.spacing != Spacing::Equal {
         return Err(TessError::PatternSpacing {
             spacing: key.spacing,
         });
     }
-    RefinementPattern::generate(key.domain, generated_segments(key.level()))
+    RefinementPattern::generate(key.domain, generated_segments(level))
+}
+
+/// [`RefinementPattern::generate_edges`] for a key of whole levels in equal spacing, its points
+/// where the device's tessellator puts each level's ([`LevelParameters::of_pattern`] of its
+/// uniform pattern) when [`from_tessellator`] and the level is within its 64, else at the
+/// generated parameters.
+fn generate_for_edges(ctx: &mut Context, key: PatternKey) -> Result<RefinementPattern> {
+    let refuse = |why| TessError::PatternEdges {
+        domain: key.domain,
+        outer: key.outer().to_vec(),
+        inner: key.inner().to_vec(),
+        why,
+    };
+    if key.spacing != Spacing::Equal {
+        return Err(TessError::PatternSpacing {
+            spacing: key.spacing,
+        });
+    }
+    if key.domain != Domain::Quad {
+        return Err(refuse("per-edge patterns are made for quads only"));
+    }
+    let whole = |l: f32| {
+        (l.fract() == 0.0 && (1.0..=MAX_GENERATED_SEGMENTS as f32).contains(&l)).then_some(l as u32)
+    };
+    let ([Some(a), Some(b), Some(c), Some(d)], [Some(u), Some(v)]) =
+        (key.outer().map(whole), key.inner().map(whole))
+    else {
+        return Err(refuse("expected whole levels 1..256"));
+    };
+    let mut tessellated = HashMap::new();
+    if from_tessellator(ctx.device()) {
+        for n in [a, b, c, d, u, v] {
+            if n as f32 <= crate::tessellator::MAX_LEVEL && !tessellated.contains_key(&n) {
+                let uniform = ctx.refinement_pattern(Domain::Quad, Spacing::Equal, n as f32)?;
+                let at = LevelParameters::of_pattern(&uniform, n).ok_or_else(|| {
+                    refuse("the tessellator's uniform pattern of a level is not a 16.16 lattice")
+                })?;
+                tessellated.insert(n, at);
+            }
+        }
+    }
+    RefinementPattern::generate_edges([a, b, c, d], [u, v], &|n| {
+        Ok(tessellated
+            .get(&n)
+            .cloned()
+            .unwrap_or_else(|| LevelParameters::generated(n)))
+    })
 }
 
 /// One patch of `key`'s domain over the unit domain, drawn flat through the tessellator at
 /// `key`'s level and spacing and captured: the tessellator's points and triangles.
-fn tessellator_pattern(ctx: &mut Context, key: PatternKey) -> Result<RefinementPattern> {
-    let corners: &[[f64; 3]] = match key.domain {
+fn tessellator_pattern(
+    ctx: &mut Context,
+    domain: Domain,
+    spacing: Spacing,
+    level: f32,
+) -> Result<RefinementPattern> {
+    let corners: &[[f64; 3]] = match domain {
         Domain::Quad => &[
             [0.0, 0.0, 0.0],
             [1.0, 0.0, 0.0],
@@ -307,10 +653,8 @@ fn tessellator_pattern(ctx: &mut Context, key: PatternKey) -> Result<RefinementP
     let mesh = ControlMesh::from_polygons(corners.to_vec(), &[face]);
     let mut patch = Flat::new(ctx.device(), &mesh, DrawPath::Tessellation)?;
     let params = FrameParams {
-        factors: FactorPolicy::Uniform {
-            segments: key.level(),
-        },
-        spacing: key.spacing,
+        factors: FactorPolicy::Uniform { segments: level },
+        spacing,
         ..FrameParams::default()
     };
     let extent = vk_core::vk::Extent2D {
@@ -318,7 +662,7 @@ fn tessellator_pattern(ctx: &mut Context, key: PatternKey) -> Result<RefinementP
         height: 1,
     };
     let (soup, _) = Capturer::new(ctx)?.capture(ctx, &mut patch, &params, extent)?;
-    RefinementPattern::from_capture(key.domain, &soup)
+    RefinementPattern::from_capture(domain, &soup)
 }
 
 #[cfg(test)]
@@ -394,6 +738,90 @@ mod tests {
             // The lattice has exactly 3n points on its boundary.
             let boundary = p.points.iter().filter(|q| q.contains(&0.0)).count();
             assert_eq!(boundary as u32, 3 * n, "{n}");
+        }
+    }
+
+    /// Per-edge patterns of the planned patches' transitions (one edge doubled, inner levels
+    /// the larger of each facing pair) and others: counter-clockwise, tiling the square, each
+    /// edge at its own level, every inner lattice point present.
+    #[test]
+    fn per_edge_patterns_tile_the_square_with_each_edge_at_its_level() {
+        let generated = |n| Ok(LevelParameters::generated(n));
+        let cases: [([u32; 4], [u32; 2]); 9] = [
+            ([4, 8, 4, 4], [8, 4]),
+            ([8, 4, 4, 4], [4, 8]),
+            ([8, 8, 4, 4], [8, 8]),
+            ([2, 1, 2, 1], [1, 2]),
+            ([1, 2, 1, 1], [2, 1]),
+            ([1, 1, 2, 1], [1, 2]),
+            ([3, 5, 7, 2], [5, 7]),
+            ([64, 32, 32, 32], [32, 64]),
+            ([6, 6, 6, 6], [6, 6]),
+        ];
+        for (outer, inner) in cases {
+            let p = RefinementPattern::generate_edges(outer, inner, &generated).unwrap();
+            let mut area = 0.0;
+            for &t in &p.triangles {
+                let a = signed_area(&p, t);
+                assert!(
+                    a > 0.0,
+                    "{outer:?} {inner:?}: {t:?} turns clockwise or is degenerate"
+                );
+                area += a / 2.0;
+            }
+            assert!(
+                (area - 1.0).abs() < 1e-9,
+                "{outer:?} {inner:?}: area {area}"
+            );
+            let on = |e: usize, q: &[f32; 3]| match e {
+                0 => q[0] == 0.0,
+                1 => q[1] == 0.0,
+                2 => q[0] == 1.0,
+                _ => q[1] == 1.0,
+            };
+            for (e, &n) in outer.iter().enumerate() {
+                let mut along: Vec<f32> = p
+                    .points
+                    .iter()
+                    .filter(|q| on(e, q))
+                    .map(|q| if e % 2 == 0 { q[1] } else { q[0] })
+                    .collect();
+                along.sort_by(f32::total_cmp);
+                let want: Vec<f32> = (0..=n).map(|k| to_f32(fixed_parameter(k, n))).collect();
+                assert_eq!(along, want, "{outer:?} {inner:?}: edge {e}");
+            }
+            let interior = p
+                .points
+                .iter()
+                .filter(|q| !(0..4).any(|e| on(e, q)))
+                .count();
+            let lattice = if inner.contains(&1) {
+                0
+            } else {
+                (inner[0] - 1) * (inner[1] - 1)
+            };
+            assert_eq!(interior as u32, lattice, "{outer:?} {inner:?}");
+        }
+        assert_eq!(
+            RefinementPattern::generate_edges([1; 4], [1; 2], &generated).unwrap(),
+            RefinementPattern::generate(Domain::Quad, 1).unwrap()
+        );
+        // A uniform pattern's parameters are read back from it.
+        let grid = RefinementPattern::generate(Domain::Quad, 7).unwrap();
+        assert_eq!(
+            LevelParameters::of_pattern(&grid, 7),
+            Some(LevelParameters::generated(7))
+        );
+        assert_eq!(LevelParameters::of_pattern(&grid, 6), None);
+        for (outer, inner) in [
+            ([2, 1, 1, 1], [1, 1]),
+            ([1, 1, 1, 1], [0, 1]),
+            ([300, 1, 1, 1], [2, 2]),
+        ] {
+            assert!(
+                RefinementPattern::generate_edges(outer, inner, &generated).is_err(),
+                "{outer:?} {inner:?}"
+            );
         }
     }
 

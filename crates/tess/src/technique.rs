@@ -81,6 +81,17 @@ pub enum PatchType {
     PatternTriangle,
     /// A base quad drawn through a refinement pattern.
     PatternQuad,
+    /// A [`PatchType::BSpline`] patch drawn through refinement patterns, one per edge-level
+    /// key: the vertex stage evaluates the patch the instance names (not the instance in
+    /// order) at each pattern vertex. A captured id names the patch as on the tessellation
+    /// path.
+    PatternBSpline,
+    /// A [`PatchType::Gregory`] end cap (or ACC-1 net) through refinement patterns.
+    PatternGregory,
+    /// A [`PatchType::Bilinear`] end cap through refinement patterns.
+    PatternBilinear,
+    /// A [`PatchType::GregoryTriangle`] through refinement patterns.
+    PatternGregoryTriangle,
 }
 
 impl PatchType {
@@ -90,12 +101,16 @@ impl PatchType {
             | PatchType::BSpline
             | PatchType::Gregory
             | PatchType::Bilinear
-            | PatchType::PatternQuad => Domain::Quad,
+            | PatchType::PatternQuad
+            | PatchType::PatternBSpline
+            | PatchType::PatternGregory
+            | PatchType::PatternBilinear => Domain::Quad,
             PatchType::Triangle
             | PatchType::LoopBft
             | PatchType::GregoryTriangle
             | PatchType::MeshTriangles
-            | PatchType::PatternTriangle => Domain::Triangle,
+            | PatchType::PatternTriangle
+            | PatchType::PatternGregoryTriangle => Domain::Triangle,
         }
     }
 
@@ -103,7 +118,12 @@ impl PatchType {
     pub fn path(self) -> DrawPath {
         match self {
             PatchType::MeshTriangles => DrawPath::VertexStage,
-            PatchType::PatternTriangle | PatchType::PatternQuad => DrawPath::Pattern,
+            PatchType::PatternTriangle
+            | PatchType::PatternQuad
+            | PatchType::PatternBSpline
+            | PatchType::PatternGregory
+            | PatchType::PatternBilinear
+            | PatchType::PatternGregoryTriangle => DrawPath::Pattern,
             _ => DrawPath::Tessellation,
         }
     }

@@ -602,7 +602,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
     // patch records, control points and curves.
     let adaptive_push = || Layout {
         name: "AdaptivePush",
-        offsets: offsets!(AdaptivePush: mode, first_patch, factor_mode, options, uniform_level, pixels_per_segment, distance_ref, max_level, first_item, count, displace_scale, first_corner),
+        offsets: offsets!(AdaptivePush: mode, first_patch, factor_mode, options, uniform_level, pixels_per_segment, distance_ref, max_level, first_item, count, displace_scale, first_corner, pattern_outer),
         size: size_of::<AdaptivePush>(),
     };
     let adaptive_arrays = || Layout {
@@ -633,6 +633,13 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         Stage::AdaptiveGregoryTese,
         Stage::AdaptiveBilinearTese,
         Stage::AdaptiveTriangleTese,
+    ];
+    // The evaluation stages' code as the pattern path's vertex stages.
+    let adaptive_pattern = [
+        Stage::AdaptivePatternRegularVert,
+        Stage::AdaptivePatternGregoryVert,
+        Stage::AdaptivePatternBilinearVert,
+        Stage::AdaptivePatternTriangleVert,
     ];
     rows.extend([
         (Stage::AdaptiveCanonicalComp, PLAIN, adaptive_push()),
@@ -764,7 +771,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
         for &(v, _) in stage.compiled() {
             if v.capture {
                 rows.push((stage, v, capture()));
-                if adaptive_tese.contains(&stage) {
+                if adaptive_tese.contains(&stage) || adaptive_pattern.contains(&stage) {
                     rows.push((stage, v, adaptive_push()));
                 } else if [Stage::BftBftTese, Stage::BftPatternVert].contains(&stage) {
                     rows.push((stage, v, bft_push()));
@@ -773,6 +780,22 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
                 }
             }
         }
+    }
+    for stage in adaptive_pattern {
+        for surface in [false, true] {
+            let v = Variant { surface, ..PLAIN };
+            rows.push((stage, v, adaptive_push()));
+            rows.push((stage, v, adaptive_arrays_binding()));
+        }
+        let input = super::pattern_input::PATCH_IDS;
+        let at = |name, binding| Check::PatternInput {
+            name,
+            input,
+            binding,
+            offset: 0,
+        };
+        rows.push((stage, PLAIN, at("in_domain", 0)));
+        rows.push((stage, PLAIN, at("in_patch", 1)));
     }
     rows.extend(pattern_input_rows());
     rows.extend(tagged_input_rows());
@@ -927,6 +950,7 @@ fn check(stage: Stage, v: Variant, check: &Check) -> Result<(), String> {
                 .ok_or_else(|| format!("{name}: location {location} has no vertex attribute"))?;
             let size = match attr.format {
                 vk::Format::R32G32B32A32_SFLOAT => 16,
+                vk::Format::R32_UINT => 4,
                 _ => 12,
             };
             if attr.binding != *binding || attr.offset as usize != *offset || bytes != size {
@@ -1020,8 +1044,10 @@ fn the_table_covers_every_storage_binding_and_capture_build() {
     // Nine TESs in three spacings, the four adaptive ones and BFT's also with their surface code,
     // the adaptive ones also in their face-varying build, BFT's also with and without its patch
     // block; the CPU mesh's and Doo-Sabin's vertex stages, the four refinement-pattern vertex
-    // stages, PN's also in its scalar-tagged build, and BFT's with and without its surface code.
-    assert_eq!(capture_builds, 81);
+    // stages, PN's also in its scalar-tagged build, BFT's with and without its surface code, and
+    // the four adaptive pattern vertex stages with and without their surface and face-varying
+    // code.
+    assert_eq!(capture_builds, 97);
     assert_eq!(xfb_rows, capture_builds);
 }
 
@@ -1099,7 +1125,7 @@ fn capture_variants_and_only_they_have_xfb() {
             captures += v.capture as usize;
         }
     }
-    assert_eq!(captures, 81);
+    assert_eq!(captures, 97);
 }
 
 #[test]
@@ -1120,6 +1146,10 @@ fn plain_builds_have_no_surface_varyings() {
         Stage::AdaptiveBilinearTese,
         Stage::AdaptiveTriangleTese,
         Stage::BftBftTese,
+        Stage::AdaptivePatternRegularVert,
+        Stage::AdaptivePatternGregoryVert,
+        Stage::AdaptivePatternBilinearVert,
+        Stage::AdaptivePatternTriangleVert,
     ];
     let mut checked = 0;
     for stage in tese {
@@ -1151,8 +1181,9 @@ fn plain_builds_have_no_surface_varyings() {
     }
     // Four adaptive TESs and BFT's, three spacings, capture or not, plain or surface; the
     // adaptive ones with and without their face-varying look-up, BFT's with and without its
-    // patch block.
-    assert_eq!(checked, 120);
+    // patch block; the four adaptive pattern vertex stages, capture or not, plain or surface,
+    // with and without the face-varying look-up.
+    assert_eq!(checked, 152);
 }
 
 /// (NoContraction decorations, GLSL.std.450 FMix calls) in a SPIR-V module.

@@ -128,9 +128,12 @@ pub struct AdaptivePush {
     pub displace_scale: f32,
     /// Global id of the first canonical corner (the first of [`AdaptiveArrays::corner_owners`]).
     pub first_corner: u32,
+    /// The refinement-pattern path: the drawn pattern's edge levels, in `gl_TessLevelOuter`'s
+    /// order (the evaluation stage reads its own; `glsl/adaptive/pattern_patch.glsl`).
+    pub pattern_outer: [f32; 4],
 }
 
-const _: () = assert!(size_of::<AdaptivePush>() == 48);
+const _: () = assert!(size_of::<AdaptivePush>() == 64);
 
 /// `AdaptiveArrays` uniform block of every planned-patch stage, `glsl/adaptive/adaptive.glsl`
 /// ([`bindings::ADAPTIVE_ARRAYS_BINDING`]): the device address of each array the canonical
@@ -400,6 +403,33 @@ pub mod pattern_input {
     };
     const POINT_BINDINGS: [vk::VertexInputBindingDescription; 1] = [TRIANGLE_BINDINGS[0]];
     const POINT_ATTRIBUTES: [vk::VertexInputAttributeDescription; 1] = [TRIANGLE_ATTRIBUTES[0]];
+
+    const PATCH_ID_BINDINGS: [vk::VertexInputBindingDescription; 2] = [
+        TRIANGLE_BINDINGS[0],
+        vk::VertexInputBindingDescription {
+            binding: 1,
+            stride: size_of::<u32>() as u32,
+            input_rate: vk::VertexInputRate::INSTANCE,
+        },
+    ];
+    const PATCH_ID_ATTRIBUTES: [vk::VertexInputAttributeDescription; 2] = [
+        TRIANGLE_ATTRIBUTES[0],
+        vk::VertexInputAttributeDescription {
+            location: 1,
+            binding: 1,
+            format: vk::Format::R32_UINT,
+            offset: 0,
+        },
+    ];
+
+    /// The pattern's domain points (location 0) and, per instance at binding 1, the frame-wide
+    /// id of the patch drawn (location 1, `u32`): techniques whose instances are not their
+    /// patches in order (the planned patches draw one pattern per edge-level key, each over its
+    /// own list of patches; `glsl/adaptive/pattern_patch.glsl`).
+    pub const PATCH_IDS: VertexInput = VertexInput {
+        bindings: &PATCH_ID_BINDINGS,
+        attributes: &PATCH_ID_ATTRIBUTES,
+    };
 
     /// The pattern's domain points only (location 0): techniques whose vertex stage reads the
     /// patch from its own buffers by the instance (BFT).

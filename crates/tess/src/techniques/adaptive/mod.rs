@@ -60,6 +60,11 @@ fn build_registered(
             name: options.name.clone(),
             maps: options.maps.clone(),
             single_pass: false,
+            path: planned_patches::resolve_path(
+                TechniqueId::ADAPTIVE,
+                options.pipeline,
+                ctx.device(),
+            )?,
         },
     )?;
     Ok(Built {

@@ -1080,24 +1080,6 @@ pub fn check_frame(table_level: u32, params: &FrameParams) -> Result<()> {
     check_adaptive_policy(params)
 }
 
-/// What BFT's pattern path refuses beyond [`check_frame`]: factors other than uniform (a family
-/// of patterns per edge level is not built), and fractional spacing.
-fn check_pattern_frame(params: &FrameParams) -> Result<()> {
-    if !matches!(params.factors, FactorPolicy::Uniform { .. }) {
-        return Err(TessError::Unsupported {
-            technique: TechniqueId::BFT,
-            what: "screen-space and distance factors on the refinement-pattern path (uniform \
-                   only; --pipeline tessellation takes them)",
-        });
-    }
-    if params.spacing != Spacing::Equal {
-        return Err(TessError::PatternSpacing {
-            spacing: params.spacing,
-        });
-    }
-    Ok(())
-}
-
 impl Technique for Bft {
     fn id(&self) -> TechniqueId {
         TechniqueId::BFT
@@ -1119,7 +1101,7 @@ impl Technique for Bft {
         }
         check_frame(self.summary.table.level, params)?;
         if self.pattern.is_some() {
-            check_pattern_frame(params)?;
+            super::shared::check_uniform_pattern_frame(TechniqueId::BFT, params)?;
         }
         Ok(())
     }

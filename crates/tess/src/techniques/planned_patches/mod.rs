@@ -39,6 +39,7 @@
 //!
 //! The GPU data is [`layout`].
 pub mod layout;
+mod patterns;
 
 use super::shared::{check_adaptive_policy, compute_pipeline, factor_fields, upload_base, STAGES};
 use crate::animation::base_positions;
@@ -69,6 +70,7 @@ use crate::tessellator::{
     quad_triangle_count, triangle_triangle_count, uniform_vertex_count, Domain, Spacing,
 };
 use layout::GpuPlan;
+use patterns::{key_of_kinds, PatternDraws};
 use std::ops::Range;
 use topology::patches::adaptive::single_pass::{
     plan_single_pass, SinglePassOptions, SinglePassPatch,
@@ -98,13 +100,15 @@ static SET_BINDINGS: [BindingDesc; 3] = [
 /// Usage of every array the shaders read by address.
 const BY_ADDRESS: vk::BufferUsageFlags = vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
 
-/// A combined image sampler of the set (the fragment stage reads the texture, the TES both).
+/// A combined image sampler of the set (the fragment stage reads the texture, the TES or the
+/// pattern path's vertex stage both).
 const fn sampler_binding(binding: u32) -> BindingDesc {
     BindingDesc {
         binding,
         ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
         stages: vk::ShaderStageFlags::from_raw(
-            vk::ShaderStageFlags::TESSELLATION_EVALUATION.as_raw()
+            vk::ShaderStageFlags::VERTEX.as_raw()
+                | vk::ShaderStageFlags::TESSELLATION_EVALUATION.as_raw()
                 | vk::ShaderStageFlags::FRAGMENT.as_raw(),
         ),
     }
@@ -332,6 +336,38 @@ fn base_buffers(
         .collect()
 }
 
+/// The plan's arrays, one per patch kind with patches, on `path`: one control point per patch
+/// on the tessellation path (it carries the patch), none on the pattern path.
+fn patch_arrays(gpu: &GpuPlan, path: DrawPath) -> Vec<PatchArray> {
+    let [regular, gregory, bilinear, triangles] = gpu.counts;
+    let (types, control_points) = match path {
+        DrawPath::Pattern => (
+            [
+                PatchType::PatternBSpline,
+                PatchType::PatternGregory,
+                PatchType::PatternBilinear,
+                PatchType::PatternGregoryTriangle,
+            ],
+            0,
+        ),
+        _ => (
+            [
+                PatchType::BSpline,
+                PatchType::Gregory,
+                PatchType::Bilinear,
+                PatchType::GregoryTriangle,
+            ],
+            1,
+        ),
+    };
+    number_arrays(&[
+        (types[0], regular, control_points),
+        (types[1], gregory, control_points),
+        (types[2], bilinear, control_points),
+        (types[3], triangles, control_points),
+    ])
+}
+
 /// Per array, how many of its patches have each combination of edge kinds.
 fn edge_kind_counts(arrays: &[PatchArray], gpu: &GpuPlan) -> Vec<Vec<(u32, u64)>> {
     arrays
@@ -362,7 +398,7 @@ pub const PLANNED: Features = Features {
     surface: true,
     single_pass: false,
     sine_displacement: false,
-    paths: &[DrawPath::Tessellation],
+    paths: &[DrawPath::Tessellation, DrawPath::Pattern],
 };
 
 /// What the single-pass techniques (gregory, acc) take: the planned surface's options, no
@@ -400,6 +436,8 @@ pub struct PlanBuild {
     pub name: String,
     /// Colour texture and height map sampled at the surface's texture coordinates.
     pub maps: SurfaceMaps,
+    /// The tessellation stage, or refinement patterns ([`resolve_path`]).
+    pub path: DrawPath,
 }
 
 impl Default for PlanBuild {
@@ -412,7 +450,49 @@ impl Default for PlanBuild {
             follow_semi_sharp: true,
             name: "mesh".into(),
             maps: SurfaceMaps::default(),
+            path: DrawPath::Tessellation,
         }
+    }
+}
+
+/// A planned surface's draw path for `choice` on `device`. On the refinement-pattern path the
+/// planned patches take uniform factors only (no pattern family per edge level follows
+/// screen-space or distance factors yet), so `auto` keeps the tessellation stage wherever the
+/// device has one and draws patterns only where it has none.
+pub fn resolve_path(
+    technique: TechniqueId,
+    choice: crate::technique::PipelineChoice,
+    device: &vk_core::Device,
+) -> Result<DrawPath> {
+    match choice {
+        crate::technique::PipelineChoice::Auto if device.info.caps.tessellation_shader => {
+            Ok(DrawPath::Tessellation)
+        }
+        choice => choice.resolve(technique, PLANNED.paths, device),
+    }
+}
+
+/// The level `edge_level` in `adaptive.glsl` gives an edge of kind `kind` under uniform factors
+/// of `segments` per patch edge with the largest level `lim` (mirrored operation for
+/// operation).
+fn uniform_edge_level(lim: f32, segments: f32, spacing: Spacing, kind: u32) -> f32 {
+    let fractional = spacing == Spacing::FractionalEven;
+    if kind == ADAPTIVE_EDGE_PLAIN {
+        if fractional {
+            return segments.clamp(2.0, lim);
+        }
+        return segments.clamp(1.0, lim).ceil().min(lim);
+    }
+    let half = (lim * 0.5).floor();
+    let f = if fractional {
+        2.0 * (segments.clamp(2.0, half) * 0.5).ceil()
+    } else {
+        segments.clamp(1.0, half).ceil().min(half)
+    };
+    if kind == ADAPTIVE_EDGE_COARSE {
+        2.0 * f
+    } else {
+        f
     }
 }
 
@@ -443,6 +523,8 @@ pub struct PlannedPatches {
     /// Per array: how many patches have each combination of edge kinds (the 2-bit kinds of
     /// `edge_info`), counted once so uniform triangle counts cost a few entries per call.
     edge_kinds: Vec<Vec<(u32, u64)>>,
+    /// The refinement-pattern path's draws (`None` on the tessellation path).
+    patterns: Option<PatternDraws>,
     pub gpu: GpuPlan,
     pub plan: AdaptivePlan,
     pub mesh: ControlMesh,
@@ -554,15 +636,18 @@ impl PlannedPatches {
             &[ctx.frame_set_layout().raw, set_layout.raw],
             std::mem::size_of::<AdaptivePush>(),
         )?;
-        let [regular, gregory, bilinear, triangles] = gpu.counts;
-        let arrays = number_arrays(&[
-            (PatchType::BSpline, regular, 1),
-            (PatchType::Gregory, gregory, 1),
-            (PatchType::Bilinear, bilinear, 1),
-            (PatchType::GregoryTriangle, triangles, 1),
-        ]);
+        let arrays = patch_arrays(&gpu, options.path);
         let edge_kinds = edge_kind_counts(&arrays, &gpu);
-        let max_level = device.info.caps.max_tessellation_generation_level as f32;
+        let patterns = match options.path {
+            DrawPath::Pattern => Some(PatternDraws::new(&device, &arrays, &gpu)?),
+            _ => None,
+        };
+        // The pattern path keeps the tessellator's bound, so both paths give a patch the same
+        // edge levels.
+        let max_level = match options.path {
+            DrawPath::Pattern => crate::tessellator::MAX_LEVEL,
+            _ => device.info.caps.max_tessellation_generation_level as f32,
+        };
         Ok(Self {
             id,
             evaluator,
@@ -576,6 +661,7 @@ impl PlannedPatches {
             _textures: textures,
             arrays,
             edge_kinds,
+            patterns,
             gpu,
             plan,
             mesh: mesh.clone(),
@@ -670,30 +756,29 @@ impl PlannedPatches {
             count: 0,
             displace_scale: params.displace,
             first_corner: self.gpu.first_corner,
+            pattern_outer: [0.0; 4],
         }
     }
 
-    /// The level `edge_level` in `adaptive.glsl` gives an edge of kind `kind` under uniform
-    /// factors of `segments` per patch edge (mirrored operation for operation).
+    /// [`uniform_edge_level`] with the surface's largest level.
     fn uniform_edge_level(&self, segments: f32, spacing: Spacing, kind: u32) -> f32 {
-        let lim = self.factor_limit();
-        let fractional = spacing == Spacing::FractionalEven;
-        if kind == ADAPTIVE_EDGE_PLAIN {
-            if fractional {
-                return segments.clamp(2.0, lim);
-            }
-            return segments.clamp(1.0, lim).ceil().min(lim);
-        }
-        let half = (lim * 0.5).floor();
-        let f = if fractional {
-            2.0 * (segments.clamp(2.0, half) * 0.5).ceil()
-        } else {
-            segments.clamp(1.0, half).ceil().min(half)
-        };
-        if kind == ADAPTIVE_EDGE_COARSE {
-            2.0 * f
-        } else {
-            f
+        uniform_edge_level(self.factor_limit(), segments, spacing, kind)
+    }
+
+    /// The pattern path's key of a group of array `array` with edge kinds `kinds` under
+    /// `params` (uniform factors; [`Technique::check`] refuses others there).
+    fn pattern_keys(
+        &self,
+        params: &FrameParams,
+    ) -> impl Fn(usize, u32) -> crate::pattern::PatternKey {
+        let domains: Vec<Domain> = self.arrays.iter().map(|a| a.patch.domain()).collect();
+        let (lim, spacing) = (self.factor_limit(), params.spacing);
+        let segments = params.uniform_segments().unwrap_or(1.0);
+        move |array, kinds| {
+            let domain = domains.get(array).copied().unwrap_or(Domain::Quad);
+            key_of_kinds(domain, spacing, kinds, |k| {
+                uniform_edge_level(lim, segments, spacing, k)
+            })
         }
     }
 
@@ -736,29 +821,38 @@ impl PlannedPatches {
     }
 }
 
-/// Plans `mesh` one patch per base face (`patch` Gregory: `--method gregory`, ACC-1:
-/// `--method acc`) and uploads it.
+/// How a single-pass surface is built ([`single_pass`]).
+pub struct SinglePassBuild<'a> {
+    /// Gregory (`--method gregory`) or ACC-1 (`--method acc`).
+    pub patch: SinglePassPatch,
+    pub sharpness_scale: f32,
+    /// One Gregory triangle patch per triangle (else triangles are split once).
+    pub gregory_triangles: bool,
+    /// Name for messages (the mesh's file).
+    pub name: &'a str,
+    pub maps: &'a crate::surface::SurfaceMaps,
+    pub path: DrawPath,
+}
+
+/// Plans `mesh` one patch per base face and uploads it.
 pub fn single_pass(
     ctx: &mut Context,
     mesh: &ControlMesh,
-    patch: SinglePassPatch,
-    sharpness_scale: f32,
-    gregory_triangles: bool,
-    name: &str,
-    maps: &crate::surface::SurfaceMaps,
+    build: &SinglePassBuild,
 ) -> Result<PlannedPatches> {
-    check_texcoords(mesh, maps, name)?;
+    let name = build.name;
+    check_texcoords(mesh, build.maps, name)?;
     let plan_options = SinglePassOptions {
-        patch,
-        sharpness_scale,
-        gregory_triangles,
+        patch: build.patch,
+        sharpness_scale: build.sharpness_scale,
+        gregory_triangles: build.gregory_triangles,
     };
     let plan = plan_single_pass(mesh, &plan_options).map_err(|e| TessError::Mesh {
         name: name.to_string(),
         source: e.into(),
     })?;
     let fvar = fvar_patches(mesh, &FVarPlan::SinglePass(plan_options), name)?;
-    let id = match patch {
+    let id = match build.patch {
         SinglePassPatch::Gregory => TechniqueId::GREGORY,
         SinglePassPatch::Acc1 => TechniqueId::ACC,
     };
@@ -770,10 +864,11 @@ pub fn single_pass(
         &PlanBuild {
             single_pass: true,
             isolation: 1,
-            sharpness_scale,
+            sharpness_scale: build.sharpness_scale,
             follow_semi_sharp: false,
             name: name.to_string(),
-            maps: maps.clone(),
+            maps: build.maps.clone(),
+            path: build.path,
             ..PlanBuild::default()
         },
         id,
@@ -788,14 +883,21 @@ pub fn build_single_pass(
     options: &BuildOptions,
     patch: SinglePassPatch,
 ) -> Result<Built> {
+    let id = match patch {
+        SinglePassPatch::Gregory => TechniqueId::GREGORY,
+        SinglePassPatch::Acc1 => TechniqueId::ACC,
+    };
     let surface = single_pass(
         ctx,
         mesh,
-        patch,
-        options.sharpness_scale,
-        !options.split_triangles,
-        &options.name,
-        &options.maps,
+        &SinglePassBuild {
+            patch,
+            sharpness_scale: options.sharpness_scale,
+            gregory_triangles: !options.split_triangles,
+            name: &options.name,
+            maps: &options.maps,
+            path: resolve_path(id, options.pipeline, ctx.device())?,
+        },
     )?;
     Ok(Built {
         notes: surface.param_error_note().into_iter().collect(),
@@ -853,10 +955,35 @@ impl Technique for PlannedPatches {
                 what: "the param-error view on a surface built without its Eq. 1 error lattice (build with SurfaceMaps::param_error)",
             });
         }
-        check_frame(self.id, Some(self.factor_limit()), params)
+        check_frame(self.id, Some(self.factor_limit()), params)?;
+        if self.patterns.is_some() {
+            super::shared::check_uniform_pattern_frame(self.id, params)?;
+        }
+        Ok(())
     }
 
     fn patch_pipeline(&self, patch: PatchType) -> PatchPipeline {
+        // The texture look-up of face-varying patches only where there are some (its code
+        // costs every vertex on lavapipe).
+        let axes = crate::shaders::Variant {
+            face_varying: self.fvar.is_some(),
+            ..Default::default()
+        };
+        let push_constant_bytes = std::mem::size_of::<AdaptivePush>() as u32;
+        if patch.path() == DrawPath::Pattern {
+            let vertex = match patch {
+                PatchType::PatternGregory => Stage::AdaptivePatternGregoryVert,
+                PatchType::PatternBilinear => Stage::AdaptivePatternBilinearVert,
+                PatchType::PatternGregoryTriangle => Stage::AdaptivePatternTriangleVert,
+                _ => Stage::AdaptivePatternRegularVert,
+            };
+            return PatchPipeline {
+                push_constant_bytes,
+                axes,
+                vertex_input: crate::gpu::pattern_input::PATCH_IDS,
+                ..PatchPipeline::triangles(vertex, Stage::AdaptiveAdaptiveFrag)
+            };
+        }
         // Regular and Gregory control stages fetch the patch's points once (Bezier net,
         // Gregory points); the bilinear cap reads only its curves.
         let (control, evaluation) = match patch {
@@ -868,13 +995,8 @@ impl Technique for PlannedPatches {
             _ => (Stage::AdaptiveRegularTesc, Stage::AdaptiveRegularTese),
         };
         PatchPipeline {
-            push_constant_bytes: std::mem::size_of::<AdaptivePush>() as u32,
-            // The texture look-up of face-varying patches only where there are some (its code
-            // costs every vertex on lavapipe).
-            axes: crate::shaders::Variant {
-                face_varying: self.fvar.is_some(),
-                ..Default::default()
-            },
+            push_constant_bytes,
+            axes,
             ..PatchPipeline::tessellated(
                 Stage::AdaptivePatchVert,
                 control,
@@ -906,6 +1028,9 @@ impl Technique for PlannedPatches {
 
     /// At the largest level an edge can get (a coarse transition edge's doubled level).
     fn max_vertices_per_patch(&self, params: &FrameParams, array: usize) -> u64 {
+        if let Some(p) = &self.patterns {
+            return p.max_vertices(array, &self.pattern_keys(params));
+        }
         let max = match params.factors {
             FactorPolicy::Uniform { segments } => 2.0 * segments,
             _ => self.factor_limit(),
@@ -923,6 +1048,9 @@ impl Technique for PlannedPatches {
         let FactorPolicy::Uniform { segments } = params.factors else {
             return None;
         };
+        if let Some(p) = &self.patterns {
+            return p.triangles(array, &self.pattern_keys(params));
+        }
         let triangle = self.arrays.get(array)?.patch.domain() == Domain::Triangle;
         Some(
             self.edge_kinds
@@ -961,6 +1089,16 @@ impl Technique for PlannedPatches {
         Ok(())
     }
 
+    /// On the pattern path, takes the frame's patterns (one per edge-level key) from the
+    /// context.
+    fn prepare_frame(&mut self, ctx: &mut Context, params: &FrameParams) -> Result<()> {
+        let keys = self.pattern_keys(params);
+        match &mut self.patterns {
+            Some(p) => p.prepare(ctx, &keys),
+            None => Ok(()),
+        }
+    }
+
     /// The base copy, the stencil evaluator's blocks, then the canonical kernel: each step
     /// reads what the steps before it wrote, so each is ordered after them.
     fn record_pre_pass<'a>(
@@ -974,9 +1112,16 @@ impl Technique for PlannedPatches {
             .base
             .get(slot)
             .ok_or(TessError::FrameSlot { slot, slots })?;
-        let tess_stages = vk::PipelineStageFlags::VERTEX_SHADER
-            | vk::PipelineStageFlags::TESSELLATION_CONTROL_SHADER
-            | vk::PipelineStageFlags::TESSELLATION_EVALUATION_SHADER;
+        // The stages that read the vertices: the pattern path's vertex stage alone (a device
+        // without tessellation shaders may name no tessellation stage in a barrier).
+        let tess_stages = match self.patterns {
+            Some(_) => vk::PipelineStageFlags::VERTEX_SHADER,
+            None => {
+                vk::PipelineStageFlags::VERTEX_SHADER
+                    | vk::PipelineStageFlags::TESSELLATION_CONTROL_SHADER
+                    | vk::PipelineStageFlags::TESSELLATION_EVALUATION_SHADER
+            }
+        };
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let transfer = vk::PipelineStageFlags::TRANSFER;
         let ordered = (
@@ -1039,6 +1184,9 @@ impl Technique for PlannedPatches {
             .ok_or(TessError::NoPatchArray { array })?;
         let mut push = self.push(params, pass.mode());
         push.first_patch = a.first_patch;
+        if let Some(p) = &self.patterns {
+            return p.record(enc, array, &self.pattern_keys(params), push);
+        }
         enc.push_constants(&push)?;
         for_each_draw(a.patches, per_draw, |first, n| {
             enc.draw(first..first + n)?;
@@ -1081,6 +1229,7 @@ impl Technique for PlannedPatches {
             .chain([&self.vertices])
             .chain(self.evaluator.buffers())
             .chain(&self._static)
+            .chain(self.patterns.iter().flat_map(|p| p.buffers()))
             .map(DeviceAllocation::of_buffer)
             .chain(self._textures.iter().map(DeviceAllocation::of_texture))
             .collect()
