@@ -1192,6 +1192,14 @@ fn the_draw_path_options_draw_or_name_what_is_wrong() {
             "tessellation path",
         ),
         (
+            vec!["--method", "adaptive", "--pipeline", "pattern"],
+            "pattern path",
+        ),
+        (
+            vec!["--method", "gregory", "--no-tessellation-shader"],
+            "pattern path",
+        ),
+        (
             vec![
                 "--method",
                 "pn",
@@ -1214,16 +1222,23 @@ fn the_draw_path_options_draw_or_name_what_is_wrong() {
         all
     };
     fails(
-        &render(&["--method", "adaptive", "--pipeline", "pattern"]),
+        &render(&["--method", "cpu-catmark", "--pipeline", "pattern"]),
         &[],
         1,
-        &["adaptive", "--pipeline pattern"],
+        &["cpu-catmark", "--pipeline pattern"],
     );
     fails(
-        &render(&["--method", "gregory", "--no-tessellation-shader"]),
+        &render(&[
+            "--method",
+            "adaptive",
+            "--pipeline",
+            "pattern",
+            "--factors",
+            "distance",
+        ]),
         &[],
         1,
-        &["gregory", "--no-tessellation-shader", "--pipeline pattern"],
+        &["adaptive", "distance", "--pipeline tessellation"],
     );
     fails(
         &render(&[
