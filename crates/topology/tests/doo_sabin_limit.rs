@@ -234,6 +234,22 @@ fn check_watertight(name: &str, mesh: &ControlMesh, plan: &AdaptivePlan) {
         (0..t.num_edges()).all(|e| !t.is_boundary_edge(e))
     };
     assert_eq!(sides.len(), plan.curves.len(), "{name}: an unused curve");
+    // Distinct canonical corners are distinct limit points.
+    let mut corners: Vec<[f64; 3]> = (plan.first_corner..plan.first_curve_point)
+        .map(|c| verts[c as usize])
+        .collect();
+    corners.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    for (i, a) in corners.iter().enumerate() {
+        for b in corners[i + 1..]
+            .iter()
+            .take_while(|b| b[0] - a[0] <= 1e-12 * d)
+        {
+            assert!(
+                dist(a, b) > 1e-12 * d,
+                "{name}: two corner ids at one point"
+            );
+        }
+    }
     for (c, levels) in &sides {
         let n = levels.len();
         assert!(
@@ -407,6 +423,10 @@ fn end_caps_per_extraordinary_face_and_level_counts() {
             }
             assert_eq!(s[iso as usize].end_caps as usize, total, "{name}");
             assert!(s.iter().take(iso as usize).all(|l| l.end_caps == 0));
+            assert!(
+                s.iter().all(|l| l.faces as u64 <= l.uniform_faces),
+                "{name}"
+            );
             assert_eq!(
                 s.iter().map(|l| l.regular + l.end_caps).sum::<u32>() as usize,
                 plan.patches.len()
