@@ -4,6 +4,8 @@
 //! - [`acc`]: ACC-1 bicubic Bézier patches and their tangent patches;
 //! - [`bft`]: Loop basis-function tables and the patch records that index them;
 //! - [`doo_sabin`]: Doo-Sabin vertex patches and the index maps of their one-dimensional layout;
+//! - [`doo_sabin_limit`]: the exact Doo-Sabin limit surface as a feature-adaptive plan (regular
+//!   B-spline patches of the biquadratic pieces, bilinear end caps at extraordinary faces);
 //! - [`adaptive`]: the feature-adaptive Catmull-Clark plan (sparse refinement to the isolation
 //!   level, regular patches, end caps, stencil blocks, canonical curves) and the single-pass
 //!   plan ([`adaptive::single_pass`]);
@@ -19,6 +21,7 @@ pub mod acc;
 pub mod adaptive;
 pub mod bft;
 pub mod doo_sabin;
+pub mod doo_sabin_limit;
 pub mod fvar;
 pub mod gregory;
 pub mod reparam;
