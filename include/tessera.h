@@ -352,6 +352,11 @@ typedef struct TesseraHostDesc {
 // (`--method cpu-doo-sabin`: the CPU baseline of `TESSERA_TECHNIQUE_DOO_SABIN`).
 #define TESSERA_TECHNIQUE_CPU_DOO_SABIN 11
 
+// The exact Doo-Sabin limit surface: biquadratic patches isolated feature-adaptively around the
+// centres of non-quad faces, bilinear end caps (`--method doo-sabin-limit`; the default for
+// `TESSERA_SCHEME_DOO_SABIN`).
+#define TESSERA_TECHNIQUE_DOO_SABIN_LIMIT 12
+
 // Catmull-Clark unless every face is a triangle (then Loop); a Loop technique fan-triangulates.
 #define TESSERA_SCHEME_AUTO 0
 
@@ -360,8 +365,8 @@ typedef struct TesseraHostDesc {
 // Loop, strictly: a mesh with a face that is not a triangle is refused (`TESSERA_STATUS_MESH`).
 #define TESSERA_SCHEME_LOOP 2
 
-// Doo-Sabin (drawn by `TESSERA_TECHNIQUE_DOO_SABIN` and `TESSERA_TECHNIQUE_CPU_DOO_SABIN`; its
-// limit evaluator evaluates the exact Doo-Sabin limit).
+// Doo-Sabin (drawn by `TESSERA_TECHNIQUE_DOO_SABIN_LIMIT`, `TESSERA_TECHNIQUE_DOO_SABIN` and
+// `TESSERA_TECHNIQUE_CPU_DOO_SABIN`; its limit evaluator evaluates the exact Doo-Sabin limit).
 #define TESSERA_SCHEME_DOO_SABIN 3
 
 // `factor` segments per base edge.

@@ -264,6 +264,18 @@ fn row(id: TechniqueId) -> [Cell; 10] {
             CATMARK_RULE,
             NO_TEXCOORDS,
         ],
+        "doo-sabin-limit" => [
+            Exact,
+            Ignored("the boundary is the quadratic B-spline of the boundary polygon"),
+            Refused("has no holes"),
+            Refused("has no holes"),
+            Refused("has no creases"),
+            Refused("has no creases"),
+            Refused("has no creases"),
+            Refused("has no sharp vertices"),
+            CATMARK_RULE,
+            NO_TEXCOORDS,
+        ],
         other => panic!("{other}: no row in the option table"),
     }
 }

@@ -10,8 +10,9 @@
 vec3 tc_bezier[16];
 
 void pattern_begin() {
-    AdaptivePatch p = begin_patch();
-    for (uint k = 0u; k < 16u; ++k) tc_bezier[k] = bezier_point(p, k);
+    vec3 cp[16];
+    bspline_points(begin_patch(), cp);
+    for (uint k = 0u; k < 16u; ++k) tc_bezier[k] = bezier_point(cp, k);
 }
 
 #include "regular_eval.glsl"

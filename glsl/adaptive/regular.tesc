@@ -16,7 +16,9 @@ layout(location = 1) out vec3 tc_bezier[];
 void main() {
     uint id = in_patch[0];
     AdaptivePatch p = PATCHES[id];
-    tc_bezier[gl_InvocationID] = bezier_point(p, uint(gl_InvocationID));
+    vec3 cp[16];
+    bspline_points(p, cp);
+    tc_bezier[gl_InvocationID] = bezier_point(cp, uint(gl_InvocationID));
     if (gl_InvocationID == 0) {
         tc_patch = id;
         tc_info = p.info;

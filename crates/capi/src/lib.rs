@@ -115,6 +115,10 @@ pub const TESSERA_TECHNIQUE_DOO_SABIN: TesseraTechnique = 10;
 /// Doo-Sabin subdivision on the CPU to level log2 S, drawn as a static mesh
 /// (`--method cpu-doo-sabin`: the CPU baseline of `TESSERA_TECHNIQUE_DOO_SABIN`).
 pub const TESSERA_TECHNIQUE_CPU_DOO_SABIN: TesseraTechnique = 11;
+/// The exact Doo-Sabin limit surface: biquadratic patches isolated feature-adaptively around the
+/// centres of non-quad faces, bilinear end caps (`--method doo-sabin-limit`; the default for
+/// `TESSERA_SCHEME_DOO_SABIN`).
+pub const TESSERA_TECHNIQUE_DOO_SABIN_LIMIT: TesseraTechnique = 12;
 
 /// The subdivision scheme (`TESSERA_SCHEME_*`).
 pub type TesseraScheme = u32;
@@ -123,8 +127,8 @@ pub const TESSERA_SCHEME_AUTO: TesseraScheme = 0;
 pub const TESSERA_SCHEME_CATMULL_CLARK: TesseraScheme = 1;
 /// Loop, strictly: a mesh with a face that is not a triangle is refused (`TESSERA_STATUS_MESH`).
 pub const TESSERA_SCHEME_LOOP: TesseraScheme = 2;
-/// Doo-Sabin (drawn by `TESSERA_TECHNIQUE_DOO_SABIN` and `TESSERA_TECHNIQUE_CPU_DOO_SABIN`; its
-/// limit evaluator evaluates the exact Doo-Sabin limit).
+/// Doo-Sabin (drawn by `TESSERA_TECHNIQUE_DOO_SABIN_LIMIT`, `TESSERA_TECHNIQUE_DOO_SABIN` and
+/// `TESSERA_TECHNIQUE_CPU_DOO_SABIN`; its limit evaluator evaluates the exact Doo-Sabin limit).
 pub const TESSERA_SCHEME_DOO_SABIN: TesseraScheme = 3;
 
 /// How tessellation factors are chosen (`TESSERA_FACTORS_*`).

@@ -202,6 +202,7 @@ pub(crate) fn tess_status(e: &TessError) -> TesseraStatus {
         | E::ShaderVariant { .. }
         | E::BftLayout(_)
         | E::PatternLevel { .. }
+        | E::PatternEdges { .. }
         | E::Stencil(_)
         | E::UnmappedPatch { .. } => TesseraStatus::Internal,
         E::CaptureTooLarge { .. } | E::CaptureOverflow { .. } | E::PartialTriangle { .. } => {

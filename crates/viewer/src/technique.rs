@@ -159,13 +159,20 @@ fn method_or_scheme_default(
     scheme: Option<&str>,
     mesh: &topology::ControlMesh,
 ) -> Result<TechniqueId> {
+    let parsed = scheme
+        .map(|s| {
+            crate::topo_cmds::parse_scheme(s).map_err(|e| anyhow::anyhow!("--scheme {s}: {e}"))
+        })
+        .transpose()?;
+    // `--scheme doo-sabin --method adaptive`: Doo-Sabin's feature-adaptive limit patches.
+    if method == Some(TechniqueId::ADAPTIVE) && parsed == Some(topology::Scheme::DooSabin) {
+        return Ok(TechniqueId::DOO_SABIN_LIMIT);
+    }
     if let Some(m) = method {
         return Ok(m);
     }
-    let scheme = match scheme {
-        Some(s) => {
-            crate::topo_cmds::parse_scheme(s).map_err(|e| anyhow::anyhow!("--scheme {s}: {e}"))?
-        }
+    let scheme = match parsed {
+        Some(s) => s,
         // A USD mesh whose scheme is bilinear or none: its faces, drawn flat (quads as
         // bilinear patches).
         None if mesh.scheme == Some(topology::Scheme::Bilinear) => return Ok(TechniqueId::FLAT),

@@ -1207,6 +1207,18 @@ fn render_draws_the_limit_surface_of_the_mesh_scheme_by_default() {
     for (extra, want) in [
         (&[][..], "bft"),
         (&["--scheme", "catmull-clark"][..], "adaptive"),
+        (&["--scheme", "doo-sabin"][..], "doo-sabin-limit"),
+        (
+            &[
+                "--scheme",
+                "doo-sabin",
+                "--method",
+                "adaptive",
+                "--isolation",
+                "2",
+            ][..],
+            "doo-sabin-limit",
+        ),
     ] {
         let o = tessera(
             &[

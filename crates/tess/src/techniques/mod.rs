@@ -10,6 +10,7 @@ pub mod adaptive;
 pub mod bft;
 pub mod cpu;
 pub mod doo_sabin;
+pub mod doo_sabin_limit;
 pub mod face_patches;
 pub mod flat;
 pub mod gregory;
@@ -60,7 +61,7 @@ pub struct TechniqueInfo {
 
 /// Every technique, one line each, in the order reports and the window's number keys list
 /// them (flat first: ratios divide by it).
-pub static REGISTRY: [&TechniqueInfo; 11] = [
+pub static REGISTRY: [&TechniqueInfo; 12] = [
     &flat::INFO,
     &phong::INFO,
     &pn::INFO,
@@ -70,6 +71,7 @@ pub static REGISTRY: [&TechniqueInfo; 11] = [
     &acc::INFO,
     &cpu::INFO,
     &cpu::CATMARK_INFO,
+    &doo_sabin_limit::INFO,
     &doo_sabin::INFO,
     &cpu::DOO_SABIN_INFO,
 ];

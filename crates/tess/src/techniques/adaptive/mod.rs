@@ -65,6 +65,7 @@ fn build_registered(
                 options.pipeline,
                 ctx.device(),
             )?,
+            corner_quads: false,
         },
     )?;
     Ok(Built {

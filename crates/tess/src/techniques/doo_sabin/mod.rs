@@ -83,7 +83,7 @@ pub static INFO: TechniqueInfo = TechniqueInfo {
         paths: &[DrawPath::VertexStage],
     },
     scheme: Some(Scheme::DooSabin),
-    default_for_scheme: true,
+    default_for_scheme: false,
     shader_folder: "doo_sabin",
     abi_code: 10,
     legend: &[],

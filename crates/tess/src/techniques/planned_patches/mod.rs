@@ -438,6 +438,10 @@ pub struct PlanBuild {
     pub maps: SurfaceMaps,
     /// The tessellation stage, or refinement patterns ([`resolve_path`]).
     pub path: DrawPath,
+    /// Every patch's `sub_face` is its base face's corner and its square lies in that corner's
+    /// quad (`topology::limit::face_domain::subface_domain`), quads included (Doo-Sabin plans);
+    /// otherwise a quad's patches lie in the whole face (Catmull-Clark plans).
+    pub corner_quads: bool,
 }
 
 impl Default for PlanBuild {
@@ -451,6 +455,7 @@ impl Default for PlanBuild {
             name: "mesh".into(),
             maps: SurfaceMaps::default(),
             path: DrawPath::Tessellation,
+            corner_quads: false,
         }
     }
 }
@@ -786,8 +791,13 @@ impl PlannedPatches {
     /// as the TES computes it (`glsl/adaptive/surface.glsl`'s `texcoord_at`, in `f64`): the
     /// texture parameter (Eq. 3's when `reparam`), then the corners' bilinear blend, then,
     /// with face-varying patches, their look-up at that (sub-)face parameter. `None` for an
-    /// unknown patch or a mesh without texture coordinates.
+    /// unknown patch, a mesh without texture coordinates or a corner-quad plan
+    /// ([`PlanBuild::corner_quads`]).
     pub fn texcoord_at(&self, patch: u32, u: f64, v: f64, reparam: bool) -> Option<[f64; 2]> {
+        // A corner-quad plan's patches are not numbered over the whole quad the look-up assumes.
+        if self.options.corner_quads {
+            return None;
+        }
         let pi = *self.gpu.order.get(patch as usize)?;
         let p = self.plan.patches.get(pi as usize)?;
         let [s, t] = topology::patches::texcoord::patch_parameter(p, u, v, reparam);
@@ -1204,7 +1214,7 @@ impl Technique for PlannedPatches {
     fn face_point(&self, patch: u32, domain: [f32; 2]) -> Option<FacePoint> {
         let (face, sub, u, v) = self.base_param(patch, domain[0] as f64, domain[1] as f64)?;
         let n = self.mesh.face(face as usize).len() as u32;
-        if n == 4 {
+        if n == 4 && !self.options.corner_quads {
             return Some(FacePoint {
                 face,
                 u: u as f32,
@@ -1252,8 +1262,9 @@ impl Technique for PlannedPatches {
             )];
         }
         vec![format!(
-            "adaptive: isolation {}, {r} regular patches, {g} Gregory and {b} bilinear end caps, \
+            "{}: isolation {}, {r} regular patches, {g} Gregory and {b} bilinear end caps, \
              {} vertices ({} refined + local), tables {} bytes",
+            self.id,
             self.plan.isolation,
             self.gpu.num_vertices,
             self.gpu.num_vertices - self.gpu.num_base_vertices,
