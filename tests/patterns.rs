@@ -377,7 +377,6 @@ fn without_tessellation_shaders_the_base_face_techniques_draw_generated_patterns
             (TechniqueId::FLAT, PipelineChoice::Tessellation),
             (TechniqueId::BFT, PipelineChoice::Tessellation),
             (TechniqueId::ADAPTIVE, PipelineChoice::Tessellation),
-            (TechniqueId::CPU, PipelineChoice::Tessellation),
         ] {
             match build(&mut ctx, id, &cube, choice) {
                 Err(e @ TessError::NoTessellationShader { .. }) => {
@@ -579,12 +578,13 @@ fn exact_limit_error(t: &dyn Technique, soup: &CapturedSoup, cpu: &LocalMesh) ->
     worst
 }
 
-/// The planned Catmull-Clark surfaces (feature-adaptive, Gregory, ACC-1), which evaluate at a
-/// patch domain point.
-const PLANNED_TECHNIQUES: [TechniqueId; 3] = [
+/// The planned surfaces (feature-adaptive Catmull-Clark, Gregory, ACC-1, the Doo-Sabin limit),
+/// which evaluate at a patch domain point.
+const PLANNED_TECHNIQUES: [TechniqueId; 4] = [
     TechniqueId::ADAPTIVE,
     TechniqueId::GREGORY,
     TechniqueId::ACC,
+    TechniqueId::DOO_SABIN_LIMIT,
 ];
 
 fn build_isolated(
