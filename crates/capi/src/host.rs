@@ -424,16 +424,16 @@ pub unsafe extern "C" fn tessera_record_draw(
         let slot = c.slot();
         s.sync_positions(slot)?;
         let (params, extent) = s.frame;
+        let eye = view.inverse().w_axis.truncate();
+        let m = tess::camera::CameraMatrices { view, proj, eye };
+        let uniforms = tess::context::frame_uniforms_with(m, s.technique.bbox(), &params, extent);
+        s.tess.write_frame_uniforms(slot, &uniforms)?;
         s.tess.prepare(
             s.technique.as_mut(),
             &params,
             tess::Context::frame_passes(&params),
         )?;
         let technique = s.technique.as_ref();
-        let eye = view.inverse().w_axis.truncate();
-        let m = tess::camera::CameraMatrices { view, proj, eye };
-        let uniforms = tess::context::frame_uniforms_with(m, technique.bbox(), &params, extent);
-        s.tess.write_frame_uniforms(slot, &uniforms)?;
         // SAFETY: the caller's contract: a recording command buffer of this device inside the
         // host's scope as the context describes it (dynamic rendering of these formats, or
         // the render pass's subpass), whose execution the host waits for before destroying

@@ -203,6 +203,7 @@ pub(crate) fn tess_status(e: &TessError) -> TesseraStatus {
         | E::BftLayout(_)
         | E::PatternLevel { .. }
         | E::PatternEdges { .. }
+        | E::NoFrameView { .. }
         | E::Stencil(_)
         | E::UnmappedPatch { .. } => TesseraStatus::Internal,
         E::CaptureTooLarge { .. } | E::CaptureOverflow { .. } | E::PartialTriangle { .. } => {

@@ -125,6 +125,8 @@ pub struct Context {
     /// The host's render pass subpass the draw pipelines are made for; `None`: dynamic
     /// rendering ([`Self::for_subpass`]).
     subpass: Option<Subpass>,
+    /// The frame block last written ([`Self::frame_view`]).
+    view: Option<FrameUniforms>,
     device: Device,
 }
 
@@ -145,6 +147,7 @@ impl Context {
             patterns: Default::default(),
             set_layouts: HashMap::new(),
             frames: FrameSets::new(device, frames_in_flight)?,
+            view: None,
             color_format,
             depth_format,
             subpass: None,
@@ -281,8 +284,16 @@ impl Context {
         self.write_frame_uniforms(slot, &frame_uniforms(bbox, params, extent))
     }
 
+    /// The frame block last written ([`Self::write_frame`]): the view and viewport adaptive
+    /// factors see. A technique that chooses its levels on the host reads it in
+    /// [`Technique::prepare_frame`], so every frame writes its block before [`Self::prepare`].
+    pub fn frame_view(&self) -> Option<&FrameUniforms> {
+        self.view.as_ref()
+    }
+
     /// Writes the frame uniforms of `slot` as given (see [`frame_uniforms_with`]).
     pub fn write_frame_uniforms(&mut self, slot: usize, uniforms: &FrameUniforms) -> Result<()> {
+        self.view = Some(*uniforms);
         let slots = self.frames.slots.len();
         let (_, buffer) = self
             .frames
@@ -535,9 +546,9 @@ impl Context {
         extent: vk::Extent2D,
         statistics: bool,
     ) -> Result<OffscreenFrame> {
+        self.write_frame(0, technique.bbox(), params, extent)?;
         self.prepare(technique, params, Self::frame_passes(params))?;
         let technique = &*technique;
-        self.write_frame(0, technique.bbox(), params, extent)?;
         let device = self.device.clone();
         let target = OffscreenTarget::new(&device, extent)?;
         let readback = target.readback_buffer(&device)?;

@@ -106,6 +106,8 @@ pub enum TessError {
     PatternSpacing {
         spacing: crate::tessellator::Spacing,
     },
+    #[error("{technique} chooses its pattern levels on the host from the frame's view: write the frame block (Context::write_frame) before Context::prepare")]
+    NoFrameView { technique: TechniqueId },
     #[error("a refinement pattern of {segments} segments per edge: expected 1..256")]
     PatternLevel { segments: u32 },
     #[error(

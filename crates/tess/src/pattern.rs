@@ -108,9 +108,9 @@ impl RefinementPattern {
                 e.insert(params(l)?);
             }
         }
-        let mut b = QuadStitch {
+        let mut b = Stitch {
             levels,
-            ..QuadStitch::default()
+            ..Stitch::default()
         };
         let [iu, iv] = inner;
         match (iu >= 2, iv >= 2) {
@@ -127,6 +127,41 @@ impl RefinementPattern {
                     "an inner level of 1 needs the two edges across it at level 1",
                 ))
             }
+        }
+        Ok(b.finish())
+    }
+
+    /// The triangle pattern of per-edge levels `outer` (`gl_TessLevelOuter`'s order: the edges
+    /// u = 0, v = 0, w = 0) and inner level `inner`, whole segments in equal spacing at the
+    /// generated parameters of [`Self::generate`]: each edge at its own level, so two patterns
+    /// sharing an edge level meet point for point along it. From inner level 3 on, the inner
+    /// lattice (the barycentric lattice's points with every index at least 1) is joined to each
+    /// edge by a strip zipped along both; below it the boundary is fanned from the centroid.
+    /// Uniform levels give [`Self::generate`]'s lattice.
+    pub fn generate_triangle_edges(outer: [u32; 3], inner: u32) -> Result<Self> {
+        let all = [outer[0], outer[1], outer[2], inner];
+        if all
+            .iter()
+            .any(|&l| !(1..=MAX_GENERATED_SEGMENTS).contains(&l))
+        {
+            return Err(TessError::PatternEdges {
+                domain: Domain::Triangle,
+                outer: outer.map(|l| l as f32).to_vec(),
+                inner: vec![inner as f32],
+                why: "expected levels 1..256",
+            });
+        }
+        if all.iter().all(|&l| l == inner) {
+            return Ok(Self::triangle_lattice(inner));
+        }
+        let mut b = Stitch {
+            triangle: true,
+            ..Stitch::default()
+        };
+        if inner >= 3 {
+            b.triangle_lattice_and_strips(outer, inner);
+        } else {
+            b.triangle_fan(outer);
         }
         Ok(b.finish())
     }
@@ -226,10 +261,13 @@ impl RefinementPattern {
     }
 }
 
-/// Builds [`RefinementPattern::generate_edges`]'s quad: points merged by their parameters'
-/// bits, triangles counter-clockwise in `(u, v)`.
+/// Builds the stitched patterns ([`RefinementPattern::generate_edges`],
+/// [`RefinementPattern::generate_triangle_edges`]): points merged by their parameters' bits,
+/// triangles counter-clockwise in `(u, v)`.
 #[derive(Default)]
-struct QuadStitch {
+struct Stitch {
+    /// Triangles (`w = 1 − u − v` per point) or quads.
+    triangle: bool,
     /// Where each level used puts its points.
     levels: HashMap<u32, LevelParameters>,
     index: HashMap<[u32; 2], u32>,
@@ -294,12 +332,17 @@ impl LevelParameters {
     }
 }
 
-impl QuadStitch {
+impl Stitch {
     /// The point at fixed-point parameters `(u, v)`.
     fn point(&mut self, u: u32, v: u32) -> u32 {
         let points = &mut self.points;
+        let w = if self.triangle {
+            to_f32(FIXED_ONE - u - v)
+        } else {
+            0.0
+        };
         *self.index.entry([u, v]).or_insert_with(|| {
-            points.push([to_f32(u), to_f32(v), 0.0]);
+            points.push([to_f32(u), to_f32(v), w]);
             points.len() as u32 - 1
         })
     }
@@ -406,9 +449,72 @@ impl QuadStitch {
 
     fn finish(self) -> RefinementPattern {
         RefinementPattern {
-            domain: Domain::Quad,
+            domain: if self.triangle {
+                Domain::Triangle
+            } else {
+                Domain::Quad
+            },
             points: self.points,
             triangles: self.triangles,
+        }
+    }
+
+    /// The `n + 1` points of triangle edge `e` (0: u = 0, 1: v = 0, 2: w = 0,
+    /// `gl_TessLevelOuter`'s order) at level `n`, in the triangle's counter-clockwise direction
+    /// (v = 0 from corner (0, 0) to (1, 0), w = 0 on to (0, 1), u = 0 back to (0, 0)).
+    fn triangle_edge(&mut self, e: usize, n: u32) -> Vec<u32> {
+        (0..=n)
+            .map(|k| {
+                let t = fixed_parameter(k, n);
+                match e {
+                    0 => self.point(0, FIXED_ONE - t),
+                    1 => self.point(t, 0),
+                    _ => self.point(FIXED_ONE - t, t),
+                }
+            })
+            .collect()
+    }
+
+    /// The inner lattice of level `n ≥ 3` (its points with every barycentric index ≥ 1), then a
+    /// strip from each edge to the lattice side facing it.
+    fn triangle_lattice_and_strips(&mut self, outer: [u32; 3], n: u32) {
+        let at =
+            |s: &mut Self, i: u32, j: u32| s.point(fixed_parameter(i, n), fixed_parameter(j, n));
+        for j in 1..n - 1 {
+            for i in 1..n - 1 - j {
+                let (a, b, c) = (at(self, i, j), at(self, i + 1, j), at(self, i, j + 1));
+                self.triangles.push([a, b, c]);
+                if i + j + 3 <= n {
+                    let d = at(self, i + 1, j + 1);
+                    self.triangles.push([b, d, c]);
+                }
+            }
+        }
+        let m = n - 2;
+        let sides: [Vec<(u32, u32)>; 3] = [
+            (1..=m).rev().map(|j| (1, j)).collect(),
+            (1..=m).map(|i| (i, 1)).collect(),
+            (1..=m).rev().map(|i| (i, n - 1 - i)).collect(),
+        ];
+        for e in [1, 2, 0] {
+            let edge = self.triangle_edge(e, outer[e]);
+            let inner: Vec<u32> = sides[e].iter().map(|&(i, j)| at(self, i, j)).collect();
+            self.zip(&edge, &inner);
+        }
+    }
+
+    /// The triangle's boundary points (each edge at its level) fanned from its centroid.
+    fn triangle_fan(&mut self, outer: [u32; 3]) {
+        let third = fixed_parameter(1, 3);
+        let c = self.point(third, third);
+        let mut ring = Vec::new();
+        for e in [1, 2, 0] {
+            let edge = self.triangle_edge(e, outer[e]);
+            ring.extend_from_slice(&edge[..edge.len() - 1]);
+        }
+        for k in 0..ring.len() {
+            self.triangles
+                .push([ring[k], ring[(k + 1) % ring.len()], c]);
         }
     }
 }
@@ -601,12 +707,17 @@ fn generate_for_edges(ctx: &mut Context, key: PatternKey) -> Result<RefinementPa
             spacing: key.spacing,
         });
     }
-    if key.domain != Domain::Quad {
-        return Err(refuse("per-edge patterns are made for quads only"));
-    }
     let whole = |l: f32| {
         (l.fract() == 0.0 && (1.0..=MAX_GENERATED_SEGMENTS as f32).contains(&l)).then_some(l as u32)
     };
+    if key.domain == Domain::Triangle {
+        let ([Some(a), Some(b), Some(c), _], [Some(n), _]) =
+            (key.outer().map(whole), key.inner().map(whole))
+        else {
+            return Err(refuse("expected whole levels 1..256"));
+        };
+        return RefinementPattern::generate_triangle_edges([a, b, c], n);
+    }
     let ([Some(a), Some(b), Some(c), Some(d)], [Some(u), Some(v)]) =
         (key.outer().map(whole), key.inner().map(whole))
     else {
@@ -823,6 +934,44 @@ mod tests {
                 "{outer:?} {inner:?}"
             );
         }
+    }
+
+    /// Per-edge triangle patterns (a Gregory triangle's host-chosen levels): counter-clockwise,
+    /// tiling the triangle, each edge at its own level with w exactly 0 on the w = 0 edge.
+    #[test]
+    fn per_edge_triangle_patterns_tile_the_triangle_with_each_edge_at_its_level() {
+        for (outer, inner) in [
+            ([4, 8, 2], 8),
+            ([1, 2, 1], 2),
+            ([1, 1, 2], 2),
+            ([3, 3, 1], 3),
+            ([16, 64, 32], 64),
+            ([5, 5, 5], 5),
+        ] {
+            let p = RefinementPattern::generate_triangle_edges(outer, inner).unwrap();
+            let mut area = 0.0;
+            for &t in &p.triangles {
+                let a = signed_area(&p, t);
+                assert!(
+                    a > 0.0,
+                    "{outer:?} {inner}: {t:?} turns clockwise or is degenerate"
+                );
+                area += a / 2.0;
+            }
+            assert!((area - 0.5).abs() < 1e-9, "{outer:?} {inner}: area {area}");
+            for (e, &n) in outer.iter().enumerate() {
+                let on = p.points.iter().filter(|q| q[[0, 1, 2][e]] == 0.0).count();
+                assert_eq!(on as u32, n + 1, "{outer:?} {inner}: edge {e}");
+            }
+            for q in &p.points {
+                assert_eq!(q[0] + q[1] + q[2], 1.0, "{q:?}");
+            }
+        }
+        assert_eq!(
+            RefinementPattern::generate_triangle_edges([6; 3], 6).unwrap(),
+            RefinementPattern::generate(Domain::Triangle, 6).unwrap()
+        );
+        assert!(RefinementPattern::generate_triangle_edges([0, 1, 1], 1).is_err());
     }
 
     #[test]

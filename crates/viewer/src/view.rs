@@ -341,13 +341,13 @@ impl App {
         if let (true, Some(wave)) = (self.moved, &surface.wave) {
             surface.technique.update_base(slot, &wave.at(self.time))?;
         }
+        context.write_frame(slot, surface.technique.bbox(), &params, extent)?;
         context.prepare(
             surface.technique.as_mut(),
             &params,
             Context::frame_passes(&params),
         )?;
         let technique = surface.technique.as_ref();
-        context.write_frame(slot, technique.bbox(), &params, extent)?;
         let last = self.args.frames.is_some_and(|n| self.frames_drawn + 1 >= n);
         let recorded = Recorded {
             context,

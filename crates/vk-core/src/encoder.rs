@@ -776,6 +776,41 @@ impl<'a> Encoder<'a> {
         Ok(())
     }
 
+    /// Writes `data` into `dst` at `offset` from the command buffer itself (vkCmdUpdateBuffer,
+    /// in pieces of at most 65,536 bytes): a small table that changes every frame, without a
+    /// staging buffer or a host-visible copy per frame slot. `offset` and the length are
+    /// multiples of 4 and the range lies in `dst`; ordering against earlier readers and later
+    /// ones is the caller's barrier (a transfer write).
+    pub fn update_buffer(&mut self, dst: &'a Buffer, offset: u64, data: &[u8]) -> Result<()> {
+        const CMD: &str = "vkCmdUpdateBuffer";
+        const PIECE: usize = 65536;
+        self.outside_rendering(CMD)?;
+        Self::needs_usage(CMD, dst, vk::BufferUsageFlags::TRANSFER_DST)?;
+        Self::needs_size(CMD, dst, offset + data.len() as u64)?;
+        if offset % 4 != 0 || data.len() % 4 != 0 {
+            return Err(VkError::recording(
+                CMD,
+                E::UpdateAlignment {
+                    offset,
+                    bytes: data.len(),
+                },
+            ));
+        }
+        for (k, piece) in data.chunks(PIECE).enumerate() {
+            // SAFETY: outside a rendering scope; `dst` has TRANSFER_DST and holds the range,
+            // whose offset and size are multiples of 4 and at most 65,536 bytes.
+            unsafe {
+                self.device.raw.cmd_update_buffer(
+                    self.cmd,
+                    dst.raw,
+                    offset + (k * PIECE) as u64,
+                    piece,
+                )
+            };
+        }
+        Ok(())
+    }
+
     /// Uploads level 0 of `texture` from the start of `staging` (tightly packed texels), blits
     /// the rest of its mip chain from it, and leaves every level in SHADER_READ_ONLY_OPTIMAL.
     /// The previous contents are discarded; earlier work on the queue that samples the texture

@@ -151,6 +151,8 @@ pub enum RecordingError {
         needed: u64,
         size: u64,
     },
+    #[error("an update of {bytes} bytes at offset {offset}: both must be multiples of 4")]
+    UpdateAlignment { offset: u64, bytes: usize },
     #[error("texture {texture} lacks usage {needed:?}")]
     TextureUsage {
         texture: String,

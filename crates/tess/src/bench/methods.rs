@@ -237,8 +237,6 @@ impl TechniqueRow {
 
     pub fn begin_frame(&mut self, frame: &BenchFrame) -> Result<Option<f64>> {
         let params = self.params(frame.segments, frame.camera);
-        self.context
-            .prepare(self.technique.as_mut(), &params, &[crate::Pass::Shaded])?;
         let cpu = match (&self.wave, self.animated) {
             (Some(wave), true) => {
                 // The viewer's --animate: deform on the CPU, upload only the base positions.
@@ -251,6 +249,8 @@ impl TechniqueRow {
         };
         self.context
             .write_frame(0, self.technique.bbox(), &params, frame.extent)?;
+        self.context
+            .prepare(self.technique.as_mut(), &params, &[crate::Pass::Shaded])?;
         Ok(cpu)
     }
 

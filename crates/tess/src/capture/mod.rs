@@ -168,9 +168,9 @@ impl Capturer {
         params: &FrameParams,
         extent: vk::Extent2D,
     ) -> Result<(CapturedSoup, CaptureStats)> {
+        ctx.write_frame(0, technique.bbox(), params, extent)?;
         ctx.prepare(technique, params, &[Pass::Capture])?;
         let technique = &*technique;
-        ctx.write_frame(0, technique.bbox(), params, extent)?;
         let arrays = technique.patch_arrays();
         let known: Vec<Option<u64>> = (0..arrays.len())
             .map(|i| technique.triangles(params, i))

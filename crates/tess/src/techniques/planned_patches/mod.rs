@@ -70,7 +70,7 @@ use crate::tessellator::{
     quad_triangle_count, triangle_triangle_count, uniform_vertex_count, Domain, Spacing,
 };
 use layout::GpuPlan;
-use patterns::{key_of_kinds, PatternDraws};
+use patterns::{key_of_kinds, HostView, PatternDraws};
 use std::ops::Range;
 use topology::patches::adaptive::single_pass::{
     plan_single_pass, SinglePassOptions, SinglePassPatch,
@@ -460,10 +460,10 @@ impl Default for PlanBuild {
     }
 }
 
-/// A planned surface's draw path for `choice` on `device`. On the refinement-pattern path the
-/// planned patches take uniform factors only (no pattern family per edge level follows
-/// screen-space or distance factors yet), so `auto` keeps the tessellation stage wherever the
-/// device has one and draws patterns only where it has none.
+/// A planned surface's draw path for `choice` on `device`. `auto` keeps the tessellation stage
+/// wherever the device has one (on lavapipe the pattern path measured slower for these
+/// surfaces, whose vertex stage gathers a patch's control points per vertex: docs/patterns.md)
+/// and draws patterns where it has none.
 pub fn resolve_path(
     technique: TechniqueId,
     choice: crate::technique::PipelineChoice,
@@ -530,6 +530,9 @@ pub struct PlannedPatches {
     edge_kinds: Vec<Vec<(u32, u64)>>,
     /// The refinement-pattern path's draws (`None` on the tessellation path).
     patterns: Option<PatternDraws>,
+    /// The pattern path's host copy of the plan's vertices for host-chosen levels, with the
+    /// base positions it was computed from.
+    host_vertices: Option<(Vec<[f32; 3]>, Vec<[f64; 3]>)>,
     pub gpu: GpuPlan,
     pub plan: AdaptivePlan,
     pub mesh: ControlMesh,
@@ -667,6 +670,7 @@ impl PlannedPatches {
             arrays,
             edge_kinds,
             patterns,
+            host_vertices: None,
             gpu,
             plan,
             mesh: mesh.clone(),
@@ -768,6 +772,24 @@ impl PlannedPatches {
     /// [`uniform_edge_level`] with the surface's largest level.
     fn uniform_edge_level(&self, segments: f32, spacing: Spacing, kind: u32) -> f32 {
         uniform_edge_level(self.factor_limit(), segments, spacing, kind)
+    }
+
+    /// Makes `host_vertices` the plan's vertices from the current base positions, on
+    /// the host (again only when the base moved).
+    fn update_host_vertices(&mut self) {
+        let stale = self
+            .host_vertices
+            .as_ref()
+            .is_none_or(|(base, _)| *base != self.base_positions);
+        if stale {
+            let base: Vec<[f64; 3]> = self
+                .base_positions
+                .iter()
+                .map(|p| p.map(f64::from))
+                .collect();
+            let vertices = self.plan.apply(&base);
+            self.host_vertices = Some((self.base_positions.clone(), vertices));
+        }
     }
 
     /// The pattern path's key of a group of array `array` with edge kinds `kinds` under
@@ -966,8 +988,11 @@ impl Technique for PlannedPatches {
             });
         }
         check_frame(self.id, Some(self.factor_limit()), params)?;
-        if self.patterns.is_some() {
-            super::shared::check_uniform_pattern_frame(self.id, params)?;
+        // The pattern path's stitched patterns are equal spacing.
+        if self.patterns.is_some() && params.spacing != Spacing::Equal {
+            return Err(TessError::PatternSpacing {
+                spacing: params.spacing,
+            });
         }
         Ok(())
     }
@@ -1055,12 +1080,12 @@ impl Technique for PlannedPatches {
     /// Exact for uniform factors: each patch's edge levels as `patch.tesc` sets them (a
     /// coarse transition edge doubled), counted by the tessellator's arithmetic.
     fn triangles(&self, params: &FrameParams, array: usize) -> Option<u64> {
-        let FactorPolicy::Uniform { segments } = params.factors else {
-            return None;
-        };
         if let Some(p) = &self.patterns {
             return p.triangles(array, &self.pattern_keys(params));
         }
+        let FactorPolicy::Uniform { segments } = params.factors else {
+            return None;
+        };
         let triangle = self.arrays.get(array)?.patch.domain() == Domain::Triangle;
         Some(
             self.edge_kinds
@@ -1100,11 +1125,40 @@ impl Technique for PlannedPatches {
     }
 
     /// On the pattern path, takes the frame's patterns (one per edge-level key) from the
-    /// context.
+    /// context; under screen-space and distance factors the host chooses each patch's levels
+    /// first (`patterns` module docs, step 4).
     fn prepare_frame(&mut self, ctx: &mut Context, params: &FrameParams) -> Result<()> {
-        let keys = self.pattern_keys(params);
+        if self.patterns.is_none() {
+            return Ok(());
+        }
+        if matches!(params.factors, FactorPolicy::Uniform { .. }) {
+            let keys = self.pattern_keys(params);
+            return match &mut self.patterns {
+                Some(p) => p.prepare(ctx, &keys),
+                None => Ok(()),
+            };
+        }
+        let view = *ctx
+            .frame_view()
+            .ok_or(TessError::NoFrameView { technique: self.id })?;
+        let (mode, _, pixels, reference) = factor_fields(params.factors);
+        let host = HostView::new(&view, mode, pixels, reference, self.factor_limit());
+        self.update_host_vertices();
+        let vertices = self
+            .host_vertices
+            .as_ref()
+            .map_or(&[][..], |(_, v)| v.as_slice());
+        let factors = host.curve_factors(&self.plan, vertices);
+        let (gpu, arrays) = (&self.gpu, &self.arrays);
+        let key_of = |array: usize, id: u32| {
+            let domain = arrays.get(array).map_or(Domain::Quad, |a| a.patch.domain());
+            match gpu.patches.get(id as usize) {
+                Some(p) => host.key(domain, p, &factors),
+                None => crate::pattern::PatternKey::new(domain, Spacing::Equal, 1.0),
+            }
+        };
         match &mut self.patterns {
-            Some(p) => p.prepare(ctx, &keys),
+            Some(p) => p.prepare_host_levels(ctx, arrays, &key_of),
             None => Ok(()),
         }
     }
@@ -1139,6 +1193,9 @@ impl Technique for PlannedPatches {
             vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
         );
         enc.begin_label("adaptive subdivision tables");
+        if let Some(p) = &self.patterns {
+            p.record_ids(enc)?;
+        }
         // The previous frame's tessellation stages read the vertices before we overwrite them;
         // host writes of the base positions are visible at submit.
         enc.memory_barrier(

@@ -15,8 +15,19 @@
 //!    constants: a canonical vertex (on the patch boundary) finds its index along the edge
 //!    from them, exactly as the evaluation stage does from `gl_TessLevelOuter`, so both sides
 //!    of every edge evaluate the same canonical curve point, transitions included.
+//! 4. **Screen-space and distance factors (per frame, on the host):** there is no control
+//!    stage to choose levels, so the host does what it does: each canonical curve's factor
+//!    (`curve_factor` of `adaptive.glsl`, from the curve's four points in the frame's view),
+//!    each patch edge's level rounded up to a power of two (`edge_level`, a coarse transition
+//!    edge twice its halves'), and the patch's key from its four levels. A curve's level is one
+//!    number both patches of its edge read, so shared edges still meet point for point. The
+//!    patches are grouped by key for the frame (one draw per key, a family of patterns indexed
+//!    by the edge levels, made on first use) and their ids written into the command buffer
+//!    ahead of the draws. The curve points come from the plan on the host (`AdaptivePlan::apply`,
+//!    again only when the base moves), one frame's worth of stencils in `f64`.
 use crate::error::{Result, TessError};
-use crate::gpu::AdaptivePush;
+use crate::gpu::bindings::{ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_PLAIN, BFT_FACTORS_SCREEN};
+use crate::gpu::{AdaptivePush, FrameUniforms};
 use crate::pattern::{PatternBuffers, PatternKey};
 use crate::technique::{DrawCounts, PatchArray};
 use crate::tessellator::{Domain, Spacing};
@@ -24,7 +35,8 @@ use std::collections::{BTreeMap, HashMap};
 use std::ops::Range;
 use vk_core::{vk, Buffer, Encoder};
 
-use super::layout::GpuPlan;
+use super::layout::{GpuPlan, PatchRecord};
+use topology::patches::adaptive::AdaptivePlan;
 
 /// The patches of one array sharing their edge kinds.
 struct PatternGroup {
@@ -42,6 +54,111 @@ pub(super) struct PatternDraws {
     groups: Vec<Vec<PatternGroup>>,
     /// The device patterns of the frame's keys.
     current: HashMap<PatternKey, PatternBuffers>,
+    /// Under host-chosen levels, the frame's grouping; `None` under uniform factors.
+    frame: Option<FrameGroups>,
+    /// The frame's patch ids, written by the command buffer (`FrameGroups::ids`).
+    frame_ids: Buffer,
+}
+
+/// One frame's patches grouped by the keys the host chose for them.
+struct FrameGroups {
+    /// Frame-wide patch ids, per array, per key.
+    ids: Vec<u32>,
+    /// Per array, each key and its run of `ids`.
+    groups: Vec<Vec<(PatternKey, Range<u32>)>>,
+}
+
+/// What the host's level choice reads of a frame: the view, the policy's fields and the largest
+/// level (`curve_factor` and `edge_level` of `adaptive.glsl`).
+pub(super) struct HostView {
+    pub view_proj: glam::Mat4,
+    pub viewport: [f32; 2],
+    pub eye: glam::Vec3,
+    /// `BFT_FACTORS_SCREEN` or `BFT_FACTORS_DISTANCE`.
+    pub mode: u32,
+    pub pixels: f32,
+    pub reference: f32,
+    pub max_level: f32,
+}
+
+impl HostView {
+    pub fn new(
+        view: &FrameUniforms,
+        mode: u32,
+        pixels: f32,
+        reference: f32,
+        max_level: f32,
+    ) -> Self {
+        Self {
+            view_proj: glam::Mat4::from_cols_array_2d(&view.view_proj),
+            viewport: [view.viewport[0], view.viewport[1]],
+            eye: glam::Vec3::new(view.camera_pos[0], view.camera_pos[1], view.camera_pos[2]),
+            mode,
+            pixels,
+            reference,
+            max_level,
+        }
+    }
+
+    /// The factor a curve of control points `p` asks for (`curve_factor`).
+    fn curve_factor(&self, p: [glam::Vec3; 4]) -> f32 {
+        if self.mode == BFT_FACTORS_SCREEN {
+            let c = p.map(|q| self.view_proj * q.extend(1.0));
+            if c.iter().map(|c| c.w).fold(f32::INFINITY, f32::min) <= 1e-6 {
+                return self.max_level;
+            }
+            let h = glam::Vec2::from(self.viewport) * 0.5;
+            let s = c.map(|c| glam::Vec2::new(c.x, c.y) / c.w * h);
+            return (s[0].distance(s[1]) + s[1].distance(s[2]) + s[2].distance(s[3])) / self.pixels;
+        }
+        let d = self.eye.distance(0.5 * (p[0] + p[3]));
+        self.max_level * self.reference / d.max(1e-6)
+    }
+
+    /// Every canonical curve's factor, from the plan's vertices `verts`.
+    pub fn curve_factors(&self, plan: &AdaptivePlan, verts: &[[f64; 3]]) -> Vec<f32> {
+        let point = |id: u32| {
+            let v = verts.get(id as usize).copied().unwrap_or_default();
+            glam::Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
+        };
+        plan.curves
+            .iter()
+            .map(|c| self.curve_factor(c.map(point)))
+            .collect()
+    }
+
+    /// The level of edge `e` of patch `p` (`edge_level` with power-of-two levels, equal
+    /// spacing): a plain edge its curve's, a transition edge the larger of its halves', doubled
+    /// on the coarse side.
+    fn edge_level(&self, p: &PatchRecord, e: usize, factors: &[f32]) -> f32 {
+        let kind = (p.edge_info >> (4 * e)) & 3;
+        let factor = |h: usize| {
+            factors
+                .get(p.curves[2 * e + h] as usize)
+                .copied()
+                .unwrap_or(1.0)
+        };
+        let pow2 = |f: f32| (f.log2() - 1e-4).ceil().exp2();
+        let lim = self.max_level;
+        if kind == ADAPTIVE_EDGE_PLAIN {
+            return pow2(factor(0).clamp(1.0, lim)).ceil().min(lim);
+        }
+        let half = (lim * 0.5).floor();
+        let f = pow2(factor(0).max(factor(1)).clamp(1.0, half))
+            .ceil()
+            .min(half);
+        if kind == ADAPTIVE_EDGE_COARSE {
+            2.0 * f
+        } else {
+            f
+        }
+    }
+
+    /// The key of patch `p` on `domain`.
+    pub fn key(&self, domain: Domain, p: &PatchRecord, factors: &[f32]) -> PatternKey {
+        let e = |i: usize| self.edge_level(p, i, factors);
+        key_of_levels(domain, Spacing::Equal, [e(0), e(1), e(2), e(3)])
+    }
 }
 
 /// The edge levels of a patch with edge kinds `kinds` as the control stage sets them, as a
@@ -53,7 +170,13 @@ pub(super) fn key_of_kinds(
     level: impl Fn(u32) -> f32,
 ) -> PatternKey {
     let e = |i: u32| level((kinds >> (4 * i)) & 3);
-    let (e0, e1, e2, e3) = (e(0), e(1), e(2), e(3));
+    key_of_levels(domain, spacing, [e(0), e(1), e(2), e(3)])
+}
+
+/// The pattern key of a patch whose edges `0..4` (patch order) have levels `levels`, with the
+/// control stage's mapping to the tessellator's outer and inner levels.
+pub(super) fn key_of_levels(domain: Domain, spacing: Spacing, levels: [f32; 4]) -> PatternKey {
+    let [e0, e1, e2, e3] = levels;
     match domain {
         // tesc_levels.glsl: outer 0 is the edge u = 0 (patch edge 3), 1 is v = 0 (edge 0), 2 is
         // u = 1 (edge 1), 3 is v = 1 (edge 2).
@@ -101,6 +224,15 @@ impl PatternDraws {
         if ids.is_empty() {
             ids.push(0);
         }
+        let frame_ids = Buffer::new(
+            device,
+            &vk_core::BufferDesc {
+                name: "adaptive pattern patch ids (host-chosen levels)",
+                size: 4 * ids.len() as u64,
+                usage: vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                location: vk_core::MemoryLocation::GpuOnly,
+            },
+        )?;
         Ok(Self {
             ids: Buffer::with_data(
                 device,
@@ -110,7 +242,72 @@ impl PatternDraws {
             )?,
             groups,
             current: HashMap::new(),
+            frame: None,
+            frame_ids,
         })
+    }
+
+    /// Groups the patches of every array by the key `key_of(id)` the host chose for the frame
+    /// and takes their patterns from the context ([`Self::record_ids`] writes the ids).
+    pub fn prepare_host_levels(
+        &mut self,
+        ctx: &mut crate::context::Context,
+        arrays: &[PatchArray],
+        key_of: &dyn Fn(usize, u32) -> PatternKey,
+    ) -> Result<()> {
+        let mut ids = Vec::new();
+        let mut groups = Vec::with_capacity(arrays.len());
+        for (i, a) in arrays.iter().enumerate() {
+            let mut by_key: HashMap<PatternKey, Vec<u32>> = HashMap::new();
+            for id in a.first_patch..a.first_patch + a.patches {
+                by_key.entry(key_of(i, id)).or_default().push(id);
+            }
+            let mut keyed: Vec<(PatternKey, Vec<u32>)> = by_key.into_iter().collect();
+            keyed.sort_by_key(|(_, members)| members[0]);
+            let mut array_groups = Vec::with_capacity(keyed.len());
+            for (key, members) in keyed {
+                let first = ids.len() as u32;
+                ids.extend(members);
+                array_groups.push((key, first..ids.len() as u32));
+            }
+            groups.push(array_groups);
+        }
+        let keys: Vec<PatternKey> = groups.iter().flatten().map(|(k, _)| *k).collect();
+        self.current.retain(|k, _| keys.contains(k));
+        for key in keys {
+            if !self.current.contains_key(&key) {
+                let pattern = ctx.refinement_pattern_for(key)?;
+                self.current
+                    .insert(key, PatternBuffers::new(ctx.device(), key, pattern)?);
+            }
+        }
+        self.frame = Some(FrameGroups { ids, groups });
+        Ok(())
+    }
+
+    /// Back to uniform factors' static groups.
+    fn forget_host_levels(&mut self) {
+        self.frame = None;
+    }
+
+    /// Under host-chosen levels, writes the frame's patch ids ahead of the draws (after the
+    /// previous frame's draws read them).
+    pub fn record_ids<'a>(&'a self, enc: &mut Encoder<'a>) -> Result<()> {
+        let Some(f) = &self.frame else {
+            return Ok(());
+        };
+        let input = (
+            vk::PipelineStageFlags::VERTEX_INPUT,
+            vk::AccessFlags::VERTEX_ATTRIBUTE_READ,
+        );
+        let transfer = (
+            vk::PipelineStageFlags::TRANSFER,
+            vk::AccessFlags::TRANSFER_WRITE,
+        );
+        enc.memory_barrier(input, transfer);
+        enc.update_buffer(&self.frame_ids, 0, bytemuck::cast_slice(&f.ids))?;
+        enc.memory_barrier(transfer, input);
+        Ok(())
     }
 
     /// Every key the frame draws, per array and group (`key_of(array, kinds)`).
@@ -131,6 +328,7 @@ impl PatternDraws {
         ctx: &mut crate::context::Context,
         key_of: &dyn Fn(usize, u32) -> PatternKey,
     ) -> Result<()> {
+        self.forget_host_levels();
         let keys: Vec<PatternKey> = self.keys(key_of).collect();
         self.current.retain(|k, _| keys.contains(k));
         for key in keys {
@@ -163,23 +361,47 @@ impl PatternDraws {
             .groups
             .get(array)
             .ok_or(TessError::NoPatchArray { array })?;
+        if let Some(f) = &self.frame {
+            let groups = f
+                .groups
+                .get(array)
+                .ok_or(TessError::NoPatchArray { array })?;
+            enc.bind_vertex_buffer(1, &self.frame_ids);
+            let mut counts = DrawCounts::default();
+            for (key, instances) in groups {
+                counts += self.draw_group(enc, array, key, instances.clone(), &mut push)?;
+            }
+            return Ok(counts);
+        }
         let mut counts = DrawCounts::default();
         enc.bind_vertex_buffer(1, &self.ids);
         for g in groups {
             let key = key_of(array, g.kinds);
-            let p = self.pattern(&key, array)?;
+            counts += self.draw_group(enc, array, &key, g.instances.clone(), &mut push)?;
+        }
+        Ok(counts)
+    }
+
+    /// One instanced draw of `key`'s pattern over the patch ids `instances`.
+    fn draw_group<'a>(
+        &'a self,
+        enc: &mut Encoder<'a>,
+        array: usize,
+        key: &PatternKey,
+        instances: Range<u32>,
+        push: &mut AdaptivePush,
+    ) -> Result<DrawCounts> {
+        {
+            let p = self.pattern(key, array)?;
             enc.bind_vertex_buffer(0, &p.points);
             enc.bind_index_buffer_u32(&p.indices);
             push.pattern_outer = key.outer();
-            enc.push_constants(&push)?;
+            enc.push_constants(push)?;
             let indices = 3 * p.pattern.triangles.len() as u32;
-            enc.draw_indexed_instanced(0..indices, g.instances.clone())?;
-            counts += DrawCounts {
-                draws: 1,
-                patches: g.instances.len() as u32,
-            };
+            let patches = instances.len() as u32;
+            enc.draw_indexed_instanced(0..indices, instances)?;
+            Ok(DrawCounts { draws: 1, patches })
         }
-        Ok(counts)
     }
 
     /// Triangles `array` draws with the frame's keys, once they are prepared.
@@ -188,6 +410,16 @@ impl PatternDraws {
         array: usize,
         key_of: &dyn Fn(usize, u32) -> PatternKey,
     ) -> Option<u64> {
+        if let Some(f) = &self.frame {
+            return f
+                .groups
+                .get(array)?
+                .iter()
+                .try_fold(0u64, |sum, (key, ids)| {
+                    let p = self.current.get(key)?;
+                    Some(sum + ids.len() as u64 * p.pattern.triangles.len() as u64)
+                });
+        }
         self.groups.get(array)?.iter().try_fold(0u64, |sum, g| {
             let p = self.current.get(&key_of(array, g.kinds))?;
             Some(sum + g.instances.len() as u64 * p.pattern.triangles.len() as u64)
@@ -196,14 +428,20 @@ impl PatternDraws {
 
     /// The most pattern vertices a patch of `array` has with the frame's keys.
     pub fn max_vertices(&self, array: usize, key_of: &dyn Fn(usize, u32) -> PatternKey) -> u64 {
-        self.groups.get(array).map_or(0, |groups| {
-            groups
-                .iter()
-                .filter_map(|g| self.current.get(&key_of(array, g.kinds)))
-                .map(|p| p.pattern.points.len() as u64)
-                .max()
-                .unwrap_or(0)
-        })
+        let keys: Vec<PatternKey> = match &self.frame {
+            Some(f) => f
+                .groups
+                .get(array)
+                .map_or(Vec::new(), |g| g.iter().map(|(k, _)| *k).collect()),
+            None => self.groups.get(array).map_or(Vec::new(), |g| {
+                g.iter().map(|g| key_of(array, g.kinds)).collect()
+            }),
+        };
+        keys.iter()
+            .filter_map(|k| self.current.get(k))
+            .map(|p| p.pattern.points.len() as u64)
+            .max()
+            .unwrap_or(0)
     }
 
     /// The patch ids and the frame's patterns.
