@@ -787,7 +787,7 @@ impl<'a> Encoder<'a> {
         self.outside_rendering(CMD)?;
         Self::needs_usage(CMD, dst, vk::BufferUsageFlags::TRANSFER_DST)?;
         Self::needs_size(CMD, dst, offset + data.len() as u64)?;
-        if offset % 4 != 0 || data.len() % 4 != 0 {
+        if !offset.is_multiple_of(4) || !data.len().is_multiple_of(4) {
             return Err(VkError::recording(
                 CMD,
                 E::UpdateAlignment {
