@@ -501,6 +501,9 @@ fn uniform_edge_level(lim: f32, segments: f32, spacing: Spacing, kind: u32) -> f
     }
 }
 
+/// The base positions a host copy of the plan's vertices was computed from, and those vertices.
+type HostVertices = (Vec<[f32; 3]>, Vec<[f64; 3]>);
+
 /// One feature-adaptive Catmull-Clark surface on the GPU. Drop order: pipeline, sets (they
 /// keep their pool alive), pool, buffers.
 pub struct PlannedPatches {
@@ -530,9 +533,8 @@ pub struct PlannedPatches {
     edge_kinds: Vec<Vec<(u32, u64)>>,
     /// The refinement-pattern path's draws (`None` on the tessellation path).
     patterns: Option<PatternDraws>,
-    /// The pattern path's host copy of the plan's vertices for host-chosen levels, with the
-    /// base positions it was computed from.
-    host_vertices: Option<(Vec<[f32; 3]>, Vec<[f64; 3]>)>,
+    /// The pattern path's host copy of the plan's vertices for host-chosen levels.
+    host_vertices: Option<HostVertices>,
     pub gpu: GpuPlan,
     pub plan: AdaptivePlan,
     pub mesh: ControlMesh,

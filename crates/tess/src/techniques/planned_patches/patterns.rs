@@ -273,15 +273,25 @@ impl PatternDraws {
             groups.push(array_groups);
         }
         let keys: Vec<PatternKey> = groups.iter().flatten().map(|(k, _)| *k).collect();
+        self.take_patterns(ctx, &keys)?;
+        self.frame = Some(FrameGroups { ids, groups });
+        Ok(())
+    }
+
+    /// Takes the patterns of `keys` from the context, uploading those not on the device yet,
+    /// and drops the patterns no key uses any more.
+    fn take_patterns(
+        &mut self,
+        ctx: &mut crate::context::Context,
+        keys: &[PatternKey],
+    ) -> Result<()> {
         self.current.retain(|k, _| keys.contains(k));
-        for key in keys {
-            if !self.current.contains_key(&key) {
+        for &key in keys {
+            if let std::collections::hash_map::Entry::Vacant(slot) = self.current.entry(key) {
                 let pattern = ctx.refinement_pattern_for(key)?;
-                self.current
-                    .insert(key, PatternBuffers::new(ctx.device(), key, pattern)?);
+                slot.insert(PatternBuffers::new(ctx.device(), key, pattern)?);
             }
         }
-        self.frame = Some(FrameGroups { ids, groups });
         Ok(())
     }
 
@@ -330,16 +340,7 @@ impl PatternDraws {
     ) -> Result<()> {
         self.forget_host_levels();
         let keys: Vec<PatternKey> = self.keys(key_of).collect();
-        self.current.retain(|k, _| keys.contains(k));
-        for key in keys {
-            if self.current.contains_key(&key) {
-                continue;
-            }
-            let pattern = ctx.refinement_pattern_for(key)?;
-            let buffers = PatternBuffers::new(ctx.device(), key, pattern)?;
-            self.current.insert(key, buffers);
-        }
-        Ok(())
+        self.take_patterns(ctx, &keys)
     }
 
     /// The prepared pattern of `key`.
