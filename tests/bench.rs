@@ -390,11 +390,14 @@ fn bench_equal_triangles_and_memory_per_face() {
         let surf = planned_patches::single_pass(
             &mut tctx,
             &pyramid,
-            patch,
-            1.0,
-            true,
-            name,
-            &Default::default(),
+            &planned_patches::SinglePassBuild {
+                patch,
+                sharpness_scale: 1.0,
+                gregory_triangles: true,
+                name,
+                maps: &Default::default(),
+                path: tessera::tess::DrawPath::Tessellation,
+            },
         )
         .unwrap();
         let memory = surf.device_memory();

@@ -232,7 +232,7 @@ fn planned_run(
                 ctx,
                 mesh,
                 &planned_patches::SinglePassBuild {
-                    patch: patch,
+                    patch,
                     sharpness_scale: 1.0,
                     gregory_triangles: true,
                     name: which,

@@ -39,7 +39,13 @@ impl Standalone {
 
     /// Spot drawn by `technique`.
     fn spot(&self, technique: TesseraTechnique) -> *mut TesseraSurface {
-        let d = surface_desc(technique);
+        self.spot_as(technique, TESSERA_SCHEME_AUTO)
+    }
+
+    /// Spot drawn by `technique` as `scheme`.
+    fn spot_as(&self, technique: TesseraTechnique, scheme: TesseraScheme) -> *mut TesseraSurface {
+        let mut d = surface_desc(technique);
+        d.scheme = scheme;
         let mut s = null_mut();
         // SAFETY: NULL text builds the embedded mesh; `d` and `s` are live locals.
         let status = unsafe { tessera_surface_create_obj(self.ctx, null(), 0, null(), &d, &mut s) };
@@ -197,11 +203,16 @@ fn limit_evaluation_is_what_tessera_limit_prints() {
 fn limit_evaluation_is_the_captured_vertices_at_their_points() {
     let ctx = Standalone::new();
     let dir = common::scratch("capi-limit-capture");
-    for (technique, name) in [
-        (TESSERA_TECHNIQUE_BFT, "bft"),
-        (TESSERA_TECHNIQUE_ADAPTIVE, "adaptive"),
+    for (technique, scheme, name) in [
+        (TESSERA_TECHNIQUE_BFT, TESSERA_SCHEME_AUTO, "bft"),
+        (TESSERA_TECHNIQUE_ADAPTIVE, TESSERA_SCHEME_AUTO, "adaptive"),
+        (
+            TESSERA_TECHNIQUE_DOO_SABIN_LIMIT,
+            TESSERA_SCHEME_DOO_SABIN,
+            "doo-sabin-limit",
+        ),
     ] {
-        let s = ctx.spot(technique);
+        let s = ctx.spot_as(technique, scheme);
         let path = dir.join(format!("{name}.obj"));
         let c_path = CString::new(path.to_str().unwrap()).unwrap();
         let mut frame = frame_desc(160, 120);
@@ -443,8 +454,8 @@ fn evaluators_of_meshes_and_of_moved_surfaces() {
     }
 }
 
-/// `TESSERA_SCHEME_DOO_SABIN` with `TESSERA_TECHNIQUE_AUTO` builds the doo-sabin technique, and
-/// its limit evaluator evaluates the exact Doo-Sabin limit (topology's, in the same face
+/// `TESSERA_SCHEME_DOO_SABIN` with `TESSERA_TECHNIQUE_AUTO` builds the Doo-Sabin limit surface
+/// (`doo-sabin-limit`), and its limit evaluator evaluates the exact Doo-Sabin limit (topology's, in the same face
 /// domains): at every face's centre the face's centroid (the limit there), elsewhere what
 /// `topology::limit::face_domain::LimitEvaluator::doo_sabin` gives, bit for bit. The scheme under
 /// a technique that draws another is refused.

@@ -71,9 +71,16 @@ fn build_registered(
         options.pipeline,
         ctx.device(),
     )?;
+    // The registry builds through `techniques::split::build_split`, which refused the input's
+    // own tags; a non-manifold input arrives as its manifold split, whose tags are OpenSubdiv's
+    // sharp rules for the non-manifold parts. Doo-Sabin has no sharp features, and like the
+    // other Doo-Sabin techniques this one refines the split without them.
+    let mut untagged = mesh.clone();
+    untagged.creases.clear();
+    untagged.corners.clear();
     let surface = new(
         ctx,
-        mesh,
+        &untagged,
         &PlanBuild {
             isolation: options.isolation,
             name: options.name.clone(),
