@@ -1351,3 +1351,17 @@ fn stencil_rows_are_summed_without_contraction() {
         assert_eq!(fmix, 0, "{v:?} calls mix()");
     }
 }
+
+/// The vertex-patch kernel sums every child `precise` (no fused products), so each patch that
+/// holds a shared face writes its children with the same bits.
+#[test]
+fn vertex_patch_children_are_summed_without_contraction() {
+    for (v, words) in Stage::VertexPatchesRefineComp.compiled() {
+        let (no_contraction, fmix) = contraction_and_mix(words);
+        assert!(
+            no_contraction >= 3,
+            "{v:?}: {no_contraction} NoContraction decorations"
+        );
+        assert_eq!(fmix, 0, "{v:?} calls mix()");
+    }
+}

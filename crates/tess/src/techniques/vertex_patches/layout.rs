@@ -358,8 +358,8 @@ mod tests {
         load_obj(format!("{root}/{path}")).expect(path)
     }
 
-    /// A host mirror of `refine.comp` on the laid-out tables (f64, absolute sums), run from
-    /// the first step's rows: every deepest slot holds its level-D vertex's point, every
+    /// A host mirror of `refine.comp` on the laid-out records and flags (f64, the CPU layout's
+    /// step), run from the first step's rows (f32 weights, so within f32 rounding): every deepest slot holds its level-D vertex's point, every
     /// level-D vertex has a slot, and the fans cover each level-D face's area once.
     #[test]
     fn slots_are_the_refiners_vertices() {
@@ -405,7 +405,7 @@ mod tests {
                     }
                     let (got, q) = (buffer[d0 + s], want.positions[v as usize]);
                     for c in 0..3 {
-                        assert!((got[c] - q[c]).abs() < 1e-9 * diagonal, "{name} slot {s}");
+                        assert!((got[c] - q[c]).abs() < 1e-6 * diagonal, "{name} slot {s}");
                     }
                 }
             }
