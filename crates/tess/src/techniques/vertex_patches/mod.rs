@@ -39,6 +39,22 @@
 //! - **A captured id is a deepest slot**; the host maps it to the refiner's level-D vertex
 //!   ([`topology::patches::doo_sabin::VertexPatch::level_vertices`]) and that vertex to where
 //!   its limit lies on the base mesh ([`topology::limit::limit_mesh::doo_sabin_domain_points`]).
+//!
+//! What is measured (`tests/vertex_patches.rs`, lavapipe, validation and synchronization
+//! validation on): every captured point is the CPU refiner's level-D point of its slot's
+//! vertex within 6e-8 of the bbox diagonal (cube to D = 6, icosahedron and pyramid to 5, spot
+//! and catmark_xord_boundary to 4), every level-D point is drawn, the triangle count is the
+//! level's, and the capture welds by bits with 0 cracks; an animated base refines to the moved
+//! base's level within 5e-8. The normals' mean angle to the exact limit normal at face centres
+//! shrinks about 3× per level (cube 2.9°, 0.96°, 0.27° at D = 2–4; spot 2.7°, 0.85°, 0.25°),
+//! as `doo-sabin`'s.
+//!
+//! Where this departs from the seed as written: the seed subdivides the control mesh once on
+//! the CPU, here that step is stencil rows on the GPU; the seed's algorithm refines outer corner
+//! face `j` from the thread of corner point `C(L − 1, j)` (its "virtual corner quad") and
+//! lists no step for the v-face, here both are one work item per side; the seed does not say
+//! how threads find their patch (here a binary search over the step's records) nor how
+//! boundaries are refined (here the CPU layout's per-element flags and strip masks).
 pub mod layout;
 
 use crate::capture::FacePoint;
