@@ -357,6 +357,11 @@ typedef struct TesseraHostDesc {
 // `TESSERA_SCHEME_DOO_SABIN`).
 #define TESSERA_TECHNIQUE_DOO_SABIN_LIMIT 12
 
+// Doo-Sabin subdivision as the seed paper's vertex patches: one array per control vertex,
+// refined in a compute kernel by index arithmetic to level log2 S, drawn from the vertex stage
+// (`--method vertex-patches`; levels are powers of two from 2 to 64 segments).
+#define TESSERA_TECHNIQUE_VERTEX_PATCHES 13
+
 // Catmull-Clark unless every face is a triangle (then Loop); a Loop technique fan-triangulates.
 #define TESSERA_SCHEME_AUTO 0
 
@@ -365,8 +370,8 @@ typedef struct TesseraHostDesc {
 // Loop, strictly: a mesh with a face that is not a triangle is refused (`TESSERA_STATUS_MESH`).
 #define TESSERA_SCHEME_LOOP 2
 
-// Doo-Sabin (drawn by `TESSERA_TECHNIQUE_DOO_SABIN_LIMIT`, `TESSERA_TECHNIQUE_DOO_SABIN` and
-// `TESSERA_TECHNIQUE_CPU_DOO_SABIN`; its limit evaluator evaluates the exact Doo-Sabin limit).
+// Doo-Sabin (drawn by `TESSERA_TECHNIQUE_DOO_SABIN_LIMIT`, `TESSERA_TECHNIQUE_DOO_SABIN`,
+// `TESSERA_TECHNIQUE_VERTEX_PATCHES` and `TESSERA_TECHNIQUE_CPU_DOO_SABIN`; its limit evaluator evaluates the exact Doo-Sabin limit).
 #define TESSERA_SCHEME_DOO_SABIN 3
 
 // `factor` segments per base edge.

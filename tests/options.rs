@@ -252,7 +252,7 @@ fn row(id: TechniqueId) -> [Cell; 10] {
         // segments, with a margin (docs/options.md has the figures).
         "gregory" | "acc" => [2e-3, 1e-5, 1e-3, 1e-2, 4e-2, 3e-2, 4e-2, 0.15, 1e-2, 2e-2]
             .map(|bound| Approximated("one patch per base face", bound)),
-        "doo-sabin" | "cpu-doo-sabin" => [
+        "doo-sabin" | "cpu-doo-sabin" | "vertex-patches" => [
             Approximated("the refined mesh at depth D", 6e-2),
             Ignored("the boundary is the quadratic B-spline of the boundary polygon"),
             Refused("has no holes"),

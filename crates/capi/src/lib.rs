@@ -119,6 +119,10 @@ pub const TESSERA_TECHNIQUE_CPU_DOO_SABIN: TesseraTechnique = 11;
 /// centres of non-quad faces, bilinear end caps (`--method doo-sabin-limit`; the default for
 /// `TESSERA_SCHEME_DOO_SABIN`).
 pub const TESSERA_TECHNIQUE_DOO_SABIN_LIMIT: TesseraTechnique = 12;
+/// Doo-Sabin subdivision as the seed paper's vertex patches: one array per control vertex,
+/// refined in a compute kernel by index arithmetic to level log2 S, drawn from the vertex stage
+/// (`--method vertex-patches`; levels are powers of two from 2 to 64 segments).
+pub const TESSERA_TECHNIQUE_VERTEX_PATCHES: TesseraTechnique = 13;
 
 /// The subdivision scheme (`TESSERA_SCHEME_*`).
 pub type TesseraScheme = u32;
@@ -127,8 +131,8 @@ pub const TESSERA_SCHEME_AUTO: TesseraScheme = 0;
 pub const TESSERA_SCHEME_CATMULL_CLARK: TesseraScheme = 1;
 /// Loop, strictly: a mesh with a face that is not a triangle is refused (`TESSERA_STATUS_MESH`).
 pub const TESSERA_SCHEME_LOOP: TesseraScheme = 2;
-/// Doo-Sabin (drawn by `TESSERA_TECHNIQUE_DOO_SABIN_LIMIT`, `TESSERA_TECHNIQUE_DOO_SABIN` and
-/// `TESSERA_TECHNIQUE_CPU_DOO_SABIN`; its limit evaluator evaluates the exact Doo-Sabin limit).
+/// Doo-Sabin (drawn by `TESSERA_TECHNIQUE_DOO_SABIN_LIMIT`, `TESSERA_TECHNIQUE_DOO_SABIN`,
+/// `TESSERA_TECHNIQUE_VERTEX_PATCHES` and `TESSERA_TECHNIQUE_CPU_DOO_SABIN`; its limit evaluator evaluates the exact Doo-Sabin limit).
 pub const TESSERA_SCHEME_DOO_SABIN: TesseraScheme = 3;
 
 /// How tessellation factors are chosen (`TESSERA_FACTORS_*`).

@@ -4,7 +4,7 @@
 
 use std::collections::{HashMap, HashSet};
 use std::path::PathBuf;
-use topology::mesh::INVALID;
+use topology::mesh::{Topology, INVALID};
 use topology::patches::doo_sabin::{vertex_patches, PatchLayout, VertexPatch};
 use topology::refine::doo_sabin::refine_dual;
 use topology::refine::{refine_uniform, Level, UniformRefinement};
@@ -188,6 +188,9 @@ fn check(mesh: &ControlMesh, depth: u32) -> usize {
             points = layout.refine(d, &points, &flags[d as usize - 1]).unwrap();
         }
         let last = ids.last().unwrap();
+        // The library's numbering of the deepest array is the one derived here.
+        let levels: Vec<&Topology> = (1..depth as usize).map(|d| &r.level(d).topology).collect();
+        assert_eq!(&patch.level_vertices(&levels, depth).unwrap(), last);
         for (i, (&id, p)) in last.iter().zip(&points).enumerate() {
             if id == INVALID {
                 continue;

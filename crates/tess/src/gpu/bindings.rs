@@ -119,6 +119,24 @@ gpu_constants! {
     /// boundary strips, one v-face or vertex strip).
     DOO_SABIN_MAX_CORNERS = 4;
 
+    /// Descriptor set of one vertex-patch Doo-Sabin surface (`glsl/vertex_patches/mesh.vert`).
+    VERTEX_PATCHES_SET = 1;
+    /// The uniform block `VertexPatchArrays` ([`crate::gpu::VertexPatchArrays`]): the device
+    /// addresses of the deepest depth's patch arrays (`vec4` per slot, every patch's array one
+    /// after another) and of each slot's face corners, `DOO_SABIN_MAX_CORNERS`
+    /// `uvec2(next, previous)` slots per slot. Read through buffer references.
+    VERTEX_PATCHES_ARRAYS_BINDING = 0;
+    /// Invocations per workgroup of `glsl/vertex_patches/refine.comp`.
+    VERTEX_PATCHES_LOCAL_SIZE = 64;
+    /// The largest face a vertex patch refines (a local array of the kernel): the v-face of a
+    /// vertex of valence up to this, or a corner face of up to this many corners.
+    VERTEX_PATCHES_MAX_FACE = 32;
+    /// A patch point's flag bits ([`topology::patches::doo_sabin::PointFlags`]): a point of the
+    /// refined mesh...
+    VERTEX_PATCH_PRESENT = 1;
+    /// ...and a boundary point (its faces are refined by the strip mask).
+    VERTEX_PATCH_BOUNDARY = 2;
+
     /// Descriptor set of one feature-adaptive Catmull-Clark surface (`glsl/adaptive/adaptive.glsl`).
     ADAPTIVE_SET = 1;
     /// The uniform block `AdaptiveArrays` ([`crate::gpu::AdaptiveArrays`]): the device address of every array the canonical kernel and the draw read (vertices, patch records, control points, curves, patch surfaces, the reparameterization table, curve and corner owners, the Eq. 1 error lattice). Read through buffer references, no descriptor range limits them.

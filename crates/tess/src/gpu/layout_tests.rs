@@ -6,7 +6,7 @@ use super::bindings::*;
 use super::reflect::Reflection;
 use super::{
     AdaptiveArrays, AdaptivePush, BftPush, BftTableArrays, CaptureRecord, DooSabinArrays, DrawPush,
-    FrameUniforms, StencilPush, Vertex,
+    FrameUniforms, StencilPush, Vertex, VertexPatchArrays, VertexPatchRecord, VertexPatchStep,
 };
 use crate::shaders::{spirv, Stage, Variant};
 use crate::stencil::{StencilTerm, StencilVertex};
@@ -350,6 +350,108 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
             PLAIN,
             Referenced {
                 block: "DooSabinCornerArray",
+                members: vec![0],
+                stride: size_of::<[u32; 2]>(),
+            },
+        ),
+        // The vertex patches: the refinement kernel's push constant, record and arrays; the
+        // vertex stage's addresses, points and face corners.
+        (
+            Stage::VertexPatchesRefineComp,
+            PLAIN,
+            Layout {
+                name: "VertexPatchStep",
+                offsets: offsets!(VertexPatchStep: points, flags, records, sizes, weights, weight_starts, patch_count, items, first_item, depth),
+                size: size_of::<VertexPatchStep>(),
+            },
+        ),
+        (
+            Stage::VertexPatchesRefineComp,
+            PLAIN,
+            Layout {
+                name: "VertexPatchRecord",
+                offsets: offsets!(VertexPatchRecord: valence, sizes, source, destination, first_item),
+                size: size_of::<VertexPatchRecord>(),
+            },
+        ),
+        (
+            Stage::VertexPatchesRefineComp,
+            PLAIN,
+            Referenced {
+                block: "VertexPatchRecords",
+                members: vec![0],
+                stride: size_of::<VertexPatchRecord>(),
+            },
+        ),
+        (
+            Stage::VertexPatchesRefineComp,
+            PLAIN,
+            Referenced {
+                block: "VertexPatchPoints",
+                members: vec![0],
+                stride: size_of::<StencilVertex>(),
+            },
+        ),
+        (
+            Stage::VertexPatchesRefineComp,
+            PLAIN,
+            Referenced {
+                block: "VertexPatchFlags",
+                members: vec![0],
+                stride: size_of::<u32>(),
+            },
+        ),
+        (
+            Stage::VertexPatchesRefineComp,
+            PLAIN,
+            Referenced {
+                block: "VertexPatchWords",
+                members: vec![0],
+                stride: size_of::<u32>(),
+            },
+        ),
+        (
+            Stage::VertexPatchesRefineComp,
+            PLAIN,
+            Referenced {
+                block: "VertexPatchWeights",
+                members: vec![0],
+                stride: size_of::<f32>(),
+            },
+        ),
+        (Stage::VertexPatchesMeshVert, PLAIN, frame()),
+        (
+            Stage::VertexPatchesMeshVert,
+            PLAIN,
+            Layout {
+                name: "VertexPatchArrays",
+                offsets: offsets!(VertexPatchArrays: points, corners),
+                size: size_of::<VertexPatchArrays>(),
+            },
+        ),
+        (
+            Stage::VertexPatchesMeshVert,
+            PLAIN,
+            Uniform {
+                block: "VertexPatchArrays",
+                set: VERTEX_PATCHES_SET,
+                binding: VERTEX_PATCHES_ARRAYS_BINDING,
+            },
+        ),
+        (
+            Stage::VertexPatchesMeshVert,
+            PLAIN,
+            Referenced {
+                block: "VertexPatchPointArray",
+                members: vec![0],
+                stride: size_of::<StencilVertex>(),
+            },
+        ),
+        (
+            Stage::VertexPatchesMeshVert,
+            PLAIN,
+            Referenced {
+                block: "VertexPatchCornerArray",
                 members: vec![0],
                 stride: size_of::<[u32; 2]>(),
             },
@@ -1043,11 +1145,11 @@ fn the_table_covers_every_storage_binding_and_capture_build() {
         .count();
     // Nine TESs in three spacings, the four adaptive ones and BFT's also with their surface code,
     // the adaptive ones also in their face-varying build, BFT's also with and without its patch
-    // block; the CPU mesh's and Doo-Sabin's vertex stages, the four refinement-pattern vertex
+    // block; the CPU mesh's, Doo-Sabin's and the vertex patches' vertex stages, the four refinement-pattern vertex
     // stages, PN's also in its scalar-tagged build, BFT's with and without its surface code, and
     // the four adaptive pattern vertex stages with and without their surface and face-varying
     // code.
-    assert_eq!(capture_builds, 97);
+    assert_eq!(capture_builds, 98);
     assert_eq!(xfb_rows, capture_builds);
 }
 
@@ -1125,7 +1227,7 @@ fn capture_variants_and_only_they_have_xfb() {
             captures += v.capture as usize;
         }
     }
-    assert_eq!(captures, 97);
+    assert_eq!(captures, 98);
 }
 
 #[test]
@@ -1242,6 +1344,20 @@ fn stencil_rows_are_summed_without_contraction() {
     for (v, words) in Stage::StencilEvaluateComp.compiled() {
         let (no_contraction, fmix) = contraction_and_mix(words);
         println!("{v:?}: {no_contraction} NoContraction decorations");
+        assert!(
+            no_contraction >= 3,
+            "{v:?}: {no_contraction} NoContraction decorations"
+        );
+        assert_eq!(fmix, 0, "{v:?} calls mix()");
+    }
+}
+
+/// The vertex-patch kernel sums every child `precise` (no fused products), so each patch that
+/// holds a shared face writes its children with the same bits.
+#[test]
+fn vertex_patch_children_are_summed_without_contraction() {
+    for (v, words) in Stage::VertexPatchesRefineComp.compiled() {
+        let (no_contraction, fmix) = contraction_and_mix(words);
         assert!(
             no_contraction >= 3,
             "{v:?}: {no_contraction} NoContraction decorations"

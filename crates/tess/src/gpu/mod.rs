@@ -205,6 +205,68 @@ pub struct DooSabinArrays {
 
 const _: () = assert!(size_of::<DooSabinArrays>() == 16);
 
+/// `VertexPatchArrays` uniform block of `glsl/vertex_patches/mesh.vert`
+/// ([`bindings::VERTEX_PATCHES_ARRAYS_BINDING`]): device addresses (`uvec2` there, low word
+/// first).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct VertexPatchArrays {
+    /// `vec4` per slot of the deepest depth: the address of its first slot in the patch buffer.
+    pub points: u64,
+    /// Per slot of the deepest depth, `DOO_SABIN_MAX_CORNERS` `(next, previous)` slots.
+    pub corners: u64,
+}
+
+const _: () = assert!(size_of::<VertexPatchArrays>() == 16);
+
+/// `VertexPatchRecord` of `glsl/vertex_patches/refine.comp`: one patch in one step
+/// (depth `d` → `d + 1`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct VertexPatchRecord {
+    /// `n`, the valence (points per side of layer 0).
+    pub valence: u32,
+    /// Where its corner faces' size prefix sums start (`n + 1` words: `m_0 + … + m_{j−1}`).
+    pub sizes: u32,
+    /// Its array at depth `d`: the element of the patch buffer its slot 0 is.
+    pub source: u32,
+    /// Its array at depth `d + 1`.
+    pub destination: u32,
+    /// Its first work item in the step (`L² n + n` items a patch).
+    pub first_item: u32,
+}
+
+const _: () = assert!(size_of::<VertexPatchRecord>() == 20);
+
+/// `VertexPatchStep` push constant of `glsl/vertex_patches/refine.comp`: one dispatch of one
+/// step, the arrays' device addresses (`uvec2` there, low word first).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct VertexPatchStep {
+    /// `vec4` per element of the patch buffer (base positions, then every depth's arrays).
+    pub points: u64,
+    /// Flag bits per element of the patch buffer (`VERTEX_PATCH_PRESENT`, `_BOUNDARY`).
+    pub flags: u64,
+    /// The step's [`VertexPatchRecord`]s, in work-item order.
+    pub records: u64,
+    /// Corner-size prefix sums of every patch.
+    pub sizes: u64,
+    /// Doo-Sabin weights: per face size `m`, `m` full-face weights then `m × m` strip weights.
+    pub weights: u64,
+    /// Per face size `m` (0..=`VERTEX_PATCHES_MAX_FACE`), where its weights start.
+    pub weight_starts: u64,
+    /// Records in the step.
+    pub patch_count: u32,
+    /// Work items of the step.
+    pub items: u32,
+    /// The dispatch's first work item.
+    pub first_item: u32,
+    /// The source depth `d` (outer layer `L = 2^(d−1)`).
+    pub depth: u32,
+}
+
+const _: () = assert!(size_of::<VertexPatchStep>() == 64);
+
 /// `StencilPush` push constant of the stencil evaluator, `glsl/stencil/stencil.glsl`
 /// ([`crate::stencil`]): one dispatch, rows `first_row .. first_row + count`, and the window
 /// bases of its chunk (`techniques::windows`), subtracted from every index into a windowed

@@ -19,6 +19,7 @@ pub mod planned_patches;
 pub mod pn;
 pub mod shared;
 pub mod split;
+pub mod vertex_patches;
 pub mod windows;
 
 use crate::context::Context;
@@ -61,7 +62,7 @@ pub struct TechniqueInfo {
 
 /// Every technique, one line each, in the order reports and the window's number keys list
 /// them (flat first: ratios divide by it).
-pub static REGISTRY: [&TechniqueInfo; 12] = [
+pub static REGISTRY: [&TechniqueInfo; 13] = [
     &flat::INFO,
     &phong::INFO,
     &pn::INFO,
@@ -74,6 +75,7 @@ pub static REGISTRY: [&TechniqueInfo; 12] = [
     &doo_sabin_limit::INFO,
     &doo_sabin::INFO,
     &cpu::DOO_SABIN_INFO,
+    &vertex_patches::INFO,
 ];
 
 /// Every technique, in the order reports list them (flat first: ratios divide by it).

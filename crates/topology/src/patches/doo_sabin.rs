@@ -397,6 +397,65 @@ impl VertexPatch {
     }
 }
 
+impl VertexPatch {
+    /// The patch array at depth `depth` as the refiner's level-`depth` vertex numbers
+    /// (`INVALID` where no point is): the layout's maps run on level-`d` vertex numbers from
+    /// depth 1 ([`VertexPatch::points`]) on, each present face found in `levels[d − 1]` (the
+    /// topology of level `d`, as [`crate::refine::doo_sabin::refine_dual`] numbers it: the child
+    /// of corner `k` of face `f` is vertex `face_offset(f) + k` of level `d + 1`). What a draw of
+    /// the patch arrays maps its points back to the refined mesh by.
+    pub fn level_vertices(
+        &self,
+        levels: &[&Topology],
+        depth: u32,
+    ) -> Result<Vec<u32>, TopologyError> {
+        let layout = self.layout();
+        let mut ids = self.points.clone();
+        for d in 1..depth {
+            let t = levels
+                .get(d as usize - 1)
+                .ok_or(TopologyError::UnsupportedScheme {
+                    scheme: "doo-sabin",
+                    operation: "vertex patch numbers without the refined level",
+                })?;
+            let mut next = vec![INVALID; layout.len(d + 1)];
+            for face in layout.faces(d) {
+                let corners: Vec<u32> = face.corners.iter().map(|&i| ids[i]).collect();
+                if corners.contains(&INVALID) {
+                    continue;
+                }
+                let f = level_face(t, &corners).ok_or(TopologyError::UnsupportedScheme {
+                    scheme: "doo-sabin",
+                    operation: "a vertex patch face that is no face of the refined level",
+                })?;
+                let offset = t.face_tables().0[f];
+                let fv = t.face_vertices(f);
+                for (&c, targets) in corners.iter().zip(&face.children) {
+                    let k = fv.iter().position(|&x| x == c).unwrap_or(0) as u32;
+                    for &target in targets {
+                        next[target] = offset + k;
+                    }
+                }
+            }
+            ids = next;
+        }
+        Ok(ids)
+    }
+}
+
+/// The face of `t` whose corners are `corners` (same cyclic order and orientation).
+fn level_face(t: &Topology, corners: &[u32]) -> Option<usize> {
+    t.vertex_faces(corners[0] as usize)
+        .iter()
+        .map(|&f| f as usize)
+        .find(|&f| {
+            let fv = t.face_vertices(f);
+            let start = fv.iter().position(|&x| x == corners[0]).unwrap_or(0);
+            fv.len() == corners.len()
+                && (0..fv.len()).all(|k| fv[(start + k) % fv.len()] == corners[k])
+        })
+}
+
 /// The vertex patches of control mesh `p` (one per vertex with faces, in vertex order), over
 /// `step`, its first Doo-Sabin step ([`crate::refine::doo_sabin::refine_dual`] with `first`).
 ///

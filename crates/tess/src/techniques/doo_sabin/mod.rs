@@ -88,7 +88,7 @@ pub static INFO: TechniqueInfo = TechniqueInfo {
     abi_code: 10,
     legend: &[],
     build,
-    check_options: |_, params| depth_of(params).map(|_| ()),
+    check_options: |_, params| depth_of(TechniqueId::DOO_SABIN, params).map(|_| ()),
 };
 
 /// Deepest level a frame may ask for: 2^6 = 64 segments per base edge, the tessellator's
@@ -138,13 +138,14 @@ pub struct DooSabin {
     device: Device,
 }
 
-/// The depth a frame of `params` draws (uniform segments S = 2^D), or why it cannot.
-fn depth_of(params: &FrameParams) -> Result<u32> {
+/// The depth a frame of `params` draws (uniform segments S = 2^D), or why it cannot (refused
+/// for `technique`).
+pub(crate) fn depth_of(technique: TechniqueId, params: &FrameParams) -> Result<u32> {
     let segments = match params.factors {
         FactorPolicy::Uniform { segments } => segments,
         _ => {
             return Err(TessError::Unsupported {
-                technique: TechniqueId::DOO_SABIN,
+                technique,
                 what: "adaptive factors (a uniform refinement has one level)",
             })
         }
@@ -374,7 +375,7 @@ impl Technique for DooSabin {
     }
 
     fn check(&self, params: &FrameParams) -> Result<()> {
-        let depth = depth_of(params)?;
+        let depth = depth_of(TechniqueId::DOO_SABIN, params)?;
         let sizes = level_sizes(self.first_size, depth);
         let vertices =
             self.base.num_vertices() as u64 + sizes.iter().map(|s| s.vertices).sum::<u64>();
@@ -390,7 +391,7 @@ impl Technique for DooSabin {
     }
 
     fn prepare_frame(&mut self, _ctx: &mut crate::Context, params: &FrameParams) -> Result<()> {
-        let depth = depth_of(params)?;
+        let depth = depth_of(TechniqueId::DOO_SABIN, params)?;
         if self.depth.as_ref().map(|d| d.layout.depth) != Some(depth) {
             self.depth = None;
             self.arrays[0].patches = 0;
@@ -417,7 +418,7 @@ impl Technique for DooSabin {
 
     fn triangles(&self, params: &FrameParams, array: usize) -> Option<u64> {
         (array == 0).then_some(())?;
-        let depth = depth_of(params).ok()?;
+        let depth = depth_of(TechniqueId::DOO_SABIN, params).ok()?;
         level_sizes(self.first_size, depth)
             .last()
             .map(|s| s.triangles())
