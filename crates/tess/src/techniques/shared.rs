@@ -163,3 +163,36 @@ pub fn check_uniform_pattern_frame(technique: TechniqueId, params: &FrameParams)
     }
     Ok(())
 }
+
+/// Deepest level a frame may ask for: 2^6 = 64 segments per base edge, the tessellator's
+/// maximum, as for the other vertex-stage techniques.
+pub const MAX_DOO_SABIN_DEPTH: u32 = 6;
+
+/// The depth a frame of `params` draws (uniform segments S = 2^D), or why it cannot (refused
+/// for `technique`).
+pub fn depth_of(technique: TechniqueId, params: &FrameParams) -> Result<u32> {
+    let segments = match params.factors {
+        FactorPolicy::Uniform { segments } => segments,
+        _ => {
+            return Err(TessError::Unsupported {
+                technique,
+                what: "adaptive factors (a uniform refinement has one level)",
+            })
+        }
+    };
+    let ok = segments.fract() == 0.0
+        && (2.0..=(1u32 << MAX_DOO_SABIN_DEPTH) as f32).contains(&segments)
+        && (segments as u32).is_power_of_two();
+    if !ok {
+        return Err(ParamError::refused(
+            Param::Segments,
+            segments,
+            format!(
+                "Doo-Sabin refines to a level: a power of two in 2..={} segments per base edge \
+                 (each level halves every edge)",
+                1 << MAX_DOO_SABIN_DEPTH
+            ),
+        ));
+    }
+    Ok((segments as u32).trailing_zeros())
+}

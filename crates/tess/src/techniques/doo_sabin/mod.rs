@@ -40,16 +40,16 @@ pub mod layout;
 
 use crate::capture::FacePoint;
 use crate::context::Context;
-use crate::error::{Param, ParamError, Result, TessError};
+use crate::error::{Result, TessError};
 use crate::gpu::bindings::DOO_SABIN_ARRAYS_BINDING;
 use crate::gpu::{DooSabinArrays, DrawPush};
 use crate::shaders::Stage;
 use crate::stencil::{self, StencilEvaluator, StencilVertex, StencilVertices};
 use crate::technique::{
-    DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features, FrameParams, Pass, PatchArray,
-    PatchPipeline, PatchType, Technique, TechniqueId,
+    DeviceAllocation, DrawCounts, DrawPath, Features, FrameParams, Pass, PatchArray, PatchPipeline,
+    PatchType, Technique, TechniqueId,
 };
-use crate::techniques::shared::{upload_base, STAGES};
+use crate::techniques::shared::{depth_of, upload_base, STAGES};
 use crate::techniques::{BuildOptions, Built, TechniqueInfo};
 use layout::{DepthLayout, LayoutError};
 use std::mem::size_of;
@@ -91,9 +91,7 @@ pub static INFO: TechniqueInfo = TechniqueInfo {
     check_options: |_, params| depth_of(TechniqueId::DOO_SABIN, params).map(|_| ()),
 };
 
-/// Deepest level a frame may ask for: 2^6 = 64 segments per base edge, the tessellator's
-/// maximum, as for the other vertex-stage techniques.
-pub const MAX_DEPTH: u32 = 6;
+pub use crate::techniques::shared::MAX_DOO_SABIN_DEPTH as MAX_DEPTH;
 
 /// Set 1: the uniform block of the arrays' addresses.
 static SET_BINDINGS: [BindingDesc; 1] = [BindingDesc {
@@ -136,35 +134,6 @@ pub struct DooSabin {
     max_vertices: u64,
     set_layout: DescriptorSetLayout,
     device: Device,
-}
-
-/// The depth a frame of `params` draws (uniform segments S = 2^D), or why it cannot (refused
-/// for `technique`).
-pub(crate) fn depth_of(technique: TechniqueId, params: &FrameParams) -> Result<u32> {
-    let segments = match params.factors {
-        FactorPolicy::Uniform { segments } => segments,
-        _ => {
-            return Err(TessError::Unsupported {
-                technique,
-                what: "adaptive factors (a uniform refinement has one level)",
-            })
-        }
-    };
-    let ok = segments.fract() == 0.0
-        && (2.0..=(1u32 << MAX_DEPTH) as f32).contains(&segments)
-        && (segments as u32).is_power_of_two();
-    if !ok {
-        return Err(ParamError::refused(
-            Param::Segments,
-            segments,
-            format!(
-                "Doo-Sabin refines to a level: a power of two in 2..={} segments per base edge \
-                 (each level halves every edge)",
-                1 << MAX_DEPTH
-            ),
-        ));
-    }
-    Ok((segments as u32).trailing_zeros())
 }
 
 impl DooSabin {

@@ -68,8 +68,7 @@ use crate::technique::{
     DeviceAllocation, DrawCounts, DrawPath, Features, FrameParams, Pass, PatchArray, PatchPipeline,
     PatchType, Technique, TechniqueId,
 };
-use crate::techniques::doo_sabin::depth_of;
-use crate::techniques::shared::{compute_pipeline, upload_base, STAGES};
+use crate::techniques::shared::{compute_pipeline, depth_of, upload_base, STAGES};
 use crate::techniques::{BuildOptions, Built, TechniqueInfo};
 use layout::{LayoutError, PatchesLayout};
 use std::mem::size_of;
