@@ -1,7 +1,9 @@
 //! Feature-adaptive Catmull-Clark plan (`plan_adaptive`) of structured meshes with creases,
 //! corners, holes, both end caps and any sharpness scale, and the single-pass plans of
 //! `--method gregory|acc` (`plan_single_pass`: Gregory or ACC-1 patches, Gregory triangle
-//! patches or split triangles), which share the plan's data. For accepted input: every stencil
+//! patches or split triangles), and the Doo-Sabin limit plan (`plan_doo_sabin`, on the mesh
+//! without its tags, which Doo-Sabin refuses), which share the plan's data. For accepted
+//! input: every stencil
 //! reads only earlier vertices, every patch and curve names existing vertices, the global
 //! vertex buffer is finite, and every patch evaluates to a finite point and derivatives.
 //! Bounds: `MeshSpec` (≤ 72 faces), coordinates within `MAX_COORD`, isolation 1..=3; with
@@ -17,6 +19,7 @@ use topology::patches::adaptive::single_pass::{
 };
 use topology::patches::adaptive::PatchKind;
 use topology::patches::adaptive::{plan_adaptive, AdaptiveOptions, EndCap};
+use topology::patches::doo_sabin_limit::plan_doo_sabin;
 
 fuzz_target!(
     init: tessera_fuzz::single_thread_rayon(),
@@ -62,7 +65,13 @@ fuzz_target!(
         {
             return;
         }
-        let plan = if knobs & 16 != 0 {
+        let plan = if knobs & 128 != 0 {
+            let mut untagged = mesh.clone();
+            untagged.creases.clear();
+            untagged.corners.clear();
+            untagged.holes.clear();
+            plan_doo_sabin(&untagged, opts.isolation)
+        } else if knobs & 16 != 0 {
             // Single pass: semi-sharp tags are rounded, nothing is followed.
             plan_single_pass(
                 &mesh,
