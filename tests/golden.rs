@@ -1,6 +1,7 @@
 //! Golden images: each method on three meshes at a fixed level, with the wireframe overlay so
-//! the tessellation itself is visible; BFT and adaptive goldens; textured, reparameterized and
-//! displaced spot (gregory). Regenerate with TESSERA_UPDATE_GOLDEN=1.
+//! the tessellation itself is visible; BFT, adaptive and Doo-Sabin (limit patches and vertex
+//! patches) goldens; textured, reparameterized and displaced spot (gregory). Regenerate with
+//! TESSERA_UPDATE_GOLDEN=1.
 mod common;
 use common::Gpu;
 use tessera::tess::{Context, FrameParams, TechniqueId};
@@ -286,6 +287,82 @@ fn adaptive_golden_images_match_and_detect_an_isolation_change() {
         assert!(
             changed > TOLERANCE,
             "{name}: an isolation change passed the tolerance ({changed:.5})"
+        );
+    }
+}
+
+/// Doo-Sabin images of spot and the pyramid: the limit patches (`doo-sabin-limit`, patch
+/// colours by kind and level, one segment per patch edge) at `isolation`, and the seed's vertex
+/// patches (`vertex-patches`) at depth `depth`, both with the wireframe.
+fn render_doo_sabin(isolation: u32, depth: u32) -> Vec<(String, Rgba8)> {
+    let gpu = Gpu::new();
+    note_device(&gpu);
+    let mut ctx = Context::offscreen(gpu.device()).unwrap();
+    let mut out = Vec::new();
+    for path in [ADAPTIVE_MESHES[0], ADAPTIVE_MESHES[2]] {
+        let mesh = tessera::topology::load_obj(common::data(path)).unwrap();
+        let stem = std::path::Path::new(path)
+            .file_stem()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        for (id, segments, patch_colours) in [
+            (TechniqueId::DOO_SABIN_LIMIT, 1.0, true),
+            (TechniqueId::VERTEX_PATCHES, (1u32 << depth) as f32, false),
+        ] {
+            let options = tessera::tess::BuildOptions {
+                isolation,
+                ..Default::default()
+            };
+            let mut surf = tessera::tess::build(&mut ctx, id, &mesh, &options)
+                .unwrap()
+                .technique;
+            let params = FrameParams {
+                wireframe: true,
+                patch_colours,
+                camera: tessera::tess::Camera {
+                    yaw: 145.0,
+                    pitch: 20.0,
+                    ..Default::default()
+                },
+                ..FrameParams::uniform(segments)
+            };
+            let img = ctx
+                .render_offscreen(surf.as_mut(), &params, ADAPTIVE_EXTENT)
+                .unwrap();
+            out.push((format!("{stem}_{id}"), img));
+        }
+    }
+    out
+}
+
+/// Doo-Sabin goldens (limit patches at isolation 2, vertex patches at depth 2): they match run
+/// to run, and fail when the isolation level or the depth changes by one.
+#[test]
+fn doo_sabin_golden_images_match_and_detect_an_isolation_or_depth_change() {
+    let first = render_doo_sabin(2, 2);
+    let dir = common::data("tests/data/golden");
+    if std::env::var_os("TESSERA_UPDATE_GOLDEN").is_some() {
+        for (name, img) in &first {
+            img.save_png(&dir.join(format!("{name}.png"))).unwrap();
+        }
+    }
+    let second = render_doo_sabin(2, 2);
+    let other = render_doo_sabin(3, 3);
+    for ((name, a), (b, c)) in first.iter().zip(second.iter().zip(&other)) {
+        let golden = Rgba8::load_png(&dir.join(format!("{name}.png")))
+            .unwrap_or_else(|e| panic!("{name}: {e} (TESSERA_UPDATE_GOLDEN=1 writes it)"));
+        let d1 = differing_fraction(a, &golden);
+        let d2 = differing_fraction(&b.1, &golden);
+        let changed = differing_fraction(&c.1, &golden);
+        eprintln!("{name}: run 1 {d1:.5}, run 2 {d2:.5}, one level deeper {changed:.5}");
+        assert!(
+            d1 <= match_tolerance() && d2 <= match_tolerance(),
+            "{name}: differs from golden ({d1:.5}, {d2:.5})"
+        );
+        assert!(
+            changed > TOLERANCE,
+            "{name}: a level change passed the tolerance ({changed:.5})"
         );
     }
 }

@@ -65,6 +65,10 @@ pub struct ExportArgs {
     /// 2^(table level + 1) unless --fractional; adaptive: segments per patch edge, 1 to 32. Ignored with --factors screen or distance.
     #[arg(long, alias = "level", default_value_t = 8.0, allow_hyphen_values = true, value_parser = parse_segments)]
     pub segments: f32,
+    /// The level of a uniform refinement (Doo-Sabin's `doo-sabin`, `vertex-patches`,
+    /// `cpu-doo-sabin`): depth D draws 2^D segments per base edge, 1 to 6; instead of --segments.
+    #[arg(long, conflicts_with = "segments", allow_hyphen_values = true, value_parser = parse_depth)]
+    pub depth: Option<u32>,
     #[arg(long, default_value = "equal", value_parser = parse_spacing)]
     pub spacing: Spacing,
     #[command(flatten)]
@@ -322,6 +326,21 @@ fn parse_segments(s: &str) -> Result<f32, String> {
     numbers::float(s, "--segments", 1.0, 64.0)
 }
 
+/// `--depth`: a level 1..=6 of a uniform refinement.
+fn parse_depth(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(d) if (1..=6).contains(&d) => Ok(d),
+        _ => Err(format!(
+            "--depth {s}: expected a level from 1 to 6 (2^D segments per base edge)"
+        )),
+    }
+}
+
+/// The segments a command draws: `--depth D`'s 2^D, else `--segments`.
+pub fn segments_or_depth(segments: f32, depth: Option<u32>) -> f32 {
+    depth.map_or(segments, |d| (1u32 << d) as f32)
+}
+
 /// `--device`: `auto`, an index from `tessera info`, or part of a device's name; never empty.
 fn parse_device(s: &str) -> Result<String, String> {
     if s.trim().is_empty() {
@@ -400,6 +419,10 @@ pub struct SceneArgs {
     /// patch edge, 1 to 32 (a coarse transition edge gets twice as many).
     #[arg(long, alias = "level", default_value_t = 8.0, allow_hyphen_values = true, value_parser = parse_segments)]
     pub segments: f32,
+    /// The level of a uniform refinement (Doo-Sabin's `doo-sabin`, `vertex-patches`,
+    /// `cpu-doo-sabin`): depth D draws 2^D segments per base edge, 1 to 6; instead of --segments.
+    #[arg(long, conflicts_with = "segments", allow_hyphen_values = true, value_parser = parse_depth)]
+    pub depth: Option<u32>,
     #[arg(long, default_value = "equal", value_parser = parse_spacing)]
     pub spacing: Spacing,
     /// Draw the tessellated wireframe over the shaded surface.

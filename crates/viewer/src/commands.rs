@@ -158,9 +158,13 @@ pub fn scene_setup(s: &SceneArgs, name: &str, mesh: &topology::ControlMesh) -> R
         phong_alpha: s.alpha,
         ..FrameParams::default()
     };
-    let mut setup = s
-        .surface
-        .setup(method, s.segments, s.spacing, s.animate, params)?;
+    let mut setup = s.surface.setup(
+        method,
+        crate::cli::segments_or_depth(s.segments, s.depth),
+        s.spacing,
+        s.animate,
+        params,
+    )?;
     crate::technique::check_segments(&setup)?;
     setup.build.name = name.to_string();
     // A texture or height map without `vt`: said before the device is opened (the build

@@ -67,9 +67,13 @@ pub fn run(a: ExportArgs) -> Result<()> {
     )?;
     check_drawable(&base, &lines, &mesh_name(a.input.as_deref()), false)?;
     let method = crate::technique::resolve_method(a.method, a.surface.scheme.as_deref(), &base)?;
-    let mut setup = a
-        .surface
-        .setup(method, a.segments, a.spacing, false, params)?;
+    let mut setup = a.surface.setup(
+        method,
+        crate::cli::segments_or_depth(a.segments, a.depth),
+        a.spacing,
+        false,
+        params,
+    )?;
     crate::technique::check_segments(&setup)?;
     setup.build.name = mesh_name(a.input.as_deref());
     tess::surface::check_texcoords(&base, &setup.build.maps, &setup.build.name)?;

@@ -1303,3 +1303,57 @@ fn the_draw_path_options_draw_or_name_what_is_wrong() {
         &["--figure7", "--markdown"],
     );
 }
+
+/// `--depth D` draws a uniform refinement's level D (2^D segments): the seed's vertex patches
+/// at depth 2 draw; a depth out of 1..6 and `--depth` with `--segments` are refused by name.
+#[test]
+fn the_depth_option_draws_a_level_or_names_what_is_wrong() {
+    let png = tmp("depth.png");
+    let png = png.to_str().unwrap();
+    let o = succeeds(&[
+        "render",
+        "--size",
+        "96x72",
+        "-o",
+        png,
+        "--scheme",
+        "doo-sabin",
+        "--method",
+        "vertex-patches",
+        "--depth",
+        "2",
+    ]);
+    assert!(stdout(&o).contains("vertex-patches"), "{}", stdout(&o));
+    for depth in ["0", "7", "2.5"] {
+        fails(
+            &[
+                "render",
+                "--method",
+                "vertex-patches",
+                "--depth",
+                depth,
+                "-o",
+                png,
+            ],
+            &[],
+            2,
+            &["--depth", depth],
+        );
+    }
+    fails(
+        &[
+            "render",
+            "--method",
+            "vertex-patches",
+            "--depth",
+            "2",
+            "--segments",
+            "4",
+            "-o",
+            png,
+        ],
+        &[],
+        2,
+        &["--depth", "--segments"],
+    );
+}
