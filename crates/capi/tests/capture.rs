@@ -117,7 +117,7 @@ fn the_pipeline_choice_draws_patterns_or_is_refused() {
         );
         for (technique, pipeline, status) in [
             (
-                TESSERA_TECHNIQUE_ADAPTIVE,
+                TESSERA_TECHNIQUE_CPU_CATMARK,
                 TESSERA_PIPELINE_PATTERN,
                 TesseraStatus::Unsupported,
             ),

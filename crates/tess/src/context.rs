@@ -125,8 +125,8 @@ pub struct Context {
     /// The host's render pass subpass the draw pipelines are made for; `None`: dynamic
     /// rendering ([`Self::for_subpass`]).
     subpass: Option<Subpass>,
-    /// The frame block last written ([`Self::frame_view`]).
-    view: Option<FrameUniforms>,
+    /// The frame block last written and its frame slot ([`Self::frame_view`]).
+    view: Option<(usize, FrameUniforms)>,
     device: Device,
 }
 
@@ -288,12 +288,12 @@ impl Context {
     /// factors see. A technique that chooses its levels on the host reads it in
     /// [`Technique::prepare_frame`], so every frame writes its block before [`Self::prepare`].
     pub fn frame_view(&self) -> Option<&FrameUniforms> {
-        self.view.as_ref()
+        self.view.as_ref().map(|(_, u)| u)
     }
 
     /// Writes the frame uniforms of `slot` as given (see [`frame_uniforms_with`]).
     pub fn write_frame_uniforms(&mut self, slot: usize, uniforms: &FrameUniforms) -> Result<()> {
-        self.view = Some(*uniforms);
+        self.view = Some((slot, *uniforms));
         let slots = self.frames.slots.len();
         let (_, buffer) = self
             .frames
@@ -319,7 +319,18 @@ impl Context {
             .features
             .refuse(technique.id(), params)?;
         technique.check(params)?;
+        let written = self.view;
         technique.prepare_frame(self, params)?;
+        // Making a pattern draws a unit patch through this context (crate::pattern::make),
+        // which writes a frame block of its own: the caller's goes back into its slot.
+        if let Some((slot, uniforms)) = written {
+            let same = self.view.is_some_and(|(s, u)| {
+                s == slot && bytemuck::bytes_of(&u) == bytemuck::bytes_of(&uniforms)
+            });
+            if !same {
+                self.write_frame_uniforms(slot, &uniforms)?;
+            }
+        }
         let technique = &*technique;
         let bindings = technique.set_layout_bindings();
         if !bindings.is_empty() {
