@@ -1202,6 +1202,17 @@ fn the_draw_path_options_draw_or_name_what_is_wrong() {
         (
             vec![
                 "--method",
+                "adaptive",
+                "--pipeline",
+                "pattern",
+                "--factors",
+                "distance",
+            ],
+            "pattern path",
+        ),
+        (
+            vec![
+                "--method",
                 "pn",
                 "--pipeline",
                 "pattern",
@@ -1233,12 +1244,12 @@ fn the_draw_path_options_draw_or_name_what_is_wrong() {
             "adaptive",
             "--pipeline",
             "pattern",
-            "--factors",
-            "distance",
+            "--spacing",
+            "fractional-even",
         ]),
         &[],
         1,
-        &["adaptive", "distance", "--pipeline tessellation"],
+        &["equal spacing", "--spacing equal"],
     );
     fails(
         &render(&[
