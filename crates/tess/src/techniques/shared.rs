@@ -196,3 +196,41 @@ pub fn depth_of(technique: TechniqueId, params: &FrameParams) -> Result<u32> {
     }
     Ok((segments as u32).trailing_zeros())
 }
+
+/// The refinement-vertex budget of a Doo-Sabin uniform refinement (`doo-sabin`,
+/// `vertex-patches`): the depth `params` draws, refused by name when the base and every refined
+/// level together exceed `max` vertices.
+pub fn check_doo_sabin_budget(
+    technique: TechniqueId,
+    base_vertices: usize,
+    first: topology::refine::doo_sabin::LevelSize,
+    max: u64,
+    params: &FrameParams,
+) -> Result<u32> {
+    let depth = depth_of(technique, params)?;
+    let sizes = topology::refine::doo_sabin::level_sizes(first, depth);
+    let vertices = base_vertices as u64 + sizes.iter().map(|s| s.vertices).sum::<u64>();
+    if vertices > max {
+        return Err(TessError::RefinedTooLarge {
+            scheme: topology::Scheme::DooSabin,
+            level: depth as usize,
+            vertices,
+            max,
+        });
+    }
+    Ok(depth)
+}
+
+/// Triangles of array 0 of a Doo-Sabin uniform refinement at the depth `params` draws.
+pub fn doo_sabin_triangles(
+    technique: TechniqueId,
+    first: topology::refine::doo_sabin::LevelSize,
+    params: &FrameParams,
+    array: usize,
+) -> Option<u64> {
+    (array == 0).then_some(())?;
+    let depth = depth_of(technique, params).ok()?;
+    topology::refine::doo_sabin::level_sizes(first, depth)
+        .last()
+        .map(|s| s.triangles())
+}

@@ -49,11 +49,13 @@ use crate::technique::{
     DeviceAllocation, DrawCounts, DrawPath, Features, FrameParams, Pass, PatchArray, PatchPipeline,
     PatchType, Technique, TechniqueId,
 };
-use crate::techniques::shared::{depth_of, upload_base, STAGES};
+use crate::techniques::shared::{
+    check_doo_sabin_budget, depth_of, doo_sabin_triangles, upload_base, STAGES,
+};
 use crate::techniques::{BuildOptions, Built, TechniqueInfo};
 use layout::{DepthLayout, LayoutError};
 use std::mem::size_of;
-use topology::refine::doo_sabin::{first_level_size, level_sizes, LevelSize};
+use topology::refine::doo_sabin::{first_level_size, LevelSize};
 use topology::refine::Level;
 use topology::{ControlMesh, Scheme};
 use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
@@ -344,19 +346,14 @@ impl Technique for DooSabin {
     }
 
     fn check(&self, params: &FrameParams) -> Result<()> {
-        let depth = depth_of(TechniqueId::DOO_SABIN, params)?;
-        let sizes = level_sizes(self.first_size, depth);
-        let vertices =
-            self.base.num_vertices() as u64 + sizes.iter().map(|s| s.vertices).sum::<u64>();
-        if vertices > self.max_vertices {
-            return Err(TessError::RefinedTooLarge {
-                scheme: Scheme::DooSabin,
-                level: depth as usize,
-                vertices,
-                max: self.max_vertices,
-            });
-        }
-        Ok(())
+        check_doo_sabin_budget(
+            TechniqueId::DOO_SABIN,
+            self.base.num_vertices(),
+            self.first_size,
+            self.max_vertices,
+            params,
+        )
+        .map(|_| ())
     }
 
     fn prepare_frame(&mut self, _ctx: &mut crate::Context, params: &FrameParams) -> Result<()> {
@@ -386,11 +383,7 @@ impl Technique for DooSabin {
     }
 
     fn triangles(&self, params: &FrameParams, array: usize) -> Option<u64> {
-        (array == 0).then_some(())?;
-        let depth = depth_of(TechniqueId::DOO_SABIN, params).ok()?;
-        level_sizes(self.first_size, depth)
-            .last()
-            .map(|s| s.triangles())
+        doo_sabin_triangles(TechniqueId::DOO_SABIN, self.first_size, params, array)
     }
 
     fn base_mesh(&self) -> Option<&ControlMesh> {

@@ -86,11 +86,13 @@ pub fn layout(base: &Level, depth: u32) -> Result<PatchesLayout, LayoutError> {
     let step = refine_dual(base, true)?;
     let patches = vertex_patches(&base.topology, &step)?;
     check_faces(&patches, depth)?;
-    let mut levels = vec![step.level.clone()];
+    let mut levels = Vec::with_capacity(depth as usize);
+    let mut last = step.level.clone();
     for _ in 1..depth {
-        let next = refine_dual(levels.last().expect("level 1"), false)?.level;
-        levels.push(next);
+        let next = refine_dual(&last, false)?.level;
+        levels.push(std::mem::replace(&mut last, next));
     }
+    levels.push(last);
     // Regions and per-patch offsets at every depth.
     let base_len = base.num_vertices() as u64;
     let mut regions = Vec::new();
@@ -283,7 +285,10 @@ fn deepest(
         let local = offsets[p] - first;
         slot_vertices.extend(patch.level_vertices(&topologies, depth)?);
         let flags = patch.flags_to(depth);
-        let flags = flags.last().expect("depth 1 present");
+        // `flags_to` gives one entry per depth 1..=depth; depth 0 has no faces to draw.
+        let Some(flags) = flags.last() else {
+            continue;
+        };
         for face in patch.layout().faces(depth) {
             if !patch.draws(depth, &face, flags) {
                 continue;

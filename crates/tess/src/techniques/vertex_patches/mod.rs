@@ -68,12 +68,14 @@ use crate::technique::{
     DeviceAllocation, DrawCounts, DrawPath, Features, FrameParams, Pass, PatchArray, PatchPipeline,
     PatchType, Technique, TechniqueId,
 };
-use crate::techniques::shared::{compute_pipeline, depth_of, upload_base, STAGES};
+use crate::techniques::shared::{
+    check_doo_sabin_budget, compute_pipeline, depth_of, doo_sabin_triangles, upload_base, STAGES,
+};
 use crate::techniques::{BuildOptions, Built, TechniqueInfo};
 use layout::{LayoutError, PatchesLayout};
 use std::mem::size_of;
 use topology::mesh::INVALID;
-use topology::refine::doo_sabin::{first_level_size, level_sizes, LevelSize};
+use topology::refine::doo_sabin::{first_level_size, LevelSize};
 use topology::refine::Level;
 use topology::{ControlMesh, Scheme};
 use vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
@@ -330,7 +332,6 @@ impl DepthMesh {
             }
             tables.push(records_buffer);
         }
-        tables.push(addresses);
         let indices = Buffer::with_data(
             device,
             "vertex-patches indices",
@@ -342,8 +343,9 @@ impl DepthMesh {
         set.write_buffer(
             VERTEX_PATCHES_ARRAYS_BINDING,
             vk::DescriptorType::UNIFORM_BUFFER,
-            tables.last().expect("addresses"),
+            &addresses,
         )?;
+        tables.push(addresses);
         Ok(Self {
             layout,
             evaluator,
@@ -414,19 +416,14 @@ impl Technique for VertexPatches {
     /// Refuses what `doo-sabin` refuses, and a depth whose arrays (every depth's, about the
     /// refined levels' vertices and their copies) exceed the refined-vertex budget.
     fn check(&self, params: &FrameParams) -> Result<()> {
-        let depth = depth_of(TechniqueId::VERTEX_PATCHES, params)?;
-        let sizes = level_sizes(self.first_size, depth);
-        let vertices =
-            self.base.num_vertices() as u64 + sizes.iter().map(|s| s.vertices).sum::<u64>();
-        if vertices > self.max_vertices {
-            return Err(TessError::RefinedTooLarge {
-                scheme: Scheme::DooSabin,
-                level: depth as usize,
-                vertices,
-                max: self.max_vertices,
-            });
-        }
-        Ok(())
+        check_doo_sabin_budget(
+            TechniqueId::VERTEX_PATCHES,
+            self.base.num_vertices(),
+            self.first_size,
+            self.max_vertices,
+            params,
+        )
+        .map(|_| ())
     }
 
     fn prepare_frame(&mut self, _ctx: &mut crate::Context, params: &FrameParams) -> Result<()> {
@@ -456,11 +453,7 @@ impl Technique for VertexPatches {
     }
 
     fn triangles(&self, params: &FrameParams, array: usize) -> Option<u64> {
-        (array == 0).then_some(())?;
-        let depth = depth_of(TechniqueId::VERTEX_PATCHES, params).ok()?;
-        level_sizes(self.first_size, depth)
-            .last()
-            .map(|s| s.triangles())
+        doo_sabin_triangles(TechniqueId::VERTEX_PATCHES, self.first_size, params, array)
     }
 
     fn base_mesh(&self) -> Option<&ControlMesh> {
