@@ -81,6 +81,14 @@ fn bits(f: PointFlags) -> u32 {
     (f.present as u32) * VERTEX_PATCH_PRESENT + (f.boundary as u32) * VERTEX_PATCH_BOUNDARY
 }
 
+/// The vertex patches of `base` fit the refinement kernel at every depth: no face larger than
+/// its local arrays (a v-face of valence over `VERTEX_PATCHES_MAX_FACE`, or a corner face of
+/// that many corners). Checked when the technique is built, before any depth is asked for.
+pub fn check_patches(base: &Level) -> Result<(), LayoutError> {
+    let step = refine_dual(base, true)?;
+    check_face_sizes(&vertex_patches(&base.topology, &step)?)
+}
+
 /// Lays out depths `1..=depth` of the vertex patches of `base`.
 pub fn layout(base: &Level, depth: u32) -> Result<PatchesLayout, LayoutError> {
     let step = refine_dual(base, true)?;
@@ -161,19 +169,8 @@ pub fn layout(base: &Level, depth: u32) -> Result<PatchesLayout, LayoutError> {
 /// Every face the kernel refines fits its local arrays, and every present face with boundary
 /// points has them on one edge (the strip the kernel's mask assumes).
 fn check_faces(patches: &[VertexPatch], depth: u32) -> Result<(), LayoutError> {
+    check_face_sizes(patches)?;
     for patch in patches {
-        let too_large = patch
-            .corner_sizes
-            .iter()
-            .copied()
-            .chain([patch.faces.len()])
-            .find(|&m| m > VERTEX_PATCHES_MAX_FACE as usize);
-        if let Some(size) = too_large {
-            return Err(LayoutError::FaceTooLarge {
-                vertex: patch.vertex,
-                size,
-            });
-        }
         let layout = patch.layout();
         for (d, flags) in (1..).zip(patch.flags_to(depth)) {
             for face in layout.faces(d) {
@@ -186,6 +183,25 @@ fn check_faces(patches: &[VertexPatch], depth: u32) -> Result<(), LayoutError> {
                     depth: d,
                 })?;
             }
+        }
+    }
+    Ok(())
+}
+
+/// Every face the kernel refines fits its local arrays (and the kernel's 32-bit corner masks).
+fn check_face_sizes(patches: &[VertexPatch]) -> Result<(), LayoutError> {
+    for patch in patches {
+        let too_large = patch
+            .corner_sizes
+            .iter()
+            .copied()
+            .chain([patch.faces.len()])
+            .find(|&m| m > VERTEX_PATCHES_MAX_FACE as usize);
+        if let Some(size) = too_large {
+            return Err(LayoutError::FaceTooLarge {
+                vertex: patch.vertex,
+                size,
+            });
         }
     }
     Ok(())

@@ -171,6 +171,13 @@ impl VertexPatches {
         // Refuses holes and sharpness tags by name (Doo-Sabin has neither).
         let base = Level::from_mesh(mesh, Scheme::DooSabin).map_err(mesh_error)?;
         let first_size = first_level_size(&base).map_err(mesh_error)?;
+        layout::check_patches(&base).map_err(|e| match e {
+            LayoutError::Topology(t) => mesh_error(t),
+            other => TessError::Mesh {
+                name: options.name.clone(),
+                source: Box::new(other),
+            },
+        })?;
         let device = ctx.device().clone();
         let positions = crate::animation::base_positions(mesh);
         let base_buffers = (0..ctx.frames_in_flight())
