@@ -206,6 +206,16 @@ pub enum TopologyError {
         estimate: u64,
         bound: u64,
     },
+    /// A Doo-Sabin limit plan projected to hold more patch domains (squares) than its bound
+    /// (checked before each level is planned, so the plan stops before allocating them).
+    #[error("Doo-Sabin limit plan of a {faces}-face mesh at isolation {isolation}: about {estimate} patches projected at level {level}, above the bound of {bound} (lower the isolation)")]
+    DooSabinTooLarge {
+        faces: usize,
+        isolation: u32,
+        level: u32,
+        estimate: u64,
+        bound: u64,
+    },
     /// Gregory end caps whose point stencils were projected past their bound (checked before
     /// any is built: each of the 20 points is a row over its corners' one-rings, ~200 terms a
     /// patch, so a mesh made of end caps, such as a triangle mesh under Catmull-Clark, costs

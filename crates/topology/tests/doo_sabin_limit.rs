@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use topology::limit::doo_sabin_eval::DooSabinEvaluator;
 use topology::mesh::{EdgeCrease, VertexCorner};
 use topology::patches::adaptive::{AdaptivePlan, EdgeKind, PatchKind};
-use topology::patches::doo_sabin_limit::plan_doo_sabin;
+use topology::patches::doo_sabin_limit::{plan_doo_sabin, plan_doo_sabin_within};
 use topology::refine::doo_sabin::{boundary_vertices, refine_dual};
 use topology::refine::Level;
 use topology::{load_obj, ControlMesh, Scheme, TopologyError};
@@ -542,4 +542,35 @@ fn bad_input_is_a_named_error() {
         "{e}"
     );
     assert!(plan_doo_sabin(&ControlMesh::default(), 2).is_err());
+}
+
+/// A plan projected past its bound on patches stops with a named error before the level that
+/// would pass it; at the bound of its own size it is planned.
+#[test]
+fn a_plan_over_its_patch_bound_is_refused_by_name() {
+    let mesh = capped_prism();
+    let plan = plan_doo_sabin(&mesh, 4).expect("plan");
+    let total = plan.patches.len() as u64;
+    let within = plan_doo_sabin_within(&mesh, 4, total).expect("at its own size");
+    assert_eq!(within.patches.len() as u64, total);
+    let e = plan_doo_sabin_within(&mesh, 4, total - 1).unwrap_err();
+    match e {
+        TopologyError::DooSabinTooLarge {
+            faces,
+            isolation: 4,
+            estimate,
+            bound,
+            ..
+        } => assert!(
+            faces == mesh.num_faces() && estimate > bound && bound == total - 1,
+            "{e}"
+        ),
+        _ => panic!("{e}"),
+    }
+    assert!(e.to_string().contains("lower the isolation"), "{e}");
+    let corners = mesh.face_vertices.len() as u64;
+    let e = plan_doo_sabin_within(&mesh, 1, corners - 1).unwrap_err();
+    let at_first = matches!(e, TopologyError::DooSabinTooLarge { level: 0, estimate, .. }
+        if estimate == corners);
+    assert!(at_first, "{e}");
 }

@@ -73,7 +73,7 @@
 
 use super::adaptive::{
     AdaptivePatch, AdaptivePlan, ControlPoints, CurveOwner, EdgeKind, LevelStats, PatchEdge,
-    PatchKind, StencilBlock,
+    PatchKind, StencilBlock, MAX_REFINED_FACES,
 };
 use crate::error::TopologyError;
 use crate::mesh::ControlMesh;
@@ -549,6 +549,20 @@ fn plan_level(
 /// Doo-Sabin's rules do not define (holes, crease and corner tags), non-manifold meshes (as
 /// the dual refiner names them) and faces of more than 256 corners.
 pub fn plan_doo_sabin(mesh: &ControlMesh, isolation: u32) -> Result<AdaptivePlan, TopologyError> {
+    plan_doo_sabin_within(mesh, isolation, MAX_REFINED_FACES)
+}
+
+/// [`plan_doo_sabin`] under a bound on its patch domains (squares) other than
+/// [`MAX_REFINED_FACES`]: a plan projected past it is [`TopologyError::DooSabinTooLarge`],
+/// returned before the step that would exceed it. The projection at each level counts the
+/// squares planned and held, plus three more for each square split at every level still to
+/// come (a split square becomes four, and the squares next to an extraordinary face's centre
+/// split again at the next level).
+pub fn plan_doo_sabin_within(
+    mesh: &ControlMesh,
+    isolation: u32,
+    max_squares: u64,
+) -> Result<AdaptivePlan, TopologyError> {
     if !(1..=8).contains(&isolation) {
         return Err(TopologyError::IsolationOutOfRange { isolation });
     }
@@ -560,9 +574,29 @@ pub fn plan_doo_sabin(mesh: &ControlMesh, isolation: u32) -> Result<AdaptivePlan
             size: f.len(),
         });
     }
+    let too_large = |level: u32, estimate: u64| TopologyError::DooSabinTooLarge {
+        faces: mesh.num_faces(),
+        isolation,
+        level,
+        estimate,
+        bound: max_squares,
+    };
+    let corners = mesh.face_vertices.len() as u64;
+    if corners > max_squares {
+        return Err(too_large(0, corners));
+    }
     let (mut r, mut squares) = first_level(mesh)?;
     let (mut drafts, mut held) = (Vec::new(), Vec::new());
     for level in 1..=isolation {
+        let split = squares
+            .iter()
+            .filter(|sq| level < isolation && sq.extraordinary() > 0)
+            .count() as u64;
+        let estimate =
+            (drafts.len() + squares.len()) as u64 + 3 * split * (isolation - level) as u64;
+        if estimate > max_squares {
+            return Err(too_large(level, estimate));
+        }
         squares = plan_level(&mut r, squares, level, isolation, &mut drafts, &mut held)?;
     }
     let stats = level_stats(mesh, r.first_size, &drafts, &held);
