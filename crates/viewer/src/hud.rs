@@ -20,6 +20,9 @@ use winit::window::Window;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Action {
     Technique(TechniqueId),
+    /// The registry's next technique, after the last the first (Tab): every technique, the
+    /// ones past the ten number keys included.
+    NextTechnique,
     LevelUp,
     LevelDown,
     LevelDouble,
@@ -231,11 +234,11 @@ fn panel(ui: &mut egui::Ui, s: &Shown<'_>, history: &[f32], actions: &mut Vec<Ac
 /// The technique box (number keys 1..n).
 fn technique_choice(ui: &mut egui::Ui, s: &Shown<'_>, actions: &mut Vec<Action>) {
     ui.horizontal(|ui| {
-        // Digit keys 1-9 then 0 reach the first ten; the list reaches every technique.
+        // Digit keys 1-9 then 0 reach the first ten; Tab and the list reach every technique.
         let n = techniques::registry().len();
         ui.label(match n {
-            ..=9 => format!("technique (1-{n})"),
-            _ => "technique (1-9, 0)".to_owned(),
+            ..=9 => format!("technique (1-{n}, Tab)"),
+            _ => "technique (1-9, 0, Tab)".to_owned(),
         });
         egui::ComboBox::from_id_salt("technique")
             .selected_text(s.technique.name())

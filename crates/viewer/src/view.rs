@@ -579,6 +579,7 @@ impl App {
                 "[" => Action::DisplaceDown,
                 _ => return None,
             },
+            Key::Named(NamedKey::Tab) => Action::NextTechnique,
             Key::Named(NamedKey::ArrowUp) => Action::LevelDouble,
             Key::Named(NamedKey::ArrowDown) => Action::LevelHalve,
             Key::Named(NamedKey::Escape) => Action::Quit,
@@ -593,6 +594,7 @@ impl App {
         let p = &mut self.setup.params;
         match action {
             Action::Technique(id) => self.switch_technique(id),
+            Action::NextTechnique => self.switch_technique(next_technique(self.setup.technique)),
             Action::LevelUp => self.set_level(level + 1.0, true),
             Action::LevelDown => self.set_level(level - 1.0, false),
             Action::LevelDouble => self.set_level(level * 2.0, true),
@@ -867,6 +869,13 @@ fn initial_displace_scale(displace: f32, mesh: &ControlMesh) -> f32 {
     }
 }
 
+/// Tab: the registry's technique after `id`, the first after the last.
+fn next_technique(id: TechniqueId) -> TechniqueId {
+    let all = techniques::registry();
+    let at = all.iter().position(|i| i.id == id).unwrap_or(all.len() - 1);
+    all[(at + 1) % all.len()].id
+}
+
 /// V: shading, then the reparameterization's parameter shift, then the Eq. 1 texture error.
 fn next_show(show: tess::surface::SurfaceShow) -> tess::surface::SurfaceShow {
     use tess::surface::SurfaceShow::*;
@@ -1022,6 +1031,10 @@ mod tests {
         App::key_action(&Key::Character(SmolStr::new(c)))
     }
 
+    fn key_named(k: NamedKey) -> Option<Action> {
+        App::key_action(&Key::Named(k))
+    }
+
     #[test]
     fn v_cycles_every_surface_view() {
         use tess::surface::SurfaceShow::*;
@@ -1054,6 +1067,13 @@ mod tests {
             key("5"),
             Some(Action::Technique("adaptive".parse().unwrap()))
         );
+        assert_eq!(key_named(NamedKey::Tab), Some(Action::NextTechnique));
+        let all = techniques::registry();
+        let mut id = all[0].id;
+        for step in 1..=all.len() {
+            id = next_technique(id);
+            assert_eq!(id, all[step % all.len()].id, "Tab {step} times");
+        }
         let past = techniques::registry().len() + 1;
         if past <= 10 {
             assert_eq!(key(&(past % 10).to_string()), None);
