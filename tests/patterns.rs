@@ -819,3 +819,79 @@ fn planned_patches_take_screen_space_and_distance_factors_through_patterns() {
     }
     assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
 }
+
+/// The seed's sine displacement on the Catmull-Clark planned surfaces, on both draw paths: the
+/// pattern path emits the tessellation path's bits at every sample; both weld with 0 cracks
+/// (a boundary point moves along its canonical owner's normal); adaptive's regular patches are
+/// the exact limit moved by a·sin(f·‖P‖) along its unit normal, within 1e-5 of the diagonal; the
+/// Doo-Sabin limit, which has no owner frames to move along, refuses it by name.
+#[test]
+fn planned_surfaces_take_the_sine_displacement_on_both_paths() {
+    use tessera::tess::gpu::bindings::ADAPTIVE_KIND_REGULAR;
+    use tessera::topology::limit::face_domain::LimitEvaluator;
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let mesh = spot();
+        let diagonal = mesh.bbox_diagonal();
+        let limit = LimitEvaluator::new(&mesh, LimitScheme::CatmullClark).unwrap();
+        let p = FrameParams {
+            displace_sine: SINE,
+            ..FrameParams::uniform(4.0)
+        };
+        for id in [
+            TechniqueId::ADAPTIVE,
+            TechniqueId::GREGORY,
+            TechniqueId::ACC,
+        ] {
+            let mut soups = Vec::new();
+            for path in [PipelineChoice::Tessellation, PipelineChoice::Pattern] {
+                let what = format!("{id}, {path:?}");
+                let mut t = build_isolated(&mut ctx, id, &mesh, path).unwrap();
+                let soup = capture(&mut ctx, t.as_mut(), &p);
+                let plain = capture(&mut ctx, t.as_mut(), &FrameParams::uniform(4.0));
+                assert_ne!(samples(&soup), samples(&plain), "{what}: the surface moved");
+                let welded = soup.weld().unwrap();
+                let report = welded.open_edges();
+                let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
+                let c = classify_open_edges(&soup, &welded, &report, &map, &mesh);
+                assert_eq!((c.cracks, c.unmapped), (0, 0), "{what}");
+                if id == TechniqueId::ADAPTIVE {
+                    let mut worst = 0.0f64;
+                    let regular = soup
+                        .records
+                        .iter()
+                        .filter(|r| r.flags & 15 == ADAPTIVE_KIND_REGULAR);
+                    for r in regular {
+                        let f = t.face_point(r.patch, r.domain).unwrap();
+                        let e = limit.evaluate(f.face, f.u as f64, f.v as f64).unwrap();
+                        let want = oracle::displaced(e.position, e.normal, SINE.map(f64::from));
+                        let d = (0..3)
+                            .map(|i| (r.position[i] as f64 - want[i]).powi(2))
+                            .sum::<f64>()
+                            .sqrt();
+                        worst = worst.max(d / diagonal);
+                    }
+                    println!("{what}: regular patches {worst:.1e} from the displaced limit");
+                    assert!(worst <= 1e-5, "{what}: {worst}");
+                }
+                soups.push(soup);
+            }
+            let n = compare_samples(&soups[0], &soups[1], &format!("{id} displaced"));
+            println!("{id}: {n} displaced samples, the same bits on both paths");
+        }
+        let mut t = build_isolated(
+            &mut ctx,
+            TechniqueId::DOO_SABIN_LIMIT,
+            &mesh,
+            PipelineChoice::Tessellation,
+        )
+        .unwrap();
+        let e = ctx
+            .prepare(t.as_mut(), &p, &[tessera::tess::Pass::Shaded])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("sine displacement (--displace-sine)"), "{e}");
+    }
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+}

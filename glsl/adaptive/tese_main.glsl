@@ -23,6 +23,9 @@ layout(location = 5) out vec3 out_albedo;
 layout(location = 6) out vec2 out_texcoord;
 #endif
 #include "surface.glsl"
+#ifdef SURFACE_BUILD
+#include "sine.glsl"
+#endif
 #ifdef PATCH_SHADING_NORMAL
 // A patch kind whose shading normal is not cross(du, dv) defines this after including this
 // file (gregory.tese: ACC-1 nets and their tangent patches); `n` is cross(du, dv)'s.
@@ -100,11 +103,12 @@ void main() {
     // site: lavapipe compiles every inlined copy into the TES, and a second copy of the owner
     // evaluation made every adaptive frame 1.5x slower even where it never ran.
     bool displace = (adaptive.options & uint(ADAPTIVE_OPTION_DISPLACE)) != 0u;
+    bool sine = frame.sine.x != 0.0;
     bool owner_shading = canonical && (adaptive.options & uint(ADAPTIVE_OPTION_CANONICAL_NORMALS)) != 0u;
     uint oid = tc_patch;
     vec2 ouv = uv;
     vec3 on = n, odu = du, odv = dv;
-    if (canonical && (displace || owner_shading)) {
+    if (canonical && (displace || sine || owner_shading)) {
         canonical_owner(curve, s, oid, ouv);
         owner_frame(oid, ouv, on, odu, odv);
     }
@@ -128,6 +132,9 @@ void main() {
         if (k == 0) tex = t; else height[k] = surface_height(t);
     }
     out_texcoord = tex;
+    // The seed's a sin(f |P|) moves a boundary point along its owner's normal too, so both
+    // sides of an edge move it to the same bits; after the height map, along the same normal.
+    vec3 moving = canonical ? on : n;
     if (displace) {
         vec3 sn = owner_shading ? on : n, sdu = owner_shading ? odu : du, sdv = owner_shading ? odv : dv;
         precise vec3 moved = pos + (canonical ? on : n) * (adaptive.displace_scale * height[1]);
@@ -137,6 +144,7 @@ void main() {
     } else if (owner_shading) {
         n = on;
     }
+    pos = displace_sine(pos, moving);
     vec3 albedo = frame.base_color.rgb;
     if (show_shift) {
         // How far the reparameterization moves the texture parameter, in patch units: 0 blue,

@@ -310,9 +310,10 @@ pub struct SurfaceArgs {
     /// Height map (PNG, luminance in [0, 1]) for --displace.
     #[arg(long, value_name = "PNG")]
     pub height: Option<std::path::PathBuf>,
-    /// The refinement-pattern seed's procedural displacement (flat, phong, pn): each point
-    /// moves by A·sin(F·|P|) along its unit normal, on both draw paths. A and F finite, |A| ≤
-    /// 1000, 0 ≤ F ≤ 1e6. Meshes whose OBJ normals differ across an edge open there.
+    /// The refinement-pattern seed's procedural displacement (flat, phong, pn, adaptive,
+    /// gregory, acc): each point moves by A·sin(F·|P|) along its unit normal (on a patch edge,
+    /// its canonical owner's), on both draw paths. A and F finite, |A| ≤ 1000, 0 ≤ F ≤ 1e6.
+    /// Meshes whose OBJ normals differ across an edge open there (flat, phong, pn).
     #[arg(long, value_name = "A,F", allow_hyphen_values = true, value_parser = parse_displace_sine)]
     pub displace_sine: Option<[f32; 2]>,
     /// Texture coordinates at the Gregory patches' own parameter instead of the rational

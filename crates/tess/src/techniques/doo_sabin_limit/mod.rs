@@ -36,6 +36,9 @@ impl TechniqueId {
 pub const FEATURES: Features = Features {
     isolation: true,
     surface: false,
+    // The seed's sine moves boundary points along their owner's normal, which the surface
+    // build evaluates; the Doo-Sabin limit has no surface build (no texture coordinates).
+    sine_displacement: false,
     ..PLANNED
 };
 

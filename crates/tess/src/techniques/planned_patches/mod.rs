@@ -397,7 +397,7 @@ pub const PLANNED: Features = Features {
     isolation: false,
     surface: true,
     single_pass: false,
-    sine_displacement: false,
+    sine_displacement: true,
     paths: &[DrawPath::Tessellation, DrawPath::Pattern],
 };
 
@@ -405,7 +405,6 @@ pub const PLANNED: Features = Features {
 /// isolation.
 pub const SINGLE_PASS: Features = Features {
     single_pass: true,
-    sine_displacement: false,
     ..PLANNED
 };
 
@@ -1048,12 +1047,14 @@ impl Technique for PlannedPatches {
         &SET_BINDINGS
     }
 
-    /// A shown texture, displacement, parameter view or patch colours, or the single-pass
-    /// methods' canonical normals (and ACC-1's tangent patches) need the surface build;
-    /// adaptive's plain frames do not (and hand the rasterizer no albedo or texture varying).
+    /// A shown texture, displacement (height map or sine), parameter view or patch colours, or
+    /// the single-pass methods' canonical normals (and ACC-1's tangent patches) need the
+    /// surface build; adaptive's plain frames do not (and hand the rasterizer no albedo or
+    /// texture varying).
     fn surface_build(&self, params: &FrameParams) -> bool {
         self.options.single_pass
             || params.displace != 0.0
+            || params.displace_sine[0] != 0.0
             || params.show != SurfaceShow::Shading
             || params.patch_colours
             || self.options.maps.texture.is_some()
