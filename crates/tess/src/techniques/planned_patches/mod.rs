@@ -549,6 +549,115 @@ pub struct PlannedPatches {
     pub fvar: Option<FVarPatches>,
 }
 
+/// The device arrays of a plan and the descriptor set that binds them: the global vertex
+/// buffer, the static arrays (patches, stencils, curves, owners, surfaces, the Eq. 1 lattice,
+/// the face-varying patches) with their address table, and the surface textures.
+struct PlanArrays {
+    vertices: Buffer,
+    /// The static arrays, then their address table.
+    statics: Vec<Buffer>,
+    textures: [Texture; 2],
+    set: DescriptorSet,
+    pool: DescriptorPool,
+    has_param_errors: bool,
+    param_error_summary: ParamErrorNote,
+}
+
+impl PlanArrays {
+    fn new(
+        ctx: &Context,
+        id: TechniqueId,
+        mesh: &ControlMesh,
+        plan: &AdaptivePlan,
+        gpu: &GpuPlan,
+        fvar: Option<&FVarPatches>,
+        options: &PlanBuild,
+    ) -> Result<Self> {
+        let device = ctx.device();
+        let set_layout = ctx.set_layout(id)?;
+        let pool = DescriptorPool::new(device, "adaptive descriptor pool", set_layout, 1)?;
+        let vertices = Buffer::new(
+            device,
+            &BufferDesc {
+                name: "adaptive vertices",
+                size: gpu.vertex_bytes(),
+                // Storage: the stencil evaluator binds windows of it.
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER
+                    | vk::BufferUsageFlags::TRANSFER_DST
+                    | BY_ADDRESS,
+                location: MemoryLocation::GpuOnly,
+            },
+        )?;
+        let (param_errors, has_param_errors, param_error_summary) =
+            param_errors(mesh, plan, gpu, options)?;
+        let fvar_words = layout::fvar_words(fvar);
+        let statics = static_buffers(device, gpu, plan, mesh, &param_errors, &fvar_words, fvar)?;
+        let error_count = if has_param_errors {
+            param_errors.len() as u32
+        } else {
+            0
+        };
+        let fvar_count = u32::try_from(fvar_words.len()).map_err(|_| TessError::Mesh {
+            name: options.name.clone(),
+            source: format!(
+                "face-varying patches of {} words exceed the u32 the shaders index with",
+                fvar_words.len()
+            )
+            .into(),
+        })?;
+        let addresses = address_table(device, &vertices, &statics, error_count, fvar_count)?;
+        let textures = surface_textures(device, &options.maps)?;
+        let set = pool.allocate_set(set_layout)?;
+        set.write_buffer(
+            ADAPTIVE_ARRAYS_BINDING,
+            vk::DescriptorType::UNIFORM_BUFFER,
+            &addresses,
+        )?;
+        set.write_texture(ADAPTIVE_TEXTURE_BINDING, &textures[0])?;
+        set.write_texture(ADAPTIVE_HEIGHT_BINDING, &textures[1])?;
+        Ok(Self {
+            vertices,
+            statics: statics.into_iter().chain([addresses]).collect(),
+            textures,
+            set,
+            pool,
+            has_param_errors,
+            param_error_summary,
+        })
+    }
+}
+
+/// The plan's compute work: the stencil evaluator of its levels and local points (in place in
+/// `vertices`) and the canonical-curve kernel.
+fn plan_kernels(
+    ctx: &Context,
+    id: TechniqueId,
+    gpu: &GpuPlan,
+    vertices: &Buffer,
+) -> Result<(StencilEvaluator, Pipeline)> {
+    let device = ctx.device();
+    let evaluator = StencilEvaluator::new(
+        device,
+        "adaptive",
+        &gpu.stencils,
+        &gpu.blocks,
+        StencilVertices {
+            sources: gpu.num_vertices,
+            destinations: gpu.num_vertices,
+            in_place: true,
+        },
+        &[(vertices, vertices)],
+    )?;
+    let canonical = compute_pipeline(
+        device,
+        "adaptive canonical points",
+        Stage::AdaptiveCanonicalComp,
+        &[ctx.frame_set_layout().raw, ctx.set_layout(id)?.raw],
+        std::mem::size_of::<AdaptivePush>(),
+    )?;
+    Ok((evaluator, canonical))
+}
+
 impl PlannedPatches {
     /// Uploads a plan, drawn as technique `id`, with one base-position buffer per frame slot
     /// of `ctx`, and the face-varying patches `fvar` made for it ([`fvar_patches`]).
@@ -573,78 +682,12 @@ impl PlannedPatches {
             source: e.into(),
         })?;
         ctx.ensure_set_layout(id, &SET_BINDINGS)?;
-        let set_layout = ctx.set_layout(id)?;
         let max_groups = device.info.caps.max_compute_work_group_count[0];
         let steps = plan_canonical(&gpu, max_groups.saturating_mul(ADAPTIVE_LOCAL_SIZE));
-        let pool = DescriptorPool::new(&device, "adaptive descriptor pool", set_layout, 1)?;
-        let vertices = Buffer::new(
-            &device,
-            &BufferDesc {
-                name: "adaptive vertices",
-                size: gpu.vertex_bytes(),
-                // Storage: the stencil evaluator binds windows of it.
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER
-                    | vk::BufferUsageFlags::TRANSFER_DST
-                    | BY_ADDRESS,
-                location: MemoryLocation::GpuOnly,
-            },
-        )?;
-        let (param_errors, has_param_errors, param_error_summary) =
-            param_errors(mesh, &plan, &gpu, options)?;
-        let fvar_words = layout::fvar_words(fvar.as_ref());
-        let statics = static_buffers(
-            &device,
-            &gpu,
-            &plan,
-            mesh,
-            &param_errors,
-            &fvar_words,
-            fvar.as_ref(),
-        )?;
-        let error_count = if has_param_errors {
-            param_errors.len() as u32
-        } else {
-            0
-        };
-        let fvar_count = u32::try_from(fvar_words.len()).map_err(|_| TessError::Mesh {
-            name: options.name.clone(),
-            source: format!(
-                "face-varying patches of {} words exceed the u32 the shaders index with",
-                fvar_words.len()
-            )
-            .into(),
-        })?;
-        let addresses = address_table(&device, &vertices, &statics, error_count, fvar_count)?;
-        let textures = surface_textures(&device, &options.maps)?;
+        let a = PlanArrays::new(ctx, id, mesh, &plan, &gpu, fvar.as_ref(), options)?;
+        let (evaluator, canonical) = plan_kernels(ctx, id, &gpu, &a.vertices)?;
         let base_positions = base_positions(mesh);
         let base = base_buffers(&device, ctx.frames_in_flight(), &base_positions)?;
-        let set = pool.allocate_set(set_layout)?;
-        set.write_buffer(
-            ADAPTIVE_ARRAYS_BINDING,
-            vk::DescriptorType::UNIFORM_BUFFER,
-            &addresses,
-        )?;
-        set.write_texture(ADAPTIVE_TEXTURE_BINDING, &textures[0])?;
-        set.write_texture(ADAPTIVE_HEIGHT_BINDING, &textures[1])?;
-        let evaluator = StencilEvaluator::new(
-            &device,
-            "adaptive",
-            &gpu.stencils,
-            &gpu.blocks,
-            StencilVertices {
-                sources: gpu.num_vertices,
-                destinations: gpu.num_vertices,
-                in_place: true,
-            },
-            &[(&vertices, &vertices)],
-        )?;
-        let canonical = compute_pipeline(
-            &device,
-            "adaptive canonical points",
-            Stage::AdaptiveCanonicalComp,
-            &[ctx.frame_set_layout().raw, set_layout.raw],
-            std::mem::size_of::<AdaptivePush>(),
-        )?;
         let arrays = patch_arrays(&gpu, options.path);
         let edge_kinds = edge_kind_counts(&arrays, &gpu);
         let patterns = match options.path {
@@ -661,13 +704,13 @@ impl PlannedPatches {
             id,
             evaluator,
             canonical,
-            set,
+            set: a.set,
             steps,
-            _pool: pool,
+            _pool: a.pool,
             base,
-            vertices,
-            _static: statics.into_iter().chain([addresses]).collect(),
-            _textures: textures,
+            vertices: a.vertices,
+            _static: a.statics,
+            _textures: a.textures,
             arrays,
             edge_kinds,
             patterns,
@@ -679,8 +722,8 @@ impl PlannedPatches {
             base_positions,
             options: options.clone(),
             max_level,
-            has_param_errors,
-            param_error_summary,
+            has_param_errors: a.has_param_errors,
+            param_error_summary: a.param_error_summary,
             fvar,
         })
     }
