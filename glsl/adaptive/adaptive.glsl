@@ -144,25 +144,37 @@ vec3 edge_point(AdaptivePatch p, uint e, float t) {
 // The canonical boundary point of patch edge e at parameter t (as above) with the edge's
 // tessellation level n: integer levels name the vertex k = round(t n) and both sides evaluate
 // k / n on the curve in its own direction; fractional levels mirror t exactly (1 - t is exact
-// for tess coordinates).
-vec3 canonical_edge_point(AdaptivePatch p, uint e, float t, float n, bool integer_level, out uint curve, out float s) {
+// for tess coordinates). `morph` is the edge's geomorph weight (1: none; the pattern path's
+// fractional-even spacing): an odd vertex k, counted in the curve's direction, slides toward
+// k - 1 by 1 - morph, to the even vertex the level below keeps, so both sides slide it alike.
+// `at` is the point as a parameter along the patch's own edge.
+vec3 canonical_edge_point(AdaptivePatch p, uint e, float t, float n, bool integer_level, float morph, out uint curve, out float s, out float at) {
     uint kind = edge_kind(p, e);
+    at = t;
     if (!integer_level) {
         bool rev = edge_reversed(p, e, 0u);
         curve = p.curves[2u * e];
         s = rev ? 1.0 - t : t;
         return curve_point(curve, s);
     }
-    uint k = uint(round(t * n));
+    uint own = uint(round(t * n));
+    uint k = own;
     uint segs = uint(round(n));
     uint h = 0u;
     if (kind == ADAPTIVE_EDGE_COARSE) {
         segs /= 2u;
         if (k > segs) { h = 1u; k -= segs; }
     }
-    if (edge_reversed(p, e, h)) k = segs - k;
+    bool rev = edge_reversed(p, e, h);
+    if (rev) k = segs - k;
     curve = p.curves[2u * e + h];
-    s = float(k) / float(segs);
+    float kf = float(k);
+    if (morph < 1.0 && (k & 1u) == 1u) {
+        float d = 1.0 - morph;
+        kf -= d;
+        at = (float(own) + (rev ? d : -d)) / n;
+    }
+    s = kf / float(segs);
     return curve_point(curve, s);
 }
 

@@ -40,8 +40,6 @@ void main() {
     pattern_begin();
 #endif
     vec2 uv = TESS_COORD.xy;
-    vec3 pos, du, dv;
-    evaluate(tc_patch, uv, pos, du, dv);
 #ifdef TRIANGLE_DOMAIN
     // TESS_COORD = (u, v, 1 - u - v): the weights of patch corners 1, 2, 0.
     float w0 = TESS_COORD.z;
@@ -79,10 +77,29 @@ void main() {
         e = 3u; t = 1.0 - uv.y; tess_level = OUTER_LEVEL(0);
     }
 #endif
+    // Geomorphing on the pattern path (pattern_patch.glsl) moves the point evaluated: a
+    // boundary point along its canonical curve, an interior point inside the domain.
+    float morph = 1.0;
+#ifdef PATTERN_PATH
+    bool morphing = geomorphing();
+    if (morphing && canonical) morph = edge_morph(e);
+    if (morphing && !canonical) uv = morph_inside(uv);
+#endif
+    vec3 edge_pos = vec3(0.0);
     if (canonical) {
         bool integer_level = !fractional_factors() || edge_kind(p, e) != ADAPTIVE_EDGE_PLAIN;
-        pos = canonical_edge_point(p, e, t, tess_level, integer_level, curve, s);
+        float at;
+        edge_pos = canonical_edge_point(p, e, t, tess_level, integer_level, morph, curve, s, at);
+#ifdef PATTERN_PATH
+        if (morph < 1.0) uv = edge_domain_point(e, at);
+#endif
     }
+#ifdef PATTERN_PATH
+    tc_at = uv;
+#endif
+    vec3 pos, du, dv;
+    evaluate(tc_patch, uv, pos, du, dv);
+    if (canonical) pos = edge_pos;
     vec3 n = safe_normalize(cross(du, dv), vec3(0.0, 0.0, 1.0));
 #ifdef PATCH_SHADING_NORMAL
     n = patch_shading_normal(tc_patch, uv, n);

@@ -571,6 +571,9 @@ pub struct PatternKey {
     pub spacing: Spacing,
     outer_bits: [u32; 4],
     inner_bits: [u32; 2],
+    /// Always the generated patterns, never the tessellator's: their lattices nest from level
+    /// to level (each cell split along the same diagonal), which geomorphing needs.
+    pub generated: bool,
 }
 
 impl PatternKey {
@@ -590,6 +593,15 @@ impl PatternKey {
             spacing,
             outer_bits: outer.map(f32::to_bits),
             inner_bits: inner.map(f32::to_bits),
+            generated: false,
+        }
+    }
+
+    /// The same levels, from the generated patterns only (see the field).
+    pub fn generated(self) -> Self {
+        Self {
+            generated: true,
+            ..self
         }
     }
 
@@ -670,9 +682,10 @@ pub fn from_tessellator(device: &vk_core::Device) -> bool {
         && device.require_transform_feedback().is_ok()
 }
 
-/// Makes the pattern of `key` on `ctx`'s device. A uniform key: the tessellator's own where
-/// [`from_tessellator`] and the level is within its 64 (one flat patch over the unit domain,
-/// drawn through the tessellator and captured), otherwise generated, in equal spacing only.
+/// Makes the pattern of `key` on `ctx`'s device. A uniform key: generated where the key asks
+/// for it ([`PatternKey::generated`]), else the tessellator's own where [`from_tessellator`]
+/// and the level is within its 64 (one flat patch over the unit domain, drawn through the
+/// tessellator and captured), otherwise generated, in equal spacing only.
 /// A key with unequal levels (a transition patch's) is generated
 /// ([`RefinementPattern::generate_edges`]): its points lie where the tessellator's would, on
 /// each edge and inside, so shared edges meet; the triangulation is the pattern's own.
@@ -680,6 +693,9 @@ pub fn make(ctx: &mut Context, key: PatternKey) -> Result<RefinementPattern> {
     let Some(level) = key.uniform_level() else {
         return generate_for_edges(ctx, key);
     };
+    if key.generated && key.spacing == Spacing::Equal {
+        return RefinementPattern::generate(key.domain, generated_segments(level));
+    }
     if from_tessellator(ctx.device()) && level <= crate::tessellator::MAX_LEVEL {
         return tessellator_pattern(ctx, key.domain, key.spacing, level);
     }

@@ -1221,6 +1221,19 @@ fn the_draw_path_options_draw_or_name_what_is_wrong() {
             ],
             "pattern path",
         ),
+        (
+            vec![
+                "--method",
+                "adaptive",
+                "--pipeline",
+                "pattern",
+                "--factors",
+                "screen",
+                "--spacing",
+                "fractional-even",
+            ],
+            "pattern path",
+        ),
     ] {
         let mut all = vec!["render", "--size", "96x72", "-o", png];
         all.extend(args);
@@ -1241,7 +1254,7 @@ fn the_draw_path_options_draw_or_name_what_is_wrong() {
     fails(
         &render(&[
             "--method",
-            "adaptive",
+            "bft",
             "--pipeline",
             "pattern",
             "--spacing",

@@ -194,6 +194,10 @@ gpu_constants! {
     /// (displaced or not), so both sides of every edge emit the same normal bits (single-pass
     /// methods: their patches are not G1 across transitions and fallbacks).
     ADAPTIVE_OPTION_CANONICAL_NORMALS = 512;
+    /// `options` bit, refinement-pattern path: geomorphing between power-of-two levels (fractional-even
+    /// spacing there). Each odd pattern vertex slides toward the even one the coarser level
+    /// keeps, by its edge's or the inside's morph weight (the instance's, `pattern_patch.glsl`).
+    ADAPTIVE_OPTION_GEOMORPH = 1024;
     /// Capture flags of the adaptive TES: patch kind in bits 0..3, level above.
     ADAPTIVE_FLAG_LEVEL_SHIFT = 4;
     /// Capture flag: the point lies on a patch boundary and came from its canonical curve.

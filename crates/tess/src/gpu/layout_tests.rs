@@ -1051,7 +1051,7 @@ fn check(stage: Stage, v: Variant, check: &Check) -> Result<(), String> {
                 .find(|a| a.location == location)
                 .ok_or_else(|| format!("{name}: location {location} has no vertex attribute"))?;
             let size = match attr.format {
-                vk::Format::R32G32B32A32_SFLOAT => 16,
+                vk::Format::R32G32B32A32_SFLOAT | vk::Format::R32G32B32A32_UINT => 16,
                 vk::Format::R32_UINT => 4,
                 _ => 12,
             };

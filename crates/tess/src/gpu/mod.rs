@@ -470,7 +470,7 @@ pub mod pattern_input {
         TRIANGLE_BINDINGS[0],
         vk::VertexInputBindingDescription {
             binding: 1,
-            stride: size_of::<u32>() as u32,
+            stride: size_of::<[u32; 4]>() as u32,
             input_rate: vk::VertexInputRate::INSTANCE,
         },
     ];
@@ -479,15 +479,16 @@ pub mod pattern_input {
         vk::VertexInputAttributeDescription {
             location: 1,
             binding: 1,
-            format: vk::Format::R32_UINT,
+            format: vk::Format::R32G32B32A32_UINT,
             offset: 0,
         },
     ];
 
     /// The pattern's domain points (location 0) and, per instance at binding 1, the frame-wide
-    /// id of the patch drawn (location 1, `u32`): techniques whose instances are not their
-    /// patches in order (the planned patches draw one pattern per edge-level key, each over its
-    /// own list of patches; `glsl/adaptive/pattern_patch.glsl`).
+    /// id of the patch drawn and its morph weights (location 1, `uvec4`: the id, then edges
+    /// 0, 1, then 2, 3, then the inside's two directions as unorm16 pairs): techniques whose
+    /// instances are not their patches in order (the planned patches draw one pattern per
+    /// edge-level key, each over its own list of patches; `glsl/adaptive/pattern_patch.glsl`).
     pub const PATCH_IDS: VertexInput = VertexInput {
         bindings: &PATCH_ID_BINDINGS,
         attributes: &PATCH_ID_ATTRIBUTES,

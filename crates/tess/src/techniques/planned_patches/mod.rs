@@ -49,7 +49,7 @@ use crate::error::{Param, ParamError, Result, TessError};
 use crate::gpu::bindings::{
     ADAPTIVE_ARRAYS_BINDING, ADAPTIVE_CANONICAL_MODE_CORNERS, ADAPTIVE_CANONICAL_MODE_CURVES,
     ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_PLAIN, ADAPTIVE_LOCAL_SIZE, ADAPTIVE_OPTION_FRACTIONAL,
-    ADAPTIVE_OPTION_PATCH_COLOURS, ADAPTIVE_OPTION_POW2,
+    ADAPTIVE_OPTION_GEOMORPH, ADAPTIVE_OPTION_PATCH_COLOURS, ADAPTIVE_OPTION_POW2,
 };
 use crate::gpu::bindings::{
     ADAPTIVE_HEIGHT_BINDING, ADAPTIVE_OPTION_CANONICAL_NORMALS, ADAPTIVE_OPTION_DISPLACE,
@@ -500,6 +500,11 @@ fn uniform_edge_level(lim: f32, segments: f32, spacing: Spacing, kind: u32) -> f
     }
 }
 
+/// Whether a frame of `params` on the pattern path geomorphs (fractional-even spacing there).
+fn geomorphing(params: &FrameParams) -> bool {
+    params.spacing == Spacing::FractionalEven
+}
+
 /// The base positions a host copy of the plan's vertices was computed from, and those vertices.
 type HostVertices = (Vec<[f32; 3]>, Vec<[f64; 3]>);
 
@@ -791,7 +796,10 @@ impl PlannedPatches {
         if self.options.single_pass {
             options |= ADAPTIVE_OPTION_CANONICAL_NORMALS;
         }
-        if fractional {
+        if fractional && self.patterns.is_some() {
+            // Patterns keep whole levels: their odd vertices morph instead.
+            options |= ADAPTIVE_OPTION_GEOMORPH;
+        } else if fractional {
             options |= ADAPTIVE_OPTION_FRACTIONAL;
         } else if adaptive {
             options |= ADAPTIVE_OPTION_POW2;
@@ -1031,14 +1039,27 @@ impl Technique for PlannedPatches {
                 what: "the param-error view on a surface built without its Eq. 1 error lattice (build with SurfaceMaps::param_error)",
             });
         }
-        check_frame(self.id, Some(self.factor_limit()), params)?;
-        // The pattern path's stitched patterns are equal spacing.
-        if self.patterns.is_some() && params.spacing != Spacing::Equal {
-            return Err(TessError::PatternSpacing {
-                spacing: params.spacing,
-            });
+        // On the pattern path fractional-even spacing is geomorphing between power-of-two
+        // levels (`patterns` module docs, step 5), which takes any uniform level in range, not
+        // only whole ones; `check_frame` refuses fractional-odd.
+        match params.factors {
+            FactorPolicy::Uniform { segments }
+                if self.patterns.is_some() && geomorphing(params) =>
+            {
+                let whole = FrameParams {
+                    factors: FactorPolicy::Uniform {
+                        segments: if segments.is_finite() {
+                            segments.ceil()
+                        } else {
+                            segments
+                        },
+                    },
+                    ..*params
+                };
+                check_frame(self.id, Some(self.factor_limit()), &whole)
+            }
+            _ => check_frame(self.id, Some(self.factor_limit()), params),
         }
-        Ok(())
     }
 
     fn patch_pipeline(&self, patch: PatchType) -> PatchPipeline {
@@ -1177,7 +1198,8 @@ impl Technique for PlannedPatches {
         if self.patterns.is_none() {
             return Ok(());
         }
-        if matches!(params.factors, FactorPolicy::Uniform { .. }) {
+        let morph = geomorphing(params);
+        if matches!(params.factors, FactorPolicy::Uniform { .. }) && !morph {
             let keys = self.pattern_keys(params);
             return match &mut self.patterns {
                 Some(p) => p.prepare(ctx, &keys),
@@ -1187,8 +1209,13 @@ impl Technique for PlannedPatches {
         let view = *ctx
             .frame_view()
             .ok_or(TessError::NoFrameView { technique: self.id })?;
-        let (mode, _, pixels, reference) = factor_fields(params.factors);
-        let host = HostView::new(&view, mode, pixels, reference, self.factor_limit());
+        let (mode, segments, pixels, reference) = factor_fields(params.factors);
+        let field = match params.factors {
+            FactorPolicy::Uniform { .. } => segments,
+            FactorPolicy::Screen { .. } => pixels,
+            FactorPolicy::Distance { .. } => reference,
+        };
+        let host = HostView::new(&view, mode, field, self.factor_limit(), morph);
         self.update_host_vertices();
         let vertices = self
             .host_vertices
@@ -1200,7 +1227,10 @@ impl Technique for PlannedPatches {
             let domain = arrays.get(array).map_or(Domain::Quad, |a| a.patch.domain());
             match gpu.patches.get(id as usize) {
                 Some(p) => host.key(domain, p, &factors),
-                None => crate::pattern::PatternKey::new(domain, Spacing::Equal, 1.0),
+                None => (
+                    crate::pattern::PatternKey::new(domain, Spacing::Equal, 1.0),
+                    patterns::NO_MORPH,
+                ),
             }
         };
         match &mut self.patterns {

@@ -25,8 +25,19 @@
 //!    by the edge levels, made on first use) and their ids written into the command buffer
 //!    ahead of the draws. The curve points come from the plan on the host (`AdaptivePlan::apply`,
 //!    again only when the base moves), one frame's worth of stencils in `f64`.
+//! 5. **Geomorphing (fractional-even spacing, per frame on the host too):** the levels stay
+//!    powers of two, always from the generated patterns (their lattices nest level to level),
+//!    and each patch instance carries morph weights: each edge's from its curve factor `g`
+//!    and level `L` (`(g − L/2) / (L/2)`, the same on both sides of the edge), and the inside's
+//!    from the facing edges that set each inner level. The vertex stage slides every odd
+//!    vertex toward the even one the half level keeps by `1 − weight` and evaluates the patch
+//!    there (`glsl/adaptive/pattern_patch.glsl`); a boundary vertex slides along its canonical
+//!    curve, counted in the curve's direction, so both sides slide it to the same bits. Just
+//!    past a doubling the surface is the half level's; uniform levels need not be whole.
 use crate::error::{Result, TessError};
-use crate::gpu::bindings::{ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_PLAIN, BFT_FACTORS_SCREEN};
+use crate::gpu::bindings::{
+    ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_PLAIN, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM,
+};
 use crate::gpu::{AdaptivePush, FrameUniforms};
 use crate::pattern::{PatternBuffers, PatternKey};
 use crate::technique::{DrawCounts, PatchArray};
@@ -62,8 +73,8 @@ pub(super) struct PatternDraws {
 
 /// One frame's patches grouped by the keys the host chose for them.
 struct FrameGroups {
-    /// Frame-wide patch ids, per array, per key.
-    ids: Vec<u32>,
+    /// Frame-wide patch ids and their morph weights, per array, per key.
+    ids: Vec<[u32; 4]>,
     /// Per array, each key and its run of `ids`.
     groups: Vec<Vec<(PatternKey, Range<u32>)>>,
 }
@@ -74,34 +85,54 @@ pub(super) struct HostView {
     pub view_proj: glam::Mat4,
     pub viewport: [f32; 2],
     pub eye: glam::Vec3,
-    /// `BFT_FACTORS_SCREEN` or `BFT_FACTORS_DISTANCE`.
+    /// `BFT_FACTORS_SCREEN`, `BFT_FACTORS_DISTANCE` or `BFT_FACTORS_UNIFORM`.
     pub mode: u32,
-    pub pixels: f32,
-    pub reference: f32,
+    /// The policy's field: segments, pixels per segment or reference distance.
+    pub field: f32,
     pub max_level: f32,
+    /// Geomorphing: each edge gets the weight of its level (step 5 of the module docs).
+    pub morph: bool,
+}
+
+/// A patch's morph weights as the instance carries them: unorm16 pairs (edges 0 and 1, edges 2
+/// and 3, the inside along u and v); all 1 (no morph) without geomorphing.
+pub(super) type MorphWords = [u32; 3];
+
+/// Morph weights of 1 everywhere: each vertex where its pattern puts it.
+pub(super) const NO_MORPH: MorphWords = [u32::MAX; 3];
+
+/// The weight of a level-`level` edge whose continuous factor is `g`: 0 where `g` is half the
+/// level (the odd vertices lie on the coarser level's), 1 at the level itself.
+fn morph_weight(g: f32, level: f32) -> f32 {
+    if level <= 1.0 {
+        return 1.0;
+    }
+    ((g - 0.5 * level) / (0.5 * level)).clamp(0.0, 1.0)
+}
+
+fn unorm16_pair(a: f32, b: f32) -> u32 {
+    let q = |x: f32| (x.clamp(0.0, 1.0) * 65535.0).round() as u32;
+    q(a) | (q(b) << 16)
 }
 
 impl HostView {
-    pub fn new(
-        view: &FrameUniforms,
-        mode: u32,
-        pixels: f32,
-        reference: f32,
-        max_level: f32,
-    ) -> Self {
+    pub fn new(view: &FrameUniforms, mode: u32, field: f32, max_level: f32, morph: bool) -> Self {
         Self {
             view_proj: glam::Mat4::from_cols_array_2d(&view.view_proj),
             viewport: [view.viewport[0], view.viewport[1]],
             eye: glam::Vec3::new(view.camera_pos[0], view.camera_pos[1], view.camera_pos[2]),
             mode,
-            pixels,
-            reference,
+            field,
             max_level,
+            morph,
         }
     }
 
     /// The factor a curve of control points `p` asks for (`curve_factor`).
     fn curve_factor(&self, p: [glam::Vec3; 4]) -> f32 {
+        if self.mode == BFT_FACTORS_UNIFORM {
+            return self.field;
+        }
         if self.mode == BFT_FACTORS_SCREEN {
             let c = p.map(|q| self.view_proj * q.extend(1.0));
             if c.iter().map(|c| c.w).fold(f32::INFINITY, f32::min) <= 1e-6 {
@@ -109,10 +140,10 @@ impl HostView {
             }
             let h = glam::Vec2::from(self.viewport) * 0.5;
             let s = c.map(|c| glam::Vec2::new(c.x, c.y) / c.w * h);
-            return (s[0].distance(s[1]) + s[1].distance(s[2]) + s[2].distance(s[3])) / self.pixels;
+            return (s[0].distance(s[1]) + s[1].distance(s[2]) + s[2].distance(s[3])) / self.field;
         }
         let d = self.eye.distance(0.5 * (p[0] + p[3]));
-        self.max_level * self.reference / d.max(1e-6)
+        self.max_level * self.field / d.max(1e-6)
     }
 
     /// Every canonical curve's factor, from the plan's vertices `verts`.
@@ -129,8 +160,9 @@ impl HostView {
 
     /// The level of edge `e` of patch `p` (`edge_level` with power-of-two levels, equal
     /// spacing): a plain edge its curve's, a transition edge the larger of its halves', doubled
-    /// on the coarse side.
-    fn edge_level(&self, p: &PatchRecord, e: usize, factors: &[f32]) -> f32 {
+    /// on the coarse side; and its morph weight (both sides of an edge compute it from the same
+    /// curves, so they agree).
+    fn edge_level(&self, p: &PatchRecord, e: usize, factors: &[f32]) -> (f32, f32) {
         let kind = (p.edge_info >> (4 * e)) & 3;
         let factor = |h: usize| {
             factors
@@ -139,25 +171,57 @@ impl HostView {
                 .unwrap_or(1.0)
         };
         let pow2 = |f: f32| (f.log2() - 1e-4).ceil().exp2();
+        let weight = |g: f32, level: f32| match self.morph {
+            true => morph_weight(g, level),
+            false => 1.0,
+        };
         let lim = self.max_level;
         if kind == ADAPTIVE_EDGE_PLAIN {
-            return pow2(factor(0).clamp(1.0, lim)).ceil().min(lim);
+            let g = factor(0).clamp(1.0, lim);
+            let level = pow2(g).ceil().min(lim);
+            return (level, weight(g, level));
         }
         let half = (lim * 0.5).floor();
-        let f = pow2(factor(0).max(factor(1)).clamp(1.0, half))
-            .ceil()
-            .min(half);
-        if kind == ADAPTIVE_EDGE_COARSE {
+        let g = factor(0).max(factor(1)).clamp(1.0, half);
+        let f = pow2(g).ceil().min(half);
+        let level = if kind == ADAPTIVE_EDGE_COARSE {
             2.0 * f
         } else {
             f
-        }
+        };
+        (level, weight(g, f))
     }
 
-    /// The key of patch `p` on `domain`.
-    pub fn key(&self, domain: Domain, p: &PatchRecord, factors: &[f32]) -> PatternKey {
-        let e = |i: usize| self.edge_level(p, i, factors);
-        key_of_levels(domain, Spacing::Equal, [e(0), e(1), e(2), e(3)])
+    /// The key of patch `p` on `domain`, and its morph weights: each edge's, and the inside's
+    /// from the edge that sets each inner level (the larger continuous factor of the facing
+    /// edges, `level / 2 · (1 + weight)`).
+    pub fn key(
+        &self,
+        domain: Domain,
+        p: &PatchRecord,
+        factors: &[f32],
+    ) -> (PatternKey, MorphWords) {
+        let e: [(f32, f32); 4] = std::array::from_fn(|i| self.edge_level(p, i, factors));
+        let key = key_of_levels(domain, Spacing::Equal, e.map(|(l, _)| l));
+        if !self.morph {
+            return (key, NO_MORPH);
+        }
+        let continuous = |(l, w): (f32, f32)| if l <= 1.0 { 1.0 } else { 0.5 * l * (1.0 + w) };
+        let inner = |edges: &[usize]| {
+            let level = edges.iter().map(|&i| e[i].0).fold(0.0, f32::max);
+            let g = edges.iter().map(|&i| continuous(e[i])).fold(0.0, f32::max);
+            morph_weight(g, level)
+        };
+        let (iu, iv) = match domain {
+            Domain::Quad => (inner(&[0, 2]), inner(&[1, 3])),
+            Domain::Triangle => (inner(&[0, 1, 2]), 1.0),
+        };
+        let words = [
+            unorm16_pair(e[0].1, e[1].1),
+            unorm16_pair(e[2].1, e[3].1),
+            unorm16_pair(iu, iv),
+        ];
+        (key.generated(), words)
     }
 }
 
@@ -194,7 +258,7 @@ pub(super) fn key_of_levels(domain: Domain, spacing: Spacing, levels: [f32; 4]) 
 impl PatternDraws {
     /// Groups every array's patches by their edge kinds and uploads their ids.
     pub fn new(device: &vk_core::Device, arrays: &[PatchArray], gpu: &GpuPlan) -> Result<Self> {
-        let mut ids: Vec<u32> = Vec::with_capacity(gpu.patches.len());
+        let mut ids: Vec<[u32; 4]> = Vec::with_capacity(gpu.patches.len());
         let mut groups = Vec::with_capacity(arrays.len());
         for a in arrays {
             let mut by_kinds: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
@@ -212,7 +276,8 @@ impl PatternDraws {
             let mut array_groups = Vec::with_capacity(by_kinds.len());
             for (kinds, members) in by_kinds {
                 let first = ids.len() as u32;
-                ids.extend(members);
+                let [a, b, c] = NO_MORPH;
+                ids.extend(members.into_iter().map(|id| [id, a, b, c]));
                 array_groups.push(PatternGroup {
                     kinds,
                     instances: first..ids.len() as u32,
@@ -222,13 +287,13 @@ impl PatternDraws {
         }
         // An empty plan still binds a buffer (zero-length buffers are invalid); no draw reads it.
         if ids.is_empty() {
-            ids.push(0);
+            ids.push([0; 4]);
         }
         let frame_ids = Buffer::new(
             device,
             &vk_core::BufferDesc {
                 name: "adaptive pattern patch ids (host-chosen levels)",
-                size: 4 * ids.len() as u64,
+                size: 16 * ids.len() as u64,
                 usage: vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
                 location: vk_core::MemoryLocation::GpuOnly,
             },
@@ -247,23 +312,25 @@ impl PatternDraws {
         })
     }
 
-    /// Groups the patches of every array by the key `key_of(id)` the host chose for the frame
-    /// and takes their patterns from the context ([`Self::record_ids`] writes the ids).
+    /// Groups the patches of every array by the key `key_of(array, id)` the host chose for the
+    /// frame (with each patch's morph weights) and takes their patterns from the context
+    /// ([`Self::record_ids`] writes the ids).
     pub fn prepare_host_levels(
         &mut self,
         ctx: &mut crate::context::Context,
         arrays: &[PatchArray],
-        key_of: &dyn Fn(usize, u32) -> PatternKey,
+        key_of: &dyn Fn(usize, u32) -> (PatternKey, MorphWords),
     ) -> Result<()> {
         let mut ids = Vec::new();
         let mut groups = Vec::with_capacity(arrays.len());
         for (i, a) in arrays.iter().enumerate() {
-            let mut by_key: HashMap<PatternKey, Vec<u32>> = HashMap::new();
+            let mut by_key: HashMap<PatternKey, Vec<[u32; 4]>> = HashMap::new();
             for id in a.first_patch..a.first_patch + a.patches {
-                by_key.entry(key_of(i, id)).or_default().push(id);
+                let (key, [m0, m1, m2]) = key_of(i, id);
+                by_key.entry(key).or_default().push([id, m0, m1, m2]);
             }
-            let mut keyed: Vec<(PatternKey, Vec<u32>)> = by_key.into_iter().collect();
-            keyed.sort_by_key(|(_, members)| members[0]);
+            let mut keyed: Vec<(PatternKey, Vec<[u32; 4]>)> = by_key.into_iter().collect();
+            keyed.sort_by_key(|(_, members)| members[0][0]);
             let mut array_groups = Vec::with_capacity(keyed.len());
             for (key, members) in keyed {
                 let first = ids.len() as u32;
