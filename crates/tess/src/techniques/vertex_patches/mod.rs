@@ -250,6 +250,8 @@ fn check_indices(layout: &PatchesLayout) -> Result<()> {
 }
 
 impl DepthMesh {
+    /// Uploads one depth's layout: the point arrays, the first step's stencils, the tables and
+    /// step records the kernel reads, its dispatches, and the triangles' indices.
     fn new(
         device: &Device,
         set_layout: &DescriptorSetLayout,
@@ -278,30 +280,12 @@ impl DepthMesh {
             },
             &[(&points, &points)],
         )?;
-        let table = |name: &str, bytes: &[u8]| Buffer::with_data(device, name, BY_ADDRESS, bytes);
-        let mut tables = vec![
-            table("vertex-patches flags", bytemuck::cast_slice(&layout.flags))?,
-            table(
-                "vertex-patches corner sizes",
-                bytemuck::cast_slice(&layout.sizes),
-            )?,
-            table(
-                "vertex-patches weights",
-                bytemuck::cast_slice(&layout.weights),
-            )?,
-            table(
-                "vertex-patches weight starts",
-                bytemuck::cast_slice(&layout.weight_starts),
-            )?,
-            table(
-                "vertex-patches corners",
-                bytemuck::cast_slice(&layout.corners),
-            )?,
-        ];
+        let mut tables = kernel_tables(device, &layout)?;
+        let (dispatches, records) = step_dispatches(device, &layout, &points, &tables)?;
+        tables.extend(records);
         let vec4 = size_of::<StencilVertex>() as u64;
-        let base_address = points.device_address()?;
         let arrays = VertexPatchArrays {
-            points: base_address + *layout.regions.last().unwrap_or(&0) as u64 * vec4,
+            points: points.device_address()? + *layout.regions.last().unwrap_or(&0) as u64 * vec4,
             corners: tables[4].device_address()?,
         };
         let addresses = Buffer::with_data(
@@ -310,35 +294,6 @@ impl DepthMesh {
             vk::BufferUsageFlags::UNIFORM_BUFFER,
             bytemuck::bytes_of(&arrays),
         )?;
-        let max_items =
-            device.info.caps.max_compute_work_group_count[0] * VERTEX_PATCHES_LOCAL_SIZE;
-        let mut dispatches = Vec::new();
-        for (d, (records, items)) in (1..).zip(&layout.steps) {
-            let records_buffer = table("vertex-patches records", bytemuck::cast_slice(records))?;
-            let push = VertexPatchStep {
-                points: base_address,
-                flags: tables[0].device_address()?,
-                records: records_buffer.device_address()?,
-                sizes: tables[1].device_address()?,
-                weights: tables[2].device_address()?,
-                weight_starts: tables[3].device_address()?,
-                patch_count: records.len() as u32,
-                items: *items,
-                first_item: 0,
-                depth: d,
-            };
-            for first in (0..*items).step_by(max_items.max(1) as usize) {
-                let count = (items - first).min(max_items);
-                dispatches.push((
-                    VertexPatchStep {
-                        first_item: first,
-                        ..push
-                    },
-                    count.div_ceil(VERTEX_PATCHES_LOCAL_SIZE),
-                ));
-            }
-            tables.push(records_buffer);
-        }
         let indices = Buffer::with_data(
             device,
             "vertex-patches indices",
@@ -365,6 +320,75 @@ impl DepthMesh {
             face_points: std::sync::OnceLock::new(),
         })
     }
+}
+
+/// The kernel's read-only tables, in this order: point flags, corner sizes, weights, weight
+/// starts, the deepest depth's corners.
+fn kernel_tables(device: &Device, layout: &PatchesLayout) -> Result<Vec<Buffer>> {
+    let table = |name: &str, bytes: &[u8]| Buffer::with_data(device, name, BY_ADDRESS, bytes);
+    Ok(vec![
+        table("vertex-patches flags", bytemuck::cast_slice(&layout.flags))?,
+        table(
+            "vertex-patches corner sizes",
+            bytemuck::cast_slice(&layout.sizes),
+        )?,
+        table(
+            "vertex-patches weights",
+            bytemuck::cast_slice(&layout.weights),
+        )?,
+        table(
+            "vertex-patches weight starts",
+            bytemuck::cast_slice(&layout.weight_starts),
+        )?,
+        table(
+            "vertex-patches corners",
+            bytemuck::cast_slice(&layout.corners),
+        )?,
+    ])
+}
+
+/// Each refinement step's records and the kernel's dispatches over them, split where a step
+/// has more items than one dispatch's groups reach.
+fn step_dispatches(
+    device: &Device,
+    layout: &PatchesLayout,
+    points: &Buffer,
+    tables: &[Buffer],
+) -> Result<(Vec<(VertexPatchStep, u32)>, Vec<Buffer>)> {
+    let max_items = device.info.caps.max_compute_work_group_count[0] * VERTEX_PATCHES_LOCAL_SIZE;
+    let (mut dispatches, mut buffers) = (Vec::new(), Vec::new());
+    for (d, (records, items)) in (1..).zip(&layout.steps) {
+        let records_buffer = Buffer::with_data(
+            device,
+            "vertex-patches records",
+            BY_ADDRESS,
+            bytemuck::cast_slice(records),
+        )?;
+        let push = VertexPatchStep {
+            points: points.device_address()?,
+            flags: tables[0].device_address()?,
+            records: records_buffer.device_address()?,
+            sizes: tables[1].device_address()?,
+            weights: tables[2].device_address()?,
+            weight_starts: tables[3].device_address()?,
+            patch_count: records.len() as u32,
+            items: *items,
+            first_item: 0,
+            depth: d,
+        };
+        for first in (0..*items).step_by(max_items.max(1) as usize) {
+            let count = (items - first).min(max_items);
+            dispatches.push((
+                VertexPatchStep {
+                    first_item: first,
+                    ..push
+                },
+                count.div_ceil(VERTEX_PATCHES_LOCAL_SIZE),
+            ));
+        }
+        buffers.push(records_buffer);
+    }
+    Ok((dispatches, buffers))
 }
 
 /// A host-visible buffer of `positions` as the evaluator's vertices, the copy source of frame
