@@ -134,7 +134,7 @@ struct DepthMesh {
     /// one record buffer per step.
     tables: Vec<Buffer>,
     /// The push constants of each step's dispatches (one per chunk of work items).
-    dispatches: Vec<(VertexPatchStep, u32)>,
+    dispatches: Vec<Dispatch>,
     indices: Buffer,
     face_points: std::sync::OnceLock<Vec<Option<FacePoint>>>,
 }
@@ -322,6 +322,9 @@ impl DepthMesh {
     }
 }
 
+/// One dispatch of the refinement kernel: its push constants and its group count.
+type Dispatch = (VertexPatchStep, u32);
+
 /// The kernel's read-only tables, in this order: point flags, corner sizes, weights, weight
 /// starts, the deepest depth's corners.
 fn kernel_tables(device: &Device, layout: &PatchesLayout) -> Result<Vec<Buffer>> {
@@ -354,7 +357,7 @@ fn step_dispatches(
     layout: &PatchesLayout,
     points: &Buffer,
     tables: &[Buffer],
-) -> Result<(Vec<(VertexPatchStep, u32)>, Vec<Buffer>)> {
+) -> Result<(Vec<Dispatch>, Vec<Buffer>)> {
     let max_items = device.info.caps.max_compute_work_group_count[0] * VERTEX_PATCHES_LOCAL_SIZE;
     let (mut dispatches, mut buffers) = (Vec::new(), Vec::new());
     for (d, (records, items)) in (1..).zip(&layout.steps) {
