@@ -115,8 +115,41 @@ impl bench::BenchProgress for Progress {
     }
 }
 
-fn config(a: &BenchArgs) -> Result<BenchConfig> {
+/// `--methods` under `--scheme`: each method as render draws it for that scheme (Doo-Sabin's
+/// `adaptive` is its limit patches), a method of another scheme refused by name.
+fn scheme_methods(a: &BenchArgs) -> Result<Vec<String>> {
+    let Some(scheme) = &a.scheme else {
+        return Ok(a.methods.clone());
+    };
+    let wanted = crate::topo_cmds::parse_scheme(scheme)
+        .map_err(|e| anyhow::anyhow!("--scheme {scheme}: {e}"))?;
+    let mut methods = Vec::with_capacity(a.methods.len());
     for m in &a.methods {
+        let (name, path) = match m.split_once('@') {
+            Some((n, p)) => (n, format!("@{p}")),
+            None => (m.as_str(), String::new()),
+        };
+        let name = match (name, wanted) {
+            ("adaptive", topology::Scheme::DooSabin) => "doo-sabin-limit",
+            _ => name,
+        };
+        let mapped = format!("{name}{path}");
+        let (info, _) =
+            bench::parse_method(&mapped).map_err(|e| anyhow::anyhow!("--methods {m}: {e}"))?;
+        if info.scheme.is_some_and(|s| s != wanted) {
+            bail!(
+                "--scheme {scheme}: --methods {m} draws another scheme's limit surface (the \
+                 {scheme} rows: flat, phong, pn or a {scheme} method)"
+            );
+        }
+        methods.push(mapped);
+    }
+    Ok(methods)
+}
+
+fn config(a: &BenchArgs) -> Result<BenchConfig> {
+    let methods = scheme_methods(a)?;
+    for m in &methods {
         bench::parse_method(m).map_err(|e| anyhow::anyhow!("--methods {m}: {e}"))?;
     }
     if !(1..=8).contains(&a.isolation) {
@@ -134,7 +167,7 @@ fn config(a: &BenchArgs) -> Result<BenchConfig> {
             u32::MAX
         );
     }
-    if a.equal_triangles && !a.methods.iter().any(|m| m == "flat") {
+    if a.equal_triangles && !methods.iter().any(|m| m == "flat") {
         bail!("--equal-triangles matches Flat's triangle counts: add flat to --methods");
     }
     if let Some(&s) = a.segments.iter().find(|&&s| s == 0 || s > 64) {
@@ -153,19 +186,19 @@ fn config(a: &BenchArgs) -> Result<BenchConfig> {
     .filter_map(|(name, given)| given.then_some(name))
     .collect();
     let takers = tess::techniques::names_with(|f| f.surface);
-    if !given.is_empty() && !a.methods.iter().any(|m| takers.contains(&m.as_str())) {
+    if !given.is_empty() && !methods.iter().any(|m| takers.contains(&m.as_str())) {
         bail!(
             "{} only {} to the {} rows, and --methods {} has none",
             given.join(", "),
             if given.len() == 1 { "applies" } else { "apply" },
             takers.join(", "),
-            a.methods.join(",")
+            methods.join(",")
         );
     }
     let maps = crate::technique::load_maps(a.texture.as_deref(), a.height.as_deref(), false)?;
     Ok(BenchConfig {
         segments: a.segments.clone(),
-        methods: a.methods.clone(),
+        methods,
         frames: a.frames,
         warmup: a.warmup,
         extent: vk::Extent2D {
@@ -267,7 +300,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
     // A texture or height map needs `vt` on every mesh the surface techniques draw (as
     // loaded: they take the mesh before fan triangulation); said before the device is opened.
     let takers = tess::techniques::names_with(|f| f.surface);
-    if a.methods.iter().any(|m| takers.contains(&m.as_str())) {
+    if config.methods.iter().any(|m| takers.contains(&m.as_str())) {
         for (i, m) in meshes.iter().enumerate() {
             let file = a.mesh.get(i).map_or_else(
                 || format!("{}.obj (embedded)", m.name),

@@ -110,6 +110,11 @@ pub struct BenchArgs {
     #[arg(long, value_delimiter = ',', default_value = "flat,phong,pn,bft,cpu",
           long_help = crate::technique::methods_long_help())]
     pub methods: Vec<String>,
+    /// Subdivision scheme of the rows, as on render: `--scheme doo-sabin` makes `adaptive` the
+    /// Doo-Sabin limit patches (doo-sabin-limit); a method that draws another scheme's limit
+    /// surface is refused by name (flat, phong and pn take any).
+    #[arg(long)]
+    pub scheme: Option<String>,
     /// Timed frames per row (at least 1).
     #[arg(long, default_value_t = 30, allow_hyphen_values = true, value_parser = parse_frames)]
     pub frames: u32,

@@ -935,6 +935,42 @@ fn maps_on_a_mesh_without_vt_are_named_before_the_device() {
     ]);
 }
 
+/// `bench --scheme doo-sabin` draws `adaptive` as the Doo-Sabin limit patches, as render does.
+#[test]
+fn bench_takes_the_scheme_as_render_does() {
+    let cube = data("tests/data/opensubdiv/shapes/catmark_cube.obj");
+    let csv = tmp("doo_sabin_rows.csv");
+    let csv = csv.to_str().unwrap();
+    succeeds(&[
+        "bench",
+        "--scheme",
+        "doo-sabin",
+        "--methods",
+        "flat,adaptive",
+        "--mesh",
+        &cube,
+        "--segments",
+        "2",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--size",
+        "64x48",
+        "--csv",
+        csv,
+    ]);
+    let methods: Vec<String> = bench_csv_rows(csv).into_iter().map(|(m, _)| m).collect();
+    assert!(
+        methods.iter().any(|m| m == "doo-sabin-limit"),
+        "{methods:?}"
+    );
+    assert!(
+        !methods.iter().any(|m| m.starts_with("adaptive")),
+        "{methods:?}"
+    );
+}
+
 /// The CSV rows of a `bench --csv` run: (method, note).
 fn bench_csv_rows(path: &str) -> Vec<(String, String)> {
     let text = std::fs::read_to_string(path).unwrap();
@@ -1314,6 +1350,18 @@ fn the_draw_path_options_draw_or_name_what_is_wrong() {
         &[],
         1,
         &["flat@mesh", "tessellation or pattern"],
+    );
+    fails(
+        &["bench", "--scheme", "doo-sabin", "--methods", "flat,bft"],
+        &[],
+        1,
+        &["--scheme doo-sabin", "--methods bft", "another scheme"],
+    );
+    fails(
+        &["bench", "--scheme", "bicubic", "--methods", "flat"],
+        &[],
+        1,
+        &["--scheme bicubic"],
     );
     fails(
         &[
