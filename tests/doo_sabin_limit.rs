@@ -206,3 +206,58 @@ fn bad_input_is_refused_by_name() {
     }
     assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
 }
+
+/// Every OpenSubdiv shape without tags (closed, open, n-gons, poles) at isolation 3: the
+/// biquadratic patches are the exact limit within 1e-5 of the diagonal, the end caps within
+/// 5e-2, and the capture welds with 0 cracks; a shape is refused only by name, for tags
+/// Doo-Sabin has no rule for.
+#[test]
+#[ignore = "sweep tier: the whole OpenSubdiv shape set"]
+fn every_shape_without_tags_is_the_limit_and_welds() {
+    let (dir, other) = common::shapes_dir("DOO_SABIN_SHAPES_DIR");
+    let gpu = Gpu::new();
+    let (mut refused, mut failures, mut checked) = (Vec::new(), Vec::new(), 0);
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let capturer = Capturer::new(&ctx).unwrap();
+        for name in common::shape_names(&dir, "") {
+            let mesh = load_obj(dir.join(format!("{name}.obj"))).unwrap();
+            let options = BuildOptions {
+                name: name.clone(),
+                isolation: 3,
+                ..BuildOptions::default()
+            };
+            let id = TechniqueId::DOO_SABIN_LIMIT;
+            let mut t = match tessera::tess::build(&mut ctx, id, &mesh, &options) {
+                Ok(b) => b.technique,
+                Err(e) => {
+                    let e = e.to_string();
+                    let tagged = [mesh.creases.len(), mesh.corners.len(), mesh.holes.len()];
+                    let named = ["sharpness", "hole"].iter().any(|w| e.contains(w));
+                    if !(named && tagged != [0; 3]) || other {
+                        refused.push(format!("{name}: {e}"));
+                    }
+                    continue;
+                }
+            };
+            checked += 1;
+            let diagonal = mesh.bbox_diagonal();
+            let limit = LimitEvaluator::doo_sabin(&mesh).unwrap();
+            let (soup, _) = capturer
+                .capture(&mut ctx, t.as_mut(), &FrameParams::uniform(4.0), EXTENT)
+                .unwrap();
+            let (regular, caps) = limit_errors(t.as_ref(), &soup, &limit, diagonal);
+            let c = cracks(t.as_ref(), &soup, &mesh);
+            println!("{name}: regular {regular:.1e}, caps {caps:.1e}, (cracks, unmapped) {c:?}");
+            if regular > 1e-5 || caps > 5e-2 || c != (0, 0) {
+                failures.push(format!(
+                    "{name}: regular {regular:e}, caps {caps:e}, (cracks, unmapped) {c:?}"
+                ));
+            }
+        }
+    }
+    println!("{checked} shapes checked");
+    assert!(checked >= 20, "{checked} shapes checked");
+    common::whole_set_verdict(&refused, other, &failures);
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+}
