@@ -528,6 +528,20 @@ mod tests {
         (0..4).any(|i| (kinds >> (4 * i)) & 3 == ADAPTIVE_EDGE_COARSE)
     }
 
+    /// The morph weight runs from 0 at half the level to 1 at the level; a level-1 edge has
+    /// nothing to morph; the weights travel as unorm16, 1 exactly as 65535.
+    #[test]
+    fn morph_weights_span_a_doubling() {
+        assert_eq!(morph_weight(4.0, 8.0), 0.0);
+        assert_eq!(morph_weight(6.0, 8.0), 0.5);
+        assert_eq!(morph_weight(8.0, 8.0), 1.0);
+        assert_eq!(morph_weight(1.0, 1.0), 1.0);
+        assert_eq!(morph_weight(3.9, 8.0), 0.0);
+        assert_eq!(unorm16_pair(1.0, 0.0), 0xFFFF);
+        assert_eq!(unorm16_pair(0.0, 1.0), 0xFFFF_0000);
+        assert_eq!(NO_MORPH, [unorm16_pair(1.0, 1.0); 3]);
+    }
+
     /// The levels of tesc_levels.glsl: a coarse bottom edge (patch edge 0) is outer level 1
     /// and doubles the inner level along u; a triangle's edges map to outer 1, 2, 0.
     #[test]
