@@ -924,7 +924,7 @@ fn regular_limit_error(
 /// and every regular-patch vertex is the exact limit at the domain point it was evaluated at;
 /// just past a level's doubling (weight 0.001) every vertex is within 1e-4 of the diagonal of a
 /// vertex of the frame just before it, where the pattern of half the level was drawn: the
-/// level of detail does not pop.
+/// level of detail does not pop. The same welds on a device without tessellation shaders.
 #[test]
 fn planned_patches_geomorph_between_levels_through_patterns() {
     use tessera::topology::limit::face_domain::LimitEvaluator;
@@ -1018,6 +1018,38 @@ fn planned_patches_geomorph_between_levels_through_patterns() {
             println!("{id}: past the doubling, every vertex within {worst:.1e} of one before");
             assert!(worst <= 1e-4, "{id}: {worst}");
         }
+    }
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+    drop(gpu);
+    // The same on a device without tessellation shaders (every pattern generated).
+    let gpu = Gpu::with(&DeviceDesc {
+        without_tessellation_shader: true,
+        ..DeviceDesc::default()
+    });
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let mesh = spot();
+        let limit = LimitEvaluator::new(&mesh, LimitScheme::CatmullClark).unwrap();
+        let mut t =
+            build_isolated(&mut ctx, TechniqueId::ADAPTIVE, &mesh, PipelineChoice::Auto).unwrap();
+        let p = FrameParams {
+            factors: FactorPolicy::Screen { pixels: 5.0 },
+            spacing: Spacing::FractionalEven,
+            ..FrameParams::default()
+        };
+        let soup = capture(&mut ctx, t.as_mut(), &p);
+        let welded = soup.weld().unwrap();
+        let report = welded.open_edges();
+        let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
+        let c = classify_open_edges(&soup, &welded, &report, &map, &mesh);
+        assert_eq!(
+            (c.cracks, c.unmapped),
+            (0, 0),
+            "without tessellation shaders"
+        );
+        let worst = regular_limit_error(t.as_ref(), &soup, &limit, mesh.bbox_diagonal());
+        println!("without tessellation shaders: regular patches {worst:.1e} from the limit");
+        assert!(worst <= 1e-5, "without tessellation shaders: {worst}");
     }
     assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
 }
