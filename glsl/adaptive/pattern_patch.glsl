@@ -42,22 +42,35 @@ float edge_morph(uint e) {
 // levels are the larger of each facing pair of edge levels, as the pattern's key sets them.
 // On quads an odd lattice index k slides to k - 1, but the first (k = 1, beside the strip
 // along a patch edge) to 2: the lattice of half the level starts there, its strip covering
-// what the finer strip and first column do.
+// what the finer strip and first column do. On triangles, whose barycentric indices (i, j, k)
+// sum to an even level, a vertex has two odd indices or none; it slides to the neighbour that
+// makes both even, away from the edge where one index is 1 and the other can give.
 vec2 morph_inside(vec2 uv) {
 #ifdef TRIANGLE_DOMAIN
-    vec2 levels = vec2(max(OUTER_LEVEL(0), max(OUTER_LEVEL(1), OUTER_LEVEL(2))));
-    vec2 w = vec2(unpackUnorm2x16(in_patch.w).x);
-    vec2 k = round(uv * levels);
-    vec2 below = k - 1.0;
+    float n = max(OUTER_LEVEL(0), max(OUTER_LEVEL(1), OUTER_LEVEL(2)));
+    float w = unpackUnorm2x16(in_patch.w).x;
+    vec2 ij = round(uv * n);
+    float k = n - ij.x - ij.y;
+    vec3 odd = mod(vec3(ij, k), 2.0);
+    if (odd.x + odd.y + odd.z == 0.0) return uv;
+    vec2 d;
+    if (odd.x > 0.0 && odd.y > 0.0) {
+        d = ij.x >= 3.0 ? vec2(-1.0, 1.0) : (ij.y >= 3.0 ? vec2(1.0, -1.0) : vec2(-1.0, -1.0));
+    } else if (odd.x > 0.0) {
+        d = (ij.x >= 3.0 || k < 3.0) ? vec2(-1.0, 0.0) : vec2(1.0, 0.0);
+    } else {
+        d = (ij.y >= 3.0 || k < 3.0) ? vec2(0.0, -1.0) : vec2(0.0, 1.0);
+    }
+    return uv + (1.0 - w) * ((ij + d) / n - uv);
 #else
     vec2 levels = vec2(max(OUTER_LEVEL(1), OUTER_LEVEL(3)), max(OUTER_LEVEL(0), OUTER_LEVEL(2)));
     vec2 w = unpackUnorm2x16(in_patch.w);
     vec2 k = round(uv * levels);
     vec2 first = step(k, vec2(1.0)) * step(vec2(3.0), levels);
     vec2 below = mix(k - 1.0, vec2(2.0), first);
-#endif
     vec2 odd = mod(k, 2.0);
     return uv + odd * (1.0 - w) * (mix(k, below, odd) / levels - uv);
+#endif
 }
 
 // The point at parameter a along patch edge e (tese_main.glsl's edge numbering).
