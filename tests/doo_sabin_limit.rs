@@ -6,7 +6,6 @@
 mod common;
 
 use common::Gpu;
-use tessera::tess::capture::classify_open_edges;
 use tessera::tess::gpu::bindings::{ADAPTIVE_KIND_BILINEAR, ADAPTIVE_KIND_REGULAR};
 use tessera::tess::{
     BuildOptions, Camera, CapturedSoup, Capturer, Context, FactorPolicy, FrameParams, Spacing,
@@ -83,15 +82,6 @@ fn limit_errors(
     (regular, caps)
 }
 
-/// (cracks, unmapped) of one capture.
-fn cracks(t: &dyn Technique, soup: &CapturedSoup, mesh: &ControlMesh) -> (usize, usize) {
-    let welded = soup.weld().expect("weld");
-    let report = welded.open_edges();
-    let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
-    let c = classify_open_edges(soup, &welded, &report, &map, mesh);
-    (c.cracks, c.unmapped)
-}
-
 #[test]
 fn biquadratic_patches_are_the_limit_and_end_caps_shrink_with_the_isolation_level() {
     let gpu = Gpu::new();
@@ -115,7 +105,7 @@ fn biquadratic_patches_are_the_limit_and_end_caps_shrink_with_the_isolation_leve
                     "{name} at isolation {isolation}: biquadratic patches off by {regular:.2e}"
                 );
                 assert_eq!(
-                    cracks(t.as_ref(), &soup, &mesh),
+                    common::cracks(t.as_ref(), &soup, &mesh),
                     (0, 0),
                     "{name} at isolation {isolation}"
                 );
@@ -168,7 +158,7 @@ fn every_factor_policy_welds_without_cracks() {
                 .unwrap();
             assert!(soup.triangle_count() > 0, "{factors} {spacing:?}");
             assert_eq!(
-                cracks(t.as_ref(), &soup, &mesh),
+                common::cracks(t.as_ref(), &soup, &mesh),
                 (0, 0),
                 "{factors} {spacing:?}"
             );
@@ -232,9 +222,7 @@ fn every_shape_without_tags_is_the_limit_and_welds() {
                 Ok(b) => b.technique,
                 Err(e) => {
                     let e = e.to_string();
-                    let tagged = [mesh.creases.len(), mesh.corners.len(), mesh.holes.len()];
-                    let named = ["sharpness", "hole"].iter().any(|w| e.contains(w));
-                    if !(named && tagged != [0; 3]) || other {
+                    if !common::refused_for_doo_sabin_tags(&mesh, &e) || other {
                         refused.push(format!("{name}: {e}"));
                     }
                     continue;
@@ -247,7 +235,7 @@ fn every_shape_without_tags_is_the_limit_and_welds() {
                 .capture(&mut ctx, t.as_mut(), &FrameParams::uniform(4.0), EXTENT)
                 .unwrap();
             let (regular, caps) = limit_errors(t.as_ref(), &soup, &limit, diagonal);
-            let c = cracks(t.as_ref(), &soup, &mesh);
+            let c = common::cracks(t.as_ref(), &soup, &mesh);
             println!("{name}: regular {regular:.1e}, caps {caps:.1e}, (cracks, unmapped) {c:?}");
             if regular > 1e-5 || caps > 5e-2 || c != (0, 0) {
                 failures.push(format!(

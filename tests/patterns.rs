@@ -9,7 +9,6 @@ mod common;
 
 use common::Gpu;
 use std::collections::{BTreeSet, HashMap};
-use tessera::tess::capture::classify_open_edges;
 use tessera::tess::techniques::{flat::Flat, phong::Phong, pn::Pn};
 use tessera::tess::{
     BuildOptions, CapturedSoup, Capturer, Context, DrawPath, FactorPolicy, FrameParams,
@@ -351,11 +350,7 @@ fn without_tessellation_shaders_the_base_face_techniques_draw_generated_patterns
                         ..params(level, Spacing::Equal)
                     };
                     let soup = capture(&mut ctx, t.as_mut(), &p);
-                    let welded = soup.weld().unwrap();
-                    let report = welded.open_edges();
-                    let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
-                    let c = classify_open_edges(&soup, &welded, &report, &map, &mesh);
-                    assert_eq!((c.cracks, c.unmapped), (0, 0), "{what}");
+                    assert_eq!(common::cracks(t.as_ref(), &soup, &mesh), (0, 0), "{what}");
                     let (dp, dn) = oracle_error(id, &mesh, &soup, sine);
                     println!("{what}: position error {dp:.2e}, normal error {dn:.2e}");
                     assert!(dp <= 2e-6 * diagonal, "{what}: position off by {dp}");
@@ -531,11 +526,7 @@ fn without_tessellation_shaders_bft_draws_generated_patterns() {
         let cpu = LocalMesh::from_control_mesh(&mesh, LimitScheme::Loop).unwrap();
         for (&s, want) in levels.iter().zip(&reference) {
             let soup = capture(&mut ctx, t.as_mut(), &params(s, Spacing::Equal));
-            let welded = soup.weld().unwrap();
-            let report = welded.open_edges();
-            let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
-            let c = classify_open_edges(&soup, &welded, &report, &map, &mesh);
-            assert_eq!((c.cracks, c.unmapped), (0, 0), "S = {s}");
+            assert_eq!(common::cracks(t.as_ref(), &soup, &mesh), (0, 0), "S = {s}");
             let got = samples(&soup);
             let common: Vec<_> = got.keys().filter(|k| want.contains_key(k)).collect();
             let differing = common.iter().filter(|k| got[k] != want[k]).count();
@@ -649,11 +640,11 @@ fn planned_patches_draw_the_tessellation_paths_bits_through_patterns() {
                     let a = capture(&mut ctx, tess.as_mut(), &p);
                     let b = capture(&mut ctx, pattern.as_mut(), &p);
                     compared += compare_samples(&a, &b, &what);
-                    let welded = b.weld().unwrap();
-                    let report = welded.open_edges();
-                    let map = |p: u32, d: [f32; 2]| pattern.face_point(p, d);
-                    let c = classify_open_edges(&b, &welded, &report, &map, &mesh);
-                    assert_eq!((c.cracks, c.unmapped), (0, 0), "{what}");
+                    assert_eq!(
+                        common::cracks(pattern.as_ref(), &b, &mesh),
+                        (0, 0),
+                        "{what}"
+                    );
                 }
                 let refused = params(4.0, Spacing::FractionalOdd);
                 let e = ctx.prepare(pattern.as_mut(), &refused, &[tessera::tess::Pass::Shaded]);
@@ -710,11 +701,7 @@ fn without_tessellation_shaders_the_planned_patches_draw_generated_patterns() {
                 .iter()
                 .all(|a| a.patch.path() == DrawPath::Pattern));
             let soup = capture(&mut ctx, t.as_mut(), &params(level, Spacing::Equal));
-            let welded = soup.weld().unwrap();
-            let report = welded.open_edges();
-            let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
-            let c = classify_open_edges(&soup, &welded, &report, &map, &mesh);
-            assert_eq!((c.cracks, c.unmapped), (0, 0), "{id}");
+            assert_eq!(common::cracks(t.as_ref(), &soup, &mesh), (0, 0), "{id}");
             let got = samples(&soup);
             let common = got.keys().filter(|k| want.contains_key(k)).count();
             let differing = got
@@ -780,11 +767,7 @@ fn planned_patches_take_screen_space_and_distance_factors_through_patterns() {
                     ..FrameParams::default()
                 };
                 let soup = capture(&mut ctx, t.as_mut(), &p);
-                let welded = soup.weld().unwrap();
-                let report = welded.open_edges();
-                let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
-                let c = classify_open_edges(&soup, &welded, &report, &map, &mesh);
-                assert_eq!((c.cracks, c.unmapped), (0, 0), "{what}");
+                assert_eq!(common::cracks(t.as_ref(), &soup, &mesh), (0, 0), "{what}");
                 let mut per_patch: HashMap<u32, usize> = HashMap::new();
                 for r in &soup.records {
                     *per_patch.entry(r.patch).or_default() += 1;
@@ -849,11 +832,7 @@ fn planned_surfaces_take_the_sine_displacement_on_both_paths() {
                 let soup = capture(&mut ctx, t.as_mut(), &p);
                 let plain = capture(&mut ctx, t.as_mut(), &FrameParams::uniform(4.0));
                 assert_ne!(samples(&soup), samples(&plain), "{what}: the surface moved");
-                let welded = soup.weld().unwrap();
-                let report = welded.open_edges();
-                let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
-                let c = classify_open_edges(&soup, &welded, &report, &map, &mesh);
-                assert_eq!((c.cracks, c.unmapped), (0, 0), "{what}");
+                assert_eq!(common::cracks(t.as_ref(), &soup, &mesh), (0, 0), "{what}");
                 if id == TechniqueId::ADAPTIVE {
                     let mut worst = 0.0f64;
                     let regular = soup
@@ -973,11 +952,7 @@ fn planned_patches_geomorph_between_levels_through_patterns() {
                     ..FrameParams::default()
                 };
                 let soup = capture(&mut ctx, t.as_mut(), &p);
-                let welded = soup.weld().unwrap();
-                let report = welded.open_edges();
-                let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
-                let c = classify_open_edges(&soup, &welded, &report, &map, &mesh);
-                assert_eq!((c.cracks, c.unmapped), (0, 0), "{what}");
+                assert_eq!(common::cracks(t.as_ref(), &soup, &mesh), (0, 0), "{what}");
                 if let (Some(limit), 0.0) = (&exact, time) {
                     let worst = regular_limit_error(t.as_ref(), &soup, limit, diagonal);
                     println!("{what}: regular patches {worst:.1e} from the limit");
@@ -1038,12 +1013,8 @@ fn planned_patches_geomorph_between_levels_through_patterns() {
             ..FrameParams::default()
         };
         let soup = capture(&mut ctx, t.as_mut(), &p);
-        let welded = soup.weld().unwrap();
-        let report = welded.open_edges();
-        let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
-        let c = classify_open_edges(&soup, &welded, &report, &map, &mesh);
         assert_eq!(
-            (c.cracks, c.unmapped),
+            common::cracks(t.as_ref(), &soup, &mesh),
             (0, 0),
             "without tessellation shaders"
         );

@@ -176,11 +176,8 @@ fn every_shape_without_tags_matches_the_cpu_refiner() {
                 Ok(b) => b.technique,
                 Err(e) => {
                     let e = e.to_string();
-                    let named = ["sharpness", "hole"].iter().any(|w| e.contains(w));
-                    let tagged =
-                        [mesh.creases.len(), mesh.corners.len(), mesh.holes.len()] != [0; 3];
                     let too_large = e.contains("the refinement kernel takes");
-                    if !(named && tagged || too_large) || other {
+                    if !(common::refused_for_doo_sabin_tags(&mesh, &e) || too_large) || other {
                         refused.push(format!("{name}: {e}"));
                     }
                     continue;

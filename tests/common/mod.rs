@@ -104,6 +104,27 @@ pub fn shape_names(dir: &std::path::Path, prefix: &str) -> Vec<String> {
     names
 }
 
+/// (cracks, unmapped) of one capture of `t` drawing `mesh`: its open edges after welding by
+/// bits, classified against the base mesh.
+pub fn cracks(
+    t: &dyn tessera::tess::Technique,
+    soup: &tessera::tess::capture::CapturedSoup,
+    mesh: &tessera::topology::ControlMesh,
+) -> (usize, usize) {
+    let welded = soup.weld().expect("weld");
+    let report = welded.open_edges();
+    let map = |p: u32, d: [f32; 2]| t.face_point(p, d);
+    let c = tessera::tess::capture::classify_open_edges(soup, &welded, &report, &map, mesh);
+    (c.cracks, c.unmapped)
+}
+
+/// Whether `error`, building a Doo-Sabin technique for `mesh`, is the refusal its tags earn:
+/// it names sharpness or a hole, and the mesh has crease, corner or hole tags.
+pub fn refused_for_doo_sabin_tags(mesh: &tessera::topology::ControlMesh, error: &str) -> bool {
+    let tagged = [mesh.creases.len(), mesh.corners.len(), mesh.holes.len()] != [0; 3];
+    tagged && ["sharpness", "hole"].iter().any(|w| error.contains(w))
+}
+
 /// The verdict of a whole-set test: every refusal is printed, and allowed only in `other`'s
 /// folder (a refusal names what it refuses; nothing in tests/data is refused); every failure
 /// fails the test.
