@@ -89,6 +89,8 @@ layout(push_constant) uniform BftPush {
     uint ring_base;       // patch_rings
     uint level1_base;     // level1_pos, level1_nrm, tangent_offsets
     uint tangent_base;    // tangent_terms
+    uvec2 pad;
+    vec4 pattern_outer;   // pattern path: the drawn pattern's edge levels (gl_TessLevelOuter's order)
 } bft;
 
 // Windowed reads by global index.
@@ -246,38 +248,42 @@ void bft_accumulate(uint g, bool local, uint row, bool flip, bool geometric,
     bft_accumulate_global(g, row, flip, geometric, p, q, r);
 }
 
-// The limit point (and normal source) at tess coordinate b (weights of v0, v1, v2) of `face`.
-// Edge and corner points are evaluated by their owner face in the owner's frame; grid points
-// with a row exactly; any other point by linear interpolation on the level-L lattice (the
-// paper's virtual mesh at maximum level: fractional factors morph linearly). Returns whether
-// the point was a table point.
-bool bft_eval(uint face, vec3 b, bool geometric, out vec3 p, out vec3 n) {
-    uint g = face;
-    float u = b.y, v = b.z;
-    int corner = b.x == 1.0 ? 0 : (b.y == 1.0 ? 1 : (b.z == 1.0 ? 2 : -1));
-    int edge = b.z == 0.0 ? 0 : (b.x == 0.0 ? 1 : (b.y == 0.0 ? 2 : -1));
+// The point of owner-frame parameter t along local edge ge (edge e runs v_e -> v_(e+1)) as
+// (u, v), the weights of v1 and v2.
+vec2 bft_edge_point(uint ge, float t) {
+    return ge == 0u ? vec2(t, 0.0) : (ge == 1u ? vec2(1.0 - t, t) : vec2(0.0, 1.0 - t));
+}
+
+// Where tess coordinate b (weights of v0, v1, v2) of `face` is evaluated: the face g that owns
+// the point (its own unless b is on an edge or corner another face owns) and the point (u, v)
+// in g's frame; which corner and edge of `face` b lies on (-1: none); on an edge, the
+// parameter t along the owner's edge, in the owner's direction.
+void bft_locate(uint face, vec3 b, out uint g, out vec2 uv, out int corner, out int edge, out float t) {
+    g = face;
+    uv = b.yz;
+    t = 0.0;
+    corner = b.x == 1.0 ? 0 : (b.y == 1.0 ? 1 : (b.z == 1.0 ? 2 : -1));
+    edge = b.z == 0.0 ? 0 : (b.x == 0.0 ? 1 : (b.y == 0.0 ? 2 : -1));
     if (corner >= 0) {
         uint o = PATCH(face).corner_owner[corner];
         g = owner_face(o);
         uint c = owner_local(o);
-        u = c == 1u ? 1.0 : 0.0;
-        v = c == 2u ? 1.0 : 0.0;
+        uv = vec2(c == 1u ? 1.0 : 0.0, c == 2u ? 1.0 : 0.0);
     } else if (edge >= 0) {
-        float t = edge == 0 ? b.y : (edge == 1 ? b.z : b.x);
+        t = edge == 0 ? b.y : (edge == 1 ? b.z : b.x);
         uint o = PATCH(face).edge_owner[edge];
         g = owner_face(o);
         if (g != face) t = 1.0 - t;
-        uint ge = owner_local(o);
-        u = ge == 0u ? t : (ge == 1u ? 1.0 - t : 0.0);
-        v = ge == 0u ? 0.0 : (ge == 1u ? t : 1.0 - t);
+        uv = bft_edge_point(owner_local(o), t);
     }
-    // Shared points (edges, corners) always take the global path, also in their owner: one code
-    // path for both faces of an edge, so their bits cannot depend on how a compiler schedules
-    // two. (NVIDIA's rounds the unrolled patch-block sum differently from the global loop over
-    // the same products, which cracked every shared point; a non-unrolled block loop matches
-    // there but costs lavapipe a quarter more: docs/benchmarks.md, "Table I on an NVIDIA
-    // H100".) Only interior points read the patch block.
-    bool local = g == face && corner < 0 && edge < 0 && (tc_head.y & BFT_INFO_GATHERED) != 0u;
+}
+
+// The limit point at (u, v) of face g (local: g is this patch, its ring gathered into the patch
+// block, and the point interior): grid points with a row exactly; any other point by linear
+// interpolation on the level-L lattice (the paper's virtual mesh at maximum level: fractional
+// factors morph linearly). Returns whether the point was a table point.
+bool bft_eval_at(uint g, bool local, vec2 uv, bool geometric, out vec3 p, out vec3 n) {
+    float u = uv.x, v = uv.y;
     float grid = float(table.grid);
     float nseg = float(table.segments);
     vec2 ga = vec2(u, v) * grid;
@@ -335,4 +341,24 @@ bool bft_eval(uint face, vec3 b, bool geometric, out vec3 p, out vec3 n) {
     return false;
 #endif
 }
+
+// The limit point (and normal source) at tess coordinate b (weights of v0, v1, v2) of `face`.
+// Edge and corner points are evaluated by their owner face in the owner's frame (bft_locate);
+// the rest is bft_eval_at. Returns whether the point was a table point.
+bool bft_eval(uint face, vec3 b, bool geometric, out vec3 p, out vec3 n) {
+    uint g;
+    vec2 uv;
+    int corner, edge;
+    float t;
+    bft_locate(face, b, g, uv, corner, edge, t);
+    // Shared points (edges, corners) always take the global path, also in their owner: one code
+    // path for both faces of an edge, so their bits cannot depend on how a compiler schedules
+    // two. (NVIDIA's rounds the unrolled patch-block sum differently from the global loop over
+    // the same products, which cracked every shared point; a non-unrolled block loop matches
+    // there but costs lavapipe a quarter more: docs/benchmarks.md, "Table I on an NVIDIA
+    // H100".) Only interior points read the patch block.
+    bool local = g == face && corner < 0 && edge < 0 && (tc_head.y & BFT_INFO_GATHERED) != 0u;
+    return bft_eval_at(g, local, uv, geometric, p, n);
+}
+
 #endif

@@ -205,7 +205,7 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
     };
     let bft_push = || Layout {
         name: "BftPush",
-        offsets: offsets!(BftPush: mode, first_patch, factor_mode, options, uniform_level, pixels_per_segment, distance_ref, max_level, count, first_vertex, patch_base, ring_base, level1_base, tangent_base),
+        offsets: offsets!(BftPush: mode, first_patch, factor_mode, options, uniform_level, pixels_per_segment, distance_ref, max_level, count, first_vertex, patch_base, ring_base, level1_base, tangent_base, pad, pattern_outer),
         size: size_of::<BftPush>(),
     };
     let frame_binding = || Uniform {
@@ -264,17 +264,36 @@ fn rows() -> Vec<(Stage, Variant, Check)> {
             bft_push(),
         ),
         (Stage::BftNormalsComp, PLAIN, bft_push()),
-        // BFT's refinement-pattern vertex stage: its push constant and the pattern's domain
-        // point, its only vertex input.
+        // BFT's refinement-pattern vertex stage: its push constant (the geomorphing build
+        // reads the pattern's edge levels), the pattern's domain point and the instance's face
+        // and morph weights.
         (Stage::BftPatternVert, PLAIN, bft_push()),
+        (
+            Stage::BftPatternVert,
+            Variant {
+                geomorph: true,
+                ..PLAIN
+            },
+            bft_push(),
+        ),
         (Stage::BftPatternVert, PLAIN, frame_binding()),
         (
             Stage::BftPatternVert,
             PLAIN,
             PatternInput {
                 name: "in_domain",
-                input: super::pattern_input::POINTS,
+                input: super::pattern_input::PATCH_IDS,
                 binding: 0,
+                offset: 0,
+            },
+        ),
+        (
+            Stage::BftPatternVert,
+            PLAIN,
+            PatternInput {
+                name: "in_patch",
+                input: super::pattern_input::PATCH_IDS,
+                binding: 1,
                 offset: 0,
             },
         ),

@@ -96,9 +96,14 @@ pub struct BftPush {
     pub level1_base: u32,
     /// Tangent terms.
     pub tangent_base: u32,
+    /// Aligns [`Self::pattern_outer`] to 16 bytes, as the block does.
+    pub pad: [u32; 2],
+    /// The refinement-pattern path: the drawn pattern's edge levels, in `gl_TessLevelOuter`'s
+    /// order (the geomorphing vertex stage reads them; `glsl/bft/pattern.vert`).
+    pub pattern_outer: [f32; 4],
 }
 
-const _: () = assert!(size_of::<BftPush>() == 56);
+const _: () = assert!(size_of::<BftPush>() == 80);
 
 /// `AdaptivePush` push constant of every feature-adaptive stage, `glsl/adaptive/adaptive.glsl`.
 #[repr(C)]

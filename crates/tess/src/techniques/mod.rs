@@ -14,6 +14,7 @@ pub mod doo_sabin_limit;
 pub mod face_patches;
 pub mod flat;
 pub mod gregory;
+pub mod host_view;
 pub mod phong;
 pub mod planned_patches;
 pub mod pn;

@@ -5,7 +5,6 @@ use crate::error::{Param, ParamError, Result, TessError};
 use crate::gpu::bindings::{BFT_FACTORS_DISTANCE, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM};
 use crate::shaders::{self, Stage, Variant};
 use crate::technique::{FactorPolicy, FrameParams, TechniqueId};
-use crate::tessellator::Spacing;
 use vk_core::descriptor::BindingDesc;
 use vk_core::pipeline::{Pipeline, ShaderStage};
 use vk_core::{vk, Buffer, Device};
@@ -142,26 +141,6 @@ pub fn upload_base(
         bytemuck::cast_slice(&crate::stencil::vertices(&positions)),
     )?;
     Ok(positions)
-}
-
-/// What the refinement-pattern path of a technique with transition or table levels refuses
-/// (BFT, the planned patches): factors other than uniform (no pattern family per edge level
-/// follows screen-space or distance factors yet), and spacing other than equal (the patterns a
-/// transition or a table needs are generated, in equal spacing).
-pub fn check_uniform_pattern_frame(technique: TechniqueId, params: &FrameParams) -> Result<()> {
-    if !matches!(params.factors, FactorPolicy::Uniform { .. }) {
-        return Err(TessError::Unsupported {
-            technique,
-            what: "screen-space and distance factors on the refinement-pattern path (uniform \
-                   only; --pipeline tessellation takes them)",
-        });
-    }
-    if params.spacing != Spacing::Equal {
-        return Err(TessError::PatternSpacing {
-            spacing: params.spacing,
-        });
-    }
-    Ok(())
 }
 
 /// Deepest level a frame may ask for: 2^6 = 64 segments per base edge, the tessellator's

@@ -46,7 +46,9 @@ use crate::capture::{face_corner_uv, FacePoint};
 use crate::context::Context;
 use crate::error::{Param, ParamError, Result, TablesTooLarge, TessError};
 pub mod layout;
+mod patterns;
 
+use super::host_view::HostView;
 use super::shared::{
     check_adaptive_policy, compute_pipeline, factor_fields, storage, storage_binding, upload_base,
     STAGES,
@@ -61,7 +63,6 @@ use crate::gpu::bindings::{
     BFT_TANGENT_OFFSETS_BINDING, BFT_TANGENT_TERMS_BINDING,
 };
 use crate::gpu::{BftPush, BftTableArrays};
-use crate::pattern::{PatternBuffers, PatternKey};
 use crate::shaders::{Stage, Variant};
 use crate::stencil::{self, GpuStencils, StencilBlock, StencilEvaluator, StencilVertices};
 use crate::technique::{
@@ -72,6 +73,7 @@ use crate::technique::{
 use crate::techniques::{BuildOptions, Built, TechniqueInfo};
 use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, Domain, Spacing};
 use layout::{PackedTables, PatchHeader, TangentTerm, STORAGE_BINDINGS};
+use patterns::{BftPatterns, Piece};
 use std::ops::Range;
 use topology::patches::bft::{
     build_patch_records, face_rotations, level1_base_domain, loop_level1, loop_tables,
@@ -398,9 +400,9 @@ impl Default for BftOptions {
     }
 }
 
-/// BFT's draw path for `choice` on `device`. On the refinement-pattern path BFT takes uniform
-/// factors only (no pattern family per edge level exists yet), so `auto` keeps the tessellation
-/// stage wherever the device has one and draws patterns only where it has none.
+/// BFT's draw path for `choice` on `device`: `auto` keeps the tessellation stage wherever the
+/// device has one (the pattern path costs more there: docs/benchmarks.md) and draws patterns
+/// only where it has none.
 pub fn resolve_path(choice: PipelineChoice, device: &vk_core::Device) -> Result<DrawPath> {
     match choice {
         PipelineChoice::Auto if device.info.caps.tessellation_shader => Ok(DrawPath::Tessellation),
@@ -459,9 +461,9 @@ pub struct Bft {
     pub notes: Vec<String>,
     /// The patch-block build ([`BftOptions::patch_block`]).
     patch_block: bool,
-    /// On the refinement-pattern path: the frame's pattern, once [`Technique::prepare_frame`]
-    /// made it; `None` on the tessellation path.
-    pattern: Option<Option<PatternBuffers>>,
+    /// On the refinement-pattern path: its instances, patterns and host-chosen levels
+    /// ([`patterns`]); `None` on the tessellation path.
+    patterns: Option<BftPatterns>,
 }
 
 /// Maximal runs of the `patches` level-1 faces whose base triangle is not among `holes` (a
@@ -615,6 +617,8 @@ struct PatchStage {
     table: layout::TableHeader,
     tangents: bool,
     table_bytes: u64,
+    /// Each face's corners `v0, v1, v2` when kept (the pattern path's host levels).
+    corners: Option<Vec<[u32; 3]>>,
 }
 
 impl PatchStage {
@@ -625,6 +629,7 @@ impl PatchStage {
         level1: topology::limit::eval::LocalMesh,
         options: &BftOptions,
         limits: Limits,
+        keep_corners: bool,
         laps: &mut Laps,
         stages: &mut Vec<String>,
     ) -> Result<Self> {
@@ -643,6 +648,7 @@ impl PatchStage {
         drop(tables);
         layout::validate_patches(&patches, &rings, &packed.entries, level1_vertices)?;
         let draw_chunks = plan_draw(&patches, &rings, limits)?;
+        let corners = keep_corners.then(|| face_corners(&patches, &rings));
         let (count, ring_slots) = (patches.len() as u32, rings.len() as u64);
         let bytes = bytes_of(&patches) + bytes_of(&rings);
         let mut buffers = vec![(
@@ -668,8 +674,25 @@ impl PatchStage {
             table: packed.table,
             tangents,
             table_bytes: packed.bytes() as u64,
+            corners,
         })
     }
+}
+
+/// Each face's corners `v0, v1, v2`: the first three slots of its ring.
+fn face_corners(patches: &[PatchHeader], rings: &[u32]) -> Vec<[u32; 3]> {
+    patches
+        .iter()
+        .map(|h| {
+            let at = |k: u32| {
+                rings
+                    .get((h.ring_offset + k) as usize)
+                    .copied()
+                    .unwrap_or(0)
+            };
+            [at(0), at(1), at(2)]
+        })
+        .collect()
 }
 
 /// A set of the BFT layout: the windowed buffers of `statics` as `w`'s windows, and the
@@ -876,7 +899,8 @@ impl Bft {
             ctx.frames_in_flight(),
         )?;
         let (stencil_count, stencil_bytes) = (stencils.terms.len() as u64, stencils.bytes());
-        drop(stencils);
+        // The pattern path keeps them to choose levels on the host.
+        let host_stencils = (path == DrawPath::Pattern).then_some(stencils);
         stages.push(laps.lap("level 1"));
         let normals = NormalsStage::new(
             &device,
@@ -885,7 +909,15 @@ impl Bft {
             limits,
         )?;
         stages.push(laps.lap("tangent stencils and upload"));
-        let patches = PatchStage::new(&device, level1, options, limits, &mut laps, &mut stages)?;
+        let patches = PatchStage::new(
+            &device,
+            level1,
+            options,
+            limits,
+            path == DrawPath::Pattern,
+            &mut laps,
+            &mut stages,
+        )?;
         let summary = BftSummary {
             base_vertices,
             level1_vertices,
@@ -957,6 +989,15 @@ impl Bft {
             patches.draw_chunks.len()
         );
         let drawn = drawn_runs(summary.patch_count, &loop_mesh.holes);
+        let patterns = match (host_stencils, patches.corners) {
+            (Some(stencils), Some(corners)) => Some(BftPatterns::new(
+                &device,
+                summary.patch_count,
+                stencils,
+                corners,
+            )?),
+            _ => None,
+        };
         Ok(Self {
             patch_block,
             evaluator,
@@ -981,7 +1022,7 @@ impl Bft {
             rest_bbox: crate::framing::drawn_bbox(mesh),
             base_positions,
             notes: note.into_iter().collect(),
-            pattern: (path == DrawPath::Pattern).then_some(None),
+            patterns,
         })
     }
 
@@ -1023,6 +1064,22 @@ impl Bft {
         self.summary.table.segments
     }
 
+    /// The drawn faces of `faces` by draw chunk: `(chunk, run)` in order, each run within one
+    /// chunk and one drawn run.
+    fn drawn_pieces(&self, faces: Range<u32>) -> Vec<Piece> {
+        let mut pieces = Vec::new();
+        for (k, (items, _)) in self.draw_chunks.iter().enumerate() {
+            let (start, end) = (items.start.max(faces.start), items.end.min(faces.end));
+            for run in &self.drawn {
+                let (start, end) = (start.max(run.start), end.min(run.end));
+                if start < end {
+                    pieces.push((k, start..end));
+                }
+            }
+        }
+        pieces
+    }
+
     fn push(&self, params: &FrameParams, mode: u32) -> BftPush {
         let (factor_mode, segments, pixels, reference) = factor_fields(params.factors);
         // The tables count segments per level-1 edge: half a base edge.
@@ -1050,8 +1107,8 @@ impl Bft {
 
 /// What BFT refuses in `params` with tables of level `table_level`, known before any device or
 /// mesh exists (so callers check it first, [`crate::techniques::check_options`]): uniform `S`
-/// must be a power of two in `2..=2^(L+1)` unless fractional; spacing equal or fractional even
-/// (the linear geomorph between dyadic levels).
+/// must be a power of two in `2..=2^(L+1)`, or with fractional-even spacing any level in that
+/// range; spacing equal or fractional even (the geomorph between dyadic levels).
 pub fn check_frame(table_level: u32, params: &FrameParams) -> Result<()> {
     if params.spacing == Spacing::FractionalOdd {
         return Err(TessError::Unsupported {
@@ -1063,15 +1120,15 @@ pub fn check_frame(table_level: u32, params: &FrameParams) -> Result<()> {
     // The tables hold 2^L segments per level-1 edge, half a base edge.
     let max = 1u32.checked_shl(table_level + 1).unwrap_or(u32::MAX);
     if let FactorPolicy::Uniform { segments } = params.factors {
-        let whole = segments.fract() == 0.0 && segments >= 1.0;
-        let s = segments as u32;
-        if !whole || s < 2 || s > max || (!fractional && !s.is_power_of_two()) {
+        let in_range = segments.is_finite() && (2.0..=max as f32).contains(&segments);
+        let dyadic = segments.fract() == 0.0 && (segments as u32).is_power_of_two();
+        if !in_range || (!fractional && !dyadic) {
             return Err(ParamError::raising(
                 Param::Segments,
                 segments,
                 format!(
-                    "BFT takes a power of two in 2..={max} segments per base edge (tables at \
-                     level {table_level})"
+                    "BFT takes a power of two in 2..={max} segments per base edge, any level in \
+                     that range with fractional-even spacing (tables at level {table_level})"
                 ),
                 Param::TableLevel,
             ));
@@ -1099,11 +1156,7 @@ impl Technique for Bft {
         if params.geometric_normals && !self.summary.tangents {
             return Err(TessError::NeedsTangentTables);
         }
-        check_frame(self.summary.table.level, params)?;
-        if self.pattern.is_some() {
-            super::shared::check_uniform_pattern_frame(TechniqueId::BFT, params)?;
-        }
-        Ok(())
+        check_frame(self.summary.table.level, params)
     }
 
     /// Only patch colours need the surface build (its albedo varying).
@@ -1114,8 +1167,12 @@ impl Technique for Bft {
     fn patch_pipeline(&self, patch: PatchType) -> PatchPipeline {
         if patch.path() == DrawPath::Pattern {
             return PatchPipeline {
-                vertex_input: crate::gpu::pattern_input::POINTS,
+                vertex_input: crate::gpu::pattern_input::PATCH_IDS,
                 push_constant_bytes: std::mem::size_of::<BftPush>() as u32,
+                axes: Variant {
+                    geomorph: self.patterns.as_ref().is_some_and(BftPatterns::morph),
+                    ..Variant::default()
+                },
                 ..PatchPipeline::triangles(Stage::BftPatternVert, Stage::BftBftFrag)
             };
         }
@@ -1147,8 +1204,8 @@ impl Technique for Bft {
 
     /// At the largest factor the policy can reach.
     fn max_vertices_per_patch(&self, params: &FrameParams, _array: usize) -> u64 {
-        if let Some(Some(p)) = &self.pattern {
-            return p.pattern.points.len() as u64;
+        if let Some(p) = &self.patterns {
+            return p.max_vertices();
         }
         let max = match params.factors {
             FactorPolicy::Uniform { segments } => segments * 0.5,
@@ -1158,6 +1215,9 @@ impl Technique for Bft {
     }
 
     fn triangles(&self, params: &FrameParams, _array: usize) -> Option<u64> {
+        if let Some(p) = &self.patterns {
+            return p.triangles();
+        }
         // Patterns are the tessellator's where it has one, and equal spacing's lattice
         // otherwise: the same count at the powers of two BFT takes.
         match params.factors {
@@ -1184,23 +1244,35 @@ impl Technique for Bft {
         Ok(())
     }
 
-    /// On the pattern path, takes the frame's pattern from the context (one triangle per
-    /// level-1 face at half the base edge's segments) and uploads it when it changed.
+    /// On the pattern path, takes the frame's patterns from the context: under uniform factors
+    /// one triangle pattern per level-1 face at half the base edge's segments, else (and when
+    /// geomorphing) the levels the host chooses for each face ([`patterns`] module docs).
     fn prepare_frame(&mut self, ctx: &mut Context, params: &FrameParams) -> Result<()> {
-        let (Some(slot), FactorPolicy::Uniform { segments }) = (&mut self.pattern, params.factors)
-        else {
+        if self.patterns.is_none() {
+            return Ok(());
+        }
+        let pieces = self.drawn_pieces(0..self.summary.patch_count);
+        // The tables count segments per level-1 edge: half a base edge.
+        let uniform_level = params.uniform_segments().map(|s| s * 0.5);
+        let morph = params.spacing == Spacing::FractionalEven;
+        let view = match (uniform_level, morph) {
+            (Some(_), false) => None,
+            _ => Some(*ctx.frame_view().ok_or(TessError::NoFrameView {
+                technique: TechniqueId::BFT,
+            })?),
+        };
+        let max_level = self.max_level() as f32;
+        let Some(patterns) = &mut self.patterns else {
             return Ok(());
         };
-        let level = segments * 0.5;
-        let pattern = ctx.refinement_pattern(Domain::Triangle, params.spacing, level)?;
-        if !slot
-            .as_ref()
-            .is_some_and(|p| std::sync::Arc::ptr_eq(&p.pattern, &pattern))
-        {
-            let key = PatternKey::new(Domain::Triangle, params.spacing, level);
-            *slot = Some(PatternBuffers::new(ctx.device(), key, pattern)?);
+        let level = uniform_level.unwrap_or(1.0);
+        match view {
+            None => patterns.prepare_uniform(ctx, level, &pieces),
+            Some(view) => {
+                let host = HostView::new(&view, params.factors, level, max_level, morph);
+                patterns.prepare_host_levels(ctx, &host, &self.base_positions, &pieces)
+            }
         }
-        Ok(())
     }
 
     fn record_pre_pass<'a>(
@@ -1211,7 +1283,7 @@ impl Technique for Bft {
     ) -> Result<()> {
         // The stages that read level 1: the pattern path's vertex stage alone (a device
         // without tessellation shaders may name no tessellation stage in a barrier).
-        let tess_stages = match self.pattern {
+        let tess_stages = match self.patterns {
             Some(_) => vk::PipelineStageFlags::VERTEX_SHADER,
             None => {
                 vk::PipelineStageFlags::VERTEX_SHADER
@@ -1222,6 +1294,9 @@ impl Technique for Bft {
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
         let write = (compute, vk::AccessFlags::SHADER_WRITE);
         enc.begin_label("bft initial subdivision step");
+        if let Some(p) = &self.patterns {
+            p.record_ids(enc)?;
+        }
         // The previous frame's tessellation stages read level 1 before we overwrite it; host
         // writes of the base positions are visible at submit.
         enc.memory_barrier((tess_stages, vk::AccessFlags::SHADER_READ), write);
@@ -1268,46 +1343,33 @@ impl Technique for Bft {
             .arrays
             .get(array)
             .ok_or(TessError::NoPatchArray { array })?;
-        let mut push = self.push(params, pass.mode());
-        let pattern = match &self.pattern {
-            Some(Some(p)) => {
-                enc.bind_vertex_buffer(0, &p.points);
-                enc.bind_index_buffer_u32(&p.indices);
-                Some(3 * p.pattern.triangles.len() as u32)
-            }
-            Some(None) => return Err(TessError::NoPatchArray { array }),
-            None => None,
-        };
+        let push = self.push(params, pass.mode());
+        if let Some(p) = &self.patterns {
+            return p.record(enc, &self.draw_chunks, &self.draw_sets, push);
+        }
+        let mut push = push;
         let mut counts = DrawCounts::default();
-        let array_end = a.first_patch + a.patches;
-        for (k, ((items, w), set)) in self.draw_chunks.iter().zip(&self.draw_sets).enumerate() {
-            let start = items.start.max(a.first_patch);
-            let end = items.end.min(array_end);
-            if start >= end {
-                continue;
-            }
+        let mut bound = 0;
+        for (k, faces) in self.drawn_pieces(a.first_patch..a.first_patch + a.patches) {
             // The context bound the first chunk's set.
-            if k > 0 {
+            if k != bound {
+                let set = self
+                    .draw_sets
+                    .get(k)
+                    .ok_or(TessError::NoPatchArray { array })?;
                 enc.bind_descriptor_sets(1, &[set])?;
+                bound = k;
             }
-            w.apply(&mut push);
-            for run in &self.drawn {
-                let (start, end) = (start.max(run.start), end.min(run.end));
-                if start >= end {
-                    continue;
-                }
-                counts += for_each_draw(end - start, per_draw, |first, n| {
-                    let first = start - a.first_patch + first;
-                    push.first_patch = a.first_patch + first;
-                    enc.push_constants(&push)?;
-                    match pattern {
-                        // One instance of the pattern per patch: the instance is the patch.
-                        Some(indices) => enc.draw_indexed_instanced(0..indices, 0..n)?,
-                        None => enc.draw(first..first + n)?,
-                    }
-                    Ok(())
-                })?;
+            if let Some((_, w)) = self.draw_chunks.get(k) {
+                w.apply(&mut push);
             }
+            counts += for_each_draw(faces.end - faces.start, per_draw, |first, n| {
+                let first = faces.start - a.first_patch + first;
+                push.first_patch = a.first_patch + first;
+                enc.push_constants(&push)?;
+                enc.draw(first..first + n)?;
+                Ok(())
+            })?;
         }
         Ok(counts)
     }
@@ -1346,12 +1408,11 @@ impl Technique for Bft {
     /// Per frame slot, the base positions; the tables, patch records, stencils, level-1
     /// vertices and normals.
     fn device_memory(&self) -> Vec<DeviceAllocation> {
-        let pattern = self.pattern.iter().flatten();
         self.base
             .iter()
             .chain(self.evaluator.buffers())
             .chain(&self._static)
-            .chain(pattern.flat_map(|p| [&p.points, &p.indices]))
+            .chain(self.patterns.iter().flat_map(BftPatterns::buffers))
             .map(DeviceAllocation::of_buffer)
             .collect()
     }

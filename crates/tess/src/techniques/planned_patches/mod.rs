@@ -65,12 +65,13 @@ use crate::technique::{
     for_each_draw, number_arrays, DeviceAllocation, DrawCounts, DrawPath, FactorPolicy, Features,
     FrameParams, Pass, PatchArray, PatchPipeline, PatchType, Technique, TechniqueId,
 };
+use crate::techniques::host_view::HostView;
 use crate::techniques::{BuildOptions, Built, LegendEntry};
 use crate::tessellator::{
     quad_triangle_count, triangle_triangle_count, uniform_vertex_count, Domain, Spacing,
 };
 use layout::GpuPlan;
-use patterns::{key_of_kinds, HostView, PatternDraws};
+use patterns::{key_of_kinds, PatternDraws};
 use std::ops::Range;
 use topology::patches::adaptive::single_pass::{
     plan_single_pass, SinglePassOptions, SinglePassPatch,
@@ -1209,13 +1210,8 @@ impl Technique for PlannedPatches {
         let view = *ctx
             .frame_view()
             .ok_or(TessError::NoFrameView { technique: self.id })?;
-        let (mode, segments, pixels, reference) = factor_fields(params.factors);
-        let field = match params.factors {
-            FactorPolicy::Uniform { .. } => segments,
-            FactorPolicy::Screen { .. } => pixels,
-            FactorPolicy::Distance { .. } => reference,
-        };
-        let host = HostView::new(&view, mode, field, self.factor_limit(), morph);
+        let segments = params.uniform_segments().unwrap_or(1.0);
+        let host = HostView::new(&view, params.factors, segments, self.factor_limit(), morph);
         self.update_host_vertices();
         let vertices = self
             .host_vertices
@@ -1229,7 +1225,7 @@ impl Technique for PlannedPatches {
                 Some(p) => host.key(domain, p, &factors),
                 None => (
                     crate::pattern::PatternKey::new(domain, Spacing::Equal, 1.0),
-                    patterns::NO_MORPH,
+                    crate::techniques::host_view::NO_MORPH,
                 ),
             }
         };

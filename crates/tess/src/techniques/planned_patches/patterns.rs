@@ -38,9 +38,12 @@ use crate::error::{Result, TessError};
 use crate::gpu::bindings::{
     ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_PLAIN, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM,
 };
-use crate::gpu::{AdaptivePush, FrameUniforms};
+use crate::gpu::AdaptivePush;
 use crate::pattern::{PatternBuffers, PatternKey};
 use crate::technique::{DrawCounts, PatchArray};
+use crate::techniques::host_view::{
+    morph_weight, pow2_level, unorm16_pair, HostView, MorphWords, NO_MORPH,
+};
 use crate::tessellator::{Domain, Spacing};
 use std::collections::{BTreeMap, HashMap};
 use std::ops::Range;
@@ -79,55 +82,7 @@ struct FrameGroups {
     groups: Vec<Vec<(PatternKey, Range<u32>)>>,
 }
 
-/// What the host's level choice reads of a frame: the view, the policy's fields and the largest
-/// level (`curve_factor` and `edge_level` of `adaptive.glsl`).
-pub(super) struct HostView {
-    pub view_proj: glam::Mat4,
-    pub viewport: [f32; 2],
-    pub eye: glam::Vec3,
-    /// `BFT_FACTORS_SCREEN`, `BFT_FACTORS_DISTANCE` or `BFT_FACTORS_UNIFORM`.
-    pub mode: u32,
-    /// The policy's field: segments, pixels per segment or reference distance.
-    pub field: f32,
-    pub max_level: f32,
-    /// Geomorphing: each edge gets the weight of its level (step 5 of the module docs).
-    pub morph: bool,
-}
-
-/// A patch's morph weights as the instance carries them: unorm16 pairs (edges 0 and 1, edges 2
-/// and 3, the inside along u and v); all 1 (no morph) without geomorphing.
-pub(super) type MorphWords = [u32; 3];
-
-/// Morph weights of 1 everywhere: each vertex where its pattern puts it.
-pub(super) const NO_MORPH: MorphWords = [u32::MAX; 3];
-
-/// The weight of a level-`level` edge whose continuous factor is `g`: 0 where `g` is half the
-/// level (the odd vertices lie on the coarser level's), 1 at the level itself.
-fn morph_weight(g: f32, level: f32) -> f32 {
-    if level <= 1.0 {
-        return 1.0;
-    }
-    ((g - 0.5 * level) / (0.5 * level)).clamp(0.0, 1.0)
-}
-
-fn unorm16_pair(a: f32, b: f32) -> u32 {
-    let q = |x: f32| (x.clamp(0.0, 1.0) * 65535.0).round() as u32;
-    q(a) | (q(b) << 16)
-}
-
 impl HostView {
-    pub fn new(view: &FrameUniforms, mode: u32, field: f32, max_level: f32, morph: bool) -> Self {
-        Self {
-            view_proj: glam::Mat4::from_cols_array_2d(&view.view_proj),
-            viewport: [view.viewport[0], view.viewport[1]],
-            eye: glam::Vec3::new(view.camera_pos[0], view.camera_pos[1], view.camera_pos[2]),
-            mode,
-            field,
-            max_level,
-            morph,
-        }
-    }
-
     /// The factor a curve of control points `p` asks for (`curve_factor`).
     fn curve_factor(&self, p: [glam::Vec3; 4]) -> f32 {
         if self.mode == BFT_FACTORS_UNIFORM {
@@ -170,11 +125,8 @@ impl HostView {
                 .copied()
                 .unwrap_or(1.0)
         };
-        let pow2 = |f: f32| (f.log2() - 1e-4).ceil().exp2();
-        let weight = |g: f32, level: f32| match self.morph {
-            true => morph_weight(g, level),
-            false => 1.0,
-        };
+        let pow2 = pow2_level;
+        let weight = |g: f32, level: f32| self.weight(g, level);
         let lim = self.max_level;
         if kind == ADAPTIVE_EDGE_PLAIN {
             let g = factor(0).clamp(1.0, lim);
@@ -526,20 +478,6 @@ mod tests {
 
     fn has_coarse_edge(kinds: u32) -> bool {
         (0..4).any(|i| (kinds >> (4 * i)) & 3 == ADAPTIVE_EDGE_COARSE)
-    }
-
-    /// The morph weight runs from 0 at half the level to 1 at the level; a level-1 edge has
-    /// nothing to morph; the weights travel as unorm16, 1 exactly as 65535.
-    #[test]
-    fn morph_weights_span_a_doubling() {
-        assert_eq!(morph_weight(4.0, 8.0), 0.0);
-        assert_eq!(morph_weight(6.0, 8.0), 0.5);
-        assert_eq!(morph_weight(8.0, 8.0), 1.0);
-        assert_eq!(morph_weight(1.0, 1.0), 1.0);
-        assert_eq!(morph_weight(3.9, 8.0), 0.0);
-        assert_eq!(unorm16_pair(1.0, 0.0), 0xFFFF);
-        assert_eq!(unorm16_pair(0.0, 1.0), 0xFFFF_0000);
-        assert_eq!(NO_MORPH, [unorm16_pair(1.0, 1.0); 3]);
     }
 
     /// The levels of tesc_levels.glsl: a coarse bottom edge (patch edge 0) is outer level 1
