@@ -583,8 +583,8 @@ fn mirror_error(mirror: &GpuBft, base: &[[f32; 3]], soup: &CapturedSoup) -> f64 
 /// point, and every table point the exact Loop limit there. Geomorphing (fractional-even
 /// spacing) moves the odd vertices off the table points (some vertices are inexact), and just
 /// past a level's doubling every vertex is within 1e-4 of the diagonal of a vertex of the frame
-/// before: the level of detail does not pop. The same welds on a device without tessellation
-/// shaders.
+/// before: the level of detail does not pop. A uniform level that is not whole welds on the
+/// tessellation path too; the same welds on a device without tessellation shaders.
 #[test]
 fn bft_takes_screen_space_distance_and_geomorphing_through_patterns() {
     use tessera::tess::animation::{base_positions, Wave};
@@ -655,7 +655,6 @@ fn bft_takes_screen_space_distance_and_geomorphing_through_patterns() {
                     .filter(|r| r.flags & 1 == 1 && on_lattice(r.domain))
                     .copied()
                     .collect(),
-                ..soup.clone()
             };
             let moved = soup.records.iter().filter(|r| r.flags & 1 == 0).count();
             let limit = match time {
@@ -701,6 +700,21 @@ fn bft_takes_screen_space_distance_and_geomorphing_through_patterns() {
         }
         println!("bft: past the doubling, every vertex within {worst:.1e} of one before");
         assert!(worst <= 1e-4, "{worst}");
+        // A level that is not whole is fractional spacing's on the tessellation path too.
+        let mut tess = build(
+            &mut ctx,
+            TechniqueId::BFT,
+            &mesh,
+            PipelineChoice::Tessellation,
+        )
+        .unwrap();
+        let soup = capture(&mut ctx, tess.as_mut(), &params(5.3, morph));
+        assert!(soup.triangle_count() > 0);
+        assert_eq!(
+            common::cracks(tess.as_ref(), &soup, &mesh),
+            (0, 0),
+            "tessellation, 5.3"
+        );
     }
     assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
     drop(gpu);

@@ -62,7 +62,7 @@ pub struct ExportArgs {
     pub method: Option<TechniqueId>,
     /// Segments per base edge, the tessellation level (outer and inner): 1 to 64; flat, phong
     /// and pn on the pattern path up to 256; bft takes powers of two from 2 to
-    /// 2^(table level + 1) unless --fractional; adaptive: segments per patch edge, 1 to 32. Ignored with --factors screen or distance.
+    /// 2^(table level + 1), any level in that range with --spacing fractional-even; adaptive: segments per patch edge, 1 to 32. Ignored with --factors screen or distance.
     #[arg(long, alias = "level", default_value_t = 8.0, allow_hyphen_values = true, value_parser = parse_segments)]
     pub segments: f32,
     /// The level of a uniform refinement (Doo-Sabin's `doo-sabin`, `vertex-patches`,
@@ -420,7 +420,7 @@ pub struct SceneArgs {
           long_help = crate::technique::method_long_help())]
     pub method: Option<TechniqueId>,
     /// Segments per base edge, the tessellation level (outer and inner): 1 to 64; bft takes
-    /// powers of two from 2 to 2^(table level + 1) unless --fractional; adaptive: segments per
+    /// powers of two from 2 to 2^(table level + 1), any level in that range with --spacing fractional-even; adaptive: segments per
     /// patch edge, 1 to 32 (a coarse transition edge gets twice as many).
     #[arg(long, alias = "level", default_value_t = 8.0, allow_hyphen_values = true, value_parser = parse_segments)]
     pub segments: f32,

@@ -94,6 +94,7 @@ fn variant(spacing: Option<Spacing>, capture: bool) -> Variant {
         patch_block: false,
         scalar_tags: false,
         face_varying: false,
+        geomorph: false,
     }
 }
 
@@ -104,6 +105,7 @@ const PLAIN: Variant = Variant {
     patch_block: false,
     scalar_tags: false,
     face_varying: false,
+    geomorph: false,
 };
 
 /// BFT's patch-block build (its control stage reads the ring and level-1 buffers too).
@@ -1165,10 +1167,10 @@ fn the_table_covers_every_storage_binding_and_capture_build() {
     // Nine TESs in three spacings, the four adaptive ones and BFT's also with their surface code,
     // the adaptive ones also in their face-varying build, BFT's also with and without its patch
     // block; the CPU mesh's, Doo-Sabin's and the vertex patches' vertex stages, the four refinement-pattern vertex
-    // stages, PN's also in its scalar-tagged build, BFT's with and without its surface code, and
-    // the four adaptive pattern vertex stages with and without their surface and face-varying
-    // code.
-    assert_eq!(capture_builds, 98);
+    // stages, PN's also in its scalar-tagged build, BFT's with and without its surface code and
+    // its geomorphing build, and the four adaptive pattern vertex stages with and without their
+    // surface and face-varying code.
+    assert_eq!(capture_builds, 100);
     assert_eq!(xfb_rows, capture_builds);
 }
 
@@ -1246,7 +1248,7 @@ fn capture_variants_and_only_they_have_xfb() {
             captures += v.capture as usize;
         }
     }
-    assert_eq!(captures, 98);
+    assert_eq!(captures, 100);
 }
 
 #[test]
