@@ -1246,7 +1246,7 @@ impl Technique for Bft {
 
     /// On the pattern path, takes the frame's patterns from the context: under uniform factors
     /// one triangle pattern per level-1 face at half the base edge's segments, else (and when
-    /// geomorphing) the levels the host chooses for each face ([`patterns`] module docs).
+    /// geomorphing) the levels the host chooses for each face (the `patterns` module docs).
     fn prepare_frame(&mut self, ctx: &mut Context, params: &FrameParams) -> Result<()> {
         if self.patterns.is_none() {
             return Ok(());
