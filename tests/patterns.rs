@@ -743,6 +743,89 @@ fn bft_takes_screen_space_distance_and_geomorphing_through_patterns() {
     assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
 }
 
+/// The seed's sine displacement on BFT, on both paths: at a uniform level the pattern path
+/// has the tessellation path's bits at every sample; both weld with 0 cracks, as do the
+/// patterns under screen-space factors (a shared point has its owner's position and normal bits
+/// on both faces, so it moves to the same bits); and every vertex is the tables' f32 mirror
+/// moved by a·sin(f·‖P‖) along its unit normal, within 1e-5 of the diagonal.
+#[test]
+fn bft_takes_the_sine_displacement_on_both_paths() {
+    let mesh = spot().triangulated().0;
+    let diagonal = mesh.bbox_diagonal();
+    let gpu = Gpu::new();
+    {
+        let mut ctx = Context::offscreen(gpu.device()).unwrap();
+        let mut tess = build(
+            &mut ctx,
+            TechniqueId::BFT,
+            &mesh,
+            PipelineChoice::Tessellation,
+        )
+        .unwrap();
+        let mut pattern =
+            build(&mut ctx, TechniqueId::BFT, &mesh, PipelineChoice::Pattern).unwrap();
+        let prepared = prepare_loop_bft(tess.base_mesh().unwrap(), DEFAULT_TABLE_LEVEL, false);
+        let mirror = GpuBft::new(&prepared.unwrap()).unwrap();
+        let level1 = mirror.subdivide(&tessera::tess::animation::base_positions(&mesh));
+        let normals = mirror.normals(&level1);
+        let uniform = FrameParams {
+            displace_sine: SINE,
+            ..params(8.0, Spacing::Equal)
+        };
+        let a = capture(&mut ctx, tess.as_mut(), &uniform);
+        let b = capture(&mut ctx, pattern.as_mut(), &uniform);
+        assert_eq!(
+            common::cracks(tess.as_ref(), &a, &mesh),
+            (0, 0),
+            "tessellation"
+        );
+        assert_eq!(
+            common::cracks(pattern.as_ref(), &b, &mesh),
+            (0, 0),
+            "pattern"
+        );
+        let (sa, sb) = (samples(&a), samples(&b));
+        let differing = sa.iter().filter(|(k, v)| sb.get(k) != Some(v)).count();
+        assert_eq!(differing, 0, "of {} samples", sa.len());
+        let (mut worst, mut moved) = (0.0f64, 0.0f64);
+        for r in &a.records {
+            let [x, y] = r.domain;
+            let b = [x, y, (1.0 - x - y).max(0.0)];
+            let m = mirror.eval_tess(&level1, &normals, r.patch as usize, b, false);
+            let p = m.position.map(f64::from);
+            let n = m.normal.map(f64::from);
+            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            let norm = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+            let h = SINE[0] as f64 * (SINE[1] as f64 * norm).sin() / len;
+            let d = (0..3)
+                .map(|k| (r.position[k] as f64 - (p[k] + h * n[k])).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            worst = worst.max(d / diagonal);
+            moved = moved.max((h * len).abs());
+        }
+        println!(
+            "bft with the sine displacement: {} samples bit-identical on both paths, {worst:.1e} \
+             of the diagonal from the displaced mirror, largest move {moved:.4}",
+            sa.len()
+        );
+        assert!(worst <= 1e-5, "{worst}");
+        assert!(moved > 0.9 * SINE[0] as f64, "{moved}");
+        let screen = FrameParams {
+            factors: FactorPolicy::Screen { pixels: 5.0 },
+            displace_sine: SINE,
+            ..FrameParams::default()
+        };
+        let soup = capture(&mut ctx, pattern.as_mut(), &screen);
+        assert_eq!(
+            common::cracks(pattern.as_ref(), &soup, &mesh),
+            (0, 0),
+            "screen-space"
+        );
+    }
+    assert!(gpu.errors().is_empty(), "{:?}", gpu.errors());
+}
+
 /// The planned surfaces (feature-adaptive Catmull-Clark, Gregory, ACC-1, the Doo-Sabin limit),
 /// which evaluate at a patch domain point.
 const PLANNED_TECHNIQUES: [TechniqueId; 4] = [

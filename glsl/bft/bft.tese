@@ -11,6 +11,9 @@
 #include "bft.glsl"
 #include "tese_out.glsl"
 #include "normals.glsl"
+#ifdef SURFACE_BUILD
+#include "sine.glsl"
+#endif
 layout(triangles, SPACING, ccw) in;
 #ifdef SURFACE_BUILD
 // Only with patch colours (Technique::surface_build): a varying costs lavapipe's rasterizer on
@@ -29,6 +32,11 @@ void main() {
     uint kind = tc_head.y >> BFT_INFO_KIND_SHIFT;
 #ifdef SURFACE_BUILD
     out_albedo = (bft.options & uint(BFT_OPTION_PATCH_COLOURS)) != 0u ? KIND_COLOURS[min(kind, 3u)] : frame.base_color.rgb;
+#endif
+#ifdef SURFACE_BUILD
+    // The seed's sine displacement along the normal: shared points have their owner's position
+    // and normal bits on both faces, so they move to the same bits.
+    p = displace_sine(p, n);
 #endif
     emit_sample(p, safe_normalize(n, vec3(0.0)), face, (exact ? uint(CAPTURE_FLAG_EXACT) : 0u) | (kind << CAPTURE_FLAG_KIND_SHIFT));
 }

@@ -29,6 +29,9 @@
 #include "bft.glsl"
 #include "stage_out.glsl"
 #include "normals.glsl"
+#ifdef SURFACE_BUILD
+#include "sine.glsl"
+#endif
 layout(location = 0) in vec3 in_domain;
 layout(location = 1) in uvec4 in_patch;
 #ifdef SURFACE_BUILD
@@ -112,6 +115,7 @@ void main() {
     uint kind = table_entries[PATCH(face).entry].kind;
 #ifdef SURFACE_BUILD
     out_albedo = (bft.options & uint(BFT_OPTION_PATCH_COLOURS)) != 0u ? KIND_COLOURS[min(kind, 3u)] : frame.base_color.rgb;
+    p = displace_sine(p, n);
 #endif
     emit_vertex_at(p, safe_normalize(n, vec3(0.0)), face,
         (exact ? uint(CAPTURE_FLAG_EXACT) : 0u) | (kind << CAPTURE_FLAG_KIND_SHIFT), at);

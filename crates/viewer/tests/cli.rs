@@ -948,13 +948,41 @@ fn export_bft_writes_the_exact_limit_at_each_vertex() {
     }
 }
 
-/// Adaptive and fractional BFT factors stay watertight through the whole command.
+/// Adaptive and fractional BFT factors stay watertight through the whole command, on both
+/// draw paths (on patterns fractional-even spacing geomorphs, and its level need not be whole).
 #[test]
 fn export_bft_adaptive_and_fractional_are_watertight() {
     let cube = data("tests/data/meshes/cube.obj");
     let out = tmp("bft_adaptive.obj");
+    let pattern = ["--pipeline", "pattern"];
     for extra in [
         &["--factors", "screen", "--pixels", "6"][..],
+        &[
+            pattern[0],
+            pattern[1],
+            "--factors",
+            "screen",
+            "--pixels",
+            "6",
+        ],
+        &[
+            pattern[0],
+            pattern[1],
+            "--factors",
+            "distance",
+            "--distance",
+            "0.8",
+            "--spacing",
+            "fractional-even",
+        ],
+        &[
+            pattern[0],
+            pattern[1],
+            "--segments",
+            "5.3",
+            "--spacing",
+            "fractional-even",
+        ],
         // The old spelling of --factors is still accepted.
         &["--adaptive", "distance", "--distance", "0.8"],
         &["--factors", "screen", "--pixels", "5", "--fractional"],

@@ -1290,32 +1290,6 @@ fn the_draw_path_options_draw_or_name_what_is_wrong() {
     fails(
         &render(&[
             "--method",
-            "bft",
-            "--pipeline",
-            "pattern",
-            "--spacing",
-            "fractional-even",
-        ]),
-        &[],
-        1,
-        &["equal spacing", "--spacing equal"],
-    );
-    fails(
-        &render(&[
-            "--method",
-            "bft",
-            "--pipeline",
-            "pattern",
-            "--factors",
-            "screen",
-        ]),
-        &[],
-        1,
-        &["bft", "screen-space", "--pipeline tessellation"],
-    );
-    fails(
-        &render(&[
-            "--method",
             "pn",
             "--no-tessellation-shader",
             "--spacing",
@@ -1340,7 +1314,7 @@ fn the_draw_path_options_draw_or_name_what_is_wrong() {
         );
     }
     fails(
-        &render(&["--method", "bft", "--displace-sine", "0.1,2"]),
+        &render(&["--method", "doo-sabin-limit", "--displace-sine", "0.1,2"]),
         &[],
         1,
         &["--displace-sine", "--method pn"],

@@ -104,7 +104,7 @@ pub static INFO: TechniqueInfo = TechniqueInfo {
         isolation: false,
         surface: false,
         single_pass: false,
-        sine_displacement: false,
+        sine_displacement: true,
         paths: &[DrawPath::Tessellation, DrawPath::Pattern],
     },
     scheme: Some(topology::Scheme::Loop),
@@ -1159,9 +1159,9 @@ impl Technique for Bft {
         check_frame(self.summary.table.level, params)
     }
 
-    /// Only patch colours need the surface build (its albedo varying).
+    /// Patch colours (the albedo varying) and the sine displacement need the surface build.
     fn surface_build(&self, params: &FrameParams) -> bool {
-        params.patch_colours
+        params.patch_colours || params.displace_sine[0] != 0.0
     }
 
     fn patch_pipeline(&self, patch: PatchType) -> PatchPipeline {
