@@ -5,7 +5,8 @@
 //!   shader folder or `glsl/common/`;
 //! - a frame renders validation-clean and draws something;
 //! - a capture of what the GPU emitted welds by position bits with 0 cracks and 0 unmapped
-//!   vertices on these closed meshes;
+//!   vertices on these closed meshes, under uniform factors and (on the cube) under every
+//!   factor policy and spacing it declares;
 //! - if it declares animation, a moved base captures with 0 cracks too, and the surface moved;
 //! - each option it declares it does not take is refused by name, and animation is refused
 //!   where it is not declared.
@@ -151,6 +152,7 @@ fn every_technique_draws_captures_and_welds_on_every_declared_path() {
         let mut ctx = Context::offscreen(gpu.device()).unwrap();
         let capturer = Capturer::new(&ctx).unwrap();
         let params = FrameParams::uniform(SEGMENTS);
+        let mut policy_captures = 0;
         for info in techniques::registry() {
             assert!(!info.features.paths.is_empty(), "{}: no draw path", info.id);
             for (name, mesh) in meshes() {
@@ -165,6 +167,18 @@ fn every_technique_draws_captures_and_welds_on_every_declared_path() {
                     );
                     let (classes, rest) = capture(&mut ctx, &capturer, t.as_mut(), &mesh, &params);
                     assert_eq!(classes, (0, 0, 0), "{what}: (cracks, unmapped, boundary)");
+                    // On the cube: the tessellation path's capture is sized for the largest
+                    // level a policy can reach, past the capture budget on spot's patches.
+                    let policies = if name == "cube" {
+                        policies(info, &mesh)
+                    } else {
+                        Vec::new()
+                    };
+                    for (policy, p) in policies {
+                        let (classes, _) = capture(&mut ctx, &capturer, t.as_mut(), &mesh, &p);
+                        assert_eq!(classes, (0, 0, 0), "{what}, {policy}");
+                        policy_captures += 1;
+                    }
                     if info.features.animation {
                         let base = t.base_mesh().expect("an animated technique's base").clone();
                         let moved = Wave::new(&base).at(0.37);
@@ -178,7 +192,44 @@ fn every_technique_draws_captures_and_welds_on_every_declared_path() {
                 }
             }
         }
+        println!("{policy_captures} captures under other factor policies and spacings");
+        assert!(policy_captures >= 30, "{policy_captures}");
     }
+}
+
+/// One frame per factor policy and spacing a technique declares beyond uniform factors in
+/// equal spacing: screen-space and distance factors, and each other spacing at a level that is
+/// not a power of two.
+fn policies(info: &TechniqueInfo, mesh: &ControlMesh) -> Vec<(String, FrameParams)> {
+    let f = info.features;
+    let mut out = Vec::new();
+    if f.adaptive_factors {
+        let reference = 0.5 * mesh.bbox_diagonal() as f32;
+        for factors in [
+            FactorPolicy::Screen { pixels: 8.0 },
+            FactorPolicy::Distance { reference },
+        ] {
+            out.push((
+                format!("{factors}"),
+                FrameParams {
+                    factors,
+                    ..FrameParams::uniform(SEGMENTS)
+                },
+            ));
+        }
+    }
+    for spacing in [Spacing::FractionalEven, Spacing::FractionalOdd] {
+        if f.spacing(spacing) {
+            out.push((
+                format!("{spacing:?} spacing"),
+                FrameParams {
+                    spacing,
+                    ..FrameParams::uniform(6.0)
+                },
+            ));
+        }
+    }
+    out
 }
 
 /// One frame per option a technique's features decline, each using that option alone.
