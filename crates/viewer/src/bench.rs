@@ -2,9 +2,10 @@
 //! `tess::bench` (so GPU tests can drive it); this is the command line around it: the mesh
 //! set, the options, the console table and the CSV / Markdown files.
 use crate::cli::{BenchArgs, PlotArgs};
+use crate::technique::Factors;
 use crate::commands::{check_validation, open_device};
 use anyhow::{bail, Context, Result};
-use tess::bench::{self, BenchConfig, BenchMesh};
+use tess::bench::{self, BenchConfig, BenchFactors, BenchMesh};
 use tess::Camera;
 use vk_core::vk;
 
@@ -215,6 +216,14 @@ fn config(a: &BenchArgs) -> Result<BenchConfig> {
         maps,
         displace: a.displace.unwrap_or(0.0),
         reparam: !a.no_reparam,
+        factors: match a.factors {
+            None | Some(Factors::Uniform) => BenchFactors::Uniform,
+            Some(Factors::Screen) => BenchFactors::Screen { pixels: a.pixels },
+            Some(Factors::Distance) => BenchFactors::Distance {
+                diagonals: a.distance,
+            },
+        },
+        spacing: a.spacing,
     })
 }
 

@@ -145,6 +145,23 @@ pub struct BenchArgs {
     /// Adaptive rows stop semi-sharp creases at the isolation level (OpenSubdiv's behaviour).
     #[arg(long)]
     pub creases_at_isolation: bool,
+    /// Edge factors of the methods that take them (bft, adaptive, gregory, acc, doo-sabin-limit):
+    /// uniform (each row's S, the default), screen (projected edge length / --pixels) or
+    /// distance (--distance); under screen and distance factors S only names the rows, and the
+    /// other methods keep S.
+    #[arg(long, value_parser = crate::technique::parse_factors)]
+    pub factors: Option<crate::technique::Factors>,
+    /// --factors screen: target pixels per segment, 0.5 to 16384.
+    #[arg(long, default_value_t = 8.0, allow_hyphen_values = true, value_parser = crate::technique::parse_pixels)]
+    pub pixels: f32,
+    /// --factors distance: eye distance, in bounding-box diagonals, at which an edge gets the
+    /// largest level (above 0, at most 1000000).
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true, value_parser = crate::technique::parse_distance)]
+    pub distance: f32,
+    /// Spacing of the methods that take it (fractional-even geomorphs between levels on the
+    /// pattern path of bft and the planned surfaces); the others draw equal spacing.
+    #[arg(long, default_value = "equal", value_parser = parse_spacing)]
+    pub spacing: Spacing,
     /// Compare at equal output triangles: at each mesh and S, Flat draws S segments per base
     /// edge and every other technique the whole segments per (patch) edge whose triangle count
     /// is nearest Flat's (rows give the level drawn and the triangles over Flat's). Needs flat

@@ -36,11 +36,11 @@ fn parse_weld(s: &str) -> Result<f64, String> {
     }
 }
 
-fn parse_pixels(s: &str) -> Result<f32, String> {
+pub fn parse_pixels(s: &str) -> Result<f32, String> {
     float(s, "--pixels", 0.5, 16384.0)
 }
 
-fn parse_distance(s: &str) -> Result<f32, String> {
+pub fn parse_distance(s: &str) -> Result<f32, String> {
     float(s, "--distance", 0.0, 1e6)
 }
 
@@ -199,7 +199,7 @@ pub enum Factors {
     Distance,
 }
 
-fn parse_factors(s: &str) -> Result<Factors, String> {
+pub fn parse_factors(s: &str) -> Result<Factors, String> {
     match s {
         "uniform" => Ok(Factors::Uniform),
         "screen" => Ok(Factors::Screen),
@@ -221,10 +221,11 @@ pub struct SurfaceArgs {
     pub scheme: Option<String>,
     /// Draw path: tessellation (the tessellation stage), pattern (refinement patterns: a
     /// tessellated domain stored once and instanced over the patches, evaluated in the vertex
-    /// stage; flat, phong, pn and bft so far) or auto (where a technique has both, the one
-    /// measured faster on the device's driver: patterns on lavapipe, the tessellation stage
-    /// elsewhere, and for bft, whose patterns take uniform factors only, the tessellation stage
-    /// wherever there is one; patterns without tessellation shaders).
+    /// stage; every technique that evaluates a patch at a domain point) or auto (where a
+    /// technique has both, the one measured faster on the device's driver: patterns on
+    /// lavapipe, the tessellation stage elsewhere, and for bft and the planned surfaces, whose
+    /// patterns measured slower, the tessellation stage wherever there is one; patterns
+    /// without tessellation shaders).
     #[arg(long, default_value = "auto", value_parser = parse_pipeline)]
     pub pipeline: PipelineChoice,
     /// Merge coincident vertices before drawing: `--weld` alone merges vertices at identical

@@ -117,8 +117,25 @@ pub struct TechniqueRow {
     /// that take surface maps, else none and the default.
     displace: f32,
     reparam: bool,
+    /// The config's edge factors, and the mesh's bounding-box diagonal they are measured in.
+    factors: (super::BenchFactors, f32),
+    /// The config's spacing where the technique takes it, else equal.
+    spacing: crate::tessellator::Spacing,
     /// What the row draws beyond plain shading ([`BenchConfig::surface_note`]), for its note.
     surface_note: Option<String>,
+}
+
+/// The config's factors for a row of `info` on `mesh`: screen-space and distance factors
+/// where the technique takes them (uniform elsewhere, so Flat stays the baseline at S).
+fn row_factors(
+    config: &super::BenchConfig,
+    info: &TechniqueInfo,
+    mesh: &topology::ControlMesh,
+) -> (super::BenchFactors, f32) {
+    match info.features.adaptive_factors {
+        true => (config.factors, mesh.bbox_diagonal() as f32),
+        false => (super::BenchFactors::Uniform, 1.0),
+    }
 }
 
 impl TechniqueRow {
@@ -185,6 +202,12 @@ impl TechniqueRow {
             base_faces: ctx.mesh.input.num_faces(),
             displace: if surface { ctx.config.displace } else { 0.0 },
             reparam: !surface || ctx.config.reparam,
+            factors: row_factors(ctx.config, info, mesh),
+            spacing: if info.features.spacing(ctx.config.spacing) {
+                ctx.config.spacing
+            } else {
+                crate::tessellator::Spacing::Equal
+            },
             surface_note: if surface {
                 ctx.config.surface_note()
             } else {
@@ -211,16 +234,21 @@ impl TechniqueRow {
             base_faces: mesh.input.num_faces(),
             displace: 0.0,
             reparam: true,
+            factors: (super::BenchFactors::Uniform, 1.0),
+            spacing: crate::tessellator::Spacing::Equal,
             surface_note: None,
         }
     }
 
     fn params(&self, segments: u32, camera: Camera) -> FrameParams {
+        let (factors, diagonal) = self.factors;
         FrameParams {
             camera,
             displace: self.displace,
             reparam: self.reparam,
-            ..FrameParams::uniform(segments as f32)
+            factors: factors.policy(segments as f32, diagonal),
+            spacing: self.spacing,
+            ..FrameParams::default()
         }
     }
 

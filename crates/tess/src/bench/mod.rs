@@ -66,6 +66,52 @@ pub struct BenchConfig {
     pub displace: f32,
     /// Their texture coordinates at the reparameterized parameter on Gregory patches (seed 003).
     pub reparam: bool,
+    /// The edge factors of every frame: uniform (each row's S), or screen-space or distance
+    /// factors for the techniques that take them, whose rows then share one policy and S only
+    /// names them.
+    pub factors: BenchFactors,
+    /// The spacing of every frame of the techniques that take it (fractional-even geomorphs on
+    /// the pattern path of BFT and the planned surfaces).
+    pub spacing: crate::tessellator::Spacing,
+}
+
+/// Edge factors of a benchmark's frames ([`BenchConfig::factors`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BenchFactors {
+    /// Each row's S segments per edge.
+    Uniform,
+    /// Projected edge length over this many pixels.
+    Screen { pixels: f32 },
+    /// Halving each time the eye's distance doubles past this many bounding-box diagonals.
+    Distance { diagonals: f32 },
+}
+
+impl BenchFactors {
+    /// The policy at `segments` on a mesh of bounding-box diagonal `diagonal`.
+    pub fn policy(self, segments: f32, diagonal: f32) -> crate::FactorPolicy {
+        match self {
+            Self::Uniform => crate::FactorPolicy::Uniform { segments },
+            Self::Screen { pixels } => crate::FactorPolicy::Screen { pixels },
+            Self::Distance { diagonals } => crate::FactorPolicy::Distance {
+                reference: diagonals * diagonal.max(1e-6),
+            },
+        }
+    }
+
+    /// How the report names it, with `spacing`.
+    pub fn describe(self, spacing: crate::tessellator::Spacing) -> String {
+        let spacing = format!("{spacing:?} spacing").to_lowercase();
+        match self {
+            Self::Uniform => format!("uniform factors (S per edge), {spacing}"),
+            Self::Screen { pixels } => {
+                format!("screen-space factors ({pixels} px per segment; S names the row), {spacing}")
+            }
+            Self::Distance { diagonals } => format!(
+                "distance factors (the largest level at {diagonals} diagonals; S names the row), \
+                 {spacing}"
+            ),
+        }
+    }
 }
 
 impl BenchConfig {
@@ -123,6 +169,8 @@ impl Default for BenchConfig {
             maps: Default::default(),
             displace: 0.0,
             reparam: true,
+            factors: BenchFactors::Uniform,
+            spacing: crate::tessellator::Spacing::Equal,
         }
     }
 }
@@ -762,9 +810,12 @@ fn run_group(
             if index == 0 {
                 st.counted = stats_count;
             }
+            // Under screen-space and distance factors an animated surface's levels follow it:
+            // the row gives its first frame's triangles.
+            let fixed = config.factors == BenchFactors::Uniform;
             match st.expected {
                 None => st.expected = Some(cpu_count),
-                Some(e) if e != cpu_count => {
+                Some(e) if fixed && e != cpu_count => {
                     return Err(TessError::BenchConfig {
                         option: method.label().to_string(),
                         reason: format!("drew {cpu_count} triangles in frame {index}, {e} before"),

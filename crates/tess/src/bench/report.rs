@@ -84,7 +84,7 @@ impl BenchReport {
             format!("Date: {} UTC", self.date_utc),
             format!("Build profile: {}", self.profile),
             format!(
-                "Setup: offscreen {}x{}, default camera (yaw {}°, pitch {}°, zoom {}), equal spacing, \
+                "Setup: offscreen {}x{}, default camera (yaw {}°, pitch {}°, zoom {}), {}, \
                  {} timed frames after {} warm-up frames per row (unless a row says otherwise), the \
                  techniques' frames interleaved round robin at each mesh and S; GPU time = timestamps around the frame's work; ratio = total ms / Flat's total ms \
                  at the same mesh and S",
@@ -93,6 +93,7 @@ impl BenchReport {
                 c.camera.yaw,
                 c.camera.pitch,
                 c.camera.zoom,
+                c.factors.describe(c.spacing),
                 c.frames,
                 c.warmup
             ),
