@@ -760,6 +760,31 @@ pub struct DeviceAllocation {
 }
 
 impl DeviceAllocation {
+    /// `allocations` with those of one name as one entry, its bytes summed and its name given
+    /// the count (a family of refinement patterns: "refinement pattern Triangle points (×14)"),
+    /// in the order each name first appears.
+    pub fn merged(allocations: impl IntoIterator<Item = Self>) -> Vec<Self> {
+        let mut out: Vec<(Self, usize)> = Vec::new();
+        for a in allocations {
+            match out.iter_mut().find(|(b, _)| b.name == a.name) {
+                Some((b, n)) => {
+                    b.bytes += a.bytes;
+                    *n += 1;
+                }
+                None => out.push((a, 1)),
+            }
+        }
+        out.into_iter()
+            .map(|(a, n)| match n {
+                1 => a,
+                n => Self {
+                    name: format!("{} (×{n})", a.name),
+                    bytes: a.bytes,
+                },
+            })
+            .collect()
+    }
+
     pub fn of_buffer(b: &vk_core::Buffer) -> Self {
         Self {
             name: b.name().to_owned(),
@@ -804,6 +829,18 @@ pub fn for_each_draw(
 
 #[cfg(test)]
 mod tests {
+    /// Allocations of one name merge into one entry with their count and summed bytes; the
+    /// others keep their names and order.
+    #[test]
+    fn allocations_of_one_name_merge() {
+        let a = |name: &str, bytes| DeviceAllocation {
+            name: name.into(),
+            bytes,
+        };
+        let merged = DeviceAllocation::merged([a("p", 3), a("q", 5), a("p", 4), a("p", 1)]);
+        assert_eq!(merged, vec![a("p (×3)", 8), a("q", 5)]);
+    }
+
     use super::*;
 
     const BOTH: &[DrawPath] = &[DrawPath::Tessellation, DrawPath::Pattern];

@@ -2,8 +2,8 @@
 //! `tess::bench` (so GPU tests can drive it); this is the command line around it: the mesh
 //! set, the options, the console table and the CSV / Markdown files.
 use crate::cli::{BenchArgs, PlotArgs};
-use crate::technique::Factors;
 use crate::commands::{check_validation, open_device};
+use crate::technique::Factors;
 use anyhow::{bail, Context, Result};
 use tess::bench::{self, BenchConfig, BenchFactors, BenchMesh};
 use tess::Camera;

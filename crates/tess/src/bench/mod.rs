@@ -104,7 +104,9 @@ impl BenchFactors {
         match self {
             Self::Uniform => format!("uniform factors (S per edge), {spacing}"),
             Self::Screen { pixels } => {
-                format!("screen-space factors ({pixels} px per segment; S names the row), {spacing}")
+                format!(
+                    "screen-space factors ({pixels} px per segment; S names the row), {spacing}"
+                )
             }
             Self::Distance { diagonals } => format!(
                 "distance factors (the largest level at {diagonals} diagonals; S names the row), \

@@ -1406,15 +1406,17 @@ impl Technique for Bft {
     }
 
     /// Per frame slot, the base positions; the tables, patch records, stencils, level-1
-    /// vertices and normals.
+    /// vertices and normals; on the pattern path the instances and the frame's patterns (one
+    /// entry per kind of buffer).
     fn device_memory(&self) -> Vec<DeviceAllocation> {
-        self.base
+        let buffers = self
+            .base
             .iter()
             .chain(self.evaluator.buffers())
             .chain(&self._static)
             .chain(self.patterns.iter().flat_map(BftPatterns::buffers))
-            .map(DeviceAllocation::of_buffer)
-            .collect()
+            .map(DeviceAllocation::of_buffer);
+        DeviceAllocation::merged(buffers)
     }
 
     fn report_notes(&self) -> Vec<String> {

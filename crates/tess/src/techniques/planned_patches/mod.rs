@@ -1363,15 +1363,16 @@ impl Technique for PlannedPatches {
     /// stencils, patch records, control points, curves, patch surfaces, reparameterization
     /// table and curve and corner owners; the colour texture and height map (1×1 when none).
     fn device_memory(&self) -> Vec<DeviceAllocation> {
-        self.base
+        let buffers = self
+            .base
             .iter()
             .chain([&self.vertices])
             .chain(self.evaluator.buffers())
             .chain(&self._static)
             .chain(self.patterns.iter().flat_map(|p| p.buffers()))
             .map(DeviceAllocation::of_buffer)
-            .chain(self._textures.iter().map(DeviceAllocation::of_texture))
-            .collect()
+            .chain(self._textures.iter().map(DeviceAllocation::of_texture));
+        DeviceAllocation::merged(buffers)
     }
 
     fn report_notes(&self) -> Vec<String> {
