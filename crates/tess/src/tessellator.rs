@@ -26,6 +26,17 @@ impl std::str::FromStr for Spacing {
     }
 }
 
+/// The name `FromStr` reads: `equal`, `fractional-even`, `fractional-odd`.
+impl std::fmt::Display for Spacing {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Spacing::Equal => "equal",
+            Spacing::FractionalEven => "fractional-even",
+            Spacing::FractionalOdd => "fractional-odd",
+        })
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Domain {
     Triangle,
@@ -154,6 +165,18 @@ pub fn uniform_triangle_count(domain: Domain, spacing: Spacing, level: f32) -> u
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A spacing's name reads back as the same spacing.
+    #[test]
+    fn spacing_names_read_back() {
+        for s in [
+            Spacing::Equal,
+            Spacing::FractionalEven,
+            Spacing::FractionalOdd,
+        ] {
+            assert_eq!(s.to_string().parse::<Spacing>(), Ok(s));
+        }
+    }
 
     #[test]
     fn known_counts() {

@@ -100,7 +100,7 @@ impl BenchFactors {
 
     /// How the report names it, with `spacing`.
     pub fn describe(self, spacing: crate::tessellator::Spacing) -> String {
-        let spacing = format!("{spacing:?} spacing").to_lowercase();
+        let spacing = format!("{spacing} spacing");
         match self {
             Self::Uniform => format!("uniform factors (S per edge), {spacing}"),
             Self::Screen { pixels } => {
@@ -888,7 +888,16 @@ fn finish_row(
             }
             (c, TriangleSource::PipelineStatistics)
         }
-        None => (expected, TriangleSource::Cpu),
+        None => {
+            if expected == 0 {
+                notes.push(
+                    "triangles not counted: the control stage chooses the levels on the device, \
+                     and no pipeline-statistics query counted them"
+                        .into(),
+                );
+            }
+            (expected, TriangleSource::Cpu)
+        }
     };
     notes.extend(method.row_notes());
     let has_cpu = times.cpu_ms.iter().any(Option::is_some);
