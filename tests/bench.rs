@@ -222,6 +222,37 @@ fn bench_bft_rows_match_flat_triangles() {
     );
 }
 
+/// Screen-space factors: BFT's rows on both paths draw under them (the pattern row counts its
+/// host-chosen levels' triangles, more than one key's worth; the tessellation row's are chosen
+/// on the device and its note says they were not counted), Flat keeps its uniform S, and the
+/// report names the policy.
+#[test]
+fn bench_takes_screen_space_factors() {
+    let gpu = Gpu::new();
+    let cube = tessera::topology::load_obj(common::data("tests/data/meshes/cube.obj")).unwrap();
+    let mesh = BenchMesh::new("cube", &cube).unwrap();
+    let mut config = tiny_config(vec![4]);
+    config.methods = ["flat", "bft", "bft@pattern"].map(String::from).to_vec();
+    config.factors = bench::BenchFactors::Screen { pixels: 4.0 };
+    let report = bench::run_bench(gpu.device(), &[mesh], &config, &mut |_| {}).unwrap();
+    let row = |m: &str| report.rows.iter().find(|r| r.method == m).unwrap();
+    let flat = row("flat");
+    assert_eq!(
+        flat.triangles,
+        12 * uniform_triangle_count(Domain::Triangle, Spacing::Equal, 4.0)
+    );
+    let pattern = row("bft@pattern");
+    assert!(pattern.triangles > 0, "{pattern:?}");
+    assert!(!pattern.note.contains("not counted"), "{pattern:?}");
+    for m in ["bft", "bft-animated"] {
+        let tess = row(m);
+        assert_eq!(tess.triangles, 0, "{tess:?}");
+        assert!(tess.note.contains("not counted"), "{tess:?}");
+    }
+    let text = report.to_text();
+    assert!(text.contains("screen-space factors (4 px"), "{text}");
+}
+
 /// `--equal-triangles` on a small mixed mesh (catmull-clark pyramid: four triangles and a
 /// quad): Flat keeps S; every other technique draws the whole level per patch edge whose
 /// triangle count is nearest Flat's. Checked from outside the chooser: the GPU's count
