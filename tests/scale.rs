@@ -12,7 +12,7 @@ use tessera::tess::capture::Capturer;
 use tessera::tess::techniques::bft::{Bft, BftOptions};
 use tessera::tess::techniques::planned_patches::PlanBuild;
 use tessera::tess::techniques::{adaptive, planned_patches};
-use tessera::tess::{Context, FrameParams, Technique};
+use tessera::tess::{Context, FrameParams, PipelineChoice, Technique};
 use tessera::topology::ControlMesh;
 use tessera::vk_core::descriptor::{BindingDesc, DescriptorPool, DescriptorSetLayout};
 use tessera::vk_core::{
@@ -42,6 +42,16 @@ type BftRun = (
 /// (image, capture) of a BFT surface of `mesh` under `params` on a device capped at `cap`, its
 /// (pre-pass, draw) chunk counts and the bytes of its basis-function tables.
 fn bft_run(cap: Option<u32>, mesh: &ControlMesh, params: &FrameParams) -> BftRun {
+    bft_run_on(cap, mesh, params, PipelineChoice::Tessellation)
+}
+
+/// [`bft_run`] on the draw path `pipeline` chooses.
+fn bft_run_on(
+    cap: Option<u32>,
+    mesh: &ControlMesh,
+    params: &FrameParams,
+    pipeline: PipelineChoice,
+) -> BftRun {
     let gpu = capped(cap);
     let out = {
         let mut ctx = Context::offscreen(gpu.device()).expect("context");
@@ -53,6 +63,7 @@ fn bft_run(cap: Option<u32>, mesh: &ControlMesh, params: &FrameParams) -> BftRun
                 table_level: 2,
                 tangents: true,
                 name: "grid".into(),
+                pipeline,
                 ..BftOptions::default()
             },
         )
@@ -102,6 +113,47 @@ fn bft_under_a_tiny_storage_range_matches_the_whole_buffer_run() {
         println!("chunks under a 128 KiB range: {chunks_w:?}");
         assert!(chunks_w.0 > 1 && chunks_w.1 > 2, "{chunks_w:?}");
         assert_same_run("bft windows", (&image, &capture), (&image_w, &capture_w));
+    }
+}
+
+/// BFT's refinement patterns under a 128 KiB range: the faces are grouped by pattern key
+/// within each draw chunk (whose windows hold only its faces), so under uniform and
+/// screen-space factors, and geomorphing, the windowed run draws the same image and captures
+/// the same records (in another draw order) as the whole-buffer run.
+#[test]
+fn bft_patterns_under_a_tiny_storage_range_match_the_whole_buffer_run() {
+    let mesh = loop_grid::grid_mesh(40);
+    let screen = FrameParams {
+        factors: tessera::tess::FactorPolicy::Screen { pixels: 6.0 },
+        ..FrameParams::uniform(8.0)
+    };
+    let morph = FrameParams {
+        spacing: tessera::tess::Spacing::FractionalEven,
+        ..screen
+    };
+    let sorted = |mut records: Vec<tessera::tess::gpu::CaptureRecord>| {
+        records.sort_by_key(|r| {
+            (
+                r.patch,
+                r.domain.map(f32::to_bits),
+                r.position.map(f32::to_bits),
+            )
+        });
+        records
+    };
+    for params in [FrameParams::uniform(8.0), screen, morph] {
+        let pattern = PipelineChoice::Pattern;
+        let (image, capture, chunks, _) = bft_run_on(None, &mesh, &params, pattern);
+        assert_eq!(chunks, (1, 1));
+        let (image_w, capture_w, chunks_w, _) =
+            bft_run_on(Some(128 << 10), &mesh, &params, pattern);
+        assert!(chunks_w.1 > 2, "{chunks_w:?}");
+        let what = format!("bft patterns, {}", params.factors);
+        assert_same_run(
+            &what,
+            (&image, &sorted(capture)),
+            (&image_w, &sorted(capture_w)),
+        );
     }
 }
 
