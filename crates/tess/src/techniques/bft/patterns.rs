@@ -78,23 +78,70 @@ pub(super) struct BftPatterns {
 }
 
 impl HostLevel1 {
-    /// The level-1 positions of `base` (computed again only when it moved).
-    fn positions(&mut self, base: &[[f32; 3]]) -> &[Vec3] {
-        let stale = self.positions.as_ref().is_none_or(|(b, _)| b != base);
-        if stale {
-            let s = &self.stencils;
-            let rows = s.offsets.windows(2).map(|r| {
-                s.terms[r[0] as usize..r[1] as usize]
-                    .iter()
-                    .map(|t| {
-                        Vec3::from(base.get(t.index as usize).copied().unwrap_or_default())
-                            * t.weight
-                    })
-                    .sum::<Vec3>()
-            });
-            self.positions = Some((base.to_vec(), rows.collect()));
+    /// Recomputes the level-1 positions when `base` moved.
+    fn update_positions(&mut self, base: &[[f32; 3]]) {
+        if self.positions.as_ref().is_some_and(|(b, _)| b == base) {
+            return;
         }
-        self.positions.as_ref().map_or(&[], |(_, p)| p.as_slice())
+        let s = &self.stencils;
+        let rows = s.offsets.windows(2).map(|r| {
+            s.terms[r[0] as usize..r[1] as usize]
+                .iter()
+                .map(|t| {
+                    let p = base.get(t.index as usize).copied().unwrap_or_default();
+                    Vec3::from(p) * t.weight
+                })
+                .sum::<Vec3>()
+        });
+        self.positions = Some((base.to_vec(), rows.collect()));
+    }
+
+    /// The instances (face and morph weights) of every face of `pieces`, keyed in `host`'s view
+    /// of the level-1 surface of `base` and grouped by key within each chunk, and their draws.
+    fn keyed_draws(
+        &mut self,
+        host: &HostView,
+        base: &[[f32; 3]],
+        pieces: &[Piece],
+    ) -> Result<(Vec<[u32; 4]>, Vec<KeyDraw>)> {
+        self.update_positions(base);
+        let pos = self
+            .positions
+            .as_ref()
+            .map_or(&[][..], |(_, p)| p.as_slice());
+        let screen: Vec<Option<Vec2>> = match host.mode {
+            BFT_FACTORS_SCREEN => pos.iter().map(|&p| host.screen(p)).collect(),
+            _ => Vec::new(),
+        };
+        let factor = |a, b| host.level1_edge_factor(&screen, pos, a, b);
+        let (mut ids, mut draws) = (Vec::new(), Vec::new());
+        for (chunk, faces) in pieces {
+            let mut by_key: HashMap<PatternKey, Vec<[u32; 4]>> = HashMap::new();
+            for f in faces.clone() {
+                let c = self
+                    .corners
+                    .get(f as usize)
+                    .ok_or(TessError::IndexOutOfRange {
+                        what: "bft pattern face",
+                        index: f as u64,
+                        len: self.corners.len() as u64,
+                    })?;
+                let (key, [m0, m1, m2]) = host.face_key(*c, factor);
+                by_key.entry(key).or_default().push([f, m0, m1, m2]);
+            }
+            let mut keyed: Vec<_> = by_key.into_iter().collect();
+            keyed.sort_by_key(|(_, members)| members[0][0]);
+            for (key, members) in keyed {
+                let first = ids.len() as u32;
+                ids.extend(members);
+                draws.push(KeyDraw {
+                    chunk: *chunk,
+                    key,
+                    instances: first..ids.len() as u32,
+                });
+            }
+        }
+        Ok((ids, draws))
     }
 }
 
@@ -213,37 +260,7 @@ impl BftPatterns {
         base: &[[f32; 3]],
         pieces: &[Piece],
     ) -> Result<()> {
-        let pos = self.level1.positions(base).to_vec();
-        let screen: Vec<Option<Vec2>> = match host.mode {
-            BFT_FACTORS_SCREEN => pos.iter().map(|&p| host.screen(p)).collect(),
-            _ => Vec::new(),
-        };
-        let factor = |a, b| host.level1_edge_factor(&screen, &pos, a, b);
-        let corners = &self.level1.corners;
-        let (mut ids, mut draws) = (Vec::new(), Vec::new());
-        for (chunk, faces) in pieces {
-            let mut by_key: HashMap<PatternKey, Vec<[u32; 4]>> = HashMap::new();
-            for f in faces.clone() {
-                let c = corners.get(f as usize).ok_or(TessError::IndexOutOfRange {
-                    what: "bft pattern face",
-                    index: f as u64,
-                    len: corners.len() as u64,
-                })?;
-                let (key, [m0, m1, m2]) = host.face_key(*c, factor);
-                by_key.entry(key).or_default().push([f, m0, m1, m2]);
-            }
-            let mut keyed: Vec<_> = by_key.into_iter().collect();
-            keyed.sort_by_key(|(_, members)| members[0][0]);
-            for (key, members) in keyed {
-                let first = ids.len() as u32;
-                ids.extend(members);
-                draws.push(KeyDraw {
-                    chunk: *chunk,
-                    key,
-                    instances: first..ids.len() as u32,
-                });
-            }
-        }
+        let (ids, draws) = self.level1.keyed_draws(host, base, pieces)?;
         let keys: Vec<PatternKey> = draws.iter().map(|d| d.key).collect();
         self.take_patterns(ctx, &keys)?;
         self.ensure_frame_ids(ctx.device(), ids.len())?;
