@@ -438,6 +438,11 @@ fn bft_draws_the_same_bits_through_patterns() {
             let mut pattern =
                 build(&mut ctx, TechniqueId::BFT, mesh, PipelineChoice::Pattern).unwrap();
             assert_eq!(pattern.patch_arrays()[0].patch.path(), DrawPath::Pattern);
+            // Uniform levels' triangles are known before any frame (benchmarks choose levels
+            // by them), and are the tessellation path's.
+            let p4 = params(4.0, Spacing::Equal);
+            assert!(pattern.triangles(&p4, 0).is_some_and(|n| n > 0), "{name}");
+            assert_eq!(pattern.triangles(&p4, 0), tess.triangles(&p4, 0), "{name}");
             for (segments, time) in [(2.0, None), (4.0, None), (16.0, None), (8.0, Some(0.3))] {
                 if let Some(t) = time {
                     use tessera::tess::animation::{base_normals, base_positions, wave};

@@ -1204,8 +1204,11 @@ impl Technique for Bft {
 
     /// At the largest factor the policy can reach.
     fn max_vertices_per_patch(&self, params: &FrameParams, _array: usize) -> u64 {
-        if let Some(p) = &self.patterns {
-            return p.max_vertices();
+        // On the pattern path, the largest of the frame's patterns once prepared.
+        if let Some(n) = self.patterns.as_ref().map(BftPatterns::max_vertices) {
+            if n > 0 {
+                return n;
+            }
         }
         let max = match params.factors {
             FactorPolicy::Uniform { segments } => segments * 0.5,
@@ -1215,7 +1218,11 @@ impl Technique for Bft {
     }
 
     fn triangles(&self, params: &FrameParams, _array: usize) -> Option<u64> {
-        if let Some(p) = &self.patterns {
+        // Levels the host chooses per face (the pattern path's screen-space and distance
+        // factors, and geomorphing) are known once the frame is prepared.
+        let host_levels =
+            params.uniform_segments().is_none() || params.spacing == Spacing::FractionalEven;
+        if let (Some(p), true) = (&self.patterns, host_levels) {
             return p.triangles();
         }
         // Patterns are the tessellator's where it has one, and equal spacing's lattice
