@@ -560,6 +560,36 @@ fn exact_limit_error(t: &dyn Technique, soup: &CapturedSoup, cpu: &LocalMesh) ->
     worst
 }
 
+/// Just past a level's doubling: the largest distance, over the diagonal, from a vertex of
+/// `after` to the vertex of `before` at its patch and domain point on the 1/16 lattice (levels
+/// 4 and, on coarse transition edges, 8; a moved vertex lies next to the even point it left);
+/// every vertex of `after` must have one (`what` names the surface).
+fn past_doubling_error(
+    before: &CapturedSoup,
+    after: &CapturedSoup,
+    diagonal: f64,
+    what: &str,
+) -> f64 {
+    let key = |patch: u32, d: [f32; 2]| (patch, d.map(|x| (x * 16.0).round() as i32));
+    let old: HashMap<_, [f32; 3]> = before
+        .records
+        .iter()
+        .map(|r| (key(r.patch, r.domain), r.position))
+        .collect();
+    let mut worst = 0.0f64;
+    for r in &after.records {
+        let q = old
+            .get(&key(r.patch, r.domain))
+            .unwrap_or_else(|| panic!("{what}: no vertex before at {:?}", r.domain));
+        let d = (0..3)
+            .map(|i| (r.position[i] as f64 - q[i] as f64).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        worst = worst.max(d / diagonal);
+    }
+    worst
+}
+
 /// The largest distance between a captured BFT vertex and the tables' f32 mirror of the
 /// evaluation stage at the vertex's recorded domain point (table points exactly, other points
 /// on the level-L virtual mesh), over the level-1 surface of `base`.
@@ -685,24 +715,7 @@ fn bft_takes_screen_space_distance_and_geomorphing_through_patterns() {
             after.records.len() > before.records.len(),
             "the level doubled"
         );
-        // A vertex of `before` by its patch and domain point on the 1/16 lattice.
-        let key = |patch: u32, d: [f32; 2]| (patch, d.map(|x| (x * 16.0).round() as i32));
-        let old: HashMap<_, [f32; 3]> = before
-            .records
-            .iter()
-            .map(|r| (key(r.patch, r.domain), r.position))
-            .collect();
-        let mut worst = 0.0f64;
-        for r in &after.records {
-            let q = old
-                .get(&key(r.patch, r.domain))
-                .unwrap_or_else(|| panic!("no vertex before at {:?}", r.domain));
-            let d = (0..3)
-                .map(|i| (r.position[i] as f64 - q[i] as f64).powi(2))
-                .sum::<f64>()
-                .sqrt();
-            worst = worst.max(d / diagonal);
-        }
+        let worst = past_doubling_error(&before, &after, diagonal, "bft");
         println!("bft: past the doubling, every vertex within {worst:.1e} of one before");
         assert!(worst <= 1e-4, "{worst}");
         // A level that is not whole is fractional spacing's on the tessellation path too.
@@ -1233,25 +1246,7 @@ fn planned_patches_geomorph_between_levels_through_patterns() {
                 after.records.len() > before.records.len(),
                 "{id}: the level doubled"
             );
-            // A vertex of `before` by its patch and domain point on the 1/16 lattice (levels 4
-            // and, on coarse transition edges, 8).
-            let key = |patch: u32, d: [f32; 2]| (patch, d.map(|x| (x * 16.0).round() as i32));
-            let old: HashMap<_, [f32; 3]> = before
-                .records
-                .iter()
-                .map(|r| (key(r.patch, r.domain), r.position))
-                .collect();
-            let mut worst = 0.0f64;
-            for r in &after.records {
-                let q = old
-                    .get(&key(r.patch, r.domain))
-                    .unwrap_or_else(|| panic!("{id}: no vertex before at {:?}", r.domain));
-                let d = (0..3)
-                    .map(|i| (r.position[i] as f64 - q[i] as f64).powi(2))
-                    .sum::<f64>()
-                    .sqrt();
-                worst = worst.max(d / diagonal);
-            }
+            let worst = past_doubling_error(&before, &after, diagonal, &id.to_string());
             println!("{id}: past the doubling, every vertex within {worst:.1e} of one before");
             assert!(worst <= 1e-4, "{id}: {worst}");
         }

@@ -17,6 +17,7 @@
 // point.
 #define PATTERN_PATH
 #include "stage_out.glsl"
+#include "morph.glsl"
 layout(location = 0) in vec3 in_domain;
 layout(location = 1) in uvec4 in_patch;
 uint tc_patch;
@@ -42,26 +43,11 @@ float edge_morph(uint e) {
 // levels are the larger of each facing pair of edge levels, as the pattern's key sets them.
 // On quads an odd lattice index k slides to k - 1, but the first (k = 1, beside the strip
 // along a patch edge) to 2: the lattice of half the level starts there, its strip covering
-// what the finer strip and first column do. On triangles, whose barycentric indices (i, j, k)
-// sum to an even level, a vertex has two odd indices or none; it slides to the neighbour that
-// makes both even, away from the edge where one index is 1 and the other can give.
+// what the finer strip and first column do. On triangles, the rule of glsl/common/morph.glsl.
 vec2 morph_inside(vec2 uv) {
 #ifdef TRIANGLE_DOMAIN
     float n = max(OUTER_LEVEL(0), max(OUTER_LEVEL(1), OUTER_LEVEL(2)));
-    float w = unpackUnorm2x16(in_patch.w).x;
-    vec2 ij = round(uv * n);
-    float k = n - ij.x - ij.y;
-    vec3 odd = mod(vec3(ij, k), 2.0);
-    if (odd.x + odd.y + odd.z == 0.0) return uv;
-    vec2 d;
-    if (odd.x > 0.0 && odd.y > 0.0) {
-        d = ij.x >= 3.0 ? vec2(-1.0, 1.0) : (ij.y >= 3.0 ? vec2(1.0, -1.0) : vec2(-1.0, -1.0));
-    } else if (odd.x > 0.0) {
-        d = (ij.x >= 3.0 || k < 3.0) ? vec2(-1.0, 0.0) : vec2(1.0, 0.0);
-    } else {
-        d = (ij.y >= 3.0 || k < 3.0) ? vec2(0.0, -1.0) : vec2(0.0, 1.0);
-    }
-    return uv + (1.0 - w) * ((ij + d) / n - uv);
+    return morph_triangle_inside(uv, n, unpackUnorm2x16(in_patch.w).x);
 #else
     vec2 levels = vec2(max(OUTER_LEVEL(1), OUTER_LEVEL(3)), max(OUTER_LEVEL(0), OUTER_LEVEL(2)));
     vec2 w = unpackUnorm2x16(in_patch.w);

@@ -15,7 +15,7 @@
 // moved point (on the level-L virtual mesh between table points, as the evaluation stage's
 // fractional factors do). An edge vertex slides along its owner's edge, counted in the owner's
 // direction, so both faces of the edge move it to the same bits; an inside vertex by the rule
-// of the planned patches' triangles (glsl/adaptive/pattern_patch.glsl, morph_inside). At weight
+// of the planned patches' triangles (glsl/common/morph.glsl). At weight
 // 0 the pattern draws the surface of its half level, at 1 its own. The capture records the
 // moved point.
 // Built with and without capture and the surface code (glsl/manifest.toml; stage_out.glsl).
@@ -29,6 +29,7 @@
 #include "bft.glsl"
 #include "stage_out.glsl"
 #include "normals.glsl"
+#include "morph.glsl"
 #ifdef SURFACE_BUILD
 #include "sine.glsl"
 #endif
@@ -55,26 +56,10 @@ float morph_edge(int e, float t) {
     return (w < 1.0 && mod(k, 2.0) == 1.0) ? t - (1.0 - w) / n : t;
 }
 
-// An inside vertex at uv (weights of v1, v2) moved by the inside's weight: its barycentric
-// indices (i, j, k) sum to the even inner level, so it has two odd indices or none; it slides
-// to the neighbour that makes both even, away from the edge where one index is 1 and the
-// other can give.
+// An inside vertex at uv (weights of v1, v2) moved by the inside's weight (morph.glsl).
 vec2 morph_inside(vec2 uv) {
     float n = max(bft.pattern_outer[0], max(bft.pattern_outer[1], bft.pattern_outer[2]));
-    float w = unpackUnorm2x16(in_patch.w).x;
-    vec2 ij = round(uv * n);
-    float k = n - ij.x - ij.y;
-    vec3 odd = mod(vec3(ij, k), 2.0);
-    if (odd.x + odd.y + odd.z == 0.0) return uv;
-    vec2 d;
-    if (odd.x > 0.0 && odd.y > 0.0) {
-        d = ij.x >= 3.0 ? vec2(-1.0, 1.0) : (ij.y >= 3.0 ? vec2(1.0, -1.0) : vec2(-1.0, -1.0));
-    } else if (odd.x > 0.0) {
-        d = (ij.x >= 3.0 || k < 3.0) ? vec2(-1.0, 0.0) : vec2(1.0, 0.0);
-    } else {
-        d = (ij.y >= 3.0 || k < 3.0) ? vec2(0.0, -1.0) : vec2(0.0, 1.0);
-    }
-    return uv + (1.0 - w) * ((ij + d) / n - uv);
+    return morph_triangle_inside(uv, n, unpackUnorm2x16(in_patch.w).x);
 }
 
 // The surface at pattern point b of `face`, moved by the instance's weights; `at` the moved

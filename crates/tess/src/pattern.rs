@@ -562,6 +562,73 @@ impl PatternBuffers {
     }
 }
 
+/// The device patterns a surface draws in its frames, by key: a family indexed by edge levels,
+/// each member made on first use.
+#[derive(Default)]
+pub(crate) struct PatternFamily {
+    current: HashMap<PatternKey, PatternBuffers>,
+}
+
+impl PatternFamily {
+    /// Takes the patterns of `keys` from the context, uploading those not on the device yet,
+    /// and drops the patterns no key uses any more.
+    pub fn take(&mut self, ctx: &mut Context, keys: &[PatternKey]) -> Result<()> {
+        let wanted: std::collections::HashSet<PatternKey> = keys.iter().copied().collect();
+        self.current.retain(|k, _| wanted.contains(k));
+        for key in wanted {
+            if let std::collections::hash_map::Entry::Vacant(slot) = self.current.entry(key) {
+                let pattern = ctx.refinement_pattern_for(key)?;
+                slot.insert(PatternBuffers::new(ctx.device(), key, pattern)?);
+            }
+        }
+        Ok(())
+    }
+
+    /// The prepared pattern of `key`.
+    pub fn get(&self, key: &PatternKey) -> Option<&PatternBuffers> {
+        self.current.get(key)
+    }
+
+    /// The most points a pattern of the family has.
+    pub fn max_points(&self) -> u64 {
+        self.current
+            .values()
+            .map(|p| p.pattern.points.len() as u64)
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Every pattern's points and indices.
+    pub fn buffers(&self) -> impl Iterator<Item = &Buffer> {
+        self.current.values().flat_map(|p| [&p.points, &p.indices])
+    }
+}
+
+/// Writes a frame's instance records (`uvec4`s: a patch id and its morph weights) into
+/// `buffer` from the command buffer, after the previous frame's vertex input read them and
+/// before this frame's does, so frames in flight never share a host buffer.
+pub(crate) fn write_instances<'a>(
+    enc: &mut vk_core::Encoder<'a>,
+    buffer: &'a Buffer,
+    records: &[[u32; 4]],
+) -> Result<()> {
+    if records.is_empty() {
+        return Ok(());
+    }
+    let input = (
+        vk::PipelineStageFlags::VERTEX_INPUT,
+        vk::AccessFlags::VERTEX_ATTRIBUTE_READ,
+    );
+    let transfer = (
+        vk::PipelineStageFlags::TRANSFER,
+        vk::AccessFlags::TRANSFER_WRITE,
+    );
+    enc.memory_barrier(input, transfer);
+    enc.update_buffer(buffer, 0, bytemuck::cast_slice(records))?;
+    enc.memory_barrier(transfer, input);
+    Ok(())
+}
+
 /// What selects a pattern: domain, spacing and the tessellation levels (their bits: fractional
 /// levels are patterns of their own), outer in `gl_TessLevelOuter`'s order and inner in
 /// `gl_TessLevelInner`'s; a triangle's fourth outer and second inner level are 0.

@@ -27,7 +27,7 @@
 use super::{BftPush, SetWindows};
 use crate::error::{Result, TessError};
 use crate::gpu::bindings::{BFT_FACTORS_DISTANCE, BFT_FACTORS_SCREEN};
-use crate::pattern::{PatternBuffers, PatternKey};
+use crate::pattern::{write_instances, PatternFamily, PatternKey};
 use crate::stencil::GpuStencils;
 use crate::technique::DrawCounts;
 use crate::techniques::host_view::{
@@ -72,7 +72,7 @@ pub(super) struct BftPatterns {
     /// The instances of host-chosen levels, written by the command buffer; made on first use.
     frame_ids: Option<Buffer>,
     /// The device patterns of the frame's keys.
-    current: HashMap<PatternKey, PatternBuffers>,
+    patterns: PatternFamily,
     frame: Option<Frame>,
     level1: HostLevel1,
 }
@@ -210,7 +210,7 @@ impl BftPatterns {
                 bytemuck::cast_slice(&ids),
             )?,
             frame_ids: None,
-            current: HashMap::new(),
+            patterns: PatternFamily::default(),
             frame: None,
             level1: HostLevel1 {
                 stencils,
@@ -241,7 +241,7 @@ impl BftPatterns {
                 instances: faces.clone(),
             })
             .collect();
-        self.take_patterns(ctx, &[key])?;
+        self.patterns.take(ctx, &[key])?;
         self.frame = Some(Frame {
             draws,
             ids: None,
@@ -262,7 +262,7 @@ impl BftPatterns {
     ) -> Result<()> {
         let (ids, draws) = self.level1.keyed_draws(host, base, pieces)?;
         let keys: Vec<PatternKey> = draws.iter().map(|d| d.key).collect();
-        self.take_patterns(ctx, &keys)?;
+        self.patterns.take(ctx, &keys)?;
         self.ensure_frame_ids(ctx.device(), ids.len())?;
         self.frame = Some(Frame {
             draws,
@@ -291,45 +291,13 @@ impl BftPatterns {
         Ok(())
     }
 
-    /// Takes the patterns of `keys` from the context, uploading those not on the device yet,
-    /// and drops the patterns no key uses any more.
-    fn take_patterns(
-        &mut self,
-        ctx: &mut crate::context::Context,
-        keys: &[PatternKey],
-    ) -> Result<()> {
-        self.current.retain(|k, _| keys.contains(k));
-        for &key in keys {
-            if let std::collections::hash_map::Entry::Vacant(slot) = self.current.entry(key) {
-                let pattern = ctx.refinement_pattern_for(key)?;
-                slot.insert(PatternBuffers::new(ctx.device(), key, pattern)?);
-            }
-        }
-        Ok(())
-    }
-
     /// Under host-chosen levels, writes the frame's instances ahead of the draws (after the
     /// previous frame's draws read them).
     pub fn record_ids<'a>(&'a self, enc: &mut Encoder<'a>) -> Result<()> {
-        let (Some(Frame { ids: Some(ids), .. }), Some(buffer)) = (&self.frame, &self.frame_ids)
-        else {
-            return Ok(());
-        };
-        if ids.is_empty() {
-            return Ok(());
+        match (&self.frame, &self.frame_ids) {
+            (Some(Frame { ids: Some(ids), .. }), Some(buffer)) => write_instances(enc, buffer, ids),
+            _ => Ok(()),
         }
-        let input = (
-            vk::PipelineStageFlags::VERTEX_INPUT,
-            vk::AccessFlags::VERTEX_ATTRIBUTE_READ,
-        );
-        let transfer = (
-            vk::PipelineStageFlags::TRANSFER,
-            vk::AccessFlags::TRANSFER_WRITE,
-        );
-        enc.memory_barrier(input, transfer);
-        enc.update_buffer(buffer, 0, bytemuck::cast_slice(ids))?;
-        enc.memory_barrier(transfer, input);
-        Ok(())
     }
 
     /// The frame's draws: per chunk its set (the context bound the first chunk's) and window
@@ -363,7 +331,7 @@ impl BftPatterns {
                 bound = Some(d.chunk);
             }
             let p = self
-                .current
+                .patterns
                 .get(&d.key)
                 .ok_or(TessError::NoPatchArray { array: 0 })?;
             enc.bind_vertex_buffer(0, &p.points);
@@ -383,24 +351,20 @@ impl BftPatterns {
     /// Triangles the frame draws, once prepared.
     pub fn triangles(&self) -> Option<u64> {
         self.frame.as_ref()?.draws.iter().try_fold(0u64, |sum, d| {
-            let p = self.current.get(&d.key)?;
+            let p = self.patterns.get(&d.key)?;
             Some(sum + d.instances.len() as u64 * p.pattern.triangles.len() as u64)
         })
     }
 
     /// The most pattern vertices a face has in the frame.
     pub fn max_vertices(&self) -> u64 {
-        self.current
-            .values()
-            .map(|p| p.pattern.points.len() as u64)
-            .max()
-            .unwrap_or(0)
+        self.patterns.max_points()
     }
 
     /// The instances and the frame's patterns.
     pub fn buffers(&self) -> impl Iterator<Item = &Buffer> {
         std::iter::once(&self.ids)
             .chain(&self.frame_ids)
-            .chain(self.current.values().flat_map(|p| [&p.points, &p.indices]))
+            .chain(self.patterns.buffers())
     }
 }

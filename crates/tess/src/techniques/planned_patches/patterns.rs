@@ -39,7 +39,7 @@ use crate::gpu::bindings::{
     ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_PLAIN, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM,
 };
 use crate::gpu::AdaptivePush;
-use crate::pattern::{PatternBuffers, PatternKey};
+use crate::pattern::{write_instances, PatternBuffers, PatternFamily, PatternKey};
 use crate::technique::{DrawCounts, PatchArray};
 use crate::techniques::host_view::{
     morph_weight, pow2_level, unorm16_pair, HostView, MorphWords, NO_MORPH,
@@ -67,7 +67,7 @@ pub(super) struct PatternDraws {
     /// Per array, its groups.
     groups: Vec<Vec<PatternGroup>>,
     /// The device patterns of the frame's keys.
-    current: HashMap<PatternKey, PatternBuffers>,
+    current: PatternFamily,
     /// Under host-chosen levels, the frame's grouping; `None` under uniform factors.
     frame: Option<FrameGroups>,
     /// The frame's patch ids, written by the command buffer (`FrameGroups::ids`).
@@ -258,7 +258,7 @@ impl PatternDraws {
                 bytemuck::cast_slice(&ids),
             )?,
             groups,
-            current: HashMap::new(),
+            current: PatternFamily::default(),
             frame: None,
             frame_ids,
         })
@@ -292,25 +292,8 @@ impl PatternDraws {
             groups.push(array_groups);
         }
         let keys: Vec<PatternKey> = groups.iter().flatten().map(|(k, _)| *k).collect();
-        self.take_patterns(ctx, &keys)?;
+        self.current.take(ctx, &keys)?;
         self.frame = Some(FrameGroups { ids, groups });
-        Ok(())
-    }
-
-    /// Takes the patterns of `keys` from the context, uploading those not on the device yet,
-    /// and drops the patterns no key uses any more.
-    fn take_patterns(
-        &mut self,
-        ctx: &mut crate::context::Context,
-        keys: &[PatternKey],
-    ) -> Result<()> {
-        self.current.retain(|k, _| keys.contains(k));
-        for &key in keys {
-            if let std::collections::hash_map::Entry::Vacant(slot) = self.current.entry(key) {
-                let pattern = ctx.refinement_pattern_for(key)?;
-                slot.insert(PatternBuffers::new(ctx.device(), key, pattern)?);
-            }
-        }
         Ok(())
     }
 
@@ -322,21 +305,10 @@ impl PatternDraws {
     /// Under host-chosen levels, writes the frame's patch ids ahead of the draws (after the
     /// previous frame's draws read them).
     pub fn record_ids<'a>(&'a self, enc: &mut Encoder<'a>) -> Result<()> {
-        let Some(f) = &self.frame else {
-            return Ok(());
-        };
-        let input = (
-            vk::PipelineStageFlags::VERTEX_INPUT,
-            vk::AccessFlags::VERTEX_ATTRIBUTE_READ,
-        );
-        let transfer = (
-            vk::PipelineStageFlags::TRANSFER,
-            vk::AccessFlags::TRANSFER_WRITE,
-        );
-        enc.memory_barrier(input, transfer);
-        enc.update_buffer(&self.frame_ids, 0, bytemuck::cast_slice(&f.ids))?;
-        enc.memory_barrier(transfer, input);
-        Ok(())
+        match &self.frame {
+            Some(f) => write_instances(enc, &self.frame_ids, &f.ids),
+            None => Ok(()),
+        }
     }
 
     /// Every key the frame draws, per array and group (`key_of(array, kinds)`).
@@ -359,7 +331,7 @@ impl PatternDraws {
     ) -> Result<()> {
         self.forget_host_levels();
         let keys: Vec<PatternKey> = self.keys(key_of).collect();
-        self.take_patterns(ctx, &keys)
+        self.current.take(ctx, &keys)
     }
 
     /// The prepared pattern of `key`.
@@ -466,8 +438,7 @@ impl PatternDraws {
 
     /// The patch ids and the frame's patterns.
     pub fn buffers(&self) -> impl Iterator<Item = &Buffer> {
-        std::iter::once(&self.ids)
-            .chain(self.current.values().flat_map(|p| [&p.points, &p.indices]))
+        std::iter::once(&self.ids).chain(self.current.buffers())
     }
 }
 
