@@ -604,6 +604,34 @@ impl PatternFamily {
     }
 }
 
+/// Groups a frame's `instances` (each a pattern key and its instance record: a patch id and
+/// its morph weights) by key, appending each group to `records` as one run, the groups in the
+/// order of their first instance; returns each key and its run (one instanced draw each).
+pub(crate) fn group_by_key(
+    instances: impl IntoIterator<Item = (PatternKey, [u32; 4])>,
+    records: &mut Vec<[u32; 4]>,
+) -> Vec<(PatternKey, std::ops::Range<u32>)> {
+    let mut order: Vec<PatternKey> = Vec::new();
+    let mut by_key: HashMap<PatternKey, Vec<[u32; 4]>> = HashMap::new();
+    for (key, record) in instances {
+        by_key
+            .entry(key)
+            .or_insert_with(|| {
+                order.push(key);
+                Vec::new()
+            })
+            .push(record);
+    }
+    order
+        .into_iter()
+        .map(|key| {
+            let first = records.len() as u32;
+            records.extend(by_key.remove(&key).unwrap_or_default());
+            (key, first..records.len() as u32)
+        })
+        .collect()
+}
+
 /// Writes a frame's instance records (`uvec4`s: a patch id and its morph weights) into
 /// `buffer` from the command buffer, after the previous frame's vertex input read them and
 /// before this frame's does, so frames in flight never share a host buffer.
@@ -863,6 +891,24 @@ fn tessellator_pattern(
 mod tests {
     use super::*;
     use crate::tessellator::{uniform_triangle_count, uniform_vertex_count, Spacing};
+
+    /// Instances group by key into consecutive runs of the records, in the order of each key's
+    /// first instance, each run keeping its instances' order.
+    #[test]
+    fn instances_group_by_key_in_first_use_order() {
+        let (a, b) = (
+            PatternKey::new(Domain::Triangle, Spacing::Equal, 2.0),
+            PatternKey::new(Domain::Triangle, Spacing::Equal, 4.0),
+        );
+        let mut records = vec![[9; 4]];
+        let groups = group_by_key(
+            [(b, [1, 0, 0, 0]), (a, [2, 0, 0, 0]), (b, [3, 0, 0, 0])],
+            &mut records,
+        );
+        assert_eq!(groups, vec![(b, 1..3), (a, 3..4)]);
+        let ids: Vec<u32> = records.iter().map(|r| r[0]).collect();
+        assert_eq!(ids, vec![9, 1, 3, 2]);
+    }
 
     fn signed_area(p: &RefinementPattern, t: [u32; 3]) -> f64 {
         let [a, b, c] = t.map(|i| p.points[i as usize]);

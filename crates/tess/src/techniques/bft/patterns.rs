@@ -27,7 +27,7 @@
 use super::{BftPush, SetWindows};
 use crate::error::{Result, TessError};
 use crate::gpu::bindings::{BFT_FACTORS_DISTANCE, BFT_FACTORS_SCREEN};
-use crate::pattern::{write_instances, PatternFamily, PatternKey};
+use crate::pattern::{group_by_key, write_instances, PatternFamily, PatternKey};
 use crate::stencil::GpuStencils;
 use crate::technique::DrawCounts;
 use crate::techniques::host_view::{
@@ -35,7 +35,6 @@ use crate::techniques::host_view::{
 };
 use crate::tessellator::{Domain, Spacing};
 use glam::{Vec2, Vec3};
-use std::collections::HashMap;
 use std::ops::Range;
 use vk_core::{vk, Buffer, DescriptorSet, Encoder};
 
@@ -69,8 +68,9 @@ struct HostLevel1 {
 pub(super) struct BftPatterns {
     /// Every face with no morph, in order: the instances of uniform frames.
     ids: Buffer,
-    /// The instances of host-chosen levels, written by the command buffer; made on first use.
-    frame_ids: Option<Buffer>,
+    /// The instances of host-chosen levels (every face at most once), written by the command
+    /// buffer.
+    frame_ids: Buffer,
     /// The device patterns of the frame's keys.
     patterns: PatternFamily,
     frame: Option<Frame>,
@@ -83,17 +83,13 @@ impl HostLevel1 {
         if self.positions.as_ref().is_some_and(|(b, _)| b == base) {
             return;
         }
+        // The stencil evaluator's own arithmetic: the positions `bft.tesc` measures on the other
+        // path, bit for bit.
         let s = &self.stencils;
-        let rows = s.offsets.windows(2).map(|r| {
-            s.terms[r[0] as usize..r[1] as usize]
-                .iter()
-                .map(|t| {
-                    let p = base.get(t.index as usize).copied().unwrap_or_default();
-                    Vec3::from(p) * t.weight
-                })
-                .sum::<Vec3>()
-        });
-        self.positions = Some((base.to_vec(), rows.collect()));
+        let vertex = |i: u32| base.get(i as usize).copied().unwrap_or_default();
+        let rows = s.offsets.len().saturating_sub(1) as u32;
+        let level1 = (0..rows).map(|r| Vec3::from(s.row_point(r, vertex)));
+        self.positions = Some((base.to_vec(), level1.collect()));
     }
 
     /// The instances (face and morph weights) of every face of `pieces`, keyed in `host`'s view
@@ -116,30 +112,27 @@ impl HostLevel1 {
         let factor = |a, b| host.level1_edge_factor(&screen, pos, a, b);
         let (mut ids, mut draws) = (Vec::new(), Vec::new());
         for (chunk, faces) in pieces {
-            let mut by_key: HashMap<PatternKey, Vec<[u32; 4]>> = HashMap::new();
-            for f in faces.clone() {
-                let c = self
-                    .corners
-                    .get(f as usize)
-                    .ok_or(TessError::IndexOutOfRange {
-                        what: "bft pattern face",
-                        index: f as u64,
-                        len: self.corners.len() as u64,
-                    })?;
-                let (key, [m0, m1, m2]) = host.face_key(*c, factor);
-                by_key.entry(key).or_default().push([f, m0, m1, m2]);
-            }
-            let mut keyed: Vec<_> = by_key.into_iter().collect();
-            keyed.sort_by_key(|(_, members)| members[0][0]);
-            for (key, members) in keyed {
-                let first = ids.len() as u32;
-                ids.extend(members);
-                draws.push(KeyDraw {
-                    chunk: *chunk,
-                    key,
-                    instances: first..ids.len() as u32,
-                });
-            }
+            let instances = faces
+                .clone()
+                .map(|f| {
+                    let c = self
+                        .corners
+                        .get(f as usize)
+                        .ok_or(TessError::IndexOutOfRange {
+                            what: "bft pattern face",
+                            index: f as u64,
+                            len: self.corners.len() as u64,
+                        })?;
+                    let (key, [m0, m1, m2]) = host.face_key(*c, factor);
+                    Ok((key, [f, m0, m1, m2]))
+                })
+                .collect::<Result<Vec<_>>>()?;
+            let groups = group_by_key(instances, &mut ids);
+            draws.extend(groups.into_iter().map(|(key, instances)| KeyDraw {
+                chunk: *chunk,
+                key,
+                instances,
+            }));
         }
         Ok((ids, draws))
     }
@@ -202,6 +195,15 @@ impl BftPatterns {
         if ids.is_empty() {
             ids.push([0; 4]);
         }
+        let frame_ids = Buffer::new(
+            device,
+            &vk_core::BufferDesc {
+                name: "bft pattern faces (host-chosen levels)",
+                size: 16 * ids.len() as u64,
+                usage: vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                location: vk_core::MemoryLocation::GpuOnly,
+            },
+        )?;
         Ok(Self {
             ids: Buffer::with_data(
                 device,
@@ -209,7 +211,7 @@ impl BftPatterns {
                 vk::BufferUsageFlags::VERTEX_BUFFER,
                 bytemuck::cast_slice(&ids),
             )?,
-            frame_ids: None,
+            frame_ids,
             patterns: PatternFamily::default(),
             frame: None,
             level1: HostLevel1 {
@@ -263,7 +265,6 @@ impl BftPatterns {
         let (ids, draws) = self.level1.keyed_draws(host, base, pieces)?;
         let keys: Vec<PatternKey> = draws.iter().map(|d| d.key).collect();
         self.patterns.take(ctx, &keys)?;
-        self.ensure_frame_ids(ctx.device(), ids.len())?;
         self.frame = Some(Frame {
             draws,
             ids: Some(ids),
@@ -272,30 +273,11 @@ impl BftPatterns {
         Ok(())
     }
 
-    /// The buffer of host-chosen instances, large enough for `count` (as large as the static
-    /// one: every face at most once).
-    fn ensure_frame_ids(&mut self, device: &vk_core::Device, count: usize) -> Result<()> {
-        let size = self.ids.size().max(16 * count as u64);
-        if self.frame_ids.as_ref().is_some_and(|b| b.size() >= size) {
-            return Ok(());
-        }
-        self.frame_ids = Some(Buffer::new(
-            device,
-            &vk_core::BufferDesc {
-                name: "bft pattern faces (host-chosen levels)",
-                size,
-                usage: vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                location: vk_core::MemoryLocation::GpuOnly,
-            },
-        )?);
-        Ok(())
-    }
-
     /// Under host-chosen levels, writes the frame's instances ahead of the draws (after the
     /// previous frame's draws read them).
     pub fn record_ids<'a>(&'a self, enc: &mut Encoder<'a>) -> Result<()> {
-        match (&self.frame, &self.frame_ids) {
-            (Some(Frame { ids: Some(ids), .. }), Some(buffer)) => write_instances(enc, buffer, ids),
+        match &self.frame {
+            Some(Frame { ids: Some(ids), .. }) => write_instances(enc, &self.frame_ids, ids),
             _ => Ok(()),
         }
     }
@@ -309,12 +291,13 @@ impl BftPatterns {
         sets: &'a [DescriptorSet],
         mut push: BftPush,
     ) -> Result<DrawCounts> {
-        let no_frame = TessError::NoPatchArray { array: 0 };
-        let frame = self.frame.as_ref().ok_or(no_frame)?;
-        let instances = match (&frame.ids, &self.frame_ids) {
-            (None, _) => &self.ids,
-            (Some(_), Some(b)) => b,
-            (Some(_), None) => return Err(TessError::NoPatchArray { array: 0 }),
+        let frame = self
+            .frame
+            .as_ref()
+            .ok_or(TessError::NoPatchArray { array: 0 })?;
+        let instances = match frame.ids {
+            None => &self.ids,
+            Some(_) => &self.frame_ids,
         };
         enc.bind_vertex_buffer(1, instances);
         let mut counts = DrawCounts::default();
@@ -363,8 +346,8 @@ impl BftPatterns {
 
     /// The instances and the frame's patterns.
     pub fn buffers(&self) -> impl Iterator<Item = &Buffer> {
-        std::iter::once(&self.ids)
-            .chain(&self.frame_ids)
+        [&self.ids, &self.frame_ids]
+            .into_iter()
             .chain(self.patterns.buffers())
     }
 }

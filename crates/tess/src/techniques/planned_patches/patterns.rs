@@ -39,13 +39,13 @@ use crate::gpu::bindings::{
     ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_PLAIN, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM,
 };
 use crate::gpu::AdaptivePush;
-use crate::pattern::{write_instances, PatternBuffers, PatternFamily, PatternKey};
+use crate::pattern::{group_by_key, write_instances, PatternBuffers, PatternFamily, PatternKey};
 use crate::technique::{DrawCounts, PatchArray};
 use crate::techniques::host_view::{
     morph_weight, pow2_level, unorm16_pair, HostView, MorphWords, NO_MORPH,
 };
 use crate::tessellator::{Domain, Spacing};
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 use std::ops::Range;
 use vk_core::{vk, Buffer, Encoder};
 
@@ -276,20 +276,11 @@ impl PatternDraws {
         let mut ids = Vec::new();
         let mut groups = Vec::with_capacity(arrays.len());
         for (i, a) in arrays.iter().enumerate() {
-            let mut by_key: HashMap<PatternKey, Vec<[u32; 4]>> = HashMap::new();
-            for id in a.first_patch..a.first_patch + a.patches {
+            let instances = (a.first_patch..a.first_patch + a.patches).map(|id| {
                 let (key, [m0, m1, m2]) = key_of(i, id);
-                by_key.entry(key).or_default().push([id, m0, m1, m2]);
-            }
-            let mut keyed: Vec<(PatternKey, Vec<[u32; 4]>)> = by_key.into_iter().collect();
-            keyed.sort_by_key(|(_, members)| members[0][0]);
-            let mut array_groups = Vec::with_capacity(keyed.len());
-            for (key, members) in keyed {
-                let first = ids.len() as u32;
-                ids.extend(members);
-                array_groups.push((key, first..ids.len() as u32));
-            }
-            groups.push(array_groups);
+                (key, [id, m0, m1, m2])
+            });
+            groups.push(group_by_key(instances, &mut ids));
         }
         let keys: Vec<PatternKey> = groups.iter().flatten().map(|(k, _)| *k).collect();
         self.current.take(ctx, &keys)?;
