@@ -32,8 +32,6 @@ void main() {
     uint kind = tc_head.y >> BFT_INFO_KIND_SHIFT;
 #ifdef SURFACE_BUILD
     out_albedo = (bft.options & uint(BFT_OPTION_PATCH_COLOURS)) != 0u ? KIND_COLOURS[min(kind, 3u)] : frame.base_color.rgb;
-#endif
-#ifdef SURFACE_BUILD
     // The seed's sine displacement along the normal: shared points have their owner's position
     // and normal bits on both faces, so they move to the same bits.
     p = displace_sine(p, n);

@@ -15,9 +15,8 @@
 // moved point (on the level-L virtual mesh between table points, as the evaluation stage's
 // fractional factors do). An edge vertex slides along its owner's edge, counted in the owner's
 // direction, so both faces of the edge move it to the same bits; an inside vertex by the rule
-// of the planned patches' triangles (glsl/common/morph.glsl). At weight
-// 0 the pattern draws the surface of its half level, at 1 its own. The capture records the
-// moved point.
+// of the planned patches' triangles (glsl/common/morph.glsl). At weight 0 the pattern draws
+// the surface of its half level, at 1 its own. The capture records the moved point.
 // Built with and without capture and the surface code (glsl/manifest.toml; stage_out.glsl).
 #extension GL_EXT_control_flow_attributes : require
 #define TECHNIQUE_PUSH_CONSTANTS
