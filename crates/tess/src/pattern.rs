@@ -604,6 +604,36 @@ impl PatternFamily {
     }
 }
 
+/// The instance-rate buffers of a surface drawn through patterns: its static records (each
+/// patch with no morph) and, as large, the buffer the frames' host-chosen records are written
+/// into ([`write_instances`]); named `name` and "`name` (host-chosen levels)". An empty surface
+/// still binds one record (zero-length buffers are invalid); no draw reads it.
+pub(crate) fn instance_buffers(
+    device: &vk_core::Device,
+    name: &str,
+    mut records: Vec<[u32; 4]>,
+) -> Result<(Buffer, Buffer)> {
+    if records.is_empty() {
+        records.push([0; 4]);
+    }
+    let frame = Buffer::new(
+        device,
+        &vk_core::BufferDesc {
+            name: &format!("{name} (host-chosen levels)"),
+            size: std::mem::size_of_val(records.as_slice()) as u64,
+            usage: vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            location: vk_core::MemoryLocation::GpuOnly,
+        },
+    )?;
+    let fixed = Buffer::with_data(
+        device,
+        name,
+        vk::BufferUsageFlags::VERTEX_BUFFER,
+        bytemuck::cast_slice(&records),
+    )?;
+    Ok((fixed, frame))
+}
+
 /// Groups a frame's `instances` (each a pattern key and its instance record: a patch id and
 /// its morph weights) by key, appending each group to `records` as one run, the groups in the
 /// order of their first instance; returns each key and its run (one instanced draw each).

@@ -27,7 +27,7 @@
 use super::{BftPush, SetWindows};
 use crate::error::{Result, TessError};
 use crate::gpu::bindings::{BFT_FACTORS_DISTANCE, BFT_FACTORS_SCREEN};
-use crate::pattern::{group_by_key, write_instances, PatternFamily, PatternKey};
+use crate::pattern::{group_by_key, instance_buffers, write_instances, PatternFamily, PatternKey};
 use crate::stencil::GpuStencils;
 use crate::technique::DrawCounts;
 use crate::techniques::host_view::{
@@ -36,7 +36,7 @@ use crate::techniques::host_view::{
 use crate::tessellator::{Domain, Spacing};
 use glam::{Vec2, Vec3};
 use std::ops::Range;
-use vk_core::{vk, Buffer, DescriptorSet, Encoder};
+use vk_core::{Buffer, DescriptorSet, Encoder};
 
 /// The faces a frame draws under one draw chunk's set: `(chunk, faces)`.
 pub(super) type Piece = (usize, Range<u32>);
@@ -190,27 +190,10 @@ impl BftPatterns {
         corners: Vec<[u32; 3]>,
     ) -> Result<Self> {
         let [a, b, c] = NO_MORPH;
-        let mut ids: Vec<[u32; 4]> = (0..patch_count).map(|f| [f, a, b, c]).collect();
-        // An empty mesh still binds a buffer (zero-length buffers are invalid); no draw reads it.
-        if ids.is_empty() {
-            ids.push([0; 4]);
-        }
-        let frame_ids = Buffer::new(
-            device,
-            &vk_core::BufferDesc {
-                name: "bft pattern faces (host-chosen levels)",
-                size: 16 * ids.len() as u64,
-                usage: vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                location: vk_core::MemoryLocation::GpuOnly,
-            },
-        )?;
+        let records = (0..patch_count).map(|f| [f, a, b, c]).collect();
+        let (ids, frame_ids) = instance_buffers(device, "bft pattern faces", records)?;
         Ok(Self {
-            ids: Buffer::with_data(
-                device,
-                "bft pattern faces",
-                vk::BufferUsageFlags::VERTEX_BUFFER,
-                bytemuck::cast_slice(&ids),
-            )?,
+            ids,
             frame_ids,
             patterns: PatternFamily::default(),
             frame: None,

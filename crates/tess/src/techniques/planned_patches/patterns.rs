@@ -39,7 +39,9 @@ use crate::gpu::bindings::{
     ADAPTIVE_EDGE_COARSE, ADAPTIVE_EDGE_PLAIN, BFT_FACTORS_SCREEN, BFT_FACTORS_UNIFORM,
 };
 use crate::gpu::AdaptivePush;
-use crate::pattern::{group_by_key, write_instances, PatternBuffers, PatternFamily, PatternKey};
+use crate::pattern::{
+    group_by_key, instance_buffers, write_instances, PatternBuffers, PatternFamily, PatternKey,
+};
 use crate::technique::{DrawCounts, PatchArray};
 use crate::techniques::host_view::{
     morph_weight, pow2_level, unorm16_pair, HostView, MorphWords, NO_MORPH,
@@ -47,7 +49,7 @@ use crate::techniques::host_view::{
 use crate::tessellator::{Domain, Spacing};
 use std::collections::BTreeMap;
 use std::ops::Range;
-use vk_core::{vk, Buffer, Encoder};
+use vk_core::{Buffer, Encoder};
 
 use super::layout::{GpuPlan, PatchRecord};
 use topology::patches::adaptive::AdaptivePlan;
@@ -237,26 +239,9 @@ impl PatternDraws {
             }
             groups.push(array_groups);
         }
-        // An empty plan still binds a buffer (zero-length buffers are invalid); no draw reads it.
-        if ids.is_empty() {
-            ids.push([0; 4]);
-        }
-        let frame_ids = Buffer::new(
-            device,
-            &vk_core::BufferDesc {
-                name: "adaptive pattern patch ids (host-chosen levels)",
-                size: 16 * ids.len() as u64,
-                usage: vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                location: vk_core::MemoryLocation::GpuOnly,
-            },
-        )?;
+        let (ids, frame_ids) = instance_buffers(device, "adaptive pattern patch ids", ids)?;
         Ok(Self {
-            ids: Buffer::with_data(
-                device,
-                "adaptive pattern patch ids",
-                vk::BufferUsageFlags::VERTEX_BUFFER,
-                bytemuck::cast_slice(&ids),
-            )?,
+            ids,
             groups,
             current: PatternFamily::default(),
             frame: None,
